@@ -1,0 +1,63 @@
+#pragma once
+// Loading a mannequin (body) mesh from any format assimp reads and normalising it to the
+// project's frame: metres, +Y up, facing +Z, feet on y = 0, centred on the vertical axis.
+
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "meshing/tri_mesh.hpp"
+
+namespace sd::garment {
+
+// A body file that cannot be used (missing, unreadable, no triangles, non-finite coordinates).
+// Derives from std::invalid_argument: it is the user's input that is wrong.
+class BodyError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+// One of the six axis directions, e.g. "+z" or "-y".
+struct AxisDirection {
+  int axis = 1;    // 0 = x, 1 = y, 2 = z
+  int sign = 1;    // +1 or -1
+  std::string name() const;
+  // Parses "x", "+y", "-z" (case-insensitive); throws BodyError on anything else.
+  static AxisDirection parse(const std::string& text);
+};
+
+struct BodyOptions {
+  std::optional<AxisDirection> up;  // the file's up axis; inferred when empty
+  std::optional<double> scale;      // file units → metres; inferred when empty
+  std::optional<double> height;     // target height in metres; wins over scale
+};
+
+// What the file held before normalisation, and what was done to it.
+struct RawBodyInfo {
+  std::string source;               // path, or "builtin (<path>)"
+  Eigen::Index meshes = 0;          // meshes merged from the scene
+  meshing::BoundingBox box;         // in file units and file axes
+  AxisDirection up;                 // up axis used
+  bool up_inferred = true;          // chosen by the rule rather than given
+  AxisDirection facing;             // direction the figure faces in the file
+  double height = 0;                // extent along up, file units
+  double scale = 1;                 // applied: metres per file unit
+  std::string scale_rule;           // why that scale ("height 1.75 m given", ...)
+};
+
+struct Body {
+  meshing::TriMesh mesh;            // metres, +Y up, facing +Z
+  RawBodyInfo raw;
+  std::vector<std::string> warnings;  // repairs made while loading
+};
+
+// Path of the built-in mannequin: HUMAN.blend from Debian's assimp-testmodels.
+std::string builtin_body_path();
+
+// Loads `path` ("builtin" for the built-in mannequin, scaled to 1.75 m unless `options.height`
+// says otherwise). Merges all meshes with their node transforms, drops degenerate faces and
+// unused vertices (with a warning), then normalises. Throws BodyError on unusable input.
+Body load_body(const std::string& path, const BodyOptions& options = {});
+
+}  // namespace sd::garment

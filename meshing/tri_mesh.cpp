@@ -1,0 +1,121 @@
+#include "meshing/tri_mesh.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace sd::meshing {
+namespace {
+
+// Union-find over vertex indices, for counting connected components.
+class DisjointSets {
+ public:
+  explicit DisjointSets(Eigen::Index n) : parent_(static_cast<size_t>(n)) {
+    std::iota(parent_.begin(), parent_.end(), Eigen::Index{0});
+  }
+  Eigen::Index find(Eigen::Index i) {
+    while (parent_[i] != i) i = parent_[i] = parent_[parent_[i]];
+    return i;
+  }
+  void unite(Eigen::Index a, Eigen::Index b) { parent_[find(a)] = find(b); }
+
+ private:
+  std::vector<Eigen::Index> parent_;
+};
+
+}  // namespace
+
+BoundingBox bounding_box(const TriMesh& mesh) {
+  BoundingBox box;
+  if (mesh.vertex_count() == 0) return box;
+  box.min = mesh.vertices.colwise().minCoeff().transpose();
+  box.max = mesh.vertices.colwise().maxCoeff().transpose();
+  return box;
+}
+
+TriMeshTopology analyse_topology(const TriMesh& mesh) {
+  const Eigen::Index nv = mesh.vertex_count();
+  if (mesh.faces.size() > 0 && (mesh.faces.minCoeff() < 0 || mesh.faces.maxCoeff() >= nv))
+    throw std::invalid_argument("a face refers to a vertex index outside 0.." +
+                                std::to_string(nv - 1));
+
+  TriMeshTopology topo;
+  const double diag = bounding_box(mesh).extent().norm();
+  const double min_area = 1e-12 * diag * diag;
+
+  // Directed half-edges sorted by their undirected key; a run of equal keys is one edge.
+  struct HalfEdge {
+    int lo, hi;
+    bool forward;  // traversed lo -> hi
+  };
+  std::vector<HalfEdge> half_edges;
+  half_edges.reserve(static_cast<size_t>(mesh.face_count()) * 3);
+  std::vector<bool> used(static_cast<size_t>(nv), false);
+  DisjointSets sets(nv);
+  const Eigen::VectorXd areas = face_areas(mesh);
+  for (Eigen::Index f = 0; f < mesh.face_count(); ++f) {
+    const Eigen::Vector3i t = mesh.faces.row(f);
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || !(areas[f] > min_area))
+      ++topo.degenerate_faces;
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      used[a] = true;
+      sets.unite(a, b);
+      if (a != b) half_edges.push_back({std::min(a, b), std::max(a, b), a < b});
+    }
+  }
+  std::sort(half_edges.begin(), half_edges.end(), [](const HalfEdge& x, const HalfEdge& y) {
+    return x.lo != y.lo ? x.lo < y.lo : x.hi < y.hi;
+  });
+  for (size_t i = 0; i < half_edges.size();) {
+    size_t j = i;
+    int forward = 0;
+    while (j < half_edges.size() && half_edges[j].lo == half_edges[i].lo &&
+           half_edges[j].hi == half_edges[i].hi)
+      forward += half_edges[j++].forward ? 1 : 0;
+    const size_t count = j - i;
+    if (count == 1) ++topo.boundary_edges;
+    if (count > 2) ++topo.non_manifold_edges;
+    if (count == 2 && forward != 1) ++topo.inconsistent_edges;
+    i = j;
+  }
+  for (Eigen::Index v = 0; v < nv; ++v) {
+    if (!used[v])
+      ++topo.isolated_vertices;
+    else if (sets.find(v) == v)
+      ++topo.components;
+  }
+  return topo;
+}
+
+Eigen::VectorXd face_areas(const TriMesh& mesh) {
+  Eigen::VectorXd areas(mesh.face_count());
+  for (Eigen::Index f = 0; f < mesh.face_count(); ++f) {
+    const Eigen::Vector3d a = mesh.vertices.row(mesh.faces(f, 0));
+    const Eigen::Vector3d b = mesh.vertices.row(mesh.faces(f, 1));
+    const Eigen::Vector3d c = mesh.vertices.row(mesh.faces(f, 2));
+    areas[f] = 0.5 * (b - a).cross(c - a).norm();
+  }
+  return areas;
+}
+
+Eigen::MatrixX3d vertex_normals(const TriMesh& mesh) {
+  Eigen::MatrixX3d normals = Eigen::MatrixX3d::Zero(mesh.vertex_count(), 3);
+  for (Eigen::Index f = 0; f < mesh.face_count(); ++f) {
+    const Eigen::Vector3d a = mesh.vertices.row(mesh.faces(f, 0));
+    const Eigen::Vector3d b = mesh.vertices.row(mesh.faces(f, 1));
+    const Eigen::Vector3d c = mesh.vertices.row(mesh.faces(f, 2));
+    const Eigen::RowVector3d n = (b - a).cross(c - a).transpose();  // length = 2 * area
+    for (int k = 0; k < 3; ++k) normals.row(mesh.faces(f, k)) += n;
+  }
+  for (Eigen::Index v = 0; v < normals.rows(); ++v) {
+    const double len = normals.row(v).norm();
+    if (len > 0) normals.row(v) /= len;
+  }
+  return normals;
+}
+
+}  // namespace sd::meshing

@@ -1,0 +1,42 @@
+#pragma once
+// Writing outputs so that nothing partial is ever left behind: each file is written under a
+// temporary name in its final directory and renamed into place only when the whole command
+// has succeeded.
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace sd::app {
+
+// Writes `bytes` to `path` through a temporary file in the same directory and a rename, so a
+// reader sees either the old file or the complete new one. Throws std::runtime_error.
+void write_file_atomically(const std::filesystem::path& path, std::string_view bytes);
+
+// A set of output files that appear together or not at all. Files are staged under temporary
+// names; commit() renames them all into place; destruction without commit() removes them.
+class StagedOutputs {
+ public:
+  StagedOutputs() = default;
+  StagedOutputs(const StagedOutputs&) = delete;
+  StagedOutputs& operator=(const StagedOutputs&) = delete;
+  ~StagedOutputs();
+
+  // Writes `bytes` to a temporary file that becomes `path` on commit(). Creates the parent
+  // directory if needed. Throws std::runtime_error when the write fails.
+  void stage(const std::filesystem::path& path, std::string_view bytes);
+
+  // Renames every staged file into place, in the order staged.
+  void commit();
+
+  const std::vector<std::filesystem::path>& paths() const { return finals_; }
+
+ private:
+  std::vector<std::filesystem::path> temps_;
+  std::vector<std::filesystem::path> finals_;
+  std::vector<std::filesystem::path> created_dirs_;
+  bool committed_ = false;
+};
+
+}  // namespace sd::app

@@ -1,0 +1,58 @@
+#include "src/app/cli.hpp"
+
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <exception>
+#include <stdexcept>
+
+#include "src/app/version.hpp"
+
+namespace sd::app {
+namespace {
+
+void configure_logging(const GlobalOptions& global) {
+  auto logger = spdlog::stderr_color_mt("sketchdrape");
+  logger->set_pattern("%^%l%$: %v");
+  spdlog::set_default_logger(logger);
+  spdlog::set_level(global.quiet     ? spdlog::level::err
+                    : global.verbose ? spdlog::level::debug
+                                     : spdlog::level::info);
+}
+
+}  // namespace
+
+int run_cli(int argc, char** argv) {
+  CLI::App app{"sketchdrape: sketch-based garment design — quad meshing, cloth draping, previews"};
+  app.set_version_flag("--version", std::string("sketchdrape ") + kVersion);
+  app.require_subcommand(1);
+  app.fallthrough();
+  GlobalOptions global;
+  app.add_flag("-q,--quiet", global.quiet, "Only print errors; no progress bars");
+  app.add_flag("-v,--verbose", global.verbose, "Print debug logs (GL version, timings, ...)");
+  app.parse_complete_callback([&] { configure_logging(global); });
+
+  add_info_command(app, global);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return kExitBadInput;
+  } catch (const std::invalid_argument& e) {
+    spdlog::error("{}", e.what());
+    return kExitBadInput;
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return kExitFailure;
+  }
+  return kExitOk;
+}
+
+}  // namespace sd::app

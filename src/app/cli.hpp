@@ -1,0 +1,27 @@
+#pragma once
+// The sketchdrape command line: subcommands, global flags and exit codes (docs/cli.md).
+
+#include <CLI/CLI.hpp>
+
+namespace sd::app {
+
+enum ExitCode : int {
+  kExitOk = 0,        // the command did what was asked
+  kExitFailure = 1,   // it could not (a solver diverged, a file could not be written, ...)
+  kExitBadInput = 2,  // the user's input is wrong: usage, a bad sketch file, an unreadable body
+};
+
+// Flags every subcommand understands.
+struct GlobalOptions {
+  bool quiet = false;    // only errors on stderr, no progress bars
+  bool verbose = false;  // debug logs (GL version, timings, solver details)
+};
+
+// Parses argv, runs the chosen subcommand and maps exceptions to exit codes:
+// std::invalid_argument (bad input) → 2, any other std::exception → 1.
+int run_cli(int argc, char** argv);
+
+// Each subcommand lives in its own <name>_command.cpp and registers itself here.
+void add_info_command(CLI::App& app, const GlobalOptions& global);
+
+}  // namespace sd::app

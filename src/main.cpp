@@ -1,0 +1,3 @@
+#include "src/app/cli.hpp"
+
+int main(int argc, char** argv) { return sd::app::run_cli(argc, argv); }
