@@ -1,0 +1,76 @@
+#pragma once
+// Filling an n-sided region with a quad mesh of minimal distortion (Nasri, Sabin & Yasseen
+// 2009; Yasseen et al. 2010; see docs/meshing.md): first the topology from the edge counts of
+// the sides, then the geometry from the sides' 3D points (Coons interpolation, relaxation,
+// optional projection).
+
+#include <Eigen/Core>
+#include <functional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "meshing/quad_mesh.hpp"
+#include "meshing/quad_quality.hpp"
+
+namespace sd::meshing {
+
+// Side counts or side points that no quad mesh can fill (a zero count, an odd total, ...).
+class FillError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+struct PatchTopology {
+  QuadMesh mesh;  // positions in a 2D parameter layout (z = 0), for display
+  // side i: vertex indices from corner i to corner i+1 inclusive (l_i + 1 entries)
+  std::vector<std::vector<int>> side_vertices;
+  // "nasri" (centre of valence n), "yasseen" (large-length partition), "shifted-corners"
+  // (Nasri partition or grid on a polygon whose corners were moved along the boundary), or
+  // "single-quad"
+  std::string partition;
+  int distortion = 0;  // Σ |valence − regular| (4 inside, 3 on a side, 2 at a corner)
+  int irregular_vertices = 0;
+
+  // Corner i is side_vertices[i].front().
+  std::vector<int> corner_vertices() const;
+};
+
+// The least distorted topology this filler knows for sides with these edge counts, sides in
+// counter-clockwise order. n >= 2, every count >= 1, even total (and a total of at least 4);
+// otherwise throws FillError with a sentence.
+PatchTopology fill_region(std::span<const int> side_counts);
+
+struct FillGeometryOptions {
+  // Sweeps of interior smoothing after Coons interpolation (0 keeps the Coons positions).
+  int relax_iterations = 30;
+  // Optional: moves an interior point onto the target surface (e.g. the body's offset surface);
+  // applied after every relaxation sweep and at the end.
+  std::function<Eigen::Vector3d(const Eigen::Vector3d&)> project;
+};
+
+struct FilledPatch {
+  PatchTopology topology;
+  QuadMesh mesh;  // 3D; same connectivity and vertex indices as topology.mesh
+  QuadQuality quality;
+};
+
+// side_points[i] is (l_i + 1) by 3: the exact boundary vertices of side i, from corner i to
+// corner i+1, and side_points[i].row(last) == side_points[i+1].row(0). The result's boundary
+// vertices are these points (bitwise) and topology.side_vertices gives their indices, so
+// panels that share a side can be stitched. Throws FillError on bad input.
+FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
+                        const FillGeometryOptions& options = {});
+
+// Sides as 3D polylines from corner to corner (each at least 2 points, consecutive sides
+// sharing their end point) with the edge count of each; boundary vertices are placed along
+// each polyline at equal arc-length steps.
+FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_polylines,
+                        std::span<const int> side_counts, const FillGeometryOptions& options = {});
+
+// Boundary vertices of one side: count + 1 points at equal arc-length steps along the
+// polyline (#P by 3, at least 2 points), the first and last exactly the polyline's ends.
+Eigen::MatrixX3d resample_by_arc_length(const Eigen::MatrixX3d& polyline, int count);
+
+}  // namespace sd::meshing
