@@ -9,6 +9,9 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <numeric>
 #include <fmt/format.h>
 
 namespace sd::garment {
@@ -23,7 +26,7 @@ void collect_meshes(const aiScene& scene, const aiNode& node, const aiMatrix4x4&
   const aiMatrix4x4 transform = parent * node.mTransformation;
   for (unsigned m = 0; m < node.mNumMeshes; ++m) {
     const aiMesh& mesh = *scene.mMeshes[node.mMeshes[m]];
-    if (!(mesh.mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) continue;
+    if (!(mesh.mPrimitiveTypes & (aiPrimitiveType_TRIANGLE | aiPrimitiveType_POLYGON))) continue;
     const int base = static_cast<int>(vertices.size());
     for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
       const aiVector3D p = transform * mesh.mVertices[v];
@@ -31,15 +34,59 @@ void collect_meshes(const aiScene& scene, const aiNode& node, const aiMatrix4x4&
     }
     for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
       const aiFace& face = mesh.mFaces[f];
-      if (face.mNumIndices != 3) continue;
-      faces.emplace_back(base + static_cast<int>(face.mIndices[0]),
-                         base + static_cast<int>(face.mIndices[1]),
-                         base + static_cast<int>(face.mIndices[2]));
+      bool in_range = face.mNumIndices >= 3;  // points and lines are not surface
+      for (unsigned k = 0; in_range && k < face.mNumIndices; ++k)
+        in_range = face.mIndices[k] < mesh.mNumVertices;
+      if (!in_range) continue;
+      for (unsigned k = 1; k + 1 < face.mNumIndices; ++k)  // fan; planar convex polygons
+        faces.emplace_back(base + static_cast<int>(face.mIndices[0]),
+                           base + static_cast<int>(face.mIndices[k]),
+                           base + static_cast<int>(face.mIndices[k + 1]));
     }
     ++mesh_count;
   }
   for (unsigned c = 0; c < node.mNumChildren; ++c)
     collect_meshes(scene, *node.mChildren[c], transform, vertices, faces, mesh_count);
+}
+
+// OFF and PLY headers declare element counts up front and assimp reserves memory for them before
+// reading (invalid/OutOfMemory.off makes it reserve ~16 GB). Reject a header whose counts could
+// not fit in the file: every vertex takes at least 6 bytes ("0 0 0\n"), every face at least 8.
+void check_declared_counts(const std::string& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::string header(4096, '\0');
+  in.read(header.data(), static_cast<std::streamsize>(header.size()));
+  header.resize(static_cast<size_t>(in.gcount()));
+  std::istringstream words(header);
+  std::string word;
+  double vertices = 0, faces = 0;
+  if (!(words >> word)) return;
+  if (word.size() >= 3 && word.compare(word.size() - 3, 3, "OFF") == 0) {
+    // Skip comment lines between the keyword and the counts.
+    std::string line;
+    while (std::getline(words, line)) {
+      const auto hash = line.find('#');
+      if (hash != std::string::npos) line.resize(hash);
+      std::istringstream counts(line);
+      if (counts >> vertices >> faces) break;
+    }
+  } else if (word == "ply") {
+    while (words >> word && word != "end_header") {
+      if (word != "element") continue;
+      std::string kind;
+      double count = 0;
+      if (!(words >> kind >> count)) break;
+      if (kind == "vertex") vertices = count;
+      if (kind == "face") faces = count;
+    }
+  } else {
+    return;
+  }
+  const double size = static_cast<double>(std::filesystem::file_size(file));
+  if (vertices < 0 || faces < 0 || 6 * vertices + 8 * faces > size)
+    throw BodyError(fmt::format(
+        "body file '{}' is corrupt: its header declares {:.0f} vertices and {:.0f} faces, more "
+        "than its {:.0f} bytes can hold", file, vertices, faces, size));
 }
 
 // Rotation taking the file's `up` to +Y and its facing direction to +Z (proper rotation).
@@ -52,6 +99,72 @@ Eigen::Matrix3d frame_rotation(const AxisDirection& up, const AxisDirection& fac
   rows.row(1) = u.transpose();
   rows.row(2) = f.transpose();
   return rows;
+}
+
+// Merges vertices closer than `tolerance` (files split vertices along UV and normal seams, which
+// would leave the body open), drops faces that collapse or whose area is not above `min_area`,
+// and removes vertices no face uses.
+struct CleanupCounts {
+  Eigen::Index merged_vertices = 0;
+  Eigen::Index dropped_faces = 0;
+  Eigen::Index unused_vertices = 0;
+};
+
+CleanupCounts weld_and_clean(meshing::TriMesh& mesh, double tolerance, double min_area) {
+  CleanupCounts counts;
+  const Eigen::Index nv = mesh.vertex_count();
+  // Sort by x, then merge each vertex into the first earlier one within tolerance (sweep window).
+  std::vector<Eigen::Index> order(static_cast<size_t>(nv));
+  std::iota(order.begin(), order.end(), Eigen::Index{0});
+  std::sort(order.begin(), order.end(), [&](Eigen::Index a, Eigen::Index b) {
+    return mesh.vertices(a, 0) < mesh.vertices(b, 0);
+  });
+  std::vector<Eigen::Index> target(static_cast<size_t>(nv));
+  std::iota(target.begin(), target.end(), Eigen::Index{0});
+  const double tol2 = tolerance * tolerance;
+  for (size_t i = 0; i < order.size(); ++i) {
+    const Eigen::Index v = order[i];
+    for (size_t j = i; j-- > 0;) {
+      const Eigen::Index u = order[j];
+      if (mesh.vertices(v, 0) - mesh.vertices(u, 0) > tolerance) break;
+      if (target[u] == u && (mesh.vertices.row(v) - mesh.vertices.row(u)).squaredNorm() <= tol2) {
+        target[v] = u;
+        ++counts.merged_vertices;
+        break;
+      }
+    }
+  }
+  // Keep faces with three distinct welded corners and a non-zero area.
+  std::vector<Eigen::Vector3i> faces;
+  faces.reserve(static_cast<size_t>(mesh.face_count()));
+  for (Eigen::Index f = 0; f < mesh.face_count(); ++f) {
+    Eigen::Vector3i t;
+    for (int k = 0; k < 3; ++k) t[k] = static_cast<int>(target[mesh.faces(f, k)]);
+    const Eigen::Vector3d a = mesh.vertices.row(t[0]), b = mesh.vertices.row(t[1]),
+                          c = mesh.vertices.row(t[2]);
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2] ||
+        !(0.5 * (b - a).cross(c - a).norm() > min_area)) {
+      ++counts.dropped_faces;
+      continue;
+    }
+    faces.push_back(t);
+  }
+  // Compact: keep only vertices that a face uses.
+  std::vector<int> index(static_cast<size_t>(nv), -1);
+  int kept = 0;
+  for (const auto& t : faces)
+    for (int k = 0; k < 3; ++k)
+      if (index[t[k]] < 0) index[t[k]] = kept++;
+  meshing::TriMesh out;
+  out.vertices.resize(kept, 3);
+  for (Eigen::Index v = 0; v < nv; ++v)
+    if (index[v] >= 0) out.vertices.row(index[v]) = mesh.vertices.row(v);
+  out.faces.resize(static_cast<Eigen::Index>(faces.size()), 3);
+  for (size_t f = 0; f < faces.size(); ++f)
+    for (int k = 0; k < 3; ++k) out.faces(static_cast<Eigen::Index>(f), k) = index[faces[f][k]];
+  counts.unused_vertices = nv - counts.merged_vertices - kept;
+  mesh = std::move(out);
+  return counts;
 }
 
 }  // namespace
@@ -82,10 +195,19 @@ Body load_body(const std::string& path, const BodyOptions& options) {
                                   " is missing: install the Debian package assimp-testmodels"
                             : "body file '" + file + "' does not exist");
 
+  if (std::filesystem::is_directory(file)) throw BodyError("body path '" + file + "' is a folder");
+  check_declared_counts(file);
   Assimp::Importer importer;
-  const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                         aiProcess_SortByPType | aiProcess_FindInvalidData;
-  const aiScene* scene = importer.ReadFile(file, flags);
+  // Only structure validation: assimp's Triangulate step aborts the process (ai_assert) on some
+  // corrupt files (invalid/OutOfMemory.off), so polygons are fan-triangulated here and
+  // coincident vertices are welded afterwards.
+  const unsigned flags = aiProcess_ValidateDataStructure;
+  const aiScene* scene = nullptr;
+  try {
+    scene = importer.ReadFile(file, flags);
+  } catch (const std::exception& e) {  // assimp catches most of its own; be sure
+    throw BodyError("cannot read body file '" + file + "': " + e.what());
+  }
   if (scene == nullptr)
     throw BodyError("cannot read body file '" + file + "': " + importer.GetErrorString());
   if (scene->mRootNode == nullptr || scene->mNumMeshes == 0)
@@ -102,9 +224,33 @@ Body load_body(const std::string& path, const BodyOptions& options) {
 
   meshing::TriMesh mesh;
   mesh.vertices.resize(static_cast<Eigen::Index>(points.size()), 3);
-  for (size_t i = 0; i < points.size(); ++i) mesh.vertices.row(i) = points[i].transpose();
+  for (size_t i = 0; i < points.size(); ++i)
+    mesh.vertices.row(static_cast<Eigen::Index>(i)) = points[i].transpose();
   mesh.faces.resize(static_cast<Eigen::Index>(tris.size()), 3);
-  for (size_t i = 0; i < tris.size(); ++i) mesh.faces.row(i) = tris[i].transpose();
+  for (size_t i = 0; i < tris.size(); ++i)
+    mesh.faces.row(static_cast<Eigen::Index>(i)) = tris[i].transpose();
+
+  const double diagonal = meshing::bounding_box(mesh).extent().norm();
+  if (!(diagonal > 0)) throw BodyError("body file '" + file + "' has all its vertices at one point");
+  const CleanupCounts cleanup = weld_and_clean(mesh, 1e-6 * diagonal, 1e-12 * diagonal * diagonal);
+  if (mesh.face_count() == 0)
+    throw BodyError("body file '" + file + "' has no triangle with a non-zero area");
+  if (cleanup.dropped_faces > 0)
+    body.warnings.push_back(fmt::format("dropped {} degenerate triangle(s) (zero area or repeated corners)",
+                                        cleanup.dropped_faces));
+  if (cleanup.unused_vertices > 0)
+    spdlog::debug("removed {} vertices no triangle uses", cleanup.unused_vertices);
+  if (cleanup.merged_vertices > 0)
+    spdlog::debug("welded {} coincident vertices", cleanup.merged_vertices);
+  const meshing::TriMeshTopology topo = meshing::analyse_topology(mesh);
+  if (!topo.edge_manifold())
+    body.warnings.push_back(fmt::format(
+        "{} edge(s) are shared by more than two triangles; collision may be unreliable there",
+        topo.non_manifold_edges));
+  if (!topo.oriented())
+    body.warnings.push_back(fmt::format(
+        "{} edge(s) join triangles of opposite orientation; inside/outside tests may be wrong there",
+        topo.inconsistent_edges));
 
   RawBodyInfo& raw = body.raw;
   raw.source = builtin ? "builtin (" + file + ")" : file;
@@ -115,7 +261,15 @@ Body load_body(const std::string& path, const BodyOptions& options) {
     raw.up_inferred = false;
   } else {
     // Rule: a standing figure is tallest along its up axis; the sign is taken as positive.
-    extent.maxCoeff(&raw.up.axis);
+    // Extents within 1% of the largest are ties, settled in favour of y, then z (the two
+    // conventions in use), then x.
+    const double tallest = extent.maxCoeff();
+    raw.up.axis = 0;
+    for (int axis : {1, 2, 0})
+      if (extent[axis] >= 0.99 * tallest) {
+        raw.up.axis = axis;
+        break;
+      }
     raw.up.sign = 1;
   }
   // Facing follows the common convention of the up axis: Z-up files (Blender) face -Y,

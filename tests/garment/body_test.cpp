@@ -2,8 +2,37 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+#include <string>
+
 namespace sd::garment {
 namespace {
+
+// Writes `text` to a fresh file under the test's temporary folder and returns its path.
+std::string write_temp(const std::string& name, const std::string& text) {
+  const auto dir = std::filesystem::temp_directory_path() / "sd_body_test";
+  std::filesystem::create_directories(dir);
+  const auto path = dir / name;
+  std::ofstream(path, std::ios::binary) << text;
+  return path.string();
+}
+
+// An OBJ tetrahedron (closed, outward) with optional extra lines appended.
+std::string tetrahedron_obj(const std::string& extra = "") {
+  return "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+         "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n" + extra;
+}
+
+// Message of the BodyError thrown by load_body(path), or "" when none is thrown.
+std::string body_error(const std::string& path) {
+  try {
+    load_body(path);
+  } catch (const BodyError& e) {
+    return e.what();
+  }
+  return "";
+}
 
 TEST(Body, BuiltinIsNormalisedToYUpAndGivenHeight) {
   const Body body = load_body("builtin");
@@ -14,22 +43,34 @@ TEST(Body, BuiltinIsNormalisedToYUpAndGivenHeight) {
   EXPECT_EQ(body.raw.up.name(), "+z");
   EXPECT_NEAR(body.raw.height, 10.72, 0.01);
   EXPECT_EQ(body.mesh.face_count(), 8560);
-  EXPECT_TRUE(meshing::analyse_topology(body.mesh).closed());
+  // Seam-split vertices are welded: the mannequin is one closed, oriented surface.
+  const meshing::TriMeshTopology topo = meshing::analyse_topology(body.mesh);
+  EXPECT_TRUE(topo.closed());
+  EXPECT_TRUE(topo.oriented());
+  EXPECT_TRUE(body.warnings.empty());
+}
+
+// Largest and smallest z of the body's midline (|x| < 1.2 cm) between heights y0 and y1.
+std::pair<double, double> midline_z_range(const meshing::TriMesh& mesh, double y0, double y1) {
+  double lo = 1e9, hi = -1e9;
+  for (Eigen::Index v = 0; v < mesh.vertex_count(); ++v) {
+    const Eigen::RowVector3d p = mesh.vertices.row(v);
+    if (p.y() < y0 || p.y() >= y1 || std::abs(p.x()) > 0.012) continue;
+    lo = std::min(lo, p.z());
+    hi = std::max(hi, p.z());
+  }
+  return {lo, hi};
 }
 
 TEST(Body, BuiltinFacesPlusZ) {
-  // The nose and toes point forward: the front half (z > centre) holds the body's frontmost
-  // points near head height and near the floor.
+  // The jaw juts out over the throat on the face side: between the throat (y ~ 1.51) and the
+  // chin (y ~ 1.55) the midline profile steps by about 4 cm on the front and stays smooth on
+  // the back of the neck. So the front is the side whose profile steps.
   const Body body = load_body("builtin");
-  const meshing::BoundingBox box = meshing::bounding_box(body.mesh);
-  double toe_z = -1e9, heel_z = 1e9;
-  for (Eigen::Index v = 0; v < body.mesh.vertex_count(); ++v) {
-    if (body.mesh.vertices(v, 1) > 0.03) continue;
-    toe_z = std::max(toe_z, body.mesh.vertices(v, 2));
-    heel_z = std::min(heel_z, body.mesh.vertices(v, 2));
-  }
-  // Feet stick out forward of the ankle much more than the heel sticks back.
-  EXPECT_GT(toe_z - box.centre().z(), box.centre().z() - heel_z);
+  const auto throat = midline_z_range(body.mesh, 1.505, 1.52);
+  const auto chin = midline_z_range(body.mesh, 1.545, 1.56);
+  EXPECT_GT(chin.second - throat.second, 0.03);                // +z: throat to chin
+  EXPECT_LT(std::abs(chin.first - throat.first), 0.01);        // -z: back of the neck
 }
 
 TEST(Body, HeightOptionWins) {
@@ -40,6 +81,106 @@ TEST(Body, HeightOptionWins) {
 
 TEST(Body, MissingFileIsABodyError) {
   EXPECT_THROW(load_body("/nonexistent/body.obj"), BodyError);
+}
+
+TEST(Body, SmallObjIsCentredOnTheFloor) {
+  BodyOptions options;
+  options.up = AxisDirection::parse("y");
+  options.scale = 2.0;
+  const Body body = load_body(write_temp("tet.obj", tetrahedron_obj()), options);
+  const meshing::BoundingBox box = meshing::bounding_box(body.mesh);
+  EXPECT_NEAR(box.extent().y(), 2.0, 1e-12);
+  EXPECT_NEAR(box.min.y(), 0.0, 1e-12);
+  EXPECT_TRUE(meshing::analyse_topology(body.mesh).closed());
+}
+
+TEST(Body, UnitsAreInferredFromHeight) {
+  // 170 units tall reads as centimetres.
+  const std::string obj = "v 0 0 0\nv 30 0 0\nv 0 170 0\nv 0 0 20\n"
+                          "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  const Body body = load_body(write_temp("cm.obj", obj));
+  EXPECT_DOUBLE_EQ(body.raw.scale, 0.01);
+  EXPECT_EQ(body.raw.up.name(), "+y");
+  EXPECT_NEAR(meshing::bounding_box(body.mesh).extent().y(), 1.70, 1e-12);
+}
+
+TEST(Body, BadFilesGiveASentence) {
+  EXPECT_NE(body_error(write_temp("empty.obj", "")).find("cannot read"), std::string::npos);
+  EXPECT_NE(body_error(write_temp("points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n")), "");
+  EXPECT_NE(body_error(write_temp("lines.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\nl 2 3\n")),
+            "");
+  EXPECT_NE(body_error(write_temp("body.unknownformat", "hello")), "");
+  // A PNG header in a file that claims to be an OBJ.
+  EXPECT_NE(body_error(write_temp("fake.obj", std::string("\x89PNG\r\n\x1a\n\0\0\0\rIHDR", 16))),
+            "");
+  EXPECT_NE(body_error(std::filesystem::temp_directory_path().string()).find("folder"),
+            std::string::npos);
+  const std::string nan_obj = "v nan 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  const std::string nan_error = body_error(write_temp("nan.obj", nan_obj));
+  EXPECT_NE(nan_error, "");
+}
+
+TEST(Body, DegenerateFacesAreDroppedWithAWarning) {
+  // Two extra faces: one with a repeated corner, one with three collinear corners.
+  const std::string obj = tetrahedron_obj("v 2 0 0\nf 1 2 2\nf 1 2 5\n");
+  const Body body = load_body(write_temp("degenerate.obj", obj));
+  EXPECT_EQ(body.mesh.face_count(), 4);
+  ASSERT_EQ(body.warnings.size(), 1u);
+  EXPECT_NE(body.warnings[0].find("degenerate"), std::string::npos);
+}
+
+TEST(Body, NonManifoldEdgeIsAWarning) {
+  const std::string obj = tetrahedron_obj("v 1 1 -1\nf 1 2 5\n");
+  const Body body = load_body(write_temp("nonmanifold.obj", obj));
+  EXPECT_EQ(body.mesh.face_count(), 5);
+  bool warned = false;
+  for (const auto& w : body.warnings) warned |= w.find("more than two") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
+
+TEST(Body, AssimpInvalidModelsNeverCrash) {
+  // Debian's assimp-testmodels ships deliberately broken files: each loads or throws BodyError.
+  const std::filesystem::path dir = "/usr/share/assimp/models/invalid";
+  ASSERT_TRUE(std::filesystem::exists(dir));
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() == ".txt") continue;
+    ++files;
+    try {
+      const Body body = load_body(entry.path().string());
+      EXPECT_GT(body.mesh.face_count(), 0) << entry.path();
+    } catch (const BodyError& e) {
+      EXPECT_NE(std::string(e.what()), "") << entry.path();
+    }
+  }
+  EXPECT_GE(files, 10);
+}
+
+TEST(Body, LoadsEveryCommonFormat) {
+  const std::string models = "/usr/share/assimp/models/";
+  for (const char* file : {"OBJ/WusonOBJ.obj", "PLY/cube.ply", "STL/Spider_ascii.stl",
+                           "glTF2/BoxTextured-glTF-Binary/BoxTextured.glb", "FBX/box.fbx",
+                           "Collada/duck.dae", "OFF/Cube.off", "BLEND/HUMAN.blend"}) {
+    SCOPED_TRACE(file);
+    const Body body = load_body(models + file);
+    EXPECT_GT(body.mesh.face_count(), 0);
+    EXPECT_TRUE(body.mesh.vertices.allFinite());
+    EXPECT_NEAR(meshing::bounding_box(body.mesh).min.y(), 0.0, 1e-9);
+  }
+}
+
+TEST(Body, CubeTieSettlesOnY) {
+  const Body body = load_body("/usr/share/assimp/models/PLY/cube.ply");
+  EXPECT_EQ(body.raw.up.name(), "+y");
+}
+
+TEST(Body, CorruptHeaderIsRejectedBeforeReading) {
+  // Debian's invalid/OutOfMemory.off declares 353535235358 vertices in a 309-byte file.
+  const std::string error = body_error("/usr/share/assimp/models/invalid/OutOfMemory.off");
+  EXPECT_NE(error.find("corrupt"), std::string::npos) << error;
+  EXPECT_NE(body_error(write_temp("huge.ply", "ply\nformat ascii 1.0\nelement vertex 99999999\n"
+                                              "property float x\nend_header\n0 0 0\n")),
+            "");
 }
 
 TEST(Body, AxisParsing) {
