@@ -1,0 +1,48 @@
+#pragma once
+// CHOLMOD (SuiteSparse) as the direct alternative to the PCG on the same constrained system.
+// Constraints enter as in the filtered subspace: with s = z + S y,
+//   (S A S + (I − S)) y = S (b − A z),
+// whose matrix is SPD and has the block pattern of A (S is block diagonal), so the symbolic
+// analysis is reused while the mesh topology, hence the pattern, does not change.
+
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include "sim/cloth_model.hpp"
+#include "sim/constraint_filter.hpp"
+#include "sim/pcg_solver.hpp"
+
+namespace sd::sim {
+
+class CholmodSolver {
+ public:
+  CholmodSolver();
+  ~CholmodSolver();
+  CholmodSolver(CholmodSolver&&) noexcept;
+  CholmodSolver& operator=(CholmodSolver&&) noexcept;
+
+  // Factorises S A S + (I − S). Analyses the pattern only when it differs from the last one.
+  // Returns false if the factorisation failed (matrix not positive definite).
+  bool factorize(const SparseMatrixR& a, const ConstraintFilter& filter);
+  // Solves with the last factorisation; needs the same A and filter as factorize().
+  LinearSolveStats solve(const SparseMatrixR& a, const ConstraintFilter& filter,
+                         const Eigen::VectorXd& b, const Eigen::VectorXd& z, Eigen::VectorXd& s);
+
+  int symbolic_analyses() const { return analyses_; }
+  int numeric_factorizations() const { return factorizations_; }
+
+ private:
+  struct Factor;
+  std::unique_ptr<Factor> factor_;
+  Eigen::SparseMatrix<double, Eigen::ColMajor, int> filtered_;
+  std::vector<int> outer_;
+  std::vector<int> inner_;
+  bool factorized_ = false;
+  int analyses_ = 0;
+  int factorizations_ = 0;
+};
+
+}  // namespace sd::sim

@@ -1,0 +1,100 @@
+#pragma once
+// The per-element data of the cloth on a fixed mesh: rest (material) frames of the triangles,
+// bending hinges, lumped masses, and the sparsity pattern of the 3n-by-3n system matrix.
+// Building it is cheap (linear in the mesh size), so the adaptive mesh can rebuild it after
+// every topology change.
+
+#include <array>
+#include <stdexcept>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include "sim/fabric.hpp"
+
+namespace sd::sim {
+
+// A cloth mesh the simulator cannot use (degenerate rest triangle, index out of range, bad
+// warp direction). Message says which element and why.
+class InvalidClothError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+// Plain input data: the simulator never sees the garment types.
+struct ClothInput {
+  Eigen::MatrixX3d rest_positions;  // #V by 3, the designed shape, metres
+  Eigen::MatrixX3i triangles;       // #F by 3 vertex indices
+  // #F by 3 warp direction per triangle (projected into the triangle's plane and normalised),
+  // or empty: warp is then the in-plane direction closest to `up` (weft = normal × warp).
+  Eigen::MatrixX3d warp;
+  Eigen::Vector3d up = Eigen::Vector3d::UnitY();
+};
+
+enum class BendRestShape {
+  designed,  // rest dihedral angle of each hinge taken from the rest positions
+  flat,      // every rest angle zero
+};
+
+struct ClothModelOptions {
+  BendRestShape bend_rest = BendRestShape::designed;
+};
+
+// Row-major 3n-by-3n matrix, the layout the system matrix and the Jacobians share.
+using SparseMatrixR = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
+
+// One triangle: w_u = Σ_k du[k]·x_k and w_v = Σ_k dv[k]·x_k are the deformation gradient's
+// columns along warp and weft (Baraff & Witkin 1998, eq. 9), so |w_u| = 1 means unstretched.
+struct TriangleElement {
+  std::array<int, 3> vertices{};
+  double rest_area = 0.0;  // m²
+  Eigen::Vector3d du = Eigen::Vector3d::Zero();
+  Eigen::Vector3d dv = Eigen::Vector3d::Zero();
+  std::array<int, 9> blocks{};  // offset of block (a,b) in the matrix row, see BlockPattern
+};
+
+// One interior edge (x0,x1) with opposite vertices x2 (first triangle) and x3 (second).
+struct HingeElement {
+  std::array<int, 4> vertices{};
+  double rest_angle = 0.0;  // rad, in (−π, π]
+  double weight = 0.0;      // |e|²/(A1+A2) in the rest shape, dimensionless
+  std::array<int, 16> blocks{};
+};
+
+// Structurally symmetric block sparsity: rows 3i..3i+2 all hold the columns of the vertices
+// adjacent to i (itself included), in increasing order. Block (i,j), entry (a,b) is at value
+// index outer[3i+a] + offset(i,j) + b, where offset(i,j) is what the elements store.
+struct BlockPattern {
+  SparseMatrixR zero_matrix;          // the pattern with all values zero
+  std::vector<int> diagonal_offsets;  // offset(i,i), #V
+};
+
+struct ClothModel {
+  int vertex_count = 0;
+  FabricParameters fabric;
+  std::vector<TriangleElement> triangles;
+  std::vector<HingeElement> hinges;
+  Eigen::VectorXd mass;         // #V lumped masses, kg
+  Eigen::VectorXd vertex_area;  // #V rest area attributed to each vertex (a third of each face)
+  BlockPattern pattern;
+
+  double total_mass() const { return mass.sum(); }
+};
+
+// Builds the model. Validates the fabric and the mesh (throws InvalidFabricError or
+// InvalidClothError). Non-manifold edges get no hinge (logged as a warning).
+ClothModel build_cloth_model(const ClothInput& input, const FabricParameters& fabric,
+                             const ClothModelOptions& options = {});
+
+// Flattens #V by 3 positions into the solver's 3n vector (x0,y0,z0,x1,...) and back.
+Eigen::VectorXd flatten_positions(const Eigen::MatrixX3d& positions);
+Eigen::MatrixX3d unflatten_positions(const Eigen::VectorXd& flat);
+
+// Value index of entry (a,b) of block `offset` in row-vertex `row_vertex`.
+inline int block_value_index(const SparseMatrixR& matrix, int row_vertex, int offset, int a,
+                             int b) {
+  return matrix.outerIndexPtr()[3 * row_vertex + a] + offset + b;
+}
+
+}  // namespace sd::sim

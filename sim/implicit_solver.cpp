@@ -1,0 +1,133 @@
+#include "sim/implicit_solver.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace sd::sim {
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+void ImplicitSolver::assemble(const ClothModel& model, const ForceSettings& forces, double beta,
+                              const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                              const Eigen::VectorXd* u, ImplicitSolveResult& result) {
+  const auto start = std::chrono::steady_clock::now();
+  const SparseMatrixR& pattern = model.pattern.zero_matrix;
+  if (matrix_.rows() != pattern.rows() || matrix_.nonZeros() != pattern.nonZeros() ||
+      !std::equal(pattern.outerIndexPtr(), pattern.outerIndexPtr() + pattern.rows() + 1,
+                  matrix_.outerIndexPtr()) ||
+      !std::equal(pattern.innerIndexPtr(), pattern.innerIndexPtr() + pattern.nonZeros(),
+                  matrix_.innerIndexPtr()))
+    matrix_ = pattern;
+  else
+    std::fill(matrix_.valuePtr(), matrix_.valuePtr() + matrix_.nonZeros(), 0.0);
+  double* values = matrix_.valuePtr();
+  for (int i = 0; i < model.vertex_count; ++i)
+    for (int a = 0; a < 3; ++a)
+      values[block_value_index(matrix_, i, model.pattern.diagonal_offsets[i], a, a)] = model.mass[i];
+  JacobianTarget target;
+  target.kind = JacobianKind::solve;
+  target.matrix = &matrix_;
+  target.dfdx_scale = -beta * beta;
+  target.dfdv_scale = -beta;
+  if (u != nullptr) {
+    product_.setZero(u->size());
+    target.product_input = u;
+    target.product_output = &product_;
+  }
+  evaluate_forces(model, forces, x, v, force_, nullptr, &target);
+  result.forces_seconds += seconds_since(start);
+}
+
+bool ImplicitSolver::linear_solve(const ClothModel& model, const ConstraintFilter& filter,
+                                  const NewtonSettings& settings, bool refactor,
+                                  ImplicitSolveResult& result) {
+  const auto start = std::chrono::steady_clock::now();
+  LinearSolveStats stats;
+  if (settings.solver == LinearSolverKind::cholmod) {
+    if (refactor && !cholmod_.factorize(matrix_, filter)) {
+      result.solve_seconds += seconds_since(start);
+      return false;
+    }
+    stats = cholmod_.solve(matrix_, filter, rhs_, z_, step_);
+  } else {
+    stats = pcg_.solve(matrix_, model.pattern.diagonal_offsets, filter, rhs_, z_, step_,
+                       settings.pcg_tolerance, settings.pcg_max_iterations);
+  }
+  ++result.linear_solves;
+  result.cg_iterations += stats.iterations;
+  result.cg_iterations_max = std::max(result.cg_iterations_max, stats.iterations);
+  result.solve_seconds += seconds_since(start);
+  return stats.converged && step_.allFinite();
+}
+
+ImplicitSolveResult ImplicitSolver::solve(const ClothModel& model, const ForceSettings& forces,
+                                          const ConstraintFilter& filter,
+                                          const Eigen::VectorXd& x_hat,
+                                          const Eigen::VectorXd& v_hat, double beta,
+                                          const Eigen::VectorXd& x_lin,
+                                          const Eigen::VectorXd& v_lin,
+                                          const NewtonSettings& settings) {
+  ImplicitSolveResult result;
+  const int n = model.vertex_count;
+  const auto mass_times = [&](const Eigen::VectorXd& w) {
+    Eigen::VectorXd out(3 * n);
+    for (int i = 0; i < n; ++i) out.segment<3>(3 * i) = model.mass[i] * w.segment<3>(3 * i);
+    return out;
+  };
+
+  // First iteration, linearised at (x_lin, v_lin): with u = x̂ + β v_lin − x_lin,
+  //   A s = M (v̂ − v_lin) + β f(x_lin, v_lin) + β (∂f/∂x) u,    v1 = v_lin + s.
+  const Eigen::VectorXd u = x_hat + beta * v_lin - x_lin;
+  const bool consistent = u.lpNorm<Eigen::Infinity>() == 0.0;
+  assemble(model, forces, beta, x_lin, v_lin, consistent ? nullptr : &u, result);
+  rhs_ = mass_times(v_hat - v_lin) + beta * force_;
+  if (!consistent) rhs_ += beta * product_;
+  filter.constrained_correction(v_lin, z_);
+  result.v = v_lin;
+  result.linear_converged = linear_solve(model, filter, settings, true, result);
+  result.v += step_;
+  result.x = x_hat + beta * result.v;
+  result.newton_iterations = 1;
+  result.last_update = beta * step_.lpNorm<Eigen::Infinity>();
+  if (!result.linear_converged || !result.v.allFinite()) {
+    result.newton_converged = false;
+    return result;
+  }
+  if (settings.max_iterations <= 1) return result;  // the linearised step, by design
+
+  // Further iterations: residual g(v) = M (v − v̂) − β f(x̂ + β v, v), A s = −g.
+  result.newton_converged = result.last_update <= settings.tolerance;
+  double previous_update = result.last_update;
+  while (!result.newton_converged && result.newton_iterations < settings.max_iterations) {
+    if (settings.refresh_jacobian) {
+      assemble(model, forces, beta, result.x, result.v, nullptr, result);
+    } else {
+      const auto start = std::chrono::steady_clock::now();
+      evaluate_forces(model, forces, result.x, result.v, force_);
+      result.forces_seconds += seconds_since(start);
+    }
+    rhs_ = mass_times(v_hat - result.v) + beta * force_;
+    filter.constrained_correction(result.v, z_);
+    result.linear_converged = linear_solve(model, filter, settings, settings.refresh_jacobian, result);
+    result.v += step_;
+    result.x = x_hat + beta * result.v;
+    ++result.newton_iterations;
+    result.last_update = beta * step_.lpNorm<Eigen::Infinity>();
+    if (!result.linear_converged || !result.v.allFinite()) break;
+    result.newton_converged = result.last_update <= settings.tolerance;
+    // A simplified Newton iteration that stops contracting will not converge: give up early.
+    if (!result.newton_converged && result.newton_iterations > 2 &&
+        result.last_update > previous_update)
+      break;
+    previous_update = result.last_update;
+  }
+  return result;
+}
+
+}  // namespace sd::sim

@@ -1,0 +1,77 @@
+#pragma once
+// The nonlinear system of one implicit step, shared by implicit Euler and BDF2. Both methods
+// reduce to: find v1 with
+//     x1 = x̂ + β v1,    M (v1 − v̂) = β f(x1, v1),
+// implicit Euler with x̂ = x0, v̂ = v0, β = h; variable-step BDF2 with the history terms in x̂,
+// v̂ and β = h(1+ω)/(1+2ω) (see docs/simulator.md). It is solved by Newton iterations on v1
+// with the matrix A = M − β ∂f/∂v − β² ∂f/∂x (the "solve" Jacobian, SPD), linear systems
+// filtered by the constraints and solved by the modified PCG or CHOLMOD.
+
+#include <Eigen/Core>
+
+#include "sim/cholmod_solver.hpp"
+#include "sim/cloth_model.hpp"
+#include "sim/constraint_filter.hpp"
+#include "sim/forces.hpp"
+#include "sim/pcg_solver.hpp"
+
+namespace sd::sim {
+
+enum class LinearSolverKind { pcg, cholmod };
+
+struct NewtonSettings {
+  // 1 = a single linearised step (Baraff & Witkin's implicit Euler). More iterations run an
+  // inexact simplified Newton method: the matrix of the first iteration is kept (and its
+  // CHOLMOD factor reused) unless refresh_jacobian is set.
+  int max_iterations = 1;
+  double tolerance = 1e-6;  // m: converged when β·max|Δv| ≤ tolerance
+  bool refresh_jacobian = false;
+  LinearSolverKind solver = LinearSolverKind::pcg;
+  double pcg_tolerance = 1e-3;  // relative residual reduction (the inexact Newton forcing term)
+  int pcg_max_iterations = 1000;
+};
+
+struct ImplicitSolveResult {
+  Eigen::VectorXd x;  // 3n positions at the end of the step
+  Eigen::VectorXd v;  // 3n velocities
+  int newton_iterations = 0;
+  int linear_solves = 0;
+  int cg_iterations = 0;      // summed over the linear solves
+  int cg_iterations_max = 0;  // largest single solve
+  bool linear_converged = true;
+  bool newton_converged = true;
+  double last_update = 0.0;  // β·max|Δv| of the last Newton update, m
+  double forces_seconds = 0.0;
+  double solve_seconds = 0.0;
+};
+
+class ImplicitSolver {
+ public:
+  // Solves the step. (x_lin, v_lin) is where the first iteration linearises the force: the
+  // start of the step (x0, v0) for Baraff-Witkin's linearised implicit Euler, a consistent
+  // predictor (x̂ + β v_guess, v_guess) for BDF2. The filter must hold the velocity targets
+  // of the constrained vertices for the end of the step.
+  ImplicitSolveResult solve(const ClothModel& model, const ForceSettings& forces,
+                            const ConstraintFilter& filter, const Eigen::VectorXd& x_hat,
+                            const Eigen::VectorXd& v_hat, double beta,
+                            const Eigen::VectorXd& x_lin, const Eigen::VectorXd& v_lin,
+                            const NewtonSettings& settings);
+
+  // The system matrix of the last assembly (for tests and benchmarks).
+  const SparseMatrixR& matrix() const { return matrix_; }
+  const CholmodSolver& cholmod() const { return cholmod_; }
+
+ private:
+  void assemble(const ClothModel& model, const ForceSettings& forces, double beta,
+                const Eigen::VectorXd& x, const Eigen::VectorXd& v, const Eigen::VectorXd* u,
+                ImplicitSolveResult& result);
+  bool linear_solve(const ClothModel& model, const ConstraintFilter& filter,
+                    const NewtonSettings& settings, bool refactor, ImplicitSolveResult& result);
+
+  SparseMatrixR matrix_;
+  PcgSolver pcg_;
+  CholmodSolver cholmod_;
+  Eigen::VectorXd force_, product_, rhs_, z_, step_;
+};
+
+}  // namespace sd::sim

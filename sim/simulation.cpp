@@ -1,0 +1,286 @@
+#include "sim/simulation.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <utility>
+
+#include <spdlog/spdlog.h>
+
+namespace sd::sim {
+namespace {
+
+void require(bool ok, const std::string& message) {
+  if (!ok) throw InvalidSimulationSettingsError(message);
+}
+
+double max_speed(const Eigen::VectorXd& v) {
+  double speed = 0.0;
+  for (Eigen::Index i = 0; i < v.size() / 3; ++i) speed = std::max(speed, v.segment<3>(3 * i).norm());
+  return speed;
+}
+
+}  // namespace
+
+void SimulationSettings::validate() const {
+  const auto positive = [](double value) { return std::isfinite(value) && value > 0.0; };
+  require(positive(dt), "the time step dt must be a positive number of seconds");
+  require(positive(min_dt) && min_dt <= dt,
+          "the minimum time step must be positive and not larger than dt");
+  require(std::isfinite(duration) && duration >= 0.0, "the duration must be zero or more seconds");
+  require(!newton_iterations || *newton_iterations >= 1, "Newton iterations must be at least 1");
+  require(positive(newton_tolerance), "the Newton tolerance must be positive");
+  require(positive(pcg_tolerance) && pcg_tolerance < 1.0,
+          "the PCG tolerance must be between 0 and 1");
+  require(pcg_max_iterations >= 1, "the PCG iteration limit must be at least 1");
+  require(positive(max_strain), "the strain limit must be positive");
+  require(positive(max_speed), "the speed limit must be positive");
+  require(easy_steps_to_grow >= 1, "easy_steps_to_grow must be at least 1");
+  require(std::isfinite(grow_factor) && grow_factor >= 1.0, "the growth factor must be at least 1");
+  require(positive(rest_speed) && positive(rest_kinetic_energy) &&
+              std::isfinite(rest_window) && rest_window >= 0.0,
+          "the at-rest thresholds must be positive and the window zero or more");
+  require(forces.gravity.allFinite() && forces.wind.allFinite() &&
+              std::isfinite(forces.air_drag) && forces.air_drag >= 0.0,
+          "gravity, wind and air drag must be finite (air drag zero or more)");
+}
+
+Simulation::Simulation(ClothModel model, Eigen::VectorXd x0, std::vector<Pin> pins,
+                       SimulationSettings settings)
+    : settings_(std::move(settings)) {
+  settings_.validate();
+  dt_ = settings_.dt;
+  replace_model(std::move(model), std::move(x0), Eigen::VectorXd(), std::move(pins));
+  report_.dt_min_used = 0.0;
+}
+
+void Simulation::replace_model(ClothModel model, Eigen::VectorXd x, Eigen::VectorXd v,
+                               std::vector<Pin> pins) {
+  const int n = model.vertex_count;
+  if (x.size() != 3 * n)
+    throw std::invalid_argument("the start positions must have 3 coordinates per cloth vertex");
+  if (!x.allFinite()) throw std::invalid_argument("the start positions must be finite");
+  if (v.size() == 0) v = Eigen::VectorXd::Zero(3 * n);
+  if (v.size() != 3 * n || !v.allFinite())
+    throw std::invalid_argument("the start velocities must be finite, 3 per cloth vertex");
+  for (const Pin& pin : pins)
+    if (pin.vertex < 0 || pin.vertex >= n)
+      throw std::invalid_argument("pinned vertex " + std::to_string(pin.vertex) +
+                                  " is not a cloth vertex (the cloth has " + std::to_string(n) +
+                                  ")");
+  model_ = std::move(model);
+  x_ = std::move(x);
+  v_ = std::move(v);
+  pins_ = std::move(pins);
+  pin_rest_.clear();
+  for (const Pin& pin : pins_) pin_rest_.emplace_back(x_.segment<3>(3 * pin.vertex));
+  filter_ = ConstraintFilter(n);
+  has_history_ = false;
+  report_.vertices = n;
+  report_.triangles = static_cast<int>(model_.triangles.size());
+}
+
+void Simulation::set_velocities(const Eigen::VectorXd& v) {
+  if (v.size() != x_.size() || !v.allFinite())
+    throw std::invalid_argument("velocities must be finite, 3 per cloth vertex");
+  v_ = v;
+  has_history_ = false;
+}
+
+EnergyBreakdown Simulation::energy() const {
+  Eigen::VectorXd force;
+  EnergyBreakdown energy;
+  evaluate_forces(model_, settings_.forces, x_, v_, force, &energy);
+  return energy;
+}
+
+double Simulation::residual_force() const {
+  Eigen::VectorXd force;
+  evaluate_forces(model_, settings_.forces, x_, Eigen::VectorXd::Zero(x_.size()), force);
+  ConstraintFilter filter(model_.vertex_count);
+  for (const Pin& pin : pins_) filter.pin(pin.vertex, Eigen::Vector3d::Zero());
+  filter.apply(force);
+  return force.lpNorm<Eigen::Infinity>();
+}
+
+Simulation::Attempt Simulation::attempt(double h) {
+  Attempt result;
+  const bool bdf2 = settings_.integrator == Integrator::bdf2;
+  const int newton = settings_.newton_iterations.value_or(bdf2 ? 8 : 1);
+  NewtonSettings newton_settings;
+  newton_settings.max_iterations = newton;
+  newton_settings.tolerance = settings_.newton_tolerance;
+  newton_settings.solver = settings_.solver;
+  newton_settings.pcg_tolerance = settings_.pcg_tolerance;
+  newton_settings.pcg_max_iterations = settings_.pcg_max_iterations;
+
+  // Variable-step BDF2 (ω = h/h_prev): y1 − (1+ω)²/(1+2ω) y0 + ω²/(1+2ω) y−1 = h(1+ω)/(1+2ω) f1.
+  Eigen::VectorXd x_hat, v_hat, x_lin, v_lin;
+  double beta = h;
+  if (bdf2 && has_history_) {
+    const double omega = h / h_previous_;
+    const double a0 = (1.0 + omega) * (1.0 + omega) / (1.0 + 2.0 * omega);
+    const double a1 = omega * omega / (1.0 + 2.0 * omega);
+    beta = h * (1.0 + omega) / (1.0 + 2.0 * omega);
+    x_hat = a0 * x_ - a1 * x_previous_;
+    v_hat = a0 * v_ - a1 * v_previous_;
+    v_lin = v_ + omega * (v_ - v_previous_);  // linear extrapolation of the velocity
+    x_lin = x_hat + beta * v_lin;
+  } else {
+    x_hat = x_;
+    v_hat = v_;
+    x_lin = x_;
+    v_lin = v_;
+  }
+  filter_.clear();
+  for (std::size_t k = 0; k < pins_.size(); ++k) {
+    const int i = pins_[k].vertex;
+    const Eigen::Vector3d target = pins_[k].path ? pins_[k].path(time_ + h) : pin_rest_[k];
+    filter_.pin(i, (target - x_hat.segment<3>(3 * i)) / beta);
+  }
+  result.solve = solver_.solve(model_, settings_.forces, filter_, x_hat, v_hat, beta, x_lin, v_lin,
+                               newton_settings);
+  result.x = std::move(result.solve.x);
+  result.v = std::move(result.solve.v);
+
+  std::ostringstream why;
+  if (!result.x.allFinite() || !result.v.allFinite()) {
+    why << "non-finite positions or velocities";
+    result.hard_failure = true;
+  } else if (const double speed = max_speed(result.v); speed > settings_.max_speed) {
+    why << "a vertex reached " << speed << " m/s (limit " << settings_.max_speed << ")";
+    result.hard_failure = true;
+  } else if (!result.solve.linear_converged) {
+    why << (settings_.solver == LinearSolverKind::pcg ? "PCG did not converge"
+                                                      : "CHOLMOD factorisation failed");
+  } else if (!result.solve.newton_converged) {
+    why << "Newton did not converge in " << result.solve.newton_iterations << " iterations (last update "
+        << result.solve.last_update << " m)";
+  } else if (const double strain = max_stretch_strain(model_, result.x);
+             strain > settings_.max_strain) {
+    why << "stretch strain " << strain << " above the limit " << settings_.max_strain;
+  }
+  result.failure = why.str();
+  return result;
+}
+
+void Simulation::accept(Attempt& attempt, double h) {
+  x_previous_ = std::move(x_);
+  v_previous_ = std::move(v_);
+  x_ = std::move(attempt.x);
+  v_ = std::move(attempt.v);
+  h_previous_ = h;
+  has_history_ = true;
+  time_ += h;
+  ++report_.steps;
+  report_.sim_time = time_;
+  report_.dt_min_used = report_.steps == 1 ? h : std::min(report_.dt_min_used, h);
+  report_.dt_max_used = std::max(report_.dt_max_used, h);
+
+  const double mass = model_.total_mass();
+  const double speed = max_speed(v_);
+  const double kinetic = kinetic_energy(model_, v_);
+  if (speed < settings_.rest_speed && kinetic / mass < settings_.rest_kinetic_energy)
+    rest_time_ += h;
+  else
+    rest_time_ = 0.0;
+}
+
+StepOutcome Simulation::step(double max_step) {
+  StepOutcome outcome;
+  double h = std::min(dt_, max_step);
+  // Land exactly on max_step instead of leaving a sliver for the next step.
+  if (max_step - h < 1e-3 * h) h = max_step;
+  Attempt candidate;
+  for (;;) {
+    candidate = attempt(h);
+    report_.forces_s += candidate.solve.forces_seconds;
+    report_.solve_s += candidate.solve.solve_seconds;
+    report_.linear_solves += candidate.solve.linear_solves;
+    cg_total_ += candidate.solve.cg_iterations;
+    report_.cg_iterations_max = std::max(report_.cg_iterations_max, candidate.solve.cg_iterations_max);
+    if (candidate.failure.empty()) break;
+    if (h * 0.5 < settings_.min_dt) {
+      if (!candidate.hard_failure) {
+        spdlog::warn("sim: t = {:.6f} s: accepting a step of {:.3g} s at the minimum despite: {}",
+                     time_, h, candidate.failure);
+        ++report_.forced_steps;
+        break;
+      }
+      spdlog::error("sim: t = {:.6f} s: step failed at the minimum step {:.3g} s: {}", time_, h,
+                    candidate.failure);
+      outcome.failure_reason = candidate.failure;
+      outcome.dt = h;
+      return outcome;
+    }
+    ++outcome.retries;
+    ++report_.retries;
+    spdlog::debug("sim: t = {:.6f} s: step {:.4g} s rejected ({}), retrying with {:.4g} s", time_,
+                  h, candidate.failure, 0.5 * h);
+    h *= 0.5;
+    dt_ = h;
+    easy_steps_ = 0;
+  }
+  outcome.accepted = true;
+  outcome.dt = h;
+  outcome.newton_iterations = candidate.solve.newton_iterations;
+  outcome.cg_iterations = candidate.solve.cg_iterations;
+  newton_total_ += candidate.solve.newton_iterations;
+  accept(candidate, h);
+
+  // Grow back after a run of easy steps: no retry and Newton converging in a few iterations.
+  const int newton_budget = settings_.newton_iterations.value_or(
+      settings_.integrator == Integrator::bdf2 ? 8 : 1);
+  const bool easy = outcome.retries == 0 &&
+                    outcome.newton_iterations <= std::max(1, (newton_budget + 1) / 2);
+  easy_steps_ = easy ? easy_steps_ + 1 : 0;
+  if (easy_steps_ >= settings_.easy_steps_to_grow && dt_ < settings_.dt) {
+    const double factor = settings_.integrator == Integrator::bdf2
+                              ? std::min(settings_.grow_factor, 2.0)
+                              : settings_.grow_factor;
+    dt_ = std::min(settings_.dt, dt_ * factor);
+    easy_steps_ = 0;
+    spdlog::debug("sim: t = {:.6f} s: step grows to {:.4g} s", time_, dt_);
+  }
+  return outcome;
+}
+
+SimulationReport Simulation::run(const std::function<void(const Simulation&)>& on_step) {
+  const auto start = std::chrono::steady_clock::now();
+  const double forces_before = report_.forces_s;
+  const double solve_before = report_.solve_s;
+  const auto sample = [&] {
+    if (!settings_.record_energy) return;
+    const EnergyBreakdown e = energy();
+    report_.energy.push_back({time_, e.stretch, e.shear, e.bend, e.kinetic, e.potential});
+  };
+  if (report_.energy.empty()) sample();
+  const double epsilon = 1e-9 * std::max(1.0, settings_.duration);
+  while (time_ < settings_.duration - epsilon) {
+    const StepOutcome outcome = step(settings_.duration - time_);
+    if (!outcome.accepted) {
+      report_.failed = true;
+      report_.failure_reason = outcome.failure_reason;
+      break;
+    }
+    sample();
+    if (on_step) on_step(*this);
+    if (settings_.stop_at_rest && at_rest()) {
+      report_.at_rest = true;
+      break;
+    }
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report_.wall_time_s += wall;
+  report_.other_s += wall - (report_.forces_s - forces_before) - (report_.solve_s - solve_before);
+  report_.cg_iterations_mean =
+      report_.linear_solves > 0 ? static_cast<double>(cg_total_) / report_.linear_solves : 0.0;
+  report_.newton_iterations_mean =
+      report_.steps > 0 ? static_cast<double>(newton_total_) / report_.steps : 0.0;
+  report_.max_strain = max_stretch_strain(model_, x_);
+  report_.nan_free = x_.allFinite() && v_.allFinite();
+  return report_;
+}
+
+}  // namespace sd::sim

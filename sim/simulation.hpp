@@ -1,0 +1,160 @@
+#pragma once
+// The driver: time stepping with implicit Euler or variable-step BDF2, step control (rollback
+// and halving on failure, growth after easy steps), at-rest detection and the run report.
+
+#include <functional>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "sim/cloth_model.hpp"
+#include "sim/forces.hpp"
+#include "sim/implicit_solver.hpp"
+
+namespace sd::sim {
+
+// A setting that cannot work (dt ≤ 0, negative tolerance, ...). The message names it.
+class InvalidSimulationSettingsError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+enum class Integrator { implicit_euler, bdf2 };
+
+struct SimulationSettings {
+  Integrator integrator = Integrator::implicit_euler;
+  LinearSolverKind solver = LinearSolverKind::pcg;
+  double dt = 1.0 / 60.0;     // s, the largest step (and the step the run starts with)
+  double min_dt = 1.0e-5;     // s, halving stops here
+  double duration = 2.0;      // s of simulated time
+  // Newton iterations per step; empty: 1 for implicit Euler (the linearised step), 8 for BDF2.
+  std::optional<int> newton_iterations;
+  double newton_tolerance = 1.0e-6;  // m, see NewtonSettings
+  double pcg_tolerance = 1.0e-3;
+  int pcg_max_iterations = 1000;
+  double max_strain = 1.0;    // a step that stretches any triangle by more (100 %) fails
+  double max_speed = 50.0;    // m/s, a step with a faster vertex fails
+  int easy_steps_to_grow = 4; // consecutive steps without trouble before the step grows
+  double grow_factor = 2.0;   // capped at 2 for BDF2 (zero-stability needs ω < 1 + √2)
+  bool stop_at_rest = true;
+  double rest_speed = 5.0e-3;            // m/s, maximum vertex speed at rest
+  double rest_kinetic_energy = 1.0e-6;   // J/kg, kinetic energy per unit mass at rest
+  double rest_window = 0.25;             // s the two must stay below their thresholds
+  bool record_energy = true;             // energy time series in the report (one sample a step)
+  ForceSettings forces;
+
+  void validate() const;  // throws InvalidSimulationSettingsError
+};
+
+// A constrained vertex: fixed where it starts, or driven along `path` (position at time t).
+struct Pin {
+  int vertex = 0;
+  std::function<Eigen::Vector3d(double)> path;
+};
+
+struct EnergySample {
+  double time = 0.0;
+  double stretch = 0.0;
+  double shear = 0.0;
+  double bend = 0.0;
+  double kinetic = 0.0;
+  double potential = 0.0;
+};
+
+struct SimulationReport {
+  int steps = 0;             // accepted steps
+  double sim_time = 0.0;     // s simulated
+  double wall_time_s = 0.0;
+  bool at_rest = false;      // the run stopped early because the cloth was at rest
+  int retries = 0;           // rejected attempts (each one halved the step)
+  int forced_steps = 0;      // steps accepted at min_dt despite a soft failure (logged)
+  bool nan_free = true;      // no accepted state had a non-finite value (always, by design)
+  bool failed = false;       // a step could not be completed even at min_dt
+  std::string failure_reason;
+  int vertices = 0;
+  int triangles = 0;
+  int linear_solves = 0;
+  double cg_iterations_mean = 0.0;  // per linear solve (0 with CHOLMOD)
+  int cg_iterations_max = 0;
+  double newton_iterations_mean = 0.0;  // per accepted step
+  double dt_min_used = 0.0;
+  double dt_max_used = 0.0;
+  double forces_s = 0.0;     // wall time in force and Jacobian evaluation
+  double solve_s = 0.0;      // in linear solves (PCG or CHOLMOD factor + solve)
+  double other_s = 0.0;      // the rest (bookkeeping, checks, energy samples, callbacks)
+  double max_strain = 0.0;   // largest stretch strain at the end
+  std::vector<EnergySample> energy;
+};
+
+struct StepOutcome {
+  bool accepted = false;
+  double dt = 0.0;        // the step that was taken
+  int retries = 0;
+  int newton_iterations = 0;
+  int cg_iterations = 0;
+  std::string failure_reason;  // when not accepted
+};
+
+class Simulation {
+ public:
+  // x0: 3n start positions (flattened, see flatten_positions). Velocities start at zero.
+  Simulation(ClothModel model, Eigen::VectorXd x0, std::vector<Pin> pins,
+             SimulationSettings settings);
+
+  // One accepted step of at most min(current step, max_step), with retries. If it cannot be
+  // completed even at min_dt the state is left unchanged and `accepted` is false.
+  StepOutcome step(double max_step = 1e300);
+  // Steps until `duration` (or at rest, or failure); calls on_step after each accepted step.
+  SimulationReport run(const std::function<void(const Simulation&)>& on_step = {});
+
+  // Replaces the mesh (after an adaptive refine/coarsen) with matching 3n state; the BDF2
+  // history restarts with an implicit Euler step.
+  void replace_model(ClothModel model, Eigen::VectorXd x, Eigen::VectorXd v,
+                     std::vector<Pin> pins);
+  void set_velocities(const Eigen::VectorXd& v);
+
+  const ClothModel& model() const { return model_; }
+  const SimulationSettings& settings() const { return settings_; }
+  const Eigen::VectorXd& positions() const { return x_; }
+  const Eigen::VectorXd& velocities() const { return v_; }
+  double time() const { return time_; }
+  double current_dt() const { return dt_; }
+  bool at_rest() const { return rest_time_ >= settings_.rest_window; }
+  const SimulationReport& report() const { return report_; }
+  EnergyBreakdown energy() const;
+  // |S f(x, 0)|∞ over the free vertices, newtons: the residual force of a static state.
+  double residual_force() const;
+
+ private:
+  struct Attempt {
+    Eigen::VectorXd x, v;
+    ImplicitSolveResult solve;
+    std::string failure;  // empty when the attempt passed every check
+    bool hard_failure = false;  // non-finite or too fast: never accepted
+  };
+  Attempt attempt(double h);
+  void accept(Attempt& attempt, double h);
+
+  ClothModel model_;
+  SimulationSettings settings_;
+  std::vector<Pin> pins_;
+  std::vector<Eigen::Vector3d> pin_rest_;
+  Eigen::VectorXd x_, v_;
+  Eigen::VectorXd x_previous_, v_previous_;
+  bool has_history_ = false;
+  double h_previous_ = 0.0;
+  double time_ = 0.0;
+  double dt_ = 0.0;
+  int easy_steps_ = 0;
+  double rest_time_ = 0.0;
+  ConstraintFilter filter_;
+  ImplicitSolver solver_;
+  SimulationReport report_;
+  long long newton_total_ = 0;
+  long long cg_total_ = 0;
+};
+
+}  // namespace sd::sim
