@@ -26,9 +26,9 @@ struct PatchTopology {
   QuadMesh mesh;  // positions in a 2D parameter layout (z = 0), for display
   // side i: vertex indices from corner i to corner i+1 inclusive (l_i + 1 entries)
   std::vector<std::vector<int>> side_vertices;
-  // "nasri" (centre of valence n), "yasseen" (large-length partition), "shifted-corners"
-  // (Nasri partition or grid on a polygon whose corners were moved along the boundary), or
-  // "single-quad"
+  // "nasri" (centre of valence n; for n = 4 a plain grid), "yasseen" (large-length partition)
+  // or "shifted-corners" (a Nasri partition or a grid on a polygon whose corners were moved
+  // along the boundary: some corners dropped, some side vertices promoted)
   std::string partition;
   int distortion = 0;  // Σ |valence − regular| (4 inside, 3 on a side, 2 at a corner)
   int irregular_vertices = 0;

@@ -16,7 +16,7 @@ struct QuadQuality {
   double max_aspect_ratio = 0;       // over quads: longest edge / shortest edge
   double scaled_jacobian_min = 0;    // over all quad corners; 1 for a square, ≤ 0 when inverted
   double scaled_jacobian_mean = 0;   // mean over quads of each quad's minimum corner value
-  int inverted_quads = 0;            // quads with a corner whose scaled Jacobian is ≤ 0
+  int inverted_quads = 0;            // quads with a corner whose scaled Jacobian is < 0
 };
 
 // Valence figures only (cheap, no geometry): distortion and irregular_vertices.

@@ -1,0 +1,88 @@
+#include "meshing/quad_quality.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <vector>
+
+namespace sd::meshing {
+namespace {
+
+// Regular valence of each vertex: 4 inside, 3 on the boundary, 2 at a corner.
+Eigen::VectorXi regular_valences(const QuadMesh& mesh, std::span<const int> corner_vertices) {
+  Eigen::VectorXi regular = Eigen::VectorXi::Constant(mesh.vertices.rows(), 4);
+  for (const int v : boundary_loop(mesh)) regular(v) = 3;
+  for (const int c : corner_vertices) regular(c) = 2;
+  return regular;
+}
+
+}  // namespace
+
+QuadQuality measure_valence(const QuadMesh& mesh, std::span<const int> corner_vertices) {
+  QuadQuality quality;
+  const Eigen::VectorXi valence = vertex_valences(mesh);
+  const Eigen::VectorXi regular = regular_valences(mesh, corner_vertices);
+  for (Eigen::Index v = 0; v < valence.size(); ++v) {
+    const int deviation = std::abs(valence(v) - regular(v));
+    quality.distortion += deviation;
+    quality.irregular_vertices += deviation != 0 ? 1 : 0;
+  }
+  return quality;
+}
+
+QuadQuality measure_quality(const QuadMesh& mesh, std::span<const int> corner_vertices) {
+  QuadQuality quality = measure_valence(mesh, corner_vertices);
+  const auto& x = mesh.vertices;
+  const auto& q = mesh.faces;
+  // Vertex normals: sums of the corner cross products of the incident quads.
+  Eigen::MatrixX3d normals = Eigen::MatrixX3d::Zero(x.rows(), 3);
+  for (Eigen::Index f = 0; f < q.rows(); ++f)
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector3d p = x.row(q(f, k));
+      const Eigen::Vector3d e1 = x.row(q(f, (k + 1) % 4)).transpose() - p;
+      const Eigen::Vector3d e2 = x.row(q(f, (k + 3) % 4)).transpose() - p;
+      normals.row(q(f, k)) += e1.cross(e2).transpose();
+    }
+  double min_angle = std::numeric_limits<double>::infinity(), max_angle = 0;
+  double max_aspect = 0, jac_min = std::numeric_limits<double>::infinity(), jac_sum = 0;
+  for (Eigen::Index f = 0; f < q.rows(); ++f) {
+    double quad_jac = std::numeric_limits<double>::infinity();
+    double shortest = std::numeric_limits<double>::infinity(), longest = 0;
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector3d p = x.row(q(f, k));
+      const Eigen::Vector3d e1 = x.row(q(f, (k + 1) % 4)).transpose() - p;
+      const Eigen::Vector3d e2 = x.row(q(f, (k + 3) % 4)).transpose() - p;
+      const double l1 = e1.norm(), l2 = e2.norm();
+      shortest = std::min(shortest, l1);
+      longest = std::max(longest, l1);
+      const double angle =
+          (l1 > 0 && l2 > 0) ? std::acos(std::clamp(e1.dot(e2) / (l1 * l2), -1.0, 1.0)) : 0.0;
+      Eigen::Vector3d n = normals.row(q(f, k));
+      const double nn = n.norm();
+      const double jac = (l1 > 0 && l2 > 0 && nn > 0) ? e1.cross(e2).dot(n / nn) / (l1 * l2) : 0.0;
+      // A corner whose scaled Jacobian is negative is reflex or folded: its angle is > 180°.
+      const double degrees = (jac < 0 ? 2 * std::numbers::pi - angle : angle) * 180 / std::numbers::pi;
+      min_angle = std::min(min_angle, degrees);
+      max_angle = std::max(max_angle, degrees);
+      quad_jac = std::min(quad_jac, jac);
+    }
+    max_aspect = std::max(max_aspect, shortest > 0 ? longest / shortest
+                                                   : std::numeric_limits<double>::infinity());
+    jac_min = std::min(jac_min, quad_jac);
+    jac_sum += quad_jac;
+    // A corner of exactly 180° (a quad at a side vertex of valence 2) is flat, not folded.
+    if (quad_jac < -1e-9) ++quality.inverted_quads;
+  }
+  if (q.rows() > 0) {
+    quality.min_angle_deg = min_angle;
+    quality.max_angle_deg = max_angle;
+    quality.max_aspect_ratio = max_aspect;
+    quality.scaled_jacobian_min = jac_min;
+    quality.scaled_jacobian_mean = jac_sum / static_cast<double>(q.rows());
+  }
+  return quality;
+}
+
+}  // namespace sd::meshing

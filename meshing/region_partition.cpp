@@ -1,0 +1,472 @@
+#include "meshing/region_partition.hpp"
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+#include <tuple>
+
+namespace sd::meshing::detail {
+namespace {
+
+int wrap(int i, int n) { return ((i % n) + n) % n; }
+
+// The loop positions from `from` to `to` (inclusive), walking forward around a loop of size S.
+std::vector<int> loop_segment(std::span<const int> loop, int from, int to) {
+  const auto size = static_cast<int>(loop.size());
+  std::vector<int> out{loop[static_cast<size_t>(from)]};
+  for (int p = from; p != to;) {
+    p = wrap(p + 1, size);
+    out.push_back(loop[static_cast<size_t>(p)]);
+  }
+  return out;
+}
+
+// Arc lengths between consecutive corners (positions increasing) around a loop of size S.
+std::vector<int> corner_arcs(std::span<const int> corners, int loop_size) {
+  const auto m = static_cast<int>(corners.size());
+  std::vector<int> arcs(static_cast<size_t>(m));
+  for (int j = 0; j < m; ++j)
+    arcs[static_cast<size_t>(j)] =
+        wrap(corners[static_cast<size_t>(wrap(j + 1, m))] - corners[static_cast<size_t>(j)],
+             loop_size);
+  if (m == 1) arcs[0] = loop_size;
+  return arcs;
+}
+
+int layout_cost(std::span<const int> corners, const PositionCosts& costs) {
+  int cost = std::abs(static_cast<int>(corners.size()) - 4);
+  std::vector<bool> is_corner(costs.as_side.size(), false);
+  for (const int c : corners) is_corner[static_cast<size_t>(c)] = true;
+  for (size_t p = 0; p < is_corner.size(); ++p)
+    cost += is_corner[p] ? costs.as_corner[p] : costs.as_side[p];
+  // A grid (n' = 4) has no centre; a Nasri centre of valence n' costs |n' − 4|.
+  return cost;
+}
+
+// The always-available layouts: the cheapest single grid block over every placement of its
+// corners (O(S²) constant-time checks), and triangles with arcs as equal as possible (each at
+// most S/2 − 1, so every spoke is >= 1) starting at each natural corner. A loop of 4 is one quad.
+PolygonLayout fallback_layout(int loop_size, std::span<const int> starts,
+                              const PositionCosts& costs) {
+  PolygonLayout best;
+  best.cost = INT_MAX;
+  const int half = loop_size / 2;
+  auto delta = [&](int p) {
+    p = wrap(p, loop_size);
+    return costs.as_corner[static_cast<size_t>(p)] - costs.as_side[static_cast<size_t>(p)];
+  };
+  const int base = std::accumulate(costs.as_side.begin(), costs.as_side.end(), 0);
+  int best_balance = -1;
+  for (int p = 0; p < half; ++p)
+    for (int a = 1; a < half; ++a) {
+      const int cost = base + delta(p) + delta(p + a) + delta(p + half) + delta(p + half + a);
+      const int balance = std::min(a, half - a);
+      if (cost < best.cost || (cost == best.cost && balance > best_balance)) {
+        best.corners = {p, p + a, p + half, wrap(p + half + a, loop_size)};
+        best.cost = cost;
+        best_balance = balance;
+      }
+    }
+  std::sort(best.corners.begin(), best.corners.end());
+  if (loop_size < 6) return best;
+  std::vector<int> start_list(starts.begin(), starts.end());
+  if (start_list.empty()) start_list.push_back(0);
+  for (const int start : start_list) {
+    const int a = loop_size / 3, b = (loop_size - a) / 2;
+    std::vector<int> corners = {start, wrap(start + a, loop_size), wrap(start + a + b, loop_size)};
+    std::sort(corners.begin(), corners.end());
+    const int cost = layout_cost(corners, costs);
+    if (cost < best.cost) {
+      best.corners = corners;
+      best.spokes = *nasri_spokes(corner_arcs(corners, loop_size));
+      best.cost = cost;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+std::vector<int> nasri_distances_doubled(std::span<const int> lengths) {
+  const auto n = static_cast<int>(lengths.size());
+  if (n % 4 == 0) throw std::logic_error("closed-form distances need n not divisible by 4");
+  // n odd: one cycle j → j+2 of length n; n/2 odd: two cycles of length n/2.
+  const int terms = n % 2 == 1 ? n : n / 2;
+  std::vector<int> doubled(static_cast<size_t>(n), 0);
+  for (int j = 0; j < n; ++j)
+    for (int k = 0; k < terms; ++k)
+      doubled[static_cast<size_t>(j)] +=
+          (k % 2 == 0 ? 1 : -1) * lengths[static_cast<size_t>(wrap(j + 1 + 2 * k, n))];
+  return doubled;
+}
+
+namespace {
+
+// nasri_spokes() without allocation (d is resized); false when infeasible.
+bool solve_spokes(std::span<const int> arcs, std::vector<int>& d) {
+  const auto m = static_cast<int>(arcs.size());
+  if (m < 3) return false;
+  d.resize(static_cast<size_t>(m));
+  if (m % 4 != 0) {
+    const int terms = m % 2 == 1 ? m : m / 2;
+    for (int j = 0; j < m; ++j) {
+      int twice = 0;
+      for (int k = 0; k < terms; ++k)
+        twice += (k % 2 == 0 ? 1 : -1) * arcs[static_cast<size_t>(wrap(j + 1 + 2 * k, m))];
+      if (twice % 2 != 0 || twice < 2) return false;
+      d[static_cast<size_t>(j)] = twice / 2;
+    }
+    return true;
+  }
+  // m divisible by 4: the d's of each parity form an even cycle arcs_{j+1} = d_j + d_{j+2}.
+  // Write d_{r+2k} = s_k t + c_k; the cycle closes only if c_h = 0 (alternating sum zero).
+  const int h = m / 2;
+  for (int r = 0; r < 2; ++r) {
+    std::vector<int> s(static_cast<size_t>(h) + 1), c(static_cast<size_t>(h) + 1);
+    s[0] = 1;
+    c[0] = 0;
+    for (int k = 0; k < h; ++k) {
+      s[static_cast<size_t>(k) + 1] = -s[static_cast<size_t>(k)];
+      c[static_cast<size_t>(k) + 1] =
+          arcs[static_cast<size_t>(wrap(r + 2 * k + 1, m))] - c[static_cast<size_t>(k)];
+    }
+    if (c[static_cast<size_t>(h)] != 0) return false;
+    int lo = INT_MIN / 2, hi = INT_MAX / 2;
+    for (int k = 0; k < h; ++k) {
+      if (s[static_cast<size_t>(k)] > 0) lo = std::max(lo, 1 - c[static_cast<size_t>(k)]);
+      else hi = std::min(hi, c[static_cast<size_t>(k)] - 1);
+    }
+    if (lo > hi) return false;
+    const int t = lo + (hi - lo) / 2;  // the middle keeps the shortest spoke longest
+    for (int k = 0; k < h; ++k)
+      d[static_cast<size_t>(wrap(r + 2 * k, m))] =
+          s[static_cast<size_t>(k)] * t + c[static_cast<size_t>(k)];
+  }
+  return true;
+}
+
+}  // namespace
+
+std::optional<std::vector<int>> nasri_spokes(std::span<const int> arcs) {
+  std::vector<int> d;
+  if (!solve_spokes(arcs, d)) return std::nullopt;
+  return d;
+}
+
+PositionCosts region_costs(std::span<const int> side_counts) {
+  const int total = std::accumulate(side_counts.begin(), side_counts.end(), 0);
+  PositionCosts costs{std::vector<int>(static_cast<size_t>(total), 1),
+                      std::vector<int>(static_cast<size_t>(total), 0)};
+  int p = 0;
+  for (const int count : side_counts) {
+    costs.as_corner[static_cast<size_t>(p)] = 0;
+    costs.as_side[static_cast<size_t>(p)] = 1;
+    p += count;
+  }
+  return costs;
+}
+
+PolygonLayout best_layout(const PositionCosts& costs, int budget) {
+  const auto size = static_cast<int>(costs.as_side.size());
+  if (size < 4 || size % 2 != 0) throw std::logic_error("a quad-fillable loop has an even size >= 4");
+  std::vector<int> naturals, others;  // positions that would rather be corners / the rest
+  for (int p = 0; p < size; ++p)
+    (costs.as_corner[static_cast<size_t>(p)] < costs.as_side[static_cast<size_t>(p)] ? naturals
+                                                                                      : others)
+        .push_back(p);
+  const PolygonLayout fallback = fallback_layout(size, naturals, costs);
+  auto delta = [&](int p) {
+    return costs.as_corner[static_cast<size_t>(p)] - costs.as_side[static_cast<size_t>(p)];
+  };
+  const int base = std::accumulate(costs.as_side.begin(), costs.as_side.end(), 0);
+  const auto n_natural = static_cast<int>(naturals.size());
+  int natural_sum = 0;
+  std::vector<int> drop_costs;  // what dropping each natural corner adds, cheapest first
+  for (const int p : naturals) {
+    natural_sum += delta(p);
+    drop_costs.push_back(-delta(p));
+  }
+  std::sort(drop_costs.begin(), drop_costs.end());
+  int min_add = INT_MAX;
+  for (const int p : others) min_add = std::min(min_add, delta(p));
+
+  // (dropped, added) pairs with a lower bound on their cost, cheapest first.
+  constexpr int kMaxAdded = 4;
+  struct Plan {
+    int dropped, added, bound;
+  };
+  std::vector<Plan> plans;
+  for (int k = 0; k <= n_natural && k <= 20; ++k)
+    for (int a = 0; a <= kMaxAdded && a <= static_cast<int>(others.size()); ++a) {
+      const int corners = n_natural - k + a;
+      if (corners < 3) continue;
+      const int drop = std::accumulate(drop_costs.begin(), drop_costs.begin() + k, 0);
+      plans.push_back({k, a, std::abs(corners - 4) + base + natural_sum + drop + a * min_add});
+    }
+  std::stable_sort(plans.begin(), plans.end(), [](const Plan& x, const Plan& y) {
+    return x.bound != y.bound ? x.bound < y.bound : x.dropped + x.added < y.dropped + y.added;
+  });
+
+  std::optional<PolygonLayout> best;
+  int best_balance = -1, best_irregular = INT_MAX;
+  const auto base_irregular = static_cast<int>(
+      std::count_if(costs.as_side.begin(), costs.as_side.end(), [](int c) { return c != 0; }));
+  std::vector<int> arcs, spokes;  // reused buffers: a check allocates nothing
+  auto consider = [&](std::vector<int>& chosen) {
+    --budget;
+    std::sort(chosen.begin(), chosen.end());
+    const auto m = chosen.size();
+    arcs.resize(m);
+    for (size_t j = 0; j < m; ++j)
+      arcs[j] = wrap(chosen[(j + 1) % m] - chosen[j], size);
+    int balance;
+    bool grid = false;
+    if (m == 4 && arcs[0] == arcs[2] && arcs[1] == arcs[3]) {
+      grid = true;
+      balance = std::min(arcs[0], arcs[1]);
+    } else if (solve_spokes(arcs, spokes)) {
+      balance = *std::min_element(spokes.begin(), spokes.end());
+    } else {
+      return;
+    }
+    int cost = std::abs(static_cast<int>(m) - 4) + base;
+    int irregular = (m != 4 ? 1 : 0) + base_irregular;
+    for (const int p : chosen) {
+      cost += delta(p);
+      irregular += (costs.as_corner[static_cast<size_t>(p)] != 0 ? 1 : 0) -
+                   (costs.as_side[static_cast<size_t>(p)] != 0 ? 1 : 0);
+    }
+    // Least distortion, then fewest irregular vertices, then the longest shortest spoke.
+    if (!best || std::tuple(cost, irregular, -balance) <
+                     std::tuple(best->cost, best_irregular, -best_balance)) {
+      best = PolygonLayout{chosen, grid ? std::vector<int>{} : spokes, cost};
+      best_balance = balance;
+      best_irregular = irregular;
+    }
+  };
+  for (const Plan& plan : plans) {
+    // Ties with the fallback are still searched: a Nasri centre beats a grid with moved corners
+    // of equal distortion by having fewer irregular vertices.
+    if ((best && plan.bound > best->cost) || plan.bound > fallback.cost || budget <= 0) break;
+    // Every subset of `plan.dropped` natural corners (bit masks), then every choice of
+    // `plan.added` promoted positions in increasing order.
+    const int full = 1 << std::min(n_natural, 20);
+    for (int mask = 0; mask < full && budget > 0; ++mask) {
+      if (__builtin_popcount(static_cast<unsigned>(mask)) != plan.dropped) continue;
+      std::vector<int> kept;
+      for (int i = 0; i < n_natural; ++i)
+        if ((mask & (1 << i)) == 0) kept.push_back(naturals[static_cast<size_t>(i)]);
+      std::vector<int> added, chosen;
+      auto recurse = [&](auto&& self, size_t from) -> void {
+        if (budget <= 0) return;
+        if (static_cast<int>(added.size()) == plan.added) {
+          chosen = kept;
+          chosen.insert(chosen.end(), added.begin(), added.end());
+          consider(chosen);
+          return;
+        }
+        for (size_t i = from; i < others.size() && budget > 0; ++i) {
+          added.push_back(others[i]);
+          self(self, i + 1);
+          added.pop_back();
+        }
+      };
+      recurse(recurse, 0);
+    }
+  }
+  if (best && best->cost <= fallback.cost) return *best;
+  return fallback;
+}
+
+void fill_polygon(QuadMeshBuilder& builder, std::span<const int> loop,
+                  const PolygonLayout& layout) {
+  const auto size = static_cast<int>(loop.size());
+  const auto m = static_cast<int>(layout.corners.size());
+  auto corner = [&](int j) { return layout.corners[static_cast<size_t>(wrap(j, m))]; };
+  if (layout.spokes.empty()) {
+    if (m != 4) throw std::logic_error("a grid layout has four corners");
+    std::vector<std::vector<int>> sides;
+    for (int j = 0; j < 4; ++j) sides.push_back(loop_segment(loop, corner(j), corner(j + 1)));
+    builder.add_grid(sides[0], sides[1], sides[2], sides[3]);
+    return;
+  }
+  // Nasri partition: centre G, spoke j from G to E_j on layout side j, E_j at d_{j-1} edges
+  // from corner j; region j (at corner j) is a d_{j-1} by d_j grid.
+  auto spoke = [&](int j) { return layout.spokes[static_cast<size_t>(wrap(j, m))]; };
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const int v : loop) centre += builder.position(v);
+  const int g = builder.add_vertex(centre / size);
+  std::vector<int> e(static_cast<size_t>(m));
+  std::vector<std::vector<int>> spokes(static_cast<size_t>(m));
+  for (int j = 0; j < m; ++j) {
+    e[static_cast<size_t>(j)] = wrap(corner(j) + spoke(j - 1), size);
+    spokes[static_cast<size_t>(j)] =
+        builder.add_chain(g, loop[static_cast<size_t>(e[static_cast<size_t>(j)])], spoke(j));
+  }
+  for (int j = 0; j < m; ++j) {
+    const int prev = wrap(j - 1, m);
+    const std::vector<int> bottom = loop_segment(loop, corner(j), e[static_cast<size_t>(j)]);
+    std::vector<int> right(spokes[static_cast<size_t>(j)].rbegin(),
+                           spokes[static_cast<size_t>(j)].rend());
+    const std::vector<int>& top = spokes[static_cast<size_t>(prev)];
+    const std::vector<int> left = loop_segment(loop, e[static_cast<size_t>(prev)], corner(j));
+    builder.add_grid(bottom, right, top, left);
+  }
+}
+
+bool fill_yasseen(QuadMeshBuilder& builder, const std::vector<std::vector<int>>& sides,
+                  int budget) {
+  const auto n = static_cast<int>(sides.size());
+  if (n < 3 || n % 4 == 0) return false;
+  std::vector<int> l(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) l[static_cast<size_t>(i)] = static_cast<int>(sides[static_cast<size_t>(i)].size()) - 1;
+  auto at = [n](auto& v, int i) -> auto& { return v[static_cast<size_t>(wrap(i, n))]; };
+  const std::vector<int> doubled = nasri_distances_doubled(l);
+  std::vector<int> d(static_cast<size_t>(n));
+  bool any_short = false;
+  for (int i = 0; i < n; ++i) {
+    if (at(doubled, i) % 2 != 0) return false;
+    at(d, i) = at(doubled, i) / 2;
+    any_short = any_short || at(d, i) < 1;
+  }
+  if (!any_short) return false;
+
+  // Large sides: those entering a non-positive d_i with a minus sign (i+3, i+7, ...).
+  const int terms = n % 2 == 1 ? n : n / 2;
+  std::vector<char> large(static_cast<size_t>(n), 0);
+  for (int i = 0; i < n; ++i)
+    if (at(d, i) < 1)
+      for (int k = 1; k < terms; k += 2) at(large, i + 1 + 2 * k) = true;
+  // Distorted regions (region i sits at corner i, between sides i-1 and i).
+  std::vector<char> distorted(static_cast<size_t>(n), 0);
+  for (int i = 0; i < n; ++i) {
+    if (!at(large, i)) continue;
+    const bool prev = at(large, i - 1), next = at(large, i + 1);
+    if (!prev && !next) at(distorted, i) = at(distorted, i + 1) = true;
+    if (next) at(distorted, i + 1) = true;
+    if (prev) at(distorted, i) = true;
+  }
+  // New distances: the non-positive ones set to 2 (own side large) or 1, then propagated
+  // through the sides that are not large (l_i = d_{i-1} + d_{i+1}).
+  std::vector<char> known(static_cast<size_t>(n), 0);
+  for (int i = 0; i < n; ++i)
+    if (at(d, i) < 1) {
+      at(d, i) = at(large, i) ? 2 : 1;
+      at(known, i) = true;
+    }
+  for (int sweep = 0; sweep < 4 * n; ++sweep) {  // min() only lowers values: few sweeps
+    bool changed = false;
+    for (int i = 0; i < n; ++i) {
+      if (at(large, i)) continue;
+      auto settle = [&](int from, int to) {
+        int value = at(l, i) - at(d, from);
+        if (at(known, to)) value = std::min(value, at(d, to));
+        if (!at(known, to) || value != at(d, to)) {
+          at(d, to) = value;
+          at(known, to) = true;
+          changed = true;
+        }
+      };
+      if (at(known, i - 1)) settle(i - 1, i + 1);
+      else if (at(known, i + 1)) settle(i + 1, i - 1);
+      else {
+        at(d, i - 1) = at(l, i) / 2;
+        at(d, i + 1) = at(l, i) - at(l, i) / 2;
+        at(known, i - 1) = at(known, i + 1) = true;
+        changed = true;
+      }
+    }
+    if (!changed) break;
+  }
+  if (*std::min_element(d.begin(), d.end()) < 1) return false;
+
+  // Where E_i splits side i: x_i edges from corner i, l_i − x_i to corner i+1.
+  std::vector<int> x(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    if (at(l, i) < 2) return false;
+    int split;
+    if (!at(large, i)) split = at(d, i - 1);
+    else if (at(distorted, i) && !at(distorted, i + 1)) split = at(l, i) - at(d, i + 1);
+    else if (!at(distorted, i) && at(distorted, i + 1)) split = at(d, i - 1);
+    else
+      split = static_cast<int>(std::lround(static_cast<double>(at(l, i)) * at(d, i - 1) /
+                                           (at(d, i - 1) + at(d, i + 1))));
+    at(x, i) = std::clamp(split, 1, at(l, i) - 1);
+  }
+  // A region that is not an exact rectangle is distorted too.
+  for (int i = 0; i < n; ++i)
+    if (at(l, i - 1) - at(x, i - 1) != at(d, i) || at(x, i) != at(d, i - 1)) at(distorted, i) = true;
+  if (std::all_of(distorted.begin(), distorted.end(), [](char b) { return b != 0; })) return false;
+  // Runs of consecutive distorted regions are merged; each run must have an even perimeter.
+  const int start = static_cast<int>(std::find(distorted.begin(), distorted.end(), 0) -
+                                     distorted.begin());
+  std::vector<std::pair<int, int>> runs;  // first and last region of each run
+  for (int k = 1; k <= n; ++k) {
+    const int i = start + k;
+    if (!at(distorted, i)) continue;
+    if (!runs.empty() && runs.back().second == i - 1) runs.back().second = i;
+    else runs.emplace_back(i, i);
+  }
+  for (const auto& [a, b] : runs) {
+    int perimeter = (at(l, a - 1) - at(x, a - 1)) + at(x, b) + at(d, b) + at(d, a - 1);
+    for (int i = a; i < b; ++i) perimeter += at(l, i);
+    if (perimeter % 2 != 0 || perimeter < 4) return false;
+  }
+
+  // Build: centre, the spokes that are not inside a merged run, rectangles, then the runs.
+  auto side_vertex = [&](int i, int offset) {
+    return sides[static_cast<size_t>(wrap(i, n))][static_cast<size_t>(offset)];
+  };
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  int boundary_count = 0;
+  for (const auto& side : sides)
+    for (size_t k = 0; k + 1 < side.size(); ++k, ++boundary_count) centre += builder.position(side[k]);
+  const int g = builder.add_vertex(centre / boundary_count);
+  std::vector<std::vector<int>> spoke(static_cast<size_t>(n));  // G → E_i
+  for (int i = 0; i < n; ++i)
+    if (!(at(distorted, i) && at(distorted, i + 1)))
+      at(spoke, i) = builder.add_chain(g, side_vertex(i, at(x, i)), at(d, i));
+  auto side_part = [&](int i, int from, int to) {
+    const auto& side = sides[static_cast<size_t>(wrap(i, n))];
+    return std::vector<int>(side.begin() + from, side.begin() + to + 1);
+  };
+  for (int i = 0; i < n; ++i) {
+    if (at(distorted, i)) continue;
+    const std::vector<int> bottom = side_part(i, 0, at(x, i));
+    const std::vector<int> right(at(spoke, i).rbegin(), at(spoke, i).rend());
+    const std::vector<int> left = side_part(i - 1, at(x, i - 1), at(l, i - 1));
+    builder.add_grid(bottom, right, at(spoke, i - 1), left);
+  }
+  // Regular valence of every vertex of the whole region: 2 at corners, 3 on sides, 4 inside.
+  std::vector<int> regular(static_cast<size_t>(builder.vertex_count()), 4);
+  for (int i = 0; i < n; ++i)
+    for (size_t k = 0; k < sides[static_cast<size_t>(i)].size(); ++k)
+      regular[static_cast<size_t>(sides[static_cast<size_t>(i)][k])] = k == 0 ? 2 : (k + 1 == sides[static_cast<size_t>(i)].size() ? 2 : 3);
+  for (const auto& [a, b] : runs) {
+    // Loop, counter-clockwise: E_{a-1} → corner a → … → E_b → G → E_{a-1}.
+    std::vector<int> loop = side_part(a - 1, at(x, a - 1), at(l, a - 1));
+    for (int i = a; i < b; ++i) {
+      const std::vector<int> part = side_part(i, 1, at(l, i));
+      loop.insert(loop.end(), part.begin(), part.end());
+    }
+    const std::vector<int> last = side_part(b, 1, at(x, b));
+    loop.insert(loop.end(), last.begin(), last.end());
+    loop.insert(loop.end(), at(spoke, b).rbegin() + 1, at(spoke, b).rend());
+    loop.insert(loop.end(), at(spoke, a - 1).begin() + 1, at(spoke, a - 1).end() - 1);
+    // Position costs from the edges each loop vertex already has outside this polygon.
+    const std::vector<int> valence = builder.valences();
+    PositionCosts costs;
+    for (const int v : loop) {
+      const int outside = valence[static_cast<size_t>(v)] - 2;
+      const int reg = regular[static_cast<size_t>(v)];
+      costs.as_corner.push_back(std::abs(2 + outside - reg));
+      costs.as_side.push_back(std::abs(3 + outside - reg));
+    }
+    fill_polygon(builder, loop, best_layout(costs, budget));
+  }
+  return true;
+}
+
+}  // namespace sd::meshing::detail
