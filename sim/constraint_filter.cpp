@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <Eigen/Geometry>
+
 namespace sd::sim {
 
 ConstraintFilter::ConstraintFilter(int vertex_count)

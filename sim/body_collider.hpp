@@ -1,0 +1,203 @@
+#pragma once
+// Cloth-against-body proximity: the body triangle mesh in an FCL bounding volume hierarchy
+// (RSS boxes), refitted when the body moves, answering per cloth vertex "how far from the body,
+// on which side, where is the closest point and how fast is the body moving there".
+//
+// Inside/outside is decided with angle-weighted pseudo-normals of the closest feature (face,
+// edge or vertex; Bærentzen & Aanæs 2005), so points whose closest point is an edge or a corner
+// get the right sign, and points deep inside a closed body get a negative distance.
+// See docs/collision.md.
+
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "meshing/tri_mesh.hpp"
+#include "sim/collision_geometry.hpp"
+
+namespace fcl {
+template <typename S>
+class RSS;
+template <typename BV>
+class BVHModel;
+}  // namespace fcl
+
+namespace sd::sim {
+
+// A body mesh the collider cannot use (no triangles, index out of range, non-finite vertex) or a
+// pose that does not match it. Derives from std::invalid_argument: the input is wrong.
+class InvalidBodyMeshError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+// The closest point on the body to one query point.
+struct BodyProximity {
+  int triangle = -1;                                           // body face index
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();             // on the surface, metres
+  Eigen::Vector3d barycentric = Eigen::Vector3d::Zero();       // of `point` in `triangle`
+  TriangleFeature feature = TriangleFeature::face;             // where in the triangle
+  int feature_index = 0;                                       // edge or corner index
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitY();           // unit, outward push direction
+  double distance = 0.0;                                       // signed, negative inside
+};
+
+// One cloth vertex that needs the solver's attention: within the thickness of the body, inside
+// it, or (continuous check) passed through its surface during the step. The solver keeps the
+// vertex at `point + thickness·normal` along `normal` and moves it with `body_velocity` there.
+struct BodyContact {
+  int vertex = -1;                                            // cloth vertex index
+  int triangle = -1;                                          // body face holding `point`
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();            // on the body (current pose), m
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitY();          // unit, outward
+  double distance = 0.0;                                      // (x − point)·normal; < 0 inside
+  Eigen::Vector3d body_velocity = Eigen::Vector3d::Zero();    // body surface at `point`, m/s
+  bool crossed = false;  // found by the continuous check: pushed back to the side it came from
+};
+
+struct ContactQuery {
+  double thickness = 0.005;  // m: vertices closer than this (signed) become contacts
+  // m: with a cache, searches reach this much further than the thickness, so that a vertex found
+  // clear by more than the thickness can be skipped for a few steps without any search.
+  double search_margin = 0.02;
+  // Continuous check: the largest relative cloth-body motion (m) between two samples of a
+  // vertex's path. Must stay below half the thinnest body part (fingers, ~2 cm).
+  double max_substep_motion = 0.01;
+  int max_substeps = 64;  // cap on samples per vertex and step
+};
+
+// What a query did, for diagnostics and benchmarks.
+struct ContactQueryStats {
+  int vertices = 0;          // cloth vertices looked at
+  int skipped = 0;           // cleared by the cache without a search
+  int bounded_searches = 0;  // BVH searches limited to thickness (+ margin)
+  int full_searches = 0;     // unbounded searches (sign of a point far from the surface)
+  int sweep_samples = 0;     // continuous check: points sampled along paths
+  int crossings = 0;         // continuous check: vertices that passed through the surface
+  int contacts = 0;          // contacts returned
+};
+
+// Per-cloth-vertex memory between queries: where the vertex was, whether it was outside, and a
+// lower bound of its distance to the body then. The unsigned distance is 1-Lipschitz in the
+// point and changes by at most the body's largest vertex displacement, so a vertex that has
+// moved less than its clearance minus the thickness needs no search. Reset (or let the size
+// change do it) whenever the cloth's vertices are renumbered.
+class ContactCache {
+ public:
+  void reset() { entries_.clear(); }
+  int vertex_count() const { return static_cast<int>(entries_.size()); }
+
+ private:
+  friend class BodyCollider;
+  enum class State : unsigned char { unknown, outside, inside };
+  struct Entry {
+    Eigen::Vector3d position = Eigen::Vector3d::Zero();  // where the vertex was evaluated
+    double clearance = 0.0;  // lower bound of the unsigned distance to the body there, m
+    double stamp = 0.0;      // the collider's cumulative motion at the evaluated pose, m
+    State state = State::unknown;
+  };
+  std::vector<Entry> entries_;
+  std::uint64_t collider_id_ = 0;
+};
+
+class BodyCollider {
+ public:
+  // Builds the hierarchy over `body` (metres, counter-clockwise seen from outside, closed for a
+  // meaningful inside). Throws InvalidBodyMeshError on an unusable mesh.
+  explicit BodyCollider(const meshing::TriMesh& body);
+  ~BodyCollider();
+  BodyCollider(BodyCollider&&) noexcept;
+  BodyCollider& operator=(BodyCollider&&) noexcept;
+  BodyCollider(const BodyCollider&) = delete;
+  BodyCollider& operator=(const BodyCollider&) = delete;
+
+  int vertex_count() const;
+  int face_count() const;
+  const Eigen::MatrixX3i& faces() const;
+  // Current pose, #V by 3 (copy).
+  Eigen::MatrixX3d vertices() const;
+  // Pose before the last set_pose (the current one if never moved), #V by 3 (copy).
+  Eigen::MatrixX3d previous_vertices() const;
+
+  // Moves the body to a new pose with the same topology (#V by 3 positions, and #V by 3
+  // velocities in m/s or an empty matrix for zero). Refits the FCL hierarchy rather than
+  // rebuilding it; its boxes then bound the motion from the previous pose to this one, which is
+  // what the continuous check sweeps. Call once per cloth step.
+  void set_pose(const Eigen::MatrixX3d& vertices, const Eigen::MatrixX3d& velocities = {});
+
+  // Largest vertex displacement of the last set_pose (m): a bound on how far any surface point
+  // moved in that step.
+  double last_motion() const { return last_motion_; }
+
+  // Closest point of the current pose within `max_distance` of p (unbounded by default), with
+  // the signed distance and outward normal; nothing when the surface is farther than that.
+  std::optional<BodyProximity> closest_point(
+      const Eigen::Vector3d& p,
+      double max_distance = std::numeric_limits<double>::infinity()) const;
+  // Signed distance of p to the current pose (negative inside), m.
+  double signed_distance(const Eigen::Vector3d& p) const;
+  // Velocity of the body surface at barycentric point `barycentric` of `triangle`, m/s.
+  Eigen::Vector3d surface_velocity(int triangle, const Eigen::Vector3d& barycentric) const;
+
+  // Contacts of cloth positions `x` (3n, xyz per vertex) with the current pose: every vertex
+  // closer than query.thickness, including vertices deep inside. Sorted by vertex. `cache`
+  // (optional) skips vertices that cannot have come near since the last query.
+  std::vector<BodyContact> find_contacts(const Eigen::VectorXd& x, const ContactQuery& query,
+                                         ContactCache* cache = nullptr,
+                                         ContactQueryStats* stats = nullptr) const;
+
+  // The same at the end of a step, plus the continuous check: the cloth moved from `x0` (at the
+  // previous pose) to `x1` (at the current pose) while the body moved between its last two
+  // poses. A vertex whose path passed through the surface gets a contact with crossed = true on
+  // the side it came from (entry point carried to the current pose), even if it ended outside
+  // on the far side of a thin part. Paths are sampled so that the relative motion between
+  // samples stays below query.max_substep_motion.
+  std::vector<BodyContact> find_contacts_swept(const Eigen::VectorXd& x0,
+                                               const Eigen::VectorXd& x1,
+                                               const ContactQuery& query,
+                                               ContactCache* cache = nullptr,
+                                               ContactQueryStats* stats = nullptr) const;
+
+ private:
+  struct Topology;
+  using Model = fcl::BVHModel<fcl::RSS<double>>;
+
+  // Closest point at pose time t ∈ [0, 1] (0 = previous pose, 1 = current), searching only
+  // within `bound`; nothing if the surface is farther.
+  std::optional<BodyProximity> nearest(const Eigen::Vector3d& p, double t, double bound) const;
+  Eigen::Vector3d corner(int vertex, double t) const;
+  Eigen::Vector3d feature_normal(int triangle, TriangleFeature feature, int index,
+                                 double t) const;
+  void update_normals();
+  bool outside_box(const Eigen::Vector3d& p) const;
+  BodyContact make_contact(int vertex, const BodyProximity& proximity) const;
+  // The discrete test at the current pose for one vertex, given what is already known about it.
+  void classify_current(int vertex, const Eigen::Vector3d& p, bool known_outside,
+                        double clearance_lower_bound, const ContactQuery& query, bool use_margin,
+                        ContactCache::Entry* entry, std::vector<BodyContact>& contacts,
+                        ContactQueryStats& stats) const;
+  void prepare_cache(ContactCache* cache, int vertex_count) const;
+
+  std::unique_ptr<Model> model_;
+  std::unique_ptr<Topology> topology_;
+  Eigen::MatrixX3i faces_;
+  std::vector<Eigen::Vector3d> velocities_;
+  // Pseudo-normals of the current pose: per face, per face edge (3 per face), per vertex.
+  std::vector<Eigen::Vector3d> face_normals_;
+  std::vector<Eigen::Vector3d> edge_normals_;
+  std::vector<Eigen::Vector3d> vertex_normals_;
+  Eigen::Vector3d box_min_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d box_max_ = Eigen::Vector3d::Zero();
+  double normal_epsilon_ = 0.0;  // m: below this offset the feature normal replaces p − c
+  int tree_depth_ = 0;            // levels of FCL's tree (search stack size)
+  double last_motion_ = 0.0;
+  double total_motion_ = 0.0;  // sum of last_motion over all set_pose calls (cache stamps)
+  std::uint64_t id_ = 0;
+};
+
+}  // namespace sd::sim

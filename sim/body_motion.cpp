@@ -1,0 +1,157 @@
+#include "sim/body_motion.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <utility>
+
+namespace sd::sim {
+
+namespace {
+
+// 0 below `edge0`, 1 above `edge1`, C¹ cubic in between.
+double smoothstep(double edge0, double edge1, double x) {
+  const double s = std::clamp((x - edge0) / (edge1 - edge0), 0.0, 1.0);
+  return s * s * (3.0 - 2.0 * s);
+}
+
+}  // namespace
+
+PoseSequence::PoseSequence(Eigen::MatrixX3i faces, std::vector<double> times,
+                           std::vector<Eigen::MatrixX3d> poses)
+    : faces_(std::move(faces)), times_(std::move(times)), poses_(std::move(poses)) {
+  if (poses_.empty()) throw InvalidBodyMotionError("a body motion needs at least one pose");
+  if (times_.size() != poses_.size())
+    throw InvalidBodyMotionError("a body motion has " + std::to_string(poses_.size()) +
+                                 " poses but " + std::to_string(times_.size()) + " times");
+  for (std::size_t k = 0; k < times_.size(); ++k) {
+    if (!std::isfinite(times_[k]))
+      throw InvalidBodyMotionError("pose " + std::to_string(k) + " has a non-finite time");
+    if (k > 0 && !(times_[k] > times_[k - 1]))
+      throw InvalidBodyMotionError("pose times must increase strictly (pose " +
+                                   std::to_string(k) + " is at " + std::to_string(times_[k]) +
+                                   " s, not after " + std::to_string(times_[k - 1]) + " s)");
+    if (poses_[k].rows() != poses_.front().rows())
+      throw InvalidBodyMotionError("pose " + std::to_string(k) + " has " +
+                                   std::to_string(poses_[k].rows()) +
+                                   " vertices; every pose must have the same vertices as the "
+                                   "first (" +
+                                   std::to_string(poses_.front().rows()) + ")");
+    if (!poses_[k].allFinite())
+      throw InvalidBodyMotionError("pose " + std::to_string(k) + " has a non-finite coordinate");
+  }
+  if (faces_.size() > 0 && (faces_.minCoeff() < 0 || faces_.maxCoeff() >= vertex_count()))
+    throw InvalidBodyMotionError("a face of the moving body refers to a vertex that does not "
+                                 "exist");
+}
+
+int PoseSequence::segment(double t) const {
+  const auto after = std::upper_bound(times_.begin(), times_.end(), t);
+  const int k = static_cast<int>(after - times_.begin()) - 1;
+  return std::clamp(k, 0, std::max(0, keyframe_count() - 2));
+}
+
+Eigen::MatrixX3d PoseSequence::vertices_at(double t) const {
+  if (keyframe_count() == 1 || t <= times_.front()) return poses_.front();
+  if (t >= times_.back()) return poses_.back();
+  const int k = segment(t);
+  const double s = (t - times_[k]) / (times_[k + 1] - times_[k]);
+  return (1.0 - s) * poses_[k] + s * poses_[k + 1];
+}
+
+meshing::TriMesh PoseSequence::mesh_at(double t) const {
+  meshing::TriMesh mesh;
+  mesh.vertices = vertices_at(t);
+  mesh.faces = faces_;
+  return mesh;
+}
+
+Eigen::MatrixX3d PoseSequence::velocity_at(double t) const {
+  if (keyframe_count() == 1 || t < times_.front() || t >= times_.back())
+    return Eigen::MatrixX3d::Zero(vertex_count(), 3);
+  const int k = segment(t);
+  return (poses_[k + 1] - poses_[k]) / (times_[k + 1] - times_[k]);
+}
+
+Eigen::MatrixX3d PoseSequence::average_velocity(double t0, double t1) const {
+  if (!(t1 != t0)) return velocity_at(t0);
+  return (vertices_at(t1) - vertices_at(t0)) / (t1 - t0);
+}
+
+PoseSequence make_pose_sequence(const meshing::TriMesh& rest, const std::vector<double>& times,
+                                const std::function<Eigen::MatrixX3d(double)>& displacement) {
+  std::vector<Eigen::MatrixX3d> poses;
+  poses.reserve(times.size());
+  for (const double t : times) {
+    Eigen::MatrixX3d d = displacement(t);
+    if (d.rows() != rest.vertex_count())
+      throw InvalidBodyMotionError("a displacement field has " + std::to_string(d.rows()) +
+                                   " rows for a body of " +
+                                   std::to_string(rest.vertex_count()) + " vertices");
+    poses.push_back(rest.vertices + d);
+  }
+  return PoseSequence(rest.faces, times, std::move(poses));
+}
+
+Eigen::VectorXd arm_rotation_weights(const meshing::TriMesh& rest,
+                                     const ArmLoweringOptions& options) {
+  const meshing::BoundingBox box = meshing::bounding_box(rest);
+  const double height = box.extent().y();
+  if (!(height > 0.0)) throw InvalidBodyMotionError("the body has no height to find its arms");
+  const double tilt = options.arm_tilt_degrees * std::numbers::pi / 180.0;
+  // In the frontal plane, for the figure's left side (x > 0; the right side is mirrored):
+  const Eigen::Vector2d joint(options.shoulder_offset * height,
+                              box.min.y() + options.shoulder_height * height);
+  const Eigen::Vector2d along(std::sin(tilt), -std::cos(tilt));  // down the arm
+  const Eigen::Vector2d across(std::cos(tilt), std::sin(tilt));  // away from the torso
+  const double boundary = -options.arm_boundary * height;
+  const double boundary_width = 0.007 * height;  // soft edge of the arm selection, ~1.2 cm
+  const double blend = options.blend_length * height;
+
+  Eigen::VectorXd weights(rest.vertex_count());
+  for (Eigen::Index v = 0; v < rest.vertex_count(); ++v) {
+    const Eigen::Vector2d q(std::abs(rest.vertices(v, 0)), rest.vertices(v, 1));
+    const Eigen::Vector2d r = q - joint;
+    const double on_arm =
+        smoothstep(boundary - boundary_width, boundary + boundary_width, r.dot(across));
+    const double below_joint = smoothstep(0.0, blend, r.dot(along));
+    weights[v] = on_arm * below_joint;
+  }
+  return weights;
+}
+
+PoseSequence make_arm_lowering(const meshing::TriMesh& rest, const ArmLoweringOptions& options) {
+  if (options.keyframes < 2) throw InvalidBodyMotionError("arm lowering needs at least 2 poses");
+  if (!(options.duration > 0.0))
+    throw InvalidBodyMotionError("arm lowering needs a positive duration");
+  const Eigen::VectorXd weights = arm_rotation_weights(rest, options);
+  const meshing::BoundingBox box = meshing::bounding_box(rest);
+  const double height = box.extent().y();
+  const Eigen::Vector2d joint(options.shoulder_offset * height,
+                              box.min.y() + options.shoulder_height * height);
+  const double full_angle = options.angle_degrees * std::numbers::pi / 180.0;
+
+  std::vector<double> times;
+  for (int k = 0; k < options.keyframes; ++k)
+    times.push_back(options.duration * k / (options.keyframes - 1));
+  return make_pose_sequence(rest, times, [&](double t) {
+    const double angle = full_angle * smoothstep(0.0, options.duration, t);
+    Eigen::MatrixX3d displacement = Eigen::MatrixX3d::Zero(rest.vertex_count(), 3);
+    for (Eigen::Index v = 0; v < rest.vertex_count(); ++v) {
+      if (weights[v] == 0.0) continue;
+      const double side = rest.vertices(v, 0) >= 0.0 ? 1.0 : -1.0;
+      const Eigen::Vector2d r(side * rest.vertices(v, 0) - joint.x(), rest.vertices(v, 1) - joint.y());
+      // Lowering turns the left arm clockwise seen from the front (towards −x); mirrored on the
+      // right.
+      const double phi = -weights[v] * angle;
+      const Eigen::Vector2d turned(std::cos(phi) * r.x() - std::sin(phi) * r.y(),
+                                   std::sin(phi) * r.x() + std::cos(phi) * r.y());
+      displacement(v, 0) = side * (turned.x() - r.x());
+      displacement(v, 1) = turned.y() - r.y();
+    }
+    return displacement;
+  });
+}
+
+}  // namespace sd::sim

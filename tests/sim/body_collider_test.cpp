@@ -1,0 +1,489 @@
+#include "sim/body_collider.hpp"
+
+#include <cmath>
+#include <map>
+#include <memory>
+#include <random>
+#include <utility>
+
+#include <fcl/fcl.h>
+#include <gtest/gtest.h>
+
+#include "garment/body.hpp"
+#include "sim/collision_geometry.hpp"
+#include "sim/collision_repair.hpp"
+
+namespace sd::sim {
+namespace {
+
+using Eigen::Vector3d;
+
+// Icosphere of radius r centred at `centre`: every vertex on the sphere, triangles inside it.
+meshing::TriMesh make_sphere(double r, int subdivisions, const Vector3d& centre = Vector3d::Zero()) {
+  const double g = (1.0 + std::sqrt(5.0)) / 2.0;
+  std::vector<Vector3d> v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0},
+                             {0, -1, g}, {0, 1, g}, {0, -1, -g}, {0, 1, -g},
+                             {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
+  std::vector<Eigen::Vector3i> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                                    {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                                    {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                                    {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+  for (auto& p : v) p.normalize();
+  for (int s = 0; s < subdivisions; ++s) {
+    std::map<std::pair<int, int>, int> midpoint;
+    const auto mid = [&](int a, int b) {
+      const auto key = std::minmax(a, b);
+      const auto it = midpoint.find(key);
+      if (it != midpoint.end()) return it->second;
+      v.push_back((v[a] + v[b]).normalized());
+      midpoint[key] = static_cast<int>(v.size()) - 1;
+      return static_cast<int>(v.size()) - 1;
+    };
+    std::vector<Eigen::Vector3i> next;
+    for (const auto& t : f) {
+      const int a = mid(t[0], t[1]), b = mid(t[1], t[2]), c = mid(t[2], t[0]);
+      next.push_back({t[0], a, c});
+      next.push_back({t[1], b, a});
+      next.push_back({t[2], c, b});
+      next.push_back({a, b, c});
+    }
+    f = next;
+  }
+  meshing::TriMesh mesh;
+  mesh.vertices.resize(static_cast<Eigen::Index>(v.size()), 3);
+  for (std::size_t i = 0; i < v.size(); ++i) mesh.vertices.row(i) = (centre + r * v[i]).transpose();
+  mesh.faces.resize(static_cast<Eigen::Index>(f.size()), 3);
+  for (std::size_t i = 0; i < f.size(); ++i) mesh.faces.row(i) = f[i].transpose();
+  return mesh;
+}
+
+// Axis-aligned box [lo, hi] as 12 triangles, outward-facing.
+meshing::TriMesh make_box(const Vector3d& lo, const Vector3d& hi) {
+  meshing::TriMesh mesh;
+  mesh.vertices.resize(8, 3);
+  for (int i = 0; i < 8; ++i)
+    mesh.vertices.row(i) << (i & 1 ? hi.x() : lo.x()), (i & 2 ? hi.y() : lo.y()),
+        (i & 4 ? hi.z() : lo.z());
+  mesh.faces.resize(12, 3);
+  mesh.faces << 0, 2, 3, 0, 3, 1,  // z = lo
+      4, 5, 7, 4, 7, 6,            // z = hi
+      0, 1, 5, 0, 5, 4,            // y = lo
+      2, 6, 7, 2, 7, 3,            // y = hi
+      0, 4, 6, 0, 6, 2,            // x = lo
+      1, 3, 7, 1, 7, 5;            // x = hi
+  return mesh;
+}
+
+// Closed prism along z whose cross-section is a thin isosceles triangle with apex (0, apex_y):
+// a knife edge with apex angle `apex_degrees`.
+meshing::TriMesh make_wedge(double apex_degrees, double apex_y, double half_length) {
+  const double half_base = apex_y * std::tan(apex_degrees * M_PI / 360.0);
+  meshing::TriMesh mesh;
+  mesh.vertices.resize(6, 3);
+  mesh.vertices << -half_base, 0, -half_length, half_base, 0, -half_length, 0, apex_y,
+      -half_length, -half_base, 0, half_length, half_base, 0, half_length, 0, apex_y, half_length;
+  mesh.faces.resize(8, 3);
+  mesh.faces << 0, 2, 1,  // back cap (z = −L), normal −z
+      3, 4, 5,            // front cap, +z
+      0, 1, 4, 0, 4, 3,   // base, −y
+      1, 2, 5, 1, 5, 4,   // right slope
+      2, 0, 3, 2, 3, 5;   // left slope
+  return mesh;
+}
+
+// Largest distance from the centre to any face plane's complement: the mesh of a unit-radius
+// sphere lies between radius r_inner (its faces' smallest plane distance) and r.
+double inner_radius(const meshing::TriMesh& mesh, const Vector3d& centre) {
+  double r = std::numeric_limits<double>::infinity();
+  for (Eigen::Index f = 0; f < mesh.face_count(); ++f) {
+    const Vector3d a = mesh.vertices.row(mesh.faces(f, 0)).transpose();
+    const Vector3d b = mesh.vertices.row(mesh.faces(f, 1)).transpose();
+    const Vector3d c = mesh.vertices.row(mesh.faces(f, 2)).transpose();
+    r = std::min(r, std::abs((centre - a).dot(triangle_normal(a, b, c))));
+  }
+  return r;
+}
+
+Eigen::VectorXd flatten(const std::vector<Vector3d>& points) {
+  Eigen::VectorXd x(3 * points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) x.segment<3>(3 * i) = points[i];
+  return x;
+}
+
+TEST(ClosestPointOnTriangle, MatchesDenseSamplingAndClassifiesRegions) {
+  const Vector3d a(0, 0, 0), b(1, 0, 0), c(0.3, 0.8, 0);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-0.7, 1.5);
+  for (int trial = 0; trial < 200; ++trial) {
+    const Vector3d p(u(rng), u(rng), 0.5 * u(rng));
+    const TriangleClosestPoint cp = closest_point_on_triangle(p, a, b, c);
+    // Sampling the triangle on a fine grid can only find points at least as far.
+    double sampled = std::numeric_limits<double>::infinity();
+    const int n = 200;
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; i + j <= n; ++j) {
+        const Vector3d q = a + (b - a) * i / n + (c - a) * j / n;
+        sampled = std::min(sampled, (p - q).norm());
+      }
+    const double d = std::sqrt(cp.squared_distance);
+    EXPECT_LE(d, sampled + 1e-12);
+    EXPECT_GE(d, sampled - 1.2 / n);  // grid spacing bounds how much closer the truth can be
+    EXPECT_NEAR(cp.barycentric.sum(), 1.0, 1e-12);
+    EXPECT_TRUE((cp.barycentric.array() >= -1e-12).all());
+    EXPECT_LT((cp.barycentric[0] * a + cp.barycentric[1] * b + cp.barycentric[2] * c - cp.point)
+                  .norm(),
+              1e-12);
+  }
+  EXPECT_EQ(closest_point_on_triangle(Vector3d(0.4, 0.3, 1), a, b, c).feature,
+            TriangleFeature::face);
+  const TriangleClosestPoint edge = closest_point_on_triangle(Vector3d(0.5, -1, 0), a, b, c);
+  EXPECT_EQ(edge.feature, TriangleFeature::edge);
+  EXPECT_EQ(edge.index, 0);
+  const TriangleClosestPoint corner = closest_point_on_triangle(Vector3d(1.5, -0.2, 0), a, b, c);
+  EXPECT_EQ(corner.feature, TriangleFeature::vertex);
+  EXPECT_EQ(corner.index, 1);
+}
+
+TEST(BodyCollider, SphereSignedDistanceWithinChordalBound) {
+  const double r = 0.2;
+  const meshing::TriMesh sphere = make_sphere(r, 3);
+  const double r_inner = inner_radius(sphere, Vector3d::Zero());
+  ASSERT_LT(r - r_inner, 0.002);  // the mesh is fine enough for the bounds below to be tight
+  const BodyCollider collider(sphere);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> radius(0.01, 0.4);
+  std::normal_distribution<double> gauss;
+  for (int trial = 0; trial < 500; ++trial) {
+    const Vector3d direction = Vector3d(gauss(rng), gauss(rng), gauss(rng)).normalized();
+    const double rho = radius(rng);
+    const Vector3d p = rho * direction;
+    const std::optional<BodyProximity> hit = collider.closest_point(p);
+    ASSERT_TRUE(hit);
+    // The polyhedron lies between the inscribed and the circumscribed sphere, so the signed
+    // distance lies between the two spheres' signed distances.
+    EXPECT_GE(hit->distance, rho - r - 1e-12) << rho;
+    EXPECT_LE(hit->distance, rho - r_inner + 1e-12) << rho;
+    EXPECT_GT(hit->normal.dot(direction), 0.97) << rho;  // within a facet's angular size
+    EXPECT_NEAR(hit->normal.norm(), 1.0, 1e-12);
+    EXPECT_NEAR((p - hit->point).dot(hit->normal), hit->distance, 1e-12);
+  }
+}
+
+TEST(BodyCollider, BoxEdgesAndCornersGetExactDistancesAndNormals) {
+  const BodyCollider box(make_box(Vector3d(-0.1, -0.1, -0.1), Vector3d(0.1, 0.1, 0.1)));
+  struct Case {
+    Vector3d p;
+    double distance;
+    Vector3d normal;
+  };
+  const std::vector<Case> cases = {
+      {{0.13, 0.14, 0.02}, std::hypot(0.03, 0.04), Vector3d(0.03, 0.04, 0).normalized()},
+      {{0.12, 0.12, 0.11}, Vector3d(0.02, 0.02, 0.01).norm(), Vector3d(2, 2, 1).normalized()},
+      {{-0.11, -0.12, -0.13}, Vector3d(0.01, 0.02, 0.03).norm(), -Vector3d(1, 2, 3).normalized()},
+      {{0.09, 0.08, 0.0}, -0.01, Vector3d::UnitX()},                 // inside, near an edge
+      {{0.09, 0.08, 0.07}, -0.01, Vector3d::UnitX()},                // inside, near a corner
+      {{0.0, 0.0, 0.1001}, 0.0001, Vector3d::UnitZ()},               // above a face diagonal
+      {{0.02, -0.02, -0.095}, -0.005, -Vector3d::UnitZ()},           // just inside a face
+      {{0.1, 0.1, 0.1}, 0.0, Vector3d(1, 1, 1).normalized()},        // on a corner
+      {{0.1, 0.1, 0.0}, 0.0, Vector3d(1, 1, 0).normalized()},        // on an edge
+  };
+  for (const Case& c : cases) {
+    const std::optional<BodyProximity> hit = box.closest_point(c.p);
+    ASSERT_TRUE(hit);
+    EXPECT_NEAR(hit->distance, c.distance, 1e-12) << c.p.transpose();
+    EXPECT_LT((hit->normal - c.normal).norm(), 1e-9) << c.p.transpose();
+  }
+}
+
+TEST(BodyCollider, KnifeEdgeSignUsesThePseudoNormal) {
+  // Apex angle 20°: the two slope normals make 160°, so a point just outside the edge can lie
+  // behind one of the faces that contain its closest point.
+  const meshing::TriMesh wedge = make_wedge(20.0, 0.1, 0.1);
+  const BodyCollider collider(wedge);
+  const Vector3d apex(0, 0.1, 0);
+  const Vector3d outside = apex + Vector3d(0.004, 0.002, 0);
+  const std::optional<BodyProximity> hit = collider.closest_point(outside);
+  ASSERT_TRUE(hit);
+  EXPECT_EQ(hit->feature, TriangleFeature::edge);
+  EXPECT_NEAR(hit->distance, Vector3d(0.004, 0.002, 0).norm(), 1e-12);
+  // The premise: one face holding the closest point would call this point inside.
+  bool some_face_disagrees = false;
+  for (Eigen::Index f = 0; f < wedge.face_count(); ++f) {
+    const Vector3d a = wedge.vertices.row(wedge.faces(f, 0)).transpose();
+    const Vector3d b = wedge.vertices.row(wedge.faces(f, 1)).transpose();
+    const Vector3d c = wedge.vertices.row(wedge.faces(f, 2)).transpose();
+    const TriangleClosestPoint cp = closest_point_on_triangle(outside, a, b, c);
+    if (std::abs(std::sqrt(cp.squared_distance) - hit->distance) < 1e-12 &&
+        (outside - cp.point).dot(triangle_normal(a, b, c)) < 0)
+      some_face_disagrees = true;
+  }
+  EXPECT_TRUE(some_face_disagrees);
+
+  // Just inside the edge: negative, pushed out through the nearer slope.
+  const Vector3d inside(0.0, 0.095, 0.0);
+  const double expected = -0.005 * std::sin(10.0 * M_PI / 180.0);
+  EXPECT_NEAR(collider.signed_distance(inside), expected, 1e-12);
+  // The tip of the edge at a cap: a corner with three faces.
+  EXPECT_GT(collider.signed_distance(Vector3d(0.001, 0.1005, 0.1003)), 0.0);
+  EXPECT_LT(collider.signed_distance(Vector3d(0.0, 0.099, 0.0999)), 0.0);
+}
+
+TEST(BodyCollider, DeepInsidePointsAreContactsWithTheRightPushDirection) {
+  const double r = 0.2;
+  const meshing::TriMesh sphere = make_sphere(r, 3);
+  const double r_inner = inner_radius(sphere, Vector3d::Zero());
+  const BodyCollider collider(sphere);
+  const Vector3d direction = Vector3d(0.3, -0.5, 0.8).normalized();
+  const std::vector<Vector3d> points = {
+      0.17 * direction,        // 3 cm inside
+      Vector3d(0.001, 0, 0),   // centre
+      0.5 * direction,         // far outside
+      0.203 * direction,       // 3 mm outside
+  };
+  ContactQuery query;
+  query.thickness = 0.005;
+  ContactQueryStats stats;
+  const std::vector<BodyContact> contacts =
+      collider.find_contacts(flatten(points), query, nullptr, &stats);
+  ASSERT_EQ(contacts.size(), 3u);
+  EXPECT_EQ(contacts[0].vertex, 0);
+  EXPECT_LE(contacts[0].distance, -(r_inner - 0.17) + 1e-12);
+  EXPECT_GE(contacts[0].distance, -(r - 0.17) - 1e-12);
+  EXPECT_GT(contacts[0].normal.dot(direction), 0.97);
+  EXPECT_EQ(contacts[1].vertex, 1);
+  EXPECT_LT(contacts[1].distance, -r_inner + 0.002);
+  EXPECT_EQ(contacts[2].vertex, 3);
+  EXPECT_GT(contacts[2].distance, 0.0);
+  EXPECT_GE(stats.full_searches, 2);  // the two deep points needed the full search for the sign
+}
+
+TEST(BodyCollider, BuiltinBodyPointsInsideAndAgreementWithFcl) {
+  const garment::Body body = garment::load_body("builtin");
+  const BodyCollider collider(body.mesh);
+  const Eigen::MatrixX3d normals = meshing::vertex_normals(body.mesh);
+  // 3 cm under the skin of the front torso.
+  int tested = 0;
+  for (Eigen::Index v = 0; v < body.mesh.vertex_count(); v += 7) {
+    const Vector3d x = body.mesh.vertices.row(v).transpose();
+    if (std::abs(x.x()) > 0.1 || x.y() < 1.0 || x.y() > 1.4 || x.z() < 0.05) continue;
+    const Vector3d n = normals.row(v).transpose();
+    const std::optional<BodyProximity> hit = collider.closest_point(x - 0.03 * n);
+    ASSERT_TRUE(hit);
+    EXPECT_LT(hit->distance, -0.02) << v;
+    EXPECT_GE(hit->distance, -0.03 - 1e-9) << v;
+    EXPECT_GT(hit->normal.dot(n), 0.8) << v;
+    ++tested;
+  }
+  EXPECT_GT(tested, 5);
+
+  // Unsigned distances agree with FCL's own distance query (a zero-radius sphere as the point).
+  std::vector<fcl::Vector3d> points;
+  for (Eigen::Index v = 0; v < body.mesh.vertex_count(); ++v)
+    points.push_back(body.mesh.vertices.row(v).transpose());
+  std::vector<fcl::Triangle> triangles;
+  for (Eigen::Index f = 0; f < body.mesh.face_count(); ++f)
+    triangles.emplace_back(body.mesh.faces(f, 0), body.mesh.faces(f, 1), body.mesh.faces(f, 2));
+  auto model = std::make_shared<fcl::BVHModel<fcl::OBBRSSd>>();
+  model->beginModel();
+  model->addSubModel(points, triangles);
+  model->endModel();
+  fcl::CollisionObjectd mesh_object(model);
+  fcl::CollisionObjectd point_object(std::make_shared<fcl::Sphered>(0.0));
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    const Vector3d p(0.8 * u(rng) - 0.4, 1.8 * u(rng), 0.4 * u(rng) - 0.2);
+    point_object.setTranslation(p);
+    point_object.computeAABB();
+    fcl::DistanceRequestd request(true);
+    fcl::DistanceResultd result;
+    fcl::distance(&mesh_object, &point_object, request, result);
+    const std::optional<BodyProximity> hit = collider.closest_point(p);
+    ASSERT_TRUE(hit);
+    EXPECT_NEAR(std::abs(hit->distance), result.min_distance, 1e-9);
+  }
+}
+
+TEST(BodyCollider, RefitAnswersLikeARebuild) {
+  const meshing::TriMesh rest = make_sphere(0.2, 2);
+  BodyCollider moved(rest);
+  meshing::TriMesh pose = rest;
+  for (int step = 1; step <= 2; ++step) {
+    for (Eigen::Index v = 0; v < pose.vertex_count(); ++v) {
+      const Vector3d x = rest.vertices.row(v).transpose();
+      pose.vertices.row(v) =
+          (Vector3d(1.0 + 0.3 * step, 1.0, 0.8) .asDiagonal() * x +
+           Vector3d(0.05 * step, 0.02 * std::sin(20 * x.y()), -0.03 * step))
+              .transpose();
+    }
+    moved.set_pose(pose.vertices);
+    const BodyCollider rebuilt(pose);
+    std::mt19937 rng(step);
+    std::uniform_real_distribution<double> u(-0.5, 0.5);
+    for (int trial = 0; trial < 300; ++trial) {
+      const Vector3d p(u(rng), u(rng), u(rng));
+      const BodyProximity a = *moved.closest_point(p);
+      const BodyProximity b = *rebuilt.closest_point(p);
+      EXPECT_NEAR(a.distance, b.distance, 1e-12);
+      EXPECT_LT((a.point - b.point).norm(), 1e-9);
+      EXPECT_LT((a.normal - b.normal).norm(), 1e-6);
+    }
+  }
+  EXPECT_GT(moved.last_motion(), 0.05);
+}
+
+TEST(BodyCollider, CacheSkipsWorkWithoutChangingTheContacts) {
+  meshing::TriMesh sphere = make_sphere(0.2, 3);
+  BodyCollider collider(sphere);
+  std::mt19937 rng(11);
+  std::normal_distribution<double> gauss;
+  std::uniform_real_distribution<double> shell(0.12, 0.3);
+  std::vector<Vector3d> points;
+  for (int i = 0; i < 1500; ++i)
+    points.push_back(shell(rng) * Vector3d(gauss(rng), gauss(rng), gauss(rng)).normalized());
+  ContactQuery query;
+  query.thickness = 0.01;
+  ContactCache cache;
+  int skipped = 0;
+  for (int step = 0; step < 25; ++step) {
+    if (step % 5 == 4) {  // the body moves now and then
+      const Vector3d shift(0.003 * step, -0.002 * step, 0.001 * step);
+      Eigen::MatrixX3d moved = sphere.vertices.rowwise() + shift.transpose();
+      collider.set_pose(moved);
+    }
+    for (auto& p : points) p += 0.004 * Vector3d(gauss(rng), gauss(rng), gauss(rng));
+    const Eigen::VectorXd x = flatten(points);
+    ContactQueryStats stats;
+    const std::vector<BodyContact> cached = collider.find_contacts(x, query, &cache, &stats);
+    const std::vector<BodyContact> fresh = collider.find_contacts(x, query);
+    ASSERT_EQ(cached.size(), fresh.size()) << step;
+    for (std::size_t k = 0; k < fresh.size(); ++k) {
+      EXPECT_EQ(cached[k].vertex, fresh[k].vertex);
+      EXPECT_NEAR(cached[k].distance, fresh[k].distance, 1e-12);
+    }
+    skipped += stats.skipped;
+  }
+  EXPECT_GT(skipped, 1000);  // the cache did let vertices go unsearched
+}
+
+// A 2 cm slab y ∈ [0, 0.02], wide in x and z.
+meshing::TriMesh make_slab(double y_low = 0.0) {
+  return make_box(Vector3d(-0.5, y_low, -0.5), Vector3d(0.5, y_low + 0.02, 0.5));
+}
+
+TEST(BodyCollider, ContinuousCheckCatchesAPointPassingThroughAThinBody) {
+  const BodyCollider slab(make_slab());
+  ContactQuery query;
+  query.thickness = 0.003;
+  const auto one = [](const Vector3d& p) { return flatten({p}); };
+
+  // Straight through in one step: the end position alone looks fine.
+  const Vector3d start(0.1, 0.1, 0.05), end(0.1, -0.1, 0.05);
+  EXPECT_TRUE(slab.find_contacts(one(end), query).empty());
+  ContactQueryStats stats;
+  std::vector<BodyContact> contacts = slab.find_contacts_swept(one(start), one(end), query,
+                                                               nullptr, &stats);
+  ASSERT_EQ(contacts.size(), 1u);
+  EXPECT_TRUE(contacts[0].crossed);
+  EXPECT_LT((contacts[0].normal - Vector3d::UnitY()).norm(), 1e-9);
+  EXPECT_NEAR(contacts[0].point.y(), 0.02, 1e-9);
+  EXPECT_NEAR(contacts[0].distance, -0.12, 1e-9);
+  EXPECT_EQ(stats.crossings, 1);
+
+  // Ending past the middle of the slab: the nearest surface is the far one, the entry side wins.
+  contacts = slab.find_contacts_swept(one(start), one(Vector3d(0.1, 0.004, 0.05)), query);
+  ASSERT_EQ(contacts.size(), 1u);
+  EXPECT_TRUE(contacts[0].crossed);
+  EXPECT_LT((contacts[0].normal - Vector3d::UnitY()).norm(), 1e-9);
+  EXPECT_NEAR(contacts[0].distance, 0.004 - 0.02, 1e-9);
+
+  // Ending shallow on the entry side: the ordinary contact.
+  contacts = slab.find_contacts_swept(one(start), one(Vector3d(0.1, 0.017, 0.05)), query);
+  ASSERT_EQ(contacts.size(), 1u);
+  EXPECT_FALSE(contacts[0].crossed);
+  EXPECT_NEAR(contacts[0].distance, -0.003, 1e-9);
+
+  // Moving near but not through: nothing.
+  EXPECT_TRUE(slab.find_contacts_swept(one(start), one(Vector3d(0.3, 0.03, 0.1)), query).empty());
+}
+
+TEST(BodyCollider, ContinuousCheckCatchesAFastBodyPassingAStillPoint) {
+  // The slab jumps 0.2 m up in one step (4.8 m/s at 24 steps per second) past a still point.
+  const meshing::TriMesh below = make_slab(-0.1);
+  BodyCollider slab(below);
+  const Vector3d velocity(0, 4.8, 0);
+  ContactQuery query;
+  query.thickness = 0.003;
+  const Eigen::VectorXd x = flatten({Vector3d(0.05, 0.05, 0.0), Vector3d(0.05, 0.3, 0.0)});
+  ContactCache cache;
+  EXPECT_TRUE(slab.find_contacts(x, query, &cache).empty());
+  const Eigen::MatrixX3d above = below.vertices.rowwise() + Vector3d(0, 0.2, 0).transpose();
+  slab.set_pose(above, Eigen::MatrixX3d(velocity.transpose().replicate(above.rows(), 1)));
+  EXPECT_TRUE(slab.find_contacts(x, query).empty());
+  ContactQueryStats stats;
+  const std::vector<BodyContact> contacts = slab.find_contacts_swept(x, x, query, &cache, &stats);
+  ASSERT_EQ(contacts.size(), 1u);
+  EXPECT_EQ(contacts[0].vertex, 0);
+  EXPECT_TRUE(contacts[0].crossed);
+  EXPECT_LT((contacts[0].normal - Vector3d::UnitY()).norm(), 1e-9);
+  EXPECT_NEAR(contacts[0].point.y(), 0.12, 1e-9);
+  EXPECT_NEAR(contacts[0].distance, 0.05 - 0.12, 1e-9);
+  EXPECT_LT((contacts[0].body_velocity - velocity).norm(), 1e-12);
+  EXPECT_GT(stats.sweep_samples, 1);
+}
+
+TEST(StartRepair, PushesInsideVerticesOutAlongTheNearestSurface) {
+  const double r = 0.2;
+  const meshing::TriMesh sphere = make_sphere(r, 3);
+  const double r_inner = inner_radius(sphere, Vector3d::Zero());
+  const BodyCollider collider(sphere);
+  // A flat sheet at z = 0.1 cutting through the sphere's cap.
+  std::vector<Vector3d> grid;
+  for (int i = 0; i <= 20; ++i)
+    for (int j = 0; j <= 20; ++j) grid.emplace_back(-0.3 + 0.03 * i, -0.3 + 0.03 * j, 0.1);
+  const Eigen::VectorXd x = flatten(grid);
+  StartRepairOptions options;
+  options.thickness = 0.004;
+  options.steps = 8;
+  const StartRepair repair = plan_start_repair(collider, x, options);
+  ASSERT_FALSE(repair.empty());
+  EXPECT_NEAR(repair.max_depth, r - 0.1, r - r_inner + 1e-9);
+  std::vector<bool> pushed(grid.size(), false);
+  for (const BodyContact& c : repair.pushed) pushed[c.vertex] = true;
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    const bool inside = grid[i].norm() < r_inner;
+    if (inside) EXPECT_TRUE(pushed[i]) << i;
+    if (grid[i].norm() > r) EXPECT_FALSE(pushed[i]) << i;
+    const Vector3d target = repair.target.segment<3>(3 * i);
+    if (!pushed[i]) {
+      EXPECT_EQ(target, grid[i]);
+      continue;
+    }
+    EXPECT_NEAR(collider.signed_distance(target), options.thickness, 1e-9) << i;
+    EXPECT_GT((target - grid[i]).normalized().dot(grid[i].normalized()), 0.95);  // radially out
+    // Linear over the steps, then held.
+    EXPECT_EQ(repair.goal(static_cast<int>(i), 0), grid[i]);
+    EXPECT_LT((repair.goal(static_cast<int>(i), 4) - 0.5 * (grid[i] + target)).norm(), 1e-15);
+    EXPECT_EQ(repair.goal(static_cast<int>(i), 8), target);
+    EXPECT_EQ(repair.goal(static_cast<int>(i), 20), target);
+  }
+  const BodyCollider& body = collider;
+  ContactQuery strict;
+  strict.thickness = 0.0;
+  for (const BodyContact& c : body.find_contacts(repair.positions_after(options.steps), strict))
+    EXPECT_GE(c.distance, options.thickness - 1e-9);
+}
+
+TEST(BodyCollider, RejectsUnusableInput) {
+  meshing::TriMesh empty;
+  EXPECT_THROW(BodyCollider{empty}, InvalidBodyMeshError);
+  meshing::TriMesh bad = make_box(Vector3d::Zero(), Vector3d::Ones());
+  bad.faces(3, 1) = 8;
+  EXPECT_THROW(BodyCollider{bad}, InvalidBodyMeshError);
+  BodyCollider box(make_box(Vector3d::Zero(), Vector3d::Ones()));
+  EXPECT_THROW(box.set_pose(Eigen::MatrixX3d::Zero(7, 3)), InvalidBodyMeshError);
+  EXPECT_THROW(box.find_contacts(Eigen::VectorXd::Zero(4), ContactQuery{}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace sd::sim

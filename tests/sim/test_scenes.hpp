@@ -1,0 +1,42 @@
+#pragma once
+// Small scenes shared by the simulator tests.
+
+#include <random>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "sim/cloth_model.hpp"
+#include "sim/fabric.hpp"
+#include "sim/sheet.hpp"
+#include "sim/simulation.hpp"
+
+namespace sd::sim::testing {
+
+inline std::vector<Pin> fixed_pins(const SheetScene& scene) {
+  std::vector<Pin> pins;
+  for (int v : scene.pinned_vertices) pins.push_back({v, {}});
+  return pins;
+}
+
+// A random smooth deformation of the rest shape (rotation, anisotropic stretch, a bend and
+// noise), so conditions are stretched, compressed, sheared and folded at once.
+inline Eigen::VectorXd random_configuration(const Eigen::MatrixX3d& rest, std::mt19937& rng,
+                                            double noise = 0.05) {
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  Eigen::Matrix3d deformation = Eigen::Matrix3d::Identity();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) deformation(r, c) += 0.3 * uniform(rng);
+  const double bend = 2.0 * uniform(rng);
+  Eigen::VectorXd x(3 * rest.rows());
+  for (Eigen::Index i = 0; i < rest.rows(); ++i) {
+    Eigen::Vector3d p = rest.row(i).transpose();
+    p.z() += bend * p.x() * p.x();
+    p = deformation * p;
+    for (int k = 0; k < 3; ++k) p[k] += noise * uniform(rng);
+    x.segment<3>(3 * i) = p;
+  }
+  return x;
+}
+
+}  // namespace sd::sim::testing
