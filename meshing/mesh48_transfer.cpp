@@ -80,4 +80,17 @@ void place_split_vertex(const BlockChange& change, Eigen::MatrixX3d& positions) 
       0.5 * (positions.row(change.b.value()) + positions.row(change.c.value()));
 }
 
+Eigen::MatrixXd remap_rows(const Eigen::MatrixXd& rows, const std::vector<int>& old_to_new,
+                           int new_count) {
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(new_count, rows.cols());
+  const Eigen::Index n = std::min<Eigen::Index>(rows.rows(), static_cast<Eigen::Index>(old_to_new.size()));
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const int to = old_to_new[static_cast<std::size_t>(i)];
+    if (to < 0) continue;
+    if (to >= new_count) throw std::invalid_argument("remap_rows: a new row index is out of range");
+    out.row(to) = rows.row(i);
+  }
+  return out;
+}
+
 }  // namespace sd::meshing

@@ -4,6 +4,7 @@
 // Pure arithmetic on arrays indexed by VertexId value; the simulator owns the arrays.
 
 #include <Eigen/Core>
+#include <vector>
 
 #include "meshing/mesh48.hpp"
 
@@ -32,5 +33,10 @@ void transfer_mass_and_velocity(const BlockChange& change, const BlockDensities&
 // Current (deformed) position of a split's new vertex: the midpoint of B and C, matching its
 // rest position. positions (#slots by 3) grows to hold E. A merge needs nothing.
 void place_split_vertex(const BlockChange& change, Eigen::MatrixX3d& positions);
+
+// Carries per-vertex (or per-triangle, per-block) rows through compact(): row old moves to row
+// old_to_new[old]; rows mapped to -1 are dropped. Returns new_count rows.
+Eigen::MatrixXd remap_rows(const Eigen::MatrixXd& rows, const std::vector<int>& old_to_new,
+                           int new_count);
 
 }  // namespace sd::meshing

@@ -431,6 +431,15 @@ TEST(Mesh48Split, SplitEdgeOfAQuadEdgeSplitsBothQuadsFirst) {
   EXPECT_EQ(mesh.split_edge(b, c).size(), 1u);
   EXPECT_THROW((void)mesh.split_edge(VertexId(0), VertexId(15)), Mesh48OperationError);
   EXPECT_VALID(mesh);
+  // A boundary quad edge (vertices 2-3, y = 0): the quad, then the boundary block it leaves.
+  const auto boundary = mesh.split_edge(VertexId(2), VertexId(3));
+  ASSERT_EQ(boundary.size(), 2u);
+  EXPECT_TRUE(boundary[0].forced);
+  EXPECT_FALSE(boundary[1].d.valid());
+  EXPECT_TRUE(mesh.on_boundary(boundary[1].e));
+  EXPECT_EQ(mesh.rest_position(boundary[1].e), Eigen::Vector3d(2.5, 0, 0));
+  EXPECT_EQ(mesh.valence(boundary[1].e), 3);
+  EXPECT_VALID(mesh);
 }
 
 TEST(Mesh48Split, DeepRefinementAtACornerKeepsAdjacentLevelsWithinOne) {

@@ -131,5 +131,27 @@ TEST(Mesh48Transfer, MassAndMomentumConservedOverThousandsOfRandomOperations) {
   check_conservation(Mesh48::from_triangles_sqrt3(icosphere(1)), 2, 3000, 800);
 }
 
+TEST(Mesh48Transfer, RemapRowsFollowsCompaction) {
+  const auto g = quad_grid(3, 3);
+  Mesh48 mesh = Mesh48::from_quads(g.vertices, g.quads);
+  std::mt19937 rng(3);
+  for (int i = 0; i < 60; ++i) {
+    const auto leaves = mesh.leaf_blocks();
+    (void)mesh.split(leaves[rng() % leaves.size()]);
+  }
+  for (const BlockId k : mesh.mergeable_blocks())
+    if (mesh.can_merge(k) && rng() % 2 == 0) (void)mesh.merge(k);
+  ASSERT_FALSE(mesh.is_compact());
+  // Per-vertex state = the rest position, so that it can be checked after renumbering.
+  Eigen::MatrixXd state = Eigen::MatrixXd::Zero(mesh.vertex_capacity(), 3);
+  for (int v = 0; v < mesh.vertex_capacity(); ++v)
+    if (mesh.alive(VertexId(v))) state.row(v) = mesh.rest_position(VertexId(v)).transpose();
+  const Mesh48Remap remap = mesh.compact();
+  const Eigen::MatrixXd moved = remap_rows(state, remap.vertices, remap.vertex_count);
+  ASSERT_EQ(moved.rows(), mesh.vertex_count());
+  for (int v = 0; v < mesh.vertex_count(); ++v)
+    EXPECT_EQ(moved.row(v).transpose(), mesh.rest_position(VertexId(v)));
+}
+
 }  // namespace
 }  // namespace sd::meshing
