@@ -25,11 +25,6 @@ constexpr double kDegenerateAreaRatio = 1e-14;
 // Walking around a vertex more than this many triangles means the adjacency is corrupt.
 constexpr int kMaxStar = 1 << 16;
 
-std::uint64_t edge_key(int from, int to) {
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(from)) << 32) |
-         static_cast<std::uint32_t>(to);
-}
-
 double triangle_area(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
   return 0.5 * (b - a).cross(c - a).norm();
 }
@@ -41,17 +36,70 @@ bool degenerate(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen:
   return !std::isfinite(area) || longest == 0 || area <= kDegenerateAreaRatio * longest;
 }
 
-// Smallest interior angle (radians) of a triangle given by its corners.
+// Smallest interior angle (radians) of a triangle given by its corners: the one opposite the
+// shortest edge.
 double min_angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
-  const auto angle = [](const Eigen::Vector3d& p, const Eigen::Vector3d& q,
-                        const Eigen::Vector3d& r) {
-    const Eigen::Vector3d u = q - p, w = r - p;
-    return std::atan2(u.cross(w).norm(), u.dot(w));
-  };
-  return std::min({angle(a, b, c), angle(b, c, a), angle(c, a, b)});
+  const double ab = (b - a).squaredNorm(), bc = (c - b).squaredNorm(), ca = (a - c).squaredNorm();
+  const Eigen::Vector3d& p = (bc <= ab && bc <= ca) ? a : (ca <= ab ? b : c);  // opposite corner
+  const Eigen::Vector3d& q = (&p == &a) ? b : (&p == &b ? c : a);
+  const Eigen::Vector3d& r = (&p == &a) ? c : (&p == &b ? a : b);
+  const Eigen::Vector3d u = q - p, w = r - p;
+  return std::atan2(u.cross(w).norm(), u.dot(w));
 }
 
 std::string edge_name(int u, int v) { return std::to_string(u) + "-" + std::to_string(v); }
+
+// Directed edges of a triangle list grouped by their start vertex (compressed rows), so that an
+// edge's reverse is found in O(valence) without sorting.
+class HalfEdgeIndex {
+ public:
+  struct Entry {
+    int to;
+    int face;
+    int corner;  // local index of the face's vertex opposite the edge
+  };
+
+  // corner_vertex(f, k): vertex k of face f, for 0 <= f < face_count, in 0..vertex_count-1.
+  template <class CornerVertex>
+  HalfEdgeIndex(int vertex_count, int face_count, CornerVertex corner_vertex)
+      : start_(static_cast<std::size_t>(vertex_count) + 1, 0),
+        entries_(3 * static_cast<std::size_t>(face_count)) {
+    for (int f = 0; f < face_count; ++f)
+      for (int k = 0; k < 3; ++k) ++start_[corner_vertex(f, (k + 1) % 3) + 1];
+    for (int v = 0; v < vertex_count; ++v) start_[v + 1] += start_[v];
+    std::vector<int> fill(start_.begin(), start_.end() - 1);
+    for (int f = 0; f < face_count; ++f)
+      for (int k = 0; k < 3; ++k)
+        entries_[fill[corner_vertex(f, (k + 1) % 3)]++] = {corner_vertex(f, (k + 2) % 3), f, k};
+  }
+
+  int vertex_count() const { return static_cast<int>(start_.size()) - 1; }
+  int out_degree(int v) const { return start_[v + 1] - start_[v]; }
+  const Entry* begin(int v) const { return entries_.data() + start_[v]; }
+  const Entry* end(int v) const { return entries_.data() + start_[v + 1]; }
+  const Entry* find(int from, int to) const {
+    for (const Entry* e = begin(from); e != end(from); ++e)
+      if (e->to == to) return e;
+    return nullptr;
+  }
+  // A directed edge listed twice (inconsistent orientation or a non-manifold edge), else
+  // {-1, -1}.
+  std::pair<int, int> duplicate() const {
+    for (int v = 0; v < vertex_count(); ++v)
+      for (const Entry* e = begin(v); e != end(v); ++e)
+        for (const Entry* g = e + 1; g != end(v); ++g)
+          if (e->to == g->to) return {v, e->to};
+    return {-1, -1};
+  }
+
+ private:
+  std::vector<int> start_;
+  std::vector<Entry> entries_;
+};
+
+const char* const kDuplicateEdgeText =
+    " is traversed in the same direction by two faces: the faces are not consistently "
+    "oriented or the edge is shared by more than two faces";
 
 }  // namespace
 
@@ -75,14 +123,6 @@ Mesh48 Mesh48::build(std::vector<Eigen::Vector3d> rest,
   m.root_normals_.resize(triangles.size());
   m.root_areas_.resize(triangles.size());
 
-  // Directed half-edges (from -> to) with the triangle and the opposite local corner.
-  struct HalfEdge {
-    std::uint64_t key;
-    int tri;
-    int corner;
-  };
-  std::vector<HalfEdge> half_edges;
-  half_edges.reserve(3 * triangles.size());
   for (int t = 0; t < nt; ++t) {
     Triangle& tri = m.triangles_[t];
     for (int k = 0; k < 3; ++k) tri.v[k] = VertexId(triangles[t][k]);
@@ -99,33 +139,21 @@ Mesh48 Mesh48::build(std::vector<Eigen::Vector3d> rest,
     m.root_normals_[t] = (b - a).cross(c - a).normalized();
     m.root_areas_[t] = triangle_area(a, b, c);
     m.input_area_ += m.root_areas_[t];
-    for (int k = 0; k < 3; ++k)
-      half_edges.push_back({edge_key(triangles[t][(k + 1) % 3], triangles[t][(k + 2) % 3]), t, k});
   }
-  std::sort(half_edges.begin(), half_edges.end(),
-            [](const HalfEdge& x, const HalfEdge& y) { return x.key < y.key; });
-  const auto key_from = [](std::uint64_t key) { return static_cast<int>(key >> 32); };
-  const auto key_to = [](std::uint64_t key) { return static_cast<int>(key & 0xffffffffu); };
-  for (std::size_t i = 1; i < half_edges.size(); ++i)
-    if (half_edges[i].key == half_edges[i - 1].key)
-      throw Mesh48InputError(
-          "the edge " + edge_name(key_from(half_edges[i].key), key_to(half_edges[i].key)) +
-          " is traversed in the same direction by two faces: the faces are not consistently "
-          "oriented or the edge is shared by more than two faces");
+  const HalfEdgeIndex index(nv, nt, [&](int f, int k) { return triangles[f][k]; });
+  if (const auto [from, to] = index.duplicate(); from >= 0)
+    throw Mesh48InputError("the edge " + edge_name(from, to) + kDuplicateEdgeText);
   std::vector<int> incident(rest.size(), 0);
-  for (const HalfEdge& h : half_edges) {
-    const int from = key_from(h.key), to = key_to(h.key);
-    ++incident[from];
-    const std::uint64_t reverse = edge_key(to, from);
-    const auto it = std::lower_bound(
-        half_edges.begin(), half_edges.end(), reverse,
-        [](const HalfEdge& x, std::uint64_t key) { return x.key < key; });
-    if (it != half_edges.end() && it->key == reverse) {
-      m.triangles_[h.tri].adj[h.corner] = TriangleId(it->tri);
-    } else {
-      m.vertices_[from].on_boundary = true;
-      m.vertices_[to].on_boundary = true;
-      m.input_boundary_length_ += (rest[to] - rest[from]).norm();
+  for (int from = 0; from < nv; ++from) {
+    incident[from] = index.out_degree(from);
+    for (const HalfEdgeIndex::Entry* h = index.begin(from); h != index.end(from); ++h) {
+      if (const HalfEdgeIndex::Entry* back = index.find(h->to, from)) {
+        m.triangles_[h->face].adj[h->corner] = TriangleId(back->face);
+      } else {
+        m.vertices_[from].on_boundary = true;
+        m.vertices_[h->to].on_boundary = true;
+        m.input_boundary_length_ += (rest[h->to] - rest[from]).norm();
+      }
     }
   }
   for (int i = 0; i < nv; ++i)
@@ -235,24 +263,12 @@ Mesh48 Mesh48::from_triangles_sqrt3(const TriMesh& mesh, Sqrt3Stats* stats) {
   }
 
   // Directed edges of the input; each undirected edge is visited once, from its first face.
-  std::vector<std::pair<std::uint64_t, int>> directed;
-  directed.reserve(3 * face_slots);
-  for (int f = 0; f < nf; ++f)
-    for (int k = 0; k < 3; ++k)
-      directed.emplace_back(edge_key(mesh.faces(f, k), mesh.faces(f, (k + 1) % 3)), f);
-  std::sort(directed.begin(), directed.end());
-  for (std::size_t i = 1; i < directed.size(); ++i)
-    if (directed[i].first == directed[i - 1].first)
-      throw Mesh48InputError(
-          "the edge " +
-          edge_name(static_cast<int>(directed[i].first >> 32),
-                    static_cast<int>(directed[i].first & 0xffffffffu)) +
-          " is traversed in the same direction by two faces: the faces are not consistently "
-          "oriented or the edge is shared by more than two faces");
+  const HalfEdgeIndex index(nv, nf, [&](int f, int k) { return mesh.faces(f, k); });
+  if (const auto [from, to] = index.duplicate(); from >= 0)
+    throw Mesh48InputError("the edge " + edge_name(from, to) + kDuplicateEdgeText);
   const auto face_across = [&](int from, int to) {
-    const std::uint64_t key = edge_key(to, from);
-    const auto it = std::lower_bound(directed.begin(), directed.end(), std::make_pair(key, -1));
-    return (it != directed.end() && it->first == key) ? it->second : -1;
+    const HalfEdgeIndex::Entry* back = index.find(to, from);
+    return back ? back->face : -1;
   };
   const auto face_normal = [&](int f) {
     const Eigen::Vector3d a = rest[mesh.faces(f, 0)];
@@ -978,13 +994,8 @@ std::vector<std::string> Mesh48::validate() const {
   // Conformity: every directed edge once, its reverse (if any) is the recorded neighbour, and
   // edges without a neighbour lie on the input boundary (their total length is the input's:
   // a hanging vertex would add unmatched edges inside).
-  struct HalfEdge {
-    std::uint64_t key;
-    int tri;
-    int corner;
-  };
-  std::vector<HalfEdge> half_edges;
-  half_edges.reserve(3 * static_cast<std::size_t>(triangle_count_));
+  std::vector<int> checked;  // live triangles whose vertices and neighbours are live
+  checked.reserve(static_cast<std::size_t>(triangle_count_));
   for (int t = 0; t < triangle_capacity(); ++t) {
     const Triangle& tri = triangles_[t];
     if (!tri.alive) continue;
@@ -1003,36 +1014,32 @@ std::vector<std::string> Mesh48::validate() const {
         ok = false;
       }
     }
-    if (!ok) continue;
-    for (int k = 0; k < 3; ++k)
-      half_edges.push_back(
-          {edge_key(tri.v[(k + 1) % 3].value(), tri.v[(k + 2) % 3].value()), t, k});
+    if (ok) checked.push_back(t);
   }
-  std::sort(half_edges.begin(), half_edges.end(),
-            [](const HalfEdge& x, const HalfEdge& y) { return x.key < y.key; });
+  const HalfEdgeIndex index(vertex_capacity(), static_cast<int>(checked.size()), [&](int f, int k) {
+    return triangles_[checked[f]].v[k].value();
+  });
+  if (const auto [from, to] = index.duplicate(); from >= 0)
+    report("edge " + edge_name(from, to) + " is used twice in the same direction");
   double boundary_length = 0;
-  for (std::size_t i = 0; i < half_edges.size(); ++i) {
-    const HalfEdge& h = half_edges[i];
-    const int from = static_cast<int>(h.key >> 32), to = static_cast<int>(h.key & 0xffffffffu);
-    if (i > 0 && half_edges[i - 1].key == h.key)
-      report("edge " + edge_name(from, to) + " is used twice in the same direction");
-    const std::uint64_t reverse = edge_key(to, from);
-    const auto it = std::lower_bound(
-        half_edges.begin(), half_edges.end(), reverse,
-        [](const HalfEdge& x, std::uint64_t key) { return x.key < key; });
-    const TriangleId recorded = triangles_[h.tri].adj[h.corner];
-    if (it != half_edges.end() && it->key == reverse) {
-      if (recorded.value() != it->tri)
-        report(tname(TriangleId(h.tri)) + " records neighbour " + tname(recorded) + " across " +
-               edge_name(from, to) + " but " + tname(TriangleId(it->tri)) + " is there");
-    } else {
-      if (recorded.valid())
-        report(tname(TriangleId(h.tri)) + " records a neighbour across unmatched edge " +
-               edge_name(from, to));
-      if (!vertices_[from].on_boundary || !vertices_[to].on_boundary)
-        report("edge " + edge_name(from, to) +
-               " has one triangle but is not on the boundary (hanging vertex)");
-      boundary_length += (vertices_[to].rest - vertices_[from].rest).norm();
+  for (int from = 0; from < index.vertex_count(); ++from) {
+    for (const HalfEdgeIndex::Entry* h = index.begin(from); h != index.end(from); ++h) {
+      const int to = h->to, tri = checked[h->face];
+      const TriangleId recorded = triangles_[tri].adj[h->corner];
+      if (const HalfEdgeIndex::Entry* back = index.find(to, from)) {
+        if (recorded.value() != checked[back->face])
+          report(tname(TriangleId(tri)) + " records neighbour " + tname(recorded) + " across " +
+                 edge_name(from, to) + " but " + tname(TriangleId(checked[back->face])) +
+                 " is there");
+      } else {
+        if (recorded.valid())
+          report(tname(TriangleId(tri)) + " records a neighbour across unmatched edge " +
+                 edge_name(from, to));
+        if (!vertices_[from].on_boundary || !vertices_[to].on_boundary)
+          report("edge " + edge_name(from, to) +
+                 " has one triangle but is not on the boundary (hanging vertex)");
+        boundary_length += (vertices_[to].rest - vertices_[from].rest).norm();
+      }
     }
   }
   const double length_scale = std::max(input_boundary_length_, 1e-300);

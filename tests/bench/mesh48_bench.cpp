@@ -37,15 +37,23 @@ void BM_ConvertSqrt3TriangleGrid64(benchmark::State& state) {
 }
 BENCHMARK(BM_ConvertSqrt3TriangleGrid64)->Unit(benchmark::kMillisecond);
 
-// Splits every level-0 block of the grid in turn (no forced split is needed for those); a fresh
-// grid is built, untimed, when all have been split.
+// The operation benchmarks run on a grid whose slot arrays have already grown (everything split
+// once and merged back), as in a simulation past its first steps; undoing a round of operations
+// between rounds is not timed.
+
+// Splits every level-0 block of the grid in turn (no forced split is needed for those).
 void BM_SplitOneBlock(benchmark::State& state) {
   Mesh48 mesh = grid_mesh();
+  const auto merge_all = [&] {
+    for (int k = 0; k < kGrid * kGrid; ++k) (void)mesh.merge(BlockId(k));
+  };
+  for (int k = 0; k < kGrid * kGrid; ++k) (void)mesh.split(BlockId(k));
+  merge_all();
   int next = 0;
   for (auto _ : state) {
     if (next == kGrid * kGrid) {
       state.PauseTiming();
-      mesh = grid_mesh();
+      merge_all();
       next = 0;
       state.ResumeTiming();
     }
@@ -54,8 +62,8 @@ void BM_SplitOneBlock(benchmark::State& state) {
 }
 BENCHMARK(BM_SplitOneBlock);
 
-// Splits interior vertical quad edges of a fresh grid, each between two unsplit quads: every
-// call makes two forced splits (the quads) and the requested one.
+// Splits interior vertical quad edges, each between two unsplit quads: every call makes two
+// forced splits (the quads) and the requested one.
 void BM_SplitEdgeWithTwoForcedSplits(benchmark::State& state) {
   std::vector<std::pair<VertexId, VertexId>> edges;
   for (int j = 0; j < kGrid; ++j)
@@ -64,17 +72,28 @@ void BM_SplitEdgeWithTwoForcedSplits(benchmark::State& state) {
       edges.emplace_back(VertexId(v), VertexId(v + kGrid + 1));
     }
   Mesh48 mesh = grid_mesh();
-  std::size_t next = 0;
-  std::size_t splits = 0, calls = 0;
+  std::vector<BlockId> done;  // split blocks in order, to undo a round
+  const auto run_round = [&] {
+    for (const auto& [u, v] : edges)
+      for (const auto& change : mesh.split_edge(u, v)) done.push_back(change.block);
+  };
+  const auto undo_round = [&] {
+    for (auto it = done.rbegin(); it != done.rend(); ++it) (void)mesh.merge(*it);
+    done.clear();
+  };
+  run_round();
+  undo_round();
+  std::size_t next = 0, splits = 0, calls = 0;
   for (auto _ : state) {
     if (next == edges.size()) {
       state.PauseTiming();
-      mesh = grid_mesh();
+      undo_round();
       next = 0;
       state.ResumeTiming();
     }
     const auto changes = mesh.split_edge(edges[next].first, edges[next].second);
     ++next;
+    for (const auto& change : changes) done.push_back(change.block);
     splits += changes.size();
     ++calls;
   }
@@ -84,17 +103,16 @@ BENCHMARK(BM_SplitEdgeWithTwoForcedSplits);
 
 // Merges the level-0 blocks of a fully split grid back, one per iteration.
 void BM_MergeOneBlock(benchmark::State& state) {
-  const auto split_all = [] {
-    Mesh48 mesh = grid_mesh();
+  Mesh48 mesh = grid_mesh();
+  const auto split_all = [&] {
     for (int k = 0; k < kGrid * kGrid; ++k) (void)mesh.split(BlockId(k));
-    return mesh;
   };
-  Mesh48 mesh = split_all();
+  split_all();
   int next = 0;
   for (auto _ : state) {
     if (next == kGrid * kGrid) {
       state.PauseTiming();
-      mesh = split_all();
+      split_all();
       next = 0;
       state.ResumeTiming();
     }
