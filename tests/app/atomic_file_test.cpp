@@ -1,0 +1,67 @@
+#include "src/app/atomic_file.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace sd::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / "sd_atomic_test" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::string read(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(AtomicFile, ReplacesContentWithoutLeavingTemporaries) {
+  const fs::path dir = fresh_dir("replace");
+  write_file_atomically(dir / "a.txt", "first");
+  write_file_atomically(dir / "a.txt", "second");
+  EXPECT_EQ(read(dir / "a.txt"), "second");
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);
+}
+
+TEST(AtomicFile, UnwritableFolderThrows) {
+  EXPECT_THROW(write_file_atomically("/nonexistent-folder/a.txt", "x"), std::runtime_error);
+}
+
+TEST(StagedOutputs, NothingAppearsUntilCommit) {
+  const fs::path dir = fresh_dir("commit");
+  StagedOutputs outputs;
+  outputs.stage(dir / "out" / "a.png", "png");
+  outputs.stage(dir / "out" / "report.json", "{}");
+  EXPECT_FALSE(fs::exists(dir / "out" / "a.png"));
+  outputs.commit();
+  EXPECT_EQ(read(dir / "out" / "a.png"), "png");
+  EXPECT_EQ(read(dir / "out" / "report.json"), "{}");
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir / "out"), fs::directory_iterator()), 2);
+}
+
+TEST(StagedOutputs, AbandonedOutputsLeaveNothingBehind) {
+  const fs::path dir = fresh_dir("abandon");
+  write_file_atomically(dir / "keep.txt", "old");
+  {
+    StagedOutputs outputs;
+    outputs.stage(dir / "keep.txt", "new");
+    outputs.stage(dir / "new" / "deeper" / "b.txt", "b");
+    // A command failing here: the destructor runs without commit().
+  }
+  EXPECT_EQ(read(dir / "keep.txt"), "old");
+  EXPECT_FALSE(fs::exists(dir / "new"));
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);
+}
+
+}  // namespace
+}  // namespace sd::app
