@@ -47,7 +47,9 @@ double min_angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen
   return std::atan2(u.cross(w).norm(), u.dot(w));
 }
 
-std::string edge_name(int u, int v) { return std::to_string(u) + "-" + std::to_string(v); }
+std::string edge_name(int u, int v) {
+  return std::to_string(u) + "-" + std::to_string(v);
+}
 
 // Directed edges of a triangle list grouped by their start vertex (compressed rows), so that an
 // edge's reverse is found in O(valence) without sorting.
@@ -114,7 +116,8 @@ Mesh48 Mesh48::build(std::vector<Eigen::Vector3d> rest,
   m.vertices_.resize(rest.size());
   for (int i = 0; i < nv; ++i) {
     if (!rest[i].allFinite())
-      throw Mesh48InputError("vertex " + std::to_string(i) + " has a coordinate that is not a "
+      throw Mesh48InputError("vertex " + std::to_string(i) +
+                             " has a coordinate that is not a "
                              "finite number");
     m.vertices_[i].rest = rest[i];
     m.vertices_[i].alive = true;
@@ -179,11 +182,10 @@ Mesh48 Mesh48::build(std::vector<Eigen::Vector3d> rest,
     if (other.v[1] != tri.v[2] || other.v[2] != tri.v[1])
       throw std::logic_error("Mesh48::build: the triangles across a block diagonal do not pair");
     if (other.v[0] == tri.v[0])
-      throw Mesh48InputError("two faces share all three vertices " +
-                             std::to_string(tri.v[0].value()) + ", " +
-                             std::to_string(tri.v[1].value()) + ", " +
-                             std::to_string(tri.v[2].value()) +
-                             " (a closed two-face pillow); such a piece cannot be simulated");
+      throw Mesh48InputError(
+          "two faces share all three vertices " + std::to_string(tri.v[0].value()) + ", " +
+          std::to_string(tri.v[1].value()) + ", " + std::to_string(tri.v[2].value()) +
+          " (a closed two-face pillow); such a piece cannot be simulated");
     blk.apex[1] = other.v[0];
     blk.tri[1] = partner;
     other.block = k;
@@ -241,7 +243,9 @@ Mesh48 Mesh48::from_quads(const Eigen::MatrixX3d& vertices, const Eigen::MatrixX
   return build(std::move(rest), triangles);
 }
 
-Mesh48 Mesh48::from_quads(const QuadMesh& mesh) { return from_quads(mesh.vertices, mesh.faces); }
+Mesh48 Mesh48::from_quads(const QuadMesh& mesh) {
+  return from_quads(mesh.vertices, mesh.faces);
+}
 
 Mesh48 Mesh48::from_triangles_sqrt3(const TriMesh& mesh, Sqrt3Stats* stats) {
   const int nv = static_cast<int>(mesh.vertex_count());
@@ -413,10 +417,18 @@ bool Mesh48::alive(BlockId k) const {
   return k.valid() && k.value() < block_capacity() && blocks_[k.value()].alive;
 }
 
-const Eigen::Vector3d& Mesh48::rest_position(VertexId v) const { return vertex_at(v).rest; }
-int Mesh48::level(VertexId v) const { return vertex_at(v).level; }
-BlockId Mesh48::parent_block(VertexId v) const { return vertex_at(v).parent; }
-bool Mesh48::on_boundary(VertexId v) const { return vertex_at(v).on_boundary; }
+const Eigen::Vector3d& Mesh48::rest_position(VertexId v) const {
+  return vertex_at(v).rest;
+}
+int Mesh48::level(VertexId v) const {
+  return vertex_at(v).level;
+}
+BlockId Mesh48::parent_block(VertexId v) const {
+  return vertex_at(v).parent;
+}
+bool Mesh48::on_boundary(VertexId v) const {
+  return vertex_at(v).on_boundary;
+}
 
 int Mesh48::valence(VertexId v) const {
   int fan = 0;
@@ -424,10 +436,18 @@ int Mesh48::valence(VertexId v) const {
   return fan + (vertex_at(v).on_boundary ? 1 : 0);
 }
 
-const std::array<VertexId, 3>& Mesh48::vertices(TriangleId t) const { return triangle_at(t).v; }
-TriangleId Mesh48::neighbor(TriangleId t, int k) const { return triangle_at(t).adj.at(k); }
-BlockId Mesh48::block(TriangleId t) const { return triangle_at(t).block; }
-int Mesh48::level(TriangleId t) const { return triangle_at(t).level; }
+const std::array<VertexId, 3>& Mesh48::vertices(TriangleId t) const {
+  return triangle_at(t).v;
+}
+TriangleId Mesh48::neighbor(TriangleId t, int k) const {
+  return triangle_at(t).adj.at(k);
+}
+BlockId Mesh48::block(TriangleId t) const {
+  return triangle_at(t).block;
+}
+int Mesh48::level(TriangleId t) const {
+  return triangle_at(t).level;
+}
 
 double Mesh48::rest_area(TriangleId t) const {
   const Triangle& tri = triangle_at(t);
@@ -443,14 +463,30 @@ Eigen::Vector3d Mesh48::rest_normal(TriangleId t) const {
       .normalized();
 }
 
-int Mesh48::level(BlockId k) const { return block_at(k).level; }
-bool Mesh48::is_split(BlockId k) const { return block_at(k).split.valid(); }
-std::array<VertexId, 2> Mesh48::diagonal(BlockId k) const { return block_at(k).diagonal; }
-std::array<VertexId, 2> Mesh48::apexes(BlockId k) const { return block_at(k).apex; }
-std::array<TriangleId, 2> Mesh48::triangles(BlockId k) const { return block_at(k).tri; }
-std::array<BlockId, 2> Mesh48::parents(BlockId k) const { return block_at(k).parent; }
-std::array<BlockId, 4> Mesh48::children(BlockId k) const { return block_at(k).child; }
-VertexId Mesh48::split_vertex(BlockId k) const { return block_at(k).split; }
+int Mesh48::level(BlockId k) const {
+  return block_at(k).level;
+}
+bool Mesh48::is_split(BlockId k) const {
+  return block_at(k).split.valid();
+}
+std::array<VertexId, 2> Mesh48::diagonal(BlockId k) const {
+  return block_at(k).diagonal;
+}
+std::array<VertexId, 2> Mesh48::apexes(BlockId k) const {
+  return block_at(k).apex;
+}
+std::array<TriangleId, 2> Mesh48::triangles(BlockId k) const {
+  return block_at(k).tri;
+}
+std::array<BlockId, 2> Mesh48::parents(BlockId k) const {
+  return block_at(k).parent;
+}
+std::array<BlockId, 4> Mesh48::children(BlockId k) const {
+  return block_at(k).child;
+}
+VertexId Mesh48::split_vertex(BlockId k) const {
+  return block_at(k).split;
+}
 
 bool Mesh48::is_pending(BlockId k) const {
   const Block& blk = block_at(k);
@@ -582,7 +618,9 @@ void Mesh48::attach_child(BlockId parent, int child_index, TriangleId child) {
 // ---------------------------------------------------------------------------------------------
 // Split
 
-bool Mesh48::can_split(BlockId k) const { return alive(k) && !blocks_[k.value()].split.valid(); }
+bool Mesh48::can_split(BlockId k) const {
+  return alive(k) && !blocks_[k.value()].split.valid();
+}
 
 std::vector<BlockChange> Mesh48::split(BlockId k) {
   if (!can_split(k))
@@ -730,11 +768,11 @@ bool Mesh48::can_merge(BlockId k) const {
 
 BlockChange Mesh48::merge(BlockId k) {
   if (!can_merge(k))
-    throw Mesh48OperationError(
-        "block " + std::to_string(k.value()) +
-        (!alive(k) ? " is not live"
-                   : !blocks_[k.value()].split.valid() ? " is not split"
-                                                       : " has a split child and cannot merge"));
+    throw Mesh48OperationError("block " + std::to_string(k.value()) +
+                               (!alive(k) ? " is not live"
+                                : !blocks_[k.value()].split.valid()
+                                    ? " is not split"
+                                    : " has a split child and cannot merge"));
   const Block blk = blocks_[k.value()];
   const bool has_d = blk.apex[1].valid();
 
@@ -911,7 +949,9 @@ Mesh48Remap Mesh48::compact() {
   remap.vertex_count = ranks(vertices_, remap.vertices);
   remap.triangle_count = ranks(triangles_, remap.triangles);
   remap.block_count = ranks(blocks_, remap.blocks);
-  const auto map_v = [&](VertexId v) { return v.valid() ? VertexId(remap.vertices[v.value()]) : v; };
+  const auto map_v = [&](VertexId v) {
+    return v.valid() ? VertexId(remap.vertices[v.value()]) : v;
+  };
   const auto map_t = [&](TriangleId t) {
     return t.valid() ? TriangleId(remap.triangles[t.value()]) : t;
   };
@@ -1016,9 +1056,8 @@ std::vector<std::string> Mesh48::validate() const {
     }
     if (ok) checked.push_back(t);
   }
-  const HalfEdgeIndex index(vertex_capacity(), static_cast<int>(checked.size()), [&](int f, int k) {
-    return triangles_[checked[f]].v[k].value();
-  });
+  const HalfEdgeIndex index(vertex_capacity(), static_cast<int>(checked.size()),
+                            [&](int f, int k) { return triangles_[checked[f]].v[k].value(); });
   if (const auto [from, to] = index.duplicate(); from >= 0)
     report("edge " + edge_name(from, to) + " is used twice in the same direction");
   double boundary_length = 0;
@@ -1140,7 +1179,8 @@ std::vector<std::string> Mesh48::validate() const {
       if (sides == 1 && alive(blk.tri[0])) {
         const TriangleId across = triangles_[blk.tri[0].value()].adj[0];
         if (alive(across) && triangles_[across.value()].level != blk.level - 1)
-          report(bname(id) + " has one triangle but the triangle across its diagonal is not "
+          report(bname(id) +
+                 " has one triangle but the triangle across its diagonal is not "
                  "one level coarser");
       }
     } else {
@@ -1204,13 +1244,11 @@ std::vector<std::string> Mesh48::validate() const {
     const Vertex& vx = vertices_[v];
     if (!vx.alive) continue;
     const VertexId id(v);
-    if (!alive(vx.triangle) ||
-        std::find(triangles_[vx.triangle.value()].v.begin(),
-                  triangles_[vx.triangle.value()].v.end(), id) ==
-            triangles_[vx.triangle.value()].v.end())
+    if (!alive(vx.triangle) || std::find(triangles_[vx.triangle.value()].v.begin(),
+                                         triangles_[vx.triangle.value()].v.end(),
+                                         id) == triangles_[vx.triangle.value()].v.end())
       report(vname(id) + " does not point to a live incident triangle");
-    if (vx.level > 0 &&
-        (!alive(vx.parent) || blocks_[vx.parent.value()].split != id))
+    if (vx.level > 0 && (!alive(vx.parent) || blocks_[vx.parent.value()].split != id))
       report(vname(id) + " is not the split vertex of its parent block");
   }
   if (problems.size() == kMaxProblems) problems.push_back("(further problems not listed)");

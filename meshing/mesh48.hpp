@@ -47,8 +47,8 @@ struct BlockChange {
   // Rest areas (m² in the input's units squared), from the 3D rest positions.
   double area_a1 = 0, area_a2 = 0;
   double area_a10 = 0, area_a11 = 0, area_a20 = 0, area_a21 = 0;
-  TriangleId a1, a2;                  // parent triangles
-  TriangleId a10, a11, a20, a21;      // child triangles
+  TriangleId a1, a2;              // parent triangles
+  TriangleId a10, a11, a20, a21;  // child triangles
 };
 
 // Flat arrays for the solver. Rows are compact: vertex row r is vertex_ids[r]; when the mesh
@@ -109,10 +109,10 @@ class Mesh48 {
   // --- vertices ---
   bool alive(VertexId v) const;
   const Eigen::Vector3d& rest_position(VertexId v) const;
-  int level(VertexId v) const;                   // 0 for input vertices
-  BlockId parent_block(VertexId v) const;        // the block whose split made it, or invalid
+  int level(VertexId v) const;             // 0 for input vertices
+  BlockId parent_block(VertexId v) const;  // the block whose split made it, or invalid
   bool on_boundary(VertexId v) const;
-  int valence(VertexId v) const;                 // number of incident edges
+  int valence(VertexId v) const;  // number of incident edges
 
   // --- triangles: vertices (apex, b, c), counter-clockwise, b-c being the block's diagonal ---
   bool alive(TriangleId t) const;
@@ -127,12 +127,12 @@ class Mesh48 {
   bool alive(BlockId k) const;
   int level(BlockId k) const;
   bool is_split(BlockId k) const;
-  std::array<VertexId, 2> diagonal(BlockId k) const;    // (b, c) as seen by triangles(k)[0]
-  std::array<VertexId, 2> apexes(BlockId k) const;      // (A, D); D invalid for one triangle
-  std::array<TriangleId, 2> triangles(BlockId k) const; // (A1, A2) of a leaf block, else invalid
-  std::array<BlockId, 2> parents(BlockId k) const;      // per side, invalid at level 0
-  std::array<BlockId, 4> children(BlockId k) const;     // split blocks: (AB, AC, DC, DB) sides
-  VertexId split_vertex(BlockId k) const;               // E of a split block, else invalid
+  std::array<VertexId, 2> diagonal(BlockId k) const;     // (b, c) as seen by triangles(k)[0]
+  std::array<VertexId, 2> apexes(BlockId k) const;       // (A, D); D invalid for one triangle
+  std::array<TriangleId, 2> triangles(BlockId k) const;  // (A1, A2) of a leaf block, else invalid
+  std::array<BlockId, 2> parents(BlockId k) const;       // per side, invalid at level 0
+  std::array<BlockId, 4> children(BlockId k) const;      // split blocks: (AB, AC, DC, DB) sides
+  VertexId split_vertex(BlockId k) const;                // E of a split block, else invalid
   // A leaf block with one triangle whose diagonal is shared with a coarser triangle: splitting
   // it forces the coarser block's split first.
   bool is_pending(BlockId k) const;

@@ -19,8 +19,8 @@ void ensure_rows(Eigen::VectorXd& masses, Eigen::MatrixX3d& velocities, int rows
 }
 
 int max_id(const BlockChange& change) {
-  return std::max({change.e.value(), change.a.value(), change.b.value(), change.c.value(),
-                   change.d.value()});
+  return std::max(
+      {change.e.value(), change.a.value(), change.b.value(), change.c.value(), change.d.value()});
 }
 
 }  // namespace
@@ -39,8 +39,10 @@ void transfer_mass_and_velocity(const BlockChange& change, const BlockDensities&
     const double to_e_from_b = rho1 * change.area_a10 + rho2 * change.area_a21;
     const double to_e_from_c = rho1 * change.area_a11 + rho2 * change.area_a20;
     masses(e) = parent_mass / 3;
-    masses(b) += (rho1 * (change.area_a11 - change.area_a1) + rho2 * (change.area_a20 - change.area_a2)) / 3;
-    masses(c) += (rho1 * (change.area_a10 - change.area_a1) + rho2 * (change.area_a21 - change.area_a2)) / 3;
+    masses(b) +=
+        (rho1 * (change.area_a11 - change.area_a1) + rho2 * (change.area_a20 - change.area_a2)) / 3;
+    masses(c) +=
+        (rho1 * (change.area_a10 - change.area_a1) + rho2 * (change.area_a21 - change.area_a2)) / 3;
     if (parent_mass > 0)
       velocities.row(e) =
           (velocities.row(c) * to_e_from_c + velocities.row(b) * to_e_from_b) / parent_mass;
@@ -50,10 +52,10 @@ void transfer_mass_and_velocity(const BlockChange& change, const BlockDensities&
   }
 
   // Merge: the split took (ρ1 (A1 − A11) + ρ2 (A2 − A20)) / 3 from B and the like from C.
-  const double from_b =
-      std::max(0.0, rho1 * (change.area_a1 - change.area_a11) + rho2 * (change.area_a2 - change.area_a20));
-  const double from_c =
-      std::max(0.0, rho1 * (change.area_a1 - change.area_a10) + rho2 * (change.area_a2 - change.area_a21));
+  const double from_b = std::max(
+      0.0, rho1 * (change.area_a1 - change.area_a11) + rho2 * (change.area_a2 - change.area_a20));
+  const double from_c = std::max(
+      0.0, rho1 * (change.area_a1 - change.area_a10) + rho2 * (change.area_a2 - change.area_a21));
   const double share_b = (from_b + from_c) > 0 ? from_b / (from_b + from_c) : 0.5;
   const double m_e = masses(e);
   const double gain_b = share_b * m_e, gain_c = m_e - gain_b;
@@ -83,7 +85,8 @@ void place_split_vertex(const BlockChange& change, Eigen::MatrixX3d& positions) 
 Eigen::MatrixXd remap_rows(const Eigen::MatrixXd& rows, const std::vector<int>& old_to_new,
                            int new_count) {
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(new_count, rows.cols());
-  const Eigen::Index n = std::min<Eigen::Index>(rows.rows(), static_cast<Eigen::Index>(old_to_new.size()));
+  const Eigen::Index n =
+      std::min<Eigen::Index>(rows.rows(), static_cast<Eigen::Index>(old_to_new.size()));
   for (Eigen::Index i = 0; i < n; ++i) {
     const int to = old_to_new[static_cast<std::size_t>(i)];
     if (to < 0) continue;

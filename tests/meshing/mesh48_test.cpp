@@ -18,9 +18,15 @@ struct Mesh48TestAccess {
   static void swap_diagonal_ends(Mesh48& m, TriangleId t) {
     std::swap(m.triangles_[t.value()].v[1], m.triangles_[t.value()].v[2]);
   }
-  static void set_level(Mesh48& m, TriangleId t, int level) { m.triangles_[t.value()].level = level; }
-  static void clear_neighbor(Mesh48& m, TriangleId t, int k) { m.triangles_[t.value()].adj[k] = {}; }
-  static void nudge_rest(Mesh48& m, VertexId v, double dx) { m.vertices_[v.value()].rest.x() += dx; }
+  static void set_level(Mesh48& m, TriangleId t, int level) {
+    m.triangles_[t.value()].level = level;
+  }
+  static void clear_neighbor(Mesh48& m, TriangleId t, int k) {
+    m.triangles_[t.value()].adj[k] = {};
+  }
+  static void nudge_rest(Mesh48& m, VertexId v, double dx) {
+    m.vertices_[v.value()].rest.x() += dx;
+  }
   static void drop_child(Mesh48& m, BlockId k, int i) { m.blocks_[k.value()].child[i] = {}; }
   static void miscount(Mesh48& m) { ++m.triangle_count_; }
   // Removes a triangle cleanly from the slots and its neighbours: leaves a hole in the surface.
@@ -45,9 +51,9 @@ std::string joined(const std::vector<std::string>& problems) {
   return text;
 }
 
-#define EXPECT_VALID(mesh)                              \
-  do {                                                  \
-    const auto problems_ = (mesh).validate();           \
+#define EXPECT_VALID(mesh)                               \
+  do {                                                   \
+    const auto problems_ = (mesh).validate();            \
     EXPECT_TRUE(problems_.empty()) << joined(problems_); \
   } while (false)
 
@@ -183,7 +189,8 @@ TEST(Mesh48Quads, RejectsMeshesThatCannotBeSimulated) {
 
 TEST(Mesh48Sqrt3, ClosedSphereHasOneBlockPerEdge) {
   const TriMesh sphere = icosphere(2);
-  const int nv = static_cast<int>(sphere.vertex_count()), nf = static_cast<int>(sphere.face_count());
+  const int nv = static_cast<int>(sphere.vertex_count()),
+            nf = static_cast<int>(sphere.face_count());
   const int ne = 3 * nf / 2;
   Sqrt3Stats stats;
   const Mesh48 mesh = Mesh48::from_triangles_sqrt3(sphere, &stats);
@@ -204,9 +211,11 @@ TEST(Mesh48Sqrt3, ClosedSphereHasOneBlockPerEdge) {
   }
   // Face centres are the centroids and input vertices keep their positions.
   for (int f = 0; f < nf; ++f) {
-    const Eigen::Vector3d centre = (sphere.vertices.row(sphere.faces(f, 0)) +
-                                    sphere.vertices.row(sphere.faces(f, 1)) +
-                                    sphere.vertices.row(sphere.faces(f, 2))).transpose() / 3;
+    const Eigen::Vector3d centre =
+        (sphere.vertices.row(sphere.faces(f, 0)) + sphere.vertices.row(sphere.faces(f, 1)) +
+         sphere.vertices.row(sphere.faces(f, 2)))
+            .transpose() /
+        3;
     EXPECT_LT((mesh.rest_position(VertexId(nv + f)) - centre).norm(), 1e-15);
   }
   // Orientation follows the input: outward normals on the sphere.
@@ -256,6 +265,13 @@ TEST(Mesh48Sqrt3, KeepsTheInputEdgeWhereASwapWouldFold) {
   EXPECT_EQ(stats.unswapped_blocks, 1);
   EXPECT_VALID(mesh);
   for (const TriangleId t : mesh.live_triangles()) EXPECT_GT(unnormalised_normal(mesh, t).z(), 0);
+  // The unswapped block refines like any other.
+  Mesh48 refined = mesh;
+  for (int round = 0; round < 3; ++round)
+    for (const BlockId k : refined.leaf_blocks())
+      if (refined.can_split(k)) (void)refined.split(k);
+  EXPECT_VALID(refined);
+  EXPECT_GE(refined.max_level(), 3);
 }
 
 TEST(Mesh48Sqrt3, RejectsInconsistentOrientation) {

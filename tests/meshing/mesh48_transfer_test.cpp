@@ -16,7 +16,8 @@ using testing::quad_grid;
 Eigen::VectorXd lumped_masses(const Mesh48& mesh, const std::vector<double>& density) {
   Eigen::VectorXd m = Eigen::VectorXd::Zero(mesh.vertex_capacity());
   for (const TriangleId t : mesh.live_triangles())
-    for (const VertexId v : mesh.vertices(t)) m(v.value()) += density[t.value()] * mesh.rest_area(t) / 3;
+    for (const VertexId v : mesh.vertices(t))
+      m(v.value()) += density[t.value()] * mesh.rest_area(t) / 3;
   return m;
 }
 
@@ -50,7 +51,7 @@ TEST(Mesh48Transfer, SplitOfAUnitSquareMatchesTheFormulas) {
   const auto g = quad_grid(1, 1);
   Mesh48 mesh = Mesh48::from_quads(g.vertices, g.quads);
   const double rho = 0.2;  // kg/m²
-  Eigen::VectorXd m(4);  // lumped: ρ A / 3 from each triangle at a corner
+  Eigen::VectorXd m(4);    // lumped: ρ A / 3 from each triangle at a corner
   const auto [b, c] = mesh.diagonal(BlockId(0));
   const auto [a, d] = mesh.apexes(BlockId(0));
   m(a.value()) = m(d.value()) = rho * 0.5 / 3;
@@ -63,9 +64,9 @@ TEST(Mesh48Transfer, SplitOfAUnitSquareMatchesTheFormulas) {
   transfer_mass_and_velocity(ch, {rho, rho}, m, v);
   place_split_vertex(ch, x);
   ASSERT_EQ(m.size(), 5);
-  EXPECT_NEAR(m(ch.e.value()), rho * 1.0 / 3, 1e-15);          // ρ (A1 + A2) / 3
-  EXPECT_NEAR(m(b.value()), rho / 3 - rho * 0.5 / 3, 1e-15);     // lost half its share
-  EXPECT_NEAR(m(a.value()), rho * 0.5 / 3, 1e-15);               // unchanged
+  EXPECT_NEAR(m(ch.e.value()), rho * 1.0 / 3, 1e-15);         // ρ (A1 + A2) / 3
+  EXPECT_NEAR(m(b.value()), rho / 3 - rho * 0.5 / 3, 1e-15);  // lost half its share
+  EXPECT_NEAR(m(a.value()), rho * 0.5 / 3, 1e-15);            // unchanged
   EXPECT_NEAR(m.sum(), rho, 1e-15);
   const Eigen::RowVector3d midpoint_velocity = 0.5 * (v0.row(b.value()) + v0.row(c.value()));
   EXPECT_LT((v.row(ch.e.value()) - midpoint_velocity).norm(), 1e-15);
@@ -88,7 +89,8 @@ void check_conservation(Mesh48 mesh, unsigned seed, int operations, int target_t
   for (double& rho : density) rho = 0.1 + uniform(rng);  // panels of different fabrics
   Eigen::VectorXd m = lumped_masses(mesh, density);
   Eigen::MatrixX3d v(mesh.vertex_capacity(), 3);
-  for (Eigen::Index i = 0; i < v.rows(); ++i) v.row(i) << uniform(rng) - 0.5, uniform(rng), -uniform(rng);
+  for (Eigen::Index i = 0; i < v.rows(); ++i)
+    v.row(i) << uniform(rng) - 0.5, uniform(rng), -uniform(rng);
   const double mass0 = m.sum();
   const Eigen::RowVector3d momentum0 = (m.asDiagonal() * v).colwise().sum();
   const double momentum_scale = (m.array() * v.rowwise().norm().array()).sum();
