@@ -488,6 +488,19 @@ VertexId Mesh48::split_vertex(BlockId k) const {
   return block_at(k).split;
 }
 
+std::array<TriangleId, 4> Mesh48::child_triangles(BlockId k) const {
+  std::array<TriangleId, 4> out;
+  const Block& blk = block_at(k);
+  for (int i = 0; i < 4; ++i) {
+    const BlockId child = blk.child[i];
+    if (!alive(child)) continue;
+    const Block& cb = blocks_[child.value()];
+    for (int s = 0; s < 2; ++s)
+      if (cb.parent[s] == k && alive(cb.tri[s])) out[i] = cb.tri[s];
+  }
+  return out;
+}
+
 bool Mesh48::is_pending(BlockId k) const {
   const Block& blk = block_at(k);
   return !blk.split.valid() && !blk.tri[1].valid() && triangles_[blk.tri[0].value()].adj[0].valid();

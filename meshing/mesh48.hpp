@@ -133,6 +133,10 @@ class Mesh48 {
   std::array<BlockId, 2> parents(BlockId k) const;       // per side, invalid at level 0
   std::array<BlockId, 4> children(BlockId k) const;      // split blocks: (AB, AC, DC, DB) sides
   VertexId split_vertex(BlockId k) const;                // E of a split block, else invalid
+  // The triangles around E of a split block, ordered like children(): (A11, A10, A21, A20) in
+  // DESIGN.md's names; an entry is invalid when that child block is split (or absent). Lets the
+  // simulator judge a merge (flatness, hinge rates) before making it.
+  std::array<TriangleId, 4> child_triangles(BlockId k) const;
   // A leaf block with one triangle whose diagonal is shared with a coarser triangle: splitting
   // it forces the coarser block's split first.
   bool is_pending(BlockId k) const;

@@ -505,6 +505,8 @@ TEST(Mesh48Merge, SplitThenMergeRestoresTheExactTopology) {
     with_forced += changes.size() > 1 ? 1 : 0;
     for (auto it = changes.rbegin(); it != changes.rend(); ++it) {
       ASSERT_TRUE(mesh.can_merge(it->block));
+      EXPECT_EQ(mesh.child_triangles(it->block),
+                (std::array<TriangleId, 4>{it->a11, it->a10, it->a21, it->a20}));
       const BlockChange undo = mesh.merge(it->block);
       EXPECT_EQ(undo.kind, BlockChange::Kind::kMerge);
       EXPECT_EQ(undo.e, it->e);
@@ -535,6 +537,8 @@ TEST(Mesh48Merge, OnlyWhenNoChildIsSplit) {
   EXPECT_VALID(mesh);
   EXPECT_GT(mesh.valence(e), 4);
   EXPECT_FALSE(mesh.can_merge(BlockId(4)));
+  EXPECT_FALSE(mesh.child_triangles(BlockId(4))[0].valid());  // the split child
+  EXPECT_TRUE(mesh.child_triangles(BlockId(4))[1].valid());
   EXPECT_THROW((void)mesh.merge(BlockId(4)), Mesh48OperationError);
   // Undo the child's split: the parent is mergeable again.
   (void)mesh.merge(child);
