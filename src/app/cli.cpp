@@ -34,6 +34,8 @@ int run_cli(int argc, char** argv) {
 
   add_info_command(app, global);
   add_render_command(app, global);
+  add_validate_command(app, global);
+  add_mesh_command(app, global);
 
   try {
     app.parse(argc, argv);

@@ -1,0 +1,49 @@
+#pragma once
+// Geometric queries on the body mesh (closest point, first ray hit, smooth normal), behind a
+// header without CGAL: the AABB tree lives in body_surface.cpp only.
+
+#include <Eigen/Core>
+#include <memory>
+#include <optional>
+
+#include "meshing/tri_mesh.hpp"
+
+namespace sd::garment {
+
+struct SurfacePoint {
+  Eigen::Vector3d position;  // on the body surface
+  Eigen::Vector3d normal;    // unit, outward: vertex normals interpolated barycentrically
+  int face = -1;             // body triangle
+  double distance = 0;       // from the query point (closest point) or the ray origin (hit)
+};
+
+class BodySurface {
+ public:
+  // Builds the AABB tree (a few ms for 10k triangles). The mesh is copied.
+  explicit BodySurface(const meshing::TriMesh& mesh);
+  ~BodySurface();
+  BodySurface(BodySurface&&) noexcept;
+  BodySurface& operator=(BodySurface&&) noexcept;
+
+  // Closest point of the surface to `p`.
+  SurfacePoint closest_point(const Eigen::Vector3d& p) const;
+
+  // First intersection of the ray origin + t·direction, t > 0; empty when the ray misses.
+  std::optional<SurfacePoint> first_hit(const Eigen::Vector3d& origin,
+                                        const Eigen::Vector3d& direction) const;
+
+  // Signed distance of `p` from the surface: positive on the side the normal points to.
+  double signed_distance(const Eigen::Vector3d& p) const;
+
+  // The point on the offset surface (`offset` metres out along the normal) nearest to `p`.
+  Eigen::Vector3d snap_to_offset(const Eigen::Vector3d& p, double offset) const;
+
+  const meshing::TriMesh& mesh() const;
+  const meshing::BoundingBox& box() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace sd::garment

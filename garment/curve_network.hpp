@@ -1,0 +1,56 @@
+#pragma once
+// The curve network: projected curves cut into edges between junction nodes. Endpoints closer
+// than the junction tolerance become one node; an endpoint on the interior of another curve
+// splits that curve there (a T-junction). Curves of mirrored panels get mirror copies across
+// x = 0 ("<id>.mirror"); a curve lying on the plane is its own mirror.
+
+#include <Eigen/Core>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "garment/sketch_file.hpp"
+#include "garment/stroke_projection.hpp"
+
+namespace sd::garment {
+
+struct NetworkEdge {
+  int curve = -1;            // NetworkCurve index
+  int from = -1, to = -1;    // node indices
+  Eigen::MatrixX3d points;   // #P by 3 polyline from node `from` to node `to` (exact ends)
+  double length = 0;         // metres
+  int orbit = -1;            // the original edge of a mirror copy; itself for originals
+};
+
+struct NetworkCurve {
+  std::string id;            // "side_l", or "side_l.mirror" for a copy
+  int spec = -1;             // index into Sketch::curves
+  bool mirror_copy = false;
+  bool closed = false;
+  std::vector<int> edges;    // in curve order
+  std::vector<int> nodes;    // edges.size() + 1 nodes along the curve (closed: first == last)
+};
+
+struct CurveNetwork {
+  std::vector<Eigen::Vector3d> nodes;
+  std::vector<NetworkEdge> edges;
+  std::vector<NetworkCurve> curves;
+
+  // Curve by id ("x.mirror" for a copy; the copy of an on-plane curve is the curve itself);
+  // -1 when unknown.
+  int find_curve(const std::string& id) const;
+};
+
+// Builds the network. `mirrored` holds the ids of the curves that need mirror copies.
+// Curves within `tolerance` of x = 0 at an end (or entirely) are snapped onto the plane when
+// mirrored, so their copies meet them there exactly.
+CurveNetwork build_network(const Sketch& sketch, const std::vector<ProjectedCurve>& curves,
+                           const std::set<std::string>& mirrored);
+
+// Polyline length, metres.
+double polyline_length(const Eigen::MatrixX3d& points);
+
+// Mirror image across x = 0.
+inline Eigen::Vector3d mirror_point(const Eigen::Vector3d& p) { return {-p.x(), p.y(), p.z()}; }
+
+}  // namespace sd::garment

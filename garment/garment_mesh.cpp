@@ -1,0 +1,312 @@
+#include "garment/garment_mesh.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <map>
+#include <numeric>
+#include <stdexcept>
+
+#include "garment/curve_network.hpp"
+#include "garment/edge_counts.hpp"
+#include "garment/panel_loop.hpp"
+#include "garment/stroke_projection.hpp"
+#include "meshing/patch_fill.hpp"
+
+namespace sd::garment {
+namespace {
+
+// Global vertices of the garment: node and curve-piece vertices are made once and shared.
+struct VertexPool {
+  std::vector<Eigen::Vector3d> positions;
+  int add(const Eigen::Vector3d& p) {
+    positions.push_back(p);
+    return static_cast<int>(positions.size()) - 1;
+  }
+};
+
+}  // namespace
+
+std::string body_part_name(BodyPart part) {
+  switch (part) {
+    case BodyPart::kHead: return "head";
+    case BodyPart::kTorso: return "torso";
+    case BodyPart::kLeftArm: return "left_arm";
+    case BodyPart::kRightArm: return "right_arm";
+    case BodyPart::kLeftLeg: return "left_leg";
+    case BodyPart::kRightLeg: return "right_leg";
+  }
+  return "torso";
+}
+
+BodyPart classify_body_point(const Eigen::Vector3d& p, double height) {
+  const double y = p.y() / height, x = p.x() / height;
+  if (y > 0.86) return BodyPart::kHead;
+  if (y < 0.45) return x >= 0 ? BodyPart::kLeftLeg : BodyPart::kRightLeg;
+  if (std::abs(x) > 0.105) return x > 0 ? BodyPart::kLeftArm : BodyPart::kRightArm;
+  return BodyPart::kTorso;
+}
+
+Garment build_garment(const Sketch& sketch, const BodySurface& body) {
+  if (sketch.garment_mesh)
+    throw std::logic_error("build_garment: a garment_mesh sketch has no curves to mesh");
+  const std::vector<ProjectedCurve> projected = project_curves(sketch, body);
+  const CurveNetwork net = build_network(sketch, projected, curves_to_mirror(sketch));
+  const std::vector<PanelLoop> loops = resolve_panels(sketch, net, body);
+  const EdgeCounts counts = compute_edge_counts(sketch, net, loops);
+
+  // A curve piece is a seam between at most two panels.
+  std::vector<std::vector<int>> users(net.edges.size());
+  for (size_t l = 0; l < loops.size(); ++l)
+    for (const LoopEdge& e : loops[l].edges) {
+      auto& u = users[static_cast<size_t>(e.edge)];
+      if (u.size() == 2) {
+        const std::string& curve = net.curves[static_cast<size_t>(net.edges[static_cast<size_t>(e.edge)].curve)].id;
+        sketch.fail(loops[l].json_path + "/boundary",
+                    fmt::format("curve '{}' already joins panels '{}' and '{}'; a seam joins "
+                                "exactly two panels, so '{}' cannot use it too",
+                                curve, loops[static_cast<size_t>(u[0])].id,
+                                loops[static_cast<size_t>(u[1])].id, loops[l].id));
+      }
+      u.push_back(static_cast<int>(l));
+    }
+
+  // Boundary vertices: placed once per curve piece by arc length; a copy's are the exact mirror
+  // images of its original's (so mirrored panels match bitwise).
+  VertexPool pool;
+  std::vector<int> node_vertex(net.nodes.size(), -1);
+  std::vector<Eigen::MatrixX3d> placed(net.edges.size());
+  std::vector<std::vector<int>> edge_ids(net.edges.size());
+  auto placed_points = [&](int e) -> const Eigen::MatrixX3d& {
+    Eigen::MatrixX3d& p = placed[static_cast<size_t>(e)];
+    if (p.rows() > 0) return p;
+    const NetworkEdge& edge = net.edges[static_cast<size_t>(e)];
+    const int orbit = edge.orbit;
+    const int n = counts.counts[static_cast<size_t>(e)];
+    if (orbit == e) {
+      p = meshing::resample_by_arc_length(edge.points, n);
+      if (edge.points.col(0).cwiseAbs().maxCoeff() == 0) p.col(0).setZero();
+    } else {
+      Eigen::MatrixX3d original = meshing::resample_by_arc_length(net.edges[static_cast<size_t>(orbit)].points, n);
+      if (net.edges[static_cast<size_t>(orbit)].points.col(0).cwiseAbs().maxCoeff() == 0) original.col(0).setZero();
+      original.col(0) *= -1.0;
+      p = original;
+    }
+    p.row(0) = net.nodes[static_cast<size_t>(edge.from)].transpose();
+    p.row(p.rows() - 1) = net.nodes[static_cast<size_t>(edge.to)].transpose();
+    return p;
+  };
+  auto ids_of = [&](int e) -> const std::vector<int>& {
+    std::vector<int>& ids = edge_ids[static_cast<size_t>(e)];
+    if (!ids.empty()) return ids;
+    const NetworkEdge& edge = net.edges[static_cast<size_t>(e)];
+    const Eigen::MatrixX3d& p = placed_points(e);
+    auto node_id = [&](int node) {
+      int& v = node_vertex[static_cast<size_t>(node)];
+      if (v < 0) v = pool.add(net.nodes[static_cast<size_t>(node)]);
+      return v;
+    };
+    ids.push_back(node_id(edge.from));
+    for (Eigen::Index k = 1; k + 1 < p.rows(); ++k) ids.push_back(pool.add(p.row(k).transpose()));
+    ids.push_back(node_id(edge.to));
+    return ids;
+  };
+
+  Garment garment;
+  std::vector<std::array<int, 4>> faces;
+  std::vector<int> face_panel;
+  // Per original loop: patch vertex → global id, kept for its mirror copy.
+  std::map<int, std::vector<int>> patch_globals;
+  std::map<int, meshing::FilledPatch> patches;
+
+  for (size_t l = 0; l < loops.size(); ++l) {
+    const PanelLoop& loop = loops[l];
+    const PanelSpec& spec = sketch.panels[static_cast<size_t>(loop.spec)];
+    GarmentPanel panel;
+    panel.id = loop.id;
+    panel.group = loop.id;
+    panel.fabric = spec.fabric;
+    panel.mirror_copy = loop.mirror_copy;
+    panel.ease = spec.ease;
+    for (const LoopEdge& e : loop.edges)
+      panel.curves.push_back(net.curves[static_cast<size_t>(net.edges[static_cast<size_t>(e.edge)].curve)].id);
+
+    // Sides: points and global ids from corner i to corner i+1.
+    std::vector<Eigen::MatrixX3d> side_points;
+    std::vector<std::vector<int>> side_ids;
+    for (int s = 0; s < loop.side_count(); ++s) {
+      std::vector<Eigen::Vector3d> pts;
+      std::vector<int> ids;
+      for (int k = loop.side_begin[static_cast<size_t>(s)]; k < loop.side_end(s); ++k) {
+        const LoopEdge& e = loop.edges[static_cast<size_t>(k)];
+        const Eigen::MatrixX3d& p = placed_points(e.edge);
+        const std::vector<int>& g = ids_of(e.edge);
+        const Eigen::Index n = p.rows();
+        for (Eigen::Index j = 0; j < n; ++j) {
+          const Eigen::Index src = e.forward ? j : n - 1 - j;
+          if (!ids.empty() && j == 0) continue;  // the junction is already there
+          pts.push_back(p.row(src).transpose());
+          ids.push_back(g[static_cast<size_t>(src)]);
+        }
+      }
+      Eigen::MatrixX3d m(static_cast<Eigen::Index>(pts.size()), 3);
+      for (size_t j = 0; j < pts.size(); ++j) m.row(static_cast<Eigen::Index>(j)) = pts[j].transpose();
+      side_points.push_back(std::move(m));
+      side_ids.push_back(std::move(ids));
+      panel.side_counts.push_back(static_cast<int>(side_ids.back().size()) - 1);
+    }
+
+    const int panel_index = static_cast<int>(garment.panels.size());
+    std::vector<int> globals;
+    if (!loop.mirror_copy) {
+      // Project interior points onto the offset surface where the panel lies on the body:
+      // inside it, or less than one edge length outside it; points spanning a hollow (between
+      // the legs, under the bust) are left where the relaxation puts them.
+      double offset = 0;
+      int on_body = 0;
+      for (const LoopEdge& e : loop.edges) {
+        const CurveSpec& cs = sketch.curves[static_cast<size_t>(net.curves[static_cast<size_t>(net.edges[static_cast<size_t>(e.edge)].curve)].spec)];
+        offset += cs.offset;
+        on_body += cs.on_body ? 1 : 0;
+      }
+      offset /= static_cast<double>(loop.edges.size());
+      const double reach = spec.edge_length.value_or(sketch.edge_length);
+      meshing::FillGeometryOptions options;
+      options.relax_iterations = sketch.relax_iterations;
+      if (2 * on_body >= static_cast<int>(loop.edges.size()))
+        options.project = [&body, offset, reach](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+          const SurfacePoint s = body.closest_point(p);
+          const double signed_distance = (p - s.position).dot(s.normal);
+          if (signed_distance < offset + reach) return s.position + offset * s.normal;
+          return p;
+        };
+      meshing::FilledPatch patch;
+      try {
+        patch = meshing::fill_region(side_points, options);
+      } catch (const meshing::FillError& e) {
+        sketch.fail(loop.json_path, fmt::format("panel '{}' cannot be filled with quads: {}", loop.id, e.what()));
+      }
+      globals.assign(static_cast<size_t>(patch.mesh.vertex_count()), -1);
+      for (size_t s = 0; s < patch.topology.side_vertices.size(); ++s)
+        for (size_t j = 0; j < patch.topology.side_vertices[s].size(); ++j)
+          globals[static_cast<size_t>(patch.topology.side_vertices[s][j])] = side_ids[s][j];
+      for (size_t v = 0; v < globals.size(); ++v)
+        if (globals[v] < 0) globals[v] = pool.add(patch.mesh.vertices.row(static_cast<Eigen::Index>(v)).transpose());
+      for (Eigen::Index f = 0; f < patch.mesh.face_count(); ++f) {
+        std::array<int, 4> q;
+        for (int k = 0; k < 4; ++k) q[static_cast<size_t>(k)] = globals[static_cast<size_t>(patch.mesh.faces(f, k))];
+        faces.push_back(q);
+        face_panel.push_back(panel_index);
+      }
+      panel.partition = patch.topology.partition;
+      panel.distortion = patch.topology.distortion;
+      panel.irregular_vertices = patch.topology.irregular_vertices;
+      panel.quality = patch.quality;
+      panel.faces = static_cast<int>(patch.mesh.face_count());
+      patch_globals[static_cast<int>(l)] = globals;
+      patches[static_cast<int>(l)] = std::move(patch);
+    } else {
+      // Reflect the original's fill: boundary vertices map through the mirrored curve pieces,
+      // interior vertices are reflected, and faces are reversed to stay outward.
+      const PanelLoop& original = loops[static_cast<size_t>(loop.original)];
+      const meshing::FilledPatch& patch = patches.at(loop.original);
+      const std::vector<int>& og = patch_globals.at(loop.original);
+      std::map<int, int> image;  // original global → copy global, for boundary vertices
+      const size_t m = original.edges.size();
+      for (size_t k = 0; k < m; ++k) {
+        const LoopEdge& a = original.edges[k];
+        // The copy runs the mirrored edges in reverse order; find a's image by edge orbit.
+        const LoopEdge* b = nullptr;
+        for (const LoopEdge& c : loop.edges) {
+          const NetworkEdge& ce = net.edges[static_cast<size_t>(c.edge)];
+          const NetworkEdge& ae = net.edges[static_cast<size_t>(a.edge)];
+          const bool same_orbit = ce.orbit == ae.orbit;
+          if (same_orbit && (c.edge != a.edge || ce.points.col(0).cwiseAbs().maxCoeff() == 0)) b = &c;
+        }
+        if (b == nullptr) throw std::runtime_error("mirror copy lost a boundary edge of " + original.id);
+        const std::vector<int>& ga = ids_of(a.edge);
+        const std::vector<int>& gb = ids_of(b->edge);
+        for (size_t j = 0; j < ga.size(); ++j) image[ga[j]] = gb[j];
+      }
+      globals.assign(og.size(), -1);
+      for (size_t v = 0; v < og.size(); ++v) {
+        const auto it = image.find(og[v]);
+        globals[v] = it != image.end()
+                         ? it->second
+                         : pool.add(mirror_point(patch.mesh.vertices.row(static_cast<Eigen::Index>(v)).transpose()));
+      }
+      for (Eigen::Index f = 0; f < patch.mesh.face_count(); ++f) {
+        const auto& pf = patch.mesh.faces;
+        faces.push_back({globals[static_cast<size_t>(pf(f, 0))], globals[static_cast<size_t>(pf(f, 3))],
+                         globals[static_cast<size_t>(pf(f, 2))], globals[static_cast<size_t>(pf(f, 1))]});
+        face_panel.push_back(panel_index);
+      }
+      const GarmentPanel& op = garment.panels[static_cast<size_t>(loop.original)];
+      panel.partition = op.partition;
+      panel.distortion = op.distortion;
+      panel.irregular_vertices = op.irregular_vertices;
+      panel.quality = op.quality;
+      panel.faces = op.faces;
+    }
+    garment.panels.push_back(std::move(panel));
+  }
+
+  garment.mesh.vertices.resize(static_cast<Eigen::Index>(pool.positions.size()), 3);
+  for (size_t v = 0; v < pool.positions.size(); ++v) garment.mesh.vertices.row(static_cast<Eigen::Index>(v)) = pool.positions[v].transpose();
+  garment.mesh.faces.resize(static_cast<Eigen::Index>(faces.size()), 4);
+  for (size_t f = 0; f < faces.size(); ++f)
+    for (int k = 0; k < 4; ++k) garment.mesh.faces(static_cast<Eigen::Index>(f), k) = faces[f][static_cast<size_t>(k)];
+  garment.face_panel = Eigen::Map<const Eigen::VectorXi>(face_panel.data(), static_cast<Eigen::Index>(face_panel.size()));
+
+  // Seams must be traversed in opposite directions by their two panels.
+  std::map<std::pair<int, int>, std::pair<int, int>> directed;  // (a, b) → (face, count)
+  for (size_t f = 0; f < faces.size(); ++f)
+    for (int k = 0; k < 4; ++k) {
+      const int a = faces[f][static_cast<size_t>(k)], b = faces[f][static_cast<size_t>((k + 1) % 4)];
+      auto [it, inserted] = directed.try_emplace({a, b}, static_cast<int>(f), 0);
+      if (!inserted) {
+        const GarmentPanel& p1 = garment.panels[static_cast<size_t>(face_panel[static_cast<size_t>(it->second.first)])];
+        const GarmentPanel& p2 = garment.panels[static_cast<size_t>(face_panel[f])];
+        sketch.fail("/panels",
+                    fmt::format("panels '{}' and '{}' face opposite ways along their shared seam; "
+                                "check that both lie on the same side of the body",
+                                p1.id, p2.id));
+      }
+    }
+  for (const auto& [edge, face] : directed)
+    if (edge.first < edge.second && directed.contains({edge.second, edge.first}) &&
+        face_panel[static_cast<size_t>(face.first)] != face_panel[static_cast<size_t>(directed.at({edge.second, edge.first}).first)])
+      ++garment.seam_edges;
+
+  // Joins relabel their panels' group.
+  for (const JoinSpec& join : sketch.joins)
+    for (const std::string& id : join.panels)
+      for (GarmentPanel& p : garment.panels)
+        if (p.id == id) p.group = join.id;
+
+  // Body part (majority over faces), area, and how far on-body vertices sit from the offset.
+  const double height = body.box().max.y() - body.box().min.y();
+  for (size_t pi = 0; pi < garment.panels.size(); ++pi) {
+    GarmentPanel& panel = garment.panels[pi];
+    std::array<int, 6> votes{};
+    for (size_t f = 0; f < faces.size(); ++f) {
+      if (face_panel[f] != static_cast<int>(pi)) continue;
+      Eigen::Vector3d c = Eigen::Vector3d::Zero();
+      for (int v : faces[f]) c += pool.positions[static_cast<size_t>(v)];
+      c /= 4;
+      const Eigen::Vector3d a = pool.positions[static_cast<size_t>(faces[f][0])], b = pool.positions[static_cast<size_t>(faces[f][1])],
+                            cc = pool.positions[static_cast<size_t>(faces[f][2])], d = pool.positions[static_cast<size_t>(faces[f][3])];
+      panel.area += 0.5 * (cc - a).cross(d - b).norm();
+      if (f % 3 == 0) ++votes[static_cast<size_t>(classify_body_point(body.closest_point(c).position, height))];
+    }
+    panel.body_part = body_part_name(static_cast<BodyPart>(std::max_element(votes.begin(), votes.end()) - votes.begin()));
+  }
+  garment.parity_changes = static_cast<int>(counts.changed.size());
+  for (const auto& u : users) garment.curve_pieces += u.empty() ? 0 : 1;
+  return garment;
+}
+
+}  // namespace sd::garment

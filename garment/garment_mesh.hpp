@@ -1,0 +1,58 @@
+#pragma once
+// From a sketch to one stitched garment: strokes projected on the body, the curve network, panel
+// loops, edge counts with the parity fix, boundary vertices placed once per curve piece (shared
+// by the panels on both sides), every panel filled with quads and projected onto the body's
+// offset surface, mirror copies made by reflecting the filled original.
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "garment/body_surface.hpp"
+#include "garment/sketch_file.hpp"
+#include "meshing/quad_mesh.hpp"
+#include "meshing/quad_quality.hpp"
+
+namespace sd::garment {
+
+// Coarse body regions, for collision handling and reports.
+enum class BodyPart { kHead, kTorso, kLeftArm, kRightArm, kLeftLeg, kRightLeg };
+std::string body_part_name(BodyPart part);
+
+// Region of a point on (or near) an upright, normalised body of height `height` (feet at y = 0,
+// facing +Z, left = +x). Bands: head above 0.86 h, legs below the crotch at 0.45 h, arms beyond
+// |x| = 0.105 h in between (an A-pose body: torso ±0.09 h at the waist, shoulders ±0.10 h).
+BodyPart classify_body_point(const Eigen::Vector3d& p, double height);
+
+struct GarmentPanel {
+  std::string id;              // "front", "front.mirror"
+  std::string group;           // the join it belongs to, else its id
+  std::string fabric;
+  std::string body_part;       // nearest body region (majority over its faces)
+  bool mirror_copy = false;
+  double ease = 1.0;
+  std::vector<std::string> curves;  // boundary curves in loop order (pieces repeat their curve)
+  std::vector<int> side_counts;     // edges per side, counter-clockwise from outside
+  std::string partition;            // the filler's construction
+  int distortion = 0;
+  int irregular_vertices = 0;
+  meshing::QuadQuality quality;
+  int faces = 0;
+  double area = 0;                  // m²
+  double max_body_gap = 0;          // m: largest |distance to body − offset| of on-body vertices
+};
+
+struct Garment {
+  meshing::QuadMesh mesh;           // one conforming mesh, outward orientation
+  Eigen::VectorXi face_panel;       // #Q: index into panels
+  std::vector<GarmentPanel> panels;
+  int seam_edges = 0;               // mesh edges shared by two panels
+  int parity_changes = 0;           // curve pieces whose count the parity fix changed
+  int curve_pieces = 0;             // network edges used by panels
+};
+
+// The whole meshing pipeline for a sketch with curves and panels. Throws SketchError for
+// anything the designer can fix (with the JSON path), std::runtime_error for internal failures.
+Garment build_garment(const Sketch& sketch, const BodySurface& body);
+
+}  // namespace sd::garment

@@ -1,0 +1,322 @@
+#include "garment/panel_loop.hpp"
+
+#include <fmt/format.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <numbers>
+
+namespace sd::garment {
+namespace {
+
+constexpr double kTangentArc = 0.02;  // metres of curve used to estimate a tangent at a junction
+
+// Points of a loop edge in traversal order.
+Eigen::MatrixX3d ordered_points(const CurveNetwork& net, const LoopEdge& e) {
+  const Eigen::MatrixX3d& p = net.edges[static_cast<size_t>(e.edge)].points;
+  return e.forward ? p : Eigen::MatrixX3d(p.colwise().reverse());
+}
+
+// Unit direction of the polyline leaving its first point (at_start) or arriving at its last,
+// averaged over kTangentArc (or a third of the length when shorter).
+Eigen::Vector3d end_tangent(const Eigen::MatrixX3d& p, bool at_start) {
+  const double reach = std::min(kTangentArc, polyline_length(p) / 3);
+  const Eigen::Index n = p.rows();
+  if (at_start) {
+    double arc = 0;
+    Eigen::Index k = 1;
+    for (; k < n - 1; ++k) {
+      arc += (p.row(k) - p.row(k - 1)).norm();
+      if (arc >= reach) break;
+    }
+    return (p.row(k) - p.row(0)).transpose().normalized();
+  }
+  double arc = 0;
+  Eigen::Index k = n - 2;
+  for (; k > 0; --k) {
+    arc += (p.row(k + 1) - p.row(k)).norm();
+    if (arc >= reach) break;
+  }
+  return (p.row(n - 1) - p.row(k)).transpose().normalized();
+}
+
+struct Run {
+  std::vector<LoopEdge> edges;
+  int start = -1, end = -1;
+};
+
+// Every contiguous run along curve c starting at node `start` (any node when start < 0), shortest
+// first.
+std::vector<Run> runs_from(const CurveNetwork& net, int c, int start, int boundary) {
+  const NetworkCurve& curve = net.curves[static_cast<size_t>(c)];
+  const int m = static_cast<int>(curve.edges.size());
+  std::vector<Run> runs;
+  const int positions = curve.closed ? m : m + 1;
+  for (int s = 0; s < positions; ++s) {
+    if (start >= 0 && curve.nodes[static_cast<size_t>(s)] != start) continue;
+    for (int dir : {+1, -1}) {
+      for (int len = 1; len <= m; ++len) {
+        if (!curve.closed && (dir > 0 ? s + len > m : s - len < 0)) break;
+        Run run;
+        run.start = curve.nodes[static_cast<size_t>(s)];
+        for (int k = 0; k < len; ++k) {
+          const int edge_pos = dir > 0 ? (s + k) % m : ((s - k - 1) % m + m) % m;
+          run.edges.push_back({curve.edges[static_cast<size_t>(edge_pos)], dir > 0, boundary});
+        }
+        const int end_pos = dir > 0 ? (s + len) % (curve.closed ? m : m + 1)
+                                    : (((s - len) % positions) + positions) % positions;
+        run.end = curve.nodes[static_cast<size_t>(end_pos)];
+        runs.push_back(std::move(run));
+        if (curve.closed && len == m && dir < 0) break;
+      }
+    }
+  }
+  std::stable_sort(runs.begin(), runs.end(),
+                   [](const Run& a, const Run& b) { return a.edges.size() < b.edges.size(); });
+  return runs;
+}
+
+bool curve_has_node(const CurveNetwork& net, int c, int node) {
+  const auto& nodes = net.curves[static_cast<size_t>(c)].nodes;
+  return std::find(nodes.begin(), nodes.end(), node) != nodes.end();
+}
+
+double node_gap(const CurveNetwork& net, int a, int b) {
+  double best = std::numeric_limits<double>::infinity();
+  for (int x : net.curves[static_cast<size_t>(a)].nodes)
+    for (int y : net.curves[static_cast<size_t>(b)].nodes)
+      best = std::min(best, (net.nodes[static_cast<size_t>(x)] - net.nodes[static_cast<size_t>(y)]).norm());
+  return best;
+}
+
+// Explicit boundary list → loop edges (unoriented), or a SketchError.
+std::vector<LoopEdge> resolve_explicit(const Sketch& sketch, const CurveNetwork& net,
+                                       const PanelSpec& panel) {
+  std::vector<int> curve_ids;
+  for (size_t i = 0; i < panel.boundary.size(); ++i) {
+    const int c = net.find_curve(panel.boundary[i]);
+    if (c < 0)
+      sketch.fail(fmt::format("{}/boundary/{}", panel.json_path, i),
+                  fmt::format("curve '{}' is not defined", panel.boundary[i]));
+    curve_ids.push_back(c);
+  }
+  const size_t k = curve_ids.size();
+  // Neighbours in the list must share a junction; say which pair does not.
+  for (size_t i = 0; i < k; ++i) {
+    const int a = curve_ids[i], b = curve_ids[(i + 1) % k];
+    if (k == 1) break;
+    bool meet = false;
+    for (int node : net.curves[static_cast<size_t>(a)].nodes) meet = meet || curve_has_node(net, b, node);
+    if (meet) continue;
+    const double gap = node_gap(net, a, b);
+    if (i + 1 == k)
+      sketch.fail(fmt::format("{}/boundary", panel.json_path),
+                  fmt::format("panel '{}' does not close: its last curve '{}' does not meet its "
+                              "first curve '{}' (their junctions are {:.1f} cm apart; curves "
+                              "meet when their ends are within {:.1f} cm)",
+                              panel.id, panel.boundary[i], panel.boundary[0], gap * 100,
+                              sketch.junction_tolerance * 100));
+    sketch.fail(fmt::format("{}/boundary/{}", panel.json_path, i + 1),
+                fmt::format("curve '{}' does not meet curve '{}' before it in panel '{}' (their "
+                            "junctions are {:.1f} cm apart; curves meet when their ends are "
+                            "within {:.1f} cm)",
+                            panel.boundary[i + 1], panel.boundary[i], panel.id, gap * 100,
+                            sketch.junction_tolerance * 100));
+  }
+  std::vector<LoopEdge> loop;
+  std::vector<int> used(net.edges.size(), 0);
+  int budget = 200000;  // depth-first search steps; lists are short in practice
+  std::function<bool(size_t, int, int)> search = [&](size_t i, int current, int first) -> bool {
+    if (--budget < 0) return false;
+    const int c = curve_ids[i];
+    for (const Run& run : runs_from(net, c, i == 0 ? -1 : current, static_cast<int>(i))) {
+      const bool last = i + 1 == k;
+      const int start = i == 0 ? run.start : first;
+      if (last ? run.end != start : !curve_has_node(net, curve_ids[i + 1], run.end)) continue;
+      bool clash = false;
+      for (const LoopEdge& e : run.edges) clash = clash || used[static_cast<size_t>(e.edge)] > 0;
+      if (clash) continue;
+      for (const LoopEdge& e : run.edges) {
+        ++used[static_cast<size_t>(e.edge)];
+        loop.push_back(e);
+      }
+      if (last || search(i + 1, run.end, start)) return true;
+      for (const LoopEdge& e : run.edges) {
+        --used[static_cast<size_t>(e.edge)];
+        loop.pop_back();
+      }
+    }
+    return false;
+  };
+  if (!search(0, -1, -1))
+    sketch.fail(fmt::format("{}/boundary", panel.json_path),
+                fmt::format("the curves of panel '{}' do not form one closed loop in the order "
+                            "listed (each curve must continue from where the one before it "
+                            "ends, and the last must return to the first)",
+                            panel.id));
+  return loop;
+}
+
+}  // namespace
+
+int PanelLoop::side_end(int i) const {
+  return i + 1 < side_count() ? side_begin[static_cast<size_t>(i + 1)] : static_cast<int>(edges.size());
+}
+
+int loop_start_node(const CurveNetwork& net, const LoopEdge& e) {
+  const NetworkEdge& edge = net.edges[static_cast<size_t>(e.edge)];
+  return e.forward ? edge.from : edge.to;
+}
+
+int loop_end_node(const CurveNetwork& net, const LoopEdge& e) {
+  const NetworkEdge& edge = net.edges[static_cast<size_t>(e.edge)];
+  return e.forward ? edge.to : edge.from;
+}
+
+std::set<std::string> curves_to_mirror(const Sketch& sketch) {
+  std::set<std::string> ids;
+  for (const PanelSpec& p : sketch.panels)
+    for (const std::string& id : p.boundary) {
+      const bool copy = id.ends_with(".mirror");
+      const std::string base = copy ? id.substr(0, id.size() - 7) : id;
+      if (p.mirror || copy) ids.insert(base);
+    }
+  return ids;
+}
+
+std::vector<PanelLoop> resolve_panels(const Sketch& sketch, const CurveNetwork& net,
+                                      const BodySurface& body) {
+  // Edge mirror map: copies point at their originals and back; on-plane edges at themselves.
+  std::vector<int> mirror_edge(net.edges.size(), -1);
+  for (size_t e = 0; e < net.edges.size(); ++e) {
+    const int o = net.edges[e].orbit;
+    if (o != static_cast<int>(e)) {
+      mirror_edge[e] = o;
+      mirror_edge[static_cast<size_t>(o)] = static_cast<int>(e);
+    }
+  }
+  for (size_t e = 0; e < net.edges.size(); ++e)
+    if (mirror_edge[e] < 0 && net.edges[e].points.col(0).cwiseAbs().maxCoeff() == 0)
+      mirror_edge[e] = static_cast<int>(e);
+
+  const double corner_cos = std::cos(sketch.corner_angle_degrees * std::numbers::pi / 180);
+  std::vector<PanelLoop> loops;
+  for (size_t p = 0; p < sketch.panels.size(); ++p) {
+    const PanelSpec& spec = sketch.panels[p];
+    if (spec.auto_boundary)
+      sketch.fail(spec.json_path + "/boundary",
+                  "\"auto\" boundaries are not available in this version; list the panel's "
+                  "curves in order");
+    PanelLoop loop;
+    loop.id = spec.id;
+    loop.json_path = spec.json_path;
+    loop.spec = static_cast<int>(p);
+    loop.edges = resolve_explicit(sketch, net, spec);
+    const size_t m = loop.edges.size();
+
+    // Orientation: counter-clockwise seen from outside, i.e. the loop's vector area agrees with
+    // the body normals at the boundary.
+    Eigen::Vector3d area = Eigen::Vector3d::Zero(), outward = Eigen::Vector3d::Zero();
+    std::vector<Eigen::Vector3d> boundary;
+    for (const LoopEdge& e : loop.edges) {
+      const Eigen::MatrixX3d pts = ordered_points(net, e);
+      for (Eigen::Index k = 0; k + 1 < pts.rows(); ++k) boundary.push_back(pts.row(k).transpose());
+    }
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (const auto& q : boundary) centroid += q;
+    centroid /= static_cast<double>(boundary.size());
+    for (size_t k = 0; k < boundary.size(); ++k) {
+      area += (boundary[k] - centroid).cross(boundary[(k + 1) % boundary.size()] - centroid);
+      if (k % 4 == 0) outward += body.closest_point(boundary[k]).normal;
+    }
+    if (area.dot(outward) < 0) {
+      std::reverse(loop.edges.begin(), loop.edges.end());
+      for (LoopEdge& e : loop.edges) e.forward = !e.forward;
+    }
+
+    // Turning angle at the start of each edge.
+    loop.turning_deg.resize(m);
+    for (size_t k = 0; k < m; ++k) {
+      const Eigen::Vector3d in = end_tangent(ordered_points(net, loop.edges[(k + m - 1) % m]), false);
+      const Eigen::Vector3d out = end_tangent(ordered_points(net, loop.edges[k]), true);
+      loop.turning_deg[k] = std::acos(std::clamp(in.dot(out), -1.0, 1.0)) * 180 / std::numbers::pi;
+    }
+    std::vector<bool> corner(m, false);
+    if (!spec.corners.empty()) {
+      // A listed curve names the junction where it begins in the file's order, i.e. where the
+      // curve listed before it ends; that holds whichever way the loop was oriented.
+      const int count = static_cast<int>(spec.boundary.size());
+      for (size_t k = 0; k < m; ++k) {
+        const int a = loop.edges[(k + m - 1) % m].boundary, b = loop.edges[k].boundary;
+        if (a == b) continue;  // inside one curve (a T-junction)
+        const int later = (a + 1) % count == b ? b : a;
+        const std::string& name = spec.boundary[static_cast<size_t>(later)];
+        if (std::find(spec.corners.begin(), spec.corners.end(), name) != spec.corners.end())
+          corner[k] = true;
+      }
+    } else {
+      for (size_t k = 0; k < m; ++k)
+        corner[k] = std::cos(loop.turning_deg[k] * std::numbers::pi / 180) < corner_cos;
+    }
+    int corners = static_cast<int>(std::count(corner.begin(), corner.end(), true));
+    if (static_cast<int>(m) < 3)
+      sketch.fail(spec.json_path + "/boundary",
+                  fmt::format("panel '{}' has only {} junction(s) on its boundary; a panel needs "
+                              "at least 3 corners, so split its boundary into 3 or more curves",
+                              spec.id, m));
+    while (corners < 3) {  // promote the sharpest remaining junctions
+      size_t best = m;
+      for (size_t k = 0; k < m; ++k)
+        if (!corner[k] && (best == m || loop.turning_deg[k] > loop.turning_deg[best])) best = k;
+      corner[best] = true;
+      ++corners;
+    }
+    // Rotate so the loop starts at a corner; sides run between consecutive corners.
+    const size_t first = static_cast<size_t>(std::find(corner.begin(), corner.end(), true) - corner.begin());
+    std::rotate(loop.edges.begin(), loop.edges.begin() + static_cast<long>(first), loop.edges.end());
+    std::rotate(loop.turning_deg.begin(), loop.turning_deg.begin() + static_cast<long>(first), loop.turning_deg.end());
+    std::rotate(corner.begin(), corner.begin() + static_cast<long>(first), corner.end());
+    for (size_t k = 0; k < m; ++k)
+      if (corner[k]) loop.side_begin.push_back(static_cast<int>(k));
+    loop.original = static_cast<int>(loops.size());
+    loops.push_back(loop);
+
+    if (spec.mirror) {
+      PanelLoop copy;
+      copy.id = spec.id + ".mirror";
+      copy.json_path = spec.json_path;
+      copy.spec = static_cast<int>(p);
+      copy.mirror_copy = true;
+      copy.original = loop.original;
+      // Mirroring reverses the orientation, so the copy runs the mirrored edges backwards.
+      for (size_t k = m; k-- > 0;) {
+        const LoopEdge& e = loop.edges[k];
+        const int image = mirror_edge[static_cast<size_t>(e.edge)];
+        if (image < 0)
+          sketch.fail(spec.json_path + "/mirror",
+                      fmt::format("panel '{}' cannot be mirrored: curve '{}' has no mirror copy",
+                                  spec.id, net.curves[static_cast<size_t>(net.edges[static_cast<size_t>(e.edge)].curve)].id));
+        copy.edges.push_back({image, !e.forward, e.boundary});
+      }
+      // Corner at the start of original edge k is at the start of copy edge (m - k) mod m.
+      std::vector<bool> copy_corner(m, false);
+      for (size_t k = 0; k < m; ++k)
+        if (corner[k]) copy_corner[(m - k) % m] = true;
+      copy.turning_deg.resize(m);
+      for (size_t k = 0; k < m; ++k) copy.turning_deg[(m - k) % m] = loop.turning_deg[k];
+      for (size_t k = 0; k < m; ++k)
+        if (copy_corner[k]) copy.side_begin.push_back(static_cast<int>(k));
+      // Start at a corner.
+      const int shift = copy.side_begin.front();
+      std::rotate(copy.edges.begin(), copy.edges.begin() + shift, copy.edges.end());
+      std::rotate(copy.turning_deg.begin(), copy.turning_deg.begin() + shift, copy.turning_deg.end());
+      for (int& s : copy.side_begin) s -= shift;
+      loops.push_back(std::move(copy));
+    }
+  }
+  return loops;
+}
+
+}  // namespace sd::garment

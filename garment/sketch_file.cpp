@@ -1,0 +1,589 @@
+#include "garment/sketch_file.hpp"
+
+#include <fmt/format.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <initializer_list>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+namespace sd::garment {
+namespace {
+
+using nlohmann::json;
+
+// Levenshtein distance, for "did you mean" hints on misspelt keys and names.
+size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+std::string type_name(const json& value) {
+  if (value.is_string()) return fmt::format("the text \"{}\"", value.get<std::string>());
+  if (value.is_boolean()) return value.get<bool>() ? "true" : "false";
+  if (value.is_number()) return fmt::format("the number {}", value.dump());
+  if (value.is_null()) return "null";
+  if (value.is_array()) return "a list";
+  return "an object";
+}
+
+// Reads one JSON document with the context needed for messages.
+class Reader {
+ public:
+  explicit Reader(const Sketch& sketch) : sketch_(sketch) {}
+
+  [[noreturn]] void fail(const std::string& path, const std::string& sentence) const {
+    sketch_.fail(path, sentence);
+  }
+
+  // Rejects keys not in `known`, suggesting the nearest known one.
+  void check_keys(const json& object, const std::string& path,
+                  std::initializer_list<std::string_view> known) const {
+    for (const auto& [key, value] : object.items()) {
+      if (std::find(known.begin(), known.end(), key) != known.end()) continue;
+      std::string_view best;
+      size_t best_distance = 3;  // suggest only close spellings
+      for (std::string_view k : known) {
+        const size_t d = edit_distance(key, k);
+        if (d < best_distance) best = k, best_distance = d;
+      }
+      std::string sentence = fmt::format("unknown key '{}'", key);
+      if (!best.empty())
+        sentence += fmt::format(" (did you mean '{}'?)", best);
+      else
+        sentence += fmt::format(" (known keys here: {})", fmt::join(known, ", "));
+      fail(path + "/" + key, sentence);
+    }
+  }
+
+  void require_object(const json& value, const std::string& path, std::string_view what) const {
+    if (!value.is_object())
+      fail(path, fmt::format("{} must be an object {{...}}, not {}", what, type_name(value)));
+  }
+
+  double number(const json& value, const std::string& path) const {
+    if (value.is_string()) {
+      fail(path, fmt::format("expected a number, got {}; JSON numbers are written without quotes "
+                             "and must be finite (no NaN or infinity)",
+                             type_name(value)));
+    }
+    if (!value.is_number()) fail(path, fmt::format("expected a number, got {}", type_name(value)));
+    const double x = value.get<double>();
+    if (!std::isfinite(x))
+      fail(path, fmt::format("the number {} is not finite; coordinates and sizes must be finite "
+                             "numbers",
+                             value.dump()));
+    return x;
+  }
+
+  double positive(const json& value, const std::string& path) const {
+    const double x = number(value, path);
+    if (!(x > 0)) fail(path, fmt::format("must be greater than zero, not {}", x));
+    return x;
+  }
+
+  double non_negative(const json& value, const std::string& path) const {
+    const double x = number(value, path);
+    if (x < 0) fail(path, fmt::format("must not be negative, not {}", x));
+    return x;
+  }
+
+  int integer(const json& value, const std::string& path, int min_value) const {
+    const double x = number(value, path);
+    if (x != std::floor(x) || x < min_value || x > 1e7)
+      fail(path, fmt::format("expected a whole number of at least {}, got {}", min_value,
+                             value.dump()));
+    return static_cast<int>(x);
+  }
+
+  bool boolean(const json& value, const std::string& path) const {
+    if (!value.is_boolean())
+      fail(path, fmt::format("expected true or false, got {}", type_name(value)));
+    return value.get<bool>();
+  }
+
+  std::string text(const json& value, const std::string& path) const {
+    if (!value.is_string()) fail(path, fmt::format("expected text in quotes, got {}", type_name(value)));
+    return value.get<std::string>();
+  }
+
+  std::string identifier(const json& value, const std::string& path) const {
+    std::string id = text(value, path);
+    if (id.empty()) fail(path, "an id must not be empty");
+    const bool ok = std::all_of(id.begin(), id.end(), [](char c) {
+      return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
+    });
+    if (!ok)
+      fail(path, fmt::format("id '{}' may only use letters, digits, '_' and '-'", id));
+    return id;
+  }
+
+  template <int N>
+  Eigen::Matrix<double, N, 1> vector(const json& value, const std::string& path) const {
+    if (!value.is_array() || value.size() != N)
+      fail(path, fmt::format("expected a point of {} numbers [{}], got {}", N,
+                             N == 2 ? "x, y" : "x, y, z",
+                             value.is_array() ? fmt::format("{} numbers", value.size())
+                                              : type_name(value)));
+    Eigen::Matrix<double, N, 1> v;
+    for (int k = 0; k < N; ++k) v[k] = number(value[k], fmt::format("{}/{}", path, k));
+    return v;
+  }
+
+  ViewSpec view(const json& value, const std::string& path) const {
+    ViewSpec view;
+    if (value.is_string()) {
+      const std::string name = value.get<std::string>();
+      static const std::pair<const char*, ViewKind> kNames[] = {{"front", ViewKind::kFront},
+                                                                {"back", ViewKind::kBack},
+                                                                {"left", ViewKind::kLeft},
+                                                                {"right", ViewKind::kRight}};
+      for (const auto& [n, kind] : kNames)
+        if (name == n) {
+          view.kind = kind;
+          return view;
+        }
+      fail(path, fmt::format("there is no view called '{}'; use front, back, left, right or "
+                             "{{\"camera\": {{\"eye\": [...], \"target\": [...]}}}}",
+                             name));
+    }
+    if (!value.is_object())
+      fail(path, fmt::format("a view is a name (front, back, left, right) or a camera object, "
+                             "not {}",
+                             type_name(value)));
+    check_keys(value, path, {"camera"});
+    if (!value.contains("camera")) fail(path, "a view object needs a \"camera\"");
+    const json& cam = value["camera"];
+    const std::string cpath = path + "/camera";
+    require_object(cam, cpath, "a camera");
+    check_keys(cam, cpath, {"eye", "target", "up", "fov"});
+    view.kind = ViewKind::kCamera;
+    if (!cam.contains("eye")) fail(cpath, "a camera needs an \"eye\" point [x, y, z]");
+    view.camera.eye = vector<3>(cam["eye"], cpath + "/eye");
+    if (cam.contains("target")) view.camera.target = vector<3>(cam["target"], cpath + "/target");
+    if (cam.contains("up")) view.camera.up = vector<3>(cam["up"], cpath + "/up");
+    if (cam.contains("fov")) {
+      view.camera.fov_degrees = positive(cam["fov"], cpath + "/fov");
+      if (view.camera.fov_degrees >= 170) fail(cpath + "/fov", "the field of view must be below 170 degrees");
+    }
+    const Eigen::Vector3d dir = view.camera.target - view.camera.eye;
+    if (dir.norm() < 1e-6) fail(cpath, "the camera's eye and target are the same point");
+    if (dir.normalized().cross(view.camera.up).norm() < 1e-3)
+      fail(cpath + "/up", "the camera's up direction is parallel to its viewing direction");
+    return view;
+  }
+
+ private:
+  const Sketch& sketch_;
+};
+
+void parse_body(const Reader& r, const json& j, BodySpec& body) {
+  const std::string path = "/body";
+  if (j.is_string()) {  // shorthand: "body": "builtin"
+    body.mesh = r.text(j, path);
+    return;
+  }
+  r.require_object(j, path, "body");
+  r.check_keys(j, path, {"mesh", "height", "up", "scale"});
+  if (j.contains("mesh")) body.mesh = r.text(j["mesh"], path + "/mesh");
+  if (body.mesh.empty()) r.fail(path + "/mesh", "the body mesh path is empty");
+  if (j.contains("height")) body.height = r.positive(j["height"], path + "/height");
+  if (j.contains("scale")) body.scale = r.positive(j["scale"], path + "/scale");
+  if (j.contains("up")) {
+    const std::string up = r.text(j["up"], path + "/up");
+    static const std::set<std::string> kAxes = {"x", "y", "z", "+x", "+y", "+z", "-x", "-y", "-z",
+                                                "X", "Y", "Z", "+X", "+Y", "+Z", "-X", "-Y", "-Z"};
+    if (!kAxes.contains(up))
+      r.fail(path + "/up", fmt::format("'{}' is not an axis; use +x, -x, +y, -y, +z or -z", up));
+    body.up = up;
+  }
+}
+
+CurveSpec parse_curve(const Reader& r, const json& j, const std::string& path, const Sketch& sk) {
+  r.require_object(j, path, "a curve");
+  r.check_keys(j, path,
+               {"id", "view", "points", "points3d", "offset", "on_body", "smooth", "closed",
+                "edge_length", "edges"});
+  CurveSpec curve;
+  curve.json_path = path;
+  if (!j.contains("id")) r.fail(path, "every curve needs an \"id\"");
+  curve.id = r.identifier(j["id"], path + "/id");
+  const bool has_2d = j.contains("points"), has_3d = j.contains("points3d");
+  if (has_2d == has_3d)
+    r.fail(path, fmt::format("curve '{}' needs exactly one of \"points\" (2D, drawn in a view) or "
+                             "\"points3d\"",
+                             curve.id));
+  const std::string key = has_2d ? "points" : "points3d";
+  const json& pts = j[key];
+  const std::string ppath = path + "/" + key;
+  if (!pts.is_array()) r.fail(ppath, fmt::format("expected a list of points, got {}", type_name(pts)));
+  if (pts.size() < 2) r.fail(ppath, fmt::format("curve '{}' needs at least 2 points", curve.id));
+  for (size_t i = 0; i < pts.size(); ++i) {
+    const std::string ip = fmt::format("{}/{}", ppath, i);
+    if (has_2d)
+      curve.points.push_back(r.vector<2>(pts[i], ip));
+    else
+      curve.points3d.push_back(r.vector<3>(pts[i], ip));
+  }
+  if (j.contains("view")) {
+    if (has_3d)
+      r.fail(path + "/view", "a \"view\" only applies to 2D \"points\"; \"points3d\" are world "
+                             "coordinates");
+    curve.view = r.view(j["view"], path + "/view");
+  }
+  curve.offset = j.contains("offset") ? r.number(j["offset"], path + "/offset") : sk.offset;
+  if (std::abs(curve.offset) > 0.5)
+    r.fail(path + "/offset", fmt::format("an offset of {} m is more than half a metre from the "
+                                         "body; offsets are in metres (1 cm = 0.01)",
+                                         curve.offset));
+  if (j.contains("on_body")) curve.on_body = r.boolean(j["on_body"], path + "/on_body");
+  if (j.contains("smooth")) curve.smooth = r.boolean(j["smooth"], path + "/smooth");
+  if (j.contains("closed")) curve.closed = r.boolean(j["closed"], path + "/closed");
+  if (curve.closed && pts.size() < 3)
+    r.fail(ppath, fmt::format("closed curve '{}' needs at least 3 points", curve.id));
+  if (j.contains("edge_length")) curve.edge_length = r.positive(j["edge_length"], path + "/edge_length");
+  if (j.contains("edges")) curve.edges = r.integer(j["edges"], path + "/edges", 1);
+  // Repeated consecutive points make a stroke without direction there.
+  const size_t n = has_2d ? curve.points.size() : curve.points3d.size();
+  for (size_t i = 1; i < n; ++i) {
+    const double d = has_2d ? (curve.points[i] - curve.points[i - 1]).norm()
+                            : (curve.points3d[i] - curve.points3d[i - 1]).norm();
+    if (d < 1e-6)
+      r.fail(fmt::format("{}/{}", ppath, i),
+             fmt::format("point {} of curve '{}' repeats the point before it", i, curve.id));
+  }
+  return curve;
+}
+
+PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, const Sketch& sk) {
+  r.require_object(j, path, "a panel");
+  r.check_keys(j, path, {"id", "boundary", "corners", "fabric", "mirror", "edge_length", "ease"});
+  PanelSpec panel;
+  panel.json_path = path;
+  if (!j.contains("id")) r.fail(path, "every panel needs an \"id\"");
+  panel.id = r.identifier(j["id"], path + "/id");
+  if (!j.contains("boundary"))
+    r.fail(path, fmt::format("panel '{}' needs a \"boundary\": its curve ids in order, or "
+                             "\"auto\"",
+                             panel.id));
+  const json& b = j["boundary"];
+  if (b.is_string()) {
+    if (b.get<std::string>() != "auto")
+      r.fail(path + "/boundary", fmt::format("\"boundary\" is a list of curve ids or \"auto\", "
+                                             "not \"{}\"",
+                                             b.get<std::string>()));
+    panel.auto_boundary = true;
+  } else {
+    if (!b.is_array())
+      r.fail(path + "/boundary", fmt::format("expected a list of curve ids, got {}", type_name(b)));
+    if (b.empty()) r.fail(path + "/boundary", fmt::format("panel '{}' has no boundary curves", panel.id));
+    for (size_t i = 0; i < b.size(); ++i) {
+      const std::string ip = fmt::format("{}/boundary/{}", path, i);
+      std::string id = r.text(b[i], ip);
+      const std::string base = id.ends_with(".mirror") ? id.substr(0, id.size() - 7) : id;
+      if (sk.find_curve(base) == nullptr) {
+        std::string sentence = fmt::format("curve '{}' is not defined", id);
+        size_t best = 3;
+        std::string hint;
+        for (const CurveSpec& c : sk.curves) {
+          const size_t d = edit_distance(base, c.id);
+          if (d < best) best = d, hint = c.id;
+        }
+        if (!hint.empty()) sentence += fmt::format(" (did you mean '{}'?)", hint);
+        r.fail(ip, sentence);
+      }
+      panel.boundary.push_back(std::move(id));
+    }
+  }
+  if (j.contains("corners")) {
+    const json& c = j["corners"];
+    if (!c.is_array()) r.fail(path + "/corners", "expected a list of curve ids");
+    for (size_t i = 0; i < c.size(); ++i) {
+      const std::string ip = fmt::format("{}/corners/{}", path, i);
+      std::string id = r.text(c[i], ip);
+      if (std::find(panel.boundary.begin(), panel.boundary.end(), id) == panel.boundary.end())
+        r.fail(ip, fmt::format("corner '{}' is not one of panel '{}''s boundary curves (a corner "
+                               "is named by the curve that starts there)",
+                               id, panel.id));
+      panel.corners.push_back(std::move(id));
+    }
+    if (panel.auto_boundary)
+      r.fail(path + "/corners", "explicit corners need an explicit boundary list");
+  }
+  panel.fabric = j.contains("fabric") ? r.text(j["fabric"], path + "/fabric") : sk.fabric;
+  if (j.contains("mirror")) panel.mirror = r.boolean(j["mirror"], path + "/mirror");
+  if (j.contains("edge_length")) panel.edge_length = r.positive(j["edge_length"], path + "/edge_length");
+  if (j.contains("ease")) {
+    panel.ease = r.positive(j["ease"], path + "/ease");
+    if (panel.ease < 0.5 || panel.ease > 2.0)
+      r.fail(path + "/ease", fmt::format("ease {} is outside 0.5 .. 2 (1 = rest shape as "
+                                         "designed, 1.05 = 5% looser)",
+                                         panel.ease));
+  }
+  return panel;
+}
+
+void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
+  const std::string path = "/simulate";
+  r.require_object(j, path, "simulate");
+  r.check_keys(j, path, {"duration", "adaptive", "time_step", "integrator", "solver",
+                         "stop_at_rest", "gravity"});
+  if (j.contains("duration")) sim.duration = r.positive(j["duration"], path + "/duration");
+  if (j.contains("adaptive")) sim.adaptive = r.boolean(j["adaptive"], path + "/adaptive");
+  if (j.contains("time_step")) sim.time_step = r.positive(j["time_step"], path + "/time_step");
+  if (j.contains("integrator")) {
+    sim.integrator = r.text(j["integrator"], path + "/integrator");
+    if (sim.integrator != "implicit-euler" && sim.integrator != "bdf2")
+      r.fail(path + "/integrator", fmt::format("unknown integrator '{}'; use \"implicit-euler\" "
+                                               "or \"bdf2\"",
+                                               sim.integrator));
+  }
+  if (j.contains("solver")) {
+    sim.solver = r.text(j["solver"], path + "/solver");
+    if (sim.solver != "pcg" && sim.solver != "cholmod")
+      r.fail(path + "/solver",
+             fmt::format("unknown solver '{}'; use \"pcg\" or \"cholmod\"", sim.solver));
+  }
+  if (j.contains("stop_at_rest")) sim.stop_at_rest = r.boolean(j["stop_at_rest"], path + "/stop_at_rest");
+  if (j.contains("gravity")) sim.gravity = r.vector<3>(j["gravity"], path + "/gravity");
+}
+
+void parse_output(const Reader& r, const json& j, OutputSpec& out) {
+  const std::string path = "/output";
+  r.require_object(j, path, "output");
+  r.check_keys(j, path, {"images", "mesh", "report", "wireframe"});
+  if (j.contains("mesh")) {
+    out.mesh = r.text(j["mesh"], path + "/mesh");
+    if (!out.mesh.ends_with(".obj") && !out.mesh.ends_with(".glb"))
+      r.fail(path + "/mesh", fmt::format("'{}' must end in .obj or .glb", out.mesh));
+    if (out.mesh.find('/') != std::string::npos)
+      r.fail(path + "/mesh", "give a file name only; the directory comes from -o");
+  }
+  if (j.contains("report")) out.report = r.boolean(j["report"], path + "/report");
+  if (j.contains("wireframe")) out.wireframe = r.boolean(j["wireframe"], path + "/wireframe");
+  if (j.contains("images")) {
+    const json& images = j["images"];
+    if (!images.is_array()) r.fail(path + "/images", "expected a list of images");
+    for (size_t i = 0; i < images.size(); ++i) {
+      const std::string ip = fmt::format("{}/images/{}", path, i);
+      const json& im = images[i];
+      r.require_object(im, ip, "an image");
+      r.check_keys(im, ip, {"view", "size", "wireframe"});
+      ImageSpec image;
+      if (im.contains("view")) {
+        const json& v = im["view"];
+        if (v.is_string() && v.get<std::string>() == "three-quarter") {
+          image.view = "three-quarter";
+        } else {
+          const ViewSpec view = r.view(v, ip + "/view");
+          image.view = view.name();
+          image.camera = view.camera;
+        }
+      }
+      if (im.contains("size")) {
+        const json& s = im["size"];
+        if (!s.is_array() || s.size() != 2)
+          r.fail(ip + "/size", "expected [width, height] in pixels");
+        image.width = r.integer(s[0], ip + "/size/0", 16);
+        image.height = r.integer(s[1], ip + "/size/1", 16);
+        if (image.width > 8192 || image.height > 8192)
+          r.fail(ip + "/size", "images are at most 8192 pixels on a side");
+      }
+      if (im.contains("wireframe")) image.wireframe = r.boolean(im["wireframe"], ip + "/wireframe");
+      out.images.push_back(image);
+    }
+  }
+}
+
+// "line 3, column 7" from a byte offset.
+std::string position_of(std::string_view text, size_t byte) {
+  byte = std::min(byte, text.size());
+  size_t line = 1, column = 1;
+  for (size_t i = 0; i + 1 < byte; ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      column = 1;
+    } else {
+      ++column;
+    }
+  }
+  return fmt::format("line {}, column {}", line, column);
+}
+
+}  // namespace
+
+std::string ViewSpec::name() const {
+  switch (kind) {
+    case ViewKind::kFront: return "front";
+    case ViewKind::kBack: return "back";
+    case ViewKind::kLeft: return "left";
+    case ViewKind::kRight: return "right";
+    case ViewKind::kCamera: return "camera";
+  }
+  return "?";
+}
+
+void Sketch::fail(const std::string& json_path, const std::string& sentence) const {
+  throw SketchError(file, json_path, sentence);
+}
+
+const CurveSpec* Sketch::find_curve(std::string_view id) const {
+  for (const CurveSpec& c : curves)
+    if (c.id == id) return &c;
+  return nullptr;
+}
+
+const PanelSpec* Sketch::find_panel(std::string_view id) const {
+  for (const PanelSpec& p : panels)
+    if (p.id == id) return &p;
+  return nullptr;
+}
+
+std::filesystem::path Sketch::resolve(const std::string& relative) const {
+  const std::filesystem::path p(relative);
+  return p.is_absolute() ? p : base_dir / p;
+}
+
+Sketch parse_sketch(std::string_view text, const std::string& file,
+                    const std::filesystem::path& base_dir) {
+  Sketch sketch;
+  sketch.file = file;
+  sketch.base_dir = base_dir;
+  const Reader r(sketch);
+
+  json root;
+  try {
+    root = json::parse(text, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
+  } catch (const json::parse_error& e) {
+    std::string detail = e.what();
+    const size_t colon = detail.find("error while parsing");
+    if (colon != std::string::npos) detail = detail.substr(colon);
+    r.fail("", fmt::format("{}: the file is not valid JSON ({})", position_of(text, e.byte),
+                           detail));
+  }
+  r.require_object(root, "", "a sketch file");
+  r.check_keys(root, "",
+               {"format", "body", "edge_length", "offset", "junction_tolerance", "corner_angle",
+                "relax_iterations", "fabric", "garment_mesh", "curves", "panels", "join",
+                "simulate", "output"});
+  if (root.contains("format")) {
+    const std::string format = r.text(root["format"], "/format");
+    if (format != kSketchFormat)
+      r.fail("/format", fmt::format("this program reads format \"{}\", not \"{}\"", kSketchFormat,
+                                    format));
+  }
+  if (root.contains("body")) parse_body(r, root["body"], sketch.body);
+  if (root.contains("edge_length")) {
+    sketch.edge_length = r.positive(root["edge_length"], "/edge_length");
+    if (sketch.edge_length < 0.002 || sketch.edge_length > 0.5)
+      r.fail("/edge_length", fmt::format("an edge length of {} m is outside 2 mm .. 50 cm",
+                                         sketch.edge_length));
+  }
+  if (root.contains("offset")) sketch.offset = r.number(root["offset"], "/offset");
+  if (root.contains("junction_tolerance"))
+    sketch.junction_tolerance = r.positive(root["junction_tolerance"], "/junction_tolerance");
+  if (root.contains("corner_angle")) {
+    sketch.corner_angle_degrees = r.positive(root["corner_angle"], "/corner_angle");
+    if (sketch.corner_angle_degrees >= 180)
+      r.fail("/corner_angle", "a corner angle is a turn in degrees below 180");
+  }
+  if (root.contains("relax_iterations"))
+    sketch.relax_iterations = r.integer(root["relax_iterations"], "/relax_iterations", 0);
+  if (root.contains("fabric")) sketch.fabric = r.text(root["fabric"], "/fabric");
+  if (root.contains("simulate")) parse_simulate(r, root["simulate"], sketch.simulate);
+  if (root.contains("output")) parse_output(r, root["output"], sketch.output);
+
+  if (root.contains("garment_mesh")) {
+    sketch.garment_mesh = r.text(root["garment_mesh"], "/garment_mesh");
+    if (root.contains("curves") || root.contains("panels"))
+      r.fail("/garment_mesh", "a file with \"garment_mesh\" skips sketching: remove \"curves\" "
+                              "and \"panels\" (or remove \"garment_mesh\")");
+    return sketch;
+  }
+
+  if (!root.contains("curves")) r.fail("", "the file has no \"curves\"");
+  const json& curves = root["curves"];
+  if (!curves.is_array()) r.fail("/curves", "expected a list of curves");
+  if (curves.empty()) r.fail("/curves", "the list of curves is empty");
+  for (size_t i = 0; i < curves.size(); ++i) {
+    CurveSpec curve = parse_curve(r, curves[i], fmt::format("/curves/{}", i), sketch);
+    if (const CurveSpec* other = sketch.find_curve(curve.id))
+      r.fail(curve.json_path + "/id", fmt::format("two curves have the id '{}' ({} and {})",
+                                                  curve.id, other->json_path, curve.json_path));
+    sketch.curves.push_back(std::move(curve));
+  }
+
+  if (!root.contains("panels")) r.fail("", "the file has no \"panels\"");
+  const json& panels = root["panels"];
+  if (!panels.is_array()) r.fail("/panels", "expected a list of panels");
+  if (panels.empty()) r.fail("/panels", "the list of panels is empty: a garment needs at least one panel");
+  for (size_t i = 0; i < panels.size(); ++i) {
+    PanelSpec panel = parse_panel(r, panels[i], fmt::format("/panels/{}", i), sketch);
+    if (const PanelSpec* other = sketch.find_panel(panel.id))
+      r.fail(panel.json_path + "/id", fmt::format("two panels have the id '{}' ({} and {})",
+                                                  panel.id, other->json_path, panel.json_path));
+    sketch.panels.push_back(std::move(panel));
+  }
+  if (root.contains("join")) {
+    const json& joins = root["join"];
+    if (!joins.is_array()) r.fail("/join", "expected a list of {\"id\": ..., \"panels\": [...]}");
+    std::set<std::string> joined;
+    for (size_t i = 0; i < joins.size(); ++i) {
+      const std::string ip = fmt::format("/join/{}", i);
+      const json& jj = joins[i];
+      r.require_object(jj, ip, "a join");
+      r.check_keys(jj, ip, {"id", "panels"});
+      JoinSpec join;
+      join.json_path = ip;
+      if (!jj.contains("id")) r.fail(ip, "a join needs an \"id\" for the merged panel");
+      join.id = r.identifier(jj["id"], ip + "/id");
+      if (!jj.contains("panels") || !jj["panels"].is_array() || jj["panels"].size() < 2)
+        r.fail(ip + "/panels", "a join lists at least two panel ids");
+      for (size_t k = 0; k < jj["panels"].size(); ++k) {
+        const std::string kp = fmt::format("{}/panels/{}", ip, k);
+        const std::string id = r.text(jj["panels"][k], kp);
+        const bool is_copy = id.ends_with(".mirror");
+        const PanelSpec* p = sketch.find_panel(is_copy ? id.substr(0, id.size() - 7) : id);
+        if (p == nullptr) r.fail(kp, fmt::format("panel '{}' is not defined", id));
+        if (is_copy && !p->mirror)
+          r.fail(kp, fmt::format("panel '{}' has no mirror copy (set \"mirror\": true on '{}')",
+                                 id, p->id));
+        if (!joined.insert(id).second)
+          r.fail(kp, fmt::format("panel '{}' is already part of a join", id));
+        join.panels.push_back(id);
+      }
+      for (const JoinSpec& other : sketch.joins)
+        if (other.id == join.id) r.fail(ip + "/id", fmt::format("two joins have the id '{}'", join.id));
+      sketch.joins.push_back(std::move(join));
+    }
+  }
+  return sketch;
+}
+
+Sketch load_sketch(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    const bool exists = std::filesystem::exists(path);
+    throw SketchError(path.string(), "",
+                      exists ? "the sketch file cannot be read" : "the sketch file does not exist");
+  }
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  return parse_sketch(buffer.str(), path.string(), path.parent_path());
+}
+
+}  // namespace sd::garment

@@ -1,0 +1,138 @@
+#pragma once
+// The sketch file (format "sketchdrape/1", docs/sketch-format.md): a plain model of what the
+// designer wrote, every value validated, with defaults filled in. Units are metres, +Y up, the
+// mannequin faces +Z. Parsing checks each field on its own; whether curves meet, panels close
+// and strokes land on the body is checked later (curve network, projection), with the same
+// SketchError and JSON paths.
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "garment/sketch_error.hpp"
+
+namespace sd::garment {
+
+inline constexpr const char* kSketchFormat = "sketchdrape/1";
+
+enum class ViewKind { kFront, kBack, kLeft, kRight, kCamera };
+
+// A perspective camera; 2D stroke points are metres in the plane through `target` that faces
+// the camera (x to the camera's right, y to its up).
+struct CameraSpec {
+  Eigen::Vector3d eye{0.0, 1.3, 3.0};
+  Eigen::Vector3d target{0.0, 1.0, 0.0};
+  Eigen::Vector3d up{0.0, 1.0, 0.0};
+  double fov_degrees = 35.0;  // vertical field of view (images only)
+};
+
+struct ViewSpec {
+  ViewKind kind = ViewKind::kFront;
+  CameraSpec camera;  // used when kind == kCamera
+  std::string name() const;
+};
+
+struct CurveSpec {
+  std::string id;
+  std::string json_path;                   // "/curves/3"
+  ViewSpec view;                           // the view `points` were drawn in
+  std::vector<Eigen::Vector2d> points;     // view-plane metres; empty when points3d is given
+  std::vector<Eigen::Vector3d> points3d;   // world metres; empty when points is given
+  double offset = 0.0;                     // metres along the body normal (default: file's)
+  bool on_body = true;                     // project/snap onto the body's offset surface
+  bool smooth = true;                      // Catmull-Rom through the points (false: polyline)
+  bool closed = false;                     // the last point joins the first
+  std::optional<double> edge_length;       // metres; overrides panel and global
+  std::optional<int> edges;                // fixed edge count (parity may not change it)
+
+  bool is_3d() const { return !points3d.empty(); }
+};
+
+struct PanelSpec {
+  std::string id;
+  std::string json_path;                   // "/panels/1"
+  std::vector<std::string> boundary;       // curve ids in order around the panel
+  bool auto_boundary = false;              // "boundary": "auto"
+  std::vector<std::string> corners;        // curves whose start (along the loop) is a corner
+  std::string fabric;                      // default: the file's fabric
+  bool mirror = false;                     // also make the copy across x = 0
+  std::optional<double> edge_length;       // metres
+  double ease = 1.0;                       // rest shape scale (1 = as designed)
+};
+
+struct JoinSpec {
+  std::string id;
+  std::string json_path;
+  std::vector<std::string> panels;
+};
+
+struct BodySpec {
+  std::string mesh = "builtin";            // "builtin" or a path relative to the sketch file
+  std::optional<double> height;            // metres
+  std::optional<double> scale;             // metres per file unit
+  std::optional<std::string> up;           // "+z", "y", ...
+};
+
+// Read now, used by the simulator (issue 5): plain values with defaults.
+struct SimulateSpec {
+  double duration = 3.0;                   // seconds of simulated time at most
+  bool adaptive = true;                    // 4-8 refinement/coarsening
+  double time_step = 0.005;                // seconds, initial
+  std::string integrator = "bdf2";         // "implicit-euler" | "bdf2"
+  std::string solver = "pcg";              // "pcg" | "cholmod"
+  bool stop_at_rest = true;
+  Eigen::Vector3d gravity{0.0, -9.81, 0.0};
+};
+
+struct ImageSpec {
+  // "front", "back", "left", "right", "three-quarter", or "camera" (then `camera` is used).
+  std::string view = "front";
+  CameraSpec camera;
+  int width = 800;
+  int height = 1200;
+  std::optional<bool> wireframe;           // default: output.wireframe
+};
+
+struct OutputSpec {
+  std::vector<ImageSpec> images;
+  std::string mesh = "garment.obj";        // file name of the stitched garment (.obj or .glb)
+  bool report = true;
+  bool wireframe = false;
+};
+
+struct Sketch {
+  std::string file;                        // as given, for messages
+  std::filesystem::path base_dir;          // relative paths resolve here
+  BodySpec body;
+  double edge_length = 0.03;               // metres
+  double offset = 0.01;                    // default curve offset, metres
+  double junction_tolerance = 0.015;       // metres: endpoints closer than this meet
+  double corner_angle_degrees = 35.0;      // a junction turning more than this is a corner
+  int relax_iterations = 30;               // interior smoothing sweeps of the quad filler
+  std::string fabric = "cotton-jersey";
+  std::optional<std::string> garment_mesh; // triangle garment file: skips sketching and meshing
+  std::vector<CurveSpec> curves;
+  std::vector<PanelSpec> panels;
+  std::vector<JoinSpec> joins;
+  SimulateSpec simulate;
+  OutputSpec output;
+
+  // Throws SketchError(file, json_path, sentence).
+  [[noreturn]] void fail(const std::string& json_path, const std::string& sentence) const;
+  const CurveSpec* find_curve(std::string_view id) const;
+  const PanelSpec* find_panel(std::string_view id) const;
+  std::filesystem::path resolve(const std::string& relative) const;
+};
+
+// Parses and validates the text of a sketch file; `file` names it in errors, `base_dir` is where
+// relative paths point. Throws SketchError.
+Sketch parse_sketch(std::string_view text, const std::string& file,
+                    const std::filesystem::path& base_dir = {});
+
+// Reads and parses a sketch file. Throws SketchError (also when the file cannot be read).
+Sketch load_sketch(const std::filesystem::path& path);
+
+}  // namespace sd::garment

@@ -1,0 +1,300 @@
+#include "garment/stroke_projection.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+namespace sd::garment {
+namespace {
+
+// Distance between segments [p0,p1] and [q0,q1] (Eberly's clamped closest points).
+double segment_distance(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
+                        const Eigen::Vector3d& q0, const Eigen::Vector3d& q1) {
+  const Eigen::Vector3d d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
+  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
+  double s = 0, t = 0;
+  if (a <= 1e-30 && e <= 1e-30) return r.norm();
+  if (a <= 1e-30) {
+    t = std::clamp(f / e, 0.0, 1.0);
+  } else {
+    const double c = d1.dot(r);
+    if (e <= 1e-30) {
+      s = std::clamp(-c / a, 0.0, 1.0);
+    } else {
+      const double b = d1.dot(d2), denom = a * e - b * b;
+      s = denom > 1e-30 ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
+      t = (b * s + f) / e;
+      if (t < 0) {
+        t = 0;
+        s = std::clamp(-c / a, 0.0, 1.0);
+      } else if (t > 1) {
+        t = 1;
+        s = std::clamp((b - c) / a, 0.0, 1.0);
+      }
+    }
+  }
+  return ((p0 + s * d1) - (q0 + t * d2)).norm();
+}
+
+double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return a.x() * b.y() - a.y() * b.x();
+}
+
+// Proper crossing (or touching) of two 2D segments.
+bool segments_cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,
+                    const Eigen::Vector2d& d) {
+  const double d1 = cross2(b - a, c - a), d2 = cross2(b - a, d - a);
+  const double d3 = cross2(d - c, a - c), d4 = cross2(d - c, b - c);
+  return ((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0)) && d1 != 0 && d2 != 0 && d3 != 0 &&
+         d4 != 0;
+}
+
+template <int D>
+using Vec = Eigen::Matrix<double, D, 1>;
+
+// Centripetal Catmull-Rom segment between p1 and p2 at parameter u in [0, 1].
+template <int D>
+Vec<D> catmull_rom(const Vec<D>& p0, const Vec<D>& p1, const Vec<D>& p2, const Vec<D>& p3,
+                   double u) {
+  auto knot = [](const Vec<D>& a, const Vec<D>& b) {
+    return std::max(std::sqrt((b - a).norm()), 1e-9);
+  };
+  const double t0 = 0, t1 = t0 + knot(p0, p1), t2 = t1 + knot(p1, p2), t3 = t2 + knot(p2, p3);
+  const double t = t1 + u * (t2 - t1);
+  const Vec<D> a1 = (t1 - t) / (t1 - t0) * p0 + (t - t0) / (t1 - t0) * p1;
+  const Vec<D> a2 = (t2 - t) / (t2 - t1) * p1 + (t - t1) / (t2 - t1) * p2;
+  const Vec<D> a3 = (t3 - t) / (t3 - t2) * p2 + (t - t2) / (t3 - t2) * p3;
+  const Vec<D> b1 = (t2 - t) / (t2 - t0) * a1 + (t - t0) / (t2 - t0) * a2;
+  const Vec<D> b2 = (t3 - t) / (t3 - t1) * a2 + (t - t1) / (t3 - t1) * a3;
+  return (t2 - t) / (t2 - t1) * b1 + (t - t1) / (t2 - t1) * b2;
+}
+
+}  // namespace
+
+Eigen::Vector3d ViewFrame::plane_point(const Eigen::Vector2d& uv) const {
+  return plane_origin + uv.x() * right + uv.y() * up;
+}
+
+void ViewFrame::ray(const Eigen::Vector2d& uv, double far, Eigen::Vector3d& origin,
+                    Eigen::Vector3d& unit_direction) const {
+  const Eigen::Vector3d p = plane_point(uv);
+  if (perspective) {
+    origin = eye;
+    unit_direction = (p - eye).normalized();
+  } else {
+    origin = p - far * direction;
+    unit_direction = direction;
+  }
+}
+
+ViewFrame view_frame(const ViewSpec& view) {
+  ViewFrame f;
+  f.plane_origin = Eigen::Vector3d::Zero();
+  f.up = Eigen::Vector3d::UnitY();
+  switch (view.kind) {
+    case ViewKind::kFront:
+      f.right = Eigen::Vector3d::UnitX();
+      f.direction = -Eigen::Vector3d::UnitZ();
+      break;
+    case ViewKind::kBack:
+      f.right = -Eigen::Vector3d::UnitX();
+      f.direction = Eigen::Vector3d::UnitZ();
+      break;
+    case ViewKind::kLeft:
+      f.right = -Eigen::Vector3d::UnitZ();
+      f.direction = -Eigen::Vector3d::UnitX();
+      break;
+    case ViewKind::kRight:
+      f.right = Eigen::Vector3d::UnitZ();
+      f.direction = Eigen::Vector3d::UnitX();
+      break;
+    case ViewKind::kCamera: {
+      const CameraSpec& c = view.camera;
+      f.perspective = true;
+      f.eye = c.eye;
+      f.direction = (c.target - c.eye).normalized();
+      f.right = f.direction.cross(c.up).normalized();
+      f.up = f.right.cross(f.direction);
+      f.plane_origin = c.target;
+      break;
+    }
+  }
+  return f;
+}
+
+template <int D>
+std::vector<Vec<D>> sample_stroke(const std::vector<Vec<D>>& points, bool closed, bool smooth,
+                                  double spacing) {
+  const int n = static_cast<int>(points.size());
+  const int segments = closed ? n : n - 1;
+  auto at = [&](int i) -> const Vec<D>& {
+    if (closed) return points[static_cast<size_t>(((i % n) + n) % n)];
+    return points[static_cast<size_t>(std::clamp(i, 0, n - 1))];
+  };
+  std::vector<Vec<D>> out;
+  for (int s = 0; s < segments; ++s) {
+    const Vec<D>& a = at(s);
+    const Vec<D>& b = at(s + 1);
+    Vec<D> before = at(s - 1), after = at(s + 2);
+    if (!closed && s == 0) before = 2 * a - b;  // reflected end tangents
+    if (!closed && s == segments - 1) after = 2 * b - a;
+    const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / spacing)));
+    for (int k = 0; k < steps; ++k) {
+      const double u = static_cast<double>(k) / steps;
+      out.push_back(smooth && n > 2 ? catmull_rom<D>(before, a, b, after, u) : Vec<D>(a + u * (b - a)));
+    }
+  }
+  if (!closed) out.push_back(points.back());
+  return out;
+}
+
+template std::vector<Vec<2>> sample_stroke<2>(const std::vector<Vec<2>>&, bool, bool, double);
+template std::vector<Vec<3>> sample_stroke<3>(const std::vector<Vec<3>>&, bool, bool, double);
+
+std::pair<int, int> find_self_intersection(const std::vector<Eigen::Vector2d>& polyline,
+                                           bool closed) {
+  const int n = static_cast<int>(polyline.size());
+  const int segments = closed ? n : n - 1;
+  for (int i = 0; i < segments; ++i)
+    for (int j = i + 2; j < segments; ++j) {
+      if (closed && i == 0 && j == segments - 1) continue;  // neighbours through the wrap
+      if (segments_cross(polyline[static_cast<size_t>(i)], polyline[static_cast<size_t>((i + 1) % n)],
+                         polyline[static_cast<size_t>(j)], polyline[static_cast<size_t>((j + 1) % n)]))
+        return {i, j};
+    }
+  return {-1, -1};
+}
+
+std::pair<int, int> find_self_intersection(const Eigen::MatrixX3d& polyline, bool closed,
+                                           double tolerance) {
+  const int n = static_cast<int>(polyline.rows());
+  const int segments = closed ? n : n - 1;
+  for (int i = 0; i < segments; ++i)
+    for (int j = i + 3; j < segments; ++j) {
+      if (closed && (i + segments - j) < 3) continue;
+      const double d = segment_distance(polyline.row(i), polyline.row((i + 1) % n),
+                                        polyline.row(j), polyline.row((j + 1) % n));
+      if (d < tolerance) return {i, j};
+    }
+  return {-1, -1};
+}
+
+ProjectedCurve project_curve(const Sketch& sketch, const CurveSpec& curve, const BodySurface* body) {
+  ProjectedCurve out;
+  out.id = curve.id;
+  out.json_path = curve.json_path;
+  out.closed = curve.closed;
+  out.offset = curve.offset;
+  out.on_body = curve.on_body;
+  const std::string points_path = curve.json_path + (curve.is_3d() ? "/points3d" : "/points");
+
+  if (curve.is_3d()) {
+    const auto dense = sample_stroke<3>(curve.points3d, curve.closed, curve.smooth, kCurveSampleSpacing);
+    out.points.resize(static_cast<Eigen::Index>(dense.size()), 3);
+    for (size_t i = 0; i < dense.size(); ++i) {
+      Eigen::Vector3d p = dense[i];
+      if (curve.on_body && body != nullptr) p = body->snap_to_offset(p, curve.offset);
+      out.points.row(static_cast<Eigen::Index>(i)) = p.transpose();
+    }
+  } else {
+    const auto dense = sample_stroke<2>(curve.points, curve.closed, curve.smooth, kCurveSampleSpacing);
+    const auto [i, j] = find_self_intersection(dense, curve.closed);
+    if (i >= 0) {
+      const Eigen::Vector2d where = dense[static_cast<size_t>(i)];
+      sketch.fail(points_path,
+                  fmt::format("curve '{}' crosses itself near ({:.3f}, {:.3f}) in the {} view; a "
+                              "curve must not cross itself",
+                              curve.id, where.x(), where.y(), curve.view.name()));
+    }
+    const ViewFrame frame = view_frame(curve.view);
+    const double far = 10.0;  // metres behind the plane: outside any body of human size
+    const size_t n = dense.size();
+    std::vector<Eigen::Vector3d> origins(n), directions(n);
+    std::vector<double> depth(n, 0.0);
+    std::vector<bool> hit(n, false);
+    int hits = 0;
+    for (size_t k = 0; k < n; ++k) {
+      frame.ray(dense[k], far, origins[k], directions[k]);
+      if (!curve.on_body || body == nullptr) {
+        depth[k] = frame.perspective ? (frame.plane_point(dense[k]) - origins[k]).norm() : far;
+        hit[k] = true;
+        ++hits;
+        continue;
+      }
+      if (auto s = body->first_hit(origins[k], directions[k])) {
+        const Eigen::Vector3d p = s->position + curve.offset * s->normal;
+        depth[k] = (p - origins[k]).dot(directions[k]);
+        hit[k] = true;
+        ++hits;
+      }
+    }
+    if (hits == 0)
+      sketch.fail(points_path,
+                  fmt::format("curve '{}' misses the body entirely in the {} view: none of its "
+                              "rays meets the mannequin (check the coordinates: metres, y up "
+                              "from the feet), or set \"on_body\": false",
+                              curve.id, curve.view.name()));
+    // Misses take their depth from the nearest hits on either side (linear in sample index,
+    // which is proportional to 2D arc length), or from the one hit side at the ends.
+    out.misses = static_cast<int>(n) - hits;
+    std::vector<int> previous(n, -1), next(n, -1);
+    for (size_t k = 0, last = static_cast<size_t>(-1); k < n; ++k) {
+      if (hit[k]) last = k;
+      previous[k] = static_cast<int>(last);
+    }
+    for (size_t k = n, last = static_cast<size_t>(-1); k-- > 0;) {
+      if (hit[k]) last = k;
+      next[k] = static_cast<int>(last);
+    }
+    out.points.resize(static_cast<Eigen::Index>(n), 3);
+    for (size_t k = 0; k < n; ++k) {
+      double d = depth[k];
+      if (!hit[k]) {
+        const int a = previous[k], b = next[k];
+        if (a >= 0 && b >= 0) {
+          const double w = (static_cast<double>(k) - a) / (b - a);
+          d = (1 - w) * depth[static_cast<size_t>(a)] + w * depth[static_cast<size_t>(b)];
+        } else {
+          d = depth[static_cast<size_t>(a >= 0 ? a : b)];
+        }
+      }
+      out.points.row(static_cast<Eigen::Index>(k)) = (origins[k] + d * directions[k]).transpose();
+    }
+    if (out.misses > 0)
+      spdlog::debug("curve '{}': {} of {} rays missed the body; depth interpolated", curve.id,
+                    out.misses, n);
+  }
+  // A light smoothing pass removes the facets of the body from the projected curve.
+  const Eigen::Index n = out.points.rows();
+  for (int pass = 0; pass < 2 && n > 2; ++pass) {
+    Eigen::MatrixX3d smoothed = out.points;
+    for (Eigen::Index k = 0; k < n; ++k) {
+      if (!curve.closed && (k == 0 || k == n - 1)) continue;
+      const Eigen::Index a = (k + n - 1) % n, b = (k + 1) % n;
+      smoothed.row(k) = 0.5 * out.points.row(k) + 0.25 * (out.points.row(a) + out.points.row(b));
+    }
+    out.points = smoothed;
+  }
+  if (curve.closed && n > 1 && (out.points.row(0) - out.points.row(n - 1)).norm() < 1e-9)
+    out.points.conservativeResize(n - 1, 3);
+  const auto [i, j] = find_self_intersection(out.points, curve.closed, 1e-3);
+  if (i >= 0) {
+    const Eigen::RowVector3d where = out.points.row(i);
+    sketch.fail(points_path, fmt::format("curve '{}' crosses itself near ({:.3f}, {:.3f}, {:.3f}); "
+                                         "a curve must not cross itself",
+                                         curve.id, where.x(), where.y(), where.z()));
+  }
+  return out;
+}
+
+std::vector<ProjectedCurve> project_curves(const Sketch& sketch, const BodySurface& body) {
+  std::vector<ProjectedCurve> curves;
+  curves.reserve(sketch.curves.size());
+  for (const CurveSpec& c : sketch.curves) curves.push_back(project_curve(sketch, c, &body));
+  return curves;
+}
+
+}  // namespace sd::garment
