@@ -240,7 +240,10 @@ Mesh48 Mesh48::from_quads(const Eigen::MatrixX3d& vertices, const Eigen::MatrixX
       triangles.push_back({c[2], c[3], c[1]});
     }
   }
-  return build(std::move(rest), triangles);
+  Mesh48 m = build(std::move(rest), triangles);
+  m.root_source_.resize(triangles.size());
+  for (std::size_t t = 0; t < triangles.size(); ++t) m.root_source_[t] = static_cast<int>(t / 2);
+  return m;
 }
 
 Mesh48 Mesh48::from_quads(const QuadMesh& mesh) {
@@ -281,7 +284,9 @@ Mesh48 Mesh48::from_triangles_sqrt3(const TriMesh& mesh, Sqrt3Stats* stats) {
 
   Sqrt3Stats counts;
   std::vector<std::array<int, 3>> triangles;
+  std::vector<int> source;  // input face each triangle is attributed to
   triangles.reserve(6 * face_slots);
+  source.reserve(6 * face_slots);
   for (int f = 0; f < nf; ++f) {
     for (int k = 0; k < 3; ++k) {
       const int i = mesh.faces(f, k), j = mesh.faces(f, (k + 1) % 3);
@@ -289,6 +294,7 @@ Mesh48 Mesh48::from_triangles_sqrt3(const TriMesh& mesh, Sqrt3Stats* stats) {
       const int cf = nv + f;
       if (g < 0) {  // boundary edge: one triangle, its diagonal is the input edge
         triangles.push_back({cf, i, j});
+        source.push_back(f);
         ++counts.blocks;
         ++counts.boundary_blocks;
         continue;
@@ -305,15 +311,19 @@ Mesh48 Mesh48::from_triangles_sqrt3(const TriMesh& mesh, Sqrt3Stats* stats) {
       if (keeps_side(i, cg, cf) && keeps_side(j, cf, cg)) {
         triangles.push_back({i, cg, cf});
         triangles.push_back({j, cf, cg});
+        source.insert(source.end(), {f, g});
       } else {
         triangles.push_back({cf, i, j});
         triangles.push_back({cg, j, i});
+        source.insert(source.end(), {f, g});
         ++counts.unswapped_blocks;
       }
     }
   }
   if (stats) *stats = counts;
-  return build(std::move(rest), triangles);
+  Mesh48 m = build(std::move(rest), triangles);
+  m.root_source_ = std::move(source);
+  return m;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -447,6 +457,9 @@ BlockId Mesh48::block(TriangleId t) const {
 }
 int Mesh48::level(TriangleId t) const {
   return triangle_at(t).level;
+}
+int Mesh48::source_face(TriangleId t) const {
+  return root_source_[triangle_at(t).root];
 }
 
 double Mesh48::rest_area(TriangleId t) const {

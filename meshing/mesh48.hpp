@@ -120,6 +120,10 @@ class Mesh48 {
   TriangleId neighbor(TriangleId t, int k) const;  // across the edge opposite vertex k
   BlockId block(TriangleId t) const;
   int level(TriangleId t) const;
+  // The input face the triangle lies in: its quad for from_quads; for √3, whose blocks straddle
+  // an input edge, one of the edge's two faces (each triangle of a block gets one of them).
+  // Lets per-face data (panel, fabric) reach every level.
+  int source_face(TriangleId t) const;
   double rest_area(TriangleId t) const;
   Eigen::Vector3d rest_normal(TriangleId t) const;  // unit
 
@@ -238,6 +242,7 @@ class Mesh48 {
   // total boundary length.
   std::vector<Eigen::Vector3d> root_normals_;
   std::vector<double> root_areas_;
+  std::vector<int> root_source_;  // input face of each level-0 triangle
   double input_area_ = 0;
   double input_boundary_length_ = 0;
 };

@@ -127,6 +127,14 @@ TEST(Mesh48Quads, GridGivesOneLevelZeroBlockPerQuad) {
     EXPECT_TRUE(mesh.triangles(k)[1].valid());  // every quad block has both triangles
     EXPECT_FALSE(mesh.is_pending(k));
   }
+  for (const TriangleId t : mesh.live_triangles()) {
+    // Each triangle lies in its source quad: its centroid is inside the quad's square.
+    const int q = mesh.source_face(t);
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (const VertexId v : mesh.vertices(t)) centroid += mesh.rest_position(v) / 3;
+    EXPECT_NEAR(centroid.x(), (q % nx + 0.5) * 0.1, 0.05);
+    EXPECT_NEAR(centroid.y(), (q / nx + 0.5) * 0.1, 0.05);
+  }
   const Mesh48Arrays arrays = mesh.arrays();
   EXPECT_EQ(arrays.faces.rows(), 2 * nx * ny);
   EXPECT_EQ(arrays.rest_positions, g.vertices);
@@ -209,6 +217,18 @@ TEST(Mesh48Sqrt3, ClosedSphereHasOneBlockPerEdge) {
     for (const VertexId v : mesh.diagonal(k)) EXPECT_GE(v.value(), nv);
     for (const VertexId v : mesh.apexes(k)) EXPECT_LT(v.value(), nv);
   }
+  // A triangle's source face is one whose centre it touches; refinement passes it down.
+  Mesh48 refined = mesh;
+  for (const BlockId k : refined.leaf_blocks())
+    if (refined.can_split(k)) (void)refined.split(k);
+  for (const TriangleId t : mesh.live_triangles()) {
+    const auto& v = mesh.vertices(t);
+    const VertexId centre(nv + mesh.source_face(t));
+    EXPECT_TRUE(std::find(v.begin(), v.end(), centre) != v.end());
+  }
+  std::vector<int> per_face(static_cast<std::size_t>(nf), 0);
+  for (const TriangleId t : refined.live_triangles()) ++per_face[refined.source_face(t)];
+  for (const int count : per_face) EXPECT_EQ(count, 6);  // 3 triangles per face, each halved
   // Face centres are the centroids and input vertices keep their positions.
   for (int f = 0; f < nf; ++f) {
     const Eigen::Vector3d centre =
