@@ -117,8 +117,7 @@ Mesh48 Mesh48::build(std::vector<Eigen::Vector3d> rest,
   for (int i = 0; i < nv; ++i) {
     if (!rest[i].allFinite())
       throw Mesh48InputError("vertex " + std::to_string(i) +
-                             " has a coordinate that is not a "
-                             "finite number");
+                             " has a coordinate that is not a finite number");
     m.vertices_[i].rest = rest[i];
     m.vertices_[i].alive = true;
   }
