@@ -422,6 +422,20 @@ TEST(Mesh48Split, OneBlockBisectsItsDiagonalIntoExactHalves) {
   EXPECT_TRUE(mesh.can_merge(k));
 }
 
+TEST(Mesh48Split, RefusesSplitBlocksAndDeadIds) {
+  const auto g = quad_grid(2, 2);
+  Mesh48 mesh = Mesh48::from_quads(g.vertices, g.quads);
+  (void)mesh.split(BlockId(0));
+  EXPECT_FALSE(mesh.can_split(BlockId(0)));
+  EXPECT_THROW((void)mesh.split(BlockId(0)), Mesh48OperationError);
+  EXPECT_FALSE(mesh.can_split(BlockId(999)));
+  EXPECT_THROW((void)mesh.split(BlockId(999)), Mesh48OperationError);
+  EXPECT_THROW((void)mesh.split(BlockId{}), Mesh48OperationError);
+  EXPECT_THROW((void)mesh.rest_position(VertexId(999)), Mesh48OperationError);
+  EXPECT_THROW((void)mesh.split_edge(VertexId(0), VertexId(999)), Mesh48OperationError);
+  EXPECT_VALID(mesh);
+}
+
 TEST(Mesh48Split, PendingBlockForcesTheCoarserNeighbourFirst) {
   const auto g = quad_grid(2, 1);
   Mesh48 mesh = Mesh48::from_quads(g.vertices, g.quads);
