@@ -117,32 +117,20 @@ PatchTopology build_topology(const std::vector<Eigen::MatrixX3d>& side_points,
   return topology;
 }
 
-// Sides for display: corners on the unit circle at angles proportional to the edge counts
-// before them, each side a circular arc bulging outwards (sagitta 15% of its chord), so that
-// no two sides are collinear and promoted corners do not sit on a straight line.
+// Sides for display: every boundary vertex on the unit circle at an angle proportional to its
+// position along the boundary, so no three are collinear (a promoted corner never sits on a
+// straight line) and side lengths follow the counts.
 std::vector<Eigen::MatrixX3d> display_sides(std::span<const int> counts) {
   const int total = std::accumulate(counts.begin(), counts.end(), 0);
-  auto on_circle = [&](double position) {
-    const double angle = 2 * std::numbers::pi * position / total - std::numbers::pi / 2;
-    return Eigen::Vector2d(std::cos(angle), std::sin(angle));
-  };
   std::vector<Eigen::MatrixX3d> sides;
   int start = 0;
   for (const int count : counts) {
-    const Eigen::Vector2d a = on_circle(start), b = on_circle(start + count);
-    Eigen::Vector2d outward = 0.5 * (a + b);  // towards the side's outside
-    const double chord = (b - a).norm();
-    outward = outward.norm() > 1e-9 ? Eigen::Vector2d(outward.normalized())
-                                    : Eigen::Vector2d(Eigen::Vector2d(b - a).normalized().y(),
-                                                      -Eigen::Vector2d(b - a).normalized().x());
     Eigen::MatrixX3d side(count + 1, 3);
     for (int k = 0; k <= count; ++k) {
-      const double t = static_cast<double>(k) / count;
-      const Eigen::Vector2d p = (1 - t) * a + t * b + 4 * 0.15 * chord * t * (1 - t) * outward;
-      side.row(k) << p.x(), p.y(), 0.0;
+      const double angle =
+          2 * std::numbers::pi * ((start + k) % total) / total - std::numbers::pi / 2;
+      side.row(k) << std::cos(angle), std::sin(angle), 0.0;
     }
-    side.row(0) << a.x(), a.y(), 0.0;
-    side.row(count) << b.x(), b.y(), 0.0;
     sides.push_back(side);
     start += count;
   }

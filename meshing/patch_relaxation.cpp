@@ -65,12 +65,14 @@ double local_min_jacobian(const QuadMesh& mesh, const Adjacency& adj,
   for (int c = adj.corner_start[static_cast<size_t>(v)];
        c < adj.corner_start[static_cast<size_t>(v) + 1]; ++c) {
     const int f = adj.corners[static_cast<size_t>(c)] / 4;
+    Eigen::Vector3d n = Eigen::Vector3d::Zero();  // the quad's reference normal
+    for (int k = 0; k < 4; ++k) n += normals.row(mesh.faces(f, k)).transpose();
     for (int k = 0; k < 4; ++k) {
       const int a = mesh.faces(f, k);
       const Eigen::Vector3d e1 = pos(mesh.faces(f, (k + 1) % 4)) - pos(a);
       const Eigen::Vector3d e2 = pos(mesh.faces(f, (k + 3) % 4)) - pos(a);
       const double denom = e1.norm() * e2.norm();
-      const double jac = denom > 0 ? e1.cross(e2).dot(normals.row(a)) / denom : -1.0;
+      const double jac = denom > 0 ? e1.cross(e2).dot(n) / (denom * n.norm()) : -1.0;
       worst = std::min(worst, jac);
     }
   }

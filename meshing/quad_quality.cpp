@@ -50,6 +50,11 @@ QuadQuality measure_quality(const QuadMesh& mesh, std::span<const int> corner_ve
   for (Eigen::Index f = 0; f < q.rows(); ++f) {
     double quad_jac = std::numeric_limits<double>::infinity();
     double shortest = std::numeric_limits<double>::infinity(), longest = 0;
+    // The quad's reference normal: the sum of its vertices' normals, so that a folded corner
+    // (or a whole flipped quad among good neighbours) shows a negative Jacobian.
+    Eigen::Vector3d n = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 4; ++k) n += normals.row(q(f, k)).transpose();
+    const double nn = n.norm();
     for (int k = 0; k < 4; ++k) {
       const Eigen::Vector3d p = x.row(q(f, k));
       const Eigen::Vector3d e1 = x.row(q(f, (k + 1) % 4)).transpose() - p;
@@ -59,8 +64,6 @@ QuadQuality measure_quality(const QuadMesh& mesh, std::span<const int> corner_ve
       longest = std::max(longest, l1);
       const double angle =
           (l1 > 0 && l2 > 0) ? std::acos(std::clamp(e1.dot(e2) / (l1 * l2), -1.0, 1.0)) : 0.0;
-      Eigen::Vector3d n = normals.row(q(f, k));
-      const double nn = n.norm();
       const double jac = (l1 > 0 && l2 > 0 && nn > 0) ? e1.cross(e2).dot(n / nn) / (l1 * l2) : 0.0;
       // A corner whose scaled Jacobian is negative is reflex or folded: its angle is > 180°.
       const double degrees = (jac < 0 ? 2 * std::numbers::pi - angle : angle) * 180 / std::numbers::pi;

@@ -25,8 +25,8 @@ struct QuadQuality {
 QuadQuality measure_valence(const QuadMesh& mesh, std::span<const int> corner_vertices);
 
 // All figures. The scaled Jacobian at a corner is ((e1 × e2) · n) / (|e1| |e2|), with n the
-// vertex normal there (area-weighted over the incident quads), so a folded quad shows up as
-// negative even on a curved 3D patch.
+// quad's reference normal: the sum of its vertices' normals (each the sum of the corner cross
+// products around the vertex), so a folded quad shows up as negative even on a curved patch.
 QuadQuality measure_quality(const QuadMesh& mesh, std::span<const int> corner_vertices);
 
 }  // namespace sd::meshing

@@ -33,6 +33,7 @@ int run_cli(int argc, char** argv) {
   app.parse_complete_callback([&] { configure_logging(global); });
 
   add_info_command(app, global);
+  add_fill_command(app, global);
   add_render_command(app, global);
   add_validate_command(app, global);
   add_mesh_command(app, global);

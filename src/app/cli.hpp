@@ -23,6 +23,7 @@ int run_cli(int argc, char** argv);
 
 // Each subcommand lives in its own <name>_command.cpp and registers itself here.
 void add_info_command(CLI::App& app, const GlobalOptions& global);
+void add_fill_command(CLI::App& app, const GlobalOptions& global);
 void add_render_command(CLI::App& app, const GlobalOptions& global);
 void add_validate_command(CLI::App& app, const GlobalOptions& global);
 void add_mesh_command(CLI::App& app, const GlobalOptions& global);

@@ -1,0 +1,58 @@
+#!/usr/bin/env python3
+"""Writes the case list of the meshing regression corpus (corpus.json) WITHOUT expectations.
+
+Run once to (re)create the list; then fill in the expected figures with
+    SD_UPDATE_MESHING_CORPUS=1 ctest -R MeshingCorpus    (see docs/meshing.md)
+Deterministic: a fixed seed, so the same list comes out every time.
+"""
+import json
+import random
+import sys
+
+rng = random.Random(20240611)
+
+
+def even(counts):
+    """Makes the total even by adding 1 to the shortest side (never to zero)."""
+    if sum(counts) % 2:
+        i = counts.index(min(counts))
+        counts[i] += 1
+    return counts
+
+
+cases = []
+
+
+def add(family, counts):
+    counts = even(list(counts))
+    name = f"{family}-n{len(counts)}-{sum(1 for c in cases if c['family'] == family and len(c['sides']) == len(counts))}"
+    cases.append({"name": name, "family": family, "sides": counts})
+
+
+# The figures Takayama, Panozzo & Sorkine-Hornung (2014) report; we must never be worse.
+for counts in ([3, 3, 4], [5, 5, 6], [5, 6, 3, 6, 4], [3, 3, 3, 3, 4], [6, 4, 4, 2], [10, 4, 4, 2],
+               [2, 2, 2, 2, 2, 2], [4, 3, 3, 4, 3, 3], [2, 8, 4], [4, 4, 4, 4]):
+    add("reference", counts)
+
+for n in range(2, 11):
+    for _ in range(9):
+        add("fair", [rng.randint(4, 12) for _ in range(n)])
+    for _ in range(4):
+        counts = [rng.randint(2, 6) for _ in range(n)]
+        counts[rng.randrange(n)] = rng.randint(30, 60)
+        add("one-long", counts)
+    for _ in range(3):
+        counts = [rng.randint(2, 6) for _ in range(n)]
+        i = rng.randrange(n)
+        j = (i + rng.randint(1, n - 1)) % n
+        counts[i], counts[j] = rng.randint(20, 40), rng.randint(20, 40)
+        add("two-long", counts)
+    for _ in range(2):
+        add("alternating", [rng.randint(12, 24) if k % 2 == 0 else rng.randint(1, 4) for k in range(n)])
+    add("all-ones", [1] * n if n > 2 else [1, 3])
+    for _ in range(3):
+        add("large", [rng.randint(30, 60) for _ in range(n)])
+
+# One case per line, so that a diff shows which figures changed.
+lines = [json.dumps(c) for c in cases]
+sys.stdout.write('{"format": "sketchdrape-meshing-corpus/1",\n "cases": [\n  ' + ",\n  ".join(lines) + "\n ]\n}\n")
