@@ -44,7 +44,7 @@ PatchTopology fill_region(std::span<const int> side_counts);
 
 struct FillGeometryOptions {
   // Sweeps of interior smoothing after Coons interpolation (0 keeps the Coons positions).
-  int relax_iterations = 30;
+  int relax_iterations = 10;
   // Optional: moves an interior point onto the target surface (e.g. the body's offset surface);
   // applied after every relaxation sweep and at the end.
   std::function<Eigen::Vector3d(const Eigen::Vector3d&)> project;

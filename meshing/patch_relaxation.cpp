@@ -86,11 +86,11 @@ void relax_interior(QuadMesh& mesh, std::span<const char> fixed, int sweeps,
   if (sweeps <= 0) return;
   const Adjacency adj = build_adjacency(mesh);
   constexpr double kAcceptable = 0.05;  // a move may lower the local minimum down to this
-  // Stop once no vertex moves more than 1e-4 of the mean edge length in a sweep.
+  // Stop once no vertex moves more than 1e-3 of the mean edge length in a sweep.
   double edge_sum = 0;
   for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f)
     edge_sum += (mesh.vertices.row(mesh.faces(f, 0)) - mesh.vertices.row(mesh.faces(f, 1))).norm();
-  const double tolerance = 1e-4 * edge_sum / std::max<Eigen::Index>(mesh.faces.rows(), 1);
+  const double tolerance = 1e-3 * edge_sum / std::max<Eigen::Index>(mesh.faces.rows(), 1);
   const double tolerance2 = tolerance * tolerance;
   for (int sweep = 0; sweep < sweeps; ++sweep) {
     const Eigen::MatrixX3d normals = corner_normals(mesh);

@@ -14,7 +14,7 @@ namespace sd::meshing {
 // smallest scaled Jacobian of the vertex's quads below min(current, 0.05), measured against
 // the vertex normals at the start of the sweep; so the relaxation never folds a quad it did not
 // receive folded, and can only unfold. `project`, when set, maps each moved vertex back onto
-// the target surface after the move. Stops early once no vertex moves more than 1e-4 of the
+// the target surface after the move. Stops early once no vertex moves more than 1e-3 of the
 // mean edge length in a sweep.
 void relax_interior(QuadMesh& mesh, std::span<const char> fixed, int sweeps,
                     const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& project = {});

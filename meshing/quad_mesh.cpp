@@ -2,7 +2,6 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
-#include <map>
 #include <span>
 #include <sstream>
 #include <stdexcept>
@@ -10,16 +9,6 @@
 
 namespace sd::meshing {
 namespace {
-
-// Directed edge (from, to) → how many faces traverse it that way.
-using EdgeUses = std::map<std::pair<int, int>, int>;
-
-EdgeUses directed_edges(const QuadMesh& mesh) {
-  EdgeUses uses;
-  for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f)
-    for (int k = 0; k < 4; ++k) ++uses[{mesh.faces(f, k), mesh.faces(f, (k + 1) % 4)}];
-  return uses;
-}
 
 bool indices_in_range(const QuadMesh& mesh) {
   const auto nv = static_cast<int>(mesh.vertices.rows());
@@ -127,20 +116,34 @@ MeshCheck validate(const QuadMesh& mesh) {
         if (q(a) == q(b))
           problems.push_back("face " + std::to_string(f) + " repeats vertex " + std::to_string(q(a)));
   }
-  const EdgeUses uses = directed_edges(mesh);
+  const OutgoingEdges out = outgoing_edges(mesh);
+  auto uses = [&](int from, int to) {
+    const auto row = out.of(from);
+    return static_cast<int>(std::count(row.begin(), row.end(), to));
+  };
   int non_manifold = 0, inconsistent = 0;
-  for (const auto& [edge, count] : uses) {
-    if (count > 1) ++inconsistent;  // two faces traverse it the same way
-    const auto twin = uses.find({edge.second, edge.first});
-    const int total = count + (twin == uses.end() ? 0 : twin->second);
-    if (total > 2 && edge.first < edge.second) ++non_manifold;
+  Eigen::Index undirected_edges = 0;
+  for (int v = 0; v < static_cast<int>(mesh.vertices.rows()); ++v) {
+    const auto row = out.of(v);
+    for (size_t i = 0; i < row.size(); ++i) {
+      const int w = row[i];
+      if (std::find(row.begin(), row.begin() + static_cast<std::ptrdiff_t>(i), w) !=
+          row.begin() + static_cast<std::ptrdiff_t>(i))
+        continue;  // this directed edge was already counted
+      const int forward = uses(v, w), backward = uses(w, v);
+      if (forward > 1) ++inconsistent;  // two faces traverse it the same way
+      if (backward == 0 || v < w) {
+        ++undirected_edges;
+        if (forward + backward > 2) ++non_manifold;
+      }
+    }
   }
   if (non_manifold > 0)
     problems.push_back(std::to_string(non_manifold) + " edge(s) have more than two faces");
   if (inconsistent > 0)
     problems.push_back(std::to_string(inconsistent) +
-                         " edge(s) are traversed the same way by two faces (inconsistent "
-                         "orientation)");
+                       " edge(s) are traversed the same way by two faces (inconsistent "
+                       "orientation)");
   std::vector<bool> used(static_cast<size_t>(mesh.vertices.rows()), false);
   for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f)
     for (int k = 0; k < 4; ++k) used[static_cast<size_t>(mesh.faces(f, k))] = true;
@@ -153,13 +156,10 @@ MeshCheck validate(const QuadMesh& mesh) {
       problems.emplace_back(e.what());
     }
   }
-  // Vertex manifoldness: the faces around each vertex form one fan (checked through the
-  // Euler characteristic of a disk: V - E + F = 1, given one boundary loop and no bad edges).
+  // A fan at every vertex (no two disks touching at a vertex): with one boundary loop and no
+  // bad edges, that is the Euler characteristic of a disk, V - E + F = 1.
   if (problems.empty()) {
-    std::map<std::pair<int, int>, bool> undirected;
-    for (const auto& [edge, count] : uses) undirected[std::minmax(edge.first, edge.second)] = true;
-    const auto euler = mesh.vertices.rows() - static_cast<Eigen::Index>(undirected.size()) +
-                       mesh.faces.rows();
+    const auto euler = mesh.vertices.rows() - undirected_edges + mesh.faces.rows();
     if (euler != 1)
       problems.push_back("Euler characteristic is " + std::to_string(euler) + ", not 1 (not a disk)");
   }
