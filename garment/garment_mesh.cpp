@@ -165,18 +165,21 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
       // Project interior points onto the offset surface where the panel lies on the body:
       // inside it, or less than one edge length outside it; points spanning a hollow (between
       // the legs, under the bust) are left where the relaxation puts them.
+      // Any on-body curve makes the panel a body panel; free-hanging parts (a flared hem) are
+      // more than `reach` off the body and are not pulled in.
       double offset = 0;
       int on_body = 0;
       for (const LoopEdge& e : loop.edges) {
         const CurveSpec& cs = sketch.curves[static_cast<size_t>(net.curves[static_cast<size_t>(net.edges[static_cast<size_t>(e.edge)].curve)].spec)];
+        if (!cs.on_body) continue;
         offset += cs.offset;
-        on_body += cs.on_body ? 1 : 0;
+        ++on_body;
       }
-      offset /= static_cast<double>(loop.edges.size());
+      if (on_body > 0) offset /= on_body;
       const double reach = spec.edge_length.value_or(sketch.edge_length);
       meshing::FillGeometryOptions options;
       options.relax_iterations = sketch.relax_iterations;
-      if (2 * on_body >= static_cast<int>(loop.edges.size()))
+      if (on_body > 0)
         options.project = [&body, offset, reach](const Eigen::Vector3d& p) -> Eigen::Vector3d {
           const SurfacePoint s = body.closest_point(p);
           const double signed_distance = (p - s.position).dot(s.normal);

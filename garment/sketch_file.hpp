@@ -111,7 +111,7 @@ struct Sketch {
   double offset = 0.01;                    // default curve offset, metres
   double junction_tolerance = 0.015;       // metres: endpoints closer than this meet
   double corner_angle_degrees = 35.0;      // a junction turning more than this is a corner
-  int relax_iterations = 30;               // interior smoothing sweeps of the quad filler
+  int relax_iterations = 10;               // interior smoothing sweeps of the quad filler
   std::string fabric = "cotton-jersey";
   std::optional<std::string> garment_mesh; // triangle garment file: skips sketching and meshing
   std::vector<CurveSpec> curves;
