@@ -160,11 +160,13 @@ void BodyCollider::set_pose(const Eigen::MatrixX3d& vertices, const Eigen::Matri
   double motion = 0.0;
   for (int v = 0; v < vertex_count(); ++v)
     motion = std::max(motion, (vertices.row(v).transpose() - model_->vertices[v]).norm());
-  // Refit keeps the tree; FCL then fits each box around the triangle at both poses.
+  // Refit keeps the tree; FCL then fits each box around its triangles at both poses. Top-down:
+  // FCL 0.7's bottom-up refit merges child RSS boxes into boxes that do not contain them
+  // (vertices metres outside, measured), so the search would prune the true closest triangle.
   if (model_->beginUpdateModel() != fcl::BVH_OK)
     throw InvalidBodyMeshError("FCL refused to update the body hierarchy");
   for (int v = 0; v < vertex_count(); ++v) model_->updateVertex(vertices.row(v).transpose());
-  if (model_->endUpdateModel(true, true) != fcl::BVH_OK)
+  if (model_->endUpdateModel(true, false) != fcl::BVH_OK)
     throw InvalidBodyMeshError("FCL could not refit the body hierarchy");
 
   for (int v = 0; v < vertex_count(); ++v)

@@ -66,8 +66,9 @@ struct ContactQuery {
   // clear by more than the thickness can be skipped for a few steps without any search.
   double search_margin = 0.02;
   // Continuous check: the largest relative cloth-body motion (m) between two samples of a
-  // vertex's path. Must stay below half the thinnest body part (fingers, ~2 cm).
-  double max_substep_motion = 0.01;
+  // vertex's path. Must stay below half the thinnest body part (fingers, ~2 cm): a vertex is
+  // caught at most this deep, where its nearest surface is still the one it came through.
+  double max_substep_motion = 0.005;
   int max_substeps = 64;  // cap on samples per vertex and step
 };
 

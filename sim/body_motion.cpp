@@ -118,6 +118,28 @@ Eigen::VectorXd arm_rotation_weights(const meshing::TriMesh& rest,
     const double below_joint = smoothstep(0.0, blend, r.dot(along));
     weights[v] = on_arm * below_joint;
   }
+  // Diffuse the weights along the surface (Jacobi averaging over mesh neighbours): where arm and
+  // torso skin meet in the armpit fold, the selection above jumps within a few centimetres.
+  std::vector<std::vector<int>> neighbours(static_cast<std::size_t>(rest.vertex_count()));
+  for (Eigen::Index f = 0; f < rest.face_count(); ++f)
+    for (int k = 0; k < 3; ++k)
+      neighbours[rest.faces(f, k)].push_back(rest.faces(f, (k + 1) % 3)),
+          neighbours[rest.faces(f, (k + 1) % 3)].push_back(rest.faces(f, k));
+  for (int iteration = 0; iteration < options.smoothing_iterations; ++iteration) {
+    Eigen::VectorXd next = weights;
+    for (Eigen::Index v = 0; v < rest.vertex_count(); ++v) {
+      if (neighbours[v].empty()) continue;
+      double sum = 0.0;
+      for (const int u : neighbours[v]) sum += weights[u];
+      next[v] = 0.5 * weights[v] + 0.5 * sum / static_cast<double>(neighbours[v].size());
+    }
+    weights = next;
+  }
+  // Diffusion leaves a faint tail on the torso and takes a little off the hand: snap both ends
+  // back with a C¹ ramp, so the torso stays exactly still and the forearm turns rigidly.
+  if (options.smoothing_iterations > 0)
+    for (Eigen::Index v = 0; v < rest.vertex_count(); ++v)
+      weights[v] = smoothstep(0.1, 0.9, weights[v]);
   return weights;
 }
 

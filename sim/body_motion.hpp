@@ -73,6 +73,7 @@ struct ArmLoweringOptions {
   // tilt, offset inwards by this fraction of the height (the gap between arm and torso).
   double arm_boundary = 0.040;
   double blend_length = 0.06;  // fraction of height over which the rotation fades in below the joint
+  int smoothing_iterations = 30;  // averaging passes over mesh neighbours (softens the armpit)
 };
 
 // Per-vertex share of the arm rotation in [0, 1] (0 on the torso and head, 1 on the forearm).

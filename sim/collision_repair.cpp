@@ -6,13 +6,17 @@
 namespace sd::sim {
 
 Eigen::Vector3d StartRepair::goal(int vertex, int step) const {
-  const double s = std::clamp(static_cast<double>(step) / steps, 0.0, 1.0);
+  if (step <= 0) return start.segment<3>(3 * vertex);
+  if (step >= steps) return target.segment<3>(3 * vertex);
+  const double s = static_cast<double>(step) / steps;
   return start.segment<3>(3 * vertex) +
          s * (target.segment<3>(3 * vertex) - start.segment<3>(3 * vertex));
 }
 
 Eigen::VectorXd StartRepair::positions_after(int step) const {
-  const double s = std::clamp(static_cast<double>(step) / steps, 0.0, 1.0);
+  if (step <= 0) return start;
+  if (step >= steps) return target;
+  const double s = static_cast<double>(step) / steps;
   return start + s * (target - start);
 }
 
