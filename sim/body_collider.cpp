@@ -142,14 +142,13 @@ const Eigen::MatrixX3i& BodyCollider::faces() const { return faces_; }
 
 Eigen::MatrixX3d BodyCollider::vertices() const {
   Eigen::MatrixX3d result(vertex_count(), 3);
-  for (int v = 0; v < vertex_count(); ++v) result.row(v) = model_->vertices[v].transpose();
+  for (int v = 0; v < vertex_count(); ++v) result.row(v) = corner(v, 1.0).transpose();
   return result;
 }
 
 Eigen::MatrixX3d BodyCollider::previous_vertices() const {
-  if (model_->prev_vertices == nullptr) return vertices();
   Eigen::MatrixX3d result(vertex_count(), 3);
-  for (int v = 0; v < vertex_count(); ++v) result.row(v) = model_->prev_vertices[v].transpose();
+  for (int v = 0; v < vertex_count(); ++v) result.row(v) = corner(v, 0.0).transpose();
   return result;
 }
 
@@ -158,22 +157,71 @@ void BodyCollider::set_pose(const Eigen::MatrixX3d& vertices, const Eigen::Matri
   if (velocities.size() != 0) check_pose_matrix(velocities, vertex_count(), "velocity");
 
   double motion = 0.0;
-  for (int v = 0; v < vertex_count(); ++v)
-    motion = std::max(motion, (vertices.row(v).transpose() - model_->vertices[v]).norm());
-  // Refit keeps the tree; FCL then fits each box around its triangles at both poses. Top-down:
-  // FCL 0.7's bottom-up refit merges child RSS boxes into boxes that do not contain them
-  // (vertices metres outside, measured), so the search would prune the true closest triangle.
-  if (model_->beginUpdateModel() != fcl::BVH_OK)
-    throw InvalidBodyMeshError("FCL refused to update the body hierarchy");
-  for (int v = 0; v < vertex_count(); ++v) model_->updateVertex(vertices.row(v).transpose());
-  if (model_->endUpdateModel(true, false) != fcl::BVH_OK)
-    throw InvalidBodyMeshError("FCL could not refit the body hierarchy");
+  std::vector<Eigen::Vector3d> current(static_cast<std::size_t>(vertex_count()));
+  for (int v = 0; v < vertex_count(); ++v) {
+    current[v] = corner(v, 1.0);
+    motion = std::max(motion, (vertices.row(v).transpose() - current[v]).norm());
+  }
+  refit(current, vertices);
+  span_from_ = 0.0;
+  span_to_ = 1.0;
 
   for (int v = 0; v < vertex_count(); ++v)
     velocities_[v] = velocities.size() != 0 ? Eigen::Vector3d(velocities.row(v).transpose())
                                              : Eigen::Vector3d::Zero();
   last_motion_ = motion;
   total_motion_ += motion;
+  update_normals();
+}
+
+void BodyCollider::refit(const std::vector<Eigen::Vector3d>& from, const Eigen::MatrixX3d& to) {
+  // Refit keeps the tree; FCL fits each box around its triangles at both poses (its
+  // prev_vertices and vertices), so the boxes bound every pose in between. Top-down: FCL 0.7's
+  // bottom-up refit merges child RSS boxes into boxes that do not contain them (vertices metres
+  // outside, measured), and the search would prune the true closest triangle.
+  if (model_->beginUpdateModel() != fcl::BVH_OK)
+    throw InvalidBodyMeshError("FCL refused to update the body hierarchy");
+  for (int v = 0; v < vertex_count(); ++v) model_->updateVertex(to.row(v).transpose());
+  // beginUpdateModel made the last fitted pose the previous one; the motion starts from `from`.
+  for (int v = 0; v < vertex_count(); ++v) model_->prev_vertices[v] = from[v];
+  if (model_->endUpdateModel(true, false) != fcl::BVH_OK)
+    throw InvalidBodyMeshError("FCL could not refit the body hierarchy");
+  ++refit_count_;
+}
+
+void BodyCollider::set_pose_on_segment(const Eigen::MatrixX3d& from, const Eigen::MatrixX3d& to,
+                                       double s0, double s1,
+                                       const Eigen::MatrixX3d& velocities) {
+  check_pose_matrix(from, vertex_count(), "segment start");
+  check_pose_matrix(to, vertex_count(), "segment end");
+  if (velocities.size() != 0) check_pose_matrix(velocities, vertex_count(), "velocity");
+  if (!(0.0 <= s0 && s0 <= s1 && s1 <= 1.0))
+    throw std::invalid_argument("segment fractions must satisfy 0 <= s0 <= s1 <= 1");
+
+  bool fitted = model_->prev_vertices != nullptr;
+  double jump = 0.0;
+  double span = 0.0;
+  for (int v = 0; v < vertex_count(); ++v) {
+    const Eigen::Vector3d a = from.row(v).transpose();
+    const Eigen::Vector3d b = to.row(v).transpose();
+    fitted = fitted && model_->prev_vertices[v] == a && model_->vertices[v] == b;
+    jump = std::max(jump, (a + s0 * (b - a) - corner(v, 1.0)).norm());
+    span = std::max(span, (b - a).norm());
+  }
+  if (!fitted) {
+    std::vector<Eigen::Vector3d> start(static_cast<std::size_t>(vertex_count()));
+    for (int v = 0; v < vertex_count(); ++v) start[v] = from.row(v).transpose();
+    refit(start, to);
+  }
+  span_from_ = s0;
+  span_to_ = s1;
+  for (int v = 0; v < vertex_count(); ++v)
+    velocities_[v] = velocities.size() != 0 ? Eigen::Vector3d(velocities.row(v).transpose())
+                                             : Eigen::Vector3d::Zero();
+  last_motion_ = (s1 - s0) * span;
+  // A jump between the old pose and the start of this one still moves the surface: the cache's
+  // bounds must include it (the sweep cannot, see the header).
+  total_motion_ += jump + last_motion_;
   update_normals();
 }
 
@@ -208,16 +256,19 @@ void BodyCollider::update_normals() {
   box_min_ = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   box_max_ = -box_min_;
   for (int v = 0; v < nv; ++v) {
-    box_min_ = box_min_.cwiseMin(model_->vertices[v]);
-    box_max_ = box_max_.cwiseMax(model_->vertices[v]);
+    const Eigen::Vector3d x = corner(v, 1.0);
+    box_min_ = box_min_.cwiseMin(x);
+    box_max_ = box_max_.cwiseMax(x);
   }
 }
 
 Eigen::Vector3d BodyCollider::corner(int vertex, double t) const {
-  const Eigen::Vector3d& now = model_->vertices[vertex];
-  if (t >= 1.0 || model_->prev_vertices == nullptr) return now;
-  const Eigen::Vector3d& before = model_->prev_vertices[vertex];
-  return before + t * (now - before);
+  const Eigen::Vector3d& b = model_->vertices[vertex];
+  if (model_->prev_vertices == nullptr) return b;
+  const double s = span_from_ + t * (span_to_ - span_from_);
+  if (s >= 1.0) return b;
+  const Eigen::Vector3d& a = model_->prev_vertices[vertex];
+  return a + s * (b - a);
 }
 
 Eigen::Vector3d BodyCollider::feature_normal(int triangle, TriangleFeature feature, int index,

@@ -131,9 +131,19 @@ class BodyCollider {
   // what the continuous check sweeps. Call once per cloth step.
   void set_pose(const Eigen::MatrixX3d& vertices, const Eigen::MatrixX3d& velocities = {});
 
-  // Largest vertex displacement of the last set_pose (m): a bound on how far any surface point
-  // moved in that step.
+  // The same for a body moving along a straight segment of its motion (two keyframes of a pose
+  // sequence): during this step it went from lerp(from, to, s0) to lerp(from, to, s1),
+  // 0 <= s0 <= s1 <= 1. The hierarchy is refitted only when the segment changes, so the many
+  // steps between two keyframes cost no refit; its boxes then bound the whole segment. The
+  // previous pose should be where the body was (a jump is allowed but not swept).
+  void set_pose_on_segment(const Eigen::MatrixX3d& from, const Eigen::MatrixX3d& to, double s0,
+                           double s1, const Eigen::MatrixX3d& velocities = {});
+
+  // Largest vertex displacement of the last step (m): a bound on how far any surface point
+  // moved in it.
   double last_motion() const { return last_motion_; }
+  // FCL refits so far (diagnostics).
+  int refit_count() const { return refit_count_; }
 
   // Closest point of the current pose within `max_distance` of p (unbounded by default), with
   // the signed distance and outward normal; nothing when the surface is farther than that.
@@ -171,7 +181,10 @@ class BodyCollider {
   // Closest point at pose time t ∈ [0, 1] (0 = previous pose, 1 = current), searching only
   // within `bound`; nothing if the surface is farther.
   std::optional<BodyProximity> nearest(const Eigen::Vector3d& p, double t, double bound) const;
+  // Body vertex at time t ∈ [0, 1] of the current step (0 = previous pose, 1 = current).
   Eigen::Vector3d corner(int vertex, double t) const;
+  // FCL refit with prev_vertices = from and vertices = to (#V each).
+  void refit(const std::vector<Eigen::Vector3d>& from, const Eigen::MatrixX3d& to);
   Eigen::Vector3d feature_normal(int triangle, TriangleFeature feature, int index,
                                  double t) const;
   void update_normals();
@@ -196,6 +209,11 @@ class BodyCollider {
   Eigen::Vector3d box_max_ = Eigen::Vector3d::Zero();
   double normal_epsilon_ = 0.0;  // m: below this offset the feature normal replaces p − c
   int tree_depth_ = 0;            // levels of FCL's tree (search stack size)
+  // The step spans [span_from_, span_to_] of the motion FCL's boxes bound (its prev_vertices
+  // at 0, vertices at 1).
+  double span_from_ = 0.0;
+  double span_to_ = 1.0;
+  int refit_count_ = 0;
   double last_motion_ = 0.0;
   double total_motion_ = 0.0;  // sum of last_motion over all set_pose calls (cache stamps)
   std::uint64_t id_ = 0;

@@ -79,6 +79,31 @@ Eigen::MatrixX3d PoseSequence::average_velocity(double t0, double t1) const {
   return (vertices_at(t1) - vertices_at(t0)) / (t1 - t0);
 }
 
+void move_body(BodyCollider& collider, const PoseSequence& motion, double t0, double t1) {
+  if (!(t1 > t0)) throw std::invalid_argument("a body step needs t1 > t0");
+  const std::vector<double>& times = motion.times();
+  const Eigen::MatrixX3d velocity = motion.average_velocity(t0, t1);
+  if (motion.keyframe_count() == 1) {
+    collider.set_pose_on_segment(motion.keyframe(0), motion.keyframe(0), 0.0, 0.0, velocity);
+    return;
+  }
+  const double start = std::clamp(t0, times.front(), times.back());
+  const double end = std::clamp(t1, times.front(), times.back());
+  // The segment holding the step's start; a start on a keyframe belongs to the segment after it
+  // unless it is the last keyframe.
+  const int last = motion.keyframe_count() - 2;
+  int k = static_cast<int>(std::upper_bound(times.begin(), times.end(), start) - times.begin()) - 1;
+  k = std::clamp(k, 0, last);
+  if (end <= times[k + 1]) {
+    const double length = times[k + 1] - times[k];
+    collider.set_pose_on_segment(motion.keyframe(k), motion.keyframe(k + 1),
+                                 std::clamp((start - times[k]) / length, 0.0, 1.0),
+                                 std::clamp((end - times[k]) / length, 0.0, 1.0), velocity);
+  } else {
+    collider.set_pose(motion.vertices_at(t1), velocity);
+  }
+}
+
 PoseSequence make_pose_sequence(const meshing::TriMesh& rest, const std::vector<double>& times,
                                 const std::function<Eigen::MatrixX3d(double)>& displacement) {
   std::vector<Eigen::MatrixX3d> poses;

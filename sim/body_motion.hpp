@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 
 #include "meshing/tri_mesh.hpp"
+#include "sim/body_collider.hpp"
 
 namespace sd::sim {
 
@@ -54,6 +55,12 @@ class PoseSequence {
   std::vector<double> times_;
   std::vector<Eigen::MatrixX3d> poses_;
 };
+
+// Moves `collider` (built on this sequence's mesh) for a cloth step from t0 to t1 > t0, with the
+// step's mean body velocity. Within one keyframe segment the body moves on a straight line and
+// the collider is refitted only when the segment changes (set_pose_on_segment); a step that
+// spans a keyframe falls back to set_pose on the pose at t1 (its chord).
+void move_body(BodyCollider& collider, const PoseSequence& motion, double t0, double t1);
 
 // Keyframes at `times` with positions rest + displacement(t) (#V by 3 each).
 PoseSequence make_pose_sequence(const meshing::TriMesh& rest, const std::vector<double>& times,

@@ -432,6 +432,60 @@ TEST(BodyCollider, ContinuousCheckCatchesAFastBodyPassingAStillPoint) {
   EXPECT_GT(stats.sweep_samples, 1);
 }
 
+TEST(BodyCollider, SegmentStepsRefitOnceAndMatchARebuild) {
+  const meshing::TriMesh rest = make_sphere(0.2, 2);
+  const Eigen::MatrixX3d from = rest.vertices;
+  const Eigen::MatrixX3d to = (1.2 * rest.vertices).rowwise() + Vector3d(0.1, -0.05, 0.02).transpose();
+  BodyCollider collider(rest);
+  const double fractions[] = {0.0, 0.3, 0.7, 1.0};
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-0.4, 0.4);
+  for (int k = 0; k < 3; ++k) {
+    collider.set_pose_on_segment(from, to, fractions[k], fractions[k + 1]);
+    EXPECT_EQ(collider.refit_count(), 1);
+    const double s = fractions[k + 1];
+    meshing::TriMesh pose = rest;
+    pose.vertices = from + s * (to - from);
+    EXPECT_LT((collider.vertices() - pose.vertices).norm(), 1e-12);
+    EXPECT_NEAR(collider.last_motion(), (fractions[k + 1] - fractions[k]) * (to - from).rowwise().norm().maxCoeff(), 1e-12);
+    const BodyCollider rebuilt(pose);
+    for (int trial = 0; trial < 100; ++trial) {
+      const Vector3d p(u(rng), u(rng), u(rng));
+      EXPECT_NEAR(collider.signed_distance(p), rebuilt.signed_distance(p), 1e-12);
+    }
+  }
+  // Back to a plain pose: one more refit, and the segment is forgotten.
+  collider.set_pose(from);
+  EXPECT_EQ(collider.refit_count(), 2);
+  EXPECT_LT((collider.vertices() - from).norm(), 1e-15);
+}
+
+TEST(BodyCollider, ContinuousCheckWithinASegment) {
+  // The slab rises 0.2 m along one segment, swept in four steps; the still point at y = 0.045 is
+  // passed during the third (top face from 0.045 at s = 0.625, bottom at s = 0.725).
+  const meshing::TriMesh below = make_slab(-0.1);
+  const Eigen::MatrixX3d above = below.vertices.rowwise() + Vector3d(0, 0.2, 0).transpose();
+  BodyCollider slab(below);
+  ContactQuery query;
+  query.thickness = 0.003;
+  const Eigen::VectorXd x = flatten({Vector3d(0.05, 0.045, 0.0)});
+  ContactCache cache;
+  for (int step = 0; step < 4; ++step) {
+    slab.set_pose_on_segment(below.vertices, above, 0.25 * step, 0.25 * (step + 1));
+    const std::vector<BodyContact> contacts = slab.find_contacts_swept(x, x, query, &cache);
+    if (step != 2) {
+      EXPECT_TRUE(contacts.empty()) << step;
+      continue;
+    }
+    ASSERT_EQ(contacts.size(), 1u);
+    EXPECT_TRUE(contacts[0].crossed);
+    EXPECT_LT((contacts[0].normal - Vector3d::UnitY()).norm(), 1e-9);
+    EXPECT_NEAR(contacts[0].point.y(), -0.08 + 0.2 * 0.75, 1e-9);
+    EXPECT_NEAR(contacts[0].distance, 0.045 - (-0.08 + 0.2 * 0.75), 1e-9);
+  }
+  EXPECT_EQ(slab.refit_count(), 1);
+}
+
 TEST(StartRepair, PushesInsideVerticesOutAlongTheNearestSurface) {
   const double r = 0.2;
   const meshing::TriMesh sphere = make_sphere(r, 3);

@@ -140,5 +140,27 @@ TEST(ArmLowering, KeepsTopologyAndLowersTheHands) {
   EXPECT_GT(collider.signed_distance(rest.vertices.row(left_tip).transpose()), 0.01);
 }
 
+TEST(MoveBody, FollowsTheSequenceWithOneRefitPerSegment) {
+  const garment::Body body = garment::load_body("builtin");
+  ArmLoweringOptions options;
+  options.keyframes = 5;  // keyframes every 0.25 s
+  const PoseSequence motion = make_arm_lowering(body.mesh, options);
+  BodyCollider collider(body.mesh);
+  const double dt = 1.0 / 16.0;
+  for (int step = 0; step < 16; ++step) {
+    move_body(collider, motion, step * dt, (step + 1) * dt);
+    EXPECT_LT((collider.vertices() - motion.vertices_at((step + 1) * dt)).norm(), 1e-12) << step;
+    EXPECT_LT((collider.previous_vertices() - motion.vertices_at(step * dt)).norm(), 1e-12);
+  }
+  EXPECT_EQ(collider.refit_count(), 4);
+  // A step across a keyframe moves along the chord; after the end the body rests.
+  move_body(collider, motion, 0.2, 0.3);
+  EXPECT_LT((collider.vertices() - motion.vertices_at(0.3)).norm(), 1e-12);
+  move_body(collider, motion, 1.0, 1.1);
+  EXPECT_LT((collider.vertices() - motion.vertices_at(1.0)).norm(), 1e-12);
+  EXPECT_EQ(collider.last_motion(), 0.0);
+  EXPECT_THROW(move_body(collider, motion, 0.5, 0.5), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace sd::sim
