@@ -172,9 +172,12 @@ void BM_FindContacts(benchmark::State& state) {
 }
 BENCHMARK(BM_FindContacts)->Args({0, 0})->Args({0, 1})->Args({1, 0})->Args({1, 1});
 
-// A cloth step against the moving body: refit to the next pose of the arms-lowering motion
-// (1/24 s steps of a 1 s motion) and the swept query for 5,000 near points moving 2 mm.
+// A cloth step against the moving body: move to the next pose of the arms-lowering motion
+// (1/24 s steps of a 1 s motion, 6 keyframes) and the swept query for 5,000 near points moving
+// 2 mm. Arg 0: set_pose every step (a refit per step); 1: move_body (a refit per keyframe
+// segment, boxes bounding the whole segment).
 void BM_SweptStep(benchmark::State& state) {
+  const bool segments = state.range(0) == 1;
   sd::sim::BodyCollider collider(body());
   const sd::sim::PoseSequence motion = sd::sim::make_arm_lowering(body());
   const std::size_t n = 5000;
@@ -187,7 +190,10 @@ void BM_SweptStep(benchmark::State& state) {
   sd::sim::ContactQueryStats stats;
   for (auto _ : state) {
     const double t1 = (step++ % 24 + 1) / 24.0;
-    collider.set_pose(motion.vertices_at(t1), motion.average_velocity(t1 - 1.0 / 24.0, t1));
+    if (segments)
+      sd::sim::move_body(collider, motion, t1 - 1.0 / 24.0, t1);
+    else
+      collider.set_pose(motion.vertices_at(t1), motion.average_velocity(t1 - 1.0 / 24.0, t1));
     const Eigen::VectorXd x0 = x;
     for (Eigen::Index k = 0; k < x.size(); ++k) x[k] += jitter(rng);
     benchmark::DoNotOptimize(collider.find_contacts_swept(x0, x, query, &cache, &stats));
@@ -196,8 +202,9 @@ void BM_SweptStep(benchmark::State& state) {
   state.counters["samples"] = stats.sweep_samples;
   state.counters["skipped"] = stats.skipped;
   state.counters["contacts"] = stats.contacts;
+  state.counters["refits_per_step"] = static_cast<double>(collider.refit_count()) / step;
 }
-BENCHMARK(BM_SweptStep)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SweptStep)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
