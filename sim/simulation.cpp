@@ -206,6 +206,7 @@ StepOutcome Simulation::step(double max_step) {
         spdlog::warn("sim: t = {:.6f} s: accepting a step of {:.3g} s at the minimum despite: {}",
                      time_, h, candidate.failure);
         ++report_.forced_steps;
+        outcome.forced = true;
         break;
       }
       spdlog::error("sim: t = {:.6f} s: step failed at the minimum step {:.3g} s: {}", time_, h,
@@ -232,7 +233,7 @@ StepOutcome Simulation::step(double max_step) {
   // Grow back after a run of easy steps: no retry and Newton converging in a few iterations.
   const int newton_budget = settings_.newton_iterations.value_or(
       settings_.integrator == Integrator::bdf2 ? 8 : 1);
-  const bool easy = outcome.retries == 0 &&
+  const bool easy = outcome.retries == 0 && !outcome.forced &&
                     outcome.newton_iterations <= std::max(1, (newton_budget + 1) / 2);
   easy_steps_ = easy ? easy_steps_ + 1 : 0;
   if (easy_steps_ >= settings_.easy_steps_to_grow && dt_ < settings_.dt) {

@@ -93,6 +93,7 @@ struct StepOutcome {
   bool accepted = false;
   double dt = 0.0;        // the step that was taken
   int retries = 0;
+  bool forced = false;    // accepted at min_dt despite a soft failure
   int newton_iterations = 0;
   int cg_iterations = 0;
   std::string failure_reason;  // when not accepted
