@@ -1,15 +1,15 @@
 #include "sim/body_collider.hpp"
 
+#include <fcl/geometry/bvh/BVH_model.h>
+#include <fcl/math/bv/RSS.h>
+#include <fcl/math/bv/utility.h>
+
 #include <algorithm>
 #include <array>
 #include <atomic>
 #include <cmath>
 #include <string>
 #include <utility>
-
-#include <fcl/geometry/bvh/BVH_model.h>
-#include <fcl/math/bv/RSS.h>
-#include <fcl/math/bv/utility.h>
 
 namespace sd::sim {
 
@@ -33,8 +33,7 @@ void check_pose_matrix(const Eigen::MatrixX3d& vertices, Eigen::Index expected, 
                                std::to_string(vertices.rows()) + " vertices but the body has " +
                                std::to_string(expected) + "; a pose must keep the topology");
   if (!vertices.allFinite())
-    throw InvalidBodyMeshError(std::string("the body ") + what +
-                               " has a non-finite coordinate");
+    throw InvalidBodyMeshError(std::string("the body ") + what + " has a non-finite coordinate");
 }
 
 Eigen::Vector3d row(const Eigen::VectorXd& x, Eigen::Index vertex) {
@@ -136,9 +135,15 @@ BodyCollider::~BodyCollider() = default;
 BodyCollider::BodyCollider(BodyCollider&&) noexcept = default;
 BodyCollider& BodyCollider::operator=(BodyCollider&&) noexcept = default;
 
-int BodyCollider::vertex_count() const { return model_->num_vertices; }
-int BodyCollider::face_count() const { return model_->num_tris; }
-const Eigen::MatrixX3i& BodyCollider::faces() const { return faces_; }
+int BodyCollider::vertex_count() const {
+  return model_->num_vertices;
+}
+int BodyCollider::face_count() const {
+  return model_->num_tris;
+}
+const Eigen::MatrixX3i& BodyCollider::faces() const {
+  return faces_;
+}
 
 Eigen::MatrixX3d BodyCollider::vertices() const {
   Eigen::MatrixX3d result(vertex_count(), 3);
@@ -168,7 +173,7 @@ void BodyCollider::set_pose(const Eigen::MatrixX3d& vertices, const Eigen::Matri
 
   for (int v = 0; v < vertex_count(); ++v)
     velocities_[v] = velocities.size() != 0 ? Eigen::Vector3d(velocities.row(v).transpose())
-                                             : Eigen::Vector3d::Zero();
+                                            : Eigen::Vector3d::Zero();
   last_motion_ = motion;
   total_motion_ += motion;
   update_normals();
@@ -190,8 +195,7 @@ void BodyCollider::refit(const std::vector<Eigen::Vector3d>& from, const Eigen::
 }
 
 void BodyCollider::set_pose_on_segment(const Eigen::MatrixX3d& from, const Eigen::MatrixX3d& to,
-                                       double s0, double s1,
-                                       const Eigen::MatrixX3d& velocities) {
+                                       double s0, double s1, const Eigen::MatrixX3d& velocities) {
   check_pose_matrix(from, vertex_count(), "segment start");
   check_pose_matrix(to, vertex_count(), "segment end");
   if (velocities.size() != 0) check_pose_matrix(velocities, vertex_count(), "velocity");
@@ -217,7 +221,7 @@ void BodyCollider::set_pose_on_segment(const Eigen::MatrixX3d& from, const Eigen
   span_to_ = s1;
   for (int v = 0; v < vertex_count(); ++v)
     velocities_[v] = velocities.size() != 0 ? Eigen::Vector3d(velocities.row(v).transpose())
-                                             : Eigen::Vector3d::Zero();
+                                            : Eigen::Vector3d::Zero();
   last_motion_ = (s1 - s0) * span;
   // A jump between the old pose and the start of this one still moves the surface: the cache's
   // bounds must include it (the sweep cannot, see the header).
@@ -275,9 +279,12 @@ Eigen::Vector3d BodyCollider::feature_normal(int triangle, TriangleFeature featu
                                              double t) const {
   if (t >= 1.0 || model_->prev_vertices == nullptr) {
     switch (feature) {
-      case TriangleFeature::face: return face_normals_[triangle];
-      case TriangleFeature::edge: return edge_normals_[3 * triangle + index];
-      case TriangleFeature::vertex: return vertex_normals_[faces_(triangle, index)];
+      case TriangleFeature::face:
+        return face_normals_[triangle];
+      case TriangleFeature::edge:
+        return edge_normals_[3 * triangle + index];
+      case TriangleFeature::vertex:
+        return vertex_normals_[faces_(triangle, index)];
     }
   }
   // An intermediate pose of a sweep: the same pseudo-normals from interpolated corners.
@@ -288,7 +295,8 @@ Eigen::Vector3d BodyCollider::feature_normal(int triangle, TriangleFeature featu
   const Topology& topo = *topology_;
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   switch (feature) {
-    case TriangleFeature::face: return normal_at(triangle);
+    case TriangleFeature::face:
+      return normal_at(triangle);
     case TriangleFeature::edge: {
       const int edge = topo.face_edge[3 * triangle + index];
       for (int i = topo.edge_face_start[edge]; i < topo.edge_face_start[edge + 1]; ++i)
@@ -366,9 +374,9 @@ std::optional<BodyProximity> BodyCollider::nearest(const Eigen::Vector3d& p, dou
   Eigen::Vector3d pseudo_normal =
       feature_normal(best_triangle, best_point.feature, best_point.index, t);
   if (!(pseudo_normal.squaredNorm() > 0.0))
-    pseudo_normal = triangle_normal(corner(faces_(best_triangle, 0), t),
-                                    corner(faces_(best_triangle, 1), t),
-                                    corner(faces_(best_triangle, 2), t));
+    pseudo_normal =
+        triangle_normal(corner(faces_(best_triangle, 0), t), corner(faces_(best_triangle, 1), t),
+                        corner(faces_(best_triangle, 2), t));
   const Eigen::Vector3d offset = p - best_point.point;
   const double sign = offset.dot(pseudo_normal) >= 0.0 ? 1.0 : -1.0;
   result.distance = sign * best;
@@ -445,8 +453,7 @@ void BodyCollider::classify_current(int vertex, const Eigen::Vector3d& p, bool k
 }
 
 std::vector<BodyContact> BodyCollider::find_contacts(const Eigen::VectorXd& x,
-                                                     const ContactQuery& query,
-                                                     ContactCache* cache,
+                                                     const ContactQuery& query, ContactCache* cache,
                                                      ContactQueryStats* stats) const {
   if (x.size() % 3 != 0)
     throw std::invalid_argument("cloth positions must hold 3 coordinates per vertex");
@@ -463,8 +470,8 @@ std::vector<BodyContact> BodyCollider::find_contacts(const Eigen::VectorXd& x,
     bool known_outside = false;
     double lower_bound = 0.0;
     if (entry != nullptr && entry->state == ContactCache::State::outside) {
-      lower_bound = entry->clearance - (p - entry->position).norm() -
-                    std::abs(total_motion_ - entry->stamp);
+      lower_bound =
+          entry->clearance - (p - entry->position).norm() - std::abs(total_motion_ - entry->stamp);
       known_outside = lower_bound > 0.0;
     }
     classify_current(i, p, known_outside, lower_bound, query, cache != nullptr, entry, contacts,
@@ -509,8 +516,8 @@ std::vector<BodyContact> BodyCollider::find_contacts_swept(const Eigen::VectorXd
     bool sign_known = false;
     double clearance = 0.0;
     if (entry != nullptr && entry->state == State::outside) {
-      const double lower_bound = entry->clearance - (p0 - entry->position).norm() -
-                                 std::abs(stamp_before - entry->stamp);
+      const double lower_bound =
+          entry->clearance - (p0 - entry->position).norm() - std::abs(stamp_before - entry->stamp);
       if (lower_bound > 0.0) {
         outside_at_start = sign_known = true;
         clearance = lower_bound;
@@ -537,9 +544,9 @@ std::vector<BodyContact> BodyCollider::find_contacts_swept(const Eigen::VectorXd
         known_outside_at_end = true;
         end_lower_bound = clearance - relative_motion;
       } else {
-        const int samples = std::clamp(
-            static_cast<int>(std::ceil(relative_motion / query.max_substep_motion)), 1,
-            query.max_substeps);
+        const int samples =
+            std::clamp(static_cast<int>(std::ceil(relative_motion / query.max_substep_motion)), 1,
+                       query.max_substeps);
         double t_last = 0.0;
         double clearance_last = clearance;
         bool clear_to_end = false;
@@ -589,8 +596,7 @@ std::vector<BodyContact> BodyCollider::find_contacts_swept(const Eigen::VectorXd
       ++local.full_searches;
       // Came back out on the entry side, or ended inside with the nearest surface facing the
       // way it came in: the ordinary contact is right. Otherwise it tunnelled.
-      const bool tunnelled =
-          behind < 0.0 && (end.distance >= 0.0 || end.normal.dot(normal) < 0.0);
+      const bool tunnelled = behind < 0.0 && (end.distance >= 0.0 || end.normal.dot(normal) < 0.0);
       if (tunnelled) {
         BodyContact contact;
         contact.vertex = i;
@@ -613,8 +619,8 @@ std::vector<BodyContact> BodyCollider::find_contacts_swept(const Eigen::VectorXd
     }
 
     // 4. Everything else: the discrete test at the end of the step.
-    classify_current(i, p1, known_outside_at_end, end_lower_bound, query, cache != nullptr,
-                     entry, contacts, local);
+    classify_current(i, p1, known_outside_at_end, end_lower_bound, query, cache != nullptr, entry,
+                     contacts, local);
   }
   local.contacts = static_cast<int>(contacts.size());
   if (stats != nullptr) *stats = local;

@@ -8,14 +8,13 @@
 // get the right sign, and points deep inside a closed body get a negative distance.
 // See docs/collision.md.
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <limits>
 #include <memory>
 #include <optional>
 #include <stdexcept>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "meshing/tri_mesh.hpp"
 #include "sim/collision_geometry.hpp"
@@ -38,25 +37,25 @@ class InvalidBodyMeshError : public std::invalid_argument {
 
 // The closest point on the body to one query point.
 struct BodyProximity {
-  int triangle = -1;                                           // body face index
-  Eigen::Vector3d point = Eigen::Vector3d::Zero();             // on the surface, metres
-  Eigen::Vector3d barycentric = Eigen::Vector3d::Zero();       // of `point` in `triangle`
-  TriangleFeature feature = TriangleFeature::face;             // where in the triangle
-  int feature_index = 0;                                       // edge or corner index
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitY();           // unit, outward push direction
-  double distance = 0.0;                                       // signed, negative inside
+  int triangle = -1;                                      // body face index
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();        // on the surface, metres
+  Eigen::Vector3d barycentric = Eigen::Vector3d::Zero();  // of `point` in `triangle`
+  TriangleFeature feature = TriangleFeature::face;        // where in the triangle
+  int feature_index = 0;                                  // edge or corner index
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitY();      // unit, outward push direction
+  double distance = 0.0;                                  // signed, negative inside
 };
 
 // One cloth vertex that needs the solver's attention: within the thickness of the body, inside
 // it, or (continuous check) passed through its surface during the step. The solver keeps the
 // vertex at `point + thickness·normal` along `normal` and moves it with `body_velocity` there.
 struct BodyContact {
-  int vertex = -1;                                            // cloth vertex index
-  int triangle = -1;                                          // body face holding `point`
-  Eigen::Vector3d point = Eigen::Vector3d::Zero();            // on the body (current pose), m
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitY();          // unit, outward
-  double distance = 0.0;                                      // (x − point)·normal; < 0 inside
-  Eigen::Vector3d body_velocity = Eigen::Vector3d::Zero();    // body surface at `point`, m/s
+  int vertex = -1;                                          // cloth vertex index
+  int triangle = -1;                                        // body face holding `point`
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();          // on the body (current pose), m
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitY();        // unit, outward
+  double distance = 0.0;                                    // (x − point)·normal; < 0 inside
+  Eigen::Vector3d body_velocity = Eigen::Vector3d::Zero();  // body surface at `point`, m/s
   bool crossed = false;  // found by the continuous check: pushed back to the side it came from
 };
 
@@ -168,8 +167,7 @@ class BodyCollider {
   // the side it came from (entry point carried to the current pose), even if it ended outside
   // on the far side of a thin part. Paths are sampled so that the relative motion between
   // samples stays below query.max_substep_motion.
-  std::vector<BodyContact> find_contacts_swept(const Eigen::VectorXd& x0,
-                                               const Eigen::VectorXd& x1,
+  std::vector<BodyContact> find_contacts_swept(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1,
                                                const ContactQuery& query,
                                                ContactCache* cache = nullptr,
                                                ContactQueryStats* stats = nullptr) const;
@@ -185,8 +183,7 @@ class BodyCollider {
   Eigen::Vector3d corner(int vertex, double t) const;
   // FCL refit with prev_vertices = from and vertices = to (#V each).
   void refit(const std::vector<Eigen::Vector3d>& from, const Eigen::MatrixX3d& to);
-  Eigen::Vector3d feature_normal(int triangle, TriangleFeature feature, int index,
-                                 double t) const;
+  Eigen::Vector3d feature_normal(int triangle, TriangleFeature feature, int index, double t) const;
   void update_normals();
   bool outside_box(const Eigen::Vector3d& p) const;
   BodyContact make_contact(int vertex, const BodyProximity& proximity) const;
@@ -208,7 +205,7 @@ class BodyCollider {
   Eigen::Vector3d box_min_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d box_max_ = Eigen::Vector3d::Zero();
   double normal_epsilon_ = 0.0;  // m: below this offset the feature normal replaces p − c
-  int tree_depth_ = 0;            // levels of FCL's tree (search stack size)
+  int tree_depth_ = 0;           // levels of FCL's tree (search stack size)
   // The step spans [span_from_, span_to_] of the motion FCL's boxes bound (its prev_vertices
   // at 0, vertices at 1).
   double span_from_ = 0.0;

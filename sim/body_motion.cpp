@@ -29,9 +29,9 @@ PoseSequence::PoseSequence(Eigen::MatrixX3i faces, std::vector<double> times,
     if (!std::isfinite(times_[k]))
       throw InvalidBodyMotionError("pose " + std::to_string(k) + " has a non-finite time");
     if (k > 0 && !(times_[k] > times_[k - 1]))
-      throw InvalidBodyMotionError("pose times must increase strictly (pose " +
-                                   std::to_string(k) + " is at " + std::to_string(times_[k]) +
-                                   " s, not after " + std::to_string(times_[k - 1]) + " s)");
+      throw InvalidBodyMotionError("pose times must increase strictly (pose " + std::to_string(k) +
+                                   " is at " + std::to_string(times_[k]) + " s, not after " +
+                                   std::to_string(times_[k - 1]) + " s)");
     if (poses_[k].rows() != poses_.front().rows())
       throw InvalidBodyMotionError("pose " + std::to_string(k) + " has " +
                                    std::to_string(poses_[k].rows()) +
@@ -42,8 +42,9 @@ PoseSequence::PoseSequence(Eigen::MatrixX3i faces, std::vector<double> times,
       throw InvalidBodyMotionError("pose " + std::to_string(k) + " has a non-finite coordinate");
   }
   if (faces_.size() > 0 && (faces_.minCoeff() < 0 || faces_.maxCoeff() >= vertex_count()))
-    throw InvalidBodyMotionError("a face of the moving body refers to a vertex that does not "
-                                 "exist");
+    throw InvalidBodyMotionError(
+        "a face of the moving body refers to a vertex that does not "
+        "exist");
 }
 
 int PoseSequence::segment(double t) const {
@@ -112,8 +113,8 @@ PoseSequence make_pose_sequence(const meshing::TriMesh& rest, const std::vector<
     Eigen::MatrixX3d d = displacement(t);
     if (d.rows() != rest.vertex_count())
       throw InvalidBodyMotionError("a displacement field has " + std::to_string(d.rows()) +
-                                   " rows for a body of " +
-                                   std::to_string(rest.vertex_count()) + " vertices");
+                                   " rows for a body of " + std::to_string(rest.vertex_count()) +
+                                   " vertices");
     poses.push_back(rest.vertices + d);
   }
   return PoseSequence(rest.faces, times, std::move(poses));
@@ -188,7 +189,8 @@ PoseSequence make_arm_lowering(const meshing::TriMesh& rest, const ArmLoweringOp
     for (Eigen::Index v = 0; v < rest.vertex_count(); ++v) {
       if (weights[v] == 0.0) continue;
       const double side = rest.vertices(v, 0) >= 0.0 ? 1.0 : -1.0;
-      const Eigen::Vector2d r(side * rest.vertices(v, 0) - joint.x(), rest.vertices(v, 1) - joint.y());
+      const Eigen::Vector2d r(side * rest.vertices(v, 0) - joint.x(),
+                              rest.vertices(v, 1) - joint.y());
       // Lowering turns the left arm clockwise seen from the front (towards −x); mirrored on the
       // right.
       const double phi = -weights[v] * angle;

@@ -4,11 +4,10 @@
 // Builders: from any per-vertex displacement function of time, and the mannequin's arms lowering
 // from the A-pose (rotation about each shoulder, blended smoothly near the armpit).
 
+#include <Eigen/Core>
 #include <functional>
 #include <stdexcept>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "meshing/tri_mesh.hpp"
 #include "sim/body_collider.hpp"
@@ -72,14 +71,15 @@ PoseSequence make_pose_sequence(const meshing::TriMesh& rest, const std::vector<
 struct ArmLoweringOptions {
   double angle_degrees = 10.0;  // rotation at the end; negative raises the arms
   double duration = 1.0;        // seconds from start to end
-  int keyframes = 6;            // poses over the duration (≥ 2): rotations are sampled, not lerped
-  double shoulder_height = 0.80;  // joint centre height / body height
+  int keyframes = 6;  // poses over the duration (≥ 2): rotations are sampled, not lerped
+  double shoulder_height = 0.80;   // joint centre height / body height
   double shoulder_offset = 0.109;  // joint centre |x| / body height
   double arm_tilt_degrees = 17.0;  // angle of the rest arm axis from the vertical
   // A vertex belongs to the arm when it lies outside the line through the joint at the arm's
   // tilt, offset inwards by this fraction of the height (the gap between arm and torso).
   double arm_boundary = 0.040;
-  double blend_length = 0.06;  // fraction of height over which the rotation fades in below the joint
+  double blend_length =
+      0.06;  // fraction of height over which the rotation fades in below the joint
   int smoothing_iterations = 30;  // averaging passes over mesh neighbours (softens the armpit)
 };
 

@@ -1,10 +1,9 @@
 #include "sim/collision_geometry.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>
-
-#include <Eigen/Geometry>
 
 namespace sd::sim {
 
@@ -25,8 +24,7 @@ TriangleClosestPoint make_result(const Eigen::Vector3d& p, const Eigen::Vector3d
 }  // namespace
 
 TriangleClosestPoint closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
-                                               const Eigen::Vector3d& b,
-                                               const Eigen::Vector3d& c) {
+                                               const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
   const Eigen::Vector3d ab = b - a;
   const Eigen::Vector3d ac = c - a;
   const Eigen::Vector3d ap = p - a;
@@ -80,8 +78,7 @@ TriangleClosestPoint closest_point_on_triangle(const Eigen::Vector3d& p, const E
       Eigen::Vector3d weights = Eigen::Vector3d::Zero();
       weights[k] = 1 - t;
       weights[(k + 1) % 3] += t;
-      TriangleClosestPoint candidate =
-          make_result(p, s + t * e, weights, TriangleFeature::edge, k);
+      TriangleClosestPoint candidate = make_result(p, s + t * e, weights, TriangleFeature::edge, k);
       if (candidate.squared_distance < best.squared_distance) best = candidate;
     }
     return best;

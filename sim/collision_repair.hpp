@@ -6,9 +6,8 @@
 // it there linearly over `steps` steps (constraining the vertex's velocity along the push
 // normal), and ordinary contacts take over afterwards.
 
-#include <vector>
-
 #include <Eigen/Core>
+#include <vector>
 
 #include "sim/body_collider.hpp"
 

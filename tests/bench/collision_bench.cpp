@@ -2,12 +2,12 @@
 // build per bounding-volume type, refit, point queries (near the surface and far from it), and
 // the per-step contact queries with and without the cache. Numbers in docs/benchmarks.md.
 
+#include <benchmark/benchmark.h>
+#include <fcl/fcl.h>
+
 #include <memory>
 #include <random>
 #include <vector>
-
-#include <benchmark/benchmark.h>
-#include <fcl/fcl.h>
 
 #include "garment/body.hpp"
 #include "sim/body_collider.hpp"
@@ -60,7 +60,8 @@ template <typename BV>
 std::shared_ptr<fcl::BVHModel<BV>> build_model() {
   const sd::meshing::TriMesh& mesh = body();
   std::vector<fcl::Vector3d> v;
-  for (Eigen::Index i = 0; i < mesh.vertex_count(); ++i) v.push_back(mesh.vertices.row(i).transpose());
+  for (Eigen::Index i = 0; i < mesh.vertex_count(); ++i)
+    v.push_back(mesh.vertices.row(i).transpose());
   std::vector<fcl::Triangle> t;
   for (Eigen::Index i = 0; i < mesh.face_count(); ++i)
     t.emplace_back(mesh.faces(i, 0), mesh.faces(i, 1), mesh.faces(i, 2));

@@ -1,13 +1,13 @@
 #include "sim/body_collider.hpp"
 
+#include <fcl/fcl.h>
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <map>
 #include <memory>
 #include <random>
 #include <utility>
-
-#include <fcl/fcl.h>
-#include <gtest/gtest.h>
 
 #include "garment/body.hpp"
 #include "sim/collision_geometry.hpp"
@@ -19,7 +19,8 @@ namespace {
 using Eigen::Vector3d;
 
 // Icosphere of radius r centred at `centre`: every vertex on the sphere, triangles inside it.
-meshing::TriMesh make_sphere(double r, int subdivisions, const Vector3d& centre = Vector3d::Zero()) {
+meshing::TriMesh make_sphere(double r, int subdivisions,
+                             const Vector3d& centre = Vector3d::Zero()) {
   const double g = (1.0 + std::sqrt(5.0)) / 2.0;
   std::vector<Vector3d> v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0},
                              {0, -1, g}, {0, 1, g}, {0, -1, -g}, {0, 1, -g},
@@ -80,8 +81,8 @@ meshing::TriMesh make_wedge(double apex_degrees, double apex_y, double half_leng
   const double half_base = apex_y * std::tan(apex_degrees * M_PI / 360.0);
   meshing::TriMesh mesh;
   mesh.vertices.resize(6, 3);
-  mesh.vertices << -half_base, 0, -half_length, half_base, 0, -half_length, 0, apex_y,
-      -half_length, -half_base, 0, half_length, half_base, 0, half_length, 0, apex_y, half_length;
+  mesh.vertices << -half_base, 0, -half_length, half_base, 0, -half_length, 0, apex_y, -half_length,
+      -half_base, 0, half_length, half_base, 0, half_length, 0, apex_y, half_length;
   mesh.faces.resize(8, 3);
   mesh.faces << 0, 2, 1,  // back cap (z = −L), normal −z
       3, 4, 5,            // front cap, +z
@@ -130,9 +131,9 @@ TEST(ClosestPointOnTriangle, MatchesDenseSamplingAndClassifiesRegions) {
     EXPECT_GE(d, sampled - 1.2 / n);  // grid spacing bounds how much closer the truth can be
     EXPECT_NEAR(cp.barycentric.sum(), 1.0, 1e-12);
     EXPECT_TRUE((cp.barycentric.array() >= -1e-12).all());
-    EXPECT_LT((cp.barycentric[0] * a + cp.barycentric[1] * b + cp.barycentric[2] * c - cp.point)
-                  .norm(),
-              1e-12);
+    EXPECT_LT(
+        (cp.barycentric[0] * a + cp.barycentric[1] * b + cp.barycentric[2] * c - cp.point).norm(),
+        1e-12);
   }
   EXPECT_EQ(closest_point_on_triangle(Vector3d(0.4, 0.3, 1), a, b, c).feature,
             TriangleFeature::face);
@@ -180,12 +181,12 @@ TEST(BodyCollider, BoxEdgesAndCornersGetExactDistancesAndNormals) {
       {{0.13, 0.14, 0.02}, std::hypot(0.03, 0.04), Vector3d(0.03, 0.04, 0).normalized()},
       {{0.12, 0.12, 0.11}, Vector3d(0.02, 0.02, 0.01).norm(), Vector3d(2, 2, 1).normalized()},
       {{-0.11, -0.12, -0.13}, Vector3d(0.01, 0.02, 0.03).norm(), -Vector3d(1, 2, 3).normalized()},
-      {{0.09, 0.08, 0.0}, -0.01, Vector3d::UnitX()},                 // inside, near an edge
-      {{0.09, 0.08, 0.07}, -0.01, Vector3d::UnitX()},                // inside, near a corner
-      {{0.0, 0.0, 0.1001}, 0.0001, Vector3d::UnitZ()},               // above a face diagonal
-      {{0.02, -0.02, -0.095}, -0.005, -Vector3d::UnitZ()},           // just inside a face
-      {{0.1, 0.1, 0.1}, 0.0, Vector3d(1, 1, 1).normalized()},        // on a corner
-      {{0.1, 0.1, 0.0}, 0.0, Vector3d(1, 1, 0).normalized()},        // on an edge
+      {{0.09, 0.08, 0.0}, -0.01, Vector3d::UnitX()},           // inside, near an edge
+      {{0.09, 0.08, 0.07}, -0.01, Vector3d::UnitX()},          // inside, near a corner
+      {{0.0, 0.0, 0.1001}, 0.0001, Vector3d::UnitZ()},         // above a face diagonal
+      {{0.02, -0.02, -0.095}, -0.005, -Vector3d::UnitZ()},     // just inside a face
+      {{0.1, 0.1, 0.1}, 0.0, Vector3d(1, 1, 1).normalized()},  // on a corner
+      {{0.1, 0.1, 0.0}, 0.0, Vector3d(1, 1, 0).normalized()},  // on an edge
   };
   for (const Case& c : cases) {
     const std::optional<BodyProximity> hit = box.closest_point(c.p);
@@ -235,10 +236,10 @@ TEST(BodyCollider, DeepInsidePointsAreContactsWithTheRightPushDirection) {
   const BodyCollider collider(sphere);
   const Vector3d direction = Vector3d(0.3, -0.5, 0.8).normalized();
   const std::vector<Vector3d> points = {
-      0.17 * direction,        // 3 cm inside
-      Vector3d(0.001, 0, 0),   // centre
-      0.5 * direction,         // far outside
-      0.203 * direction,       // 3 mm outside
+      0.17 * direction,       // 3 cm inside
+      Vector3d(0.001, 0, 0),  // centre
+      0.5 * direction,        // far outside
+      0.203 * direction,      // 3 mm outside
   };
   ContactQuery query;
   query.thickness = 0.005;
@@ -311,10 +312,9 @@ TEST(BodyCollider, RefitAnswersLikeARebuild) {
   for (int step = 1; step <= 2; ++step) {
     for (Eigen::Index v = 0; v < pose.vertex_count(); ++v) {
       const Vector3d x = rest.vertices.row(v).transpose();
-      pose.vertices.row(v) =
-          (Vector3d(1.0 + 0.3 * step, 1.0, 0.8) .asDiagonal() * x +
-           Vector3d(0.05 * step, 0.02 * std::sin(20 * x.y()), -0.03 * step))
-              .transpose();
+      pose.vertices.row(v) = (Vector3d(1.0 + 0.3 * step, 1.0, 0.8).asDiagonal() * x +
+                              Vector3d(0.05 * step, 0.02 * std::sin(20 * x.y()), -0.03 * step))
+                                 .transpose();
     }
     moved.set_pose(pose.vertices);
     const BodyCollider rebuilt(pose);
@@ -381,8 +381,8 @@ TEST(BodyCollider, ContinuousCheckCatchesAPointPassingThroughAThinBody) {
   const Vector3d start(0.1, 0.1, 0.05), end(0.1, -0.1, 0.05);
   EXPECT_TRUE(slab.find_contacts(one(end), query).empty());
   ContactQueryStats stats;
-  std::vector<BodyContact> contacts = slab.find_contacts_swept(one(start), one(end), query,
-                                                               nullptr, &stats);
+  std::vector<BodyContact> contacts =
+      slab.find_contacts_swept(one(start), one(end), query, nullptr, &stats);
   ASSERT_EQ(contacts.size(), 1u);
   EXPECT_TRUE(contacts[0].crossed);
   EXPECT_LT((contacts[0].normal - Vector3d::UnitY()).norm(), 1e-9);
@@ -435,7 +435,8 @@ TEST(BodyCollider, ContinuousCheckCatchesAFastBodyPassingAStillPoint) {
 TEST(BodyCollider, SegmentStepsRefitOnceAndMatchARebuild) {
   const meshing::TriMesh rest = make_sphere(0.2, 2);
   const Eigen::MatrixX3d from = rest.vertices;
-  const Eigen::MatrixX3d to = (1.2 * rest.vertices).rowwise() + Vector3d(0.1, -0.05, 0.02).transpose();
+  const Eigen::MatrixX3d to =
+      (1.2 * rest.vertices).rowwise() + Vector3d(0.1, -0.05, 0.02).transpose();
   BodyCollider collider(rest);
   const double fractions[] = {0.0, 0.3, 0.7, 1.0};
   std::mt19937 rng(9);
@@ -447,7 +448,8 @@ TEST(BodyCollider, SegmentStepsRefitOnceAndMatchARebuild) {
     meshing::TriMesh pose = rest;
     pose.vertices = from + s * (to - from);
     EXPECT_LT((collider.vertices() - pose.vertices).norm(), 1e-12);
-    EXPECT_NEAR(collider.last_motion(), (fractions[k + 1] - fractions[k]) * (to - from).rowwise().norm().maxCoeff(), 1e-12);
+    EXPECT_NEAR(collider.last_motion(),
+                (fractions[k + 1] - fractions[k]) * (to - from).rowwise().norm().maxCoeff(), 1e-12);
     const BodyCollider rebuilt(pose);
     for (int trial = 0; trial < 100; ++trial) {
       const Vector3d p(u(rng), u(rng), u(rng));

@@ -1,8 +1,8 @@
 #include "sim/body_motion.hpp"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "garment/body.hpp"
 #include "sim/body_collider.hpp"
@@ -99,7 +99,8 @@ TEST(ArmLowering, KeepsTopologyAndLowersTheHands) {
   const double angle = options.angle_degrees * M_PI / 180.0;
   for (const Eigen::Index tip : {left_tip, right_tip}) {
     const double side = rest.vertices(tip, 0) > 0 ? 1.0 : -1.0;
-    const Eigen::Vector2d r(side * rest.vertices(tip, 0) - joint.x(), rest.vertices(tip, 1) - joint.y());
+    const Eigen::Vector2d r(side * rest.vertices(tip, 0) - joint.x(),
+                            rest.vertices(tip, 1) - joint.y());
     // A rigid turn of the hand about the joint, towards the body.
     const Eigen::Vector2d turned(std::cos(angle) * r.x() + std::sin(angle) * r.y(),
                                  -std::sin(angle) * r.x() + std::cos(angle) * r.y());
@@ -120,8 +121,8 @@ TEST(ArmLowering, KeepsTopologyAndLowersTheHands) {
   for (Eigen::Index f = 0; f < rest.face_count(); ++f)
     for (int k = 0; k < 3; ++k) {
       const int a = rest.faces(f, k), b = rest.faces(f, (k + 1) % 3);
-      const double ratio = (end.row(a) - end.row(b)).norm() /
-                           (rest.vertices.row(a) - rest.vertices.row(b)).norm();
+      const double ratio =
+          (end.row(a) - end.row(b)).norm() / (rest.vertices.row(a) - rest.vertices.row(b)).norm();
       stretch = std::max(stretch, ratio);
       shrink = std::min(shrink, ratio);
     }
