@@ -395,7 +395,8 @@ std::optional<BodyProximity> BodyCollider::closest_point(const Eigen::Vector3d& 
 }
 
 double BodyCollider::signed_distance(const Eigen::Vector3d& p) const {
-  return nearest(p, 1.0, std::numeric_limits<double>::infinity())->distance;
+  const std::optional<BodyProximity> hit = nearest(p, 1.0, std::numeric_limits<double>::infinity());
+  return hit ? hit->distance : std::numeric_limits<double>::quiet_NaN();  // only for a NaN point
 }
 
 Eigen::Vector3d BodyCollider::surface_velocity(int triangle,
@@ -457,6 +458,8 @@ std::vector<BodyContact> BodyCollider::find_contacts(const Eigen::VectorXd& x,
                                                      ContactQueryStats* stats) const {
   if (x.size() % 3 != 0)
     throw std::invalid_argument("cloth positions must hold 3 coordinates per vertex");
+  if (!x.allFinite())
+    throw std::invalid_argument("a cloth position is not finite (the simulation diverged?)");
   if (!(query.thickness >= 0.0) || !(query.search_margin >= 0.0))
     throw std::invalid_argument("the collision thickness and search margin must be >= 0");
   const int n = static_cast<int>(x.size() / 3);
@@ -490,6 +493,8 @@ std::vector<BodyContact> BodyCollider::find_contacts_swept(const Eigen::VectorXd
   if (x0.size() != x1.size() || x1.size() % 3 != 0)
     throw std::invalid_argument(
         "start and end cloth positions must have the same size, 3 coordinates per vertex");
+  if (!x0.allFinite() || !x1.allFinite())
+    throw std::invalid_argument("a cloth position is not finite (the simulation diverged?)");
   if (!(query.thickness >= 0.0) || !(query.search_margin >= 0.0) ||
       !(query.max_substep_motion > 0.0) || query.max_substeps < 1)
     throw std::invalid_argument(

@@ -543,6 +543,12 @@ TEST(BodyCollider, RejectsUnusableInput) {
   BodyCollider box(make_box(Vector3d::Zero(), Vector3d::Ones()));
   EXPECT_THROW(box.set_pose(Eigen::MatrixX3d::Zero(7, 3)), InvalidBodyMeshError);
   EXPECT_THROW(box.find_contacts(Eigen::VectorXd::Zero(4), ContactQuery{}), std::invalid_argument);
+  Eigen::VectorXd diverged = Eigen::VectorXd::Zero(6);
+  diverged[4] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(box.find_contacts(diverged, ContactQuery{}), std::invalid_argument);
+  EXPECT_THROW(box.find_contacts_swept(Eigen::VectorXd::Zero(6), diverged, ContactQuery{}),
+               std::invalid_argument);
+  EXPECT_TRUE(std::isnan(box.signed_distance(Vector3d(std::nan(""), 0, 0))));
 }
 
 }  // namespace
