@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "garment/body.hpp"
+#include "meshing/tri_mesh.hpp"
 #include "sim/body_collider.hpp"
 
 namespace sd::sim {
@@ -161,6 +162,44 @@ TEST(MoveBody, FollowsTheSequenceWithOneRefitPerSegment) {
   EXPECT_LT((collider.vertices() - motion.vertices_at(1.0)).norm(), 1e-12);
   EXPECT_EQ(collider.last_motion(), 0.0);
   EXPECT_THROW(move_body(collider, motion, 0.5, 0.5), std::invalid_argument);
+}
+
+TEST(MoveBody, ClothRidingOnTheMovingArmsIsNeverTakenForACrossing) {
+  // Points 1 cm off the skin that move with the body (offset along the posed normals) while the
+  // arms come down: the swept check must not call any of them a crossing, and no rigidly carried
+  // point may end deeper than the armpit fold squeezes it.
+  const garment::Body body = garment::load_body("builtin");
+  ArmLoweringOptions options;
+  options.duration = 0.5;
+  const PoseSequence motion = make_arm_lowering(body.mesh, options);
+  const auto riding = [&](double t) {
+    const meshing::TriMesh pose = motion.mesh_at(t);
+    const Eigen::MatrixX3d normals = meshing::vertex_normals(pose);
+    Eigen::VectorXd x(3 * pose.vertex_count());
+    for (Eigen::Index v = 0; v < pose.vertex_count(); ++v)
+      x.segment<3>(3 * v) = (pose.vertices.row(v) + 0.01 * normals.row(v)).transpose();
+    return x;
+  };
+  BodyCollider collider(body.mesh);
+  ContactCache cache;
+  ContactQuery query;
+  int crossings = 0, samples = 0;
+  const int steps = 12;
+  Eigen::VectorXd x0 = riding(0.0);
+  for (int step = 0; step < steps; ++step) {
+    const double t0 = options.duration * step / steps, t1 = options.duration * (step + 1) / steps;
+    move_body(collider, motion, t0, t1);
+    const Eigen::VectorXd x1 = riding(t1);
+    ContactQueryStats stats;
+    for (const BodyContact& c : collider.find_contacts_swept(x0, x1, query, &cache, &stats)) {
+      crossings += c.crossed ? 1 : 0;
+      EXPECT_GT(c.distance, -0.015);
+    }
+    samples += stats.sweep_samples;
+    x0 = x1;
+  }
+  EXPECT_EQ(crossings, 0);
+  EXPECT_GT(samples, 0);  // the motion did make the check walk some paths
 }
 
 }  // namespace
