@@ -20,18 +20,19 @@ vec3 srgb_to_linear(vec3 c) { return pow(c, vec3(2.2)); }
 vec3 linear_to_srgb(vec3 c) { return pow(clamp(c, 0.0, 1.0), vec3(1.0 / 2.2)); }
 
 // Fraction of the key light reaching `p` (1 lit, 0 in shadow): percentage-closer filtering over
-// a 5x5 grid of bilinear depth comparisons, which gives a penumbra about 5 spreads wide.
+// a 3x3 grid of bilinear depth comparisons u_pcf_spread texels apart, a penumbra about
+// 2 spreads + 1 texel wide. (A 5x5 grid cost 30% more per frame on llvmpipe for little gain.)
 float key_visibility(vec3 p, vec3 n) {
   if (!u_shadows) return 1.0;
   vec4 clip = u_light_view_proj * vec4(p + n * u_normal_offset, 1.0);
   vec3 uvz = clip.xyz / clip.w * 0.5 + 0.5;
   if (uvz.z >= 1.0) return 1.0;
   float lit = 0.0;
-  for (int i = -2; i <= 2; ++i)
-    for (int j = -2; j <= 2; ++j)
+  for (int i = -1; i <= 1; ++i)
+    for (int j = -1; j <= 1; ++j)
       lit += texture(u_shadow_map,
                      vec3(uvz.xy + vec2(i, j) * (u_pcf_spread * u_shadow_texel), uvz.z));
-  return lit / 25.0;
+  return lit / 9.0;
 }
 
 // Diffuse light arriving at a surface with unit normal n (without the surface's colour).

@@ -6,6 +6,8 @@ layout(location = 1) in vec3 a_normal;  // smooth vertex normal
 
 uniform mat4 u_view_proj;  // world → clip
 
+invariant gl_Position;  // same depth as the pre-pass (shadow.vert)
+
 out vec3 v_world_pos;
 out vec3 v_normal;
 

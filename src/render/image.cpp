@@ -29,6 +29,13 @@ void append_to_string(png_structp png, png_bytep data, png_size_t length) {
 
 void flush_nothing(png_structp) {}
 
+// libpng's default handlers print to stderr; these keep the message for the exception instead.
+[[noreturn]] void keep_error(png_structp png, png_const_charp message) {
+  *static_cast<std::string*>(png_get_error_ptr(png)) = message;
+  png_longjmp(png, 1);
+}
+void ignore_warning(png_structp, png_const_charp) {}
+
 struct ReadCursor {
   std::string_view bytes;
   size_t offset = 0;
@@ -61,7 +68,9 @@ std::string encode_png(const Image& image) {
       image.rgba.size() != static_cast<size_t>(image.width) * image.height * 4)
     throw std::invalid_argument("encode_png: image buffer does not match its size");
   auto out = std::make_unique<std::string>();
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  auto error = std::make_unique<std::string>();
+  png_structp png =
+      png_create_write_struct(PNG_LIBPNG_VER_STRING, error.get(), keep_error, ignore_warning);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
   if (png == nullptr || info == nullptr) {
     png_destroy_write_struct(&png, &info);
@@ -69,7 +78,7 @@ std::string encode_png(const Image& image) {
   }
   if (setjmp(png_jmpbuf(png))) {
     png_destroy_write_struct(&png, &info);
-    throw std::runtime_error("libpng failed to encode the image");
+    throw std::runtime_error("libpng failed to encode the image: " + *error);
   }
   png_set_write_fn(png, out.get(), append_to_string, flush_nothing);
   png_set_IHDR(png, info, static_cast<png_uint_32>(image.width),
@@ -90,7 +99,9 @@ std::string encode_png(const Image& image) {
 Image decode_png(std::string_view bytes) {
   if (bytes.size() < 8 || png_sig_cmp(reinterpret_cast<png_const_bytep>(bytes.data()), 0, 8) != 0)
     throw PngError("the data is not a PNG image");
-  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  auto error = std::make_unique<std::string>();
+  png_structp png =
+      png_create_read_struct(PNG_LIBPNG_VER_STRING, error.get(), keep_error, ignore_warning);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
   if (png == nullptr || info == nullptr) {
     png_destroy_read_struct(&png, &info, nullptr);
@@ -100,7 +111,7 @@ Image decode_png(std::string_view bytes) {
   auto cursor = std::make_unique<ReadCursor>(ReadCursor{bytes, 0});
   if (setjmp(png_jmpbuf(png))) {
     png_destroy_read_struct(&png, &info, nullptr);
-    throw PngError("the PNG image is corrupt");
+    throw PngError("the PNG image is corrupt: " + *error);
   }
   png_set_read_fn(png, cursor.get(), read_from_view);
   png_read_info(png, info);

@@ -29,9 +29,9 @@ struct ImageSize {
   bool operator==(const ImageSize&) const = default;
 };
 
-// Largest side accepted from users, in pixels (llvmpipe's framebuffer limit is 16384; 8192 keeps
-// a 4x-multisampled frame under ~1 GB).
-inline constexpr int kMaxImageSide = 8192;
+// Largest side accepted, in pixels: a 4096x4096 frame with 4 samples of colour + depth per pixel
+// takes 0.5 GB (llvmpipe's own limit is 16384, but that would be 8 GB).
+inline constexpr int kMaxImageSide = 4096;
 
 // Parses "WxH" (e.g. "800x1200"); both sides in [1, kMaxImageSide]. Throws ImageSizeError.
 ImageSize parse_image_size(std::string_view text);
