@@ -41,6 +41,49 @@ std::string type_name(const json& value) {
   return "an object";
 }
 
+// JSON has no NaN or infinity literal, but a number like 1e999 overflows a double; the JSON
+// library rejects it without saying where. Such literals are replaced by a marked string before
+// parsing, so the reader reports them with their JSON path.
+constexpr const char* kOverflowMarker = "\x01sketchdrape-overflow:";
+
+std::string mark_overflowing_numbers(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  size_t i = 0;
+  while (i < text.size()) {
+    const char c = text[i];
+    if (c == '"') {  // copy a string literal with its escapes
+      size_t j = i + 1;
+      while (j < text.size() && text[j] != '"') j += text[j] == '\\' ? 2 : 1;
+      j = std::min(j + 1, text.size());
+      out.append(text.substr(i, j - i));
+      i = j;
+    } else if (c == '/' && i + 1 < text.size() && (text[i + 1] == '/' || text[i + 1] == '*')) {
+      const bool line = text[i + 1] == '/';
+      size_t j = line ? text.find('\n', i) : text.find("*/", i + 2);
+      j = j == std::string_view::npos ? text.size() : j + (line ? 0 : 2);
+      out.append(text.substr(i, j - i));
+      i = j;
+    } else if (c == '-' || (c >= '0' && c <= '9')) {
+      size_t j = i + 1;
+      while (j < text.size() && (std::isdigit(static_cast<unsigned char>(text[j])) || text[j] == '.' ||
+                                 text[j] == 'e' || text[j] == 'E' || text[j] == '+' || text[j] == '-'))
+        ++j;
+      const std::string token(text.substr(i, j - i));
+      const double value = std::strtod(token.c_str(), nullptr);
+      if (std::isinf(value))
+        out += fmt::format("\"\\u0001sketchdrape-overflow:{}\"", token);  // JSON escape of the marker
+      else
+        out += token;
+      i = j;
+    } else {
+      out += c;
+      ++i;
+    }
+  }
+  return out;
+}
+
 // Reads one JSON document with the context needed for messages.
 class Reader {
  public:
@@ -76,6 +119,11 @@ class Reader {
   }
 
   double number(const json& value, const std::string& path) const {
+    if (value.is_string() && value.get<std::string>().starts_with(kOverflowMarker)) {
+      fail(path, fmt::format("the number {} is not finite (too large for a double); coordinates "
+                             "and sizes must be finite numbers",
+                             value.get<std::string>().substr(std::string_view(kOverflowMarker).size())));
+    }
     if (value.is_string()) {
       fail(path, fmt::format("expected a number, got {}; JSON numbers are written without quotes "
                              "and must be finite (no NaN or infinity)",
@@ -467,7 +515,8 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
 
   json root;
   try {
-    root = json::parse(text, nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
+    root = json::parse(mark_overflowing_numbers(text), nullptr, /*allow_exceptions=*/true,
+                       /*ignore_comments=*/true);
   } catch (const json::parse_error& e) {
     std::string detail = e.what();
     const size_t colon = detail.find("error while parsing");

@@ -214,19 +214,21 @@ ProjectedCurve project_curve(const Sketch& sketch, const CurveSpec& curve, const
     const size_t n = dense.size();
     std::vector<Eigen::Vector3d> origins(n), directions(n);
     std::vector<double> depth(n, 0.0);
+    std::vector<Eigen::Vector3d> landed(n);  // hit + offset · normal, for samples that hit
     std::vector<bool> hit(n, false);
     int hits = 0;
     for (size_t k = 0; k < n; ++k) {
       frame.ray(dense[k], far, origins[k], directions[k]);
       if (!curve.on_body || body == nullptr) {
         depth[k] = frame.perspective ? (frame.plane_point(dense[k]) - origins[k]).norm() : far;
+        landed[k] = origins[k] + depth[k] * directions[k];
         hit[k] = true;
         ++hits;
         continue;
       }
       if (auto s = body->first_hit(origins[k], directions[k])) {
-        const Eigen::Vector3d p = s->position + curve.offset * s->normal;
-        depth[k] = (p - origins[k]).dot(directions[k]);
+        landed[k] = s->position + curve.offset * s->normal;
+        depth[k] = (landed[k] - origins[k]).dot(directions[k]);
         hit[k] = true;
         ++hits;
       }
@@ -251,8 +253,12 @@ ProjectedCurve project_curve(const Sketch& sketch, const CurveSpec& curve, const
     }
     out.points.resize(static_cast<Eigen::Index>(n), 3);
     for (size_t k = 0; k < n; ++k) {
+      if (hit[k]) {
+        out.points.row(static_cast<Eigen::Index>(k)) = landed[k].transpose();
+        continue;
+      }
       double d = depth[k];
-      if (!hit[k]) {
+      {
         const int a = previous[k], b = next[k];
         if (a >= 0 && b >= 0) {
           const double w = (static_cast<double>(k) - a) / (b - a);

@@ -11,6 +11,7 @@ packages=(
   libopenblas0-pthread libfcl-dev libosmesa6-dev libpng-dev
   libcli11-dev nlohmann-json3-dev libspdlog-dev
   libgtest-dev libbenchmark-dev
+  python3-jsonschema  # tests validate the example sketch files against data/schema/
 )
 
 missing=()

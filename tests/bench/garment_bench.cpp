@@ -1,0 +1,53 @@
+// Meshing a sketch, body loading excluded: sketch parse + stroke projection + curve network +
+// panels + edge counts + quad fill + stitching (build_garment), for each example garment.
+// The body and its AABB tree are built once, outside the timed loop (as `mesh` reports them
+// apart). Run: ./build/tests/bench/garment_bench
+
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+
+#include "garment/body.hpp"
+#include "garment/body_surface.hpp"
+#include "garment/garment_mesh.hpp"
+#include "garment/sketch_file.hpp"
+
+namespace {
+
+const sd::garment::BodySurface& surface() {
+  static const sd::garment::Body body = sd::garment::load_body("builtin");
+  static const sd::garment::BodySurface s(body.mesh);
+  return s;
+}
+
+void mesh_example(benchmark::State& state, const char* name) {
+  const std::filesystem::path file = std::filesystem::path(SD_SOURCE_DIR) / "data/examples" / name;
+  const sd::garment::BodySurface& body = surface();
+  long quads = 0;
+  for (auto _ : state) {
+    const sd::garment::Sketch sketch = sd::garment::load_sketch(file);
+    const sd::garment::Garment g = sd::garment::build_garment(sketch, body);
+    quads = static_cast<long>(g.mesh.face_count());
+    benchmark::DoNotOptimize(g.mesh.vertices.data());
+  }
+  state.counters["quads"] = static_cast<double>(quads);
+}
+
+void body_surface_build(benchmark::State& state) {
+  static const sd::garment::Body body = sd::garment::load_body("builtin");
+  for (auto _ : state) {
+    sd::garment::BodySurface s(body.mesh);
+    benchmark::DoNotOptimize(&s);
+  }
+}
+
+}  // namespace
+
+BENCHMARK_CAPTURE(mesh_example, tshirt, "tshirt.json")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(mesh_example, a_line_skirt, "a-line-skirt.json")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(mesh_example, sleeveless_dress, "sleeveless-dress.json")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(mesh_example, shorts, "shorts.json")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(mesh_example, godet_skirt, "godet-skirt.json")->Unit(benchmark::kMillisecond);
+BENCHMARK(body_surface_build)->Unit(benchmark::kMillisecond);
+
+BENCHMARK_MAIN();

@@ -1,0 +1,264 @@
+#include "garment/garment_mesh.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <map>
+#include <set>
+
+#include "garment/body.hpp"
+#include "garment/material_frames.hpp"
+#include "garment/sketch_inputs.hpp"
+#include "meshing/quad_mesh.hpp"
+#include "tests/garment/test_helpers.hpp"
+
+namespace sd::garment {
+namespace {
+
+const BodySurface& builtin_surface() {
+  static const Body body = load_body("builtin");
+  static const BodySurface surface(body.mesh);
+  return surface;
+}
+
+// The sub-mesh of one panel, re-indexed.
+meshing::QuadMesh panel_mesh(const Garment& g, int panel) {
+  std::map<int, int> index;
+  std::vector<Eigen::RowVector4i> faces;
+  for (Eigen::Index f = 0; f < g.mesh.face_count(); ++f) {
+    if (g.face_panel(f) != panel) continue;
+    Eigen::RowVector4i q;
+    for (int k = 0; k < 4; ++k) {
+      const int v = g.mesh.faces(f, k);
+      auto [it, inserted] = index.try_emplace(v, static_cast<int>(index.size()));
+      q(k) = it->second;
+    }
+    faces.push_back(q);
+  }
+  meshing::QuadMesh m;
+  m.vertices.resize(static_cast<Eigen::Index>(index.size()), 3);
+  for (const auto& [v, i] : index) m.vertices.row(i) = g.mesh.vertices.row(v);
+  m.faces.resize(static_cast<Eigen::Index>(faces.size()), 4);
+  for (size_t f = 0; f < faces.size(); ++f) m.faces.row(static_cast<Eigen::Index>(f)) = faces[f];
+  return m;
+}
+
+class ExampleGarment : public ::testing::TestWithParam<std::filesystem::path> {};
+
+TEST_P(ExampleGarment, IsOneStitchedConformingMesh) {
+  const Sketch sketch = load_sketch(GetParam());
+  const Garment g = build_garment(sketch, builtin_surface());
+  ASSERT_GT(g.mesh.face_count(), 100);
+  ASSERT_EQ(g.face_panel.size(), g.mesh.face_count());
+
+  // The garment passes every quad-mesh check except "one boundary loop" (a shirt has several).
+  for (const std::string& p : meshing::validate(g.mesh).problems)
+    EXPECT_NE(p.find("boundary"), std::string::npos) << GetParam() << ": " << p;
+
+  // Every edge has one or two faces, and two faces traverse it in opposite directions.
+  std::map<std::pair<int, int>, std::vector<int>> directed;
+  for (Eigen::Index f = 0; f < g.mesh.face_count(); ++f)
+    for (int k = 0; k < 4; ++k)
+      directed[{g.mesh.faces(f, k), g.mesh.faces(f, (k + 1) % 4)}].push_back(static_cast<int>(f));
+  int seams = 0;
+  for (const auto& [edge, faces] : directed) {
+    EXPECT_EQ(faces.size(), 1u) << "edge traversed twice the same way";
+    const auto twin = directed.find({edge.second, edge.first});
+    if (twin != directed.end() && edge.first < edge.second &&
+        g.face_panel(faces[0]) != g.face_panel(twin->second[0]))
+      ++seams;
+  }
+  EXPECT_EQ(seams, g.seam_edges);
+  EXPECT_GT(seams, 0);
+
+  // No duplicated seam vertices: no two vertices at the same place.
+  std::vector<std::array<double, 3>> sorted;
+  for (Eigen::Index v = 0; v < g.mesh.vertex_count(); ++v)
+    sorted.push_back({g.mesh.vertices(v, 0), g.mesh.vertices(v, 1), g.mesh.vertices(v, 2)});
+  std::sort(sorted.begin(), sorted.end());
+  for (size_t k = 1; k < sorted.size(); ++k) {
+    const Eigen::Vector3d a(sorted[k - 1].data()), b(sorted[k].data());
+    EXPECT_GT((a - b).norm(), 1e-7) << "duplicate vertex at " << a.transpose();
+  }
+
+  // Each panel on its own is a valid disk, and its figures add up.
+  int distortion = 0;
+  for (size_t p = 0; p < g.panels.size(); ++p) {
+    const meshing::MeshCheck check = meshing::validate(panel_mesh(g, static_cast<int>(p)));
+    EXPECT_TRUE(check.ok()) << g.panels[p].id << ": " << (check.ok() ? "" : check.problems.front());
+    EXPECT_GE(g.panels[p].side_counts.size(), 3u);
+    EXPECT_FALSE(g.panels[p].body_part.empty());
+    distortion += g.panels[p].distortion;
+  }
+  EXPECT_GE(distortion, 0);
+
+  // Every example is mirrored across x = 0: the vertex set is symmetric.
+  std::set<std::array<long long, 3>> keys;
+  auto key = [](double x, double y, double z) {
+    return std::array<long long, 3>{std::llround(x * 1e7), std::llround(y * 1e7), std::llround(z * 1e7)};
+  };
+  for (Eigen::Index v = 0; v < g.mesh.vertex_count(); ++v)
+    keys.insert(key(g.mesh.vertices(v, 0), g.mesh.vertices(v, 1), g.mesh.vertices(v, 2)));
+  int asymmetric = 0;
+  for (Eigen::Index v = 0; v < g.mesh.vertex_count(); ++v)
+    asymmetric += keys.contains(key(-g.mesh.vertices(v, 0), g.mesh.vertices(v, 1), g.mesh.vertices(v, 2))) ? 0 : 1;
+  EXPECT_EQ(asymmetric, 0);
+
+  // The outside of the garment faces away from the body: most face normals point away from the
+  // nearest body point.
+  int outward = 0;
+  for (Eigen::Index f = 0; f < g.mesh.face_count(); ++f) {
+    const Eigen::Vector3d a = g.mesh.vertices.row(g.mesh.faces(f, 0)), b = g.mesh.vertices.row(g.mesh.faces(f, 1)),
+                          c = g.mesh.vertices.row(g.mesh.faces(f, 2)), d = g.mesh.vertices.row(g.mesh.faces(f, 3));
+    const Eigen::Vector3d centre = (a + b + c + d) / 4, n = (c - a).cross(d - b);
+    outward += n.dot(builtin_surface().closest_point(centre).normal) > 0 ? 1 : 0;
+  }
+  EXPECT_GT(outward, 0.95 * static_cast<double>(g.mesh.face_count()));
+}
+
+TEST_P(ExampleGarment, MaterialFramesAndRestShape) {
+  const Garment g = build_garment(load_sketch(GetParam()), builtin_surface());
+  const MaterialFrames frames = material_frames(g.mesh);
+  for (Eigen::Index f = 0; f < g.mesh.face_count(); ++f) {
+    const Eigen::Vector3d w = frames.warp.row(f), t = frames.weft.row(f), n = frames.normal.row(f);
+    EXPECT_NEAR(w.norm(), 1, 1e-12);
+    EXPECT_NEAR(w.dot(t), 0, 1e-12);
+    EXPECT_NEAR(w.dot(n), 0, 1e-12);
+    // Warp is the in-face direction closest to +Y: no unit tangent has a larger y.
+    EXPECT_NEAR(w.y(), std::sqrt(std::max(0.0, 1 - n.y() * n.y())), 1e-9);
+  }
+  meshing::TriMesh tris;
+  tris.vertices = g.mesh.vertices;
+  tris.faces.resize(2 * g.mesh.face_count(), 3);
+  Eigen::VectorXi tri_quad(2 * g.mesh.face_count());
+  for (Eigen::Index f = 0; f < g.mesh.face_count(); ++f) {
+    tris.faces.row(2 * f) << g.mesh.faces(f, 0), g.mesh.faces(f, 1), g.mesh.faces(f, 2);
+    tris.faces.row(2 * f + 1) << g.mesh.faces(f, 0), g.mesh.faces(f, 2), g.mesh.faces(f, 3);
+    tri_quad(2 * f) = tri_quad(2 * f + 1) = static_cast<int>(f);
+  }
+  const Eigen::VectorXd ease = Eigen::VectorXd::Constant(g.mesh.face_count(), 1.1);
+  const Eigen::MatrixXd rest = triangle_rest_coordinates(tris, tri_quad, frames, ease);
+  for (Eigen::Index t = 0; t < tris.face_count(); t += 7) {
+    const Eigen::Vector3d p0 = tris.vertices.row(tris.faces(t, 0)), p1 = tris.vertices.row(tris.faces(t, 1)),
+                          p2 = tris.vertices.row(tris.faces(t, 2));
+    const Eigen::Vector2d u1(rest(t, 2), rest(t, 3)), u2(rest(t, 4), rest(t, 5));
+    EXPECT_NEAR(u1.norm(), 1.1 * (p1 - p0).norm(), 1e-12);
+    EXPECT_NEAR(u2.norm(), 1.1 * (p2 - p0).norm(), 1e-12);
+    EXPECT_NEAR((u2 - u1).norm(), 1.1 * (p2 - p1).norm(), 1e-12);
+    EXPECT_GT(u1.x() * u2.y() - u1.y() * u2.x(), 0);  // orientation kept (normal = warp × weft)
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Wardrobe, ExampleGarment, ::testing::ValuesIn(test::example_files()),
+                         [](const auto& param_info) {
+                           std::string name = param_info.param.stem().string();
+                           std::replace(name.begin(), name.end(), '-', '_');
+                           return name;
+                         });
+
+TEST(Garment, ParityMakesEveryPanelEvenWithFewChanges) {
+  for (const auto& file : test::example_files()) {
+    const Garment g = build_garment(load_sketch(file), builtin_surface());
+    for (const GarmentPanel& p : g.panels) {
+      int total = 0;
+      for (int c : p.side_counts) total += c;
+      EXPECT_EQ(total % 2, 0) << file << " " << p.id;
+      for (int c : p.side_counts) EXPECT_GE(c, 1);
+    }
+    EXPECT_LE(g.parity_changes, static_cast<int>(g.panels.size()));
+  }
+}
+
+TEST(Garment, BodyPartsOfTheTshirt) {
+  const Garment g = build_garment(load_sketch(std::filesystem::path(SD_SOURCE_DIR) / "data/examples/tshirt.json"),
+                                  builtin_surface());
+  std::map<std::string, std::string> part;
+  for (const GarmentPanel& p : g.panels) part[p.id] = p.body_part;
+  EXPECT_EQ(part["front"], "torso");
+  EXPECT_EQ(part["back.mirror"], "torso");
+  EXPECT_EQ(part["sleeve_front"], "left_arm");
+  EXPECT_EQ(part["sleeve_back.mirror"], "right_arm");
+}
+
+TEST(Garment, ClassifyBodyPoint) {
+  EXPECT_EQ(classify_body_point({0, 1.65, 0}, 1.75), BodyPart::kHead);
+  EXPECT_EQ(classify_body_point({0.1, 1.2, 0.1}, 1.75), BodyPart::kTorso);
+  EXPECT_EQ(classify_body_point({0.3, 1.0, 0}, 1.75), BodyPart::kLeftArm);
+  EXPECT_EQ(classify_body_point({-0.3, 1.0, 0}, 1.75), BodyPart::kRightArm);
+  EXPECT_EQ(classify_body_point({0.1, 0.3, 0}, 1.75), BodyPart::kLeftLeg);
+  EXPECT_EQ(classify_body_point({-0.1, 0.3, 0}, 1.75), BodyPart::kRightLeg);
+}
+
+TEST(Garment, JoinRelabelsGroupsAndSeamOnSphereStitches) {
+  // Two panels side by side on a sphere, sharing the middle curve, then joined.
+  Sketch s = parse_sketch(R"({
+    "curves": [
+      { "id": "top_l", "points": [[-0.1, 1.1], [0, 1.1]] }, { "id": "top_r", "points": [[0, 1.1], [0.1, 1.1]] },
+      { "id": "mid", "points": [[0, 1.1], [0, 0.9]] },
+      { "id": "bot_l", "points": [[-0.1, 0.9], [0, 0.9]] }, { "id": "bot_r", "points": [[0, 0.9], [0.1, 0.9]] },
+      { "id": "left", "points": [[-0.1, 0.9], [-0.1, 1.1]] }, { "id": "right", "points": [[0.1, 0.9], [0.1, 1.1]] }
+    ],
+    "panels": [ { "id": "l", "boundary": ["top_l", "mid", "bot_l", "left"] },
+                { "id": "r", "boundary": ["top_r", "right", "bot_r", "mid"] } ],
+    "join": [ { "id": "both", "panels": ["l", "r"] } ],
+    "edge_length": 0.02
+  })", "s.json");
+  const BodySurface sphere(test::sphere_mesh(0.3, {0, 1, 0}, 5));
+  const Garment g = build_garment(s, sphere);
+  ASSERT_EQ(g.panels.size(), 2u);
+  EXPECT_EQ(g.panels[0].group, "both");
+  EXPECT_EQ(g.panels[1].group, "both");
+  // The 20 cm stroke lies on the 0.30 m sphere and is pushed out radially by the 1 cm offset, so
+  // it measures 0.2041 m × 0.31 / 0.30 = 0.211 m: 11 edges of 2 cm.
+  EXPECT_EQ(g.seam_edges, 11);
+  // Every vertex lies on the offset sphere (boundary by projection, interior by the filler's
+  // projection callback).
+  for (Eigen::Index v = 0; v < g.mesh.vertex_count(); ++v)
+    EXPECT_NEAR((g.mesh.vertices.row(v).transpose() - Eigen::Vector3d(0, 1, 0)).norm(), 0.31, 2e-3);
+}
+
+TEST(Garment, ThreePanelsOnOneCurveIsAnError) {
+  Sketch s = parse_sketch(R"({
+    "curves": [ { "id": "a", "points": [[-0.1, 1.1], [0.1, 1.1]] },
+                { "id": "b", "points": [[0.1, 1.1], [0, 0.9]] },
+                { "id": "c", "points": [[0, 0.9], [-0.1, 1.1]] } ],
+    "panels": [ { "id": "p", "boundary": ["a", "b", "c"] }, { "id": "q", "boundary": ["a", "b", "c"] },
+                { "id": "r", "boundary": ["a", "b", "c"] } ]
+  })", "s.json");
+  const BodySurface sphere(test::sphere_mesh(0.3, {0, 1, 0}, 4));
+  try {
+    build_garment(s, sphere);
+    FAIL();
+  } catch (const SketchError& e) {
+    EXPECT_EQ(e.json_path(), "/panels/2/boundary");
+    EXPECT_NE(std::string(e.what()).find("already joins panels 'p' and 'q'"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Garment, TJunctionSplitsTheCurve) {
+  // "mid" ends on the interior of "top" and "bottom": both are split, each panel uses a part.
+  Sketch s = parse_sketch(R"({
+    "curves": [ { "id": "top", "points": [[-0.1, 1.1], [0.1, 1.1]] },
+                { "id": "bottom", "points": [[-0.1, 0.9], [0.1, 0.9]] },
+                { "id": "mid", "points": [[0.0, 1.1], [0.0, 0.9]] },
+                { "id": "left", "points": [[-0.1, 0.9], [-0.1, 1.1]] },
+                { "id": "right", "points": [[0.1, 0.9], [0.1, 1.1]] } ],
+    "panels": [ { "id": "l", "boundary": ["top", "mid", "bottom", "left"] },
+                { "id": "r", "boundary": ["top", "right", "bottom", "mid"] } ],
+    "edge_length": 0.02
+  })", "s.json");
+  const BodySurface sphere(test::sphere_mesh(0.3, {0, 1, 0}, 5));
+  const Garment g = build_garment(s, sphere);
+  EXPECT_EQ(g.seam_edges, 11);  // mid: 0.211 m on the offset sphere (see the test above)
+  ASSERT_EQ(g.panels[0].side_counts.size(), 4u);
+  // The left panel uses half of "top" and half of "bottom" (about 0.105 m: 5 edges each), all of
+  // "mid" and "left" (11 each).
+  std::vector<int> counts = g.panels[0].side_counts;
+  std::sort(counts.begin(), counts.end());
+  EXPECT_EQ(counts, (std::vector<int>{5, 5, 11, 11}));
+  EXPECT_EQ(std::count(g.panels[0].curves.begin(), g.panels[0].curves.end(), "top"), 1);
+}
+
+}  // namespace
+}  // namespace sd::garment

@@ -1,0 +1,150 @@
+#include "garment/sketch_file.hpp"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+namespace sd::garment {
+namespace {
+
+const char* kMinimal = R"({
+  // comments are allowed
+  "curves": [ { "id": "a", "points": [[0, 1], [0.1, 1.2]] },
+              { "id": "b", "points3d": [[0, 1, 0], [0.1, 1, 0]], "on_body": false, "edges": 4 } ],
+  "panels": [ { "id": "p", "boundary": ["a", "b", "a.mirror"], "mirror": true } ]
+})";
+
+// The error a text produces, or "" when it parses.
+SketchError error_of(const std::string& text) {
+  try {
+    parse_sketch(text, "test.json");
+  } catch (const SketchError& e) {
+    return e;
+  }
+  return SketchError("", "", "");
+}
+
+TEST(SketchFile, MinimalFileGetsDefaults) {
+  const Sketch s = parse_sketch(kMinimal, "test.json");
+  EXPECT_EQ(s.body.mesh, "builtin");
+  EXPECT_DOUBLE_EQ(s.edge_length, 0.03);
+  EXPECT_DOUBLE_EQ(s.offset, 0.01);
+  EXPECT_EQ(s.relax_iterations, 10);
+  ASSERT_EQ(s.curves.size(), 2u);
+  EXPECT_EQ(s.curves[0].view.kind, ViewKind::kFront);
+  EXPECT_DOUBLE_EQ(s.curves[0].offset, 0.01);  // the file's offset
+  EXPECT_TRUE(s.curves[0].smooth);
+  EXPECT_FALSE(s.curves[1].on_body);
+  EXPECT_EQ(*s.curves[1].edges, 4);
+  EXPECT_TRUE(s.curves[1].is_3d());
+  EXPECT_EQ(s.panels[0].fabric, "cotton-jersey");
+  EXPECT_TRUE(s.panels[0].mirror);
+  EXPECT_DOUBLE_EQ(s.simulate.duration, 3.0);
+  EXPECT_EQ(s.simulate.integrator, "bdf2");
+  EXPECT_EQ(s.output.mesh, "garment.obj");
+  EXPECT_TRUE(s.output.images.empty());
+}
+
+TEST(SketchFile, ReadsEverySection) {
+  const Sketch s = parse_sketch(R"({
+    "format": "sketchdrape/1",
+    "body": { "mesh": "b.obj", "height": 1.6, "up": "+z", "scale": 0.01 },
+    "edge_length": 0.02, "offset": 0.005, "junction_tolerance": 0.01, "corner_angle": 50,
+    "relax_iterations": 3, "fabric": "denim",
+    "curves": [ { "id": "c", "view": { "camera": { "eye": [0, 1, 3], "target": [0, 1, 0], "fov": 30 } },
+                  "points": [[0, 0], [0.1, 0]], "offset": 0.02, "smooth": false, "closed": false,
+                  "edge_length": 0.01 } ],
+    "panels": [ { "id": "p", "boundary": ["c"], "fabric": "silk", "edge_length": 0.015, "ease": 1.1 },
+                { "id": "q", "boundary": ["c"] } ],
+    "join": [ { "id": "pq", "panels": ["p", "q"] } ],
+    "simulate": { "duration": 2, "adaptive": false, "time_step": 0.01, "integrator": "implicit-euler",
+                  "solver": "cholmod", "stop_at_rest": false, "gravity": [0, -9.8, 0] },
+    "output": { "images": [ { "view": "back", "size": [640, 480], "wireframe": true },
+                            { "view": "three-quarter" } ],
+                "mesh": "g.glb", "report": false, "wireframe": true }
+  })", "x.json", "/base");
+  EXPECT_EQ(s.resolve(s.body.mesh), std::filesystem::path("/base/b.obj"));
+  EXPECT_DOUBLE_EQ(*s.body.height, 1.6);
+  EXPECT_EQ(s.curves[0].view.kind, ViewKind::kCamera);
+  EXPECT_DOUBLE_EQ(s.curves[0].view.camera.fov_degrees, 30);
+  EXPECT_FALSE(s.curves[0].smooth);
+  EXPECT_DOUBLE_EQ(*s.panels[0].edge_length, 0.015);
+  EXPECT_DOUBLE_EQ(s.panels[0].ease, 1.1);
+  EXPECT_EQ(s.joins[0].panels.size(), 2u);
+  EXPECT_EQ(s.simulate.solver, "cholmod");
+  EXPECT_DOUBLE_EQ(s.simulate.gravity.y(), -9.8);
+  ASSERT_EQ(s.output.images.size(), 2u);
+  EXPECT_EQ(s.output.images[0].view, "back");
+  EXPECT_EQ(s.output.images[0].width, 640);
+  EXPECT_EQ(s.output.images[1].view, "three-quarter");
+  EXPECT_EQ(s.output.mesh, "g.glb");
+}
+
+TEST(SketchFile, ErrorsCarryFilePathAndSentence) {
+  struct Case {
+    const char* text;
+    const char* path;
+    const char* fragment;
+  };
+  const Case cases[] = {
+      {R"({"curves": [{"id": "a", "points": [[0, 1], [1, 1]], "ofset": 1}], "panels": []})",
+       "/curves/0/ofset", "did you mean 'offset'?"},
+      {R"({"curves": [{"id": "a", "points": [["NaN", 1], [1, 1]]}], "panels": [{"id": "p", "boundary": ["a"]}]})",
+       "/curves/0/points/0/0", "expected a number"},
+      {R"({"curves": [{"id": "a", "points": [[0, 1], [1, -1e400]]}], "panels": [{"id": "p", "boundary": ["a"]}]})",
+       "/curves/0/points/1/1", "-1e400 is not finite"},
+      {R"({"curves": [{"id": "a", "points": [[0, 1], [1, 1]]}], "panels": [{"id": "p", "boundary": ["b"]}]})",
+       "/panels/0/boundary/0", "curve 'b' is not defined"},
+      {R"({"curves": [{"id": "a", "points": [[0, 1], [1, 1]]}], "panels": []})", "/panels",
+       "the list of panels is empty"},
+      {R"({"curves": [{"id": "a", "view": "side", "points": [[0, 1], [1, 1]]}], "panels": []})",
+       "/curves/0/view", "no view called 'side'"},
+      {R"({"curves": [{"id": "a", "points": [[0, 1], [0, 1]]}], "panels": []})",
+       "/curves/0/points/1", "repeats the point before it"},
+      {R"({"curves": [{"id": "a", "points": [[0, 1], [1, 1]], "points3d": [[0, 0, 0], [1, 0, 0]]}]})",
+       "/curves/0", "exactly one of"},
+      {R"({"format": "sketchdrape/2", "curves": []})", "/format", "reads format"},
+      {R"({"curves": [{"id": "a", "points": [[0, 1], [1, 1]]}], "panels": [{"id": "p", "boundary": ["a"]}],
+          "output": {"images": [{"size": [10, 100]}]}})",
+       "/output/images/0/size/0", "at least 16"},
+      {R"({"curves": [{"id": "a b", "points": [[0, 1], [1, 1]]}], "panels": []})", "/curves/0/id",
+       "may only use letters"},
+      {R"({"curves": [{"id": "a", "points": [[0, 1], [1, 1]]}], "panels": [{"id": "p", "boundary": ["a"]}],
+          "join": [{"id": "j", "panels": ["p", "p.mirror"]}]})",
+       "/join/0/panels/1", "has no mirror copy"},
+  };
+  for (const Case& c : cases) {
+    const SketchError e = error_of(c.text);
+    EXPECT_EQ(e.file(), "test.json") << c.text;
+    EXPECT_EQ(e.json_path(), c.path) << e.what();
+    EXPECT_NE(std::string(e.what()).find(c.fragment), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).rfind(std::string("test.json: ") + c.path + ": ", 0), 0u) << e.what();
+  }
+}
+
+TEST(SketchFile, SyntaxErrorGivesLineAndColumn) {
+  const SketchError e = error_of("{\n  \"curves\": [\n    {\"id\": }\n]}");
+  EXPECT_TRUE(e.json_path().empty());
+  EXPECT_NE(std::string(e.what()).find("line 3"), std::string::npos) << e.what();
+}
+
+TEST(SketchFile, OverflowMarkerDoesNotTouchStringsOrComments) {
+  // "1e999" inside a string and a comment is not a number and must stay as written.
+  const Sketch s = parse_sketch(R"({ // 1e999 in a comment
+    "fabric": "1e999",
+    "curves": [{"id": "a", "points": [[0, 1], [1, 1]]}], "panels": [{"id": "p", "boundary": ["a"]}]})",
+                                "t.json");
+  EXPECT_EQ(s.fabric, "1e999");
+}
+
+TEST(SketchFile, MissingFileIsSketchError) {
+  try {
+    load_sketch("/nonexistent/sketch.json");
+    FAIL();
+  } catch (const SketchError& e) {
+    EXPECT_NE(std::string(e.what()).find("does not exist"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace sd::garment

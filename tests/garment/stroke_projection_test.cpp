@@ -1,0 +1,130 @@
+#include "garment/stroke_projection.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "tests/garment/test_helpers.hpp"
+
+namespace sd::garment {
+namespace {
+
+constexpr double kRadius = 0.3;
+const Eigen::Vector3d kCentre(0, 1, 0);
+
+// Sag of a level-5 octahedral sphere is below 4e-4 R; 5e-4 m bounds it for R = 0.3 m.
+constexpr double kFacetTolerance = 5e-4;
+
+Sketch sketch_with(const CurveSpec& curve) {
+  Sketch s;
+  s.file = "t.json";
+  s.curves.push_back(curve);
+  return s;
+}
+
+TEST(StrokeProjection, FrontViewLandsOnOffsetSphere) {
+  const BodySurface body(test::sphere_mesh(kRadius, kCentre, 5));
+  CurveSpec c;
+  c.id = "c";
+  c.json_path = "/curves/0";
+  c.points = {{-0.1, 1.0}, {0.0, 1.1}, {0.1, 1.05}};
+  c.offset = 0.02;
+  const ProjectedCurve p = project_curve(sketch_with(c), c, &body);
+  ASSERT_GT(p.points.rows(), 20);
+  EXPECT_EQ(p.misses, 0);
+  for (Eigen::Index k = 0; k < p.points.rows(); ++k) {
+    const Eigen::Vector3d q = p.points.row(k).transpose();
+    EXPECT_NEAR((q - kCentre).norm(), kRadius + 0.02, kFacetTolerance);
+    EXPECT_GT(q.z(), 0);  // the side facing the camera
+  }
+  // The ends are exactly where they were drawn in x and y (smoothing keeps the ends).
+  EXPECT_NEAR(p.points(0, 0), -0.1 * (kRadius + 0.02) / kRadius, 0.01);
+}
+
+TEST(StrokeProjection, EachViewHitsItsOwnSide) {
+  const BodySurface body(test::sphere_mesh(kRadius, kCentre, 4));
+  const std::pair<ViewKind, Eigen::Vector3d> views[] = {{ViewKind::kFront, {0, 0, 1}},
+                                                        {ViewKind::kBack, {0, 0, -1}},
+                                                        {ViewKind::kLeft, {1, 0, 0}},
+                                                        {ViewKind::kRight, {-1, 0, 0}}};
+  for (const auto& [kind, side] : views) {
+    CurveSpec c;
+    c.id = "c";
+    c.view.kind = kind;
+    c.points = {{0.05, 1.0}, {0.1, 1.0}};
+    c.offset = 0;
+    const ProjectedCurve p = project_curve(sketch_with(c), c, &body);
+    const Eigen::Vector3d q = p.points.row(0).transpose() - kCentre;
+    EXPECT_GT(q.dot(side), 0.25) << static_cast<int>(kind);
+    // The view's "x to the right" convention: u = +0.05 lands on the viewer's right.
+    const ViewFrame f = view_frame(c.view);
+    EXPECT_NEAR(q.dot(f.right), 0.05, 1e-3);
+  }
+}
+
+TEST(StrokeProjection, MissesTakeDepthFromNeighbours) {
+  const BodySurface body(test::sphere_mesh(kRadius, kCentre, 5));
+  CurveSpec c;
+  c.id = "c";
+  c.smooth = false;
+  c.offset = 0;
+  // Starts on the sphere and runs out past its silhouette (x > 0.3).
+  c.points = {{0.0, 1.0}, {0.5, 1.0}};
+  const ProjectedCurve p = project_curve(sketch_with(c), c, &body);
+  EXPECT_GT(p.misses, 0);
+  const Eigen::Index last = p.points.rows() - 1;
+  EXPECT_NEAR(p.points(last, 0), 0.5, 1e-9);
+  // The missed end keeps the depth of the last hit, which is near the silhouette (z ≈ 0).
+  EXPECT_LT(std::abs(p.points(last, 2)), 0.06);
+}
+
+TEST(StrokeProjection, CurveMissingEverythingIsAnError) {
+  const BodySurface body(test::sphere_mesh(kRadius, kCentre, 3));
+  CurveSpec c;
+  c.id = "far";
+  c.json_path = "/curves/0";
+  c.points = {{1.0, 1.0}, {1.2, 1.0}};
+  try {
+    project_curve(sketch_with(c), c, &body);
+    FAIL();
+  } catch (const SketchError& e) {
+    EXPECT_EQ(e.json_path(), "/curves/0/points");
+  }
+  c.on_body = false;  // drawn in free space: fine, lies in the view plane
+  const ProjectedCurve p = project_curve(sketch_with(c), c, &body);
+  EXPECT_NEAR(p.points(0, 2), 0.0, 1e-12);
+}
+
+TEST(StrokeProjection, Points3dSnapToOffsetSurface) {
+  const BodySurface body(test::sphere_mesh(kRadius, kCentre, 5));
+  CurveSpec c;
+  c.id = "c";
+  c.points3d = {{0.5, 1.0, 0.0}, {0.0, 1.0, 0.5}};
+  c.offset = 0.01;
+  const ProjectedCurve p = project_curve(sketch_with(c), c, &body);
+  for (Eigen::Index k = 0; k < p.points.rows(); ++k)
+    EXPECT_NEAR((p.points.row(k).transpose() - kCentre).norm(), kRadius + 0.01, 2e-3);
+}
+
+TEST(StrokeProjection, SelfIntersectionFound) {
+  const std::vector<Eigen::Vector2d> figure8 = {{0, 0}, {1, 1}, {1, 0}, {0, 1}};
+  EXPECT_GE(find_self_intersection(figure8, false).first, 0);
+  const std::vector<Eigen::Vector2d> zigzag = {{0, 0}, {1, 1}, {2, 0}, {3, 1}};
+  EXPECT_EQ(find_self_intersection(zigzag, false).first, -1);
+  const std::vector<Eigen::Vector2d> square = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  EXPECT_EQ(find_self_intersection(square, true).first, -1);
+}
+
+TEST(StrokeProjection, SamplingKeepsControlPointsAndSpacing) {
+  const std::vector<Eigen::Vector2d> pts = {{0, 0}, {0.1, 0.05}, {0.2, 0}};
+  const auto dense = sample_stroke<2>(pts, false, true, 0.005);
+  EXPECT_EQ(dense.front(), pts.front());
+  EXPECT_EQ(dense.back(), pts.back());
+  bool passes_middle = false;
+  for (const auto& q : dense) passes_middle = passes_middle || (q - pts[1]).norm() < 1e-12;
+  EXPECT_TRUE(passes_middle);  // Catmull-Rom interpolates its control points
+  for (size_t k = 1; k < dense.size(); ++k) EXPECT_LT((dense[k] - dense[k - 1]).norm(), 0.0075);
+}
+
+}  // namespace
+}  // namespace sd::garment
