@@ -74,7 +74,10 @@ void BM_SheetDrape64(benchmark::State& state) {
   state.counters["max_strain"] = report.max_strain;
   state.counters["vertices"] = report.vertices;
 }
-BENCHMARK(BM_SheetDrape64)->Args({0, 0})->Args({1, 0})->Args({0, 1})->Args({1, 1})
+// BDF2 with the PCG is left out: at default settings the run had not finished after 6 min
+// (several simplified-Newton iterations per step, each a PCG solve of hundreds of
+// iterations, plus retries); not analysed further yet, see docs/benchmarks.md.
+BENCHMARK(BM_SheetDrape64)->Args({0, 0})->Args({1, 0})->Args({1, 1})
     ->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // One implicit Euler step of the 64x64 sheet in mid-swing (after 0.5 s).
