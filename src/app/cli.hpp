@@ -27,5 +27,6 @@ void add_fill_command(CLI::App& app, const GlobalOptions& global);
 void add_render_command(CLI::App& app, const GlobalOptions& global);
 void add_validate_command(CLI::App& app, const GlobalOptions& global);
 void add_mesh_command(CLI::App& app, const GlobalOptions& global);
+void add_batch_command(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace sd::app
