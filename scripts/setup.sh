@@ -12,6 +12,8 @@ packages=(
   libcli11-dev nlohmann-json3-dev libspdlog-dev
   libgtest-dev libbenchmark-dev
   python3-jsonschema  # tests validate the example sketch files against data/schema/
+  chromium  # tests/batch: the batch contact sheet (index.html) loads in headless Chromium
+  slurmctld slurmd slurm-client munge  # tests/batch/slurm_test.sh: a one-node Slurm cluster
 )
 
 missing=()
