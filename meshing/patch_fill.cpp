@@ -1,10 +1,13 @@
 #include "meshing/patch_fill.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <numeric>
+#include <optional>
 #include <string>
+#include <tuple>
 
 #include "meshing/patch_relaxation.hpp"
 #include "meshing/quad_layout.hpp"
@@ -38,7 +41,6 @@ void check_counts(std::span<const int> counts) {
 struct Built {
   detail::QuadMeshBuilder builder;
   std::vector<std::vector<int>> sides;  // vertex ids per side, corner to corner
-  std::string partition;
 };
 
 // Creates the boundary vertices from side_points (corner i = side_points[i].row(0)).
@@ -62,58 +64,202 @@ std::vector<int> boundary_loop_of(const std::vector<std::vector<int>>& sides) {
   return loop;
 }
 
-Built build_layout(const std::vector<Eigen::MatrixX3d>& side_points,
-                   std::span<const int> counts) {
-  Built built;
-  built.sides = add_boundary(built.builder, side_points);
-  const detail::PolygonLayout layout = detail::best_layout(detail::region_costs(counts), kSearchBudget);
-  detail::fill_polygon(built.builder, boundary_loop_of(built.sides), layout);
-  std::vector<int> real_corners;
-  for (int p = 0; const int count : counts) {
-    real_corners.push_back(p);
-    p += count;
-  }
-  built.partition = layout.corners == real_corners ? "nasri" : "shifted-corners";
-  return built;
-}
-
-std::optional<Built> build_yasseen(const std::vector<Eigen::MatrixX3d>& side_points) {
-  Built built;
-  built.sides = add_boundary(built.builder, side_points);
-  if (!detail::fill_yasseen(built.builder, built.sides, kSearchBudget)) return std::nullopt;
-  built.partition = "yasseen";
-  return built;
-}
-
 std::vector<int> corners_of(const std::vector<std::vector<int>>& sides) {
   std::vector<int> corners;
   for (const auto& side : sides) corners.push_back(side.front());
   return corners;
 }
 
-// The least distorted of the constructions that apply (ties keep the corner search's).
-PatchTopology build_topology(const std::vector<Eigen::MatrixX3d>& side_points,
-                             std::span<const int> counts) {
-  Built best = build_layout(side_points, counts);
-  QuadMesh best_mesh = best.builder.build();
-  QuadQuality best_figures = measure_valence(best_mesh, corners_of(best.sides));
-  if (auto yasseen = build_yasseen(side_points)) {
-    QuadMesh mesh = yasseen->builder.build();
-    const QuadQuality figures = measure_valence(mesh, corners_of(yasseen->sides));
-    if (validate(mesh).ok() &&
-        std::pair(figures.distortion, figures.irregular_vertices) <
-            std::pair(best_figures.distortion, best_figures.irregular_vertices)) {
-      best = std::move(*yasseen);
-      best_mesh = std::move(mesh);
-      best_figures = figures;
-    }
+std::vector<int> corner_positions(std::span<const int> counts) {
+  std::vector<int> corners;
+  for (int p = 0; const int count : counts) {
+    corners.push_back(p);
+    p += count;
   }
+  return corners;
+}
+
+// How the boundary bends at each loop position, for judging where a vertex of valence 2 (one
+// quad, with the boundary's own angle) is acceptable.
+struct BoundaryShape {
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // the loop is counter-clockwise about it
+  std::vector<char> reflex;  // interior angle above 180°: one quad there is folded
+  std::vector<char> flat;    // interior angle above kFlatDegrees (reflex included)
+};
+
+// A quad corner wider than this is treated as flat (a side vertex of valence 2 on a straight
+// or gently curved side); above 180° plus kReflexSlackDegrees it is reflex.
+constexpr double kFlatDegrees = 165;
+constexpr double kReflexSlackDegrees = 0.5;
+
+// Straight sides, convex corners: what fill_region(counts) assumes.
+BoundaryShape straight_sided_shape(std::span<const int> counts) {
+  const int total = std::accumulate(counts.begin(), counts.end(), 0);
+  BoundaryShape shape;
+  shape.reflex.assign(static_cast<size_t>(total), 0);
+  shape.flat.assign(static_cast<size_t>(total), 1);
+  for (const int c : corner_positions(counts)) shape.flat[static_cast<size_t>(c)] = 0;
+  return shape;
+}
+
+// Interior angles of the boundary loop about its Newell normal (for a panel on a curved body
+// the overall normal; the sign of a turn is right as long as the surface tilts less than 90°
+// from it).
+BoundaryShape measured_shape(const std::vector<Eigen::MatrixX3d>& side_points) {
+  std::vector<Eigen::Vector3d> loop;
+  for (const auto& side : side_points)
+    for (Eigen::Index r = 0; r + 1 < side.rows(); ++r) loop.emplace_back(side.row(r).transpose());
+  const size_t size = loop.size();
+  BoundaryShape shape;
+  Eigen::Vector3d newell = Eigen::Vector3d::Zero();
+  const Eigen::Vector3d origin = loop.front();
+  for (size_t k = 0; k < size; ++k)
+    newell += (loop[k] - origin).cross(loop[(k + 1) % size] - origin);
+  if (newell.norm() > 0) shape.normal = newell.normalized();
+  shape.reflex.assign(size, 0);
+  shape.flat.assign(size, 0);
+  for (size_t k = 0; k < size; ++k) {
+    const Eigen::Vector3d in = loop[k] - loop[(k + size - 1) % size];
+    const Eigen::Vector3d out = loop[(k + 1) % size] - loop[k];
+    const double turn = std::atan2(shape.normal.dot(in.cross(out)), in.dot(out));
+    const double interior = 180.0 - turn * 180.0 / std::numbers::pi;
+    shape.reflex[k] = interior > 180.0 + kReflexSlackDegrees;
+    shape.flat[k] = interior > kFlatDegrees;
+  }
+  return shape;
+}
+
+// A construction, chosen from the edge counts and the boundary's shape before any mesh is
+// built (except the Yasseen candidate, which is built to be measured): strips of padding along
+// some sides, then a layout of what is left.
+struct Plan {
+  bool yasseen = false;
+  std::vector<int> strips;  // side indices, in the order they are added
+  detail::PolygonLayout layout;
+  std::string partition;
+  int distortion = 0, irregular_vertices = 0;
+  int folded = 0;  // boundary vertices of valence 2 where the boundary is reflex
+  int flat = 0;    // boundary vertices of valence 2 where it is flat (or reflex)
+
+  // Never fold where another construction does not; then least distortion, fewest irregular
+  // vertices (the corpus figures), then fewest flat corners.
+  auto rank() const { return std::tuple(folded, distortion, irregular_vertices, flat); }
+};
+
+detail::StripRegion region_of(std::span<const int> loop_ids, std::span<const int> counts,
+                              const BoundaryShape& shape) {
+  detail::StripRegion region;
+  for (size_t p = 0; p < loop_ids.size(); ++p)
+    region.loop.push_back({loop_ids[p], 0, 3, shape.flat[p] != 0, shape.reflex[p] != 0});
+  region.corners = corner_positions(counts);
+  for (const int c : region.corners) region.loop[static_cast<size_t>(c)].regular = 2;
+  return region;
+}
+
+// The plan with these strips (nullopt when one of them cannot be added).
+std::optional<Plan> plan_with_strips(std::span<const int> counts, const BoundaryShape& shape,
+                                     std::span<const int> strips) {
+  const std::vector<int> no_ids(shape.flat.size(), -1);
+  detail::StripRegion region = region_of(no_ids, counts, shape);
+  for (const int side : strips)
+    if (!region.strip(side)) return std::nullopt;
+  const detail::PositionCosts costs = region.costs();
+  Plan plan;
+  plan.strips.assign(strips.begin(), strips.end());
+  plan.layout = detail::best_layout(costs, kSearchBudget);
+  int layout_folds = 0;
+  for (const int c : plan.layout.corners)
+    layout_folds += costs.as_corner[static_cast<size_t>(c)] >= detail::kFoldPenalty ? 1 : 0;
+  plan.distortion = region.fixed_cost + plan.layout.cost - detail::kFoldPenalty * layout_folds;
+  plan.irregular_vertices = region.fixed_irregular + plan.layout.irregular;
+  plan.folded = region.folded + layout_folds;
+  plan.flat = region.flat + plan.layout.flat;
+  if (!strips.empty()) plan.partition = "padded";
+  else plan.partition = plan.layout.corners == region.corners ? "nasri" : "shifted-corners";
+  return plan;
+}
+
+// What the Yasseen construction gives on these sides, built (nullopt when it does not apply).
+std::optional<std::pair<Plan, Built>> yasseen_candidate(
+    const std::vector<Eigen::MatrixX3d>& side_points, const BoundaryShape& shape) {
+  Built built;
+  built.sides = add_boundary(built.builder, side_points);
+  if (!detail::fill_yasseen(built.builder, built.sides, kSearchBudget)) return std::nullopt;
+  const QuadMesh mesh = built.builder.build();
+  if (!validate(mesh).ok()) return std::nullopt;
+  const QuadQuality figures = measure_valence(mesh, corners_of(built.sides));
+  Plan plan;
+  plan.yasseen = true;
+  plan.partition = "yasseen";
+  plan.distortion = figures.distortion;
+  plan.irregular_vertices = figures.irregular_vertices;
+  const std::vector<int> valence = built.builder.valences();
+  const std::vector<int> loop = boundary_loop_of(built.sides);
+  for (size_t p = 0; p < loop.size(); ++p)
+    if (valence[static_cast<size_t>(loop[p])] == 2) {
+      plan.folded += shape.reflex[p];
+      plan.flat += shape.flat[p];
+    }
+  return std::pair(std::move(plan), std::move(built));
+}
+
+// The best plan for these counts on a boundary of this shape; when the Yasseen construction
+// wins, `yasseen` receives it already built on `side_points`.
+Plan choose_plan(std::span<const int> counts, const BoundaryShape& shape,
+                 const std::vector<Eigen::MatrixX3d>& side_points, std::optional<Built>& yasseen) {
+  Plan best = *plan_with_strips(counts, shape, {});
+  // Padding only pays when the plain layout leaves a valence-2 vertex where the boundary is
+  // flat or reflex; otherwise it would rebuild the same distortion elsewhere. Strips along one
+  // side, two sides, and all sides (a full ring) are tried.
+  if (best.flat > 0 || best.folded > 0) {
+    const auto n = static_cast<int>(counts.size());
+    auto consider = [&](std::span<const int> strips) {
+      if (auto plan = plan_with_strips(counts, shape, strips); plan && plan->rank() < best.rank())
+        best = std::move(*plan);
+    };
+    for (int i = 0; i < n; ++i) {
+      consider(std::vector<int>{i});
+      for (int j = i + 1; j < n; ++j) consider(std::vector<int>{i, j});
+    }
+    std::vector<int> all(static_cast<size_t>(n));
+    std::iota(all.begin(), all.end(), 0);
+    if (n > 2) consider(all);
+  }
+  if (auto candidate = yasseen_candidate(side_points, shape);
+      candidate && candidate->first.rank() < best.rank()) {
+    best = std::move(candidate->first);
+    yasseen = std::move(candidate->second);
+  }
+  return best;
+}
+
+// The mesh of a plan on these sides (the same connectivity for any sides).
+Built realize(const Plan& plan, std::span<const int> counts,
+              const std::vector<Eigen::MatrixX3d>& side_points, const BoundaryShape& shape) {
+  Built built;
+  built.sides = add_boundary(built.builder, side_points);
+  if (plan.yasseen) {
+    if (!detail::fill_yasseen(built.builder, built.sides, kSearchBudget))
+      throw std::logic_error("the Yasseen construction depends on geometry");
+    return built;
+  }
+  detail::StripRegion region = region_of(boundary_loop_of(built.sides), counts, shape);
+  for (const int side : plan.strips)
+    if (!region.strip(side, &built.builder, shape.normal))
+      throw std::logic_error("a planned strip cannot be added");
+  std::vector<int> loop;
+  for (const auto& v : region.loop) loop.push_back(v.id);
+  detail::fill_polygon(built.builder, loop, plan.layout);
+  return built;
+}
+
+PatchTopology to_topology(Built&& built, const Plan& plan) {
   PatchTopology topology;
-  topology.mesh = std::move(best_mesh);
-  topology.side_vertices = std::move(best.sides);
-  topology.partition = std::move(best.partition);
-  topology.distortion = best_figures.distortion;
-  topology.irregular_vertices = best_figures.irregular_vertices;
+  topology.mesh = built.builder.build();
+  topology.side_vertices = std::move(built.sides);
+  topology.partition = plan.partition;
+  topology.distortion = plan.distortion;
+  topology.irregular_vertices = plan.irregular_vertices;
   return topology;
 }
 
@@ -167,7 +313,12 @@ std::vector<int> PatchTopology::corner_vertices() const { return corners_of(side
 
 PatchTopology fill_region(std::span<const int> side_counts) {
   check_counts(side_counts);
-  return build_topology(display_sides(side_counts), side_counts);
+  const std::vector<Eigen::MatrixX3d> sides = display_sides(side_counts);
+  const BoundaryShape shape = straight_sided_shape(side_counts);
+  std::optional<Built> yasseen;
+  const Plan plan = choose_plan(side_counts, shape, sides, yasseen);
+  return to_topology(yasseen ? std::move(*yasseen) : realize(plan, side_counts, sides, shape),
+                     plan);
 }
 
 FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
@@ -176,9 +327,15 @@ FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
   std::vector<int> counts;
   for (const auto& side : side_points) counts.push_back(static_cast<int>(side.rows()) - 1);
   check_counts(counts);
+  const BoundaryShape shape = measured_shape(side_points);
+  std::optional<Built> yasseen;
+  const Plan plan = choose_plan(counts, shape, side_points, yasseen);
   FilledPatch patch;
-  patch.topology = fill_region(counts);
-  patch.mesh = build_topology(side_points, counts).mesh;
+  Built built = yasseen ? std::move(*yasseen) : realize(plan, counts, side_points, shape);
+  patch.mesh = built.builder.build();
+  // The same connectivity laid out flat for display.
+  patch.topology = to_topology(
+      realize(plan, counts, display_sides(counts), straight_sided_shape(counts)), plan);
   if (patch.mesh.faces != patch.topology.mesh.faces)
     throw std::logic_error("the fill's connectivity depends on geometry");
   std::vector<char> fixed(static_cast<size_t>(patch.mesh.vertices.rows()), 0);

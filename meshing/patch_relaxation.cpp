@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <vector>
 
@@ -39,42 +40,40 @@ Adjacency build_adjacency(const QuadMesh& mesh) {
   return adj;
 }
 
-Eigen::MatrixX3d corner_normals(const QuadMesh& mesh) {
-  Eigen::MatrixX3d normals = Eigen::MatrixX3d::Zero(mesh.vertices.rows(), 3);
+// Unit reference normal of each quad: the sum of its vertices' normals (each the sum of the
+// corner cross products around the vertex), so that a folded quad among good neighbours shows
+// a negative Jacobian even on a curved patch.
+std::vector<Eigen::Vector3d> quad_normals(const QuadMesh& mesh,
+                                          const std::vector<Eigen::Vector3d>& x) {
+  std::vector<Eigen::Vector3d> vertex_normal(x.size(), Eigen::Vector3d::Zero());
   for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f)
     for (int k = 0; k < 4; ++k) {
-      const Eigen::Vector3d p = mesh.vertices.row(mesh.faces(f, k));
-      const Eigen::Vector3d e1 = mesh.vertices.row(mesh.faces(f, (k + 1) % 4)).transpose() - p;
-      const Eigen::Vector3d e2 = mesh.vertices.row(mesh.faces(f, (k + 3) % 4)).transpose() - p;
-      normals.row(mesh.faces(f, k)) += e1.cross(e2).transpose();
+      const Eigen::Vector3d& p = x[static_cast<size_t>(mesh.faces(f, k))];
+      vertex_normal[static_cast<size_t>(mesh.faces(f, k))] +=
+          (x[static_cast<size_t>(mesh.faces(f, (k + 1) % 4))] - p)
+              .cross(x[static_cast<size_t>(mesh.faces(f, (k + 3) % 4))] - p);
     }
-  for (Eigen::Index v = 0; v < normals.rows(); ++v) {
-    const double len = normals.row(v).norm();
-    if (len > 0) normals.row(v) /= len;
+  for (auto& n : vertex_normal)
+    if (n.norm() > 0) n.normalize();
+  std::vector<Eigen::Vector3d> normals(static_cast<size_t>(mesh.faces.rows()));
+  for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f) {
+    Eigen::Vector3d n = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 4; ++k) n += vertex_normal[static_cast<size_t>(mesh.faces(f, k))];
+    normals[static_cast<size_t>(f)] = n.norm() > 0 ? Eigen::Vector3d(n.normalized()) : n;
   }
   return normals;
 }
 
-// Smallest scaled Jacobian over every corner of the quads around v, with v at position p.
-double local_min_jacobian(const QuadMesh& mesh, const Adjacency& adj,
-                          const Eigen::MatrixX3d& normals, int v, const Eigen::Vector3d& p) {
+// Smallest scaled Jacobian over the four corners of quad f at positions x.
+double quad_min_jacobian(const QuadMesh& mesh, Eigen::Index f, const Eigen::Vector3d& normal,
+                         const std::vector<Eigen::Vector3d>& x) {
   double worst = std::numeric_limits<double>::infinity();
-  auto pos = [&](int w) -> Eigen::Vector3d {
-    return w == v ? p : Eigen::Vector3d(mesh.vertices.row(w));
-  };
-  for (int c = adj.corner_start[static_cast<size_t>(v)];
-       c < adj.corner_start[static_cast<size_t>(v) + 1]; ++c) {
-    const int f = adj.corners[static_cast<size_t>(c)] / 4;
-    Eigen::Vector3d n = Eigen::Vector3d::Zero();  // the quad's reference normal
-    for (int k = 0; k < 4; ++k) n += normals.row(mesh.faces(f, k)).transpose();
-    for (int k = 0; k < 4; ++k) {
-      const int a = mesh.faces(f, k);
-      const Eigen::Vector3d e1 = pos(mesh.faces(f, (k + 1) % 4)) - pos(a);
-      const Eigen::Vector3d e2 = pos(mesh.faces(f, (k + 3) % 4)) - pos(a);
-      const double denom = e1.norm() * e2.norm();
-      const double jac = denom > 0 ? e1.cross(e2).dot(n) / (denom * n.norm()) : -1.0;
-      worst = std::min(worst, jac);
-    }
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Vector3d& p = x[static_cast<size_t>(mesh.faces(f, k))];
+    const Eigen::Vector3d e1 = x[static_cast<size_t>(mesh.faces(f, (k + 1) % 4))] - p;
+    const Eigen::Vector3d e2 = x[static_cast<size_t>(mesh.faces(f, (k + 3) % 4))] - p;
+    const double denom = std::sqrt(e1.squaredNorm() * e2.squaredNorm());
+    worst = std::min(worst, denom > 0 ? e1.cross(e2).dot(normal) / denom : -1.0);
   }
   return worst;
 }
@@ -83,38 +82,72 @@ double local_min_jacobian(const QuadMesh& mesh, const Adjacency& adj,
 
 void relax_interior(QuadMesh& mesh, std::span<const char> fixed, int sweeps,
                     const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& project) {
-  if (sweeps <= 0) return;
+  if (sweeps <= 0 || mesh.faces.rows() == 0) return;
   const Adjacency adj = build_adjacency(mesh);
-  constexpr double kAcceptable = 0.05;  // a move may lower the local minimum down to this
+  const auto nv = static_cast<size_t>(mesh.vertices.rows());
+  const auto nf = static_cast<size_t>(mesh.faces.rows());
+  std::vector<Eigen::Vector3d> old(nv), next(nv);
+  for (size_t v = 0; v < nv; ++v) old[v] = mesh.vertices.row(static_cast<Eigen::Index>(v)).transpose();
+  // Reference normals from the starting positions: they only tell a quad's front from its back.
+  const std::vector<Eigen::Vector3d> normals = quad_normals(mesh, old);
+  constexpr double kAcceptable = 0.05;  // a move may lower a quad's minimum down to this
   // Stop once no vertex moves more than 1e-3 of the mean edge length in a sweep.
   double edge_sum = 0;
-  for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f)
-    edge_sum += (mesh.vertices.row(mesh.faces(f, 0)) - mesh.vertices.row(mesh.faces(f, 1))).norm();
-  const double tolerance = 1e-3 * edge_sum / std::max<Eigen::Index>(mesh.faces.rows(), 1);
-  const double tolerance2 = tolerance * tolerance;
+  for (size_t f = 0; f < nf; ++f)
+    edge_sum += (old[static_cast<size_t>(mesh.faces(static_cast<Eigen::Index>(f), 0))] -
+                 old[static_cast<size_t>(mesh.faces(static_cast<Eigen::Index>(f), 1))])
+                    .norm();
+  const double tolerance = 1e-3 * edge_sum / static_cast<double>(nf);
+  std::vector<char> bad(nf, 0);
+  std::vector<int> queue, reverted;
   for (int sweep = 0; sweep < sweeps; ++sweep) {
-    const Eigen::MatrixX3d normals = corner_normals(mesh);
-    double largest_move = 0;
-    for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v) {
-      if (fixed[static_cast<size_t>(v)]) continue;
-      const int begin = adj.neighbour_start[static_cast<size_t>(v)];
-      const int end = adj.neighbour_start[static_cast<size_t>(v) + 1];
-      if (end == begin) continue;
+    // Jacobi step: every free vertex to the mean of its neighbours' old positions.
+    for (size_t v = 0; v < nv; ++v) {
+      next[v] = old[v];
+      const int begin = adj.neighbour_start[v], end = adj.neighbour_start[v + 1];
+      if (fixed[v] || end == begin) continue;
       Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-      for (int i = begin; i < end; ++i)
-        mean += mesh.vertices.row(adj.neighbours[static_cast<size_t>(i)]).transpose();
+      for (int i = begin; i < end; ++i) mean += old[static_cast<size_t>(adj.neighbours[static_cast<size_t>(i)])];
       mean /= end - begin;
-      if (project) mean = project(mean);
-      const Eigen::Vector3d old = mesh.vertices.row(v);
-      const double after = local_min_jacobian(mesh, adj, normals, static_cast<int>(v), mean);
-      if (after < kAcceptable &&
-          after < local_min_jacobian(mesh, adj, normals, static_cast<int>(v), old) - 1e-12)
-        continue;
-      largest_move = std::max(largest_move, (mean - old).squaredNorm());
-      mesh.vertices.row(v) = mean.transpose();
+      next[v] = project ? project(mean) : mean;
     }
-    if (largest_move < tolerance2) break;  // converged
+    // A quad whose smallest scaled Jacobian would fall below min(before, kAcceptable) keeps
+    // its free vertices where they were; quads around a kept vertex are checked again.
+    auto worse = [&](size_t f) {
+      const auto fi = static_cast<Eigen::Index>(f);
+      const double after = quad_min_jacobian(mesh, fi, normals[f], next);
+      return after < kAcceptable && after < quad_min_jacobian(mesh, fi, normals[f], old) - 1e-12;
+    };
+    queue.clear();
+    for (size_t f = 0; f < nf; ++f)
+      if (worse(f)) queue.push_back(static_cast<int>(f));
+    while (!queue.empty()) {
+      reverted.clear();
+      for (const int f : queue)
+        for (int k = 0; k < 4; ++k) {
+          const auto v = static_cast<size_t>(mesh.faces(f, k));
+          if (next[v] != old[v]) {
+            next[v] = old[v];
+            reverted.push_back(static_cast<int>(v));
+          }
+        }
+      queue.clear();
+      for (const int v : reverted)
+        for (int c = adj.corner_start[static_cast<size_t>(v)]; c < adj.corner_start[static_cast<size_t>(v) + 1]; ++c) {
+          const auto f = static_cast<size_t>(adj.corners[static_cast<size_t>(c)] / 4);
+          if (!bad[f] && worse(f)) {
+            bad[f] = 1;
+            queue.push_back(static_cast<int>(f));
+          }
+        }
+      for (const int f : queue) bad[static_cast<size_t>(f)] = 0;
+    }
+    double largest_move = 0;
+    for (size_t v = 0; v < nv; ++v) largest_move = std::max(largest_move, (next[v] - old[v]).squaredNorm());
+    std::swap(old, next);
+    if (largest_move < tolerance * tolerance) break;  // converged
   }
+  for (size_t v = 0; v < nv; ++v) mesh.vertices.row(static_cast<Eigen::Index>(v)) = old[v].transpose();
 }
 
 }  // namespace sd::meshing

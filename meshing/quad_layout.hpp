@@ -35,6 +35,9 @@ class QuadMeshBuilder {
   void add_grid(std::span<const int> bottom, std::span<const int> right, std::span<const int> top,
                 std::span<const int> left);
 
+  // One quad, counter-clockwise, of existing vertices.
+  void add_quad(const std::array<int, 4>& quad) { faces_.push_back(quad); }
+
   const Eigen::Vector3d& position(int v) const { return positions_[static_cast<size_t>(v)]; }
   int vertex_count() const { return static_cast<int>(positions_.size()); }
   int face_count() const { return static_cast<int>(faces_.size()); }

@@ -1,5 +1,6 @@
 #include "meshing/region_partition.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <climits>
 #include <cmath>
@@ -35,14 +36,21 @@ std::vector<int> corner_arcs(std::span<const int> corners, int loop_size) {
   return arcs;
 }
 
-int layout_cost(std::span<const int> corners, const PositionCosts& costs) {
-  int cost = std::abs(static_cast<int>(corners.size()) - 4);
+// Fills in cost, irregular and flat of a layout from its corners and the position costs.
+void assess(PolygonLayout& layout, const PositionCosts& costs) {
+  const auto m = static_cast<int>(layout.corners.size());
+  // A grid (m = 4) has no centre; a Nasri centre of valence m costs |m − 4|.
+  layout.cost = std::abs(m - 4);
+  layout.irregular = m != 4 ? 1 : 0;
+  layout.flat = 0;
   std::vector<bool> is_corner(costs.as_side.size(), false);
-  for (const int c : corners) is_corner[static_cast<size_t>(c)] = true;
-  for (size_t p = 0; p < is_corner.size(); ++p)
-    cost += is_corner[p] ? costs.as_corner[p] : costs.as_side[p];
-  // A grid (n' = 4) has no centre; a Nasri centre of valence n' costs |n' − 4|.
-  return cost;
+  for (const int c : layout.corners) is_corner[static_cast<size_t>(c)] = true;
+  for (size_t p = 0; p < is_corner.size(); ++p) {
+    const int c = is_corner[p] ? costs.as_corner[p] : costs.as_side[p];
+    layout.cost += c;
+    layout.irregular += c != 0 ? 1 : 0;
+    if (is_corner[p] && !costs.flat.empty() && costs.flat[p]) ++layout.flat;
+  }
 }
 
 // The always-available layouts: the cheapest single grid block over every placement of its
@@ -58,18 +66,24 @@ PolygonLayout fallback_layout(int loop_size, std::span<const int> starts,
     return costs.as_corner[static_cast<size_t>(p)] - costs.as_side[static_cast<size_t>(p)];
   };
   const int base = std::accumulate(costs.as_side.begin(), costs.as_side.end(), 0);
-  int best_balance = -1;
+  auto flat = [&](int p) {
+    return costs.flat.empty() ? 0 : static_cast<int>(costs.flat[static_cast<size_t>(wrap(p, loop_size))]);
+  };
+  int best_balance = -1, best_flat = INT_MAX;
   for (int p = 0; p < half; ++p)
     for (int a = 1; a < half; ++a) {
       const int cost = base + delta(p) + delta(p + a) + delta(p + half) + delta(p + half + a);
+      const int flats = flat(p) + flat(p + a) + flat(p + half) + flat(p + half + a);
       const int balance = std::min(a, half - a);
-      if (cost < best.cost || (cost == best.cost && balance > best_balance)) {
+      if (std::tuple(cost, flats, -balance) < std::tuple(best.cost, best_flat, -best_balance)) {
         best.corners = {p, p + a, p + half, wrap(p + half + a, loop_size)};
         best.cost = cost;
+        best_flat = flats;
         best_balance = balance;
       }
     }
   std::sort(best.corners.begin(), best.corners.end());
+  assess(best, costs);
   if (loop_size < 6) return best;
   std::vector<int> start_list(starts.begin(), starts.end());
   if (start_list.empty()) start_list.push_back(0);
@@ -77,12 +91,11 @@ PolygonLayout fallback_layout(int loop_size, std::span<const int> starts,
     const int a = loop_size / 3, b = (loop_size - a) / 2;
     std::vector<int> corners = {start, wrap(start + a, loop_size), wrap(start + a + b, loop_size)};
     std::sort(corners.begin(), corners.end());
-    const int cost = layout_cost(corners, costs);
-    if (cost < best.cost) {
-      best.corners = corners;
-      best.spokes = *nasri_spokes(corner_arcs(corners, loop_size));
-      best.cost = cost;
-    }
+    PolygonLayout triangle{corners, *nasri_spokes(corner_arcs(corners, loop_size))};
+    assess(triangle, costs);
+    if (std::tuple(triangle.cost, triangle.irregular, triangle.flat) <
+        std::tuple(best.cost, best.irregular, best.flat))
+      best = std::move(triangle);
   }
   return best;
 }
@@ -158,11 +171,13 @@ std::optional<std::vector<int>> nasri_spokes(std::span<const int> arcs) {
 PositionCosts region_costs(std::span<const int> side_counts) {
   const int total = std::accumulate(side_counts.begin(), side_counts.end(), 0);
   PositionCosts costs{std::vector<int>(static_cast<size_t>(total), 1),
-                      std::vector<int>(static_cast<size_t>(total), 0)};
+                      std::vector<int>(static_cast<size_t>(total), 0),
+                      std::vector<char>(static_cast<size_t>(total), 1)};
   int p = 0;
   for (const int count : side_counts) {
     costs.as_corner[static_cast<size_t>(p)] = 0;
     costs.as_side[static_cast<size_t>(p)] = 1;
+    costs.flat[static_cast<size_t>(p)] = 0;
     p += count;
   }
   return costs;
@@ -210,7 +225,7 @@ PolygonLayout best_layout(const PositionCosts& costs, int budget) {
   });
 
   std::optional<PolygonLayout> best;
-  int best_balance = -1, best_irregular = INT_MAX;
+  int best_balance = -1;
   const auto base_irregular = static_cast<int>(
       std::count_if(costs.as_side.begin(), costs.as_side.end(), [](int c) { return c != 0; }));
   std::vector<int> arcs, spokes;  // reused buffers: a check allocates nothing
@@ -233,17 +248,19 @@ PolygonLayout best_layout(const PositionCosts& costs, int budget) {
     }
     int cost = std::abs(static_cast<int>(m) - 4) + base;
     int irregular = (m != 4 ? 1 : 0) + base_irregular;
+    int flats = 0;
     for (const int p : chosen) {
       cost += delta(p);
       irregular += (costs.as_corner[static_cast<size_t>(p)] != 0 ? 1 : 0) -
                    (costs.as_side[static_cast<size_t>(p)] != 0 ? 1 : 0);
+      if (!costs.flat.empty() && costs.flat[static_cast<size_t>(p)]) ++flats;
     }
-    // Least distortion, then fewest irregular vertices, then the longest shortest spoke.
-    if (!best || std::tuple(cost, irregular, -balance) <
-                     std::tuple(best->cost, best_irregular, -best_balance)) {
-      best = PolygonLayout{chosen, grid ? std::vector<int>{} : spokes, cost};
+    // Least distortion, then fewest irregular vertices, fewest flat corners, and the longest
+    // shortest spoke.
+    if (!best || std::tuple(cost, irregular, flats, -balance) <
+                     std::tuple(best->cost, best->irregular, best->flat, -best_balance)) {
+      best = PolygonLayout{chosen, grid ? std::vector<int>{} : spokes, cost, irregular, flats};
       best_balance = balance;
-      best_irregular = irregular;
     }
   };
   for (const Plan& plan : plans) {
@@ -276,7 +293,9 @@ PolygonLayout best_layout(const PositionCosts& costs, int budget) {
       recurse(recurse, 0);
     }
   }
-  if (best && best->cost <= fallback.cost) return *best;
+  if (best && std::tuple(best->cost, best->irregular, best->flat) <=
+                  std::tuple(fallback.cost, fallback.irregular, fallback.flat))
+    return *best;
   return fallback;
 }
 
@@ -467,6 +486,85 @@ bool fill_yasseen(QuadMeshBuilder& builder, const std::vector<std::vector<int>>&
     fill_polygon(builder, loop, best_layout(costs, budget));
   }
   return true;
+}
+
+bool StripRegion::strip(int side, QuadMeshBuilder* builder, const Eigen::Vector3d& normal) {
+  const auto size = static_cast<int>(loop.size());
+  const auto n = static_cast<int>(corners.size());
+  auto corner = [&](int i) { return corners[static_cast<size_t>(wrap(i, n))]; };
+  auto arc = [&](int i) { return wrap(corner(i + 1) - corner(i), size); };
+  const int a = corner(side), b = corner(side + 1), l = arc(side);
+  if (n < 2 || size - 2 < 4 ||
+      (n == 2 ? arc(side + 1) < 3 : arc(side - 1) < 2 || arc(side + 1) < 2))
+    return false;
+  auto at = [&](int p) -> LoopVertex& { return loop[static_cast<size_t>(wrap(p, size))]; };
+  // Vertices a..b leave the loop: the corners with no further edge, the rest with one.
+  for (int k = 0; k <= l; ++k) {
+    const LoopVertex& v = at(a + k);
+    const int valence = v.outside + (k == 0 || k == l ? 2 : 3);
+    fixed_cost += std::abs(valence - v.regular);
+    fixed_irregular += valence != v.regular ? 1 : 0;
+    if (valence == 2 && v.exposed) {
+      ++flat;
+      folded += v.reflex ? 1 : 0;
+    }
+  }
+  std::vector<LoopVertex> chain(static_cast<size_t>(l - 1), LoopVertex{-1, 1, 4, false, false});
+  if (builder != nullptr) {
+    auto pos = [&](int p) -> Eigen::Vector3d { return builder->position(at(p).id); };
+    for (int k = 1; k < l; ++k) {
+      Eigen::Vector3d position;
+      if (k == 1 || k == l - 1) {  // next to a corner: complete the corner quad's parallelogram
+        position = Eigen::Vector3d::Zero();
+        if (k == 1) position += pos(a - 1) + pos(a + 1) - pos(a);
+        if (k == l - 1) position += pos(b + 1) + pos(b - 1) - pos(b);
+        if (l == 2) position /= 2;
+      } else {  // one mean edge length inwards, square to the chord through the neighbours
+        const Eigen::Vector3d before = pos(a + k - 1), here = pos(a + k), after = pos(a + k + 1);
+        Eigen::Vector3d inward = normal.cross(after - before);
+        if (inward.norm() > 0) inward.normalize();
+        position = here + 0.5 * ((here - before).norm() + (after - here).norm()) * inward;
+      }
+      chain[static_cast<size_t>(k - 1)].id = builder->add_vertex(position);
+    }
+    // Quad k: side edge (a+k, a+k+1) and chain edge (inner k+1, inner k), where the chain runs
+    // a−1, w_1, ..., w_{l−1}, b+1.
+    auto inner = [&](int k) {
+      return k == 0 ? at(a - 1).id : k == l ? at(b + 1).id : chain[static_cast<size_t>(k - 1)].id;
+    };
+    for (int k = 0; k < l; ++k) builder->add_quad({at(a + k).id, at(a + k + 1).id, inner(k + 1), inner(k)});
+  }
+  at(a - 1).outside += 1;
+  at(b + 1).outside += 1;
+  // New loop from b+1 around to a−1, then the chain; corner side+1 at b+1, corner side at a−1.
+  std::vector<LoopVertex> next;
+  std::vector<int> position_of(static_cast<size_t>(size), -1);
+  for (int p = b + 1; wrap(p, size) != wrap(a, size); ++p) {
+    position_of[static_cast<size_t>(wrap(p, size))] = static_cast<int>(next.size());
+    next.push_back(at(p));
+  }
+  const int last_kept = static_cast<int>(next.size()) - 1;
+  next.insert(next.end(), chain.begin(), chain.end());
+  for (int i = 0; i < n; ++i) {
+    int& c = corners[static_cast<size_t>(i)];
+    if (i == wrap(side, n)) c = last_kept;
+    else if (i == wrap(side + 1, n)) c = 0;
+    else c = position_of[static_cast<size_t>(c)];
+  }
+  loop = std::move(next);
+  return true;
+}
+
+PositionCosts StripRegion::costs() const {
+  PositionCosts costs;
+  for (const LoopVertex& v : loop) {
+    const bool single_quad = v.outside == 0;
+    costs.as_corner.push_back(std::abs(v.outside + 2 - v.regular) +
+                              (single_quad && v.reflex ? kFoldPenalty : 0));
+    costs.as_side.push_back(std::abs(v.outside + 3 - v.regular));
+    costs.flat.push_back(single_quad && v.exposed ? 1 : 0);
+  }
+  return costs;
 }
 
 }  // namespace sd::meshing::detail

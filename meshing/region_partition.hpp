@@ -7,6 +7,7 @@
 //    corners (valence 2, cost 1 each), searched for the least total cost;
 //  * the Yasseen et al. (2010) large-length partition with distorted 4-sided regions.
 
+#include <Eigen/Core>
 #include <optional>
 #include <span>
 #include <vector>
@@ -29,6 +30,8 @@ struct PolygonLayout {
   std::vector<int> corners;  // loop positions of the layout corners, increasing
   std::vector<int> spokes;   // Nasri spoke lengths d_j; empty for a single grid block
   int cost = 0;              // the distortion this layout causes, from the position costs
+  int irregular = 0;         // vertices of the loop and the centre left irregular
+  int flat = 0;              // layout corners at positions flagged in PositionCosts::flat
 };
 
 // What it costs (in valence deviation) for each loop position to become a layout corner
@@ -36,6 +39,10 @@ struct PolygonLayout {
 struct PositionCosts {
   std::vector<int> as_corner;
   std::vector<int> as_side;
+  // Optional (empty = none flagged): 1 where a layout corner would leave a single quad with
+  // the boundary's own angle there, flat (180°) or reflex. Among layouts of equal cost the
+  // search prefers fewer flagged corners.
+  std::vector<char> flat;
 };
 
 // The least costly layout found: cost = |n' − 4| (the centre) + the position costs. Searches
@@ -47,8 +54,49 @@ PolygonLayout best_layout(const PositionCosts& costs, int budget);
 void fill_polygon(QuadMeshBuilder& builder, std::span<const int> loop,
                   const PolygonLayout& layout);
 
-// Position costs of a region's own boundary: real corners want to stay corners.
+// Position costs of a region's own boundary: real corners want to stay corners. Every side
+// vertex is flagged flat (straight sides); real corners are not.
 PositionCosts region_costs(std::span<const int> side_counts);
+
+// Padding (after Takayama et al. 2014), one side at a time. A *strip* along side i of a region
+// is a row of l_i quads between the side and a chain from the vertex before corner i to the
+// vertex after corner i+1; the region left over has the same number of sides, side i replaced
+// by the chain (same count) and sides i−1, i+1 one edge shorter. Corners i and i+1 keep
+// valence 2 (one quad each), every other vertex of side i gets valence 3, and the two vertices
+// that become the left-over region's corners get valence 3 when they stay its corners: so a
+// strip costs nothing, and a layout corner the left-over region promotes on the chain is an
+// interior vertex of valence 3 instead of a boundary vertex of valence 2 (flat or folded
+// quad). Strips on all sides make a full padding ring.
+struct LoopVertex {
+  int id = -1;        // vertex id in the builder (or -1 when only planning)
+  int outside = 0;    // edges it has outside the current region
+  int regular = 3;    // its regular valence in the whole fill
+  bool exposed = false;  // on the region's boundary with a flat or reflex angle: valence 2 here
+                         // would leave one quad with that angle
+  bool reflex = false;   // ... and that quad would be folded
+};
+
+struct StripRegion {
+  std::vector<LoopVertex> loop;  // counter-clockwise
+  std::vector<int> corners;      // loop position of corner i, side i from corner i to i+1
+  int fixed_cost = 0;            // distortion of the vertices already enclosed by strips
+  int fixed_irregular = 0;
+  int folded = 0;  // enclosed vertices of valence 2 where the boundary is reflex
+  int flat = 0;    // ... flat or reflex
+
+  // Adds a strip along side `side`; false (nothing changed) when a neighbouring side has fewer
+  // than 2 edges or the loop would shrink below 4 vertices. With a builder, creates the chain's vertices (one edge length inwards of the
+  // side about `normal`, parallelogram points next to the corners) and the strip's quads.
+  bool strip(int side, QuadMeshBuilder* builder = nullptr,
+             const Eigen::Vector3d& normal = Eigen::Vector3d::UnitZ());
+
+  // Position costs of the current loop (a reflex position with no outside edge costs
+  // kFoldPenalty more as a corner, so that layouts avoid folding first).
+  PositionCosts costs() const;
+};
+
+// Added to the corner cost of a position where a layout corner would fold a quad.
+constexpr int kFoldPenalty = 64;
 
 // Fills the region with the Yasseen et al. (2010) large-length partition: spokes from a
 // centre as in Nasri's partition, large sides absorbed by distorted regions, merged distorted

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <set>
 #include <span>
 #include <string>
@@ -68,6 +69,31 @@ inline ::testing::AssertionResult within_bounds(const PatchTopology& topo,
       topo.distortion > n + 2)
     return ::testing::AssertionFailure() << describe(counts) << ": distortion " << topo.distortion;
   return ::testing::AssertionSuccess();
+}
+
+// Every count vector of n sides with entries 1..6 and an even total, in a fixed order; for
+// 6^n above kMaxCasesPerN a deterministic subsample: vector indices 0, s, 2s, ... with s prime
+// to 6, so that every side still takes every value. Calls visit(counts) for each.
+template <class Visit>
+void for_each_count_vector(int n, Visit&& visit) {
+  constexpr int kMaxCount = 6;
+  constexpr std::int64_t kMaxCasesPerN = 6000;
+  std::int64_t total_vectors = 1;
+  for (int i = 0; i < n; ++i) total_vectors *= kMaxCount;
+  std::int64_t stride = std::max<std::int64_t>(1, total_vectors / kMaxCasesPerN);
+  while (stride % 2 == 0 || stride % 3 == 0) ++stride;
+  if (total_vectors <= kMaxCasesPerN) stride = 1;
+  for (std::int64_t index = 0; index < total_vectors; index += stride) {
+    std::vector<int> counts(static_cast<size_t>(n));
+    std::int64_t rest = index;
+    int sum = 0;
+    for (int& c : counts) {
+      c = 1 + static_cast<int>(rest % kMaxCount);
+      rest /= kMaxCount;
+      sum += c;
+    }
+    if (sum % 2 == 0) visit(counts);
+  }
 }
 
 }  // namespace sd::meshing::test

@@ -1,0 +1,138 @@
+// Geometric validity of every topology the filler produces: over the exhaustive count range of
+// the property test (n = 2..8, entries 1..6, same subsample), the 3D fill of a straight-sided
+// regular polygon has no inverted quad and its smallest quad angle stays above a bound; so do
+// fills of mildly concave boundaries with reflex corners. The bounds are justified in
+// docs/meshing.md ("Angles").
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <numeric>
+
+#include "meshing/patch_fill.hpp"
+#include "tests/meshing/patch_fill_checks.hpp"
+
+namespace sd::meshing {
+namespace {
+
+// Smallest quad angle on a straight-sided regular polygon (and the circle for n = 2), and the
+// largest one below 180° by as much.
+constexpr double kMinAngleConvexDeg = 12;
+// In a quad at a flat vertex (180°), the other three angles share 180°.
+constexpr double kMinAngleAtFlatDeg = 8;
+// On the concave shapes below, with reflex corners of about 195-215°.
+constexpr double kMinAngleConcaveDeg = 10;
+
+// Quad angles of a flat (z = 0) patch, split by whether the quad has a *flat vertex*: a side
+// vertex of valence 2, whose one quad takes the boundary's own angle (180° on a straight side).
+struct Angles {
+  double min_deg = 180, max_deg = 0;  // over quads without a flat vertex
+  double min_deg_at_flat = 180;       // smallest angle of the quads with one
+  int flat_vertices = 0;
+  bool any_inverted = false;
+};
+
+Angles measure_angles(const FilledPatch& patch) {
+  const auto& mesh = patch.mesh;
+  const Eigen::VectorXi valence = vertex_valences(mesh);
+  std::vector<char> flat(static_cast<size_t>(mesh.vertices.rows()), 0);
+  Angles angles;
+  for (const auto& side : patch.topology.side_vertices)
+    for (size_t k = 1; k + 1 < side.size(); ++k)
+      if (valence(side[k]) == 2) {
+        flat[static_cast<size_t>(side[k])] = 1;
+        ++angles.flat_vertices;
+      }
+  for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f) {
+    bool has_flat = false;
+    for (int k = 0; k < 4; ++k) has_flat = has_flat || flat[static_cast<size_t>(mesh.faces(f, k))];
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector2d p = mesh.vertices.row(mesh.faces(f, k)).head<2>();
+      const Eigen::Vector2d e1 = Eigen::Vector2d(mesh.vertices.row(mesh.faces(f, (k + 1) % 4)).head<2>()) - p;
+      const Eigen::Vector2d e2 = Eigen::Vector2d(mesh.vertices.row(mesh.faces(f, (k + 3) % 4)).head<2>()) - p;
+      const double cross = e1.x() * e2.y() - e1.y() * e2.x();
+      // Counter-clockwise quads have angles in (0, 180]; a flat one (collinear edges, cross
+      // product at rounding level) is 180, not -180.
+      double deg = std::atan2(cross, e1.dot(e2)) * 180 / std::numbers::pi;
+      if (std::abs(cross) <= 1e-12 * e1.norm() * e2.norm()) deg = std::abs(deg);
+      if (deg < 0) angles.any_inverted = true;
+      if (deg < 0) deg += 360;
+      if (has_flat) {
+        angles.min_deg_at_flat = std::min(angles.min_deg_at_flat, deg);
+      } else {
+        angles.min_deg = std::min(angles.min_deg, deg);
+        angles.max_deg = std::max(angles.max_deg, deg);
+      }
+    }
+  }
+  return angles;
+}
+
+// Corner i at `corner_point(i)`, straight sides split evenly (n = 2: two half circles).
+template <class CornerPoint>
+std::vector<Eigen::MatrixX3d> straight_sides(std::span<const int> counts,
+                                             const CornerPoint& corner_point) {
+  const auto n = static_cast<int>(counts.size());
+  std::vector<Eigen::MatrixX3d> sides;
+  for (int i = 0; i < n; ++i) {
+    const int count = counts[static_cast<size_t>(i)];
+    Eigen::MatrixX3d side(count + 1, 3);
+    for (int k = 0; k <= count; ++k) {
+      const double t = static_cast<double>(k) / count;
+      if (n == 2) {
+        const double a = std::numbers::pi * (i + t);
+        side.row(k) << std::cos(a), std::sin(a), 0;
+      } else {
+        side.row(k) = ((1 - t) * corner_point(i) + t * corner_point((i + 1) % n)).transpose();
+      }
+    }
+    sides.push_back(side);
+  }
+  for (int i = 0; i < n; ++i) sides[static_cast<size_t>(i)].bottomRows<1>() = sides[static_cast<size_t>((i + 1) % n)].topRows<1>();
+  return sides;
+}
+
+Eigen::Vector3d on_circle(int i, int n, double radius = 1) {
+  const double a = 2 * std::numbers::pi * i / n;
+  return {radius * std::cos(a), radius * std::sin(a), 0};
+}
+
+class PatchFillAngles : public ::testing::TestWithParam<int> {};
+
+TEST_P(PatchFillAngles, RegularPolygonsHaveNoInvertedOrThinQuads) {
+  const int n = GetParam();
+  Angles worst;
+  int fills = 0, with_flat = 0;
+  std::map<std::string, int> partitions;
+  test::for_each_count_vector(n, [&](const std::vector<int>& counts) {
+    if (std::accumulate(counts.begin(), counts.end(), 0) < 4) return;
+    const FilledPatch patch =
+        fill_region(straight_sides(counts, [n](int i) { return on_circle(i, n); }));
+    ++fills;
+    ++partitions[patch.topology.partition];
+    ASSERT_TRUE(validate(patch.mesh).ok()) << test::describe(counts);
+    const Angles angles = measure_angles(patch);
+    EXPECT_FALSE(angles.any_inverted) << test::describe(counts);
+    EXPECT_EQ(patch.quality.inverted_quads, 0) << test::describe(counts);
+    EXPECT_GT(angles.min_deg, kMinAngleConvexDeg) << test::describe(counts);
+    EXPECT_LT(angles.max_deg, 180 - kMinAngleAtFlatDeg) << test::describe(counts);
+    EXPECT_GT(angles.min_deg_at_flat, kMinAngleAtFlatDeg) << test::describe(counts);
+    EXPECT_EQ(patch.quality.distortion, fill_region(counts).distortion) << test::describe(counts);
+    with_flat += angles.flat_vertices > 0 ? 1 : 0;
+    worst.min_deg = std::min(worst.min_deg, angles.min_deg);
+    worst.max_deg = std::max(worst.max_deg, angles.max_deg);
+    worst.min_deg_at_flat = std::min(worst.min_deg_at_flat, angles.min_deg_at_flat);
+  });
+  std::string used;
+  for (const auto& [name, count] : partitions) used += " " + name + ": " + std::to_string(count);
+  std::cout << "n = " << n << ", " << fills << " fills, angles " << worst.min_deg << ".."
+            << worst.max_deg << " deg; " << with_flat << " with a flat vertex, smallest angle there "
+            << worst.min_deg_at_flat << ";" << used << "\n";
+}
+
+INSTANTIATE_TEST_SUITE_P(AllSideCounts, PatchFillAngles, ::testing::Range(2, 9));
+
+}  // namespace
+}  // namespace sd::meshing
