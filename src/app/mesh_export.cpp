@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "meshing/tri_mesh.hpp"
+#include "src/render/scene.hpp"
 
 namespace sd::app {
 namespace {
@@ -36,23 +37,6 @@ std::vector<Eigen::Vector3i> triangles_of(const ExportMesh& mesh, Eigen::Index f
 }
 
 }  // namespace
-
-Eigen::Vector3f group_colour(int group) {
-  // Hues spaced by the golden angle, at fixed saturation and value.
-  const float hue = std::fmod(0.08f + 0.618034f * static_cast<float>(group), 1.0f) * 6.0f;
-  const float s = 0.45f, v = 0.92f;
-  const int sector = static_cast<int>(hue);
-  const float f = hue - static_cast<float>(sector);
-  const float p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
-  switch (sector % 6) {
-    case 0: return {v, t, p};
-    case 1: return {q, v, p};
-    case 2: return {p, v, t};
-    case 3: return {p, q, v};
-    case 4: return {t, p, v};
-    default: return {v, p, q};
-  }
-}
 
 std::string to_obj(const ExportMesh& mesh, const std::string& object_name) {
   std::string out = fmt::format("# sketchdrape: {} vertices, {} faces\no {}\n",
@@ -136,7 +120,7 @@ std::string to_glb(const ExportMesh& mesh, const std::string& object_name) {
     auto* material = new aiMaterial();
     const aiString name(group_name(mesh, g));
     material->AddProperty(&name, AI_MATKEY_NAME);
-    const Eigen::Vector3f c = group_colour(g);
+    const Eigen::Vector3f c = render::panel_colours(Eigen::VectorXi::Constant(1, g)).row(0);
     const aiColor4D colour(c.x(), c.y(), c.z(), 1.0f);
     material->AddProperty(&colour, 1, AI_MATKEY_COLOR_DIFFUSE);
     material->AddProperty(&colour, 1, AI_MATKEY_BASE_COLOR);

@@ -21,12 +21,10 @@ struct ExportMesh {
 // OBJ text: `o`, then per group a `g <name>` followed by its faces (1-based indices).
 std::string to_obj(const ExportMesh& mesh, const std::string& object_name);
 
-// Binary glTF 2.0 (.glb): one glTF mesh per group, each with its own material colour, smooth
+// Binary glTF 2.0 (.glb): one glTF mesh per group, each with its material colour taken from the
+// renderer's panel palette (render::panel_colours) so files and previews agree; smooth
 // normals. Quads are split along their shorter diagonal. Throws std::runtime_error if assimp's
 // exporter fails.
 std::string to_glb(const ExportMesh& mesh, const std::string& object_name);
-
-// Distinct, light colours for groups (the renderer's panel palette uses the same sequence).
-Eigen::Vector3f group_colour(int group);
 
 }  // namespace sd::app

@@ -54,11 +54,5 @@ TEST(MeshExport, GlbReimportsWithSameGeometry) {
   EXPECT_NEAR(area, 2.0, 1e-6);
 }
 
-TEST(MeshExport, GroupColoursAreDistinct) {
-  for (int a = 0; a < 12; ++a)
-    for (int b = a + 1; b < 12; ++b)
-      EXPECT_GT((group_colour(a) - group_colour(b)).norm(), 0.05f) << a << " " << b;
-}
-
 }  // namespace
 }  // namespace sd::app
