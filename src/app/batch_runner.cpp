@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <deque>
 #include <map>
@@ -169,6 +170,7 @@ BatchResult run_batch(const BatchOptions& options) {
   BatchResult result;
   std::map<std::string, KnownRecord> records;  // this run's outcome per job id
   std::deque<const PlannedJob*> queue;
+  const Progress* bar = nullptr;  // cleared before a warning so the two do not share a line
   auto finish = [&](const PlannedJob& p, JobRecord record, bool write_marker) {
     record.inputs_hash = p.inputs_hash;
     record.stage = options.stage;
@@ -186,7 +188,10 @@ BatchResult run_batch(const BatchOptions& options) {
         spdlog::warn("{}: {}", p.job.id, e.what());
       }
     }
-    if (record.status != "done") spdlog::warn("{} {}: {}", p.job.id, record.status, record.reason);
+    if (record.status != "done") {
+      if (bar != nullptr && bar->visible()) std::fputs("\r\033[K", stderr);
+      spdlog::warn("{} {}: {}", p.job.id, record.status, record.reason);
+    }
     records[p.job.id] = {record, false};
   };
 
@@ -219,6 +224,7 @@ BatchResult run_batch(const BatchOptions& options) {
                         ? fmt::format("batch {}/{}", options.shard->first, options.shard->second)
                         : "batch",
                     total, options.quiet);
+  bar = &progress;
   const auto batch_start = Clock::now();
   int finished = 0, failed = 0;
   auto update_progress = [&] {

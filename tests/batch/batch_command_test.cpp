@@ -334,6 +334,52 @@ TEST(BatchFaults, SigkillMidwayThenResumeRedoesOnlyUnfinishedJobs) {
   EXPECT_EQ(summary["counts"]["reused"], static_cast<int>(finished.size()));
 }
 
+TEST(BatchFaults, SigtermStopsChildrenWritesTheSummaryAndResumes) {
+  const fs::path dir = fresh_batch_dir("sigterm");
+  const fs::path manifest = wardrobe(dir, {"jersey", "denim", "silk"});  // 9 jobs
+  const fs::path out = dir / "out";
+  const pid_t pid = start_in_new_group(
+      {"batch", manifest.string(), "-o", out.string(), "--stage", "mesh", "-j", "2"},
+      dir / "first.log");
+  bool started = false;
+  for (int i = 0; i < 1200 && !started; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(25));
+    std::error_code ec;
+    for (const auto& d : fs::directory_iterator(out / "jobs", ec))
+      started = started || fs::exists(d.path() / "log.txt");
+  }
+  ASSERT_TRUE(started) << read_text(dir / "first.log");
+  ASSERT_EQ(kill(pid, SIGTERM), 0);  // the batch only: it must end its children itself
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status)) << read_text(dir / "first.log");
+  EXPECT_EQ(WEXITSTATUS(status), 1);
+  EXPECT_NE(read_text(dir / "first.log").find("the batch was stopped"), std::string::npos);
+  // No child is left running: every job folder's log is closed and no mesh process remains in
+  // the group.
+  EXPECT_EQ(kill(-pid, 0), -1) << "a child of the stopped batch is still alive";
+  const json summary = read_json(out / "batch.json");
+  ASSERT_EQ(summary["jobs"].size(), 9u);
+  int done = 0;
+  for (const json& j : summary["jobs"]) {
+    if (j["status"] == "done") {
+      ++done;
+      continue;
+    }
+    const std::string reason = j["reason"];
+    EXPECT_TRUE(reason.find("interrupted") != std::string::npos || j["status"] == "missing")
+        << j.dump();
+    EXPECT_FALSE(fs::exists(out / "jobs" / j["id"].get<std::string>() / "failed"))
+        << "an interrupted job is not recorded as failed";
+  }
+  EXPECT_LT(done, 9);
+  const CommandResult resumed = run_sketchdrape("batch " + shell_quoted(manifest) + " -o " +
+                                                shell_quoted(out) + " --stage mesh -j 2");
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  EXPECT_EQ(read_json(out / "batch.json")["counts"]["done"], 9);
+  EXPECT_EQ(read_json(out / "batch.json")["counts"]["reused"], done);
+}
+
 TEST(BatchFaults, FullDiskEndsTheJobFailedWithAClearReason) {
   const fs::path dir = fresh_batch_dir("full_disk");
   fs::copy_file(kExamples / "tshirt.json", dir / "tshirt.json");
