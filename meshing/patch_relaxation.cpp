@@ -78,6 +78,20 @@ double quad_min_jacobian(const QuadMesh& mesh, Eigen::Index f, const Eigen::Vect
   return worst;
 }
 
+// Whether every corner of quad f has a scaled Jacobian of at least `bound` (> 0), without
+// square roots: c >= bound |e1| |e2|  <=>  c >= 0 and c² >= bound² |e1|² |e2|².
+bool quad_at_least(const QuadMesh& mesh, Eigen::Index f, const Eigen::Vector3d& normal,
+                   const std::vector<Eigen::Vector3d>& x, double bound) {
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Vector3d& p = x[static_cast<size_t>(mesh.faces(f, k))];
+    const Eigen::Vector3d e1 = x[static_cast<size_t>(mesh.faces(f, (k + 1) % 4))] - p;
+    const Eigen::Vector3d e2 = x[static_cast<size_t>(mesh.faces(f, (k + 3) % 4))] - p;
+    const double c = e1.cross(e2).dot(normal);
+    if (c < 0 || c * c < bound * bound * e1.squaredNorm() * e2.squaredNorm()) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 void relax_interior(QuadMesh& mesh, std::span<const char> fixed, int sweeps,
@@ -115,6 +129,7 @@ void relax_interior(QuadMesh& mesh, std::span<const char> fixed, int sweeps,
     // its free vertices where they were; quads around a kept vertex are checked again.
     auto worse = [&](size_t f) {
       const auto fi = static_cast<Eigen::Index>(f);
+      if (quad_at_least(mesh, fi, normals[f], next, kAcceptable)) return false;
       const double after = quad_min_jacobian(mesh, fi, normals[f], next);
       return after < kAcceptable && after < quad_min_jacobian(mesh, fi, normals[f], old) - 1e-12;
     };
