@@ -9,6 +9,8 @@
 namespace sd::garment {
 namespace {
 
+constexpr double kOnPlaneFraction = 0.25;
+
 struct UnionFind {
   std::vector<int> parent;
   explicit UnionFind(int n) : parent(static_cast<size_t>(n)) {
@@ -127,7 +129,10 @@ CurveNetwork build_network(const Sketch& sketch, const std::vector<ProjectedCurv
     w.points = curves[c].points;
     w.closed = curves[c].closed;
     w.mirrored = mirrored.contains(curves[c].id);
-    if (w.mirrored && w.points.col(0).cwiseAbs().maxCoeff() < tol) {
+    // On the plane means within a quarter of the junction tolerance everywhere (a stroke drawn
+    // at x = 0 lands within a millimetre or two); a curve near the plane but off it (an inseam
+    // along the inner thigh) keeps its own mirror copy.
+    if (w.mirrored && w.points.col(0).cwiseAbs().maxCoeff() < kOnPlaneFraction * tol) {
       w.on_plane = true;
       w.points.col(0).setZero();
     }

@@ -28,6 +28,40 @@ struct VertexPool {
   }
 };
 
+
+// A seam vertex where both panels have a side vertex of valence 2 (the filler may move a corner
+// of a region along its boundary, and a mirrored panel and its copy do it at the same place)
+// becomes an interior vertex of valence 2: quads F1 = (b, c, x, a) and F2 = (b, a, y, c) folded
+// onto each other along a-b-c. Such a doublet is removed by merging them into (c, x, a, y),
+// which keeps F1's panel. Returns how many were removed; `faces`/`face_panel` are edited.
+int remove_doublets(std::vector<std::array<int, 4>>& faces, std::vector<int>& face_panel,
+                    size_t vertex_count) {
+  int removed = 0;
+  for (bool changed = true; changed;) {
+    changed = false;
+    std::vector<std::vector<int>> incident(vertex_count);
+    for (size_t f = 0; f < faces.size(); ++f)
+      for (int v : faces[f]) incident[static_cast<size_t>(v)].push_back(static_cast<int>(f));
+    for (size_t b = 0; b < vertex_count && !changed; ++b) {
+      if (incident[b].size() != 2) continue;
+      auto rotated = [&](int f) {  // the face with b first
+        std::array<int, 4> q = faces[static_cast<size_t>(f)];
+        while (q[0] != static_cast<int>(b)) std::rotate(q.begin(), q.begin() + 1, q.end());
+        return q;
+      };
+      const std::array<int, 4> f1 = rotated(incident[b][0]), f2 = rotated(incident[b][1]);
+      if (f2[1] != f1[3] || f2[3] != f1[1]) continue;  // b is a boundary vertex, not a doublet
+      faces[static_cast<size_t>(incident[b][0])] = {f1[1], f1[2], f1[3], f2[2]};
+      faces.erase(faces.begin() + incident[b][1]);
+      face_panel.erase(face_panel.begin() + incident[b][1]);
+      ++removed;
+      changed = true;
+    }
+  }
+  return removed;
+}
+
+
 }  // namespace
 
 std::string body_part_name(BodyPart part) {
@@ -56,7 +90,7 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
   const std::vector<ProjectedCurve> projected = project_curves(sketch, body);
   const CurveNetwork net = build_network(sketch, projected, curves_to_mirror(sketch));
   const std::vector<PanelLoop> loops = resolve_panels(sketch, net, body);
-  const EdgeCounts counts = compute_edge_counts(sketch, net, loops);
+  EdgeCounts counts = compute_edge_counts(sketch, net, loops);
 
   // A curve piece is a seam between at most two panels.
   std::vector<std::vector<int>> users(net.edges.size());
@@ -137,27 +171,33 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
     // Sides: points and global ids from corner i to corner i+1.
     std::vector<Eigen::MatrixX3d> side_points;
     std::vector<std::vector<int>> side_ids;
-    for (int s = 0; s < loop.side_count(); ++s) {
-      std::vector<Eigen::Vector3d> pts;
-      std::vector<int> ids;
-      for (int k = loop.side_begin[static_cast<size_t>(s)]; k < loop.side_end(s); ++k) {
-        const LoopEdge& e = loop.edges[static_cast<size_t>(k)];
-        const Eigen::MatrixX3d& p = placed_points(e.edge);
-        const std::vector<int>& g = ids_of(e.edge);
-        const Eigen::Index n = p.rows();
-        for (Eigen::Index j = 0; j < n; ++j) {
-          const Eigen::Index src = e.forward ? j : n - 1 - j;
-          if (!ids.empty() && j == 0) continue;  // the junction is already there
-          pts.push_back(p.row(src).transpose());
-          ids.push_back(g[static_cast<size_t>(src)]);
+    auto build_sides = [&] {
+      side_points.clear();
+      side_ids.clear();
+      panel.side_counts.clear();
+      for (int s = 0; s < loop.side_count(); ++s) {
+        std::vector<Eigen::Vector3d> pts;
+        std::vector<int> ids;
+        for (int k = loop.side_begin[static_cast<size_t>(s)]; k < loop.side_end(s); ++k) {
+          const LoopEdge& e = loop.edges[static_cast<size_t>(k)];
+          const Eigen::MatrixX3d& p = placed_points(e.edge);
+          const std::vector<int>& g = ids_of(e.edge);
+          const Eigen::Index n = p.rows();
+          for (Eigen::Index j = 0; j < n; ++j) {
+            const Eigen::Index src = e.forward ? j : n - 1 - j;
+            if (!ids.empty() && j == 0) continue;  // the junction is already there
+            pts.push_back(p.row(src).transpose());
+            ids.push_back(g[static_cast<size_t>(src)]);
+          }
         }
+        Eigen::MatrixX3d m(static_cast<Eigen::Index>(pts.size()), 3);
+        for (size_t j = 0; j < pts.size(); ++j) m.row(static_cast<Eigen::Index>(j)) = pts[j].transpose();
+        side_points.push_back(std::move(m));
+        side_ids.push_back(std::move(ids));
+        panel.side_counts.push_back(static_cast<int>(side_ids.back().size()) - 1);
       }
-      Eigen::MatrixX3d m(static_cast<Eigen::Index>(pts.size()), 3);
-      for (size_t j = 0; j < pts.size(); ++j) m.row(static_cast<Eigen::Index>(j)) = pts[j].transpose();
-      side_points.push_back(std::move(m));
-      side_ids.push_back(std::move(ids));
-      panel.side_counts.push_back(static_cast<int>(side_ids.back().size()) - 1);
-    }
+    };
+    build_sides();
 
     const int panel_index = static_cast<int>(garment.panels.size());
     std::vector<int> globals;
@@ -257,6 +297,27 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
     garment.panels.push_back(std::move(panel));
   }
 
+  if (const int doublets = remove_doublets(faces, face_panel, pool.positions.size()); doublets > 0)
+    spdlog::warn("{} seam vertex(es) had only two quads folded onto each other; merged them into "
+                 "one quad each (the seam steps one vertex aside there)",
+                 doublets);
+  for (GarmentPanel& p : garment.panels) p.faces = 0;
+  for (int p : face_panel) ++garment.panels[static_cast<size_t>(p)].faces;
+  // Drop vertices no face uses (the centres of removed doublets), keeping order.
+  {
+    std::vector<int> remap(pool.positions.size(), -1);
+    for (const auto& q : faces)
+      for (int v : q) remap[static_cast<size_t>(v)] = 0;
+    std::vector<Eigen::Vector3d> kept;
+    for (size_t v = 0; v < remap.size(); ++v)
+      if (remap[v] == 0) {
+        remap[v] = static_cast<int>(kept.size());
+        kept.push_back(pool.positions[v]);
+      }
+    for (auto& q : faces)
+      for (int& v : q) v = remap[static_cast<size_t>(v)];
+    pool.positions = std::move(kept);
+  }
   garment.mesh.vertices.resize(static_cast<Eigen::Index>(pool.positions.size()), 3);
   for (size_t v = 0; v < pool.positions.size(); ++v) garment.mesh.vertices.row(static_cast<Eigen::Index>(v)) = pool.positions[v].transpose();
   garment.mesh.faces.resize(static_cast<Eigen::Index>(faces.size()), 4);
