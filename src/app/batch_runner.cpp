@@ -307,7 +307,12 @@ BatchResult run_batch(const BatchOptions& options) {
                         : record.exit_code == 2 ? "bad-input"
                                                 : "failed";
         if (record.exit_code != 0) {
+          // Paths inside the job's own folder read better relative to it ("sketch.json: /fabric").
           record.reason = failure_reason_from_log(log);
+          const std::string prefix = (jobs_dir / p.job.id).string() + "/";
+          for (size_t at = record.reason.find(prefix); at != std::string::npos;
+               at = record.reason.find(prefix, at))
+            record.reason.erase(at, prefix.size());
           if (record.reason.empty())
             record.reason = fmt::format("exited with code {}", record.exit_code);
         }

@@ -176,6 +176,8 @@ TEST(BatchCommand, BadJobsFailWithTheirReasonWhileOthersFinish) {
   EXPECT_EQ(jobs.at("negative-edge")["status"], "bad-input");
   EXPECT_EQ(jobs.at("negative-edge")["exit_code"], 2);
   const std::string edge_reason = jobs.at("negative-edge")["reason"];
+  EXPECT_EQ(edge_reason.rfind("sketch.json: /edge_length", 0), 0u)
+      << "paths in the job's folder are shown relative to it: " << edge_reason;
   EXPECT_NE(edge_reason.find("/edge_length: must be greater than zero"), std::string::npos)
       << edge_reason;
   const std::string body_reason = jobs.at("no-body")["reason"];
@@ -380,6 +382,28 @@ TEST(BatchFaults, SigtermStopsChildrenWritesTheSummaryAndResumes) {
   EXPECT_EQ(read_json(out / "batch.json")["counts"]["reused"], done);
 }
 
+TEST(BatchFaults, TimeoutKillsSlowJobsAndARerunFinishesThem) {
+  const fs::path dir = fresh_batch_dir("timeout");
+  write_text(dir / "m.csv", "sketch,/fabric\n" + (kExamples / "tshirt.json").string() + ",denim\n" +
+                                (kExamples / "tshirt.json").string() + ",silk\n");
+  const fs::path out = dir / "out";
+  // Meshing the t-shirt with its three 600x900 images takes far longer than 50 ms.
+  const CommandResult slow =
+      run_sketchdrape("batch " + shell_quoted(dir / "m.csv") + " -o " + shell_quoted(out) +
+                      " --stage mesh -j 2 --timeout 0.05");
+  EXPECT_EQ(slow.exit_code, 1) << slow.output;
+  for (const json& j : read_json(out / "batch.json")["jobs"]) {
+    EXPECT_EQ(j["status"], "failed");
+    EXPECT_EQ(j["reason"], "timed out after 0.05 s (--timeout)");
+    EXPECT_EQ(j["exit_code"], -1);
+    EXPECT_FALSE(fs::exists(out / "jobs" / j["id"].get<std::string>() / "done"));
+  }
+  const CommandResult again = run_sketchdrape("batch " + shell_quoted(dir / "m.csv") + " -o " +
+                                              shell_quoted(out) + " --stage mesh -j 2");
+  EXPECT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_EQ(read_json(out / "batch.json")["counts"]["done"], 2);
+}
+
 TEST(BatchFaults, FullDiskEndsTheJobFailedWithAClearReason) {
   const fs::path dir = fresh_batch_dir("full_disk");
   fs::copy_file(kExamples / "tshirt.json", dir / "tshirt.json");
@@ -458,6 +482,18 @@ TEST(ContactSheet, LoadsInHeadlessChromium) {
   EXPECT_NE(dom.find("<tr class=\"job bad-input\" data-id=\"broken\""), std::string::npos);
   EXPECT_NE(dom.find("6 thumbnails loaded"), std::string::npos);
 }
+
+// Removes this process's test folders when every test passed (they are kept for inspection
+// otherwise).
+class RemoveTestFolders : public ::testing::Environment {
+ public:
+  void TearDown() override {
+    if (!::testing::UnitTest::GetInstance()->Passed()) return;
+    std::error_code ignored;
+    fs::remove_all(fresh_batch_dir("x").parent_path(), ignored);
+  }
+};
+const auto* const kRemoveTestFolders = ::testing::AddGlobalTestEnvironment(new RemoveTestFolders);
 
 }  // namespace
 }  // namespace sd::test
