@@ -213,8 +213,9 @@ Plan choose_plan(std::span<const int> counts, const BoundaryShape& shape,
                  const std::vector<Eigen::MatrixX3d>& side_points, std::optional<Built>& yasseen) {
   Plan best = *plan_with_strips(counts, shape, {}, kSearchBudget);
   // Padding only pays when the plain layout promotes a side vertex where the boundary is flat
-  // or reflex (strips keep the real corners at valence 2, so a flat real corner is the layout's
-  // business).
+  // or reflex, or folds a quad (a reflex real corner it could not drop without promoting a
+  // corner on a reflex stretch); strips keep the real corners at valence 2, so a merely flat
+  // real corner is the layout's business.
   const std::vector<int> real_corners = corner_positions(counts);
   const auto n = static_cast<int>(counts.size());
   std::vector<int> exposed_sides;  // sides with a promoted corner where the boundary is flat
@@ -226,7 +227,7 @@ Plan choose_plan(std::span<const int> counts, const BoundaryShape& shape,
       if (std::find(exposed_sides.begin(), exposed_sides.end(), side) == exposed_sides.end())
         exposed_sides.push_back(side);
     }
-  if (!exposed_sides.empty()) {
+  if (!exposed_sides.empty() || best.folded > 0) {
     auto consider = [&](std::span<const int> strips) {
       if (auto plan = plan_with_strips(counts, shape, strips, kStripSearchBudget);
           plan && plan->rank() < best.rank())

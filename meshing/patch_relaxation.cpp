@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -17,25 +18,31 @@ struct Adjacency {
 
 Adjacency build_adjacency(const QuadMesh& mesh) {
   const auto nv = static_cast<size_t>(mesh.vertices.rows());
-  std::vector<std::vector<int>> nbr(nv), crn(nv);
-  for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f)
-    for (int k = 0; k < 4; ++k) {
-      const int v = mesh.faces(f, k);
-      crn[static_cast<size_t>(v)].push_back(static_cast<int>(f) * 4 + k);
-      // Each undirected edge is seen from both faces (or once on the boundary): deduplicate.
-      for (const int w : {mesh.faces(f, (k + 1) % 4), mesh.faces(f, (k + 3) % 4)}) {
-        auto& list = nbr[static_cast<size_t>(v)];
-        if (std::find(list.begin(), list.end(), w) == list.end()) list.push_back(w);
-      }
-    }
   Adjacency adj;
-  adj.neighbour_start.push_back(0);
-  adj.corner_start.push_back(0);
+  adj.corner_start.assign(nv + 1, 0);
+  for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f)
+    for (int k = 0; k < 4; ++k) ++adj.corner_start[static_cast<size_t>(mesh.faces(f, k)) + 1];
+  for (size_t v = 0; v < nv; ++v) adj.corner_start[v + 1] += adj.corner_start[v];
+  adj.corners.resize(static_cast<size_t>(adj.corner_start[nv]));
+  std::vector<int> fill(adj.corner_start.begin(), adj.corner_start.end() - 1);
+  for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f)
+    for (int k = 0; k < 4; ++k)
+      adj.corners[static_cast<size_t>(fill[static_cast<size_t>(mesh.faces(f, k))]++)] =
+          static_cast<int>(f) * 4 + k;
+  // Edge neighbours: the two face neighbours of every corner, each undirected edge seen from
+  // both of its faces (once on the boundary), so deduplicated per vertex.
+  adj.neighbour_start.assign(nv + 1, 0);
+  adj.neighbours.reserve(2 * adj.corners.size());
   for (size_t v = 0; v < nv; ++v) {
-    adj.neighbours.insert(adj.neighbours.end(), nbr[v].begin(), nbr[v].end());
-    adj.corners.insert(adj.corners.end(), crn[v].begin(), crn[v].end());
-    adj.neighbour_start.push_back(static_cast<int>(adj.neighbours.size()));
-    adj.corner_start.push_back(static_cast<int>(adj.corners.size()));
+    const auto begin = adj.neighbours.size();
+    for (int c = adj.corner_start[v]; c < adj.corner_start[v + 1]; ++c) {
+      const int f = adj.corners[static_cast<size_t>(c)] / 4, k = adj.corners[static_cast<size_t>(c)] % 4;
+      for (const int w : {mesh.faces(f, (k + 1) % 4), mesh.faces(f, (k + 3) % 4)})
+        if (std::find(adj.neighbours.begin() + static_cast<std::ptrdiff_t>(begin), adj.neighbours.end(), w) ==
+            adj.neighbours.end())
+          adj.neighbours.push_back(w);
+    }
+    adj.neighbour_start[v + 1] = static_cast<int>(adj.neighbours.size());
   }
   return adj;
 }
@@ -64,30 +71,41 @@ std::vector<Eigen::Vector3d> quad_normals(const QuadMesh& mesh,
   return normals;
 }
 
-// Smallest scaled Jacobian over the four corners of quad f at positions x.
-double quad_min_jacobian(const QuadMesh& mesh, Eigen::Index f, const Eigen::Vector3d& normal,
+using Quad = std::array<int, 4>;
+
+// Edges of quad q at positions x: e[k] runs from corner k to corner k+1; the corner k is
+// spanned by e[k] and −e[k−1], so its cross product is e[k−1] × e[k].
+std::array<Eigen::Vector3d, 4> quad_edges(const Quad& q, const std::vector<Eigen::Vector3d>& x) {
+  std::array<Eigen::Vector3d, 4> e;
+  for (int k = 0; k < 4; ++k)
+    e[static_cast<size_t>(k)] = x[static_cast<size_t>(q[static_cast<size_t>((k + 1) % 4)])] -
+                                x[static_cast<size_t>(q[static_cast<size_t>(k)])];
+  return e;
+}
+
+// Smallest scaled Jacobian over the four corners of quad q at positions x.
+double quad_min_jacobian(const Quad& q, const Eigen::Vector3d& normal,
                          const std::vector<Eigen::Vector3d>& x) {
+  const auto e = quad_edges(q, x);
   double worst = std::numeric_limits<double>::infinity();
-  for (int k = 0; k < 4; ++k) {
-    const Eigen::Vector3d& p = x[static_cast<size_t>(mesh.faces(f, k))];
-    const Eigen::Vector3d e1 = x[static_cast<size_t>(mesh.faces(f, (k + 1) % 4))] - p;
-    const Eigen::Vector3d e2 = x[static_cast<size_t>(mesh.faces(f, (k + 3) % 4))] - p;
-    const double denom = std::sqrt(e1.squaredNorm() * e2.squaredNorm());
-    worst = std::min(worst, denom > 0 ? e1.cross(e2).dot(normal) / denom : -1.0);
+  for (size_t k = 0; k < 4; ++k) {
+    const Eigen::Vector3d& before = e[(k + 3) % 4];
+    const double denom = std::sqrt(before.squaredNorm() * e[k].squaredNorm());
+    worst = std::min(worst, denom > 0 ? before.cross(e[k]).dot(normal) / denom : -1.0);
   }
   return worst;
 }
 
-// Whether every corner of quad f has a scaled Jacobian of at least `bound` (> 0), without
+// Whether every corner of quad q has a scaled Jacobian of at least `bound` (> 0), without
 // square roots: c >= bound |e1| |e2|  <=>  c >= 0 and c² >= bound² |e1|² |e2|².
-bool quad_at_least(const QuadMesh& mesh, Eigen::Index f, const Eigen::Vector3d& normal,
+bool quad_at_least(const Quad& q, const Eigen::Vector3d& normal,
                    const std::vector<Eigen::Vector3d>& x, double bound) {
-  for (int k = 0; k < 4; ++k) {
-    const Eigen::Vector3d& p = x[static_cast<size_t>(mesh.faces(f, k))];
-    const Eigen::Vector3d e1 = x[static_cast<size_t>(mesh.faces(f, (k + 1) % 4))] - p;
-    const Eigen::Vector3d e2 = x[static_cast<size_t>(mesh.faces(f, (k + 3) % 4))] - p;
-    const double c = e1.cross(e2).dot(normal);
-    if (c < 0 || c * c < bound * bound * e1.squaredNorm() * e2.squaredNorm()) return false;
+  const auto e = quad_edges(q, x);
+  std::array<double, 4> length2;
+  for (size_t k = 0; k < 4; ++k) length2[k] = e[k].squaredNorm();
+  for (size_t k = 0; k < 4; ++k) {
+    const double c = e[(k + 3) % 4].cross(e[k]).dot(normal);
+    if (c < 0 || c * c < bound * bound * length2[(k + 3) % 4] * length2[k]) return false;
   }
   return true;
 }
@@ -112,6 +130,10 @@ void relax_interior(QuadMesh& mesh, std::span<const char> fixed, int sweeps,
                  old[static_cast<size_t>(mesh.faces(static_cast<Eigen::Index>(f), 1))])
                     .norm();
   const double tolerance = 1e-3 * edge_sum / static_cast<double>(nf);
+  std::vector<Quad> quads(nf);
+  for (size_t f = 0; f < nf; ++f)
+    for (int k = 0; k < 4; ++k)
+      quads[f][static_cast<size_t>(k)] = mesh.faces(static_cast<Eigen::Index>(f), k);
   std::vector<char> bad(nf, 0);
   std::vector<int> queue, reverted;
   for (int sweep = 0; sweep < sweeps; ++sweep) {
@@ -128,10 +150,9 @@ void relax_interior(QuadMesh& mesh, std::span<const char> fixed, int sweeps,
     // A quad whose smallest scaled Jacobian would fall below min(before, kAcceptable) keeps
     // its free vertices where they were; quads around a kept vertex are checked again.
     auto worse = [&](size_t f) {
-      const auto fi = static_cast<Eigen::Index>(f);
-      if (quad_at_least(mesh, fi, normals[f], next, kAcceptable)) return false;
-      const double after = quad_min_jacobian(mesh, fi, normals[f], next);
-      return after < kAcceptable && after < quad_min_jacobian(mesh, fi, normals[f], old) - 1e-12;
+      if (quad_at_least(quads[f], normals[f], next, kAcceptable)) return false;
+      return quad_min_jacobian(quads[f], normals[f], next) <
+             quad_min_jacobian(quads[f], normals[f], old) - 1e-12;
     };
     queue.clear();
     for (size_t f = 0; f < nf; ++f)
