@@ -1,0 +1,566 @@
+#include "sim/adaptive_detail.hpp"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include <Eigen/Geometry>
+#include <spdlog/spdlog.h>
+
+#include "meshing/mesh48_transfer.hpp"
+#include "sim/element_forces.hpp"
+
+namespace sd::sim {
+namespace {
+
+using meshing::BlockChange;
+using meshing::BlockId;
+using meshing::TriangleId;
+using meshing::VertexId;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+void require(bool ok, const std::string& message) {
+  if (!ok) throw InvalidAdaptiveSettingsError(message);
+}
+
+// θ − θ0 wrapped into (−π, π].
+double angle_difference(double theta, double rest) {
+  return std::remainder(theta - rest, 2.0 * std::numbers::pi);
+}
+
+// The hinge of two triangles that share an edge, in element_forces' convention: triangles
+// (x0, x1, x2) and (x1, x0, x3). Empty if they share no edge.
+std::optional<std::array<int, 4>> hinge_between(const meshing::Mesh48& mesh, TriangleId t1,
+                                                TriangleId t2) {
+  const auto& a = mesh.vertices(t1);
+  const auto& b = mesh.vertices(t2);
+  for (int k = 0; k < 3; ++k)
+    for (int m = 0; m < 3; ++m)
+      if (b[m] == a[(k + 1) % 3] && b[(m + 1) % 3] == a[k])
+        return std::array<int, 4>{a[k].value(), a[(k + 1) % 3].value(), a[(k + 2) % 3].value(),
+                                  b[(m + 2) % 3].value()};
+  return std::nullopt;
+}
+
+Eigen::Vector3d row3(const Eigen::VectorXd& flat, int i) { return flat.segment<3>(3 * i); }
+
+}  // namespace
+
+void AdaptiveSettings::validate() const {
+  const auto positive = [](double value) { return std::isfinite(value) && value > 0.0; };
+  require(positive(refine_threshold), "the refine threshold must be a positive length in metres");
+  require(positive(coarsen_threshold) && coarsen_threshold < refine_threshold,
+          "the coarsen threshold must be positive and below the refine threshold (metres)");
+  require(std::isfinite(steady_rate) && steady_rate >= 0.0,
+          "the steady hinge rate must be zero or more radians per second");
+  require(std::isfinite(min_lifetime) && min_lifetime >= 0.0,
+          "the minimum triangle lifetime must be zero or more seconds");
+  require(min_level >= 0 && max_level >= min_level && max_level <= 30,
+          "the adaptive levels must satisfy 0 <= min_level <= max_level <= 30");
+  require(max_vertices >= 0, "the particle budget must be zero (none) or a positive count");
+}
+
+// The state by vertex and triangle id while a batch of splits and merges is applied (ids are
+// Mesh48 slots: they stay valid until compact(), rows grow as new vertices appear).
+struct AdaptiveCloth::Transfer {
+  Eigen::MatrixX3d x, v;
+  Eigen::VectorXd m;
+  std::vector<double> birth;
+  std::vector<PinRecord> pins;
+  std::vector<int> pin_of;           // vertex id -> index into pins, or -1
+  std::vector<char> touched_blocks;  // made, completed or merged in this batch
+  double now = 0.0;
+  bool changed = false;
+  bool measured = false;
+  ConservedQuantities before;
+};
+
+AdaptiveCloth::AdaptiveCloth(meshing::Mesh48 mesh, AdaptiveMaterial material,
+                             Eigen::MatrixX3d positions, std::vector<Pin> pins,
+                             SimulationSettings simulation, AdaptiveSettings adaptive)
+    : mesh_(std::move(mesh)), material_(std::move(material)), settings_(adaptive) {
+  settings_.validate();
+  simulation.validate();
+  if (!mesh_.is_compact())
+    throw std::invalid_argument("the adaptive cloth needs a compact 4-8 mesh (call compact())");
+  arrays_ = mesh_.arrays();
+  const int n = mesh_.vertex_count();
+  if (positions.rows() == 0) positions = arrays_.rest_positions;
+  if (positions.rows() != n || !positions.allFinite())
+    throw std::invalid_argument("the start positions must be finite, one row per cloth vertex (" +
+                                std::to_string(n) + ")");
+  for (const Pin& pin : pins) {
+    if (pin.vertex < 0 || pin.vertex >= n)
+      throw std::invalid_argument("pinned vertex " + std::to_string(pin.vertex) +
+                                  " is not a cloth vertex (the cloth has " + std::to_string(n) +
+                                  ")");
+    pins_.push_back({pin.vertex, pin.path, positions.row(pin.vertex).transpose()});
+  }
+  birth_.assign(static_cast<std::size_t>(mesh_.triangle_count()), 0.0);
+
+  Transfer state;
+  state.x = std::move(positions);
+  state.v = Eigen::MatrixX3d::Zero(n, 3);
+  state.birth = birth_;
+  state.pins = pins_;
+  rebuild(state, &simulation);  // the model (with its lumped masses) and the simulation
+}
+
+AdaptiveCloth::~AdaptiveCloth() = default;
+AdaptiveCloth::AdaptiveCloth(AdaptiveCloth&&) noexcept = default;
+AdaptiveCloth& AdaptiveCloth::operator=(AdaptiveCloth&&) noexcept = default;
+
+Eigen::MatrixX3d AdaptiveCloth::positions() const {
+  return unflatten_positions(simulation_->positions());
+}
+
+Eigen::MatrixX3d AdaptiveCloth::velocities() const {
+  return unflatten_positions(simulation_->velocities());
+}
+
+Eigen::Vector3d AdaptiveCloth::linear_momentum() const {
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  const Eigen::VectorXd& v = simulation_->velocities();
+  for (Eigen::Index i = 0; i < masses_.size(); ++i) p += masses_(i) * row3(v, static_cast<int>(i));
+  return p;
+}
+
+ConservedQuantities AdaptiveCloth::conserved_quantities() const {
+  return {masses_.sum(), linear_momentum(), simulation_->energy()};
+}
+
+std::vector<int> AdaptiveCloth::pinned_vertices() const {
+  std::vector<int> out;
+  for (const PinRecord& pin : pins_) out.push_back(pin.vertex);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+double AdaptiveCloth::hinge_sag(const std::array<int, 4>& hinge, double theta) const {
+  std::array<Eigen::Vector3d, 4> p;
+  for (int m = 0; m < 4; ++m) p[m] = mesh_.rest_position(VertexId(hinge[m]));
+  const double rest = material_.model_options.bend_rest == BendRestShape::designed
+                          ? dihedral_angle(p[0], p[1], p[2], p[3])
+                          : 0.0;
+  const double areas =
+      0.5 * ((p[1] - p[0]).cross(p[2] - p[0]).norm() + (p[3] - p[0]).cross(p[1] - p[0]).norm());
+  return std::abs(angle_difference(theta, rest)) * areas / (p[1] - p[0]).norm() / 8.0;
+}
+
+Eigen::VectorXd AdaptiveCloth::edge_errors() const {
+  const Eigen::VectorXd& x = simulation_->positions();
+  const Eigen::MatrixX4i& edges = arrays_.interior_edges;
+  Eigen::VectorXd errors(edges.rows());
+  for (Eigen::Index r = 0; r < edges.rows(); ++r) {
+    const double theta = dihedral_angle(row3(x, edges(r, 0)), row3(x, edges(r, 1)),
+                                        row3(x, edges(r, 2)), row3(x, edges(r, 3)));
+    errors(r) = std::abs(angle_difference(theta, edge_rest_angle_(r))) * edge_width_(r) / 8.0;
+  }
+  return errors;
+}
+
+AdaptiveCloth::Transfer AdaptiveCloth::begin_transfer() const {
+  Transfer state;
+  state.x = positions();
+  state.v = velocities();
+  state.m = masses_;
+  state.birth = birth_;
+  state.pins = pins_;
+  state.pin_of.assign(static_cast<std::size_t>(mesh_.vertex_capacity()), -1);
+  for (std::size_t k = 0; k < state.pins.size(); ++k)
+    state.pin_of[static_cast<std::size_t>(state.pins[k].vertex)] = static_cast<int>(k);
+  state.now = simulation_->time();
+  return state;
+}
+
+void AdaptiveCloth::apply(const BlockChange& change, Transfer& state) {
+  if (!state.changed && settings_.measure_jumps) {
+    state.before = conserved_quantities();  // the simulation still holds the old state
+    state.measured = true;
+  }
+  state.changed = true;
+  const double rho = material_.fabric.area_density;
+  meshing::transfer_mass_and_velocity(change, {rho, rho}, state.m, state.v);
+  const auto grow = [](auto& vector, int size, auto fill) {
+    if (static_cast<int>(vector.size()) < size) vector.resize(static_cast<std::size_t>(size), fill);
+  };
+  grow(state.birth, mesh_.triangle_capacity(), 0.0);
+  grow(state.touched_blocks, mesh_.block_capacity(), char{0});
+  grow(state.pin_of, mesh_.vertex_capacity(), -1);
+  state.touched_blocks[static_cast<std::size_t>(change.block.value())] = 1;
+  const auto pin_index = [&](VertexId v) { return state.pin_of[static_cast<std::size_t>(v.value())]; };
+
+  if (change.kind == BlockChange::Kind::kSplit) {
+    // E at the midpoint of BC in world space, as in rest space: each child keeps its parent's
+    // deformation gradient, so stretch, shear and the centre of mass are unchanged.
+    meshing::place_split_vertex(change, state.x);
+    for (TriangleId t : {change.a10, change.a11, change.a20, change.a21}) {
+      if (!t.valid()) continue;
+      state.birth[static_cast<std::size_t>(t.value())] = state.now;
+      state.touched_blocks[static_cast<std::size_t>(mesh_.block(t).value())] = 1;
+    }
+    state.pin_of[static_cast<std::size_t>(change.e.value())] = -1;
+    // A split edge between two pinned vertices (a pinned border) is pinned at its midpoint,
+    // following the two pins' paths.
+    const int pb = pin_index(change.b), pc = pin_index(change.c);
+    if (pb >= 0 && pc >= 0) {
+      const PinRecord b = state.pins[static_cast<std::size_t>(pb)];
+      const PinRecord c = state.pins[static_cast<std::size_t>(pc)];
+      PinRecord e;
+      e.vertex = change.e.value();
+      e.fixed = 0.5 * (b.fixed + c.fixed);
+      if (b.path || c.path)
+        e.path = [b, c](double t) {
+          const Eigen::Vector3d xb = b.path ? b.path(t) : b.fixed;
+          const Eigen::Vector3d xc = c.path ? c.path(t) : c.fixed;
+          return Eigen::Vector3d(0.5 * (xb + xc));
+        };
+      state.pin_of[static_cast<std::size_t>(e.vertex)] = static_cast<int>(state.pins.size());
+      state.pins.push_back(std::move(e));
+    }
+  } else {
+    for (TriangleId t : {change.a1, change.a2})
+      if (t.valid()) state.birth[static_cast<std::size_t>(t.value())] = state.now;
+    if (const int pe = pin_index(change.e); pe >= 0) {
+      state.pins.erase(state.pins.begin() + pe);
+      std::fill(state.pin_of.begin(), state.pin_of.end(), -1);
+      for (std::size_t k = 0; k < state.pins.size(); ++k)
+        state.pin_of[static_cast<std::size_t>(state.pins[k].vertex)] = static_cast<int>(k);
+    }
+  }
+}
+
+double AdaptiveCloth::rebuild(Transfer& state, const SimulationSettings* first_settings) {
+  const auto start = Clock::now();
+  const bool first = simulation_ == nullptr;
+  if (!first) {
+    const meshing::Mesh48Remap remap = mesh_.compact();
+    state.x = meshing::remap_rows(state.x, remap.vertices, remap.vertex_count);
+    state.v = meshing::remap_rows(state.v, remap.vertices, remap.vertex_count);
+    state.m = meshing::remap_rows(state.m, remap.vertices, remap.vertex_count);
+    std::vector<double> birth(static_cast<std::size_t>(remap.triangle_count), 0.0);
+    for (std::size_t t = 0; t < remap.triangles.size() && t < state.birth.size(); ++t)
+      if (remap.triangles[t] >= 0) birth[static_cast<std::size_t>(remap.triangles[t])] = state.birth[t];
+    state.birth = std::move(birth);
+    for (PinRecord& pin : state.pins) pin.vertex = remap.vertices[static_cast<std::size_t>(pin.vertex)];
+    arrays_ = mesh_.arrays();
+  }
+
+  ClothInput input;
+  input.rest_positions = arrays_.rest_positions;
+  input.triangles = arrays_.faces;
+  input.up = material_.up;
+  if (material_.source_warp.rows() > 0) {
+    input.warp.resize(arrays_.faces.rows(), 3);
+    for (Eigen::Index f = 0; f < arrays_.faces.rows(); ++f) {
+      const int source = mesh_.source_face(arrays_.triangle_ids[static_cast<std::size_t>(f)]);
+      if (source < 0 || source >= material_.source_warp.rows())
+        throw InvalidClothError("the warp directions must be given for every input face (" +
+                                std::to_string(material_.source_warp.rows()) + " given, face " +
+                                std::to_string(source) + " needed)");
+      input.warp.row(f) = material_.source_warp.row(source);
+    }
+  }
+  ClothModel model = build_cloth_model(input, material_.fabric, material_.model_options);
+  if (first) {
+    state.m = model.mass;
+  } else {
+    // The carried masses equal the lumped masses ρ·A/3 of the new mesh (4-8 children are exact
+    // halves); use the carried ones, which conserve the total exactly.
+    const double scale = std::max(1e-300, state.m.cwiseAbs().maxCoeff());
+    const double deviation = (model.mass - state.m).cwiseAbs().maxCoeff();
+    if (deviation > 1e-9 * scale)
+      spdlog::warn("adaptive: carried masses differ from the lumped ones by {:.3g} kg", deviation);
+    model.mass = state.m;
+  }
+
+  // Per interior edge: rest dihedral angle and mean rest height (A1 + A2)/|e|.
+  const Eigen::MatrixX4i& edges = arrays_.interior_edges;
+  const Eigen::MatrixX3d& rest = arrays_.rest_positions;
+  edge_rest_angle_.resize(edges.rows());
+  edge_width_.resize(edges.rows());
+  for (Eigen::Index r = 0; r < edges.rows(); ++r) {
+    const Eigen::Vector3d p0 = rest.row(edges(r, 0)), p1 = rest.row(edges(r, 1));
+    const Eigen::Vector3d p2 = rest.row(edges(r, 2)), p3 = rest.row(edges(r, 3));
+    edge_rest_angle_(r) = material_.model_options.bend_rest == BendRestShape::designed
+                              ? dihedral_angle(p0, p1, p2, p3)
+                              : 0.0;
+    const double areas = 0.5 * ((p1 - p0).cross(p2 - p0).norm() + (p3 - p0).cross(p1 - p0).norm());
+    edge_width_(r) = areas / (p1 - p0).norm();
+  }
+
+  std::vector<Pin> pins;
+  for (const PinRecord& pin : state.pins) pins.push_back({pin.vertex, pin.path});
+  masses_ = state.m;
+  birth_ = std::move(state.birth);
+  pins_ = std::move(state.pins);
+  if (first) {
+    simulation_ = std::make_unique<Simulation>(std::move(model), flatten_positions(state.x),
+                                               std::move(pins), *first_settings);
+  } else {
+    simulation_->replace_model(std::move(model), flatten_positions(state.x),
+                               flatten_positions(state.v), std::move(pins));
+  }
+  return seconds_since(start);
+}
+
+AdaptStats AdaptiveCloth::finish(Transfer& state, AdaptStats stats,
+                                 Clock::time_point operations_start) {
+  stats.operations_s = seconds_since(operations_start);
+  if (state.changed) {
+    stats.rebuild_s = rebuild(state);
+    if (state.measured) {
+      stats.before = state.before;
+      stats.after = conserved_quantities();
+    }
+  }
+  stats.vertices = mesh_.vertex_count();
+  stats.triangles = mesh_.triangle_count();
+  report_.splits += stats.splits;
+  report_.forced_splits += stats.forced_splits;
+  report_.merges += stats.merges;
+  report_.topology_changes += stats.changed() ? 1 : 0;
+  report_.estimate_s += stats.estimate_s;
+  report_.operations_s += stats.operations_s;
+  report_.rebuild_s += stats.rebuild_s;
+  return stats;
+}
+
+void AdaptiveCloth::count_split(const std::vector<BlockChange>& changes, Transfer& state,
+                                AdaptStats& stats) {
+  for (const BlockChange& change : changes) {
+    apply(change, state);
+    ++(change.forced ? stats.forced_splits : stats.splits);
+  }
+}
+
+AdaptStats AdaptiveCloth::adapt() {
+  AdaptStats stats;
+  if (!settings_.enabled || !(settings_.refine || settings_.coarsen)) {
+    stats.vertices = mesh_.vertex_count();
+    stats.triangles = mesh_.triangle_count();
+    return stats;
+  }
+  const auto estimate_start = Clock::now();
+  const Eigen::VectorXd& x = simulation_->positions();
+  const Eigen::VectorXd& v = simulation_->velocities();
+  const double now = simulation_->time();
+
+  // Merge candidates: split blocks whose children are leaves, at or above the coarsest level,
+  // old enough, flat (merging moves the surface by |x_E − (x_B + x_C)/2|) and steady (every
+  // hinge around E turns slower than steady_rate). Flattest first.
+  std::vector<std::pair<double, BlockId>> merges;
+  if (settings_.coarsen) {
+    for (BlockId k : mesh_.mergeable_blocks()) {
+      if (mesh_.level(k) < settings_.min_level) continue;
+      const std::array<TriangleId, 4> children = mesh_.child_triangles(k);
+      bool old_enough = true;
+      for (TriangleId t : children)
+        if (t.valid() && birth_[static_cast<std::size_t>(t.value())] >
+                             now - settings_.min_lifetime + 1e-12)
+          old_enough = false;
+      if (!old_enough) continue;
+      const auto [b, c] = mesh_.diagonal(k);
+      const VertexId e = mesh_.split_vertex(k);
+      const double error =
+          (row3(x, e.value()) - 0.5 * (row3(x, b.value()) + row3(x, c.value()))).norm();
+      if (!(error < settings_.coarsen_threshold)) continue;
+      // Every hinge around E: steady (|dθ/dt| below steady_rate) and with a sag estimate below
+      // coarsen_threshold. E–B and E–C have the width of the parent's diagonal BC, so their sag
+      // is what BC's estimate would be after the merge: a block split for a fold along its
+      // diagonal is not merged back while the fold is there.
+      bool keep = true;
+      for (int p = 0; p < 4 && keep; ++p)
+        for (int q = p + 1; q < 4 && keep; ++q) {
+          if (!children[p].valid() || !children[q].valid()) continue;
+          const auto hinge = hinge_between(mesh_, children[p], children[q]);
+          if (!hinge) continue;
+          const Condition<12> theta = dihedral_angle_condition(
+              row3(x, (*hinge)[0]), row3(x, (*hinge)[1]), row3(x, (*hinge)[2]),
+              row3(x, (*hinge)[3]), false);
+          double rate = 0.0;
+          for (int m = 0; m < 4; ++m)
+            rate += theta.gradient.segment<3>(3 * m).dot(row3(v, (*hinge)[m]));
+          keep = std::abs(rate) < settings_.steady_rate &&
+                 hinge_sag(*hinge, theta.value) < settings_.coarsen_threshold;
+        }
+      if (keep) merges.emplace_back(error, k);
+    }
+    std::sort(merges.begin(), merges.end());
+  }
+
+  // Refinement candidates: interior edges above the threshold, largest first.
+  std::vector<std::pair<double, int>> refinements;
+  if (settings_.refine) {
+    const Eigen::VectorXd errors = edge_errors();
+    for (Eigen::Index r = 0; r < errors.size(); ++r)
+      if (errors(r) > settings_.refine_threshold)
+        refinements.emplace_back(errors(r), static_cast<int>(r));
+    std::sort(refinements.begin(), refinements.end(), std::greater<>());
+  }
+  stats.estimate_s = seconds_since(estimate_start);
+
+  const auto operations_start = Clock::now();
+  Transfer state = begin_transfer();
+  const auto touched = [&](BlockId k) {
+    const auto i = static_cast<std::size_t>(k.value());
+    return i < state.touched_blocks.size() && state.touched_blocks[i] != 0;
+  };
+  for (const auto& [error, k] : merges) {
+    if (!mesh_.can_merge(k) || touched(k)) continue;
+    apply(mesh_.merge(k), state);
+    ++stats.merges;
+  }
+  for (const auto& [error, r] : refinements) {
+    if (settings_.max_vertices > 0 && mesh_.vertex_count() >= settings_.max_vertices) break;
+    const VertexId i(arrays_.interior_edges(r, 0)), j(arrays_.interior_edges(r, 1));
+    // The blocks on the two sides of the edge, if the edge still exists (an edge already split
+    // or merged away in this batch waits for the next step: one level per block per step).
+    std::array<BlockId, 2> blocks;
+    for (int side = 0; side < 2; ++side) {
+      const TriangleId t = arrays_.triangle_ids[static_cast<std::size_t>(arrays_.edge_faces(r, side))];
+      if (!mesh_.alive(t)) continue;
+      const auto& corners = mesh_.vertices(t);
+      const bool has_edge = std::find(corners.begin(), corners.end(), i) != corners.end() &&
+                            std::find(corners.begin(), corners.end(), j) != corners.end();
+      if (has_edge) blocks[static_cast<std::size_t>(side)] = mesh_.block(t);
+    }
+    if (blocks[1] == blocks[0]) blocks[1] = BlockId();
+    for (BlockId k : blocks) {
+      if (!k.valid() || !mesh_.can_split(k) || touched(k)) continue;
+      if (mesh_.level(k) + 1 > settings_.max_level) continue;
+      count_split(mesh_.split(k), state, stats);
+    }
+  }
+  return finish(state, stats, operations_start);
+}
+
+AdaptStats AdaptiveCloth::split_blocks(const std::vector<BlockId>& blocks) {
+  AdaptStats stats;
+  const auto start = Clock::now();
+  Transfer state = begin_transfer();
+  for (BlockId k : blocks)
+    if (mesh_.can_split(k)) count_split(mesh_.split(k), state, stats);
+  return finish(state, stats, start);
+}
+
+AdaptStats AdaptiveCloth::merge_blocks(const std::vector<BlockId>& blocks) {
+  AdaptStats stats;
+  const auto start = Clock::now();
+  Transfer state = begin_transfer();
+  for (BlockId k : blocks)
+    if (mesh_.alive(k) && mesh_.can_merge(k)) {
+      apply(mesh_.merge(k), state);
+      ++stats.merges;
+    }
+  return finish(state, stats, start);
+}
+
+AdaptStats AdaptiveCloth::refine_uniformly(int level) {
+  AdaptStats stats;
+  const auto start = Clock::now();
+  Transfer state = begin_transfer();
+  for (;;) {
+    std::vector<BlockId> coarse;
+    for (BlockId k : mesh_.leaf_blocks())
+      if (mesh_.level(k) < level) coarse.push_back(k);
+    if (coarse.empty()) break;
+    for (BlockId k : coarse)
+      if (mesh_.can_split(k)) count_split(mesh_.split(k), state, stats);
+  }
+  return finish(state, stats, start);
+}
+
+void AdaptiveCloth::record(const StepOutcome& outcome, const AdaptStats& stats) {
+  AdaptiveStepRecord step;
+  step.time = simulation_->time();
+  step.dt = outcome.dt;
+  step.splits = stats.splits;
+  step.forced_splits = stats.forced_splits;
+  step.merges = stats.merges;
+  step.vertices = mesh_.vertex_count();
+  step.triangles = mesh_.triangle_count();
+  step.max_level = mesh_.max_level();
+  step.measured = settings_.measure_jumps && stats.changed();
+  step.before = stats.before;
+  step.after = stats.after;
+  report_.steps.push_back(step);
+  report_.vertices_min =
+      report_.steps.size() == 1 ? step.vertices : std::min(report_.vertices_min, step.vertices);
+  report_.vertices_max = std::max(report_.vertices_max, step.vertices);
+  report_.max_level_reached = std::max(report_.max_level_reached, step.max_level);
+}
+
+StepOutcome AdaptiveCloth::step(double max_step) {
+  const StepOutcome outcome = simulation_->step(max_step);
+  if (!outcome.accepted) return outcome;
+  newton_total_ += outcome.newton_iterations;
+  cg_total_ += outcome.cg_iterations;
+  record(outcome, adapt());
+  return outcome;
+}
+
+AdaptiveReport AdaptiveCloth::run(const std::function<void(const AdaptiveCloth&)>& on_step) {
+  const auto start = Clock::now();
+  const SimulationSettings& settings = simulation_->settings();
+  const SimulationReport before = simulation_->report();
+  std::vector<EnergySample>& energy = report_.simulation.energy;
+  const auto sample = [&] {
+    if (!settings.record_energy) return;
+    const EnergyBreakdown e = simulation_->energy();
+    energy.push_back({simulation_->time(), e.stretch, e.shear, e.bend, e.kinetic, e.potential});
+  };
+  if (energy.empty()) sample();
+  bool failed = false, at_rest = false;
+  std::string failure;
+  const double epsilon = 1e-9 * std::max(1.0, settings.duration);
+  while (simulation_->time() < settings.duration - epsilon) {
+    const StepOutcome outcome = step(settings.duration - simulation_->time());
+    if (!outcome.accepted) {
+      failed = true;
+      failure = outcome.failure_reason;
+      break;
+    }
+    sample();
+    if (on_step) on_step(*this);
+    if (settings.stop_at_rest && simulation_->at_rest()) {
+      at_rest = true;
+      break;
+    }
+  }
+  const double wall = seconds_since(start);
+  // The simulation's own counters (steps, solves, timings) plus what its run() would add.
+  std::vector<EnergySample> series = std::move(energy);
+  const double wall_before = report_.simulation.wall_time_s;
+  const double other_before = report_.simulation.other_s;
+  report_.simulation = simulation_->report();
+  report_.simulation.energy = std::move(series);
+  report_.simulation.wall_time_s = wall_before + wall;
+  report_.simulation.other_s = other_before + wall -
+                               (report_.simulation.forces_s - before.forces_s) -
+                               (report_.simulation.solve_s - before.solve_s);
+  report_.simulation.at_rest = at_rest;
+  report_.simulation.failed = failed;
+  report_.simulation.failure_reason = failure;
+  const SimulationReport& s = report_.simulation;
+  report_.simulation.cg_iterations_mean =
+      s.linear_solves > 0 ? static_cast<double>(cg_total_) / s.linear_solves : 0.0;
+  report_.simulation.newton_iterations_mean =
+      s.steps > 0 ? static_cast<double>(newton_total_) / s.steps : 0.0;
+  report_.simulation.max_strain =
+      max_stretch_strain(simulation_->model(), simulation_->positions());
+  report_.simulation.nan_free =
+      simulation_->positions().allFinite() && simulation_->velocities().allFinite();
+  return report_;
+}
+
+}  // namespace sd::sim

@@ -1,0 +1,213 @@
+#pragma once
+// Adaptive level of detail for the implicit cloth simulator (Birra & Santos 2008; DESIGN.md
+// "Adaptive level of detail"): an AdaptiveCloth owns a 4-8 mesh and a Simulation on it. After
+// every accepted step it estimates, per interior edge, how far the mesh is from a smooth surface,
+// refines edges above a threshold (largest first, one level per block per step, forced splits
+// as the 4-8 rules need) and merges blocks that are flat, steady and old enough; masses and
+// velocities move with each split or merge so that total mass and linear momentum are conserved
+// exactly, and the model is rebuilt only on steps where the topology changed. See
+// docs/adaptive.md for the estimate, the rules, the transfer and measured figures.
+
+#include <array>
+#include <chrono>
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "meshing/mesh48.hpp"
+#include "sim/cloth_model.hpp"
+#include "sim/fabric.hpp"
+#include "sim/forces.hpp"
+#include "sim/simulation.hpp"
+
+namespace sd::sim {
+
+// An adaptive setting that cannot work (negative threshold, max level below min level, ...).
+class InvalidAdaptiveSettingsError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+// Thresholds of the adaptive level of detail. The error estimate of an interior edge is the sag
+// of the polygon across it, ε = |θ − θ0|·w/8 in metres (θ the dihedral angle in rad, θ0 its
+// rest value, w = (A1 + A2)/|e| the mean height of the two rest triangles): the distance
+// between the mesh and a circular arc through the two triangles. The merge error of a split
+// block is |x_E − (x_B + x_C)/2| in metres: exactly how far merging moves the surface.
+struct AdaptiveSettings {
+  bool enabled = true;               // false: a fixed mesh (no estimates, no operations)
+  double refine_threshold = 2.0e-3;  // m: split an edge whose sag estimate is larger
+  // m: merge a block whose merge moves the surface less. Must be below refine_threshold (the
+  // gap is the hysteresis that keeps a merged block from being split back at once).
+  double coarsen_threshold = 5.0e-4;
+  // rad/s: merge only if every hinge around the split vertex turns slower than this
+  // (dθ/dt = Σ ∂θ/∂x_i · v_i, Birra & Santos §4.1).
+  double steady_rate = 0.05;
+  double min_lifetime = 0.25;  // s of simulated time a triangle lives before it may be merged
+  int min_level = 0;           // coarsest level a merge may return to
+  int max_level = 6;           // finest triangle level a split may make
+  int max_vertices = 0;        // particle budget (0: none); forced splits may exceed it slightly
+  bool refine = true;
+  bool coarsen = true;
+  // Measure energies, total mass and linear momentum just before and just after each topology
+  // change (two extra force evaluations on those steps) and keep them in the step record: for
+  // tests and studies.
+  bool measure_jumps = false;
+
+  void validate() const;  // throws InvalidAdaptiveSettingsError
+};
+
+// What the cloth is made of, beyond the mesh: fabric, bending rest shape and material frames.
+struct AdaptiveMaterial {
+  FabricParameters fabric;
+  ClothModelOptions model_options;
+  // Warp direction per input face (Mesh48::source_face of any triangle), #faces by 3, or empty:
+  // then the in-plane direction closest to `up` (children's rest planes are their parent's, so
+  // this is the parent's frame too).
+  Eigen::MatrixX3d source_warp;
+  Eigen::Vector3d up = Eigen::Vector3d::UnitY();
+};
+
+// What a topology change must conserve (mass, momentum) or may change only within a bound
+// (energies; see docs/adaptive.md).
+struct ConservedQuantities {
+  double mass = 0.0;                                  // kg
+  Eigen::Vector3d momentum = Eigen::Vector3d::Zero();  // kg·m/s
+  EnergyBreakdown energy;                              // J
+};
+
+// What one call of adapt() (or of the explicit operations) did.
+struct AdaptStats {
+  int splits = 0;         // requested splits made
+  int forced_splits = 0;  // splits the 4-8 rules forced first
+  int merges = 0;
+  int vertices = 0;       // after the change
+  int triangles = 0;
+  double estimate_s = 0.0;    // wall time: error estimates and merge candidates
+  double operations_s = 0.0;  // splits, merges, mass/velocity/pin transfer
+  double rebuild_s = 0.0;     // compact, export, build_cloth_model, Simulation::replace_model
+  bool changed() const { return splits + forced_splits + merges > 0; }
+  // The state just before and after the change (measure_jumps only).
+  ConservedQuantities before, after;
+};
+
+// One accepted step: time after it and what the adaptation then did.
+struct AdaptiveStepRecord {
+  double time = 0.0;
+  double dt = 0.0;
+  int splits = 0;
+  int forced_splits = 0;
+  int merges = 0;
+  int vertices = 0;
+  int triangles = 0;
+  int max_level = 0;
+  bool measured = false;  // measure_jumps and the mesh changed
+  ConservedQuantities before, after;
+};
+
+struct AdaptiveReport {
+  SimulationReport simulation;  // wall time, solves, retries, energy series, ...
+  int splits = 0;
+  int forced_splits = 0;
+  int merges = 0;
+  int topology_changes = 0;  // steps on which the mesh changed (and the model was rebuilt)
+  int vertices_min = 0, vertices_max = 0;
+  int max_level_reached = 0;
+  double estimate_s = 0.0;
+  double operations_s = 0.0;
+  double rebuild_s = 0.0;
+  std::vector<AdaptiveStepRecord> steps;
+  double adaptivity_s() const { return estimate_s + operations_s + rebuild_s; }
+};
+
+class AdaptiveCloth {
+ public:
+  // mesh: a compact 4-8 mesh (e.g. fresh from Mesh48::from_quads), rest positions in metres.
+  // positions: #V by 3 start positions by vertex id (empty: the rest positions). pins: vertex
+  // ids (fixed where they start, or driven along a path). Throws InvalidAdaptiveSettingsError,
+  // InvalidSimulationSettingsError, InvalidFabricError or InvalidClothError.
+  AdaptiveCloth(meshing::Mesh48 mesh, AdaptiveMaterial material, Eigen::MatrixX3d positions,
+                std::vector<Pin> pins, SimulationSettings simulation, AdaptiveSettings adaptive);
+  ~AdaptiveCloth();
+  AdaptiveCloth(AdaptiveCloth&&) noexcept;
+  AdaptiveCloth& operator=(AdaptiveCloth&&) noexcept;
+
+  // One accepted simulation step (see Simulation::step), then adapt() if it was accepted.
+  StepOutcome step(double max_step = 1e300);
+  // Steps until the duration, at rest or failure (as Simulation::run), adapting after each.
+  AdaptiveReport run(const std::function<void(const AdaptiveCloth&)>& on_step = {});
+
+  // Error estimates, then merges (flattest first) and splits (largest first) as the settings
+  // allow; rebuilds the model only if something changed. Called by step().
+  AdaptStats adapt();
+
+  // Explicit operations through the same transfer and rebuild path (pre-refinement, tests).
+  // Blocks that are no longer leaves (or, for merges, no longer mergeable) are skipped; max_level
+  // and the budget are not applied.
+  AdaptStats split_blocks(const std::vector<meshing::BlockId>& blocks);
+  AdaptStats merge_blocks(const std::vector<meshing::BlockId>& blocks);
+  // Splits every leaf block until all triangles are at `level` (a uniform fixed-resolution mesh).
+  AdaptStats refine_uniformly(int level);
+
+  const meshing::Mesh48& mesh() const { return mesh_; }  // compact between calls
+  const Simulation& simulation() const { return *simulation_; }
+  const AdaptiveSettings& settings() const { return settings_; }
+  const AdaptiveReport& report() const { return report_; }
+  double time() const { return simulation_->time(); }
+  // Current positions and velocities, #V by 3 (row = vertex id).
+  Eigen::MatrixX3d positions() const;
+  Eigen::MatrixX3d velocities() const;
+  // The masses carried through every split and merge (what the model uses), #V.
+  const Eigen::VectorXd& masses() const { return masses_; }
+  const Eigen::MatrixX3i& faces() const { return arrays_.faces; }      // #F by 3
+  const Eigen::VectorXi& face_levels() const { return arrays_.face_level; }  // #F, for rendering
+  const Eigen::MatrixX3d& rest_positions() const { return arrays_.rest_positions; }
+  // Sag estimate ε per interior edge of the current mesh (rows of mesh().arrays().interior_edges)
+  // for the current positions, metres.
+  Eigen::VectorXd edge_errors() const;
+  // Σ m_i v_i, kg·m/s.
+  Eigen::Vector3d linear_momentum() const;
+  ConservedQuantities conserved_quantities() const;
+  // Vertices that are pinned now (ids), sorted.
+  std::vector<int> pinned_vertices() const;
+
+ private:
+  struct PinRecord {
+    int vertex = 0;
+    std::function<Eigen::Vector3d(double)> path;  // empty: fixed at `fixed`
+    Eigen::Vector3d fixed = Eigen::Vector3d::Zero();
+  };
+  // Sag estimate |θ − θ0|·w/8 of the hinge (x0, x1, x2, x3) at dihedral angle theta, from the
+  // rest shape of the current mesh (ids).
+  double hinge_sag(const std::array<int, 4>& hinge, double theta) const;
+  struct Transfer;  // the state by vertex/triangle id while a batch of changes is applied
+
+  // Compacts the mesh and state, rebuilds the model and hands it to the simulation (creates the
+  // simulation with first_settings on the first call). Returns the wall time taken.
+  double rebuild(Transfer& state, const SimulationSettings* first_settings = nullptr);
+  Transfer begin_transfer() const;
+  void apply(const meshing::BlockChange& change, Transfer& state);
+  AdaptStats finish(Transfer& state, AdaptStats stats,
+                    std::chrono::steady_clock::time_point operations_start);
+  void count_split(const std::vector<meshing::BlockChange>& changes, Transfer& state,
+                   AdaptStats& stats);
+  void record(const StepOutcome& outcome, const AdaptStats& stats);
+
+  meshing::Mesh48 mesh_;
+  AdaptiveMaterial material_;
+  AdaptiveSettings settings_;
+  std::unique_ptr<Simulation> simulation_;
+  meshing::Mesh48Arrays arrays_;
+  Eigen::VectorXd masses_;        // #V, by vertex id
+  std::vector<double> birth_;     // #F, simulated time each triangle was made
+  std::vector<PinRecord> pins_;
+  Eigen::VectorXd edge_rest_angle_;  // per interior edge (rows of arrays_.interior_edges), rad
+  Eigen::VectorXd edge_width_;       // per interior edge: (A1 + A2)/|e| in the rest shape, m
+  AdaptiveReport report_;
+  long long newton_total_ = 0;
+  long long cg_total_ = 0;
+};
+
+}  // namespace sd::sim

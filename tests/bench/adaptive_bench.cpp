@@ -1,0 +1,280 @@
+// Adaptive level of detail (docs/adaptive.md, docs/benchmarks.md "Adaptive detail").
+//
+// Two modes:
+//   adaptive_bench [google benchmark flags]   kernels: the error estimate, one adapt() with
+//                                             splits and merges, a model rebuild
+//   adaptive_bench --study=DIR [--quick]      the work-precision study: the 3-corner and 2-corner
+//                                             sheets run fixed at levels 2, 4, 6 and adaptively
+//                                             (max level 6) against a fixed level-8 reference;
+//                                             writes DIR/<scene>_<run>.csv time series and
+//                                             DIR/summary.csv, prints the summary.
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "sim/adaptive_detail.hpp"
+#include "tests/sim/adaptive_scenes.hpp"
+
+namespace {
+
+using namespace sd::sim;
+using namespace sd::sim::testing;
+using Clock = std::chrono::steady_clock;
+
+AdaptiveSettings fixed_settings() {
+  AdaptiveSettings settings;
+  settings.enabled = false;
+  return settings;
+}
+
+AdaptiveSettings adaptive_settings(double refine_threshold) {
+  AdaptiveSettings settings;
+  settings.refine_threshold = refine_threshold;
+  settings.coarsen_threshold = 0.25 * refine_threshold;
+  settings.max_level = 6;
+  return settings;
+}
+
+// --- kernels -------------------------------------------------------------------------------
+
+// A 3-corner sheet that has fallen for 1 s adaptively (a fold at the free corner).
+AdaptiveCloth fallen_sheet() {
+  AdaptiveSheetSpec spec;
+  spec.duration = 1.0;
+  AdaptiveCloth cloth = make_adaptive_sheet(spec, 0, adaptive_settings(2e-3));
+  cloth.run();
+  return cloth;
+}
+
+void BM_EdgeErrors(benchmark::State& state) {
+  const AdaptiveCloth cloth = fallen_sheet();
+  for (auto _ : state) benchmark::DoNotOptimize(cloth.edge_errors());
+  state.counters["edges"] = static_cast<double>(cloth.edge_errors().size());
+  state.counters["vertices"] = cloth.mesh().vertex_count();
+}
+BENCHMARK(BM_EdgeErrors)->Unit(benchmark::kMicrosecond);
+
+// Splitting every leaf block once, then merging them back, with transfer and two rebuilds.
+void BM_SplitMergeRebuild(benchmark::State& state) {
+  AdaptiveCloth cloth = fallen_sheet();
+  double operations = 0, rebuild = 0;
+  int changes = 0;
+  for (auto _ : state) {
+    std::vector<sd::meshing::BlockId> leaves;
+    for (auto k : cloth.mesh().leaf_blocks())
+      if (cloth.mesh().level(k) < 7) leaves.push_back(k);
+    const AdaptStats split = cloth.split_blocks(leaves);
+    std::vector<sd::meshing::BlockId> mergeable = cloth.mesh().mergeable_blocks();
+    const AdaptStats merge = cloth.merge_blocks(mergeable);
+    operations += split.operations_s + merge.operations_s;
+    rebuild += split.rebuild_s + merge.rebuild_s;
+    changes += split.splits + split.forced_splits + merge.merges;
+  }
+  state.counters["changes"] = benchmark::Counter(changes, benchmark::Counter::kAvgIterations);
+  state.counters["operations_ms"] =
+      benchmark::Counter(1e3 * operations, benchmark::Counter::kAvgIterations);
+  state.counters["rebuild_ms"] = benchmark::Counter(1e3 * rebuild, benchmark::Counter::kAvgIterations);
+}
+BENCHMARK(BM_SplitMergeRebuild)->Unit(benchmark::kMillisecond);
+
+// The model rebuild after a topology change, on the uniform level-L sheet: arg 0 builds the model
+// (build_cloth_model), arg 1 the whole AdaptStats::rebuild path (one split and one merge: compact,
+// export, build, replace_model).
+void BM_Rebuild(benchmark::State& state) {
+  AdaptiveSheetSpec spec;
+  AdaptiveCloth cloth = make_adaptive_sheet(spec, static_cast<int>(state.range(0)), fixed_settings());
+  const sd::meshing::Mesh48Arrays arrays = cloth.mesh().arrays();
+  ClothInput input;
+  input.rest_positions = arrays.rest_positions;
+  input.triangles = arrays.faces;
+  const FabricParameters fabric = adaptive_sheet_fabric();
+  double rebuild = 0;
+  for (auto _ : state) {
+    if (state.range(1) == 0) {
+      benchmark::DoNotOptimize(build_cloth_model(input, fabric));
+    } else {
+      const sd::meshing::BlockId leaf = cloth.mesh().leaf_blocks().front();
+      rebuild += cloth.split_blocks({leaf}).rebuild_s;
+      rebuild += cloth.merge_blocks(cloth.mesh().mergeable_blocks()).rebuild_s;
+    }
+  }
+  state.counters["vertices"] = cloth.mesh().vertex_count();
+  if (state.range(1) == 1)
+    state.counters["rebuild_ms"] =
+        benchmark::Counter(1e3 * rebuild / 2, benchmark::Counter::kAvgIterations);
+}
+BENCHMARK(BM_Rebuild)->ArgsProduct({{4, 6, 8}, {0, 1}})->Unit(benchmark::kMillisecond);
+
+// One adaptive step of the falling sheet (solve + estimate + operations + rebuild).
+void BM_AdaptiveStep(benchmark::State& state) {
+  AdaptiveCloth cloth = fallen_sheet();
+  for (auto _ : state) cloth.step();
+  state.counters["vertices"] = cloth.mesh().vertex_count();
+}
+BENCHMARK(BM_AdaptiveStep)->Unit(benchmark::kMillisecond)->Iterations(30);
+
+// --- study ---------------------------------------------------------------------------------
+
+struct RunResult {
+  std::string name;
+  double wall_s = 0;       // stepping only (sampling for the error excluded)
+  double solve_s = 0;
+  double forces_s = 0;
+  double adaptivity_s = 0;  // estimates + operations + rebuild
+  double estimate_s = 0, operations_s = 0, rebuild_s = 0;
+  int vertices_final = 0, vertices_max = 0;
+  int splits = 0, merges = 0, forced = 0, changes = 0, steps = 0, retries = 0;
+  std::vector<Eigen::MatrixX3d> samples;  // material-point positions at the sample times
+  double error_final = 0, error_trajectory = 0;
+  ShapeFigures shape;
+};
+
+RunResult run_case(const std::string& dir, const std::string& scene, const std::string& name,
+                   const AdaptiveSheetSpec& spec, int start_level, const AdaptiveSettings& adaptive,
+                   const Eigen::MatrixX3d& points, double sample_every) {
+  AdaptiveCloth cloth = make_adaptive_sheet(spec, start_level, adaptive);
+  RunResult result;
+  result.name = name;
+  std::ofstream csv(dir + "/" + scene + "_" + name + ".csv");
+  csv << "time,wall_s,vertices,triangles,splits,merges,stretch,shear,bend,kinetic,potential\n";
+  double wall = 0.0;
+  double next_sample = 0.0;
+  const auto write_row = [&](const AdaptiveCloth& c, int splits, int merges) {
+    const EnergyBreakdown e = c.simulation().energy();
+    csv << c.time() << ',' << wall << ',' << c.mesh().vertex_count() << ','
+        << c.mesh().triangle_count() << ',' << splits << ',' << merges << ',' << e.stretch << ','
+        << e.shear << ',' << e.bend << ',' << e.kinetic << ',' << e.potential << '\n';
+  };
+  write_row(cloth, 0, 0);
+  result.samples.push_back(material_positions(cloth, points));
+  next_sample += sample_every;
+  const double epsilon = 1e-9;
+  while (cloth.time() < spec.duration - epsilon) {
+    const double until = std::min(spec.duration, next_sample) - cloth.time();
+    const auto start = Clock::now();
+    const StepOutcome outcome = cloth.step(until);
+    wall += std::chrono::duration<double>(Clock::now() - start).count();
+    if (!outcome.accepted) {
+      std::fprintf(stderr, "%s %s: step failed: %s\n", scene.c_str(), name.c_str(),
+                   outcome.failure_reason.c_str());
+      break;
+    }
+    const AdaptiveStepRecord& record = cloth.report().steps.back();
+    write_row(cloth, record.splits + record.forced_splits, record.merges);
+    if (cloth.time() >= next_sample - epsilon) {
+      result.samples.push_back(material_positions(cloth, points));
+      next_sample += sample_every;
+    }
+  }
+  const AdaptiveReport& report = cloth.report();
+  const SimulationReport& sim = cloth.simulation().report();
+  result.wall_s = wall;
+  result.solve_s = sim.solve_s;
+  result.forces_s = sim.forces_s;
+  result.estimate_s = report.estimate_s;
+  result.operations_s = report.operations_s;
+  result.rebuild_s = report.rebuild_s;
+  result.adaptivity_s = report.adaptivity_s();
+  result.vertices_final = cloth.mesh().vertex_count();
+  result.vertices_max = report.vertices_max;
+  result.splits = report.splits;
+  result.forced = report.forced_splits;
+  result.merges = report.merges;
+  result.changes = report.topology_changes;
+  result.steps = sim.steps;
+  result.retries = sim.retries;
+  result.shape = shape_figures(cloth.positions());
+  return result;
+}
+
+void errors_against(RunResult& run, const RunResult& reference) {
+  const std::size_t n = std::min(run.samples.size(), reference.samples.size());
+  double sum = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double e = rms_distance(run.samples[k], reference.samples[k]);
+    sum += e * e;
+  }
+  run.error_trajectory = std::sqrt(sum / static_cast<double>(n));
+  run.error_final = rms_distance(run.samples[n - 1], reference.samples[n - 1]);
+}
+
+int run_study(const std::string& dir, bool quick) {
+  std::filesystem::create_directories(dir);
+  std::ofstream summary(dir + "/summary.csv");
+  summary << "scene,run,wall_s,forces_s,solve_s,estimate_s,operations_s,rebuild_s,steps,retries,"
+             "vertices_final,vertices_max,splits,forced_splits,merges,topology_changes,"
+             "error_final_m,error_trajectory_m,lowest_m,extent_x,extent_y,extent_z\n";
+  const std::vector<std::pair<std::string, std::vector<std::string>>> scenes = {
+      {"three_corner", {"top-left", "top-right", "bottom-left"}},
+      {"two_corner", {"top-left", "top-right"}}};
+  for (const auto& [scene, pins] : scenes) {
+    AdaptiveSheetSpec spec;
+    spec.pins = pins;
+    spec.duration = quick ? 1.0 : 4.0;
+    const Eigen::MatrixX3d points = sheet_material_points(spec, 33);
+    const double every = 0.25;
+    std::vector<RunResult> runs;
+    RunResult reference =
+        run_case(dir, scene, "fixed_l8", spec, quick ? 7 : 8, fixed_settings(), points, every);
+    for (int level : {2, 4, 6})
+      runs.push_back(run_case(dir, scene, "fixed_l" + std::to_string(level), spec, level,
+                              fixed_settings(), points, every));
+    for (double threshold : {4e-3, 2e-3, 1e-3, 5e-4}) {
+      char name[64];
+      std::snprintf(name, sizeof name, "adaptive_%gmm", threshold * 1e3);
+      runs.push_back(run_case(dir, scene, name, spec, 0, adaptive_settings(threshold), points, every));
+    }
+    runs.push_back(reference);
+    for (RunResult& run : runs) {
+      errors_against(run, reference);
+      summary << scene << ',' << run.name << ',' << run.wall_s << ',' << run.forces_s << ','
+              << run.solve_s << ',' << run.estimate_s << ',' << run.operations_s << ','
+              << run.rebuild_s << ',' << run.steps << ',' << run.retries << ','
+              << run.vertices_final << ',' << run.vertices_max << ',' << run.splits << ','
+              << run.forced << ',' << run.merges << ',' << run.changes << ',' << run.error_final
+              << ',' << run.error_trajectory << ',' << run.shape.lowest << ','
+              << run.shape.extent.x() << ',' << run.shape.extent.y() << ',' << run.shape.extent.z()
+              << '\n';
+      std::printf(
+          "%-13s %-16s wall %7.2f s (forces %6.2f solve %6.2f adapt %5.3f = est %5.3f + ops %5.3f "
+          "+ rebuild %5.3f) steps %4d retries %3d verts %5d (max %5d) splits %5d+%4d merges %5d "
+          "error final %.2f mm trajectory %.2f mm lowest %.4f\n",
+          scene.c_str(), run.name.c_str(), run.wall_s, run.forces_s, run.solve_s,
+          run.adaptivity_s, run.estimate_s, run.operations_s, run.rebuild_s, run.steps,
+          run.retries, run.vertices_final, run.vertices_max, run.splits, run.forced, run.merges,
+          1e3 * run.error_final, 1e3 * run.error_trajectory, run.shape.lowest);
+      std::fflush(stdout);
+    }
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string study;
+  bool quick = false;
+  std::vector<char*> rest;
+  for (int i = 0; i < argc; ++i) {
+    if (std::strncmp(argv[i], "--study=", 8) == 0)
+      study = argv[i] + 8;
+    else if (std::strcmp(argv[i], "--quick") == 0)
+      quick = true;
+    else
+      rest.push_back(argv[i]);
+  }
+  if (!study.empty()) return run_study(study, quick);
+  int count = static_cast<int>(rest.size());
+  benchmark::Initialize(&count, rest.data());
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,0 +1,395 @@
+// Tests of sim/adaptive_detail: conservation through splits and merges, energy bounds at a
+// topology change, churn stress, limits, pins, and agreement with a fixed-resolution run
+// (Birra & Santos 2008, fig. 5).
+#include "sim/adaptive_detail.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include "sim/surface_sampling.hpp"
+#include "tests/sim/adaptive_scenes.hpp"
+
+namespace sd::sim {
+namespace {
+
+using meshing::BlockId;
+using testing::AdaptiveSheetSpec;
+using testing::make_adaptive_sheet;
+
+AdaptiveSettings fixed() {
+  AdaptiveSettings settings;
+  settings.enabled = false;
+  return settings;
+}
+
+// Lumped masses ρ·A/3 of the cloth's current mesh, #V.
+Eigen::VectorXd lumped_masses(const AdaptiveCloth& cloth) {
+  const Eigen::MatrixX3d& rest = cloth.rest_positions();
+  Eigen::VectorXd mass = Eigen::VectorXd::Zero(rest.rows());
+  const double rho = cloth.simulation().model().fabric.area_density;
+  for (Eigen::Index f = 0; f < cloth.faces().rows(); ++f) {
+    const Eigen::Vector3d a = rest.row(cloth.faces()(f, 0)), b = rest.row(cloth.faces()(f, 1)),
+                          c = rest.row(cloth.faces()(f, 2));
+    const double area = 0.5 * (b - a).cross(c - a).norm();
+    for (int k = 0; k < 3; ++k) mass(cloth.faces()(f, k)) += rho * area / 3.0;
+  }
+  return mass;
+}
+
+// A small 3-corner sheet that has fallen for a while at fixed resolution (level 2): moving, bent.
+AdaptiveCloth moving_sheet(int steps = 12) {
+  AdaptiveSheetSpec spec;
+  spec.quads = 2;
+  AdaptiveCloth cloth = make_adaptive_sheet(spec, 2, fixed());
+  for (int i = 0; i < steps; ++i) EXPECT_TRUE(cloth.step().accepted);
+  return cloth;
+}
+
+TEST(AdaptiveDetail, RejectsBadSettings) {
+  const auto bad = [](auto change) {
+    AdaptiveSettings settings;
+    change(settings);
+    return settings;
+  };
+  EXPECT_THROW(bad([](AdaptiveSettings& s) { s.refine_threshold = -1; }).validate(),
+               InvalidAdaptiveSettingsError);
+  EXPECT_THROW(bad([](AdaptiveSettings& s) { s.coarsen_threshold = s.refine_threshold; }).validate(),
+               InvalidAdaptiveSettingsError);
+  EXPECT_THROW(bad([](AdaptiveSettings& s) { s.steady_rate = NAN; }).validate(),
+               InvalidAdaptiveSettingsError);
+  EXPECT_THROW(bad([](AdaptiveSettings& s) { s.min_lifetime = -0.1; }).validate(),
+               InvalidAdaptiveSettingsError);
+  EXPECT_THROW(bad([](AdaptiveSettings& s) { s.max_level = -1; }).validate(),
+               InvalidAdaptiveSettingsError);
+  EXPECT_THROW(bad([](AdaptiveSettings& s) { s.min_level = 3, s.max_level = 2; }).validate(),
+               InvalidAdaptiveSettingsError);
+  EXPECT_THROW(bad([](AdaptiveSettings& s) { s.max_vertices = -5; }).validate(),
+               InvalidAdaptiveSettingsError);
+  EXPECT_NO_THROW(AdaptiveSettings{}.validate());
+  testing::AdaptiveSheet sheet = testing::build_adaptive_sheet({});
+  AdaptiveSettings wrong;
+  wrong.max_level = 31;
+  EXPECT_THROW(AdaptiveCloth(std::move(sheet.mesh), sheet.material, {}, sheet.pins,
+                             SimulationSettings{}, wrong),
+               InvalidAdaptiveSettingsError);
+}
+
+// One split at a time on a moving, bent sheet. With E at the midpoint of BC in world and rest
+// space every child keeps its parent's deformation gradient, so (docs/adaptive.md):
+// mass, momentum, stretch, shear and potential energy are unchanged (to rounding), kinetic energy
+// drops by m_E|v_B − v_C|²/8 at most, and bending changes only on the four outer hinges, whose
+// weight |e|²/(A1 + A2) grows by at most 3/2 (a neighbour one level finer), so
+// E_bend' ≤ 1.5·E_bend.
+TEST(AdaptiveDetail, EachSplitConservesMassMomentumAndMembraneEnergy) {
+  AdaptiveCloth cloth = moving_sheet();
+  ASSERT_GT(cloth.linear_momentum().norm(), 1e-3);
+  std::vector<BlockId> leaves = cloth.mesh().leaf_blocks();
+  int splits = 0;
+  for (std::size_t i = 0; i < leaves.size(); i += 3) {
+    // Ids change with compact(): pick the i-th leaf of the current mesh instead.
+    const std::vector<BlockId> now = cloth.mesh().leaf_blocks();
+    if (i >= now.size()) break;
+    const ConservedQuantities before = cloth.conserved_quantities();
+    const AdaptStats stats = cloth.split_blocks({now[i]});
+    ASSERT_TRUE(stats.changed());
+    splits += stats.splits + stats.forced_splits;
+    const ConservedQuantities after = cloth.conserved_quantities();
+    EXPECT_NEAR(after.mass, before.mass, 1e-14 * before.mass);
+    EXPECT_LE((after.momentum - before.momentum).norm(), 1e-13 * before.mass);
+    EXPECT_NEAR(after.energy.stretch, before.energy.stretch, 1e-9 * before.energy.stretch + 1e-15);
+    EXPECT_NEAR(after.energy.shear, before.energy.shear, 1e-9 * before.energy.shear + 1e-15);
+    EXPECT_NEAR(after.energy.potential, before.energy.potential,
+                1e-12 * std::abs(before.energy.potential) + 1e-15);
+    EXPECT_LE(after.energy.kinetic, before.energy.kinetic * (1 + 1e-12));
+    EXPECT_LE(after.energy.bend, 1.5 * before.energy.bend + 1e-15);
+    EXPECT_TRUE(cloth.mesh().validate().empty());
+    const Eigen::VectorXd lumped = lumped_masses(cloth);
+    EXPECT_LE((cloth.masses() - lumped).cwiseAbs().maxCoeff(), 1e-15 * lumped.sum());
+    EXPECT_TRUE(cloth.step().accepted);
+  }
+  EXPECT_GT(splits, 5);
+}
+
+TEST(AdaptiveDetail, EachMergeConservesMassAndMomentum) {
+  AdaptiveCloth cloth = moving_sheet(4);
+  cloth.refine_uniformly(4);
+  for (int i = 0; i < 6; ++i) ASSERT_TRUE(cloth.step().accepted);
+  int merges = 0;
+  for (int round = 0; round < 40; ++round) {
+    const std::vector<BlockId> candidates = cloth.mesh().mergeable_blocks();
+    if (candidates.empty()) break;
+    const ConservedQuantities before = cloth.conserved_quantities();
+    const AdaptStats stats = cloth.merge_blocks({candidates[candidates.size() / 2]});
+    ASSERT_EQ(stats.merges, 1);
+    ++merges;
+    const ConservedQuantities after = cloth.conserved_quantities();
+    EXPECT_NEAR(after.mass, before.mass, 1e-14 * before.mass);
+    EXPECT_LE((after.momentum - before.momentum).norm(), 1e-13 * before.mass);
+    // A merge lumps E into B and C conserving momentum: inelastic, kinetic energy never grows.
+    EXPECT_LE(after.energy.kinetic, before.energy.kinetic * (1 + 1e-12));
+    EXPECT_TRUE(cloth.mesh().validate().empty());
+    const Eigen::VectorXd lumped = lumped_masses(cloth);
+    EXPECT_LE((cloth.masses() - lumped).cwiseAbs().maxCoeff(), 1e-14 * lumped.sum());
+    ASSERT_TRUE(cloth.step().accepted);
+  }
+  EXPECT_GE(merges, 20);
+}
+
+// A new vertex on a pinned border is pinned at the midpoint of its pinned ends, following their
+// paths; merging it away unpins nothing else.
+TEST(AdaptiveDetail, PinsFollowSplitsAndMerges) {
+  AdaptiveSheetSpec spec;
+  spec.quads = 2;
+  testing::AdaptiveSheet sheet = testing::build_adaptive_sheet(spec);
+  // Pin the whole top edge (z = −0.5) and drive it up at 0.2 m/s.
+  std::vector<Pin> pins;
+  const Eigen::MatrixX3d rest = sheet.mesh.arrays().rest_positions;
+  for (Eigen::Index v = 0; v < rest.rows(); ++v)
+    if (std::abs(rest(v, 2) + 0.5) < 1e-12) {
+      const Eigen::Vector3d start = rest.row(v);
+      pins.push_back({static_cast<int>(v), [start](double t) {
+                        return Eigen::Vector3d(start + Eigen::Vector3d(0.0, 0.2 * t, 0.0));
+                      }});
+    }
+  ASSERT_EQ(pins.size(), 3u);
+  SimulationSettings settings = testing::adaptive_sheet_settings(spec);
+  AdaptiveCloth cloth(std::move(sheet.mesh), sheet.material, {}, pins, settings, fixed());
+  cloth.refine_uniformly(4);  // the top edge now has 9 vertices
+  const auto top_row = [&] {
+    std::vector<int> top;
+    for (Eigen::Index v = 0; v < cloth.rest_positions().rows(); ++v)
+      if (std::abs(cloth.rest_positions()(v, 2) + 0.5) < 1e-12) top.push_back(static_cast<int>(v));
+    return top;
+  };
+  EXPECT_EQ(cloth.pinned_vertices(), top_row());
+  EXPECT_EQ(top_row().size(), 9u);
+  for (int i = 0; i < 10; ++i) ASSERT_TRUE(cloth.step().accepted);
+  const Eigen::MatrixX3d x = cloth.positions();
+  for (int v : cloth.pinned_vertices()) {
+    const Eigen::Vector3d expected = cloth.rest_positions().row(v).transpose() +
+                                     Eigen::Vector3d(0.0, 0.2 * cloth.time(), 0.0);
+    EXPECT_LE((x.row(v).transpose() - expected).norm(), 1e-9) << "vertex " << v;
+  }
+  // Merge everything that can be merged: pinned midpoints go, the three original pins stay.
+  for (int round = 0; round < 8; ++round) cloth.merge_blocks(cloth.mesh().mergeable_blocks());
+  EXPECT_EQ(cloth.mesh().vertex_count(), 9);
+  EXPECT_EQ(cloth.pinned_vertices().size(), 3u);
+  EXPECT_TRUE(cloth.step().accepted);
+}
+
+// A sheet hanging flat from its top edge has no bend: nothing is refined and the model is never
+// rebuilt (the solver keeps its symbolic analysis).
+TEST(AdaptiveDetail, FlatHangingSheetIsNotRefined) {
+  AdaptiveSheetSpec spec;
+  spec.pins = {"top"};
+  testing::AdaptiveSheet sheet = testing::build_adaptive_sheet(spec);
+  // Turn it vertical: rest and start in the XY plane, hanging from the top edge.
+  SheetSpec vertical;
+  vertical.size = {1.0, 1.0};
+  vertical.columns = vertical.rows = spec.quads;
+  vertical.pins = {"top"};
+  const SheetScene scene = build_sheet(vertical);
+  Eigen::MatrixX4i quads(spec.quads * spec.quads, 4);
+  int q = 0;
+  for (int r = 0; r < spec.quads; ++r)
+    for (int c = 0; c < spec.quads; ++c)
+      quads.row(q++) << scene.vertex(r + 1, c), scene.vertex(r + 1, c + 1), scene.vertex(r, c + 1),
+          scene.vertex(r, c);
+  AdaptiveMaterial material = sheet.material;
+  material.source_warp.rowwise() = Eigen::RowVector3d(0.0, 1.0, 0.0);
+  std::vector<Pin> pins;
+  for (int v : scene.pinned_vertices) pins.push_back({v, {}});
+  SimulationSettings settings = testing::adaptive_sheet_settings(spec);
+  settings.duration = 1.0;
+  AdaptiveCloth cloth(meshing::Mesh48::from_quads(scene.input.rest_positions, quads), material,
+                      {}, pins, settings, AdaptiveSettings{});
+  const AdaptiveReport report = cloth.run();
+  EXPECT_FALSE(report.simulation.failed);
+  EXPECT_EQ(report.splits + report.forced_splits + report.merges, 0);
+  EXPECT_EQ(report.topology_changes, 0);
+  EXPECT_EQ(report.rebuild_s, 0.0);
+  EXPECT_LT(cloth.edge_errors().maxCoeff(), 1e-6);
+}
+
+// Forcing a split or a merge before every step for thousands of steps: never diverges, the mesh
+// stays valid, mass stays exact, the simulation always has the mesh's vertices.
+TEST(AdaptiveDetail, ChurnStress) {
+  AdaptiveSheetSpec spec;
+  spec.quads = 2;
+  spec.pins = {"top-left", "top-right"};
+  spec.dt = 1.0 / 120.0;
+  spec.solver = LinearSolverKind::pcg;  // no symbolic analysis per step: keeps the test quick
+  AdaptiveCloth cloth = make_adaptive_sheet(spec, 0, fixed());
+  const double mass = cloth.masses().sum();
+  std::mt19937 rng(6);
+  int splits = 0, merges = 0;
+  const int steps = 2000;
+  for (int i = 0; i < steps; ++i) {
+    const std::vector<BlockId> mergeable = cloth.mesh().mergeable_blocks();
+    std::vector<BlockId> splittable;
+    for (BlockId k : cloth.mesh().leaf_blocks())
+      if (cloth.mesh().level(k) < 6) splittable.push_back(k);
+    const bool merge = !mergeable.empty() && (splittable.empty() || rng() % 2 == 0);
+    AdaptStats stats;
+    if (merge)
+      stats = cloth.merge_blocks({mergeable[rng() % mergeable.size()]});
+    else
+      stats = cloth.split_blocks({splittable[rng() % splittable.size()]});
+    ASSERT_TRUE(stats.changed()) << "step " << i;
+    merges += stats.merges;
+    splits += stats.splits + stats.forced_splits;
+    const std::vector<std::string> problems = cloth.mesh().validate();
+    ASSERT_TRUE(problems.empty()) << "step " << i << ": " << problems.front();
+    const StepOutcome outcome = cloth.step();
+    ASSERT_TRUE(outcome.accepted) << "step " << i << ": " << outcome.failure_reason;
+    ASSERT_TRUE(cloth.positions().allFinite());
+    ASSERT_EQ(cloth.simulation().model().vertex_count, cloth.mesh().vertex_count());
+    ASSERT_NEAR(cloth.masses().sum(), mass, 1e-12 * mass) << "step " << i;
+  }
+  EXPECT_GT(merges, steps / 4);
+  EXPECT_GT(splits, steps / 4);
+  const double strain =
+      max_stretch_strain(cloth.simulation().model(), cloth.simulation().positions());
+  EXPECT_LT(strain, 0.1);
+  std::printf("churn: %d splits, %d merges, %d retries, final %d vertices, max strain %.4f\n",
+              splits, merges, cloth.simulation().report().retries, cloth.mesh().vertex_count(),
+              strain);
+}
+
+TEST(AdaptiveDetail, LevelLimitsAndBudgetHold) {
+  AdaptiveSheetSpec spec;
+  spec.duration = 1.0;
+  AdaptiveSettings settings;
+  settings.refine_threshold = 2e-4;  // far below what the fold needs: limits decide
+  settings.coarsen_threshold = 1e-4;
+  settings.max_level = 4;
+  AdaptiveCloth capped = make_adaptive_sheet(spec, 0, settings);
+  const AdaptiveReport by_level = capped.run();
+  EXPECT_EQ(by_level.max_level_reached, 4);
+  for (const AdaptiveStepRecord& step : by_level.steps) EXPECT_LE(step.max_level, 4);
+
+  settings.max_level = 8;
+  settings.max_vertices = 150;
+  AdaptiveCloth budget = make_adaptive_sheet(spec, 0, settings);
+  const AdaptiveReport by_budget = budget.run();
+  EXPECT_GE(by_budget.vertices_max, 150);
+  // The last requested split may bring its forced splits (a few vertices) past the budget.
+  EXPECT_LE(by_budget.vertices_max, 150 + 12);
+
+  settings.max_vertices = 0;
+  settings.min_level = 2;
+  settings.max_level = 5;
+  settings.refine_threshold = 4e-3;
+  settings.coarsen_threshold = 3.9e-3;  // merge eagerly: min_level must stop it
+  settings.min_lifetime = 0.0;
+  AdaptiveCloth floor = make_adaptive_sheet(spec, 2, settings);
+  floor.run();
+  EXPECT_GT(floor.report().merges, 0);
+  for (Eigen::Index f = 0; f < floor.face_levels().size(); ++f)
+    EXPECT_GE(floor.face_levels()(f), 2);
+}
+
+// Birra & Santos' fig. 5: a sheet hung by 3 corners, fixed at the finest level (level 6, 2048
+// triangles) and adaptive from 32 triangles (max 2048). Conservation across every topology
+// change of the run; the settled shapes agree; the energy curves agree.
+TEST(AdaptiveDetail, MatchesFixedResolutionOnThreeCornerSheet) {
+  AdaptiveSheetSpec spec;
+  spec.duration = 3.0;
+  AdaptiveSettings settings;
+  settings.max_level = 6;
+  settings.measure_jumps = true;
+  AdaptiveCloth adaptive = make_adaptive_sheet(spec, 0, settings);
+  ASSERT_EQ(adaptive.mesh().triangle_count(), 32);
+  AdaptiveCloth fine = make_adaptive_sheet(spec, 6, fixed());
+  ASSERT_EQ(fine.mesh().triangle_count(), 2048);
+  const AdaptiveReport a = adaptive.run();
+  const AdaptiveReport f = fine.run();
+  ASSERT_FALSE(a.simulation.failed);
+  ASSERT_FALSE(f.simulation.failed);
+  EXPECT_GT(a.splits, 100);
+  EXPECT_GT(a.merges, 0);
+  EXPECT_EQ(a.max_level_reached, 6);
+
+  // Conservation at every topology change of the run.
+  int changes = 0;
+  double worst_jump = 0.0;
+  for (const AdaptiveStepRecord& step : a.steps) {
+    if (!step.measured) continue;
+    ++changes;
+    const ConservedQuantities& b = step.before;
+    const ConservedQuantities& c = step.after;
+    EXPECT_NEAR(c.mass, b.mass, 1e-13 * b.mass) << "t = " << step.time;
+    EXPECT_LE((c.momentum - b.momentum).norm(), 1e-13 * b.mass) << "t = " << step.time;
+    // Energy bound (docs/adaptive.md): splits leave membrane and potential energy unchanged and
+    // can only lower kinetic energy; bending grows on hinges next to a split by ≤ 2x; a merge
+    // moves the surface by less than coarsen_threshold at a steady hinge. Together: the total
+    // changes by less than the bending energy plus m·g·coarsen_threshold.
+    const double jump = std::abs(c.energy.total() - b.energy.total());
+    const double bound = b.energy.bend + b.mass * 9.81 * settings.coarsen_threshold;
+    EXPECT_LE(jump, bound) << "t = " << step.time;
+    worst_jump = std::max(worst_jump, jump / bound);
+  }
+  EXPECT_EQ(changes, a.topology_changes);
+
+  // Shapes at the end.
+  const Eigen::MatrixX3d xa = adaptive.positions(), xf = fine.positions();
+  const testing::ShapeFigures sa = testing::shape_figures(xa), sf = testing::shape_figures(xf);
+  const double drop_a = 1.0 - sa.lowest, drop_f = 1.0 - sf.lowest;
+  EXPECT_NEAR(drop_a, drop_f, 0.03 * drop_f);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(sa.extent(k), sf.extent(k), 0.03 * sf.extent.maxCoeff());
+  const Eigen::MatrixX3d points = testing::sheet_material_points(spec, 21);
+  const double rms = rms_distance(testing::material_positions(adaptive, points),
+                                  testing::material_positions(fine, points));
+  EXPECT_LT(rms, 0.02 * spec.size);
+
+  // Energy curves at common times: stretch, shear and bend within a fraction of each curve's
+  // range over the run (single samples during the fall differ more: compared as RMS).
+  ASSERT_EQ(a.simulation.energy.size(), f.simulation.energy.size());
+  const auto curve_difference = [&](auto field) {
+    double range = 0.0, sum = 0.0;
+    for (std::size_t i = 0; i < f.simulation.energy.size(); ++i) {
+      range = std::max(range, std::abs(field(f.simulation.energy[i])));
+      const double d = field(a.simulation.energy[i]) - field(f.simulation.energy[i]);
+      sum += d * d;
+    }
+    return std::sqrt(sum / static_cast<double>(f.simulation.energy.size())) / range;
+  };
+  const double stretch = curve_difference([](const EnergySample& e) { return e.stretch; });
+  const double shear = curve_difference([](const EnergySample& e) { return e.shear; });
+  const double bend = curve_difference([](const EnergySample& e) { return e.bend; });
+  const double potential = curve_difference([](const EnergySample& e) { return e.potential; });
+  std::printf(
+      "fig5: adaptive %d..%d vertices, %d splits + %d forced, %d merges, %d changes; drop %.4f vs "
+      "%.4f m, extent %.4f %.4f %.4f vs %.4f %.4f %.4f; rms %.2f mm; curves rms/range stretch "
+      "%.3f shear %.3f bend %.3f potential %.4f; worst jump/bound %.3f; wall %.2f vs %.2f s\n",
+      a.vertices_min, a.vertices_max, a.splits, a.forced_splits, a.merges, a.topology_changes,
+      drop_a, drop_f, sa.extent.x(), sa.extent.y(), sa.extent.z(), sf.extent.x(), sf.extent.y(),
+      sf.extent.z(), 1e3 * rms, stretch, shear, bend, potential, worst_jump,
+      a.simulation.wall_time_s, f.simulation.wall_time_s);
+  EXPECT_LT(stretch, 0.15);
+  EXPECT_LT(shear, 0.15);
+  EXPECT_LT(bend, 0.15);
+  EXPECT_LT(potential, 0.02);
+}
+
+TEST(SurfaceSampling, InterpolatesAffineMapsExactly) {
+  const testing::AdaptiveSheet sheet = testing::build_adaptive_sheet({});
+  const meshing::Mesh48Arrays arrays = sheet.mesh.arrays();
+  Eigen::Matrix3d map;
+  map << 1.2, 0.1, -0.3, 0.0, 0.9, 0.2, 0.4, -0.1, 1.1;
+  const Eigen::MatrixX3d moved = arrays.rest_positions * map.transpose();
+  const Eigen::MatrixX3d points = testing::sheet_material_points({}, 7);
+  const Eigen::MatrixX3d sampled =
+      positions_at_material_points(arrays.rest_positions, arrays.faces, moved, points);
+  EXPECT_LT(rms_distance(sampled, points * map.transpose()), 1e-12);
+  EXPECT_NEAR(rms_distance(points, points.array() + 0.5), std::sqrt(3.0) * 0.5, 1e-12);
+}
+
+}  // namespace
+}  // namespace sd::sim
