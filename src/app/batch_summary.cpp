@@ -214,7 +214,12 @@ json report_figures(const json& report) {
       if (value.is_number() || value.is_boolean()) figures[key] = value;
   };
   take(report);
-  if (report.contains("totals") && report["totals"].is_object()) take(report["totals"]);
+  // Objects whose scalars are figures too (a top-level name wins over a nested one).
+  for (const char* group : {"totals", "meshing", "collision", "contact"})
+    if (report.contains(group) && report[group].is_object())
+      for (const auto& [key, value] : report[group].items())
+        if ((value.is_number() || value.is_boolean()) && !figures.contains(key))
+          figures[key] = value;
   return figures;
 }
 

@@ -67,8 +67,9 @@ std::vector<JobSummary> summarise_jobs(const BatchPlan& plan, const std::filesys
                                        const std::map<std::string, KnownRecord>& current,
                                        const std::map<std::string, KnownRecord>& fallback);
 
-// Figures copied from a report.json: its top-level numbers and booleans, and those of its
-// "totals" object (where `mesh` keeps vertices, quads, distortion, ...).
+// Figures copied from a report.json: its top-level numbers and booleans, then those of its
+// "totals", "meshing", "collision" and "contact" objects (`mesh` keeps vertices, quads,
+// distortion in "totals"; `run` keeps distortion in "meshing"). A top-level name wins.
 nlohmann::json report_figures(const nlohmann::json& report);
 
 nlohmann::json summary_json(const BatchPlan& plan, const std::vector<JobSummary>& jobs);

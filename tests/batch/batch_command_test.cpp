@@ -255,6 +255,41 @@ TEST(BatchCommand, ShardsCoverTheBatchAndCollectBuildsTheSummary) {
   EXPECT_EQ(std::count(list.output.begin(), list.output.end(), '\n'), 2);
 }
 
+// The default stage, `run` (mesh, simulate, images), when this build has it: two short drapes
+// (0.1 s of simulated time) with their figures in the summary, then a re-run that reuses both.
+TEST(BatchCommand, RunStageWhenTheBuildHasIt) {
+  if (run_sketchdrape("run --help").exit_code != 0)
+    GTEST_SKIP() << "SKIPPED: this build has no `run` command";
+  const fs::path dir = fresh_batch_dir("run_stage");
+  write_text(dir / "m.json",
+             json{{"format", "sketchdrape-batch/1"},
+                  {"set",
+                   {{"/simulate/duration", 0.1},
+                    {"/output/images", json::array({{{"view", "front"}, {"size", {120, 180}}}})}}},
+                  {"jobs", json::array({{{"sketch", (kExamples / "a-line-skirt.json").string()},
+                                         {"matrix", {{"/fabric", {"denim", "silk"}}}}}})}}
+                 .dump());
+  const fs::path out = dir / "out";
+  const CommandResult r = run_sketchdrape("batch " + shell_quoted(dir / "m.json") + " -o " +
+                                          shell_quoted(out) + " -j 2");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  json summary = read_json(out / "batch.json");
+  EXPECT_EQ(summary["stage"], "run");
+  ASSERT_EQ(summary["jobs"].size(), 2u);
+  for (const json& j : summary["jobs"]) {
+    EXPECT_EQ(j["status"], "done") << j.dump();
+    EXPECT_TRUE(j["figures"]["at_rest"].is_boolean()) << j["figures"].dump();
+    EXPECT_GT(j["figures"]["vertices"].get<int>(), 50);
+    EXPECT_GT(j["figures"]["steps"].get<int>(), 0);
+    ASSERT_EQ(j["images"].size(), 1u);
+    EXPECT_TRUE(fs::exists(out / j["images"][0].get<std::string>()));
+  }
+  const CommandResult again = run_sketchdrape("batch " + shell_quoted(dir / "m.json") + " -o " +
+                                              shell_quoted(out) + " -j 2");
+  ASSERT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_EQ(read_json(out / "batch.json")["counts"]["reused"], 2);
+}
+
 // Starts the binary in its own process group (so the whole group can be killed).
 pid_t start_in_new_group(const std::vector<std::string>& args, const fs::path& log) {
   const pid_t pid = fork();

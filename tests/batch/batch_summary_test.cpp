@@ -38,12 +38,12 @@ BatchPlan plan_of(const std::vector<std::string>& ids) {
   return plan;
 }
 
-TEST(ReportFigures, TopLevelAndTotalsScalarsOnly) {
+TEST(ReportFigures, TopLevelThenNamedGroupsScalarsOnly) {
   const json report = json::parse(R"({"format": "x", "at_rest": true, "max_penetration_m": 0.001,
-      "totals": {"vertices": 812, "distortion": 3, "area_m2": 1.25},
-      "panels": [{"distortion": 99}], "timing_ms": {"total": 12}})");
+      "vertices": 900, "totals": {"vertices": 812, "distortion": 3, "area_m2": 1.25},
+      "meshing": {"quads": 400, "panels": [{"distortion": 99}]}, "timing_ms": {"total": 12}})");
   EXPECT_EQ(report_figures(report), json::parse(R"({"at_rest": true, "max_penetration_m": 0.001,
-      "vertices": 812, "distortion": 3, "area_m2": 1.25})"));
+      "vertices": 900, "distortion": 3, "area_m2": 1.25, "quads": 400})"));
 }
 
 TEST(SummariseJobs, RecordsCountOnlyWithThePlansDigestAndCurrentWins) {
