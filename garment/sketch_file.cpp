@@ -389,7 +389,8 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
   const std::string path = "/simulate";
   r.require_object(j, path, "simulate");
   r.check_keys(j, path, {"duration", "adaptive", "time_step", "integrator", "solver",
-                         "stop_at_rest", "gravity"});
+                         "stop_at_rest", "gravity", "pin_above"});
+  if (j.contains("pin_above")) sim.pin_above = r.number(j["pin_above"], path + "/pin_above");
   if (j.contains("duration")) sim.duration = r.positive(j["duration"], path + "/duration");
   if (j.contains("adaptive")) sim.adaptive = r.boolean(j["adaptive"], path + "/adaptive");
   if (j.contains("time_step")) sim.time_step = r.positive(j["time_step"], path + "/time_step");
@@ -410,6 +411,52 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
   if (j.contains("gravity")) sim.gravity = r.vector<3>(j["gravity"], path + "/gravity");
 }
 
+SheetSpec parse_sheet(const Reader& r, const json& j) {
+  const std::string path = "/sheet";
+  r.require_object(j, path, "sheet");
+  r.check_keys(j, path, {"size", "resolution", "orientation", "centre", "pins"});
+  SheetSpec sheet;
+  if (j.contains("size")) {
+    sheet.size = r.vector<2>(j["size"], path + "/size");
+    for (int k = 0; k < 2; ++k)
+      if (!(sheet.size[k] > 0))
+        r.fail(fmt::format("{}/size/{}", path, k), "a sheet's width and height must be positive");
+  }
+  if (j.contains("resolution")) {
+    const json& res = j["resolution"];
+    if (!res.is_array() || res.size() != 2)
+      r.fail(path + "/resolution", "expected [columns, rows] of quads");
+    sheet.columns = r.integer(res[0], path + "/resolution/0", 1);
+    sheet.rows = r.integer(res[1], path + "/resolution/1", 1);
+    if (sheet.columns > 1024 || sheet.rows > 1024)
+      r.fail(path + "/resolution", "a sheet has at most 1024 quads along a side");
+  }
+  if (j.contains("orientation")) {
+    const std::string o = r.text(j["orientation"], path + "/orientation");
+    if (o != "vertical" && o != "horizontal")
+      r.fail(path + "/orientation",
+             fmt::format("unknown orientation '{}'; use \"vertical\" or \"horizontal\"", o));
+    sheet.horizontal = o == "horizontal";
+  }
+  if (j.contains("centre")) sheet.centre = r.vector<3>(j["centre"], path + "/centre");
+  if (j.contains("pins")) {
+    const json& pins = j["pins"];
+    if (!pins.is_array()) r.fail(path + "/pins", "expected a list of corner or edge names");
+    static constexpr std::string_view kNames[] = {"top-left", "top-right", "bottom-left",
+                                                  "bottom-right", "top", "bottom", "left", "right"};
+    for (size_t i = 0; i < pins.size(); ++i) {
+      const std::string pp = fmt::format("{}/pins/{}", path, i);
+      const std::string name = r.text(pins[i], pp);
+      if (std::find(std::begin(kNames), std::end(kNames), name) == std::end(kNames))
+        r.fail(pp, fmt::format("unknown pin '{}'; use a corner (top-left, top-right, bottom-left, "
+                               "bottom-right) or an edge (top, bottom, left, right)",
+                               name));
+      sheet.pins.push_back(name);
+    }
+  }
+  return sheet;
+}
+
 void parse_output(const Reader& r, const json& j, OutputSpec& out) {
   const std::string path = "/output";
   r.require_object(j, path, "output");
@@ -424,6 +471,7 @@ void parse_output(const Reader& r, const json& j, OutputSpec& out) {
   if (j.contains("report")) out.report = r.boolean(j["report"], path + "/report");
   if (j.contains("wireframe")) out.wireframe = r.boolean(j["wireframe"], path + "/wireframe");
   if (j.contains("images")) {
+    out.images_listed = true;
     const json& images = j["images"];
     if (!images.is_array()) r.fail(path + "/images", "expected a list of images");
     for (size_t i = 0; i < images.size(); ++i) {
@@ -528,7 +576,7 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
   r.check_keys(root, "",
                {"format", "body", "edge_length", "offset", "junction_tolerance", "corner_angle",
                 "relax_iterations", "fabric", "garment_mesh", "curves", "panels", "join",
-                "simulate", "output"});
+                "simulate", "output", "sheet"});
   if (root.contains("format")) {
     const std::string format = r.text(root["format"], "/format");
     if (format != kSketchFormat)
@@ -555,6 +603,15 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
   if (root.contains("fabric")) sketch.fabric = r.text(root["fabric"], "/fabric");
   if (root.contains("simulate")) parse_simulate(r, root["simulate"], sketch.simulate);
   if (root.contains("output")) parse_output(r, root["output"], sketch.output);
+
+  if (root.contains("sheet")) {
+    sketch.sheet = parse_sheet(r, root["sheet"]);
+    for (const char* key : {"curves", "panels", "garment_mesh", "join"})
+      if (root.contains(key))
+        r.fail("/sheet", fmt::format("a sheet scene has no \"{}\": remove one or the other", key));
+    if (!root.contains("body")) sketch.body.mesh = "none";  // a sheet falls freely unless given a body
+    return sketch;
+  }
 
   if (root.contains("garment_mesh")) {
     sketch.garment_mesh = r.text(root["garment_mesh"], "/garment_mesh");

@@ -70,21 +70,32 @@ struct JoinSpec {
 };
 
 struct BodySpec {
-  std::string mesh = "builtin";            // "builtin" or a path relative to the sketch file
+  std::string mesh = "builtin";            // "builtin", "none", or a path relative to the sketch file
   std::optional<double> height;            // metres
   std::optional<double> scale;             // metres per file unit
   std::optional<std::string> up;           // "+z", "y", ...
 };
 
-// Read now, used by the simulator (issue 5): plain values with defaults.
+// How the drape is simulated (`sketchdrape run`): plain values with defaults.
 struct SimulateSpec {
   double duration = 3.0;                   // seconds of simulated time at most
   bool adaptive = true;                    // 4-8 refinement/coarsening
-  double time_step = 0.005;                // seconds, initial
-  std::string integrator = "bdf2";         // "implicit-euler" | "bdf2"
-  std::string solver = "pcg";              // "pcg" | "cholmod"
+  double time_step = 1.0 / 60.0;           // seconds, the largest step
+  std::string integrator = "implicit-euler";  // "implicit-euler" | "bdf2"
+  std::string solver = "cholmod";          // "pcg" | "cholmod"
   bool stop_at_rest = true;
   Eigen::Vector3d gravity{0.0, -9.81, 0.0};
+  std::optional<double> pin_above;         // metres: garment vertices designed at y >= this are pinned
+};
+
+// A rectangular sheet of cloth instead of a garment: scenes for tests and benchmarks.
+struct SheetSpec {
+  Eigen::Vector2d size{1.0, 1.0};          // metres: width (x) and height (y, or z when horizontal)
+  int columns = 16;                        // quads along the width
+  int rows = 16;                           // quads along the height
+  bool horizontal = false;                 // in the XZ plane instead of the XY plane
+  Eigen::Vector3d centre{0.0, 1.0, 0.0};   // metres
+  std::vector<std::string> pins;           // "top-left", ..., or whole edges "top", "left", ...
 };
 
 struct ImageSpec {
@@ -98,6 +109,7 @@ struct ImageSpec {
 
 struct OutputSpec {
   std::vector<ImageSpec> images;
+  bool images_listed = false;              // "images" was given (an empty list means none)
   std::string mesh = "garment.obj";        // file name of the stitched garment (.obj or .glb)
   bool report = true;
   bool wireframe = false;
@@ -112,8 +124,9 @@ struct Sketch {
   double junction_tolerance = 0.015;       // metres: endpoints closer than this meet
   double corner_angle_degrees = 35.0;      // a junction turning more than this is a corner
   int relax_iterations = 10;               // interior smoothing sweeps of the quad filler
-  std::string fabric = "cotton-jersey";
+  std::string fabric = "jersey";            // a preset of data/fabrics (sketchdrape run checks it)
   std::optional<std::string> garment_mesh; // triangle garment file: skips sketching and meshing
+  std::optional<SheetSpec> sheet;          // a sheet scene: no curves, panels or (unless given) body
   std::vector<CurveSpec> curves;
   std::vector<PanelSpec> panels;
   std::vector<JoinSpec> joins;

@@ -10,6 +10,9 @@
 namespace sd::garment {
 
 Body load_sketch_body(const Sketch& sketch) {
+  if (sketch.body.mesh == "none")
+    sketch.fail("/body/mesh", "a garment is designed on a body: give \"builtin\" or a body mesh "
+                              "file instead of \"none\"");
   BodyOptions options;
   options.height = sketch.body.height;
   options.scale = sketch.body.scale;

@@ -19,6 +19,7 @@
 #include "src/app/atomic_file.hpp"
 #include "src/app/cli.hpp"
 #include "src/app/mesh_export.hpp"
+#include "src/app/preview_images.hpp"
 #include "src/render/previews.hpp"
 
 namespace sd::app {
@@ -57,45 +58,6 @@ nlohmann::json quality_json(const meshing::QuadQuality& q) {
           {"scaled_jacobian_min", q.scaled_jacobian_min},
           {"scaled_jacobian_mean", q.scaled_jacobian_mean},
           {"inverted_quads", q.inverted_quads}};
-}
-
-// PNGs of the garment (one colour per panel) on the body, one per requested image.
-void stage_images(const garment::Sketch& sketch, const meshing::TriMesh& body,
-                  const meshing::TriMesh& cloth, const Eigen::VectorXi& panel_ids,
-                  const Eigen::MatrixX2i& wire_edges, const std::filesystem::path& dir,
-                  StagedOutputs& outputs) {
-  if (sketch.output.images.empty()) return;
-  render::Renderer renderer;
-  std::map<std::string, int> used_names;
-  for (size_t i = 0; i < sketch.output.images.size(); ++i) {
-    const garment::ImageSpec& spec = sketch.output.images[i];
-    const bool wireframe = spec.wireframe.value_or(sketch.output.wireframe);
-    render::Scene scene = render::cloth_over_body_scene(body, cloth, panel_ids);
-    if (wireframe) {
-      render::Wireframe wire;
-      wire.edges = wire_edges;
-      scene.meshes[1].wireframe = wire;
-    }
-    const render::ImageSize size{spec.width, spec.height};
-    render::Camera camera;
-    std::string name;
-    if (spec.view == "camera") {
-      camera.eye = spec.camera.eye;
-      camera.target = spec.camera.target;
-      camera.up = spec.camera.up;
-      camera.fov_y_deg = spec.camera.fov_degrees;
-      name = "camera";
-    } else {
-      name = spec.view;
-      camera = render::frame_view(render::parse_view_name(name), render::scene_bounds(scene),
-                                  size.aspect());
-    }
-    const int n = used_names[name]++;
-    const std::string file = n == 0 ? fmt::format("garment-{}.png", name)
-                                    : fmt::format("garment-{}-{}.png", name, n + 1);
-    const render::Image image = renderer.render(scene, camera, size);
-    outputs.stage(dir / file, render::encode_png(image));
-  }
 }
 
 void run_mesh(const MeshOptions& options) {
@@ -206,7 +168,9 @@ void run_mesh(const MeshOptions& options) {
     cloth.faces = render::triangulate_quads(g.mesh.faces);
     Eigen::VectorXi tri_panel(2 * g.face_panel.size());
     for (Eigen::Index f = 0; f < g.face_panel.size(); ++f) tri_panel(2 * f) = tri_panel(2 * f + 1) = g.face_panel(f);
-    stage_images(sketch, body.mesh, cloth, tri_panel, render::quad_edges(g.mesh.faces), dir, outputs);
+    const PreviewCloth preview{cloth, tri_panel, render::quad_edges(g.mesh.faces), {}};
+    stage_preview_images(sketch.output.images, sketch.output.wireframe, &body.mesh, preview,
+                         "garment", dir, outputs);
   }
   report["timing_ms"] = {{"body", body_ms}, {"meshing", mesh_ms}, {"images", ms_since(image_start)}, {"total", ms_since(start)}};
   if (sketch.output.report) outputs.stage(dir / "report.json", report.dump(2) + "\n");

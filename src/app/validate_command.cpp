@@ -1,18 +1,15 @@
-// `sketchdrape validate SKETCH`: checks a sketch file the way `mesh` would use it — fields,
-// body, strokes on the body, curve network, panels, edge counts and the quad fill — and
-// writes nothing.
+// `sketchdrape validate SKETCH`: checks a sketch file the way `mesh` and `run` would use it —
+// fields, body, strokes on the body, curve network, panels, edge counts, the quad fill, the
+// fabric and the simulation settings — and writes nothing.
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <iostream>
 
-#include "garment/body_surface.hpp"
-#include "garment/garment_mesh.hpp"
 #include "garment/sketch_file.hpp"
-#include "garment/sketch_inputs.hpp"
-#include "meshing/mesh48.hpp"
 #include "src/app/cli.hpp"
+#include "src/app/cloth_scene.hpp"
 
 namespace sd::app {
 namespace {
@@ -23,24 +20,20 @@ struct ValidateOptions {
 
 void run_validate(const ValidateOptions& options) {
   const garment::Sketch sketch = garment::load_sketch(options.sketch);
-  if (sketch.garment_mesh) {
-    const meshing::TriMesh mesh = garment::load_garment_mesh(sketch);
-    try {
-      (void)meshing::Mesh48::from_triangles_sqrt3(mesh);
-    } catch (const meshing::Mesh48InputError& e) {
-      sketch.fail("/garment_mesh", fmt::format("the garment mesh cannot become a 4-8 mesh: {}", e.what()));
-    }
-    std::cout << fmt::format("{}: ok (garment mesh: {} vertices, {} triangles)\n", sketch.file,
-                             mesh.vertex_count(), mesh.face_count());
-    return;
+  (void)simulation_settings(sketch);
+  const ClothScene scene = build_cloth_scene(sketch);
+  std::string what;
+  if (scene.garment) {
+    int distortion = 0;
+    for (const auto& p : scene.garment->panels) distortion += p.distortion;
+    what = fmt::format("{} curves, {} panels, {} quads, distortion {}", sketch.curves.size(),
+                       scene.garment->panels.size(), scene.garment->mesh.face_count(), distortion);
+  } else {
+    what = fmt::format("{} {}: {} vertices, {} triangles", sketch.sheet ? "sheet" : "garment mesh",
+                       scene.fabric_name, scene.input.rest_positions.rows(),
+                       scene.input.triangles.rows());
   }
-  const garment::Body body = garment::load_sketch_body(sketch);
-  const garment::BodySurface surface(body.mesh);
-  const garment::Garment g = garment::build_garment(sketch, surface);
-  int distortion = 0;
-  for (const auto& p : g.panels) distortion += p.distortion;
-  std::cout << fmt::format("{}: ok ({} curves, {} panels, {} quads, distortion {})\n", sketch.file,
-                           sketch.curves.size(), g.panels.size(), g.mesh.face_count(), distortion);
+  std::cout << fmt::format("{}: ok ({}, fabric {})\n", sketch.file, what, scene.fabric_name);
 }
 
 }  // namespace

@@ -37,12 +37,53 @@ TEST(SketchFile, MinimalFileGetsDefaults) {
   EXPECT_FALSE(s.curves[1].on_body);
   EXPECT_EQ(*s.curves[1].edges, 4);
   EXPECT_TRUE(s.curves[1].is_3d());
-  EXPECT_EQ(s.panels[0].fabric, "cotton-jersey");
+  EXPECT_EQ(s.panels[0].fabric, "jersey");
   EXPECT_TRUE(s.panels[0].mirror);
   EXPECT_DOUBLE_EQ(s.simulate.duration, 3.0);
-  EXPECT_EQ(s.simulate.integrator, "bdf2");
+  EXPECT_EQ(s.simulate.integrator, "implicit-euler");
+  EXPECT_EQ(s.simulate.solver, "cholmod");
+  EXPECT_FALSE(s.simulate.pin_above.has_value());
   EXPECT_EQ(s.output.mesh, "garment.obj");
   EXPECT_TRUE(s.output.images.empty());
+  EXPECT_FALSE(s.output.images_listed);
+  EXPECT_FALSE(s.sheet.has_value());
+}
+
+TEST(SketchFile, SheetSceneNeedsNoCurvesAndHasNoBody) {
+  const Sketch s = parse_sketch(R"({
+    "format": "sketchdrape/1",
+    // a sheet scene
+    "sheet": {"size": [0.5, 2], "resolution": [8, 32], "orientation": "horizontal",
+              "centre": [0, 1.5, 0], "pins": ["top-left", "right"]},
+    "simulate": {"pin_above": 1.4},
+    "output": {"images": []}
+  })", "sheet.json");
+  ASSERT_TRUE(s.sheet.has_value());
+  EXPECT_EQ(s.sheet->size, Eigen::Vector2d(0.5, 2));
+  EXPECT_EQ(s.sheet->columns, 8);
+  EXPECT_EQ(s.sheet->rows, 32);
+  EXPECT_TRUE(s.sheet->horizontal);
+  EXPECT_EQ(s.sheet->pins, (std::vector<std::string>{"top-left", "right"}));
+  EXPECT_EQ(s.body.mesh, "none");
+  EXPECT_DOUBLE_EQ(*s.simulate.pin_above, 1.4);
+  EXPECT_TRUE(s.output.images_listed);
+  EXPECT_TRUE(s.output.images.empty());
+}
+
+TEST(SketchFile, SheetMistakesNameTheirPath) {
+  const auto error_of = [](const std::string& text) {
+    try {
+      parse_sketch(text, "bad.json");
+    } catch (const SketchError& e) {
+      return std::string(e.json_path()) + ": " + e.sentence();
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(error_of(R"({"sheet": {"pins": ["middle"]}})").rfind("/sheet/pins/0: unknown pin", 0), 0u);
+  EXPECT_EQ(error_of(R"({"sheet": {"resolution": [0, 4]}})").rfind("/sheet/resolution/0", 0), 0u);
+  EXPECT_EQ(error_of(R"({"sheet": {"size": [1, -1]}})").rfind("/sheet/size/1", 0), 0u);
+  EXPECT_EQ(error_of(R"({"sheet": {}, "panels": []})").rfind("/sheet: a sheet scene has no", 0), 0u);
+  EXPECT_EQ(error_of(R"({"sheet": {"orientation": "diagonal"}})").rfind("/sheet/orientation", 0), 0u);
 }
 
 TEST(SketchFile, ReadsEverySection) {

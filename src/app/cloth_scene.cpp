@@ -1,0 +1,170 @@
+#include "src/app/cloth_scene.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+
+#include "garment/body_surface.hpp"
+#include "garment/material_frames.hpp"
+#include "garment/sketch_inputs.hpp"
+#include "sim/sheet.hpp"
+#include "sim/simulation.hpp"
+
+namespace sd::app {
+namespace {
+
+// The preset named at `json_path`, or a SketchError that lists the known ones.
+sim::FabricParameters fabric_at(const garment::Sketch& sketch, const std::string& name,
+                                const std::string& json_path) {
+  try {
+    return sim::fabric_preset(name);
+  } catch (const sim::UnknownFabricError& e) {
+    sketch.fail(json_path, e.what());
+  }
+}
+
+// simulate.pin_above: holds every vertex that starts at or above that height.
+void pin_above(const garment::Sketch& sketch, ClothScene& scene) {
+  if (!sketch.simulate.pin_above) return;
+  for (Eigen::Index v = 0; v < scene.start.rows(); ++v)
+    if (scene.start(v, 1) >= *sketch.simulate.pin_above) scene.pinned.push_back(static_cast<int>(v));
+  if (scene.pinned.empty())
+    sketch.fail("/simulate/pin_above",
+                fmt::format("no garment vertex lies at or above {} m (the garment's top is at "
+                            "{:.3f} m)",
+                            *sketch.simulate.pin_above, scene.start.col(1).maxCoeff()));
+}
+
+void build_sheet_scene(const garment::Sketch& sketch, ClothScene& scene) {
+  const garment::SheetSpec& spec = *sketch.sheet;
+  sim::SheetSpec sheet;
+  sheet.size = spec.size;
+  sheet.columns = spec.columns;
+  sheet.rows = spec.rows;
+  sheet.orientation =
+      spec.horizontal ? sim::SheetOrientation::horizontal : sim::SheetOrientation::vertical;
+  sheet.centre = spec.centre;
+  sheet.pins = spec.pins;
+  sim::SheetScene built = sim::build_sheet(sheet);
+  scene.input = std::move(built.input);
+  scene.start = scene.input.rest_positions;
+  scene.pinned = std::move(built.pinned_vertices);
+  scene.triangle_group = Eigen::VectorXi::Zero(scene.input.triangles.rows());
+  scene.group_names = {"sheet"};
+  scene.fabric_name = sketch.fabric;
+  scene.fabric = fabric_at(sketch, sketch.fabric, "/fabric");
+}
+
+void build_garment_scene(const garment::Sketch& sketch, ClothScene& scene) {
+  scene.body = garment::load_sketch_body(sketch);
+  const garment::BodySurface surface(scene.body->mesh);
+  const auto start = std::chrono::steady_clock::now();
+  garment::Garment g = garment::build_garment(sketch, surface);
+  scene.meshing_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+
+  // One fabric per simulation for now: the first panel's; others are reported if different.
+  const garment::GarmentPanel& first = g.panels.front();
+  scene.fabric_name = first.fabric;
+  const garment::PanelSpec* first_spec = sketch.find_panel(first.id);
+  scene.fabric = fabric_at(sketch, first.fabric,
+                           first_spec ? first_spec->json_path + "/fabric" : "/fabric");
+  for (const garment::GarmentPanel& p : g.panels)
+    if (p.fabric != first.fabric)
+      spdlog::warn("panel '{}' asks for fabric '{}'; this version simulates a garment in one fabric "
+                   "and uses '{}' (panel '{}') throughout",
+                   p.id, p.fabric, first.fabric, first.id);
+
+  meshing::Mesh48 m48 = meshing::Mesh48::from_quads(g.mesh);
+  const std::vector<std::string> problems = m48.validate();
+  if (!problems.empty()) throw std::runtime_error("4-8 mesh check failed: " + problems.front());
+  const meshing::Mesh48Arrays arrays = m48.arrays();
+  const garment::MaterialFrames frames = garment::material_frames(g.mesh);
+
+  // Groups: a join's panels share its group.
+  std::vector<int> panel_group(g.panels.size());
+  for (size_t p = 0; p < g.panels.size(); ++p) {
+    auto it = std::find(scene.group_names.begin(), scene.group_names.end(), g.panels[p].group);
+    if (it == scene.group_names.end())
+      it = scene.group_names.insert(scene.group_names.end(), g.panels[p].group);
+    panel_group[p] = static_cast<int>(it - scene.group_names.begin());
+  }
+
+  const Eigen::Index triangles = arrays.faces.rows();
+  scene.input.rest_positions = arrays.rest_positions;
+  scene.input.triangles = arrays.faces;
+  scene.input.warp.resize(triangles, 3);
+  scene.triangle_group.resize(triangles);
+  for (Eigen::Index t = 0; t < triangles; ++t) {
+    const int quad = m48.source_face(arrays.triangle_ids[static_cast<size_t>(t)]);
+    scene.input.warp.row(t) = frames.warp.row(quad);
+    scene.triangle_group(t) = panel_group[static_cast<size_t>(g.face_panel(quad))];
+  }
+  scene.start = arrays.rest_positions;
+  pin_above(sketch, scene);
+  scene.mesh48 = std::move(m48);
+  scene.garment = std::move(g);
+}
+
+// An imported triangle garment: its 4-8 mesh comes from the sqrt3 conversion; warp is the
+// in-plane direction closest to +Y (the simulator's default when no warp is given).
+void build_imported_scene(const garment::Sketch& sketch, ClothScene& scene) {
+  if (sketch.body.mesh != "none") scene.body = garment::load_sketch_body(sketch);
+  const meshing::TriMesh triangles = garment::load_garment_mesh(sketch);
+  meshing::Mesh48 m48 = [&] {
+    try {
+      return meshing::Mesh48::from_triangles_sqrt3(triangles);
+    } catch (const meshing::Mesh48InputError& e) {
+      sketch.fail("/garment_mesh",
+                  fmt::format("the garment mesh cannot become a 4-8 mesh: {}", e.what()));
+    }
+  }();
+  const meshing::Mesh48Arrays arrays = m48.arrays();
+  scene.input.rest_positions = arrays.rest_positions;
+  scene.input.triangles = arrays.faces;
+  scene.start = arrays.rest_positions;
+  scene.triangle_group = Eigen::VectorXi::Zero(arrays.faces.rows());
+  scene.group_names = {"garment"};
+  scene.fabric_name = sketch.fabric;
+  scene.fabric = fabric_at(sketch, sketch.fabric, "/fabric");
+  pin_above(sketch, scene);
+  scene.mesh48 = std::move(m48);
+}
+
+}  // namespace
+
+sim::SimulationSettings simulation_settings(const garment::Sketch& sketch) {
+  const garment::SimulateSpec& spec = sketch.simulate;
+  sim::SimulationSettings settings;
+  settings.integrator =
+      spec.integrator == "bdf2" ? sim::Integrator::bdf2 : sim::Integrator::implicit_euler;
+  settings.solver = spec.solver == "pcg" ? sim::LinearSolverKind::pcg : sim::LinearSolverKind::cholmod;
+  settings.dt = spec.time_step;
+  settings.min_dt = std::min(settings.min_dt, spec.time_step / 64);
+  settings.duration = spec.duration;
+  settings.stop_at_rest = spec.stop_at_rest;
+  settings.forces.gravity = spec.gravity;
+  try {
+    settings.validate();
+  } catch (const sim::InvalidSimulationSettingsError& e) {
+    sketch.fail("/simulate", e.what());
+  }
+  return settings;
+}
+
+ClothScene build_cloth_scene(const garment::Sketch& sketch) {
+  ClothScene scene;
+  if (sketch.sheet) {
+    build_sheet_scene(sketch, scene);
+    if (sketch.body.mesh != "none") scene.body = garment::load_sketch_body(sketch);
+  } else if (sketch.garment_mesh) {
+    build_imported_scene(sketch, scene);
+  } else {
+    build_garment_scene(sketch, scene);
+  }
+  return scene;
+}
+
+}  // namespace sd::app

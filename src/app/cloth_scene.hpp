@@ -1,0 +1,42 @@
+#pragma once
+// What `sketchdrape run` simulates, built from a sketch file: the cloth as plain simulator input
+// (a stitched garment's 4-8 triangles, or a sheet), its pins, its fabric, and the body it drapes
+// over. Only what the scene needs is built: a sheet scene loads no body and meshes no panels.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "garment/body.hpp"
+#include "garment/garment_mesh.hpp"
+#include "garment/sketch_file.hpp"
+#include "meshing/mesh48.hpp"
+#include "sim/cloth_model.hpp"
+#include "sim/fabric.hpp"
+#include "sim/simulation.hpp"
+
+namespace sd::app {
+
+struct ClothScene {
+  sim::ClothInput input;               // rest shape (the designed garment), triangles, warp
+  Eigen::MatrixX3d start;              // #V by 3 start positions, metres
+  std::vector<int> pinned;             // vertex indices held in place
+  std::string fabric_name;
+  sim::FabricParameters fabric;
+  std::optional<garment::Body> body;   // absent for a sheet without a body
+  std::optional<meshing::Mesh48> mesh48;  // the garment's 4-8 hierarchy (absent for sheets)
+  std::optional<garment::Garment> garment;
+  Eigen::VectorXi triangle_group;      // #F: group (panel or join) of each triangle
+  std::vector<std::string> group_names;
+  double meshing_ms = 0;               // time spent building the garment
+};
+
+// Builds the scene. Throws garment::SketchError (with the JSON path) for anything the designer
+// can fix: an unknown fabric, a body that will not load, panels that do not close, ...
+ClothScene build_cloth_scene(const garment::Sketch& sketch);
+
+// The simulator settings of the file's "simulate" section (integrator, solver, step, duration,
+// gravity). Throws garment::SketchError at /simulate when they cannot work together.
+sim::SimulationSettings simulation_settings(const garment::Sketch& sketch);
+
+}  // namespace sd::app

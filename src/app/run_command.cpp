@@ -1,0 +1,203 @@
+// `sketchdrape run SKETCH -o DIR`: the scene's cloth (a stitched garment or a sheet) draped by
+// the implicit simulator until it is at rest or the duration is over, then the draped mesh
+// (drape.glb and drape.obj), report.json, the images the file asks for and, with --trace, a
+// per-step log. Only the stages the scene needs run; every output appears together or not at all.
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "garment/sketch_file.hpp"
+#include "sim/simulation.hpp"
+#include "src/app/cli.hpp"
+#include "src/app/cloth_scene.hpp"
+#include "src/app/mesh_export.hpp"
+#include "src/app/preview_images.hpp"
+#include "src/app/progress.hpp"
+#include "src/render/scene.hpp"
+
+namespace sd::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct RunOptions {
+  std::string sketch;
+  std::string out = ".";
+  bool trace = false;
+};
+
+// The images of a run: the file's list, or front, back and left when it lists none.
+std::vector<garment::ImageSpec> run_images(const garment::Sketch& sketch) {
+  if (sketch.output.images_listed) return sketch.output.images;
+  std::vector<garment::ImageSpec> images;
+  for (const char* view : {"front", "back", "left"}) {
+    garment::ImageSpec image;
+    image.view = view;
+    image.width = 600;
+    image.height = 900;
+    images.push_back(image);
+  }
+  return images;
+}
+
+nlohmann::json energy_json(const std::vector<sim::EnergySample>& samples) {
+  nlohmann::json series = {{"time", nlohmann::json::array()},    {"stretch", nlohmann::json::array()},
+                           {"shear", nlohmann::json::array()},   {"bend", nlohmann::json::array()},
+                           {"kinetic", nlohmann::json::array()}, {"potential", nlohmann::json::array()}};
+  for (const sim::EnergySample& s : samples) {
+    series["time"].push_back(s.time);
+    series["stretch"].push_back(s.stretch);
+    series["shear"].push_back(s.shear);
+    series["bend"].push_back(s.bend);
+    series["kinetic"].push_back(s.kinetic);
+    series["potential"].push_back(s.potential);
+  }
+  return series;
+}
+
+nlohmann::json simulation_json(const sim::SimulationReport& r, const sim::SimulationSettings& s) {
+  return {{"steps", r.steps},
+          {"sim_time", r.sim_time},
+          {"wall_time_s", r.wall_time_s},
+          {"at_rest", r.at_rest},
+          {"retries", r.retries},
+          {"forced_steps", r.forced_steps},
+          {"nan_free", r.nan_free},
+          {"vertices", r.vertices},
+          {"triangles", r.triangles},
+          {"linear_solves", r.linear_solves},
+          {"cg_iterations_mean", r.cg_iterations_mean},
+          {"cg_iterations_max", r.cg_iterations_max},
+          {"newton_iterations_mean", r.newton_iterations_mean},
+          {"dt_min_used", r.dt_min_used},
+          {"dt_max_used", r.dt_max_used},
+          {"max_strain", r.max_strain},
+          {"timing_s", {{"forces", r.forces_s}, {"solve", r.solve_s}, {"other", r.other_s}}},
+          {"settings",
+           {{"integrator", s.integrator == sim::Integrator::bdf2 ? "bdf2" : "implicit-euler"},
+            {"solver", s.solver == sim::LinearSolverKind::pcg ? "pcg" : "cholmod"},
+            {"dt", s.dt},
+            {"duration", s.duration},
+            {"stop_at_rest", s.stop_at_rest}}},
+          {"energy", energy_json(r.energy)}};
+}
+
+nlohmann::json meshing_json(const ClothScene& scene) {
+  if (!scene.garment) return nullptr;
+  int distortion = 0, irregular = 0;
+  nlohmann::json panels = nlohmann::json::array();
+  for (const garment::GarmentPanel& p : scene.garment->panels) {
+    distortion += p.distortion;
+    irregular += p.irregular_vertices;
+    panels.push_back({{"id", p.id},
+                      {"sides", p.side_counts.size()},
+                      {"distortion", p.distortion},
+                      {"irregular_vertices", p.irregular_vertices},
+                      {"partition", p.partition},
+                      {"quads", p.faces}});
+  }
+  return {{"distortion", distortion},
+          {"irregular_vertices", irregular},
+          {"quads", scene.garment->mesh.face_count()},
+          {"meshing_ms", scene.meshing_ms},
+          {"panels", panels}};
+}
+
+void run_drape(const RunOptions& options, const GlobalOptions& global) {
+  const auto start = Clock::now();
+  const garment::Sketch sketch = garment::load_sketch(options.sketch);
+  const sim::SimulationSettings settings = simulation_settings(sketch);
+  const ClothScene scene = build_cloth_scene(sketch);
+  if (scene.pinned.empty())
+    spdlog::warn("nothing holds the cloth (no pins{}): it will fall for the whole run",
+                 scene.body ? " and body contact is not simulated yet" : "");
+
+  sim::ClothModel model = [&] {
+    try {
+      return sim::build_cloth_model(scene.input, scene.fabric);
+    } catch (const sim::InvalidFabricError& e) {
+      sketch.fail("/fabric", e.what());
+    }
+  }();
+  std::vector<sim::Pin> pins;
+  for (int v : scene.pinned) pins.push_back({v, {}});
+  sim::Simulation simulation(std::move(model), sim::flatten_positions(scene.start), pins, settings);
+
+  const std::filesystem::path dir(options.out);
+  StagedOutputs outputs;
+  std::string trace;
+  Progress progress("draping", static_cast<long>(std::ceil(settings.duration * 1000)), global.quiet);
+  const sim::SimulationReport& report = simulation.run([&](const sim::Simulation& s) {
+    progress.update(static_cast<long>(s.time() * 1000), fmt::format("t = {:.2f} s", s.time()));
+    if (!options.trace) return;
+    const sim::SimulationReport& r = s.report();
+    nlohmann::json line = {{"step", r.steps}, {"time", s.time()}, {"dt", s.current_dt()},
+                           {"retries", r.retries}};
+    if (!r.energy.empty()) {
+      const sim::EnergySample& e = r.energy.back();
+      line["energy"] = {{"stretch", e.stretch}, {"shear", e.shear}, {"bend", e.bend},
+                        {"kinetic", e.kinetic}, {"potential", e.potential}};
+    }
+    trace += line.dump() + "\n";
+  });
+  progress.finish();
+  if (report.failed)
+    throw std::runtime_error(fmt::format("the simulation failed at t = {:.3f} s: {}",
+                                         report.sim_time, report.failure_reason));
+
+  // The draped cloth, one group per panel.
+  meshing::TriMesh draped;
+  draped.vertices = sim::unflatten_positions(simulation.positions());
+  draped.faces = scene.input.triangles;
+  const ExportMesh mesh{draped.vertices, draped.faces,
+                        std::vector<int>(scene.triangle_group.data(),
+                                         scene.triangle_group.data() + scene.triangle_group.size()),
+                        scene.group_names};
+  outputs.stage(dir / "drape.glb", to_glb(mesh, "drape"));
+  outputs.stage(dir / "drape.obj", to_obj(mesh, "drape"));
+
+  const auto image_start = Clock::now();
+  const PreviewCloth preview{draped, scene.triangle_group, render::triangle_edges(draped), {}};
+  const std::vector<std::string> images =
+      stage_preview_images(run_images(sketch), sketch.output.wireframe,
+                           scene.body ? &scene.body->mesh : nullptr, preview, "drape", dir, outputs);
+  const double image_s = std::chrono::duration<double>(Clock::now() - image_start).count();
+
+  nlohmann::json out = simulation_json(report, settings);
+  out["format"] = "sketchdrape/1 run report";
+  out["sketch"] = sketch.file;
+  out["scene"] = sketch.sheet ? "sheet" : (sketch.garment_mesh ? "imported garment" : "garment");
+  out["fabric"] = scene.fabric_name;
+  out["body"] = scene.body ? nlohmann::json(scene.body->raw.source) : nlohmann::json(nullptr);
+  out["pinned_vertices"] = scene.pinned.size();
+  out["meshing"] = meshing_json(scene);
+  out["images"] = images;
+  out["timing_s"]["images"] = image_s;
+  out["timing_s"]["total"] = std::chrono::duration<double>(Clock::now() - start).count();
+  if (sketch.output.report) outputs.stage(dir / "report.json", out.dump(2) + "\n");
+  if (options.trace) outputs.stage(dir / "trace.jsonl", trace);
+  outputs.commit();
+  spdlog::info("draped {} → {}: {} steps, {:.2f} s simulated{}, {:.2f} s wall", sketch.file,
+               dir.string(), report.steps, report.sim_time, report.at_rest ? " (at rest)" : "",
+               report.wall_time_s);
+}
+
+}  // namespace
+
+void add_run_command(CLI::App& app, const GlobalOptions& global) {
+  auto options = std::make_shared<RunOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "run", "Drape a sketch's garment (or sheet) with the cloth simulator: draped mesh, report, "
+             "images");
+  cmd->add_option("SKETCH", options->sketch, "Sketch file (format sketchdrape/1)")->required();
+  cmd->add_option("-o,--out", options->out, "Output directory (created if needed)");
+  cmd->add_flag("--trace", options->trace, "Also write trace.jsonl: one JSON line per step");
+  cmd->callback([options, &global] { run_drape(*options, global); });
+}
+
+}  // namespace sd::app

@@ -1,0 +1,139 @@
+// `sketchdrape run` as a user runs it: a sheet scene and a pinned garment drape and write their
+// outputs; mistakes exit 2 and write nothing.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "tests/cli/run_command.hpp"
+
+namespace sd::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / "sd_run_test" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+fs::path write_sketch(const fs::path& dir, const nlohmann::json& sketch) {
+  const fs::path path = dir / "scene.json";
+  std::ofstream(path) << sketch.dump(2);
+  return path;
+}
+
+nlohmann::json read_json(const fs::path& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in, nullptr, true, /*ignore_comments=*/true);
+}
+
+nlohmann::json small_sheet() {
+  return {{"format", "sketchdrape/1"},
+          {"sheet",
+           {{"size", {0.5, 0.5}},
+            {"resolution", {6, 6}},
+            {"orientation", "horizontal"},
+            {"pins", {"top-left", "top-right"}}}},
+          {"fabric", "cotton"},
+          {"simulate", {{"duration", 0.5}}},
+          {"output", {{"images", nlohmann::json::array()}}}};
+}
+
+TEST(RunCommand, SheetSceneWritesReportMeshAndTrace) {
+  const fs::path dir = fresh_dir("sheet");
+  const fs::path out = dir / "out";
+  const CommandResult r =
+      run_sketchdrape("-q run " + write_sketch(dir, small_sheet()).string() + " -o " + out.string() + " --trace");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json report = read_json(out / "report.json");
+  for (const char* key : {"steps", "sim_time", "wall_time_s", "at_rest", "retries", "nan_free",
+                          "vertices", "triangles", "cg_iterations_mean", "cg_iterations_max",
+                          "timing_s", "energy"})
+    EXPECT_TRUE(report.contains(key)) << key;
+  EXPECT_EQ(report["vertices"], 49);
+  EXPECT_EQ(report["triangles"], 72);
+  EXPECT_TRUE(report["nan_free"].get<bool>());
+  EXPECT_EQ(report["scene"], "sheet");
+  EXPECT_EQ(report["pinned_vertices"], 2);
+  const int steps = report["steps"];
+  EXPECT_GT(steps, 0);
+  EXPECT_NEAR(report["sim_time"].get<double>(), 0.5, 1e-9);
+  EXPECT_EQ(report["energy"]["kinetic"].size(), static_cast<size_t>(steps) + 1);  // and t = 0
+  for (const char* phase : {"forces", "solve", "other"})
+    EXPECT_GE(report["timing_s"][phase].get<double>(), 0.0) << phase;
+  // Gravity did work: the free corners fell below the pinned edge.
+  EXPECT_LT(report["energy"]["potential"].back().get<double>(),
+            report["energy"]["potential"].front().get<double>());
+
+  std::ifstream trace(out / "trace.jsonl");
+  std::string line;
+  int lines = 0;
+  while (std::getline(trace, line)) {
+    const auto j = nlohmann::json::parse(line);
+    EXPECT_EQ(j["step"], ++lines);
+  }
+  EXPECT_EQ(lines, steps);
+  EXPECT_TRUE(fs::exists(out / "drape.glb"));
+  std::ifstream obj(out / "drape.obj");
+  std::stringstream text;
+  text << obj.rdbuf();
+  size_t faces = 0;
+  for (size_t at = text.str().find("\nf "); at != std::string::npos; at = text.str().find("\nf ", at + 1))
+    ++faces;
+  EXPECT_EQ(faces, 72u);
+  EXPECT_FALSE(fs::exists(out / "drape-front.png"));  // "images": [] asks for none
+}
+
+TEST(RunCommand, PinnedGarmentDrapesWithImages) {
+  const fs::path dir = fresh_dir("garment");
+  nlohmann::json sketch = read_json(fs::path(SD_SOURCE_DIR) / "data/examples/a-line-skirt.json");
+  sketch["simulate"] = {{"duration", 0.1}, {"pin_above", 0.98}};
+  sketch["output"] = {{"images", {{{"view", "front"}, {"size", {120, 180}}}}}};
+  // The example's body path ("builtin") does not depend on where the sketch lives.
+  const fs::path out = dir / "out";
+  const CommandResult r =
+      run_sketchdrape("-q run " + write_sketch(dir, sketch).string() + " -o " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json report = read_json(out / "report.json");
+  EXPECT_EQ(report["scene"], "garment");
+  EXPECT_GT(report["pinned_vertices"].get<int>(), 0);
+  EXPECT_GT(report["meshing"]["quads"].get<int>(), 0);
+  EXPECT_EQ(report["triangles"].get<int>(), 2 * report["meshing"]["quads"].get<int>());
+  EXPECT_TRUE(fs::exists(out / "drape-front.png"));
+  EXPECT_TRUE(report["nan_free"].get<bool>());
+}
+
+TEST(RunCommand, MistakesExitTwoAndWriteNothing) {
+  struct Case {
+    std::string name;
+    nlohmann::json patch;
+    std::string fragment;
+  };
+  const std::vector<Case> cases = {
+      {"fabric", {{"fabric", "velvet"}}, "/fabric"},
+      {"step", {{"simulate", {{"time_step", -0.01}}}}, "/simulate/time_step"},
+      {"pins", {{"sheet", {{"pins", {"middle"}}}}}, "/sheet/pins/0"},
+      {"integrator", {{"simulate", {{"integrator", "rk4"}}}}, "/simulate/integrator"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const fs::path dir = fresh_dir("bad-" + c.name);
+    nlohmann::json sketch = small_sheet();
+    sketch.merge_patch(c.patch);
+    const fs::path out = dir / "out";
+    const CommandResult r =
+        run_sketchdrape("run " + write_sketch(dir, sketch).string() + " -o " + out.string());
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find(c.fragment), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(out)) << "nothing may be written";
+  }
+}
+
+}  // namespace
+}  // namespace sd::test
