@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <fmt/format.h>
+#include <poll.h>
 #include <signal.h>
 #include <spawn.h>
 #include <spdlog/spdlog.h>
@@ -9,6 +10,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -35,43 +38,64 @@ std::filesystem::path own_executable() {
   return exe;
 }
 
-// Blocks SIGCHLD, SIGINT and SIGTERM while the batch runs so they are taken one at a time with
-// sigtimedwait (no handlers, no races); restores the old mask on destruction.
+// Turns SIGCHLD, SIGINT and SIGTERM into bytes on a pipe that the loop polls. Handlers rather
+// than blocked signals and sigtimedwait: libraries start threads (OpenBLAS does at load time)
+// that do not block them, and a process-directed signal may be delivered to any such thread.
+// A handler runs in whichever thread gets the signal, and the pipe wakes the loop either way.
+int g_wake_fd = -1;
+volatile sig_atomic_t g_stop_signal = 0;
+
+extern "C" void on_batch_signal(int sig) {
+  if (sig != SIGCHLD) g_stop_signal = sig;
+  const int saved = errno;
+  const char byte = 0;
+  [[maybe_unused]] const ssize_t n = ::write(g_wake_fd, &byte, 1);
+  errno = saved;
+}
+
 class SignalGate {
  public:
   SignalGate() {
-    sigemptyset(&set_);
-    sigaddset(&set_, SIGCHLD);
-    sigaddset(&set_, SIGINT);
-    sigaddset(&set_, SIGTERM);
-    sigprocmask(SIG_BLOCK, &set_, &old_);
+    if (::pipe2(fds_, O_CLOEXEC | O_NONBLOCK) != 0)
+      throw std::runtime_error(std::string("cannot create a pipe: ") + std::strerror(errno));
+    g_wake_fd = fds_[1];
+    g_stop_signal = 0;
+    struct sigaction action {};
+    action.sa_handler = on_batch_signal;
+    sigemptyset(&action.sa_mask);
+    action.sa_flags = SA_RESTART | SA_NOCLDSTOP;
+    for (size_t i = 0; i < kSignals.size(); ++i) {
+      sigaction(kSignals[i], nullptr, &old_[i]);
+      // An ignored SIGINT (a batch started with nohup or in the background) stays ignored.
+      if (kSignals[i] == SIGINT && old_[i].sa_handler == SIG_IGN) continue;
+      sigaction(kSignals[i], &action, nullptr);
+    }
   }
   ~SignalGate() {
-    // Drop a pending SIGCHLD so it is not delivered (ignored by default anyway) later.
-    timespec zero{0, 0};
-    siginfo_t info;
-    sigset_t chld;
-    sigemptyset(&chld);
-    sigaddset(&chld, SIGCHLD);
-    while (sigtimedwait(&chld, &info, &zero) > 0) {
-    }
-    sigprocmask(SIG_SETMASK, &old_, nullptr);
+    for (size_t i = 0; i < kSignals.size(); ++i) sigaction(kSignals[i], &old_[i], nullptr);
+    g_wake_fd = -1;
+    ::close(fds_[0]);
+    ::close(fds_[1]);
   }
   SignalGate(const SignalGate&) = delete;
   SignalGate& operator=(const SignalGate&) = delete;
 
-  // Waits up to `timeout` for a signal of the set; returns its number or 0.
+  // Waits up to `timeout` for a signal; returns SIGINT or SIGTERM if one came, else 0.
   int wait(std::chrono::milliseconds timeout) const {
-    timespec ts{static_cast<time_t>(timeout.count() / 1000),
-                static_cast<long>((timeout.count() % 1000) * 1000000)};
-    siginfo_t info;
-    const int sig = sigtimedwait(&set_, &info, &ts);
-    return sig > 0 ? sig : 0;
+    pollfd fd{fds_[0], POLLIN, 0};
+    ::poll(&fd, 1, static_cast<int>(timeout.count()));
+    char buffer[64];
+    while (::read(fds_[0], buffer, sizeof buffer) > 0) {
+    }
+    const int sig = g_stop_signal;
+    g_stop_signal = 0;
+    return sig;
   }
 
  private:
-  sigset_t set_;
-  sigset_t old_;
+  static constexpr std::array<int, 3> kSignals = {SIGCHLD, SIGINT, SIGTERM};
+  int fds_[2] = {-1, -1};
+  std::array<struct sigaction, 3> old_{};
 };
 
 struct RunningJob {
@@ -93,14 +117,15 @@ pid_t spawn_child(const std::filesystem::path& exe, const std::vector<std::strin
   posix_spawn_file_actions_adddup2(&actions, 1, 2);
   posix_spawnattr_t attr;
   posix_spawnattr_init(&attr);
-  sigset_t none, all;
+  // Children start with no blocked signals and default SIGTERM and SIGCHLD (exec resets caught
+  // signals anyway; an ignored SIGINT stays ignored, as nohup intends).
+  sigset_t none, defaults;
   sigemptyset(&none);
-  sigemptyset(&all);
-  sigaddset(&all, SIGINT);
-  sigaddset(&all, SIGTERM);
-  sigaddset(&all, SIGCHLD);
+  sigemptyset(&defaults);
+  sigaddset(&defaults, SIGTERM);
+  sigaddset(&defaults, SIGCHLD);
   posix_spawnattr_setsigmask(&attr, &none);
-  posix_spawnattr_setsigdefault(&attr, &all);
+  posix_spawnattr_setsigdefault(&attr, &defaults);
   posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
 
   std::vector<std::string> argv_strings;
