@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -101,9 +102,12 @@ void BM_Rebuild(benchmark::State& state) {
     if (state.range(1) == 0) {
       benchmark::DoNotOptimize(build_cloth_model(input, fabric));
     } else {
+      // Split one block and merge it back: its split vertex is the newest (last) vertex.
       const sd::meshing::BlockId leaf = cloth.mesh().leaf_blocks().front();
       rebuild += cloth.split_blocks({leaf}).rebuild_s;
-      rebuild += cloth.merge_blocks(cloth.mesh().mergeable_blocks()).rebuild_s;
+      const sd::meshing::VertexId newest(cloth.mesh().vertex_count() - 1);
+      for (sd::meshing::BlockId k : cloth.mesh().mergeable_blocks())
+        if (cloth.mesh().split_vertex(k) == newest) rebuild += cloth.merge_blocks({k}).rebuild_s;
     }
   }
   state.counters["vertices"] = cloth.mesh().vertex_count();
@@ -126,6 +130,7 @@ BENCHMARK(BM_AdaptiveStep)->Unit(benchmark::kMillisecond)->Iterations(30);
 struct RunResult {
   std::string name;
   double wall_s = 0;       // stepping only (sampling for the error excluded)
+  double cpu_s = 0;        // process CPU time of the stepping (single-threaded BLAS/OpenMP)
   double solve_s = 0;
   double forces_s = 0;
   double adaptivity_s = 0;  // estimates + operations + rebuild
@@ -137,6 +142,22 @@ struct RunResult {
   ShapeFigures shape;
 };
 
+// The mesh as gnuplot polygons: per triangle its 3 corners (x y z rgb-of-level), blank line after.
+void write_mesh(const std::string& path, const AdaptiveCloth& cloth) {
+  static const int kColours[] = {0x440154, 0x3b528b, 0x21918c, 0x5ec962, 0xb5de2b,
+                                 0xfde725, 0xf89540, 0xcc4778, 0x7e03a8};
+  std::ofstream out(path);
+  const Eigen::MatrixX3d x = cloth.positions();
+  for (Eigen::Index f = 0; f < cloth.faces().rows(); ++f) {
+    const int colour = kColours[std::min(8, cloth.face_levels()(f))];
+    for (int k = 0; k < 3; ++k) {
+      const auto p = x.row(cloth.faces()(f, k));
+      out << p(0) << ' ' << p(1) << ' ' << p(2) << ' ' << colour << '\n';
+    }
+    out << "\n";
+  }
+}
+
 RunResult run_case(const std::string& dir, const std::string& scene, const std::string& name,
                    const AdaptiveSheetSpec& spec, int start_level, const AdaptiveSettings& adaptive,
                    const Eigen::MatrixX3d& points, double sample_every) {
@@ -144,12 +165,12 @@ RunResult run_case(const std::string& dir, const std::string& scene, const std::
   RunResult result;
   result.name = name;
   std::ofstream csv(dir + "/" + scene + "_" + name + ".csv");
-  csv << "time,wall_s,vertices,triangles,splits,merges,stretch,shear,bend,kinetic,potential\n";
+  csv << "time,wall_s,cpu_s,vertices,triangles,splits,merges,stretch,shear,bend,kinetic,potential\n";
   double wall = 0.0;
   double next_sample = 0.0;
   const auto write_row = [&](const AdaptiveCloth& c, int splits, int merges) {
     const EnergyBreakdown e = c.simulation().energy();
-    csv << c.time() << ',' << wall << ',' << c.mesh().vertex_count() << ','
+    csv << c.time() << ',' << wall << ',' << result.cpu_s << ',' << c.mesh().vertex_count() << ','
         << c.mesh().triangle_count() << ',' << splits << ',' << merges << ',' << e.stretch << ','
         << e.shear << ',' << e.bend << ',' << e.kinetic << ',' << e.potential << '\n';
   };
@@ -160,8 +181,10 @@ RunResult run_case(const std::string& dir, const std::string& scene, const std::
   while (cloth.time() < spec.duration - epsilon) {
     const double until = std::min(spec.duration, next_sample) - cloth.time();
     const auto start = Clock::now();
+    const std::clock_t cpu_start = std::clock();
     const StepOutcome outcome = cloth.step(until);
     wall += std::chrono::duration<double>(Clock::now() - start).count();
+    result.cpu_s += static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
     if (!outcome.accepted) {
       std::fprintf(stderr, "%s %s: step failed: %s\n", scene.c_str(), name.c_str(),
                    outcome.failure_reason.c_str());
@@ -169,11 +192,13 @@ RunResult run_case(const std::string& dir, const std::string& scene, const std::
     }
     const AdaptiveStepRecord& record = cloth.report().steps.back();
     write_row(cloth, record.splits + record.forced_splits, record.merges);
+    if (std::abs(cloth.time() - 1.0) < epsilon) write_mesh(dir + "/" + scene + "_" + name + "_t1.dat", cloth);
     if (cloth.time() >= next_sample - epsilon) {
       result.samples.push_back(material_positions(cloth, points));
       next_sample += sample_every;
     }
   }
+  write_mesh(dir + "/" + scene + "_" + name + "_end.dat", cloth);
   const AdaptiveReport& report = cloth.report();
   const SimulationReport& sim = cloth.simulation().report();
   result.wall_s = wall;
@@ -209,7 +234,7 @@ void errors_against(RunResult& run, const RunResult& reference) {
 int run_study(const std::string& dir, bool quick) {
   std::filesystem::create_directories(dir);
   std::ofstream summary(dir + "/summary.csv");
-  summary << "scene,run,wall_s,forces_s,solve_s,estimate_s,operations_s,rebuild_s,steps,retries,"
+  summary << "scene,run,cpu_s,wall_s,forces_s,solve_s,estimate_s,operations_s,rebuild_s,steps,retries,"
              "vertices_final,vertices_max,splits,forced_splits,merges,topology_changes,"
              "error_final_m,error_trajectory_m,lowest_m,extent_x,extent_y,extent_z\n";
   const std::vector<std::pair<std::string, std::vector<std::string>>> scenes = {
@@ -235,7 +260,7 @@ int run_study(const std::string& dir, bool quick) {
     runs.push_back(reference);
     for (RunResult& run : runs) {
       errors_against(run, reference);
-      summary << scene << ',' << run.name << ',' << run.wall_s << ',' << run.forces_s << ','
+      summary << scene << ',' << run.name << ',' << run.cpu_s << ',' << run.wall_s << ',' << run.forces_s << ','
               << run.solve_s << ',' << run.estimate_s << ',' << run.operations_s << ','
               << run.rebuild_s << ',' << run.steps << ',' << run.retries << ','
               << run.vertices_final << ',' << run.vertices_max << ',' << run.splits << ','
@@ -244,10 +269,10 @@ int run_study(const std::string& dir, bool quick) {
               << run.shape.extent.x() << ',' << run.shape.extent.y() << ',' << run.shape.extent.z()
               << '\n';
       std::printf(
-          "%-13s %-16s wall %7.2f s (forces %6.2f solve %6.2f adapt %5.3f = est %5.3f + ops %5.3f "
+          "%-13s %-16s cpu %7.2f s wall %7.2f s (forces %6.2f solve %6.2f adapt %5.3f = est %5.3f + ops %5.3f "
           "+ rebuild %5.3f) steps %4d retries %3d verts %5d (max %5d) splits %5d+%4d merges %5d "
           "error final %.2f mm trajectory %.2f mm lowest %.4f\n",
-          scene.c_str(), run.name.c_str(), run.wall_s, run.forces_s, run.solve_s,
+          scene.c_str(), run.name.c_str(), run.cpu_s, run.wall_s, run.forces_s, run.solve_s,
           run.adaptivity_s, run.estimate_s, run.operations_s, run.rebuild_s, run.steps,
           run.retries, run.vertices_final, run.vertices_max, run.splits, run.forced, run.merges,
           1e3 * run.error_final, 1e3 * run.error_trajectory, run.shape.lowest);
