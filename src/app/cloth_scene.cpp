@@ -104,6 +104,9 @@ void build_garment_scene(const garment::Sketch& sketch, ClothScene& scene) {
   }
   scene.start = arrays.rest_positions;
   pin_above(sketch, scene);
+  scene.mesh48_face_group.resize(g.mesh.face_count());
+  for (Eigen::Index q = 0; q < g.mesh.face_count(); ++q)
+    scene.mesh48_face_group(q) = panel_group[static_cast<size_t>(g.face_panel(q))];
   scene.mesh48 = std::move(m48);
   scene.garment = std::move(g);
 }
@@ -130,6 +133,7 @@ void build_imported_scene(const garment::Sketch& sketch, ClothScene& scene) {
   scene.fabric_name = sketch.fabric;
   scene.fabric = fabric_at(sketch, sketch.fabric, "/fabric");
   pin_above(sketch, scene);
+  scene.mesh48_face_group = Eigen::VectorXi::Zero(triangles.face_count());
   scene.mesh48 = std::move(m48);
 }
 

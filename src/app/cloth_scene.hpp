@@ -27,6 +27,7 @@ struct ClothScene {
   std::optional<meshing::Mesh48> mesh48;  // the garment's 4-8 hierarchy (absent for sheets)
   std::optional<garment::Garment> garment;
   Eigen::VectorXi triangle_group;      // #F: group (panel or join) of each triangle
+  Eigen::VectorXi mesh48_face_group;   // group of each input face of mesh48 (quad or triangle)
   std::vector<std::string> group_names;
   double meshing_ms = 0;               // time spent building the garment
 };

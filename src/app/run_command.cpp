@@ -12,6 +12,8 @@
 #include <nlohmann/json.hpp>
 
 #include "garment/sketch_file.hpp"
+#include "garment/material_frames.hpp"
+#include "sim/adaptive_detail.hpp"
 #include "sim/simulation.hpp"
 #include "src/app/cli.hpp"
 #include "src/app/cloth_scene.hpp"
@@ -117,52 +119,87 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
     spdlog::warn("nothing holds the cloth (no pins{}): it will fall for the whole run",
                  scene.body ? " and body contact is not simulated yet" : "");
 
-  sim::ClothModel model = [&] {
-    try {
-      return sim::build_cloth_model(scene.input, scene.fabric);
-    } catch (const sim::InvalidFabricError& e) {
-      sketch.fail("/fabric", e.what());
-    }
-  }();
   std::vector<sim::Pin> pins;
   for (int v : scene.pinned) pins.push_back({v, {}});
-  sim::Simulation simulation(std::move(model), sim::flatten_positions(scene.start), pins, settings);
 
   const std::filesystem::path dir(options.out);
   StagedOutputs outputs;
   std::string trace;
   Progress progress("draping", static_cast<long>(std::ceil(settings.duration * 1000)), global.quiet);
-  const sim::SimulationReport& report = simulation.run([&](const sim::Simulation& s) {
+  // Called after every accepted step, by either driver.
+  const auto on_step = [&](const sim::Simulation& s) {
     progress.update(static_cast<long>(s.time() * 1000), fmt::format("t = {:.2f} s", s.time()));
     if (!options.trace) return;
     const sim::SimulationReport& r = s.report();
     nlohmann::json line = {{"step", r.steps}, {"time", s.time()}, {"dt", s.current_dt()},
-                           {"retries", r.retries}};
+                           {"retries", r.retries}, {"vertices", s.model().vertex_count}};
     if (!r.energy.empty()) {
       const sim::EnergySample& e = r.energy.back();
       line["energy"] = {{"stretch", e.stretch}, {"shear", e.shear}, {"bend", e.bend},
                         {"kinetic", e.kinetic}, {"potential", e.potential}};
     }
     trace += line.dump() + "\n";
-  });
+  };
+
+  // Adaptive 4-8 detail needs the garment's block hierarchy; a sheet runs on its fixed mesh.
+  sim::SimulationReport report;
+  nlohmann::json adaptive_json = nullptr;
+  meshing::TriMesh draped;
+  Eigen::VectorXi triangle_group = scene.triangle_group;
+  Eigen::VectorXd face_levels;
+  try {
+    if (sketch.simulate.adaptive && scene.mesh48) {
+      sim::AdaptiveMaterial material;
+      material.fabric = scene.fabric;
+      if (scene.garment) material.source_warp = garment::material_frames(scene.garment->mesh).warp;
+      sim::AdaptiveCloth cloth(*scene.mesh48, material, scene.start, pins, settings,
+                               sim::AdaptiveSettings{});
+      const sim::AdaptiveReport adaptive =
+          cloth.run([&](const sim::AdaptiveCloth& c) { on_step(c.simulation()); });
+      report = adaptive.simulation;
+      draped.vertices = cloth.positions();
+      draped.faces = cloth.faces();
+      face_levels = cloth.face_levels().cast<double>();
+      // Each triangle keeps the group of the input face (quad) it descends from.
+      const meshing::Mesh48Arrays arrays = cloth.mesh().arrays();
+      const Eigen::VectorXi source_group = scene.mesh48_face_group;
+      triangle_group.resize(arrays.faces.rows());
+      for (Eigen::Index t = 0; t < arrays.faces.rows(); ++t)
+        triangle_group(t) = source_group(
+            cloth.mesh().source_face(arrays.triangle_ids[static_cast<size_t>(t)]));
+      adaptive_json = {{"splits", adaptive.splits},
+                       {"forced_splits", adaptive.forced_splits},
+                       {"merges", adaptive.merges},
+                       {"topology_changes", adaptive.topology_changes},
+                       {"vertices_min", adaptive.vertices_min},
+                       {"vertices_max", adaptive.vertices_max},
+                       {"max_level_reached", adaptive.max_level_reached},
+                       {"adaptivity_s", adaptive.adaptivity_s()}};
+    } else {
+      sim::Simulation simulation(sim::build_cloth_model(scene.input, scene.fabric),
+                                 sim::flatten_positions(scene.start), pins, settings);
+      report = simulation.run(on_step);
+      draped.vertices = sim::unflatten_positions(simulation.positions());
+      draped.faces = scene.input.triangles;
+    }
+  } catch (const sim::InvalidFabricError& e) {
+    sketch.fail("/fabric", e.what());
+  }
   progress.finish();
   if (report.failed)
     throw std::runtime_error(fmt::format("the simulation failed at t = {:.3f} s: {}",
                                          report.sim_time, report.failure_reason));
 
   // The draped cloth, one group per panel.
-  meshing::TriMesh draped;
-  draped.vertices = sim::unflatten_positions(simulation.positions());
-  draped.faces = scene.input.triangles;
   const ExportMesh mesh{draped.vertices, draped.faces,
-                        std::vector<int>(scene.triangle_group.data(),
-                                         scene.triangle_group.data() + scene.triangle_group.size()),
+                        std::vector<int>(triangle_group.data(),
+                                         triangle_group.data() + triangle_group.size()),
                         scene.group_names};
   outputs.stage(dir / "drape.glb", to_glb(mesh, "drape"));
   outputs.stage(dir / "drape.obj", to_obj(mesh, "drape"));
 
   const auto image_start = Clock::now();
-  const PreviewCloth preview{draped, scene.triangle_group, render::triangle_edges(draped), {}};
+  const PreviewCloth preview{draped, triangle_group, render::triangle_edges(draped), face_levels};
   const std::vector<std::string> images =
       stage_preview_images(run_images(sketch), sketch.output.wireframe,
                            scene.body ? &scene.body->mesh : nullptr, preview, "drape", dir, outputs);
@@ -176,6 +213,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   out["body"] = scene.body ? nlohmann::json(scene.body->raw.source) : nlohmann::json(nullptr);
   out["pinned_vertices"] = scene.pinned.size();
   out["meshing"] = meshing_json(scene);
+  out["adaptive"] = adaptive_json;
   out["images"] = images;
   out["timing_s"]["images"] = image_s;
   out["timing_s"]["total"] = std::chrono::duration<double>(Clock::now() - start).count();
