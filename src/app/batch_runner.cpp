@@ -190,7 +190,7 @@ BatchResult run_batch(const BatchOptions& options) {
   if (ec)
     throw std::runtime_error(
         fmt::format("cannot create '{}': {}", jobs_dir.string(), ec.message()));
-  write_file_atomically(options.out / kPlanFile, plan_to_json(plan).dump(2) + "\n");
+  write_plan(options.out, plan);
 
   BatchResult result;
   std::map<std::string, KnownRecord> records;  // this run's outcome per job id

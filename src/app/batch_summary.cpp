@@ -1,10 +1,13 @@
 #include "src/app/batch_summary.hpp"
 
+#include <unistd.h>
+
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cctype>
 #include <fstream>
+#include <random>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -386,6 +389,38 @@ std::string contact_sheet_html(const BatchPlan& plan, const std::vector<JobSumma
   }
   h += "</tbody>\n</table>\n<script>" + std::string(kScript) + "</script>\n</body>\n</html>\n";
   return h;
+}
+
+void write_plan(const std::filesystem::path& out, const BatchPlan& plan) {
+  const std::string text = plan_to_json(plan).dump(2) + "\n";
+  const std::filesystem::path path = out / kPlanFile;
+  {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream existing;
+    existing << in.rdbuf();
+    if (in && existing.str() == text) return;
+  }
+  char host[256] = "host";
+  ::gethostname(host, sizeof host - 1);
+  std::random_device random;
+  const std::filesystem::path temp =
+      out / fmt::format(".{}.tmp-{}-{}-{:08x}", kPlanFile, host, ::getpid(), random());
+  {
+    std::ofstream file(temp, std::ios::binary);
+    file << text;
+    file.close();
+    if (!file) {
+      std::error_code ignored;
+      std::filesystem::remove(temp, ignored);
+      throw std::runtime_error(fmt::format("cannot write '{}'", path.string()));
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(temp, path, ec);
+  if (ec) {
+    std::filesystem::remove(temp, ec);
+    throw std::runtime_error(fmt::format("cannot write '{}': {}", path.string(), ec.message()));
+  }
 }
 
 void write_summary(const std::filesystem::path& out, const BatchPlan& plan,

@@ -78,6 +78,11 @@ nlohmann::json summary_json(const BatchPlan& plan, const std::vector<JobSummary>
 // with a table of one row per job, sortable by clicking a column header.
 std::string contact_sheet_html(const BatchPlan& plan, const std::vector<JobSummary>& jobs);
 
+// Writes <out>/batch-plan.json unless it already holds exactly this plan. Shards on several
+// hosts write it at once into a shared folder, so the temporary file's name carries the host
+// name, the process id and a random number (a pid alone may repeat across hosts).
+void write_plan(const std::filesystem::path& out, const BatchPlan& plan);
+
 // Writes batch.json and index.html atomically into `out`.
 void write_summary(const std::filesystem::path& out, const BatchPlan& plan,
                    const std::vector<JobSummary>& jobs);

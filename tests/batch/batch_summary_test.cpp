@@ -110,6 +110,21 @@ TEST(ContactSheet, OneRowPerJobEscapedTextRelativeImagesAndSortableHeaders) {
   EXPECT_EQ(html.find("<script src"), std::string::npos);
 }
 
+TEST(WritePlan, WritesOnceLeavesNoTemporariesAndReplacesAChangedPlan) {
+  const fs::path out = test::fresh_batch_dir("write_plan");
+  BatchPlan plan = plan_of({"a", "b"});
+  write_plan(out, plan);
+  EXPECT_EQ(plan_from_json(json::parse(test::read_text(out / kPlanFile)), "p").jobs.size(), 2u);
+  const auto first = fs::last_write_time(out / kPlanFile);
+  fs::last_write_time(out / kPlanFile, first - std::chrono::hours(1));
+  write_plan(out, plan);  // the same plan: the file is left alone
+  EXPECT_EQ(fs::last_write_time(out / kPlanFile), first - std::chrono::hours(1));
+  plan.jobs.pop_back();
+  write_plan(out, plan);
+  EXPECT_EQ(plan_from_json(json::parse(test::read_text(out / kPlanFile)), "p").jobs.size(), 1u);
+  EXPECT_EQ(std::distance(fs::directory_iterator(out), fs::directory_iterator()), 1);
+}
+
 TEST(Collect, RebuildsFromPlanMarkersAndShardFiles) {
   const fs::path out = test::fresh_batch_dir("collect");
   EXPECT_THROW(collect_batch(out), std::invalid_argument);
