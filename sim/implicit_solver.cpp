@@ -13,9 +13,18 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
+void ImplicitSolver::add_damping_force(const std::vector<VertexDamping>* damping,
+                                       const Eigen::VectorXd& v) {
+  if (damping == nullptr) return;
+  for (const VertexDamping& d : *damping)
+    force_.segment<3>(3 * d.vertex) +=
+        d.force - d.coefficient * (v.segment<3>(3 * d.vertex) - d.reference_velocity);
+}
+
 void ImplicitSolver::assemble(const ClothModel& model, const ForceSettings& forces, double beta,
                               const Eigen::VectorXd& x, const Eigen::VectorXd& v,
-                              const Eigen::VectorXd* u, ImplicitSolveResult& result) {
+                              const Eigen::VectorXd* u, const std::vector<VertexDamping>* damping,
+                              ImplicitSolveResult& result) {
   const auto start = std::chrono::steady_clock::now();
   const SparseMatrixR& pattern = model.pattern.zero_matrix;
   if (matrix_.rows() != pattern.rows() || matrix_.nonZeros() != pattern.nonZeros() ||
@@ -41,6 +50,14 @@ void ImplicitSolver::assemble(const ClothModel& model, const ForceSettings& forc
     target.product_output = &product_;
   }
   evaluate_forces(model, forces, x, v, force_, nullptr, &target);
+  // Vertex drags: ∂f/∂v = −C, so A gains β C on the vertex's diagonal block.
+  if (damping != nullptr)
+    for (const VertexDamping& d : *damping)
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b)
+          values[block_value_index(matrix_, d.vertex, model.pattern.diagonal_offsets[d.vertex], a,
+                                   b)] += beta * d.coefficient(a, b);
+  add_damping_force(damping, v);
   result.forces_seconds += seconds_since(start);
 }
 
@@ -66,13 +83,28 @@ bool ImplicitSolver::linear_solve(const ClothModel& model, const ConstraintFilte
   return stats.converged && step_.allFinite();
 }
 
+void ImplicitSolver::record_constraint_impulse(const ConstraintFilter& filter,
+                                               ImplicitSolveResult& result) {
+  if (filter.constrained_count() == 0) {
+    result.constraint_impulse.resize(0);
+    return;
+  }
+  // A s − b is zero in the free directions (up to the solver's tolerance) and, in the
+  // constrained ones, the impulse the constraint had to add: keep only that part.
+  Eigen::VectorXd residual = matrix_ * step_ - rhs_;
+  Eigen::VectorXd free_part = residual;
+  filter.apply(free_part);
+  result.constraint_impulse = residual - free_part;
+}
+
 ImplicitSolveResult ImplicitSolver::solve(const ClothModel& model, const ForceSettings& forces,
                                           const ConstraintFilter& filter,
                                           const Eigen::VectorXd& x_hat,
                                           const Eigen::VectorXd& v_hat, double beta,
                                           const Eigen::VectorXd& x_lin,
                                           const Eigen::VectorXd& v_lin,
-                                          const NewtonSettings& settings) {
+                                          const NewtonSettings& settings,
+                                          const std::vector<VertexDamping>* damping) {
   ImplicitSolveResult result;
   const int n = model.vertex_count;
   const auto mass_times = [&](const Eigen::VectorXd& w) {
@@ -85,7 +117,7 @@ ImplicitSolveResult ImplicitSolver::solve(const ClothModel& model, const ForceSe
   //   A s = M (v̂ − v_lin) + β f(x_lin, v_lin) + β (∂f/∂x) u,    v1 = v_lin + s.
   const Eigen::VectorXd u = x_hat + beta * v_lin - x_lin;
   const bool consistent = u.lpNorm<Eigen::Infinity>() == 0.0;
-  assemble(model, forces, beta, x_lin, v_lin, consistent ? nullptr : &u, result);
+  assemble(model, forces, beta, x_lin, v_lin, consistent ? nullptr : &u, damping, result);
   rhs_ = mass_times(v_hat - v_lin) + beta * force_;
   if (!consistent) rhs_ += beta * product_;
   filter.constrained_correction(v_lin, z_);
@@ -99,6 +131,7 @@ ImplicitSolveResult ImplicitSolver::solve(const ClothModel& model, const ForceSe
     result.newton_converged = false;
     return result;
   }
+  record_constraint_impulse(filter, result);
   if (settings.max_iterations <= 1) return result;  // the linearised step, by design
 
   // Further iterations: residual g(v) = M (v − v̂) − β f(x̂ + β v, v), A s = −g.
@@ -106,10 +139,11 @@ ImplicitSolveResult ImplicitSolver::solve(const ClothModel& model, const ForceSe
   double previous_update = result.last_update;
   while (!result.newton_converged && result.newton_iterations < settings.max_iterations) {
     if (settings.refresh_jacobian) {
-      assemble(model, forces, beta, result.x, result.v, nullptr, result);
+      assemble(model, forces, beta, result.x, result.v, nullptr, damping, result);
     } else {
       const auto start = std::chrono::steady_clock::now();
       evaluate_forces(model, forces, result.x, result.v, force_);
+      add_damping_force(damping, result.v);
       result.forces_seconds += seconds_since(start);
     }
     rhs_ = mass_times(v_hat - result.v) + beta * force_;
@@ -120,6 +154,7 @@ ImplicitSolveResult ImplicitSolver::solve(const ClothModel& model, const ForceSe
     ++result.newton_iterations;
     result.last_update = beta * step_.lpNorm<Eigen::Infinity>();
     if (!result.linear_converged || !result.v.allFinite()) break;
+    record_constraint_impulse(filter, result);
     result.newton_converged = result.last_update <= settings.tolerance;
     // A simplified Newton iteration that stops contracting will not converge: give up early.
     if (!result.newton_converged && result.newton_iterations > 2 &&

@@ -7,6 +7,8 @@
 // with the matrix A = M − β ∂f/∂v − β² ∂f/∂x (the "solve" Jacobian, SPD), linear systems
 // filtered by the constraints and solved by the modified PCG or CHOLMOD.
 
+#include <vector>
+
 #include <Eigen/Core>
 
 #include "sim/cholmod_solver.hpp"
@@ -31,6 +33,15 @@ struct NewtonSettings {
   int pcg_max_iterations = 1000;
 };
 
+// A force on one vertex, affine in its velocity: f = force − C (v − v_ref), C symmetric
+// positive semi-definite (kg/s). Contact friction enters the solve this way.
+struct VertexDamping {
+  int vertex = 0;
+  Eigen::Matrix3d coefficient = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d reference_velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();  // N
+};
+
 struct ImplicitSolveResult {
   Eigen::VectorXd x;  // 3n positions at the end of the step
   Eigen::VectorXd v;  // 3n velocities
@@ -41,6 +52,10 @@ struct ImplicitSolveResult {
   bool linear_converged = true;
   bool newton_converged = true;
   double last_update = 0.0;  // β·max|Δv| of the last Newton update, m
+  // 3n, N·s: the impulse the constraints applied over the step, (I − S)(A s − b) of the last
+  // linear solve (the linearised residual M(v1 − v̂) − β f at v1, in the constrained directions);
+  // the constraint force is this divided by β. Zero at free vertices; empty without constraints.
+  Eigen::VectorXd constraint_impulse;
   double forces_seconds = 0.0;
   double solve_seconds = 0.0;
 };
@@ -50,12 +65,14 @@ class ImplicitSolver {
   // Solves the step. (x_lin, v_lin) is where the first iteration linearises the force: the
   // start of the step (x0, v0) for Baraff-Witkin's linearised implicit Euler, a consistent
   // predictor (x̂ + β v_guess, v_guess) for BDF2. The filter must hold the velocity targets
-  // of the constrained vertices for the end of the step.
+  // of the constrained vertices for the end of the step. `damping` (optional) adds per-vertex
+  // linear drags to the force, implicitly (its matrix goes into A).
   ImplicitSolveResult solve(const ClothModel& model, const ForceSettings& forces,
                             const ConstraintFilter& filter, const Eigen::VectorXd& x_hat,
                             const Eigen::VectorXd& v_hat, double beta,
                             const Eigen::VectorXd& x_lin, const Eigen::VectorXd& v_lin,
-                            const NewtonSettings& settings);
+                            const NewtonSettings& settings,
+                            const std::vector<VertexDamping>* damping = nullptr);
 
   // The system matrix of the last assembly (for tests and benchmarks).
   const SparseMatrixR& matrix() const { return matrix_; }
@@ -64,9 +81,12 @@ class ImplicitSolver {
  private:
   void assemble(const ClothModel& model, const ForceSettings& forces, double beta,
                 const Eigen::VectorXd& x, const Eigen::VectorXd& v, const Eigen::VectorXd* u,
-                ImplicitSolveResult& result);
+                const std::vector<VertexDamping>* damping, ImplicitSolveResult& result);
+  // force_ += force − C (v − v_ref) for each vertex term.
+  void add_damping_force(const std::vector<VertexDamping>* damping, const Eigen::VectorXd& v);
   bool linear_solve(const ClothModel& model, const ConstraintFilter& filter,
                     const NewtonSettings& settings, bool refactor, ImplicitSolveResult& result);
+  void record_constraint_impulse(const ConstraintFilter& filter, ImplicitSolveResult& result);
 
   SparseMatrixR matrix_;
   PcgSolver pcg_;

@@ -44,6 +44,11 @@ void SimulationSettings::validate() const {
   require(forces.gravity.allFinite() && forces.wind.allFinite() &&
               std::isfinite(forces.air_drag) && forces.air_drag >= 0.0,
           "gravity, wind and air drag must be finite (air drag zero or more)");
+  try {
+    contact.validate();
+  } catch (const InvalidContactSettingsError& error) {
+    throw InvalidSimulationSettingsError(error.what());
+  }
 }
 
 Simulation::Simulation(ClothModel model, Eigen::VectorXd x0, std::vector<Pin> pins,
@@ -79,6 +84,33 @@ void Simulation::replace_model(ClothModel model, Eigen::VectorXd x, Eigen::Vecto
   has_history_ = false;
   report_.vertices = n;
   report_.triangles = static_cast<int>(model_.triangles.size());
+  // New vertex numbering: the contact cache and last step's contacts no longer apply.
+  if (contact_) {
+    contact_->set_fabric_friction(model_.fabric.friction);
+    contact_->reset_cloth(x_, model_.mass, settings_.forces.gravity.norm());
+    report_.collision_s += contact_->step_stats().collision_seconds;
+  }
+}
+
+void Simulation::set_body(const meshing::TriMesh& body) {
+  contact_ = std::make_unique<ContactResponse>(body, settings_.contact);
+  start_body();
+}
+
+void Simulation::set_body_motion(PoseSequence motion) {
+  contact_ = std::make_unique<ContactResponse>(std::move(motion), time_, settings_.contact);
+  start_body();
+}
+
+void Simulation::clear_body() { contact_.reset(); }
+
+void Simulation::start_body() {
+  contact_->set_fabric_friction(model_.fabric.friction);
+  contact_->reset_cloth(x_, model_.mass, settings_.forces.gravity.norm());
+  const StartRepair& repair = contact_->start_repair();
+  report_.start_repair_vertices = static_cast<int>(repair.pushed.size());
+  report_.start_repair_depth_m = repair.max_depth;
+  report_.collision_s += contact_->step_stats().collision_seconds;
 }
 
 void Simulation::set_velocities(const Eigen::VectorXd& v) {
@@ -139,10 +171,40 @@ Simulation::Attempt Simulation::attempt(double h) {
     const Eigen::Vector3d target = pins_[k].path ? pins_[k].path(time_ + h) : pin_rest_[k];
     filter_.pin(i, (target - x_hat.segment<3>(3 * i)) / beta);
   }
-  result.solve = solver_.solve(model_, settings_.forces, filter_, x_hat, v_hat, beta, x_lin, v_lin,
-                               newton_settings);
-  result.x = std::move(result.solve.x);
-  result.v = std::move(result.solve.v);
+  // Body contact (see sim/contact_response.hpp): start contacts constrain the normal velocity
+  // and correct the start by y; after each solve, friction, then vertices that still ended too
+  // deep join the constraints and the step is solved again.
+  ContactResponse* contact = settings_.contact.enabled ? contact_.get() : nullptr;
+  Eigen::VectorXd& y = result.correction;
+  if (contact != nullptr) {
+    contact->move_body_to(time_, h);
+    contact->constrain_start(x_hat, v_, beta, filter_, y, friction_);
+  }
+  for (;;) {
+    if (contact != nullptr) {
+      result.solve = solver_.solve(model_, settings_.forces, filter_, x_hat + y, v_hat, beta,
+                                   x_lin + y, v_lin, newton_settings, &friction_);
+    } else {
+      result.solve = solver_.solve(model_, settings_.forces, filter_, x_hat, v_hat, beta, x_lin,
+                                   v_lin, newton_settings);
+    }
+    result.forces_seconds += result.solve.forces_seconds;
+    result.solve_seconds += result.solve.solve_seconds;
+    result.linear_solves += result.solve.linear_solves;
+    result.cg_iterations += result.solve.cg_iterations;
+    result.cg_iterations_max = std::max(result.cg_iterations_max, result.solve.cg_iterations_max);
+    result.x = std::move(result.solve.x);
+    result.v = std::move(result.solve.v);
+    if (contact == nullptr || !result.solve.linear_converged || !result.x.allFinite() ||
+        !result.v.allFinite())
+      break;
+    contact->apply_friction(result.solve.constraint_impulse, model_.mass, x_hat + y, beta,
+                            result.v, result.x);
+    if (contact->constrain_deep(x_, result.x, x_hat, beta, filter_, y) == 0) {
+      contact->finish_step(result.x, result.v);
+      break;
+    }
+  }
 
   std::ostringstream why;
   if (!result.x.allFinite() || !result.v.allFinite()) {
@@ -166,6 +228,9 @@ Simulation::Attempt Simulation::attempt(double h) {
 }
 
 void Simulation::accept(Attempt& attempt, double h) {
+  // The position correction moved the start: shift the history with it, so that BDF2 does not
+  // read the correction as motion (x̂ = a0 x0 − a1 x−1 with a0 − a1 = 1 moves by y exactly).
+  if (attempt.correction.size() == x_.size()) x_ += attempt.correction;
   x_previous_ = std::move(x_);
   v_previous_ = std::move(v_);
   x_ = std::move(attempt.x);
@@ -177,6 +242,15 @@ void Simulation::accept(Attempt& attempt, double h) {
   report_.sim_time = time_;
   report_.dt_min_used = report_.steps == 1 ? h : std::min(report_.dt_min_used, h);
   report_.dt_max_used = std::max(report_.dt_max_used, h);
+  if (contact_ && settings_.contact.enabled) {
+    const ContactStepStats& stats = contact_->step_stats();
+    report_.contacts_max = std::max(report_.contacts_max, stats.contacts);
+    report_.contacts_final = stats.contacts;
+    report_.max_penetration_m = std::max(report_.max_penetration_m, stats.max_penetration);
+    report_.contact_resolves += stats.resolves;
+    report_.projected_vertices += stats.projected;
+    contact_->accept_step(attempt.solve.constraint_impulse);
+  }
 
   const double mass = model_.total_mass();
   const double speed = max_speed(v_);
@@ -195,11 +269,12 @@ StepOutcome Simulation::step(double max_step) {
   Attempt candidate;
   for (;;) {
     candidate = attempt(h);
-    report_.forces_s += candidate.solve.forces_seconds;
-    report_.solve_s += candidate.solve.solve_seconds;
-    report_.linear_solves += candidate.solve.linear_solves;
-    cg_total_ += candidate.solve.cg_iterations;
-    report_.cg_iterations_max = std::max(report_.cg_iterations_max, candidate.solve.cg_iterations_max);
+    report_.forces_s += candidate.forces_seconds;
+    report_.solve_s += candidate.solve_seconds;
+    if (contact_) report_.collision_s += contact_->step_stats().collision_seconds;
+    report_.linear_solves += candidate.linear_solves;
+    cg_total_ += candidate.cg_iterations;
+    report_.cg_iterations_max = std::max(report_.cg_iterations_max, candidate.cg_iterations_max);
     if (candidate.failure.empty()) break;
     if (h * 0.5 < settings_.min_dt) {
       if (!candidate.hard_failure) {
@@ -226,7 +301,7 @@ StepOutcome Simulation::step(double max_step) {
   outcome.accepted = true;
   outcome.dt = h;
   outcome.newton_iterations = candidate.solve.newton_iterations;
-  outcome.cg_iterations = candidate.solve.cg_iterations;
+  outcome.cg_iterations = candidate.cg_iterations;
   newton_total_ += candidate.solve.newton_iterations;
   accept(candidate, h);
 
@@ -251,6 +326,7 @@ SimulationReport Simulation::run(const std::function<void(const Simulation&)>& o
   const auto start = std::chrono::steady_clock::now();
   const double forces_before = report_.forces_s;
   const double solve_before = report_.solve_s;
+  const double collision_before = report_.collision_s;
   const auto sample = [&] {
     if (!settings_.record_energy) return;
     const EnergyBreakdown e = energy();
@@ -272,9 +348,16 @@ SimulationReport Simulation::run(const std::function<void(const Simulation&)>& o
       break;
     }
   }
+  if (contact_ && settings_.contact.enabled) {
+    const auto query_start = std::chrono::steady_clock::now();
+    report_.penetrating_vertices_final = contact_->count_penetrating(x_);
+    report_.collision_s +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - query_start).count();
+  }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   report_.wall_time_s += wall;
-  report_.other_s += wall - (report_.forces_s - forces_before) - (report_.solve_s - solve_before);
+  report_.other_s += wall - (report_.forces_s - forces_before) - (report_.solve_s - solve_before) -
+                     (report_.collision_s - collision_before);
   report_.cg_iterations_mean =
       report_.linear_solves > 0 ? static_cast<double>(cg_total_) / report_.linear_solves : 0.0;
   report_.newton_iterations_mean =

@@ -3,6 +3,7 @@
 // and halving on failure, growth after easy steps), at-rest detection and the run report.
 
 #include <functional>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -10,7 +11,10 @@
 
 #include <Eigen/Core>
 
+#include "meshing/tri_mesh.hpp"
+#include "sim/body_motion.hpp"
 #include "sim/cloth_model.hpp"
+#include "sim/contact_response.hpp"
 #include "sim/forces.hpp"
 #include "sim/implicit_solver.hpp"
 
@@ -45,6 +49,7 @@ struct SimulationSettings {
   double rest_window = 0.25;             // s the two must stay below their thresholds
   bool record_energy = true;             // energy time series in the report (one sample a step)
   ForceSettings forces;
+  ContactSettings contact;               // used once a body is set (set_body, set_body_motion)
 
   void validate() const;  // throws InvalidSimulationSettingsError
 };
@@ -84,8 +89,20 @@ struct SimulationReport {
   double dt_max_used = 0.0;
   double forces_s = 0.0;     // wall time in force and Jacobian evaluation
   double solve_s = 0.0;      // in linear solves (PCG or CHOLMOD factor + solve)
+  double collision_s = 0.0;  // in collider queries, body motion and contact bookkeeping
   double other_s = 0.0;      // the rest (bookkeeping, checks, energy samples, callbacks)
   double max_strain = 0.0;   // largest stretch strain at the end
+  // Body contact (zero without a body). Penetration is depth inside the body (negative signed
+  // distance), measured after every accepted step; vertices still being pushed out of an
+  // intersecting start are left out of it until their repair is over.
+  int contacts_max = 0;             // most constrained contacts in one accepted step
+  int contacts_final = 0;           // constrained contacts in the last step
+  double max_penetration_m = 0.0;   // deepest penetration at the end of any accepted step
+  int penetrating_vertices_final = 0;  // vertices deeper than the tolerance at the end
+  int contact_resolves = 0;         // extra solves for vertices that ended a solve too deep
+  int projected_vertices = 0;       // vertices projected out after the re-solves (last resort)
+  int start_repair_vertices = 0;    // vertices that started inside the body
+  double start_repair_depth_m = 0.0;  // deepest of them
   std::vector<EnergySample> energy;
 };
 
@@ -117,6 +134,17 @@ class Simulation {
                      std::vector<Pin> pins);
   void set_velocities(const Eigen::VectorXd& v);
 
+  // The body the cloth rests on and cannot enter: a still mesh (metres, closed, counter-
+  // clockwise seen from outside), or a pose sequence the body follows in simulation time
+  // (from the current time on). Cloth vertices that start inside are pushed out over
+  // settings.contact.repair_steps steps. Throws InvalidBodyMeshError / InvalidBodyMotionError.
+  void set_body(const meshing::TriMesh& body);
+  void set_body_motion(PoseSequence motion);
+  void clear_body();
+  bool has_body() const { return contact_ != nullptr; }
+  // The contact state (collider, last step's contacts, start repair); null without a body.
+  const ContactResponse* contact() const { return contact_.get(); }
+
   const ClothModel& model() const { return model_; }
   const SimulationSettings& settings() const { return settings_; }
   const Eigen::VectorXd& positions() const { return x_; }
@@ -132,12 +160,20 @@ class Simulation {
  private:
   struct Attempt {
     Eigen::VectorXd x, v;
-    ImplicitSolveResult solve;
+    ImplicitSolveResult solve;  // the last solve
+    Eigen::VectorXd correction;  // 3n contact position correction of the start (or empty)
+    // Summed over the attempt's solves (more than one when contacts are re-solved).
+    double forces_seconds = 0.0;
+    double solve_seconds = 0.0;
+    int linear_solves = 0;
+    int cg_iterations = 0;
+    int cg_iterations_max = 0;
     std::string failure;  // empty when the attempt passed every check
     bool hard_failure = false;  // non-finite or too fast: never accepted
   };
   Attempt attempt(double h);
   void accept(Attempt& attempt, double h);
+  void start_body();
 
   ClothModel model_;
   SimulationSettings settings_;
@@ -152,7 +188,9 @@ class Simulation {
   int easy_steps_ = 0;
   double rest_time_ = 0.0;
   ConstraintFilter filter_;
+  std::vector<VertexDamping> friction_;  // stick-regime friction drags of the current attempt
   ImplicitSolver solver_;
+  std::unique_ptr<ContactResponse> contact_;
   SimulationReport report_;
   long long newton_total_ = 0;
   long long cg_total_ = 0;

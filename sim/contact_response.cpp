@@ -1,0 +1,366 @@
+#include "sim/contact_response.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include <spdlog/spdlog.h>
+
+namespace sd::sim {
+namespace {
+
+constexpr double kNoImpulse = std::numeric_limits<double>::quiet_NaN();
+// A contact of the last step is kept while its vertex is within (1 + kHoldMargin)·thickness:
+// a vertex held at exactly `thickness` ends a step on the tangent plane, a hair farther from a
+// curved body, and without this hysteresis it would drop out, fall back in and be pushed out
+// again every other step (measured on a sheet draped on a sphere: ~25 of 60 contacts flickering
+// each step, with a position correction each time, and the drape never came to rest).
+constexpr double kHoldMargin = 0.25;
+// A contact is released when its constraint pulled the vertex towards the body with more than
+// this fraction of the vertex's weight. At the line where a draped cloth leaves the body the
+// contact force is about zero and changes sign from step to step; releasing at any pull made
+// those vertices switch between held and free every other step, and the switching shook the
+// whole (stiff) sheet in a period-2 oscillation that never came to rest.
+constexpr double kReleaseFraction = 0.1;
+// Rounds of re-projection for a vertex whose projected position is still inside (a concave
+// spot where the pushed point lands inside another part of the body).
+constexpr int kProjectionRounds = 3;
+
+class Stopwatch {
+ public:
+  explicit Stopwatch(double& total) : total_(total), start_(std::chrono::steady_clock::now()) {}
+  ~Stopwatch() {
+    total_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+  Stopwatch(const Stopwatch&) = delete;
+  Stopwatch& operator=(const Stopwatch&) = delete;
+
+ private:
+  double& total_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+void require(bool ok, const char* message) {
+  if (!ok) throw InvalidContactSettingsError(message);
+}
+
+}  // namespace
+
+void ContactSettings::validate() const {
+  const auto finite_at_least = [](double value, double low) {
+    return std::isfinite(value) && value >= low;
+  };
+  require(std::isfinite(thickness) && thickness > 0.0,
+          "the contact thickness must be a positive distance in metres");
+  require(std::isfinite(penetration_tolerance) && penetration_tolerance > 0.0,
+          "the penetration tolerance must be a positive distance in metres");
+  require(!static_friction || finite_at_least(*static_friction, 0.0),
+          "the static friction coefficient must be zero or more");
+  require(!kinetic_friction || finite_at_least(*kinetic_friction, 0.0),
+          "the kinetic friction coefficient must be zero or more");
+  require(!static_friction || !kinetic_friction || *static_friction >= *kinetic_friction,
+          "the static friction coefficient must not be smaller than the kinetic one");
+  require(max_resolves >= 0, "the number of contact re-solves must be zero or more");
+  require(repair_steps >= 1, "the start repair needs at least one step");
+  require(finite_at_least(search_margin, 0.0), "the contact search margin must be zero or more");
+  require(std::isfinite(max_substep_motion) && max_substep_motion > 0.0,
+          "the swept check's sub-step motion must be positive");
+  require(std::isfinite(stick_speed) && stick_speed > 0.0,
+          "the friction stick speed must be positive");
+}
+
+ContactResponse::ContactResponse(const meshing::TriMesh& body, ContactSettings settings)
+    : settings_(std::move(settings)), collider_(body) {
+  settings_.validate();
+}
+
+ContactResponse::ContactResponse(PoseSequence motion, double start_time, ContactSettings settings)
+    : settings_(std::move(settings)), collider_(motion.mesh_at(start_time)) {
+  settings_.validate();
+  collider_.set_pose(motion.vertices_at(start_time), motion.velocity_at(start_time));
+  motion_ = std::move(motion);
+  body_time_ = start_time;
+}
+
+ContactQuery ContactResponse::query() const {
+  ContactQuery q;
+  q.thickness = settings_.thickness;
+  q.search_margin = settings_.search_margin;
+  q.max_substep_motion = settings_.max_substep_motion;
+  return q;
+}
+
+void ContactResponse::reset_cloth(const Eigen::VectorXd& x, const Eigen::VectorXd& mass,
+                                  double gravity) {
+  stats_ = ContactStepStats{};
+  Stopwatch watch(stats_.collision_seconds);
+  const int n = static_cast<int>(x.size() / 3);
+  release_force_ = (kReleaseFraction * gravity) * mass;
+  cache_.reset();
+  last_normal_force_.assign(n, kNoImpulse);
+  active_index_.assign(n, -1);
+  active_.clear();
+  too_deep_.clear();
+  end_contacts_.clear();
+  accepted_contacts_.clear();
+  // Plan the push-out on the first cloth, or again (over the remaining steps) when the cloth
+  // is renumbered in the middle of one.
+  if (!repair_planned_ || repairing()) {
+    const int steps = repair_planned_ ? repair_.steps - repair_step_ : settings_.repair_steps;
+    repair_ = plan_start_repair(collider_, x, {settings_.thickness, std::max(1, steps)});
+    repair_step_ = 0;
+    if (!repair_planned_ && !repair_.empty())
+      spdlog::warn(
+          "sim: {} cloth vertices start inside the body (deepest {:.1f} mm); pushing them out "
+          "over {} steps",
+          repair_.pushed.size(), 1e3 * repair_.max_depth, repair_.steps);
+    repair_planned_ = true;
+  }
+  in_repair_.assign(n, 0);
+  for (const BodyContact& c : repair_.pushed) in_repair_[c.vertex] = 1;
+}
+
+void ContactResponse::move_body_to(double t, double h) {
+  stats_ = ContactStepStats{};
+  if (!motion_) return;
+  Stopwatch watch(stats_.collision_seconds);
+  // A retried step starts again from t: put the body back first, so that the step's sweep
+  // starts where the cloth's does.
+  if (body_time_ != t) collider_.set_pose(motion_->vertices_at(t), motion_->velocity_at(t));
+  move_body(collider_, *motion_, t, t + h);
+  body_time_ = t + h;
+}
+
+int ContactResponse::add_contact(const BodyContact& contact, const Eigen::VectorXd& x_hat,
+                                 double beta, ConstraintFilter& filter, Eigen::VectorXd& y,
+                                 bool allow_release) {
+  const int i = contact.vertex;
+  const Eigen::Vector3d& n = contact.normal;
+  const double body_normal_velocity = contact.body_velocity.dot(n);
+  // Distance above `thickness` the vertex would end at if it moved with the body along n:
+  // x1 = x̂ + y + β v1 against the surface at its end-of-step pose.
+  const Eigen::Vector3d start = x_hat.segment<3>(3 * i) + y.segment<3>(3 * i);
+  const double gap = (start - contact.point).dot(n) + beta * body_normal_velocity -
+                     settings_.thickness;
+  // Too close: move the start out (position correction, no velocity). Farther (a vertex that
+  // ended too deep after an unconstrained solve): a normal velocity that lands it at thickness.
+  if (gap < 0.0) y.segment<3>(3 * i) -= gap * n;
+  const double normal_velocity = body_normal_velocity - std::max(gap, 0.0) / beta;
+  // Its constraint pulled the cloth towards the body last step: let it leave.
+  const bool released = allow_release && last_normal_force_[i] < -release_force_[i];
+  if (!released) filter.constrain_direction(i, n, normal_velocity);
+  ActiveContact active{contact, normal_velocity, released};
+  if (active_index_[i] >= 0) {
+    // Its friction is already in the solve.
+    const ActiveContact& old = active_[active_index_[i]];
+    active.stuck = old.stuck;
+    active.friction_in_solve = old.friction_in_solve;
+    active.slide_direction = old.slide_direction;
+    active_[active_index_[i]] = active;
+  } else {
+    active_index_[i] = static_cast<int>(active_.size());
+    active_.push_back(active);
+  }
+  return active_index_[i];
+}
+
+void ContactResponse::constrain_start(const Eigen::VectorXd& x_hat, const Eigen::VectorXd& v0,
+                                      double beta, ConstraintFilter& filter, Eigen::VectorXd& y,
+                                      std::vector<VertexDamping>& friction) {
+  Stopwatch watch(stats_.collision_seconds);
+  const int n = static_cast<int>(x_hat.size() / 3);
+  y.setZero(3 * n);
+  friction.clear();
+  beta_ = beta;
+  for (const ActiveContact& a : active_) active_index_[a.contact.vertex] = -1;
+  active_.clear();
+  too_deep_.clear();
+  end_contacts_.clear();
+
+  // Vertices being pushed out of an intersecting start move along their push normal to this
+  // step's goal; ordinary contacts leave them alone until the repair is over.
+  const bool repair = repairing();
+  if (repair) {
+    for (const BodyContact& c : repair_.pushed) {
+      const int i = c.vertex;
+      if (filter.is_pinned(i)) continue;
+      const Eigen::Vector3d goal = repair_.goal(i, repair_step_ + 1);
+      const double normal_velocity = (goal - x_hat.segment<3>(3 * i)).dot(c.normal) / beta;
+      filter.constrain_direction(i, c.normal, normal_velocity);
+      active_index_[i] = static_cast<int>(active_.size());
+      ActiveContact pushed{c, normal_velocity};
+      pushed.repair = true;
+      active_.push_back(pushed);
+      ++stats_.repairing;
+    }
+  }
+  ContactQuery hold = query();
+  hold.thickness *= 1.0 + kHoldMargin;
+  for (const BodyContact& c : collider_.find_contacts(x_hat, hold, &cache_)) {
+    if (filter.is_pinned(c.vertex) || (repair && in_repair_[c.vertex])) continue;
+    // Farther than thickness: only a contact of the last step is held (and pulled back to the
+    // thickness; if that pulls, it is released next step).
+    // (A vertex placed at exactly the thickness counts as a contact despite rounding.)
+    if (c.distance >= settings_.thickness * (1.0 + 1e-9) &&
+        std::isnan(last_normal_force_[c.vertex]))
+      continue;
+    ActiveContact& a = active_[add_contact(c, x_hat, beta, filter, y, true)];
+    // Friction inside the solve for a contact pressed last step (λ > 0), relative to the body:
+    //  * slower than ε = stick_speed at the start: a drag C = μ_s λ / ε on the tangential
+    //    velocity; it holds the vertex (creeping at most at ε) while the pull stays below
+    //    μ_s λ, and lets it go beyond;
+    //  * sliding along t̂: Coulomb's force −μ_k λ t̂, linearised at the start velocity: constant
+    //    along t̂, a drag μ_k λ / |v_t0| across it (the direction turns with the velocity).
+    // Implicit, so the cloth around it responds, and the same for PCG and CHOLMOD.
+    const double lambda = last_normal_force_[c.vertex];
+    if (a.released || !(lambda > 0.0)) continue;
+    const Eigen::Vector3d& normal = c.normal;
+    const Eigen::Matrix3d tangent_projector =
+        Eigen::Matrix3d::Identity() - normal * normal.transpose();
+    const Eigen::Vector3d relative = tangent_projector * (v0.segment<3>(3 * c.vertex) - c.body_velocity);
+    const double speed = relative.norm();
+    VertexDamping term{c.vertex, Eigen::Matrix3d::Zero(), c.body_velocity, Eigen::Vector3d::Zero()};
+    if (speed < settings_.stick_speed) {
+      term.coefficient = (static_friction() * lambda / settings_.stick_speed) * tangent_projector;
+      a.stuck = true;
+    } else {
+      a.slide_direction = relative / speed;
+      term.coefficient = (kinetic_friction() * lambda / speed) *
+                         (tangent_projector - a.slide_direction * a.slide_direction.transpose());
+      term.force = -kinetic_friction() * lambda * a.slide_direction;
+    }
+    a.friction_in_solve = true;
+    friction.push_back(term);
+  }
+}
+
+void ContactResponse::apply_friction(const Eigen::VectorXd& impulse, const Eigen::VectorXd& mass,
+                                     const Eigen::VectorXd& x_hat, double beta,
+                                     Eigen::VectorXd& v, Eigen::VectorXd& x) {
+  stats_.stuck = 0;
+  if (impulse.size() != v.size()) return;
+  const double mu_static = static_friction();
+  const double mu_kinetic = kinetic_friction();
+  for (const ActiveContact& a : active_) {
+    if (a.released || a.repair) continue;
+    if (a.stuck) {  // held by the solve's drag
+      ++stats_.stuck;
+      continue;
+    }
+    const int i = a.contact.vertex;
+    const Eigen::Vector3d& n = a.contact.normal;
+    auto vi = v.segment<3>(3 * i);
+    const Eigen::Vector3d relative = vi - a.contact.body_velocity;
+    const Eigen::Vector3d tangential = relative - relative.dot(n) * n;
+    if (a.friction_in_solve) {
+      // Sliding: the solve applied Coulomb's force. If that reversed the motion, friction
+      // stopped it within the step (the linearisation cannot know): it stops.
+      if (tangential.dot(a.slide_direction) >= 0.0) continue;
+      vi -= tangential;
+      ++stats_.stuck;
+    } else {
+      // A new contact: Coulomb's law from this step's normal impulse. Friction changes the
+      // relative tangential velocity by at most μ·Δv_n, Δv_n = j_n / m.
+      const double normal_dv = std::max(impulse.segment<3>(3 * i).dot(n), 0.0) / mass[i];
+      const double speed = tangential.norm();
+      if (speed <= mu_static * normal_dv) {
+        vi -= tangential;
+        ++stats_.stuck;
+      } else {
+        vi -= (mu_kinetic * normal_dv / speed) * tangential;
+      }
+    }
+    x.segment<3>(3 * i) = x_hat.segment<3>(3 * i) + beta * vi;
+  }
+}
+
+int ContactResponse::constrain_deep(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1,
+                                    const Eigen::VectorXd& x_hat, double beta,
+                                    ConstraintFilter& filter, Eigen::VectorXd& y) {
+  Stopwatch watch(stats_.collision_seconds);
+  end_contacts_ = collider_.find_contacts_swept(x0, x1, query(), &cache_);
+  too_deep_.clear();
+  const bool repair = repairing();
+  for (const BodyContact& c : end_contacts_) {
+    if (filter.is_pinned(c.vertex) || (repair && in_repair_[c.vertex])) continue;
+    if (c.crossed || c.distance < -settings_.penetration_tolerance) too_deep_.push_back(c);
+  }
+  if (too_deep_.empty() || stats_.resolves >= settings_.max_resolves) return 0;
+  for (const BodyContact& c : too_deep_) add_contact(c, x_hat, beta, filter, y, false);
+  ++stats_.resolves;
+  return static_cast<int>(too_deep_.size());
+}
+
+void ContactResponse::finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v) {
+  Stopwatch watch(stats_.collision_seconds);
+  // Last resort for what the re-solves did not fix: onto the surface, with the body's normal
+  // velocity (the approaching part of the relative velocity removed).
+  std::vector<unsigned char> projected(x.size() / 3, 0);
+  for (const BodyContact& c : too_deep_) {
+    const int i = c.vertex;
+    Eigen::Vector3d point = c.point;
+    Eigen::Vector3d normal = c.normal;
+    for (int round = 0; round < kProjectionRounds; ++round) {
+      x.segment<3>(3 * i) = point + settings_.thickness * normal;
+      const std::optional<BodyProximity> check = collider_.closest_point(x.segment<3>(3 * i));
+      if (!check || check->distance >= -settings_.penetration_tolerance) break;
+      point = check->point;
+      normal = check->normal;
+    }
+    auto vi = v.segment<3>(3 * i);
+    const double approach = (vi - c.body_velocity).dot(normal);
+    if (approach < 0.0) vi -= approach * normal;
+    projected[i] = 1;
+    ++stats_.projected;
+  }
+  if (stats_.projected > 0)
+    spdlog::debug("sim: {} cloth vertices projected out of the body after {} re-solves",
+                  stats_.projected, stats_.resolves);
+  // Penetration at the end of the step, from the last end check (projected vertices measured
+  // again, the repair's vertices excluded while it runs).
+  const bool repair = repairing();
+  for (const BodyContact& c : end_contacts_) {
+    const int i = c.vertex;
+    if (repair && in_repair_[i]) continue;
+    const double distance =
+        projected[i] ? collider_.signed_distance(x.segment<3>(3 * i)) : c.distance;
+    if (distance < 0.0) stats_.max_penetration = std::max(stats_.max_penetration, -distance);
+    if (distance < -settings_.penetration_tolerance) ++stats_.penetrating;
+  }
+  for (const ActiveContact& a : active_)
+    if (!a.released && !a.repair) ++stats_.contacts;
+    else if (a.released) ++stats_.released;
+}
+
+void ContactResponse::accept_step(const Eigen::VectorXd& impulse) {
+  std::fill(last_normal_force_.begin(), last_normal_force_.end(), kNoImpulse);
+  if (impulse.size() == static_cast<Eigen::Index>(3 * last_normal_force_.size()))
+    for (const ActiveContact& a : active_)
+      if (!a.released && !a.repair)
+        last_normal_force_[a.contact.vertex] =
+            impulse.segment<3>(3 * a.contact.vertex).dot(a.contact.normal) / beta_;
+  accepted_contacts_ = active_;
+  if (repairing()) {
+    ++repair_step_;
+    if (!repairing())
+      spdlog::info("sim: start repair done: {} vertices pushed out of the body",
+                   repair_.pushed.size());
+  }
+}
+
+int ContactResponse::count_penetrating(const Eigen::VectorXd& x, double* deepest) const {
+  ContactQuery q = query();
+  q.thickness = 0.0;  // every vertex inside (or on) the surface
+  int count = 0;
+  double depth = 0.0;
+  for (const BodyContact& c : collider_.find_contacts(x, q)) {
+    depth = std::max(depth, -c.distance);
+    if (c.distance < -settings_.penetration_tolerance) ++count;
+  }
+  if (deepest != nullptr) *deepest = depth;
+  return count;
+}
+
+}  // namespace sd::sim

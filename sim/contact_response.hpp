@@ -1,0 +1,195 @@
+#pragma once
+// Body contact as constraints of the implicit step (Baraff & Witkin 1998 §5-6, with the
+// active-set and friction treatment of Bridson et al. 2002): what the simulator does with the
+// contacts the collider finds. Per step from t to t + h, with the body already at its pose
+// for t + h:
+//
+//  1. Start contacts: every cloth vertex of the predicted start x̂ within `thickness` of the
+//     body. Its normal velocity is constrained to the body's (filtered in PCG, eliminated in
+//     CHOLMOD: the same ConstraintFilter), and if it would end closer than `thickness`, its
+//     start is moved out along the normal first (the position correction y, which shifts the
+//     state rather than adding a velocity, so a correction never turns into a bounce). A
+//     contact whose constraint pulled the cloth towards the body in the last step is released.
+//  2. Solve, with Coulomb friction. A contact pressed in the last step (normal force λ > 0)
+//     has its friction inside the solve (implicit, so the cloth around it responds, and the
+//     same for PCG and CHOLMOD): slower than `stick_speed` relative to the body, a drag
+//     C = μ_s λ / stick_speed on its tangential velocity, which holds it (creep below
+//     stick_speed) while the pull stays under μ_s λ; sliding, Coulomb's force −μ_k λ t̂
+//     linearised at the start velocity (stopped after the solve if it would reverse the
+//     motion). A new contact gets Coulomb's law after the solve from this step's normal impulse:
+//     its tangential velocity is stopped if |v_t| ≤ μ_s Δv_n, else reduced by μ_k Δv_n.
+//  3. End check (swept along each vertex's path, so a fast body cannot carry cloth through a
+//     thin part unseen): vertices that ended deeper than `penetration_tolerance` inside or
+//     passed through become constraints that land them at `thickness`, and the step is solved
+//     again (at most `max_resolves` times). What is still too deep after that is projected
+//     onto the surface (counted: it should not happen in practice).
+//
+// The simulator (sim/simulation.hpp) drives this; it is separate so that the contact logic
+// reads in one place and can be tested on its own.
+
+#include <optional>
+#include <stdexcept>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "meshing/tri_mesh.hpp"
+#include "sim/body_collider.hpp"
+#include "sim/body_motion.hpp"
+#include "sim/cloth_model.hpp"
+#include "sim/collision_repair.hpp"
+#include "sim/constraint_filter.hpp"
+#include "sim/implicit_solver.hpp"
+
+namespace sd::sim {
+
+struct ContactSettings {
+  bool enabled = true;      // with a body set; off: the body is ignored
+  double thickness = 0.003; // m: distance kept between a cloth vertex and the body surface
+  // m: no vertex may end an accepted step deeper than this inside the body (signed distance
+  // below −tolerance); deeper ones are re-solved as contacts, then projected.
+  double penetration_tolerance = 0.001;
+  // Coulomb coefficients of the cloth on the body. Unset: the fabric's `friction` for both.
+  std::optional<double> static_friction;
+  std::optional<double> kinetic_friction;
+  // m/s: relative tangential speed below which a contact is in the stick regime; the largest
+  // creep of a vertex held by static friction.
+  double stick_speed = 5.0e-4;
+  int max_resolves = 2;   // extra solves per step for vertices that ended too deep
+  int repair_steps = 10;  // steps over which a garment starting inside the body is pushed out
+  // Collider query parameters (see sim/body_collider.hpp, ContactQuery).
+  double search_margin = 0.02;
+  double max_substep_motion = 0.005;
+
+  void validate() const;  // throws InvalidContactSettingsError
+};
+
+// A contact setting that cannot work (negative thickness, static friction below kinetic, ...).
+class InvalidContactSettingsError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+// One constrained contact of a step: the body contact and what the solve was asked for.
+struct ActiveContact {
+  BodyContact contact;
+  double normal_velocity = 0.0;  // m/s prescribed along contact.normal
+  bool released = false;         // near the body but left free (its constraint was adhesive)
+  bool stuck = false;            // slower than stick_speed at the start: held by the drag
+  bool repair = false;           // pushed out of an intersecting start (moving target)
+  bool friction_in_solve = false;  // its friction was a term of the solve
+  Eigen::Vector3d slide_direction = Eigen::Vector3d::Zero();  // sliding: t̂ at the start
+};
+
+// Per-step contact figures, summed into the simulation report.
+struct ContactStepStats {
+  int contacts = 0;          // constrained contacts in the final solve
+  int released = 0;          // near the body but released
+  int resolves = 0;          // extra solves for vertices that ended too deep
+  int projected = 0;         // vertices projected out after the last solve
+  int stuck = 0;             // contacts in the stick regime (or stopped by friction)
+  int repairing = 0;         // vertices still being pushed out of an intersecting start
+  double max_penetration = 0.0;  // m, deepest vertex inside the body at the end (repair excluded)
+  int penetrating = 0;       // vertices deeper than the tolerance at the end (repair excluded)
+  double collision_seconds = 0.0;  // collider queries and body motion
+};
+
+// The body, its motion, the per-cloth contact cache and the memory between steps (which
+// contacts were adhesive, the start repair). Owned by the Simulation.
+class ContactResponse {
+ public:
+  ContactResponse(const meshing::TriMesh& body, ContactSettings settings);
+  ContactResponse(PoseSequence motion, double start_time, ContactSettings settings);
+
+  const ContactSettings& settings() const { return settings_; }
+  const BodyCollider& collider() const { return collider_; }
+  const PoseSequence* motion() const { return motion_ ? &*motion_ : nullptr; }
+  const StartRepair& start_repair() const { return repair_; }
+  bool repairing() const { return repair_step_ < repair_.steps && !repair_.empty(); }
+  // Contacts of the last accepted step (constrained and released).
+  const std::vector<ActiveContact>& contacts() const { return accepted_contacts_; }
+
+  // A new cloth (first call, or vertices renumbered by replace_model): resets the cache and the
+  // memory of the last step, and plans the push-out of vertices inside the body. A repair in
+  // progress is planned again for its remaining steps.
+  // mass: #V lumped masses (kg); gravity: |g| (m/s²), which scale the force that releases a
+  // contact.
+  void reset_cloth(const Eigen::VectorXd& x, const Eigen::VectorXd& mass, double gravity);
+
+  // Moves the body to its pose at t + h (a step from t). Handles retried steps.
+  void move_body_to(double t, double h);
+
+  // Step 1: start contacts of x̂ (3n) into `filter` (pins stay pins), the position correction
+  // y (3n) the caller adds to x̂ and to the linearisation point, and the stick-regime friction
+  // drags for the solve. v0: velocities at the start of the step (3n).
+  void constrain_start(const Eigen::VectorXd& x_hat, const Eigen::VectorXd& v0, double beta,
+                       ConstraintFilter& filter, Eigen::VectorXd& y,
+                       std::vector<VertexDamping>& friction);
+
+  // Step 2: Coulomb friction on the sliding and new contacts, from the solve's constraint
+  // impulse (3n, N·s). Changes v1 and x1 = x̂ + β v1 of those vertices.
+  void apply_friction(const Eigen::VectorXd& impulse, const Eigen::VectorXd& mass,
+                      const Eigen::VectorXd& x_hat, double beta, Eigen::VectorXd& v,
+                      Eigen::VectorXd& x);
+
+  // Step 3: swept check of the path x0 (previous pose) → x1 (current pose). Vertices deeper
+  // than the tolerance (or that passed through) become constraints in `filter` (and y for the
+  // ones already too close at x̂); returns how many were added, 0 when the step is clean.
+  int constrain_deep(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1,
+                     const Eigen::VectorXd& x_hat, double beta, ConstraintFilter& filter,
+                     Eigen::VectorXd& y);
+
+  // After the last solve: projects the vertices the last end check found too deep onto
+  // point + thickness·normal with the body's normal velocity, and measures the penetration.
+  void finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v);
+
+  ContactStepStats& step_stats() { return stats_; }
+  const ContactStepStats& step_stats() const { return stats_; }
+
+  // The step was accepted: remember which contacts pulled (release next step) and advance the
+  // start repair.
+  void accept_step(const Eigen::VectorXd& impulse);
+
+  // Vertices of x (3n) deeper than the tolerance inside the body at its current pose.
+  int count_penetrating(const Eigen::VectorXd& x, double* deepest = nullptr) const;
+  // The cloth's own friction coefficient (FabricParameters::friction), used for whichever of
+  // the two coefficients the settings leave unset.
+  void set_fabric_friction(double friction) { fabric_friction_ = friction; }
+  double static_friction() const { return settings_.static_friction.value_or(fabric_friction_); }
+  double kinetic_friction() const {
+    return settings_.kinetic_friction.value_or(fabric_friction_);
+  }
+
+ private:
+  ContactQuery query() const;
+  // Constrains one contact's normal velocity so that it ends at `thickness` (moving x̂ + y out
+  // first when it is already too close); `allow_release`: leave it free if it was adhesive.
+  // Returns the index of its ActiveContact.
+  int add_contact(const BodyContact& contact, const Eigen::VectorXd& x_hat, double beta,
+                  ConstraintFilter& filter, Eigen::VectorXd& y, bool allow_release);
+
+  ContactSettings settings_;
+  BodyCollider collider_;
+  std::optional<PoseSequence> motion_;
+  double body_time_ = 0.0;   // time of the collider's current pose
+  ContactCache cache_;
+  StartRepair repair_;
+  bool repair_planned_ = false;
+  int repair_step_ = 0;      // accepted steps of the repair so far
+  double fabric_friction_ = 0.3;
+  // Per vertex: normal force of its contact in the last accepted step (N, < 0: adhesive), NaN
+  // when it had no constrained contact.
+  std::vector<double> last_normal_force_;
+  Eigen::VectorXd release_force_;  // per vertex, N: an adhesive force above this releases
+  double beta_ = 0.0;  // β of the step being solved
+  std::vector<unsigned char> in_repair_;  // 1 for vertices the start repair is pushing
+  // Current attempt.
+  std::vector<ActiveContact> active_;
+  std::vector<int> active_index_;        // per vertex: index into active_, or −1
+  std::vector<BodyContact> too_deep_;    // from the last end check, after the last solve
+  std::vector<BodyContact> end_contacts_;
+  ContactStepStats stats_;
+  std::vector<ActiveContact> accepted_contacts_;
+};
+
+}  // namespace sd::sim
