@@ -518,17 +518,5 @@ TEST(ContactSheet, LoadsInHeadlessChromium) {
   EXPECT_NE(dom.find("6 thumbnails loaded"), std::string::npos);
 }
 
-// Removes this process's test folders when every test passed (they are kept for inspection
-// otherwise).
-class RemoveTestFolders : public ::testing::Environment {
- public:
-  void TearDown() override {
-    if (!::testing::UnitTest::GetInstance()->Passed()) return;
-    std::error_code ignored;
-    fs::remove_all(fresh_batch_dir("x").parent_path(), ignored);
-  }
-};
-const auto* const kRemoveTestFolders = ::testing::AddGlobalTestEnvironment(new RemoveTestFolders);
-
 }  // namespace
 }  // namespace sd::test

@@ -1,6 +1,7 @@
 #pragma once
 // Helpers shared by the batch tests: fresh folders and small files.
 
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -30,5 +31,20 @@ inline std::string read_text(const std::filesystem::path& path) {
   s << in.rdbuf();
   return s.str();
 }
+
+// Removes this process's test folders when every test passed (they are kept for inspection
+// otherwise). Registered once per test executable that includes this header.
+class RemoveBatchTestFolders : public ::testing::Environment {
+ public:
+  void TearDown() override {
+    if (!::testing::UnitTest::GetInstance()->Passed()) return;
+    std::error_code ignored;
+    std::filesystem::remove_all(
+        std::filesystem::temp_directory_path() / ("sd_batch_test_" + std::to_string(::getpid())),
+        ignored);
+  }
+};
+inline ::testing::Environment* const kRemoveBatchTestFolders =
+    ::testing::AddGlobalTestEnvironment(new RemoveBatchTestFolders);
 
 }  // namespace sd::test
