@@ -2,7 +2,8 @@
 # The main job on the built-in examples: installs what is missing, builds, then
 #   1. renders the built-in mannequin from three views,
 #   2. meshes the example t-shirt into one stitched garment on the body (mesh, report, images),
-#   3. drapes a cloth sheet with the implicit simulator (draped mesh, report, image).
+#   3. drapes the t-shirt on the body with the implicit simulator and body contact,
+#   4. drapes a cloth sheet held by two corners.
 # Outputs go to out/demo/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -21,6 +22,9 @@ echo "==> the built-in body"
 
 echo "==> meshing the example t-shirt"
 ./build/sketchdrape mesh data/examples/tshirt.json -o "$out/tshirt"
+
+echo "==> draping the t-shirt on the body"
+./build/sketchdrape run data/examples/tshirt.json -o "$out/tshirt-drape"
 
 echo "==> draping a sheet"
 ./build/sketchdrape run data/scenes/hanging-sheet.json -o "$out/sheet"

@@ -79,6 +79,9 @@ nlohmann::json simulation_json(const sim::SimulationReport& r, const sim::Simula
           {"dt_min_used", r.dt_min_used},
           {"dt_max_used", r.dt_max_used},
           {"max_strain", r.max_strain},
+          {"contacts_max", r.contacts_max},
+          {"max_penetration_m", r.max_penetration_m},
+          {"penetrating_vertices_final", r.penetrating_vertices_final},
           {"timing_s", {{"forces", r.forces_s}, {"solve", r.solve_s}, {"other", r.other_s}}},
           {"settings",
            {{"integrator", s.integrator == sim::Integrator::bdf2 ? "bdf2" : "implicit-euler"},
@@ -115,9 +118,11 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   const garment::Sketch sketch = garment::load_sketch(options.sketch);
   const sim::SimulationSettings settings = simulation_settings(sketch);
   const ClothScene scene = build_cloth_scene(sketch);
-  if (scene.pinned.empty())
-    spdlog::warn("nothing holds the cloth (no pins{}): it will fall for the whole run",
-                 scene.body ? " and body contact is not simulated yet" : "");
+  if (scene.pinned.empty() && !scene.body)
+    spdlog::warn("nothing holds the cloth (no pins, no body): it will fall for the whole run");
+  if (scene.body && sketch.simulate.adaptive && scene.mesh48)
+    spdlog::warn("adaptive detail does not simulate body contact yet: the garment will pass "
+                 "through the body (set \"simulate\": {{\"adaptive\": false}} to drape on it)");
 
   std::vector<sim::Pin> pins;
   for (int v : scene.pinned) pins.push_back({v, {}});
@@ -178,6 +183,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
     } else {
       sim::Simulation simulation(sim::build_cloth_model(scene.input, scene.fabric),
                                  sim::flatten_positions(scene.start), pins, settings);
+      if (scene.body) simulation.set_body(scene.body->mesh);  // contacts and friction
       report = simulation.run(on_step);
       draped.vertices = sim::unflatten_positions(simulation.positions());
       draped.faces = scene.input.triangles;
