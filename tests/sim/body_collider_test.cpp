@@ -12,68 +12,15 @@
 #include "garment/body.hpp"
 #include "sim/collision_geometry.hpp"
 #include "sim/collision_repair.hpp"
+#include "tests/sim/test_bodies.hpp"
 
 namespace sd::sim {
 namespace {
 
 using Eigen::Vector3d;
 
-// Icosphere of radius r centred at `centre`: every vertex on the sphere, triangles inside it.
-meshing::TriMesh make_sphere(double r, int subdivisions,
-                             const Vector3d& centre = Vector3d::Zero()) {
-  const double g = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<Vector3d> v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0},
-                             {0, -1, g}, {0, 1, g}, {0, -1, -g}, {0, 1, -g},
-                             {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
-  std::vector<Eigen::Vector3i> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-                                    {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                                    {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-                                    {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
-  for (auto& p : v) p.normalize();
-  for (int s = 0; s < subdivisions; ++s) {
-    std::map<std::pair<int, int>, int> midpoint;
-    const auto mid = [&](int a, int b) {
-      const auto key = std::minmax(a, b);
-      const auto it = midpoint.find(key);
-      if (it != midpoint.end()) return it->second;
-      v.push_back((v[a] + v[b]).normalized());
-      midpoint[key] = static_cast<int>(v.size()) - 1;
-      return static_cast<int>(v.size()) - 1;
-    };
-    std::vector<Eigen::Vector3i> next;
-    for (const auto& t : f) {
-      const int a = mid(t[0], t[1]), b = mid(t[1], t[2]), c = mid(t[2], t[0]);
-      next.push_back({t[0], a, c});
-      next.push_back({t[1], b, a});
-      next.push_back({t[2], c, b});
-      next.push_back({a, b, c});
-    }
-    f = next;
-  }
-  meshing::TriMesh mesh;
-  mesh.vertices.resize(static_cast<Eigen::Index>(v.size()), 3);
-  for (std::size_t i = 0; i < v.size(); ++i) mesh.vertices.row(i) = (centre + r * v[i]).transpose();
-  mesh.faces.resize(static_cast<Eigen::Index>(f.size()), 3);
-  for (std::size_t i = 0; i < f.size(); ++i) mesh.faces.row(i) = f[i].transpose();
-  return mesh;
-}
-
-// Axis-aligned box [lo, hi] as 12 triangles, outward-facing.
-meshing::TriMesh make_box(const Vector3d& lo, const Vector3d& hi) {
-  meshing::TriMesh mesh;
-  mesh.vertices.resize(8, 3);
-  for (int i = 0; i < 8; ++i)
-    mesh.vertices.row(i) << (i & 1 ? hi.x() : lo.x()), (i & 2 ? hi.y() : lo.y()),
-        (i & 4 ? hi.z() : lo.z());
-  mesh.faces.resize(12, 3);
-  mesh.faces << 0, 2, 3, 0, 3, 1,  // z = lo
-      4, 5, 7, 4, 7, 6,            // z = hi
-      0, 1, 5, 0, 5, 4,            // y = lo
-      2, 6, 7, 2, 7, 3,            // y = hi
-      0, 4, 6, 0, 6, 2,            // x = lo
-      1, 3, 7, 1, 7, 5;            // x = hi
-  return mesh;
-}
+using testing::make_box;
+using testing::make_sphere;
 
 // Closed prism along z whose cross-section is a thin isosceles triangle with apex (0, apex_y):
 // a knife edge with apex angle `apex_degrees`.
@@ -90,19 +37,6 @@ meshing::TriMesh make_wedge(double apex_degrees, double apex_y, double half_leng
       1, 2, 5, 1, 5, 4,   // right slope
       2, 0, 3, 2, 3, 5;   // left slope
   return mesh;
-}
-
-// Largest distance from the centre to any face plane's complement: the mesh of a unit-radius
-// sphere lies between radius r_inner (its faces' smallest plane distance) and r.
-double inner_radius(const meshing::TriMesh& mesh, const Vector3d& centre) {
-  double r = std::numeric_limits<double>::infinity();
-  for (Eigen::Index f = 0; f < mesh.face_count(); ++f) {
-    const Vector3d a = mesh.vertices.row(mesh.faces(f, 0)).transpose();
-    const Vector3d b = mesh.vertices.row(mesh.faces(f, 1)).transpose();
-    const Vector3d c = mesh.vertices.row(mesh.faces(f, 2)).transpose();
-    r = std::min(r, std::abs((centre - a).dot(triangle_normal(a, b, c))));
-  }
-  return r;
 }
 
 Eigen::VectorXd flatten(const std::vector<Vector3d>& points) {
@@ -148,7 +82,7 @@ TEST(ClosestPointOnTriangle, MatchesDenseSamplingAndClassifiesRegions) {
 TEST(BodyCollider, SphereSignedDistanceWithinChordalBound) {
   const double r = 0.2;
   const meshing::TriMesh sphere = make_sphere(r, 3);
-  const double r_inner = inner_radius(sphere, Vector3d::Zero());
+  const double r_inner = testing::inscribed_radius(sphere, Vector3d::Zero());
   ASSERT_LT(r - r_inner, 0.002);  // the mesh is fine enough for the bounds below to be tight
   const BodyCollider collider(sphere);
   std::mt19937 rng(3);
@@ -232,7 +166,7 @@ TEST(BodyCollider, KnifeEdgeSignUsesThePseudoNormal) {
 TEST(BodyCollider, DeepInsidePointsAreContactsWithTheRightPushDirection) {
   const double r = 0.2;
   const meshing::TriMesh sphere = make_sphere(r, 3);
-  const double r_inner = inner_radius(sphere, Vector3d::Zero());
+  const double r_inner = testing::inscribed_radius(sphere, Vector3d::Zero());
   const BodyCollider collider(sphere);
   const Vector3d direction = Vector3d(0.3, -0.5, 0.8).normalized();
   const std::vector<Vector3d> points = {
@@ -491,7 +425,7 @@ TEST(BodyCollider, ContinuousCheckWithinASegment) {
 TEST(StartRepair, PushesInsideVerticesOutAlongTheNearestSurface) {
   const double r = 0.2;
   const meshing::TriMesh sphere = make_sphere(r, 3);
-  const double r_inner = inner_radius(sphere, Vector3d::Zero());
+  const double r_inner = testing::inscribed_radius(sphere, Vector3d::Zero());
   const BodyCollider collider(sphere);
   // A flat sheet at z = 0.1 cutting through the sphere's cap.
   std::vector<Vector3d> grid;
