@@ -22,6 +22,9 @@ constexpr int kSearchBudget = 4000;
 // promotes a corner where the boundary is flat). 4,000 here finds three corpus cases with fewer
 // irregular vertices but makes a skewed fill of Σl = 200 take 5 ms instead of 3.
 constexpr int kStripSearchBudget = 400;
+// ... and all padded candidates of one fill together (a skewed fill of n = 10 sides has 56 of
+// them; without this cap its topology took 2 ms).
+constexpr int kPaddedSearchBudget = 4000;
 
 void check_counts(std::span<const int> counts) {
   if (counts.size() < 2)
@@ -160,14 +163,22 @@ detail::StripRegion region_of(std::span<const int> loop_ids, std::span<const int
   return region;
 }
 
-// The plan with these strips (nullopt when one of them cannot be added).
+// The plan with these strips (nullopt when one of them cannot be added, or when `rival` is
+// given and the plan provably cannot rank before it).
 std::optional<Plan> plan_with_strips(std::span<const int> counts, const BoundaryShape& shape,
-                                     std::span<const int> strips, int budget) {
+                                     std::span<const int> strips, int budget,
+                                     const Plan* rival = nullptr) {
   const std::vector<int> no_ids(shape.flat.size(), -1);
   detail::StripRegion region = region_of(no_ids, counts, shape);
   for (const int side : strips)
     if (!region.strip(side)) return std::nullopt;
   const detail::PositionCosts costs = region.costs();
+  if (rival != nullptr) {
+    // The plan folds at least region.folded quads and costs at least this much distortion.
+    const int least = region.fixed_cost + detail::layout_cost_lower_bound(costs);
+    if (std::tuple(region.folded, least) > std::tuple(rival->folded, rival->distortion))
+      return std::nullopt;
+  }
   Plan plan;
   plan.strips.assign(strips.begin(), strips.end());
   plan.layout = detail::best_layout(costs, budget);
@@ -183,27 +194,37 @@ std::optional<Plan> plan_with_strips(std::span<const int> counts, const Boundary
   return plan;
 }
 
-// What the Yasseen construction gives on these sides, built (nullopt when it does not apply).
+// What the Yasseen construction gives on these sides, built (nullopt when it does not apply,
+// or when it would not rank before `rival`). Its figures come from the builder's valences
+// (corners regular at 2, other side vertices at 3, the rest at 4); the mesh is validated only
+// when it would win.
 std::optional<std::pair<Plan, Built>> yasseen_candidate(
-    const std::vector<Eigen::MatrixX3d>& side_points, const BoundaryShape& shape) {
+    const std::vector<Eigen::MatrixX3d>& side_points, const BoundaryShape& shape,
+    const Plan& rival) {
   Built built;
   built.sides = add_boundary(built.builder, side_points);
   if (!detail::fill_yasseen(built.builder, built.sides, kSearchBudget)) return std::nullopt;
-  const QuadMesh mesh = built.builder.build();
-  if (!validate(mesh).ok()) return std::nullopt;
-  const QuadQuality figures = measure_valence(mesh, corners_of(built.sides));
+  const std::vector<int> valence = built.builder.valences();
+  std::vector<int> regular(valence.size(), 4);
+  for (const auto& side : built.sides) {
+    for (const int v : side) regular[static_cast<size_t>(v)] = 3;
+  }
+  for (const auto& side : built.sides) regular[static_cast<size_t>(side.front())] = 2;
   Plan plan;
   plan.yasseen = true;
   plan.partition = "yasseen";
-  plan.distortion = figures.distortion;
-  plan.irregular_vertices = figures.irregular_vertices;
-  const std::vector<int> valence = built.builder.valences();
+  for (size_t v = 0; v < valence.size(); ++v) {
+    const int deviation = std::abs(valence[v] - regular[v]);
+    plan.distortion += deviation;
+    plan.irregular_vertices += deviation != 0 ? 1 : 0;
+  }
   const std::vector<int> loop = boundary_loop_of(built.sides);
   for (size_t p = 0; p < loop.size(); ++p)
     if (valence[static_cast<size_t>(loop[p])] == 2) {
       plan.folded += shape.reflex[p];
       plan.flat += shape.flat[p];
     }
+  if (!(plan.rank() < rival.rank()) || !validate(built.builder.build()).ok()) return std::nullopt;
   return std::pair(std::move(plan), std::move(built));
 }
 
@@ -228,10 +249,13 @@ Plan choose_plan(std::span<const int> counts, const BoundaryShape& shape,
         exposed_sides.push_back(side);
     }
   if (!exposed_sides.empty() || best.folded > 0) {
+    int padded_budget = kPaddedSearchBudget;
     auto consider = [&](std::span<const int> strips) {
-      if (auto plan = plan_with_strips(counts, shape, strips, kStripSearchBudget);
-          plan && plan->rank() < best.rank())
-        best = std::move(*plan);
+      auto plan = plan_with_strips(counts, shape, strips,
+                                   std::min(kStripSearchBudget, padded_budget), &best);
+      if (!plan) return;
+      padded_budget = std::max(0, padded_budget - plan->layout.checks);
+      if (plan->rank() < best.rank()) best = std::move(*plan);
     };
     // Every side and every pair of sides (the layout may move its promotions elsewhere), and a
     // full ring.
@@ -243,8 +267,11 @@ Plan choose_plan(std::span<const int> counts, const BoundaryShape& shape,
     std::iota(all.begin(), all.end(), 0);
     if (n > 2) consider(all);
   }
-  if (auto candidate = yasseen_candidate(side_points, shape);
-      candidate && candidate->first.rank() < best.rank()) {
+  // Nothing ranks before a fold-free plan with the least possible distortion, a single
+  // irregular vertex (none for a grid) and no flat corner: no need to build the Yasseen one.
+  const bool unbeatable = best.folded == 0 && best.distortion == std::abs(n - 4) &&
+                          best.irregular_vertices == (n == 4 ? 0 : 1) && best.flat == 0;
+  if (auto candidate = unbeatable ? std::nullopt : yasseen_candidate(side_points, shape, best)) {
     best = std::move(candidate->first);
     yasseen = std::move(candidate->second);
   }

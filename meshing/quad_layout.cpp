@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cassert>
-#include <set>
 #include <stdexcept>
 #include <utility>
 
@@ -68,14 +67,31 @@ void QuadMeshBuilder::add_grid(std::span<const int> bottom, std::span<const int>
 }
 
 std::vector<int> QuadMeshBuilder::valences() const {
-  std::set<std::pair<int, int>> edges;
-  for (const auto& e : chain_edges_) edges.insert(std::minmax(e[0], e[1]));
-  for (const auto& f : faces_)
-    for (int k = 0; k < 4; ++k) edges.insert(std::minmax(f[k], f[(k + 1) % 4]));
-  std::vector<int> valence(positions_.size(), 0);
-  for (const auto& [u, v] : edges) {
-    ++valence[static_cast<size_t>(u)];
-    ++valence[static_cast<size_t>(v)];
+  // Every edge in both directions, bucketed by its first vertex (counting sort, O(E)); a
+  // vertex's valence is the number of distinct second vertices in its bucket.
+  const size_t nv = positions_.size();
+  std::vector<int> start(nv + 1, 0);
+  auto each_edge = [&](auto&& visit) {
+    for (const auto& e : chain_edges_) visit(e[0], e[1]);
+    for (const auto& f : faces_)
+      for (size_t k = 0; k < 4; ++k) visit(f[k], f[(k + 1) % 4]);
+  };
+  each_edge([&](int u, int v) {
+    ++start[static_cast<size_t>(u) + 1];
+    ++start[static_cast<size_t>(v) + 1];
+  });
+  for (size_t v = 0; v < nv; ++v) start[v + 1] += start[v];
+  std::vector<int> target(static_cast<size_t>(start[nv]));
+  std::vector<int> fill(start.begin(), start.end() - 1);
+  each_edge([&](int u, int v) {
+    target[static_cast<size_t>(fill[static_cast<size_t>(u)]++)] = v;
+    target[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = u;
+  });
+  std::vector<int> valence(nv, 0);
+  for (size_t v = 0; v < nv; ++v) {
+    const auto begin = target.begin() + start[v], end = target.begin() + start[v + 1];
+    std::sort(begin, end);
+    valence[v] = static_cast<int>(std::unique(begin, end) - begin);
   }
   return valence;
 }

@@ -34,41 +34,48 @@ QuadQuality measure_valence(const QuadMesh& mesh, std::span<const int> corner_ve
 
 QuadQuality measure_quality(const QuadMesh& mesh, std::span<const int> corner_vertices) {
   QuadQuality quality = measure_valence(mesh, corner_vertices);
-  const auto& x = mesh.vertices;
-  const auto& q = mesh.faces;
+  // Column per vertex / per face: the rows of the #V by 3 matrices are strided in memory.
+  const Eigen::Matrix3Xd x = mesh.vertices.transpose();
+  const Eigen::Matrix4Xi q = mesh.faces.transpose();
   // Vertex normals: sums of the corner cross products of the incident quads.
-  Eigen::MatrixX3d normals = Eigen::MatrixX3d::Zero(x.rows(), 3);
-  for (Eigen::Index f = 0; f < q.rows(); ++f)
+  Eigen::Matrix3Xd normals = Eigen::Matrix3Xd::Zero(3, x.cols());
+  for (Eigen::Index f = 0; f < q.cols(); ++f)
     for (int k = 0; k < 4; ++k) {
-      const Eigen::Vector3d p = x.row(q(f, k));
-      const Eigen::Vector3d e1 = x.row(q(f, (k + 1) % 4)).transpose() - p;
-      const Eigen::Vector3d e2 = x.row(q(f, (k + 3) % 4)).transpose() - p;
-      normals.row(q(f, k)) += e1.cross(e2).transpose();
+      const Eigen::Vector3d p = x.col(q(k, f));
+      const Eigen::Vector3d e1 = x.col(q((k + 1) % 4, f)) - p;
+      const Eigen::Vector3d e2 = x.col(q((k + 3) % 4, f)) - p;
+      normals.col(q(k, f)) += e1.cross(e2);
     }
-  double min_angle = std::numeric_limits<double>::infinity(), max_angle = 0;
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  double convex_cos_min = kInf, convex_cos_max = -kInf, reflex_cos_min = kInf, reflex_cos_max = -kInf;
   double max_aspect = 0, jac_min = std::numeric_limits<double>::infinity(), jac_sum = 0;
-  for (Eigen::Index f = 0; f < q.rows(); ++f) {
+  for (Eigen::Index f = 0; f < q.cols(); ++f) {
     double quad_jac = std::numeric_limits<double>::infinity();
     double shortest = std::numeric_limits<double>::infinity(), longest = 0;
     // The quad's reference normal: the sum of its vertices' normals, so that a folded corner
     // (or a whole flipped quad among good neighbours) shows a negative Jacobian.
     Eigen::Vector3d n = Eigen::Vector3d::Zero();
-    for (int k = 0; k < 4; ++k) n += normals.row(q(f, k)).transpose();
+    for (int k = 0; k < 4; ++k) n += normals.col(q(k, f));
     const double nn = n.norm();
     for (int k = 0; k < 4; ++k) {
-      const Eigen::Vector3d p = x.row(q(f, k));
-      const Eigen::Vector3d e1 = x.row(q(f, (k + 1) % 4)).transpose() - p;
-      const Eigen::Vector3d e2 = x.row(q(f, (k + 3) % 4)).transpose() - p;
+      const Eigen::Vector3d p = x.col(q(k, f));
+      const Eigen::Vector3d e1 = x.col(q((k + 1) % 4, f)) - p;
+      const Eigen::Vector3d e2 = x.col(q((k + 3) % 4, f)) - p;
       const double l1 = e1.norm(), l2 = e2.norm();
       shortest = std::min(shortest, l1);
       longest = std::max(longest, l1);
-      const double angle =
-          (l1 > 0 && l2 > 0) ? std::acos(std::clamp(e1.dot(e2) / (l1 * l2), -1.0, 1.0)) : 0.0;
+      const double cosine = (l1 > 0 && l2 > 0) ? std::clamp(e1.dot(e2) / (l1 * l2), -1.0, 1.0) : 1.0;
       const double jac = (l1 > 0 && l2 > 0 && nn > 0) ? e1.cross(e2).dot(n / nn) / (l1 * l2) : 0.0;
-      // A corner whose scaled Jacobian is negative is reflex or folded: its angle is > 180°.
-      const double degrees = (jac < 0 ? 2 * std::numbers::pi - angle : angle) * 180 / std::numbers::pi;
-      min_angle = std::min(min_angle, degrees);
-      max_angle = std::max(max_angle, degrees);
+      // A corner whose scaled Jacobian is negative is reflex or folded: its angle is
+      // 360° − acos(cosine) > 180°. The angle is monotonic in the cosine on either side, so
+      // only the extreme cosines are kept and acos is taken four times per mesh.
+      if (jac < 0) {
+        reflex_cos_min = std::min(reflex_cos_min, cosine);
+        reflex_cos_max = std::max(reflex_cos_max, cosine);
+      } else {
+        convex_cos_min = std::min(convex_cos_min, cosine);
+        convex_cos_max = std::max(convex_cos_max, cosine);
+      }
       quad_jac = std::min(quad_jac, jac);
     }
     max_aspect = std::max(max_aspect, shortest > 0 ? longest / shortest
@@ -78,12 +85,22 @@ QuadQuality measure_quality(const QuadMesh& mesh, std::span<const int> corner_ve
     // A corner of exactly 180° (a quad at a side vertex of valence 2) is flat, not folded.
     if (quad_jac < -1e-9) ++quality.inverted_quads;
   }
-  if (q.rows() > 0) {
+  if (q.cols() > 0) {
+    constexpr double kDegrees = 180 / std::numbers::pi;
+    double min_angle = kInf, max_angle = 0;
+    if (convex_cos_max > -kInf) {
+      min_angle = std::acos(convex_cos_max) * kDegrees;
+      max_angle = std::acos(convex_cos_min) * kDegrees;
+    }
+    if (reflex_cos_max > -kInf) {
+      min_angle = std::min(min_angle, (2 * std::numbers::pi - std::acos(reflex_cos_min)) * kDegrees);
+      max_angle = std::max(max_angle, (2 * std::numbers::pi - std::acos(reflex_cos_max)) * kDegrees);
+    }
     quality.min_angle_deg = min_angle;
     quality.max_angle_deg = max_angle;
     quality.max_aspect_ratio = max_aspect;
     quality.scaled_jacobian_min = jac_min;
-    quality.scaled_jacobian_mean = jac_sum / static_cast<double>(q.rows());
+    quality.scaled_jacobian_mean = jac_sum / static_cast<double>(q.cols());
   }
   return quality;
 }

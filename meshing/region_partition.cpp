@@ -36,20 +36,31 @@ std::vector<int> corner_arcs(std::span<const int> corners, int loop_size) {
   return arcs;
 }
 
-// Fills in cost, irregular and flat of a layout from its corners and the position costs.
-void assess(PolygonLayout& layout, const PositionCosts& costs) {
+// Σ as_side and the number of positions with a nonzero as_side: a layout's figures start from
+// these (every position a side vertex) and change only at its corners.
+struct SideTotals {
+  int cost = 0, irregular = 0;
+  explicit SideTotals(const PositionCosts& costs) {
+    for (const int c : costs.as_side) {
+      cost += c;
+      irregular += c != 0 ? 1 : 0;
+    }
+  }
+};
+
+// Fills in cost, irregular and flat of a layout from its corners and the position costs
+// (corners distinct), in O(corners).
+void assess(PolygonLayout& layout, const PositionCosts& costs, const SideTotals& totals) {
   const auto m = static_cast<int>(layout.corners.size());
   // A grid (m = 4) has no centre; a Nasri centre of valence m costs |m − 4|.
-  layout.cost = std::abs(m - 4);
-  layout.irregular = m != 4 ? 1 : 0;
+  layout.cost = std::abs(m - 4) + totals.cost;
+  layout.irregular = (m != 4 ? 1 : 0) + totals.irregular;
   layout.flat = 0;
-  std::vector<bool> is_corner(costs.as_side.size(), false);
-  for (const int c : layout.corners) is_corner[static_cast<size_t>(c)] = true;
-  for (size_t p = 0; p < is_corner.size(); ++p) {
-    const int c = is_corner[p] ? costs.as_corner[p] : costs.as_side[p];
-    layout.cost += c;
-    layout.irregular += c != 0 ? 1 : 0;
-    if (is_corner[p] && !costs.flat.empty() && costs.flat[p]) ++layout.flat;
+  for (const int c : layout.corners) {
+    const auto p = static_cast<size_t>(c);
+    layout.cost += costs.as_corner[p] - costs.as_side[p];
+    layout.irregular += (costs.as_corner[p] != 0 ? 1 : 0) - (costs.as_side[p] != 0 ? 1 : 0);
+    if (!costs.flat.empty() && costs.flat[p]) ++layout.flat;
   }
 }
 
@@ -69,21 +80,50 @@ PolygonLayout fallback_layout(int loop_size, std::span<const int> starts,
   auto flat = [&](int p) {
     return costs.flat.empty() ? 0 : static_cast<int>(costs.flat[static_cast<size_t>(wrap(p, loop_size))]);
   };
-  int best_balance = -1, best_flat = INT_MAX;
-  for (int p = 0; p < half; ++p)
-    for (int a = 1; a < half; ++a) {
-      const int cost = base + delta(p) + delta(p + a) + delta(p + half) + delta(p + half + a);
-      const int flats = flat(p) + flat(p + a) + flat(p + half) + flat(p + half + a);
+  // A grid's corners are two antipodal pairs (p, p + half) and (q, q + half), q = p + a: its
+  // cost is base + g(p) + g(q) with g(p) = delta(p) + delta(p + half), which has period half.
+  // Pairs that cannot reach the best cost so far are skipped (only a strictly higher cost is
+  // skipped, so ties are still broken exactly as by the full double loop).
+  std::vector<int> g(static_cast<size_t>(half)), flats_at(static_cast<size_t>(half));
+  for (int p = 0; p < half; ++p) {
+    g[static_cast<size_t>(p)] = delta(p) + delta(p + half);
+    flats_at[static_cast<size_t>(p)] = flat(p) + flat(p + half);
+  }
+  // The q to pair with p, cheapest g first: once a cost is found, only a prefix needs looking
+  // at. Ties keep the smallest a for the first p, as the plain double loop over (p, a) would.
+  std::vector<int> by_g(static_cast<size_t>(half));
+  std::iota(by_g.begin(), by_g.end(), 0);
+  std::stable_sort(by_g.begin(), by_g.end(), [&](int x, int y) {
+    return g[static_cast<size_t>(x)] < g[static_cast<size_t>(y)];
+  });
+  const int g_min = g[static_cast<size_t>(by_g.front())];
+  int best_balance = -1, best_flat = INT_MAX, best_a = INT_MAX;
+  for (int p = 0; p < half; ++p) {
+    const int g_p = g[static_cast<size_t>(p)];
+    if (best.cost != INT_MAX && base + g_p + g_min > best.cost) continue;
+    bool found_here = false;
+    for (const int q : by_g) {
+      const int cost = base + g_p + g[static_cast<size_t>(q)];
+      if (cost > best.cost) break;
+      if (q == p) continue;
+      const int a = q > p ? q - p : q + half - p;
+      const int flats = flats_at[static_cast<size_t>(p)] + flats_at[static_cast<size_t>(q)];
       const int balance = std::min(a, half - a);
-      if (std::tuple(cost, flats, -balance) < std::tuple(best.cost, best_flat, -best_balance)) {
+      const auto key = std::tuple(cost, flats, -balance);
+      const auto best_key = std::tuple(best.cost, best_flat, -best_balance);
+      if (key < best_key || (found_here && key == best_key && a < best_a)) {
         best.corners = {p, p + a, p + half, wrap(p + half + a, loop_size)};
         best.cost = cost;
         best_flat = flats;
         best_balance = balance;
+        best_a = a;
+        found_here = true;
       }
     }
+  }
   std::sort(best.corners.begin(), best.corners.end());
-  assess(best, costs);
+  const SideTotals totals(costs);
+  assess(best, costs, totals);
   if (loop_size < 6) return best;
   std::vector<int> start_list(starts.begin(), starts.end());
   if (start_list.empty()) start_list.push_back(0);
@@ -92,7 +132,7 @@ PolygonLayout fallback_layout(int loop_size, std::span<const int> starts,
     std::vector<int> corners = {start, wrap(start + a, loop_size), wrap(start + a + b, loop_size)};
     std::sort(corners.begin(), corners.end());
     PolygonLayout triangle{corners, *nasri_spokes(corner_arcs(corners, loop_size))};
-    assess(triangle, costs);
+    assess(triangle, costs, totals);
     if (std::tuple(triangle.cost, triangle.irregular, triangle.flat) <
         std::tuple(best.cost, best.irregular, best.flat))
       best = std::move(triangle);
@@ -123,13 +163,23 @@ bool solve_spokes(std::span<const int> arcs, std::vector<int>& d) {
   if (m < 3) return false;
   d.resize(static_cast<size_t>(m));
   if (m % 4 != 0) {
+    // The closed form gives 2 d_j as an alternating sum of `terms` arcs; it is computed once
+    // per cycle j, j+2, j+4, ... (one cycle for m odd, two for m/2 odd) and the rest follows
+    // from arcs_{j+1} = d_j + d_{j+2}: O(m) instead of O(m²). Within a cycle every 2 d_j has
+    // the parity of the first.
     const int terms = m % 2 == 1 ? m : m / 2;
-    for (int j = 0; j < m; ++j) {
+    for (int r = 0; r < (m % 2 == 1 ? 1 : 2); ++r) {
       int twice = 0;
-      for (int k = 0; k < terms; ++k)
-        twice += (k % 2 == 0 ? 1 : -1) * arcs[static_cast<size_t>(wrap(j + 1 + 2 * k, m))];
-      if (twice % 2 != 0 || twice < 2) return false;
-      d[static_cast<size_t>(j)] = twice / 2;
+      for (int k = 0, i = r + 1; k < terms; ++k, i = i + 2 >= m ? i + 2 - m : i + 2)
+        twice += (k % 2 == 0 ? 1 : -1) * arcs[static_cast<size_t>(i)];
+      if (twice % 2 != 0) return false;
+      for (int k = 0, j = r; k < terms; ++k) {
+        if (twice < 2) return false;
+        d[static_cast<size_t>(j)] = twice / 2;
+        const int next_arc = j + 1 == m ? 0 : j + 1;
+        twice = 2 * arcs[static_cast<size_t>(next_arc)] - twice;
+        j = j + 2 >= m ? j + 2 - m : j + 2;
+      }
     }
     return true;
   }
@@ -184,6 +234,7 @@ PositionCosts region_costs(std::span<const int> side_counts) {
 }
 
 PolygonLayout best_layout(const PositionCosts& costs, int budget) {
+  const int given = budget;
   const auto size = static_cast<int>(costs.as_side.size());
   if (size < 4 || size % 2 != 0) throw std::logic_error("a quad-fillable loop has an even size >= 4");
   std::vector<int> naturals, others;  // positions that would rather be corners / the rest
@@ -228,14 +279,13 @@ PolygonLayout best_layout(const PositionCosts& costs, int budget) {
   int best_balance = -1;
   const auto base_irregular = static_cast<int>(
       std::count_if(costs.as_side.begin(), costs.as_side.end(), [](int c) { return c != 0; }));
-  std::vector<int> arcs, spokes;  // reused buffers: a check allocates nothing
-  auto consider = [&](std::vector<int>& chosen) {
+  std::vector<int> arcs, spokes, kept, added, chosen;  // reused: a check allocates nothing
+  auto consider = [&](const std::vector<int>& corners) {
     --budget;
-    std::sort(chosen.begin(), chosen.end());
-    const auto m = chosen.size();
+    const auto m = corners.size();
     arcs.resize(m);
-    for (size_t j = 0; j < m; ++j)
-      arcs[j] = wrap(chosen[(j + 1) % m] - chosen[j], size);
+    for (size_t j = 0; j + 1 < m; ++j) arcs[j] = corners[j + 1] - corners[j];
+    arcs[m - 1] = corners[0] + size - corners[m - 1];
     int balance;
     bool grid = false;
     if (m == 4 && arcs[0] == arcs[2] && arcs[1] == arcs[3]) {
@@ -249,7 +299,7 @@ PolygonLayout best_layout(const PositionCosts& costs, int budget) {
     int cost = std::abs(static_cast<int>(m) - 4) + base;
     int irregular = (m != 4 ? 1 : 0) + base_irregular;
     int flats = 0;
-    for (const int p : chosen) {
+    for (const int p : corners) {
       cost += delta(p);
       irregular += (costs.as_corner[static_cast<size_t>(p)] != 0 ? 1 : 0) -
                    (costs.as_side[static_cast<size_t>(p)] != 0 ? 1 : 0);
@@ -259,7 +309,7 @@ PolygonLayout best_layout(const PositionCosts& costs, int budget) {
     // shortest spoke.
     if (!best || std::tuple(cost, irregular, flats, -balance) <
                      std::tuple(best->cost, best->irregular, best->flat, -best_balance)) {
-      best = PolygonLayout{chosen, grid ? std::vector<int>{} : spokes, cost, irregular, flats};
+      best = PolygonLayout{corners, grid ? std::vector<int>{} : spokes, cost, irregular, flats};
       best_balance = balance;
     }
   };
@@ -269,18 +319,18 @@ PolygonLayout best_layout(const PositionCosts& costs, int budget) {
     if ((best && plan.bound > best->cost) || plan.bound > fallback.cost || budget <= 0) break;
     // Every subset of `plan.dropped` natural corners (bit masks), then every choice of
     // `plan.added` promoted positions in increasing order.
-    const int full = 1 << std::min(n_natural, 20);
-    for (int mask = 0; mask < full && budget > 0; ++mask) {
-      if (__builtin_popcount(static_cast<unsigned>(mask)) != plan.dropped) continue;
-      std::vector<int> kept;
+    // Masks with `plan.dropped` bits in increasing order (Gosper's next-combination step).
+    const unsigned full = 1u << std::min(n_natural, 20);
+    for (unsigned mask = (1u << plan.dropped) - 1; mask < full && budget > 0;) {
+      kept.clear();
       for (int i = 0; i < n_natural; ++i)
-        if ((mask & (1 << i)) == 0) kept.push_back(naturals[static_cast<size_t>(i)]);
-      std::vector<int> added, chosen;
+        if ((mask & (1u << i)) == 0) kept.push_back(naturals[static_cast<size_t>(i)]);
       auto recurse = [&](auto&& self, size_t from) -> void {
         if (budget <= 0) return;
         if (static_cast<int>(added.size()) == plan.added) {
-          chosen = kept;
-          chosen.insert(chosen.end(), added.begin(), added.end());
+          // kept and added are both increasing: the corners in loop order
+          chosen.resize(kept.size() + added.size());
+          std::merge(kept.begin(), kept.end(), added.begin(), added.end(), chosen.begin());
           consider(chosen);
           return;
         }
@@ -291,12 +341,53 @@ PolygonLayout best_layout(const PositionCosts& costs, int budget) {
         }
       };
       recurse(recurse, 0);
+      if (mask == 0) break;
+      const unsigned low = mask & (~mask + 1u), ripple = mask + low;
+      mask = (((ripple ^ mask) >> 2) / low) | ripple;
     }
   }
+  PolygonLayout chosen_layout = fallback;
   if (best && std::tuple(best->cost, best->irregular, best->flat) <=
                   std::tuple(fallback.cost, fallback.irregular, fallback.flat))
-    return *best;
-  return fallback;
+    chosen_layout = std::move(*best);
+  chosen_layout.checks = given - budget;
+  return chosen_layout;
+}
+
+int layout_cost_lower_bound(const PositionCosts& costs) {
+  // Every layout costs |m − 4| + Σ as_side + Σ over its corners (as_corner − as_side): with k
+  // of the positions that would rather be corners dropped and a others added, at least
+  // |m − 4| + base + (sum of the natural deltas) + (k cheapest drops) + a · (cheapest add).
+  auto corner_cost = [&](size_t p) {
+    const int c = costs.as_corner[p];
+    return c >= kFoldPenalty ? c - kFoldPenalty : c;
+  };
+  int base = 0, natural_sum = 0, min_add = INT_MAX, others = 0;
+  std::vector<int> drop_costs;
+  for (size_t p = 0; p < costs.as_side.size(); ++p) {
+    base += costs.as_side[p];
+    const int delta = corner_cost(p) - costs.as_side[p];
+    if (delta < 0) {
+      natural_sum += delta;
+      drop_costs.push_back(-delta);
+    } else {
+      min_add = std::min(min_add, delta);
+      ++others;
+    }
+  }
+  std::sort(drop_costs.begin(), drop_costs.end());
+  const auto naturals = static_cast<int>(drop_costs.size());
+  int best = INT_MAX, drop = 0;
+  for (int k = 0; k <= naturals; ++k) {
+    if (k > 0) drop += drop_costs[static_cast<size_t>(k) - 1];
+    // Beyond m = 4 another added corner raises |m − 4| and costs min_add >= 0 more.
+    for (int a = 0; a <= others; ++a) {
+      const int m = naturals - k + a;
+      if (m >= 3) best = std::min(best, std::abs(m - 4) + base + natural_sum + drop + a * min_add);
+      if (m >= 4) break;
+    }
+  }
+  return best;
 }
 
 void fill_polygon(QuadMeshBuilder& builder, std::span<const int> loop,

@@ -32,6 +32,7 @@ struct PolygonLayout {
   int cost = 0;              // the distortion this layout causes, from the position costs
   int irregular = 0;         // vertices of the loop and the centre left irregular
   int flat = 0;              // layout corners at positions flagged in PositionCosts::flat
+  int checks = 0;            // feasibility checks best_layout spent finding it
 };
 
 // What it costs (in valence deviation) for each loop position to become a layout corner
@@ -49,6 +50,11 @@ struct PositionCosts {
 // corner sets in order of a lower bound on their cost, at most `budget` feasibility checks;
 // always returns a layout for a loop of >= 4 positions (a triangle or a single quad at worst).
 PolygonLayout best_layout(const PositionCosts& costs, int budget);
+
+// A lower bound on the cost of any layout best_layout can return for these costs (the cost a
+// layout with the cheapest possible corners would have), ignoring kFoldPenalty: so a caller
+// can skip a search that cannot beat what it already has.
+int layout_cost_lower_bound(const PositionCosts& costs);
 
 // Fills the polygon whose boundary loop (vertex ids, counter-clockwise) is `loop`.
 void fill_polygon(QuadMeshBuilder& builder, std::span<const int> loop,
