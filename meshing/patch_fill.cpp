@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <numeric>
 #include <optional>
@@ -97,7 +98,7 @@ struct BoundaryShape {
 // A quad corner wider than this is treated as flat (a side vertex of valence 2 on a straight
 // or gently curved side); above 180° plus kReflexSlackDegrees it is reflex.
 constexpr double kFlatDegrees = 165;
-constexpr double kReflexSlackDegrees = 0.5;
+constexpr double kReflexSlackDegrees = 0.01;
 
 // Straight sides, convex corners: what fill_region(counts) assumes.
 BoundaryShape straight_sided_shape(std::span<const int> counts) {
@@ -147,19 +148,27 @@ struct Plan {
   int distortion = 0, irregular_vertices = 0;
   int folded = 0;  // boundary vertices of valence 2 where the boundary is reflex
   int flat = 0;    // boundary vertices of valence 2 where it is flat (or reflex)
+  // Loop positions of the corners the strips work with: empty for the region's own corners;
+  // without its reflex corners when those must not keep a single quad (a strip keeps the
+  // corners it runs between at valence 2, so it can only pass a reflex corner as a side
+  // vertex of valence 3).
+  std::vector<int> strip_corners;
 
   // Never fold where another construction does not; then least distortion, fewest irregular
   // vertices (the corpus figures), then fewest flat corners.
   auto rank() const { return std::tuple(folded, distortion, irregular_vertices, flat); }
 };
 
+// The region to pad: every real corner regular at valence 2, the strips' sides between
+// `strip_corners` (empty: the real corners).
 detail::StripRegion region_of(std::span<const int> loop_ids, std::span<const int> counts,
-                              const BoundaryShape& shape) {
+                              const BoundaryShape& shape, std::span<const int> strip_corners) {
   detail::StripRegion region;
   for (size_t p = 0; p < loop_ids.size(); ++p)
     region.loop.push_back({loop_ids[p], 0, 3, shape.flat[p] != 0, shape.reflex[p] != 0});
   region.corners = corner_positions(counts);
   for (const int c : region.corners) region.loop[static_cast<size_t>(c)].regular = 2;
+  if (!strip_corners.empty()) region.corners.assign(strip_corners.begin(), strip_corners.end());
   return region;
 }
 
@@ -167,9 +176,10 @@ detail::StripRegion region_of(std::span<const int> loop_ids, std::span<const int
 // given and the plan provably cannot rank before it).
 std::optional<Plan> plan_with_strips(std::span<const int> counts, const BoundaryShape& shape,
                                      std::span<const int> strips, int budget,
-                                     const Plan* rival = nullptr) {
+                                     const Plan* rival = nullptr,
+                                     std::span<const int> strip_corners = {}) {
   const std::vector<int> no_ids(shape.flat.size(), -1);
-  detail::StripRegion region = region_of(no_ids, counts, shape);
+  detail::StripRegion region = region_of(no_ids, counts, shape, strip_corners);
   for (const int side : strips)
     if (!region.strip(side)) return std::nullopt;
   const detail::PositionCosts costs = region.costs();
@@ -181,6 +191,7 @@ std::optional<Plan> plan_with_strips(std::span<const int> counts, const Boundary
   }
   Plan plan;
   plan.strips.assign(strips.begin(), strips.end());
+  plan.strip_corners.assign(strip_corners.begin(), strip_corners.end());
   plan.layout = detail::best_layout(costs, budget);
   int layout_folds = 0;
   for (const int c : plan.layout.corners)
@@ -190,7 +201,7 @@ std::optional<Plan> plan_with_strips(std::span<const int> counts, const Boundary
   plan.folded = region.folded + layout_folds;
   plan.flat = region.flat + plan.layout.flat;
   if (!strips.empty()) plan.partition = "padded";
-  else plan.partition = plan.layout.corners == region.corners ? "nasri" : "shifted-corners";
+  else plan.partition = plan.layout.corners == corner_positions(counts) ? "nasri" : "shifted-corners";
   return plan;
 }
 
@@ -230,9 +241,21 @@ std::optional<std::pair<Plan, Built>> yasseen_candidate(
 
 // The best plan for these counts on a boundary of this shape; when the Yasseen construction
 // wins, `yasseen` receives it already built on `side_points`.
+// Plans listed in `excluded` (same strips, strip corners and construction) are passed over.
 Plan choose_plan(std::span<const int> counts, const BoundaryShape& shape,
-                 const std::vector<Eigen::MatrixX3d>& side_points, std::optional<Built>& yasseen) {
+                 const std::vector<Eigen::MatrixX3d>& side_points, std::optional<Built>& yasseen,
+                 const std::vector<Plan>& excluded = {}) {
+  auto allowed = [&](const Plan& plan) {
+    return std::none_of(excluded.begin(), excluded.end(), [&](const Plan& other) {
+      return other.yasseen == plan.yasseen && other.strips == plan.strips &&
+             other.strip_corners == plan.strip_corners;
+    });
+  };
   Plan best = *plan_with_strips(counts, shape, {}, kSearchBudget);
+  if (!allowed(best)) {
+    best.folded = std::numeric_limits<int>::max();  // anything else ranks before it
+    best.distortion = std::numeric_limits<int>::max();
+  }
   // Padding only pays when the plain layout promotes a side vertex where the boundary is flat
   // or reflex, or folds a quad (a reflex real corner it could not drop without promoting a
   // corner on a reflex stretch); strips keep the real corners at valence 2, so a merely flat
@@ -248,30 +271,45 @@ Plan choose_plan(std::span<const int> counts, const BoundaryShape& shape,
       if (std::find(exposed_sides.begin(), exposed_sides.end(), side) == exposed_sides.end())
         exposed_sides.push_back(side);
     }
-  if (!exposed_sides.empty() || best.folded > 0) {
-    int padded_budget = kPaddedSearchBudget;
+  int padded_budget = kPaddedSearchBudget;
+  // Every side and every pair of sides between these corners (the layout may move its
+  // promotions elsewhere), and a full ring.
+  auto pad = [&](std::span<const int> strip_corners, bool with_plain) {
     auto consider = [&](std::span<const int> strips) {
       auto plan = plan_with_strips(counts, shape, strips,
-                                   std::min(kStripSearchBudget, padded_budget), &best);
+                                   std::min(kStripSearchBudget, padded_budget), &best,
+                                   strip_corners);
       if (!plan) return;
       padded_budget = std::max(0, padded_budget - plan->layout.checks);
-      if (plan->rank() < best.rank()) best = std::move(*plan);
+      if (plan->rank() < best.rank() && allowed(*plan)) best = std::move(*plan);
     };
-    // Every side and every pair of sides (the layout may move its promotions elsewhere), and a
-    // full ring.
-    for (int i = 0; i < n; ++i) {
+    const auto sides = static_cast<int>(strip_corners.empty() ? n : strip_corners.size());
+    if (with_plain) consider({});
+    for (int i = 0; i < sides; ++i) {
       consider(std::vector<int>{i});
-      for (int j = i + 1; j < n; ++j) consider(std::vector<int>{i, j});
+      for (int j = i + 1; j < sides; ++j) consider(std::vector<int>{i, j});
     }
-    std::vector<int> all(static_cast<size_t>(n));
+    std::vector<int> all(static_cast<size_t>(sides));
     std::iota(all.begin(), all.end(), 0);
-    if (n > 2) consider(all);
+    if (sides > 2) consider(all);
+  };
+  if (!exposed_sides.empty() || best.folded > 0) pad({}, false);
+  if (best.folded > 0) {
+    // Strips that pass the reflex real corners as side vertices.
+    std::vector<int> convex;
+    for (const int c : real_corners)
+      if (!shape.reflex[static_cast<size_t>(c)]) convex.push_back(c);
+    if (convex.size() >= 2 && convex.size() < real_corners.size()) pad(convex, true);
   }
   // Nothing ranks before a fold-free plan with the least possible distortion, a single
   // irregular vertex (none for a grid) and no flat corner: no need to build the Yasseen one.
   const bool unbeatable = best.folded == 0 && best.distortion == std::abs(n - 4) &&
                           best.irregular_vertices == (n == 4 ? 0 : 1) && best.flat == 0;
-  if (auto candidate = unbeatable ? std::nullopt : yasseen_candidate(side_points, shape, best)) {
+  Plan yasseen_plan;
+  yasseen_plan.yasseen = true;
+  if (auto candidate = unbeatable || !allowed(yasseen_plan)
+                           ? std::nullopt
+                           : yasseen_candidate(side_points, shape, best)) {
     best = std::move(candidate->first);
     yasseen = std::move(candidate->second);
   }
@@ -288,7 +326,8 @@ Built realize(const Plan& plan, std::span<const int> counts,
       throw std::logic_error("the Yasseen construction depends on geometry");
     return built;
   }
-  detail::StripRegion region = region_of(boundary_loop_of(built.sides), counts, shape);
+  detail::StripRegion region =
+      region_of(boundary_loop_of(built.sides), counts, shape, plan.strip_corners);
   for (const int side : plan.strips)
     if (!region.strip(side, &built.builder, shape.normal))
       throw std::logic_error("a planned strip cannot be added");
@@ -352,6 +391,15 @@ void check_side_points(const std::vector<Eigen::MatrixX3d>& side_points) {
   }
 }
 
+// The 3D fill with this plan: build, the display layout, relaxation, quality.
+FilledPatch fill_with_plan(const Plan& plan, std::span<const int> counts,
+                           const std::vector<Eigen::MatrixX3d>& side_points,
+                           const BoundaryShape& shape, std::optional<Built>& yasseen,
+                           const FillGeometryOptions& options);
+
+// Plans tried by the geometric fill before it settles for the one with fewest inverted quads.
+constexpr int kGeometryAttempts = 4;
+
 }  // namespace
 
 std::vector<int> PatchTopology::corner_vertices() const { return corners_of(side_vertices); }
@@ -373,8 +421,31 @@ FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
   for (const auto& side : side_points) counts.push_back(static_cast<int>(side.rows()) - 1);
   check_counts(counts);
   const BoundaryShape shape = measured_shape(side_points);
-  std::optional<Built> yasseen;
-  const Plan plan = choose_plan(counts, shape, side_points, yasseen);
+  // When the relaxed mesh still has inverted quads (a layout whose blocks start overlapping
+  // near a reflex corner that relaxation and untangling could not undo), the next best plans
+  // are tried; the first without inverted quads wins, else the one with fewest.
+  std::vector<Plan> tried;
+  std::optional<FilledPatch> best_patch;
+  for (int attempt = 0; attempt < kGeometryAttempts; ++attempt) {
+    std::optional<Built> yasseen;
+    const Plan plan = choose_plan(counts, shape, side_points, yasseen, tried);
+    if (plan.folded == std::numeric_limits<int>::max()) break;  // nothing left to try
+    FilledPatch patch = fill_with_plan(plan, counts, side_points, shape, yasseen, options);
+    const bool clean = patch.quality.inverted_quads == 0;
+    if (!best_patch || patch.quality.inverted_quads < best_patch->quality.inverted_quads)
+      best_patch = std::move(patch);
+    if (clean) break;
+    tried.push_back(plan);
+  }
+  return std::move(*best_patch);
+}
+
+namespace {
+
+FilledPatch fill_with_plan(const Plan& plan, std::span<const int> counts,
+                           const std::vector<Eigen::MatrixX3d>& side_points,
+                           const BoundaryShape& shape, std::optional<Built>& yasseen,
+                           const FillGeometryOptions& options) {
   FilledPatch patch;
   Built built = yasseen ? std::move(*yasseen) : realize(plan, counts, side_points, shape);
   patch.mesh = built.builder.build();
@@ -394,6 +465,8 @@ FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
   patch.quality = measure_quality(patch.mesh, patch.topology.corner_vertices());
   return patch;
 }
+
+}  // namespace
 
 Eigen::MatrixX3d resample_by_arc_length(const Eigen::MatrixX3d& polyline, int count) {
   if (polyline.rows() < 2) throw FillError("a side polyline needs at least 2 points");

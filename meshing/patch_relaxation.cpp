@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <vector>
 
 namespace sd::meshing {
@@ -48,9 +49,11 @@ Adjacency build_adjacency(const QuadMesh& mesh) {
 }
 
 // Unit reference normal of each quad: the sum of its vertices' normals (each the sum of the
-// corner cross products around the vertex), so that a folded quad among good neighbours shows
-// a negative Jacobian even on a curved patch.
-std::vector<Eigen::Vector3d> quad_normals(const QuadMesh& mesh,
+// corner cross products around the vertex, averaged over kNormalRings rings of neighbours), so
+// that a folded quad among good neighbours shows a negative Jacobian even on a curved patch.
+constexpr int kNormalRings = 4;
+
+std::vector<Eigen::Vector3d> quad_normals(const QuadMesh& mesh, const Adjacency& adj,
                                           const std::vector<Eigen::Vector3d>& x) {
   std::vector<Eigen::Vector3d> vertex_normal(x.size(), Eigen::Vector3d::Zero());
   for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f)
@@ -62,6 +65,18 @@ std::vector<Eigen::Vector3d> quad_normals(const QuadMesh& mesh,
     }
   for (auto& n : vertex_normal)
     if (n.norm() > 0) n.normalize();
+  // Averaged over a few rings, so that a cluster of quads that start folded (a Coons block
+  // overlapping its neighbour near a reflex corner) cannot turn its own reference around.
+  std::vector<Eigen::Vector3d> averaged(x.size());
+  for (int ring = 0; ring < kNormalRings; ++ring) {
+    for (size_t v = 0; v < x.size(); ++v) {
+      Eigen::Vector3d sum = vertex_normal[v];
+      for (int i = adj.neighbour_start[v]; i < adj.neighbour_start[v + 1]; ++i)
+        sum += vertex_normal[static_cast<size_t>(adj.neighbours[static_cast<size_t>(i)])];
+      averaged[v] = sum.norm() > 0 ? Eigen::Vector3d(sum.normalized()) : sum;
+    }
+    std::swap(vertex_normal, averaged);
+  }
   std::vector<Eigen::Vector3d> normals(static_cast<size_t>(mesh.faces.rows()));
   for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f) {
     Eigen::Vector3d n = Eigen::Vector3d::Zero();
@@ -110,6 +125,92 @@ bool quad_at_least(const Quad& q, const Eigen::Vector3d& normal,
   return true;
 }
 
+using Projection = std::function<Eigen::Vector3d(const Eigen::Vector3d&)>;
+
+// Untangling: moves free vertices of quads whose smallest scaled Jacobian is below
+// kUntangleTarget (and their free neighbours) one at a time to raise the smallest scaled
+// Jacobian over the quads around them (a pattern search in the plane square to their quads'
+// reference normals, step halving from half the mean edge length), and accepts a move only when
+// that minimum rises. Laplacian smoothing moves a vertex to the mean of its neighbours, which
+// near a reflex boundary corner or a strongly graded strip can lie outside the vertex's
+// feasible region; this search looks at the quads' orientation itself. Stops when no quad is
+// below the target or after kUntanglePasses passes.
+constexpr double kUntangleTarget = 0.02;
+constexpr int kUntanglePasses = 100;
+
+void untangle(std::vector<Eigen::Vector3d>& x, const std::vector<Quad>& quads,
+              const std::vector<Eigen::Vector3d>& normals, const Adjacency& adj,
+              std::span<const char> fixed, const Projection& project) {
+  const size_t nf = quads.size(), nv = x.size();
+  auto around = [&](size_t v) {  // smallest scaled Jacobian of the quads at v
+    double worst = std::numeric_limits<double>::infinity();
+    for (int c = adj.corner_start[v]; c < adj.corner_start[v + 1]; ++c) {
+      const auto f = static_cast<size_t>(adj.corners[static_cast<size_t>(c)] / 4);
+      worst = std::min(worst, quad_min_jacobian(quads[f], normals[f], x));
+    }
+    return worst;
+  };
+  std::vector<char> chosen(nv, 0);
+  std::vector<size_t> movable;
+  for (int pass = 0; pass < kUntanglePasses; ++pass) {
+    movable.clear();
+    std::fill(chosen.begin(), chosen.end(), 0);
+    auto choose = [&](size_t v) {
+      if (!fixed[v] && !chosen[v]) {
+        chosen[v] = 1;
+        movable.push_back(v);
+      }
+    };
+    for (size_t f = 0; f < nf; ++f) {
+      if (quad_min_jacobian(quads[f], normals[f], x) >= kUntangleTarget) continue;
+      for (const int v : quads[f]) {
+        choose(static_cast<size_t>(v));
+        for (int i = adj.neighbour_start[static_cast<size_t>(v)]; i < adj.neighbour_start[static_cast<size_t>(v) + 1]; ++i)
+          choose(static_cast<size_t>(adj.neighbours[static_cast<size_t>(i)]));
+      }
+    }
+    if (movable.empty()) return;
+    bool improved = false;
+    for (const size_t v : movable) {
+      Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+      double edge_sum = 0;
+      for (int c = adj.corner_start[v]; c < adj.corner_start[v + 1]; ++c)
+        normal += normals[static_cast<size_t>(adj.corners[static_cast<size_t>(c)] / 4)];
+      const int begin = adj.neighbour_start[v], end = adj.neighbour_start[v + 1];
+      for (int i = begin; i < end; ++i)
+        edge_sum += (x[static_cast<size_t>(adj.neighbours[static_cast<size_t>(i)])] - x[v]).norm();
+      if (normal.norm() == 0 || end == begin) continue;
+      normal.normalize();
+      const Eigen::Vector3d t1 = normal.unitOrthogonal(), t2 = normal.cross(t1);
+      double step = 0.5 * edge_sum / (end - begin);
+      double current = around(v);
+      for (int halving = 0; halving < 12; ++halving) {
+        const Eigen::Vector3d start = x[v];
+        Eigen::Vector3d best_position = start;
+        double best = current;
+        for (int k = 0; k < 8; ++k) {
+          const double angle = k * std::numbers::pi / 4;
+          const Eigen::Vector3d candidate = start + step * (std::cos(angle) * t1 + std::sin(angle) * t2);
+          x[v] = project ? project(candidate) : candidate;
+          const double value = around(v);
+          if (value > best + 1e-12) {
+            best = value;
+            best_position = x[v];
+          }
+        }
+        x[v] = best_position;
+        if (best > current) {
+          current = best;
+          improved = true;
+        } else {
+          step *= 0.5;
+        }
+      }
+    }
+    if (!improved) return;
+  }
+}
+
 }  // namespace
 
 void relax_interior(QuadMesh& mesh, std::span<const char> fixed, int sweeps,
@@ -121,7 +222,7 @@ void relax_interior(QuadMesh& mesh, std::span<const char> fixed, int sweeps,
   std::vector<Eigen::Vector3d> old(nv), next(nv);
   for (size_t v = 0; v < nv; ++v) old[v] = mesh.vertices.row(static_cast<Eigen::Index>(v)).transpose();
   // Reference normals from the starting positions: they only tell a quad's front from its back.
-  const std::vector<Eigen::Vector3d> normals = quad_normals(mesh, old);
+  const std::vector<Eigen::Vector3d> normals = quad_normals(mesh, adj, old);
   constexpr double kAcceptable = 0.05;  // a move may lower a quad's minimum down to this
   // Stop once no vertex moves more than 1e-3 of the mean edge length in a sweep.
   double edge_sum = 0;
@@ -168,6 +269,7 @@ void relax_interior(QuadMesh& mesh, std::span<const char> fixed, int sweeps,
                    quad_min_jacobian(quads[f], normals[f], x) >=
                        quad_min_jacobian(quads[f], normals[f], old) - 1e-12;
     if (acceptable) {
+      untangle(x, quads, normals, adj, fixed, project);
       for (size_t v = 0; v < nv; ++v) mesh.vertices.row(static_cast<Eigen::Index>(v)) = x[v].transpose();
       return;
     }
@@ -211,6 +313,7 @@ void relax_interior(QuadMesh& mesh, std::span<const char> fixed, int sweeps,
     std::swap(old, next);
     if (move < tolerance * tolerance) break;  // converged
   }
+  untangle(old, quads, normals, adj, fixed, project);
   for (size_t v = 0; v < nv; ++v) mesh.vertices.row(static_cast<Eigen::Index>(v)) = old[v].transpose();
 }
 
