@@ -93,6 +93,7 @@ struct BoundaryShape {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // the loop is counter-clockwise about it
   std::vector<char> reflex;  // interior angle above 180°: one quad there is folded
   std::vector<char> flat;    // interior angle above kFlatDegrees (reflex included)
+  bool measured = false;     // from real side points (not the count-only assumption)
 };
 
 // A quad corner wider than this is treated as flat (a side vertex of valence 2 on a straight
@@ -124,6 +125,7 @@ BoundaryShape measured_shape(const std::vector<Eigen::MatrixX3d>& side_points) {
   for (size_t k = 0; k < size; ++k)
     newell += (loop[k] - origin).cross(loop[(k + 1) % size] - origin);
   if (newell.norm() > 0) shape.normal = newell.normalized();
+  shape.measured = true;
   shape.reflex.assign(size, 0);
   shape.flat.assign(size, 0);
   for (size_t k = 0; k < size; ++k) {
@@ -154,9 +156,15 @@ struct Plan {
   // vertex of valence 3).
   std::vector<int> strip_corners;
 
-  // Never fold where another construction does not; then least distortion, fewest irregular
-  // vertices (the corpus figures), then fewest flat corners.
-  auto rank() const { return std::tuple(folded, distortion, irregular_vertices, flat); }
+  // Never fold where another construction does not; then least distortion; then, for a
+  // count-only fill, fewest irregular vertices (the corpus figures) before fewest flat
+  // corners, and for a fill of real sides (`shape_first`) the other way round: a side vertex
+  // of valence 2 leaves one quad with a 180° corner and the other three sharing 180°, which on
+  // a long side next to short ones makes a sliver (3° for (30,4,4,4,4) on the `fill` circle).
+  auto rank(bool shape_first) const {
+    return std::tuple(folded, distortion, shape_first ? flat : irregular_vertices,
+                      shape_first ? irregular_vertices : flat);
+  }
 };
 
 // The region to pad: every real corner regular at valence 2, the strips' sides between
@@ -235,7 +243,9 @@ std::optional<std::pair<Plan, Built>> yasseen_candidate(
       plan.folded += shape.reflex[p];
       plan.flat += shape.flat[p];
     }
-  if (!(plan.rank() < rival.rank()) || !validate(built.builder.build()).ok()) return std::nullopt;
+  if (!(plan.rank(shape.measured) < rival.rank(shape.measured)) ||
+      !validate(built.builder.build()).ok())
+    return std::nullopt;
   return std::pair(std::move(plan), std::move(built));
 }
 
@@ -281,7 +291,8 @@ Plan choose_plan(std::span<const int> counts, const BoundaryShape& shape,
                                    strip_corners);
       if (!plan) return;
       padded_budget = std::max(0, padded_budget - plan->layout.checks);
-      if (plan->rank() < best.rank() && allowed(*plan)) best = std::move(*plan);
+      if (plan->rank(shape.measured) < best.rank(shape.measured) && allowed(*plan))
+        best = std::move(*plan);
     };
     const auto sides = static_cast<int>(strip_corners.empty() ? n : strip_corners.size());
     if (with_plain) consider({});
