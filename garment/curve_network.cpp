@@ -105,6 +105,26 @@ double polyline_length(const Eigen::MatrixX3d& points) {
   return length;
 }
 
+Eigen::Vector3d polyline_end_tangent(const Eigen::MatrixX3d& p, bool at_start, double reach) {
+  reach = std::min(reach, polyline_length(p) / 3);
+  const Eigen::Index n = p.rows();
+  double arc = 0;
+  if (at_start) {
+    Eigen::Index k = 1;
+    for (; k < n - 1; ++k) {
+      arc += (p.row(k) - p.row(k - 1)).norm();
+      if (arc >= reach) break;
+    }
+    return (p.row(k) - p.row(0)).transpose().normalized();
+  }
+  Eigen::Index k = n - 2;
+  for (; k > 0; --k) {
+    arc += (p.row(k + 1) - p.row(k)).norm();
+    if (arc >= reach) break;
+  }
+  return (p.row(n - 1) - p.row(k)).transpose().normalized();
+}
+
 int CurveNetwork::find_curve(const std::string& id) const {
   for (size_t i = 0; i < curves.size(); ++i)
     if (curves[i].id == id) return static_cast<int>(i);

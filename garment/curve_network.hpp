@@ -50,6 +50,14 @@ CurveNetwork build_network(const Sketch& sketch, const std::vector<ProjectedCurv
 // Polyline length, metres.
 double polyline_length(const Eigen::MatrixX3d& points);
 
+// Metres of curve used to estimate a tangent at a junction.
+inline constexpr double kJunctionTangentArc = 0.02;
+
+// Unit direction of a polyline (#P by 3, at least 2 points) leaving its first point (at_start)
+// or arriving at its last, measured over `reach` metres of it (a third of its length when
+// shorter), so a tangent at a junction is not thrown off by the last few millimetres.
+Eigen::Vector3d polyline_end_tangent(const Eigen::MatrixX3d& points, bool at_start, double reach);
+
 // Mirror image across x = 0.
 inline Eigen::Vector3d mirror_point(const Eigen::Vector3d& p) { return {-p.x(), p.y(), p.z()}; }
 

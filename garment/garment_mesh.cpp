@@ -8,10 +8,12 @@
 #include <array>
 #include <map>
 #include <numeric>
+#include <set>
 #include <stdexcept>
 
 #include "garment/curve_network.hpp"
 #include "garment/edge_counts.hpp"
+#include "garment/network_faces.hpp"
 #include "garment/panel_loop.hpp"
 #include "garment/stroke_projection.hpp"
 #include "meshing/patch_fill.hpp"
@@ -88,7 +90,16 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
   if (sketch.garment_mesh)
     throw std::logic_error("build_garment: a garment_mesh sketch has no curves to mesh");
   const std::vector<ProjectedCurve> projected = project_curves(sketch, body);
-  const CurveNetwork net = build_network(sketch, projected, curves_to_mirror(sketch));
+  std::set<std::string> mirrored = curves_to_mirror(sketch);
+  CurveNetwork net = build_network(sketch, projected, mirrored);
+  // A mirrored "auto" panel's curves are known only once its region is found; their copies can
+  // change the regions on the other side, so repeat until the set settles (twice in practice).
+  for (int pass = 0; pass < 4; ++pass) {
+    const size_t before = mirrored.size();
+    mirrored.merge(auto_panel_curves_to_mirror(sketch, net, body));
+    if (mirrored.size() == before) break;
+    net = build_network(sketch, projected, mirrored);
+  }
   const std::vector<PanelLoop> loops = resolve_panels(sketch, net, body);
   EdgeCounts counts = compute_edge_counts(sketch, net, loops);
 

@@ -6,40 +6,20 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <map>
 #include <numbers>
+#include <optional>
+
+#include "garment/network_faces.hpp"
 
 namespace sd::garment {
 namespace {
 
-constexpr double kTangentArc = 0.02;  // metres of curve used to estimate a tangent at a junction
 
 // Points of a loop edge in traversal order.
 Eigen::MatrixX3d ordered_points(const CurveNetwork& net, const LoopEdge& e) {
   const Eigen::MatrixX3d& p = net.edges[static_cast<size_t>(e.edge)].points;
   return e.forward ? p : Eigen::MatrixX3d(p.colwise().reverse());
-}
-
-// Unit direction of the polyline leaving its first point (at_start) or arriving at its last,
-// averaged over kTangentArc (or a third of the length when shorter).
-Eigen::Vector3d end_tangent(const Eigen::MatrixX3d& p, bool at_start) {
-  const double reach = std::min(kTangentArc, polyline_length(p) / 3);
-  const Eigen::Index n = p.rows();
-  if (at_start) {
-    double arc = 0;
-    Eigen::Index k = 1;
-    for (; k < n - 1; ++k) {
-      arc += (p.row(k) - p.row(k - 1)).norm();
-      if (arc >= reach) break;
-    }
-    return (p.row(k) - p.row(0)).transpose().normalized();
-  }
-  double arc = 0;
-  Eigen::Index k = n - 2;
-  for (; k > 0; --k) {
-    arc += (p.row(k + 1) - p.row(k)).norm();
-    if (arc >= reach) break;
-  }
-  return (p.row(n - 1) - p.row(k)).transpose().normalized();
 }
 
 struct Run {
@@ -202,18 +182,28 @@ std::vector<PanelLoop> resolve_panels(const Sketch& sketch, const CurveNetwork& 
       mirror_edge[e] = static_cast<int>(e);
 
   const double corner_cos = std::cos(sketch.corner_angle_degrees * std::numbers::pi / 180);
+  std::optional<NetworkFaces> faces;  // traced when a panel is "auto"
+  std::map<int, std::string> auto_faces;  // face → the auto panel that picked it
   std::vector<PanelLoop> loops;
   for (size_t p = 0; p < sketch.panels.size(); ++p) {
     const PanelSpec& spec = sketch.panels[p];
-    if (spec.auto_boundary)
-      sketch.fail(spec.json_path + "/boundary",
-                  "\"auto\" boundaries are not available in this version; list the panel's "
-                  "curves in order");
     PanelLoop loop;
     loop.id = spec.id;
     loop.json_path = spec.json_path;
     loop.spec = static_cast<int>(p);
-    loop.edges = resolve_explicit(sketch, net, spec);
+    if (spec.auto_boundary) {
+      if (!faces) faces = trace_faces(net, body);
+      loop.edges = auto_panel_loop(sketch, net, *faces, body, spec);
+      const int face = faces->face_left[static_cast<size_t>(2 * loop.edges.front().edge + (loop.edges.front().forward ? 0 : 1))];
+      const auto [it, fresh] = auto_faces.try_emplace(face, spec.id);
+      if (!fresh)
+        sketch.fail(spec.seed->json_path,
+                    fmt::format("the seeds of panels '{}' and '{}' lie in the same region of the "
+                                "curves; move one of them into the region it is meant for",
+                                it->second, spec.id));
+    } else {
+      loop.edges = resolve_explicit(sketch, net, spec);
+    }
     const size_t m = loop.edges.size();
 
     // Orientation: counter-clockwise seen from outside, i.e. the loop's vector area agrees with
@@ -239,8 +229,8 @@ std::vector<PanelLoop> resolve_panels(const Sketch& sketch, const CurveNetwork& 
     // Turning angle at the start of each edge.
     loop.turning_deg.resize(m);
     for (size_t k = 0; k < m; ++k) {
-      const Eigen::Vector3d in = end_tangent(ordered_points(net, loop.edges[(k + m - 1) % m]), false);
-      const Eigen::Vector3d out = end_tangent(ordered_points(net, loop.edges[k]), true);
+      const Eigen::Vector3d in = polyline_end_tangent(ordered_points(net, loop.edges[(k + m - 1) % m]), false, kJunctionTangentArc);
+      const Eigen::Vector3d out = polyline_end_tangent(ordered_points(net, loop.edges[k]), true, kJunctionTangentArc);
       loop.turning_deg[k] = std::acos(std::clamp(in.dot(out), -1.0, 1.0)) * 180 / std::numbers::pi;
     }
     std::vector<bool> corner(m, false);

@@ -319,7 +319,8 @@ CurveSpec parse_curve(const Reader& r, const json& j, const std::string& path, c
 
 PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, const Sketch& sk) {
   r.require_object(j, path, "a panel");
-  r.check_keys(j, path, {"id", "boundary", "corners", "fabric", "mirror", "edge_length", "ease"});
+  r.check_keys(j, path,
+               {"id", "boundary", "corners", "fabric", "mirror", "edge_length", "ease", "seed"});
   PanelSpec panel;
   panel.json_path = path;
   if (!j.contains("id")) r.fail(path, "every panel needs an \"id\"");
@@ -335,6 +336,12 @@ PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, c
                                              "not \"{}\"",
                                              b.get<std::string>()));
     panel.auto_boundary = true;
+    if (!j.contains("seed"))
+      r.fail(path + "/boundary",
+             fmt::format("panel '{}' has \"boundary\": \"auto\" but no \"seed\": say which "
+                         "region of the curves it is with a point inside it, e.g. \"seed\": "
+                         "{{\"view\": \"front\", \"point\": [0.1, 1.0]}}",
+                         panel.id));
   } else {
     if (!b.is_array())
       r.fail(path + "/boundary", fmt::format("expected a list of curve ids, got {}", type_name(b)));
@@ -357,7 +364,32 @@ PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, c
       panel.boundary.push_back(std::move(id));
     }
   }
+  if (j.contains("seed")) {
+    const std::string sp = path + "/seed";
+    if (!panel.auto_boundary)
+      r.fail(sp, "a \"seed\" only picks the region of a \"boundary\": \"auto\" panel; this "
+                 "panel lists its curves");
+    const json& sj = j["seed"];
+    r.require_object(sj, sp, "a seed");
+    r.check_keys(sj, sp, {"view", "point", "point3d"});
+    SeedSpec seed;
+    seed.json_path = sp;
+    if (sj.contains("point") == sj.contains("point3d"))
+      r.fail(sp, "a seed needs exactly one of \"point\" ([x, y] in its \"view\") or "
+                 "\"point3d\" ([x, y, z])");
+    if (sj.contains("point")) seed.point = r.vector<2>(sj["point"], sp + "/point");
+    if (sj.contains("point3d")) seed.point3d = r.vector<3>(sj["point3d"], sp + "/point3d");
+    if (sj.contains("view")) {
+      if (seed.point3d)
+        r.fail(sp + "/view", "a \"view\" only applies to a 2D \"point\"; \"point3d\" is in "
+                             "world coordinates");
+      seed.view = r.view(sj["view"], sp + "/view");
+    }
+    panel.seed = seed;
+  }
   if (j.contains("corners")) {
+    if (panel.auto_boundary)
+      r.fail(path + "/corners", "explicit corners need an explicit boundary list");
     const json& c = j["corners"];
     if (!c.is_array()) r.fail(path + "/corners", "expected a list of curve ids");
     for (size_t i = 0; i < c.size(); ++i) {
@@ -369,8 +401,6 @@ PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, c
                                id, panel.id));
       panel.corners.push_back(std::move(id));
     }
-    if (panel.auto_boundary)
-      r.fail(path + "/corners", "explicit corners need an explicit boundary list");
   }
   panel.fabric = j.contains("fabric") ? r.text(j["fabric"], path + "/fabric") : sk.fabric;
   if (j.contains("mirror")) panel.mirror = r.boolean(j["mirror"], path + "/mirror");

@@ -51,11 +51,21 @@ struct CurveSpec {
   bool is_3d() const { return !points3d.empty(); }
 };
 
+// A point inside an "auto" panel: drawn in a view (`point`, projected onto the body like a
+// stroke point) or given in the world (`point3d`, used as written).
+struct SeedSpec {
+  std::string json_path;                   // "/panels/1/seed"
+  ViewSpec view;                           // the view `point` was drawn in
+  std::optional<Eigen::Vector2d> point;    // view-plane metres
+  std::optional<Eigen::Vector3d> point3d;  // world metres
+};
+
 struct PanelSpec {
   std::string id;
   std::string json_path;                   // "/panels/1"
   std::vector<std::string> boundary;       // curve ids in order around the panel
   bool auto_boundary = false;              // "boundary": "auto"
+  std::optional<SeedSpec> seed;            // "auto": which region of the curve network
   std::vector<std::string> corners;        // curves whose start (along the loop) is a corner
   std::string fabric;                      // default: the file's fabric
   bool mirror = false;                     // also make the copy across x = 0
