@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <functional>
 #include <map>
@@ -46,6 +47,77 @@ std::optional<std::vector<int>> exact_group(int p, std::uint32_t start,
     chosen.push_back(v);
     s ^= masks[static_cast<size_t>(v)];
   }
+  return chosen;
+}
+
+// Minimum T-join (Edmonds & Johnson) when every variable toggles one or two constraints: the
+// variables are edges of a graph on the group's constraints plus an "outside" node (a variable
+// of one constraint, a hem, joins it to the outside); T is the odd constraints, plus the outside
+// when their number is odd. A cheapest set of edges with odd degree exactly on T is the union
+// of shortest paths between the pairs of a minimum-weight perfect matching of T in the
+// shortest-path metric. The matching is exact by dynamic programming over subsets of T (the
+// lowest unmatched node is paired first), O(2^|T|·|T|) for |T| up to kExactParityOdd.
+// `edges[v]` = (a, b), b = outside for one-constraint variables. Empty optional when T cannot be
+// paired (an odd number of odd panels with no hem).
+std::optional<std::vector<int>> t_join(int nodes, const std::vector<int>& terminals,
+                                       const std::vector<std::pair<int, int>>& edges,
+                                       const std::vector<double>& costs) {
+  const size_t k = terminals.size();
+  std::vector<std::vector<std::pair<int, int>>> adjacent(static_cast<size_t>(nodes));  // (node, edge)
+  for (size_t e = 0; e < edges.size(); ++e) {
+    adjacent[static_cast<size_t>(edges[e].first)].emplace_back(edges[e].second, static_cast<int>(e));
+    adjacent[static_cast<size_t>(edges[e].second)].emplace_back(edges[e].first, static_cast<int>(e));
+  }
+  // Shortest paths from every terminal (Dijkstra), with the edge each node was reached by.
+  std::vector<std::vector<double>> dist(k);
+  std::vector<std::vector<int>> via(k);
+  for (size_t t = 0; t < k; ++t) {
+    dist[t].assign(static_cast<size_t>(nodes), std::numeric_limits<double>::infinity());
+    via[t].assign(static_cast<size_t>(nodes), -1);
+    using Item = std::pair<double, int>;
+    std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
+    dist[t][static_cast<size_t>(terminals[t])] = 0;
+    queue.emplace(0.0, terminals[t]);
+    while (!queue.empty()) {
+      const auto [d, u] = queue.top();
+      queue.pop();
+      if (d > dist[t][static_cast<size_t>(u)]) continue;
+      for (const auto& [w, e] : adjacent[static_cast<size_t>(u)])
+        if (d + costs[static_cast<size_t>(e)] < dist[t][static_cast<size_t>(w)]) {
+          dist[t][static_cast<size_t>(w)] = d + costs[static_cast<size_t>(e)];
+          via[t][static_cast<size_t>(w)] = e;
+          queue.emplace(dist[t][static_cast<size_t>(w)], w);
+        }
+    }
+  }
+  // best[S]: cheapest perfect matching of the terminals in S (bit i = terminal i).
+  const size_t states = size_t{1} << k;
+  std::vector<double> best(states, std::numeric_limits<double>::infinity());
+  std::vector<int> partner(states, -1);
+  best[0] = 0;
+  for (size_t s = 1; s < states; ++s) {
+    if (std::popcount(s) % 2 != 0) continue;
+    const int i = std::countr_zero(s);
+    for (size_t j = static_cast<size_t>(i) + 1; j < k; ++j) {
+      if (!(s >> j & 1)) continue;
+      const double c = best[s & ~(size_t{1} << i) & ~(size_t{1} << j)] + dist[static_cast<size_t>(i)][static_cast<size_t>(terminals[j])];
+      if (c < best[s]) best[s] = c, partner[s] = static_cast<int>(j);
+    }
+  }
+  if (!std::isfinite(best[states - 1])) return std::nullopt;
+  std::vector<char> used(edges.size(), 0);
+  for (size_t s = states - 1; s != 0;) {
+    const size_t i = static_cast<size_t>(std::countr_zero(s)), j = static_cast<size_t>(partner[s]);
+    for (int node = terminals[j]; node != terminals[i];) {  // walk back from j to i
+      const int e = via[i][static_cast<size_t>(node)];
+      used[static_cast<size_t>(e)] ^= 1;  // a shared stretch of two paths cancels
+      node = edges[static_cast<size_t>(e)].first == node ? edges[static_cast<size_t>(e)].second : edges[static_cast<size_t>(e)].first;
+    }
+    s &= ~(size_t{1} << i) & ~(size_t{1} << j);
+  }
+  std::vector<int> chosen;
+  for (size_t e = 0; e < edges.size(); ++e)
+    if (used[e]) chosen.push_back(static_cast<int>(e));
   return chosen;
 }
 
@@ -110,7 +182,22 @@ std::optional<std::vector<int>> solve_parity(int constraint_count, const std::ve
       columns.push_back(rows);
     }
     std::optional<std::vector<int>> solution;
-    if (static_cast<int>(group.size()) <= kExactParityConstraints) {
+    const bool graph = std::all_of(columns.begin(), columns.end(), [](const std::vector<int>& c) { return c.size() <= 2; });
+    const int odd_count = static_cast<int>(std::count_if(group.begin(), group.end(), [&](int c) { return odd[static_cast<size_t>(c)]; }));
+    if (graph && odd_count + 1 <= kExactParityOdd) {
+      const int outside = static_cast<int>(group.size());
+      std::vector<int> terminals;
+      for (size_t k = 0; k < group.size(); ++k)
+        if (odd[static_cast<size_t>(group[k])]) terminals.push_back(static_cast<int>(k));
+      if (terminals.size() % 2 == 1) terminals.push_back(outside);
+      std::vector<std::pair<int, int>> edges;
+      std::vector<double> costs;
+      for (size_t k = 0; k < ids.size(); ++k) {
+        edges.emplace_back(columns[k][0], columns[k].size() == 2 ? columns[k][1] : outside);
+        costs.push_back(variables[static_cast<size_t>(ids[k])].cost);
+      }
+      solution = t_join(outside + 1, terminals, edges, costs);
+    } else if (static_cast<int>(group.size()) <= kExactParityConstraints) {
       std::uint32_t start = 0;
       for (size_t k = 0; k < group.size(); ++k)
         if (odd[static_cast<size_t>(group[k])]) start |= 1u << k;
@@ -125,9 +212,10 @@ std::optional<std::vector<int>> solve_parity(int constraint_count, const std::ve
       solution = exact_group(static_cast<int>(group.size()), start, masks, costs);
     } else {
       solution = eliminate(group, odd, columns);
-      spdlog::warn("parity fix: {} connected panels; the edge-count change is feasible but not "
+      spdlog::warn("parity fix: {} connected panels ({} with an odd total) and curve pieces "
+                   "shared by more than two panels; the edge-count change is feasible but not "
                    "guaranteed minimal",
-                   group.size());
+                   group.size(), odd_count);
     }
     if (!solution) {
       if (unfixable)

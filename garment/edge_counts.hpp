@@ -25,12 +25,16 @@ struct ParityVariable {
   double cost = 1.0;
 };
 
-// Chooses variables so that every constraint with odd[c] becomes even, at least total cost:
-// exact (Dijkstra over the parity states of each connected group of constraints) for groups of
-// up to kExactParityConstraints constraints, else a feasible Gaussian-elimination solution.
+// Chooses variables so that every constraint with odd[c] becomes even, at least total cost,
+// per connected group of constraints: when each of the group's variables toggles at most two
+// constraints (seams and hems) it is a minimum T-join, exact for any number of constraints and
+// up to kExactParityOdd - 1 odd ones (shortest paths + exact minimum-weight perfect matching);
+// otherwise exact by Dijkstra over the 2^k parity states for groups of up to
+// kExactParityConstraints constraints; else a feasible Gaussian-elimination solution (warned).
 // Empty optional when some group cannot be made even; `unfixable` then names one of its odd
 // constraints.
 inline constexpr int kExactParityConstraints = 16;
+inline constexpr int kExactParityOdd = 20;
 std::optional<std::vector<int>> solve_parity(int constraint_count, const std::vector<bool>& odd,
                                              const std::vector<ParityVariable>& variables,
                                              int* unfixable = nullptr);
