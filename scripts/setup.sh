@@ -14,6 +14,7 @@ packages=(
   python3-jsonschema  # tests validate the example sketch files against data/schema/
   chromium  # tests/batch: the batch contact sheet (index.html) loads in headless Chromium
   slurmctld slurmd slurm-client munge  # tests/batch/slurm_test.sh: a one-node Slurm cluster
+  gnuplot-nox  # sketchdrape bench: the work-precision plots (optional: the CSV is written without it)
 )
 
 missing=()
