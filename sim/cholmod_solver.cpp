@@ -1,19 +1,22 @@
 #include "sim/cholmod_solver.hpp"
 
+#include <Eigen/CholmodSupport>
 #include <algorithm>
 #include <cmath>
-
-#include <Eigen/CholmodSupport>
 
 namespace sd::sim {
 
 using ColMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
 struct CholmodSolver::Factor {
-  Eigen::CholmodSupernodalLLT<ColMatrix, Eigen::Lower> llt;
+  Eigen::CholmodDecomposition<ColMatrix, Eigen::Lower> llt;
 };
 
-CholmodSolver::CholmodSolver() : factor_(std::make_unique<Factor>()) {}
+CholmodSolver::CholmodSolver(CholmodMethod method)
+    : method_(method), factor_(std::make_unique<Factor>()) {
+  factor_->llt.setMode(method == CholmodMethod::supernodal ? Eigen::CholmodSupernodalLLt
+                                                           : Eigen::CholmodSimplicialLLt);
+}
 CholmodSolver::~CholmodSolver() = default;
 CholmodSolver::CholmodSolver(CholmodSolver&&) noexcept = default;
 CholmodSolver& CholmodSolver::operator=(CholmodSolver&&) noexcept = default;

@@ -5,11 +5,10 @@
 // whose matrix is SPD and has the block pattern of A (S is block diagonal), so the symbolic
 // analysis is reused while the mesh topology, hence the pattern, does not change.
 
-#include <memory>
-#include <vector>
-
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <memory>
+#include <vector>
 
 #include "sim/cloth_model.hpp"
 #include "sim/constraint_filter.hpp"
@@ -17,9 +16,13 @@
 
 namespace sd::sim {
 
+// CHOLMOD's two factorisations of the same LLᵀ: supernodal (dense BLAS kernels on groups of
+// columns) or simplicial (column by column, no BLAS).
+enum class CholmodMethod { supernodal, simplicial };
+
 class CholmodSolver {
  public:
-  CholmodSolver();
+  explicit CholmodSolver(CholmodMethod method = CholmodMethod::supernodal);
   ~CholmodSolver();
   CholmodSolver(CholmodSolver&&) noexcept;
   CholmodSolver& operator=(CholmodSolver&&) noexcept;
@@ -33,9 +36,11 @@ class CholmodSolver {
 
   int symbolic_analyses() const { return analyses_; }
   int numeric_factorizations() const { return factorizations_; }
+  CholmodMethod method() const { return method_; }
 
  private:
   struct Factor;
+  CholmodMethod method_;
   std::unique_ptr<Factor> factor_;
   Eigen::SparseMatrix<double, Eigen::ColMajor, int> filtered_;
   std::vector<int> outer_;

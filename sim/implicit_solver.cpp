@@ -38,7 +38,8 @@ void ImplicitSolver::assemble(const ClothModel& model, const ForceSettings& forc
   double* values = matrix_.valuePtr();
   for (int i = 0; i < model.vertex_count; ++i)
     for (int a = 0; a < 3; ++a)
-      values[block_value_index(matrix_, i, model.pattern.diagonal_offsets[i], a, a)] = model.mass[i];
+      values[block_value_index(matrix_, i, model.pattern.diagonal_offsets[i], a, a)] =
+          model.mass[i];
   JacobianTarget target;
   target.kind = JacobianKind::solve;
   target.matrix = &matrix_;
@@ -73,8 +74,9 @@ bool ImplicitSolver::linear_solve(const ClothModel& model, const ConstraintFilte
     }
     stats = cholmod_.solve(matrix_, filter, rhs_, z_, step_);
   } else {
+    pcg_.set_preconditioner(settings.pcg_preconditioner);
     stats = pcg_.solve(matrix_, model.pattern.diagonal_offsets, filter, rhs_, z_, step_,
-                       settings.pcg_tolerance, settings.pcg_max_iterations);
+                       settings.pcg_tolerance, settings.pcg_max_iterations, refactor);
   }
   ++result.linear_solves;
   result.cg_iterations += stats.iterations;
@@ -97,14 +99,11 @@ void ImplicitSolver::record_constraint_impulse(const ConstraintFilter& filter,
   result.constraint_impulse = residual - free_part;
 }
 
-ImplicitSolveResult ImplicitSolver::solve(const ClothModel& model, const ForceSettings& forces,
-                                          const ConstraintFilter& filter,
-                                          const Eigen::VectorXd& x_hat,
-                                          const Eigen::VectorXd& v_hat, double beta,
-                                          const Eigen::VectorXd& x_lin,
-                                          const Eigen::VectorXd& v_lin,
-                                          const NewtonSettings& settings,
-                                          const std::vector<VertexDamping>* damping) {
+ImplicitSolveResult ImplicitSolver::solve(
+    const ClothModel& model, const ForceSettings& forces, const ConstraintFilter& filter,
+    const Eigen::VectorXd& x_hat, const Eigen::VectorXd& v_hat, double beta,
+    const Eigen::VectorXd& x_lin, const Eigen::VectorXd& v_lin, const NewtonSettings& settings,
+    const std::vector<VertexDamping>* damping) {
   ImplicitSolveResult result;
   const int n = model.vertex_count;
   const auto mass_times = [&](const Eigen::VectorXd& w) {
@@ -137,8 +136,9 @@ ImplicitSolveResult ImplicitSolver::solve(const ClothModel& model, const ForceSe
   // Further iterations: residual g(v) = M (v − v̂) − β f(x̂ + β v, v), A s = −g.
   result.newton_converged = result.last_update <= settings.tolerance;
   double previous_update = result.last_update;
+  bool refresh = settings.refresh_jacobian;
   while (!result.newton_converged && result.newton_iterations < settings.max_iterations) {
-    if (settings.refresh_jacobian) {
+    if (refresh) {
       assemble(model, forces, beta, result.x, result.v, nullptr, damping, result);
     } else {
       const auto start = std::chrono::steady_clock::now();
@@ -148,7 +148,7 @@ ImplicitSolveResult ImplicitSolver::solve(const ClothModel& model, const ForceSe
     }
     rhs_ = mass_times(v_hat - result.v) + beta * force_;
     filter.constrained_correction(result.v, z_);
-    result.linear_converged = linear_solve(model, filter, settings, settings.refresh_jacobian, result);
+    result.linear_converged = linear_solve(model, filter, settings, refresh, result);
     result.v += step_;
     result.x = x_hat + beta * result.v;
     ++result.newton_iterations;
@@ -156,10 +156,19 @@ ImplicitSolveResult ImplicitSolver::solve(const ClothModel& model, const ForceSe
     if (!result.linear_converged || !result.v.allFinite()) break;
     record_constraint_impulse(filter, result);
     result.newton_converged = result.last_update <= settings.tolerance;
-    // A simplified Newton iteration that stops contracting will not converge: give up early.
-    if (!result.newton_converged && result.newton_iterations > 2 &&
-        result.last_update > previous_update)
-      break;
+    if (result.newton_converged) break;
+    // A growing update is a divergence that a refreshed (still projected) matrix does not cure
+    // on buckling cloth: stop at once, the caller falls back to the linearised step. A poor
+    // contraction means the kept matrix no longer describes the system near the iterate (EG
+    // 2002 tutorial §2.2.3 needs J ≈ J^(k)): reassemble it there.
+    const double contraction = result.last_update / previous_update;
+    if (contraction >= 1.0 && result.newton_iterations > 2) break;
+    refresh = settings.refresh_jacobian;
+    if (contraction > settings.refresh_contraction &&
+        result.jacobian_refreshes < settings.max_refreshes) {
+      refresh = true;
+      ++result.jacobian_refreshes;
+    }
     previous_update = result.last_update;
   }
   return result;

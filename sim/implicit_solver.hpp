@@ -7,9 +7,8 @@
 // with the matrix A = M − β ∂f/∂v − β² ∂f/∂x (the "solve" Jacobian, SPD), linear systems
 // filtered by the constraints and solved by the modified PCG or CHOLMOD.
 
-#include <vector>
-
 #include <Eigen/Core>
+#include <vector>
 
 #include "sim/cholmod_solver.hpp"
 #include "sim/cloth_model.hpp"
@@ -24,13 +23,19 @@ enum class LinearSolverKind { pcg, cholmod };
 struct NewtonSettings {
   // 1 = a single linearised step (Baraff & Witkin's implicit Euler). More iterations run an
   // inexact simplified Newton method: the matrix of the first iteration is kept (and its
-  // CHOLMOD factor reused) unless refresh_jacobian is set.
+  // CHOLMOD factor or PCG preconditioner reused) unless refresh_jacobian is set.
   int max_iterations = 1;
-  double tolerance = 1e-6;  // m: converged when β·max|Δv| ≤ tolerance
-  bool refresh_jacobian = false;
+  double tolerance = 1e-6;        // m: converged when β·max|Δv| ≤ tolerance
+  bool refresh_jacobian = false;  // reassemble at every iteration (full Newton, projected matrix)
+  // When an update shrinks by less than this factor (contraction θ = |Δ_k|/|Δ_{k−1}|), the kept
+  // matrix is too far from the current Jacobian: it is reassembled at the current iterate, at
+  // most max_refreshes times per solve. θ ≥ 1 after the second iteration ends the iteration.
+  double refresh_contraction = 0.5;
+  int max_refreshes = 1;
   LinearSolverKind solver = LinearSolverKind::pcg;
   double pcg_tolerance = 1e-3;  // relative residual reduction (the inexact Newton forcing term)
   int pcg_max_iterations = 1000;
+  PcgPreconditioner pcg_preconditioner = PcgPreconditioner::block_incomplete_cholesky;
 };
 
 // A force on one vertex, affine in its velocity: f = force − C (v − v_ref), C symmetric
@@ -46,6 +51,7 @@ struct ImplicitSolveResult {
   Eigen::VectorXd x;  // 3n positions at the end of the step
   Eigen::VectorXd v;  // 3n velocities
   int newton_iterations = 0;
+  int jacobian_refreshes = 0;  // reassemblies after a poor contraction
   int linear_solves = 0;
   int cg_iterations = 0;      // summed over the linear solves
   int cg_iterations_max = 0;  // largest single solve
@@ -69,9 +75,8 @@ class ImplicitSolver {
   // linear drags to the force, implicitly (its matrix goes into A).
   ImplicitSolveResult solve(const ClothModel& model, const ForceSettings& forces,
                             const ConstraintFilter& filter, const Eigen::VectorXd& x_hat,
-                            const Eigen::VectorXd& v_hat, double beta,
-                            const Eigen::VectorXd& x_lin, const Eigen::VectorXd& v_lin,
-                            const NewtonSettings& settings,
+                            const Eigen::VectorXd& v_hat, double beta, const Eigen::VectorXd& x_lin,
+                            const Eigen::VectorXd& v_lin, const NewtonSettings& settings,
                             const std::vector<VertexDamping>* damping = nullptr);
 
   // The system matrix of the last assembly (for tests and benchmarks).

@@ -1,17 +1,132 @@
 #include "sim/pcg_solver.hpp"
 
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/LU>
-
 namespace sd::sim {
 
-LinearSolveStats PcgSolver::solve(const SparseMatrixR& a, const std::vector<int>& diagonal_offsets,
-                                  const ConstraintFilter& filter, const Eigen::VectorXd& b,
-                                  const Eigen::VectorXd& z, Eigen::VectorXd& s, double tolerance,
-                                  int max_iterations) {
+bool BlockIncompleteCholesky::factorize(const SparseMatrixR& a,
+                                        const std::vector<int>& diagonal_offsets,
+                                        const ConstraintFilter& filter) {
   const int n = filter.vertex_count();
+  const int* outer = a.outerIndexPtr();
+  const int* inner = a.innerIndexPtr();
+  const double* values = a.valuePtr();
+  std::vector<Eigen::Matrix3d> filters;
+  if (filter.constrained_count() > 0) {
+    filters.resize(n);
+    for (int i = 0; i < n; ++i) filters[i] = filter.filter_matrix(i);
+  }
+  const auto read_block = [&](int i, int offset) {
+    Eigen::Matrix3d block;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) block(r, c) = values[outer[3 * i + r] + offset + c];
+    return block;
+  };
+  row_start_.assign(1, 0);
+  column_.clear();
+  b_upper_.clear();
+  b_diagonal_.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const bool free_i = filters.empty() || filter.is_free(i);
+    const int width = outer[3 * i + 1] - outer[3 * i];
+    for (int offset = diagonal_offsets[i] + 3; offset < width; offset += 3) {
+      const int j = inner[outer[3 * i] + offset] / 3;
+      Eigen::Matrix3d block = read_block(i, offset);
+      if (!free_i || !(filters.empty() || filter.is_free(j)))
+        block = filters[i] * block * filters[j];
+      column_.push_back(j);
+      b_upper_.push_back(block);
+    }
+    row_start_.push_back(static_cast<int>(column_.size()));
+    Eigen::Matrix3d diagonal = read_block(i, diagonal_offsets[i]);
+    if (!free_i)
+      diagonal = filters[i] * diagonal * filters[i] + (Eigen::Matrix3d::Identity() - filters[i]);
+    b_diagonal_[i] = 0.5 * (diagonal + diagonal.transpose());
+  }
+  for (double alpha : {0.0, 1e-4, 1e-3, 1e-2, 1e-1, 1.0})
+    if (factorize_shifted(alpha)) {
+      shift_ = alpha;
+      return true;
+    }
+  return false;
+}
+
+bool BlockIncompleteCholesky::factorize_shifted(double alpha) {
+  const int n = static_cast<int>(b_diagonal_.size());
+  upper_ = b_upper_;
+  std::vector<Eigen::Matrix3d>& pivot = pivot_;
+  pivot.resize(n);
+  for (int i = 0; i < n; ++i) pivot[i] = (1.0 + alpha) * b_diagonal_[i];
+  pivot_inverse_.resize(n);
+  for (int i = 0; i < n; ++i) {
+    pivot[i] = 0.5 * (pivot[i] + pivot[i].transpose());
+    const Eigen::LLT<Eigen::Matrix3d> llt(pivot[i]);
+    if (llt.info() != Eigen::Success) return false;
+    pivot_inverse_[i] = llt.solve(Eigen::Matrix3d::Identity());
+    if (!pivot_inverse_[i].allFinite()) return false;
+    // Schur complement restricted to the pattern: for k < j both above-diagonal neighbours of
+    // i, U_kj −= U_ikᵀ P_i⁻¹ U_ij (no fill: dropped if (k, j) is not in the pattern).
+    const int begin = row_start_[i];
+    const int end = row_start_[i + 1];
+    for (int p_index = begin; p_index < end; ++p_index) {
+      const int k = column_[p_index];
+      const Eigen::Matrix3d w = upper_[p_index].transpose() * pivot_inverse_[i];
+      pivot[k].noalias() -= w * upper_[p_index];
+      int cursor = row_start_[k];
+      const int row_end = row_start_[k + 1];
+      for (int q_index = p_index + 1; q_index < end; ++q_index) {
+        const int j = column_[q_index];
+        while (cursor < row_end && column_[cursor] < j) ++cursor;
+        if (cursor == row_end) break;
+        if (column_[cursor] == j) upper_[cursor].noalias() -= w * upper_[q_index];
+      }
+    }
+  }
+  return true;
+}
+
+void BlockIncompleteCholesky::apply(const Eigen::VectorXd& r, Eigen::VectorXd& out) const {
+  const int n = static_cast<int>(pivot_inverse_.size());
+  // Forward: (P Lᵀ)ᵀ y = Uᵀ y = r, column by column.
+  out = r;
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d y = pivot_inverse_[i] * out.segment<3>(3 * i);
+    out.segment<3>(3 * i) = y;
+    for (int k = row_start_[i]; k < row_start_[i + 1]; ++k)
+      out.segment<3>(3 * column_[k]).noalias() -= upper_[k].transpose() * y;
+  }
+  // Backward: Lᵀ x = y, i.e. x_i = y_i − P_i⁻¹ Σ_{j>i} U_ij x_j.
+  for (int i = n - 1; i >= 0; --i) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (int k = row_start_[i]; k < row_start_[i + 1]; ++k)
+      sum.noalias() += upper_[k] * out.segment<3>(3 * column_[k]);
+    out.segment<3>(3 * i) -= pivot_inverse_[i] * sum;
+  }
+}
+
+void BlockIncompleteCholesky::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& out) const {
+  const int n = static_cast<int>(pivot_.size());
+  // t = Lᵀ x = P⁻¹ U x, then out = L (P t) with L = Uᵀ P⁻¹: out_i = P_i t_i + Σ_{k<i} U_kiᵀ t_k.
+  Eigen::VectorXd t(3 * n);
+  for (int i = 0; i < n; ++i) {
+    Eigen::Vector3d sum = pivot_[i] * x.segment<3>(3 * i);
+    for (int k = row_start_[i]; k < row_start_[i + 1]; ++k)
+      sum.noalias() += upper_[k] * x.segment<3>(3 * column_[k]);
+    t.segment<3>(3 * i) = pivot_inverse_[i] * sum;
+  }
+  out.resize(3 * n);
+  for (int i = 0; i < n; ++i) out.segment<3>(3 * i) = pivot_[i] * t.segment<3>(3 * i);
+  for (int i = 0; i < n; ++i)
+    for (int k = row_start_[i]; k < row_start_[i + 1]; ++k)
+      out.segment<3>(3 * column_[k]).noalias() += upper_[k].transpose() * t.segment<3>(3 * i);
+}
+
+void PcgSolver::build_block_jacobi(const SparseMatrixR& a,
+                                   const std::vector<int>& diagonal_offsets) {
+  const int n = static_cast<int>(diagonal_offsets.size());
   inverse_blocks_.resize(n);
   const double* values = a.valuePtr();
   for (int i = 0; i < n; ++i) {
@@ -29,12 +144,31 @@ LinearSolveStats PcgSolver::solve(const SparseMatrixR& a, const std::vector<int>
     }
     inverse_blocks_[i] = inverse;
   }
+}
+
+LinearSolveStats PcgSolver::solve(const SparseMatrixR& a, const std::vector<int>& diagonal_offsets,
+                                  const ConstraintFilter& filter, const Eigen::VectorXd& b,
+                                  const Eigen::VectorXd& z, Eigen::VectorXd& s, double tolerance,
+                                  int max_iterations, bool refresh_preconditioner) {
+  const int n = filter.vertex_count();
+  const bool reuse =
+      !refresh_preconditioner && inverse_blocks_.size() == static_cast<std::size_t>(n);
+  if (!reuse) {
+    incomplete_ready_ = preconditioner_ == PcgPreconditioner::block_incomplete_cholesky &&
+                        incomplete_.factorize(a, diagonal_offsets, filter);
+    // Block Jacobi is always built: the fallback if IC(0) broke down even with a shift.
+    build_block_jacobi(a, diagonal_offsets);
+  }
+  const bool incomplete = incomplete_ready_;
   const auto precondition = [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) {
-    out.resize(in.size());
-    for (int i = 0; i < n; ++i) out.segment<3>(3 * i) = inverse_blocks_[i] * in.segment<3>(3 * i);
+    if (incomplete) {
+      incomplete_.apply(in, out);
+    } else {
+      out.resize(in.size());
+      for (int i = 0; i < n; ++i) out.segment<3>(3 * i) = inverse_blocks_[i] * in.segment<3>(3 * i);
+    }
     filter.apply(out);
   };
-
   LinearSolveStats stats;
   s = z;
   r_.noalias() = b - a * s;

@@ -5,6 +5,7 @@
 // prescribed correction in the constrained directions.
 
 #include <Eigen/Core>
+#include <vector>
 
 #include "sim/cloth_model.hpp"
 #include "sim/constraint_filter.hpp"
@@ -12,27 +13,77 @@
 namespace sd::sim {
 
 struct LinearSolveStats {
-  int iterations = 0;              // PCG iterations (0 for a direct solve)
+  int iterations = 0;  // PCG iterations (0 for a direct solve)
   // Residual reduction in the norm the solver uses: preconditioned for the PCG, Euclidean
   // |S(b − A s)| / |S(b − A z)| for the direct solver.
   double relative_residual = 0.0;
   bool converged = false;
 };
 
+enum class PcgPreconditioner {
+  block_jacobi,               // the inverse of each 3x3 diagonal block (Baraff & Witkin)
+  block_incomplete_cholesky,  // IC(0) on 3x3 blocks of the filtered matrix, see below
+};
+
+// Incomplete Cholesky with no fill, IC(0), on the 3x3 blocks of the filtered matrix
+//   B = S A S + (I − S)
+// (SPD, with A's block pattern; it is the matrix CHOLMOD factorises exactly). B ≈ L P Lᵀ with
+// L unit lower block-triangular on the pattern of A's lower half and P block diagonal, both
+// computed from the upper half U = P Lᵀ in vertex order. Because S is block diagonal, the
+// factor keeps the constrained directions decoupled, so the preconditioner respects the
+// filter. IC(0) can break down (a pivot block that is not positive definite) on matrices that
+// are SPD but not diagonally dominant; it is then recomputed for B + α·blockdiag(B) with α
+// growing from 1e-4 (Manteuffel's shift), and `shift()` says which α was used.
+class BlockIncompleteCholesky {
+ public:
+  // Returns false only if no shift up to α = 1 gave positive definite pivots.
+  bool factorize(const SparseMatrixR& a, const std::vector<int>& diagonal_offsets,
+                 const ConstraintFilter& filter);
+  // out = (L P Lᵀ)⁻¹ r, 3n.
+  void apply(const Eigen::VectorXd& r, Eigen::VectorXd& out) const;
+  // out = L P Lᵀ x, 3n: the matrix the factor represents (equal to B + α·blockdiag(B) on the
+  // pattern, for tests).
+  void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& out) const;
+  double shift() const { return shift_; }
+
+ private:
+  bool factorize_shifted(double alpha);
+
+  // Upper half of B, block row by block row: blocks (i, column_[k]) for k in
+  // [row_start_[i], row_start_[i+1]), columns increasing and > i.
+  std::vector<int> row_start_;
+  std::vector<int> column_;
+  std::vector<Eigen::Matrix3d> b_upper_, b_diagonal_;   // B's blocks
+  std::vector<Eigen::Matrix3d> upper_;                  // the factor's U_ij (i < j)
+  std::vector<Eigen::Matrix3d> pivot_, pivot_inverse_;  // P_i, P_i⁻¹
+  double shift_ = 0.0;
+};
+
 // Baraff & Witkin's modified preconditioned conjugate gradient: the iterates stay in the
-// filtered subspace, so constrained directions never change. Preconditioner: the inverse of
-// each 3x3 diagonal block of A (block Jacobi). Stops when the preconditioned residual norm has
-// dropped by `tolerance` relative to the start, or after `max_iterations`.
+// filtered subspace, so constrained directions never change. Stops when the preconditioned
+// residual norm has dropped by `tolerance` relative to the start, or after `max_iterations`.
 class PcgSolver {
  public:
+  explicit PcgSolver(PcgPreconditioner preconditioner = PcgPreconditioner::block_jacobi)
+      : preconditioner_(preconditioner) {}
+  void set_preconditioner(PcgPreconditioner preconditioner) { preconditioner_ = preconditioner; }
+  PcgPreconditioner preconditioner() const { return preconditioner_; }
+
+  // `refresh_preconditioner` false reuses the preconditioner of the last solve (same A and
+  // filter, e.g. the later iterations of a simplified Newton method).
   LinearSolveStats solve(const SparseMatrixR& a, const std::vector<int>& diagonal_offsets,
                          const ConstraintFilter& filter, const Eigen::VectorXd& b,
                          const Eigen::VectorXd& z, Eigen::VectorXd& s, double tolerance,
-                         int max_iterations);
+                         int max_iterations, bool refresh_preconditioner = true);
 
  private:
+  void build_block_jacobi(const SparseMatrixR& a, const std::vector<int>& diagonal_offsets);
+
+  PcgPreconditioner preconditioner_;
+  bool incomplete_ready_ = false;  // incomplete_ holds the factor of the last refresh
   Eigen::VectorXd r_, c_, q_, t_;
   std::vector<Eigen::Matrix3d> inverse_blocks_;
+  BlockIncompleteCholesky incomplete_;
 };
 
 // |S(b − A s)| / |S(b − A z)|: how well s solves the constrained system (for reports and tests).

@@ -139,13 +139,16 @@ double Simulation::residual_force() const {
 Simulation::Attempt Simulation::attempt(double h) {
   Attempt result;
   const bool bdf2 = settings_.integrator == Integrator::bdf2;
-  const int newton = settings_.newton_iterations.value_or(bdf2 ? 8 : 1);
+  const int newton = fallback_ || linearised_steps_ > 0
+                         ? 1
+                         : settings_.newton_iterations.value_or(bdf2 ? 8 : 1);
   NewtonSettings newton_settings;
   newton_settings.max_iterations = newton;
   newton_settings.tolerance = settings_.newton_tolerance;
   newton_settings.solver = settings_.solver;
   newton_settings.pcg_tolerance = settings_.pcg_tolerance;
   newton_settings.pcg_max_iterations = settings_.pcg_max_iterations;
+  newton_settings.pcg_preconditioner = settings_.pcg_preconditioner;
 
   // Variable-step BDF2 (ω = h/h_prev): y1 − (1+ω)²/(1+2ω) y0 + ω²/(1+2ω) y−1 = h(1+ω)/(1+2ω) f1.
   Eigen::VectorXd x_hat, v_hat, x_lin, v_lin;
@@ -159,6 +162,13 @@ Simulation::Attempt Simulation::attempt(double h) {
     v_hat = a0 * v_ - a1 * v_previous_;
     v_lin = v_ + omega * (v_ - v_previous_);  // linear extrapolation of the velocity
     x_lin = x_hat + beta * v_lin;
+    // A single iteration is the linearly implicit BDF2 step: linearised at the start of the
+    // step like Baraff & Witkin's implicit Euler (stable on stiff cloth, where the predictor
+    // is not; see the fallback in step()).
+    if (newton == 1) {
+      x_lin = x_;
+      v_lin = v_;
+    }
   } else {
     x_hat = x_;
     v_hat = v_;
@@ -276,6 +286,21 @@ StepOutcome Simulation::step(double max_step) {
     cg_total_ += candidate.cg_iterations;
     report_.cg_iterations_max = std::max(report_.cg_iterations_max, candidate.cg_iterations_max);
     if (candidate.failure.empty()) break;
+    // A BDF2 step whose Newton iteration failed is first retried at the same step as the
+    // linearly implicit step, one solve linearised at the start (implicit Euler for the first
+    // step); only a failure of that one halves the step.
+    if (settings_.integrator == Integrator::bdf2 && !fallback_ &&
+        settings_.newton_iterations.value_or(8) > 1) {
+      ++outcome.retries;
+      ++report_.retries;
+      ++report_.integrator_fallbacks;
+      spdlog::debug("sim: t = {:.6f} s: BDF2 step {:.4g} s rejected ({}), retrying linearised",
+                    time_, h, candidate.failure);
+      fallback_ = true;
+      // Newton is likely to fail on the next steps too: stay linearised for a few.
+      linearised_steps_ = settings_.easy_steps_to_grow;
+      continue;
+    }
     if (h * 0.5 < settings_.min_dt) {
       if (!candidate.hard_failure) {
         spdlog::warn("sim: t = {:.6f} s: accepting a step of {:.3g} s at the minimum despite: {}",
@@ -298,6 +323,8 @@ StepOutcome Simulation::step(double max_step) {
     dt_ = h;
     easy_steps_ = 0;
   }
+  if (!fallback_ && linearised_steps_ > 0) --linearised_steps_;
+  fallback_ = false;
   outcome.accepted = true;
   outcome.dt = h;
   outcome.newton_iterations = candidate.solve.newton_iterations;

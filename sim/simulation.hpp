@@ -39,6 +39,7 @@ struct SimulationSettings {
   double newton_tolerance = 1.0e-6;  // m, see NewtonSettings
   double pcg_tolerance = 1.0e-3;
   int pcg_max_iterations = 1000;
+  PcgPreconditioner pcg_preconditioner = PcgPreconditioner::block_incomplete_cholesky;
   double max_strain = 1.0;    // a step that stretches any triangle by more (100 %) fails
   double max_speed = 50.0;    // m/s, a step with a faster vertex fails
   int easy_steps_to_grow = 4; // consecutive steps without trouble before the step grows
@@ -74,7 +75,9 @@ struct SimulationReport {
   double sim_time = 0.0;     // s simulated
   double wall_time_s = 0.0;
   bool at_rest = false;      // the run stopped early because the cloth was at rest
-  int retries = 0;           // rejected attempts (each one halved the step)
+  int retries = 0;           // rejected attempts (each one halved the step or, for BDF2, was
+                             // retried at the same step linearised: a fallback)
+  int integrator_fallbacks = 0;  // BDF2 steps retried as one linearised solve
   int forced_steps = 0;      // steps accepted at min_dt despite a soft failure (logged)
   bool nan_free = true;      // no accepted state had a non-finite value (always, by design)
   bool failed = false;       // a step could not be completed even at min_dt
@@ -182,6 +185,8 @@ class Simulation {
   Eigen::VectorXd x_, v_;
   Eigen::VectorXd x_previous_, v_previous_;
   bool has_history_ = false;
+  bool fallback_ = false;  // the next attempt is one linearised solve (BDF2's Newton failed)
+  int linearised_steps_ = 0;  // BDF2 steps still to take linearised after a fallback
   double h_previous_ = 0.0;
   double time_ = 0.0;
   double dt_ = 0.0;

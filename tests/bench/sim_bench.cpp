@@ -1,10 +1,13 @@
 // Simulator kernels and the 64x64 sheet drape (docs/benchmarks.md, "Simulator").
 #include <benchmark/benchmark.h>
 
+#include <Eigen/IterativeLinearSolvers>
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <vector>
 
+#include "sim/cholmod_solver.hpp"
 #include "sim/forces.hpp"
 #include "sim/pcg_solver.hpp"
 #include "sim/sheet.hpp"
@@ -50,15 +53,24 @@ SimulationSettings drape_settings(LinearSolverKind solver, Integrator integrator
   return settings;
 }
 
-// The whole 2 s drape of the 64x64 sheet; args: solver (0 PCG, 1 CHOLMOD), integrator (0 IE, 1 BDF2).
+// Linear solver by benchmark argument: 0 PCG + block Jacobi, 1 CHOLMOD, 2 PCG + block IC(0).
+void set_solver(SimulationSettings& settings, int64_t which) {
+  settings.solver = which == 1 ? LinearSolverKind::cholmod : LinearSolverKind::pcg;
+  settings.pcg_preconditioner =
+      which == 0 ? PcgPreconditioner::block_jacobi : PcgPreconditioner::block_incomplete_cholesky;
+}
+
+// The whole 2 s drape of the 64x64 sheet; args: solver (see set_solver), integrator (0 IE,
+// 1 BDF2 with simplified Newton and its fallback, 2 linearly implicit BDF2: one solve a step).
 void BM_SheetDrape64(benchmark::State& state) {
   const Sheet s = sheet(64);
-  const auto solver = state.range(0) == 0 ? LinearSolverKind::pcg : LinearSolverKind::cholmod;
   const auto integrator = state.range(1) == 0 ? Integrator::implicit_euler : Integrator::bdf2;
+  SimulationSettings settings = drape_settings(LinearSolverKind::pcg, integrator);
+  set_solver(settings, state.range(0));
+  if (state.range(1) == 2) settings.newton_iterations = 1;
   SimulationReport report;
   for (auto _ : state) {
-    Simulation sim(s.model, flatten_positions(s.scene.input.rest_positions), pins(s),
-                   drape_settings(solver, integrator));
+    Simulation sim(s.model, flatten_positions(s.scene.input.rest_positions), pins(s), settings);
     report = sim.run();
     benchmark::DoNotOptimize(sim.positions().data());
   }
@@ -72,19 +84,21 @@ void BM_SheetDrape64(benchmark::State& state) {
   state.counters["forces_s"] = report.forces_s;
   state.counters["solve_s"] = report.solve_s;
   state.counters["max_strain"] = report.max_strain;
+  state.counters["fallbacks"] = report.integrator_fallbacks;
   state.counters["vertices"] = report.vertices;
 }
-// BDF2 with the PCG is left out: at default settings the run had not finished after 6 min
-// (several simplified-Newton iterations per step, each a PCG solve of hundreds of
-// iterations, plus retries); not analysed further yet, see docs/benchmarks.md.
-BENCHMARK(BM_SheetDrape64)->Args({0, 0})->Args({1, 0})->Args({1, 1})
-    ->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_SheetDrape64)
+    ->ArgsProduct({{0, 1, 2}, {0}})
+    ->ArgsProduct({{1, 2}, {1, 2}})
+    ->Iterations(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // One implicit Euler step of the 64x64 sheet in mid-swing (after 0.5 s).
 void BM_SheetStep64(benchmark::State& state) {
   const Sheet s = sheet(64);
-  const auto solver = state.range(0) == 0 ? LinearSolverKind::pcg : LinearSolverKind::cholmod;
-  SimulationSettings settings = drape_settings(solver, Integrator::implicit_euler);
+  SimulationSettings settings = drape_settings(LinearSolverKind::pcg, Integrator::implicit_euler);
+  set_solver(settings, state.range(0));
   settings.duration = 0.5;
   Simulation warm(s.model, flatten_positions(s.scene.input.rest_positions), pins(s), settings);
   warm.run();
@@ -98,7 +112,146 @@ void BM_SheetStep64(benchmark::State& state) {
     benchmark::DoNotOptimize(sim.step().cg_iterations);
   }
 }
-BENCHMARK(BM_SheetStep64)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SheetStep64)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+
+// The linear system of that mid-swing step (implicit Euler, h = 1/24 s, pins at rest):
+// A = M − h ∂f/∂v − h² ∂f/∂x, b = h (f + h ∂f/∂x v), and its exact solution (CHOLMOD).
+struct MidSwingSystem {
+  Sheet sheet;
+  SparseMatrixR a;
+  Eigen::VectorXd b, z, exact;
+  ConstraintFilter filter;
+};
+
+const MidSwingSystem& mid_swing_system() {
+  static const MidSwingSystem system = [] {
+    MidSwingSystem m{sheet(64), {}, {}, {}, {}, {}};
+    const Sheet& s = m.sheet;
+    SimulationSettings settings =
+        drape_settings(LinearSolverKind::cholmod, Integrator::implicit_euler);
+    settings.duration = 0.5;
+    Simulation warm(s.model, flatten_positions(s.scene.input.rest_positions), pins(s), settings);
+    warm.run();
+    const double h = 1.0 / 24;
+    m.a = s.model.pattern.zero_matrix;
+    for (int i = 0; i < s.model.vertex_count; ++i)
+      for (int k = 0; k < 3; ++k)
+        m.a.valuePtr()[block_value_index(m.a, i, s.model.pattern.diagonal_offsets[i], k, k)] =
+            s.model.mass[i];
+    Eigen::VectorXd force, kv = Eigen::VectorXd::Zero(warm.velocities().size());
+    JacobianTarget target;
+    target.matrix = &m.a;
+    target.dfdx_scale = -h * h;
+    target.dfdv_scale = -h;
+    target.product_input = &warm.velocities();
+    target.product_output = &kv;
+    evaluate_forces(s.model, settings.forces, warm.positions(), warm.velocities(), force, nullptr,
+                    &target);
+    m.b = h * (force + h * kv);
+    m.filter = ConstraintFilter(s.model.vertex_count);
+    for (int p : s.scene.pinned_vertices) m.filter.pin(p, Eigen::Vector3d::Zero());
+    m.filter.constrained_correction(warm.velocities(), m.z);
+    CholmodSolver cholmod;
+    cholmod.factorize(m.a, m.filter);
+    cholmod.solve(m.a, m.filter, m.b, m.z, m.exact);
+    return m;
+  }();
+  return system;
+}
+
+// Error of an approximate solution in the energy norm of A, relative to the exact step.
+double energy_error(const MidSwingSystem& m, const Eigen::VectorXd& s) {
+  const Eigen::VectorXd e = s - m.exact;
+  const Eigen::VectorXd d = m.exact - m.z;
+  return std::sqrt(e.dot(m.a * e) / d.dot(m.a * d));
+}
+
+// The PCG alone on the mid-swing system; args: preconditioner (0 block Jacobi, 1 block IC(0)),
+// tolerance 10^-arg. Reports iterations and the energy-norm error of the result.
+void BM_MidSwingPcg64(benchmark::State& state) {
+  const MidSwingSystem& m = mid_swing_system();
+  PcgSolver pcg(state.range(0) == 0 ? PcgPreconditioner::block_jacobi
+                                    : PcgPreconditioner::block_incomplete_cholesky);
+  const double tolerance = std::pow(10.0, -static_cast<double>(state.range(1)));
+  Eigen::VectorXd step;
+  LinearSolveStats stats;
+  for (auto _ : state) {
+    stats = pcg.solve(m.a, m.sheet.model.pattern.diagonal_offsets, m.filter, m.b, m.z, step,
+                      tolerance, 5000);
+    benchmark::DoNotOptimize(step.data());
+  }
+  state.counters["iterations"] = stats.iterations;
+  state.counters["energy_error"] = energy_error(m, step);
+  state.counters["residual"] = constrained_relative_residual(m.a, m.filter, m.b, m.z, step);
+}
+BENCHMARK(BM_MidSwingPcg64)->ArgsProduct({{0, 1}, {2, 3, 4}})->Unit(benchmark::kMillisecond);
+
+// Building each preconditioner alone (block IC(0): filtered copy + factorisation).
+void BM_MidSwingIncompleteCholesky64(benchmark::State& state) {
+  const MidSwingSystem& m = mid_swing_system();
+  BlockIncompleteCholesky ic;
+  for (auto _ : state)
+    benchmark::DoNotOptimize(ic.factorize(m.a, m.sheet.model.pattern.diagonal_offsets, m.filter));
+  state.counters["shift"] = ic.shift();
+}
+BENCHMARK(BM_MidSwingIncompleteCholesky64)->Unit(benchmark::kMillisecond);
+
+// Eigen's scalar IncompleteCholesky (AMD ordering, fill limited to the pattern's column counts,
+// diagonal shift) in Eigen's CG on the explicitly filtered matrix S A S + (I − S), to the
+// same Euclidean residual reduction the block IC(0) PCG reaches at 1e-3.
+void BM_MidSwingEigenIncompleteCholesky64(benchmark::State& state) {
+  const MidSwingSystem& m = mid_swing_system();
+  using ColMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+  ColMatrix filtered = m.a;  // structurally symmetric
+  const int n = m.sheet.model.vertex_count;
+  for (int k = 0; k < filtered.outerSize(); ++k)
+    for (ColMatrix::InnerIterator it(filtered, k); it; ++it) {
+      const int i = static_cast<int>(it.row()) / 3, j = static_cast<int>(it.col()) / 3;
+      if (!m.filter.is_free(i) || !m.filter.is_free(j))
+        it.valueRef() = it.row() == it.col() ? 1.0 : 0.0;  // pins only: S_i = 0
+    }
+  Eigen::VectorXd rhs = m.b - m.a * m.z;
+  m.filter.apply(rhs);
+  PcgSolver reference(PcgPreconditioner::block_incomplete_cholesky);
+  Eigen::VectorXd step;
+  reference.solve(m.a, m.sheet.model.pattern.diagonal_offsets, m.filter, m.b, m.z, step, 1e-3,
+                  5000);
+  const double target = constrained_relative_residual(m.a, m.filter, m.b, m.z, step);
+  Eigen::ConjugateGradient<ColMatrix, Eigen::Lower | Eigen::Upper,
+                           Eigen::IncompleteCholesky<double, Eigen::Lower>>
+      cg;
+  cg.setTolerance(target);
+  cg.setMaxIterations(5000);
+  Eigen::VectorXd y;
+  for (auto _ : state) {
+    cg.compute(filtered);
+    y = cg.solve(rhs);
+    benchmark::DoNotOptimize(y.data());
+  }
+  Eigen::VectorXd s = m.z + y;
+  state.counters["iterations"] = static_cast<double>(cg.iterations());
+  state.counters["energy_error"] = energy_error(m, s);
+  state.counters["residual"] = constrained_relative_residual(m.a, m.filter, m.b, m.z, s);
+  state.counters["vertices"] = n;
+}
+BENCHMARK(BM_MidSwingEigenIncompleteCholesky64)->Unit(benchmark::kMillisecond);
+
+// CHOLMOD on the mid-swing system: numeric factorisation (analysis reused) + solve;
+// arg 0 supernodal, 1 simplicial.
+void BM_MidSwingCholmod64(benchmark::State& state) {
+  const MidSwingSystem& m = mid_swing_system();
+  CholmodSolver cholmod(state.range(0) == 0 ? CholmodMethod::supernodal
+                                            : CholmodMethod::simplicial);
+  Eigen::VectorXd step;
+  cholmod.factorize(m.a, m.filter);  // the symbolic analysis, outside the timing
+  for (auto _ : state) {
+    cholmod.factorize(m.a, m.filter);
+    cholmod.solve(m.a, m.filter, m.b, m.z, step);
+    benchmark::DoNotOptimize(step.data());
+  }
+  state.counters["energy_error"] = energy_error(m, step);
+}
+BENCHMARK(BM_MidSwingCholmod64)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 // Force and Jacobian assembly alone (64x64).
 void BM_AssembleForcesJacobian64(benchmark::State& state) {
@@ -128,7 +281,8 @@ void BM_PcgIterationPerVertex64(benchmark::State& state) {
   SparseMatrixR a = s.model.pattern.zero_matrix;
   for (int i = 0; i < s.model.vertex_count; ++i)
     for (int k = 0; k < 3; ++k)
-      a.valuePtr()[block_value_index(a, i, s.model.pattern.diagonal_offsets[i], k, k)] = s.model.mass[i];
+      a.valuePtr()[block_value_index(a, i, s.model.pattern.diagonal_offsets[i], k, k)] =
+          s.model.mass[i];
   JacobianTarget target;
   target.matrix = &a;
   const double h = 1.0 / 24;
@@ -149,9 +303,9 @@ void BM_PcgIterationPerVertex64(benchmark::State& state) {
     iterations += stats.iterations;
     benchmark::DoNotOptimize(step.data());
   }
-  state.counters["ns_per_iteration_vertex"] = benchmark::Counter(
-      static_cast<double>(iterations) * s.model.vertex_count * 1e-9,
-      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["ns_per_iteration_vertex"] =
+      benchmark::Counter(static_cast<double>(iterations) * s.model.vertex_count * 1e-9,
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
   // Bytes the SpMV must stream at least: values + column indices + row pointers + x + y.
   const double bytes = 12.0 * a.nonZeros() + 4.0 * a.rows() + 16.0 * a.rows();
   state.counters["spmv_bytes_per_vertex"] = bytes / s.model.vertex_count;

@@ -133,7 +133,7 @@ TEST(Simulation, ResolutionInvariance) {
 }
 
 // Error at T against a much smaller step, for two steps h and h/2: observed order log2(e1/e2).
-double observed_order(Integrator integrator) {
+double observed_order(Integrator integrator, int bdf2_newton = 20) {
   SheetSpec spec;
   spec.size = {0.3, 0.3};
   spec.columns = 4;
@@ -149,7 +149,7 @@ double observed_order(Integrator integrator) {
   fabric.bend = 1e-4;
   fabric.damping = fabric.bend_damping = 0.0;
   const ClothModel model = build_cloth_model(scene.input, fabric);
-  const auto run = [&](double dt, Integrator method) {
+  const auto run = [&](double dt, Integrator method, int newton) {
     SimulationSettings settings;
     settings.integrator = method;
     settings.solver = LinearSolverKind::cholmod;
@@ -157,7 +157,7 @@ double observed_order(Integrator integrator) {
     settings.duration = 0.2;
     settings.stop_at_rest = false;
     settings.record_energy = false;
-    settings.newton_iterations = method == Integrator::bdf2 ? 20 : 1;
+    settings.newton_iterations = method == Integrator::bdf2 ? newton : 1;
     settings.newton_tolerance = 1e-13;
     settings.easy_steps_to_grow = 1000000;
     Simulation sim(model, flatten_positions(scene.input.rest_positions),
@@ -167,12 +167,15 @@ double observed_order(Integrator integrator) {
     EXPECT_EQ(report.forced_steps, 0);
     return sim.positions();
   };
-  const Eigen::VectorXd reference = run(0.2 / 3200, Integrator::bdf2);
-  const double e1 = (run(0.2 / 40, integrator) - reference).lpNorm<Eigen::Infinity>();
-  const double e2 = (run(0.2 / 80, integrator) - reference).lpNorm<Eigen::Infinity>();
-  const double e3 = (run(0.2 / 160, integrator) - reference).lpNorm<Eigen::Infinity>();
+  const Eigen::VectorXd reference = run(0.2 / 3200, Integrator::bdf2, 20);
+  const double e1 = (run(0.2 / 40, integrator, bdf2_newton) - reference).lpNorm<Eigen::Infinity>();
+  const double e2 = (run(0.2 / 80, integrator, bdf2_newton) - reference).lpNorm<Eigen::Infinity>();
+  const double e3 = (run(0.2 / 160, integrator, bdf2_newton) - reference).lpNorm<Eigen::Infinity>();
   std::printf("convergence (%s): errors %.3g %.3g %.3g m, orders %.2f %.2f\n",
-              integrator == Integrator::bdf2 ? "BDF2" : "implicit Euler", e1, e2, e3,
+              integrator == Integrator::bdf2
+                  ? (bdf2_newton == 1 ? "linearised BDF2" : "BDF2")
+                  : "implicit Euler",
+              e1, e2, e3,
               std::log2(e1 / e2), std::log2(e2 / e3));
   return std::log2(e2 / e3);
 }
@@ -185,6 +188,15 @@ TEST(Simulation, ConvergenceOrderImplicitEulerIsOne) {
 
 TEST(Simulation, ConvergenceOrderBdf2IsTwo) {
   const double order = observed_order(Integrator::bdf2);
+  EXPECT_GT(order, 1.7);
+  EXPECT_LT(order, 2.4);
+}
+
+// The linearly implicit BDF2 step (one solve linearised at the start, the fallback) keeps
+// second order in this smooth regime: the projected Jacobian is exact for the stretched,
+// undamped sheet up to the shear/bend curvature terms it drops.
+TEST(Simulation, ConvergenceOrderLinearisedBdf2) {
+  const double order = observed_order(Integrator::bdf2, 1);
   EXPECT_GT(order, 1.7);
   EXPECT_LT(order, 2.4);
 }
@@ -264,6 +276,71 @@ TEST(Simulation, StressStiffnessStepIntegratorSolver) {
           total_retries += report.retries;
         }
   std::printf("stress: %d retries over 48 runs\n", total_retries);
+}
+
+// The PCG tolerance judged by the error it causes: a 1 s drape of a stiff cotton sheet at
+// film steps with the default PCG (IC(0), 1e-3) ends within a small fraction of the time-
+// discretisation error (exact solves at h against h/2) of the exactly solved run.
+TEST(Simulation, PcgToleranceErrorIsSmallAgainstTheTimeStepError) {
+  const HangingSheet h = hanging_sheet(24, 1.0);
+  const auto drape = [&](LinearSolverKind solver, PcgPreconditioner preconditioner, double dt) {
+    SimulationSettings settings;
+    settings.solver = solver;
+    settings.pcg_preconditioner = preconditioner;
+    settings.dt = dt;
+    settings.duration = 1.0;
+    settings.stop_at_rest = false;
+    settings.record_energy = false;
+    settings.forces.air_drag = 0.1;
+    Simulation sim = make_simulation(h, settings);
+    const SimulationReport report = sim.run();
+    EXPECT_EQ(report.retries, 0);
+    return sim.positions();
+  };
+  const double step = 1.0 / 24;
+  const Eigen::VectorXd exact = drape(LinearSolverKind::cholmod, {}, step);
+  const Eigen::VectorXd half = drape(LinearSolverKind::cholmod, {}, step / 2);
+  const Eigen::VectorXd ic =
+      drape(LinearSolverKind::pcg, PcgPreconditioner::block_incomplete_cholesky, step);
+  const Eigen::VectorXd jacobi = drape(LinearSolverKind::pcg, PcgPreconditioner::block_jacobi, step);
+  const double time_error = (exact - half).lpNorm<Eigen::Infinity>();
+  const double ic_error = (ic - exact).lpNorm<Eigen::Infinity>();
+  const double jacobi_error = (jacobi - exact).lpNorm<Eigen::Infinity>();
+  std::printf("PCG tolerance 1e-3 after 1 s: IC(0) %.3g m, block Jacobi %.3g m; time step h vs "
+              "h/2 %.3g m\n", ic_error, jacobi_error, time_error);
+  EXPECT_GT(time_error, 1e-3);  // a real swing: the comparison is not against noise
+  EXPECT_LT(ic_error, 0.1 * time_error);
+}
+
+// BDF2 on a stiff woven sheet at one step per film frame: Newton may fail where the sheet
+// buckles (the projected Jacobian drops the compression terms); such a step is retried once
+// as linearised implicit Euler and BDF2 resumes, so the run finishes with few retries and
+// mostly BDF2 steps.
+TEST(Simulation, Bdf2FinishesAStiffSheetAtFilmSteps) {
+  const HangingSheet h = hanging_sheet(32, 1.0);
+  for (LinearSolverKind solver : {LinearSolverKind::cholmod, LinearSolverKind::pcg}) {
+    SimulationSettings settings;
+    settings.integrator = Integrator::bdf2;
+    settings.solver = solver;
+    settings.dt = 1.0 / 24;
+    settings.duration = 1.0;
+    settings.stop_at_rest = false;
+    settings.record_energy = false;
+    settings.forces.air_drag = 0.1;
+    Simulation sim = make_simulation(h, settings);
+    const SimulationReport report = sim.run();
+    std::printf("BDF2 32x32 at 1/24 s (%s): steps %d, retries %d (fallbacks %d), Newton %.2f "
+                "per step, max strain %.4f\n",
+                solver == LinearSolverKind::pcg ? "PCG" : "CHOLMOD", report.steps,
+                report.retries, report.integrator_fallbacks, report.newton_iterations_mean,
+                report.max_strain);
+    EXPECT_FALSE(report.failed) << report.failure_reason;
+    EXPECT_NEAR(report.sim_time, settings.duration, 1e-9);
+    EXPECT_EQ(report.forced_steps, 0);
+    EXPECT_LE(report.steps, 2 * 24);       // at most twice the frames
+    EXPECT_LE(report.retries, report.steps / 2);
+    EXPECT_LT(report.max_strain, 0.05);
+  }
 }
 
 TEST(Simulation, FailedStepsAreRolledBackHalvedAndCounted) {
