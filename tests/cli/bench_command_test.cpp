@@ -1,0 +1,256 @@
+// `sketchdrape bench` as a user runs it, on the tiny grid (seconds): the CSV has every run and
+// the promised columns, the error falls with resolution and with the step, the reference is
+// computed once and then read from the cache (and recomputed when the scene changes), plots are
+// written when gnuplot is installed. Also the error definition and the trace format directly.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "src/app/bench_study.hpp"
+#include "tests/cli/run_command.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using sd::test::run_sketchdrape;
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / "sd_bench_test" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+nlohmann::json read_json(const fs::path& path) { return nlohmann::json::parse(read_text(path)); }
+
+// CSV with quoted fields ("a, b" and "" escapes), one vector per line.
+std::vector<std::vector<std::string>> parse_csv(const std::string& text) {
+  std::vector<std::vector<std::string>> rows(1);
+  std::string field;
+  bool quoted = false;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < text.size() && text[i + 1] == '"') {
+        field += '"';
+        ++i;
+      } else if (c == '"') {
+        quoted = false;
+      } else {
+        field += c;
+      }
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',') {
+      rows.back().push_back(field);
+      field.clear();
+    } else if (c == '\n') {
+      rows.back().push_back(field);
+      field.clear();
+      rows.emplace_back();
+    } else {
+      field += c;
+    }
+  }
+  if (rows.back().empty()) rows.pop_back();
+  return rows;
+}
+
+// The CSV as maps from column name to value, one per run id (scene/run).
+std::map<std::string, std::map<std::string, std::string>> csv_by_run(const fs::path& path) {
+  const auto rows = parse_csv(read_text(path));
+  std::map<std::string, std::map<std::string, std::string>> out;
+  for (size_t r = 1; r < rows.size(); ++r) {
+    std::map<std::string, std::string> row;
+    for (size_t c = 0; c < rows[0].size() && c < rows[r].size(); ++c) row[rows[0][c]] = rows[r][c];
+    out[row["scene"] + "/" + (row["note"].rfind("reference", 0) == 0 ? "reference" : row["run"])] = row;
+  }
+  return out;
+}
+
+double rms(const std::map<std::string, std::map<std::string, std::string>>& runs, const std::string& id) {
+  const auto it = runs.find("hanging-sheet/" + id);
+  if (it == runs.end()) {
+    ADD_FAILURE() << "no row " << id;
+    return NAN;
+  }
+  EXPECT_EQ(it->second.at("status"), "ok") << id << ": " << it->second.at("note");
+  return std::stod(it->second.at("rms_error_m"));
+}
+
+bool has_gnuplot() { return std::system("command -v gnuplot >/dev/null 2>&1") == 0; }
+
+const std::vector<std::string> kColumns = {
+    "scene", "run", "mesh", "level", "threshold_mm", "integrator", "solver", "dt_s", "families",
+    "status", "wall_s", "cpu_s", "process_cpu_s", "peak_rss_mb", "rss_before_run_mb",
+    "vertices_max", "triangles_max", "steps", "retries", "linear_solves", "cg_iterations_mean",
+    "rms_error_m", "max_error_m", "final_rms_error_m", "energy_error_j", "energy_error_relative",
+    "pareto", "note"};
+
+TEST(BenchCommand, TinyGridMeasuresErrorsAndReusesTheCachedReference) {
+  const fs::path dir = fresh_dir("tiny");
+  const std::string args = "-q bench --grid tiny -o " + (dir / "out").string() + " --cache " +
+                           (dir / "cache").string();
+  const auto first = run_sketchdrape(args);
+  ASSERT_EQ(first.exit_code, 0) << first.output;
+
+  // Every run and the reference, with the promised columns.
+  const auto rows = parse_csv(read_text(dir / "out/bench.csv"));
+  ASSERT_FALSE(rows.empty());
+  EXPECT_EQ(rows[0], kColumns);
+  const sd::app::BenchScene scene = sd::app::build_bench_scene("hanging-sheet", sd::app::BenchGrid::tiny);
+  const sd::app::BenchPlan plan = sd::app::bench_plan(scene, sd::app::BenchGrid::tiny);
+  EXPECT_EQ(rows.size(), plan.runs.size() + 2);  // header + reference + runs
+  for (size_t r = 1; r < rows.size(); ++r) EXPECT_EQ(rows[r].size(), kColumns.size()) << r;
+  auto runs = csv_by_run(dir / "out/bench.csv");
+  for (const sd::app::BenchConfig& c : plan.runs) {
+    const auto& row = runs["hanging-sheet/" + c.id()];
+    EXPECT_EQ(row.at("status"), "ok") << c.id() << ": " << row.at("note");
+    EXPECT_GT(std::stod(row.at("peak_rss_mb")), 1.0) << c.id();
+    EXPECT_GT(std::stod(row.at("cpu_s")), 0.0) << c.id();
+    EXPECT_GE(std::stod(row.at("max_error_m")), std::stod(row.at("rms_error_m"))) << c.id();
+  }
+
+  // Resolution: level 1 (a quarter of level 3's triangles) against level 3, same step. At 1/60 s
+  // the step's error dominates on this falling sheet, so only the order is asserted.
+  EXPECT_GT(rms(runs, "fixed-L1-ie-cholmod-60"), rms(runs, "fixed-L3-ie-cholmod-60"));
+  // Step: the same mesh at 1/30, 1/60 and 1/120 s.
+  EXPECT_GT(rms(runs, "fixed-L3-ie-cholmod-30"), rms(runs, "fixed-L3-ie-cholmod-60"));
+  EXPECT_GT(rms(runs, "fixed-L3-ie-cholmod-60"), rms(runs, "fixed-L3-ie-cholmod-120"));
+  // PCG solves the same system as CHOLMOD to its tolerance: the same error within 20 %.
+  EXPECT_NEAR(rms(runs, "fixed-L3-ie-pcg-60"), rms(runs, "fixed-L3-ie-cholmod-60"),
+              0.2 * rms(runs, "fixed-L3-ie-cholmod-60"));
+
+  const nlohmann::json report = read_json(dir / "out/bench.json");
+  EXPECT_FALSE(report["scenes"][0]["reference"]["cached"].get<bool>());
+  EXPECT_EQ(report["scenes"][0]["runs"].size(), plan.runs.size());
+  const std::string key = report["scenes"][0]["reference"]["key"];
+  EXPECT_TRUE(fs::exists(dir / "cache" / (key + ".bin")));
+  EXPECT_NE(first.output.find("defaults:"), std::string::npos) << first.output;
+
+  if (has_gnuplot()) {
+    const std::string png = read_text(dir / "out/bench_hanging-sheet.png");
+    ASSERT_GT(png.size(), 1000u);
+    EXPECT_EQ(png.substr(1, 3), "PNG");
+    EXPECT_NE(read_text(dir / "out/bench_hanging-sheet.svg").find("<svg"), std::string::npos);
+    EXPECT_TRUE(report["plots"].get<bool>());
+  } else {
+    EXPECT_FALSE(fs::exists(dir / "out/bench_hanging-sheet.png"));
+    EXPECT_NE(first.output.find("gnuplot is not installed"), std::string::npos);
+  }
+
+  // Second run: the reference comes from the cache, and the errors are the same to the bit.
+  const auto second = run_sketchdrape(args);
+  ASSERT_EQ(second.exit_code, 0) << second.output;
+  const nlohmann::json again = read_json(dir / "out/bench.json");
+  EXPECT_TRUE(again["scenes"][0]["reference"]["cached"].get<bool>());
+  EXPECT_EQ(again["scenes"][0]["reference"]["key"], key);
+  const auto runs_again = csv_by_run(dir / "out/bench.csv");
+  EXPECT_EQ(runs_again.at("hanging-sheet/reference").at("note"), "reference (cached)");
+  for (const sd::app::BenchConfig& c : plan.runs)
+    EXPECT_EQ(runs_again.at("hanging-sheet/" + c.id()).at("rms_error_m"),
+              runs.at("hanging-sheet/" + c.id()).at("rms_error_m"))
+        << c.id();
+}
+
+nlohmann::json sheet_sketch(const std::string& fabric) {
+  return {{"format", "sketchdrape/1"},
+          {"sheet",
+           {{"size", {0.5, 0.5}},
+            {"resolution", {6, 6}},
+            {"orientation", "horizontal"},
+            {"pins", {"top-left", "top-right"}}}},
+          {"fabric", fabric},
+          {"simulate", {{"duration", 0.3}}}};
+}
+
+TEST(BenchCommand, SketchSceneReferenceIsRecomputedWhenTheSceneChanges) {
+  const fs::path dir = fresh_dir("sketch");
+  const fs::path sketch = dir / "sheet.json";
+  std::ofstream(sketch) << sheet_sketch("cotton").dump(2);
+  const std::string args = "-q bench --grid tiny --scene " + sketch.string() + " -o " +
+                           (dir / "out").string() + " --cache " + (dir / "cache").string() + " --json";
+  const auto cached_flag = [&] {
+    const auto result = run_sketchdrape(args);
+    EXPECT_EQ(result.exit_code, 0) << result.output;
+    const nlohmann::json printed = nlohmann::json::parse(result.output);  // --json: only JSON
+    EXPECT_EQ(printed["scenes"][0]["name"], "sheet");
+    EXPECT_EQ(printed["scenes"][0]["duration_s"], 0.3);  // the file's duration, under the grid's
+    return printed["scenes"][0]["reference"]["cached"].get<bool>();
+  };
+  EXPECT_FALSE(cached_flag());
+  EXPECT_TRUE(cached_flag());
+  std::ofstream(sketch) << sheet_sketch("denim").dump(2);  // another fabric: another reference
+  EXPECT_FALSE(cached_flag());
+  EXPECT_TRUE(cached_flag());
+  int cached_files = 0;
+  for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir / "cache")) ++cached_files;
+  EXPECT_EQ(cached_files, 2);
+}
+
+TEST(BenchCommand, BadInputExitsWithTwoAndWritesNothing) {
+  const fs::path dir = fresh_dir("bad");
+  const auto unknown = run_sketchdrape("bench --grid tiny --scene no-such-scene -o " + (dir / "out").string());
+  EXPECT_EQ(unknown.exit_code, 2) << unknown.output;
+  EXPECT_NE(unknown.output.find("unknown scene 'no-such-scene'"), std::string::npos) << unknown.output;
+  const auto grid = run_sketchdrape("bench --grid huge -o " + (dir / "out").string());
+  EXPECT_EQ(grid.exit_code, 2) << grid.output;
+  EXPECT_NE(grid.output.find("--grid must be tiny, quick or full"), std::string::npos) << grid.output;
+  const auto both = run_sketchdrape("bench --quick --grid full -o " + (dir / "out").string());
+  EXPECT_EQ(both.exit_code, 2) << both.output;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
+// The error definition on hand-made traces: a rigid shift by d gives RMS = max = d, and the
+// energy difference is measured against the reference's range.
+TEST(BenchError, ShiftedTraceHasTheShiftAsError) {
+  sd::app::BenchTrace reference;
+  for (int s = 0; s < 4; ++s) {
+    reference.times.push_back(0.1 * s);
+    reference.positions.push_back(Eigen::MatrixX3d::Random(50, 3));
+    reference.energy.push_back(10.0 - s);  // range 3 J
+  }
+  EXPECT_EQ(sd::app::bench_error(reference, reference).rms_m, 0.0);
+  sd::app::BenchTrace run = reference;
+  for (size_t s = 1; s < run.positions.size(); ++s) {
+    run.positions[s].col(1).array() += 0.004 * static_cast<double>(s);  // 4, 8, 12 mm
+    run.energy[s] += 0.3;
+  }
+  const sd::app::BenchError e = sd::app::bench_error(run, reference);
+  EXPECT_EQ(e.samples, 3);
+  EXPECT_NEAR(e.rms_m, std::sqrt((16.0 + 64.0 + 144.0) / 3.0) * 1e-3, 1e-12);
+  EXPECT_NEAR(e.max_m, 0.012, 1e-12);
+  EXPECT_NEAR(e.final_rms_m, 0.012, 1e-12);
+  EXPECT_NEAR(e.energy_j, 0.3, 1e-12);
+  EXPECT_NEAR(e.energy_relative, 0.1, 1e-12);
+
+  // The trace survives its binary form exactly.
+  run.failed = false;
+  run.cpu_s = 1.25;
+  run.steps = 17;
+  const sd::app::BenchTrace back = sd::app::deserialize_trace(sd::app::serialize_trace(run));
+  ASSERT_EQ(back.positions.size(), run.positions.size());
+  for (size_t s = 0; s < run.positions.size(); ++s) EXPECT_EQ(back.positions[s], run.positions[s]);
+  EXPECT_EQ(back.energy, run.energy);
+  EXPECT_EQ(back.cpu_s, 1.25);
+  EXPECT_EQ(back.steps, 17);
+  EXPECT_THROW(sd::app::deserialize_trace("not a trace"), std::runtime_error);
+}
+
+}  // namespace
