@@ -77,8 +77,10 @@ struct AdaptiveCloth::Transfer {
   std::vector<double> birth;
   std::vector<PinRecord> pins;
   std::vector<int> pin_of;           // vertex id -> index into pins, or -1
+  std::vector<VertexOrigin> origin;  // vertex id -> where it comes from (ids before the batch)
   std::vector<char> touched_blocks;  // made, completed or merged in this batch
   double now = 0.0;
+  int moved_off_body = 0;  // split vertices moved out to the contact thickness
   bool changed = false;
   bool measured = false;
   ConservedQuantities before;
@@ -178,6 +180,9 @@ AdaptiveCloth::Transfer AdaptiveCloth::begin_transfer() const {
   state.pin_of.assign(static_cast<std::size_t>(mesh_.vertex_capacity()), -1);
   for (std::size_t k = 0; k < state.pins.size(); ++k)
     state.pin_of[static_cast<std::size_t>(state.pins[k].vertex)] = static_cast<int>(k);
+  state.origin.resize(static_cast<std::size_t>(mesh_.vertex_capacity()));
+  for (int i = 0; i < mesh_.vertex_capacity(); ++i)
+    state.origin[static_cast<std::size_t>(i)] = {i, i};
   state.now = simulation_->time();
   return state;
 }
@@ -196,6 +201,7 @@ void AdaptiveCloth::apply(const BlockChange& change, Transfer& state) {
   grow(state.birth, mesh_.triangle_capacity(), 0.0);
   grow(state.touched_blocks, mesh_.block_capacity(), char{0});
   grow(state.pin_of, mesh_.vertex_capacity(), -1);
+  grow(state.origin, mesh_.vertex_capacity(), VertexOrigin{});
   state.touched_blocks[static_cast<std::size_t>(change.block.value())] = 1;
   const auto pin_index = [&](VertexId v) { return state.pin_of[static_cast<std::size_t>(v.value())]; };
 
@@ -203,6 +209,14 @@ void AdaptiveCloth::apply(const BlockChange& change, Transfer& state) {
     // E at the midpoint of BC in world space, as in rest space: each child keeps its parent's
     // deformation gradient, so stretch, shear and the centre of mass are unchanged.
     meshing::place_split_vertex(change, state.x);
+    keep_off_body(change.e.value(), state);
+    // E comes from the edge BC if both are particles from before the batch.
+    const VertexOrigin& from_b = state.origin[static_cast<std::size_t>(change.b.value())];
+    const VertexOrigin& from_c = state.origin[static_cast<std::size_t>(change.c.value())];
+    state.origin[static_cast<std::size_t>(change.e.value())] =
+        from_b.a >= 0 && from_b.a == from_b.b && from_c.a >= 0 && from_c.a == from_c.b
+            ? VertexOrigin{from_b.a, from_c.a}
+            : VertexOrigin{};
     for (TriangleId t : {change.a10, change.a11, change.a20, change.a21}) {
       if (!t.valid()) continue;
       state.birth[static_cast<std::size_t>(t.value())] = state.now;
@@ -228,6 +242,7 @@ void AdaptiveCloth::apply(const BlockChange& change, Transfer& state) {
       state.pins.push_back(std::move(e));
     }
   } else {
+    state.origin[static_cast<std::size_t>(change.e.value())] = VertexOrigin{};  // gone
     for (TriangleId t : {change.a1, change.a2})
       if (t.valid()) state.birth[static_cast<std::size_t>(t.value())] = state.now;
     if (const int pe = pin_index(change.e); pe >= 0) {
@@ -238,6 +253,26 @@ void AdaptiveCloth::apply(const BlockChange& change, Transfer& state) {
     }
   }
 }
+
+void AdaptiveCloth::keep_off_body(int e, Transfer& state) const {
+  const ContactResponse* contact = simulation_->contact();
+  if (contact == nullptr || !simulation_->settings().contact.enabled) return;
+  const double thickness = contact->settings().thickness;
+  const Eigen::Vector3d x = state.x.row(e).transpose();
+  // Unbounded: a chord across a sharp edge can put E deeper inside than the thickness.
+  const std::optional<BodyProximity> near = contact->collider().closest_point(x);
+  if (!near || near->distance >= thickness) return;
+  state.x.row(e) += ((thickness - near->distance) * near->normal).transpose();
+  ++state.moved_off_body;
+}
+
+void AdaptiveCloth::set_body(const meshing::TriMesh& body) { simulation_->set_body(body); }
+
+void AdaptiveCloth::set_body_motion(PoseSequence motion) {
+  simulation_->set_body_motion(std::move(motion));
+}
+
+void AdaptiveCloth::clear_body() { simulation_->clear_body(); }
 
 double AdaptiveCloth::rebuild(Transfer& state, const SimulationSettings* first_settings) {
   const auto start = Clock::now();
@@ -252,6 +287,11 @@ double AdaptiveCloth::rebuild(Transfer& state, const SimulationSettings* first_s
       if (remap.triangles[t] >= 0) birth[static_cast<std::size_t>(remap.triangles[t])] = state.birth[t];
     state.birth = std::move(birth);
     for (PinRecord& pin : state.pins) pin.vertex = remap.vertices[static_cast<std::size_t>(pin.vertex)];
+    std::vector<VertexOrigin> origin(static_cast<std::size_t>(remap.vertex_count));
+    for (std::size_t slot = 0; slot < remap.vertices.size() && slot < state.origin.size(); ++slot)
+      if (remap.vertices[slot] >= 0)
+        origin[static_cast<std::size_t>(remap.vertices[slot])] = state.origin[slot];
+    state.origin = std::move(origin);
     arrays_ = mesh_.arrays();
   }
 
@@ -308,7 +348,7 @@ double AdaptiveCloth::rebuild(Transfer& state, const SimulationSettings* first_s
                                                std::move(pins), *first_settings);
   } else {
     simulation_->replace_model(std::move(model), flatten_positions(state.x),
-                               flatten_positions(state.v), std::move(pins));
+                               flatten_positions(state.v), std::move(pins), state.origin);
   }
   return seconds_since(start);
 }
@@ -316,6 +356,7 @@ double AdaptiveCloth::rebuild(Transfer& state, const SimulationSettings* first_s
 AdaptStats AdaptiveCloth::finish(Transfer& state, AdaptStats stats,
                                  Clock::time_point operations_start) {
   stats.operations_s = seconds_since(operations_start);
+  stats.moved_off_body = state.moved_off_body;
   if (state.changed) {
     stats.rebuild_s = rebuild(state);
     if (state.measured) {
@@ -328,6 +369,7 @@ AdaptStats AdaptiveCloth::finish(Transfer& state, AdaptStats stats,
   report_.splits += stats.splits;
   report_.forced_splits += stats.forced_splits;
   report_.merges += stats.merges;
+  report_.moved_off_body += stats.moved_off_body;
   report_.topology_changes += stats.changed() ? 1 : 0;
   report_.estimate_s += stats.estimate_s;
   report_.operations_s += stats.operations_s;
@@ -393,6 +435,30 @@ AdaptStats AdaptiveCloth::adapt() {
           keep = std::abs(rate) < settings_.steady_rate &&
                  hinge_sag(*hinge, theta.value) < settings_.coarsen_threshold;
         }
+      // The block's outer edges after the merge: the parent triangles are twice the children,
+      // so a bend across an outer edge that was fine for the children can have twice their
+      // sag. Below coarsen_threshold too, or a merge next to a fold is split again at once and
+      // the mesh churns every min_lifetime.
+      for (TriangleId t : children) {
+        if (!keep || !t.valid()) continue;
+        const auto& corners = mesh_.vertices(t);
+        const int at_e =
+            static_cast<int>(std::find(corners.begin(), corners.end(), e) - corners.begin());
+        if (at_e > 2) continue;
+        const TriangleId across = mesh_.neighbor(t, at_e);
+        if (!across.valid()) continue;  // a boundary edge: no hinge
+        const VertexId u = corners[static_cast<std::size_t>((at_e + 1) % 3)];
+        const VertexId w = corners[static_cast<std::size_t>((at_e + 2) % 3)];
+        const VertexId third = (u == b || w == b) ? c : b;  // of the parent triangle
+        VertexId opposite;
+        for (VertexId corner : mesh_.vertices(across))
+          if (corner != u && corner != w) opposite = corner;
+        // Element_forces' hinge order: (x0, x1, x2) and (x1, x0, x3) with x0 → x1 along t.
+        const std::array<int, 4> hinge{u.value(), w.value(), third.value(), opposite.value()};
+        const double theta = dihedral_angle(row3(x, hinge[0]), row3(x, hinge[1]),
+                                            row3(x, hinge[2]), row3(x, hinge[3]));
+        keep = hinge_sag(hinge, theta) < settings_.coarsen_threshold;
+      }
       if (keep) merges.emplace_back(error, k);
     }
     std::sort(merges.begin(), merges.end());
@@ -537,6 +603,15 @@ AdaptiveReport AdaptiveCloth::run(const std::function<void(const AdaptiveCloth&)
       break;
     }
   }
+  // As Simulation::run: what is still inside the body at the end (after the last adaptation).
+  int penetrating = 0;
+  double query_s = 0.0;
+  if (const ContactResponse* contact = simulation_->contact();
+      contact != nullptr && settings.contact.enabled) {
+    const auto query_start = Clock::now();
+    penetrating = contact->count_penetrating(simulation_->positions());
+    query_s = seconds_since(query_start);
+  }
   const double wall = seconds_since(start);
   // The simulation's own counters (steps, solves, timings) plus what its run() would add.
   std::vector<EnergySample> series = std::move(energy);
@@ -545,9 +620,12 @@ AdaptiveReport AdaptiveCloth::run(const std::function<void(const AdaptiveCloth&)
   report_.simulation = simulation_->report();
   report_.simulation.energy = std::move(series);
   report_.simulation.wall_time_s = wall_before + wall;
+  report_.simulation.collision_s += query_s;
+  report_.simulation.penetrating_vertices_final = penetrating;
   report_.simulation.other_s = other_before + wall -
                                (report_.simulation.forces_s - before.forces_s) -
-                               (report_.simulation.solve_s - before.solve_s);
+                               (report_.simulation.solve_s - before.solve_s) -
+                               (report_.simulation.collision_s - before.collision_s);
   report_.simulation.at_rest = at_rest;
   report_.simulation.failed = failed;
   report_.simulation.failure_reason = failure;

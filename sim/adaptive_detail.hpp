@@ -83,6 +83,7 @@ struct AdaptStats {
   int splits = 0;         // requested splits made
   int forced_splits = 0;  // splits the 4-8 rules forced first
   int merges = 0;
+  int moved_off_body = 0;  // split vertices moved out to the contact thickness
   int vertices = 0;       // after the change
   int triangles = 0;
   double estimate_s = 0.0;    // wall time: error estimates and merge candidates
@@ -113,6 +114,7 @@ struct AdaptiveReport {
   int forced_splits = 0;
   int merges = 0;
   int topology_changes = 0;  // steps on which the mesh changed (and the model was rebuilt)
+  int moved_off_body = 0;    // split vertices moved out to the contact thickness
   int vertices_min = 0, vertices_max = 0;
   int max_level_reached = 0;
   double estimate_s = 0.0;
@@ -150,6 +152,18 @@ class AdaptiveCloth {
   AdaptStats merge_blocks(const std::vector<meshing::BlockId>& blocks);
   // Splits every leaf block until all triangles are at `level` (a uniform fixed-resolution mesh).
   AdaptStats refine_uniformly(int level);
+
+  // The body the cloth drapes on, as Simulation::set_body / set_body_motion (contacts, Coulomb
+  // friction, start repair, swept end checks). The simulation and its collider live through
+  // every split and merge (the hierarchy is never rebuilt; the per-vertex contact memory
+  // restarts with each new numbering), and a split vertex that the midpoint rule puts closer to
+  // the body than the contact thickness (a chord across a curved or sharp body) is moved out
+  // to the thickness along the body's normal before the next step. Call before stepping.
+  // Throws InvalidBodyMeshError / InvalidBodyMotionError.
+  void set_body(const meshing::TriMesh& body);
+  void set_body_motion(PoseSequence motion);
+  void clear_body();
+  bool has_body() const { return simulation_->has_body(); }
 
   const meshing::Mesh48& mesh() const { return mesh_; }  // compact between calls
   const Simulation& simulation() const { return *simulation_; }
@@ -189,6 +203,9 @@ class AdaptiveCloth {
   double rebuild(Transfer& state, const SimulationSettings* first_settings = nullptr);
   Transfer begin_transfer() const;
   void apply(const meshing::BlockChange& change, Transfer& state);
+  // Moves the split vertex `e` (row of state.x) out to the contact thickness if the body is
+  // closer than that.
+  void keep_off_body(int e, Transfer& state) const;
   AdaptStats finish(Transfer& state, AdaptStats stats,
                     std::chrono::steady_clock::time_point operations_start);
   void count_split(const std::vector<meshing::BlockChange>& changes, Transfer& state,

@@ -122,6 +122,12 @@ void ContactResponse::reset_cloth(const Eigen::VectorXd& x, const Eigen::VectorX
   for (const BodyContact& c : repair_.pushed) in_repair_[c.vertex] = 1;
 }
 
+void ContactResponse::restore_normal_forces(std::vector<double> forces) {
+  if (forces.size() != last_normal_force_.size())
+    throw std::invalid_argument("restore_normal_forces needs one force per cloth vertex");
+  last_normal_force_ = std::move(forces);
+}
+
 void ContactResponse::move_body_to(double t, double h) {
   stats_ = ContactStepStats{};
   if (!motion_) return;

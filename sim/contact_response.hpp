@@ -108,6 +108,13 @@ class ContactResponse {
   bool repairing() const { return repair_step_ < repair_.steps && !repair_.empty(); }
   // Contacts of the last accepted step (constrained and released).
   const std::vector<ActiveContact>& contacts() const { return accepted_contacts_; }
+  // Per cloth vertex, the normal force of its constrained contact in the last accepted step
+  // (N; negative: the constraint pulled; NaN: none). After reset_cloth for a cloth that was
+  // refined or coarsened (adaptive detail), the caller hands this memory back in the new
+  // numbering, so that held contacts, friction inside the solve and releases carry on across
+  // the change. `forces` must have one entry per vertex of the new cloth.
+  const std::vector<double>& last_normal_forces() const { return last_normal_force_; }
+  void restore_normal_forces(std::vector<double> forces);
 
   // A new cloth (first call, or vertices renumbered by replace_model): resets the cache and the
   // memory of the last step, and plans the push-out of vertices inside the body. A repair in

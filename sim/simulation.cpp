@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <utility>
 
@@ -90,6 +91,34 @@ void Simulation::replace_model(ClothModel model, Eigen::VectorXd x, Eigen::Vecto
     contact_->reset_cloth(x_, model_.mass, settings_.forces.gravity.norm());
     report_.collision_s += contact_->step_stats().collision_seconds;
   }
+}
+
+void Simulation::replace_model(ClothModel model, Eigen::VectorXd x, Eigen::VectorXd v,
+                               std::vector<Pin> pins, const std::vector<VertexOrigin>& origin) {
+  if (static_cast<int>(origin.size()) != model.vertex_count)
+    throw std::invalid_argument("replace_model needs the origin of every new cloth vertex");
+  // Normal force per unit mass (N/kg) of every old vertex, NaN without a pressed contact.
+  std::vector<double> specific;
+  if (contact_) {
+    specific = contact_->last_normal_forces();
+    for (std::size_t i = 0; i < specific.size(); ++i)
+      specific[i] /= model_.mass[static_cast<Eigen::Index>(i)];
+  }
+  replace_model(std::move(model), std::move(x), std::move(v), std::move(pins));
+  if (!contact_) return;
+  const auto old_force = [&](int i) {
+    if (i < 0 || i >= static_cast<int>(specific.size()))
+      return std::numeric_limits<double>::quiet_NaN();
+    return specific[static_cast<std::size_t>(i)];
+  };
+  std::vector<double> forces(origin.size());
+  for (std::size_t i = 0; i < origin.size(); ++i) {
+    // NaN (no contact) unless both origins had one: the mean force per unit mass, times the
+    // new mass (a particle's share of a pressure scales with its mass, i.e. its area).
+    const double f = 0.5 * (old_force(origin[i].a) + old_force(origin[i].b));
+    forces[i] = f * model_.mass[static_cast<Eigen::Index>(i)];
+  }
+  contact_->restore_normal_forces(std::move(forces));
 }
 
 void Simulation::set_body(const meshing::TriMesh& body) {

@@ -55,6 +55,14 @@ struct SimulationSettings {
   void validate() const;  // throws InvalidSimulationSettingsError
 };
 
+// Where a vertex of a refined or coarsened mesh comes from, in the numbering of the mesh it
+// replaces: a = b for the same particle; a ≠ b for a vertex made on the edge between a and b;
+// a = −1 when unknown (treated as a new particle).
+struct VertexOrigin {
+  int a = -1;
+  int b = -1;
+};
+
 // A constrained vertex: fixed where it starts, or driven along `path` (position at time t).
 struct Pin {
   int vertex = 0;
@@ -135,6 +143,13 @@ class Simulation {
   // history restarts with an implicit Euler step.
   void replace_model(ClothModel model, Eigen::VectorXd x, Eigen::VectorXd v,
                      std::vector<Pin> pins);
+  // The same for a mesh refined or coarsened from the current one, origin[i] naming where new
+  // vertex i comes from: the body contacts' memory of the last step (which contacts pressed
+  // and how hard, per unit mass) carries over to the same particles, and to a vertex made
+  // between two pressed ones, so that held contacts and friction do not restart at every
+  // topology change.
+  void replace_model(ClothModel model, Eigen::VectorXd x, Eigen::VectorXd v,
+                     std::vector<Pin> pins, const std::vector<VertexOrigin>& origin);
   void set_velocities(const Eigen::VectorXd& v);
 
   // The body the cloth rests on and cannot enter: a still mesh (metres, closed, counter-

@@ -120,9 +120,6 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   const ClothScene scene = build_cloth_scene(sketch);
   if (scene.pinned.empty() && !scene.body)
     spdlog::warn("nothing holds the cloth (no pins, no body): it will fall for the whole run");
-  if (scene.body && sketch.simulate.adaptive && scene.mesh48)
-    spdlog::warn("adaptive detail does not simulate body contact yet: the garment will pass "
-                 "through the body (set \"simulate\": {{\"adaptive\": false}} to drape on it)");
 
   std::vector<sim::Pin> pins;
   for (int v : scene.pinned) pins.push_back({v, {}});
@@ -159,6 +156,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
       if (scene.garment) material.source_warp = garment::material_frames(scene.garment->mesh).warp;
       sim::AdaptiveCloth cloth(*scene.mesh48, material, scene.start, pins, settings,
                                sim::AdaptiveSettings{});
+      if (scene.body) cloth.set_body(scene.body->mesh);  // contacts through every split and merge
       const sim::AdaptiveReport adaptive =
           cloth.run([&](const sim::AdaptiveCloth& c) { on_step(c.simulation()); });
       report = adaptive.simulation;

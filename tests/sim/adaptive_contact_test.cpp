@@ -1,0 +1,298 @@
+// Adaptive 4-8 detail with body contact: a free sheet dropped on a sphere and a sheet folded
+// over a box edge, adapting all the way. No vertex ends a step (adaptation included) deeper
+// than the penetration tolerance, the drape comes to rest, mass and momentum are carried
+// exactly through every split and merge, and the detail goes to the folds rather than to the
+// cloth lying on the body.
+#include "sim/adaptive_detail.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "sim/body_collider.hpp"
+#include "tests/sim/adaptive_scenes.hpp"
+#include "tests/sim/test_bodies.hpp"
+
+namespace sd::sim {
+namespace {
+
+using Eigen::Vector3d;
+using testing::AdaptiveSheetSpec;
+
+SimulationSettings drape_settings(double duration) {
+  SimulationSettings settings;
+  settings.solver = LinearSolverKind::cholmod;
+  settings.duration = duration;
+  settings.forces.air_drag = 0.3;  // settles the drapes sooner; not part of what is tested
+  settings.contact.thickness = 0.003;
+  settings.contact.penetration_tolerance = 0.001;
+  return settings;
+}
+
+// Deepest point of the cloth inside `body` (0 when all vertices are outside), by a collider of
+// its own (not the simulation's).
+double deepest_inside(const BodyCollider& body, const Eigen::MatrixX3d& x) {
+  double depth = 0.0;
+  for (Eigen::Index i = 0; i < x.rows(); ++i)
+    depth = std::max(depth, -body.signed_distance(x.row(i).transpose()));
+  return depth;
+}
+
+struct DrapeRun {
+  AdaptiveReport report;
+  double worst = 0.0;          // deepest inside the body after any step and its adaptation, m
+  double mass_drift = 0.0;     // largest |Σm − Σm0| / Σm0 over the steps
+  double momentum_jump = 0.0;  // largest |Δp| across a topology change / (Σm · 1 m/s)
+  int measured_changes = 0;
+};
+
+// Runs `cloth` to its end, checking penetration after every step (with an independent
+// collider) and conservation across every topology change.
+DrapeRun run_drape(AdaptiveCloth& cloth, const meshing::TriMesh& body) {
+  const BodyCollider check(body);
+  DrapeRun run;
+  const double mass = cloth.masses().sum();
+  run.report = cloth.run([&](const AdaptiveCloth& c) {
+    run.worst = std::max(run.worst, deepest_inside(check, c.positions()));
+    run.mass_drift = std::max(run.mass_drift, std::abs(c.masses().sum() - mass) / mass);
+  });
+  for (const AdaptiveStepRecord& step : run.report.steps) {
+    if (!step.measured) continue;
+    ++run.measured_changes;
+    EXPECT_NEAR(step.after.mass, step.before.mass, 1e-14 * mass);
+    run.momentum_jump =
+        std::max(run.momentum_jump, (step.after.momentum - step.before.momentum).norm() / mass);
+  }
+  return run;
+}
+
+// Mean block level of the triangles lying on the body (every corner within twice the thickness)
+// and of the others, and how many of each.
+struct LevelSplit {
+  double on_body = 0.0, off_body = 0.0;
+  int on_count = 0, off_count = 0;
+  int finest_on = 0, finest_off = 0;  // triangles at the mesh's finest level
+};
+
+LevelSplit level_split(const AdaptiveCloth& cloth, const BodyCollider& body, double thickness) {
+  const Eigen::MatrixX3d x = cloth.positions();
+  std::vector<char> near(static_cast<std::size_t>(x.rows()));
+  for (Eigen::Index i = 0; i < x.rows(); ++i)
+    near[static_cast<std::size_t>(i)] = body.signed_distance(x.row(i).transpose()) < 2 * thickness;
+  LevelSplit split;
+  for (Eigen::Index f = 0; f < cloth.faces().rows(); ++f) {
+    bool on = true;
+    for (int k = 0; k < 3; ++k) on = on && near[static_cast<std::size_t>(cloth.faces()(f, k))];
+    const int level = cloth.face_levels()(f);
+    const bool finest = level == cloth.mesh().max_level();
+    if (on) {
+      split.on_body += level;
+      ++split.on_count;
+      split.finest_on += finest ? 1 : 0;
+    } else {
+      split.off_body += level;
+      ++split.off_count;
+      split.finest_off += finest ? 1 : 0;
+    }
+  }
+  if (split.on_count > 0) split.on_body /= split.on_count;
+  if (split.off_count > 0) split.off_body /= split.off_count;
+  return split;
+}
+
+std::vector<int> level_histogram(const AdaptiveCloth& cloth) {
+  std::vector<int> count(static_cast<std::size_t>(cloth.mesh().max_level() + 1), 0);
+  for (Eigen::Index f = 0; f < cloth.face_levels().size(); ++f)
+    ++count[static_cast<std::size_t>(cloth.face_levels()(f))];
+  return count;
+}
+
+void print_histogram(const char* name, const std::vector<int>& count) {
+  std::printf("%s triangles by level:", name);
+  for (std::size_t l = 0; l < count.size(); ++l) std::printf(" L%zu %d", l, count[l]);
+  std::printf("\n");
+}
+
+// A free 0.6 m sheet (4x4 level-0 quads, started at level 2) 5 cm above a sphere of radius 0.2 m.
+TEST(AdaptiveContact, SheetDropsOnASphereAdaptivelyAndDrapesOutside) {
+  AdaptiveSheetSpec spec;
+  spec.size = 0.6;
+  spec.pins = {};
+  testing::AdaptiveSheet sheet = testing::build_adaptive_sheet(spec);  // at y = 1
+  sheet.material.fabric = fabric_preset("cotton");
+  const double radius = 0.2;
+  const Vector3d centre(0.0, 1.0 - 0.05 - radius, 0.0);
+  const meshing::TriMesh sphere = testing::make_sphere(radius, 3, centre);
+  const SimulationSettings settings = drape_settings(6.0);
+  AdaptiveSettings adaptive;
+  adaptive.max_level = 6;  // 2048 triangles if uniform, 1.9 cm quads
+  adaptive.measure_jumps = true;
+  AdaptiveCloth cloth(std::move(sheet.mesh), sheet.material, {}, {}, settings, adaptive);
+  cloth.refine_uniformly(2);
+  cloth.set_body(sphere);
+  ASSERT_TRUE(cloth.has_body());
+
+  const DrapeRun run = run_drape(cloth, sphere);
+  const SimulationReport& s = run.report.simulation;
+  const LevelSplit levels = level_split(cloth, BodyCollider(sphere), settings.contact.thickness);
+  std::printf(
+      "adaptive sphere drape: %d steps, at rest %d at %.2f s, %d-%d vertices (final %d), %d "
+      "splits %d forced %d merges in %d changes, %d moved off the body; deepest %.3g mm (report "
+      "%.3g mm), contacts max %d final %d, re-solves %d, projected %d; mean level on the body "
+      "%.2f (%d triangles, %d finest), off it %.2f (%d, %d finest); wall %.2f s (solve %.2f, "
+      "adaptivity %.3f)\n",
+      s.steps, s.at_rest, s.sim_time, run.report.vertices_min, run.report.vertices_max,
+      cloth.mesh().vertex_count(), run.report.splits, run.report.forced_splits, run.report.merges,
+      run.report.topology_changes, run.report.moved_off_body, 1e3 * run.worst,
+      1e3 * s.max_penetration_m, s.contacts_max, s.contacts_final, s.contact_resolves,
+      s.projected_vertices, levels.on_body, levels.on_count, levels.finest_on, levels.off_body,
+      levels.off_count, levels.finest_off, s.wall_time_s, s.solve_s, run.report.adaptivity_s());
+  print_histogram("sphere", level_histogram(cloth));
+
+  EXPECT_FALSE(s.failed) << s.failure_reason;
+  EXPECT_TRUE(s.at_rest);
+  EXPECT_LE(run.worst, settings.contact.penetration_tolerance);
+  EXPECT_LE(s.max_penetration_m, settings.contact.penetration_tolerance);
+  EXPECT_EQ(s.penetrating_vertices_final, 0);
+  EXPECT_GT(s.contacts_final, 20);
+  EXPECT_LT(run.mass_drift, 1e-13);
+  EXPECT_GT(run.measured_changes, 5);
+  EXPECT_LT(run.momentum_jump, 1e-13);
+  EXPECT_TRUE(cloth.mesh().validate().empty());
+  // Draped: the middle of the sheet rests on the top at the thickness.
+  Eigen::Index middle = 0;
+  (cloth.rest_positions().rowwise() - Eigen::RowVector3d(0.0, 1.0, 0.0))
+      .rowwise()
+      .squaredNorm()
+      .minCoeff(&middle);
+  EXPECT_NEAR(cloth.positions()(middle, 1), centre.y() + radius + settings.contact.thickness,
+              5e-4);
+  EXPECT_LT(cloth.positions().col(1).minCoeff(), centre.y());
+  // The detail went to the folds of the hanging rim: the cloth lying on the sphere (which needs
+  // only what its curvature asks for, about level 4-5 at 2 mm sag) is coarser on average, few
+  // finest triangles lie on it, and the whole mesh has well under the uniform finest count.
+  EXPECT_GT(levels.off_body, levels.on_body + 0.25);
+  EXPECT_LT(levels.finest_on, 0.15 * (levels.finest_on + levels.finest_off));
+  const int uniform_finest = 33 * 33;  // level 6: 32 x 32 quads
+  EXPECT_LT(cloth.mesh().vertex_count(), 0.65 * uniform_finest);
+}
+
+// A 0.4 m sheet (4x4 level-0 quads, started at level 2) 2 cm above a box whose edge runs along
+// z; 0.12 m of it overhangs the edge, folds over it and hangs down the side face.
+TEST(AdaptiveContact, SheetFoldsOverABoxEdgeWithDetailAtTheFold) {
+  AdaptiveSheetSpec spec;
+  spec.size = 0.4;
+  spec.pins = {};
+  testing::AdaptiveSheet sheet = testing::build_adaptive_sheet(spec);  // x, z in ±0.2 at y = 1
+  sheet.material.fabric = fabric_preset("cotton");
+  const double edge_x = 0.08, top_y = 0.98;
+  const meshing::TriMesh box =
+      testing::make_box({edge_x - 0.5, top_y - 0.5, -0.3}, {edge_x, top_y, 0.3});
+  const SimulationSettings settings = drape_settings(6.0);
+  AdaptiveSettings adaptive;
+  adaptive.max_level = 6;
+  adaptive.measure_jumps = true;
+  AdaptiveCloth cloth(std::move(sheet.mesh), sheet.material, {}, {}, settings, adaptive);
+  cloth.refine_uniformly(2);
+  cloth.set_body(box);
+
+  const DrapeRun run = run_drape(cloth, box);
+  const SimulationReport& s = run.report.simulation;
+  // Mean level of the triangles at the fold (centroid within 2 cm of the edge) and of those
+  // lying on the top away from it (more than 5 cm in).
+  const Eigen::MatrixX3d x = cloth.positions();
+  double fold_level = 0.0, top_level = 0.0;
+  int fold_count = 0, top_count = 0;
+  for (Eigen::Index f = 0; f < cloth.faces().rows(); ++f) {
+    const Eigen::RowVector3d centroid =
+        (x.row(cloth.faces()(f, 0)) + x.row(cloth.faces()(f, 1)) + x.row(cloth.faces()(f, 2))) / 3;
+    const double level = cloth.face_levels()(f);
+    if (std::hypot(centroid.x() - edge_x, centroid.y() - top_y) < 0.02) {
+      fold_level += level;
+      ++fold_count;
+    } else if (centroid.x() < edge_x - 0.05 && centroid.y() > top_y) {
+      top_level += level;
+      ++top_count;
+    }
+  }
+  fold_level /= std::max(fold_count, 1);
+  top_level /= std::max(top_count, 1);
+  double hanging_x = -1.0, hanging_y = 1.0;  // the lowest vertex
+  for (Eigen::Index i = 0; i < x.rows(); ++i)
+    if (x(i, 1) < hanging_y) hanging_x = x(i, 0), hanging_y = x(i, 1);
+  std::printf(
+      "adaptive box edge: %d steps, at rest %d at %.2f s, %d-%d vertices (final %d), %d splits %d "
+      "forced %d merges, %d moved off the body; deepest %.3g mm, contacts final %d; mean level at "
+      "the fold %.2f (%d triangles), on the top %.2f (%d); lowest vertex x %.4f y %.4f; wall "
+      "%.2f s\n",
+      s.steps, s.at_rest, s.sim_time, run.report.vertices_min, run.report.vertices_max,
+      cloth.mesh().vertex_count(), run.report.splits, run.report.forced_splits, run.report.merges,
+      run.report.moved_off_body, 1e3 * run.worst, s.contacts_final, fold_level, fold_count,
+      top_level, top_count, hanging_x, hanging_y, s.wall_time_s);
+  print_histogram("box edge", level_histogram(cloth));
+
+  EXPECT_FALSE(s.failed) << s.failure_reason;
+  EXPECT_TRUE(s.at_rest);
+  EXPECT_LE(run.worst, settings.contact.penetration_tolerance);
+  EXPECT_EQ(s.penetrating_vertices_final, 0);
+  EXPECT_LT(run.mass_drift, 1e-13);
+  EXPECT_LT(run.momentum_jump, 1e-13);
+  EXPECT_TRUE(cloth.mesh().validate().empty());
+  // The overhang hangs down the side face, just outside it.
+  EXPECT_LT(hanging_y, top_y - 0.08);
+  EXPECT_GT(hanging_x, edge_x - settings.contact.penetration_tolerance);
+  EXPECT_LT(hanging_x, edge_x + 0.03);
+  // Detail at the fold over the edge, the flat cloth on the top merged back to coarse blocks.
+  EXPECT_GE(fold_level, top_level + 2.0);
+  EXPECT_GT(fold_count, 20);
+  EXPECT_GT(top_count, 10);
+
+  // A split on the top carries the contacts' memory of the last step (which pressed, how hard):
+  // every particle keeps its normal force per unit mass, and the new vertex between two pressed
+  // ones gets their mean. (Splits only add vertices: the old ids stay.)
+  const Eigen::VectorXd mass_before = cloth.masses();
+  const std::vector<double> force_before = cloth.simulation().contact()->last_normal_forces();
+  meshing::BlockId block;
+  for (meshing::BlockId k : cloth.mesh().leaf_blocks()) {
+    const auto [b, c] = cloth.mesh().diagonal(k);
+    if (x(b.value(), 0) < edge_x - 0.1 && x(c.value(), 0) < edge_x - 0.1 &&
+        !std::isnan(force_before[static_cast<std::size_t>(b.value())]) &&
+        !std::isnan(force_before[static_cast<std::size_t>(c.value())]))
+      block = k;
+  }
+  ASSERT_TRUE(block.valid());
+  const auto [b, c] = cloth.mesh().diagonal(block);
+  const int n = static_cast<int>(mass_before.size());
+  ASSERT_TRUE(cloth.split_blocks({block}).changed());
+  const std::vector<double> force_after = cloth.simulation().contact()->last_normal_forces();
+  ASSERT_GT(static_cast<int>(force_after.size()), n);
+  const auto specific = [](const std::vector<double>& force, const Eigen::VectorXd& mass, int i) {
+    return force[static_cast<std::size_t>(i)] / mass(i);
+  };
+  for (int i = 0; i < n; ++i) {
+    ASSERT_EQ(cloth.positions().row(i), x.row(i));  // the same particle
+    const double was = specific(force_before, mass_before, i);
+    const double is = specific(force_after, cloth.masses(), i);
+    if (std::isnan(was))
+      EXPECT_TRUE(std::isnan(is)) << "vertex " << i;
+    else
+      EXPECT_NEAR(is, was, 1e-12 * std::abs(was)) << "vertex " << i;
+  }
+  Eigen::Index e = 0;
+  (cloth.rest_positions().rowwise() -
+   0.5 * (cloth.rest_positions().row(b.value()) + cloth.rest_positions().row(c.value())))
+      .rowwise()
+      .squaredNorm()
+      .minCoeff(&e);
+  EXPECT_GE(e, n);
+  EXPECT_NEAR(specific(force_after, cloth.masses(), static_cast<int>(e)),
+              0.5 * (specific(force_before, mass_before, b.value()) +
+                     specific(force_before, mass_before, c.value())),
+              1e-9);
+}
+
+}  // namespace
+}  // namespace sd::sim
