@@ -415,6 +415,46 @@ PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, c
   return panel;
 }
 
+// "adaptive": true | false | {"enabled": ..., "refine_threshold": ..., ...}.
+void parse_adaptive(const Reader& r, const json& a, SimulateSpec& sim) {
+  const std::string path = "/simulate/adaptive";
+  if (a.is_boolean()) {
+    sim.adaptive = a.get<bool>();
+    return;
+  }
+  if (!a.is_object())
+    r.fail(path, "expected true, false or an object of adaptive settings {\"refine_threshold\": "
+                 "0.002, ...}");
+  r.check_keys(a, path, {"enabled", "refine_threshold", "coarsen_threshold", "steady_rate",
+                         "min_lifetime", "min_level", "max_level", "max_vertices"});
+  AdaptiveSpec& s = sim.adaptive_settings;
+  if (a.contains("enabled")) sim.adaptive = r.boolean(a["enabled"], path + "/enabled");
+  if (a.contains("refine_threshold"))
+    s.refine_threshold = r.positive(a["refine_threshold"], path + "/refine_threshold");
+  if (a.contains("coarsen_threshold"))
+    s.coarsen_threshold = r.positive(a["coarsen_threshold"], path + "/coarsen_threshold");
+  if (s.refine_threshold && s.coarsen_threshold && !(*s.coarsen_threshold < *s.refine_threshold))
+    r.fail(path + "/coarsen_threshold",
+           fmt::format("the coarsen threshold ({} m) must be below the refine threshold ({} m): "
+                       "the gap keeps a merged block from being split again at once",
+                       *s.coarsen_threshold, *s.refine_threshold));
+  if (a.contains("steady_rate"))
+    s.steady_rate = r.non_negative(a["steady_rate"], path + "/steady_rate");
+  if (a.contains("min_lifetime"))
+    s.min_lifetime = r.non_negative(a["min_lifetime"], path + "/min_lifetime");
+  for (const auto& [key, level] : {std::pair{"min_level", &s.min_level},
+                                   std::pair{"max_level", &s.max_level}}) {
+    if (!a.contains(key)) continue;
+    *level = r.integer(a[key], path + "/" + key, 0);
+    if (**level > 30) r.fail(path + "/" + key, "levels go from 0 (the input's blocks) to 30");
+  }
+  if (s.min_level && s.max_level && *s.max_level < *s.min_level)
+    r.fail(path + "/max_level", fmt::format("max_level ({}) must not be below min_level ({})",
+                                            *s.max_level, *s.min_level));
+  if (a.contains("max_vertices"))
+    s.max_vertices = r.integer(a["max_vertices"], path + "/max_vertices", 0);
+}
+
 void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
   const std::string path = "/simulate";
   r.require_object(j, path, "simulate");
@@ -422,7 +462,7 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
                          "stop_at_rest", "gravity", "pin_above"});
   if (j.contains("pin_above")) sim.pin_above = r.number(j["pin_above"], path + "/pin_above");
   if (j.contains("duration")) sim.duration = r.positive(j["duration"], path + "/duration");
-  if (j.contains("adaptive")) sim.adaptive = r.boolean(j["adaptive"], path + "/adaptive");
+  if (j.contains("adaptive")) parse_adaptive(r, j["adaptive"], sim);
   if (j.contains("time_step")) sim.time_step = r.positive(j["time_step"], path + "/time_step");
   if (j.contains("integrator")) {
     sim.integrator = r.text(j["integrator"], path + "/integrator");

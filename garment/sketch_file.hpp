@@ -86,10 +86,23 @@ struct BodySpec {
   std::optional<std::string> up;           // "+z", "y", ...
 };
 
+// "simulate": {"adaptive": {...}}: the adaptive 4-8 detail's settings. Unset values take the
+// simulator's defaults (sim::AdaptiveSettings, docs/adaptive.md).
+struct AdaptiveSpec {
+  std::optional<double> refine_threshold;   // m of sag above which an edge is split
+  std::optional<double> coarsen_threshold;  // m of sag below which a block may be merged
+  std::optional<double> steady_rate;        // rad/s: hinges turning faster are not merged
+  std::optional<double> min_lifetime;       // s a triangle lives before it may be merged
+  std::optional<int> min_level;             // coarsest level a merge returns to
+  std::optional<int> max_level;             // finest level a split makes
+  std::optional<int> max_vertices;          // particle budget, 0: none
+};
+
 // How the drape is simulated (`sketchdrape run`): plain values with defaults.
 struct SimulateSpec {
   double duration = 3.0;                   // seconds of simulated time at most
   bool adaptive = true;                    // 4-8 refinement/coarsening
+  AdaptiveSpec adaptive_settings;          // "adaptive": {...} (with "enabled" for the bool)
   double time_step = 1.0 / 60.0;           // seconds, the largest step
   std::string integrator = "implicit-euler";  // "implicit-euler" | "bdf2"
   std::string solver = "cholmod";          // "pcg" | "cholmod"

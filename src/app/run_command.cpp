@@ -113,6 +113,38 @@ nlohmann::json meshing_json(const ClothScene& scene) {
           {"panels", panels}};
 }
 
+// The sketch's "simulate": {"adaptive": {...}} over the simulator's defaults.
+sim::AdaptiveSettings adaptive_settings(const garment::Sketch& sketch) {
+  const garment::AdaptiveSpec& spec = sketch.simulate.adaptive_settings;
+  sim::AdaptiveSettings s;
+  s.refine_threshold = spec.refine_threshold.value_or(s.refine_threshold);
+  s.coarsen_threshold = spec.coarsen_threshold.value_or(s.coarsen_threshold);
+  s.steady_rate = spec.steady_rate.value_or(s.steady_rate);
+  s.min_lifetime = spec.min_lifetime.value_or(s.min_lifetime);
+  s.min_level = spec.min_level.value_or(s.min_level);
+  s.max_level = spec.max_level.value_or(s.max_level);
+  s.max_vertices = spec.max_vertices.value_or(s.max_vertices);
+  try {
+    s.validate();  // e.g. a coarsen threshold set at or above the default refine threshold
+  } catch (const sim::InvalidAdaptiveSettingsError& e) {
+    sketch.fail("/simulate/adaptive", e.what());
+  }
+  return s;
+}
+
+// Per accepted step: time, splits (requested and forced), merges and particles after it.
+nlohmann::json adaptive_steps_json(const std::vector<sim::AdaptiveStepRecord>& steps) {
+  nlohmann::json out = {{"time", nlohmann::json::array()}, {"splits", nlohmann::json::array()},
+                        {"merges", nlohmann::json::array()}, {"vertices", nlohmann::json::array()}};
+  for (const sim::AdaptiveStepRecord& step : steps) {
+    out["time"].push_back(step.time);
+    out["splits"].push_back(step.splits + step.forced_splits);
+    out["merges"].push_back(step.merges);
+    out["vertices"].push_back(step.vertices);
+  }
+  return out;
+}
+
 void run_drape(const RunOptions& options, const GlobalOptions& global) {
   const auto start = Clock::now();
   const garment::Sketch sketch = garment::load_sketch(options.sketch);
@@ -155,7 +187,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
       material.fabric = scene.fabric;
       if (scene.garment) material.source_warp = garment::material_frames(scene.garment->mesh).warp;
       sim::AdaptiveCloth cloth(*scene.mesh48, material, scene.start, pins, settings,
-                               sim::AdaptiveSettings{});
+                               adaptive_settings(sketch));
       if (scene.body) cloth.set_body(scene.body->mesh);  // contacts through every split and merge
       const sim::AdaptiveReport adaptive =
           cloth.run([&](const sim::AdaptiveCloth& c) { on_step(c.simulation()); });
@@ -177,7 +209,8 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
                        {"vertices_min", adaptive.vertices_min},
                        {"vertices_max", adaptive.vertices_max},
                        {"max_level_reached", adaptive.max_level_reached},
-                       {"adaptivity_s", adaptive.adaptivity_s()}};
+                       {"adaptivity_s", adaptive.adaptivity_s()},
+                       {"steps", adaptive_steps_json(adaptive.steps)}};
     } else {
       sim::Simulation simulation(sim::build_cloth_model(scene.input, scene.fabric),
                                  sim::flatten_positions(scene.start), pins, settings);
