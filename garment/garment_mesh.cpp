@@ -16,7 +16,9 @@
 #include "garment/network_faces.hpp"
 #include "garment/panel_loop.hpp"
 #include "garment/stroke_projection.hpp"
+#include "garment/surface_untangle.hpp"
 #include "meshing/patch_fill.hpp"
+#include "meshing/quad_quality.hpp"
 
 namespace sd::garment {
 namespace {
@@ -237,11 +239,26 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
           if (signed_distance < offset + reach) return s.position + offset * s.normal;
           return p;
         };
+      const auto normal = [&body](const Eigen::Vector3d& p) -> Eigen::Vector3d { return body.closest_point(p).normal; };
       meshing::FilledPatch patch;
       try {
         patch = meshing::fill_region(side_points, options);
       } catch (const meshing::FillError& e) {
         sketch.fail(loop.json_path, fmt::format("panel '{}' cannot be filled with quads: {}", loop.id, e.what()));
+      }
+      if (patch.quality.inverted_quads > 0) {
+        // Unfold against the body's normals, then measure again as the filler does; kept only
+        // when it leaves fewer folded quads by that measure.
+        std::vector<char> fixed(static_cast<size_t>(patch.mesh.vertex_count()), 0);
+        for (const auto& side : patch.topology.side_vertices)
+          for (int v : side) fixed[static_cast<size_t>(v)] = 1;
+        meshing::QuadMesh unfolded = patch.mesh;
+        untangle_on_surface(unfolded, fixed, options.project, normal);
+        const meshing::QuadQuality quality = meshing::measure_quality(unfolded, patch.topology.corner_vertices());
+        if (quality.inverted_quads < patch.quality.inverted_quads) {
+          patch.mesh = std::move(unfolded);
+          patch.quality = quality;
+        }
       }
       globals.assign(static_cast<size_t>(patch.mesh.vertex_count()), -1);
       for (size_t s = 0; s < patch.topology.side_vertices.size(); ++s)
@@ -308,7 +325,8 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
     garment.panels.push_back(std::move(panel));
   }
 
-  if (const int doublets = remove_doublets(faces, face_panel, pool.positions.size()); doublets > 0)
+  garment.merged_doublets = remove_doublets(faces, face_panel, pool.positions.size());
+  if (const int doublets = garment.merged_doublets; doublets > 0)
     spdlog::warn("{} seam vertex(es) had only two quads folded onto each other; merged them into "
                  "one quad each (the seam steps one vertex aside there)",
                  doublets);

@@ -49,6 +49,10 @@ struct Garment {
   int seam_edges = 0;               // mesh edges shared by two panels
   int parity_changes = 0;           // curve pieces whose count the parity fix changed
   int curve_pieces = 0;             // network edges used by panels
+  // Seam vertices left inside only two quads folded onto each other, merged away (warned): a
+  // side vertex of one quad on a seam a panel shares with its own mirror copy (the shorts' centre
+  // front has one).
+  int merged_doublets = 0;
 };
 
 // The whole meshing pipeline for a sketch with curves and panels. Throws SketchError for
