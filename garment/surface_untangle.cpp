@@ -49,13 +49,13 @@ UntangleResult untangle_on_surface(meshing::QuadMesh& mesh, std::span<const char
     for (int v : f) c += mesh.vertices.row(v).transpose();
     return Eigen::Vector3d(c / 4);
   };
+  // Surface normals per quad, taken once: the moves are small, and each query costs a closest
+  // point search on the body.
   std::vector<Eigen::Vector3d> normals(faces.size());
+  for (size_t f = 0; f < faces.size(); ++f) normals[f] = normal(centre(faces[f]));
   auto count_folded = [&] {
     int folded = 0;
-    for (size_t f = 0; f < faces.size(); ++f) {
-      normals[f] = normal(centre(faces[f]));
-      folded += worst_corner(mesh, faces[f], normals[f]) < kFolded ? 1 : 0;
-    }
+    for (size_t f = 0; f < faces.size(); ++f) folded += worst_corner(mesh, faces[f], normals[f]) < kFolded ? 1 : 0;
     return folded;
   };
 
