@@ -106,8 +106,24 @@ struct RunningJob {
   bool stopped = false;  // sent SIGTERM because the batch is being stopped
 };
 
+// The environment children run with: this process's, plus OPENBLAS_NUM_THREADS=1 unless the
+// user set it. Each child is one job on one core; OpenBLAS (under CHOLMOD) otherwise starts a
+// thread per core in every child, and -j N children then oversubscribe the machine N-fold
+// (docs/batch.md, "Performance").
+std::vector<std::string> child_environment() {
+  std::vector<std::string> env;
+  bool openblas_set = false;
+  for (char** e = environ; *e != nullptr; ++e) {
+    env.emplace_back(*e);
+    if (env.back().rfind("OPENBLAS_NUM_THREADS=", 0) == 0) openblas_set = true;
+  }
+  if (!openblas_set) env.emplace_back("OPENBLAS_NUM_THREADS=1");
+  return env;
+}
+
 // Starts `exe <args>` with stdout and stderr going to `log` (truncated) and stdin from /dev/null,
-// with default signal mask and dispositions. Throws std::runtime_error.
+// with default signal mask and dispositions and the child_environment(). Throws
+// std::runtime_error.
 pid_t spawn_child(const std::filesystem::path& exe, const std::vector<std::string>& args,
                   const std::filesystem::path& log) {
   posix_spawn_file_actions_t actions;
@@ -134,8 +150,12 @@ pid_t spawn_child(const std::filesystem::path& exe, const std::vector<std::strin
   std::vector<char*> argv;
   for (std::string& s : argv_strings) argv.push_back(s.data());
   argv.push_back(nullptr);
+  std::vector<std::string> env_strings = child_environment();
+  std::vector<char*> envp;
+  for (std::string& s : env_strings) envp.push_back(s.data());
+  envp.push_back(nullptr);
   pid_t pid = 0;
-  const int error = posix_spawn(&pid, exe.c_str(), &actions, &attr, argv.data(), environ);
+  const int error = posix_spawn(&pid, exe.c_str(), &actions, &attr, argv.data(), envp.data());
   posix_spawn_file_actions_destroy(&actions);
   posix_spawnattr_destroy(&attr);
   if (error != 0)

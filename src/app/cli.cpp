@@ -39,6 +39,7 @@ int run_cli(int argc, char** argv) {
   add_mesh_command(app, global);
   add_run_command(app, global);
   add_batch_command(app, global);
+  add_stress_command(app, global);
   add_bench_command(app, global);
 
   try {

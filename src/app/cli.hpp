@@ -29,6 +29,7 @@ void add_validate_command(CLI::App& app, const GlobalOptions& global);
 void add_mesh_command(CLI::App& app, const GlobalOptions& global);
 void add_run_command(CLI::App& app, const GlobalOptions& global);
 void add_batch_command(CLI::App& app, const GlobalOptions& global);
+void add_stress_command(CLI::App& app, const GlobalOptions& global);
 void add_bench_command(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace sd::app
