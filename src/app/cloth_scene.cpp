@@ -97,11 +97,14 @@ void build_garment_scene(const garment::Sketch& sketch, ClothScene& scene) {
   scene.input.triangles = arrays.faces;
   scene.input.warp.resize(triangles, 3);
   scene.triangle_group.resize(triangles);
+  scene.triangle_ease.resize(triangles);
   for (Eigen::Index t = 0; t < triangles; ++t) {
     const int quad = m48.source_face(arrays.triangle_ids[static_cast<size_t>(t)]);
     scene.input.warp.row(t) = frames.warp.row(quad);
     scene.triangle_group(t) = panel_group[static_cast<size_t>(g.face_panel(quad))];
+    scene.triangle_ease(t) = g.panels[static_cast<size_t>(g.face_panel(quad))].ease;
   }
+  if ((scene.triangle_ease.array() == 1.0).all()) scene.triangle_ease.resize(0);
   scene.start = arrays.rest_positions;
   pin_above(sketch, scene);
   scene.mesh48_face_group.resize(g.mesh.face_count());
@@ -156,6 +159,27 @@ sim::SimulationSettings simulation_settings(const garment::Sketch& sketch) {
     sketch.fail("/simulate", e.what());
   }
   return settings;
+}
+
+sim::ClothModel build_scene_model(const ClothScene& scene) {
+  sim::ClothModel model = sim::build_cloth_model(scene.input, scene.fabric);
+  if (scene.triangle_ease.size() == 0) return model;
+  // Rest coordinates scale by e: the gradient operators du, dv (inverse rest coordinates) by
+  // 1/e, the rest area by e². Masses and vertex areas follow the rest areas.
+  model.mass.setZero();
+  model.vertex_area.setZero();
+  for (size_t t = 0; t < model.triangles.size(); ++t) {
+    sim::TriangleElement& element = model.triangles[t];
+    const double e = scene.triangle_ease(static_cast<Eigen::Index>(t));
+    element.du /= e;
+    element.dv /= e;
+    element.rest_area *= e * e;
+    for (int v : element.vertices) {
+      model.vertex_area[v] += element.rest_area / 3.0;
+      model.mass[v] += model.fabric.area_density * element.rest_area / 3.0;
+    }
+  }
+  return model;
 }
 
 ClothScene build_cloth_scene(const garment::Sketch& sketch) {

@@ -27,6 +27,9 @@ struct ClothScene {
   std::optional<meshing::Mesh48> mesh48;  // the garment's 4-8 hierarchy (absent for sheets)
   std::optional<garment::Garment> garment;
   Eigen::VectorXi triangle_group;      // #F: group (panel or join) of each triangle
+  // #F: the `ease` of each triangle's panel (rest shape scale, 1 = as designed); empty when
+  // every triangle is as designed (sheets, imported garments).
+  Eigen::VectorXd triangle_ease;
   Eigen::VectorXi mesh48_face_group;   // group of each input face of mesh48 (quad or triangle)
   std::vector<std::string> group_names;
   double meshing_ms = 0;               // time spent building the garment
@@ -35,6 +38,12 @@ struct ClothScene {
 // Builds the scene. Throws garment::SketchError (with the JSON path) for anything the designer
 // can fix: an unknown fabric, a body that will not load, panels that do not close, ...
 ClothScene build_cloth_scene(const garment::Sketch& sketch);
+
+// The simulator's model of the scene's cloth on its fixed mesh: build_cloth_model on the input,
+// then each triangle's rest shape scaled by its panel's ease (lengths by e, so rest area and
+// mass by e²; rest angles do not change under a uniform scale). A waistband with ease below 1
+// is cut smaller than the body it was drawn on and holds the garment up.
+sim::ClothModel build_scene_model(const ClothScene& scene);
 
 // The simulator settings of the file's "simulate" section (integrator, solver, step, duration,
 // gravity). Throws garment::SketchError at /simulate when they cannot work together.
