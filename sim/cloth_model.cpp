@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
+#include <tuple>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -113,29 +113,45 @@ ClothModel build_cloth_model(const ClothInput& input, const FabricParameters& fa
     }
   }
 
-  // Hinges: each edge with exactly two triangles. Key: (min, max) vertex; value: (face, corner
-  // of the edge's first vertex in traversal order).
-  std::map<std::pair<int, int>, std::vector<std::pair<int, int>>> edge_faces;
+  // Hinges: each edge with exactly two triangles. The face edges sorted by (min, max) vertex,
+  // then face and corner: runs of equal edges are the faces around an edge, in the order the
+  // faces come (a flat sort instead of a map: this runs after every adaptive topology change).
+  struct FaceEdge {
+    int low, high, face, corner;  // corner: of the edge's first vertex in traversal order
+  };
+  std::vector<FaceEdge> face_edges;
+  face_edges.reserve(3 * model.triangles.size());
   for (int f = 0; f < static_cast<int>(model.triangles.size()); ++f)
     for (int k = 0; k < 3; ++k) {
       const int a = model.triangles[f].vertices[k];
       const int b = model.triangles[f].vertices[(k + 1) % 3];
-      edge_faces[{std::min(a, b), std::max(a, b)}].emplace_back(f, k);
+      face_edges.push_back({std::min(a, b), std::max(a, b), f, k});
     }
+  std::sort(face_edges.begin(), face_edges.end(), [](const FaceEdge& p, const FaceEdge& q) {
+    return std::tie(p.low, p.high, p.face, p.corner) < std::tie(q.low, q.high, q.face, q.corner);
+  });
   int non_manifold = 0;
-  for (const auto& [edge, faces] : edge_faces) {
-    if (faces.size() == 1) continue;
-    if (faces.size() > 2) {
+  for (std::size_t begin = 0; begin < face_edges.size();) {
+    std::size_t end = begin + 1;
+    while (end < face_edges.size() && face_edges[end].low == face_edges[begin].low &&
+           face_edges[end].high == face_edges[begin].high)
+      ++end;
+    const std::size_t count = end - begin;
+    const FaceEdge& e0 = face_edges[begin];
+    const FaceEdge& e1 = face_edges[begin + (count > 1 ? 1 : 0)];
+    begin = end;
+    if (count == 1) continue;
+    if (count > 2) {
       ++non_manifold;
       continue;
     }
-    const auto& first = model.triangles[faces[0].first];
-    const auto& second = model.triangles[faces[1].first];
+    const auto& first = model.triangles[e0.face];
+    const auto& second = model.triangles[e1.face];
     HingeElement h;
-    h.vertices[0] = first.vertices[faces[0].second];
-    h.vertices[1] = first.vertices[(faces[0].second + 1) % 3];
-    h.vertices[2] = first.vertices[(faces[0].second + 2) % 3];
-    h.vertices[3] = second.vertices[(faces[1].second + 2) % 3];
+    h.vertices[0] = first.vertices[e0.corner];
+    h.vertices[1] = first.vertices[(e0.corner + 1) % 3];
+    h.vertices[2] = first.vertices[(e0.corner + 2) % 3];
+    h.vertices[3] = second.vertices[(e1.corner + 2) % 3];
     const Vector3d p0 = rest.row(h.vertices[0]);
     const Vector3d p1 = rest.row(h.vertices[1]);
     h.weight = (p1 - p0).squaredNorm() / (first.rest_area + second.rest_area);
@@ -147,25 +163,39 @@ ClothModel build_cloth_model(const ClothInput& input, const FabricParameters& fa
   if (non_manifold > 0)
     spdlog::warn("cloth mesh: {} non-manifold edges get no bending stiffness", non_manifold);
 
-  // Block sparsity pattern: vertex adjacency through triangles and hinges.
-  std::vector<std::vector<int>> adjacent(n);
-  for (int i = 0; i < n; ++i) adjacent[i].push_back(i);
+  // Block sparsity pattern: vertex adjacency through triangles and hinges, as one flat array
+  // (CSR by vertex: room for every element's entries, then each vertex's run sorted and
+  // deduplicated in place).
+  std::vector<int> start(n + 1, 0);
+  for (int i = 0; i < n; ++i) start[i + 1] = 1;  // itself
+  for (const TriangleElement& t : model.triangles)
+    for (int v : t.vertices) start[v + 1] += 2;
+  for (const HingeElement& h : model.hinges)
+    for (int v : h.vertices) start[v + 1] += 3;
+  for (int i = 0; i < n; ++i) start[i + 1] += start[i];
+  std::vector<int> fill(start.begin(), start.end() - 1);
+  std::vector<int> neighbours(static_cast<std::size_t>(start[n]));
+  for (int i = 0; i < n; ++i) neighbours[fill[i]++] = i;
   const auto connect = [&](const int* vertices, int count) {
     for (int k = 0; k < count; ++k)
       for (int l = 0; l < count; ++l)
-        if (k != l) adjacent[vertices[k]].push_back(vertices[l]);
+        if (k != l) neighbours[fill[vertices[k]]++] = vertices[l];
   };
   for (const TriangleElement& t : model.triangles) connect(t.vertices.data(), 3);
   for (const HingeElement& h : model.hinges) connect(h.vertices.data(), 4);
+  std::vector<int> size(n);  // distinct neighbours of each vertex, at the start of its run
+  for (int i = 0; i < n; ++i) {
+    const auto first = neighbours.begin() + start[i];
+    std::sort(first, neighbours.begin() + start[i + 1]);
+    size[i] = static_cast<int>(std::unique(first, neighbours.begin() + start[i + 1]) - first);
+  }
   std::vector<int> outer(3 * n + 1, 0);
   std::vector<int> inner;
+  inner.reserve(static_cast<std::size_t>(9 * start[n]));
   for (int i = 0; i < n; ++i) {
-    auto& list = adjacent[i];
-    std::sort(list.begin(), list.end());
-    list.erase(std::unique(list.begin(), list.end()), list.end());
     for (int a = 0; a < 3; ++a) {
-      for (int j : list)
-        for (int b = 0; b < 3; ++b) inner.push_back(3 * j + b);
+      for (int m = 0; m < size[i]; ++m)
+        for (int b = 0; b < 3; ++b) inner.push_back(3 * neighbours[start[i] + m] + b);
       outer[3 * i + a + 1] = static_cast<int>(inner.size());
     }
   }
@@ -173,8 +203,8 @@ ClothModel build_cloth_model(const ClothInput& input, const FabricParameters& fa
   model.pattern.zero_matrix = Eigen::Map<const SparseMatrixR>(
       3 * n, 3 * n, static_cast<int>(inner.size()), outer.data(), inner.data(), zeros.data());
   const auto offset = [&](int i, int j) {
-    const auto& list = adjacent[i];
-    return 3 * static_cast<int>(std::lower_bound(list.begin(), list.end(), j) - list.begin());
+    const auto first = neighbours.begin() + start[i];
+    return 3 * static_cast<int>(std::lower_bound(first, first + size[i], j) - first);
   };
   model.pattern.diagonal_offsets.resize(n);
   for (int i = 0; i < n; ++i) model.pattern.diagonal_offsets[i] = offset(i, i);
