@@ -320,7 +320,7 @@ std::vector<StressCase> stress_matrix(bool quick) {
       c.condition = fmt::format("a column of triangles with area ratio 1e-6, step {} s", step_label(dt));
       c.parameters["area_ratio"] = kRatio;
       c.settings = base_settings(dt, combo);
-      c.quick = combo_label(combo) == "ie-pcg";
+      c.quick = false;  // every combination diverges today (docs/stress.md)
       c.build = [] { return sliver_sheet(kRatio); };
       add(std::move(c));
     }

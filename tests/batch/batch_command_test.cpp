@@ -290,6 +290,52 @@ TEST(BatchCommand, RunStageWhenTheBuildHasIt) {
   EXPECT_EQ(read_json(out / "batch.json")["counts"]["reused"], 2);
 }
 
+// A job whose simulation diverges: gravity of 1e9 m/s² makes a vertex exceed the simulator's
+// speed limit even at the minimum step, so step control gives up and `run` exits 1. The job is
+// recorded as failed with the simulator's reason; the other job of the batch finishes.
+TEST(BatchFaults, DivergingSimulationFailsItsJobOnly) {
+  if (run_sketchdrape("run --help").exit_code != 0)
+    GTEST_SKIP() << "SKIPPED: this build has no `run` command";
+  const fs::path dir = fresh_batch_dir("diverging");
+  const json sheet = {
+      {"format", "sketchdrape/1"},
+      {"sheet",
+       {{"size", {0.3, 0.3}}, {"resolution", {4, 4}}, {"orientation", "horizontal"},
+        {"pins", {"top-left", "top-right"}}}},
+      {"fabric", "cotton"},
+      {"simulate", {{"duration", 0.2}, {"solver", "cholmod"}}},
+      {"output", {{"images", json::array()}}}};
+  write_text(dir / "sheet.json", sheet.dump(2));
+  write_text(dir / "m.json",
+             json{{"format", "sketchdrape-batch/1"},
+                  {"jobs", json::array({{{"sketch", "sheet.json"}, {"id", "calm"}},
+                                        {{"sketch", "sheet.json"},
+                                         {"id", "diverging"},
+                                         {"set", {{"/simulate/gravity", {0, -1e9, 0}}}}}})}}
+                 .dump(2));
+  const fs::path out = dir / "out";
+  const CommandResult r = run_sketchdrape("batch " + shell_quoted(dir / "m.json") + " -o " +
+                                          shell_quoted(out) + " -j 2");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("1 of 2 jobs did not finish"), std::string::npos) << r.output;
+  const auto jobs = jobs_by_id(read_json(out / "batch.json"));
+  ASSERT_EQ(jobs.size(), 2u);
+  EXPECT_EQ(jobs.at("calm")["status"], "done") << jobs.at("calm").dump();
+  EXPECT_GT(jobs.at("calm")["figures"]["steps"].get<int>(), 0);
+  const json& bad = jobs.at("diverging");
+  EXPECT_EQ(bad["status"], "failed") << bad.dump();
+  EXPECT_EQ(bad["exit_code"], 1);
+  const std::string reason = bad["reason"];
+  EXPECT_NE(reason.find("the simulation failed"), std::string::npos) << reason;
+  EXPECT_NE(reason.find("m/s (limit 50)"), std::string::npos) << reason;
+  EXPECT_TRUE(fs::exists(out / "jobs" / "diverging" / "failed"));
+  EXPECT_FALSE(fs::exists(out / "jobs" / "diverging" / "done"));
+  EXPECT_FALSE(fs::exists(out / "jobs" / "diverging" / "report.json"))
+      << "a failed run writes no outputs";
+  EXPECT_NE(read_text(out / "index.html").find("<tr class=\"job failed\" data-id=\"diverging\""),
+            std::string::npos);
+}
+
 // Starts the binary in its own process group (so the whole group can be killed).
 pid_t start_in_new_group(const std::vector<std::string>& args, const fs::path& log) {
   const pid_t pid = fork();
