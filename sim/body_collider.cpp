@@ -389,6 +389,120 @@ std::optional<BodyProximity> BodyCollider::nearest(const Eigen::Vector3d& p, dou
   return result;
 }
 
+std::vector<BodyPiercing> BodyCollider::find_piercings(
+    const Eigen::VectorXd& x, const std::vector<std::array<int, 3>>& triangles, double min_height,
+    double max_height, double unchecked_height, PiercingQueryStats* stats_out) const {
+  PiercingQueryStats stats;
+  std::vector<BodyPiercing> result;
+  if (x.size() % 3 != 0)
+    throw std::invalid_argument("cloth positions must hold 3 coordinates per vertex");
+  if (!x.allFinite()) throw std::invalid_argument("cloth positions must be finite");
+  for (const auto& t : triangles)
+    for (int k = 0; k < 3; ++k)
+      if (t[k] < 0 || 3 * static_cast<Eigen::Index>(t[k]) >= x.size())
+        throw std::invalid_argument("a cloth triangle's vertex index is out of range");
+  if (triangles.empty() || !(max_height > min_height)) return result;
+  // Cells as large as the longest cloth edge: a triangle's box spans at most two cells per axis.
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d high = -low;
+  double longest = 0.0;
+  for (const auto& t : triangles)
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d a = row(x, t[k]);
+      low = low.cwiseMin(a);
+      high = high.cwiseMax(a);
+      longest = std::max(longest, (row(x, t[(k + 1) % 3]) - a).norm());
+    }
+  if (!(longest > 0.0)) return result;
+  // The grid covers the cloth's box, expanded by the largest height reported.
+  const double reach = std::max({std::abs(min_height), std::abs(max_height), 1e-9});
+  low.array() -= reach;
+  high.array() += reach;
+  const double cell = longest;
+  const Eigen::Vector3d extent = high - low;
+  constexpr std::int64_t kMaxCells = 1 << 20;  // per axis, so that a key packs in 63 bits
+  if ((extent / cell).maxCoeff() >= static_cast<double>(kMaxCells)) return result;
+  const auto cell_of = [&](const Eigen::Vector3d& p) {
+    return Eigen::Vector3i(static_cast<int>((p.x() - low.x()) / cell),
+                           static_cast<int>((p.y() - low.y()) / cell),
+                           static_cast<int>((p.z() - low.z()) / cell));
+  };
+  const auto key_of = [&](const Eigen::Vector3i& c) {
+    return (static_cast<std::int64_t>(c.x()) * kMaxCells + c.y()) * kMaxCells + c.z();
+  };
+  // (cell key, triangle) for every cell a triangle's box, grown by the reach (where the body
+  // vertices it can cover lie), overlaps; sorted by key.
+  std::vector<std::pair<std::int64_t, int>> cells;
+  cells.reserve(8 * triangles.size());
+  for (int t = 0; t < static_cast<int>(triangles.size()); ++t) {
+    Eigen::Vector3d a = row(x, triangles[t][0]), b = a;
+    for (int k = 1; k < 3; ++k) {
+      a = a.cwiseMin(row(x, triangles[t][k]));
+      b = b.cwiseMax(row(x, triangles[t][k]));
+    }
+    const Eigen::Vector3i c0 = cell_of(a.array() - reach), c1 = cell_of(b.array() + reach);
+    for (int i = c0.x(); i <= c1.x(); ++i)
+      for (int j = c0.y(); j <= c1.y(); ++j)
+        for (int k = c0.z(); k <= c1.z(); ++k) cells.emplace_back(key_of({i, j, k}), t);
+  }
+  std::sort(cells.begin(), cells.end());
+
+  for (int v = 0; v < vertex_count(); ++v) {
+    const Eigen::Vector3d b = corner(v, 1.0);
+    if ((b - low).minCoeff() < 0.0 || (high - b).minCoeff() < 0.0) continue;
+    ++stats.body_vertices;
+    const std::int64_t key = key_of(cell_of(b));
+    auto it = std::lower_bound(cells.begin(), cells.end(), std::make_pair(key, -1));
+    const Eigen::Vector3d body_normal = vertex_normals_[v].normalized();
+    std::optional<BodyPiercing> best;
+    for (; it != cells.end() && it->first == key; ++it) {
+      const int t = it->second;
+      ++stats.pairs;
+      const Eigen::Vector3d p0 = row(x, triangles[t][0]), p1 = row(x, triangles[t][1]),
+                            p2 = row(x, triangles[t][2]);
+      Eigen::Vector3d normal = triangle_normal(p0, p1, p2);
+      const double facing = normal.dot(body_normal);
+      // Cloth edge-on to the body surface there (or degenerate): not covering the vertex.
+      if (std::abs(facing) < 0.2) continue;
+      if (facing < 0.0) normal = -normal;
+      // The closest point of the triangle, not only the projection: a body vertex pushed
+      // through a ridge of the cloth (the shared edge of two triangles folded over it) projects
+      // outside both triangles, but it is above both planes and its closest points lie on
+      // the edge.
+      const TriangleClosestPoint closest = closest_point_on_triangle(b, p0, p1, p2);
+      const double height = (b - closest.point).dot(normal);
+      if (height <= min_height || height >= max_height ||
+          closest.squared_distance >= max_height * max_height)
+        continue;
+      if (best && height <= best->height) continue;
+      // Not through (within the asked band below the cloth): only where the cloth covers the
+      // vertex, its projection inside the triangle.
+      if (height <= 0.0 && closest.feature != TriangleFeature::face) continue;
+      // The triangle must dip into the body under the vertex (for a height above zero): a
+      // cloth triangle lying beyond a body part, or beside it, is not pierced by it.
+      if (height > unchecked_height) {
+        ++stats.inside_checks;
+        const std::optional<BodyProximity> under =
+            nearest(closest.point, 1.0, std::sqrt(closest.squared_distance) + 1e-9);
+        if (!under || under->distance > 0.0) continue;
+      }
+      const Eigen::Vector3d w = closest.barycentric;
+      BodyPiercing piercing;
+      piercing.body_vertex = v;
+      piercing.cloth_triangle = t;
+      piercing.barycentric = w;
+      piercing.normal = normal;
+      piercing.height = height;
+      piercing.body_velocity = velocities_[v];
+      best = piercing;
+    }
+    if (best) result.push_back(*best);
+  }
+  stats.piercings = static_cast<int>(result.size());
+  if (stats_out != nullptr) *stats_out = stats;
+  return result;
+}
+
 std::optional<BodyProximity> BodyCollider::closest_point(const Eigen::Vector3d& p,
                                                          double max_distance) const {
   return nearest(p, 1.0, max_distance);

@@ -9,6 +9,7 @@
 // See docs/collision.md.
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -57,6 +58,29 @@ struct BodyContact {
   double distance = 0.0;                                    // (x − point)·normal; < 0 inside
   Eigen::Vector3d body_velocity = Eigen::Vector3d::Zero();  // body surface at `point`, m/s
   bool crossed = false;  // found by the continuous check: pushed back to the side it came from
+};
+
+// A body vertex poking through a cloth triangle: it lies in front of the triangle (along the
+// body's outward normal) while the triangle dips into the body beneath it. Happens at sharp
+// body features (box corners, shoulder tips, elbows) where every cloth vertex is outside the
+// body but a triangle spans the feature; the vertex test alone cannot see it.
+struct BodyPiercing {
+  int body_vertex = -1;
+  int cloth_triangle = -1;  // index into the triangle list given to find_piercings
+  // Of the triangle's closest point to the body vertex (all ≥ 0, sum 1).
+  Eigen::Vector3d barycentric = Eigen::Vector3d::Zero();
+  // Unit normal of the cloth triangle, oriented to the body's outward side at the vertex: the
+  // direction the triangle must move to uncover the vertex.
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitY();
+  double height = 0.0;  // m, (body vertex − closest point)·normal; > 0: through the cloth
+  Eigen::Vector3d body_velocity = Eigen::Vector3d::Zero();  // of the body vertex, m/s
+};
+
+struct PiercingQueryStats {
+  int body_vertices = 0;  // body vertices inside the cloth's bounding box (looked up)
+  int pairs = 0;          // vertex-triangle pairs tested
+  int inside_checks = 0;  // signed-distance searches to confirm the triangle dips into the body
+  int piercings = 0;
 };
 
 struct ContactQuery {
@@ -143,6 +167,25 @@ class BodyCollider {
   double last_motion() const { return last_motion_; }
   // FCL refits so far (diagnostics).
   int refit_count() const { return refit_count_; }
+
+  // Body vertices of the current pose that poke through the cloth: x is 3n cloth positions,
+  // `triangles` the cloth's triangles. The height of a body vertex over a triangle is measured
+  // from the triangle's closest point (the projection when it falls inside the triangle; on an
+  // edge for a vertex pushed through a ridge where two triangles fold over it) along the
+  // triangle's normal oriented to the body's outside. Reported: heights in (min_height,
+  // max_height) (m; min_height 0: through the cloth; −thickness: also closer than the
+  // thickness, then only with the projection inside the triangle) within max_height of the
+  // triangle; a height above `unchecked_height` only when that closest point lies inside the
+  // body (a cloth triangle beyond a body part, such as the far side of a sleeve, or beside it
+  // is not pierced). Smaller heights are taken as they are: no body part is that thin, and at a
+  // sharp tip under tilted cloth the closest point can lie just outside the body. Broad phase: a uniform grid over the cloth triangles' boxes grown by max_height,
+  // built per call (the cloth changes every step; cells the size of the longest cloth edge).
+  // Sorted by body vertex; at most one (the highest) per body vertex.
+  std::vector<BodyPiercing> find_piercings(const Eigen::VectorXd& x,
+                                           const std::vector<std::array<int, 3>>& triangles,
+                                           double min_height, double max_height,
+                                           double unchecked_height = 0.0,
+                                           PiercingQueryStats* stats = nullptr) const;
 
   // Closest point of the current pose within `max_distance` of p (unbounded by default), with
   // the signed distance and outward normal; nothing when the surface is farther than that.

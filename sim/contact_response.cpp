@@ -27,6 +27,14 @@ constexpr double kReleaseFraction = 0.1;
 // Rounds of re-projection for a vertex whose projected position is still inside (a concave
 // spot where the pushed point lands inside another part of the body).
 constexpr int kProjectionRounds = 3;
+// A cloth triangle a body vertex pokes through is lifted until the vertex is this fraction of
+// the thickness behind it: clear, but not so far that the triangle's own vertices (held at the
+// thickness by their contacts) are pulled back through the vertex at the next step.
+constexpr double kPiercingClearance = 0.5;
+// Body vertices farther than this many thicknesses (at least kMinPiercingReach) through the
+// cloth are not looked for: the broad phase grows every triangle's box by this reach.
+constexpr double kPiercingReachThicknesses = 4.0;
+constexpr double kMinPiercingReach = 0.01;  // m
 
 class Stopwatch {
  public:
@@ -90,6 +98,45 @@ ContactQuery ContactResponse::query() const {
   q.search_margin = settings_.search_margin;
   q.max_substep_motion = settings_.max_substep_motion;
   return q;
+}
+
+void ContactResponse::set_cloth_triangles(const ClothModel& model) {
+  cloth_triangles_.clear();
+  cloth_triangles_.reserve(model.triangles.size());
+  for (const TriangleElement& t : model.triangles) cloth_triangles_.push_back(t.vertices);
+  piercings_.clear();
+}
+
+std::vector<BodyPiercing> ContactResponse::find_piercings(const Eigen::VectorXd& x1,
+                                                          double min_height) const {
+  if (!settings_.check_body_vertices || cloth_triangles_.empty()) return {};
+  const double reach =
+      std::max(kPiercingReachThicknesses * settings_.thickness, kMinPiercingReach);
+  return collider_.find_piercings(x1, cloth_triangles_, min_height, reach, settings_.thickness);
+}
+
+std::vector<Eigen::Vector3d> ContactResponse::piercing_lifts(
+    const std::vector<BodyPiercing>& piercings, const ConstraintFilter* filter,
+    int vertices) const {
+  std::vector<Eigen::Vector3d> lift(static_cast<std::size_t>(vertices), Eigen::Vector3d::Zero());
+  for (const BodyPiercing& p : piercings) {
+    // Move the triangle's point under the body vertex by δ along the normal: corner k moves
+    // w_k δ / Σ w_j² (Bridson et al. 2002's weighting, the least motion that does it), the
+    // pinned corners not at all.
+    const double delta = p.height + kPiercingClearance * settings_.thickness;
+    const std::array<int, 3>& t = cloth_triangles_[p.cloth_triangle];
+    double weights = 0.0;
+    for (int k = 0; k < 3; ++k)
+      if (filter == nullptr || !filter->is_pinned(t[k])) weights += p.barycentric[k] * p.barycentric[k];
+    if (!(weights > 0.0)) continue;
+    for (int k = 0; k < 3; ++k) {
+      if (filter != nullptr && filter->is_pinned(t[k])) continue;
+      const Eigen::Vector3d move = (p.barycentric[k] * delta / weights) * p.normal;
+      // A vertex under two piercings takes the larger lift.
+      if (move.squaredNorm() > lift[t[k]].squaredNorm()) lift[t[k]] = move;
+    }
+  }
+  return lift;
 }
 
 void ContactResponse::reset_cloth(const Eigen::VectorXd& x, const Eigen::VectorXd& mass,
@@ -293,10 +340,33 @@ int ContactResponse::constrain_deep(const Eigen::VectorXd& x0, const Eigen::Vect
     if (filter.is_pinned(c.vertex) || (repair && in_repair_[c.vertex])) continue;
     if (c.crossed || c.distance < -settings_.penetration_tolerance) too_deep_.push_back(c);
   }
-  if (too_deep_.empty() || stats_.resolves >= settings_.max_resolves) return 0;
+  // Body vertices more than the tolerance through the cloth. Not any height: over a smooth
+  // convex body the cloth's chords pass a fraction of a millimetre under body vertices between
+  // cloth vertices held at the thickness; lifting those made a sheet on a sphere re-solve
+  // every step and never come to rest.
+  piercings_ = repair ? std::vector<BodyPiercing>{}
+                      : find_piercings(x1, settings_.penetration_tolerance);
+  pinned_.assign(x1.size() / 3, 0);
+  for (int i = 0; i < static_cast<int>(pinned_.size()); ++i) pinned_[i] = filter.is_pinned(i);
+  if ((too_deep_.empty() && piercings_.empty()) || stats_.resolves >= settings_.max_resolves)
+    return 0;
   for (const BodyContact& c : too_deep_) add_contact(c, x_hat, beta, filter, y, false);
+  // Lifted triangle corners: their normal velocity lands them at x1 + lift along the lift.
+  int added = static_cast<int>(too_deep_.size());
+  const std::vector<Eigen::Vector3d> lifts =
+      piercing_lifts(piercings_, &filter, static_cast<int>(x1.size() / 3));
+  for (int i = 0; i < static_cast<int>(lifts.size()); ++i) {
+    const double length = lifts[i].norm();
+    if (!(length > 0.0)) continue;
+    const Eigen::Vector3d n = lifts[i] / length;
+    const double target = (x1.segment<3>(3 * i) + lifts[i]).dot(n);
+    const double start = (x_hat.segment<3>(3 * i) + y.segment<3>(3 * i)).dot(n);
+    filter.constrain_direction(i, n, (target - start) / beta);
+    ++added;
+  }
+  stats_.piercings_resolved += static_cast<int>(piercings_.size());
   ++stats_.resolves;
-  return static_cast<int>(too_deep_.size());
+  return added;
 }
 
 void ContactResponse::finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v) {
@@ -324,6 +394,33 @@ void ContactResponse::finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v) {
   if (stats_.projected > 0)
     spdlog::debug("sim: {} cloth vertices projected out of the body after {} re-solves",
                   stats_.projected, stats_.resolves);
+  // Body vertices still through the cloth after the re-solves: lift their triangles (positions,
+  // and the corners' velocity towards the body vertex removed), then measure again.
+  if (!piercings_.empty()) {
+    const int n = static_cast<int>(x.size() / 3);
+    std::vector<Eigen::Vector3d> body_velocity(static_cast<std::size_t>(n), Eigen::Vector3d::Zero());
+    for (const BodyPiercing& p : piercings_)
+      for (int k : cloth_triangles_[p.cloth_triangle]) body_velocity[k] = p.body_velocity;
+    ConstraintFilter pins(n);
+    for (int i = 0; i < n && i < static_cast<int>(pinned_.size()); ++i)
+      if (pinned_[i]) pins.pin(i, Eigen::Vector3d::Zero());
+    const std::vector<Eigen::Vector3d> lifts = piercing_lifts(piercings_, &pins, n);
+    for (int i = 0; i < n; ++i) {
+      const double length = lifts[i].norm();
+      if (!(length > 0.0)) continue;
+      const Eigen::Vector3d normal = lifts[i] / length;
+      x.segment<3>(3 * i) += lifts[i];
+      auto vi = v.segment<3>(3 * i);
+      const double approach = (vi - body_velocity[i]).dot(normal);
+      if (approach < 0.0) vi -= approach * normal;
+    }
+    stats_.piercings_resolved += static_cast<int>(piercings_.size());
+    piercings_ = find_piercings(x, settings_.penetration_tolerance);
+  }
+  for (const BodyPiercing& p : piercings_) {
+    stats_.max_piercing = std::max(stats_.max_piercing, p.height);
+    if (p.height > settings_.penetration_tolerance) ++stats_.piercing;
+  }
   // Penetration at the end of the step, from the last end check (projected vertices measured
   // again, the repair's vertices excluded while it runs).
   const bool repair = repairing();

@@ -27,6 +27,7 @@
 // The simulator (sim/simulation.hpp) drives this; it is separate so that the contact logic
 // reads in one place and can be tested on its own.
 
+#include <array>
 #include <optional>
 #include <stdexcept>
 #include <vector>
@@ -57,6 +58,10 @@ struct ContactSettings {
   double stick_speed = 5.0e-4;
   int max_resolves = 2;   // extra solves per step for vertices that ended too deep
   int repair_steps = 10;  // steps over which a garment starting inside the body is pushed out
+  // Also keep body vertices from poking through cloth triangles (sharp features: shoulder tips,
+  // elbows, corners). Off by default: the response is not finished (see docs/collision.md,
+  // "Body vertices poking through the cloth"); only cloth vertices are kept outside the body.
+  bool check_body_vertices = false;
   // Collider query parameters (see sim/body_collider.hpp, ContactQuery).
   double search_margin = 0.02;
   double max_substep_motion = 0.005;
@@ -90,6 +95,11 @@ struct ContactStepStats {
   int stuck = 0;             // contacts in the stick regime (or stopped by friction)
   int repairing = 0;         // vertices still being pushed out of an intersecting start
   double max_penetration = 0.0;  // m, deepest vertex inside the body at the end (repair excluded)
+  // Body vertices poking through cloth triangles (sharp features): re-solved like deep
+  // vertices, then the triangles lifted. Measured at the end of the step.
+  int piercings_resolved = 0;   // body vertices whose triangles were constrained or lifted
+  int piercing = 0;             // body vertices more than the tolerance through the cloth at the end
+  double max_piercing = 0.0;    // m, highest body vertex above the cloth at the end (0: none)
   int penetrating = 0;       // vertices deeper than the tolerance at the end (repair excluded)
   double collision_seconds = 0.0;  // collider queries and body motion
 };
@@ -116,6 +126,11 @@ class ContactResponse {
   const std::vector<double>& last_normal_forces() const { return last_normal_force_; }
   void restore_normal_forces(std::vector<double> forces);
 
+  // The cloth's triangles, for the check of body vertices poking through them (sharp body
+  // features). Without them (never called, or an empty model) only cloth vertices are checked.
+  // Call with reset_cloth whenever the triangles change.
+  void set_cloth_triangles(const ClothModel& model);
+
   // A new cloth (first call, or vertices renumbered by replace_model): resets the cache and the
   // memory of the last step, and plans the push-out of vertices inside the body. A repair in
   // progress is planned again for its remaining steps.
@@ -141,13 +156,17 @@ class ContactResponse {
 
   // Step 3: swept check of the path x0 (previous pose) → x1 (current pose). Vertices deeper
   // than the tolerance (or that passed through) become constraints in `filter` (and y for the
-  // ones already too close at x̂); returns how many were added, 0 when the step is clean.
+  // ones already too close at x̂); so do the vertices of cloth triangles a body vertex pokes
+  // through (each lifted along the triangle's normal, weighted by its barycentric share, so
+  // the triangle clears the body vertex by half the thickness). Returns how many were added,
+  // 0 when the step is clean.
   int constrain_deep(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1,
                      const Eigen::VectorXd& x_hat, double beta, ConstraintFilter& filter,
                      Eigen::VectorXd& y);
 
   // After the last solve: projects the vertices the last end check found too deep onto
-  // point + thickness·normal with the body's normal velocity, and measures the penetration.
+  // point + thickness·normal with the body's normal velocity, lifts the cloth triangles body
+  // vertices still poke through, and measures the penetration and piercing.
   void finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v);
 
   ContactStepStats& step_stats() { return stats_; }
@@ -174,6 +193,13 @@ class ContactResponse {
   // Returns the index of its ActiveContact.
   int add_contact(const BodyContact& contact, const Eigen::VectorXd& x_hat, double beta,
                   ConstraintFilter& filter, Eigen::VectorXd& y, bool allow_release);
+  // Piercings of x1 whose body vertex is more than `min_height` through the cloth.
+  std::vector<BodyPiercing> find_piercings(const Eigen::VectorXd& x1, double min_height) const;
+  // Per cloth vertex, the normal displacement (direction × metres) that lifts the triangles of
+  // `piercings` clear of their body vertices; vertices not involved get zero. Pinned vertices
+  // (per `filter`, may be null) do not move; the others take their share.
+  std::vector<Eigen::Vector3d> piercing_lifts(const std::vector<BodyPiercing>& piercings,
+                                              const ConstraintFilter* filter, int vertices) const;
 
   ContactSettings settings_;
   BodyCollider collider_;
@@ -195,6 +221,9 @@ class ContactResponse {
   std::vector<int> active_index_;        // per vertex: index into active_, or −1
   std::vector<BodyContact> too_deep_;    // from the last end check, after the last solve
   std::vector<BodyContact> end_contacts_;
+  std::vector<std::array<int, 3>> cloth_triangles_;
+  std::vector<BodyPiercing> piercings_;  // from the last end check, after the last solve
+  std::vector<unsigned char> pinned_;   // per cloth vertex, pinned in the step's filter
   ContactStepStats stats_;
   std::vector<ActiveContact> accepted_contacts_;
 };

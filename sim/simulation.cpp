@@ -88,6 +88,7 @@ void Simulation::replace_model(ClothModel model, Eigen::VectorXd x, Eigen::Vecto
   // New vertex numbering: the contact cache and last step's contacts no longer apply.
   if (contact_) {
     contact_->set_fabric_friction(model_.fabric.friction);
+    contact_->set_cloth_triangles(model_);
     contact_->reset_cloth(x_, model_.mass, settings_.forces.gravity.norm());
     report_.collision_s += contact_->step_stats().collision_seconds;
   }
@@ -135,6 +136,7 @@ void Simulation::clear_body() { contact_.reset(); }
 
 void Simulation::start_body() {
   contact_->set_fabric_friction(model_.fabric.friction);
+  contact_->set_cloth_triangles(model_);
   contact_->reset_cloth(x_, model_.mass, settings_.forces.gravity.norm());
   const StartRepair& repair = contact_->start_repair();
   report_.start_repair_vertices = static_cast<int>(repair.pushed.size());
@@ -294,7 +296,9 @@ void Simulation::accept(Attempt& attempt, double h) {
   const double mass = model_.total_mass();
   const double speed = max_speed(v_);
   const double kinetic = kinetic_energy(model_, v_);
-  if (speed < settings_.rest_speed && kinetic / mass < settings_.rest_kinetic_energy)
+  // A body still moving (a pose sequence not yet over) is not a scene at rest.
+  const bool body_moving = contact_ && contact_->motion() && time_ < contact_->motion()->end_time();
+  if (speed < settings_.rest_speed && kinetic / mass < settings_.rest_kinetic_energy && !body_moving)
     rest_time_ += h;
   else
     rest_time_ = 0.0;

@@ -3,6 +3,7 @@
 #include <fcl/fcl.h>
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -466,6 +467,79 @@ TEST(StartRepair, PushesInsideVerticesOutAlongTheNearestSurface) {
   strict.thickness = 0.0;
   EXPECT_TRUE(collider.find_contacts(repair.positions_after(options.steps), strict).empty());
   EXPECT_EQ(repair.positions_after(0), x);
+}
+
+// One cloth triangle (x, z corners at height y), 3 cloth vertices as 3n positions.
+Eigen::VectorXd flat_triangle(double y) {
+  Eigen::VectorXd x(9);
+  x << -0.3, y, -0.2, 0.0, y, 0.3, 0.3, y, -0.2;  // counter-clockwise seen from below
+  return x;
+}
+
+TEST(BodyCollider, BodyVertexThroughAClothTriangleIsAPiercing) {
+  // A cone apex (a sharp body vertex) 20 cm up, under one large cloth triangle: the cloth's
+  // vertices are all far outside the body, so the vertex test cannot see it.
+  const meshing::TriMesh cone = testing::make_cone(0.1, 0.2, 24);
+  const BodyCollider collider(cone);
+  const std::vector<std::array<int, 3>> triangles = {{0, 1, 2}};
+  const Eigen::VectorXd below = flat_triangle(0.19);  // 1 cm under the apex
+  ContactQuery strict;
+  strict.thickness = 0.0;
+  ASSERT_TRUE(collider.find_contacts(below, strict).empty());  // the premise
+  PiercingQueryStats stats;
+  const std::vector<BodyPiercing> found = collider.find_piercings(below, triangles, 0.0, 0.05, 0.0, &stats);
+  ASSERT_EQ(found.size(), 1u);
+  const BodyPiercing& p = found.front();
+  EXPECT_EQ(p.body_vertex, 0);
+  EXPECT_EQ(p.cloth_triangle, 0);
+  EXPECT_NEAR(p.height, 0.01, 1e-12);
+  EXPECT_NEAR((p.normal - Vector3d::UnitY()).norm(), 0.0, 1e-12);  // oriented outwards
+  // The apex (0, 0.2, 0) projects to (0, 0.19, 0): barycentric coordinates in the triangle.
+  const Vector3d projected = p.barycentric[0] * below.segment<3>(0) +
+                             p.barycentric[1] * below.segment<3>(3) +
+                             p.barycentric[2] * below.segment<3>(6);
+  EXPECT_NEAR((projected - Vector3d(0.0, 0.19, 0.0)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR(p.barycentric.sum(), 1.0, 1e-12);
+  EXPECT_EQ(stats.piercings, 1);
+  // Deeper than the reach asked for: not reported.
+  EXPECT_TRUE(collider.find_piercings(below, triangles, 0.0, 0.005).empty());
+
+  // 2 mm above the apex: not through; within a 3 mm thickness when asked for that.
+  const Eigen::VectorXd above = flat_triangle(0.202);
+  EXPECT_TRUE(collider.find_piercings(above, triangles, 0.0, 0.05).empty());
+  const std::vector<BodyPiercing> close = collider.find_piercings(above, triangles, -0.003, 0.05);
+  ASSERT_EQ(close.size(), 1u);
+  EXPECT_NEAR(close.front().height, -0.002, 1e-12);
+
+  // The same triangle moved sideways so that the apex projects outside it: nothing.
+  Eigen::VectorXd aside = below;
+  for (int k = 0; k < 3; ++k) aside[3 * k] += 0.4;
+  EXPECT_TRUE(collider.find_piercings(aside, triangles, 0.0, 0.05).empty());
+}
+
+TEST(BodyCollider, ClothBeyondAThinBodyPartIsNotAPiercing) {
+  // A 1 cm slab; cloth 3 mm under it (a sleeve under the arm): the slab's top corners are
+  // 13 mm "in front of" the cloth along their normals, but the cloth does not enter the body.
+  const meshing::TriMesh slab = make_box({-0.1, 0.0, -0.1}, {0.1, 0.01, 0.1});
+  const BodyCollider collider(slab);
+  const std::vector<std::array<int, 3>> triangles = {{0, 1, 2}};
+  const Eigen::VectorXd under = flat_triangle(-0.003);
+  PiercingQueryStats stats;
+  EXPECT_TRUE(collider.find_piercings(under, triangles, 0.0, 0.05, 0.003, &stats).empty());
+  EXPECT_GT(stats.pairs, 0);  // candidates were looked at and rejected
+  // The same cloth cutting through the middle of the slab (y = 5 mm): all eight corners are
+  // 5 mm through it on their own side. (Their closest cloth points lie on the slab's vertical
+  // edges, on the surface, so the inside test cannot decide: heights up to 6 mm are taken
+  // unchecked here, as the simulator takes heights up to its thickness.)
+  const std::vector<BodyPiercing> through =
+      collider.find_piercings(flat_triangle(0.005), triangles, 0.0, 0.05, 0.006);
+  EXPECT_EQ(through.size(), 8u);
+  for (const BodyPiercing& p : through) {
+    EXPECT_NEAR(p.height, 0.005, 1e-12);
+    // Normal along the corner's side: +y for the top corners, −y for the bottom ones.
+    EXPECT_NEAR(p.normal.y(), slab.vertices(p.body_vertex, 1) > 0.0 ? 1.0 : -1.0, 1e-12);
+  }
+  EXPECT_THROW(collider.find_piercings(under, {{0, 1, 3}}, 0.0, 0.05), std::invalid_argument);
 }
 
 TEST(BodyCollider, RejectsUnusableInput) {

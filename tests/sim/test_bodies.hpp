@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <utility>
 #include <vector>
 
@@ -84,6 +85,29 @@ inline meshing::TriMesh make_box(const Eigen::Vector3d& lo, const Eigen::Vector3
       2, 6, 7, 2, 7, 3,            // y = hi
       0, 4, 6, 0, 6, 2,            // x = lo
       1, 3, 7, 1, 7, 5;            // x = hi
+  return mesh;
+}
+
+// A cone standing on y = base_y with its apex straight above `centre` (x, z) at base_y + height:
+// `segments` triangles around the side meeting at the sharp apex, a fan closing the base.
+// Outward-facing. Vertex 0 is the apex.
+inline meshing::TriMesh make_cone(double radius, double height, int segments,
+                                  const Eigen::Vector3d& base_centre = Eigen::Vector3d::Zero()) {
+  meshing::TriMesh mesh;
+  mesh.vertices.resize(segments + 2, 3);
+  mesh.vertices.row(0) = (base_centre + Eigen::Vector3d(0.0, height, 0.0)).transpose();
+  mesh.vertices.row(1) = base_centre.transpose();
+  for (int k = 0; k < segments; ++k) {
+    const double a = 2.0 * std::numbers::pi * k / segments;
+    mesh.vertices.row(2 + k) =
+        (base_centre + Eigen::Vector3d(radius * std::cos(a), 0.0, radius * std::sin(a))).transpose();
+  }
+  mesh.faces.resize(2 * segments, 3);
+  for (int k = 0; k < segments; ++k) {
+    const int a = 2 + k, b = 2 + (k + 1) % segments;
+    mesh.faces.row(k) << 0, b, a;                // side, seen from outside counter-clockwise
+    mesh.faces.row(segments + k) << 1, a, b;     // base, facing down
+  }
   return mesh;
 }
 
