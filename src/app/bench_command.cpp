@@ -11,6 +11,7 @@
 #include <signal.h>
 #include <spawn.h>
 #include <spdlog/spdlog.h>
+#include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -199,6 +200,7 @@ struct SceneResult {
   ChildResult reference;  // trace from the cache or this run
   std::vector<RunRow> rows;
   std::string defaults_note;
+  std::string reference_failure;  // why the reference did not finish (the scene's runs are skipped)
 };
 
 bool usable(const RunRow& row) { return row.child.status == "ok" && row.error.samples > 0; }
@@ -390,6 +392,7 @@ bool stage_plots(const std::vector<SceneResult>& scenes, const fs::path& work, c
     return false;
   }
   for (const SceneResult& s : scenes) {
+    if (std::none_of(s.rows.begin(), s.rows.end(), usable)) continue;  // nothing to draw
     const std::string stem = "bench_" + s.scene.name;
     const std::string data = plot_data(s);
     const std::string script = plot_script(s, stem);
@@ -417,6 +420,10 @@ std::string summary_table(const std::vector<SceneResult>& scenes, bool plots, co
     out += fmt::format("\n{} ({:g} s simulated; reference: {}, {}{:.1f} s CPU)\n", s.scene.name,
                        s.scene.duration, s.plan.reference.label(),
                        s.reference_cached ? "cached, " : "", s.reference.trace.cpu_s);
+    if (!s.reference_failure.empty()) {
+      out += fmt::format("  not measured: {}\n", s.reference_failure);
+      continue;
+    }
     out += fmt::format("  {:<44} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9}\n", "configuration",
                        "CPU s", "wall s", "peak MB", "vertices", "RMS mm", "max mm", "energy %");
     std::vector<const RunRow*> order;
@@ -448,6 +455,9 @@ std::string summary_table(const std::vector<SceneResult>& scenes, bool plots, co
 // --- the command ----------------------------------------------------------------------------------
 
 void run_worker_side(const BenchOptions& options) {
+  // A worker must not outlive the study (killed parent, Ctrl-C in another terminal).
+  prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (getppid() == 1) return;  // the parent is already gone
   const BenchGrid grid = parse_grid(options);
   const BenchScene scene = build_bench_scene(options.worker_scene, grid);
   const BenchConfig config = config_from_json(options.worker_config);
@@ -518,9 +528,17 @@ void run_bench(const BenchOptions& options, const GlobalOptions& global) {
       s.reference = run_worker(exe, scene_arg, grid, s.plan.reference, work.path,
                                s.scene.name + "-reference", 4 * timeout, progress, done,
                                s.scene.name + " reference");
-      if (s.reference.status != "ok")
-        throw std::runtime_error(fmt::format("the reference run of {} did not finish ({}): {}",
-                                             s.scene.name, s.reference.status, s.reference.message));
+      if (s.reference.status != "ok") {
+        // Nothing to measure against: the scene's runs are skipped, the other scenes go on.
+        s.reference_failure = fmt::format("the reference run ({}) did not finish ({}): {}",
+                                          s.plan.reference.label(), s.reference.status,
+                                          s.reference.message);
+        spdlog::error("{}: {}", s.scene.name, s.reference_failure);
+        s.defaults_note = "not measured (no reference)";
+        done += static_cast<long>(s.plan.runs.size()) + 1;
+        progress.update(done);
+        continue;
+      }
       write_file_atomically(cached, serialize_trace(s.reference.trace));
     }
     progress.update(++done);
@@ -554,7 +572,9 @@ void run_bench(const BenchOptions& options, const GlobalOptions& global) {
                          {"scenes", nlohmann::json::array()}};
   for (const SceneResult& s : scenes) {
     csv += csv_row(s, s.plan.reference, {"reference"}, s.reference, nullptr, false,
-                   s.reference_cached ? "reference (cached)" : "reference");
+                   !s.reference_failure.empty() ? "reference: " + s.reference_failure
+                   : s.reference_cached         ? "reference (cached)"
+                                                : "reference");
     for (const RunRow& row : s.rows)
       csv += csv_row(s, row.config, row.families, row.child, usable(row) ? &row.error : nullptr,
                      row.pareto, row.child.message);
@@ -570,6 +590,7 @@ void run_bench(const BenchOptions& options, const GlobalOptions& global) {
                                 {"label", s.plan.reference.label()},
                                 {"key", s.key},
                                 {"cached", s.reference_cached},
+                                {"failure", s.reference_failure},
                                 {"cpu_s", s.reference.trace.cpu_s},
                                 {"wall_s", s.reference.trace.wall_s}}},
                               {"runs", runs},
@@ -584,6 +605,10 @@ void run_bench(const BenchOptions& options, const GlobalOptions& global) {
     fmt::print("{}\n", json.dump(2));
   else
     fmt::print("{}", summary_table(scenes, plots, dir));
+  for (const SceneResult& s : scenes)
+    if (!s.reference_failure.empty())
+      throw std::runtime_error(fmt::format("{}: {} (the other scenes were written)", s.scene.name,
+                                           s.reference_failure));
 }
 
 }  // namespace

@@ -24,9 +24,9 @@
 namespace sd::app {
 namespace {
 
-// AdaptiveCloth does not take a body yet (docs/adaptive.md): scenes with a body have no
-// adaptive family until it does.
-constexpr bool kAdaptiveWithBody = false;
+// AdaptiveCloth drapes on a body (AdaptiveCloth::set_body), so scenes with a body have an
+// adaptive family too.
+constexpr bool kAdaptiveWithBody = true;
 
 // --- scenes ------------------------------------------------------------------------------------
 
@@ -543,6 +543,7 @@ BenchTrace run_bench_config(const BenchScene& scene, const BenchConfig& config) 
     adaptive.max_level = config.level;
     sim::AdaptiveCloth cloth(*scene.mesh, scene.material, scene.start, pins, settings, adaptive);
     if (scene.start_level > 0) cloth.refine_uniformly(scene.start_level);
+    if (scene.body) cloth.set_body(*scene.body);
     trace.rss_before_mb = peak_rss_mb();
     drive(
         scene, trace,

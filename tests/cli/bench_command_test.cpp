@@ -167,6 +167,7 @@ TEST(BenchCommand, TinyGridMeasuresErrorsAndReusesTheCachedReference) {
     EXPECT_EQ(runs_again.at("hanging-sheet/" + c.id()).at("rms_error_m"),
               runs.at("hanging-sheet/" + c.id()).at("rms_error_m"))
         << c.id();
+  if (!HasFailure()) fs::remove_all(dir);
 }
 
 nlohmann::json sheet_sketch(const std::string& fabric) {
@@ -202,6 +203,7 @@ TEST(BenchCommand, SketchSceneReferenceIsRecomputedWhenTheSceneChanges) {
   int cached_files = 0;
   for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir / "cache")) ++cached_files;
   EXPECT_EQ(cached_files, 2);
+  if (!HasFailure()) fs::remove_all(dir);
 }
 
 TEST(BenchCommand, BadInputExitsWithTwoAndWritesNothing) {
