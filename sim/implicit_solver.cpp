@@ -69,6 +69,8 @@ bool ImplicitSolver::linear_solve(const ClothModel& model, const ConstraintFilte
   LinearSolveStats stats;
   if (settings.solver == LinearSolverKind::cholmod) {
     if (refactor && !cholmod_.factorize(matrix_, filter)) {
+      // No step: callers still add step_, so it must be a zero of the right size.
+      step_.setZero(3 * model.vertex_count);
       result.solve_seconds += seconds_since(start);
       return false;
     }
