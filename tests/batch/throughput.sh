@@ -20,6 +20,8 @@ trap 'rm -rf "$work"' EXIT
 
 now() { date +%s.%N; }
 calc() { awk "BEGIN {print $*}"; }
+# Sum of the jobs' own wall times (a drape job's figures also hold its report's wall_time_s).
+children_wall() { python3 -c 'import json, sys; print(sum(j.get("wall_time_s", 0) for j in json.load(open(sys.argv[1]))["jobs"]))' "$1"; }
 median() { sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR + 1) / 2] : (a[NR / 2] + a[NR / 2 + 1]) / 2}'; }
 
 manifest="$source_dir/data/batch/wardrobe.json"
@@ -54,7 +56,7 @@ for r in $(seq 1 "$repeats"); do
   "$binary" -q batch "$manifest" -o "$work/wardrobe" --stage "$stage" -j 1 --force
   t1=$(now)
   j1+=("$(calc "$t1 - $t0")")
-  children=$(grep -o '"wall_time_s": [0-9.e+-]*' "$work/wardrobe/batch.json" | awk '{s += $2} END {print s}')
+  children=$(children_wall "$work/wardrobe/batch.json")
   layer+=("$(calc "($t1 - $t0 - $children) * 1000 / 6")")
   t0=$(now)
   # The same OpenBLAS setting the batch gives its children.
@@ -122,7 +124,7 @@ for r in $(seq 1 "$repeats"); do
   t1=$(now)
   batch_times+=("$(calc "$t1 - $t0")")
   # The children's own wall times, as batch.json records them: the rest is the batch layer.
-  children=$(grep -o '"wall_time_s": [0-9.e+-]*' "$work/instant/batch.json" | awk '{s += $2} END {print s}')
+  children=$(children_wall "$work/instant/batch.json")
   layer_times+=("$(calc "($t1 - $t0 - $children) * 1000 / 60")")
   t0=$(now)
   for d in "$work"/instant/jobs/*/; do "$binary" -q "$stage" "$d/sketch.json" -o "$d" 2>/dev/null || true; done
