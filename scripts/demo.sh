@@ -12,8 +12,6 @@ cd "$(dirname "$0")/.."
 out=out/demo
 rm -rf "$out"
 mkdir -p "$out"
-# CHOLMOD's BLAS threads fight over 2 cores; one thread is faster here (docs/simulator.md).
-export OPENBLAS_NUM_THREADS=1
 
 echo "==> the built-in body"
 ./build/sketchdrape info builtin
