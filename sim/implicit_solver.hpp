@@ -35,8 +35,8 @@ struct NewtonSettings {
   LinearSolverKind solver = LinearSolverKind::pcg;
   double pcg_tolerance = 1e-3;  // relative residual reduction (the inexact Newton forcing term)
   int pcg_max_iterations = 1000;
-  // The default of SimulationSettings (see there); block_incomplete_cholesky is 4x faster.
-  PcgPreconditioner pcg_preconditioner = PcgPreconditioner::block_jacobi;
+  // The default of SimulationSettings (see there).
+  PcgPreconditioner pcg_preconditioner = PcgPreconditioner::block_incomplete_cholesky;
 };
 
 // A force on one vertex, affine in its velocity: f = force − C (v − v_ref), C symmetric

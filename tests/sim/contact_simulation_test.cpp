@@ -4,14 +4,13 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <functional>
 #include <numbers>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 #include "sim/body_collider.hpp"
 #include "sim/body_motion.hpp"
@@ -74,8 +73,9 @@ TEST(ContactSimulation, SheetDropsOnASphereAndDrapesOutside) {
   Simulation sim(s.model, flatten_positions(s.scene.input.rest_positions), {}, settings);
   sim.set_body(sphere);
   double worst = 0.0;
-  const SimulationReport report = sim.run(
-      [&](const Simulation& run) { worst = std::max(worst, deepest_inside(check, run.positions())); });
+  const SimulationReport report = sim.run([&](const Simulation& run) {
+    worst = std::max(worst, deepest_inside(check, run.positions()));
+  });
   const Eigen::VectorXd& x = sim.positions();
   const int middle = s.scene.vertex(8, 8);
   const int corner = s.scene.vertex(0, 0);
@@ -110,8 +110,9 @@ TEST(ContactSimulation, SheetDrapesOverABoxEdge) {
   Simulation sim(s.model, flatten_positions(s.scene.input.rest_positions), {}, settings);
   sim.set_body(box);
   double worst = 0.0;
-  const SimulationReport report = sim.run(
-      [&](const Simulation& run) { worst = std::max(worst, deepest_inside(check, run.positions())); });
+  const SimulationReport report = sim.run([&](const Simulation& run) {
+    worst = std::max(worst, deepest_inside(check, run.positions()));
+  });
   const Eigen::VectorXd& x = sim.positions();
   double hanging_y = 0.0, hanging_x = 0.0, top_y = 0.0, top_x = 0.0;
   for (int r = 0; r <= 12; ++r) {
@@ -123,8 +124,8 @@ TEST(ContactSimulation, SheetDrapesOverABoxEdge) {
   std::printf(
       "box edge: %d steps, at rest %d at %.2f s, deepest %.3g mm, contacts %d, free edge at "
       "x %.4f y %.4f, far edge on top at x %.4f y %.4f\n",
-      report.steps, report.at_rest, report.sim_time, 1e3 * worst, report.contacts_final,
-      hanging_x, hanging_y, top_x, top_y);
+      report.steps, report.at_rest, report.sim_time, 1e3 * worst, report.contacts_final, hanging_x,
+      hanging_y, top_x, top_y);
   EXPECT_FALSE(report.failed);
   EXPECT_TRUE(report.at_rest);
   EXPECT_LE(worst, settings.contact.penetration_tolerance);
@@ -316,31 +317,53 @@ TEST(ContactSimulation, IntersectingStartIsPushedOutWithinTheRepairSteps) {
   EXPECT_EQ(report.penetrating_vertices_final, 0);
 }
 
+// The sheet is dropped off the sphere's apex: centred on it, its middle vertex lands exactly on
+// the sphere's top vertex, where which neighbours touch first is decided by rounding (CHOLMOD
+// against CHOLMOD with the start moved by 1e-12 m differed by 0.3 mm there). Off the apex the
+// drape is a smooth function of the start and the solvers must agree to well under the contact
+// tolerance.
 TEST(ContactSimulation, PcgAndCholmodAgreeWithContacts) {
   const meshing::TriMesh sphere = testing::make_sphere(0.2, 3);
-  const SheetSetup s = horizontal_sheet(10, 0.5, {0.0, 0.22, 0.0});
+  const SheetSetup s = horizontal_sheet(10, 0.5, {0.031, 0.22, -0.017});
+  struct Solver {
+    LinearSolverKind kind;
+    PcgPreconditioner preconditioner;
+    double start_shift;  // m along x: shows the scene is not a knife edge
+    const char* name;
+  };
+  const PcgPreconditioner ic0 = PcgPreconditioner::block_incomplete_cholesky;
+  const std::vector<Solver> solvers = {
+      {LinearSolverKind::cholmod, ic0, 0.0, "CHOLMOD"},
+      {LinearSolverKind::pcg, ic0, 0.0, "PCG IC(0)"},
+      {LinearSolverKind::pcg, PcgPreconditioner::block_jacobi, 0.0, "PCG block Jacobi"},
+      {LinearSolverKind::cholmod, ic0, 1e-12, "CHOLMOD, start moved 1e-12 m"}};
   std::vector<Eigen::VectorXd> ends;
   std::vector<int> contacts;
-  for (const LinearSolverKind solver : {LinearSolverKind::cholmod, LinearSolverKind::pcg}) {
+  for (const Solver& solver : solvers) {
     SimulationSettings settings = contact_settings();
-    settings.solver = solver;
+    settings.solver = solver.kind;
+    settings.pcg_preconditioner = solver.preconditioner;
     settings.pcg_tolerance = 1e-10;
     settings.duration = 0.4;
     settings.stop_at_rest = false;
-    Simulation sim(s.model, flatten_positions(s.scene.input.rest_positions), {}, settings);
+    Eigen::VectorXd start = flatten_positions(s.scene.input.rest_positions);
+    for (Eigen::Index i = 0; i < start.size(); i += 3) start(i) += solver.start_shift;
+    Simulation sim(s.model, start, {}, settings);
     sim.set_body(sphere);
     const SimulationReport report = sim.run();
-    EXPECT_FALSE(report.failed);
-    EXPECT_EQ(report.retries, 0);
+    EXPECT_FALSE(report.failed) << solver.name;
+    EXPECT_EQ(report.retries, 0) << solver.name;
     ends.push_back(sim.positions());
     contacts.push_back(report.contacts_final);
   }
-  const double difference = (ends[0] - ends[1]).lpNorm<Eigen::Infinity>();
-  std::printf("PCG vs CHOLMOD with contacts after 0.4 s: %.3g m apart, %d / %d contacts\n",
-              difference, contacts[0], contacts[1]);
   EXPECT_GT(contacts[0], 10);
-  EXPECT_EQ(contacts[0], contacts[1]);
-  EXPECT_LT(difference, 1e-6);
+  for (std::size_t k = 1; k < solvers.size(); ++k) {
+    const double difference = (ends[0] - ends[k]).lpNorm<Eigen::Infinity>();
+    std::printf("%s vs CHOLMOD with contacts after 0.4 s: %.3g m apart, %d / %d contacts\n",
+                solvers[k].name, difference, contacts[k], contacts[0]);
+    EXPECT_EQ(contacts[k], contacts[0]) << solvers[k].name;
+    EXPECT_LT(difference, 1e-6) << solvers[k].name;
+  }
 }
 
 TEST(ContactSimulation, StressStepThicknessAndBodySpeed) {
@@ -391,7 +414,8 @@ TEST(ContactSimulation, ReplaceModelWithRenumberedVerticesKeepsTheClothOutside) 
   // Reverse the vertex order.
   const int n = s.model.vertex_count;
   ClothInput input = s.scene.input;
-  for (int i = 0; i < n; ++i) input.rest_positions.row(i) = s.scene.input.rest_positions.row(n - 1 - i);
+  for (int i = 0; i < n; ++i)
+    input.rest_positions.row(i) = s.scene.input.rest_positions.row(n - 1 - i);
   for (Eigen::Index f = 0; f < input.triangles.rows(); ++f)
     for (int k = 0; k < 3; ++k) input.triangles(f, k) = n - 1 - s.scene.input.triangles(f, k);
   Eigen::VectorXd x(3 * n), v(3 * n);
@@ -402,8 +426,9 @@ TEST(ContactSimulation, ReplaceModelWithRenumberedVerticesKeepsTheClothOutside) 
   sim.replace_model(build_cloth_model(input, fabric_preset("cotton")), x, v, {});
   EXPECT_TRUE(sim.contact()->contacts().empty());
   double worst = 0.0;
-  const SimulationReport report = sim.run(
-      [&](const Simulation& run) { worst = std::max(worst, deepest_inside(check, run.positions())); });
+  const SimulationReport report = sim.run([&](const Simulation& run) {
+    worst = std::max(worst, deepest_inside(check, run.positions()));
+  });
   EXPECT_FALSE(report.failed);
   EXPECT_TRUE(report.at_rest);
   EXPECT_LE(worst, settings.contact.penetration_tolerance);
