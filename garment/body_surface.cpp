@@ -21,16 +21,20 @@ using Iterator = std::vector<Triangle>::const_iterator;
 using Primitive = CGAL::AABB_triangle_primitive<Kernel, Iterator>;
 using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
 
-Point to_cgal(const Eigen::Vector3d& p) { return {p.x(), p.y(), p.z()}; }
-Eigen::Vector3d to_eigen(const Point& p) { return {p.x(), p.y(), p.z()}; }
+Point to_cgal(const Eigen::Vector3d& p) {
+  return {p.x(), p.y(), p.z()};
+}
+Eigen::Vector3d to_eigen(const Point& p) {
+  return {p.x(), p.y(), p.z()};
+}
 
 }  // namespace
 
 struct BodySurface::Impl {
   meshing::TriMesh mesh;
   meshing::BoundingBox box;
-  Eigen::MatrixX3d normals;          // #V by 3, unit
-  std::vector<Triangle> triangles;   // #F, same order as mesh.faces
+  Eigen::MatrixX3d normals;         // #V by 3, unit
+  std::vector<Triangle> triangles;  // #F, same order as mesh.faces
   Tree tree;
 
   // Smooth outward normal at `p` inside face f (barycentric blend of vertex normals).
@@ -52,6 +56,9 @@ struct BodySurface::Impl {
     if (blended.squaredNorm() < 1e-20) blended = n;
     return blended.normalized();
   }
+
+  // The SurfacePoint of a closest-point query's answer for the query point p.
+  SurfacePoint answer(const Eigen::Vector3d& p, const Tree::Point_and_primitive_id& found) const;
 };
 
 BodySurface::BodySurface(const meshing::TriMesh& mesh) : impl_(std::make_unique<Impl>()) {
@@ -74,11 +81,24 @@ BodySurface::BodySurface(BodySurface&&) noexcept = default;
 BodySurface& BodySurface::operator=(BodySurface&&) noexcept = default;
 
 SurfacePoint BodySurface::closest_point(const Eigen::Vector3d& p) const {
-  const auto [point, id] = impl_->tree.closest_point_and_primitive(to_cgal(p));
+  return impl_->answer(p, impl_->tree.closest_point_and_primitive(to_cgal(p)));
+}
+
+SurfacePoint BodySurface::closest_point(const Eigen::Vector3d& p, const SurfacePoint& near) const {
+  if (near.face < 0 || near.face >= static_cast<int>(impl_->triangles.size()))
+    return closest_point(p);
+  const Tree::Point_and_primitive_id hint(to_cgal(near.position),
+                                          impl_->triangles.cbegin() + near.face);
+  return impl_->answer(p, impl_->tree.closest_point_and_primitive(to_cgal(p), hint));
+}
+
+SurfacePoint BodySurface::Impl::answer(const Eigen::Vector3d& p,
+                                       const Tree::Point_and_primitive_id& found) const {
+  const auto& [point, id] = found;
   SurfacePoint s;
   s.position = to_eigen(point);
-  s.face = static_cast<int>(id - impl_->triangles.cbegin());
-  s.normal = impl_->normal_at(s.face, s.position);
+  s.face = static_cast<int>(id - triangles.cbegin());
+  s.normal = normal_at(s.face, s.position);
   s.distance = (s.position - p).norm();
   return s;
 }
@@ -108,7 +128,11 @@ Eigen::Vector3d BodySurface::snap_to_offset(const Eigen::Vector3d& p, double off
   return s.position + offset * s.normal;
 }
 
-const meshing::TriMesh& BodySurface::mesh() const { return impl_->mesh; }
-const meshing::BoundingBox& BodySurface::box() const { return impl_->box; }
+const meshing::TriMesh& BodySurface::mesh() const {
+  return impl_->mesh;
+}
+const meshing::BoundingBox& BodySurface::box() const {
+  return impl_->box;
+}
 
 }  // namespace sd::garment

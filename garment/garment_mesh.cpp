@@ -10,6 +10,7 @@
 #include <numeric>
 #include <set>
 #include <stdexcept>
+#include <unordered_map>
 
 #include "garment/curve_network.hpp"
 #include "garment/edge_counts.hpp"
@@ -232,9 +233,21 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
       const double reach = spec.edge_length.value_or(sketch.edge_length);
       meshing::FillGeometryOptions options;
       options.relax_iterations = sketch.relax_iterations;
+      // Each query starts from the last answer found in the same cell of half an edge length: a
+      // vertex moves less than that per relaxation sweep, so the hint is usually its own last
+      // projection (a hash collision only gives a poorer hint, never another answer).
+      std::unordered_map<std::int64_t, SurfacePoint> hints;
+      const double cell = 0.5 * reach;
       if (on_body > 0)
-        options.project = [&body, offset, reach](const Eigen::Vector3d& p) -> Eigen::Vector3d {
-          const SurfacePoint s = body.closest_point(p);
+        options.project = [&body, &hints, cell, offset,
+                           reach](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+          const Eigen::Vector3d q = (p / cell).array().floor();
+          const std::int64_t key = (static_cast<std::int64_t>(q.x()) * 73856093) ^
+                                   (static_cast<std::int64_t>(q.y()) * 19349663) ^
+                                   (static_cast<std::int64_t>(q.z()) * 83492791);
+          SurfacePoint& hint = hints[key];
+          const SurfacePoint s = body.closest_point(p, hint);
+          hint = s;
           const double signed_distance = (p - s.position).dot(s.normal);
           if (signed_distance < offset + reach) return s.position + offset * s.normal;
           return p;

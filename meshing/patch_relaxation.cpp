@@ -137,6 +137,9 @@ using Projection = std::function<Eigen::Vector3d(const Eigen::Vector3d&)>;
 // below the target or after kUntanglePasses passes.
 constexpr double kUntangleTarget = 0.02;
 constexpr int kUntanglePasses = 100;
+// A pass that raises no vertex's minimum by more than this is the last one (the search creeps by
+// ever smaller steps when a fold cannot be undone).
+constexpr double kUntangleProgress = 1e-4;
 
 void untangle(std::vector<Eigen::Vector3d>& x, const std::vector<Quad>& quads,
               const std::vector<Eigen::Vector3d>& normals, const Adjacency& adj,
@@ -184,25 +187,34 @@ void untangle(std::vector<Eigen::Vector3d>& x, const std::vector<Quad>& quads,
       const Eigen::Vector3d t1 = normal.unitOrthogonal(), t2 = normal.cross(t1);
       double step = 0.5 * edge_sum / (end - begin);
       double current = around(v);
+      // Pattern search in the tangent plane. The candidates are judged where they are, off the
+      // projection surface by O(step² · curvature), and only the winner is projected and judged
+      // again: one projection per halving instead of eight (projection onto a body is a BVH
+      // query, ~90 % of a garment fill's time when every candidate was projected).
       for (int halving = 0; halving < 12; ++halving) {
         const Eigen::Vector3d start = x[v];
         Eigen::Vector3d best_position = start;
         double best = current;
         for (int k = 0; k < 8; ++k) {
           const double angle = k * std::numbers::pi / 4;
-          const Eigen::Vector3d candidate = start + step * (std::cos(angle) * t1 + std::sin(angle) * t2);
-          x[v] = project ? project(candidate) : candidate;
+          x[v] = start + step * (std::cos(angle) * t1 + std::sin(angle) * t2);
           const double value = around(v);
           if (value > best + 1e-12) {
             best = value;
             best_position = x[v];
           }
         }
-        x[v] = best_position;
+        if (project && best > current) {
+          best_position = project(best_position);
+          x[v] = best_position;
+          best = around(v);
+        }
         if (best > current) {
+          x[v] = best_position;
+          improved = improved || best > current + kUntangleProgress;
           current = best;
-          improved = true;
         } else {
+          x[v] = start;
           step *= 0.5;
         }
       }
