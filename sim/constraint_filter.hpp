@@ -4,9 +4,8 @@
 // solution must take in those directions. A pin constrains all three directions (S_i = 0);
 // a contact will constrain its normal n (S_i = I − n nᵀ), two contacts two normals.
 
-#include <vector>
-
 #include <Eigen/Core>
+#include <vector>
 
 namespace sd::sim {
 
@@ -27,6 +26,10 @@ class ConstraintFilter {
 
   bool is_free(int vertex) const { return kind_[vertex] == 0; }
   bool is_pinned(int vertex) const { return kind_[vertex] == 3; }
+  // Number of constrained directions of a vertex (0..3; 3: pinned).
+  int direction_count(int vertex) const { return kind_[vertex]; }
+  // The first constrained unit direction (meaningful when direction_count ≥ 1).
+  const Eigen::Vector3d& first_direction(int vertex) const { return first_[vertex]; }
   int constrained_count() const { return constrained_; }
 
   // S_i as a 3x3 matrix.
@@ -40,7 +43,7 @@ class ConstraintFilter {
   void constrained_correction(const Eigen::VectorXd& v, Eigen::VectorXd& z) const;
 
  private:
-  std::vector<unsigned char> kind_;  // number of constrained directions per vertex (0..3)
+  std::vector<unsigned char> kind_;      // number of constrained directions per vertex (0..3)
   std::vector<Eigen::Vector3d> first_;   // first constrained unit direction
   std::vector<Eigen::Vector3d> second_;  // second one (orthogonal to the first)
   Eigen::VectorXd target_;

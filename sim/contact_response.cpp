@@ -1,12 +1,12 @@
 #include "sim/contact_response.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <utility>
-
-#include <spdlog/spdlog.h>
 
 namespace sd::sim {
 namespace {
@@ -35,6 +35,24 @@ constexpr double kPiercingClearance = 0.5;
 // cloth are not looked for: the broad phase grows every triangle's box by this reach.
 constexpr double kPiercingReachThicknesses = 4.0;
 constexpr double kMinPiercingReach = 0.01;  // m
+// Heights above this fraction of the reach count only when the triangle's closest point lies
+// inside the body (BodyCollider::find_piercings: a cloth triangle beyond a thin body part is
+// not pierced by it). Below, heights count as they are, so only a body part thinner than
+// about this (6 mm at the default thickness) could be taken for a tip through the cloth. Not
+// the thickness: when the cloth folds over a tip at one of its vertices, that vertex is held
+// outside by its own contact, and a tip sliding out beside it (measured on the cone test:
+// 3.3 mm, then 8.6 mm the next step) has that vertex as its closest point, outside the body.
+constexpr double kPiercingUncheckedFraction = 0.5;
+// A piercing held last step stays held while the triangle's point over the body vertex would
+// end the step within the clearance plus this many thicknesses in front of it (the same
+// hysteresis as kHoldMargin for contacts: without it a triangle resting on a tip at the
+// clearance drops out as soon as it ends a hair farther, falls back and is lifted again).
+constexpr double kPiercingHoldMargin = 0.25;
+// A piercing constraint on a vertex that already has a contact direction becomes a second
+// direction only when the two differ by more than ~15° (sine above this); closer, the second
+// direction's value (d − d₁ cos θ)/sin θ would amplify small differences, so the contact's
+// direction carries both demands.
+constexpr double kMergeSine = 0.26;
 
 class Stopwatch {
  public:
@@ -107,36 +125,146 @@ void ContactResponse::set_cloth_triangles(const ClothModel& model) {
   piercings_.clear();
 }
 
+double ContactResponse::piercing_reach() const {
+  return std::max(kPiercingReachThicknesses * settings_.thickness, kMinPiercingReach);
+}
+
 std::vector<BodyPiercing> ContactResponse::find_piercings(const Eigen::VectorXd& x1,
                                                           double min_height) const {
   if (!settings_.check_body_vertices || cloth_triangles_.empty()) return {};
-  const double reach =
-      std::max(kPiercingReachThicknesses * settings_.thickness, kMinPiercingReach);
-  return collider_.find_piercings(x1, cloth_triangles_, min_height, reach, settings_.thickness);
+  const double reach = piercing_reach();
+  return collider_.find_piercings(x1, cloth_triangles_, min_height, reach,
+                                  kPiercingUncheckedFraction * reach);
 }
 
-std::vector<Eigen::Vector3d> ContactResponse::piercing_lifts(
-    const std::vector<BodyPiercing>& piercings, const ConstraintFilter* filter,
-    int vertices) const {
-  std::vector<Eigen::Vector3d> lift(static_cast<std::size_t>(vertices), Eigen::Vector3d::Zero());
-  for (const BodyPiercing& p : piercings) {
+std::vector<ContactResponse::CornerLift> ContactResponse::corner_lifts(
+    const std::vector<BodyPiercing>& piercings, const std::vector<double>& deltas,
+    const std::vector<unsigned char>& pinned, int vertices) const {
+  const auto is_pinned = [&](int i) {
+    return i < static_cast<int>(pinned.size()) && pinned[i] != 0;
+  };
+  std::vector<CornerLift> lift(static_cast<std::size_t>(vertices));
+  for (std::size_t p = 0; p < piercings.size(); ++p) {
     // Move the triangle's point under the body vertex by δ along the normal: corner k moves
     // w_k δ / Σ w_j² (Bridson et al. 2002's weighting, the least motion that does it), the
     // pinned corners not at all.
-    const double delta = p.height + kPiercingClearance * settings_.thickness;
-    const std::array<int, 3>& t = cloth_triangles_[p.cloth_triangle];
+    const BodyPiercing& piercing = piercings[p];
+    const std::array<int, 3>& t = cloth_triangles_[piercing.cloth_triangle];
     double weights = 0.0;
     for (int k = 0; k < 3; ++k)
-      if (filter == nullptr || !filter->is_pinned(t[k])) weights += p.barycentric[k] * p.barycentric[k];
+      if (!is_pinned(t[k])) weights += piercing.barycentric[k] * piercing.barycentric[k];
     if (!(weights > 0.0)) continue;
     for (int k = 0; k < 3; ++k) {
-      if (filter != nullptr && filter->is_pinned(t[k])) continue;
-      const Eigen::Vector3d move = (p.barycentric[k] * delta / weights) * p.normal;
+      if (is_pinned(t[k])) continue;
+      const double distance = piercing.barycentric[k] * deltas[p] / weights;
+      CornerLift& corner = lift[t[k]];
       // A vertex under two piercings takes the larger lift.
-      if (move.squaredNorm() > lift[t[k]].squaredNorm()) lift[t[k]] = move;
+      if (corner.set && distance <= corner.distance) continue;
+      corner = {piercing.normal, distance, piercing.body_velocity, true};
     }
   }
   return lift;
+}
+
+void ContactResponse::constrain_corner(ConstraintFilter& filter, int i, const Eigen::Vector3d& n,
+                                       double normal_velocity) {
+  if (filter.direction_count(i) == 0) {
+    filter.constrain_direction(i, n, normal_velocity);
+  } else if (filter.direction_count(i) == 1) {
+    const Eigen::Vector3d& first = filter.first_direction(i);
+    const double cosine = n.dot(first);
+    const double first_velocity = filter.constrained_velocity().segment<3>(3 * i).dot(first);
+    const double sine = std::sqrt(std::max(0.0, 1.0 - cosine * cosine));
+    if (sine >= kMergeSine) {
+      // The filter's second direction is n made orthogonal to the first, e; v·n =
+      // d₁ cos θ + v_e sin θ, so v_e = (d − d₁ cos θ)/sin θ gives v·n = d exactly.
+      filter.constrain_direction(i, n, (normal_velocity - first_velocity * cosine) / sine);
+    } else if (cosine > 0.0) {
+      // Nearly the contact's own direction: moving at s along it moves s cos θ along n.
+      filter.constrain_direction(i, first, std::max(first_velocity, normal_velocity / cosine));
+    } else {
+      return;  // the contact pushes the other way: leave it to the contact
+    }
+  } else {
+    return;  // two directions held already (or pinned): leave it
+  }
+  corner_normal_[i] = n;
+}
+
+std::vector<double> ContactResponse::clearance_deltas(
+    const std::vector<BodyPiercing>& piercings) const {
+  std::vector<double> deltas;
+  deltas.reserve(piercings.size());
+  for (const BodyPiercing& p : piercings)
+    deltas.push_back(p.height + kPiercingClearance * settings_.thickness);
+  return deltas;
+}
+
+void ContactResponse::hold_piercing(const BodyPiercing& piercing, bool released) {
+  int& index = held_index_[piercing.body_vertex];
+  if (index >= 0) {
+    held_piercings_[index] = {piercing, released && held_piercings_[index].released};
+    return;
+  }
+  index = static_cast<int>(held_piercings_.size());
+  held_piercings_.push_back({piercing, released});
+}
+
+void ContactResponse::constrain_start_piercings(const Eigen::VectorXd& x_hat,
+                                                const Eigen::VectorXd& v0, double beta,
+                                                ConstraintFilter& filter, Eigen::VectorXd& y) {
+  if (!settings_.check_body_vertices || cloth_triangles_.empty() || repairing()) return;
+  const int n = static_cast<int>(x_hat.size() / 3);
+  const double clearance = kPiercingClearance * settings_.thickness;
+  const double hold = clearance + kPiercingHoldMargin * settings_.thickness;
+  const Eigen::VectorXd start = x_hat + y;
+  std::vector<BodyPiercing> held;
+  std::vector<double> deltas;
+  // Triangles up to `reach` in front of a body vertex: one falling towards a tip is seen
+  // before it passes it.
+  for (const BodyPiercing& p : find_piercings(start, -piercing_reach())) {
+    const std::array<int, 3>& t = cloth_triangles_[p.cloth_triangle];
+    // Height over the point at the end of the step (body at its end pose already) if the
+    // triangle moved along n with the body vertex, and if it kept its start velocity.
+    const double body_normal_velocity = p.body_velocity.dot(p.normal);
+    const double with_body = p.height - beta * body_normal_velocity;
+    double point_velocity = 0.0;
+    for (int k = 0; k < 3; ++k)
+      point_velocity += p.barycentric[k] * v0.segment<3>(3 * t[k]).dot(p.normal);
+    const double coasting = p.height - beta * point_velocity;
+    const double force = last_piercing_force_[p.body_vertex];
+    const bool was_held = !std::isnan(force);
+    // New: through by more than the tolerance, or about to be. Not at any height: over a
+    // smooth body the chords of the cloth between vertices held at the thickness pass a
+    // fraction of a millimetre under body vertices (a sheet on a sphere), and holding those
+    // would constrain most of a drape twice.
+    if (!was_held && std::max(with_body, coasting) <= settings_.penetration_tolerance) continue;
+    if (was_held && with_body <= -hold) continue;  // it left
+    double release_force = 0.0;
+    for (int k = 0; k < 3; ++k) release_force += p.barycentric[k] * release_force_[t[k]];
+    if (was_held && force < -release_force) {
+      hold_piercing(p, true);
+      ++stats_.piercings_released;
+      continue;
+    }
+    held.push_back(p);
+    deltas.push_back(with_body + clearance);
+  }
+  std::vector<unsigned char> pinned(static_cast<std::size_t>(n), 0);
+  for (int i = 0; i < n; ++i) pinned[i] = filter.is_pinned(i);
+  const std::vector<CornerLift> lifts = corner_lifts(held, deltas, pinned, n);
+  for (int i = 0; i < n; ++i) {
+    const CornerLift& lift = lifts[i];
+    if (!lift.set) continue;
+    // Through (or closer than the clearance): move the start out, like a contact's position
+    // correction; farther: a normal velocity that brings it back to the clearance.
+    if (lift.distance > 0.0) y.segment<3>(3 * i) += lift.distance * lift.normal;
+    const double normal_velocity =
+        lift.body_velocity.dot(lift.normal) + std::min(lift.distance, 0.0) / beta;
+    constrain_corner(filter, i, lift.normal, normal_velocity);
+  }
+  for (const BodyPiercing& p : held) hold_piercing(p, false);
+  stats_.piercings_held = static_cast<int>(held.size());
 }
 
 void ContactResponse::reset_cloth(const Eigen::VectorXd& x, const Eigen::VectorXd& mass,
@@ -152,6 +280,11 @@ void ContactResponse::reset_cloth(const Eigen::VectorXd& x, const Eigen::VectorX
   too_deep_.clear();
   end_contacts_.clear();
   accepted_contacts_.clear();
+  // Piercings are remembered by body vertex, but their triangles were the old cloth's.
+  last_piercing_force_.assign(static_cast<std::size_t>(collider_.vertex_count()), kNoImpulse);
+  held_index_.assign(static_cast<std::size_t>(collider_.vertex_count()), -1);
+  held_piercings_.clear();
+  corner_normal_.assign(static_cast<std::size_t>(n), Eigen::Vector3d::Zero());
   // Plan the push-out on the first cloth, or again (over the remaining steps) when the cloth
   // is renumbered in the middle of one.
   if (!repair_planned_ || repairing()) {
@@ -195,8 +328,8 @@ int ContactResponse::add_contact(const BodyContact& contact, const Eigen::Vector
   // Distance above `thickness` the vertex would end at if it moved with the body along n:
   // x1 = x̂ + y + β v1 against the surface at its end-of-step pose.
   const Eigen::Vector3d start = x_hat.segment<3>(3 * i) + y.segment<3>(3 * i);
-  const double gap = (start - contact.point).dot(n) + beta * body_normal_velocity -
-                     settings_.thickness;
+  const double gap =
+      (start - contact.point).dot(n) + beta * body_normal_velocity - settings_.thickness;
   // Too close: move the start out (position correction, no velocity). Farther (a vertex that
   // ended too deep after an unconstrained solve): a normal velocity that lands it at thickness.
   if (gap < 0.0) y.segment<3>(3 * i) -= gap * n;
@@ -231,6 +364,9 @@ void ContactResponse::constrain_start(const Eigen::VectorXd& x_hat, const Eigen:
   active_.clear();
   too_deep_.clear();
   end_contacts_.clear();
+  for (const HeldPiercing& h : held_piercings_) held_index_[h.piercing.body_vertex] = -1;
+  held_piercings_.clear();
+  corner_normal_.assign(static_cast<std::size_t>(n), Eigen::Vector3d::Zero());
 
   // Vertices being pushed out of an intersecting start move along their push normal to this
   // step's goal; ordinary contacts leave them alone until the repair is over.
@@ -272,7 +408,8 @@ void ContactResponse::constrain_start(const Eigen::VectorXd& x_hat, const Eigen:
     const Eigen::Vector3d& normal = c.normal;
     const Eigen::Matrix3d tangent_projector =
         Eigen::Matrix3d::Identity() - normal * normal.transpose();
-    const Eigen::Vector3d relative = tangent_projector * (v0.segment<3>(3 * c.vertex) - c.body_velocity);
+    const Eigen::Vector3d relative =
+        tangent_projector * (v0.segment<3>(3 * c.vertex) - c.body_velocity);
     const double speed = relative.norm();
     VertexDamping term{c.vertex, Eigen::Matrix3d::Zero(), c.body_velocity, Eigen::Vector3d::Zero()};
     if (speed < settings_.stick_speed) {
@@ -287,11 +424,13 @@ void ContactResponse::constrain_start(const Eigen::VectorXd& x_hat, const Eigen:
     a.friction_in_solve = true;
     friction.push_back(term);
   }
+  // After the contacts, so that a corner's piercing direction is added to its contact's.
+  constrain_start_piercings(x_hat, v0, beta, filter, y);
 }
 
 void ContactResponse::apply_friction(const Eigen::VectorXd& impulse, const Eigen::VectorXd& mass,
-                                     const Eigen::VectorXd& x_hat, double beta,
-                                     Eigen::VectorXd& v, Eigen::VectorXd& x) {
+                                     const Eigen::VectorXd& x_hat, double beta, Eigen::VectorXd& v,
+                                     Eigen::VectorXd& x) {
   stats_.stuck = 0;
   if (impulse.size() != v.size()) return;
   const double mu_static = static_friction();
@@ -344,26 +483,27 @@ int ContactResponse::constrain_deep(const Eigen::VectorXd& x0, const Eigen::Vect
   // convex body the cloth's chords pass a fraction of a millimetre under body vertices between
   // cloth vertices held at the thickness; lifting those made a sheet on a sphere re-solve
   // every step and never come to rest.
-  piercings_ = repair ? std::vector<BodyPiercing>{}
-                      : find_piercings(x1, settings_.penetration_tolerance);
+  piercings_ =
+      repair ? std::vector<BodyPiercing>{} : find_piercings(x1, settings_.penetration_tolerance);
   pinned_.assign(x1.size() / 3, 0);
   for (int i = 0; i < static_cast<int>(pinned_.size()); ++i) pinned_[i] = filter.is_pinned(i);
   if ((too_deep_.empty() && piercings_.empty()) || stats_.resolves >= settings_.max_resolves)
     return 0;
   for (const BodyContact& c : too_deep_) add_contact(c, x_hat, beta, filter, y, false);
-  // Lifted triangle corners: their normal velocity lands them at x1 + lift along the lift.
+  // Lifted triangle corners: their normal velocity lands them at x1 + lift along the lift,
+  // and the piercings are held from now on.
   int added = static_cast<int>(too_deep_.size());
-  const std::vector<Eigen::Vector3d> lifts =
-      piercing_lifts(piercings_, &filter, static_cast<int>(x1.size() / 3));
+  const std::vector<CornerLift> lifts = corner_lifts(piercings_, clearance_deltas(piercings_),
+                                                     pinned_, static_cast<int>(x1.size() / 3));
   for (int i = 0; i < static_cast<int>(lifts.size()); ++i) {
-    const double length = lifts[i].norm();
-    if (!(length > 0.0)) continue;
-    const Eigen::Vector3d n = lifts[i] / length;
-    const double target = (x1.segment<3>(3 * i) + lifts[i]).dot(n);
-    const double start = (x_hat.segment<3>(3 * i) + y.segment<3>(3 * i)).dot(n);
-    filter.constrain_direction(i, n, (target - start) / beta);
+    const CornerLift& lift = lifts[i];
+    if (!lift.set) continue;
+    const double target = x1.segment<3>(3 * i).dot(lift.normal) + lift.distance;
+    const double start = (x_hat.segment<3>(3 * i) + y.segment<3>(3 * i)).dot(lift.normal);
+    constrain_corner(filter, i, lift.normal, (target - start) / beta);
     ++added;
   }
+  for (const BodyPiercing& p : piercings_) hold_piercing(p, false);
   stats_.piercings_resolved += static_cast<int>(piercings_.size());
   ++stats_.resolves;
   return added;
@@ -398,22 +538,17 @@ void ContactResponse::finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v) {
   // and the corners' velocity towards the body vertex removed), then measure again.
   if (!piercings_.empty()) {
     const int n = static_cast<int>(x.size() / 3);
-    std::vector<Eigen::Vector3d> body_velocity(static_cast<std::size_t>(n), Eigen::Vector3d::Zero());
-    for (const BodyPiercing& p : piercings_)
-      for (int k : cloth_triangles_[p.cloth_triangle]) body_velocity[k] = p.body_velocity;
-    ConstraintFilter pins(n);
-    for (int i = 0; i < n && i < static_cast<int>(pinned_.size()); ++i)
-      if (pinned_[i]) pins.pin(i, Eigen::Vector3d::Zero());
-    const std::vector<Eigen::Vector3d> lifts = piercing_lifts(piercings_, &pins, n);
+    const std::vector<CornerLift> lifts =
+        corner_lifts(piercings_, clearance_deltas(piercings_), pinned_, n);
     for (int i = 0; i < n; ++i) {
-      const double length = lifts[i].norm();
-      if (!(length > 0.0)) continue;
-      const Eigen::Vector3d normal = lifts[i] / length;
-      x.segment<3>(3 * i) += lifts[i];
+      const CornerLift& lift = lifts[i];
+      if (!lift.set) continue;
+      x.segment<3>(3 * i) += lift.distance * lift.normal;
       auto vi = v.segment<3>(3 * i);
-      const double approach = (vi - body_velocity[i]).dot(normal);
-      if (approach < 0.0) vi -= approach * normal;
+      const double approach = (vi - lift.body_velocity).dot(lift.normal);
+      if (approach < 0.0) vi -= approach * lift.normal;
     }
+    for (const BodyPiercing& p : piercings_) hold_piercing(p, false);
     stats_.piercings_resolved += static_cast<int>(piercings_.size());
     piercings_ = find_piercings(x, settings_.penetration_tolerance);
   }
@@ -433,17 +568,56 @@ void ContactResponse::finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v) {
     if (distance < -settings_.penetration_tolerance) ++stats_.penetrating;
   }
   for (const ActiveContact& a : active_)
-    if (!a.released && !a.repair) ++stats_.contacts;
-    else if (a.released) ++stats_.released;
+    if (!a.released && !a.repair)
+      ++stats_.contacts;
+    else if (a.released)
+      ++stats_.released;
+}
+
+void ContactResponse::record_normal_forces(const Eigen::VectorXd& impulse) {
+  std::fill(last_normal_force_.begin(), last_normal_force_.end(), kNoImpulse);
+  std::fill(last_piercing_force_.begin(), last_piercing_force_.end(), kNoImpulse);
+  const bool solved = impulse.size() == static_cast<Eigen::Index>(3 * last_normal_force_.size());
+  // The impulse r of a vertex held along unit a and b lies in their span, r = α a + β b (least
+  // squares: the 2×2 Gram system). Closer than kMergeSine the piercing was carried by the
+  // contact's direction (constrain_corner), which then takes all of it.
+  const auto along = [](const Eigen::Vector3d& r, const Eigen::Vector3d& a,
+                        const Eigen::Vector3d& b) {
+    const double cosine = a.dot(b);
+    const double sine2 = 1.0 - cosine * cosine;
+    if (sine2 < kMergeSine * kMergeSine) return r.dot(a);
+    return (r.dot(a) - cosine * r.dot(b)) / sine2;
+  };
+  if (solved)
+    for (const ActiveContact& a : active_) {
+      if (a.released || a.repair) continue;
+      const int i = a.contact.vertex;
+      const Eigen::Vector3d r = impulse.segment<3>(3 * i);
+      const Eigen::Vector3d& piercing = corner_normal_[i];
+      last_normal_force_[i] =
+          (piercing.isZero() ? r.dot(a.contact.normal) : along(r, a.contact.normal, piercing)) /
+          beta_;
+    }
+  for (const HeldPiercing& h : held_piercings_) {
+    if (h.released) continue;
+    // Lifted after the last solve (or no solve): no force known, held as pressing.
+    double force = 0.0;
+    if (solved)
+      for (int k : cloth_triangles_[h.piercing.cloth_triangle]) {
+        if (corner_normal_[k].isZero()) continue;
+        const Eigen::Vector3d r = impulse.segment<3>(3 * k);
+        const int c = active_index_[k];
+        const bool contact = c >= 0 && !active_[c].released && !active_[c].repair;
+        force += (contact ? along(r, corner_normal_[k], active_[c].contact.normal)
+                          : r.dot(corner_normal_[k])) /
+                 beta_;
+      }
+    last_piercing_force_[h.piercing.body_vertex] = force;
+  }
 }
 
 void ContactResponse::accept_step(const Eigen::VectorXd& impulse) {
-  std::fill(last_normal_force_.begin(), last_normal_force_.end(), kNoImpulse);
-  if (impulse.size() == static_cast<Eigen::Index>(3 * last_normal_force_.size()))
-    for (const ActiveContact& a : active_)
-      if (!a.released && !a.repair)
-        last_normal_force_[a.contact.vertex] =
-            impulse.segment<3>(3 * a.contact.vertex).dot(a.contact.normal) / beta_;
+  record_normal_forces(impulse);
   accepted_contacts_ = active_;
   if (repairing()) {
     ++repair_step_;

@@ -24,15 +24,26 @@
 //     again (at most `max_resolves` times). What is still too deep after that is projected
 //     onto the surface (counted: it should not happen in practice).
 //
+// With `check_body_vertices`, body vertices are also kept behind the cloth triangles (sharp
+// features: a cloth triangle can span a cone tip or a shoulder with its three corners
+// outside). A body vertex more than the tolerance through a triangle (or about to be, at the
+// triangle's start velocity) becomes a piercing constraint: the triangle's point over it must
+// end `kPiercingClearance`·thickness in front of it, moving with the body vertex along the
+// triangle's normal. The corners share the motion by Bridson et al. 2002's weights
+// (w_k / Σ w_j², the least motion that moves the point), each corner's normal velocity a
+// constraint of the filter. Like a contact, a piercing is held at the next step's start while
+// the cloth stays within reach (the resting state of cloth hung on a tip), and released when
+// its constraint pulled the cloth towards the body vertex. The end check lifts the ones the
+// start missed, re-solving as for deep vertices.
+//
 // The simulator (sim/simulation.hpp) drives this; it is separate so that the contact logic
 // reads in one place and can be tested on its own.
 
+#include <Eigen/Core>
 #include <array>
 #include <optional>
 #include <stdexcept>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "meshing/tri_mesh.hpp"
 #include "sim/body_collider.hpp"
@@ -45,8 +56,8 @@
 namespace sd::sim {
 
 struct ContactSettings {
-  bool enabled = true;      // with a body set; off: the body is ignored
-  double thickness = 0.003; // m: distance kept between a cloth vertex and the body surface
+  bool enabled = true;       // with a body set; off: the body is ignored
+  double thickness = 0.003;  // m: distance kept between a cloth vertex and the body surface
   // m: no vertex may end an accepted step deeper than this inside the body (signed distance
   // below −tolerance); deeper ones are re-solved as contacts, then projected.
   double penetration_tolerance = 0.001;
@@ -59,8 +70,8 @@ struct ContactSettings {
   int max_resolves = 2;   // extra solves per step for vertices that ended too deep
   int repair_steps = 10;  // steps over which a garment starting inside the body is pushed out
   // Also keep body vertices from poking through cloth triangles (sharp features: shoulder tips,
-  // elbows, corners). Off by default: the response is not finished (see docs/collision.md,
-  // "Body vertices poking through the cloth"); only cloth vertices are kept outside the body.
+  // elbows, corners). See docs/collision.md, "Body vertices poking through the cloth", for
+  // what it does and costs.
   bool check_body_vertices = false;
   // Collider query parameters (see sim/body_collider.hpp, ContactQuery).
   double search_margin = 0.02;
@@ -78,29 +89,31 @@ class InvalidContactSettingsError : public std::invalid_argument {
 // One constrained contact of a step: the body contact and what the solve was asked for.
 struct ActiveContact {
   BodyContact contact;
-  double normal_velocity = 0.0;  // m/s prescribed along contact.normal
-  bool released = false;         // near the body but left free (its constraint was adhesive)
-  bool stuck = false;            // slower than stick_speed at the start: held by the drag
-  bool repair = false;           // pushed out of an intersecting start (moving target)
+  double normal_velocity = 0.0;    // m/s prescribed along contact.normal
+  bool released = false;           // near the body but left free (its constraint was adhesive)
+  bool stuck = false;              // slower than stick_speed at the start: held by the drag
+  bool repair = false;             // pushed out of an intersecting start (moving target)
   bool friction_in_solve = false;  // its friction was a term of the solve
   Eigen::Vector3d slide_direction = Eigen::Vector3d::Zero();  // sliding: t̂ at the start
 };
 
 // Per-step contact figures, summed into the simulation report.
 struct ContactStepStats {
-  int contacts = 0;          // constrained contacts in the final solve
-  int released = 0;          // near the body but released
-  int resolves = 0;          // extra solves for vertices that ended too deep
-  int projected = 0;         // vertices projected out after the last solve
-  int stuck = 0;             // contacts in the stick regime (or stopped by friction)
-  int repairing = 0;         // vertices still being pushed out of an intersecting start
+  int contacts = 0;              // constrained contacts in the final solve
+  int released = 0;              // near the body but released
+  int resolves = 0;              // extra solves for vertices that ended too deep
+  int projected = 0;             // vertices projected out after the last solve
+  int stuck = 0;                 // contacts in the stick regime (or stopped by friction)
+  int repairing = 0;             // vertices still being pushed out of an intersecting start
   double max_penetration = 0.0;  // m, deepest vertex inside the body at the end (repair excluded)
   // Body vertices poking through cloth triangles (sharp features): re-solved like deep
   // vertices, then the triangles lifted. Measured at the end of the step.
-  int piercings_resolved = 0;   // body vertices whose triangles were constrained or lifted
-  int piercing = 0;             // body vertices more than the tolerance through the cloth at the end
-  double max_piercing = 0.0;    // m, highest body vertex above the cloth at the end (0: none)
-  int penetrating = 0;       // vertices deeper than the tolerance at the end (repair excluded)
+  int piercings_held = 0;      // body vertices held behind their triangle from the start
+  int piercings_released = 0;  // held last step, left free (their constraint pulled)
+  int piercings_resolved = 0;  // body vertices whose triangles were constrained or lifted
+  int piercing = 0;            // body vertices more than the tolerance through the cloth at the end
+  double max_piercing = 0.0;   // m, highest body vertex above the cloth at the end (0: none)
+  int penetrating = 0;         // vertices deeper than the tolerance at the end (repair excluded)
   double collision_seconds = 0.0;  // collider queries and body motion
 };
 
@@ -182,9 +195,7 @@ class ContactResponse {
   // the two coefficients the settings leave unset.
   void set_fabric_friction(double friction) { fabric_friction_ = friction; }
   double static_friction() const { return settings_.static_friction.value_or(fabric_friction_); }
-  double kinetic_friction() const {
-    return settings_.kinetic_friction.value_or(fabric_friction_);
-  }
+  double kinetic_friction() const { return settings_.kinetic_friction.value_or(fabric_friction_); }
 
  private:
   ContactQuery query() const;
@@ -193,37 +204,84 @@ class ContactResponse {
   // Returns the index of its ActiveContact.
   int add_contact(const BodyContact& contact, const Eigen::VectorXd& x_hat, double beta,
                   ConstraintFilter& filter, Eigen::VectorXd& y, bool allow_release);
+  // m: body vertices farther than this through the cloth are not looked for.
+  double piercing_reach() const;
   // Piercings of x1 whose body vertex is more than `min_height` through the cloth.
   std::vector<BodyPiercing> find_piercings(const Eigen::VectorXd& x1, double min_height) const;
-  // Per cloth vertex, the normal displacement (direction × metres) that lifts the triangles of
-  // `piercings` clear of their body vertices; vertices not involved get zero. Pinned vertices
-  // (per `filter`, may be null) do not move; the others take their share.
-  std::vector<Eigen::Vector3d> piercing_lifts(const std::vector<BodyPiercing>& piercings,
-                                              const ConstraintFilter* filter, int vertices) const;
+  // What a set of piercings asks of one cloth vertex: move `distance` (m, signed: negative
+  // moves it towards the body vertex) along `normal`, the triangle's normal.
+  struct CornerLift {
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+    double distance = 0.0;
+    Eigen::Vector3d body_velocity = Eigen::Vector3d::Zero();  // of the body vertex, m/s
+    bool set = false;
+  };
+  // Per cloth vertex (#V), the motion that moves the point of each piercing's triangle under
+  // its body vertex by deltas[p] along the triangle's normal (Bridson's weighting); a vertex
+  // under several piercings takes the largest. Pinned vertices (per `pinned`, may be empty) do
+  // not move, the others take their share.
+  std::vector<CornerLift> corner_lifts(const std::vector<BodyPiercing>& piercings,
+                                       const std::vector<double>& deltas,
+                                       const std::vector<unsigned char>& pinned,
+                                       int vertices) const;
+  // Start of step: body vertices through the cloth at x̂ + y, or held last step, become
+  // piercing constraints (see the file comment). v0: start velocities (3n).
+  void constrain_start_piercings(const Eigen::VectorXd& x_hat, const Eigen::VectorXd& v0,
+                                 double beta, ConstraintFilter& filter, Eigen::VectorXd& y);
+  // Per piercing, the lift along its normal that leaves its body vertex the clearance behind
+  // the triangle: height + kPiercingClearance·thickness.
+  std::vector<double> clearance_deltas(const std::vector<BodyPiercing>& piercings) const;
+  // Normal forces (N) of the last solve from its constraint impulse (3n, N·s): per cloth
+  // vertex into last_normal_force_, per held body vertex into last_piercing_force_. A vertex
+  // constrained both by its contact and by a piercing has its impulse split between the two
+  // directions.
+  void record_normal_forces(const Eigen::VectorXd& impulse);
+  // Constrains the velocity of cloth vertex i along unit n to `normal_velocity` on top of what
+  // the filter already holds for it (a contact): a second direction whose value is chosen so
+  // that the velocity along n itself is right, or, for a direction nearly parallel to the
+  // contact's, the contact's direction with the larger of the two demands.
+  void constrain_corner(ConstraintFilter& filter, int i, const Eigen::Vector3d& n,
+                        double normal_velocity);
+  // Adds `piercing` to this attempt's held piercings (once per body vertex).
+  void hold_piercing(const BodyPiercing& piercing, bool released);
 
   ContactSettings settings_;
   BodyCollider collider_;
   std::optional<PoseSequence> motion_;
-  double body_time_ = 0.0;   // time of the collider's current pose
+  double body_time_ = 0.0;  // time of the collider's current pose
   ContactCache cache_;
   StartRepair repair_;
   bool repair_planned_ = false;
-  int repair_step_ = 0;      // accepted steps of the repair so far
+  int repair_step_ = 0;  // accepted steps of the repair so far
   double fabric_friction_ = 0.3;
   // Per vertex: normal force of its contact in the last accepted step (N, < 0: adhesive), NaN
   // when it had no constrained contact.
   std::vector<double> last_normal_force_;
-  Eigen::VectorXd release_force_;  // per vertex, N: an adhesive force above this releases
-  double beta_ = 0.0;  // β of the step being solved
+  Eigen::VectorXd release_force_;         // per vertex, N: an adhesive force above this releases
+  double beta_ = 0.0;                     // β of the step being solved
   std::vector<unsigned char> in_repair_;  // 1 for vertices the start repair is pushing
   // Current attempt.
   std::vector<ActiveContact> active_;
-  std::vector<int> active_index_;        // per vertex: index into active_, or −1
-  std::vector<BodyContact> too_deep_;    // from the last end check, after the last solve
+  std::vector<int> active_index_;      // per vertex: index into active_, or −1
+  std::vector<BodyContact> too_deep_;  // from the last end check, after the last solve
   std::vector<BodyContact> end_contacts_;
   std::vector<std::array<int, 3>> cloth_triangles_;
   std::vector<BodyPiercing> piercings_;  // from the last end check, after the last solve
-  std::vector<unsigned char> pinned_;   // per cloth vertex, pinned in the step's filter
+  // Body vertices held behind a cloth triangle in this attempt (start or end check).
+  struct HeldPiercing {
+    BodyPiercing piercing;
+    bool released = false;  // within reach but left free: its constraint pulled last step
+  };
+  std::vector<HeldPiercing> held_piercings_;
+  std::vector<int> held_index_;  // per body vertex: index into held_piercings_, or −1
+  // Per cloth vertex, the direction a piercing constrained it along in this attempt (zero:
+  // none); splits its constraint impulse between its contact and the piercing.
+  std::vector<Eigen::Vector3d> corner_normal_;
+  // Per body vertex: the normal force (N, along the triangle's normal; < 0: it pulled the
+  // cloth towards the body) of its piercing constraint in the last accepted step, NaN when it
+  // was not held.
+  std::vector<double> last_piercing_force_;
+  std::vector<unsigned char> pinned_;  // per cloth vertex, pinned in the step's filter
   ContactStepStats stats_;
   std::vector<ActiveContact> accepted_contacts_;
 };

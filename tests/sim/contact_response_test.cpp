@@ -1,0 +1,208 @@
+// Body vertices poking through cloth triangles (ContactResponse with
+// ContactSettings::check_body_vertices): a sheet dropped on a cone tip keeps the tip covered,
+// a sheet on a smooth sphere still comes to rest, and the two linear solvers agree.
+
+#include "sim/contact_response.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <vector>
+
+#include "sim/body_collider.hpp"
+#include "sim/collision_geometry.hpp"
+#include "sim/sheet.hpp"
+#include "sim/simulation.hpp"
+#include "test_bodies.hpp"
+
+namespace sd::sim {
+namespace {
+
+using Eigen::Vector3d;
+
+struct Sheet {
+  SheetScene scene;
+  ClothModel model;
+};
+
+// A free horizontal sheet of `size` metres with n×n quads centred at `centre`, cotton.
+Sheet horizontal_sheet(int n, double size, const Vector3d& centre) {
+  SheetSpec spec;
+  spec.orientation = SheetOrientation::horizontal;
+  spec.size = {size, size};
+  spec.columns = n;
+  spec.rows = n;
+  spec.centre = centre;
+  Sheet s{build_sheet(spec), {}};
+  s.model = build_cloth_model(s.scene.input, fabric_preset("cotton"));
+  return s;
+}
+
+SimulationSettings piercing_settings(bool check_body_vertices) {
+  SimulationSettings settings;
+  settings.dt = 1.0 / 60.0;
+  settings.solver = LinearSolverKind::cholmod;
+  settings.forces.air_drag = 0.3;  // settles the drapes sooner; not part of what is tested
+  settings.contact.thickness = 0.003;
+  settings.contact.penetration_tolerance = 0.001;
+  settings.contact.check_body_vertices = check_body_vertices;
+  return settings;
+}
+
+// How far `point` is through the cloth, independently of the collider: its distance to the
+// cloth surface (closest point over all triangles), positive when the cloth straight below it
+// (−y) is lower than the point (the point stands above the cloth), negative when the cloth is
+// above it. +infinity when no triangle lies over or under it (the cloth slid off).
+double height_above_cloth(const Vector3d& point, const ClothModel& model,
+                          const Eigen::VectorXd& x) {
+  double below = std::numeric_limits<double>::infinity();  // lowest point.y − cloth y
+  double distance = std::numeric_limits<double>::infinity();
+  for (const TriangleElement& t : model.triangles) {
+    const Vector3d a = x.segment<3>(3 * t.vertices[0]), b = x.segment<3>(3 * t.vertices[1]),
+                   c = x.segment<3>(3 * t.vertices[2]);
+    distance = std::min(distance, (point - closest_point_on_triangle(point, a, b, c).point).norm());
+    // Barycentric coordinates of the point's footprint in the triangle's footprint (xz).
+    const double det = (b.x() - a.x()) * (c.z() - a.z()) - (c.x() - a.x()) * (b.z() - a.z());
+    if (std::abs(det) < 1e-14) continue;
+    const double u =
+        ((point.x() - a.x()) * (c.z() - a.z()) - (c.x() - a.x()) * (point.z() - a.z())) / det;
+    const double v =
+        ((b.x() - a.x()) * (point.z() - a.z()) - (point.x() - a.x()) * (b.z() - a.z())) / det;
+    if (u < 0.0 || v < 0.0 || u + v > 1.0) continue;
+    below = std::min(below, point.y() - (a.y() + u * (b.y() - a.y()) + v * (c.y() - a.y())));
+  }
+  if (std::isinf(below)) return below;
+  return below > 0.0 ? distance : -distance;
+}
+
+struct ConeRun {
+  SimulationReport report;
+  Eigen::VectorXd x;
+  double highest_apex = -std::numeric_limits<double>::infinity();  // m through the cloth
+  double highest_apex_time = 0.0;
+  int steps_pierced = 0;   // steps the simulator itself counted a body vertex through
+  double end_speed = 0.0;  // m/s, fastest cloth vertex at the end
+};
+
+// A 5×5 sheet of 0.6 m (12 cm quads: the cone's tip is much sharper than the cloth's
+// resolution) dropped from 5 cm above the tip of a cone of radius 10 cm and height 20 cm
+// (half-angle 26.6°), the tip inside a triangle of the middle quad (off both diagonals).
+ConeRun drop_on_cone(bool check, LinearSolverKind solver, double duration,
+                     bool stop_at_rest = true) {
+  const Vector3d base(0.03, 0.0, 0.01);
+  const meshing::TriMesh cone = testing::make_cone(0.1, 0.2, 24, base);
+  const Vector3d apex = cone.vertices.row(0).transpose();
+  const Sheet s = horizontal_sheet(5, 0.6, {0.0, 0.25, 0.0});
+  SimulationSettings settings = piercing_settings(check);
+  settings.solver = solver;
+  settings.pcg_tolerance = 1e-10;
+  settings.duration = duration;
+  settings.stop_at_rest = stop_at_rest;
+  Simulation sim(s.model, flatten_positions(s.scene.input.rest_positions), {}, settings);
+  sim.set_body(cone);
+  ConeRun run;
+  run.report = sim.run([&](const Simulation& step) {
+    const double height = height_above_cloth(apex, s.model, step.positions());
+    if (height > run.highest_apex) {
+      run.highest_apex = height;
+      run.highest_apex_time = step.time();
+    }
+    if (step.contact()->step_stats().piercing > 0) ++run.steps_pierced;
+  });
+  run.x = sim.positions();
+  for (Eigen::Index i = 0; i < run.x.size() / 3; ++i)
+    run.end_speed = std::max(run.end_speed, sim.velocities().segment<3>(3 * i).norm());
+  return run;
+}
+
+TEST(ContactResponsePiercing, ConeTipStaysCoveredAtEveryStep) {
+  const double tolerance = piercing_settings(true).contact.penetration_tolerance;
+  const ConeRun off = drop_on_cone(false, LinearSolverKind::cholmod, 4.0);
+  const ConeRun on = drop_on_cone(true, LinearSolverKind::cholmod, 4.0);
+  for (const ConeRun* run : {&off, &on})
+    std::printf(
+        "cone tip, check %s: %d steps to %.2f s (at rest %d), apex at most %.2f mm through the "
+        "cloth (at %.2f s), %d steps pierced, re-solves %d, fastest vertex at the end %.3f m/s\n",
+        run == &on ? "on" : "off", run->report.steps, run->report.sim_time, run->report.at_rest,
+        1e3 * run->highest_apex, run->highest_apex_time, run->steps_pierced,
+        run->report.contact_resolves, run->end_speed);
+  // Without the check the tip goes right through (cloth vertices alone are kept outside).
+  EXPECT_GT(off.highest_apex, 0.05);
+  EXPECT_FALSE(on.report.failed);
+  EXPECT_TRUE(on.report.nan_free);
+  EXPECT_TRUE(on.x.allFinite());
+  // Covered at every step: the simulator lifts every body vertex more than the tolerance
+  // through, so none is left at a step's end, and the independent measure agrees. It is the
+  // distance to the cloth surface, never below the simulator's height along the triangle's
+  // normal (equal when the closest point is inside a triangle, as at the end of this run);
+  // the 5 % allows for the two measures differing where the tip sits under a fold's edge.
+  EXPECT_EQ(on.steps_pierced, 0);
+  EXPECT_LE(on.highest_apex, 1.05 * tolerance);
+  // Bounded: the sheet (hung on a sharp tip off its centre, with no friction at the tip) is
+  // still turning slowly at 4 s (measured 0.1 m/s), but nothing grows.
+  EXPECT_LT(on.end_speed, 0.5);
+}
+
+// On a smooth body the check should change nothing, and it does not yet: the drape stays
+// outside and finite, but with the check it does not come to rest within 6 s (measured: at rest
+// at 2.4 s without; with, 18 body vertices held, 32 re-solves, still moving at 6 s). The sheet
+// lands at about 1 m/s, the landing triangles are held at the clearance in front of the
+// sphere's vertices, and the chords between cloth vertices held at the thickness naturally sit
+// closer than that, so the piercing and contact constraints pull against each other. This is
+// why ContactSettings::check_body_vertices stays off by default (docs/collision.md); the test
+// checks what holds and prints the rest times.
+TEST(ContactResponsePiercing, SheetOnASphereStaysOutsideWithTheCheck) {
+  const meshing::TriMesh sphere = testing::make_sphere(0.2, 3);
+  const BodyCollider check_body(sphere);
+  const Sheet s = horizontal_sheet(16, 0.6, {0.0, 0.25, 0.0});
+  for (const bool check : {false, true}) {
+    SimulationSettings settings = piercing_settings(check);
+    settings.duration = 6.0;
+    Simulation sim(s.model, flatten_positions(s.scene.input.rest_positions), {}, settings);
+    sim.set_body(sphere);
+    int held = 0;
+    double deepest = 0.0;
+    const SimulationReport r = sim.run([&](const Simulation& step) {
+      held = std::max(held, step.contact()->step_stats().piercings_held);
+      for (Eigen::Index i = 0; i < step.positions().size() / 3; ++i)
+        deepest =
+            std::max(deepest, -check_body.signed_distance(step.positions().segment<3>(3 * i)));
+    });
+    std::printf(
+        "sphere, check %s: at rest %d at %.2f s, %d steps, re-solves %d, most piercings held %d, "
+        "deepest %.3f mm, collision %.3f s of %.3f s\n",
+        check ? "on" : "off", r.at_rest, r.sim_time, r.steps, r.contact_resolves, held,
+        1e3 * deepest, r.collision_s, r.forces_s + r.solve_s + r.collision_s + r.other_s);
+    EXPECT_FALSE(r.failed);
+    EXPECT_TRUE(r.nan_free);
+    EXPECT_TRUE(sim.positions().allFinite());
+    EXPECT_LE(deepest, settings.contact.penetration_tolerance);
+    if (!check) {
+      EXPECT_TRUE(r.at_rest);
+    }
+  }
+}
+
+// Piercing constraints go through the same ConstraintFilter as contacts: filtered in PCG,
+// eliminated in CHOLMOD. Over the first 0.5 s (the sheet lands on the tip at 0.1 s and hangs
+// on it) the two give the same drape.
+TEST(ContactResponsePiercing, PcgAndCholmodAgreeOnTheConeTip) {
+  const ConeRun cholmod = drop_on_cone(true, LinearSolverKind::cholmod, 0.5, false);
+  const ConeRun pcg = drop_on_cone(true, LinearSolverKind::pcg, 0.5, false);
+  const double difference = (cholmod.x - pcg.x).lpNorm<Eigen::Infinity>();
+  std::printf("cone tip, PCG vs CHOLMOD after 0.5 s: %.3g m apart, apex %.2f / %.2f mm\n",
+              difference, 1e3 * cholmod.highest_apex, 1e3 * pcg.highest_apex);
+  EXPECT_FALSE(cholmod.report.failed);
+  EXPECT_FALSE(pcg.report.failed);
+  EXPECT_EQ(cholmod.report.contact_resolves, pcg.report.contact_resolves);
+  // PCG stops at a relative residual of 1e-10; over 30 steps that leaves nanometres (the
+  // sphere comparison in contact_simulation_test.cpp measured 1.2e-9 m), far below the
+  // 1e-6 m a different set of constraints would show.
+  EXPECT_LT(difference, 1e-6);
+}
+
+}  // namespace
+}  // namespace sd::sim
