@@ -1,6 +1,7 @@
 #include "sim/adaptive_detail.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -193,8 +194,13 @@ void AdaptiveCloth::apply(const BlockChange& change, Transfer& state) {
     state.measured = true;
   }
   state.changed = true;
+  // Mass moves at each triangle's eased density ρ·e² (a split's parents are gone: their
+  // children carry the same input face, hence the same ease).
   const double rho = material_.fabric.area_density;
-  meshing::transfer_mass_and_velocity(change, {rho, rho}, state.m, state.v);
+  const bool split = change.kind == BlockChange::Kind::kSplit;
+  const TriangleId t1 = split ? change.a10 : change.a1, t2 = split ? change.a20 : change.a2;
+  const double e1 = ease(t1), e2 = t2.valid() ? ease(t2) : 1.0;
+  meshing::transfer_mass_and_velocity(change, {rho * e1 * e1, rho * e2 * e2}, state.m, state.v);
   const auto grow = [](auto& vector, int size, auto fill) {
     if (static_cast<int>(vector.size()) < size) vector.resize(static_cast<std::size_t>(size), fill);
   };
@@ -254,6 +260,16 @@ void AdaptiveCloth::apply(const BlockChange& change, Transfer& state) {
   }
 }
 
+double AdaptiveCloth::ease(TriangleId t) const {
+  if (material_.source_ease.size() == 0) return 1.0;
+  const int source = mesh_.source_face(t);
+  if (source < 0 || source >= material_.source_ease.size())
+    throw InvalidClothError("the ease must be given for every input face (" +
+                            std::to_string(material_.source_ease.size()) + " given, face " +
+                            std::to_string(source) + " needed)");
+  return material_.source_ease(source);
+}
+
 void AdaptiveCloth::keep_off_body(int e, Transfer& state) const {
   const ContactResponse* contact = simulation_->contact();
   if (contact == nullptr || !simulation_->settings().contact.enabled) return;
@@ -264,6 +280,33 @@ void AdaptiveCloth::keep_off_body(int e, Transfer& state) const {
   if (!near || near->distance >= thickness) return;
   state.x.row(e) += ((thickness - near->distance) * near->normal).transpose();
   ++state.moved_off_body;
+}
+
+bool AdaptiveCloth::split_stays_off_body(BlockId k, const Eigen::VectorXd& x) const {
+  const ContactResponse* contact = simulation_->contact();
+  if (contact == nullptr || !simulation_->settings().contact.enabled) return true;
+  const auto [b, c] = mesh_.diagonal(k);
+  const Eigen::Vector3d middle = 0.5 * (row3(x, b.value()) + row3(x, c.value()));
+  const std::optional<BodyProximity> near = contact->collider().closest_point(middle);
+  if (!near) return true;
+  const double lift = contact->settings().thickness - near->distance;
+  if (lift <= 0.0) return true;
+  // Lifting E by δ changes each child triangle (E, apex, B or C) by δ against its height from E,
+  // the distance from E to the opposite side: a lift along the surface stretches it by δ/height,
+  // one square to it by about (δ/height)²/2. The smallest height decides, and a flat parent
+  // (an apex near the diagonal) has a small one: refined there, a lift of a centimetre had
+  // stretched a t-shirt's children by 340 % and the drape failed.
+  const auto height = [&](VertexId apex, VertexId end) {
+    const Eigen::Vector3d p = row3(x, apex.value()), q = row3(x, end.value());
+    const Eigen::Vector3d side = q - p;
+    const double length = side.norm();
+    return length > 0.0 ? side.cross(middle - p).norm() / length : 0.0;
+  };
+  double shortest = std::numeric_limits<double>::infinity();
+  for (VertexId apex : mesh_.apexes(k))
+    if (apex.valid()) shortest = std::min({shortest, height(apex, b), height(apex, c)});
+  constexpr double kMaxLiftPerHeight = 0.3;
+  return lift <= kMaxLiftPerHeight * shortest;
 }
 
 void AdaptiveCloth::set_body(const meshing::TriMesh& body) { simulation_->set_body(body); }
@@ -311,6 +354,12 @@ double AdaptiveCloth::rebuild(Transfer& state, const SimulationSettings* first_s
     }
   }
   ClothModel model = build_cloth_model(input, material_.fabric, material_.model_options);
+  if (material_.source_ease.size() > 0) {
+    Eigen::VectorXd scale(arrays_.faces.rows());
+    for (Eigen::Index f = 0; f < scale.size(); ++f)
+      scale(f) = ease(arrays_.triangle_ids[static_cast<std::size_t>(f)]);
+    scale_rest_shapes(model, scale);
+  }
   if (first) {
     state.m = model.mass;
   } else {
@@ -370,6 +419,7 @@ AdaptStats AdaptiveCloth::finish(Transfer& state, AdaptStats stats,
   report_.forced_splits += stats.forced_splits;
   report_.merges += stats.merges;
   report_.moved_off_body += stats.moved_off_body;
+  report_.splits_declined_on_body += stats.splits_declined_on_body;
   report_.topology_changes += stats.changed() ? 1 : 0;
   report_.estimate_s += stats.estimate_s;
   report_.operations_s += stats.operations_s;
@@ -504,6 +554,10 @@ AdaptStats AdaptiveCloth::adapt() {
     for (BlockId k : blocks) {
       if (!k.valid() || !mesh_.can_split(k) || touched(k)) continue;
       if (mesh_.level(k) + 1 > settings_.max_level) continue;
+      if (!split_stays_off_body(k, x)) {
+        ++stats.splits_declined_on_body;
+        continue;
+      }
       count_split(mesh_.split(k), state, stats);
     }
   }

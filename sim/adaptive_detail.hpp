@@ -68,6 +68,10 @@ struct AdaptiveMaterial {
   // this is the parent's frame too).
   Eigen::MatrixX3d source_warp;
   Eigen::Vector3d up = Eigen::Vector3d::UnitY();
+  // Rest-shape scale per input face (a panel's `ease`, see scale_rest_shapes), or empty: 1.
+  // Children inherit their input face's, so an eased panel keeps its ease at every level; mass
+  // moves between triangles at the eased density ρ·e².
+  Eigen::VectorXd source_ease;
 };
 
 // What a topology change must conserve (mass, momentum) or may change only within a bound
@@ -84,6 +88,7 @@ struct AdaptStats {
   int forced_splits = 0;  // splits the 4-8 rules forced first
   int merges = 0;
   int moved_off_body = 0;  // split vertices moved out to the contact thickness
+  int splits_declined_on_body = 0;  // requests not made: lifting E off the body would stretch
   int vertices = 0;       // after the change
   int triangles = 0;
   double estimate_s = 0.0;    // wall time: error estimates and merge candidates
@@ -115,6 +120,7 @@ struct AdaptiveReport {
   int merges = 0;
   int topology_changes = 0;  // steps on which the mesh changed (and the model was rebuilt)
   int moved_off_body = 0;    // split vertices moved out to the contact thickness
+  int splits_declined_on_body = 0;  // per step, see split_stays_off_body
   int vertices_min = 0, vertices_max = 0;
   int max_level_reached = 0;
   double estimate_s = 0.0;
@@ -206,6 +212,13 @@ class AdaptiveCloth {
   // Moves the split vertex `e` (row of state.x) out to the contact thickness if the body is
   // closer than that.
   void keep_off_body(int e, Transfer& state) const;
+  // The rest-shape scale of triangle t (its input face's ease, 1 without).
+  double ease(meshing::TriangleId t) const;
+  // False when splitting block k would put its new vertex so deep inside the body (a chord of a
+  // coarse block across a sharp body feature, or of a flat block) that moving it out to the
+  // contact thickness would stretch its children by more than a few per cent; such blocks stay
+  // coarse (and are counted in splits_declined_on_body).
+  bool split_stays_off_body(meshing::BlockId k, const Eigen::VectorXd& x) const;
   AdaptStats finish(Transfer& state, AdaptStats stats,
                     std::chrono::steady_clock::time_point operations_start);
   void count_split(const std::vector<meshing::BlockChange>& changes, Transfer& state,

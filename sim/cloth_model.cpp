@@ -59,6 +59,29 @@ void check_input(const ClothInput& input) {
 
 }  // namespace
 
+void scale_rest_shapes(ClothModel& model, const Eigen::VectorXd& scale) {
+  if (scale.size() != static_cast<Eigen::Index>(model.triangles.size()))
+    throw InvalidClothError("a rest-shape scale is needed for every triangle (" +
+                            std::to_string(scale.size()) + " given, " +
+                            std::to_string(model.triangles.size()) + " triangles)");
+  model.mass.setZero();
+  model.vertex_area.setZero();
+  for (std::size_t t = 0; t < model.triangles.size(); ++t) {
+    const double e = scale(static_cast<Eigen::Index>(t));
+    if (!(e > 0.0) || !std::isfinite(e))
+      throw InvalidClothError("rest-shape scale " + std::to_string(e) + " of triangle " +
+                              std::to_string(t) + " is not positive");
+    TriangleElement& element = model.triangles[t];
+    element.du /= e;
+    element.dv /= e;
+    element.rest_area *= e * e;
+    for (int v : element.vertices) {
+      model.vertex_area[v] += element.rest_area / 3.0;
+      model.mass[v] += model.fabric.area_density * element.rest_area / 3.0;
+    }
+  }
+}
+
 Eigen::VectorXd flatten_positions(const Eigen::MatrixX3d& positions) {
   Eigen::VectorXd flat(3 * positions.rows());
   for (Eigen::Index i = 0; i < positions.rows(); ++i) flat.segment<3>(3 * i) = positions.row(i);

@@ -87,6 +87,12 @@ struct ClothModel {
 ClothModel build_cloth_model(const ClothInput& input, const FabricParameters& fabric,
                              const ClothModelOptions& options = {});
 
+// Scales each triangle's rest shape by scale(t) (a panel's `ease`: lengths by e, so the gradient
+// operators du, dv by 1/e and the rest area by e²) and recomputes the lumped masses and vertex
+// areas from the scaled areas. Rest angles, and the bending weights |e|²/(A1+A2), do not change
+// under a uniform scale. `scale` is #triangles, every entry positive.
+void scale_rest_shapes(ClothModel& model, const Eigen::VectorXd& scale);
+
 // Flattens #V by 3 positions into the solver's 3n vector (x0,y0,z0,x1,...) and back.
 Eigen::VectorXd flatten_positions(const Eigen::MatrixX3d& positions);
 Eigen::MatrixX3d unflatten_positions(const Eigen::VectorXd& flat);

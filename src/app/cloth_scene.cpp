@@ -163,22 +163,7 @@ sim::SimulationSettings simulation_settings(const garment::Sketch& sketch) {
 
 sim::ClothModel build_scene_model(const ClothScene& scene) {
   sim::ClothModel model = sim::build_cloth_model(scene.input, scene.fabric);
-  if (scene.triangle_ease.size() == 0) return model;
-  // Rest coordinates scale by e: the gradient operators du, dv (inverse rest coordinates) by
-  // 1/e, the rest area by e². Masses and vertex areas follow the rest areas.
-  model.mass.setZero();
-  model.vertex_area.setZero();
-  for (size_t t = 0; t < model.triangles.size(); ++t) {
-    sim::TriangleElement& element = model.triangles[t];
-    const double e = scene.triangle_ease(static_cast<Eigen::Index>(t));
-    element.du /= e;
-    element.dv /= e;
-    element.rest_area *= e * e;
-    for (int v : element.vertices) {
-      model.vertex_area[v] += element.rest_area / 3.0;
-      model.mass[v] += model.fabric.area_density * element.rest_area / 3.0;
-    }
-  }
+  if (scene.triangle_ease.size() > 0) sim::scale_rest_shapes(model, scene.triangle_ease);
   return model;
 }
 

@@ -157,9 +157,6 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   const ClothScene scene = build_cloth_scene(sketch);
   if (scene.pinned.empty() && !scene.body)
     spdlog::warn("nothing holds the cloth (no pins, no body): it will fall for the whole run");
-  if (scene.triangle_ease.size() > 0 && sketch.simulate.adaptive && scene.mesh48)
-    spdlog::warn("panel ease is simulated on the fixed mesh only: adaptive detail drapes the "
-                 "panels as designed (set \"simulate\": {\"adaptive\": false} to use ease)");
 
   std::vector<sim::Pin> pins;
   for (int v : scene.pinned) pins.push_back({v, {}});
@@ -193,7 +190,15 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
     if (sketch.simulate.adaptive && scene.mesh48) {
       sim::AdaptiveMaterial material;
       material.fabric = scene.fabric;
-      if (scene.garment) material.source_warp = garment::material_frames(scene.garment->mesh).warp;
+      if (scene.garment) {
+        material.source_warp = garment::material_frames(scene.garment->mesh).warp;
+        if (scene.triangle_ease.size() > 0) {
+          const garment::Garment& g = *scene.garment;
+          material.source_ease.resize(g.face_panel.size());
+          for (Eigen::Index q = 0; q < g.face_panel.size(); ++q)
+            material.source_ease(q) = g.panels[static_cast<std::size_t>(g.face_panel(q))].ease;
+        }
+      }
       sim::AdaptiveCloth cloth(*scene.mesh48, material, scene.start, pins, settings,
                                adaptive_settings(sketch));
       if (scene.body) cloth.set_body(scene.body->mesh);  // contacts through every split and merge
@@ -213,6 +218,8 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
       adaptive_json = {{"splits", adaptive.splits},
                        {"forced_splits", adaptive.forced_splits},
                        {"merges", adaptive.merges},
+                       {"moved_off_body", adaptive.moved_off_body},
+                       {"splits_declined_on_body", adaptive.splits_declined_on_body},
                        {"topology_changes", adaptive.topology_changes},
                        {"vertices_min", adaptive.vertices_min},
                        {"vertices_max", adaptive.vertices_max},

@@ -104,16 +104,22 @@ struct Example {
   double top_min;
   double top_max;
   double max_centroid_drop;
+  // Drape with adaptive 4-8 detail on the body (one level finer where the folds ask for it)
+  // instead of the example's fixed mesh.
+  bool adaptive = false;
 };
 
 // gtest prints a parameter with PrintTo: the example's name.
-void PrintTo(const Example& e, std::ostream* os) { *os << e.name; }
+void PrintTo(const Example& e, std::ostream* os) {
+  *os << e.name << (e.adaptive ? " (adaptive)" : "");
+}
 
 class ExampleDrape : public ::testing::TestWithParam<Example> {};
 
 TEST_P(ExampleDrape, DrapesToRestOutsideTheBodyAndStaysOn) {
   const Example& example = GetParam();
-  const fs::path dir = fs::temp_directory_path() / "sd_examples_drape" / example.name;
+  const fs::path dir = fs::temp_directory_path() / "sd_examples_drape" /
+                       (example.name + (example.adaptive ? "-adaptive" : ""));
   fs::remove_all(dir);
   fs::create_directories(dir);
 
@@ -122,6 +128,8 @@ TEST_P(ExampleDrape, DrapesToRestOutsideTheBodyAndStaysOn) {
   nlohmann::json sketch =
       read_json(fs::path(SD_SOURCE_DIR) / "data/examples" / (example.name + ".json"));
   sketch["output"] = {{"images", nlohmann::json::array()}};
+  if (example.adaptive)
+    sketch["simulate"]["adaptive"] = {{"enabled", true}, {"max_level", 1}};
   const fs::path sketch_path = dir / (example.name + ".json");
   std::ofstream(sketch_path) << sketch.dump(2);
 
@@ -165,18 +173,31 @@ TEST_P(ExampleDrape, DrapesToRestOutsideTheBodyAndStaysOn) {
 // drawn line, centroid 8 mm lower); the godet skirt and the shorts, cut as drawn with a waist
 // 5-6 cm longer than the body's, settle 4-5 cm lower, where the hips fill them (measured: tops
 // 1.010 and 0.997 m, centroids 4.1 and 5.2 cm lower); the t-shirt and the dress drop 1-2 cm.
-INSTANTIATE_TEST_SUITE_P(Examples, ExampleDrape,
-                         ::testing::Values(Example{"a-line-skirt", 1.02, 1.06, 0.03},
-                                           Example{"godet-skirt", 0.98, 1.06, 0.06},
-                                           Example{"shorts", 0.97, 1.06, 0.07},
-                                           Example{"sleeveless-dress", 1.47, 1.52, 0.03},
-                                           Example{"tshirt", 1.47, 1.53, 0.04}),
-                         [](const ::testing::TestParamInfo<Example>& param_info) {
-                           std::string name = param_info.param.name;
-                           for (char& c : name)
-                             if (c == '-') c = '_';
-                           return name;
-                         });
+const std::vector<Example> kExamples = {{"a-line-skirt", 1.02, 1.06, 0.03},
+                                        {"godet-skirt", 0.98, 1.06, 0.06},
+                                        {"shorts", 0.97, 1.06, 0.07},
+                                        {"sleeveless-dress", 1.47, 1.52, 0.03},
+                                        {"tshirt", 1.47, 1.53, 0.04}};
+
+std::vector<Example> adaptive_examples() {
+  std::vector<Example> examples = kExamples;
+  for (Example& e : examples) e.adaptive = true;
+  return examples;
+}
+
+std::string test_name(const ::testing::TestParamInfo<Example>& param_info) {
+  std::string name = param_info.param.name;
+  for (char& c : name)
+    if (c == '-') c = '_';
+  return name;
+}
+
+INSTANTIATE_TEST_SUITE_P(Examples, ExampleDrape, ::testing::ValuesIn(kExamples), test_name);
+// The same garments with adaptive detail on the body: the t-shirt's first adaptive drape failed
+// at 0.05 s when a split of a flat block under the arm lifted its new vertex 14 mm out of the
+// body and stretched its children by 340 % (AdaptiveCloth::split_stays_off_body now declines it).
+INSTANTIATE_TEST_SUITE_P(AdaptiveExamples, ExampleDrape,
+                         ::testing::ValuesIn(adaptive_examples()), test_name);
 
 }  // namespace
 }  // namespace sd::test

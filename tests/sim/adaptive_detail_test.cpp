@@ -141,6 +141,58 @@ TEST(AdaptiveDetail, EachMergeConservesMassAndMomentum) {
   EXPECT_GE(merges, 20);
 }
 
+// A panel cut with ease e has its rest shape scaled by e (scale_rest_shapes): rest areas by e²,
+// so mass by e². Its children inherit the ease at every level: the carried masses stay the eased
+// lumped masses ρ·e²·A/3 through splits and merges, the total stays ρ·Σ e²·A, and momentum is
+// conserved (the transfer moves mass at each triangle's eased density).
+TEST(AdaptiveDetail, EasedPanelsKeepTheirEaseThroughSplitsAndMerges) {
+  AdaptiveSheetSpec spec;
+  spec.quads = 4;
+  testing::AdaptiveSheet sheet = testing::build_adaptive_sheet(spec);
+  const Eigen::Index quads = spec.quads * spec.quads;
+  sheet.material.source_ease = Eigen::VectorXd::Ones(quads);
+  for (Eigen::Index q = 0; q < quads / 2; ++q) sheet.material.source_ease(q) = 0.9;  // 2 rows
+  AdaptiveCloth cloth(std::move(sheet.mesh), sheet.material, {}, sheet.pins,
+                      testing::adaptive_sheet_settings(spec), fixed());
+  const double rho = cloth.simulation().model().fabric.area_density;
+  const double quad_area = std::pow(spec.size / spec.quads, 2);
+  const double expected_mass = rho * quad_area * (quads / 2 * 0.81 + quads / 2 * 1.0);
+  const auto eased_lumped = [&] {
+    const ClothModel& model = cloth.simulation().model();
+    Eigen::VectorXd mass = Eigen::VectorXd::Zero(model.vertex_count);
+    for (const TriangleElement& t : model.triangles)
+      for (int v : t.vertices) mass(v) += rho * t.rest_area / 3.0;
+    return mass;
+  };
+  EXPECT_NEAR(cloth.masses().sum(), expected_mass, 1e-14 * expected_mass);
+  // The model's rest areas are the eased ones: 0.81 of the plain area in the eased rows.
+  const Eigen::VectorXd plain = lumped_masses(cloth);
+  EXPECT_LT(eased_lumped().sum(), plain.sum());
+  cloth.refine_uniformly(2);
+  for (int i = 0; i < 8; ++i) ASSERT_TRUE(cloth.step().accepted);
+  int changes = 0;
+  for (int round = 0; round < 16; ++round) {
+    const ConservedQuantities before = cloth.conserved_quantities();
+    AdaptStats stats;
+    if (round % 2 == 0) {
+      const std::vector<BlockId> leaves = cloth.mesh().leaf_blocks();
+      stats = cloth.split_blocks({leaves[(7 * round) % leaves.size()]});
+    } else {
+      const std::vector<BlockId> candidates = cloth.mesh().mergeable_blocks();
+      if (candidates.empty()) continue;
+      stats = cloth.merge_blocks({candidates[(5 * round) % candidates.size()]});
+    }
+    if (!stats.changed()) continue;
+    ++changes;
+    const ConservedQuantities after = cloth.conserved_quantities();
+    EXPECT_NEAR(after.mass, expected_mass, 1e-13 * expected_mass);
+    EXPECT_LE((after.momentum - before.momentum).norm(), 1e-13 * expected_mass);
+    EXPECT_LE((cloth.masses() - eased_lumped()).cwiseAbs().maxCoeff(), 1e-14 * expected_mass);
+    ASSERT_TRUE(cloth.step().accepted);
+  }
+  EXPECT_GE(changes, 12);
+}
+
 // A new vertex on a pinned border is pinned at the midpoint of its pinned ends, following their
 // paths; merging it away unpins nothing else.
 TEST(AdaptiveDetail, PinsFollowSplitsAndMerges) {
