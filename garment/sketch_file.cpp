@@ -459,7 +459,7 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
   const std::string path = "/simulate";
   r.require_object(j, path, "simulate");
   r.check_keys(j, path, {"duration", "adaptive", "time_step", "integrator", "solver",
-                         "stop_at_rest", "gravity", "pin_above"});
+                         "stop_at_rest", "gravity", "pin_above", "check_body_vertices"});
   if (j.contains("pin_above")) sim.pin_above = r.number(j["pin_above"], path + "/pin_above");
   if (j.contains("duration")) sim.duration = r.positive(j["duration"], path + "/duration");
   if (j.contains("adaptive")) parse_adaptive(r, j["adaptive"], sim);
@@ -479,6 +479,8 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
   }
   if (j.contains("stop_at_rest")) sim.stop_at_rest = r.boolean(j["stop_at_rest"], path + "/stop_at_rest");
   if (j.contains("gravity")) sim.gravity = r.vector<3>(j["gravity"], path + "/gravity");
+  if (j.contains("check_body_vertices"))
+    sim.check_body_vertices = r.boolean(j["check_body_vertices"], path + "/check_body_vertices");
 }
 
 SheetSpec parse_sheet(const Reader& r, const json& j) {

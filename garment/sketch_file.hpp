@@ -109,6 +109,10 @@ struct SimulateSpec {
   bool stop_at_rest = true;
   Eigen::Vector3d gravity{0.0, -9.81, 0.0};
   std::optional<double> pin_above;         // metres: garment vertices designed at y >= this are pinned
+  // Also keep the body's vertices from poking through cloth triangles (sharp features: a dress
+  // form's edges, shoulder tips). Off by default: on smooth bodies it keeps the drape from
+  // settling (docs/collision.md).
+  bool check_body_vertices = false;
 };
 
 // A rectangular sheet of cloth instead of a garment: scenes for tests and benchmarks.

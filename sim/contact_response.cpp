@@ -53,6 +53,12 @@ constexpr double kPiercingHoldMargin = 0.25;
 // direction's value (d − d₁ cos θ)/sin θ would amplify small differences, so the contact's
 // direction carries both demands.
 constexpr double kMergeSine = 0.26;
+// m/s: the fastest a piercing correction (start of step, or re-solve) moves a corner. A
+// correction is a displacement the step's velocity inherits (v = Δx/h), so lifting a garment
+// that starts with body vertices a centimetre through it in one step made 1,172 m/s when the
+// step was halved to its minimum; capped, a deep start is lifted over a few steps (0.5 m/s:
+// 8 mm per 1/60 s step).
+constexpr double kMaxPiercingLiftSpeed = 0.5;
 
 class Stopwatch {
  public:
@@ -258,7 +264,8 @@ void ContactResponse::constrain_start_piercings(const Eigen::VectorXd& x_hat,
     if (!lift.set) continue;
     // Through (or closer than the clearance): move the start out, like a contact's position
     // correction; farther: a normal velocity that brings it back to the clearance.
-    if (lift.distance > 0.0) y.segment<3>(3 * i) += lift.distance * lift.normal;
+    if (lift.distance > 0.0)
+      y.segment<3>(3 * i) += std::min(lift.distance, kMaxPiercingLiftSpeed * beta) * lift.normal;
     const double normal_velocity =
         lift.body_velocity.dot(lift.normal) + std::min(lift.distance, 0.0) / beta;
     constrain_corner(filter, i, lift.normal, normal_velocity);
@@ -498,7 +505,10 @@ int ContactResponse::constrain_deep(const Eigen::VectorXd& x0, const Eigen::Vect
   for (int i = 0; i < static_cast<int>(lifts.size()); ++i) {
     const CornerLift& lift = lifts[i];
     if (!lift.set) continue;
-    const double target = x1.segment<3>(3 * i).dot(lift.normal) + lift.distance;
+    // The lift beyond where the solve put the corner, at most kMaxPiercingLiftSpeed · β: the
+    // rest waits for the next steps (and for finish_step's direct lift).
+    const double target = x1.segment<3>(3 * i).dot(lift.normal) +
+                          std::min(lift.distance, kMaxPiercingLiftSpeed * beta);
     const double start = (x_hat.segment<3>(3 * i) + y.segment<3>(3 * i)).dot(lift.normal);
     constrain_corner(filter, i, lift.normal, (target - start) / beta);
     ++added;

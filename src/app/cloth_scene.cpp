@@ -153,6 +153,7 @@ sim::SimulationSettings simulation_settings(const garment::Sketch& sketch) {
   settings.duration = spec.duration;
   settings.stop_at_rest = spec.stop_at_rest;
   settings.forces.gravity = spec.gravity;
+  settings.contact.check_body_vertices = spec.check_body_vertices;
   try {
     settings.validate();
   } catch (const sim::InvalidSimulationSettingsError& e) {

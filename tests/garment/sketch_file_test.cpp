@@ -43,6 +43,7 @@ TEST(SketchFile, MinimalFileGetsDefaults) {
   EXPECT_EQ(s.simulate.integrator, "implicit-euler");
   EXPECT_EQ(s.simulate.solver, "cholmod");
   EXPECT_FALSE(s.simulate.pin_above.has_value());
+  EXPECT_FALSE(s.simulate.check_body_vertices);
   EXPECT_EQ(s.output.mesh, "garment.obj");
   EXPECT_TRUE(s.output.images.empty());
   EXPECT_FALSE(s.output.images_listed);
@@ -99,7 +100,8 @@ TEST(SketchFile, ReadsEverySection) {
                 { "id": "q", "boundary": ["c"] } ],
     "join": [ { "id": "pq", "panels": ["p", "q"] } ],
     "simulate": { "duration": 2, "adaptive": false, "time_step": 0.01, "integrator": "implicit-euler",
-                  "solver": "cholmod", "stop_at_rest": false, "gravity": [0, -9.8, 0] },
+                  "solver": "cholmod", "stop_at_rest": false, "gravity": [0, -9.8, 0],
+                  "check_body_vertices": true },
     "output": { "images": [ { "view": "back", "size": [640, 480], "wireframe": true },
                             { "view": "three-quarter" } ],
                 "mesh": "g.glb", "report": false, "wireframe": true }
@@ -114,6 +116,7 @@ TEST(SketchFile, ReadsEverySection) {
   EXPECT_EQ(s.joins[0].panels.size(), 2u);
   EXPECT_EQ(s.simulate.solver, "cholmod");
   EXPECT_DOUBLE_EQ(s.simulate.gravity.y(), -9.8);
+  EXPECT_TRUE(s.simulate.check_body_vertices);
   ASSERT_EQ(s.output.images.size(), 2u);
   EXPECT_EQ(s.output.images[0].view, "back");
   EXPECT_EQ(s.output.images[0].width, 640);
