@@ -15,6 +15,7 @@
 #include "sim/body_collider.hpp"
 #include "sim/collision_geometry.hpp"
 #include "sim/sheet.hpp"
+#include "tests/sim/test_scenes.hpp"
 #include "sim/simulation.hpp"
 #include "test_bodies.hpp"
 
@@ -23,23 +24,8 @@ namespace {
 
 using Eigen::Vector3d;
 
-struct Sheet {
-  SheetScene scene;
-  ClothModel model;
-};
-
-// A free horizontal sheet of `size` metres with n×n quads centred at `centre`, cotton.
-Sheet horizontal_sheet(int n, double size, const Vector3d& centre) {
-  SheetSpec spec;
-  spec.orientation = SheetOrientation::horizontal;
-  spec.size = {size, size};
-  spec.columns = n;
-  spec.rows = n;
-  spec.centre = centre;
-  Sheet s{build_sheet(spec), {}};
-  s.model = build_cloth_model(s.scene.input, fabric_preset("cotton"));
-  return s;
-}
+using testing::horizontal_sheet;
+using Sheet = testing::SheetSetup;
 
 SimulationSettings piercing_settings(bool check_body_vertices) {
   SimulationSettings settings;

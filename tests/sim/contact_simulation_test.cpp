@@ -24,24 +24,8 @@ namespace {
 
 using Eigen::Vector3d;
 
-struct SheetSetup {
-  SheetScene scene;
-  ClothModel model;
-};
-
-// A free horizontal sheet (no pins) of `size` metres with n×n quads centred at `centre`.
-SheetSetup horizontal_sheet(int n, double size, const Vector3d& centre,
-                            const FabricParameters& fabric = fabric_preset("cotton")) {
-  SheetSpec spec;
-  spec.orientation = SheetOrientation::horizontal;
-  spec.size = {size, size};
-  spec.columns = n;
-  spec.rows = n;
-  spec.centre = centre;
-  SheetSetup s{build_sheet(spec), {}};
-  s.model = build_cloth_model(s.scene.input, fabric);
-  return s;
-}
+using testing::horizontal_sheet;
+using testing::SheetSetup;
 
 SimulationSettings contact_settings(double dt = 1.0 / 60.0) {
   SimulationSettings settings;

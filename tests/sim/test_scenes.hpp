@@ -13,6 +13,25 @@
 
 namespace sd::sim::testing {
 
+struct SheetSetup {
+  SheetScene scene;
+  ClothModel model;
+};
+
+// A free horizontal sheet (no pins) of `size` metres with n×n quads centred at `centre`.
+inline SheetSetup horizontal_sheet(int n, double size, const Eigen::Vector3d& centre,
+                                   const FabricParameters& fabric = fabric_preset("cotton")) {
+  SheetSpec spec;
+  spec.orientation = SheetOrientation::horizontal;
+  spec.size = {size, size};
+  spec.columns = n;
+  spec.rows = n;
+  spec.centre = centre;
+  SheetSetup s{build_sheet(spec), {}};
+  s.model = build_cloth_model(s.scene.input, fabric);
+  return s;
+}
+
 inline std::vector<Pin> fixed_pins(const SheetScene& scene) {
   std::vector<Pin> pins;
   for (int v : scene.pinned_vertices) pins.push_back({v, {}});
