@@ -206,6 +206,12 @@ BenchScene sketch_scene(const std::filesystem::path& file, BenchGrid grid) {
     scene.mesh = std::move(*cloth.mesh48);
     scene.material.fabric = cloth.fabric;
     scene.material.source_warp = garment::material_frames(cloth.garment->mesh).warp;
+    if (cloth.triangle_ease.size() > 0) {  // panel ease, as `run` applies it
+      const garment::Garment& g = *cloth.garment;
+      scene.material.source_ease.resize(g.face_panel.size());
+      for (Eigen::Index q = 0; q < g.face_panel.size(); ++q)
+        scene.material.source_ease(q) = g.panels[static_cast<size_t>(g.face_panel(q))].ease;
+    }
     scene.start = cloth.start;
     scene.pinned = cloth.pinned;
     if (cloth.body) scene.body = cloth.body->mesh;
@@ -504,6 +510,7 @@ std::string reference_key(const BenchScene& scene, const BenchConfig& reference,
   hash_matrix(hash, arrays.rest_positions);
   hash_matrix(hash, arrays.faces);
   hash_matrix(hash, scene.material.source_warp);
+  hash_matrix(hash, scene.material.source_ease);
   hash_matrix(hash, scene.start);
   hash_matrix(hash, scene.material_points);
   for (int v : scene.pinned) hash.update(fmt::format("pin {}\n", v));
@@ -573,6 +580,7 @@ BenchTrace run_bench_config(const BenchScene& scene, const BenchConfig& config) 
   // Fixed: the scene's 4-8 mesh refined uniformly, draped by the plain simulator (with the body).
   sim::ClothInput input;
   Eigen::MatrixX3d start;
+  Eigen::VectorXd triangle_ease;  // empty: every panel as designed
   std::vector<sim::Pin> fixed_pins;
   {
     sim::AdaptiveSettings off;
@@ -593,12 +601,21 @@ BenchTrace run_bench_config(const BenchScene& scene, const BenchConfig& config) 
         input.warp.row(t) = scene.material.source_warp.row(
             refined.mesh().source_face(arrays.triangle_ids[static_cast<size_t>(t)]));
     }
+    if (scene.material.source_ease.size() > 0) {
+      const meshing::Mesh48Arrays arrays = refined.mesh().arrays();
+      triangle_ease.resize(input.triangles.rows());
+      for (Eigen::Index t = 0; t < input.triangles.rows(); ++t)
+        triangle_ease(t) = scene.material.source_ease(
+            refined.mesh().source_face(arrays.triangle_ids[static_cast<size_t>(t)]));
+    }
     start = refined.positions();
     for (int v : refined.pinned_vertices()) fixed_pins.push_back({v, {}});
   }
-  sim::Simulation simulation(sim::build_cloth_model(input, scene.material.fabric,
-                                                    scene.material.model_options),
-                             sim::flatten_positions(start), fixed_pins, settings);
+  sim::ClothModel model =
+      sim::build_cloth_model(input, scene.material.fabric, scene.material.model_options);
+  if (triangle_ease.size() > 0) sim::scale_rest_shapes(model, triangle_ease);
+  sim::Simulation simulation(std::move(model), sim::flatten_positions(start), fixed_pins,
+                             settings);
   if (scene.body) simulation.set_body(*scene.body);
   const auto located = locate(input.rest_positions, input.triangles, scene.material_points);
   trace.rss_before_mb = peak_rss_mb();
