@@ -47,4 +47,9 @@ Eigen::VectorXd face_areas(const TriMesh& mesh);
 // Area-weighted vertex normals, #V by 3, unit length (zero for unused vertices).
 Eigen::MatrixX3d vertex_normals(const TriMesh& mesh);
 
+// An icosphere: the icosahedron subdivided `subdivisions` times (20·4^s triangles), every vertex
+// on the sphere of `radius` around `centre`, faces outward. One vertex sits at the top,
+// centre + radius·(0, 1, 0), once subdivisions ≥ 1.
+TriMesh icosphere(double radius, int subdivisions, const Eigen::Vector3d& centre);
+
 }  // namespace sd::meshing

@@ -102,38 +102,6 @@ StressScene sliver_sheet(double ratio) {
   return scene;
 }
 
-// An icosphere of radius r (every vertex on the sphere), outward-facing.
-meshing::TriMesh icosphere(double r, int subdivisions, const Vector3d& centre) {
-  const double g = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<Vector3d> v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
-                             {0, -1, -g}, {0, 1, -g}, {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
-  std::vector<Eigen::Vector3i> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-                                    {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                                    {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-                                    {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
-  for (Vector3d& p : v) p.normalize();
-  for (int s = 0; s < subdivisions; ++s) {
-    std::map<std::pair<int, int>, int> midpoint;
-    const auto mid = [&](int a, int b) {
-      const auto key = std::minmax(a, b);
-      if (const auto it = midpoint.find(key); it != midpoint.end()) return it->second;
-      v.push_back((v[a] + v[b]).normalized());
-      return midpoint[key] = static_cast<int>(v.size()) - 1;
-    };
-    std::vector<Eigen::Vector3i> next;
-    for (const Eigen::Vector3i& t : f) {
-      const int a = mid(t[0], t[1]), b = mid(t[1], t[2]), c = mid(t[2], t[0]);
-      next.insert(next.end(), {{t[0], a, c}, {t[1], b, a}, {t[2], c, b}, {a, b, c}});
-    }
-    f = std::move(next);
-  }
-  meshing::TriMesh mesh;
-  mesh.vertices.resize(static_cast<Eigen::Index>(v.size()), 3);
-  for (size_t i = 0; i < v.size(); ++i) mesh.vertices.row(static_cast<Eigen::Index>(i)) = centre + r * v[i];
-  mesh.faces.resize(static_cast<Eigen::Index>(f.size()), 3);
-  for (size_t i = 0; i < f.size(); ++i) mesh.faces.row(static_cast<Eigen::Index>(i)) = f[i];
-  return mesh;
-}
 
 // A free 0.6 m sheet at y = 1 m and a 15 cm sphere that starts 30 cm below it and moves up at
 // `speed` for `travel` metres, hitting the falling sheet, then stops: the sheet drapes on it.
@@ -143,7 +111,7 @@ StressScene sphere_strike(double speed) {
   StressScene scene;
   scene.model = sim::build_cloth_model(sheet.input, sim::fabric_preset("cotton"));
   scene.x0 = sim::flatten_positions(sheet.input.rest_positions);
-  const meshing::TriMesh sphere = icosphere(kRadius, 3, Vector3d(0.0, 1.0 - kRadius - 0.3, 0.0));
+  const meshing::TriMesh sphere = meshing::icosphere(kRadius, 3, Vector3d(0.0, 1.0 - kRadius - 0.3, 0.0));
   const double end = kTravel / speed;
   scene.body = sim::make_pose_sequence(sphere, {0.0, end}, [&](double t) {
     Eigen::MatrixX3d d = Eigen::MatrixX3d::Zero(sphere.vertex_count(), 3);

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <algorithm>
+
 namespace sd::meshing {
 namespace {
 
@@ -23,6 +26,41 @@ TEST(TriMesh, CubeIsClosedOrientedSingleComponent) {
   EXPECT_EQ(topo.components, 1);
   EXPECT_EQ(topo.degenerate_faces, 0);
   EXPECT_NEAR(face_areas(cube()).sum(), 6.0, 1e-12);
+}
+
+// Every level: closed, oriented, on the sphere, faces outward (the enclosed volume, by the
+// divergence theorem, is positive and approaches 4/3 π r³), with a vertex at the top.
+TEST(TriMesh, IcosphereIsAClosedOutwardSphere) {
+  const Eigen::Vector3d centre(0.1, 1.0, -0.2);
+  const double radius = 0.25;
+  for (int level = 0; level <= 4; ++level) {
+    const TriMesh sphere = icosphere(radius, level, centre);
+    EXPECT_EQ(sphere.face_count(), 20 << (2 * level));
+    const TriMeshTopology topo = analyse_topology(sphere);
+    EXPECT_TRUE(topo.closed() && topo.oriented());
+    EXPECT_EQ(topo.components, 1);
+    double volume = 0.0, top = -1.0;
+    for (Eigen::Index v = 0; v < sphere.vertices.rows(); ++v) {
+      const Eigen::Vector3d p = sphere.vertices.row(v).transpose() - centre;
+      EXPECT_NEAR(p.norm(), radius, 1e-12);
+      top = std::max(top, p.y());
+    }
+    for (Eigen::Index f = 0; f < sphere.face_count(); ++f) {
+      const Eigen::Vector3d a = sphere.vertices.row(sphere.faces(f, 0)).transpose() - centre;
+      const Eigen::Vector3d b = sphere.vertices.row(sphere.faces(f, 1)).transpose() - centre;
+      const Eigen::Vector3d c = sphere.vertices.row(sphere.faces(f, 2)).transpose() - centre;
+      volume += a.dot(b.cross(c)) / 6.0;
+    }
+    const double ball = 4.0 / 3.0 * 3.14159265358979323846 * radius * radius * radius;
+    EXPECT_GT(volume, 0.6 * ball);
+    EXPECT_LT(volume, ball);
+    if (level >= 4) {
+      EXPECT_GT(volume, 0.99 * ball);
+    }
+    if (level >= 1) {
+      EXPECT_NEAR(top, radius, 1e-12);
+    }
+  }
 }
 
 TEST(TriMesh, OpenFlippedAndNonManifoldAreCounted) {
