@@ -4,6 +4,7 @@
 #include <limits>
 #include <array>
 #include <chrono>
+#include <initializer_list>
 #include <cmath>
 #include <numbers>
 #include <optional>
@@ -53,6 +54,27 @@ std::optional<std::array<int, 4>> hinge_between(const meshing::Mesh48& mesh, Tri
 }
 
 Eigen::Vector3d row3(const Eigen::VectorXd& flat, int i) { return flat.segment<3>(3 * i); }
+
+// How far a split vertex at `e` (on the diagonal b–c) may be lifted off the body. Lifting E by δ
+// changes each child triangle (E, apex, b or c) by δ against its height from E, the distance
+// from E to the opposite side: a lift along the surface stretches it by δ/height, one square to
+// it by about (δ/height)²/2. 0.3 × the smallest height keeps the stretch below ~4.4 % (about 5x
+// the strain of draped cotton). A flat parent (an apex near the diagonal) has small heights:
+// lifted without this bound, a t-shirt split under the arm was moved 14 mm off the body and its
+// children stretched by 340 %.
+double safe_lift(const Eigen::Vector3d& e, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                 std::initializer_list<const Eigen::Vector3d*> apexes) {
+  constexpr double kMaxLiftPerHeight = 0.3;
+  const auto height = [&](const Eigen::Vector3d& p, const Eigen::Vector3d& q) {
+    const Eigen::Vector3d side = q - p;
+    const double length = side.norm();
+    return length > 0.0 ? side.cross(e - p).norm() / length : 0.0;
+  };
+  double shortest = std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector3d* apex : apexes)
+    if (apex != nullptr) shortest = std::min({shortest, height(*apex, b), height(*apex, c)});
+  return kMaxLiftPerHeight * shortest;
+}
 
 }  // namespace
 
@@ -215,7 +237,7 @@ void AdaptiveCloth::apply(const BlockChange& change, Transfer& state) {
     // E at the midpoint of BC in world space, as in rest space: each child keeps its parent's
     // deformation gradient, so stretch, shear and the centre of mass are unchanged.
     meshing::place_split_vertex(change, state.x);
-    keep_off_body(change.e.value(), state);
+    keep_off_body(change, state);
     // E comes from the edge BC if both are particles from before the batch.
     const VertexOrigin& from_b = state.origin[static_cast<std::size_t>(change.b.value())];
     const VertexOrigin& from_c = state.origin[static_cast<std::size_t>(change.c.value())];
@@ -270,43 +292,43 @@ double AdaptiveCloth::ease(TriangleId t) const {
   return material_.source_ease(source);
 }
 
-void AdaptiveCloth::keep_off_body(int e, Transfer& state) const {
+void AdaptiveCloth::keep_off_body(const BlockChange& change, Transfer& state) const {
   const ContactResponse* contact = simulation_->contact();
   if (contact == nullptr || !simulation_->settings().contact.enabled) return;
   const double thickness = contact->settings().thickness;
+  const int e = change.e.value();
   const Eigen::Vector3d x = state.x.row(e).transpose();
   // Unbounded: a chord across a sharp edge can put E deeper inside than the thickness.
   const std::optional<BodyProximity> near = contact->collider().closest_point(x);
   if (!near || near->distance >= thickness) return;
-  state.x.row(e) += ((thickness - near->distance) * near->normal).transpose();
+  // At most the safe lift (adapt() declines splits that need more; a uniform refinement cannot,
+  // and leaves the rest to the contacts): what is left inside is pushed out by the simulator.
+  const auto position = [&](VertexId v) -> Eigen::Vector3d { return state.x.row(v.value()); };
+  const Eigen::Vector3d xa = position(change.a);
+  const Eigen::Vector3d xd = change.d.valid() ? position(change.d) : Eigen::Vector3d::Zero();
+  const double lift =
+      std::min(thickness - near->distance,
+               safe_lift(x, position(change.b), position(change.c),
+                         {&xa, change.d.valid() ? &xd : nullptr}));
+  state.x.row(e) += (lift * near->normal).transpose();
   ++state.moved_off_body;
 }
 
-bool AdaptiveCloth::split_stays_off_body(BlockId k, const Eigen::VectorXd& x) const {
+bool AdaptiveCloth::split_stays_off_body(BlockId k, const Eigen::MatrixX3d& x) const {
   const ContactResponse* contact = simulation_->contact();
   if (contact == nullptr || !simulation_->settings().contact.enabled) return true;
+  const auto position = [&](VertexId v) -> Eigen::Vector3d { return x.row(v.value()); };
   const auto [b, c] = mesh_.diagonal(k);
-  const Eigen::Vector3d middle = 0.5 * (row3(x, b.value()) + row3(x, c.value()));
+  const Eigen::Vector3d xb = position(b), xc = position(c);
+  const Eigen::Vector3d middle = 0.5 * (xb + xc);
   const std::optional<BodyProximity> near = contact->collider().closest_point(middle);
   if (!near) return true;
   const double lift = contact->settings().thickness - near->distance;
   if (lift <= 0.0) return true;
-  // Lifting E by δ changes each child triangle (E, apex, B or C) by δ against its height from E,
-  // the distance from E to the opposite side: a lift along the surface stretches it by δ/height,
-  // one square to it by about (δ/height)²/2. The smallest height decides, and a flat parent
-  // (an apex near the diagonal) has a small one: refined there, a lift of a centimetre had
-  // stretched a t-shirt's children by 340 % and the drape failed.
-  const auto height = [&](VertexId apex, VertexId end) {
-    const Eigen::Vector3d p = row3(x, apex.value()), q = row3(x, end.value());
-    const Eigen::Vector3d side = q - p;
-    const double length = side.norm();
-    return length > 0.0 ? side.cross(middle - p).norm() / length : 0.0;
-  };
-  double shortest = std::numeric_limits<double>::infinity();
-  for (VertexId apex : mesh_.apexes(k))
-    if (apex.valid()) shortest = std::min({shortest, height(apex, b), height(apex, c)});
-  constexpr double kMaxLiftPerHeight = 0.3;
-  return lift <= kMaxLiftPerHeight * shortest;
+  const auto [a, d] = mesh_.apexes(k);
+  const Eigen::Vector3d xa = position(a);
+  const Eigen::Vector3d xd = d.valid() ? position(d) : Eigen::Vector3d::Zero();
+  return lift <= safe_lift(middle, xb, xc, {&xa, d.valid() ? &xd : nullptr});
 }
 
 void AdaptiveCloth::set_body(const meshing::TriMesh& body) { simulation_->set_body(body); }
@@ -554,7 +576,7 @@ AdaptStats AdaptiveCloth::adapt() {
     for (BlockId k : blocks) {
       if (!k.valid() || !mesh_.can_split(k) || touched(k)) continue;
       if (mesh_.level(k) + 1 > settings_.max_level) continue;
-      if (!split_stays_off_body(k, x)) {
+      if (!split_stays_off_body(k, state.x)) {
         ++stats.splits_declined_on_body;
         continue;
       }
@@ -589,13 +611,28 @@ AdaptStats AdaptiveCloth::refine_uniformly(int level) {
   AdaptStats stats;
   const auto start = Clock::now();
   Transfer state = begin_transfer();
+  // Blocks whose split would have to stretch the cloth to stay off the body stay coarse, as in
+  // adapt(); each is asked once.
+  std::vector<char> declined;
+  const auto is_declined = [&](BlockId k) {
+    const auto i = static_cast<std::size_t>(k.value());
+    return i < declined.size() && declined[i] != 0;
+  };
   for (;;) {
     std::vector<BlockId> coarse;
     for (BlockId k : mesh_.leaf_blocks())
-      if (mesh_.level(k) < level) coarse.push_back(k);
+      if (mesh_.level(k) < level && !is_declined(k)) coarse.push_back(k);
     if (coarse.empty()) break;
-    for (BlockId k : coarse)
-      if (mesh_.can_split(k)) count_split(mesh_.split(k), state, stats);
+    for (BlockId k : coarse) {
+      if (!mesh_.alive(k) || !mesh_.can_split(k)) continue;
+      if (!split_stays_off_body(k, state.x)) {
+        declined.resize(std::max(declined.size(), static_cast<std::size_t>(k.value()) + 1), 0);
+        declined[static_cast<std::size_t>(k.value())] = 1;
+        ++stats.splits_declined_on_body;
+        continue;
+      }
+      count_split(mesh_.split(k), state, stats);
+    }
   }
   return finish(state, stats, start);
 }

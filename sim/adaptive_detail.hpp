@@ -156,7 +156,9 @@ class AdaptiveCloth {
   // and the budget are not applied.
   AdaptStats split_blocks(const std::vector<meshing::BlockId>& blocks);
   AdaptStats merge_blocks(const std::vector<meshing::BlockId>& blocks);
-  // Splits every leaf block until all triangles are at `level` (a uniform fixed-resolution mesh).
+  // Splits every leaf block until all triangles are at `level` (a uniform fixed-resolution mesh),
+  // except, with a body set, blocks whose new vertex could not be lifted off the body without
+  // stretching the cloth (split_stays_off_body; counted in splits_declined_on_body).
   AdaptStats refine_uniformly(int level);
 
   // The body the cloth drapes on, as Simulation::set_body / set_body_motion (contacts, Coulomb
@@ -209,16 +211,16 @@ class AdaptiveCloth {
   double rebuild(Transfer& state, const SimulationSettings* first_settings = nullptr);
   Transfer begin_transfer() const;
   void apply(const meshing::BlockChange& change, Transfer& state);
-  // Moves the split vertex `e` (row of state.x) out to the contact thickness if the body is
-  // closer than that.
-  void keep_off_body(int e, Transfer& state) const;
+  // Moves the split's new vertex (row of state.x) out towards the contact thickness if the body
+  // is closer than that, by at most what its children can take without stretching (safe_lift).
+  void keep_off_body(const meshing::BlockChange& change, Transfer& state) const;
   // The rest-shape scale of triangle t (its input face's ease, 1 without).
   double ease(meshing::TriangleId t) const;
   // False when splitting block k would put its new vertex so deep inside the body (a chord of a
   // coarse block across a sharp body feature, or of a flat block) that moving it out to the
   // contact thickness would stretch its children by more than a few per cent; such blocks stay
   // coarse (and are counted in splits_declined_on_body).
-  bool split_stays_off_body(meshing::BlockId k, const Eigen::VectorXd& x) const;
+  bool split_stays_off_body(meshing::BlockId k, const Eigen::MatrixX3d& x) const;
   AdaptStats finish(Transfer& state, AdaptStats stats,
                     std::chrono::steady_clock::time_point operations_start);
   void count_split(const std::vector<meshing::BlockChange>& changes, Transfer& state,
