@@ -211,9 +211,9 @@ class AdaptiveCloth {
   double rebuild(Transfer& state, const SimulationSettings* first_settings = nullptr);
   Transfer begin_transfer() const;
   void apply(const meshing::BlockChange& change, Transfer& state);
-  // Moves the split's new vertex (row of state.x) out towards the contact thickness if the body
-  // is closer than that, by at most what its children can take without stretching (safe_lift).
-  void keep_off_body(const meshing::BlockChange& change, Transfer& state) const;
+  // Moves the split vertex `e` (row of state.x) out to the contact thickness if the body is
+  // closer than that (splits that would need more than safe_lift are declined before).
+  void keep_off_body(int e, Transfer& state) const;
   // The rest-shape scale of triangle t (its input face's ease, 1 without).
   double ease(meshing::TriangleId t) const;
   // False when splitting block k would put its new vertex so deep inside the body (a chord of a
