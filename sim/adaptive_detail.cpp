@@ -1,11 +1,11 @@
 #include "sim/adaptive_detail.hpp"
 
 #include <algorithm>
-#include <limits>
 #include <array>
 #include <chrono>
-#include <initializer_list>
 #include <cmath>
+#include <initializer_list>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <string>
@@ -618,8 +618,10 @@ AdaptStats AdaptiveCloth::refine_uniformly(int level) {
     for (BlockId k : mesh_.leaf_blocks())
       if (mesh_.level(k) < level && !is_declined(k)) coarse.push_back(k);
     if (coarse.empty()) break;
+    bool progress = false;
     for (BlockId k : coarse) {
       if (!mesh_.alive(k) || !mesh_.can_split(k)) continue;
+      progress = true;
       if (!split_stays_off_body(k, state.x)) {
         declined.resize(std::max(declined.size(), static_cast<std::size_t>(k.value()) + 1), 0);
         declined[static_cast<std::size_t>(k.value())] = 1;
@@ -628,6 +630,7 @@ AdaptStats AdaptiveCloth::refine_uniformly(int level) {
       }
       count_split(mesh_.split(k), state, stats);
     }
+    if (!progress) break;  // nothing left that can be split
   }
   return finish(state, stats, start);
 }
