@@ -57,11 +57,11 @@ Eigen::Vector3d row3(const Eigen::VectorXd& flat, int i) { return flat.segment<3
 
 // How far a split vertex at `e` (on the diagonal b–c) may be lifted off the body. Lifting E by δ
 // changes each child triangle (E, apex, b or c) by δ against its height from E, the distance
-// from E to the opposite side: a lift along the surface stretches it by δ/height, one square to
-// it by about (δ/height)²/2. 0.3 × the smallest height keeps the stretch below ~4.4 % (about 5x
-// the strain of draped cotton). A flat parent (an apex near the diagonal) has small heights:
-// lifted without this bound, a t-shirt split under the arm was moved 14 mm off the body and its
-// children stretched by 340 %.
+// from E to the opposite side: a lift square to the cloth stretches it by sqrt(1 + (δ/h)²) − 1,
+// 4.4 % at 0.3 × the smallest height (the usual case: the body's normal is near the cloth's),
+// a lift along it by up to δ/h, 30 %. A flat parent (an apex near the diagonal) has small
+// heights: lifted without this bound, a t-shirt split under the arm was moved 14 mm off the body
+// and its children stretched by 340 %.
 double safe_lift(const Eigen::Vector3d& e, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
                  std::initializer_list<const Eigen::Vector3d*> apexes) {
   constexpr double kMaxLiftPerHeight = 0.3;
