@@ -14,23 +14,12 @@
 namespace sd::sim {
 namespace {
 
-struct HangingSheet {
-  SheetScene scene;
-  ClothModel model;
-};
+using HangingSheet = testing::SheetSetup;
 
 // A horizontal sheet pinned at its two far corners: it falls, swings and settles hanging.
 HangingSheet hanging_sheet(int n, double size = 0.5,
                            const FabricParameters& fabric = fabric_preset("cotton")) {
-  SheetSpec spec;
-  spec.orientation = SheetOrientation::horizontal;
-  spec.size = {size, size};
-  spec.columns = n;
-  spec.rows = n;
-  spec.pins = {"top-left", "top-right"};
-  HangingSheet h{build_sheet(spec), {}};
-  h.model = build_cloth_model(h.scene.input, fabric);
-  return h;
+  return testing::horizontal_sheet(n, size, {0.0, 1.0, 0.0}, fabric, {"top-left", "top-right"});
 }
 
 Simulation make_simulation(const HangingSheet& h, const SimulationSettings& settings) {

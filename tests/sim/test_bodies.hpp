@@ -4,9 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <numbers>
-#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -16,45 +14,11 @@
 
 namespace sd::sim::testing {
 
-// Icosphere of radius r centred at `centre`: every vertex on the sphere, so the mesh lies
-// between the sphere and its inscribed sphere (see inscribed_radius).
+// Icosphere of radius r centred at `centre` (meshing::icosphere): every vertex on the sphere,
+// so the mesh lies between the sphere and its inscribed sphere (see inscribed_radius).
 inline meshing::TriMesh make_sphere(double r, int subdivisions,
                                     const Eigen::Vector3d& centre = Eigen::Vector3d::Zero()) {
-  const double g = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<Eigen::Vector3d> v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0},
-                                    {0, -1, g}, {0, 1, g}, {0, -1, -g}, {0, 1, -g},
-                                    {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
-  std::vector<Eigen::Vector3i> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-                                    {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                                    {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-                                    {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
-  for (auto& p : v) p.normalize();
-  for (int s = 0; s < subdivisions; ++s) {
-    std::map<std::pair<int, int>, int> midpoint;
-    const auto mid = [&](int a, int b) {
-      const auto key = std::minmax(a, b);
-      const auto it = midpoint.find(key);
-      if (it != midpoint.end()) return it->second;
-      v.push_back((v[a] + v[b]).normalized());
-      midpoint[key] = static_cast<int>(v.size()) - 1;
-      return static_cast<int>(v.size()) - 1;
-    };
-    std::vector<Eigen::Vector3i> next;
-    for (const auto& t : f) {
-      const int a = mid(t[0], t[1]), b = mid(t[1], t[2]), c = mid(t[2], t[0]);
-      next.push_back({t[0], a, c});
-      next.push_back({t[1], b, a});
-      next.push_back({t[2], c, b});
-      next.push_back({a, b, c});
-    }
-    f = next;
-  }
-  meshing::TriMesh mesh;
-  mesh.vertices.resize(static_cast<Eigen::Index>(v.size()), 3);
-  for (std::size_t i = 0; i < v.size(); ++i) mesh.vertices.row(i) = (centre + r * v[i]).transpose();
-  mesh.faces.resize(static_cast<Eigen::Index>(f.size()), 3);
-  for (std::size_t i = 0; i < f.size(); ++i) mesh.faces.row(i) = f[i].transpose();
-  return mesh;
+  return meshing::icosphere(r, subdivisions, centre);
 }
 
 // Smallest distance from `centre` to a face plane: the mesh of a sphere contains the ball of

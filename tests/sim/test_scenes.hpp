@@ -2,6 +2,7 @@
 // Small scenes shared by the simulator tests.
 
 #include <random>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -18,15 +19,18 @@ struct SheetSetup {
   ClothModel model;
 };
 
-// A free horizontal sheet (no pins) of `size` metres with n×n quads centred at `centre`.
+// A horizontal sheet of `size` metres with n×n quads centred at `centre`, free unless `pins`
+// names corners or edges (SheetSpec::pins).
 inline SheetSetup horizontal_sheet(int n, double size, const Eigen::Vector3d& centre,
-                                   const FabricParameters& fabric = fabric_preset("cotton")) {
+                                   const FabricParameters& fabric = fabric_preset("cotton"),
+                                   std::vector<std::string> pins = {}) {
   SheetSpec spec;
   spec.orientation = SheetOrientation::horizontal;
   spec.size = {size, size};
   spec.columns = n;
   spec.rows = n;
   spec.centre = centre;
+  spec.pins = std::move(pins);
   SheetSetup s{build_sheet(spec), {}};
   s.model = build_cloth_model(s.scene.input, fabric);
   return s;
