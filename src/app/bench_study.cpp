@@ -170,12 +170,7 @@ BenchScene sketch_scene(const std::filesystem::path& file, BenchGrid grid) {
     scene.mesh = std::move(*cloth.mesh48);
     scene.material.fabric = cloth.fabric;
     scene.material.source_warp = garment::material_frames(cloth.garment->mesh).warp;
-    if (cloth.triangle_ease.size() > 0) {  // panel ease, as `run` applies it
-      const garment::Garment& g = *cloth.garment;
-      scene.material.source_ease.resize(g.face_panel.size());
-      for (Eigen::Index q = 0; q < g.face_panel.size(); ++q)
-        scene.material.source_ease(q) = g.panels[static_cast<size_t>(g.face_panel(q))].ease;
-    }
+    scene.material.source_ease = cloth.mesh48_face_ease;  // panel ease, as `run` applies it
     scene.start = cloth.start;
     scene.pinned = cloth.pinned;
     if (cloth.body) scene.body = cloth.body->mesh;

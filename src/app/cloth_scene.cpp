@@ -110,6 +110,11 @@ void build_garment_scene(const garment::Sketch& sketch, ClothScene& scene) {
   scene.mesh48_face_group.resize(g.mesh.face_count());
   for (Eigen::Index q = 0; q < g.mesh.face_count(); ++q)
     scene.mesh48_face_group(q) = panel_group[static_cast<size_t>(g.face_panel(q))];
+  if (scene.triangle_ease.size() > 0) {
+    scene.mesh48_face_ease.resize(g.mesh.face_count());
+    for (Eigen::Index q = 0; q < g.mesh.face_count(); ++q)
+      scene.mesh48_face_ease(q) = g.panels[static_cast<size_t>(g.face_panel(q))].ease;
+  }
   scene.mesh48 = std::move(m48);
   scene.garment = std::move(g);
 }

@@ -31,6 +31,9 @@ struct ClothScene {
   // every triangle is as designed (sheets, imported garments).
   Eigen::VectorXd triangle_ease;
   Eigen::VectorXi mesh48_face_group;   // group of each input face of mesh48 (quad or triangle)
+  // The ease of each input face of mesh48 (what adaptive detail needs at every level); empty
+  // exactly when triangle_ease is.
+  Eigen::VectorXd mesh48_face_ease;
   std::vector<std::string> group_names;
   double meshing_ms = 0;               // time spent building the garment
 };

@@ -190,15 +190,8 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
     if (sketch.simulate.adaptive && scene.mesh48) {
       sim::AdaptiveMaterial material;
       material.fabric = scene.fabric;
-      if (scene.garment) {
-        material.source_warp = garment::material_frames(scene.garment->mesh).warp;
-        if (scene.triangle_ease.size() > 0) {
-          const garment::Garment& g = *scene.garment;
-          material.source_ease.resize(g.face_panel.size());
-          for (Eigen::Index q = 0; q < g.face_panel.size(); ++q)
-            material.source_ease(q) = g.panels[static_cast<std::size_t>(g.face_panel(q))].ease;
-        }
-      }
+      if (scene.garment) material.source_warp = garment::material_frames(scene.garment->mesh).warp;
+      material.source_ease = scene.mesh48_face_ease;
       sim::AdaptiveCloth cloth(*scene.mesh48, material, scene.start, pins, settings,
                                adaptive_settings(sketch));
       if (scene.body) cloth.set_body(scene.body->mesh);  // contacts through every split and merge
