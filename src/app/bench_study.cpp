@@ -14,6 +14,7 @@
 #include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "garment/material_frames.hpp"
 #include "garment/sketch_file.hpp"
@@ -550,11 +551,11 @@ BenchTrace run_bench_config(const BenchScene& scene, const BenchConfig& config) 
     return trace;
   }
 
-  // Fixed: the scene's 4-8 mesh refined uniformly, draped by the plain simulator (with the body).
-  sim::ClothInput input;
-  Eigen::MatrixX3d start;
-  Eigen::VectorXd triangle_ease;  // empty: every panel as designed
-  std::vector<sim::Pin> fixed_pins;
+  // Fixed: the scene's 4-8 mesh refined uniformly, draped by the plain simulator (with the body)
+  // on the model the refined cloth built (warp, panel ease and masses as in an adaptive run).
+  Eigen::MatrixX3d rest;
+  Eigen::MatrixX3i faces;
+  std::optional<sim::Simulation> fixed;
   {
     sim::AdaptiveSettings off;
     off.enabled = false;
@@ -564,33 +565,16 @@ BenchTrace run_bench_config(const BenchScene& scene, const BenchConfig& config) 
     // midpoints inside it (the t-shirt at L2: the start repair then blew up within 5 steps).
     if (scene.body) refined.set_body(*scene.body);
     if (config.level > 0) refined.refine_uniformly(config.level);
-    input.rest_positions = refined.rest_positions();
-    input.triangles = refined.faces();
-    input.up = scene.material.up;
-    if (scene.material.source_warp.rows() > 0) {
-      const meshing::Mesh48Arrays arrays = refined.mesh().arrays();
-      input.warp.resize(input.triangles.rows(), 3);
-      for (Eigen::Index t = 0; t < input.triangles.rows(); ++t)
-        input.warp.row(t) = scene.material.source_warp.row(
-            refined.mesh().source_face(arrays.triangle_ids[static_cast<size_t>(t)]));
-    }
-    if (scene.material.source_ease.size() > 0) {
-      const meshing::Mesh48Arrays arrays = refined.mesh().arrays();
-      triangle_ease.resize(input.triangles.rows());
-      for (Eigen::Index t = 0; t < input.triangles.rows(); ++t)
-        triangle_ease(t) = scene.material.source_ease(
-            refined.mesh().source_face(arrays.triangle_ids[static_cast<size_t>(t)]));
-    }
-    start = refined.positions();
+    rest = refined.rest_positions();
+    faces = refined.faces();
+    std::vector<sim::Pin> fixed_pins;
     for (int v : refined.pinned_vertices()) fixed_pins.push_back({v, {}});
+    fixed.emplace(refined.simulation().model(), sim::flatten_positions(refined.positions()),
+                  std::move(fixed_pins), settings);
   }
-  sim::ClothModel model =
-      sim::build_cloth_model(input, scene.material.fabric, scene.material.model_options);
-  if (triangle_ease.size() > 0) sim::scale_rest_shapes(model, triangle_ease);
-  sim::Simulation simulation(std::move(model), sim::flatten_positions(start), fixed_pins,
-                             settings);
+  sim::Simulation& simulation = *fixed;
   if (scene.body) simulation.set_body(*scene.body);
-  const auto located = locate(input.rest_positions, input.triangles, scene.material_points);
+  const auto located = locate(rest, faces, scene.material_points);
   trace.rss_before_mb = peak_rss_mb();
   drive(
       scene, trace,
@@ -601,7 +585,7 @@ BenchTrace run_bench_config(const BenchScene& scene, const BenchConfig& config) 
       },
       [&] {
         record(simulation.time(),
-               follow(located, input.triangles, sim::unflatten_positions(simulation.positions())),
+               follow(located, faces, sim::unflatten_positions(simulation.positions())),
                simulation.energy().total());
       });
   const sim::SimulationReport& r = simulation.report();
@@ -610,7 +594,7 @@ BenchTrace run_bench_config(const BenchScene& scene, const BenchConfig& config) 
   trace.linear_solves = r.linear_solves;
   trace.cg_iterations_mean = r.cg_iterations_mean;
   trace.vertices_max = trace.vertices_final = simulation.model().vertex_count;
-  trace.triangles_max = static_cast<int>(input.triangles.rows());
+  trace.triangles_max = static_cast<int>(faces.rows());
   return trace;
 }
 
