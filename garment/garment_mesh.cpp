@@ -17,12 +17,20 @@
 #include "garment/network_faces.hpp"
 #include "garment/panel_loop.hpp"
 #include "garment/stroke_projection.hpp"
+#include "garment/surface_relaxation.hpp"
 #include "garment/surface_untangle.hpp"
 #include "meshing/patch_fill.hpp"
 #include "meshing/quad_quality.hpp"
 
 namespace sd::garment {
 namespace {
+
+// Smoothing along the body after the fill (surface_relaxation.hpp): at most this many sweeps
+// (the t-shirt's back needs 20 to unfold its crease with steps of half an edge; 10 do not),
+// stopped early once no vertex moves more than 1e-2 edge lengths (0.25 mm) in a sweep.
+constexpr int kSurfaceSweeps = 20;
+constexpr double kSurfaceTolerance = 1e-2;  // edge lengths
+constexpr double kSurfaceMaxStep = 0.5;     // edge lengths
 
 // Global vertices of the garment: node and curve-piece vertices are made once and shared.
 struct VertexPool {
@@ -238,20 +246,21 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
       // projection (a hash collision only gives a poorer hint, never another answer).
       std::unordered_map<std::int64_t, SurfacePoint> hints;
       const double cell = 0.5 * reach;
+      const SurfaceLift lift = [&body, &hints, cell, offset,
+                                reach](const Eigen::Vector3d& p) -> LiftedPoint {
+        const Eigen::Vector3d q = (p / cell).array().floor();
+        const std::int64_t key = (static_cast<std::int64_t>(q.x()) * 73856093) ^
+                                 (static_cast<std::int64_t>(q.y()) * 19349663) ^
+                                 (static_cast<std::int64_t>(q.z()) * 83492791);
+        SurfacePoint& hint = hints[key];
+        const SurfacePoint s = body.closest_point(p, hint);
+        hint = s;
+        const double signed_distance = (p - s.position).dot(s.normal);
+        if (signed_distance < offset + reach) return {s.position + offset * s.normal, s.normal};
+        return {p, Eigen::Vector3d::Zero()};
+      };
       if (on_body > 0)
-        options.project = [&body, &hints, cell, offset,
-                           reach](const Eigen::Vector3d& p) -> Eigen::Vector3d {
-          const Eigen::Vector3d q = (p / cell).array().floor();
-          const std::int64_t key = (static_cast<std::int64_t>(q.x()) * 73856093) ^
-                                   (static_cast<std::int64_t>(q.y()) * 19349663) ^
-                                   (static_cast<std::int64_t>(q.z()) * 83492791);
-          SurfacePoint& hint = hints[key];
-          const SurfacePoint s = body.closest_point(p, hint);
-          hint = s;
-          const double signed_distance = (p - s.position).dot(s.normal);
-          if (signed_distance < offset + reach) return s.position + offset * s.normal;
-          return p;
-        };
+        options.project = [&lift](const Eigen::Vector3d& p) { return lift(p).position; };
       const auto normal = [&body](const Eigen::Vector3d& p) -> Eigen::Vector3d { return body.closest_point(p).normal; };
       meshing::FilledPatch patch;
       try {
@@ -259,12 +268,25 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
       } catch (const meshing::FillError& e) {
         sketch.fail(loop.json_path, fmt::format("panel '{}' cannot be filled with quads: {}", loop.id, e.what()));
       }
+      std::vector<char> fixed(static_cast<size_t>(patch.mesh.vertex_count()), 0);
+      for (const auto& side : patch.topology.side_vertices)
+        for (int v : side) fixed[static_cast<size_t>(v)] = 1;
+      if (on_body > 0) {
+        // Smooth along the surface (see surface_relaxation.hpp); kept when it leaves fewer
+        // folded quads, or as many and a better worst corner.
+        meshing::QuadMesh relaxed = patch.mesh;
+        relax_on_surface(relaxed, fixed, lift,
+                         {kSurfaceSweeps, kSurfaceTolerance * reach, kSurfaceMaxStep * reach});
+        const meshing::QuadQuality quality = meshing::measure_quality(relaxed, patch.topology.corner_vertices());
+        if (std::pair(quality.inverted_quads, -quality.scaled_jacobian_min) <
+            std::pair(patch.quality.inverted_quads, -patch.quality.scaled_jacobian_min)) {
+          patch.mesh = std::move(relaxed);
+          patch.quality = quality;
+        }
+      }
       if (patch.quality.inverted_quads > 0) {
         // Unfold against the body's normals, then measure again as the filler does; kept only
         // when it leaves fewer folded quads by that measure.
-        std::vector<char> fixed(static_cast<size_t>(patch.mesh.vertex_count()), 0);
-        for (const auto& side : patch.topology.side_vertices)
-          for (int v : side) fixed[static_cast<size_t>(v)] = 1;
         meshing::QuadMesh unfolded = patch.mesh;
         untangle_on_surface(unfolded, fixed, options.project, normal);
         const meshing::QuadQuality quality = meshing::measure_quality(unfolded, patch.topology.corner_vertices());

@@ -170,13 +170,26 @@ TEST(Garment, ParityMakesEveryPanelEvenWithFewChanges) {
   }
 }
 
+TEST(Garment, ExamplePanelsHaveNoCreaseOfDegenerateQuads) {
+  // Where a panel wraps a strongly curved part of the body, relaxing in 3D and projecting can
+  // leave a crease of long, thin quads (the t-shirt's back had a quad of aspect ratio 1,579,
+  // 22 cm by 0.3 mm, and the body showed through the gap); smoothing along the surface
+  // (surface_relaxation.hpp) spreads it out. Every example's worst quad now measures at most
+  // 9.9 (the shorts' front); 12 leaves room for small changes of the filler.
+  for (const auto& file : test::example_files()) {
+    const Garment g = build_garment(load_sketch(file), builtin_surface());
+    for (const GarmentPanel& p : g.panels) EXPECT_LT(p.quality.max_aspect_ratio, 12.0) << file << " " << p.id;
+  }
+}
+
 TEST(Garment, ExamplesHaveNoFoldedQuadsBeyondTheRecordedFew) {
   // Quads folded over (a corner's scaled Jacobian below zero against the mesh's own normals, as
   // the report counts them), after the garment unfolds them against the body's normals.
-  // Recorded figures per example (docs/garment.md): the t-shirt's back keeps 2 per side, the
-  // shorts' back 1 per side; every other example has none. Seam vertices folded between a panel
-  // and its own mirror copy (merged away with a warning): only the shorts' centre front, once.
-  const std::map<std::string, int> recorded = {{"tshirt", 4}, {"tshirt-arms-lowering", 4}, {"shorts", 2}};
+  // Recorded figures per example (docs/garment.md): the t-shirt's back keeps 1 per side (at the
+  // underarm), the shorts' back 1 per side; every other example has none. Seam vertices folded
+  // between a panel and its own mirror copy (merged away with a warning): only the shorts'
+  // centre front, once.
+  const std::map<std::string, int> recorded = {{"tshirt", 2}, {"tshirt-arms-lowering", 2}, {"shorts", 2}};
   for (const auto& file : test::example_files()) {
     const Garment g = build_garment(load_sketch(file), builtin_surface());
     int inverted = 0;

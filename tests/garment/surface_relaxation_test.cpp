@@ -1,0 +1,123 @@
+#include "garment/surface_relaxation.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <vector>
+
+#include "meshing/quad_quality.hpp"
+
+namespace sd::garment {
+namespace {
+
+// An n × n grid of unit-spaced quads in the plane z = 0, counter-clockwise from +z.
+meshing::QuadMesh plane_grid(int n) {
+  meshing::QuadMesh mesh;
+  mesh.vertices.resize((n + 1) * (n + 1), 3);
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j) mesh.vertices.row(i * (n + 1) + j) << j, i, 0.0;
+  mesh.faces.resize(n * n, 4);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const int a = i * (n + 1) + j;
+      mesh.faces.row(i * n + j) << a, a + 1, a + n + 2, a + n + 1;
+    }
+  return mesh;
+}
+
+std::vector<char> boundary_of_grid(int n) {
+  std::vector<char> fixed(static_cast<std::size_t>((n + 1) * (n + 1)), 0);
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j)
+      if (i == 0 || j == 0 || i == n || j == n) fixed[static_cast<std::size_t>(i * (n + 1) + j)] = 1;
+  return fixed;
+}
+
+std::vector<int> grid_corners(int n) { return {0, n, (n + 1) * (n + 1) - 1, n * (n + 1)}; }
+
+TEST(SurfaceRelaxation, SpreadsACollapsedInteriorBackToTheUniformGrid) {
+  // On a plane the fixed point of the sweeps is the discrete harmonic map, which for a square
+  // grid with uniformly spaced boundary vertices is the uniform grid itself: an exact answer.
+  const int n = 8;
+  const meshing::QuadMesh grid = plane_grid(n);
+  meshing::QuadMesh mesh = grid;
+  const std::vector<char> fixed = boundary_of_grid(n);
+  for (Eigen::Index v = 0; v < mesh.vertex_count(); ++v)
+    if (!fixed[static_cast<std::size_t>(v)]) mesh.vertices.row(v) << 0.5, 0.5, 0.0;  // one point
+  const SurfaceLift plane = [](const Eigen::Vector3d& p) {
+    return LiftedPoint{{p.x(), p.y(), 0.0}, Eigen::Vector3d::UnitZ()};
+  };
+  const SurfaceRelaxationResult result =
+      relax_on_surface(mesh, fixed, plane, {.max_sweeps = 2000, .tolerance = 1e-13, .max_step = 1.0});
+  EXPECT_LT(result.sweeps, 2000);
+  EXPECT_EQ(result.refused, 0);
+  EXPECT_LT((mesh.vertices - grid.vertices).cwiseAbs().maxCoeff(), 1e-10);
+}
+
+TEST(SurfaceRelaxation, KeepsTheBoundaryAndStaysOnASphere) {
+  // A folded patch on a sphere: the interior dragged and pushed off the surface. Relaxed, every
+  // free vertex lies on the sphere, the boundary is untouched (bitwise: panels are stitched by
+  // their boundary vertices) and no quad is folded.
+  const int n = 8;
+  const double r = 0.3;
+  meshing::QuadMesh mesh = plane_grid(n);
+  mesh.vertices *= 0.3 / n;
+  mesh.vertices.col(0).array() -= 0.15;
+  mesh.vertices.col(1).array() -= 0.15;
+  for (Eigen::Index v = 0; v < mesh.vertex_count(); ++v) {
+    const Eigen::Vector3d p(mesh.vertices(v, 0), mesh.vertices(v, 1), r);
+    mesh.vertices.row(v) = (r * p.normalized()).transpose();
+  }
+  const std::vector<char> fixed = boundary_of_grid(n);
+  const meshing::QuadMesh start = mesh;
+  // Drag one inner vertex across two of its neighbours and lift another 5 cm off the surface.
+  mesh.vertices.row(3 * (n + 1) + 3) = mesh.vertices.row(3 * (n + 1) + 6);
+  mesh.vertices.row(5 * (n + 1) + 5) *= (r + 0.05) / r;
+  ASSERT_GT(meshing::measure_quality(mesh, grid_corners(n)).inverted_quads, 0);
+  const SurfaceLift sphere = [r](const Eigen::Vector3d& p) {
+    return LiftedPoint{r * p.normalized(), p.normalized()};
+  };
+  relax_on_surface(mesh, fixed, sphere, {.max_sweeps = 200, .tolerance = 1e-9, .max_step = 0.02});
+  for (Eigen::Index v = 0; v < mesh.vertex_count(); ++v) {
+    if (fixed[static_cast<std::size_t>(v)]) {
+      EXPECT_EQ(mesh.vertices.row(v), start.vertices.row(v)) << v;
+    } else {
+      EXPECT_NEAR(mesh.vertices.row(v).norm(), r, 1e-12) << v;
+    }
+  }
+  const meshing::QuadQuality quality = meshing::measure_quality(mesh, grid_corners(n));
+  EXPECT_EQ(quality.inverted_quads, 0);
+  EXPECT_GT(quality.scaled_jacobian_min, 0.9);  // a fine grid on a sphere: nearly square
+}
+
+TEST(SurfaceRelaxation, RefusesLiftsThatJumpAcrossARidge) {
+  // A closest-point map with a ridge at x = 4.5: beyond it, points land on a parallel sheet
+  // 1 m away (as cloth under the arm lands on the torso or on the arm). Moves of at most 0.4
+  // never reach across: every vertex that would land over there stays on its own sheet.
+  const int n = 8;
+  meshing::QuadMesh mesh = plane_grid(n);
+  const std::vector<char> fixed = boundary_of_grid(n);
+  // Interior squeezed to the left half, so that relaxing pulls it across the ridge.
+  for (Eigen::Index v = 0; v < mesh.vertex_count(); ++v)
+    if (!fixed[static_cast<std::size_t>(v)]) mesh.vertices(v, 0) *= 0.5;
+  const SurfaceLift ridge = [](const Eigen::Vector3d& p) {
+    return LiftedPoint{{p.x(), p.y(), p.x() > 4.5 ? 1.0 : 0.0}, Eigen::Vector3d::UnitZ()};
+  };
+  const SurfaceRelaxationResult result =
+      relax_on_surface(mesh, fixed, ridge, {.max_sweeps = 100, .tolerance = 1e-9, .max_step = 0.4});
+  EXPECT_GT(result.refused, 0);
+  EXPECT_EQ(mesh.vertices.col(2).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_LE(mesh.vertices.col(0).maxCoeff(), n);
+}
+
+TEST(SurfaceRelaxation, RejectsAFixedListOfTheWrongLength) {
+  meshing::QuadMesh mesh = plane_grid(2);
+  const std::vector<char> fixed(3, 0);
+  const SurfaceLift plane = [](const Eigen::Vector3d& p) {
+    return LiftedPoint{p, Eigen::Vector3d::UnitZ()};
+  };
+  EXPECT_THROW(relax_on_surface(mesh, fixed, plane), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace sd::garment
