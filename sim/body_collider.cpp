@@ -446,6 +446,11 @@ std::vector<BodyPiercing> BodyCollider::find_piercings(
         for (int k = c0.z(); k <= c1.z(); ++k) cells.emplace_back(key_of({i, j, k}), t);
   }
   std::sort(cells.begin(), cells.end());
+  // Unit normals once per triangle (zero when degenerate), not once per pair.
+  std::vector<Eigen::Vector3d> normals(triangles.size());
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    normals[t] = triangle_normal(row(x, triangles[t][0]), row(x, triangles[t][1]),
+                                 row(x, triangles[t][2]));
 
   for (int v = 0; v < vertex_count(); ++v) {
     const Eigen::Vector3d b = corner(v, 1.0);
@@ -458,23 +463,24 @@ std::vector<BodyPiercing> BodyCollider::find_piercings(
     for (; it != cells.end() && it->first == key; ++it) {
       const int t = it->second;
       ++stats.pairs;
-      const Eigen::Vector3d p0 = row(x, triangles[t][0]), p1 = row(x, triangles[t][1]),
-                            p2 = row(x, triangles[t][2]);
-      Eigen::Vector3d normal = triangle_normal(p0, p1, p2);
+      Eigen::Vector3d normal = normals[static_cast<std::size_t>(t)];
       const double facing = normal.dot(body_normal);
       // Cloth edge-on to the body surface there (or degenerate): not covering the vertex.
       if (std::abs(facing) < 0.2) continue;
       if (facing < 0.0) normal = -normal;
+      // The height over the triangle's closest point is the height over its plane (the closest
+      // point lies in it): the band test needs no closest point.
+      const Eigen::Vector3d p0 = row(x, triangles[t][0]);
+      const double height = (b - p0).dot(normal);
+      if (height <= min_height || height >= max_height) continue;
+      if (best && height <= best->height) continue;
       // The closest point of the triangle, not only the projection: a body vertex pushed
       // through a ridge of the cloth (the shared edge of two triangles folded over it) projects
       // outside both triangles, but it is above both planes and its closest points lie on
       // the edge.
-      const TriangleClosestPoint closest = closest_point_on_triangle(b, p0, p1, p2);
-      const double height = (b - closest.point).dot(normal);
-      if (height <= min_height || height >= max_height ||
-          closest.squared_distance >= max_height * max_height)
-        continue;
-      if (best && height <= best->height) continue;
+      const TriangleClosestPoint closest =
+          closest_point_on_triangle(b, p0, row(x, triangles[t][1]), row(x, triangles[t][2]));
+      if (closest.squared_distance >= max_height * max_height) continue;
       // Not through (within the asked band below the cloth): only where the cloth covers the
       // vertex, its projection inside the triangle.
       if (height <= 0.0 && closest.feature != TriangleFeature::face) continue;
