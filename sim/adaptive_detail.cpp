@@ -692,13 +692,17 @@ AdaptiveReport AdaptiveCloth::run(const std::function<void(const AdaptiveCloth&)
       break;
     }
   }
-  // As Simulation::run: what is still inside the body at the end (after the last adaptation).
+  // As Simulation::run: what is still inside the body, or through the cloth, at the end (after
+  // the last adaptation).
   int penetrating = 0;
+  int piercing = 0;
+  double highest_piercing = 0.0;
   double query_s = 0.0;
   if (const ContactResponse* contact = simulation_->contact();
       contact != nullptr && settings.contact.enabled) {
     const auto query_start = Clock::now();
     penetrating = contact->count_penetrating(simulation_->positions());
+    piercing = contact->count_piercing(simulation_->positions(), &highest_piercing);
     query_s = seconds_since(query_start);
   }
   const double wall = seconds_since(start);
@@ -711,6 +715,8 @@ AdaptiveReport AdaptiveCloth::run(const std::function<void(const AdaptiveCloth&)
   report_.simulation.wall_time_s = wall_before + wall;
   report_.simulation.collision_s += query_s;
   report_.simulation.penetrating_vertices_final = penetrating;
+  report_.simulation.piercing_body_vertices_final = piercing;
+  report_.simulation.max_piercing_final_m = highest_piercing;
   report_.simulation.other_s = other_before + wall -
                                (report_.simulation.forces_s - before.forces_s) -
                                (report_.simulation.solve_s - before.solve_s) -

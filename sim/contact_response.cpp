@@ -650,4 +650,19 @@ int ContactResponse::count_penetrating(const Eigen::VectorXd& x, double* deepest
   return count;
 }
 
+int ContactResponse::count_piercing(const Eigen::VectorXd& x, double* highest) const {
+  const double reach = piercing_reach();
+  int count = 0;
+  double top = 0.0;
+  if (!cloth_triangles_.empty())
+    for (const BodyPiercing& p :
+         collider_.find_piercings(x, cloth_triangles_, settings_.penetration_tolerance, reach,
+                                  kPiercingUncheckedFraction * reach)) {
+      ++count;
+      top = std::max(top, p.height);
+    }
+  if (highest != nullptr) *highest = top;
+  return count;
+}
+
 }  // namespace sd::sim

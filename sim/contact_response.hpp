@@ -191,6 +191,10 @@ class ContactResponse {
 
   // Vertices of x (3n) deeper than the tolerance inside the body at its current pose.
   int count_penetrating(const Eigen::VectorXd& x, double* deepest = nullptr) const;
+  // Body vertices more than the tolerance through the cloth triangles (set_cloth_triangles) at
+  // x, whether or not check_body_vertices keeps them out: what a preview shows as the body
+  // poking through. `highest`: the largest height through, m (0 when none).
+  int count_piercing(const Eigen::VectorXd& x, double* highest = nullptr) const;
   // The cloth's own friction coefficient (FabricParameters::friction), used for whichever of
   // the two coefficients the settings leave unset.
   void set_fabric_friction(double friction) { fabric_friction_ = friction; }

@@ -411,6 +411,8 @@ SimulationReport Simulation::run(const std::function<void(const Simulation&)>& o
   if (contact_ && settings_.contact.enabled) {
     const auto query_start = std::chrono::steady_clock::now();
     report_.penetrating_vertices_final = contact_->count_penetrating(x_);
+    report_.piercing_body_vertices_final =
+        contact_->count_piercing(x_, &report_.max_piercing_final_m);
     report_.collision_s +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - query_start).count();
   }

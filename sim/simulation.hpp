@@ -112,6 +112,11 @@ struct SimulationReport {
   int contacts_final = 0;           // constrained contacts in the last step
   double max_penetration_m = 0.0;   // deepest penetration at the end of any accepted step
   int penetrating_vertices_final = 0;  // vertices deeper than the tolerance at the end
+  // Body vertices more than the tolerance through the cloth's triangles at the end (a body
+  // feature narrower than the cloth's triangles showing through), and the highest, m.
+  // Measured whether or not ContactSettings::check_body_vertices keeps them out.
+  int piercing_body_vertices_final = 0;
+  double max_piercing_final_m = 0.0;
   int contact_resolves = 0;         // extra solves for vertices that ended a solve too deep
   int projected_vertices = 0;       // vertices projected out after the re-solves (last resort)
   int start_repair_vertices = 0;    // vertices that started inside the body

@@ -82,6 +82,8 @@ nlohmann::json simulation_json(const sim::SimulationReport& r, const sim::Simula
           {"contacts_max", r.contacts_max},
           {"max_penetration_m", r.max_penetration_m},
           {"penetrating_vertices_final", r.penetrating_vertices_final},
+          {"piercing_body_vertices_final", r.piercing_body_vertices_final},
+          {"max_piercing_final_m", r.max_piercing_final_m},
           {"contacts_final", r.contacts_final},
           {"timing_s",
            {{"forces", r.forces_s},

@@ -517,6 +517,26 @@ TEST(BodyCollider, BodyVertexThroughAClothTriangleIsAPiercing) {
   EXPECT_TRUE(collider.find_piercings(aside, triangles, 0.0, 0.05).empty());
 }
 
+TEST(BodyCollider, BodyVertexBesideTheClothsOpenEdgeIsNotAPiercing) {
+  // The triangle 1 cm under the cone's apex, moved so that its edge z = 3 mm passes beside the
+  // apex (a neck beside a neckline): the apex is above the triangle's plane and its closest
+  // point on that edge lies inside the cone, but no cloth covers it.
+  const meshing::TriMesh cone = testing::make_cone(0.1, 0.2, 24);
+  const BodyCollider collider(cone);
+  Eigen::VectorXd beside(12);
+  beside << flat_triangle(0.19), 0.0, 0.14, -0.3;  // a fourth vertex for the ridge below
+  for (int k = 0; k < 3; ++k) beside[3 * k + 2] += 0.203;
+  ASSERT_NEAR(beside[8], 0.003, 1e-15);  // edge 2 (corners 2 and 0) runs along z = 3 mm
+  EXPECT_TRUE(collider.find_piercings(beside, {{0, 1, 2}}, 0.0, 0.05).empty());
+  // The same edge shared with a second triangle folded down behind it: a ridge of the cloth
+  // over the apex, which counts.
+  const std::vector<BodyPiercing> ridge =
+      collider.find_piercings(beside, {{0, 1, 2}, {2, 3, 0}}, 0.0, 0.05);
+  ASSERT_EQ(ridge.size(), 1u);
+  EXPECT_EQ(ridge.front().body_vertex, 0);
+  EXPECT_GT(ridge.front().height, 0.0);
+}
+
 TEST(BodyCollider, ClothBeyondAThinBodyPartIsNotAPiercing) {
   // A 1 cm slab; cloth 3 mm under it (a sleeve under the arm): the slab's top corners are
   // 13 mm "in front of" the cloth along their normals, but the cloth does not enter the body.
