@@ -175,10 +175,11 @@ TEST(Garment, ExamplePanelsHaveNoCreaseOfDegenerateQuads) {
   // leave a crease of long, thin quads (the t-shirt's back had a quad of aspect ratio 1,579,
   // 22 cm by 0.3 mm, and the body showed through the gap); smoothing along the surface
   // (surface_relaxation.hpp) spreads it out. Every example's worst quad now measures at most
-  // 9.9 (the shorts' front); 12 leaves room for small changes of the filler.
+  // 7.0 (the t-shirt's back sleeve); 10 leaves room for small changes of the filler. (The
+  // shorts at 2.5 cm quads reached 9.9, and their drape failed with check_body_vertices.)
   for (const auto& file : test::example_files()) {
     const Garment g = build_garment(load_sketch(file), builtin_surface());
-    for (const GarmentPanel& p : g.panels) EXPECT_LT(p.quality.max_aspect_ratio, 12.0) << file << " " << p.id;
+    for (const GarmentPanel& p : g.panels) EXPECT_LT(p.quality.max_aspect_ratio, 10.0) << file << " " << p.id;
   }
 }
 
@@ -187,8 +188,8 @@ TEST(Garment, ExamplesHaveNoFoldedQuadsBeyondTheRecordedFew) {
   // the report counts them), after the garment unfolds them against the body's normals.
   // Recorded figures per example (docs/garment.md): the t-shirt's back keeps 1 per side (at the
   // underarm), the shorts' back 1 per side; every other example has none. Seam vertices folded
-  // between a panel and its own mirror copy (merged away with a warning): only the shorts'
-  // centre front, once.
+  // between a panel and its own mirror copy (merged away with a warning): only on the shorts'
+  // centre seams, 4 with their 2 cm quads (1 with 2.5 cm quads).
   const std::map<std::string, int> recorded = {{"tshirt", 2}, {"tshirt-arms-lowering", 2}, {"shorts", 2}};
   for (const auto& file : test::example_files()) {
     const Garment g = build_garment(load_sketch(file), builtin_surface());
@@ -196,7 +197,7 @@ TEST(Garment, ExamplesHaveNoFoldedQuadsBeyondTheRecordedFew) {
     for (const GarmentPanel& p : g.panels) inverted += p.quality.inverted_quads;
     const auto it = recorded.find(file.stem().string());
     EXPECT_LE(inverted, it == recorded.end() ? 0 : it->second) << file;
-    EXPECT_EQ(g.merged_doublets, file.stem() == "shorts" ? 1 : 0) << file;
+    EXPECT_EQ(g.merged_doublets, file.stem() == "shorts" ? 4 : 0) << file;
     // And so every inner vertex of the stitched mesh is in at least three quads.
     std::map<int, int> quads;
     for (Eigen::Index f = 0; f < g.mesh.face_count(); ++f)
