@@ -246,7 +246,7 @@ void parse_body(const Reader& r, const json& j, BodySpec& body) {
     return;
   }
   r.require_object(j, path, "body");
-  r.check_keys(j, path, {"mesh", "height", "up", "scale"});
+  r.check_keys(j, path, {"mesh", "height", "up", "scale", "motion"});
   if (j.contains("mesh")) body.mesh = r.text(j["mesh"], path + "/mesh");
   if (body.mesh.empty()) r.fail(path + "/mesh", "the body mesh path is empty");
   if (j.contains("height")) body.height = r.positive(j["height"], path + "/height");
@@ -258,6 +258,29 @@ void parse_body(const Reader& r, const json& j, BodySpec& body) {
     if (!kAxes.contains(up))
       r.fail(path + "/up", fmt::format("'{}' is not an axis; use +x, -x, +y, -y, +z or -z", up));
     body.up = up;
+  }
+  if (j.contains("motion")) {
+    const std::string mpath = path + "/motion";
+    const json& m = j["motion"];
+    r.require_object(m, mpath, "the body's motion");
+    r.check_keys(m, mpath, {"type", "degrees", "start", "duration"});
+    if (body.mesh == "none") r.fail(mpath, "a body motion needs a body: \"mesh\" is \"none\"");
+    BodyMotionSpec motion;
+    if (m.contains("type")) motion.type = r.text(m["type"], mpath + "/type");
+    if (motion.type != "arms-lowering")
+      r.fail(mpath + "/type",
+             fmt::format("'{}' is not a body motion; the only kind so far is arms-lowering", motion.type));
+    if (m.contains("degrees")) motion.degrees = r.number(m["degrees"], mpath + "/degrees");
+    // The built-in mannequin's arms hang 17° out from the body: lowering them by more than 15°
+    // would press them into the torso.
+    if (motion.degrees < -30.0 || motion.degrees > 15.0)
+      r.fail(mpath + "/degrees",
+             fmt::format("{}° is too far: the arms can be lowered by up to 15° (into the torso "
+                         "beyond) and raised by up to 30° (negative degrees)",
+                         motion.degrees));
+    if (m.contains("start")) motion.start = r.non_negative(m["start"], mpath + "/start");
+    if (m.contains("duration")) motion.duration = r.positive(m["duration"], mpath + "/duration");
+    body.motion = motion;
   }
 }
 

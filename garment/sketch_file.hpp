@@ -79,11 +79,21 @@ struct JoinSpec {
   std::vector<std::string> panels;
 };
 
+// "body": {"motion": {...}}: the body moving during the drape. One kind so far: the A-pose
+// mannequin's arms turning towards the body about the shoulders (sim::make_arm_lowering).
+struct BodyMotionSpec {
+  std::string type = "arms-lowering";
+  double degrees = 10.0;   // rotation at the end; negative raises the arms
+  double start = 0.0;      // s: the arms start moving at this time of the drape
+  double duration = 1.0;   // s from start to end
+};
+
 struct BodySpec {
   std::string mesh = "builtin";            // "builtin", "none", or a path relative to the sketch file
   std::optional<double> height;            // metres
   std::optional<double> scale;             // metres per file unit
   std::optional<std::string> up;           // "+z", "y", ...
+  std::optional<BodyMotionSpec> motion;    // a still body when absent
 };
 
 // "simulate": {"adaptive": {...}}: the adaptive 4-8 detail's settings. Unset values take the

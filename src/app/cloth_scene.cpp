@@ -173,6 +173,21 @@ sim::ClothModel build_scene_model(const ClothScene& scene) {
   return model;
 }
 
+// The arms-lowering motion of the sketch's body, its keyframes shifted to start at `start`.
+sim::PoseSequence body_motion(const garment::BodyMotionSpec& spec, const meshing::TriMesh& body) {
+  sim::ArmLoweringOptions options;
+  options.angle_degrees = spec.degrees;
+  options.duration = spec.duration;
+  const sim::PoseSequence from_zero = sim::make_arm_lowering(body, options);
+  std::vector<double> times = from_zero.times();
+  std::vector<Eigen::MatrixX3d> poses;
+  for (int k = 0; k < from_zero.keyframe_count(); ++k) {
+    times[static_cast<size_t>(k)] += spec.start;
+    poses.push_back(from_zero.keyframe(k));
+  }
+  return sim::PoseSequence(from_zero.faces(), std::move(times), std::move(poses));
+}
+
 ClothScene build_cloth_scene(const garment::Sketch& sketch) {
   ClothScene scene;
   if (sketch.sheet) {
@@ -183,7 +198,12 @@ ClothScene build_cloth_scene(const garment::Sketch& sketch) {
   } else {
     build_garment_scene(sketch, scene);
   }
+  if (scene.body && sketch.body.motion) scene.body_motion = body_motion(*sketch.body.motion, scene.body->mesh);
   return scene;
+}
+
+meshing::TriMesh body_at(const ClothScene& scene, double t) {
+  return scene.body_motion ? scene.body_motion->mesh_at(t) : scene.body->mesh;
 }
 
 }  // namespace sd::app

@@ -13,6 +13,7 @@
 #include "meshing/mesh48.hpp"
 #include "sim/cloth_model.hpp"
 #include "sim/fabric.hpp"
+#include "sim/body_motion.hpp"
 #include "sim/simulation.hpp"
 
 namespace sd::app {
@@ -24,6 +25,8 @@ struct ClothScene {
   std::string fabric_name;
   sim::FabricParameters fabric;
   std::optional<garment::Body> body;   // absent for a sheet without a body
+  // The body's poses over the drape ("body": {"motion": ...}); absent for a still body.
+  std::optional<sim::PoseSequence> body_motion;
   std::optional<meshing::Mesh48> mesh48;  // the garment's 4-8 hierarchy (absent for sheets)
   std::optional<garment::Garment> garment;
   Eigen::VectorXi triangle_group;      // #F: group (panel or join) of each triangle
@@ -41,6 +44,10 @@ struct ClothScene {
 // Builds the scene. Throws garment::SketchError (with the JSON path) for anything the designer
 // can fix: an unknown fabric, a body that will not load, panels that do not close, ...
 ClothScene build_cloth_scene(const garment::Sketch& sketch);
+
+// The body as it stands at time t of the drape (its pose when it moves). The scene must have a
+// body.
+meshing::TriMesh body_at(const ClothScene& scene, double t);
 
 // The simulator's model of the scene's cloth on its fixed mesh: build_cloth_model on the input,
 // then each triangle's rest shape scaled by its panel's ease (lengths by e, so rest area and

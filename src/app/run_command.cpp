@@ -31,6 +31,14 @@ struct RunOptions {
   std::string sketch;
   std::string out = ".";
   bool trace = false;
+  double frames_per_second = 0.0;  // > 0: also a PNG sequence of the drape (frames/)
+};
+
+// One picture of the drape in progress, for the PNG sequence.
+struct Frame {
+  double time = 0.0;
+  meshing::TriMesh cloth;
+  Eigen::VectorXi triangle_group;
 };
 
 // The images of a run: the file's list, or front, back and left when it lists none.
@@ -182,6 +190,16 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
     trace += line.dump() + "\n";
   };
 
+  // The PNG sequence: a frame at t = 0 and whenever a step reaches the next frame time.
+  std::vector<Frame> frames;
+  const auto frame_due = [&](double t) {
+    return options.frames_per_second > 0.0 &&
+           t >= static_cast<double>(frames.size()) / options.frames_per_second - 1e-9;
+  };
+  if (frame_due(0.0)) {
+    frames.push_back({0.0, {scene.start, scene.input.triangles}, scene.triangle_group});
+  }
+
   // Adaptive 4-8 detail needs the garment's block hierarchy; a sheet runs on its fixed mesh.
   sim::SimulationReport report;
   nlohmann::json adaptive_json = nullptr;
@@ -196,20 +214,30 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
       material.source_ease = scene.mesh48_face_ease;
       sim::AdaptiveCloth cloth(*scene.mesh48, material, scene.start, pins, settings,
                                adaptive_settings(sketch));
-      if (scene.body) cloth.set_body(scene.body->mesh);  // contacts through every split and merge
-      const sim::AdaptiveReport adaptive =
-          cloth.run([&](const sim::AdaptiveCloth& c) { on_step(c.simulation()); });
+      // Contacts through every split and merge, with the body still or moving.
+      if (scene.body_motion)
+        cloth.set_body_motion(*scene.body_motion);
+      else if (scene.body)
+        cloth.set_body(scene.body->mesh);
+      // Each triangle keeps the group of the input face (quad) it descends from.
+      const auto groups_of = [&](const sim::AdaptiveCloth& c) {
+        const meshing::Mesh48Arrays arrays = c.mesh().arrays();
+        Eigen::VectorXi groups(arrays.faces.rows());
+        for (Eigen::Index t = 0; t < arrays.faces.rows(); ++t)
+          groups(t) = scene.mesh48_face_group(
+              c.mesh().source_face(arrays.triangle_ids[static_cast<size_t>(t)]));
+        return groups;
+      };
+      const sim::AdaptiveReport adaptive = cloth.run([&](const sim::AdaptiveCloth& c) {
+        on_step(c.simulation());
+        if (frame_due(c.simulation().time()))
+          frames.push_back({c.simulation().time(), {c.positions(), c.faces()}, groups_of(c)});
+      });
       report = adaptive.simulation;
       draped.vertices = cloth.positions();
       draped.faces = cloth.faces();
       face_levels = cloth.face_levels().cast<double>();
-      // Each triangle keeps the group of the input face (quad) it descends from.
-      const meshing::Mesh48Arrays arrays = cloth.mesh().arrays();
-      const Eigen::VectorXi source_group = scene.mesh48_face_group;
-      triangle_group.resize(arrays.faces.rows());
-      for (Eigen::Index t = 0; t < arrays.faces.rows(); ++t)
-        triangle_group(t) = source_group(
-            cloth.mesh().source_face(arrays.triangle_ids[static_cast<size_t>(t)]));
+      triangle_group = groups_of(cloth);
       adaptive_json = {{"splits", adaptive.splits},
                        {"forced_splits", adaptive.forced_splits},
                        {"merges", adaptive.merges},
@@ -224,8 +252,18 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
     } else {
       sim::Simulation simulation(build_scene_model(scene),
                                  sim::flatten_positions(scene.start), pins, settings);
-      if (scene.body) simulation.set_body(scene.body->mesh);  // contacts and friction
-      report = simulation.run(on_step);
+      // Contacts and friction, with the body still or moving.
+      if (scene.body_motion)
+        simulation.set_body_motion(*scene.body_motion);
+      else if (scene.body)
+        simulation.set_body(scene.body->mesh);
+      report = simulation.run([&](const sim::Simulation& s) {
+        on_step(s);
+        if (frame_due(s.time()))
+          frames.push_back({s.time(),
+                            {sim::unflatten_positions(s.positions()), scene.input.triangles},
+                            scene.triangle_group});
+      });
       draped.vertices = sim::unflatten_positions(simulation.positions());
       draped.faces = scene.input.triangles;
     }
@@ -246,10 +284,25 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   outputs.stage(dir / "drape.obj", to_obj(mesh, "drape"));
 
   const auto image_start = Clock::now();
+  // The body as it stands at the end (its last pose when it moves).
+  const std::optional<meshing::TriMesh> body_end =
+      scene.body ? std::optional(body_at(scene, report.sim_time)) : std::nullopt;
   const PreviewCloth preview{draped, triangle_group, render::triangle_edges(draped), face_levels};
   const std::vector<std::string> images =
       stage_preview_images(run_images(sketch), sketch.output.wireframe,
-                           scene.body ? &scene.body->mesh : nullptr, preview, "drape", dir, outputs);
+                           body_end ? &*body_end : nullptr, preview, "drape", dir, outputs);
+  // The sequence: the first image the file asks for (front by default), without edges.
+  std::vector<garment::ImageSpec> frame_image = {run_images(sketch).empty()
+                                                     ? garment::ImageSpec{}
+                                                     : run_images(sketch).front()};
+  frame_image.front().wireframe = false;
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const std::optional<meshing::TriMesh> body =
+        scene.body ? std::optional(body_at(scene, frames[i].time)) : std::nullopt;
+    stage_preview_images(frame_image, false, body ? &*body : nullptr,
+                         {frames[i].cloth, frames[i].triangle_group, {}, {}},
+                         fmt::format("frame-{:04d}", i), dir / "frames", outputs);
+  }
   const double image_s = std::chrono::duration<double>(Clock::now() - image_start).count();
 
   nlohmann::json out = simulation_json(report, settings);
@@ -262,6 +315,13 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   out["meshing"] = meshing_json(scene);
   out["adaptive"] = adaptive_json;
   out["images"] = images;
+  out["frames"] = frames.size();
+  out["body_motion"] = sketch.body.motion && scene.body_motion
+                           ? nlohmann::json{{"type", sketch.body.motion->type},
+                                            {"degrees", sketch.body.motion->degrees},
+                                            {"start", scene.body_motion->start_time()},
+                                            {"end", scene.body_motion->end_time()}}
+                           : nlohmann::json(nullptr);
   // Adaptivity (estimates, splits, merges, model rebuilds) next to the simulator's split.
   out["timing_s"]["adaptivity"] =
       adaptive_json.is_null() ? 0.0 : adaptive_json["adaptivity_s"].get<double>();
@@ -285,6 +345,10 @@ void add_run_command(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("SKETCH", options->sketch, "Sketch file (format sketchdrape/1)")->required();
   cmd->add_option("-o,--out", options->out, "Output directory (created if needed)");
   cmd->add_flag("--trace", options->trace, "Also write trace.jsonl: one JSON line per step");
+  cmd->add_option("--frames", options->frames_per_second,
+                  "Also write frames/frame-NNNN-<view>.png: this many pictures per simulated "
+                  "second (the first image's view, the body at its pose)")
+      ->check(CLI::PositiveNumber);
   cmd->callback([options, &global] { run_drape(*options, global); });
 }
 

@@ -5,8 +5,11 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "tests/cli/run_command.hpp"
 
@@ -43,6 +46,33 @@ nlohmann::json small_sheet() {
           {"fabric", "cotton"},
           {"simulate", {{"duration", 0.5}}},
           {"output", {{"images", nlohmann::json::array()}}}};
+}
+
+TEST(RunCommand, FramesWriteAPictureSequenceOfTheDrape) {
+  // 0.5 s at 8 frames per second: t = 0, 0.125, ..., 0.5, one PNG each, even though the file
+  // asks for no other image; the pictures differ as the sheet falls.
+  const fs::path dir = fresh_dir("frames");
+  const fs::path out = dir / "out";
+  const CommandResult r = run_sketchdrape("-q run " + write_sketch(dir, small_sheet()).string() +
+                                          " -o " + out.string() + " --frames 8");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(read_json(out / "report.json")["frames"], 5);
+  std::vector<std::string> pictures;
+  for (int i = 0; i < 5; ++i) {
+    const fs::path frame = out / "frames" / ("frame-000" + std::to_string(i) + "-front.png");
+    ASSERT_TRUE(fs::exists(frame)) << frame;
+    std::ifstream in(frame, std::ios::binary);
+    pictures.emplace_back(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    EXPECT_EQ(pictures.back().substr(1, 3), "PNG");
+  }
+  EXPECT_FALSE(fs::exists(out / "frames" / "frame-0005-front.png"));
+  EXPECT_NE(pictures.front(), pictures.back());
+  // A rate that is not a positive number is refused.
+  EXPECT_NE(run_sketchdrape("-q run " + (dir / "scene.json").string() + " -o " +
+                            (dir / "bad").string() + " --frames 0")
+                .exit_code,
+            0);
+  EXPECT_FALSE(fs::exists(dir / "bad"));
 }
 
 TEST(RunCommand, SheetSceneWritesReportMeshAndTrace) {

@@ -44,6 +44,7 @@ TEST(SketchFile, MinimalFileGetsDefaults) {
   EXPECT_EQ(s.simulate.solver, "cholmod");
   EXPECT_FALSE(s.simulate.pin_above.has_value());
   EXPECT_FALSE(s.simulate.check_body_vertices);
+  EXPECT_FALSE(s.body.motion.has_value());
   EXPECT_EQ(s.output.mesh, "garment.obj");
   EXPECT_TRUE(s.output.images.empty());
   EXPECT_FALSE(s.output.images_listed);
@@ -85,12 +86,17 @@ TEST(SketchFile, SheetMistakesNameTheirPath) {
   EXPECT_EQ(error_of(R"({"sheet": {"size": [1, -1]}})").rfind("/sheet/size/1", 0), 0u);
   EXPECT_EQ(error_of(R"({"sheet": {}, "panels": []})").rfind("/sheet: a sheet scene has no", 0), 0u);
   EXPECT_EQ(error_of(R"({"sheet": {"orientation": "diagonal"}})").rfind("/sheet/orientation", 0), 0u);
+  EXPECT_EQ(error_of(R"({"body": {"motion": {"duration": 0}}})").rfind("/body/motion/duration", 0), 0u);
+  EXPECT_EQ(error_of(R"({"body": {"motion": {"start": -1}}})").rfind("/body/motion/start", 0), 0u);
+  EXPECT_EQ(error_of(R"({"body": {"motion": {"speed": 1}}})").rfind("/body/motion", 0), 0u);
+  EXPECT_EQ(error_of(R"({"body": {"mesh": "none", "motion": {}}})").rfind("/body/motion", 0), 0u);
 }
 
 TEST(SketchFile, ReadsEverySection) {
   const Sketch s = parse_sketch(R"({
     "format": "sketchdrape/1",
-    "body": { "mesh": "b.obj", "height": 1.6, "up": "+z", "scale": 0.01 },
+    "body": { "mesh": "b.obj", "height": 1.6, "up": "+z", "scale": 0.01,
+              "motion": { "type": "arms-lowering", "degrees": -5, "start": 0.5, "duration": 2 } },
     "edge_length": 0.02, "offset": 0.005, "junction_tolerance": 0.01, "corner_angle": 50,
     "relax_iterations": 3, "fabric": "denim",
     "curves": [ { "id": "c", "view": { "camera": { "eye": [0, 1, 3], "target": [0, 1, 0], "fov": 30 } },
@@ -108,6 +114,10 @@ TEST(SketchFile, ReadsEverySection) {
   })", "x.json", "/base");
   EXPECT_EQ(s.resolve(s.body.mesh), std::filesystem::path("/base/b.obj"));
   EXPECT_DOUBLE_EQ(*s.body.height, 1.6);
+  ASSERT_TRUE(s.body.motion.has_value());
+  EXPECT_DOUBLE_EQ(s.body.motion->degrees, -5);
+  EXPECT_DOUBLE_EQ(s.body.motion->start, 0.5);
+  EXPECT_DOUBLE_EQ(s.body.motion->duration, 2);
   EXPECT_EQ(s.curves[0].view.kind, ViewKind::kCamera);
   EXPECT_DOUBLE_EQ(s.curves[0].view.camera.fov_degrees, 30);
   EXPECT_FALSE(s.curves[0].smooth);
