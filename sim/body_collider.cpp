@@ -391,9 +391,30 @@ std::optional<BodyProximity> BodyCollider::nearest(const Eigen::Vector3d& p, dou
   return result;
 }
 
+ClothTriangles::ClothTriangles(std::vector<std::array<int, 3>> list)
+    : triangles(std::move(list)), open_edges(triangles.size(), 0) {
+  std::vector<std::tuple<int, int, int>> edges;  // (smaller vertex, larger vertex, 3t + k)
+  edges.reserve(3 * triangles.size());
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const int a = triangles[t][k], b = triangles[t][(k + 1) % 3];
+      edges.emplace_back(std::min(a, b), std::max(a, b), static_cast<int>(3 * t) + k);
+    }
+  std::sort(edges.begin(), edges.end());
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i + 1;
+    while (j < edges.size() && std::get<0>(edges[j]) == std::get<0>(edges[i]) &&
+           std::get<1>(edges[j]) == std::get<1>(edges[i]))
+      ++j;
+    if (j == i + 1) open_edges[std::get<2>(edges[i]) / 3] |= 1 << (std::get<2>(edges[i]) % 3);
+    i = j;
+  }
+}
+
 std::vector<BodyPiercing> BodyCollider::find_piercings(
-    const Eigen::VectorXd& x, const std::vector<std::array<int, 3>>& triangles, double min_height,
-    double max_height, double unchecked_height, PiercingQueryStats* stats_out) const {
+    const Eigen::VectorXd& x, const ClothTriangles& cloth, double min_height, double max_height,
+    double unchecked_height, PiercingQueryStats* stats_out) const {
+  const std::vector<std::array<int, 3>>& triangles = cloth.triangles;
   PiercingQueryStats stats;
   std::vector<BodyPiercing> result;
   if (x.size() % 3 != 0)
@@ -448,27 +469,6 @@ std::vector<BodyPiercing> BodyCollider::find_piercings(
         for (int k = c0.z(); k <= c1.z(); ++k) cells.emplace_back(key_of({i, j, k}), t);
   }
   std::sort(cells.begin(), cells.end());
-  // Per triangle, bit k set when its edge k (corners k, k+1) is on the cloth's open boundary
-  // (used by this triangle only).
-  std::vector<std::uint8_t> open_edges(triangles.size(), 0);
-  {
-    std::vector<std::tuple<int, int, int>> edges;  // (smaller vertex, larger vertex, 3t + k)
-    edges.reserve(3 * triangles.size());
-    for (std::size_t t = 0; t < triangles.size(); ++t)
-      for (int k = 0; k < 3; ++k) {
-        const int a = triangles[t][k], b = triangles[t][(k + 1) % 3];
-        edges.emplace_back(std::min(a, b), std::max(a, b), static_cast<int>(3 * t) + k);
-      }
-    std::sort(edges.begin(), edges.end());
-    for (std::size_t i = 0; i < edges.size();) {
-      std::size_t j = i + 1;
-      while (j < edges.size() && std::get<0>(edges[j]) == std::get<0>(edges[i]) &&
-             std::get<1>(edges[j]) == std::get<1>(edges[i]))
-        ++j;
-      if (j == i + 1) open_edges[std::get<2>(edges[i]) / 3] |= 1 << (std::get<2>(edges[i]) % 3);
-      i = j;
-    }
-  }
   // Unit normals once per triangle (zero when degenerate), not once per pair.
   std::vector<Eigen::Vector3d> normals(triangles.size());
   for (std::size_t t = 0; t < triangles.size(); ++t)
@@ -510,7 +510,7 @@ std::vector<BodyPiercing> BodyCollider::find_piercings(
       // Closest to the cloth's open edge (or a corner on it): the vertex is beside the cloth,
       // not under it: a neck beside a neckline, a wrist beside a cuff. Over an inner edge it is
       // a ridge of the cloth folded over it, which counts.
-      const std::uint8_t open = open_edges[static_cast<std::size_t>(t)];
+      const std::uint8_t open = cloth.open_edges[static_cast<std::size_t>(t)];
       if (closest.feature == TriangleFeature::edge && (open >> closest.index & 1)) continue;
       if (closest.feature == TriangleFeature::vertex &&
           ((open >> closest.index & 1) || (open >> (closest.index + 2) % 3 & 1)))

@@ -76,6 +76,17 @@ struct BodyPiercing {
   Eigen::Vector3d body_velocity = Eigen::Vector3d::Zero();  // of the body vertex, m/s
 };
 
+// The cloth's triangles as find_piercings reads them: the list, and per triangle which of its
+// edges lie on the cloth's open boundary (in that triangle only). The positions change every
+// step, the triangles only with the topology: build this once per topology.
+struct ClothTriangles {
+  ClothTriangles() = default;
+  ClothTriangles(std::vector<std::array<int, 3>> list);  // implicit: a plain list works too
+
+  std::vector<std::array<int, 3>> triangles;
+  std::vector<std::uint8_t> open_edges;  // per triangle, bit k: edge k (corners k, k+1) is open
+};
+
 struct PiercingQueryStats {
   int body_vertices = 0;  // body vertices inside the cloth's bounding box (looked up)
   int pairs = 0;          // vertex-triangle pairs tested
@@ -181,8 +192,7 @@ class BodyCollider {
   // sharp tip under tilted cloth the closest point can lie just outside the body. Broad phase: a uniform grid over the cloth triangles' boxes grown by max_height,
   // built per call (the cloth changes every step; cells the size of the longest cloth edge).
   // Sorted by body vertex; at most one (the highest) per body vertex.
-  std::vector<BodyPiercing> find_piercings(const Eigen::VectorXd& x,
-                                           const std::vector<std::array<int, 3>>& triangles,
+  std::vector<BodyPiercing> find_piercings(const Eigen::VectorXd& x, const ClothTriangles& cloth,
                                            double min_height, double max_height,
                                            double unchecked_height = 0.0,
                                            PiercingQueryStats* stats = nullptr) const;

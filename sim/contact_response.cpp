@@ -125,9 +125,10 @@ ContactQuery ContactResponse::query() const {
 }
 
 void ContactResponse::set_cloth_triangles(const ClothModel& model) {
-  cloth_triangles_.clear();
-  cloth_triangles_.reserve(model.triangles.size());
-  for (const TriangleElement& t : model.triangles) cloth_triangles_.push_back(t.vertices);
+  std::vector<std::array<int, 3>> triangles;
+  triangles.reserve(model.triangles.size());
+  for (const TriangleElement& t : model.triangles) triangles.push_back(t.vertices);
+  cloth_ = ClothTriangles(std::move(triangles));
   piercings_.clear();
 }
 
@@ -137,9 +138,9 @@ double ContactResponse::piercing_reach() const {
 
 std::vector<BodyPiercing> ContactResponse::find_piercings(const Eigen::VectorXd& x1,
                                                           double min_height) const {
-  if (!settings_.check_body_vertices || cloth_triangles_.empty()) return {};
+  if (!settings_.check_body_vertices || cloth_.triangles.empty()) return {};
   const double reach = piercing_reach();
-  return collider_.find_piercings(x1, cloth_triangles_, min_height, reach,
+  return collider_.find_piercings(x1, cloth_, min_height, reach,
                                   kPiercingUncheckedFraction * reach);
 }
 
@@ -155,7 +156,7 @@ std::vector<ContactResponse::CornerLift> ContactResponse::corner_lifts(
     // w_k δ / Σ w_j² (Bridson et al. 2002's weighting, the least motion that does it), the
     // pinned corners not at all.
     const BodyPiercing& piercing = piercings[p];
-    const std::array<int, 3>& t = cloth_triangles_[piercing.cloth_triangle];
+    const std::array<int, 3>& t = cloth_.triangles[piercing.cloth_triangle];
     double weights = 0.0;
     for (int k = 0; k < 3; ++k)
       if (!is_pinned(t[k])) weights += piercing.barycentric[k] * piercing.barycentric[k];
@@ -219,7 +220,7 @@ void ContactResponse::hold_piercing(const BodyPiercing& piercing, bool released)
 void ContactResponse::constrain_start_piercings(const Eigen::VectorXd& x_hat,
                                                 const Eigen::VectorXd& v0, double beta,
                                                 ConstraintFilter& filter, Eigen::VectorXd& y) {
-  if (!settings_.check_body_vertices || cloth_triangles_.empty() || repairing()) return;
+  if (!settings_.check_body_vertices || cloth_.triangles.empty() || repairing()) return;
   const int n = static_cast<int>(x_hat.size() / 3);
   const double clearance = kPiercingClearance * settings_.thickness;
   const double hold = clearance + kPiercingHoldMargin * settings_.thickness;
@@ -229,7 +230,7 @@ void ContactResponse::constrain_start_piercings(const Eigen::VectorXd& x_hat,
   // Triangles up to `reach` in front of a body vertex: one falling towards a tip is seen
   // before it passes it.
   for (const BodyPiercing& p : find_piercings(start, -piercing_reach())) {
-    const std::array<int, 3>& t = cloth_triangles_[p.cloth_triangle];
+    const std::array<int, 3>& t = cloth_.triangles[p.cloth_triangle];
     // Height over the point at the end of the step (body at its end pose already) if the
     // triangle moved along n with the body vertex, and if it kept its start velocity.
     const double body_normal_velocity = p.body_velocity.dot(p.normal);
@@ -613,7 +614,7 @@ void ContactResponse::record_normal_forces(const Eigen::VectorXd& impulse) {
     // Lifted after the last solve (or no solve): no force known, held as pressing.
     double force = 0.0;
     if (solved)
-      for (int k : cloth_triangles_[h.piercing.cloth_triangle]) {
+      for (int k : cloth_.triangles[h.piercing.cloth_triangle]) {
         if (corner_normal_[k].isZero()) continue;
         const Eigen::Vector3d r = impulse.segment<3>(3 * k);
         const int c = active_index_[k];
@@ -654,9 +655,9 @@ int ContactResponse::count_piercing(const Eigen::VectorXd& x, double* highest) c
   const double reach = piercing_reach();
   int count = 0;
   double top = 0.0;
-  if (!cloth_triangles_.empty())
+  if (!cloth_.triangles.empty())
     for (const BodyPiercing& p :
-         collider_.find_piercings(x, cloth_triangles_, settings_.penetration_tolerance, reach,
+         collider_.find_piercings(x, cloth_, settings_.penetration_tolerance, reach,
                                   kPiercingUncheckedFraction * reach)) {
       ++count;
       top = std::max(top, p.height);

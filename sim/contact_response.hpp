@@ -269,7 +269,7 @@ class ContactResponse {
   std::vector<int> active_index_;      // per vertex: index into active_, or −1
   std::vector<BodyContact> too_deep_;  // from the last end check, after the last solve
   std::vector<BodyContact> end_contacts_;
-  std::vector<std::array<int, 3>> cloth_triangles_;
+  ClothTriangles cloth_;  // the cloth's triangles (set_cloth_triangles)
   std::vector<BodyPiercing> piercings_;  // from the last end check, after the last solve
   // Body vertices held behind a cloth triangle in this attempt (start or end check).
   struct HeldPiercing {

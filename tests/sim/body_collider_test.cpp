@@ -469,6 +469,8 @@ TEST(StartRepair, PushesInsideVerticesOutAlongTheNearestSurface) {
   EXPECT_EQ(repair.positions_after(0), x);
 }
 
+using Triangles = std::vector<std::array<int, 3>>;
+
 // One cloth triangle (x, z corners at height y), 3 cloth vertices as 3n positions.
 Eigen::VectorXd flat_triangle(double y) {
   Eigen::VectorXd x(9);
@@ -527,11 +529,11 @@ TEST(BodyCollider, BodyVertexBesideTheClothsOpenEdgeIsNotAPiercing) {
   beside << flat_triangle(0.19), 0.0, 0.14, -0.3;  // a fourth vertex for the ridge below
   for (int k = 0; k < 3; ++k) beside[3 * k + 2] += 0.203;
   ASSERT_NEAR(beside[8], 0.003, 1e-15);  // edge 2 (corners 2 and 0) runs along z = 3 mm
-  EXPECT_TRUE(collider.find_piercings(beside, {{0, 1, 2}}, 0.0, 0.05).empty());
+  EXPECT_TRUE(collider.find_piercings(beside, Triangles{{0, 1, 2}}, 0.0, 0.05).empty());
   // The same edge shared with a second triangle folded down behind it: a ridge of the cloth
   // over the apex, which counts.
   const std::vector<BodyPiercing> ridge =
-      collider.find_piercings(beside, {{0, 1, 2}, {2, 3, 0}}, 0.0, 0.05);
+      collider.find_piercings(beside, Triangles{{0, 1, 2}, {2, 3, 0}}, 0.0, 0.05);
   ASSERT_EQ(ridge.size(), 1u);
   EXPECT_EQ(ridge.front().body_vertex, 0);
   EXPECT_GT(ridge.front().height, 0.0);
@@ -559,7 +561,8 @@ TEST(BodyCollider, ClothBeyondAThinBodyPartIsNotAPiercing) {
     // Normal along the corner's side: +y for the top corners, −y for the bottom ones.
     EXPECT_NEAR(p.normal.y(), slab.vertices(p.body_vertex, 1) > 0.0 ? 1.0 : -1.0, 1e-12);
   }
-  EXPECT_THROW(collider.find_piercings(under, {{0, 1, 3}}, 0.0, 0.05), std::invalid_argument);
+  EXPECT_THROW(collider.find_piercings(under, Triangles{{0, 1, 3}}, 0.0, 0.05),
+               std::invalid_argument);
 }
 
 TEST(BodyCollider, RejectsUnusableInput) {
