@@ -6,32 +6,14 @@
 #include <vector>
 
 #include "meshing/quad_quality.hpp"
+#include "tests/garment/quad_grids.hpp"
 
 namespace sd::garment {
 namespace {
 
-// An n × n grid of unit-spaced quads in the plane z = 0, counter-clockwise from +z.
-meshing::QuadMesh plane_grid(int n) {
-  meshing::QuadMesh mesh;
-  mesh.vertices.resize((n + 1) * (n + 1), 3);
-  for (int i = 0; i <= n; ++i)
-    for (int j = 0; j <= n; ++j) mesh.vertices.row(i * (n + 1) + j) << j, i, 0.0;
-  mesh.faces.resize(n * n, 4);
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) {
-      const int a = i * (n + 1) + j;
-      mesh.faces.row(i * n + j) << a, a + 1, a + n + 2, a + n + 1;
-    }
-  return mesh;
-}
-
-std::vector<char> boundary_of_grid(int n) {
-  std::vector<char> fixed(static_cast<std::size_t>((n + 1) * (n + 1)), 0);
-  for (int i = 0; i <= n; ++i)
-    for (int j = 0; j <= n; ++j)
-      if (i == 0 || j == 0 || i == n || j == n) fixed[static_cast<std::size_t>(i * (n + 1) + j)] = 1;
-  return fixed;
-}
+using test::grid_boundary;
+using test::plane_grid;
+using test::sphere_grid;
 
 std::vector<int> grid_corners(int n) { return {0, n, (n + 1) * (n + 1) - 1, n * (n + 1)}; }
 
@@ -41,7 +23,7 @@ TEST(SurfaceRelaxation, SpreadsACollapsedInteriorBackToTheUniformGrid) {
   const int n = 8;
   const meshing::QuadMesh grid = plane_grid(n);
   meshing::QuadMesh mesh = grid;
-  const std::vector<char> fixed = boundary_of_grid(n);
+  const std::vector<char> fixed = grid_boundary(n);
   for (Eigen::Index v = 0; v < mesh.vertex_count(); ++v)
     if (!fixed[static_cast<std::size_t>(v)]) mesh.vertices.row(v) << 0.5, 0.5, 0.0;  // one point
   const SurfaceLift plane = [](const Eigen::Vector3d& p) {
@@ -60,15 +42,8 @@ TEST(SurfaceRelaxation, KeepsTheBoundaryAndStaysOnASphere) {
   // their boundary vertices) and no quad is folded.
   const int n = 8;
   const double r = 0.3;
-  meshing::QuadMesh mesh = plane_grid(n);
-  mesh.vertices *= 0.3 / n;
-  mesh.vertices.col(0).array() -= 0.15;
-  mesh.vertices.col(1).array() -= 0.15;
-  for (Eigen::Index v = 0; v < mesh.vertex_count(); ++v) {
-    const Eigen::Vector3d p(mesh.vertices(v, 0), mesh.vertices(v, 1), r);
-    mesh.vertices.row(v) = (r * p.normalized()).transpose();
-  }
-  const std::vector<char> fixed = boundary_of_grid(n);
+  meshing::QuadMesh mesh = sphere_grid(n, r, 0.3);
+  const std::vector<char> fixed = grid_boundary(n);
   const meshing::QuadMesh start = mesh;
   // Drag one inner vertex across two of its neighbours and lift another 5 cm off the surface.
   mesh.vertices.row(3 * (n + 1) + 3) = mesh.vertices.row(3 * (n + 1) + 6);
@@ -96,7 +71,7 @@ TEST(SurfaceRelaxation, RefusesLiftsThatJumpAcrossARidge) {
   // never reach across: every vertex that would land over there stays on its own sheet.
   const int n = 8;
   meshing::QuadMesh mesh = plane_grid(n);
-  const std::vector<char> fixed = boundary_of_grid(n);
+  const std::vector<char> fixed = grid_boundary(n);
   // Interior squeezed to the left half, so that relaxing pulls it across the ridge.
   for (Eigen::Index v = 0; v < mesh.vertex_count(); ++v)
     if (!fixed[static_cast<std::size_t>(v)]) mesh.vertices(v, 0) *= 0.5;

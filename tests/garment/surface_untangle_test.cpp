@@ -4,35 +4,19 @@
 
 #include <Eigen/Geometry>
 
+#include "tests/garment/quad_grids.hpp"
+
 namespace sd::garment {
 namespace {
 
-// An n × n grid of quads on the sphere of radius r around the origin, centred on +z, facing out.
-meshing::QuadMesh sphere_grid(int n, double r, double span) {
-  meshing::QuadMesh mesh;
-  mesh.vertices.resize((n + 1) * (n + 1), 3);
-  for (int i = 0; i <= n; ++i)
-    for (int j = 0; j <= n; ++j) {
-      const Eigen::Vector3d p(span * (j - n / 2.0) / n, span * (i - n / 2.0) / n, r);
-      mesh.vertices.row(i * (n + 1) + j) = (r * p.normalized()).transpose();
-    }
-  mesh.faces.resize(n * n, 4);
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) {
-      const int a = i * (n + 1) + j;
-      mesh.faces.row(i * n + j) << a, a + 1, a + n + 2, a + n + 1;  // counter-clockwise from +z
-    }
-  return mesh;
-}
+using test::grid_boundary;
+using test::sphere_grid;
 
 TEST(SurfaceUntangle, UnfoldsDraggedVerticesOnASphere) {
   const int n = 8;
   const double r = 0.3;
   meshing::QuadMesh mesh = sphere_grid(n, r, 0.3);
-  std::vector<char> fixed(static_cast<size_t>(mesh.vertex_count()), 0);
-  for (int i = 0; i <= n; ++i)
-    for (int j = 0; j <= n; ++j)
-      if (i == 0 || j == 0 || i == n || j == n) fixed[static_cast<size_t>(i * (n + 1) + j)] = 1;
+  const std::vector<char> fixed = grid_boundary(n);
   const auto project = [r](const Eigen::Vector3d& p) -> Eigen::Vector3d { return r * p.normalized(); };
   const auto normal = [](const Eigen::Vector3d& p) -> Eigen::Vector3d { return p.normalized(); };
   // Drag two inner vertices across their neighbours (on the sphere), folding their quads.
