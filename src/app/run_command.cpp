@@ -190,7 +190,9 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
     trace += line.dump() + "\n";
   };
 
-  // The PNG sequence: a frame at t = 0 and whenever a step reaches the next frame time.
+  // The PNG sequence: a frame at t = 0 and whenever a step reaches the next frame time (the
+  // same state again for every frame time a long step passed, so that the sequence keeps its
+  // rate).
   std::vector<Frame> frames;
   const auto frame_due = [&](double t) {
     return options.frames_per_second > 0.0 &&
@@ -230,7 +232,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
       };
       const sim::AdaptiveReport adaptive = cloth.run([&](const sim::AdaptiveCloth& c) {
         on_step(c.simulation());
-        if (frame_due(c.simulation().time()))
+        while (frame_due(c.simulation().time()))
           frames.push_back({c.simulation().time(), {c.positions(), c.faces()}, groups_of(c)});
       });
       report = adaptive.simulation;
@@ -259,7 +261,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
         simulation.set_body(scene.body->mesh);
       report = simulation.run([&](const sim::Simulation& s) {
         on_step(s);
-        if (frame_due(s.time()))
+        while (frame_due(s.time()))
           frames.push_back({s.time(),
                             {sim::unflatten_positions(s.positions()), scene.input.triangles},
                             scene.triangle_group});
@@ -288,13 +290,13 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   const std::optional<meshing::TriMesh> body_end =
       scene.body ? std::optional(body_at(scene, report.sim_time)) : std::nullopt;
   const PreviewCloth preview{draped, triangle_group, render::triangle_edges(draped), face_levels};
+  const std::vector<garment::ImageSpec> image_specs = run_images(sketch);
   const std::vector<std::string> images =
-      stage_preview_images(run_images(sketch), sketch.output.wireframe,
-                           body_end ? &*body_end : nullptr, preview, "drape", dir, outputs);
+      stage_preview_images(image_specs, sketch.output.wireframe, body_end ? &*body_end : nullptr,
+                           preview, "drape", dir, outputs);
   // The sequence: the first image the file asks for (front by default), without edges.
-  std::vector<garment::ImageSpec> frame_image = {run_images(sketch).empty()
-                                                     ? garment::ImageSpec{}
-                                                     : run_images(sketch).front()};
+  std::vector<garment::ImageSpec> frame_image = {image_specs.empty() ? garment::ImageSpec{}
+                                                                     : image_specs.front()};
   frame_image.front().wireframe = false;
   for (std::size_t i = 0; i < frames.size(); ++i) {
     const std::optional<meshing::TriMesh> body =
