@@ -190,7 +190,58 @@ Eigen::VectorXd AdaptiveCloth::edge_errors() const {
                                         row3(x, edges(r, 2)), row3(x, edges(r, 3)));
     errors(r) = std::abs(angle_difference(theta, edge_rest_angle_(r))) * edge_width_(r) / 8.0;
   }
+  if (has_body()) errors = errors.cwiseMax(body_sags());
   return errors;
+}
+
+Eigen::VectorXd AdaptiveCloth::body_sags() const {
+  const Eigen::MatrixX4i& edges = arrays_.interior_edges;
+  Eigen::VectorXd sags = Eigen::VectorXd::Zero(edges.rows());
+  const ContactResponse* contact = simulation_->contact();
+  if (contact == nullptr || !simulation_->settings().contact.enabled) return sags;
+  const Eigen::VectorXd& x = simulation_->positions();
+  const double reach = body_reach();
+  // The body point under each vertex within reach (bounded queries: most of a garment is not,
+  // and FCL prunes by the bound).
+  const int n = static_cast<int>(x.size() / 3);
+  std::vector<std::optional<BodyProximity>> under(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i)
+    under[static_cast<std::size_t>(i)] = contact->collider().closest_point(row3(x, i), reach);
+  for (Eigen::Index r = 0; r < edges.rows(); ++r) {
+    const int i = edges(r, 0), j = edges(r, 1);
+    const std::optional<BodyProximity>& at_i = under[static_cast<std::size_t>(i)];
+    const std::optional<BodyProximity>& at_j = under[static_cast<std::size_t>(j)];
+    if (at_i || at_j)
+      sags(r) = body_sag(row3(x, i), row3(x, j), at_i ? &*at_i : nullptr, at_j ? &*at_j : nullptr);
+  }
+  return sags;
+}
+
+double AdaptiveCloth::body_reach() const {
+  const ContactSettings& contact = simulation_->settings().contact;
+  return contact.thickness + contact.search_margin;
+}
+
+double AdaptiveCloth::body_sag(const Eigen::Vector3d& xi, const Eigen::Vector3d& xj,
+                               const BodyProximity* at_i, const BodyProximity* at_j) const {
+  const BodyCollider& body = simulation_->contact()->collider();
+  const double reach = body_reach();
+  // Body points under the ends not given; beyond reach of both, no sag. The other end and the
+  // midpoint are at most the edge's length farther than the near end.
+  std::optional<BodyProximity> near_i, near_j;
+  if (at_i == nullptr && at_j == nullptr) {
+    near_i = body.closest_point(xi, reach);
+    near_j = body.closest_point(xj, reach);
+    if (!near_i && !near_j) return 0.0;
+  }
+  const double bound = reach + (xi - xj).norm();
+  if (at_i == nullptr && !near_i) near_i = body.closest_point(xi, bound);
+  if (at_j == nullptr && !near_j) near_j = body.closest_point(xj, bound);
+  if (at_i == nullptr) at_i = near_i ? &*near_i : nullptr;
+  if (at_j == nullptr) at_j = near_j ? &*near_j : nullptr;
+  const std::optional<BodyProximity> middle = body.closest_point(0.5 * (xi + xj), bound);
+  if (at_i == nullptr || at_j == nullptr || !middle) return 0.0;
+  return std::max(0.0, (middle->point - 0.5 * (at_i->point + at_j->point)).dot(middle->normal));
 }
 
 AdaptiveCloth::Transfer AdaptiveCloth::begin_transfer() const {
@@ -526,6 +577,10 @@ AdaptStats AdaptiveCloth::adapt() {
                                             row3(x, hinge[2]), row3(x, hinge[3]));
         keep = hinge_sag(hinge, theta) < settings_.coarsen_threshold;
       }
+      // The body sag under the parent's diagonal: merging next to a curved body would make the
+      // next split.
+      if (keep && has_body() && simulation_->settings().contact.enabled)
+        keep = body_sag(row3(x, b.value()), row3(x, c.value())) < settings_.coarsen_threshold;
       if (keep) merges.emplace_back(error, k);
     }
     std::sort(merges.begin(), merges.end());

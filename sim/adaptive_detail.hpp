@@ -187,8 +187,16 @@ class AdaptiveCloth {
   const Eigen::VectorXi& face_levels() const { return arrays_.face_level; }  // #F, for rendering
   const Eigen::MatrixX3d& rest_positions() const { return arrays_.rest_positions; }
   // Sag estimate ε per interior edge of the current mesh (rows of mesh().arrays().interior_edges)
-  // for the current positions, metres.
+  // for the current positions, metres: the larger of the bend sag |θ − θ0|·w/8 and, with a body
+  // set, the body sag under the edge (body_sags).
   Eigen::VectorXd edge_errors() const;
+  // Per interior edge with an end within reach of the body (the contact thickness plus its
+  // search margin), how far the body's surface under the edge bulges out of the straight line
+  // between the body points under its two ends, metres; 0 for the other edges and without a
+  // body. It is the sag the edge will have once the cloth lies on the body, known while the
+  // cloth is still approaching: refining on it gives the cloth the resolution the body's
+  // curvature asks for before the contact instead of after it.
+  Eigen::VectorXd body_sags() const;
   // Σ m_i v_i, kg·m/s.
   Eigen::Vector3d linear_momentum() const;
   ConservedQuantities conserved_quantities() const;
@@ -204,6 +212,12 @@ class AdaptiveCloth {
   // Sag estimate |θ − θ0|·w/8 of the hinge (x0, x1, x2, x3) at dihedral angle theta, from the
   // rest shape of the current mesh (ids).
   double hinge_sag(const std::array<int, 4>& hinge, double theta) const;
+  // m: vertices closer to the body than this get a body sag (contact thickness + search margin).
+  double body_reach() const;
+  // Body sag (see body_sags) under the edge xi–xj, 0 when neither end is within reach; at_i,
+  // at_j: the body points under the ends if already known. Needs a body.
+  double body_sag(const Eigen::Vector3d& xi, const Eigen::Vector3d& xj,
+                  const BodyProximity* at_i = nullptr, const BodyProximity* at_j = nullptr) const;
   struct Transfer;  // the state by vertex/triangle id while a batch of changes is applied
 
   // Compacts the mesh and state, rebuilds the model and hands it to the simulation (creates the

@@ -184,6 +184,63 @@ TEST(AdaptiveContact, SheetDropsOnASphereAdaptivelyAndDrapesOutside) {
   EXPECT_LT(cloth.mesh().vertex_count(), 0.65 * uniform_finest);
 }
 
+// The same sheet falling flat onto the sphere has no bend to refine on until it lands; the body
+// sag under its edges (AdaptiveCloth::body_sags) gives it the resolution the sphere's curvature
+// asks for before it touches. At 2 mm on a sphere of radius 0.2 m that is level 4: the longest
+// edge of a level-4 triangle (5.3 cm) sags 1.8 mm over the sphere, of a level-3 one (7.5 cm)
+// 3.5 mm. Without it the sheet landed at level 2 (15 cm edges, 14 mm over the sphere) and was
+// refined after the body had pushed into its triangles, which cost the sphere-drop bench
+// accuracy (docs/adaptive.md, "Body contact").
+TEST(AdaptiveContact, SheetIsRefinedForTheSphereBeforeItLands) {
+  AdaptiveSheetSpec spec;
+  spec.size = 0.6;
+  spec.pins = {};
+  testing::AdaptiveSheet sheet = testing::build_adaptive_sheet(spec);  // at y = 1
+  sheet.material.fabric = fabric_preset("cotton");
+  const double radius = 0.2;
+  const Vector3d centre(0.0, 1.0 - 0.05 - radius, 0.0);
+  const meshing::TriMesh sphere = testing::make_sphere(radius, 3, centre);
+  const SimulationSettings settings = drape_settings(0.5);
+  AdaptiveSettings adaptive;
+  adaptive.max_level = 6;
+  AdaptiveCloth cloth(std::move(sheet.mesh), sheet.material, {}, {}, settings, adaptive);
+  cloth.refine_uniformly(2);
+  cloth.set_body(sphere);
+
+  // Step until the first contact.
+  const BodyCollider body(sphere);
+  const double near = 1.25 * settings.contact.thickness;
+  const auto touching = [&](int vertex) {
+    return body.signed_distance(cloth.positions().row(vertex).transpose()) < near;
+  };
+  bool landed = false;
+  while (!landed && cloth.time() < settings.duration) {
+    ASSERT_TRUE(cloth.step().accepted);
+    for (Eigen::Index i = 0; i < cloth.positions().rows() && !landed; ++i)
+      landed = touching(static_cast<int>(i));
+  }
+  ASSERT_TRUE(landed);
+  int at_contact = 0, finest_enough = 0;
+  for (Eigen::Index f = 0; f < cloth.faces().rows(); ++f) {
+    if (!touching(cloth.faces()(f, 0)) && !touching(cloth.faces()(f, 1)) &&
+        !touching(cloth.faces()(f, 2)))
+      continue;
+    ++at_contact;
+    if (cloth.face_levels()(f) >= 4) ++finest_enough;
+  }
+  std::printf(
+      "sheet landing on a sphere at %.3f s: %d vertices, %d triangles at the contact, %d "
+      "of them level 4 or finer, %d split vertices moved off the body\n",
+      cloth.time(), cloth.mesh().vertex_count(), at_contact, finest_enough,
+      cloth.report().moved_off_body);
+  EXPECT_GT(at_contact, 0);
+  EXPECT_EQ(finest_enough, at_contact);
+  // Refined while still in the air: no split vertex had to be lifted off the body.
+  EXPECT_EQ(cloth.report().moved_off_body, 0);
+  // Only the part over the sphere: the rest of the flat sheet stays at level 2.
+  EXPECT_LT(cloth.mesh().vertex_count(), 33 * 33 / 2);
+}
+
 // A 0.4 m sheet (4x4 level-0 quads, started at level 2) 2 cm above a box whose edge runs along
 // z; 0.12 m of it overhangs the edge, folds over it and hangs down the side face.
 TEST(AdaptiveContact, SheetFoldsOverABoxEdgeWithDetailAtTheFold) {
