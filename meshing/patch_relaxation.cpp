@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <utility>
 #include <vector>
 
 namespace sd::meshing {
@@ -17,31 +18,31 @@ struct Adjacency {
   std::vector<int> corner_start, corners;  // face * 4 + corner index
 };
 
-Adjacency build_adjacency(const QuadMesh& mesh) {
-  const auto nv = static_cast<size_t>(mesh.vertices.rows());
+using Quad = std::array<int, 4>;
+
+Adjacency build_adjacency(const std::vector<Quad>& quads, size_t nv) {
   Adjacency adj;
   adj.corner_start.assign(nv + 1, 0);
-  for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f)
-    for (int k = 0; k < 4; ++k) ++adj.corner_start[static_cast<size_t>(mesh.faces(f, k)) + 1];
+  for (const Quad& q : quads)
+    for (const int v : q) ++adj.corner_start[static_cast<size_t>(v) + 1];
   for (size_t v = 0; v < nv; ++v) adj.corner_start[v + 1] += adj.corner_start[v];
   adj.corners.resize(static_cast<size_t>(adj.corner_start[nv]));
   std::vector<int> fill(adj.corner_start.begin(), adj.corner_start.end() - 1);
-  for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f)
-    for (int k = 0; k < 4; ++k)
-      adj.corners[static_cast<size_t>(fill[static_cast<size_t>(mesh.faces(f, k))]++)] =
-          static_cast<int>(f) * 4 + k;
+  for (size_t f = 0; f < quads.size(); ++f)
+    for (size_t k = 0; k < 4; ++k)
+      adj.corners[static_cast<size_t>(fill[static_cast<size_t>(quads[f][k])]++)] =
+          static_cast<int>(f * 4 + k);
   // Edge neighbours: the two face neighbours of every corner, each undirected edge seen from
   // both of its faces (once on the boundary), so deduplicated per vertex.
   adj.neighbour_start.assign(nv + 1, 0);
   adj.neighbours.reserve(2 * adj.corners.size());
+  std::vector<size_t> listed_for(nv, nv);  // the vertex whose list has w last took w
   for (size_t v = 0; v < nv; ++v) {
-    const auto begin = adj.neighbours.size();
     for (int c = adj.corner_start[v]; c < adj.corner_start[v + 1]; ++c) {
-      const int f = adj.corners[static_cast<size_t>(c)] / 4, k = adj.corners[static_cast<size_t>(c)] % 4;
-      for (const int w : {mesh.faces(f, (k + 1) % 4), mesh.faces(f, (k + 3) % 4)})
-        if (std::find(adj.neighbours.begin() + static_cast<std::ptrdiff_t>(begin), adj.neighbours.end(), w) ==
-            adj.neighbours.end())
-          adj.neighbours.push_back(w);
+      const Quad& q = quads[static_cast<size_t>(adj.corners[static_cast<size_t>(c)] / 4)];
+      const auto k = static_cast<size_t>(adj.corners[static_cast<size_t>(c)] % 4);
+      for (const int w : {q[(k + 1) % 4], q[(k + 3) % 4]})
+        if (std::exchange(listed_for[static_cast<size_t>(w)], v) != v) adj.neighbours.push_back(w);
     }
     adj.neighbour_start[v + 1] = static_cast<int>(adj.neighbours.size());
   }
@@ -53,18 +54,18 @@ Adjacency build_adjacency(const QuadMesh& mesh) {
 // that a folded quad among good neighbours shows a negative Jacobian even on a curved patch.
 constexpr int kNormalRings = 4;
 
-std::vector<Eigen::Vector3d> quad_normals(const QuadMesh& mesh, const Adjacency& adj,
+std::vector<Eigen::Vector3d> quad_normals(const std::vector<Quad>& quads, const Adjacency& adj,
                                           const std::vector<Eigen::Vector3d>& x) {
   std::vector<Eigen::Vector3d> vertex_normal(x.size(), Eigen::Vector3d::Zero());
-  for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f)
-    for (int k = 0; k < 4; ++k) {
-      const Eigen::Vector3d& p = x[static_cast<size_t>(mesh.faces(f, k))];
-      vertex_normal[static_cast<size_t>(mesh.faces(f, k))] +=
-          (x[static_cast<size_t>(mesh.faces(f, (k + 1) % 4))] - p)
-              .cross(x[static_cast<size_t>(mesh.faces(f, (k + 3) % 4))] - p);
+  for (const Quad& q : quads)
+    for (size_t k = 0; k < 4; ++k) {
+      const Eigen::Vector3d& p = x[static_cast<size_t>(q[k])];
+      vertex_normal[static_cast<size_t>(q[k])] +=
+          (x[static_cast<size_t>(q[(k + 1) % 4])] - p)
+              .cross(x[static_cast<size_t>(q[(k + 3) % 4])] - p);
     }
-  for (auto& n : vertex_normal)
-    if (n.norm() > 0) n.normalize();
+  // normalize() and normalized() leave a zero vector as it is.
+  for (auto& n : vertex_normal) n.normalize();
   // Averaged over a few rings, so that a cluster of quads that start folded (a Coons block
   // overlapping its neighbour near a reflex corner) cannot turn its own reference around.
   std::vector<Eigen::Vector3d> averaged(x.size());
@@ -73,20 +74,18 @@ std::vector<Eigen::Vector3d> quad_normals(const QuadMesh& mesh, const Adjacency&
       Eigen::Vector3d sum = vertex_normal[v];
       for (int i = adj.neighbour_start[v]; i < adj.neighbour_start[v + 1]; ++i)
         sum += vertex_normal[static_cast<size_t>(adj.neighbours[static_cast<size_t>(i)])];
-      averaged[v] = sum.norm() > 0 ? Eigen::Vector3d(sum.normalized()) : sum;
+      averaged[v] = sum.normalized();
     }
     std::swap(vertex_normal, averaged);
   }
-  std::vector<Eigen::Vector3d> normals(static_cast<size_t>(mesh.faces.rows()));
-  for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f) {
+  std::vector<Eigen::Vector3d> normals(quads.size());
+  for (size_t f = 0; f < quads.size(); ++f) {
     Eigen::Vector3d n = Eigen::Vector3d::Zero();
-    for (int k = 0; k < 4; ++k) n += vertex_normal[static_cast<size_t>(mesh.faces(f, k))];
-    normals[static_cast<size_t>(f)] = n.norm() > 0 ? Eigen::Vector3d(n.normalized()) : n;
+    for (const int v : quads[f]) n += vertex_normal[static_cast<size_t>(v)];
+    normals[f] = n.normalized();
   }
   return normals;
 }
-
-using Quad = std::array<int, 4>;
 
 // Edges of quad q at positions x: e[k] runs from corner k to corner k+1; the corner k is
 // spanned by e[k] and −e[k−1], so its cross product is e[k−1] × e[k].
@@ -112,7 +111,8 @@ double quad_min_jacobian(const Quad& q, const Eigen::Vector3d& normal,
 }
 
 // Whether every corner of quad q has a scaled Jacobian of at least `bound` (> 0), without
-// square roots: c >= bound |e1| |e2|  <=>  c >= 0 and c² >= bound² |e1|² |e2|².
+// square roots: c >= bound |e1| |e2|  <=>  c > 0 and c² >= bound² |e1|² |e2|² (c = 0 is a zero
+// angle or a zero-length edge, which quad_min_jacobian counts as 0 or −1).
 bool quad_at_least(const Quad& q, const Eigen::Vector3d& normal,
                    const std::vector<Eigen::Vector3d>& x, double bound) {
   const auto e = quad_edges(q, x);
@@ -120,9 +120,17 @@ bool quad_at_least(const Quad& q, const Eigen::Vector3d& normal,
   for (size_t k = 0; k < 4; ++k) length2[k] = e[k].squaredNorm();
   for (size_t k = 0; k < 4; ++k) {
     const double c = e[(k + 3) % 4].cross(e[k]).dot(normal);
-    if (c < 0 || c * c < bound * bound * length2[(k + 3) % 4] * length2[k]) return false;
+    if (c <= 0 || c * c < bound * bound * length2[(k + 3) % 4] * length2[k]) return false;
   }
   return true;
+}
+
+// quad_min_jacobian(q, normal, x) >= bound, decided without square roots for the quads that clear
+// it by more than rounding (most of them).
+bool quad_min_jacobian_at_least(const Quad& q, const Eigen::Vector3d& normal,
+                                const std::vector<Eigen::Vector3d>& x, double bound) {
+  return quad_at_least(q, normal, x, bound * (1 + 1e-12)) ||
+         quad_min_jacobian(q, normal, x) >= bound;
 }
 
 using Projection = std::function<Eigen::Vector3d(const Eigen::Vector3d&)>;
@@ -165,7 +173,7 @@ void untangle(std::vector<Eigen::Vector3d>& x, const std::vector<Quad>& quads,
       }
     };
     for (size_t f = 0; f < nf; ++f) {
-      if (quad_min_jacobian(quads[f], normals[f], x) >= kUntangleTarget) continue;
+      if (quad_min_jacobian_at_least(quads[f], normals[f], x, kUntangleTarget)) continue;
       for (const int v : quads[f]) {
         choose(static_cast<size_t>(v));
         for (int i = adj.neighbour_start[static_cast<size_t>(v)]; i < adj.neighbour_start[static_cast<size_t>(v) + 1]; ++i)
@@ -228,47 +236,49 @@ void untangle(std::vector<Eigen::Vector3d>& x, const std::vector<Quad>& quads,
 void relax_interior(QuadMesh& mesh, std::span<const char> fixed, int sweeps,
                     const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& project) {
   if (sweeps <= 0 || mesh.faces.rows() == 0) return;
-  const Adjacency adj = build_adjacency(mesh);
   const auto nv = static_cast<size_t>(mesh.vertices.rows());
   const auto nf = static_cast<size_t>(mesh.faces.rows());
-  std::vector<Eigen::Vector3d> old(nv), next(nv);
-  for (size_t v = 0; v < nv; ++v) old[v] = mesh.vertices.row(static_cast<Eigen::Index>(v)).transpose();
-  // Reference normals from the starting positions: they only tell a quad's front from its back.
-  const std::vector<Eigen::Vector3d> normals = quad_normals(mesh, adj, old);
-  constexpr double kAcceptable = 0.05;  // a move may lower a quad's minimum down to this
-  // Stop once no vertex moves more than 1e-3 of the mean edge length in a sweep.
-  double edge_sum = 0;
-  for (size_t f = 0; f < nf; ++f)
-    edge_sum += (old[static_cast<size_t>(mesh.faces(static_cast<Eigen::Index>(f), 0))] -
-                 old[static_cast<size_t>(mesh.faces(static_cast<Eigen::Index>(f), 1))])
-                    .norm();
-  const double tolerance = 1e-3 * edge_sum / static_cast<double>(nf);
   std::vector<Quad> quads(nf);
   for (size_t f = 0; f < nf; ++f)
     for (int k = 0; k < 4; ++k)
       quads[f][static_cast<size_t>(k)] = mesh.faces(static_cast<Eigen::Index>(f), k);
+  const Adjacency adj = build_adjacency(quads, nv);
+  std::vector<Eigen::Vector3d> old(nv);
+  for (size_t v = 0; v < nv; ++v) old[v] = mesh.vertices.row(static_cast<Eigen::Index>(v)).transpose();
+  // Reference normals from the starting positions: they only tell a quad's front from its back.
+  const std::vector<Eigen::Vector3d> normals = quad_normals(quads, adj, old);
+  constexpr double kAcceptable = 0.05;  // a move may lower a quad's minimum down to this
+  // Stop once no vertex moves more than 1e-3 of the mean edge length in a sweep.
+  double edge_sum = 0;
+  for (const Quad& q : quads)
+    edge_sum += (old[static_cast<size_t>(q[0])] - old[static_cast<size_t>(q[1])]).norm();
+  const double tolerance = 1e-3 * edge_sum / static_cast<double>(nf);
+  // The vertices a sweep moves; every other entry of the position buffers keeps its start.
+  std::vector<size_t> movers;
+  for (size_t v = 0; v < nv; ++v)
+    if (!fixed[v] && adj.neighbour_start[v + 1] > adj.neighbour_start[v]) movers.push_back(v);
   // Jacobi step: every free vertex of `from` to the mean of its neighbours, into `to`.
-  auto laplacian_step = [&](const std::vector<Eigen::Vector3d>& from, std::vector<Eigen::Vector3d>& to) {
-    for (size_t v = 0; v < nv; ++v) {
-      to[v] = from[v];
+  auto laplacian_step = [&](const std::vector<Eigen::Vector3d>& from,
+                            std::vector<Eigen::Vector3d>& to) {
+    for (const size_t v : movers) {
       const int begin = adj.neighbour_start[v], end = adj.neighbour_start[v + 1];
-      if (fixed[v] || end == begin) continue;
       Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-      for (int i = begin; i < end; ++i) mean += from[static_cast<size_t>(adj.neighbours[static_cast<size_t>(i)])];
+      for (int i = begin; i < end; ++i)
+        mean += from[static_cast<size_t>(adj.neighbours[static_cast<size_t>(i)])];
       mean /= end - begin;
       to[v] = project ? project(mean) : mean;
     }
   };
   auto largest_move = [&](const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b) {
     double largest = 0;
-    for (size_t v = 0; v < nv; ++v) largest = std::max(largest, (a[v] - b[v]).squaredNorm());
+    for (const size_t v : movers) largest = std::max(largest, (a[v] - b[v]).squaredNorm());
     return largest;
   };
   {
     // Optimistic pass: all sweeps unguarded, then one check of every quad. On most patches no
     // quad ends below min(its start, kAcceptable) and this is the result, at a tenth of the
     // checks; otherwise start again with the guarded sweeps below.
-    std::vector<Eigen::Vector3d> x = old, y(nv);
+    std::vector<Eigen::Vector3d> x = old, y = old;
     for (int sweep = 0; sweep < sweeps; ++sweep) {
       laplacian_step(x, y);
       const double move = largest_move(x, y);
@@ -286,6 +296,7 @@ void relax_interior(QuadMesh& mesh, std::span<const char> fixed, int sweeps,
       return;
     }
   }
+  std::vector<Eigen::Vector3d> next = old;
   std::vector<char> bad(nf, 0);
   std::vector<int> queue, reverted;
   for (int sweep = 0; sweep < sweeps; ++sweep) {
@@ -303,8 +314,8 @@ void relax_interior(QuadMesh& mesh, std::span<const char> fixed, int sweeps,
     while (!queue.empty()) {
       reverted.clear();
       for (const int f : queue)
-        for (int k = 0; k < 4; ++k) {
-          const auto v = static_cast<size_t>(mesh.faces(f, k));
+        for (const int corner : quads[static_cast<size_t>(f)]) {
+          const auto v = static_cast<size_t>(corner);
           if (next[v] != old[v]) {
             next[v] = old[v];
             reverted.push_back(static_cast<int>(v));

@@ -11,90 +11,91 @@ namespace sd::meshing {
 namespace {
 
 bool indices_in_range(const QuadMesh& mesh) {
-  const auto nv = static_cast<int>(mesh.vertices.rows());
-  return (mesh.faces.array() >= 0).all() && (mesh.faces.array() < nv).all();
+  return mesh.faces.size() == 0 ||
+         (mesh.faces.minCoeff() >= 0 && mesh.faces.maxCoeff() < mesh.vertices.rows());
 }
 
 }  // namespace
 
 namespace {
 
-// For each vertex, the vertices its faces' edges leave it for (v → next in some face):
-// compressed rows, built in O(F).
-struct OutgoingEdges {
-  std::vector<int> start, target;
-  std::span<const int> of(int v) const {
-    return {target.data() + start[static_cast<size_t>(v)],
+// For each vertex v, its face corners' edges in compressed rows, built in O(F): `out` holds the
+// vertex each corner's face goes to after v (edge v → out), `in` the one it comes from
+// (edge in → v), in the same corner order.
+struct CornerEdges {
+  std::vector<int> start, out, in;
+  std::span<const int> row(const std::vector<int>& targets, int v) const {
+    return {targets.data() + start[static_cast<size_t>(v)],
             static_cast<size_t>(start[static_cast<size_t>(v) + 1] - start[static_cast<size_t>(v)])};
   }
-  bool has(int from, int to) const {
-    const auto row = of(from);
-    return std::find(row.begin(), row.end(), to) != row.end();
-  }
+  std::span<const int> out_of(int v) const { return row(out, v); }
+  std::span<const int> in_of(int v) const { return row(in, v); }
 };
 
-OutgoingEdges outgoing_edges(const QuadMesh& mesh) {
-  OutgoingEdges out;
+CornerEdges corner_edges(const QuadMesh& mesh) {
+  CornerEdges edges;
   const auto nv = static_cast<size_t>(mesh.vertices.rows());
-  out.start.assign(nv + 1, 0);
+  edges.start.assign(nv + 1, 0);
   for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f)
-    for (int k = 0; k < 4; ++k) ++out.start[static_cast<size_t>(mesh.faces(f, k)) + 1];
-  for (size_t v = 0; v < nv; ++v) out.start[v + 1] += out.start[v];
-  out.target.resize(static_cast<size_t>(out.start[nv]));
-  std::vector<int> fill(out.start.begin(), out.start.end() - 1);
+    for (int k = 0; k < 4; ++k) ++edges.start[static_cast<size_t>(mesh.faces(f, k)) + 1];
+  for (size_t v = 0; v < nv; ++v) edges.start[v + 1] += edges.start[v];
+  edges.out.resize(static_cast<size_t>(edges.start[nv]));
+  edges.in.resize(edges.out.size());
+  std::vector<int> fill(edges.start.begin(), edges.start.end() - 1);
   for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f)
-    for (int k = 0; k < 4; ++k)
-      out.target[static_cast<size_t>(fill[static_cast<size_t>(mesh.faces(f, k))]++)] =
-          mesh.faces(f, (k + 1) % 4);
-  return out;
+    for (int k = 0; k < 4; ++k) {
+      const auto slot = static_cast<size_t>(fill[static_cast<size_t>(mesh.faces(f, k))]++);
+      edges.out[slot] = mesh.faces(f, (k + 1) % 4);
+      edges.in[slot] = mesh.faces(f, (k + 3) % 4);
+    }
+  return edges;
 }
 
 }  // namespace
 
 Eigen::VectorXi vertex_valences(const QuadMesh& mesh) {
   if (!indices_in_range(mesh)) throw std::invalid_argument("a face refers to a missing vertex");
-  const OutgoingEdges out = outgoing_edges(mesh);
-  // Distinct neighbours: every outgoing target, plus every vertex with an edge into v that v
-  // has no edge back to (only boundary edges, on a good mesh).
-  Eigen::VectorXi valence = Eigen::VectorXi::Zero(mesh.vertices.rows());
-  for (int v = 0; v < static_cast<int>(mesh.vertices.rows()); ++v) {
-    const auto row = out.of(v);
-    for (size_t i = 0; i < row.size(); ++i) {
-      if (std::find(row.begin(), row.begin() + static_cast<std::ptrdiff_t>(i), row[i]) !=
-          row.begin() + static_cast<std::ptrdiff_t>(i))
-        continue;  // repeated target (non-manifold input)
-      ++valence(v);
-      if (!out.has(row[i], v)) ++valence(row[i]);
-    }
-  }
+  const CornerEdges edges = corner_edges(mesh);
+  // Distinct neighbours: the vertices v has an edge to or from, each counted once.
+  const auto nv = static_cast<int>(mesh.vertices.rows());
+  Eigen::VectorXi valence = Eigen::VectorXi::Zero(nv);
+  std::vector<int> counted_for(static_cast<size_t>(nv), -1);  // the last v that counted w
+  for (int v = 0; v < nv; ++v)
+    for (const auto& row : {edges.out_of(v), edges.in_of(v)})
+      for (const int w : row)
+        if (std::exchange(counted_for[static_cast<size_t>(w)], v) != v) ++valence(v);
   return valence;
 }
 
 std::vector<int> boundary_loop(const QuadMesh& mesh) {
   if (!indices_in_range(mesh)) throw std::invalid_argument("a face refers to a missing vertex");
-  const OutgoingEdges out = outgoing_edges(mesh);
+  const CornerEdges edges = corner_edges(mesh);
   const auto nv = static_cast<size_t>(mesh.vertices.rows());
   std::vector<int> next(nv, -1);  // boundary edge from → to, in face orientation
-  size_t edges = 0;
-  for (int v = 0; v < static_cast<int>(nv); ++v)
-    for (const int w : out.of(v)) {
-      if (out.has(w, v)) continue;
+  std::vector<int> enters(nv, -1);  // enters[w] == v: some face has the edge w → v
+  size_t boundary_edges = 0;
+  for (int v = 0; v < static_cast<int>(nv); ++v) {
+    for (const int w : edges.in_of(v)) enters[static_cast<size_t>(w)] = v;
+    for (const int w : edges.out_of(v)) {
+      if (enters[static_cast<size_t>(w)] == v) continue;  // w → v too: an inner edge
       if (next[static_cast<size_t>(v)] != -1)
         throw std::invalid_argument("the boundary is not a single simple loop");
       next[static_cast<size_t>(v)] = w;
-      ++edges;
+      ++boundary_edges;
     }
-  if (edges == 0) return {};
+  }
+  if (boundary_edges == 0) return {};
   std::vector<int> loop;
   int v = static_cast<int>(std::find_if(next.begin(), next.end(), [](int w) { return w >= 0; }) -
                            next.begin());
   do {
     loop.push_back(v);
     v = next[static_cast<size_t>(v)];
-    if (v < 0 || loop.size() > edges)
+    if (v < 0 || loop.size() > boundary_edges)
       throw std::invalid_argument("the boundary is not a single simple loop");
   } while (v != loop.front());
-  if (loop.size() != edges) throw std::invalid_argument("the boundary has more than one loop");
+  if (loop.size() != boundary_edges)
+    throw std::invalid_argument("the boundary has more than one loop");
   return loop;
 }
 
@@ -116,15 +117,15 @@ MeshCheck validate(const QuadMesh& mesh) {
         if (q(a) == q(b))
           problems.push_back("face " + std::to_string(f) + " repeats vertex " + std::to_string(q(a)));
   }
-  const OutgoingEdges out = outgoing_edges(mesh);
+  const CornerEdges edges = corner_edges(mesh);
   auto uses = [&](int from, int to) {
-    const auto row = out.of(from);
+    const auto row = edges.out_of(from);
     return static_cast<int>(std::count(row.begin(), row.end(), to));
   };
   int non_manifold = 0, inconsistent = 0;
   Eigen::Index undirected_edges = 0;
   for (int v = 0; v < static_cast<int>(mesh.vertices.rows()); ++v) {
-    const auto row = out.of(v);
+    const auto row = edges.out_of(v);
     for (size_t i = 0; i < row.size(); ++i) {
       const int w = row[i];
       if (std::find(row.begin(), row.begin() + static_cast<std::ptrdiff_t>(i), w) !=

@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -37,15 +38,24 @@ QuadQuality measure_quality(const QuadMesh& mesh, std::span<const int> corner_ve
   // Column per vertex / per face: the rows of the #V by 3 matrices are strided in memory.
   const Eigen::Matrix3Xd x = mesh.vertices.transpose();
   const Eigen::Matrix4Xi q = mesh.faces.transpose();
+  // Edge k of quad f runs from its corner k to corner k+1; corner k is spanned by edge k and
+  // the reverse of edge k−1 (x_{k−1} − x_k = −(x_k − x_{k−1}) exactly, so each edge vector and
+  // length is computed once per quad instead of once per corner).
+  std::array<Eigen::Vector3d, 4> edge;
+  std::array<double, 4> length;
+  auto quad_edges = [&](Eigen::Index f) {
+    for (Eigen::Index k = 0; k < 4; ++k)
+      edge[static_cast<size_t>(k)] = x.col(q((k + 1) % 4, f)) - x.col(q(k, f));
+  };
   // Vertex normals: sums of the corner cross products of the incident quads.
   Eigen::Matrix3Xd normals = Eigen::Matrix3Xd::Zero(3, x.cols());
-  for (Eigen::Index f = 0; f < q.cols(); ++f)
-    for (int k = 0; k < 4; ++k) {
-      const Eigen::Vector3d p = x.col(q(k, f));
-      const Eigen::Vector3d e1 = x.col(q((k + 1) % 4, f)) - p;
-      const Eigen::Vector3d e2 = x.col(q((k + 3) % 4, f)) - p;
-      normals.col(q(k, f)) += e1.cross(e2);
+  for (Eigen::Index f = 0; f < q.cols(); ++f) {
+    quad_edges(f);
+    for (size_t k = 0; k < 4; ++k) {
+      const Eigen::Vector3d e2 = -edge[(k + 3) % 4];
+      normals.col(q(static_cast<Eigen::Index>(k), f)) += edge[k].cross(e2);
     }
+  }
   constexpr double kInf = std::numeric_limits<double>::infinity();
   double convex_cos_min = kInf, convex_cos_max = -kInf, reflex_cos_min = kInf, reflex_cos_max = -kInf;
   double max_aspect = 0, jac_min = std::numeric_limits<double>::infinity(), jac_sum = 0;
@@ -57,15 +67,18 @@ QuadQuality measure_quality(const QuadMesh& mesh, std::span<const int> corner_ve
     Eigen::Vector3d n = Eigen::Vector3d::Zero();
     for (int k = 0; k < 4; ++k) n += normals.col(q(k, f));
     const double nn = n.norm();
-    for (int k = 0; k < 4; ++k) {
-      const Eigen::Vector3d p = x.col(q(k, f));
-      const Eigen::Vector3d e1 = x.col(q((k + 1) % 4, f)) - p;
-      const Eigen::Vector3d e2 = x.col(q((k + 3) % 4, f)) - p;
-      const double l1 = e1.norm(), l2 = e2.norm();
+    const Eigen::Vector3d unit_normal = nn > 0 ? Eigen::Vector3d(n / nn) : n;
+    quad_edges(f);
+    for (size_t k = 0; k < 4; ++k) length[k] = edge[k].norm();
+    for (size_t k = 0; k < 4; ++k) {
+      const Eigen::Vector3d& e1 = edge[k];
+      const Eigen::Vector3d e2 = -edge[(k + 3) % 4];
+      const double l1 = length[k], l2 = length[(k + 3) % 4];
       shortest = std::min(shortest, l1);
       longest = std::max(longest, l1);
       const double cosine = (l1 > 0 && l2 > 0) ? std::clamp(e1.dot(e2) / (l1 * l2), -1.0, 1.0) : 1.0;
-      const double jac = (l1 > 0 && l2 > 0 && nn > 0) ? e1.cross(e2).dot(n / nn) / (l1 * l2) : 0.0;
+      const double jac =
+          (l1 > 0 && l2 > 0 && nn > 0) ? e1.cross(e2).dot(unit_normal) / (l1 * l2) : 0.0;
       // A corner whose scaled Jacobian is negative is reflex or folded: its angle is
       // 360° − acos(cosine) > 180°. The angle is monotonic in the cosine on either side, so
       // only the extreme cosines are kept and acos is taken four times per mesh.

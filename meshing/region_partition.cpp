@@ -2,6 +2,8 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <climits>
 #include <cmath>
 #include <numeric>
@@ -72,13 +74,14 @@ PolygonLayout fallback_layout(int loop_size, std::span<const int> starts,
   PolygonLayout best;
   best.cost = INT_MAX;
   const int half = loop_size / 2;
-  auto delta = [&](int p) {
-    p = wrap(p, loop_size);
+  auto delta = [&](int p) {  // p in [0, 2 loop_size)
+    if (p >= loop_size) p -= loop_size;
     return costs.as_corner[static_cast<size_t>(p)] - costs.as_side[static_cast<size_t>(p)];
   };
   const int base = std::accumulate(costs.as_side.begin(), costs.as_side.end(), 0);
-  auto flat = [&](int p) {
-    return costs.flat.empty() ? 0 : static_cast<int>(costs.flat[static_cast<size_t>(wrap(p, loop_size))]);
+  auto flat = [&](int p) {  // p in [0, 2 loop_size)
+    if (p >= loop_size) p -= loop_size;
+    return costs.flat.empty() ? 0 : static_cast<int>(costs.flat[static_cast<size_t>(p)]);
   };
   // A grid's corners are two antipodal pairs (p, p + half) and (q, q + half), q = p + a: its
   // cost is base + g(p) + g(q) with g(p) = delta(p) + delta(p + half), which has period half.
@@ -93,8 +96,8 @@ PolygonLayout fallback_layout(int loop_size, std::span<const int> starts,
   // at. Ties keep the smallest a for the first p, as the plain double loop over (p, a) would.
   std::vector<int> by_g(static_cast<size_t>(half));
   std::iota(by_g.begin(), by_g.end(), 0);
-  std::stable_sort(by_g.begin(), by_g.end(), [&](int x, int y) {
-    return g[static_cast<size_t>(x)] < g[static_cast<size_t>(y)];
+  std::sort(by_g.begin(), by_g.end(), [&](int x, int y) {  // stable: ties by position
+    return std::pair(g[static_cast<size_t>(x)], x) < std::pair(g[static_cast<size_t>(y)], y);
   });
   const int g_min = g[static_cast<size_t>(by_g.front())];
   int best_balance = -1, best_flat = INT_MAX, best_a = INT_MAX;
@@ -157,58 +160,132 @@ std::vector<int> nasri_distances_doubled(std::span<const int> lengths) {
 
 namespace {
 
+// 2 d_j for every j of a polygon with m = arcs.size() >= 3 corners, m not divisible by 4, for
+// any integer arcs (no feasibility check). The closed form gives 2 d_j as an alternating sum of
+// `terms` arcs; it is computed once per cycle j, j+2, j+4, ... (one cycle for m odd, two for
+// m/2 odd) and the rest follows from arcs_{j+1} = d_j + d_{j+2}: O(m) instead of O(m²).
+void doubled_spokes(std::span<const int> arcs, std::vector<int>& twice) {
+  const auto m = static_cast<int>(arcs.size());
+  twice.resize(static_cast<size_t>(m));
+  const int terms = m % 2 == 1 ? m : m / 2;
+  for (int r = 0; r < (m % 2 == 1 ? 1 : 2); ++r) {
+    int value = 0;
+    for (int k = 0, i = r + 1; k < terms; ++k, i = i + 2 >= m ? i + 2 - m : i + 2)
+      value += (k % 2 == 0 ? 1 : -1) * arcs[static_cast<size_t>(i)];
+    for (int k = 0, j = r; k < terms; ++k) {
+      twice[static_cast<size_t>(j)] = value;
+      const int next_arc = j + 1 == m ? 0 : j + 1;
+      value = 2 * arcs[static_cast<size_t>(next_arc)] - value;
+      j = j + 2 >= m ? j + 2 - m : j + 2;
+    }
+  }
+}
+
+// For m = arcs.size() divisible by 4, the d's of parity r form an even cycle
+// arcs_{r+2k+1} = d_{r+2k} + d_{r+2k+2}, k = 0 .. m/2 − 1; it closes only when this
+// alternating sum of its arcs is zero.
+int cycle_closure(std::span<const int> arcs, int r) {
+  const auto m = static_cast<int>(arcs.size());
+  int c = 0;
+  for (int k = 0; k < m / 2; ++k) c = arcs[static_cast<size_t>(wrap(r + 2 * k + 1, m))] - c;
+  return c;
+}
+
 // nasri_spokes() without allocation (d is resized); false when infeasible.
 bool solve_spokes(std::span<const int> arcs, std::vector<int>& d) {
   const auto m = static_cast<int>(arcs.size());
   if (m < 3) return false;
   d.resize(static_cast<size_t>(m));
   if (m % 4 != 0) {
-    // The closed form gives 2 d_j as an alternating sum of `terms` arcs; it is computed once
-    // per cycle j, j+2, j+4, ... (one cycle for m odd, two for m/2 odd) and the rest follows
-    // from arcs_{j+1} = d_j + d_{j+2}: O(m) instead of O(m²). Within a cycle every 2 d_j has
-    // the parity of the first.
-    const int terms = m % 2 == 1 ? m : m / 2;
-    for (int r = 0; r < (m % 2 == 1 ? 1 : 2); ++r) {
-      int twice = 0;
-      for (int k = 0, i = r + 1; k < terms; ++k, i = i + 2 >= m ? i + 2 - m : i + 2)
-        twice += (k % 2 == 0 ? 1 : -1) * arcs[static_cast<size_t>(i)];
-      if (twice % 2 != 0) return false;
-      for (int k = 0, j = r; k < terms; ++k) {
-        if (twice < 2) return false;
-        d[static_cast<size_t>(j)] = twice / 2;
-        const int next_arc = j + 1 == m ? 0 : j + 1;
-        twice = 2 * arcs[static_cast<size_t>(next_arc)] - twice;
-        j = j + 2 >= m ? j + 2 - m : j + 2;
-      }
+    doubled_spokes(arcs, d);
+    for (int& value : d) {
+      if (value < 2 || value % 2 != 0) return false;
+      value /= 2;
     }
     return true;
   }
   // m divisible by 4: the d's of each parity form an even cycle arcs_{j+1} = d_j + d_{j+2}.
-  // Write d_{r+2k} = s_k t + c_k; the cycle closes only if c_h = 0 (alternating sum zero).
+  // Write d_{r+2k} = s_k t + c_k with s_k = (−1)^k, c_0 = 0, c_{k+1} = arcs_{r+2k+1} − c_k; the
+  // cycle closes only if c_{m/2} = 0 (cycle_closure).
   const int h = m / 2;
+  auto next_c = [&](int r, int k, int c) {
+    return arcs[static_cast<size_t>(wrap(r + 2 * k + 1, m))] - c;
+  };
   for (int r = 0; r < 2; ++r) {
-    std::vector<int> s(static_cast<size_t>(h) + 1), c(static_cast<size_t>(h) + 1);
-    s[0] = 1;
-    c[0] = 0;
-    for (int k = 0; k < h; ++k) {
-      s[static_cast<size_t>(k) + 1] = -s[static_cast<size_t>(k)];
-      c[static_cast<size_t>(k) + 1] =
-          arcs[static_cast<size_t>(wrap(r + 2 * k + 1, m))] - c[static_cast<size_t>(k)];
-    }
-    if (c[static_cast<size_t>(h)] != 0) return false;
+    if (cycle_closure(arcs, r) != 0) return false;
     int lo = INT_MIN / 2, hi = INT_MAX / 2;
-    for (int k = 0; k < h; ++k) {
-      if (s[static_cast<size_t>(k)] > 0) lo = std::max(lo, 1 - c[static_cast<size_t>(k)]);
-      else hi = std::min(hi, c[static_cast<size_t>(k)] - 1);
+    for (int k = 0, c = 0; k < h; c = next_c(r, k, c), ++k) {
+      if (k % 2 == 0)
+        lo = std::max(lo, 1 - c);
+      else
+        hi = std::min(hi, c - 1);
     }
     if (lo > hi) return false;
     const int t = lo + (hi - lo) / 2;  // the middle keeps the shortest spoke longest
-    for (int k = 0; k < h; ++k)
-      d[static_cast<size_t>(wrap(r + 2 * k, m))] =
-          s[static_cast<size_t>(k)] * t + c[static_cast<size_t>(k)];
+    for (int k = 0, c = 0; k < h; c = next_c(r, k, c), ++k)
+      d[static_cast<size_t>(wrap(r + 2 * k, m))] = (k % 2 == 0 ? t : -t) + c;
   }
   return true;
 }
+
+// The positions p of one more layout corner, between two consecutive corners of a fixed set,
+// for which solve_spokes can succeed. Along such a stretch every arc is an affine function of p
+// (the two arcs at p change by +1 and −1 per step), and so is every 2 d_j and every cycle
+// closure: the admissible p form an interval, of one parity when 2 d_j changes by an odd amount
+// per step, a single p for m divisible by 4. Exact for m not divisible by 4; for m divisible by
+// 4 only the closures are checked (necessary), the spokes' positivity is left to solve_spokes.
+class LastCornerWindow {
+ public:
+  // arcs_at_p0 and arcs_after: the layout's arcs with the corner at p0 and at p0 + 1 (arcs of
+  // zero or below are fine here: only the affine functions are read).
+  void place(std::span<const int> arcs_at_p0, std::span<const int> arcs_after, int p0) {
+    p0_ = p0;
+    lo_ = INT_MIN / 2;
+    hi_ = INT_MAX / 2;
+    parity_ = {true, true};
+    const auto m = static_cast<int>(arcs_at_p0.size());
+    if (m % 4 == 0) {
+      for (int r = 0; r < 2; ++r) {  // closure + offset · slope = 0
+        const int closure = cycle_closure(arcs_at_p0, r);
+        const int slope = cycle_closure(arcs_after, r) - closure;
+        if (slope == 0) {
+          if (closure != 0) close();
+        } else if (closure % slope != 0) {
+          close();
+        } else {
+          lo_ = std::max(lo_, -closure / slope);
+          hi_ = std::min(hi_, -closure / slope);
+        }
+      }
+      return;
+    }
+    doubled_spokes(arcs_at_p0, twice_at_p0_);
+    doubled_spokes(arcs_after, twice_after_);
+    for (size_t j = 0; j < twice_at_p0_.size(); ++j) {  // twice + offset · slope >= 2, even
+      const int twice = twice_at_p0_[j], slope = twice_after_[j] - twice;
+      if (slope > 0) lo_ = std::max(lo_, ceil_div(2 - twice, slope));
+      if (slope < 0) hi_ = std::min(hi_, floor_div(twice - 2, -slope));
+      if (slope == 0 && twice < 2) close();
+      if (slope % 2 == 0 && twice % 2 != 0) close();
+      if (slope % 2 != 0) parity_[(twice & 1) ^ 1] = false;  // the offset needs twice's parity
+    }
+  }
+
+  bool admits(int p) const {
+    const int offset = p - p0_;
+    return lo_ <= offset && offset <= hi_ && parity_[static_cast<size_t>(offset & 1)];
+  }
+
+ private:
+  static int floor_div(int a, int b) { return a / b - (a % b != 0 && (a < 0) != (b < 0) ? 1 : 0); }
+  static int ceil_div(int a, int b) { return -floor_div(-a, b); }
+  void close() { hi_ = lo_ - 1; }
+
+  int p0_ = 0;
+  int lo_ = 0, hi_ = -1;                        // admissible offsets p − p0
+  std::array<bool, 2> parity_{true, true};      // admissible offset parities
+  std::vector<int> twice_at_p0_, twice_after_;  // reused by every place()
+};
 
 }  // namespace
 
@@ -280,12 +357,16 @@ PolygonLayout best_layout(const PositionCosts& costs, int budget) {
   const auto base_irregular = static_cast<int>(
       std::count_if(costs.as_side.begin(), costs.as_side.end(), [](int c) { return c != 0; }));
   std::vector<int> arcs, spokes, kept, added, chosen;  // reused: a check allocates nothing
-  auto consider = [&](const std::vector<int>& corners) {
-    --budget;
+  auto arcs_of = [size](const std::vector<int>& corners, std::vector<int>& out) {
     const auto m = corners.size();
-    arcs.resize(m);
-    for (size_t j = 0; j + 1 < m; ++j) arcs[j] = corners[j + 1] - corners[j];
-    arcs[m - 1] = corners[0] + size - corners[m - 1];
+    out.resize(m);
+    for (size_t j = 0; j + 1 < m; ++j) out[j] = corners[j + 1] - corners[j];
+    out[m - 1] = corners[0] + size - corners[m - 1];
+  };
+  // One feasibility check (the budget is counted by the caller).
+  auto evaluate = [&](const std::vector<int>& corners) {
+    const auto m = corners.size();
+    arcs_of(corners, arcs);
     int balance;
     bool grid = false;
     if (m == 4 && arcs[0] == arcs[2] && arcs[1] == arcs[3]) {
@@ -313,6 +394,37 @@ PolygonLayout best_layout(const PositionCosts& costs, int budget) {
       best_balance = balance;
     }
   };
+  auto consider = [&](const std::vector<int>& corners) {
+    --budget;
+    evaluate(corners);
+  };
+  // The last promoted corner p runs over others[from..] with the other corners fixed: each
+  // candidate still counts as a check, but only those the window admits are solved.
+  std::vector<int> fixed, arcs_after;
+  LastCornerWindow window;
+  auto scan_last = [&](size_t from) {
+    fixed.resize(kept.size() + added.size());
+    std::merge(kept.begin(), kept.end(), added.begin(), added.end(), fixed.begin());
+    size_t stretch = fixed.size() + 1;  // where p goes among the fixed corners, for `window`
+    for (size_t i = from; i < others.size() && budget > 0; ++i) {
+      const int p = others[i];
+      --budget;
+      const auto at =
+          static_cast<size_t>(std::lower_bound(fixed.begin(), fixed.end(), p) - fixed.begin());
+      if (at != stretch) {
+        stretch = at;
+        chosen = fixed;
+        chosen.insert(chosen.begin() + static_cast<std::ptrdiff_t>(at), p + 1);
+        arcs_of(chosen, arcs_after);
+        chosen[at] = p;
+        arcs_of(chosen, arcs);
+        window.place(arcs, arcs_after, p);
+      }
+      if (!window.admits(p)) continue;
+      chosen[at] = p;  // the fixed corners with p in loop order
+      evaluate(chosen);
+    }
+  };
   for (const Plan& plan : plans) {
     // Ties with the fallback are still searched: a Nasri centre beats a grid with moved corners
     // of equal distortion by having fewer irregular vertices.
@@ -323,8 +435,10 @@ PolygonLayout best_layout(const PositionCosts& costs, int budget) {
     const unsigned full = 1u << std::min(n_natural, 20);
     for (unsigned mask = (1u << plan.dropped) - 1; mask < full && budget > 0;) {
       kept.clear();
-      for (int i = 0; i < n_natural; ++i)
-        if ((mask & (1u << i)) == 0) kept.push_back(naturals[static_cast<size_t>(i)]);
+      for (unsigned rest = ~mask & (full - 1); rest != 0; rest &= rest - 1)
+        kept.push_back(naturals[static_cast<size_t>(std::countr_zero(rest))]);
+      // Natural corners beyond the 20 a mask can drop are always kept.
+      for (int i = 20; i < n_natural; ++i) kept.push_back(naturals[static_cast<size_t>(i)]);
       auto recurse = [&](auto&& self, size_t from) -> void {
         if (budget <= 0) return;
         if (static_cast<int>(added.size()) == plan.added) {
@@ -332,6 +446,10 @@ PolygonLayout best_layout(const PositionCosts& costs, int budget) {
           chosen.resize(kept.size() + added.size());
           std::merge(kept.begin(), kept.end(), added.begin(), added.end(), chosen.begin());
           consider(chosen);
+          return;
+        }
+        if (static_cast<int>(added.size()) + 1 == plan.added) {
+          scan_last(from);
           return;
         }
         for (size_t i = from; i < others.size() && budget > 0; ++i) {
