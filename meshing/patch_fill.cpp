@@ -459,20 +459,22 @@ FilledPatch fill_with_plan(const Plan& plan, std::span<const int> counts,
                            const FillGeometryOptions& options) {
   FilledPatch patch;
   Built built = yasseen ? std::move(*yasseen) : realize(plan, counts, side_points, shape);
-  patch.mesh = built.builder.build();
   // The same connectivity laid out flat for display.
   patch.topology = to_topology(
       realize(plan, counts, display_sides(counts), straight_sided_shape(counts)), plan);
-  if (patch.mesh.faces != patch.topology.mesh.faces)
-    throw std::logic_error("the fill's connectivity depends on geometry");
-  std::vector<char> fixed(static_cast<size_t>(patch.mesh.vertices.rows()), 0);
+  // Projection and relaxation work on the builder's arrays; the mesh is built once, after.
+  std::vector<Eigen::Vector3d>& positions = built.builder.positions();
+  std::vector<char> fixed(positions.size(), 0);
   for (const auto& side : patch.topology.side_vertices)
     for (const int v : side) fixed[static_cast<size_t>(v)] = 1;
   if (options.project)
-    for (Eigen::Index v = 0; v < patch.mesh.vertices.rows(); ++v)
-      if (!fixed[static_cast<size_t>(v)])
-        patch.mesh.vertices.row(v) = options.project(patch.mesh.vertices.row(v).transpose()).transpose();
-  relax_interior(patch.mesh, fixed, options.relax_iterations, options.project);
+    for (size_t v = 0; v < positions.size(); ++v)
+      if (!fixed[v]) positions[v] = options.project(positions[v]);
+  detail::relax_interior(positions, built.builder.faces(), fixed, options.relax_iterations,
+                         options.project);
+  patch.mesh = built.builder.build();
+  if (patch.mesh.faces != patch.topology.mesh.faces)
+    throw std::logic_error("the fill's connectivity depends on geometry");
   patch.quality = measure_quality(patch.mesh, patch.topology.corner_vertices());
   return patch;
 }

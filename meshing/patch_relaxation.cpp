@@ -20,7 +20,7 @@ struct Adjacency {
 
 using Quad = std::array<int, 4>;
 
-Adjacency build_adjacency(const std::vector<Quad>& quads, size_t nv) {
+Adjacency build_adjacency(std::span<const Quad> quads, size_t nv) {
   Adjacency adj;
   adj.corner_start.assign(nv + 1, 0);
   for (const Quad& q : quads)
@@ -54,9 +54,12 @@ Adjacency build_adjacency(const std::vector<Quad>& quads, size_t nv) {
 // that a folded quad among good neighbours shows a negative Jacobian even on a curved patch.
 constexpr int kNormalRings = 4;
 
-std::vector<Eigen::Vector3d> quad_normals(const std::vector<Quad>& quads, const Adjacency& adj,
-                                          const std::vector<Eigen::Vector3d>& x) {
-  std::vector<Eigen::Vector3d> vertex_normal(x.size(), Eigen::Vector3d::Zero());
+// vertex_normal and averaged are #V scratch buffers (left with unspecified contents).
+std::vector<Eigen::Vector3d> quad_normals(std::span<const Quad> quads, const Adjacency& adj,
+                                          const std::vector<Eigen::Vector3d>& x,
+                                          std::vector<Eigen::Vector3d>& vertex_normal,
+                                          std::vector<Eigen::Vector3d>& averaged) {
+  vertex_normal.assign(x.size(), Eigen::Vector3d::Zero());
   for (const Quad& q : quads)
     for (size_t k = 0; k < 4; ++k) {
       const Eigen::Vector3d& p = x[static_cast<size_t>(q[k])];
@@ -68,7 +71,7 @@ std::vector<Eigen::Vector3d> quad_normals(const std::vector<Quad>& quads, const 
   for (auto& n : vertex_normal) n.normalize();
   // Averaged over a few rings, so that a cluster of quads that start folded (a Coons block
   // overlapping its neighbour near a reflex corner) cannot turn its own reference around.
-  std::vector<Eigen::Vector3d> averaged(x.size());
+  averaged.resize(x.size());
   for (int ring = 0; ring < kNormalRings; ++ring) {
     for (size_t v = 0; v < x.size(); ++v) {
       Eigen::Vector3d sum = vertex_normal[v];
@@ -149,7 +152,7 @@ constexpr int kUntanglePasses = 100;
 // ever smaller steps when a fold cannot be undone).
 constexpr double kUntangleProgress = 1e-4;
 
-void untangle(std::vector<Eigen::Vector3d>& x, const std::vector<Quad>& quads,
+void untangle(std::vector<Eigen::Vector3d>& x, std::span<const Quad> quads,
               const std::vector<Eigen::Vector3d>& normals, const Adjacency& adj,
               std::span<const char> fixed, const Projection& project) {
   const size_t nf = quads.size(), nv = x.size();
@@ -242,11 +245,28 @@ void relax_interior(QuadMesh& mesh, std::span<const char> fixed, int sweeps,
   for (size_t f = 0; f < nf; ++f)
     for (int k = 0; k < 4; ++k)
       quads[f][static_cast<size_t>(k)] = mesh.faces(static_cast<Eigen::Index>(f), k);
+  std::vector<Eigen::Vector3d> positions(nv);
+  for (size_t v = 0; v < nv; ++v)
+    positions[v] = mesh.vertices.row(static_cast<Eigen::Index>(v)).transpose();
+  detail::relax_interior(positions, quads, fixed, sweeps, project);
+  for (size_t v = 0; v < nv; ++v)
+    mesh.vertices.row(static_cast<Eigen::Index>(v)) = positions[v].transpose();
+}
+
+namespace detail {
+
+void relax_interior(std::vector<Eigen::Vector3d>& positions,
+                    std::span<const std::array<int, 4>> quads, std::span<const char> fixed,
+                    int sweeps,
+                    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& project) {
+  if (sweeps <= 0 || quads.empty()) return;
+  const size_t nv = positions.size(), nf = quads.size();
   const Adjacency adj = build_adjacency(quads, nv);
-  std::vector<Eigen::Vector3d> old(nv);
-  for (size_t v = 0; v < nv; ++v) old[v] = mesh.vertices.row(static_cast<Eigen::Index>(v)).transpose();
+  std::vector<Eigen::Vector3d>& old = positions;  // the start, and the result
   // Reference normals from the starting positions: they only tell a quad's front from its back.
-  const std::vector<Eigen::Vector3d> normals = quad_normals(quads, adj, old);
+  // Their scratch buffers become the sweeps' buffers.
+  std::vector<Eigen::Vector3d> x, y;
+  const std::vector<Eigen::Vector3d> normals = quad_normals(quads, adj, old, x, y);
   constexpr double kAcceptable = 0.05;  // a move may lower a quad's minimum down to this
   // Stop once no vertex moves more than 1e-3 of the mean edge length in a sweep.
   double edge_sum = 0;
@@ -278,7 +298,8 @@ void relax_interior(QuadMesh& mesh, std::span<const char> fixed, int sweeps,
     // Optimistic pass: all sweeps unguarded, then one check of every quad. On most patches no
     // quad ends below min(its start, kAcceptable) and this is the result, at a tenth of the
     // checks; otherwise start again with the guarded sweeps below.
-    std::vector<Eigen::Vector3d> x = old, y = old;
+    x = old;
+    y = old;
     for (int sweep = 0; sweep < sweeps; ++sweep) {
       laplacian_step(x, y);
       const double move = largest_move(x, y);
@@ -292,11 +313,12 @@ void relax_interior(QuadMesh& mesh, std::span<const char> fixed, int sweeps,
                        quad_min_jacobian(quads[f], normals[f], old) - 1e-12;
     if (acceptable) {
       untangle(x, quads, normals, adj, fixed, project);
-      for (size_t v = 0; v < nv; ++v) mesh.vertices.row(static_cast<Eigen::Index>(v)) = x[v].transpose();
+      positions.swap(x);
       return;
     }
   }
-  std::vector<Eigen::Vector3d> next = old;
+  std::vector<Eigen::Vector3d>& next = x;
+  next = old;
   std::vector<char> bad(nf, 0);
   std::vector<int> queue, reverted;
   for (int sweep = 0; sweep < sweeps; ++sweep) {
@@ -337,7 +359,8 @@ void relax_interior(QuadMesh& mesh, std::span<const char> fixed, int sweeps,
     if (move < tolerance * tolerance) break;  // converged
   }
   untangle(old, quads, normals, adj, fixed, project);
-  for (size_t v = 0; v < nv; ++v) mesh.vertices.row(static_cast<Eigen::Index>(v)) = old[v].transpose();
 }
+
+}  // namespace detail
 
 }  // namespace sd::meshing

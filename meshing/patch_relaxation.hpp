@@ -2,8 +2,10 @@
 // Smoothing the interior of a filled patch without folding it.
 
 #include <Eigen/Core>
+#include <array>
 #include <functional>
 #include <span>
+#include <vector>
 
 #include "meshing/quad_mesh.hpp"
 
@@ -20,5 +22,16 @@ namespace sd::meshing {
 // than 1e-3 of the mean edge length in a sweep.
 void relax_interior(QuadMesh& mesh, std::span<const char> fixed, int sweeps,
                     const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& project = {});
+
+namespace detail {
+
+// The same on a mesh being built (QuadMeshBuilder's arrays): #V positions, relaxed in place,
+// and #Q counter-clockwise quads; saves copying them into a QuadMesh and back.
+void relax_interior(std::vector<Eigen::Vector3d>& positions,
+                    std::span<const std::array<int, 4>> quads, std::span<const char> fixed,
+                    int sweeps,
+                    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& project = {});
+
+}  // namespace detail
 
 }  // namespace sd::meshing

@@ -39,6 +39,11 @@ class QuadMeshBuilder {
   void add_quad(const std::array<int, 4>& quad) { faces_.push_back(quad); }
 
   const Eigen::Vector3d& position(int v) const { return positions_[static_cast<size_t>(v)]; }
+  // All positions (#V), for moving vertices once the layout is complete (relaxation); build()
+  // takes them as they are then.
+  std::vector<Eigen::Vector3d>& positions() { return positions_; }
+  // The quads so far (#Q), counter-clockwise.
+  std::span<const std::array<int, 4>> faces() const { return faces_; }
   int vertex_count() const { return static_cast<int>(positions_.size()); }
   int face_count() const { return static_cast<int>(faces_.size()); }
 
