@@ -180,16 +180,19 @@ detail::StripRegion region_of(std::span<const int> loop_ids, std::span<const int
   return region;
 }
 
-// The plan with these strips (nullopt when one of them cannot be added, or when `rival` is
-// given and the plan provably cannot rank before it).
-std::optional<Plan> plan_with_strips(std::span<const int> counts, const BoundaryShape& shape,
+// The region to plan on (no vertex ids), before any strip.
+detail::StripRegion planning_region(std::span<const int> counts, const BoundaryShape& shape,
+                                    std::span<const int> strip_corners = {}) {
+  const std::vector<int> no_ids(shape.flat.size(), -1);
+  return region_of(no_ids, counts, shape, strip_corners);
+}
+
+// The plan for `region`, a planning region with `strips` added (nullopt when `rival` is given and
+// the plan provably cannot rank before it).
+std::optional<Plan> plan_with_strips(const detail::StripRegion& region, std::span<const int> counts,
                                      std::span<const int> strips, int budget,
                                      const Plan* rival = nullptr,
                                      std::span<const int> strip_corners = {}) {
-  const std::vector<int> no_ids(shape.flat.size(), -1);
-  detail::StripRegion region = region_of(no_ids, counts, shape, strip_corners);
-  for (const int side : strips)
-    if (!region.strip(side)) return std::nullopt;
   const detail::PositionCosts costs = region.costs();
   if (rival != nullptr) {
     // The plan folds at least region.folded quads and costs at least this much distortion.
@@ -261,7 +264,7 @@ Plan choose_plan(std::span<const int> counts, const BoundaryShape& shape,
              other.strip_corners == plan.strip_corners;
     });
   };
-  Plan best = *plan_with_strips(counts, shape, {}, kSearchBudget);
+  Plan best = *plan_with_strips(planning_region(counts, shape), counts, {}, kSearchBudget);
   if (!allowed(best)) {
     best.folded = std::numeric_limits<int>::max();  // anything else ranks before it
     best.distortion = std::numeric_limits<int>::max();
@@ -283,26 +286,38 @@ Plan choose_plan(std::span<const int> counts, const BoundaryShape& shape,
     }
   int padded_budget = kPaddedSearchBudget;
   // Every side and every pair of sides between these corners (the layout may move its
-  // promotions elsewhere), and a full ring.
+  // promotions elsewhere), and a full ring. A pair's region is its first strip's region with
+  // one more strip; when a strip cannot be added, no plan with it exists.
   auto pad = [&](std::span<const int> strip_corners, bool with_plain) {
-    auto consider = [&](std::span<const int> strips) {
-      auto plan = plan_with_strips(counts, shape, strips,
-                                   std::min(kStripSearchBudget, padded_budget), &best,
-                                   strip_corners);
+    auto consider = [&](const detail::StripRegion& region, std::span<const int> strips) {
+      auto plan =
+          plan_with_strips(region, counts, strips, std::min(kStripSearchBudget, padded_budget),
+                           &best, strip_corners);
       if (!plan) return;
       padded_budget = std::max(0, padded_budget - plan->layout.checks);
       if (plan->rank(shape.measured) < best.rank(shape.measured) && allowed(*plan))
         best = std::move(*plan);
     };
+    const detail::StripRegion unpadded = planning_region(counts, shape, strip_corners);
     const auto sides = static_cast<int>(strip_corners.empty() ? n : strip_corners.size());
-    if (with_plain) consider({});
+    if (with_plain) consider(unpadded, {});
     for (int i = 0; i < sides; ++i) {
-      consider(std::vector<int>{i});
-      for (int j = i + 1; j < sides; ++j) consider(std::vector<int>{i, j});
+      detail::StripRegion one = unpadded;
+      if (!one.strip(i)) continue;
+      consider(one, std::vector<int>{i});
+      for (int j = i + 1; j < sides; ++j) {
+        detail::StripRegion two = one;
+        if (two.strip(j)) consider(two, std::vector<int>{i, j});
+      }
     }
-    std::vector<int> all(static_cast<size_t>(sides));
-    std::iota(all.begin(), all.end(), 0);
-    if (sides > 2) consider(all);
+    if (sides > 2) {
+      detail::StripRegion ring = unpadded;
+      bool complete = true;
+      for (int i = 0; i < sides && complete; ++i) complete = ring.strip(i);
+      std::vector<int> all(static_cast<size_t>(sides));
+      std::iota(all.begin(), all.end(), 0);
+      if (complete) consider(ring, all);
+    }
   };
   if (!exposed_sides.empty() || best.folded > 0) pad({}, false);
   if (best.folded > 0) {

@@ -152,9 +152,12 @@ constexpr int kUntanglePasses = 100;
 // ever smaller steps when a fold cannot be undone).
 constexpr double kUntangleProgress = 1e-4;
 
+// `suspects`, when given, are the only quads that can be below kUntangleTarget at the start
+// (increasing), so the first pass looks at them alone.
 void untangle(std::vector<Eigen::Vector3d>& x, std::span<const Quad> quads,
               const std::vector<Eigen::Vector3d>& normals, const Adjacency& adj,
-              std::span<const char> fixed, const Projection& project) {
+              std::span<const char> fixed, const Projection& project,
+              const std::vector<size_t>* suspects = nullptr) {
   const size_t nf = quads.size(), nv = x.size();
   auto around = [&](size_t v) {  // smallest scaled Jacobian of the quads at v
     double worst = std::numeric_limits<double>::infinity();
@@ -175,13 +178,18 @@ void untangle(std::vector<Eigen::Vector3d>& x, std::span<const Quad> quads,
         movable.push_back(v);
       }
     };
-    for (size_t f = 0; f < nf; ++f) {
-      if (quad_min_jacobian_at_least(quads[f], normals[f], x, kUntangleTarget)) continue;
+    auto look_at = [&](size_t f) {
+      if (quad_min_jacobian_at_least(quads[f], normals[f], x, kUntangleTarget)) return;
       for (const int v : quads[f]) {
         choose(static_cast<size_t>(v));
         for (int i = adj.neighbour_start[static_cast<size_t>(v)]; i < adj.neighbour_start[static_cast<size_t>(v) + 1]; ++i)
           choose(static_cast<size_t>(adj.neighbours[static_cast<size_t>(i)]));
       }
+    };
+    if (pass == 0 && suspects != nullptr) {
+      for (const size_t f : *suspects) look_at(f);
+    } else {
+      for (size_t f = 0; f < nf; ++f) look_at(f);
     }
     if (movable.empty()) return;
     bool improved = false;
@@ -268,6 +276,7 @@ void relax_interior(std::vector<Eigen::Vector3d>& positions,
   std::vector<Eigen::Vector3d> x, y;
   const std::vector<Eigen::Vector3d> normals = quad_normals(quads, adj, old, x, y);
   constexpr double kAcceptable = 0.05;  // a move may lower a quad's minimum down to this
+  static_assert(kAcceptable > kUntangleTarget);
   // Stop once no vertex moves more than 1e-3 of the mean edge length in a sweep.
   double edge_sum = 0;
   for (const Quad& q : quads)
@@ -306,13 +315,18 @@ void relax_interior(std::vector<Eigen::Vector3d>& positions,
       std::swap(x, y);
       if (move < tolerance * tolerance) break;
     }
+    // Quads at kAcceptable or above are far above untangling's target too: the others are its
+    // only suspects.
     bool acceptable = true;
-    for (size_t f = 0; f < nf && acceptable; ++f)
-      acceptable = quad_at_least(quads[f], normals[f], x, kAcceptable) ||
-                   quad_min_jacobian(quads[f], normals[f], x) >=
-                       quad_min_jacobian(quads[f], normals[f], old) - 1e-12;
+    std::vector<size_t> suspects;
+    for (size_t f = 0; f < nf && acceptable; ++f) {
+      if (quad_at_least(quads[f], normals[f], x, kAcceptable)) continue;
+      suspects.push_back(f);
+      acceptable = quad_min_jacobian(quads[f], normals[f], x) >=
+                   quad_min_jacobian(quads[f], normals[f], old) - 1e-12;
+    }
     if (acceptable) {
-      untangle(x, quads, normals, adj, fixed, project);
+      untangle(x, quads, normals, adj, fixed, project, &suspects);
       positions.swap(x);
       return;
     }
