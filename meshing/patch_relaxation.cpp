@@ -266,15 +266,16 @@ namespace detail {
 void relax_interior(std::vector<Eigen::Vector3d>& positions,
                     std::span<const std::array<int, 4>> quads, std::span<const char> fixed,
                     int sweeps,
-                    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& project) {
+                    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& project,
+                    ReferenceNormals reference) {
   if (sweeps <= 0 || quads.empty()) return;
   const size_t nv = positions.size(), nf = quads.size();
   const Adjacency adj = build_adjacency(quads, nv);
   std::vector<Eigen::Vector3d>& old = positions;  // the start, and the result
-  // Reference normals from the starting positions: they only tell a quad's front from its back.
-  // Their scratch buffers become the sweeps' buffers.
-  std::vector<Eigen::Vector3d> x, y;
-  const std::vector<Eigen::Vector3d> normals = quad_normals(quads, adj, old, x, y);
+  // Reference normals (they only tell a quad's front from its back) and their scratch
+  // buffers, which become the sweeps' buffers.
+  std::vector<Eigen::Vector3d> normals, x, y, z;
+  if (reference == ReferenceNormals::kStart) normals = quad_normals(quads, adj, old, x, y);
   constexpr double kAcceptable = 0.05;  // a move may lower a quad's minimum down to this
   static_assert(kAcceptable > kUntangleTarget);
   // Stop once no vertex moves more than 1e-3 of the mean edge length in a sweep.
@@ -315,6 +316,7 @@ void relax_interior(std::vector<Eigen::Vector3d>& positions,
       std::swap(x, y);
       if (move < tolerance * tolerance) break;
     }
+    if (reference == ReferenceNormals::kAfterSweeps) normals = quad_normals(quads, adj, x, y, z);
     // Quads at kAcceptable or above are far above untangling's target too: the others are its
     // only suspects.
     bool acceptable = true;

@@ -25,12 +25,23 @@ void relax_interior(QuadMesh& mesh, std::span<const char> fixed, int sweeps,
 
 namespace detail {
 
+// Where the reference normals that tell a quad's front from its back come from: the starting
+// positions (vertex normals averaged over 4 rings), or the positions after the unguarded sweeps.
+// The start misleads when Coons blocks overlap in a cluster too large for the averaging (a
+// layout next to a reflex corner): the whole cluster counts as unfolded, and the guard keeps it
+// folded; the sweeps untangle most such clusters. Taken for every fill, the sweeps' normals
+// changed 483 of the notched test fills (docs/meshing.md), 179 of them to smaller angles, so
+// the start is the default and fill_region turns to the sweeps' normals only when every plan
+// it tried keeps inverted quads.
+enum class ReferenceNormals { kStart, kAfterSweeps };
+
 // The same on a mesh being built (QuadMeshBuilder's arrays): #V positions, relaxed in place,
 // and #Q counter-clockwise quads; saves copying them into a QuadMesh and back.
 void relax_interior(std::vector<Eigen::Vector3d>& positions,
                     std::span<const std::array<int, 4>> quads, std::span<const char> fixed,
                     int sweeps,
-                    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& project = {});
+                    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& project = {},
+                    ReferenceNormals reference = ReferenceNormals::kStart);
 
 }  // namespace detail
 
