@@ -130,15 +130,17 @@ PolygonLayout fallback_layout(int loop_size, std::span<const int> starts,
   if (loop_size < 6) return best;
   std::vector<int> start_list(starts.begin(), starts.end());
   if (start_list.empty()) start_list.push_back(0);
+  PolygonLayout triangle;
   for (const int start : start_list) {
     const int a = loop_size / 3, b = (loop_size - a) / 2;
-    std::vector<int> corners = {start, wrap(start + a, loop_size), wrap(start + a + b, loop_size)};
-    std::sort(corners.begin(), corners.end());
-    PolygonLayout triangle{corners, *nasri_spokes(corner_arcs(corners, loop_size))};
+    triangle.corners = {start, wrap(start + a, loop_size), wrap(start + a + b, loop_size)};
+    std::sort(triangle.corners.begin(), triangle.corners.end());
     assess(triangle, costs, totals);
     if (std::tuple(triangle.cost, triangle.irregular, triangle.flat) <
-        std::tuple(best.cost, best.irregular, best.flat))
-      best = std::move(triangle);
+        std::tuple(best.cost, best.irregular, best.flat)) {
+      best = triangle;  // its spokes only once it wins
+      best.spokes = *nasri_spokes(corner_arcs(best.corners, loop_size));
+    }
   }
   return best;
 }
@@ -315,6 +317,7 @@ PolygonLayout best_layout(const PositionCosts& costs, int budget) {
   const auto size = static_cast<int>(costs.as_side.size());
   if (size < 4 || size % 2 != 0) throw std::logic_error("a quad-fillable loop has an even size >= 4");
   std::vector<int> naturals, others;  // positions that would rather be corners / the rest
+  others.reserve(static_cast<size_t>(size));
   for (int p = 0; p < size; ++p)
     (costs.as_corner[static_cast<size_t>(p)] < costs.as_side[static_cast<size_t>(p)] ? naturals
                                                                                       : others)
