@@ -54,11 +54,12 @@ Adjacency build_adjacency(std::span<const Quad> quads, size_t nv) {
 // that a folded quad among good neighbours shows a negative Jacobian even on a curved patch.
 constexpr int kNormalRings = 4;
 
-// vertex_normal and averaged are #V scratch buffers (left with unspecified contents).
-std::vector<Eigen::Vector3d> quad_normals(std::span<const Quad> quads, const Adjacency& adj,
-                                          const std::vector<Eigen::Vector3d>& x,
-                                          std::vector<Eigen::Vector3d>& vertex_normal,
-                                          std::vector<Eigen::Vector3d>& averaged) {
+// Into `normals` (#Q); vertex_normal and averaged are #V scratch buffers (left with
+// unspecified contents).
+void quad_normals(std::span<const Quad> quads, const Adjacency& adj,
+                  const std::vector<Eigen::Vector3d>& x,
+                  std::vector<Eigen::Vector3d>& vertex_normal,
+                  std::vector<Eigen::Vector3d>& averaged, std::vector<Eigen::Vector3d>& normals) {
   vertex_normal.assign(x.size(), Eigen::Vector3d::Zero());
   for (const Quad& q : quads)
     for (size_t k = 0; k < 4; ++k) {
@@ -81,14 +82,21 @@ std::vector<Eigen::Vector3d> quad_normals(std::span<const Quad> quads, const Adj
     }
     std::swap(vertex_normal, averaged);
   }
-  std::vector<Eigen::Vector3d> normals(quads.size());
+  normals.resize(quads.size());
   for (size_t f = 0; f < quads.size(); ++f) {
     Eigen::Vector3d n = Eigen::Vector3d::Zero();
     for (const int v : quads[f]) n += vertex_normal[static_cast<size_t>(v)];
     normals[f] = n.normalized();
   }
-  return normals;
 }
+
+// The #V and #Q arrays of a relaxation, kept per thread from one call to the next. Allocated
+// afresh each time, their pages went back to the kernel after every fill and were faulted in
+// again by the next one: about a quarter of a 3,000-quad fill's time (meshing_bench). They never
+// leave this struct (results are copied out), so they keep their capacity.
+struct RelaxationScratch {
+  std::vector<Eigen::Vector3d> x, y, z, normals;
+};
 
 // Edges of quad q at positions x: e[k] runs from corner k to corner k+1; the corner k is
 // spanned by e[k] and −e[k−1], so its cross product is e[k−1] × e[k].
@@ -271,11 +279,12 @@ void relax_interior(std::vector<Eigen::Vector3d>& positions,
   if (sweeps <= 0 || quads.empty()) return;
   const size_t nv = positions.size(), nf = quads.size();
   const Adjacency adj = build_adjacency(quads, nv);
-  std::vector<Eigen::Vector3d>& old = positions;  // the start, and the result
+  const std::vector<Eigen::Vector3d>& old = positions;  // the start; the result is copied in
   // Reference normals (they only tell a quad's front from its back) and their scratch
   // buffers, which become the sweeps' buffers.
-  std::vector<Eigen::Vector3d> normals, x, y, z;
-  if (reference == ReferenceNormals::kStart) normals = quad_normals(quads, adj, old, x, y);
+  thread_local RelaxationScratch scratch;
+  auto& [x, y, z, normals] = scratch;
+  if (reference == ReferenceNormals::kStart) quad_normals(quads, adj, old, x, y, normals);
   constexpr double kAcceptable = 0.05;  // a move may lower a quad's minimum down to this
   static_assert(kAcceptable > kUntangleTarget);
   // Stop once no vertex moves more than 1e-3 of the mean edge length in a sweep.
@@ -316,7 +325,7 @@ void relax_interior(std::vector<Eigen::Vector3d>& positions,
       std::swap(x, y);
       if (move < tolerance * tolerance) break;
     }
-    if (reference == ReferenceNormals::kAfterSweeps) normals = quad_normals(quads, adj, x, y, z);
+    if (reference == ReferenceNormals::kAfterSweeps) quad_normals(quads, adj, x, y, z, normals);
     // Quads at kAcceptable or above are far above untangling's target too: the others are its
     // only suspects.
     bool acceptable = true;
@@ -329,22 +338,26 @@ void relax_interior(std::vector<Eigen::Vector3d>& positions,
     }
     if (acceptable) {
       untangle(x, quads, normals, adj, fixed, project, &suspects);
-      positions.swap(x);
+      positions = x;
       return;
     }
   }
+  // The guarded sweeps run between two scratch arrays, from the start again; the result is
+  // copied out.
+  std::vector<Eigen::Vector3d>& current = y;
   std::vector<Eigen::Vector3d>& next = x;
+  current = old;
   next = old;
   std::vector<char> bad(nf, 0);
   std::vector<int> queue, reverted;
   for (int sweep = 0; sweep < sweeps; ++sweep) {
-    laplacian_step(old, next);
+    laplacian_step(current, next);
     // A quad whose smallest scaled Jacobian would fall below min(before, kAcceptable) keeps
     // its free vertices where they were; quads around a kept vertex are checked again.
     auto worse = [&](size_t f) {
       if (quad_at_least(quads[f], normals[f], next, kAcceptable)) return false;
       return quad_min_jacobian(quads[f], normals[f], next) <
-             quad_min_jacobian(quads[f], normals[f], old) - 1e-12;
+             quad_min_jacobian(quads[f], normals[f], current) - 1e-12;
     };
     queue.clear();
     for (size_t f = 0; f < nf; ++f)
@@ -354,8 +367,8 @@ void relax_interior(std::vector<Eigen::Vector3d>& positions,
       for (const int f : queue)
         for (const int corner : quads[static_cast<size_t>(f)]) {
           const auto v = static_cast<size_t>(corner);
-          if (next[v] != old[v]) {
-            next[v] = old[v];
+          if (next[v] != current[v]) {
+            next[v] = current[v];
             reverted.push_back(static_cast<int>(v));
           }
         }
@@ -370,11 +383,12 @@ void relax_interior(std::vector<Eigen::Vector3d>& positions,
         }
       for (const int f : queue) bad[static_cast<size_t>(f)] = 0;
     }
-    const double move = largest_move(old, next);
-    std::swap(old, next);
+    const double move = largest_move(current, next);
+    std::swap(current, next);
     if (move < tolerance * tolerance) break;  // converged
   }
-  untangle(old, quads, normals, adj, fixed, project);
+  untangle(current, quads, normals, adj, fixed, project);
+  positions = current;
 }
 
 }  // namespace detail
