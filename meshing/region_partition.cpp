@@ -162,25 +162,36 @@ std::vector<int> nasri_distances_doubled(std::span<const int> lengths) {
 
 namespace {
 
-// 2 d_j for every j of a polygon with m = arcs.size() >= 3 corners, m not divisible by 4, for
-// any integer arcs (no feasibility check). The closed form gives 2 d_j as an alternating sum of
-// `terms` arcs; it is computed once per cycle j, j+2, j+4, ... (one cycle for m odd, two for
-// m/2 odd) and the rest follows from arcs_{j+1} = d_j + d_{j+2}: O(m) instead of O(m²).
-void doubled_spokes(std::span<const int> arcs, std::vector<int>& twice) {
+// visit(j, 2 d_j) for every j of a polygon with m = arcs.size() >= 3 corners, m not divisible
+// by 4, for any integer arcs, until visit returns false (then false). The closed form gives
+// 2 d_j as an alternating sum of `terms` arcs; it is computed once per cycle j, j+2, j+4, ...
+// (one cycle for m odd, two for m/2 odd) and the rest follows from arcs_{j+1} = d_j + d_{j+2}:
+// O(m) instead of O(m²).
+template <class Visit>
+bool visit_doubled_spokes(std::span<const int> arcs, Visit&& visit) {
   const auto m = static_cast<int>(arcs.size());
-  twice.resize(static_cast<size_t>(m));
   const int terms = m % 2 == 1 ? m : m / 2;
   for (int r = 0; r < (m % 2 == 1 ? 1 : 2); ++r) {
     int value = 0;
     for (int k = 0, i = r + 1; k < terms; ++k, i = i + 2 >= m ? i + 2 - m : i + 2)
       value += (k % 2 == 0 ? 1 : -1) * arcs[static_cast<size_t>(i)];
     for (int k = 0, j = r; k < terms; ++k) {
-      twice[static_cast<size_t>(j)] = value;
+      if (!visit(static_cast<size_t>(j), value)) return false;
       const int next_arc = j + 1 == m ? 0 : j + 1;
       value = 2 * arcs[static_cast<size_t>(next_arc)] - value;
       j = j + 2 >= m ? j + 2 - m : j + 2;
     }
   }
+  return true;
+}
+
+// Every 2 d_j (no feasibility check).
+void doubled_spokes(std::span<const int> arcs, std::vector<int>& twice) {
+  twice.resize(arcs.size());
+  visit_doubled_spokes(arcs, [&](size_t j, int value) {
+    twice[j] = value;
+    return true;
+  });
 }
 
 // For m = arcs.size() divisible by 4, the d's of parity r form an even cycle
@@ -199,12 +210,12 @@ bool solve_spokes(std::span<const int> arcs, std::vector<int>& d) {
   if (m < 3) return false;
   d.resize(static_cast<size_t>(m));
   if (m % 4 != 0) {
-    doubled_spokes(arcs, d);
-    for (int& value : d) {
+    // Stops at the first 2 d_j below 2 or odd (most candidates of a search fail early).
+    return visit_doubled_spokes(arcs, [&](size_t j, int value) {
       if (value < 2 || value % 2 != 0) return false;
-      value /= 2;
-    }
-    return true;
+      d[j] = value / 2;
+      return true;
+    });
   }
   // m divisible by 4: the d's of each parity form an even cycle arcs_{j+1} = d_j + d_{j+2}.
   // Write d_{r+2k} = s_k t + c_k with s_k = (−1)^k, c_0 = 0, c_{k+1} = arcs_{r+2k+1} − c_k; the
