@@ -116,16 +116,34 @@ void print_histogram(const char* name, const std::vector<int>& count) {
   std::printf("\n");
 }
 
-// A free 0.6 m sheet (4x4 level-0 quads, started at level 2) 5 cm above a sphere of radius 0.2 m.
-TEST(AdaptiveContact, SheetDropsOnASphereAdaptivelyAndDrapesOutside) {
+// A free cotton sheet of 0.6 m (4x4 level-0 quads) at y = 1 m, 5 cm above a sphere of radius
+// 0.2 m.
+struct SphereDrop {
+  testing::AdaptiveSheet sheet;
+  double radius = 0.2;
+  Vector3d centre = Vector3d::Zero();
+  meshing::TriMesh sphere;
+};
+
+SphereDrop sphere_drop() {
   AdaptiveSheetSpec spec;
   spec.size = 0.6;
   spec.pins = {};
-  testing::AdaptiveSheet sheet = testing::build_adaptive_sheet(spec);  // at y = 1
-  sheet.material.fabric = fabric_preset("cotton");
   const double radius = 0.2;
-  const Vector3d centre(0.0, 1.0 - 0.05 - radius, 0.0);
-  const meshing::TriMesh sphere = testing::make_sphere(radius, 3, centre);
+  const Vector3d centre(0.0, 1.0 - 0.05 - radius, 0.0);  // the sheet is at y = 1
+  SphereDrop drop{testing::build_adaptive_sheet(spec), radius, centre,
+                  testing::make_sphere(radius, 3, centre)};
+  drop.sheet.material.fabric = fabric_preset("cotton");
+  return drop;
+}
+
+// The sphere drop, started at level 2.
+TEST(AdaptiveContact, SheetDropsOnASphereAdaptivelyAndDrapesOutside) {
+  SphereDrop drop = sphere_drop();
+  testing::AdaptiveSheet& sheet = drop.sheet;
+  const double radius = drop.radius;
+  const Vector3d& centre = drop.centre;
+  const meshing::TriMesh& sphere = drop.sphere;
   const SimulationSettings settings = drape_settings(6.0);
   AdaptiveSettings adaptive;
   adaptive.max_level = 6;  // 2048 triangles if uniform, 1.9 cm quads
@@ -192,14 +210,9 @@ TEST(AdaptiveContact, SheetDropsOnASphereAdaptivelyAndDrapesOutside) {
 // refined after the body had pushed into its triangles, which cost the sphere-drop bench
 // accuracy (docs/adaptive.md, "Body contact").
 TEST(AdaptiveContact, SheetIsRefinedForTheSphereBeforeItLands) {
-  AdaptiveSheetSpec spec;
-  spec.size = 0.6;
-  spec.pins = {};
-  testing::AdaptiveSheet sheet = testing::build_adaptive_sheet(spec);  // at y = 1
-  sheet.material.fabric = fabric_preset("cotton");
-  const double radius = 0.2;
-  const Vector3d centre(0.0, 1.0 - 0.05 - radius, 0.0);
-  const meshing::TriMesh sphere = testing::make_sphere(radius, 3, centre);
+  SphereDrop drop = sphere_drop();
+  testing::AdaptiveSheet& sheet = drop.sheet;
+  const meshing::TriMesh& sphere = drop.sphere;
   const SimulationSettings settings = drape_settings(0.5);
   AdaptiveSettings adaptive;
   adaptive.max_level = 6;
