@@ -201,13 +201,26 @@ Eigen::VectorXd AdaptiveCloth::body_sags() const {
   if (contact == nullptr || !simulation_->settings().contact.enabled) return sags;
   const Eigen::VectorXd& x = simulation_->positions();
   const double reach = body_reach();
-  // The body point under each vertex within reach (bounded queries: most of a garment is not,
-  // and FCL prunes by the bound).
+  // Only edges that can still be refined need their sag (a block at the finest level cannot
+  // split; merges ask body_sag themselves), and only their vertices a body point.
   const int n = static_cast<int>(x.size() / 3);
+  std::vector<unsigned char> refinable(static_cast<std::size_t>(edges.rows()), 0);
+  std::vector<unsigned char> needed(static_cast<std::size_t>(n), 0);
+  for (Eigen::Index r = 0; r < edges.rows(); ++r) {
+    if (arrays_.face_level(arrays_.edge_faces(r, 0)) >= settings_.max_level &&
+        arrays_.face_level(arrays_.edge_faces(r, 1)) >= settings_.max_level)
+      continue;
+    refinable[static_cast<std::size_t>(r)] = 1;
+    needed[static_cast<std::size_t>(edges(r, 0))] = needed[static_cast<std::size_t>(edges(r, 1))] = 1;
+  }
+  // The body point under each of those vertices within reach (bounded queries: most of a
+  // garment is not, and FCL prunes by the bound).
   std::vector<std::optional<BodyProximity>> under(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i)
-    under[static_cast<std::size_t>(i)] = contact->collider().closest_point(row3(x, i), reach);
+    if (needed[static_cast<std::size_t>(i)])
+      under[static_cast<std::size_t>(i)] = contact->collider().closest_point(row3(x, i), reach);
   for (Eigen::Index r = 0; r < edges.rows(); ++r) {
+    if (!refinable[static_cast<std::size_t>(r)]) continue;
     const int i = edges(r, 0), j = edges(r, 1);
     const std::optional<BodyProximity>& at_i = under[static_cast<std::size_t>(i)];
     const std::optional<BodyProximity>& at_j = under[static_cast<std::size_t>(j)];

@@ -192,7 +192,8 @@ class AdaptiveCloth {
   Eigen::VectorXd edge_errors() const;
   // Per interior edge with an end within reach of the body (the contact thickness plus its
   // search margin), how far the body's surface under the edge bulges out of the straight line
-  // between the body points under its two ends, metres; 0 for the other edges and without a
+  // between the body points under its two ends, metres; 0 for the other edges, for edges whose
+  // two triangles are at the finest level already (they cannot be refined), and without a
   // body. It is the sag the edge will have once the cloth lies on the body, known while the
   // cloth is still approaching: refining on it gives the cloth the resolution the body's
   // curvature asks for before the contact instead of after it.
