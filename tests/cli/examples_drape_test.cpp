@@ -144,8 +144,10 @@ class ExampleDrape : public ::testing::TestWithParam<Example> {};
 
 TEST_P(ExampleDrape, DrapesToRestOutsideTheBodyAndStaysOn) {
   const Example& example = GetParam();
-  const fs::path dir = fs::temp_directory_path() / "sd_examples_drape" /
-                       (example.name + (example.adaptive ? "-adaptive" : ""));
+  // One directory per parameter: ctest runs the t-shirt at max_level 1 and 2 side by side.
+  const std::string variant =
+      example.adaptive ? "-adaptive-" + std::to_string(example.max_level) : "";
+  const fs::path dir = fs::temp_directory_path() / "sd_examples_drape" / (example.name + variant);
   fs::remove_all(dir);
   fs::create_directories(dir);
 
