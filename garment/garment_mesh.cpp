@@ -277,7 +277,8 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
         meshing::QuadMesh relaxed = patch.mesh;
         relax_on_surface(relaxed, fixed, lift,
                          {kSurfaceSweeps, kSurfaceTolerance * reach, kSurfaceMaxStep * reach});
-        const meshing::QuadQuality quality = meshing::measure_quality(relaxed, patch.topology.corner_vertices());
+        const meshing::QuadQuality quality =
+            meshing::measure_quality(relaxed, patch.topology.corner_vertices());
         if (std::pair(quality.inverted_quads, -quality.scaled_jacobian_min) <
             std::pair(patch.quality.inverted_quads, -patch.quality.scaled_jacobian_min)) {
           patch.mesh = std::move(relaxed);

@@ -269,7 +269,8 @@ void parse_body(const Reader& r, const json& j, BodySpec& body) {
     if (m.contains("type")) motion.type = r.text(m["type"], mpath + "/type");
     if (motion.type != "arms-lowering")
       r.fail(mpath + "/type",
-             fmt::format("'{}' is not a body motion; the only kind so far is arms-lowering", motion.type));
+             fmt::format("'{}' is not a body motion; the only kind so far is arms-lowering",
+                         motion.type));
     if (m.contains("degrees")) motion.degrees = r.number(m["degrees"], mpath + "/degrees");
     // The built-in mannequin's arms hang 17° out from the body: lowering them by more than 15°
     // would press them into the torso.

@@ -211,7 +211,8 @@ Eigen::VectorXd AdaptiveCloth::body_sags() const {
         arrays_.face_level(arrays_.edge_faces(r, 1)) >= settings_.max_level)
       continue;
     refinable[static_cast<std::size_t>(r)] = 1;
-    needed[static_cast<std::size_t>(edges(r, 0))] = needed[static_cast<std::size_t>(edges(r, 1))] = 1;
+    needed[static_cast<std::size_t>(edges(r, 0))] = 1;
+    needed[static_cast<std::size_t>(edges(r, 1))] = 1;
   }
   // The body point under each of those vertices within reach (bounded queries: most of a
   // garment is not, and FCL prunes by the bound).

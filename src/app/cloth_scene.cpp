@@ -198,7 +198,8 @@ ClothScene build_cloth_scene(const garment::Sketch& sketch) {
   } else {
     build_garment_scene(sketch, scene);
   }
-  if (scene.body && sketch.body.motion) scene.body_motion = body_motion(*sketch.body.motion, scene.body->mesh);
+  if (scene.body && sketch.body.motion)
+    scene.body_motion = body_motion(*sketch.body.motion, scene.body->mesh);
   return scene;
 }
 

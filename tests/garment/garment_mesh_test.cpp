@@ -179,7 +179,8 @@ TEST(Garment, ExamplePanelsHaveNoCreaseOfDegenerateQuads) {
   // shorts at 2.5 cm quads reached 9.9, and their drape failed with check_body_vertices.)
   for (const auto& file : test::example_files()) {
     const Garment g = build_garment(load_sketch(file), builtin_surface());
-    for (const GarmentPanel& p : g.panels) EXPECT_LT(p.quality.max_aspect_ratio, 10.0) << file << " " << p.id;
+    for (const GarmentPanel& p : g.panels)
+      EXPECT_LT(p.quality.max_aspect_ratio, 10.0) << file << " " << p.id;
   }
 }
 
@@ -190,7 +191,8 @@ TEST(Garment, ExamplesHaveNoFoldedQuadsBeyondTheRecordedFew) {
   // underarm), the shorts' back 1 per side; every other example has none. Seam vertices folded
   // between a panel and its own mirror copy (merged away with a warning): only on the shorts'
   // centre seams, 4 with their 2 cm quads (1 with 2.5 cm quads).
-  const std::map<std::string, int> recorded = {{"tshirt", 2}, {"tshirt-arms-lowering", 2}, {"shorts", 2}};
+  const std::map<std::string, int> recorded = {
+      {"tshirt", 2}, {"tshirt-arms-lowering", 2}, {"shorts", 2}};
   for (const auto& file : test::example_files()) {
     const Garment g = build_garment(load_sketch(file), builtin_surface());
     int inverted = 0;

@@ -37,7 +37,8 @@ inline std::vector<char> grid_boundary(int n) {
   std::vector<char> fixed(static_cast<std::size_t>((n + 1) * (n + 1)), 0);
   for (int i = 0; i <= n; ++i)
     for (int j = 0; j <= n; ++j)
-      if (i == 0 || j == 0 || i == n || j == n) fixed[static_cast<std::size_t>(i * (n + 1) + j)] = 1;
+      if (i == 0 || j == 0 || i == n || j == n)
+        fixed[static_cast<std::size_t>(i * (n + 1) + j)] = 1;
   return fixed;
 }
 

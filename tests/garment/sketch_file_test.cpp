@@ -86,7 +86,8 @@ TEST(SketchFile, SheetMistakesNameTheirPath) {
   EXPECT_EQ(error_of(R"({"sheet": {"size": [1, -1]}})").rfind("/sheet/size/1", 0), 0u);
   EXPECT_EQ(error_of(R"({"sheet": {}, "panels": []})").rfind("/sheet: a sheet scene has no", 0), 0u);
   EXPECT_EQ(error_of(R"({"sheet": {"orientation": "diagonal"}})").rfind("/sheet/orientation", 0), 0u);
-  EXPECT_EQ(error_of(R"({"body": {"motion": {"duration": 0}}})").rfind("/body/motion/duration", 0), 0u);
+  EXPECT_EQ(error_of(R"({"body": {"motion": {"duration": 0}}})").rfind("/body/motion/duration", 0),
+            0u);
   EXPECT_EQ(error_of(R"({"body": {"motion": {"start": -1}}})").rfind("/body/motion/start", 0), 0u);
   EXPECT_EQ(error_of(R"({"body": {"motion": {"speed": 1}}})").rfind("/body/motion", 0), 0u);
   EXPECT_EQ(error_of(R"({"body": {"mesh": "none", "motion": {}}})").rfind("/body/motion", 0), 0u);

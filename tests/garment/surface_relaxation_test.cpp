@@ -15,7 +15,9 @@ using test::grid_boundary;
 using test::plane_grid;
 using test::sphere_grid;
 
-std::vector<int> grid_corners(int n) { return {0, n, (n + 1) * (n + 1) - 1, n * (n + 1)}; }
+std::vector<int> grid_corners(int n) {
+  return {0, n, (n + 1) * (n + 1) - 1, n * (n + 1)};
+}
 
 TEST(SurfaceRelaxation, SpreadsACollapsedInteriorBackToTheUniformGrid) {
   // On a plane the fixed point of the sweeps is the discrete harmonic map, which for a square
@@ -29,8 +31,8 @@ TEST(SurfaceRelaxation, SpreadsACollapsedInteriorBackToTheUniformGrid) {
   const SurfaceLift plane = [](const Eigen::Vector3d& p) {
     return LiftedPoint{{p.x(), p.y(), 0.0}, Eigen::Vector3d::UnitZ()};
   };
-  const SurfaceRelaxationResult result =
-      relax_on_surface(mesh, fixed, plane, {.max_sweeps = 2000, .tolerance = 1e-13, .max_step = 1.0});
+  const SurfaceRelaxationResult result = relax_on_surface(
+      mesh, fixed, plane, {.max_sweeps = 2000, .tolerance = 1e-13, .max_step = 1.0});
   EXPECT_LT(result.sweeps, 2000);
   EXPECT_EQ(result.refused, 0);
   EXPECT_LT((mesh.vertices - grid.vertices).cwiseAbs().maxCoeff(), 1e-10);
