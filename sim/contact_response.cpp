@@ -138,9 +138,15 @@ double ContactResponse::piercing_reach() const {
 
 std::vector<BodyPiercing> ContactResponse::find_piercings(const Eigen::VectorXd& x1,
                                                           double min_height) const {
-  if (!settings_.check_body_vertices || cloth_.triangles.empty()) return {};
+  if (!settings_.check_body_vertices) return {};
+  return piercings_of(x1, min_height);
+}
+
+std::vector<BodyPiercing> ContactResponse::piercings_of(const Eigen::VectorXd& x,
+                                                        double min_height) const {
+  if (cloth_.triangles.empty()) return {};
   const double reach = piercing_reach();
-  return collider_.find_piercings(x1, cloth_, min_height, reach,
+  return collider_.find_piercings(x, cloth_, min_height, reach,
                                   kPiercingUncheckedFraction * reach);
 }
 
@@ -652,18 +658,11 @@ int ContactResponse::count_penetrating(const Eigen::VectorXd& x, double* deepest
 }
 
 int ContactResponse::count_piercing(const Eigen::VectorXd& x, double* highest) const {
-  const double reach = piercing_reach();
-  int count = 0;
+  const std::vector<BodyPiercing> through = piercings_of(x, settings_.penetration_tolerance);
   double top = 0.0;
-  if (!cloth_.triangles.empty())
-    for (const BodyPiercing& p :
-         collider_.find_piercings(x, cloth_, settings_.penetration_tolerance, reach,
-                                  kPiercingUncheckedFraction * reach)) {
-      ++count;
-      top = std::max(top, p.height);
-    }
+  for (const BodyPiercing& p : through) top = std::max(top, p.height);
   if (highest != nullptr) *highest = top;
-  return count;
+  return static_cast<int>(through.size());
 }
 
 }  // namespace sd::sim

@@ -210,8 +210,11 @@ class ContactResponse {
                   ConstraintFilter& filter, Eigen::VectorXd& y, bool allow_release);
   // m: body vertices farther than this through the cloth are not looked for.
   double piercing_reach() const;
-  // Piercings of x1 whose body vertex is more than `min_height` through the cloth.
+  // Piercings of x1 whose body vertex is more than `min_height` through the cloth; none when
+  // check_body_vertices is off.
   std::vector<BodyPiercing> find_piercings(const Eigen::VectorXd& x1, double min_height) const;
+  // The same whether or not the check is on (what count_piercing measures).
+  std::vector<BodyPiercing> piercings_of(const Eigen::VectorXd& x, double min_height) const;
   // What a set of piercings asks of one cloth vertex: move `distance` (m, signed: negative
   // moves it towards the body vertex) along `normal`, the triangle's normal.
   struct CornerLift {

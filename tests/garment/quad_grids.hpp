@@ -1,24 +1,13 @@
 #pragma once
-// Small quad grids for the tests of smoothing and unfolding on a surface.
+// Quad grids on a plane and a sphere for the tests of smoothing and unfolding on a surface.
 
 #include "meshing/quad_mesh.hpp"
+#include "tests/meshing/quad_grid.hpp"
 
 namespace sd::test {
 
 // An n × n grid of unit-spaced quads in the plane z = 0, counter-clockwise seen from +z.
-inline meshing::QuadMesh plane_grid(int n) {
-  meshing::QuadMesh mesh;
-  mesh.vertices.resize((n + 1) * (n + 1), 3);
-  for (int i = 0; i <= n; ++i)
-    for (int j = 0; j <= n; ++j) mesh.vertices.row(i * (n + 1) + j) << j, i, 0.0;
-  mesh.faces.resize(n * n, 4);
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) {
-      const int a = i * (n + 1) + j;
-      mesh.faces.row(i * n + j) << a, a + 1, a + n + 2, a + n + 1;
-    }
-  return mesh;
-}
+inline meshing::QuadMesh plane_grid(int n) { return quad_grid(n, n); }
 
 // The same grid spanning `span` across, centred on +z and pushed radially onto the sphere of
 // radius r around the origin (facing out).

@@ -2,23 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/meshing/quad_grid.hpp"
+
 namespace sd::meshing {
 namespace {
 
-// A w by h grid of unit squares in the z = 0 plane, counter-clockwise seen from +z.
-QuadMesh grid(int w, int h) {
-  QuadMesh mesh;
-  mesh.vertices.resize((w + 1) * (h + 1), 3);
-  for (int j = 0; j <= h; ++j)
-    for (int i = 0; i <= w; ++i) mesh.vertices.row(j * (w + 1) + i) << i, j, 0;
-  mesh.faces.resize(w * h, 4);
-  for (int j = 0; j < h; ++j)
-    for (int i = 0; i < w; ++i) {
-      const int v = j * (w + 1) + i;
-      mesh.faces.row(j * w + i) << v, v + 1, v + w + 2, v + w + 1;
-    }
-  return mesh;
-}
+using test::quad_grid;
 
 bool mentions(const MeshCheck& check, const std::string& word) {
   for (const auto& p : check.problems)
@@ -27,12 +16,12 @@ bool mentions(const MeshCheck& check, const std::string& word) {
 }
 
 TEST(QuadMesh, GridIsValid) {
-  const MeshCheck check = validate(grid(3, 2));
+  const MeshCheck check = validate(quad_grid(3, 2));
   EXPECT_TRUE(check.ok()) << (check.problems.empty() ? "" : check.problems.front());
 }
 
 TEST(QuadMesh, ValencesOfAGrid) {
-  const Eigen::VectorXi valence = vertex_valences(grid(2, 2));
+  const Eigen::VectorXi valence = vertex_valences(quad_grid(2, 2));
   // Corners 2, side midpoints 3, centre 4.
   EXPECT_EQ(valence(0), 2);
   EXPECT_EQ(valence(1), 3);
@@ -41,7 +30,7 @@ TEST(QuadMesh, ValencesOfAGrid) {
 }
 
 TEST(QuadMesh, BoundaryLoopFollowsTheFaces) {
-  const std::vector<int> loop = boundary_loop(grid(2, 1));
+  const std::vector<int> loop = boundary_loop(quad_grid(2, 1));
   ASSERT_EQ(loop.size(), 6u);
   // Counter-clockwise: after vertex 0 comes 1 (along the bottom).
   const auto it = std::find(loop.begin(), loop.end(), 0);
@@ -49,19 +38,19 @@ TEST(QuadMesh, BoundaryLoopFollowsTheFaces) {
 }
 
 TEST(QuadMesh, RepeatedVertexIsReported) {
-  QuadMesh mesh = grid(1, 1);
+  QuadMesh mesh = quad_grid(1, 1);
   mesh.faces(0, 2) = mesh.faces(0, 0);
   EXPECT_TRUE(mentions(validate(mesh), "repeats"));
 }
 
 TEST(QuadMesh, FlippedFaceIsReported) {
-  QuadMesh mesh = grid(2, 1);
+  QuadMesh mesh = quad_grid(2, 1);
   mesh.faces.row(1) = mesh.faces.row(1).reverse().eval();
   EXPECT_TRUE(mentions(validate(mesh), "orientation"));
 }
 
 TEST(QuadMesh, EdgeWithThreeFacesIsReported) {
-  QuadMesh mesh = grid(2, 1);  // vertices 0..5; add a third face on edge 1-4
+  QuadMesh mesh = quad_grid(2, 1);  // vertices 0..5; add a third face on edge 1-4
   mesh.vertices.conservativeResize(8, 3);
   mesh.vertices.row(6) << 1, 0, 1;
   mesh.vertices.row(7) << 1, 1, 1;
@@ -72,7 +61,7 @@ TEST(QuadMesh, EdgeWithThreeFacesIsReported) {
 
 TEST(QuadMesh, TwoBoundaryLoopsAreReported) {
   // A 3x3 grid without its middle quad is an annulus.
-  QuadMesh full = grid(3, 3);
+  QuadMesh full = quad_grid(3, 3);
   QuadMesh ring;
   ring.vertices = full.vertices;
   ring.faces.resize(8, 4);
@@ -83,11 +72,11 @@ TEST(QuadMesh, TwoBoundaryLoopsAreReported) {
 }
 
 TEST(QuadMesh, UnusedVertexAndZeroAreaAreReported) {
-  QuadMesh mesh = grid(1, 1);
+  QuadMesh mesh = quad_grid(1, 1);
   mesh.vertices.conservativeResize(5, 3);
   mesh.vertices.row(4) << 9, 9, 0;
   EXPECT_TRUE(mentions(validate(mesh), "used by no face"));
-  QuadMesh flat = grid(1, 1);
+  QuadMesh flat = quad_grid(1, 1);
   flat.vertices.col(1).setZero();  // all four corners on a line
   flat.vertices.conservativeResize(6, 3);
   flat.vertices.row(4) << 0, 5, 0;  // keep the bounding box non-degenerate
@@ -98,7 +87,7 @@ TEST(QuadMesh, UnusedVertexAndZeroAreaAreReported) {
 }
 
 TEST(QuadMesh, ObjHasOneLinePerVertexAndFace) {
-  const std::string obj = to_obj(grid(2, 1));
+  const std::string obj = to_obj(quad_grid(2, 1));
   EXPECT_EQ(std::count(obj.begin(), obj.end(), 'v'), 6);
   EXPECT_NE(obj.find("f 1 2 5 4"), std::string::npos);
 }
