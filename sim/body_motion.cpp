@@ -173,6 +173,8 @@ PoseSequence make_arm_lowering(const meshing::TriMesh& rest, const ArmLoweringOp
   if (options.keyframes < 2) throw InvalidBodyMotionError("arm lowering needs at least 2 poses");
   if (!(options.duration > 0.0))
     throw InvalidBodyMotionError("arm lowering needs a positive duration");
+  if (!(options.start >= 0.0))
+    throw InvalidBodyMotionError("arm lowering cannot start before the drape (negative start)");
   const Eigen::VectorXd weights = arm_rotation_weights(rest, options);
   const meshing::BoundingBox box = meshing::bounding_box(rest);
   const double height = box.extent().y();
@@ -182,9 +184,10 @@ PoseSequence make_arm_lowering(const meshing::TriMesh& rest, const ArmLoweringOp
 
   std::vector<double> times;
   for (int k = 0; k < options.keyframes; ++k)
-    times.push_back(options.duration * k / (options.keyframes - 1));
+    times.push_back(options.start + options.duration * k / (options.keyframes - 1));
   return make_pose_sequence(rest, times, [&](double t) {
-    const double angle = full_angle * smoothstep(0.0, options.duration, t);
+    const double angle =
+        full_angle * smoothstep(options.start, options.start + options.duration, t);
     Eigen::MatrixX3d displacement = Eigen::MatrixX3d::Zero(rest.vertex_count(), 3);
     for (Eigen::Index v = 0; v < rest.vertex_count(); ++v) {
       if (weights[v] == 0.0) continue;

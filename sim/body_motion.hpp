@@ -70,6 +70,7 @@ PoseSequence make_pose_sequence(const meshing::TriMesh& rest, const std::vector<
 // are fractions of the body height measured on the built-in mannequin.
 struct ArmLoweringOptions {
   double angle_degrees = 10.0;  // rotation at the end; negative raises the arms
+  double start = 0.0;           // seconds: the arms start moving then (held before)
   double duration = 1.0;        // seconds from start to end
   int keyframes = 6;  // poses over the duration (≥ 2): rotations are sampled, not lerped
   double shoulder_height = 0.80;   // joint centre height / body height

@@ -173,19 +173,13 @@ sim::ClothModel build_scene_model(const ClothScene& scene) {
   return model;
 }
 
-// The arms-lowering motion of the sketch's body, its keyframes shifted to start at `start`.
+// The arms-lowering motion of the sketch's body.
 sim::PoseSequence body_motion(const garment::BodyMotionSpec& spec, const meshing::TriMesh& body) {
   sim::ArmLoweringOptions options;
   options.angle_degrees = spec.degrees;
+  options.start = spec.start;
   options.duration = spec.duration;
-  const sim::PoseSequence from_zero = sim::make_arm_lowering(body, options);
-  std::vector<double> times = from_zero.times();
-  std::vector<Eigen::MatrixX3d> poses;
-  for (int k = 0; k < from_zero.keyframe_count(); ++k) {
-    times[static_cast<size_t>(k)] += spec.start;
-    poses.push_back(from_zero.keyframe(k));
-  }
-  return sim::PoseSequence(from_zero.faces(), std::move(times), std::move(poses));
+  return sim::make_arm_lowering(body, options);
 }
 
 ClothScene build_cloth_scene(const garment::Sketch& sketch) {

@@ -142,6 +142,23 @@ TEST(ArmLowering, KeepsTopologyAndLowersTheHands) {
   EXPECT_GT(collider.signed_distance(rest.vertices.row(left_tip).transpose()), 0.01);
 }
 
+TEST(ArmLowering, StartsLaterWithTheSameMotion) {
+  // Started at 1 s (a garment settles first), the motion is the one started at 0 shifted by 1 s,
+  // and the body holds its rest pose until then.
+  const garment::Body body = garment::load_body("builtin");
+  ArmLoweringOptions options;
+  const PoseSequence now = make_arm_lowering(body.mesh, options);
+  options.start = 1.0;
+  const PoseSequence later = make_arm_lowering(body.mesh, options);
+  EXPECT_DOUBLE_EQ(later.start_time(), 1.0);
+  EXPECT_DOUBLE_EQ(later.end_time(), 2.0);
+  EXPECT_EQ(later.vertices_at(0.5), body.mesh.vertices);
+  for (const double t : {0.1, 0.37, 0.5, 0.9})
+    EXPECT_LT((later.vertices_at(1.0 + t) - now.vertices_at(t)).cwiseAbs().maxCoeff(), 1e-12) << t;
+  options.start = -1.0;
+  EXPECT_THROW(make_arm_lowering(body.mesh, options), InvalidBodyMotionError);
+}
+
 TEST(MoveBody, FollowsTheSequenceWithOneRefitPerSegment) {
   const garment::Body body = garment::load_body("builtin");
   ArmLoweringOptions options;
