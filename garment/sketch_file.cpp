@@ -450,7 +450,8 @@ void parse_adaptive(const Reader& r, const json& a, SimulateSpec& sim) {
     r.fail(path, "expected true, false or an object of adaptive settings {\"refine_threshold\": "
                  "0.002, ...}");
   r.check_keys(a, path, {"enabled", "refine_threshold", "coarsen_threshold", "steady_rate",
-                         "min_lifetime", "min_level", "max_level", "max_vertices"});
+                         "min_lifetime", "min_level", "max_level", "max_vertices",
+                         "merge_batch"});
   AdaptiveSpec& s = sim.adaptive_settings;
   if (a.contains("enabled")) sim.adaptive = r.boolean(a["enabled"], path + "/enabled");
   if (a.contains("refine_threshold"))
@@ -477,6 +478,13 @@ void parse_adaptive(const Reader& r, const json& a, SimulateSpec& sim) {
                                             *s.max_level, *s.min_level));
   if (a.contains("max_vertices"))
     s.max_vertices = r.integer(a["max_vertices"], path + "/max_vertices", 0);
+  if (a.contains("merge_batch")) {
+    s.merge_batch = r.non_negative(a["merge_batch"], path + "/merge_batch");
+    if (!(*s.merge_batch < 1.0))
+      r.fail(path + "/merge_batch",
+             "the merge batch is a fraction of the particles (0.05: merges wait until 5 % of "
+             "them can go at once); it must be below 1");
+  }
 }
 
 void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {

@@ -106,6 +106,7 @@ struct AdaptiveSpec {
   std::optional<int> min_level;             // coarsest level a merge returns to
   std::optional<int> max_level;             // finest level a split makes
   std::optional<int> max_vertices;          // particle budget, 0: none
+  std::optional<double> merge_batch;        // fraction of the particles lone merges wait for
 };
 
 // How the drape is simulated (`sketchdrape run`): plain values with defaults.

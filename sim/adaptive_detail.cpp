@@ -90,6 +90,8 @@ void AdaptiveSettings::validate() const {
   require(min_level >= 0 && max_level >= min_level && max_level <= 30,
           "the adaptive levels must satisfy 0 <= min_level <= max_level <= 30");
   require(max_vertices >= 0, "the particle budget must be zero (none) or a positive count");
+  require(std::isfinite(merge_batch) && merge_batch >= 0.0 && merge_batch < 1.0,
+          "the merge batch must be a fraction of the particles, at least 0 and below 1");
 }
 
 // The state by vertex and triangle id while a batch of splits and merges is applied (ids are
@@ -204,13 +206,11 @@ Eigen::VectorXd AdaptiveCloth::body_sags() const {
   // Only edges that can still be refined need their sag (a block at the finest level cannot
   // split; merges ask body_sag themselves), and only their vertices a body point.
   const int n = static_cast<int>(x.size() / 3);
-  std::vector<unsigned char> refinable(static_cast<std::size_t>(edges.rows()), 0);
+  std::vector<unsigned char> can_refine(static_cast<std::size_t>(edges.rows()), 0);
   std::vector<unsigned char> needed(static_cast<std::size_t>(n), 0);
   for (Eigen::Index r = 0; r < edges.rows(); ++r) {
-    if (arrays_.face_level(arrays_.edge_faces(r, 0)) >= settings_.max_level &&
-        arrays_.face_level(arrays_.edge_faces(r, 1)) >= settings_.max_level)
-      continue;
-    refinable[static_cast<std::size_t>(r)] = 1;
+    if (!refinable(r)) continue;
+    can_refine[static_cast<std::size_t>(r)] = 1;
     needed[static_cast<std::size_t>(edges(r, 0))] = 1;
     needed[static_cast<std::size_t>(edges(r, 1))] = 1;
   }
@@ -221,7 +221,7 @@ Eigen::VectorXd AdaptiveCloth::body_sags() const {
     if (needed[static_cast<std::size_t>(i)])
       under[static_cast<std::size_t>(i)] = contact->collider().closest_point(row3(x, i), reach);
   for (Eigen::Index r = 0; r < edges.rows(); ++r) {
-    if (!refinable[static_cast<std::size_t>(r)]) continue;
+    if (!can_refine[static_cast<std::size_t>(r)]) continue;
     const int i = edges(r, 0), j = edges(r, 1);
     const std::optional<BodyProximity>& at_i = under[static_cast<std::size_t>(i)];
     const std::optional<BodyProximity>& at_j = under[static_cast<std::size_t>(j)];
@@ -229,6 +229,11 @@ Eigen::VectorXd AdaptiveCloth::body_sags() const {
       sags(r) = body_sag(row3(x, i), row3(x, j), at_i ? &*at_i : nullptr, at_j ? &*at_j : nullptr);
   }
   return sags;
+}
+
+bool AdaptiveCloth::refinable(Eigen::Index edge) const {
+  return arrays_.face_level(arrays_.edge_faces(edge, 0)) < settings_.max_level ||
+         arrays_.face_level(arrays_.edge_faces(edge, 1)) < settings_.max_level;
 }
 
 double AdaptiveCloth::body_reach() const {
@@ -605,11 +610,16 @@ AdaptStats AdaptiveCloth::adapt() {
   if (settings_.refine) {
     const Eigen::VectorXd errors = edge_errors();
     for (Eigen::Index r = 0; r < errors.size(); ++r)
-      if (errors(r) > settings_.refine_threshold)
+      if (errors(r) > settings_.refine_threshold && refinable(r))
         refinements.emplace_back(errors(r), static_cast<int>(r));
     std::sort(refinements.begin(), refinements.end(), std::greater<>());
   }
   stats.estimate_s = seconds_since(estimate_start);
+  // Merges on their own wait until enough of them pay for a rebuild (merge_batch); blocks that
+  // stay flat and steady are still candidates on the next step.
+  if (refinements.empty() &&
+      static_cast<double>(merges.size()) < settings_.merge_batch * mesh_.vertex_count())
+    merges.clear();
 
   const auto operations_start = Clock::now();
   Transfer state = begin_transfer();

@@ -49,6 +49,11 @@ struct AdaptiveSettings {
   int min_level = 0;           // coarsest level a merge may return to
   int max_level = 6;           // finest triangle level a split may make
   int max_vertices = 0;        // particle budget (0: none); forced splits may exceed it slightly
+  // Merges wait until they can share the model rebuild that a split makes anyway, or until at
+  // least this fraction of the particles can be merged at once: a rebuild (and CHOLMOD's new
+  // analysis) costs about half a step, more than the two or three particles a lone batch of
+  // merges frees would save. 0: merge whenever a block qualifies.
+  double merge_batch = 0.05;
   bool refine = true;
   bool coarsen = true;
   // Measure energies, total mass and linear momentum just before and just after each topology
@@ -215,6 +220,8 @@ class AdaptiveCloth {
   double hinge_sag(const std::array<int, 4>& hinge, double theta) const;
   // m: vertices closer to the body than this get a body sag (contact thickness + search margin).
   double body_reach() const;
+  // Whether an interior edge (row of the mesh's interior edges) has a triangle below max_level.
+  bool refinable(Eigen::Index edge) const;
   // Body sag (see body_sags) under the edge xi–xj, 0 when neither end is within reach; at_i,
   // at_j: the body points under the ends if already known. Needs a body.
   double body_sag(const Eigen::Vector3d& xi, const Eigen::Vector3d& xj,

@@ -139,6 +139,7 @@ sim::AdaptiveSettings adaptive_settings(const garment::Sketch& sketch) {
   s.min_level = spec.min_level.value_or(s.min_level);
   s.max_level = spec.max_level.value_or(s.max_level);
   s.max_vertices = spec.max_vertices.value_or(s.max_vertices);
+  s.merge_batch = spec.merge_batch.value_or(s.merge_batch);
   try {
     s.validate();  // e.g. a coarsen threshold set at or above the default refine threshold
   } catch (const sim::InvalidAdaptiveSettingsError& e) {

@@ -3,7 +3,8 @@
 // Two modes:
 //   adaptive_bench [google benchmark flags]   kernels: the error estimate, one adapt() with
 //                                             splits and merges, a model rebuild
-//   adaptive_bench --study=DIR [--quick]      the work-precision study: the 3-corner and 2-corner
+//   adaptive_bench --study=DIR [--quick] [--only=RUN]
+//                                             the work-precision study: the 3-corner and 2-corner
 //                                             sheets run fixed at levels 2, 4, 6 and adaptively
 //                                             (max level 6) against a fixed level-8 reference;
 //                                             writes DIR/<scene>_<run>.csv time series and
@@ -231,7 +232,8 @@ void errors_against(RunResult& run, const RunResult& reference) {
   run.error_final = rms_distance(run.samples[n - 1], reference.samples[n - 1]);
 }
 
-int run_study(const std::string& dir, bool quick) {
+// only: run just the runs of this name (e.g. adaptive_2mm) and no reference, for profiling.
+int run_study(const std::string& dir, bool quick, const std::string& only) {
   std::filesystem::create_directories(dir);
   std::ofstream summary(dir + "/summary.csv");
   summary << "scene,run,cpu_s,wall_s,forces_s,solve_s,estimate_s,operations_s,rebuild_s,steps,retries,"
@@ -247,17 +249,23 @@ int run_study(const std::string& dir, bool quick) {
     const Eigen::MatrixX3d points = sheet_material_points(spec, 33);
     const double every = 0.25;
     std::vector<RunResult> runs;
-    RunResult reference =
-        run_case(dir, scene, "fixed_l8", spec, quick ? 7 : 8, fixed_settings(), points, every);
+    const auto wanted = [&](const std::string& name) { return only.empty() || only == name; };
     for (int level : {2, 4, 6})
-      runs.push_back(run_case(dir, scene, "fixed_l" + std::to_string(level), spec, level,
-                              fixed_settings(), points, every));
+      if (const std::string name = "fixed_l" + std::to_string(level); wanted(name))
+        runs.push_back(run_case(dir, scene, name, spec, level, fixed_settings(), points, every));
     for (double threshold : {4e-3, 2e-3, 1e-3, 5e-4}) {
       char name[64];
       std::snprintf(name, sizeof name, "adaptive_%gmm", threshold * 1e3);
-      runs.push_back(run_case(dir, scene, name, spec, 0, adaptive_settings(threshold), points, every));
+      if (wanted(name))
+        runs.push_back(run_case(dir, scene, name, spec, 0, adaptive_settings(threshold), points, every));
     }
-    runs.push_back(reference);
+    if (runs.empty()) continue;
+    // The reference last, so that a profiled run is not preceded by it; with --only there is
+    // none and each run is measured against itself (errors 0).
+    if (only.empty())
+      runs.push_back(
+          run_case(dir, scene, "fixed_l8", spec, quick ? 7 : 8, fixed_settings(), points, every));
+    const RunResult reference = runs.back();
     for (RunResult& run : runs) {
       errors_against(run, reference);
       summary << scene << ',' << run.name << ',' << run.cpu_s << ',' << run.wall_s << ',' << run.forces_s << ','
@@ -285,18 +293,20 @@ int run_study(const std::string& dir, bool quick) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string study;
+  std::string study, only;
   bool quick = false;
   std::vector<char*> rest;
   for (int i = 0; i < argc; ++i) {
     if (std::strncmp(argv[i], "--study=", 8) == 0)
       study = argv[i] + 8;
+    else if (std::strncmp(argv[i], "--only=", 7) == 0)
+      only = argv[i] + 7;
     else if (std::strcmp(argv[i], "--quick") == 0)
       quick = true;
     else
       rest.push_back(argv[i]);
   }
-  if (!study.empty()) return run_study(study, quick);
+  if (!study.empty()) return run_study(study, quick, only);
   int count = static_cast<int>(rest.size());
   benchmark::Initialize(&count, rest.data());
   benchmark::RunSpecifiedBenchmarks();

@@ -71,6 +71,8 @@ TEST(AdaptiveDetail, RejectsBadSettings) {
                InvalidAdaptiveSettingsError);
   EXPECT_THROW(bad([](AdaptiveSettings& s) { s.max_vertices = -5; }).validate(),
                InvalidAdaptiveSettingsError);
+  EXPECT_THROW(bad([](AdaptiveSettings& s) { s.merge_batch = 1.0; }).validate(),
+               InvalidAdaptiveSettingsError);
   EXPECT_NO_THROW(AdaptiveSettings{}.validate());
   testing::AdaptiveSheet sheet = testing::build_adaptive_sheet({});
   AdaptiveSettings wrong;
@@ -271,6 +273,58 @@ TEST(AdaptiveDetail, FlatHangingSheetIsNotRefined) {
 
 // Forcing a split or a merge before every step for thousands of steps: never diverges, the mesh
 // stays valid, mass stays exact, the simulation always has the mesh's vertices.
+// Merges on their own wait for a batch worth a model rebuild (merge_batch of the particles), and
+// go together once there are enough of them.
+TEST(AdaptiveDetail, LoneMergesWaitForABatch) {
+  AdaptiveSheetSpec spec;
+  spec.pins = {};
+  const auto weightless_sheet = [&](double merge_batch) {
+    testing::AdaptiveSheet sheet = testing::build_adaptive_sheet(spec);
+    SimulationSettings settings = testing::adaptive_sheet_settings(spec);
+    settings.forces.terms.gravity = false;  // flat and still: every split block may merge at once
+    AdaptiveSettings adaptive;
+    adaptive.min_lifetime = 0.0;
+    adaptive.min_level = 2;  // only the blocks split below may merge
+    adaptive.merge_batch = merge_batch;
+    AdaptiveCloth cloth(std::move(sheet.mesh), sheet.material, {}, sheet.pins, settings, adaptive);
+    cloth.refine_uniformly(2);  // 8 by 8 quads, 81 particles
+    return cloth;
+  };
+  const auto leaves = [](const AdaptiveCloth& cloth, std::size_t count) {
+    std::vector<BlockId> blocks = cloth.mesh().leaf_blocks();
+    blocks.resize(std::min(blocks.size(), count));
+    return blocks;
+  };
+  {
+    // One split block: its merge would free 1 of 82 particles (1.2 %), below 5 %: it waits.
+    AdaptiveCloth cloth = weightless_sheet(0.05);
+    ASSERT_EQ(cloth.split_blocks(leaves(cloth, 1)).splits, 1);
+    const int vertices = cloth.mesh().vertex_count();
+    for (int i = 0; i < 5; ++i) ASSERT_TRUE(cloth.step().accepted);
+    EXPECT_EQ(cloth.report().merges, 0);
+    EXPECT_EQ(cloth.mesh().vertex_count(), vertices);
+  }
+  {
+    // Without batching it merges on the first step.
+    AdaptiveCloth cloth = weightless_sheet(0.0);
+    ASSERT_EQ(cloth.split_blocks(leaves(cloth, 1)).splits, 1);
+    ASSERT_TRUE(cloth.step().accepted);
+    EXPECT_EQ(cloth.report().merges, 1);
+  }
+  {
+    // Several split blocks free enough at once: all merge on the first step, one rebuild.
+    AdaptiveCloth cloth = weightless_sheet(0.05);
+    const AdaptStats split = cloth.split_blocks(leaves(cloth, 8));
+    ASSERT_GE(split.splits + split.forced_splits, 3);
+    const int vertices = cloth.mesh().vertex_count();
+    const int changes = cloth.report().topology_changes;
+    ASSERT_TRUE(cloth.step().accepted);
+    EXPECT_EQ(cloth.report().merges, split.splits + split.forced_splits);
+    EXPECT_EQ(cloth.mesh().vertex_count(), vertices - cloth.report().merges);
+    EXPECT_EQ(cloth.report().topology_changes, changes + 1);
+  }
+}
+
 TEST(AdaptiveDetail, ChurnStress) {
   AdaptiveSheetSpec spec;
   spec.quads = 2;

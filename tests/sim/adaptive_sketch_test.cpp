@@ -40,7 +40,7 @@ TEST(AdaptiveSketch, BoolAndObjectForms) {
   const Sketch s = parse_sketch(
       sketch_with(R"({"enabled": true, "refine_threshold": 0.004, "coarsen_threshold": 0.001,
                       "steady_rate": 0.1, "min_lifetime": 0.5, "min_level": 1, "max_level": 5,
-                      "max_vertices": 800})"),
+                      "max_vertices": 800, "merge_batch": 0.1})"),
       "t.json");
   const AdaptiveSpec& a = s.simulate.adaptive_settings;
   EXPECT_TRUE(s.simulate.adaptive);
@@ -51,6 +51,7 @@ TEST(AdaptiveSketch, BoolAndObjectForms) {
   EXPECT_EQ(*a.min_level, 1);
   EXPECT_EQ(*a.max_level, 5);
   EXPECT_EQ(*a.max_vertices, 800);
+  EXPECT_DOUBLE_EQ(*a.merge_batch, 0.1);
   EXPECT_FALSE(parse_sketch(sketch_with(R"({"enabled": false})"), "t.json").simulate.adaptive);
 }
 
@@ -68,6 +69,9 @@ TEST(AdaptiveSketch, BadValuesNameTheirPath) {
   EXPECT_EQ(error_of(R"({"min_level": 4, "max_level": 3})").rfind("/simulate/adaptive/max_level:", 0),
             0u);
   EXPECT_EQ(error_of(R"({"max_vertices": -3})").rfind("/simulate/adaptive/max_vertices:", 0), 0u);
+  EXPECT_EQ(error_of(R"({"merge_batch": 1})").rfind("/simulate/adaptive/merge_batch: the merge", 0),
+            0u);
+  EXPECT_EQ(error_of(R"({"merge_batch": -0.1})").rfind("/simulate/adaptive/merge_batch:", 0), 0u);
   EXPECT_EQ(error_of(R"({"steady_rate": -0.1})").rfind("/simulate/adaptive/steady_rate:", 0), 0u);
   EXPECT_EQ(error_of(R"({"enabled": 1})").rfind("/simulate/adaptive/enabled:", 0), 0u);
   EXPECT_EQ(error_of(R"({"refine": 0.1})").rfind("/simulate/adaptive", 0), 0u);  // unknown key
