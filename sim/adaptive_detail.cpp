@@ -4,11 +4,13 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <initializer_list>
 #include <limits>
 #include <numbers>
 #include <optional>
 #include <string>
+#include <unordered_map>
 #include <utility>
 
 #include <Eigen/Geometry>
@@ -203,16 +205,33 @@ Eigen::VectorXd AdaptiveCloth::body_sags() const {
   if (contact == nullptr || !simulation_->settings().contact.enabled) return sags;
   const Eigen::VectorXd& x = simulation_->positions();
   const double reach = body_reach();
+  // Three closest-point queries per edge are most of adaptivity's cost on a body, and the sag
+  // under an edge depends only on where its two ends are: an edge whose ends (and the body)
+  // moved less than `settle` since its sag was found keeps it. A body point then moved as
+  // little, so the kept sag is off by about 2·settle, the coarsen threshold.
+  const double settle = 0.5 * settings_.coarsen_threshold;
+  const double body_motion = contact->collider().total_motion();
+  body_sag_memory_.resize(static_cast<std::size_t>(edges.rows()));
   // Only edges that can still be refined need their sag (a block at the finest level cannot
-  // split; merges ask body_sag themselves), and only their vertices a body point.
+  // split; merges ask body_sag themselves), only the stale ones a new one, and only their
+  // vertices a body point.
   const int n = static_cast<int>(x.size() / 3);
-  std::vector<unsigned char> can_refine(static_cast<std::size_t>(edges.rows()), 0);
+  std::vector<unsigned char> stale(static_cast<std::size_t>(edges.rows()), 0);
   std::vector<unsigned char> needed(static_cast<std::size_t>(n), 0);
   for (Eigen::Index r = 0; r < edges.rows(); ++r) {
     if (!refinable(r)) continue;
-    can_refine[static_cast<std::size_t>(r)] = 1;
-    needed[static_cast<std::size_t>(edges(r, 0))] = 1;
-    needed[static_cast<std::size_t>(edges(r, 1))] = 1;
+    const BodySagMemory& memory = body_sag_memory_[static_cast<std::size_t>(r)];
+    const int i = edges(r, 0), j = edges(r, 1);
+    if (memory.valid && (row3(x, i) - memory.xi).norm() < settle &&
+        (row3(x, j) - memory.xj).norm() < settle && body_motion - memory.body_motion < settle) {
+      sags(r) = memory.sag;
+      ++body_sags_reused_;
+      continue;
+    }
+    ++body_sags_computed_;
+    stale[static_cast<std::size_t>(r)] = 1;
+    needed[static_cast<std::size_t>(i)] = 1;
+    needed[static_cast<std::size_t>(j)] = 1;
   }
   // The body point under each of those vertices within reach (bounded queries: most of a
   // garment is not, and FCL prunes by the bound).
@@ -221,12 +240,14 @@ Eigen::VectorXd AdaptiveCloth::body_sags() const {
     if (needed[static_cast<std::size_t>(i)])
       under[static_cast<std::size_t>(i)] = contact->collider().closest_point(row3(x, i), reach);
   for (Eigen::Index r = 0; r < edges.rows(); ++r) {
-    if (!can_refine[static_cast<std::size_t>(r)]) continue;
+    if (!stale[static_cast<std::size_t>(r)]) continue;
     const int i = edges(r, 0), j = edges(r, 1);
     const std::optional<BodyProximity>& at_i = under[static_cast<std::size_t>(i)];
     const std::optional<BodyProximity>& at_j = under[static_cast<std::size_t>(j)];
     if (at_i || at_j)
       sags(r) = body_sag(row3(x, i), row3(x, j), at_i ? &*at_i : nullptr, at_j ? &*at_j : nullptr);
+    body_sag_memory_[static_cast<std::size_t>(r)] = {row3(x, i), row3(x, j), body_motion, sags(r),
+                                                     true};
   }
   return sags;
 }
@@ -379,6 +400,34 @@ void AdaptiveCloth::keep_off_body(int e, Transfer& state) const {
   ++state.moved_off_body;
 }
 
+void AdaptiveCloth::carry_body_sag_memory(const Eigen::MatrixX4i& old_edges,
+                                          const std::vector<VertexOrigin>& origin) {
+  // An edge between two particles that were joined before the change is the same chord, so its
+  // body sag is the same; every other edge starts without one.
+  const auto key = [](int a, int b) {
+    return (static_cast<std::uint64_t>(std::min(a, b)) << 32) |
+           static_cast<std::uint32_t>(std::max(a, b));
+  };
+  std::unordered_map<std::uint64_t, Eigen::Index> before;  // old row of each remembered edge
+  for (Eigen::Index r = 0; r < old_edges.rows(); ++r)
+    if (static_cast<std::size_t>(r) < body_sag_memory_.size() &&
+        body_sag_memory_[static_cast<std::size_t>(r)].valid)
+      before.emplace(key(old_edges(r, 0), old_edges(r, 1)), r);
+  const Eigen::MatrixX4i& edges = arrays_.interior_edges;
+  std::vector<BodySagMemory> after(static_cast<std::size_t>(edges.rows()));
+  for (Eigen::Index r = 0; r < edges.rows() && !before.empty(); ++r) {
+    const VertexOrigin& i = origin[static_cast<std::size_t>(edges(r, 0))];
+    const VertexOrigin& j = origin[static_cast<std::size_t>(edges(r, 1))];
+    if (i.a < 0 || i.a != i.b || j.a < 0 || j.a != j.b) continue;  // a new vertex
+    const auto found = before.find(key(i.a, j.a));
+    if (found == before.end()) continue;
+    BodySagMemory memory = body_sag_memory_[static_cast<std::size_t>(found->second)];
+    if (old_edges(found->second, 0) != i.a) std::swap(memory.xi, memory.xj);  // ends reversed
+    after[static_cast<std::size_t>(r)] = memory;
+  }
+  body_sag_memory_ = std::move(after);
+}
+
 bool AdaptiveCloth::split_stays_off_body(BlockId k, const Eigen::MatrixX3d& x) const {
   const ContactResponse* contact = simulation_->contact();
   if (contact == nullptr || !simulation_->settings().contact.enabled) return true;
@@ -396,13 +445,20 @@ bool AdaptiveCloth::split_stays_off_body(BlockId k, const Eigen::MatrixX3d& x) c
   return lift <= safe_lift(middle, xb, xc, {&xa, d.valid() ? &xd : nullptr});
 }
 
-void AdaptiveCloth::set_body(const meshing::TriMesh& body) { simulation_->set_body(body); }
+void AdaptiveCloth::set_body(const meshing::TriMesh& body) {
+  simulation_->set_body(body);
+  body_sag_memory_.clear();
+}
 
 void AdaptiveCloth::set_body_motion(PoseSequence motion) {
   simulation_->set_body_motion(std::move(motion));
+  body_sag_memory_.clear();
 }
 
-void AdaptiveCloth::clear_body() { simulation_->clear_body(); }
+void AdaptiveCloth::clear_body() {
+  simulation_->clear_body();
+  body_sag_memory_.clear();
+}
 
 double AdaptiveCloth::rebuild(Transfer& state, const SimulationSettings* first_settings) {
   const auto start = Clock::now();
@@ -422,7 +478,9 @@ double AdaptiveCloth::rebuild(Transfer& state, const SimulationSettings* first_s
       if (remap.vertices[slot] >= 0)
         origin[static_cast<std::size_t>(remap.vertices[slot])] = state.origin[slot];
     state.origin = std::move(origin);
+    const Eigen::MatrixX4i old_edges = arrays_.interior_edges;
     arrays_ = mesh_.arrays();
+    carry_body_sag_memory(old_edges, state.origin);
   }
 
   ClothInput input;
@@ -732,6 +790,8 @@ void AdaptiveCloth::record(const StepOutcome& outcome, const AdaptStats& stats) 
       report_.steps.size() == 1 ? step.vertices : std::min(report_.vertices_min, step.vertices);
   report_.vertices_max = std::max(report_.vertices_max, step.vertices);
   report_.max_level_reached = std::max(report_.max_level_reached, step.max_level);
+  report_.body_sags_computed = body_sags_computed_;
+  report_.body_sags_reused = body_sags_reused_;
 }
 
 StepOutcome AdaptiveCloth::step(double max_step) {

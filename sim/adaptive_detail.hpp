@@ -128,6 +128,10 @@ struct AdaptiveReport {
   int splits_declined_on_body = 0;  // per step, see split_stays_off_body
   int vertices_min = 0, vertices_max = 0;
   int max_level_reached = 0;
+  // Body sags found by closest-point queries, and kept from an earlier step because the edge's
+  // ends and the body had not moved (body_sags).
+  long long body_sags_computed = 0;
+  long long body_sags_reused = 0;
   double estimate_s = 0.0;
   double operations_s = 0.0;
   double rebuild_s = 0.0;
@@ -222,6 +226,10 @@ class AdaptiveCloth {
   double body_reach() const;
   // Whether an interior edge (row of the mesh's interior edges) has a triangle below max_level.
   bool refinable(Eigen::Index edge) const;
+  // After a topology change: keeps the body-sag memory of every edge whose two ends were joined
+  // before (old_edges: the interior edges before it; origin: per new vertex, its old id).
+  void carry_body_sag_memory(const Eigen::MatrixX4i& old_edges,
+                             const std::vector<VertexOrigin>& origin);
   // Body sag (see body_sags) under the edge xi–xj, 0 when neither end is within reach; at_i,
   // at_j: the body points under the ends if already known. Needs a body.
   double body_sag(const Eigen::Vector3d& xi, const Eigen::Vector3d& xj,
@@ -259,6 +267,16 @@ class AdaptiveCloth {
   std::vector<PinRecord> pins_;
   Eigen::VectorXd edge_rest_angle_;  // per interior edge (rows of arrays_.interior_edges), rad
   Eigen::VectorXd edge_width_;       // per interior edge: (A1 + A2)/|e| in the rest shape, m
+  // The body sag each interior edge was last given, with where its ends and the body were then
+  // (body_sags reuses it while they stay put; carried through topology changes by rebuild).
+  struct BodySagMemory {
+    Eigen::Vector3d xi = Eigen::Vector3d::Zero(), xj = Eigen::Vector3d::Zero();
+    double body_motion = 0.0;  // BodyCollider::total_motion at the time
+    double sag = 0.0;
+    bool valid = false;
+  };
+  mutable std::vector<BodySagMemory> body_sag_memory_;
+  mutable long long body_sags_computed_ = 0, body_sags_reused_ = 0;
   AdaptiveReport report_;
   long long newton_total_ = 0;
   long long cg_total_ = 0;

@@ -176,6 +176,9 @@ class BodyCollider {
   // Largest vertex displacement of the last step (m): a bound on how far any surface point
   // moved in it.
   double last_motion() const { return last_motion_; }
+  // The sum of last_motion over every pose so far (m): no surface point moved farther between
+  // two moments than the difference of this at them (0 for a body that never moved).
+  double total_motion() const { return total_motion_; }
   // FCL refits so far (diagnostics).
   int refit_count() const { return refit_count_; }
 

@@ -246,6 +246,8 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
                        {"merges", adaptive.merges},
                        {"moved_off_body", adaptive.moved_off_body},
                        {"splits_declined_on_body", adaptive.splits_declined_on_body},
+                       {"body_sags_computed", adaptive.body_sags_computed},
+                       {"body_sags_reused", adaptive.body_sags_reused},
                        {"topology_changes", adaptive.topology_changes},
                        {"vertices_min", adaptive.vertices_min},
                        {"vertices_max", adaptive.vertices_max},

@@ -254,6 +254,31 @@ TEST(AdaptiveContact, SheetIsRefinedForTheSphereBeforeItLands) {
   EXPECT_LT(cloth.mesh().vertex_count(), 33 * 33 / 2);
 }
 
+// Body sags cost three closest-point queries per edge; an edge keeps its sag while its ends and
+// the body stay put (AdaptiveCloth::body_sags), which is off from a fresh one by at most the
+// coarsen threshold. On the sheet that came to rest on the sphere most of them are kept.
+TEST(AdaptiveContact, BodySagsAreKeptWhileTheClothLiesStill) {
+  SphereDrop drop = sphere_drop();
+  const SimulationSettings settings = drape_settings(4.0);
+  AdaptiveSettings adaptive;
+  adaptive.max_level = 6;
+  AdaptiveCloth cloth(std::move(drop.sheet.mesh), drop.sheet.material, {}, {}, settings, adaptive);
+  cloth.refine_uniformly(2);
+  cloth.set_body(drop.sphere);
+  const AdaptiveReport report = cloth.run();
+  ASSERT_TRUE(report.simulation.at_rest) << report.simulation.failure_reason;
+  std::printf("body sags on the sphere drape: %lld computed, %lld kept\n",
+              report.body_sags_computed, report.body_sags_reused);
+  EXPECT_GT(report.body_sags_reused, report.body_sags_computed / 4);
+
+  const Eigen::VectorXd kept = cloth.body_sags();  // nothing moved since the last step
+  cloth.set_body(drop.sphere);                     // a new body: nothing remembered
+  const Eigen::VectorXd fresh = cloth.body_sags();
+  ASSERT_EQ(kept.size(), fresh.size());
+  EXPECT_GT(fresh.maxCoeff(), adaptive.coarsen_threshold);  // the sphere does show
+  EXPECT_LE((kept - fresh).cwiseAbs().maxCoeff(), adaptive.coarsen_threshold);
+}
+
 // A 0.4 m sheet (4x4 level-0 quads, started at level 2) 2 cm above a box whose edge runs along
 // z; 0.12 m of it overhangs the edge, folds over it and hangs down the side face.
 TEST(AdaptiveContact, SheetFoldsOverABoxEdgeWithDetailAtTheFold) {

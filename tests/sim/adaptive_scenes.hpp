@@ -25,6 +25,7 @@ struct AdaptiveSheetSpec {
   double duration = 4.0;  // s
   double dt = 1.0 / 60.0;
   LinearSolverKind solver = LinearSolverKind::cholmod;
+  meshing::TriMesh body;  // what the sheet drapes on (a table, a sphere); no faces: none
 };
 
 // The fabric of the experiment: cotton with a bending rigidity 10x higher (the paper too made
@@ -82,6 +83,7 @@ inline AdaptiveCloth make_adaptive_sheet(const AdaptiveSheetSpec& spec, int star
   AdaptiveSheet sheet = build_adaptive_sheet(spec);
   AdaptiveCloth cloth(std::move(sheet.mesh), sheet.material, {}, sheet.pins,
                       adaptive_sheet_settings(spec), adaptive);
+  if (spec.body.face_count() > 0) cloth.set_body(spec.body);
   if (start_level > 0) cloth.refine_uniformly(start_level);
   return cloth;
 }
