@@ -26,13 +26,14 @@ plot dir."/three_corner_fixed_l6.csv" u 1:4 w l lw 2 t "fixed L6", \
      dir."/three_corner_adaptive_1mm.csv" u 1:4 w l t "adaptive 1 mm"
 unset multiplot
 
+set terminal pngcairo size 1350,560 font ",10" noenhanced
 set output out."/adaptive-work-precision.png"
-set multiplot layout 1,2 title "error against the fixed level-8 reference (4225 particles) vs CPU time of the run"
+set multiplot layout 1,3 title "error against the fixed level-8 reference (4225 particles) vs CPU time of the run"
 set logscale xy
-set xlabel "CPU time (s), OPENBLAS_NUM_THREADS=1"
+set xlabel "CPU time (s), one thread"
 set ylabel "final RMS distance at 33x33 material points (mm)"
 set key bottom left
-do for [scene in "three_corner two_corner"] {
+do for [scene in "three_corner two_corner tablecloth"] {
   set title scene
   plot "< grep -E '".scene.",fixed_l[246],' ".dir."/summary.csv" u 3:(1e3*$18) w lp pt 7 t "fixed L2, L4, L6", \
        "" u 3:(1e3*$18):2 w labels offset 1,1 notitle, \
