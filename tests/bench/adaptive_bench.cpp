@@ -5,12 +5,13 @@
 //                                             splits and merges, a model rebuild
 //   adaptive_bench --study=DIR [--quick] [--scene=SCENE] [--only=RUN]
 //                                             the work-precision study: the 3-corner and 2-corner
-//                                             sheets and a tablecloth run fixed at levels 2, 4, 6
+//                                             sheets, a tablecloth and a sheet dropped on a sphere
+//                                             run fixed at levels 2, 4, 6
 //                                             and adaptively (max level 6) against a fixed
 //                                             level-8 reference; writes DIR/<scene>_<run>.csv
 //                                             time series and DIR/summary.csv, prints the
 //                                             summary. --scene: one scene (three_corner,
-//                                             two_corner, tablecloth); --only: one run (e.g.
+//                                             two_corner, tablecloth, sphere); --only: one run (e.g.
 //                                             adaptive_2mm) without the reference, to profile.
 #include <benchmark/benchmark.h>
 
@@ -245,7 +246,7 @@ int run_study(const std::string& dir, bool quick, const std::string& only_scene,
   summary << "scene,run,cpu_s,wall_s,forces_s,solve_s,estimate_s,operations_s,rebuild_s,steps,retries,"
              "vertices_final,vertices_max,splits,forced_splits,merges,topology_changes,"
              "error_final_m,error_trajectory_m,lowest_m,extent_x,extent_y,extent_z\n";
-  std::vector<std::pair<std::string, AdaptiveSheetSpec>> scenes(3);
+  std::vector<std::pair<std::string, AdaptiveSheetSpec>> scenes(4);
   scenes[0].first = "three_corner";
   scenes[0].second.pins = {"top-left", "top-right", "bottom-left"};
   scenes[1].first = "two_corner";
@@ -257,6 +258,11 @@ int run_study(const std::string& dir, bool quick, const std::string& only_scene,
   scenes[2].first = "tablecloth";
   scenes[2].second.pins = {};
   scenes[2].second.body = make_box({-0.29, 0.2, -0.31}, {0.31, 0.98, 0.29});
+  // The sheet dropped from 5 cm onto a sphere of radius 0.25 m, off its top vertex (as the
+  // sphere-drop scene of `sketchdrape bench`).
+  scenes[3].first = "sphere";
+  scenes[3].second.pins = {};
+  scenes[3].second.body = make_sphere(0.25, 4, Eigen::Vector3d(0.031, 0.70, -0.017));
   for (auto& [scene, spec] : scenes) {
     if (!only_scene.empty() && scene != only_scene) continue;
     spec.duration = quick ? 1.0 : 4.0;
