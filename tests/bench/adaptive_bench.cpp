@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "sim/adaptive_detail.hpp"
+#include "sim/solver_threads.hpp"
 #include "tests/sim/adaptive_scenes.hpp"
 #include "tests/sim/test_bodies.hpp"
 
@@ -313,6 +314,7 @@ int run_study(const std::string& dir, bool quick, const std::string& only_scene,
 }  // namespace
 
 int main(int argc, char** argv) {
+  sd::sim::restart_with_single_threaded_solvers(argv);  // the solvers as sketchdrape runs them
   std::string study, only_scene, only;
   bool quick = false;
   std::vector<char*> rest;

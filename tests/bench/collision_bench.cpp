@@ -208,5 +208,3 @@ void BM_SweptStep(benchmark::State& state) {
 BENCHMARK(BM_SweptStep)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
-
-BENCHMARK_MAIN();

@@ -110,5 +110,3 @@ void BM_SheetOnMannequin32(benchmark::State& state) {
 BENCHMARK(BM_SheetOnMannequin32)->Unit(benchmark::kSecond)->Iterations(1);
 
 }  // namespace
-
-BENCHMARK_MAIN();

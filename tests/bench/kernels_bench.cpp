@@ -132,5 +132,3 @@ void BM_StreamTriad(benchmark::State& state) {
 BENCHMARK(BM_StreamTriad)->Unit(benchmark::kMillisecond);
 
 }  // namespace
-
-BENCHMARK_MAIN();

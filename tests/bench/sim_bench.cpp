@@ -327,5 +327,3 @@ void BM_StreamCopy(benchmark::State& state) {
 BENCHMARK(BM_StreamCopy)->Unit(benchmark::kMillisecond);
 
 }  // namespace
-
-BENCHMARK_MAIN();
