@@ -205,7 +205,9 @@ class AdaptiveCloth {
   // two triangles are at the finest level already (they cannot be refined), and without a
   // body. It is the sag the edge will have once the cloth lies on the body, known while the
   // cloth is still approaching: refining on it gives the cloth the resolution the body's
-  // curvature asks for before the contact instead of after it.
+  // curvature asks for before the contact instead of after it. An edge whose ends and the body
+  // moved less than half the coarsen threshold since its sag was found keeps that sag (counted
+  // in AdaptiveReport::body_sags_reused), so a cloth lying still asks the body nothing.
   Eigen::VectorXd body_sags() const;
   // Σ m_i v_i, kg·m/s.
   Eigen::Vector3d linear_momentum() const;
