@@ -167,34 +167,10 @@ CleanupCounts weld_and_clean(meshing::TriMesh& mesh, double tolerance, double mi
   return counts;
 }
 
-}  // namespace
-
-std::string AxisDirection::name() const {
-  return std::string(sign > 0 ? "+" : "-") + "xyz"[axis];
-}
-
-AxisDirection AxisDirection::parse(const std::string& text) {
-  std::string t;
-  for (char c : text) t += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  AxisDirection d;
-  size_t i = 0;
-  if (!t.empty() && (t[0] == '+' || t[0] == '-')) d.sign = t[i++] == '-' ? -1 : 1;
-  if (t.size() != i + 1 || t[i] < 'x' || t[i] > 'z')
-    throw BodyError("'" + text + "' is not an axis: use x, y or z with an optional + or -");
-  d.axis = t[i] - 'x';
-  return d;
-}
-
-std::string builtin_body_path() { return kBuiltinPath; }
-
-Body load_body(const std::string& path, const BodyOptions& options) {
-  const bool builtin = path == "builtin";
-  const std::string file = builtin ? kBuiltinPath : path;
-  if (!std::filesystem::exists(file))
-    throw BodyError(builtin ? "the built-in body " + file +
-                                  " is missing: install the Debian package assimp-testmodels"
-                            : "body file '" + file + "' does not exist");
-
+// The triangles of `file` as assimp reads them, merged, welded and cleaned; file units and axes.
+// Repairs are added to body.warnings, the mesh count to body.raw.meshes.
+meshing::TriMesh read_body_mesh(const std::string& file, Body& body) {
+  if (!std::filesystem::exists(file)) throw BodyError("body file '" + file + "' does not exist");
   if (std::filesystem::is_directory(file)) throw BodyError("body path '" + file + "' is a folder");
   check_declared_counts(file);
   Assimp::Importer importer;
@@ -215,7 +191,6 @@ Body load_body(const std::string& path, const BodyOptions& options) {
 
   std::vector<Eigen::Vector3d> points;
   std::vector<Eigen::Vector3i> tris;
-  Body body;
   collect_meshes(*scene, *scene->mRootNode, aiMatrix4x4(), points, tris, body.raw.meshes);
   if (tris.empty()) throw BodyError("body file '" + file + "' holds no triangles");
   for (const auto& p : points)
@@ -242,6 +217,37 @@ Body load_body(const std::string& path, const BodyOptions& options) {
     spdlog::debug("removed {} vertices no triangle uses", cleanup.unused_vertices);
   if (cleanup.merged_vertices > 0)
     spdlog::debug("welded {} coincident vertices", cleanup.merged_vertices);
+  return mesh;
+}
+
+}  // namespace
+
+std::string AxisDirection::name() const {
+  return std::string(sign > 0 ? "+" : "-") + "xyz"[axis];
+}
+
+AxisDirection AxisDirection::parse(const std::string& text) {
+  std::string t;
+  for (char c : text) t += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  AxisDirection d;
+  size_t i = 0;
+  if (!t.empty() && (t[0] == '+' || t[0] == '-')) d.sign = t[i++] == '-' ? -1 : 1;
+  if (t.size() != i + 1 || t[i] < 'x' || t[i] > 'z')
+    throw BodyError("'" + text + "' is not an axis: use x, y or z with an optional + or -");
+  d.axis = t[i] - 'x';
+  return d;
+}
+
+std::string builtin_body_path() { return kBuiltinPath; }
+
+Body load_body(const std::string& path, const BodyOptions& options) {
+  const bool builtin = path == "builtin";
+  const std::string file = builtin ? kBuiltinPath : path;
+  if (builtin && !std::filesystem::exists(file))
+    throw BodyError("the built-in body " + file +
+                    " is missing: install the Debian package assimp-testmodels");
+  Body body;
+  meshing::TriMesh mesh = read_body_mesh(file, body);
   const meshing::TriMeshTopology topo = meshing::analyse_topology(mesh);
   if (!topo.edge_manifold())
     body.warnings.push_back(fmt::format(
@@ -305,11 +311,31 @@ Body load_body(const std::string& path, const BodyOptions& options) {
   const Eigen::Matrix3d rotation = frame_rotation(raw.up, raw.facing);
   mesh.vertices = (mesh.vertices * rotation.transpose()) * raw.scale;
   const meshing::BoundingBox box = meshing::bounding_box(mesh);
-  const Eigen::RowVector3d shift(-box.centre().x(), -box.min.y(), -box.centre().z());
-  mesh.vertices.rowwise() += shift;
+  raw.shift = Eigen::Vector3d(-box.centre().x(), -box.min.y(), -box.centre().z());
+  mesh.vertices.rowwise() += raw.shift.transpose();
   body.mesh = std::move(mesh);
   for (const auto& warning : body.warnings) spdlog::warn("{}", warning);
   return body;
+}
+
+meshing::TriMesh load_body_pose(const std::string& path, const Body& rest) {
+  Body scratch;
+  meshing::TriMesh mesh = read_body_mesh(path, scratch);
+  // The same mesh moved: the same triangles over the same vertices, or the poses cannot be
+  // interpolated vertex by vertex.
+  if (mesh.vertex_count() != rest.mesh.vertex_count() || mesh.faces != rest.mesh.faces)
+    throw BodyError(fmt::format(
+        "'{}' is not the body's mesh moved: it has {} vertices and {} triangles, the "
+        "body {} and {}{} (export every pose from the same rig, without remeshing)",
+        path, mesh.vertex_count(), mesh.face_count(), rest.mesh.vertex_count(),
+        rest.mesh.face_count(),
+        mesh.vertex_count() == rest.mesh.vertex_count() && mesh.face_count() == rest.mesh.face_count()
+            ? ", but its triangles join other vertices"
+            : ""));
+  const RawBodyInfo& raw = rest.raw;
+  mesh.vertices = (mesh.vertices * frame_rotation(raw.up, raw.facing).transpose()) * raw.scale;
+  mesh.vertices.rowwise() += raw.shift.transpose();
+  return mesh;
 }
 
 }  // namespace sd::garment

@@ -44,6 +44,8 @@ struct RawBodyInfo {
   double height = 0;                // extent along up, file units
   double scale = 1;                 // applied: metres per file unit
   std::string scale_rule;           // why that scale ("height 1.75 m given", ...)
+  // Added after the rotation and the scale (feet on y = 0, centred on the vertical axis), m.
+  Eigen::Vector3d shift = Eigen::Vector3d::Zero();
 };
 
 struct Body {
@@ -59,5 +61,11 @@ std::string builtin_body_path();
 // says otherwise). Merges all meshes with their node transforms, drops degenerate faces and
 // unused vertices (with a warning), then normalises. Throws BodyError on unusable input.
 Body load_body(const std::string& path, const BodyOptions& options = {});
+
+// Loads another pose of `rest` (the same mesh moved: a frame of an animation exported from the
+// same rig) and puts it in the project's frame with exactly the rest body's rotation, scale and
+// shift, so that a pose where the arms are raised is not re-centred. Throws BodyError when the
+// file cannot be read or its triangles are not the rest body's.
+meshing::TriMesh load_body_pose(const std::string& path, const Body& rest);
 
 }  // namespace sd::garment

@@ -239,6 +239,39 @@ class Reader {
   const Sketch& sketch_;
 };
 
+// "poses": [{"time": 0.5, "mesh": "raised.obj"}, ...] of a "poses" motion.
+void parse_body_poses(const Reader& r, const json& m, const std::string& mpath,
+                      const BodySpec& body, BodyMotionSpec& motion) {
+  if (!m.contains("poses"))
+    r.fail(mpath, "a \"poses\" motion needs \"poses\": [{\"time\": 1.0, \"mesh\": "
+                  "\"pose.obj\"}, ...], the body's mesh in other poses");
+  const json& list = m["poses"];
+  const std::string lpath = mpath + "/poses";
+  if (!list.is_array() || list.empty())
+    r.fail(lpath, "expected a list of at least one pose {\"time\": seconds, \"mesh\": file}");
+  if (body.mesh == "builtin")
+    r.fail(lpath, "the poses must be meshes of the same body: give the body's own file as "
+                  "\"mesh\" (the pose at time 0) instead of \"builtin\"");
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    const std::string ppath = lpath + "/" + std::to_string(k);
+    const json& p = list[k];
+    r.require_object(p, ppath, "a pose");
+    r.check_keys(p, ppath, {"time", "mesh"});
+    if (!p.contains("time") || !p.contains("mesh"))
+      r.fail(ppath, "a pose needs a \"time\" (seconds) and a \"mesh\" (the body file in that pose)");
+    BodyPoseSpec pose;
+    pose.json_path = ppath;
+    pose.time = r.positive(p["time"], ppath + "/time");
+    pose.mesh = r.text(p["mesh"], ppath + "/mesh");
+    if (pose.mesh.empty()) r.fail(ppath + "/mesh", "the pose's mesh path is empty");
+    if (!motion.poses.empty() && !(pose.time > motion.poses.back().time))
+      r.fail(ppath + "/time",
+             fmt::format("the poses must come in time order: {} s is not after {} s", pose.time,
+                         motion.poses.back().time));
+    motion.poses.push_back(pose);
+  }
+}
+
 void parse_body(const Reader& r, const json& j, BodySpec& body) {
   const std::string path = "/body";
   if (j.is_string()) {  // shorthand: "body": "builtin"
@@ -263,14 +296,19 @@ void parse_body(const Reader& r, const json& j, BodySpec& body) {
     const std::string mpath = path + "/motion";
     const json& m = j["motion"];
     r.require_object(m, mpath, "the body's motion");
-    r.check_keys(m, mpath, {"type", "degrees", "start", "duration"});
     if (body.mesh == "none") r.fail(mpath, "a body motion needs a body: \"mesh\" is \"none\"");
     BodyMotionSpec motion;
     if (m.contains("type")) motion.type = r.text(m["type"], mpath + "/type");
+    if (motion.type == "poses") {
+      r.check_keys(m, mpath, {"type", "poses"});
+      parse_body_poses(r, m, mpath, body, motion);
+      body.motion = motion;
+      return;
+    }
     if (motion.type != "arms-lowering")
       r.fail(mpath + "/type",
-             fmt::format("'{}' is not a body motion; the only kind so far is arms-lowering",
-                         motion.type));
+             fmt::format("'{}' is not a body motion; use arms-lowering or poses", motion.type));
+    r.check_keys(m, mpath, {"type", "degrees", "start", "duration"});
     if (m.contains("degrees")) motion.degrees = r.number(m["degrees"], mpath + "/degrees");
     // The built-in mannequin's arms hang 17° out from the body: lowering them by more than 15°
     // would press them into the torso.

@@ -79,13 +79,23 @@ struct JoinSpec {
   std::vector<std::string> panels;
 };
 
-// "body": {"motion": {...}}: the body moving during the drape. One kind so far: the A-pose
-// mannequin's arms turning towards the body about the shoulders (sim::make_arm_lowering).
+// One keyframe of a "poses" motion: the body file of that pose and when the body is in it.
+struct BodyPoseSpec {
+  double time = 0.0;  // s of the drape, > 0 (the body's own mesh is the pose at 0)
+  std::string mesh;   // path relative to the sketch file
+  std::string json_path;
+};
+
+// "body": {"motion": {...}}: the body moving during the drape. Two kinds: "arms-lowering", the
+// A-pose mannequin's arms turning towards the body about the shoulders
+// (sim::make_arm_lowering), and "poses", meshes of the same body in other poses at given
+// times, interpolated linearly in between (sim::PoseSequence).
 struct BodyMotionSpec {
   std::string type = "arms-lowering";
-  double degrees = 10.0;   // rotation at the end; negative raises the arms
-  double start = 0.0;      // s: the arms start moving at this time of the drape
-  double duration = 1.0;   // s from start to end
+  double degrees = 10.0;   // arms-lowering: rotation at the end; negative raises the arms
+  double start = 0.0;      // arms-lowering: s, the arms start moving at this time of the drape
+  double duration = 1.0;   // arms-lowering: s from start to end
+  std::vector<BodyPoseSpec> poses;  // poses: strictly increasing times
 };
 
 struct BodySpec {

@@ -173,13 +173,33 @@ sim::ClothModel build_scene_model(const ClothScene& scene) {
   return model;
 }
 
-// The arms-lowering motion of the sketch's body.
-sim::PoseSequence body_motion(const garment::BodyMotionSpec& spec, const meshing::TriMesh& body) {
+// The motion of the sketch's body: the arms lowering, or the body's own poses at given times
+// (its mesh is the pose at time 0).
+sim::PoseSequence body_motion(const garment::Sketch& sketch, const garment::Body& body) {
+  const garment::BodyMotionSpec& spec = *sketch.body.motion;
+  if (spec.type == "poses") {
+    std::vector<double> times = {0.0};
+    std::vector<Eigen::MatrixX3d> poses = {body.mesh.vertices};
+    for (const garment::BodyPoseSpec& pose : spec.poses) {
+      try {
+        poses.push_back(garment::load_body_pose(sketch.resolve(pose.mesh).string(), body).vertices);
+      } catch (const garment::BodyError& e) {
+        sketch.fail(pose.json_path + "/mesh",
+                    fmt::format("the pose '{}' cannot be used: {}", pose.mesh, e.what()));
+      }
+      times.push_back(pose.time);
+    }
+    try {
+      return sim::PoseSequence(body.mesh.faces, std::move(times), std::move(poses));
+    } catch (const sim::InvalidBodyMotionError& e) {
+      sketch.fail("/body/motion/poses", e.what());
+    }
+  }
   sim::ArmLoweringOptions options;
   options.angle_degrees = spec.degrees;
   options.start = spec.start;
   options.duration = spec.duration;
-  return sim::make_arm_lowering(body, options);
+  return sim::make_arm_lowering(body.mesh, options);
 }
 
 ClothScene build_cloth_scene(const garment::Sketch& sketch) {
@@ -192,8 +212,7 @@ ClothScene build_cloth_scene(const garment::Sketch& sketch) {
   } else {
     build_garment_scene(sketch, scene);
   }
-  if (scene.body && sketch.body.motion)
-    scene.body_motion = body_motion(*sketch.body.motion, scene.body->mesh);
+  if (scene.body && sketch.body.motion) scene.body_motion = body_motion(sketch, *scene.body);
   return scene;
 }
 

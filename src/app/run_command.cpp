@@ -321,12 +321,16 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   out["adaptive"] = adaptive_json;
   out["images"] = images;
   out["frames"] = frames.size();
-  out["body_motion"] = sketch.body.motion && scene.body_motion
-                           ? nlohmann::json{{"type", sketch.body.motion->type},
-                                            {"degrees", sketch.body.motion->degrees},
-                                            {"start", scene.body_motion->start_time()},
-                                            {"end", scene.body_motion->end_time()}}
-                           : nlohmann::json(nullptr);
+  out["body_motion"] = nullptr;
+  if (sketch.body.motion && scene.body_motion) {
+    out["body_motion"] = {{"type", sketch.body.motion->type},
+                          {"start", scene.body_motion->start_time()},
+                          {"end", scene.body_motion->end_time()}};
+    if (sketch.body.motion->type == "poses")
+      out["body_motion"]["poses"] = sketch.body.motion->poses.size();
+    else
+      out["body_motion"]["degrees"] = sketch.body.motion->degrees;
+  }
   // Adaptivity (estimates, splits, merges, model rebuilds) next to the simulator's split.
   out["timing_s"]["adaptivity"] =
       adaptive_json.is_null() ? 0.0 : adaptive_json["adaptivity_s"].get<double>();

@@ -140,6 +140,75 @@ TEST(RunCommand, PinnedGarmentDrapesWithImages) {
   EXPECT_TRUE(report["nan_free"].get<bool>());
 }
 
+// A box body as an OBJ file: 0.4 m square, `top` m high (a table, a dress form's stand).
+// `faces_flipped` writes the same box with its triangles' corners in another order.
+void write_box_obj(const fs::path& path, double top, bool faces_flipped = false) {
+  std::ofstream out(path);
+  for (int i = 0; i < 8; ++i)
+    out << "v " << (i & 1 ? 0.2 : -0.2) << ' ' << (i & 2 ? top : 0.0) << ' ' << (i & 4 ? 0.2 : -0.2)
+        << '\n';
+  const int faces[12][3] = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
+                            {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+  for (const auto& f : faces)
+    if (faces_flipped)
+      out << "f " << f[1] + 1 << ' ' << f[2] + 1 << ' ' << f[0] + 1 << '\n';
+    else
+      out << "f " << f[0] + 1 << ' ' << f[1] + 1 << ' ' << f[2] + 1 << '\n';
+}
+
+// A sheet lying on a box whose top rises by 10 cm between 0.2 s and 0.6 s: the body's own mesh
+// is the pose at 0, another file of the same mesh the pose at 0.6 s ("motion": {"type":
+// "poses"}). The sheet is carried up and ends on the raised top, outside it.
+TEST(RunCommand, BodyPosesFromFilesMoveTheBody) {
+  const fs::path dir = fresh_dir("poses");
+  write_box_obj(dir / "box.obj", 0.9);
+  write_box_obj(dir / "box-raised.obj", 1.0);
+  nlohmann::json sketch = small_sheet();
+  sketch["sheet"] = {{"size", {0.3, 0.3}},
+                     {"resolution", {8, 8}},
+                     {"orientation", "horizontal"},
+                     {"centre", {0.0, 0.91, 0.0}}};
+  sketch["body"] = {{"mesh", "box.obj"},
+                    {"motion",
+                     {{"type", "poses"},
+                      {"poses", {{{"time", 0.2}, {"mesh", "box.obj"}},
+                                 {{"time", 0.6}, {"mesh", "box-raised.obj"}}}}}}};
+  sketch["simulate"] = {{"duration", 1.0}, {"stop_at_rest", false}};
+  const fs::path out = dir / "out";
+  const CommandResult r =
+      run_sketchdrape("-q run " + write_sketch(dir, sketch).string() + " -o " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json report = read_json(out / "report.json");
+  EXPECT_EQ(report["body_motion"]["type"], "poses");
+  EXPECT_EQ(report["body_motion"]["poses"], 2);
+  EXPECT_DOUBLE_EQ(report["body_motion"]["end"].get<double>(), 0.6);
+  EXPECT_EQ(report["penetrating_vertices_final"], 0);
+  // The middle of the sheet rests on the raised top (1.0 m) at the contact thickness.
+  std::ifstream obj(out / "drape.obj");
+  std::string tag;
+  double x = 0, y = 0, z = 0, middle_y = 0, nearest = 1e9;
+  while (obj >> tag) {
+    if (tag != "v") {
+      obj.ignore(1 << 20, '\n');
+      continue;
+    }
+    obj >> x >> y >> z;
+    if (x * x + z * z < nearest) nearest = x * x + z * z, middle_y = y;
+  }
+  EXPECT_NEAR(middle_y, 1.0 + 0.003, 2e-3);
+
+  // A pose that is not the body's mesh moved is refused at its path, before anything is written.
+  write_box_obj(dir / "box-other.obj", 1.0, /*faces_flipped=*/true);
+  sketch["body"]["motion"]["poses"][1]["mesh"] = "box-other.obj";
+  const fs::path bad = dir / "bad";
+  const CommandResult refused =
+      run_sketchdrape("run " + write_sketch(dir, sketch).string() + " -o " + bad.string());
+  EXPECT_EQ(refused.exit_code, 2) << refused.output;
+  EXPECT_NE(refused.output.find("/body/motion/poses/1/mesh"), std::string::npos) << refused.output;
+  EXPECT_NE(refused.output.find("is not the body's mesh moved"), std::string::npos) << refused.output;
+  EXPECT_FALSE(fs::exists(bad));
+}
+
 TEST(RunCommand, MistakesExitTwoAndWriteNothing) {
   struct Case {
     std::string name;

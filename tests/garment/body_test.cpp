@@ -94,6 +94,35 @@ TEST(Body, SmallObjIsCentredOnTheFloor) {
   EXPECT_TRUE(meshing::analyse_topology(body.mesh).closed());
 }
 
+// A pose is put in the frame of the rest body, not normalised again: a figure that raised an
+// arm is not re-centred or rescaled. 170 cm tall, standing 50 cm off the origin in the file.
+TEST(Body, PoseKeepsTheRestBodysFrame) {
+  const auto tetrahedron = [](double lean) {
+    return "v 50 0 0\nv 80 0 0\nv " + std::to_string(50 + lean) +
+           " 170 0\nv 50 0 20\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  };
+  const Body rest = load_body(write_temp("rest.obj", tetrahedron(0)));
+  const meshing::TriMesh pose = load_body_pose(write_temp("lean.obj", tetrahedron(30)), rest);
+  ASSERT_EQ(pose.vertex_count(), rest.mesh.vertex_count());
+  EXPECT_EQ(pose.faces, rest.mesh.faces);
+  // The apex moved 30 cm along x; everything else stayed where the rest body has it.
+  Eigen::Index apex = 0;
+  rest.mesh.vertices.col(1).maxCoeff(&apex);
+  for (Eigen::Index v = 0; v < pose.vertex_count(); ++v) {
+    const Eigen::RowVector3d moved = pose.vertices.row(v) - rest.mesh.vertices.row(v);
+    EXPECT_NEAR(moved.x(), v == apex ? 0.30 : 0.0, 1e-12) << v;
+    EXPECT_NEAR(moved.tail<2>().norm(), 0.0, 1e-12) << v;
+  }
+  // Another mesh is refused with a sentence.
+  try {
+    load_body_pose(write_temp("other.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), rest);
+    ADD_FAILURE() << "a different mesh was taken as a pose";
+  } catch (const BodyError& e) {
+    EXPECT_NE(std::string(e.what()).find("is not the body's mesh moved"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(Body, UnitsAreInferredFromHeight) {
   // 170 units tall reads as centimetres.
   const std::string obj = "v 0 0 0\nv 30 0 0\nv 0 170 0\nv 0 0 20\n"
