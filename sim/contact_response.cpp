@@ -169,7 +169,13 @@ std::vector<ContactResponse::CornerLift> ContactResponse::corner_lifts(
     if (!(weights > 0.0)) continue;
     for (int k = 0; k < 3; ++k) {
       if (is_pinned(t[k])) continue;
-      const double distance = piercing.barycentric[k] * deltas[p] / weights;
+      // At most 2δ: when the corners that carry the point are held (pinned, or with three
+      // directions constrained by a squeeze of contacts and piercings), the least motion of a
+      // free corner with a small share w_k is δ / w_k, unbounded (measured: a corner lifted by
+      // 1 m in the arms-lowering drape, a triangle stretched by 24,000 %). The rest of the lift
+      // waits for the next steps.
+      const double distance =
+          piercing.barycentric[k] * deltas[p] / std::max(weights, 0.5 * piercing.barycentric[k]);
       CornerLift& corner = lift[t[k]];
       // A vertex under two piercings takes the larger lift.
       if (corner.set && distance <= corner.distance) continue;

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -188,6 +189,46 @@ TEST(ContactResponsePiercing, PcgAndCholmodAgreeOnTheConeTip) {
   // sphere comparison in contact_simulation_test.cpp measured 1.2e-9 m), far below the
   // 1e-6 m a different set of constraints would show.
   EXPECT_LT(difference, 1e-6);
+}
+
+// A cone tip 5 mm through a cloth triangle whose two pinned corners carry 90 % of the point
+// over the tip: the least motion of the free corner that lifts the point is δ / w = 10 δ. After
+// the last re-solve (none allowed here) finish_step lifts the triangle directly; the free
+// corner moves at most 2 δ, the rest of the lift waits for the next steps. Uncapped it moved
+// 65 mm (in the arms-lowering drape such a lift sent a corner 1 m away).
+TEST(ContactResponsePiercing, LiftOfATriangleHeldByTwoCornersIsBounded) {
+  const Sheet s = horizontal_sheet(1, 0.1, {0.0, 0.0, 0.0});
+  const std::array<int, 3> t = s.model.triangles[0].vertices;
+  Eigen::VectorXd x = flatten_positions(s.scene.input.rest_positions);
+  const Vector3d a = x.segment<3>(3 * t[0]), b = x.segment<3>(3 * t[1]), c = x.segment<3>(3 * t[2]);
+  const double height = 0.005;
+  const Vector3d tip = 0.45 * a + 0.45 * b + 0.1 * c + Vector3d(0.0, height, 0.0);
+  const meshing::TriMesh cone = testing::make_cone(0.1, 0.2, 24, tip - Vector3d(0.0, 0.2, 0.0));
+
+  ContactSettings settings = piercing_settings(true).contact;
+  settings.max_resolves = 0;
+  ContactResponse response(cone, settings);
+  response.set_cloth_triangles(s.model);
+  response.reset_cloth(x, s.model.mass, 9.81);
+  const int n = s.model.vertex_count;
+  ConstraintFilter filter(n);
+  filter.pin(t[0], Vector3d::Zero());
+  filter.pin(t[1], Vector3d::Zero());
+  const double beta = 1.0 / 60.0;
+  Eigen::VectorXd y, v = Eigen::VectorXd::Zero(3 * n);
+  std::vector<VertexDamping> friction;
+  response.constrain_start(x, v, beta, filter, y, friction);
+  // The solve left the cloth where it was (the tip still through), and no re-solve is allowed.
+  ASSERT_EQ(response.constrain_deep(x, x, x, beta, filter, y), 0);
+  const Eigen::VectorXd before = x;
+  response.finish_step(x, v);
+  const double delta = height + 0.5 * settings.thickness;  // lift to the clearance
+  const double moved = (x - before).segment<3>(3 * t[2]).norm();
+  std::printf("free corner lifted %.2f mm (δ %.2f mm)\n", 1e3 * moved, 1e3 * delta);
+  EXPECT_GT(moved, 0.5 * delta);
+  EXPECT_LE(moved, 2.0 * delta + 1e-12);
+  EXPECT_EQ((x - before).segment<3>(3 * t[0]).norm(), 0.0);
+  EXPECT_EQ((x - before).segment<3>(3 * t[1]).norm(), 0.0);
 }
 
 }  // namespace
