@@ -323,15 +323,14 @@ meshing::TriMesh load_body_pose(const std::string& path, const Body& rest) {
   meshing::TriMesh mesh = read_body_mesh(path, scratch);
   // The same mesh moved: the same triangles over the same vertices, or the poses cannot be
   // interpolated vertex by vertex.
-  if (mesh.vertex_count() != rest.mesh.vertex_count() || mesh.faces != rest.mesh.faces)
+  const bool same_counts = mesh.vertex_count() == rest.mesh.vertex_count() &&
+                           mesh.face_count() == rest.mesh.face_count();
+  if (!same_counts || mesh.faces != rest.mesh.faces)
     throw BodyError(fmt::format(
         "'{}' is not the body's mesh moved: it has {} vertices and {} triangles, the "
         "body {} and {}{} (export every pose from the same rig, without remeshing)",
         path, mesh.vertex_count(), mesh.face_count(), rest.mesh.vertex_count(),
-        rest.mesh.face_count(),
-        mesh.vertex_count() == rest.mesh.vertex_count() && mesh.face_count() == rest.mesh.face_count()
-            ? ", but its triangles join other vertices"
-            : ""));
+        rest.mesh.face_count(), same_counts ? ", but its triangles join other vertices" : ""));
   const RawBodyInfo& raw = rest.raw;
   mesh.vertices = (mesh.vertices * frame_rotation(raw.up, raw.facing).transpose()) * raw.scale;
   mesh.vertices.rowwise() += raw.shift.transpose();

@@ -258,7 +258,8 @@ void parse_body_poses(const Reader& r, const json& m, const std::string& mpath,
     r.require_object(p, ppath, "a pose");
     r.check_keys(p, ppath, {"time", "mesh"});
     if (!p.contains("time") || !p.contains("mesh"))
-      r.fail(ppath, "a pose needs a \"time\" (seconds) and a \"mesh\" (the body file in that pose)");
+      r.fail(ppath,
+             "a pose needs a \"time\" (seconds) and a \"mesh\" (the body file in that pose)");
     BodyPoseSpec pose;
     pose.json_path = ppath;
     pose.time = r.positive(p["time"], ppath + "/time");

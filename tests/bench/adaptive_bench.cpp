@@ -11,8 +11,9 @@
 //                                             level-8 reference; writes DIR/<scene>_<run>.csv
 //                                             time series and DIR/summary.csv, prints the
 //                                             summary. --scene: one scene (three_corner,
-//                                             two_corner, tablecloth, sphere); --only: one run (e.g.
-//                                             adaptive_2mm) without the reference, to profile.
+//                                             two_corner, tablecloth, sphere); --only: one
+//                                             run (e.g. adaptive_2mm) without the reference,
+//                                             to profile.
 #include <benchmark/benchmark.h>
 
 #include <chrono>
@@ -278,7 +279,8 @@ int run_study(const std::string& dir, bool quick, const std::string& only_scene,
       char name[64];
       std::snprintf(name, sizeof name, "adaptive_%gmm", threshold * 1e3);
       if (wanted(name))
-        runs.push_back(run_case(dir, scene, name, spec, 0, adaptive_settings(threshold), points, every));
+        runs.push_back(
+            run_case(dir, scene, name, spec, 0, adaptive_settings(threshold), points, every));
     }
     if (runs.empty()) continue;
     // The reference last, so that a profiled run is not preceded by it; with --only there is

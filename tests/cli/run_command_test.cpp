@@ -205,7 +205,8 @@ TEST(RunCommand, BodyPosesFromFilesMoveTheBody) {
       run_sketchdrape("run " + write_sketch(dir, sketch).string() + " -o " + bad.string());
   EXPECT_EQ(refused.exit_code, 2) << refused.output;
   EXPECT_NE(refused.output.find("/body/motion/poses/1/mesh"), std::string::npos) << refused.output;
-  EXPECT_NE(refused.output.find("is not the body's mesh moved"), std::string::npos) << refused.output;
+  EXPECT_NE(refused.output.find("is not the body's mesh moved"), std::string::npos)
+      << refused.output;
   EXPECT_FALSE(fs::exists(bad));
 }
 

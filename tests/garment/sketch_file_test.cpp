@@ -96,23 +96,29 @@ TEST(SketchFile, SheetMistakesNameTheirPath) {
     return error_of(R"({"body": {"mesh": "b.obj", "motion": )" + motion + "}}");
   };
   EXPECT_EQ(poses(R"({"type": "poses"})").rfind("/body/motion: a \"poses\" motion needs", 0), 0u);
-  EXPECT_EQ(poses(R"({"type": "poses", "poses": []})").rfind("/body/motion/poses: expected a list", 0),
-            0u);
+  EXPECT_EQ(
+      poses(R"({"type": "poses", "poses": []})").rfind("/body/motion/poses: expected a list", 0),
+      0u);
   EXPECT_EQ(poses(R"({"type": "poses", "poses": [{"time": 0, "mesh": "p.obj"}]})")
                 .rfind("/body/motion/poses/0/time", 0),
             0u);
-  EXPECT_EQ(poses(R"({"type": "poses", "poses": [{"time": 1}]})").rfind("/body/motion/poses/0: a pose needs", 0),
+  EXPECT_EQ(poses(R"({"type": "poses", "poses": [{"time": 1}]})")
+                .rfind("/body/motion/poses/0: a pose needs", 0),
             0u);
-  EXPECT_EQ(poses(R"({"type": "poses", "poses": [{"time": 1, "mesh": "p.obj"}, {"time": 1, "mesh": "q.obj"}]})")
+  EXPECT_EQ(poses(R"({"type": "poses", "poses": [{"time": 1, "mesh": "p.obj"},
+                                                  {"time": 1, "mesh": "q.obj"}]})")
                 .rfind("/body/motion/poses/1/time: the poses must come in time order", 0),
             0u);
   EXPECT_EQ(poses(R"({"type": "poses", "poses": [{"time": 1, "mesh": "p.obj"}], "degrees": 5})")
                 .rfind("/body/motion/degrees", 0),
             0u);
-  EXPECT_EQ(error_of(R"({"body": {"motion": {"type": "poses", "poses": [{"time": 1, "mesh": "p.obj"}]}}})")
+  EXPECT_EQ(error_of(R"({"body": {"motion": {"type": "poses",
+                                               "poses": [{"time": 1, "mesh": "p.obj"}]}}})")
                 .rfind("/body/motion/poses: the poses must be meshes of the same body", 0),
             0u);
-  EXPECT_EQ(poses(R"({"type": "walk"})").rfind("/body/motion/type: 'walk' is not a body motion", 0), 0u);
+  EXPECT_EQ(
+      poses(R"({"type": "walk"})").rfind("/body/motion/type: 'walk' is not a body motion", 0),
+      0u);
 }
 
 TEST(SketchFile, ReadsEverySection) {
@@ -148,7 +154,8 @@ TEST(SketchFile, ReadsEverySection) {
   EXPECT_EQ(posed.body.motion->type, "poses");
   ASSERT_EQ(posed.body.motion->poses.size(), 2u);
   EXPECT_DOUBLE_EQ(posed.body.motion->poses[1].time, 1.5);
-  EXPECT_EQ(posed.resolve(posed.body.motion->poses[1].mesh), std::filesystem::path("/base/down.obj"));
+  EXPECT_EQ(posed.resolve(posed.body.motion->poses[1].mesh),
+            std::filesystem::path("/base/down.obj"));
   EXPECT_EQ(posed.body.motion->poses[1].json_path, "/body/motion/poses/1");
   EXPECT_EQ(s.curves[0].view.kind, ViewKind::kCamera);
   EXPECT_DOUBLE_EQ(s.curves[0].view.camera.fov_degrees, 30);
