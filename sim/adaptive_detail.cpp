@@ -106,6 +106,7 @@ struct AdaptiveCloth::Transfer {
   std::vector<int> pin_of;           // vertex id -> index into pins, or -1
   std::vector<VertexOrigin> origin;  // vertex id -> where it comes from (ids before the batch)
   std::vector<char> touched_blocks;  // made, completed or merged in this batch
+  std::vector<char> made_triangles;  // triangle ids made or removed in this batch
   double now = 0.0;
   int moved_off_body = 0;  // split vertices moved out to the contact thickness
   bool changed = false;
@@ -319,6 +320,10 @@ void AdaptiveCloth::apply(const BlockChange& change, Transfer& state) {
   };
   grow(state.birth, mesh_.triangle_capacity(), 0.0);
   grow(state.touched_blocks, mesh_.block_capacity(), char{0});
+  grow(state.made_triangles, mesh_.triangle_capacity(), char{0});
+  // Parents and children both: a removed slot may be reused by a later change of the batch.
+  for (TriangleId t : {change.a1, change.a2, change.a10, change.a11, change.a20, change.a21})
+    if (t.valid()) state.made_triangles[static_cast<std::size_t>(t.value())] = 1;
   grow(state.pin_of, mesh_.vertex_capacity(), -1);
   grow(state.origin, mesh_.vertex_capacity(), VertexOrigin{});
   state.touched_blocks[static_cast<std::size_t>(change.block.value())] = 1;
@@ -463,6 +468,7 @@ void AdaptiveCloth::clear_body() {
 double AdaptiveCloth::rebuild(Transfer& state, const SimulationSettings* first_settings) {
   const auto start = Clock::now();
   const bool first = simulation_ == nullptr;
+  ClothModelReuse reuse;
   if (!first) {
     const meshing::Mesh48Remap remap = mesh_.compact();
     state.x = meshing::remap_rows(state.x, remap.vertices, remap.vertex_count);
@@ -478,6 +484,17 @@ double AdaptiveCloth::rebuild(Transfer& state, const SimulationSettings* first_s
       if (remap.vertices[slot] >= 0)
         origin[static_cast<std::size_t>(remap.vertices[slot])] = state.origin[slot];
     state.origin = std::move(origin);
+    // What the model can keep: particles that were there before, triangles no change made.
+    reuse.previous_vertex.resize(static_cast<std::size_t>(remap.vertex_count));
+    for (std::size_t i = 0; i < reuse.previous_vertex.size(); ++i) {
+      const VertexOrigin& from = state.origin[i];
+      reuse.previous_vertex[i] = from.a >= 0 && from.a == from.b ? from.a : -1;
+    }
+    reuse.previous_triangle.resize(static_cast<std::size_t>(remap.triangle_count));
+    for (std::size_t t = 0; t < remap.triangles.size(); ++t)
+      if (const int row = remap.triangles[t]; row >= 0)
+        reuse.previous_triangle[static_cast<std::size_t>(row)] =
+            t < state.made_triangles.size() && state.made_triangles[t] ? -1 : static_cast<int>(t);
     const Eigen::MatrixX4i old_edges = arrays_.interior_edges;
     arrays_ = mesh_.arrays();
     carry_body_sag_memory(old_edges, state.origin);
@@ -498,12 +515,19 @@ double AdaptiveCloth::rebuild(Transfer& state, const SimulationSettings* first_s
       input.warp.row(f) = material_.source_warp.row(source);
     }
   }
-  ClothModel model = build_cloth_model(input, material_.fabric, material_.model_options);
+  Eigen::VectorXd ease_scale;  // per face, empty without ease
   if (material_.source_ease.size() > 0) {
-    Eigen::VectorXd scale(arrays_.faces.rows());
-    for (Eigen::Index f = 0; f < scale.size(); ++f)
-      scale(f) = ease(arrays_.triangle_ids[static_cast<std::size_t>(f)]);
-    scale_rest_shapes(model, scale);
+    ease_scale.resize(arrays_.faces.rows());
+    for (Eigen::Index f = 0; f < ease_scale.size(); ++f)
+      ease_scale(f) = ease(arrays_.triangle_ids[static_cast<std::size_t>(f)]);
+  }
+  ClothModel model;
+  if (first) {
+    model = build_cloth_model(input, material_.fabric, material_.model_options);
+    if (ease_scale.size() > 0) scale_rest_shapes(model, ease_scale);
+  } else {
+    model = update_cloth_model(simulation_->model(), reuse, input, ease_scale,
+                               material_.model_options);
   }
   if (first) {
     state.m = model.mass;

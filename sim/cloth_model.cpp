@@ -57,6 +57,167 @@ void check_input(const ClothInput& input) {
     }
 }
 
+double rest_extent(const Eigen::MatrixX3d& rest) {
+  const double extent = (rest.colwise().maxCoeff() - rest.colwise().minCoeff()).norm();
+  return extent > 0.0 ? extent : 1.0;
+}
+
+// The rest area of triangle (v0, v1, v2) before any scale, as make_triangle computes it.
+double unscaled_rest_area(const Eigen::MatrixX3d& rest, const std::array<int, 3>& v) {
+  const Vector3d p0 = rest.row(v[0]);
+  return 0.5 * (Vector3d(rest.row(v[1])) - p0).cross(Vector3d(rest.row(v[2])) - p0).norm();
+}
+
+// Triangle f flattened in its own (warp, weft) frame; blocks are left for the pattern.
+TriangleElement make_triangle(const ClothInput& input, Eigen::Index f, double extent) {
+  const Eigen::MatrixX3d& rest = input.rest_positions;
+  TriangleElement t;
+  for (int k = 0; k < 3; ++k) t.vertices[k] = input.triangles(f, k);
+  const Vector3d p0 = rest.row(t.vertices[0]);
+  const Vector3d p1 = rest.row(t.vertices[1]);
+  const Vector3d p2 = rest.row(t.vertices[2]);
+  const Vector3d cross = (p1 - p0).cross(p2 - p0);
+  t.rest_area = 0.5 * cross.norm();
+  if (!(t.rest_area > 1e-14 * extent * extent) || t.vertices[0] == t.vertices[1] ||
+      t.vertices[1] == t.vertices[2] || t.vertices[0] == t.vertices[2])
+    throw InvalidClothError(triangle_name(f) + " has (nearly) zero rest area");
+  const Vector3d normal = cross.normalized();
+  const Vector3d warp = triangle_warp(input, f, normal);
+  const Vector3d weft = normal.cross(warp);
+  // [w_u w_v] = [x1−x0, x2−x0]·D⁻¹, D = [[Δu1, Δu2], [Δv1, Δv2]] (rest coordinates).
+  Eigen::Matrix2d d;
+  d << (p1 - p0).dot(warp), (p2 - p0).dot(warp), (p1 - p0).dot(weft), (p2 - p0).dot(weft);
+  const Eigen::Matrix2d inverse = d.inverse();
+  t.du = Vector3d(-inverse(0, 0) - inverse(1, 0), inverse(0, 0), inverse(1, 0));
+  t.dv = Vector3d(-inverse(0, 1) - inverse(1, 1), inverse(0, 1), inverse(1, 1));
+  return t;
+}
+
+void scale_triangle(TriangleElement& element, double e, std::size_t t) {
+  if (!(e > 0.0) || !std::isfinite(e))
+    throw InvalidClothError("rest-shape scale " + std::to_string(e) + " of triangle " +
+                            std::to_string(t) + " is not positive");
+  element.du /= e;
+  element.dv /= e;
+  element.rest_area *= e * e;
+}
+
+// The hinge on the edge that starts at corner `first_corner` of triangle `first` (the one of
+// the two with the lower row); `second_corner` is where the edge starts in `second`.
+// `areas`: the sum of the two triangles' unscaled rest areas.
+HingeElement make_hinge(const Eigen::MatrixX3d& rest, const std::array<int, 3>& first,
+                        int first_corner, const std::array<int, 3>& second, int second_corner,
+                        double areas, const ClothModelOptions& options) {
+  HingeElement h;
+  h.vertices[0] = first[first_corner];
+  h.vertices[1] = first[(first_corner + 1) % 3];
+  h.vertices[2] = first[(first_corner + 2) % 3];
+  h.vertices[3] = second[(second_corner + 2) % 3];
+  const Vector3d p0 = rest.row(h.vertices[0]);
+  const Vector3d p1 = rest.row(h.vertices[1]);
+  h.weight = (p1 - p0).squaredNorm() / areas;
+  if (options.bend_rest == BendRestShape::designed)
+    h.rest_angle = dihedral_angle(p0, p1, rest.row(h.vertices[2]).transpose(),
+                                  rest.row(h.vertices[3]).transpose());
+  return h;
+}
+
+// The vertices adjacent to each vertex (itself included) through triangles and hinges, as one
+// flat array: vertex i's run starts at start[i], its first size[i] entries are the distinct
+// neighbours in increasing order (the rest is room left by duplicates).
+struct Neighbours {
+  std::vector<int> start, list, size;
+
+  // offset(i,j) of BlockPattern: where block (i,j) starts in row i's columns.
+  int offset(int i, int j) const {
+    const auto first = list.begin() + start[static_cast<std::size_t>(i)];
+    return 3 * static_cast<int>(std::lower_bound(first, first + size[static_cast<std::size_t>(i)],
+                                                 j) -
+                                first);
+  }
+  void sort_run(int i) {
+    const auto first = list.begin() + start[static_cast<std::size_t>(i)];
+    const auto last = list.begin() + start[static_cast<std::size_t>(i) + 1];
+    std::sort(first, last);
+    size[static_cast<std::size_t>(i)] = static_cast<int>(std::unique(first, last) - first);
+  }
+};
+
+// Room in vertex runs for every element's entries: 1 for itself, 2 per triangle, 3 per hinge.
+std::vector<int> run_starts(int n, const std::vector<TriangleElement>& triangles,
+                            const std::vector<HingeElement>& hinges) {
+  std::vector<int> start(n + 1, 0);
+  for (int i = 0; i < n; ++i) start[i + 1] = 1;  // itself
+  for (const TriangleElement& t : triangles)
+    for (int v : t.vertices) start[v + 1] += 2;
+  for (const HingeElement& h : hinges)
+    for (int v : h.vertices) start[v + 1] += 3;
+  for (int i = 0; i < n; ++i) start[i + 1] += start[i];
+  return start;
+}
+
+// Fills the runs of the vertices with wanted[i] (every vertex when empty) from the elements and
+// sorts them.
+void collect_neighbours(Neighbours& neighbours, const std::vector<TriangleElement>& triangles,
+                        const std::vector<HingeElement>& hinges, const std::vector<char>& wanted) {
+  const int n = static_cast<int>(neighbours.size.size());
+  const auto want = [&](int v) { return wanted.empty() || wanted[static_cast<std::size_t>(v)]; };
+  std::vector<int> fill(neighbours.start.begin(), neighbours.start.end() - 1);
+  for (int i = 0; i < n; ++i)
+    if (want(i)) neighbours.list[static_cast<std::size_t>(fill[i]++)] = i;
+  const auto connect = [&](const int* vertices, int count) {
+    for (int k = 0; k < count; ++k) {
+      if (!want(vertices[k])) continue;
+      for (int l = 0; l < count; ++l)
+        if (k != l) neighbours.list[static_cast<std::size_t>(fill[vertices[k]]++)] = vertices[l];
+    }
+  };
+  for (const TriangleElement& t : triangles) connect(t.vertices.data(), 3);
+  for (const HingeElement& h : hinges) connect(h.vertices.data(), 4);
+  for (int i = 0; i < n; ++i)
+    if (want(i)) neighbours.sort_run(i);
+}
+
+// The pattern's matrix: rows 3i..3i+2 hold the 3×3 blocks of vertex i's neighbours.
+SparseMatrixR zero_pattern_matrix(const Neighbours& neighbours) {
+  const int n = static_cast<int>(neighbours.size.size());
+  std::vector<int> outer(3 * n + 1, 0);
+  std::vector<int> inner;
+  inner.reserve(static_cast<std::size_t>(9 * neighbours.start[static_cast<std::size_t>(n)]));
+  for (int i = 0; i < n; ++i) {
+    const int* run = neighbours.list.data() + neighbours.start[static_cast<std::size_t>(i)];
+    for (int a = 0; a < 3; ++a) {
+      for (int m = 0; m < neighbours.size[static_cast<std::size_t>(i)]; ++m)
+        for (int b = 0; b < 3; ++b) inner.push_back(3 * run[m] + b);
+      outer[3 * i + a + 1] = static_cast<int>(inner.size());
+    }
+  }
+  const std::vector<double> zeros(inner.size(), 0.0);
+  return Eigen::Map<const SparseMatrixR>(3 * n, 3 * n, static_cast<int>(inner.size()),
+                                         outer.data(), inner.data(), zeros.data());
+}
+
+// The elements' block offsets and the diagonal offsets of the rows with wanted[i] (every row
+// when empty).
+void set_block_offsets(ClothModel& model, const Neighbours& neighbours,
+                       const std::vector<char>& wanted) {
+  const auto want = [&](int v) { return wanted.empty() || wanted[static_cast<std::size_t>(v)]; };
+  model.pattern.diagonal_offsets.resize(static_cast<std::size_t>(model.vertex_count));
+  for (int i = 0; i < model.vertex_count; ++i)
+    if (want(i))
+      model.pattern.diagonal_offsets[static_cast<std::size_t>(i)] = neighbours.offset(i, i);
+  for (TriangleElement& t : model.triangles)
+    for (int k = 0; k < 3; ++k)
+      if (want(t.vertices[k]))
+        for (int l = 0; l < 3; ++l)
+          t.blocks[3 * k + l] = neighbours.offset(t.vertices[k], t.vertices[l]);
+  for (HingeElement& h : model.hinges)
+    for (int k = 0; k < 4; ++k)
+      if (want(h.vertices[k]))
+        for (int l = 0; l < 4; ++l)
+          h.blocks[4 * k + l] = neighbours.offset(h.vertices[k], h.vertices[l]);
+}
+
 }  // namespace
 
 void scale_rest_shapes(ClothModel& model, const Eigen::VectorXd& scale) {
@@ -67,14 +228,8 @@ void scale_rest_shapes(ClothModel& model, const Eigen::VectorXd& scale) {
   model.mass.setZero();
   model.vertex_area.setZero();
   for (std::size_t t = 0; t < model.triangles.size(); ++t) {
-    const double e = scale(static_cast<Eigen::Index>(t));
-    if (!(e > 0.0) || !std::isfinite(e))
-      throw InvalidClothError("rest-shape scale " + std::to_string(e) + " of triangle " +
-                              std::to_string(t) + " is not positive");
     TriangleElement& element = model.triangles[t];
-    element.du /= e;
-    element.dv /= e;
-    element.rest_area *= e * e;
+    scale_triangle(element, scale(static_cast<Eigen::Index>(t)), t);
     for (int v : element.vertices) {
       model.vertex_area[v] += element.rest_area / 3.0;
       model.mass[v] += model.fabric.area_density * element.rest_area / 3.0;
@@ -105,31 +260,12 @@ ClothModel build_cloth_model(const ClothInput& input, const FabricParameters& fa
   model.mass = Eigen::VectorXd::Zero(n);
   model.vertex_area = Eigen::VectorXd::Zero(n);
   const Eigen::MatrixX3d& rest = input.rest_positions;
-  double extent = (rest.colwise().maxCoeff() - rest.colwise().minCoeff()).norm();
-  if (extent <= 0.0) extent = 1.0;
+  const double extent = rest_extent(rest);
 
-  // Triangles: flatten each rest triangle in its own (warp, weft) frame.
   model.triangles.resize(input.triangles.rows());
   for (Eigen::Index f = 0; f < input.triangles.rows(); ++f) {
     TriangleElement& t = model.triangles[f];
-    for (int k = 0; k < 3; ++k) t.vertices[k] = input.triangles(f, k);
-    const Vector3d p0 = rest.row(t.vertices[0]);
-    const Vector3d p1 = rest.row(t.vertices[1]);
-    const Vector3d p2 = rest.row(t.vertices[2]);
-    const Vector3d cross = (p1 - p0).cross(p2 - p0);
-    t.rest_area = 0.5 * cross.norm();
-    if (!(t.rest_area > 1e-14 * extent * extent) || t.vertices[0] == t.vertices[1] ||
-        t.vertices[1] == t.vertices[2] || t.vertices[0] == t.vertices[2])
-      throw InvalidClothError(triangle_name(f) + " has (nearly) zero rest area");
-    const Vector3d normal = cross.normalized();
-    const Vector3d warp = triangle_warp(input, f, normal);
-    const Vector3d weft = normal.cross(warp);
-    // [w_u w_v] = [x1−x0, x2−x0]·D⁻¹, D = [[Δu1, Δu2], [Δv1, Δv2]] (rest coordinates).
-    Eigen::Matrix2d d;
-    d << (p1 - p0).dot(warp), (p2 - p0).dot(warp), (p1 - p0).dot(weft), (p2 - p0).dot(weft);
-    const Eigen::Matrix2d inverse = d.inverse();
-    t.du = Vector3d(-inverse(0, 0) - inverse(1, 0), inverse(0, 0), inverse(1, 0));
-    t.dv = Vector3d(-inverse(0, 1) - inverse(1, 1), inverse(0, 1), inverse(1, 1));
+    t = make_triangle(input, f, extent);
     for (int k = 0; k < 3; ++k) {
       model.vertex_area[t.vertices[k]] += t.rest_area / 3.0;
       model.mass[t.vertices[k]] += fabric.area_density * t.rest_area / 3.0;
@@ -168,20 +304,10 @@ ClothModel build_cloth_model(const ClothInput& input, const FabricParameters& fa
       ++non_manifold;
       continue;
     }
-    const auto& first = model.triangles[e0.face];
-    const auto& second = model.triangles[e1.face];
-    HingeElement h;
-    h.vertices[0] = first.vertices[e0.corner];
-    h.vertices[1] = first.vertices[(e0.corner + 1) % 3];
-    h.vertices[2] = first.vertices[(e0.corner + 2) % 3];
-    h.vertices[3] = second.vertices[(e1.corner + 2) % 3];
-    const Vector3d p0 = rest.row(h.vertices[0]);
-    const Vector3d p1 = rest.row(h.vertices[1]);
-    h.weight = (p1 - p0).squaredNorm() / (first.rest_area + second.rest_area);
-    if (options.bend_rest == BendRestShape::designed)
-      h.rest_angle = dihedral_angle(p0, p1, rest.row(h.vertices[2]).transpose(),
-                                    rest.row(h.vertices[3]).transpose());
-    model.hinges.push_back(h);
+    const TriangleElement& first = model.triangles[e0.face];
+    const TriangleElement& second = model.triangles[e1.face];
+    model.hinges.push_back(make_hinge(rest, first.vertices, e0.corner, second.vertices,
+                                      e1.corner, first.rest_area + second.rest_area, options));
   }
   if (non_manifold > 0)
     spdlog::warn("cloth mesh: {} non-manifold edges get no bending stiffness", non_manifold);
@@ -189,54 +315,199 @@ ClothModel build_cloth_model(const ClothInput& input, const FabricParameters& fa
   // Block sparsity pattern: vertex adjacency through triangles and hinges, as one flat array
   // (CSR by vertex: room for every element's entries, then each vertex's run sorted and
   // deduplicated in place).
-  std::vector<int> start(n + 1, 0);
-  for (int i = 0; i < n; ++i) start[i + 1] = 1;  // itself
-  for (const TriangleElement& t : model.triangles)
-    for (int v : t.vertices) start[v + 1] += 2;
-  for (const HingeElement& h : model.hinges)
-    for (int v : h.vertices) start[v + 1] += 3;
-  for (int i = 0; i < n; ++i) start[i + 1] += start[i];
-  std::vector<int> fill(start.begin(), start.end() - 1);
-  std::vector<int> neighbours(static_cast<std::size_t>(start[n]));
-  for (int i = 0; i < n; ++i) neighbours[fill[i]++] = i;
-  const auto connect = [&](const int* vertices, int count) {
-    for (int k = 0; k < count; ++k)
-      for (int l = 0; l < count; ++l)
-        if (k != l) neighbours[fill[vertices[k]]++] = vertices[l];
+  Neighbours neighbours;
+  neighbours.start = run_starts(n, model.triangles, model.hinges);
+  neighbours.list.resize(static_cast<std::size_t>(neighbours.start[n]));
+  neighbours.size.resize(n);
+  collect_neighbours(neighbours, model.triangles, model.hinges, {});
+  model.pattern.zero_matrix = zero_pattern_matrix(neighbours);
+  set_block_offsets(model, neighbours, {});
+  return model;
+}
+
+ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse& reuse,
+                              const ClothInput& input, const Eigen::VectorXd& scale,
+                              const ClothModelOptions& options) {
+  check_input(input);
+  const int n = static_cast<int>(input.rest_positions.rows());
+  const int face_count = static_cast<int>(input.triangles.rows());
+  if (static_cast<int>(reuse.previous_vertex.size()) != n ||
+      static_cast<int>(reuse.previous_triangle.size()) != face_count ||
+      (scale.size() != 0 && scale.size() != face_count))
+    throw InvalidClothError("the reuse map and the scale must have a row per vertex (" +
+                            std::to_string(n) + ") and per triangle (" +
+                            std::to_string(face_count) + ")");
+  const Eigen::MatrixX3d& rest = input.rest_positions;
+  const double extent = rest_extent(rest);
+  ClothModel model;
+  model.fabric = previous.fabric;
+  model.vertex_count = n;
+  model.mass = Eigen::VectorXd::Zero(n);
+  model.vertex_area = Eigen::VectorXd::Zero(n);
+
+  std::vector<int> next_vertex(static_cast<std::size_t>(previous.vertex_count), -1);
+  for (int i = 0; i < n; ++i)
+    if (const int p = reuse.previous_vertex[static_cast<std::size_t>(i)]; p >= 0)
+      next_vertex.at(static_cast<std::size_t>(p)) = i;
+  const auto renumber = [&](int p) {
+    const int i = next_vertex[static_cast<std::size_t>(p)];
+    if (i < 0)
+      throw InvalidClothError("a kept element uses vertex " + std::to_string(p) +
+                              " that the reuse map drops");
+    return i;
   };
-  for (const TriangleElement& t : model.triangles) connect(t.vertices.data(), 3);
-  for (const HingeElement& h : model.hinges) connect(h.vertices.data(), 4);
-  std::vector<int> size(n);  // distinct neighbours of each vertex, at the start of its run
-  for (int i = 0; i < n; ++i) {
-    const auto first = neighbours.begin() + start[i];
-    std::sort(first, neighbours.begin() + start[i + 1]);
-    size[i] = static_cast<int>(std::unique(first, neighbours.begin() + start[i + 1]) - first);
-  }
-  std::vector<int> outer(3 * n + 1, 0);
-  std::vector<int> inner;
-  inner.reserve(static_cast<std::size_t>(9 * start[n]));
-  for (int i = 0; i < n; ++i) {
-    for (int a = 0; a < 3; ++a) {
-      for (int m = 0; m < size[i]; ++m)
-        for (int b = 0; b < 3; ++b) inner.push_back(3 * neighbours[start[i] + m] + b);
-      outer[3 * i + a + 1] = static_cast<int>(inner.size());
+  // Every triangle the change removed has its three vertices marked here (previous rows). A
+  // triangle with an unmarked vertex was kept; a kept triangle with three marked vertices is
+  // treated as new, and so is every hinge on it, which keeps the test local and exact.
+  std::vector<char> kept(previous.triangles.size(), 0);
+  for (int p : reuse.previous_triangle)
+    if (p >= 0) kept.at(static_cast<std::size_t>(p)) = 1;
+  std::vector<char> around_removed(static_cast<std::size_t>(previous.vertex_count), 0);
+  for (std::size_t p = 0; p < previous.triangles.size(); ++p)
+    if (!kept[p])
+      for (int v : previous.triangles[p].vertices) around_removed[static_cast<std::size_t>(v)] = 1;
+  const auto all_marked = [&](int a, int b, int c) {
+    return around_removed[static_cast<std::size_t>(a)] &&
+           around_removed[static_cast<std::size_t>(b)] &&
+           around_removed[static_cast<std::size_t>(c)];
+  };
+
+  // Triangles: kept ones copied (already scaled), the others made and scaled. `changed_row`
+  // marks the vertices whose elements are not all kept: their pattern rows are rebuilt.
+  std::vector<char> new_face(static_cast<std::size_t>(face_count), 0);
+  std::vector<char> changed_row(static_cast<std::size_t>(n), 0);
+  for (std::size_t p = 0; p < next_vertex.size(); ++p)
+    if (around_removed[p] && next_vertex[p] >= 0)
+      changed_row[static_cast<std::size_t>(next_vertex[p])] = 1;
+  for (int i = 0; i < n; ++i)
+    if (reuse.previous_vertex[static_cast<std::size_t>(i)] < 0) changed_row[i] = 1;
+  model.triangles.resize(static_cast<std::size_t>(face_count));
+  for (int f = 0; f < face_count; ++f) {
+    TriangleElement& t = model.triangles[static_cast<std::size_t>(f)];
+    const int p = reuse.previous_triangle[static_cast<std::size_t>(f)];
+    if (p >= 0) {
+      t = previous.triangles[static_cast<std::size_t>(p)];
+      new_face[f] = all_marked(t.vertices[0], t.vertices[1], t.vertices[2]);
+      for (int k = 0; k < 3; ++k) {
+        t.vertices[k] = renumber(t.vertices[k]);
+        if (t.vertices[k] != input.triangles(f, k))
+          throw InvalidClothError(triangle_name(f) + " is not the kept triangle " +
+                                  std::to_string(p) + " of the reuse map");
+      }
+    } else {
+      t = make_triangle(input, f, extent);
+      if (scale.size() > 0) scale_triangle(t, scale(f), static_cast<std::size_t>(f));
+      new_face[f] = 1;
+    }
+    for (int k = 0; k < 3; ++k) {
+      if (new_face[f]) changed_row[static_cast<std::size_t>(t.vertices[k])] = 1;
+      model.vertex_area[t.vertices[k]] += t.rest_area / 3.0;
+      model.mass[t.vertices[k]] += model.fabric.area_density * t.rest_area / 3.0;
     }
   }
-  const std::vector<double> zeros(inner.size(), 0.0);
-  model.pattern.zero_matrix = Eigen::Map<const SparseMatrixR>(
-      3 * n, 3 * n, static_cast<int>(inner.size()), outer.data(), inner.data(), zeros.data());
-  const auto offset = [&](int i, int j) {
-    const auto first = neighbours.begin() + start[i];
-    return 3 * static_cast<int>(std::lower_bound(first, first + size[i], j) - first);
+
+  // Hinges between two kept triangles keep their order; the others are found from the faces
+  // around each vertex, sorted like build_cloth_model's (by lower, higher vertex) and merged in.
+  std::vector<HingeElement> kept_hinges;
+  kept_hinges.reserve(previous.hinges.size());
+  for (const HingeElement& old : previous.hinges) {
+    const auto& v = old.vertices;
+    if (all_marked(v[0], v[1], v[2]) || all_marked(v[1], v[0], v[3])) {
+      for (int p : v)
+        if (next_vertex[static_cast<std::size_t>(p)] >= 0)
+          changed_row[static_cast<std::size_t>(next_vertex[static_cast<std::size_t>(p)])] = 1;
+      continue;
+    }
+    HingeElement h = old;
+    for (int& vertex : h.vertices) vertex = renumber(vertex);
+    kept_hinges.push_back(h);
+  }
+  std::vector<int> face_start(static_cast<std::size_t>(n) + 1, 0);
+  for (int f = 0; f < face_count; ++f)
+    for (int k = 0; k < 3; ++k) ++face_start[static_cast<std::size_t>(input.triangles(f, k)) + 1];
+  for (int i = 0; i < n; ++i) face_start[i + 1] += face_start[i];
+  std::vector<int> faces_around(static_cast<std::size_t>(face_start[n]));
+  {
+    std::vector<int> fill(face_start.begin(), face_start.end() - 1);
+    for (int f = 0; f < face_count; ++f)
+      for (int k = 0; k < 3; ++k) faces_around[fill[input.triangles(f, k)]++] = f;
+  }
+  std::vector<HingeElement> made_hinges;
+  for (int f = 0; f < face_count; ++f) {
+    if (!new_face[f]) continue;
+    const std::array<int, 3>& fv = model.triangles[static_cast<std::size_t>(f)].vertices;
+    for (int k = 0; k < 3; ++k) {
+      const int a = fv[k], b = fv[(k + 1) % 3];
+      int other = -1, other_corner = -1, count = 0;
+      for (int m = face_start[a]; m < face_start[a + 1]; ++m) {
+        const int g = faces_around[static_cast<std::size_t>(m)];
+        if (g == f) continue;
+        const std::array<int, 3>& gv = model.triangles[static_cast<std::size_t>(g)].vertices;
+        for (int j = 0; j < 3; ++j)
+          if (std::minmax(gv[j], gv[(j + 1) % 3]) == std::minmax(a, b)) {
+            other = g;
+            other_corner = j;
+            ++count;
+          }
+      }
+      // A boundary edge, a non-manifold one (no hinge, as in build_cloth_model), or a hinge
+      // made from the other face.
+      if (count != 1 || (new_face[other] && other < f)) continue;
+      const std::array<int, 3>& ov = model.triangles[static_cast<std::size_t>(other)].vertices;
+      const double areas = unscaled_rest_area(rest, fv) + unscaled_rest_area(rest, ov);
+      made_hinges.push_back(f < other
+                                ? make_hinge(rest, fv, k, ov, other_corner, areas, options)
+                                : make_hinge(rest, ov, other_corner, fv, k, areas, options));
+      for (int v : made_hinges.back().vertices) changed_row[static_cast<std::size_t>(v)] = 1;
+    }
+  }
+  const auto edge_key = [](const HingeElement& h) {
+    return std::minmax(h.vertices[0], h.vertices[1]);
   };
-  model.pattern.diagonal_offsets.resize(n);
-  for (int i = 0; i < n; ++i) model.pattern.diagonal_offsets[i] = offset(i, i);
-  for (TriangleElement& t : model.triangles)
-    for (int k = 0; k < 3; ++k)
-      for (int l = 0; l < 3; ++l) t.blocks[3 * k + l] = offset(t.vertices[k], t.vertices[l]);
-  for (HingeElement& h : model.hinges)
-    for (int k = 0; k < 4; ++k)
-      for (int l = 0; l < 4; ++l) h.blocks[4 * k + l] = offset(h.vertices[k], h.vertices[l]);
+  const auto by_edge = [&](const HingeElement& p, const HingeElement& q) {
+    return edge_key(p) < edge_key(q);
+  };
+  std::sort(made_hinges.begin(), made_hinges.end(), by_edge);
+  model.hinges.resize(kept_hinges.size() + made_hinges.size());
+  std::merge(kept_hinges.begin(), kept_hinges.end(), made_hinges.begin(), made_hinges.end(),
+             model.hinges.begin(), by_edge);
+
+  // Pattern: unchanged rows are the previous rows renumbered (kept vertices keep their order,
+  // so each run stays sorted), the changed ones are collected from the elements and sorted.
+  const SparseMatrixR& old_pattern = previous.pattern.zero_matrix;
+  const auto previous_size = [&](int i) {  // neighbours in the previous row of vertex i
+    const int p = reuse.previous_vertex[static_cast<std::size_t>(i)];
+    return (old_pattern.outerIndexPtr()[3 * p + 1] - old_pattern.outerIndexPtr()[3 * p]) / 3;
+  };
+  // A changed row gets room as in build_cloth_model, an unchanged one its previous size.
+  const std::vector<int> room = run_starts(n, model.triangles, model.hinges);
+  Neighbours neighbours;
+  neighbours.start.assign(static_cast<std::size_t>(n) + 1, 0);
+  for (int i = 0; i < n; ++i)
+    neighbours.start[i + 1] =
+        neighbours.start[i] + (changed_row[i] ? room[i + 1] - room[i] : previous_size(i));
+  neighbours.list.resize(static_cast<std::size_t>(neighbours.start[n]));
+  neighbours.size.resize(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    if (changed_row[i]) continue;
+    const int p = reuse.previous_vertex[static_cast<std::size_t>(i)];
+    const int* columns = old_pattern.innerIndexPtr() + old_pattern.outerIndexPtr()[3 * p];
+    const int size = previous_size(i);
+    for (int m = 0; m < size; ++m)
+      neighbours.list[static_cast<std::size_t>(neighbours.start[i] + m)] =
+          renumber(columns[3 * m] / 3);
+    neighbours.size[i] = size;
+  }
+  collect_neighbours(neighbours, model.triangles, model.hinges, changed_row);
+  model.pattern.zero_matrix = zero_pattern_matrix(neighbours);
+  // Offsets in unchanged rows are the previous ones (kept elements brought them along).
+  model.pattern.diagonal_offsets.resize(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i)
+    if (!changed_row[i])
+      model.pattern.diagonal_offsets[static_cast<std::size_t>(i)] =
+          previous.pattern.diagonal_offsets[static_cast<std::size_t>(
+              reuse.previous_vertex[static_cast<std::size_t>(i)])];
+  set_block_offsets(model, neighbours, changed_row);
   return model;
 }
 

@@ -87,6 +87,27 @@ struct ClothModel {
 ClothModel build_cloth_model(const ClothInput& input, const FabricParameters& fabric,
                              const ClothModelOptions& options = {});
 
+// What a topology change kept of the mesh a model was built for, in the rows of the new mesh.
+struct ClothModelReuse {
+  std::vector<int> previous_vertex;  // #V: row of the same vertex in the previous mesh, or −1
+  // #F: row of the same triangle (same vertices in the same order, same input face) in the
+  // previous mesh, or −1 for a triangle the change made.
+  std::vector<int> previous_triangle;
+};
+
+// The model that build_cloth_model(input, previous.fabric, options) and then
+// scale_rest_shapes(scale) (empty: none) would give, element for element and bit for bit, built
+// from `previous` (that model of the mesh before the change) where the change did not reach:
+// kept triangles and the hinges between two of them are copied with their vertices renumbered,
+// and the pattern rows of vertices whose elements are all kept are copied, with their elements'
+// offsets. Only the changed neighbourhood is computed and sorted. Vertex and triangle
+// renumbering must keep the order of what is kept (as Mesh48::compact does); hinges then come in
+// the reference's order. Throws InvalidClothError as build_cloth_model, and when `reuse` does
+// not describe the input.
+ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse& reuse,
+                              const ClothInput& input, const Eigen::VectorXd& scale,
+                              const ClothModelOptions& options = {});
+
 // Scales each triangle's rest shape by scale(t) (a panel's `ease`: lengths by e, so the gradient
 // operators du, dv by 1/e and the rest area by e²) and recomputes the lumped masses and vertex
 // areas from the scaled areas. Rest angles, and the bending weights |e|²/(A1+A2), do not change
