@@ -694,6 +694,8 @@ BlockChange Mesh48::split_complete(BlockId k, bool forced) {
   ch.a2 = t1;
   ch.area_a1 = rest_area(t0);
   ch.area_a2 = has_d ? rest_area(t1) : 0.0;
+  ch.source_a1 = source_face(t0);
+  ch.source_a2 = has_d ? source_face(t1) : -1;
 
   const VertexId e = new_vertex();
   {
@@ -901,6 +903,8 @@ BlockChange Mesh48::merge(BlockId k) {
   ch.a2 = t1;
   ch.area_a1 = rest_area(t0);
   ch.area_a2 = has_d ? rest_area(t1) : 0.0;
+  ch.source_a1 = source_face(t0);
+  ch.source_a2 = has_d ? source_face(t1) : -1;
   return ch;
 }
 

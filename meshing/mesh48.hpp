@@ -49,6 +49,10 @@ struct BlockChange {
   double area_a10 = 0, area_a11 = 0, area_a20 = 0, area_a21 = 0;
   TriangleId a1, a2;              // parent triangles
   TriangleId a10, a11, a20, a21;  // child triangles
+  // Input faces (source_face) of the parents on the two sides of the diagonal, which their
+  // children share; -1 for a missing second side. Recorded when the change is made: the
+  // triangle slots may be reused by the next change of a chain of forced splits.
+  int source_a1 = -1, source_a2 = -1;
 };
 
 // Flat arrays for the solver. Rows are compact: vertex row r is vertex_ids[r]; when the mesh

@@ -308,12 +308,12 @@ void AdaptiveCloth::apply(const BlockChange& change, Transfer& state) {
     state.measured = true;
   }
   state.changed = true;
-  // Mass moves at each triangle's eased density ρ·e² (a split's parents are gone: their
-  // children carry the same input face, hence the same ease).
+  // Mass moves at each triangle's eased density ρ·e². The ease comes from the input faces the
+  // change recorded: by the time a forced split of a chain is applied, its child slots may
+  // hold the triangles of the next split.
   const double rho = material_.fabric.area_density;
-  const bool split = change.kind == BlockChange::Kind::kSplit;
-  const TriangleId t1 = split ? change.a10 : change.a1, t2 = split ? change.a20 : change.a2;
-  const double e1 = ease(t1), e2 = t2.valid() ? ease(t2) : 1.0;
+  const double e1 = face_ease(change.source_a1);
+  const double e2 = change.source_a2 >= 0 ? face_ease(change.source_a2) : 1.0;
   meshing::transfer_mass_and_velocity(change, {rho * e1 * e1, rho * e2 * e2}, state.m, state.v);
   const auto grow = [](auto& vector, int size, auto fill) {
     if (static_cast<int>(vector.size()) < size) vector.resize(static_cast<std::size_t>(size), fill);
@@ -378,9 +378,10 @@ void AdaptiveCloth::apply(const BlockChange& change, Transfer& state) {
   }
 }
 
-double AdaptiveCloth::ease(TriangleId t) const {
+double AdaptiveCloth::ease(TriangleId t) const { return face_ease(mesh_.source_face(t)); }
+
+double AdaptiveCloth::face_ease(int source) const {
   if (material_.source_ease.size() == 0) return 1.0;
-  const int source = mesh_.source_face(t);
   if (source < 0 || source >= material_.source_ease.size())
     throw InvalidClothError("the ease must be given for every input face (" +
                             std::to_string(material_.source_ease.size()) + " given, face " +

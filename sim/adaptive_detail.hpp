@@ -246,8 +246,9 @@ class AdaptiveCloth {
   // Moves the split vertex `e` (row of state.x) out to the contact thickness if the body is
   // closer than that (splits that would need more than safe_lift are declined before).
   void keep_off_body(int e, Transfer& state) const;
-  // The rest-shape scale of triangle t (its input face's ease, 1 without).
+  // The rest-shape scale of triangle t (its input face's ease, 1 without), and of an input face.
   double ease(meshing::TriangleId t) const;
+  double face_ease(int source_face) const;
   // False when splitting block k would put its new vertex so deep inside the body (a chord of a
   // coarse block across a sharp body feature, or of a flat block) that moving it out to the
   // contact thickness would stretch its children by more than a few per cent; such blocks stay

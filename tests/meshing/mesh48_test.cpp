@@ -394,6 +394,11 @@ TEST(Mesh48Split, OneBlockBisectsItsDiagonalIntoExactHalves) {
   EXPECT_DOUBLE_EQ(ch.area_a2, area2);
   for (const double half : {ch.area_a10, ch.area_a11}) EXPECT_NEAR(half, area1 / 2, 1e-15);
   for (const double half : {ch.area_a20, ch.area_a21}) EXPECT_NEAR(half, area2 / 2, 1e-15);
+  // The input face of each side, as the children carry it.
+  EXPECT_EQ(ch.source_a1, 0);
+  EXPECT_EQ(ch.source_a2, 0);
+  for (const TriangleId t : {ch.a10, ch.a11}) EXPECT_EQ(mesh.source_face(t), ch.source_a1);
+  for (const TriangleId t : {ch.a20, ch.a21}) EXPECT_EQ(mesh.source_face(t), ch.source_a2);
   // Children as named in DESIGN.md, counter-clockwise like their parents.
   const auto same_cycle = [&](TriangleId t, std::array<VertexId, 3> expected) {
     auto v = mesh.vertices(t);
