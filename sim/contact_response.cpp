@@ -59,6 +59,19 @@ constexpr double kMergeSine = 0.26;
 // step was halved to its minimum; capped, a deep start is lifted over a few steps (0.5 m/s:
 // 8 mm per 1/60 s step).
 constexpr double kMaxPiercingLiftSpeed = 0.5;
+// PiercingResponse::spring: a spring's stiffness and damping are those of its point's effective
+// mass m (1/Σ w_k²/m_k over the free corners) oscillating at this angular frequency, critically
+// damped: k = m ω², c = 2 m ω. Resolution independent, and at any step size a physical
+// oscillator rather than a jump: a 1 cm gap closes at most at about ω·1 cm/e = 1.5 m/s, however
+// small step control makes the step (a constraint's correction Δx became Δx/h). Measured on the
+// examples (docs/collision.md): at 120 rad/s springs too soft for a waistband pressed on the
+// hips left 5 body vertices 1.7 mm through the A-line skirt; 400 and 1,000 rad/s left none, and
+// 400 the least motion at the end.
+constexpr double kSpringFrequency = 400.0;  // rad/s
+// The force a spring carries to the next step (and raises in a re-solve) is capped at this many
+// times its point's weight: a tip can hold up a sheet, but a squeeze that no motion of the cloth
+// can clear (two body parts closing on it) cannot build up an unbounded push.
+constexpr double kMaxSpringLoadWeights = 100.0;
 
 class Stopwatch {
  public:
@@ -293,6 +306,8 @@ void ContactResponse::reset_cloth(const Eigen::VectorXd& x, const Eigen::VectorX
   Stopwatch watch(stats_.collision_seconds);
   const int n = static_cast<int>(x.size() / 3);
   release_force_ = (kReleaseFraction * gravity) * mass;
+  mass_ = mass;
+  gravity_ = gravity;
   cache_.reset();
   last_normal_force_.assign(n, kNoImpulse);
   active_index_.assign(n, -1);
@@ -300,10 +315,16 @@ void ContactResponse::reset_cloth(const Eigen::VectorXd& x, const Eigen::VectorX
   too_deep_.clear();
   end_contacts_.clear();
   accepted_contacts_.clear();
-  // Piercings are remembered by body vertex, but their triangles were the old cloth's.
-  last_piercing_force_.assign(static_cast<std::size_t>(collider_.vertex_count()), kNoImpulse);
+  // Piercings are remembered by body vertex. A held constraint belonged to a triangle of the old
+  // cloth, and is forgotten; a spring's force is the body vertex's load, and carries over.
+  if (settings_.piercing_response == PiercingResponse::constraint ||
+      last_piercing_force_.size() != static_cast<std::size_t>(collider_.vertex_count()))
+    last_piercing_force_.assign(static_cast<std::size_t>(collider_.vertex_count()), kNoImpulse);
   held_index_.assign(static_cast<std::size_t>(collider_.vertex_count()), -1);
   held_piercings_.clear();
+  spring_index_.assign(static_cast<std::size_t>(collider_.vertex_count()), -1);
+  spring_body_vertex_.clear();
+  spring_end_force_.clear();
   corner_normal_.assign(static_cast<std::size_t>(n), Eigen::Vector3d::Zero());
   // Plan the push-out on the first cloth, or again (over the remaining steps) when the cloth
   // is renumbered in the middle of one.
@@ -374,11 +395,12 @@ int ContactResponse::add_contact(const BodyContact& contact, const Eigen::Vector
 
 void ContactResponse::constrain_start(const Eigen::VectorXd& x_hat, const Eigen::VectorXd& v0,
                                       double beta, ConstraintFilter& filter, Eigen::VectorXd& y,
-                                      std::vector<VertexDamping>& friction) {
+                                      StepForces& extra) {
   Stopwatch watch(stats_.collision_seconds);
   const int n = static_cast<int>(x_hat.size() / 3);
   y.setZero(3 * n);
-  friction.clear();
+  extra.clear();
+  std::vector<VertexDamping>& friction = extra.drags;
   beta_ = beta;
   for (const ActiveContact& a : active_) active_index_[a.contact.vertex] = -1;
   active_.clear();
@@ -445,7 +467,121 @@ void ContactResponse::constrain_start(const Eigen::VectorXd& x_hat, const Eigen:
     friction.push_back(term);
   }
   // After the contacts, so that a corner's piercing direction is added to its contact's.
-  constrain_start_piercings(x_hat, v0, beta, filter, y);
+  if (settings_.piercing_response == PiercingResponse::spring)
+    spring_start_piercings(x_hat + y, v0, beta, filter, extra);
+  else
+    constrain_start_piercings(x_hat, v0, beta, filter, y);
+}
+
+PointSpring ContactResponse::piercing_spring(const BodyPiercing& p, const Eigen::VectorXd& x,
+                                             const std::vector<unsigned char>& pinned,
+                                             double preload) const {
+  const std::array<int, 3>& t = cloth_.triangles[p.cloth_triangle];
+  PointSpring spring;
+  spring.triangle = p.cloth_triangle;
+  spring.weights = p.barycentric;
+  spring.normal = p.normal;
+  double inverse_mass = 0.0, along = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    along += p.barycentric[k] * p.normal.dot(x.segment<3>(3 * t[k]));
+    if (pinned.empty() || pinned[t[k]] == 0)
+      inverse_mass += p.barycentric[k] * p.barycentric[k] / mass_[t[k]];
+  }
+  // The body vertex is at along + height; the point must end the clearance in front of it.
+  spring.target = along + p.height + kPiercingClearance * settings_.thickness;
+  spring.reference_velocity = p.body_velocity;
+  if (!(inverse_mass > 0.0)) return spring;  // all corners pinned: nothing can move
+  const double mass = 1.0 / inverse_mass;
+  spring.stiffness = mass * kSpringFrequency * kSpringFrequency;
+  spring.damping = 2.0 * mass * kSpringFrequency;
+  spring.preload = std::min(preload, max_spring_preload(spring));
+  return spring;
+}
+
+double ContactResponse::max_spring_preload(const PointSpring& spring) const {
+  return kMaxSpringLoadWeights * gravity_ * spring.stiffness /
+         (kSpringFrequency * kSpringFrequency);
+}
+
+void ContactResponse::spring_start_piercings(const Eigen::VectorXd& start,
+                                             const Eigen::VectorXd& v0, double beta,
+                                             const ConstraintFilter& filter, StepForces& extra) {
+  for (int b : spring_body_vertex_) spring_index_[b] = -1;
+  spring_body_vertex_.clear();
+  if (!settings_.check_body_vertices || cloth_.triangles.empty() || repairing()) return;
+  const int n = static_cast<int>(start.size() / 3);
+  const double clearance = kPiercingClearance * settings_.thickness;
+  const double hold = clearance + kPiercingHoldMargin * settings_.thickness;
+  pinned_.assign(static_cast<std::size_t>(n), 0);
+  for (int i = 0; i < n; ++i) pinned_[i] = filter.is_pinned(i);
+  for (const BodyPiercing& p : find_piercings(start, -piercing_reach())) {
+    const std::array<int, 3>& t = cloth_.triangles[p.cloth_triangle];
+    // Height over the point at the end of the step if the triangle moved along n with the body
+    // vertex, and if it kept its start velocity (as constrain_start_piercings).
+    const double with_body = p.height - beta * p.body_velocity.dot(p.normal);
+    double point_velocity = 0.0;
+    for (int k = 0; k < 3; ++k)
+      point_velocity += p.barycentric[k] * v0.segment<3>(3 * t[k]).dot(p.normal);
+    const double coasting = p.height - beta * point_velocity;
+    const double force = last_piercing_force_[p.body_vertex];
+    const bool held = force > 0.0;
+    // A spring only where it would push: the point ends within the clearance of the body vertex
+    // (or through), or it pushed last step and the cloth has not left.
+    if (held ? with_body <= -hold : std::max(with_body, coasting) <= -clearance) continue;
+    spring_index_[p.body_vertex] = static_cast<int>(extra.springs.size());
+    spring_body_vertex_.push_back(p.body_vertex);
+    extra.springs.push_back(piercing_spring(p, start, pinned_, held ? force : 0.0));
+  }
+  stats_.piercings_held = static_cast<int>(extra.springs.size());
+}
+
+int ContactResponse::spring_end_piercings(const Eigen::VectorXd& x1, StepForces& extra) {
+  int changed = 0;
+  for (const BodyPiercing& p : piercings_) {
+    // What the body vertex's spring (if any) pushes with at x1.
+    double pushed = 0.0;
+    const int index = spring_index_[p.body_vertex];
+    if (index >= 0) {
+      const PointSpring& spring = extra.springs[index];
+      const std::array<int, 3>& t = cloth_.triangles[spring.triangle];
+      double along = 0.0;
+      for (int k = 0; k < 3; ++k)
+        along += spring.weights[k] * spring.normal.dot(x1.segment<3>(3 * t[k]));
+      pushed = std::max(0.0, spring.preload + spring.stiffness * (spring.target - along));
+    }
+    if (index >= 0 && extra.springs[index].triangle == p.cloth_triangle) {
+      // Still through its spring's triangle: carry what the spring ended pushing with as its
+      // preload (an augmented-Lagrangian update), so the next solve pushes harder where the
+      // spring alone is too soft.
+      PointSpring& spring = extra.springs[index];
+      const double preload = std::min(pushed, max_spring_preload(spring));
+      if (preload <= spring.preload) continue;
+      spring.preload = preload;
+    } else {
+      // New, or through another triangle (the cloth slid over the vertex, or folds over it): a
+      // spring for that triangle, carrying the load the vertex's last spring had. The old
+      // spring stays (its triangle may still rest on the vertex).
+      spring_index_[p.body_vertex] = static_cast<int>(extra.springs.size());
+      spring_body_vertex_.push_back(p.body_vertex);
+      extra.springs.push_back(piercing_spring(p, x1, pinned_, pushed));
+    }
+    ++changed;
+  }
+  return changed;
+}
+
+void ContactResponse::record_spring_forces(const Eigen::VectorXd& x, const StepForces& extra) {
+  spring_end_force_.clear();
+  for (std::size_t s = 0; s < spring_body_vertex_.size(); ++s) {
+    const PointSpring& spring = extra.springs[s];
+    const std::array<int, 3>& t = cloth_.triangles[spring.triangle];
+    double along = 0.0;
+    for (int k = 0; k < 3; ++k)
+      along += spring.weights[k] * spring.normal.dot(x.segment<3>(3 * t[k]));
+    const double force = spring.preload + spring.stiffness * (spring.target - along);
+    spring_end_force_.emplace_back(spring_body_vertex_[s],
+                                   std::min(force, max_spring_preload(spring)));
+  }
 }
 
 void ContactResponse::apply_friction(const Eigen::VectorXd& impulse, const Eigen::VectorXd& mass,
@@ -490,7 +626,8 @@ void ContactResponse::apply_friction(const Eigen::VectorXd& impulse, const Eigen
 
 int ContactResponse::constrain_deep(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1,
                                     const Eigen::VectorXd& x_hat, double beta,
-                                    ConstraintFilter& filter, Eigen::VectorXd& y) {
+                                    ConstraintFilter& filter, Eigen::VectorXd& y,
+                                    StepForces& extra) {
   Stopwatch watch(stats_.collision_seconds);
   end_contacts_ = collider_.find_contacts_swept(x0, x1, query(), &cache_);
   too_deep_.clear();
@@ -510,6 +647,13 @@ int ContactResponse::constrain_deep(const Eigen::VectorXd& x0, const Eigen::Vect
   if ((too_deep_.empty() && piercings_.empty()) || stats_.resolves >= settings_.max_resolves)
     return 0;
   for (const BodyContact& c : too_deep_) add_contact(c, x_hat, beta, filter, y, false);
+  if (settings_.piercing_response == PiercingResponse::spring) {
+    const int springs = spring_end_piercings(x1, extra);
+    stats_.piercings_resolved += springs;
+    const int added = static_cast<int>(too_deep_.size()) + springs;
+    if (added > 0) ++stats_.resolves;
+    return added;
+  }
   // Lifted triangle corners: their normal velocity lands them at x1 + lift along the lift,
   // and the piercings are held from now on.
   int added = static_cast<int>(too_deep_.size());
@@ -532,7 +676,8 @@ int ContactResponse::constrain_deep(const Eigen::VectorXd& x0, const Eigen::Vect
   return added;
 }
 
-void ContactResponse::finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v) {
+void ContactResponse::finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v,
+                                  const StepForces& extra) {
   Stopwatch watch(stats_.collision_seconds);
   // Last resort for what the re-solves did not fix: onto the surface, with the body's normal
   // velocity (the approaching part of the relative velocity removed).
@@ -557,9 +702,11 @@ void ContactResponse::finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v) {
   if (stats_.projected > 0)
     spdlog::debug("sim: {} cloth vertices projected out of the body after {} re-solves",
                   stats_.projected, stats_.resolves);
+  // Springs push on from where they ended, next step; nothing is lifted.
+  if (settings_.piercing_response == PiercingResponse::spring) record_spring_forces(x, extra);
   // Body vertices still through the cloth after the re-solves: lift their triangles (positions,
   // and the corners' velocity towards the body vertex removed), then measure again.
-  if (!piercings_.empty()) {
+  if (!piercings_.empty() && settings_.piercing_response == PiercingResponse::constraint) {
     const int n = static_cast<int>(x.size() / 3);
     const std::vector<CornerLift> lifts =
         corner_lifts(piercings_, clearance_deltas(piercings_), pinned_, n);
@@ -641,6 +788,12 @@ void ContactResponse::record_normal_forces(const Eigen::VectorXd& impulse) {
 
 void ContactResponse::accept_step(const Eigen::VectorXd& impulse) {
   record_normal_forces(impulse);
+  // A body vertex with several springs (the cloth slid over it within the step) carries the
+  // largest force.
+  for (const auto& [body_vertex, force] : spring_end_force_) {
+    double& carried = last_piercing_force_[body_vertex];
+    if (std::isnan(carried) || force > carried) carried = force;
+  }
   accepted_contacts_ = active_;
   if (repairing()) {
     ++repair_step_;

@@ -55,6 +55,17 @@
 
 namespace sd::sim {
 
+// How a body vertex poking through the cloth pushes the cloth back (check_body_vertices).
+enum class PiercingResponse {
+  // The corners' normal velocities are constraints of the filter, like contacts; what the
+  // re-solves leave is lifted as a position change at the end of the step.
+  constraint,
+  // A spring from the triangle's point over the body vertex to the clearance in front of it,
+  // part of the implicit solve (StepForces); its force is carried to the next step and raised
+  // by each re-solve, so a held tip ends at the clearance. Never a position change.
+  spring,
+};
+
 struct ContactSettings {
   bool enabled = true;       // with a body set; off: the body is ignored
   double thickness = 0.003;  // m: distance kept between a cloth vertex and the body surface
@@ -73,6 +84,7 @@ struct ContactSettings {
   // elbows, corners). See docs/collision.md, "Body vertices poking through the cloth", for
   // what it does and costs.
   bool check_body_vertices = false;
+  PiercingResponse piercing_response = PiercingResponse::spring;
   // Collider query parameters (see sim/body_collider.hpp, ContactQuery).
   double search_margin = 0.02;
   double max_substep_motion = 0.005;
@@ -158,8 +170,7 @@ class ContactResponse {
   // y (3n) the caller adds to x̂ and to the linearisation point, and the stick-regime friction
   // drags for the solve. v0: velocities at the start of the step (3n).
   void constrain_start(const Eigen::VectorXd& x_hat, const Eigen::VectorXd& v0, double beta,
-                       ConstraintFilter& filter, Eigen::VectorXd& y,
-                       std::vector<VertexDamping>& friction);
+                       ConstraintFilter& filter, Eigen::VectorXd& y, StepForces& extra);
 
   // Step 2: Coulomb friction on the sliding and new contacts, from the solve's constraint
   // impulse (3n, N·s). Changes v1 and x1 = x̂ + β v1 of those vertices.
@@ -173,14 +184,16 @@ class ContactResponse {
   // through (each lifted along the triangle's normal, weighted by its barycentric share, so
   // the triangle clears the body vertex by half the thickness). Returns how many were added,
   // 0 when the step is clean.
+  // With PiercingResponse::spring the piercings become (or raise) springs in `extra` instead.
   int constrain_deep(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1,
                      const Eigen::VectorXd& x_hat, double beta, ConstraintFilter& filter,
-                     Eigen::VectorXd& y);
+                     Eigen::VectorXd& y, StepForces& extra);
 
   // After the last solve: projects the vertices the last end check found too deep onto
   // point + thickness·normal with the body's normal velocity, lifts the cloth triangles body
   // vertices still poke through, and measures the penetration and piercing.
-  void finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v);
+  // `extra`: the step's forces (springs' end forces are remembered for the next step).
+  void finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v, const StepForces& extra);
 
   ContactStepStats& step_stats() { return stats_; }
   const ContactStepStats& step_stats() const { return stats_; }
@@ -251,6 +264,21 @@ class ContactResponse {
                         double normal_velocity);
   // Adds `piercing` to this attempt's held piercings (once per body vertex).
   void hold_piercing(const BodyPiercing& piercing, bool released);
+  // PiercingResponse::spring: the spring that pushes piercing p's triangle to the clearance in
+  // front of its body vertex, from positions x (the body at its end pose), with `preload`.
+  PointSpring piercing_spring(const BodyPiercing& p, const Eigen::VectorXd& x,
+                              const std::vector<unsigned char>& pinned, double preload) const;
+  // The largest preload a spring carries (N): kMaxSpringLoadWeights times its point's weight.
+  double max_spring_preload(const PointSpring& spring) const;
+  // Start of step, spring response: body vertices through the cloth at `start` (x̂ + y), about
+  // to be, or held last step, become springs in `extra`.
+  void spring_start_piercings(const Eigen::VectorXd& start, const Eigen::VectorXd& v0,
+                              double beta, const ConstraintFilter& filter, StepForces& extra);
+  // End check, spring response: a piercing of x1 gets a spring, or its spring's preload rises
+  // by the spring's force at x1. Returns how many changed.
+  int spring_end_piercings(const Eigen::VectorXd& x1, StepForces& extra);
+  // The force (N, ≥ 0) each spring of this attempt ends with at x, to carry to the next step.
+  void record_spring_forces(const Eigen::VectorXd& x, const StepForces& extra);
 
   ContactSettings settings_;
   BodyCollider collider_;
@@ -289,6 +317,14 @@ class ContactResponse {
   // was not held.
   std::vector<double> last_piercing_force_;
   std::vector<unsigned char> pinned_;  // per cloth vertex, pinned in the step's filter
+  Eigen::VectorXd mass_;               // per cloth vertex, kg
+  double gravity_ = 9.81;              // m/s²
+  // PiercingResponse::spring: per spring of the attempt's StepForces, its body vertex; per body
+  // vertex, the index of its latest spring or −1; the springs' end forces, committed by
+  // accept_step.
+  std::vector<int> spring_body_vertex_;
+  std::vector<int> spring_index_;
+  std::vector<std::pair<int, double>> spring_end_force_;
   ContactStepStats stats_;
   std::vector<ActiveContact> accepted_contacts_;
 };

@@ -13,17 +13,28 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
-void ImplicitSolver::add_damping_force(const std::vector<VertexDamping>* damping,
-                                       const Eigen::VectorXd& v) {
-  if (damping == nullptr) return;
-  for (const VertexDamping& d : *damping)
+void ImplicitSolver::add_extra_force(const ClothModel& model, const StepForces* extra,
+                                     const Eigen::VectorXd& x, const Eigen::VectorXd& v) {
+  if (extra == nullptr) return;
+  for (const VertexDamping& d : extra->drags)
     force_.segment<3>(3 * d.vertex) +=
         d.force - d.coefficient * (v.segment<3>(3 * d.vertex) - d.reference_velocity);
+  for (const PointSpring& s : extra->springs) {
+    const std::array<int, 3>& corners = model.triangles[s.triangle].vertices;
+    double along = 0.0, speed = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      along += s.weights[k] * s.normal.dot(x.segment<3>(3 * corners[k]));
+      speed += s.weights[k] * s.normal.dot(v.segment<3>(3 * corners[k]));
+    }
+    const double f = s.preload + s.stiffness * (s.target - along) -
+                     s.damping * (speed - s.normal.dot(s.reference_velocity));
+    for (int k = 0; k < 3; ++k) force_.segment<3>(3 * corners[k]) += (s.weights[k] * f) * s.normal;
+  }
 }
 
 void ImplicitSolver::assemble(const ClothModel& model, const ForceSettings& forces, double beta,
                               const Eigen::VectorXd& x, const Eigen::VectorXd& v,
-                              const Eigen::VectorXd* u, const std::vector<VertexDamping>* damping,
+                              const Eigen::VectorXd* u, const StepForces* extra,
                               ImplicitSolveResult& result) {
   const auto start = std::chrono::steady_clock::now();
   const SparseMatrixR& pattern = model.pattern.zero_matrix;
@@ -51,14 +62,37 @@ void ImplicitSolver::assemble(const ClothModel& model, const ForceSettings& forc
     target.product_output = &product_;
   }
   evaluate_forces(model, forces, x, v, force_, nullptr, &target);
-  // Vertex drags: ∂f/∂v = −C, so A gains β C on the vertex's diagonal block.
-  if (damping != nullptr)
-    for (const VertexDamping& d : *damping)
+  if (extra != nullptr) {
+    // Vertex drags: ∂f/∂v = −C, so A gains β C on the vertex's diagonal block.
+    for (const VertexDamping& d : extra->drags)
       for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 3; ++b)
           values[block_value_index(matrix_, d.vertex, model.pattern.diagonal_offsets[d.vertex], a,
                                    b)] += beta * d.coefficient(a, b);
-  add_damping_force(damping, v);
+    // Point springs: ∂f_k/∂x_l = −k w_k w_l n nᵀ and ∂f_k/∂v_l = −c w_k w_l n nᵀ, so block
+    // (k, l) of A gains (β² k + β c) w_k w_l n nᵀ; all within the triangle's own blocks.
+    for (const PointSpring& s : extra->springs) {
+      const TriangleElement& t = model.triangles[s.triangle];
+      const Eigen::Matrix3d outer = s.normal * s.normal.transpose();
+      const double scale = beta * beta * s.stiffness + beta * s.damping;
+      for (int k = 0; k < 3; ++k)
+        for (int l = 0; l < 3; ++l) {
+          const double w = scale * s.weights[k] * s.weights[l];
+          for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < 3; ++b)
+              values[block_value_index(matrix_, t.vertices[k], t.blocks[3 * k + l], a, b)] +=
+                  w * outer(a, b);
+        }
+      if (u != nullptr) {
+        double along = 0.0;
+        for (int l = 0; l < 3; ++l)
+          along += s.weights[l] * s.normal.dot(u->segment<3>(3 * t.vertices[l]));
+        for (int k = 0; k < 3; ++k)
+          product_.segment<3>(3 * t.vertices[k]) -= (s.stiffness * s.weights[k] * along) * s.normal;
+      }
+    }
+  }
+  add_extra_force(model, extra, x, v);
   result.forces_seconds += seconds_since(start);
 }
 
@@ -105,7 +139,7 @@ ImplicitSolveResult ImplicitSolver::solve(
     const ClothModel& model, const ForceSettings& forces, const ConstraintFilter& filter,
     const Eigen::VectorXd& x_hat, const Eigen::VectorXd& v_hat, double beta,
     const Eigen::VectorXd& x_lin, const Eigen::VectorXd& v_lin, const NewtonSettings& settings,
-    const std::vector<VertexDamping>* damping) {
+    const StepForces* extra) {
   ImplicitSolveResult result;
   const int n = model.vertex_count;
   const auto mass_times = [&](const Eigen::VectorXd& w) {
@@ -118,7 +152,7 @@ ImplicitSolveResult ImplicitSolver::solve(
   //   A s = M (v̂ − v_lin) + β f(x_lin, v_lin) + β (∂f/∂x) u,    v1 = v_lin + s.
   const Eigen::VectorXd u = x_hat + beta * v_lin - x_lin;
   const bool consistent = u.lpNorm<Eigen::Infinity>() == 0.0;
-  assemble(model, forces, beta, x_lin, v_lin, consistent ? nullptr : &u, damping, result);
+  assemble(model, forces, beta, x_lin, v_lin, consistent ? nullptr : &u, extra, result);
   rhs_ = mass_times(v_hat - v_lin) + beta * force_;
   if (!consistent) rhs_ += beta * product_;
   filter.constrained_correction(v_lin, z_);
@@ -141,11 +175,11 @@ ImplicitSolveResult ImplicitSolver::solve(
   bool refresh = settings.refresh_jacobian;
   while (!result.newton_converged && result.newton_iterations < settings.max_iterations) {
     if (refresh) {
-      assemble(model, forces, beta, result.x, result.v, nullptr, damping, result);
+      assemble(model, forces, beta, result.x, result.v, nullptr, extra, result);
     } else {
       const auto start = std::chrono::steady_clock::now();
       evaluate_forces(model, forces, result.x, result.v, force_);
-      add_damping_force(damping, result.v);
+      add_extra_force(model, extra, result.x, result.v);
       result.forces_seconds += seconds_since(start);
     }
     rhs_ = mass_times(v_hat - result.v) + beta * force_;

@@ -8,6 +8,7 @@
 // filtered by the constraints and solved by the modified PCG or CHOLMOD.
 
 #include <Eigen/Core>
+#include <array>
 #include <vector>
 
 #include "sim/cholmod_solver.hpp"
@@ -48,6 +49,35 @@ struct VertexDamping {
   Eigen::Vector3d force = Eigen::Vector3d::Zero();  // N
 };
 
+// A spring that pushes the point p = Σ_k w_k x_k of one cloth triangle (fixed weights) along
+// the unit normal n towards n·p = target, with the force
+//     F = preload + stiffness (target − n·p) − damping n·(Σ_k w_k v_k − reference_velocity),
+// of which corner k takes w_k F n. A body vertex poking through the cloth enters the solve this
+// way. F is linear in x and v, so the step treats it exactly; it is not one-sided within the
+// step (the caller decides which springs a step has).
+struct PointSpring {
+  int triangle = 0;  // model element, for its corners and matrix blocks
+  Eigen::Vector3d weights = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitY();
+  double target = 0.0;     // m, along normal
+  double preload = 0.0;    // N
+  double stiffness = 0.0;  // N/m
+  double damping = 0.0;    // kg/s
+  Eigen::Vector3d reference_velocity = Eigen::Vector3d::Zero();  // m/s
+};
+
+// Forces a step adds to the cloth's own, all implicit (their matrices go into A): contact
+// friction as per-vertex drags, body vertices poking through as point springs.
+struct StepForces {
+  std::vector<VertexDamping> drags;
+  std::vector<PointSpring> springs;
+
+  void clear() {
+    drags.clear();
+    springs.clear();
+  }
+};
+
 struct ImplicitSolveResult {
   Eigen::VectorXd x;  // 3n positions at the end of the step
   Eigen::VectorXd v;  // 3n velocities
@@ -72,13 +102,13 @@ class ImplicitSolver {
   // Solves the step. (x_lin, v_lin) is where the first iteration linearises the force: the
   // start of the step (x0, v0) for Baraff-Witkin's linearised implicit Euler, a consistent
   // predictor (x̂ + β v_guess, v_guess) for BDF2. The filter must hold the velocity targets
-  // of the constrained vertices for the end of the step. `damping` (optional) adds per-vertex
-  // linear drags to the force, implicitly (its matrix goes into A).
+  // of the constrained vertices for the end of the step. `extra` (optional) adds per-vertex
+  // drags and point springs to the force, implicitly (their matrices go into A).
   ImplicitSolveResult solve(const ClothModel& model, const ForceSettings& forces,
                             const ConstraintFilter& filter, const Eigen::VectorXd& x_hat,
                             const Eigen::VectorXd& v_hat, double beta, const Eigen::VectorXd& x_lin,
                             const Eigen::VectorXd& v_lin, const NewtonSettings& settings,
-                            const std::vector<VertexDamping>* damping = nullptr);
+                            const StepForces* extra = nullptr);
 
   // The system matrix of the last assembly (for tests and benchmarks).
   const SparseMatrixR& matrix() const { return matrix_; }
@@ -87,9 +117,10 @@ class ImplicitSolver {
  private:
   void assemble(const ClothModel& model, const ForceSettings& forces, double beta,
                 const Eigen::VectorXd& x, const Eigen::VectorXd& v, const Eigen::VectorXd* u,
-                const std::vector<VertexDamping>* damping, ImplicitSolveResult& result);
-  // force_ += force − C (v − v_ref) for each vertex term.
-  void add_damping_force(const std::vector<VertexDamping>* damping, const Eigen::VectorXd& v);
+                const StepForces* extra, ImplicitSolveResult& result);
+  // force_ += the drags' and springs' forces at (x, v).
+  void add_extra_force(const ClothModel& model, const StepForces* extra, const Eigen::VectorXd& x,
+                       const Eigen::VectorXd& v);
   bool linear_solve(const ClothModel& model, const ConstraintFilter& filter,
                     const NewtonSettings& settings, bool refactor, ImplicitSolveResult& result);
   void record_constraint_impulse(const ConstraintFilter& filter, ImplicitSolveResult& result);

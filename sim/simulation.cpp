@@ -219,12 +219,12 @@ Simulation::Attempt Simulation::attempt(double h) {
   Eigen::VectorXd& y = result.correction;
   if (contact != nullptr) {
     contact->move_body_to(time_, h);
-    contact->constrain_start(x_hat, v_, beta, filter_, y, friction_);
+    contact->constrain_start(x_hat, v_, beta, filter_, y, contact_forces_);
   }
   for (;;) {
     if (contact != nullptr) {
       result.solve = solver_.solve(model_, settings_.forces, filter_, x_hat + y, v_hat, beta,
-                                   x_lin + y, v_lin, newton_settings, &friction_);
+                                   x_lin + y, v_lin, newton_settings, &contact_forces_);
     } else {
       result.solve = solver_.solve(model_, settings_.forces, filter_, x_hat, v_hat, beta, x_lin,
                                    v_lin, newton_settings);
@@ -241,8 +241,8 @@ Simulation::Attempt Simulation::attempt(double h) {
       break;
     contact->apply_friction(result.solve.constraint_impulse, model_.mass, x_hat + y, beta,
                             result.v, result.x);
-    if (contact->constrain_deep(x_, result.x, x_hat, beta, filter_, y) == 0) {
-      contact->finish_step(result.x, result.v);
+    if (contact->constrain_deep(x_, result.x, x_hat, beta, filter_, y, contact_forces_) == 0) {
+      contact->finish_step(result.x, result.v, contact_forces_);
       break;
     }
   }

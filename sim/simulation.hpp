@@ -215,7 +215,7 @@ class Simulation {
   int easy_steps_ = 0;
   double rest_time_ = 0.0;
   ConstraintFilter filter_;
-  std::vector<VertexDamping> friction_;  // stick-regime friction drags of the current attempt
+  StepForces contact_forces_;  // friction drags and piercing springs of the current attempt
   ImplicitSolver solver_;
   std::unique_ptr<ContactResponse> contact_;
   SimulationReport report_;

@@ -1,0 +1,84 @@
+// The forces a step adds to the cloth's own (StepForces): a point spring is linear in x and v,
+// so one linearised solve must give backward Euler's answer exactly, from any linearisation
+// point, with either linear solver.
+
+#include "sim/implicit_solver.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "sim/constraint_filter.hpp"
+#include "tests/sim/test_scenes.hpp"
+
+namespace sd::sim {
+namespace {
+
+using Eigen::Vector3d;
+
+// One quad (two equal triangles) at rest, gravity and air drag off, a spring through each
+// triangle's centroid along its normal. Each triangle contributes a third of its mass to each
+// of its corners and the spring a third of its force, so the quad translates rigidly (no
+// stretch, shear or bending forces) along n and, per triangle of mass m,
+//     m (v1 − v0) = β (F0 + k (target − p0 − β v1) − c (v1 − v_ref)),
+//     v1 = (m v0 + β (F0 + k (target − p0) + c v_ref)) / (m + β² k + β c).
+TEST(ImplicitSolver, PointSpringStepIsBackwardEulerExactly) {
+  const testing::SheetSetup s = testing::horizontal_sheet(1, 0.1, Vector3d::Zero());
+  const ClothModel& model = s.model;
+  ASSERT_EQ(model.triangles.size(), 2u);
+  const double m = model.total_mass() / 2.0;
+  ASSERT_NEAR(model.triangles[0].rest_area, model.triangles[1].rest_area, 1e-15);
+
+  ForceSettings forces;
+  forces.gravity = Vector3d::Zero();
+  forces.air_drag = 0.0;
+  const Vector3d n = Vector3d::UnitY();
+  const Eigen::VectorXd x0 = flatten_positions(s.scene.input.rest_positions);
+  const int vertices = model.vertex_count;
+  Eigen::VectorXd v0 = Eigen::VectorXd::Zero(3 * vertices);
+  const double v0_normal = -0.3;  // falling onto the spring's target
+  for (int i = 0; i < vertices; ++i) v0.segment<3>(3 * i) = v0_normal * n;
+
+  StepForces extra;
+  const double p0 = x0.segment<3>(0).dot(n);  // the flat quad's height
+  for (int t = 0; t < 2; ++t) {
+    PointSpring spring;
+    spring.triangle = t;
+    spring.weights = Vector3d::Constant(1.0 / 3.0);
+    spring.normal = n;
+    spring.target = p0 + 0.004;
+    spring.preload = 0.02;
+    spring.stiffness = 40.0;
+    spring.damping = 0.5;
+    spring.reference_velocity = 0.1 * n;
+    extra.springs.push_back(spring);
+  }
+  const PointSpring& spring = extra.springs[0];
+  const double beta = 1.0 / 60.0;
+  const double expected =
+      (m * v0_normal + beta * (spring.preload + spring.stiffness * (spring.target - p0) +
+                               spring.damping * spring.reference_velocity.dot(n))) /
+      (m + beta * beta * spring.stiffness + beta * spring.damping);
+
+  const ConstraintFilter filter(vertices);
+  // Linearised at the start (u = 0), and away from it (u ≠ 0: the product term).
+  const Eigen::VectorXd shifted = x0 + Eigen::VectorXd::Constant(3 * vertices, 0.01);
+  for (const LinearSolverKind kind : {LinearSolverKind::cholmod, LinearSolverKind::pcg})
+    for (const Eigen::VectorXd* x_lin : {&x0, &shifted}) {
+      NewtonSettings settings;
+      settings.solver = kind;
+      settings.pcg_tolerance = 1e-12;
+      ImplicitSolver solver;
+      const ImplicitSolveResult r =
+          solver.solve(model, forces, filter, x0, v0, beta, *x_lin, v0, settings, &extra);
+      ASSERT_TRUE(r.linear_converged);
+      for (int i = 0; i < vertices; ++i) {
+        EXPECT_NEAR(r.v.segment<3>(3 * i).dot(n), expected, 1e-9 * std::abs(expected));
+        EXPECT_NEAR((r.v.segment<3>(3 * i) - r.v.segment<3>(3 * i).dot(n) * n).norm(), 0.0,
+                    1e-10);
+      }
+    }
+}
+
+}  // namespace
+}  // namespace sd::sim
