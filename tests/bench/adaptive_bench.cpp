@@ -3,22 +3,23 @@
 // Two modes:
 //   adaptive_bench [google benchmark flags]   kernels: the error estimate, one adapt() with
 //                                             splits and merges, a model rebuild
-//   adaptive_bench --study=DIR [--quick] [--scene=SCENE] [--only=RUN]
+//   adaptive_bench --study=DIR [--quick] [--scene=SCENE] [--only=RUN] [--finest=N]
 //                                             the work-precision study: the 3-corner and 2-corner
 //                                             sheets, a tablecloth and a sheet dropped on a sphere
-//                                             run fixed at levels 2, 4, 6
-//                                             and adaptively (max level 6) against a fixed
-//                                             level-8 reference; writes DIR/<scene>_<run>.csv
+//                                             run fixed at levels N-4, N-2, N
+//                                             and adaptively (max level N) against a fixed
+//                                             level-(N+2) reference; writes DIR/<scene>_<run>.csv
 //                                             time series and DIR/summary.csv, prints the
 //                                             summary. --scene: one scene (three_corner,
 //                                             two_corner, tablecloth, sphere); --only: one
 //                                             run (e.g. adaptive_2mm) without the reference,
-//                                             to profile.
+//                                             to profile; --finest: N, 4 to 9 (default 6).
 #include <benchmark/benchmark.h>
 
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <cstring>
 #include <filesystem>
@@ -44,12 +45,23 @@ AdaptiveSettings fixed_settings() {
   return settings;
 }
 
-AdaptiveSettings adaptive_settings(double refine_threshold) {
+AdaptiveSettings adaptive_settings(double refine_threshold, int max_level) {
   AdaptiveSettings settings;
   settings.refine_threshold = refine_threshold;
   settings.coarsen_threshold = 0.25 * refine_threshold;
-  settings.max_level = 6;
+  settings.max_level = max_level;
   return settings;
+}
+
+// The study's refine thresholds with `finest` as the max level: 4 mm halving down to
+// 0.5 mm · 2^(6 − finest) (4, 2, 1, 0.5 mm at level 6). The sag estimate on a smooth curve halves
+// with each level (θ and w both halve every two), so the threshold that lets the smooth parts
+// reach level N is half the one for level N − 1; the coarser thresholds stay for comparison.
+std::vector<double> refine_thresholds(int finest) {
+  const double smallest = 0.5e-3 * std::ldexp(1.0, 6 - finest);
+  std::vector<double> thresholds;
+  for (double t = 4e-3; t > 0.99 * smallest; t /= 2) thresholds.push_back(t);
+  return thresholds;
 }
 
 // --- kernels -------------------------------------------------------------------------------
@@ -58,7 +70,7 @@ AdaptiveSettings adaptive_settings(double refine_threshold) {
 AdaptiveCloth fallen_sheet() {
   AdaptiveSheetSpec spec;
   spec.duration = 1.0;
-  AdaptiveCloth cloth = make_adaptive_sheet(spec, 0, adaptive_settings(2e-3));
+  AdaptiveCloth cloth = make_adaptive_sheet(spec, 0, adaptive_settings(2e-3, 6));
   cloth.run();
   return cloth;
 }
@@ -240,14 +252,15 @@ void errors_against(RunResult& run, const RunResult& reference) {
 }
 
 // only_scene: that scene alone; only: just the runs of this name (e.g. adaptive_2mm) and no
-// reference, for profiling. Empty: all.
+// reference, for profiling. Empty: all. finest: the finest fixed level and the adaptive max level
+// (the reference is two levels finer).
 int run_study(const std::string& dir, bool quick, const std::string& only_scene,
-              const std::string& only) {
+              const std::string& only, int finest) {
   std::filesystem::create_directories(dir);
   std::ofstream summary(dir + "/summary.csv");
   summary << "scene,run,cpu_s,wall_s,forces_s,solve_s,estimate_s,operations_s,rebuild_s,steps,retries,"
              "vertices_final,vertices_max,splits,forced_splits,merges,topology_changes,"
-             "error_final_m,error_trajectory_m,lowest_m,extent_x,extent_y,extent_z\n";
+             "error_final_m,error_trajectory_m,lowest_m,extent_x,extent_y,extent_z,finest_level\n";
   std::vector<std::pair<std::string, AdaptiveSheetSpec>> scenes(4);
   scenes[0].first = "three_corner";
   scenes[0].second.pins = {"top-left", "top-right", "bottom-left"};
@@ -272,22 +285,22 @@ int run_study(const std::string& dir, bool quick, const std::string& only_scene,
     const double every = 0.25;
     std::vector<RunResult> runs;
     const auto wanted = [&](const std::string& name) { return only.empty() || only == name; };
-    for (int level : {2, 4, 6})
+    for (int level : {finest - 4, finest - 2, finest})
       if (const std::string name = "fixed_l" + std::to_string(level); wanted(name))
         runs.push_back(run_case(dir, scene, name, spec, level, fixed_settings(), points, every));
-    for (double threshold : {4e-3, 2e-3, 1e-3, 5e-4}) {
+    for (double threshold : refine_thresholds(finest)) {
       char name[64];
       std::snprintf(name, sizeof name, "adaptive_%gmm", threshold * 1e3);
       if (wanted(name))
-        runs.push_back(
-            run_case(dir, scene, name, spec, 0, adaptive_settings(threshold), points, every));
+        runs.push_back(run_case(dir, scene, name, spec, 0, adaptive_settings(threshold, finest),
+                                points, every));
     }
     if (runs.empty()) continue;
     // The reference last, so that a profiled run is not preceded by it; with --only there is
     // none and each run is measured against itself (errors 0).
     if (only.empty())
-      runs.push_back(
-          run_case(dir, scene, "fixed_l8", spec, quick ? 7 : 8, fixed_settings(), points, every));
+      runs.push_back(run_case(dir, scene, "fixed_l" + std::to_string(finest + 2), spec,
+                              quick ? finest + 1 : finest + 2, fixed_settings(), points, every));
     const RunResult reference = runs.back();
     for (RunResult& run : runs) {
       errors_against(run, reference);
@@ -298,7 +311,7 @@ int run_study(const std::string& dir, bool quick, const std::string& only_scene,
               << run.forced << ',' << run.merges << ',' << run.changes << ',' << run.error_final
               << ',' << run.error_trajectory << ',' << run.shape.lowest << ','
               << run.shape.extent.x() << ',' << run.shape.extent.y() << ',' << run.shape.extent.z()
-              << '\n';
+              << ',' << finest << '\n';
       std::printf(
           "%-13s %-16s cpu %7.2f s wall %7.2f s (forces %6.2f solve %6.2f adapt %5.3f = est %5.3f + ops %5.3f "
           "+ rebuild %5.3f) steps %4d retries %3d verts %5d (max %5d) splits %5d+%4d merges %5d "
@@ -319,6 +332,7 @@ int main(int argc, char** argv) {
   sd::sim::restart_with_single_threaded_solvers(argv);  // the solvers as sketchdrape runs them
   std::string study, only_scene, only;
   bool quick = false;
+  int finest = 6;
   std::vector<char*> rest;
   for (int i = 0; i < argc; ++i) {
     if (std::strncmp(argv[i], "--study=", 8) == 0)
@@ -327,12 +341,18 @@ int main(int argc, char** argv) {
       only_scene = argv[i] + 8;
     else if (std::strncmp(argv[i], "--only=", 7) == 0)
       only = argv[i] + 7;
+    else if (std::strncmp(argv[i], "--finest=", 9) == 0)
+      finest = std::atoi(argv[i] + 9);
     else if (std::strcmp(argv[i], "--quick") == 0)
       quick = true;
     else
       rest.push_back(argv[i]);
   }
-  if (!study.empty()) return run_study(study, quick, only_scene, only);
+  if (finest < 4 || finest > 9) {
+    std::fprintf(stderr, "--finest must be 4 to 9 (fixed runs at N-4, N-2, N, reference N+2)\n");
+    return 1;
+  }
+  if (!study.empty()) return run_study(study, quick, only_scene, only, finest);
   int count = static_cast<int>(rest.size());
   benchmark::Initialize(&count, rest.data());
   benchmark::RunSpecifiedBenchmarks();
