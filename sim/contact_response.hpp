@@ -26,15 +26,17 @@
 //
 // With `check_body_vertices`, body vertices are also kept behind the cloth triangles (sharp
 // features: a cloth triangle can span a cone tip or a shoulder with its three corners
-// outside). A body vertex more than the tolerance through a triangle (or about to be, at the
-// triangle's start velocity) becomes a piercing constraint: the triangle's point over it must
-// end `kPiercingClearance`·thickness in front of it, moving with the body vertex along the
-// triangle's normal. The corners share the motion by Bridson et al. 2002's weights
-// (w_k / Σ w_j², the least motion that moves the point), each corner's normal velocity a
-// constraint of the filter. Like a contact, a piercing is held at the next step's start while
-// the cloth stays within reach (the resting state of cloth hung on a tip), and released when
-// its constraint pulled the cloth towards the body vertex. The end check lifts the ones the
-// start missed, re-solving as for deep vertices.
+// outside). A body vertex through a triangle, or about to end the step closer than
+// `kPiercingClearance`·thickness in front of it, pushes the triangle's point over it out to that
+// clearance along the triangle's normal. By default (PiercingResponse::spring) the push is a
+// critically damped spring of the implicit solve on the point's corners (PointSpring), whose end
+// force is carried to the next step while it pushes and raised by the end check's re-solves: soft,
+// so two body parts squeezing the cloth between them cannot ask for opposite motions of one
+// corner, and never a jump in position. PiercingResponse::constraint makes the corners' normal
+// velocities constraints of the filter instead (Bridson et al. 2002's weights w_k / Σ w_j², the
+// least motion that moves the point), held like contacts and released when they pull; the end
+// check lifts what the re-solves left as a position change. It covers a sharp tip at every step
+// but fails where body parts close on the cloth (docs/collision.md).
 //
 // The simulator (sim/simulation.hpp) drives this; it is separate so that the contact logic
 // reads in one place and can be tested on its own.
