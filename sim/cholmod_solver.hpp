@@ -39,6 +39,10 @@ class CholmodSolver {
   CholmodMethod method() const { return method_; }
 
  private:
+  // A fill-reducing ordering of the 3n rows that keeps each vertex's three together: AMD on
+  // the vertex graph of A's pattern (row-major arrays). Empty if CHOLMOD's AMD failed.
+  std::vector<int> block_ordering(const int* outer, const int* inner, int rows);
+
   struct Factor;
   CholmodMethod method_;
   std::unique_ptr<Factor> factor_;
