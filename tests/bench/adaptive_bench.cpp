@@ -4,6 +4,7 @@
 //   adaptive_bench [google benchmark flags]   kernels: the error estimate, one adapt() with
 //                                             splits and merges, a model rebuild
 //   adaptive_bench --study=DIR [--quick] [--scene=SCENE] [--only=RUN] [--finest=N]
+//                  [--perturbed=K]
 //                                             the work-precision study: the 3-corner and 2-corner
 //                                             sheets, a tablecloth and a sheet dropped on a sphere
 //                                             run fixed at levels N-4, N-2, N
@@ -13,11 +14,14 @@
 //                                             summary. --scene: one scene (three_corner,
 //                                             two_corner, tablecloth, sphere); --only: one
 //                                             run (e.g. adaptive_2mm) without the reference,
-//                                             to profile; --finest: N, 4 to 9 (default 6).
+//                                             to profile; --finest: N, 4 to 9 (default 6);
+//                                             --perturbed: K more runs of fixed level N with
+//                                             the body moved by 1 µm (scenes with a body).
 #include <benchmark/benchmark.h>
 
 #include <chrono>
 #include <cmath>
+#include <numbers>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
@@ -253,9 +257,10 @@ void errors_against(RunResult& run, const RunResult& reference) {
 
 // only_scene: that scene alone; only: just the runs of this name (e.g. adaptive_2mm) and no
 // reference, for profiling. Empty: all. finest: the finest fixed level and the adaptive max level
-// (the reference is two levels finer).
+// (the reference is two levels finer). perturbed: runs of the finest fixed level with the body
+// moved by 1 µm, in scenes with a body.
 int run_study(const std::string& dir, bool quick, const std::string& only_scene,
-              const std::string& only, int finest) {
+              const std::string& only, int finest, int perturbed, int adaptive_start) {
   std::filesystem::create_directories(dir);
   std::ofstream summary(dir + "/summary.csv");
   summary << "scene,run,cpu_s,wall_s,forces_s,solve_s,estimate_s,operations_s,rebuild_s,steps,retries,"
@@ -288,12 +293,24 @@ int run_study(const std::string& dir, bool quick, const std::string& only_scene,
     for (int level : {finest - 4, finest - 2, finest})
       if (const std::string name = "fixed_l" + std::to_string(level); wanted(name))
         runs.push_back(run_case(dir, scene, name, spec, level, fixed_settings(), points, every));
+    // Where the drape is sensitive to its start (a sheet landing on a body), the finest fixed run
+    // with the body moved by 1 µm: how far a perturbation no mesh can resolve moves the result,
+    // the width of the fixed-finest run's own error band.
+    for (int k = 0; k < perturbed && spec.body.face_count() > 0; ++k) {
+      const std::string name = "fixed_l" + std::to_string(finest) + "_moved_" + std::to_string(k);
+      if (!wanted(name)) continue;
+      AdaptiveSheetSpec moved = spec;
+      const double angle = 2.0 * std::numbers::pi * (k + 0.5) / perturbed;
+      const Eigen::RowVector3d shift(1e-6 * std::cos(angle), 0.0, 1e-6 * std::sin(angle));
+      moved.body.vertices.rowwise() += shift;
+      runs.push_back(run_case(dir, scene, name, moved, finest, fixed_settings(), points, every));
+    }
     for (double threshold : refine_thresholds(finest)) {
       char name[64];
       std::snprintf(name, sizeof name, "adaptive_%gmm", threshold * 1e3);
       if (wanted(name))
-        runs.push_back(run_case(dir, scene, name, spec, 0, adaptive_settings(threshold, finest),
-                                points, every));
+        runs.push_back(run_case(dir, scene, name, spec, adaptive_start,
+                                adaptive_settings(threshold, finest), points, every));
     }
     if (runs.empty()) continue;
     // The reference last, so that a profiled run is not preceded by it; with --only there is
@@ -333,6 +350,8 @@ int main(int argc, char** argv) {
   std::string study, only_scene, only;
   bool quick = false;
   int finest = 6;
+  int perturbed = 0;
+  int adaptive_start = 0;
   std::vector<char*> rest;
   for (int i = 0; i < argc; ++i) {
     if (std::strncmp(argv[i], "--study=", 8) == 0)
@@ -343,6 +362,10 @@ int main(int argc, char** argv) {
       only = argv[i] + 7;
     else if (std::strncmp(argv[i], "--finest=", 9) == 0)
       finest = std::atoi(argv[i] + 9);
+    else if (std::strncmp(argv[i], "--perturbed=", 12) == 0)
+      perturbed = std::atoi(argv[i] + 12);
+    else if (std::strncmp(argv[i], "--adaptive-start=", 17) == 0)
+      adaptive_start = std::atoi(argv[i] + 17);
     else if (std::strcmp(argv[i], "--quick") == 0)
       quick = true;
     else
@@ -352,7 +375,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "--finest must be 4 to 9 (fixed runs at N-4, N-2, N, reference N+2)\n");
     return 1;
   }
-  if (!study.empty()) return run_study(study, quick, only_scene, only, finest);
+  if (!study.empty()) return run_study(study, quick, only_scene, only, finest, perturbed, adaptive_start);
   int count = static_cast<int>(rest.size());
   benchmark::Initialize(&count, rest.data());
   benchmark::RunSpecifiedBenchmarks();
