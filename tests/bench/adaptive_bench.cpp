@@ -13,14 +13,16 @@
 //                                             time series and DIR/summary.csv, prints the
 //                                             summary. --scene: one scene (three_corner,
 //                                             two_corner, tablecloth, sphere); --only: one
-//                                             run (e.g. adaptive_2mm) without the reference,
-//                                             to profile; --finest: N, 4 to 9 (default 6);
+//                                             run (e.g. adaptive_2mm) without the reference
+//                                             (measured against the one a full run kept in
+//                                             DIR, if any), to profile; --finest: N, 4 to 9 (default 6);
 //                                             --perturbed: K more runs of fixed level N with
 //                                             the body moved by 1 µm (scenes with a body).
 #include <benchmark/benchmark.h>
 
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 #include <cstdio>
 #include <cstdlib>
@@ -244,6 +246,38 @@ RunResult run_case(const std::string& dir, const std::string& scene, const std::
   return result;
 }
 
+// Sample matrices as raw doubles: count, then per sample its rows and values (column-major).
+void write_samples(const std::string& path, const std::vector<Eigen::MatrixX3d>& samples) {
+  std::ofstream out(path, std::ios::binary);
+  const auto put = [&](const void* data, std::size_t bytes) {
+    out.write(static_cast<const char*>(data), static_cast<std::streamsize>(bytes));
+  };
+  const std::int64_t count = static_cast<std::int64_t>(samples.size());
+  put(&count, sizeof count);
+  for (const Eigen::MatrixX3d& m : samples) {
+    const std::int64_t rows = m.rows();
+    put(&rows, sizeof rows);
+    put(m.data(), sizeof(double) * static_cast<std::size_t>(m.size()));
+  }
+}
+
+std::vector<Eigen::MatrixX3d> read_samples(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::vector<Eigen::MatrixX3d> samples;
+  std::int64_t count = 0;
+  if (!in.read(reinterpret_cast<char*>(&count), sizeof count)) return {};
+  for (std::int64_t k = 0; k < count; ++k) {
+    std::int64_t rows = 0;
+    if (!in.read(reinterpret_cast<char*>(&rows), sizeof rows)) return {};
+    Eigen::MatrixX3d m(rows, 3);
+    if (!in.read(reinterpret_cast<char*>(m.data()),
+                 static_cast<std::streamsize>(sizeof(double) * static_cast<std::size_t>(m.size()))))
+      return {};
+    samples.push_back(std::move(m));
+  }
+  return samples;
+}
+
 void errors_against(RunResult& run, const RunResult& reference) {
   const std::size_t n = std::min(run.samples.size(), reference.samples.size());
   double sum = 0;
@@ -313,12 +347,24 @@ int run_study(const std::string& dir, bool quick, const std::string& only_scene,
                                 adaptive_settings(threshold, finest), points, every));
     }
     if (runs.empty()) continue;
-    // The reference last, so that a profiled run is not preceded by it; with --only there is
-    // none and each run is measured against itself (errors 0).
-    if (only.empty())
-      runs.push_back(run_case(dir, scene, "fixed_l" + std::to_string(finest + 2), spec,
-                              quick ? finest + 1 : finest + 2, fixed_settings(), points, every));
-    const RunResult reference = runs.back();
+    // The reference last, so that a profiled run is not preceded by it. Its samples are kept in
+    // DIR, so that a later --only run is measured against them; with --only and no kept
+    // reference each run is measured against itself (errors 0).
+    const int reference_level = quick ? finest + 1 : finest + 2;
+    const std::string reference_name = "fixed_l" + std::to_string(reference_level);
+    const std::string kept = dir + "/" + scene + "_" + reference_name +
+                             (quick ? "_quick" : "") + "_samples.bin";
+    RunResult reference;
+    if (only.empty()) {
+      runs.push_back(run_case(dir, scene, reference_name, spec, reference_level, fixed_settings(),
+                              points, every));
+      reference = runs.back();
+      write_samples(kept, reference.samples);
+    } else if (std::vector<Eigen::MatrixX3d> samples = read_samples(kept); !samples.empty()) {
+      reference.samples = std::move(samples);
+    } else {
+      reference = runs.back();
+    }
     for (RunResult& run : runs) {
       errors_against(run, reference);
       summary << scene << ',' << run.name << ',' << run.cpu_s << ',' << run.wall_s << ',' << run.forces_s << ','
