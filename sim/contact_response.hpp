@@ -270,8 +270,9 @@ class ContactResponse {
   // front of its body vertex, from positions x (the body at its end pose), with `preload`.
   PointSpring piercing_spring(const BodyPiercing& p, const Eigen::VectorXd& x,
                               const std::vector<unsigned char>& pinned, double preload) const;
-  // The largest preload a spring carries (N): kMaxSpringLoadWeights times its point's weight.
-  double max_spring_preload(const PointSpring& spring) const;
+  // The largest preload a spring carries (N): kMaxSpringLoadClothWeights times the cloth's
+  // weight.
+  double max_spring_preload() const;
   // Start of step, spring response: body vertices through the cloth at `start` (x̂ + y), about
   // to be, or held last step, become springs in `extra`.
   void spring_start_piercings(const Eigen::VectorXd& start, const Eigen::VectorXd& v0,

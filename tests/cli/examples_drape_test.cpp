@@ -181,7 +181,7 @@ TEST_P(ExampleDrape, DrapesToRestOutsideTheBodyAndStaysOn) {
   EXPECT_EQ(report["penetrating_vertices_final"].get<int>(), 0);
   // Examples that keep the body's vertices behind the cloth end with none through it (without
   // the check the t-shirt ended with 61, up to 8 mm, the front of the shoulder showing).
-  if (sketch["simulate"].value("check_body_vertices", false)) {
+  if (sketch["simulate"].value("check_body_vertices", true)) {
     EXPECT_EQ(report["piercing_body_vertices_final"].get<int>(), 0);
   }
   EXPECT_LT(report["max_penetration_m"].get<double>(), kThickness);

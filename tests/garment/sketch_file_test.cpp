@@ -43,7 +43,7 @@ TEST(SketchFile, MinimalFileGetsDefaults) {
   EXPECT_EQ(s.simulate.integrator, "implicit-euler");
   EXPECT_EQ(s.simulate.solver, "cholmod");
   EXPECT_FALSE(s.simulate.pin_above.has_value());
-  EXPECT_FALSE(s.simulate.check_body_vertices);
+  EXPECT_TRUE(s.simulate.check_body_vertices);
   EXPECT_FALSE(s.body.motion.has_value());
   EXPECT_EQ(s.output.mesh, "garment.obj");
   EXPECT_TRUE(s.output.images.empty());
@@ -136,7 +136,7 @@ TEST(SketchFile, ReadsEverySection) {
     "join": [ { "id": "pq", "panels": ["p", "q"] } ],
     "simulate": { "duration": 2, "adaptive": false, "time_step": 0.01, "integrator": "implicit-euler",
                   "solver": "cholmod", "stop_at_rest": false, "gravity": [0, -9.8, 0],
-                  "check_body_vertices": true },
+                  "check_body_vertices": false },
     "output": { "images": [ { "view": "back", "size": [640, 480], "wireframe": true },
                             { "view": "three-quarter" } ],
                 "mesh": "g.glb", "report": false, "wireframe": true }
@@ -165,7 +165,7 @@ TEST(SketchFile, ReadsEverySection) {
   EXPECT_EQ(s.joins[0].panels.size(), 2u);
   EXPECT_EQ(s.simulate.solver, "cholmod");
   EXPECT_DOUBLE_EQ(s.simulate.gravity.y(), -9.8);
-  EXPECT_TRUE(s.simulate.check_body_vertices);
+  EXPECT_FALSE(s.simulate.check_body_vertices);  // the default is on
   ASSERT_EQ(s.output.images.size(), 2u);
   EXPECT_EQ(s.output.images[0].view, "back");
   EXPECT_EQ(s.output.images[0].width, 640);

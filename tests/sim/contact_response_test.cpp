@@ -142,21 +142,21 @@ TEST(ContactResponsePiercing, ConeTipStaysCoveredAtEveryStep) {
   EXPECT_LE(constraint.highest_apex, 1.05 * tolerance);
   // Springs are soft by design (they never move the cloth by a jump): while the sheet slides
   // over the tip, the tip can end a step a little more than the tolerance through before the
-  // spring's carried force catches up (measured: 1.53 mm at most, 9 of 240 steps). A spring
-  // that did not carry its force, or only followed one triangle while the cloth slid to the
-  // next, let it through by 6.7 mm.
-  EXPECT_LE(spring.highest_apex, 2.0 * tolerance);
+  // spring's carried force catches up, never more than the thickness (measured: 1.16-1.93 mm at
+  // most, in 4-9 of 240 steps, over the spring variants of 26 November; the sheet turning on a
+  // frictionless tip makes the exact figure sensitive to any change). A spring that did not
+  // carry its force, or only followed one triangle while the cloth slid to the next, let the
+  // tip through by 6.7 mm.
+  EXPECT_LE(spring.highest_apex, piercing_settings(true).contact.thickness);
   EXPECT_LE(spring.steps_pierced, 24);  // a tenth of the steps
 }
 
-// On a smooth body the check should change nothing, and it does not yet: the drape stays
-// outside and finite, but with the check it does not come to rest within 6 s (measured: at rest
-// at 2.4 s without; with, 18 body vertices held, 32 re-solves, still moving at 6 s). The sheet
-// lands at about 1 m/s, the landing triangles are held at the clearance in front of the
-// sphere's vertices, and the chords between cloth vertices held at the thickness naturally sit
-// closer than that, so the piercing and contact constraints pull against each other. This is
-// why ContactSettings::check_body_vertices stays off by default (docs/collision.md); the test
-// checks what holds and prints the rest times.
+// On a smooth body the check should change little: the sheet dropped on a sphere stays outside
+// and comes to rest with it too (measured: at rest at 2.40 s without, 1.93 s with, nothing
+// through). With the piercing constraints it never settled (still moving at 6 s: the held
+// triangles were pulled to the clearance while the chords between cloth vertices held at the
+// thickness sat a little closer); springs that were dropped as soon as they ended a hair beyond
+// the clearance re-solved every step and kept it moving too.
 TEST(ContactResponsePiercing, SheetOnASphereStaysOutsideWithTheCheck) {
   const meshing::TriMesh sphere = testing::make_sphere(0.2, 3);
   const BodyCollider check_body(sphere);
@@ -183,9 +183,7 @@ TEST(ContactResponsePiercing, SheetOnASphereStaysOutsideWithTheCheck) {
     EXPECT_TRUE(r.nan_free);
     EXPECT_TRUE(sim.positions().allFinite());
     EXPECT_LE(deepest, settings.contact.penetration_tolerance);
-    if (!check) {
-      EXPECT_TRUE(r.at_rest);
-    }
+    EXPECT_TRUE(r.at_rest);
   }
 }
 
