@@ -90,6 +90,31 @@ class Stopwatch {
   std::chrono::steady_clock::time_point start_;
 };
 
+// A piercing's height over its triangle at the end of the step (the body already at its end
+// pose): if the triangle moved along n with the body vertex, and if it kept its start
+// velocity v0 (3n), β the step's position factor.
+struct EndHeights {
+  double with_body = 0.0;
+  double coasting = 0.0;
+};
+
+EndHeights end_heights(const BodyPiercing& p, const std::array<int, 3>& triangle,
+                       const Eigen::VectorXd& v0, double beta) {
+  double point_velocity = 0.0;
+  for (int k = 0; k < 3; ++k)
+    point_velocity += p.barycentric[k] * v0.segment<3>(3 * triangle[k]).dot(p.normal);
+  return {p.height - beta * p.body_velocity.dot(p.normal), p.height - beta * point_velocity};
+}
+
+// n·p of a spring's point p = Σ w_k x_k on its triangle's corners.
+double spring_point_along_normal(const PointSpring& spring, const std::array<int, 3>& triangle,
+                                 const Eigen::VectorXd& x) {
+  double along = 0.0;
+  for (int k = 0; k < 3; ++k)
+    along += spring.weights[k] * spring.normal.dot(x.segment<3>(3 * triangle[k]));
+  return along;
+}
+
 void require(bool ok, const char* message) {
   if (!ok) throw InvalidContactSettingsError(message);
 }
@@ -259,14 +284,7 @@ void ContactResponse::constrain_start_piercings(const Eigen::VectorXd& x_hat,
   // before it passes it.
   for (const BodyPiercing& p : find_piercings(start, -piercing_reach())) {
     const std::array<int, 3>& t = cloth_.triangles[p.cloth_triangle];
-    // Height over the point at the end of the step (body at its end pose already) if the
-    // triangle moved along n with the body vertex, and if it kept its start velocity.
-    const double body_normal_velocity = p.body_velocity.dot(p.normal);
-    const double with_body = p.height - beta * body_normal_velocity;
-    double point_velocity = 0.0;
-    for (int k = 0; k < 3; ++k)
-      point_velocity += p.barycentric[k] * v0.segment<3>(3 * t[k]).dot(p.normal);
-    const double coasting = p.height - beta * point_velocity;
+    const auto [with_body, coasting] = end_heights(p, t, v0, beta);
     const double force = last_piercing_force_[p.body_vertex];
     const bool was_held = !std::isnan(force);
     // New: through by more than the tolerance, or about to be. Not at any height: over a
@@ -517,14 +535,8 @@ void ContactResponse::spring_start_piercings(const Eigen::VectorXd& start,
   pinned_.assign(static_cast<std::size_t>(n), 0);
   for (int i = 0; i < n; ++i) pinned_[i] = filter.is_pinned(i);
   for (const BodyPiercing& p : find_piercings(start, -piercing_reach())) {
-    const std::array<int, 3>& t = cloth_.triangles[p.cloth_triangle];
-    // Height over the point at the end of the step if the triangle moved along n with the body
-    // vertex, and if it kept its start velocity (as constrain_start_piercings).
-    const double with_body = p.height - beta * p.body_velocity.dot(p.normal);
-    double point_velocity = 0.0;
-    for (int k = 0; k < 3; ++k)
-      point_velocity += p.barycentric[k] * v0.segment<3>(3 * t[k]).dot(p.normal);
-    const double coasting = p.height - beta * point_velocity;
+    const auto [with_body, coasting] =
+        end_heights(p, cloth_.triangles[p.cloth_triangle], v0, beta);
     const double force = last_piercing_force_[p.body_vertex];
     const bool held = !std::isnan(force);
     // A spring only where it would push: the point ends within the clearance of the body vertex
@@ -548,10 +560,8 @@ int ContactResponse::spring_end_piercings(const Eigen::VectorXd& x1, StepForces&
     const int index = spring_index_[p.body_vertex];
     if (index >= 0) {
       const PointSpring& spring = extra.springs[index];
-      const std::array<int, 3>& t = cloth_.triangles[spring.triangle];
-      double along = 0.0;
-      for (int k = 0; k < 3; ++k)
-        along += spring.weights[k] * spring.normal.dot(x1.segment<3>(3 * t[k]));
+      const double along =
+          spring_point_along_normal(spring, cloth_.triangles[spring.triangle], x1);
       pushed = std::max(0.0, spring.preload + spring.stiffness * (spring.target - along));
     }
     if (index >= 0 && extra.springs[index].triangle == p.cloth_triangle) {
@@ -579,10 +589,7 @@ void ContactResponse::record_spring_forces(const Eigen::VectorXd& x, const StepF
   spring_end_force_.clear();
   for (std::size_t s = 0; s < spring_body_vertex_.size(); ++s) {
     const PointSpring& spring = extra.springs[s];
-    const std::array<int, 3>& t = cloth_.triangles[spring.triangle];
-    double along = 0.0;
-    for (int k = 0; k < 3; ++k)
-      along += spring.weights[k] * spring.normal.dot(x.segment<3>(3 * t[k]));
+    const double along = spring_point_along_normal(spring, cloth_.triangles[spring.triangle], x);
     const double force = spring.preload + spring.stiffness * (spring.target - along);
     spring_end_force_.emplace_back(spring_body_vertex_[s],
                                    std::min(force, max_spring_preload()));
