@@ -280,7 +280,8 @@ class ContactResponse {
   // End check, spring response: a piercing of x1 gets a spring, or its spring's preload rises
   // by the spring's force at x1. Returns how many changed.
   int spring_end_piercings(const Eigen::VectorXd& x1, StepForces& extra);
-  // The force (N, ≥ 0) each spring of this attempt ends with at x, to carry to the next step.
+  // The force (N; negative: it ended pulling) each spring of this attempt ends with at x, to
+  // carry to the next step.
   void record_spring_forces(const Eigen::VectorXd& x, const StepForces& extra);
 
   ContactSettings settings_;

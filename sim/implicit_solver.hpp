@@ -8,7 +8,6 @@
 // filtered by the constraints and solved by the modified PCG or CHOLMOD.
 
 #include <Eigen/Core>
-#include <array>
 #include <vector>
 
 #include "sim/cholmod_solver.hpp"
