@@ -411,9 +411,30 @@ ClothTriangles::ClothTriangles(std::vector<std::array<int, 3>> list)
   }
 }
 
+std::optional<BodyPiercing> BodyCollider::piercing_of_pair(const Eigen::VectorXd& x,
+                                                          const std::array<int, 3>& triangle,
+                                                          int triangle_index,
+                                                          int body_vertex) const {
+  const Eigen::Vector3d b = corner(body_vertex, 1.0);
+  const Eigen::Vector3d p0 = row(x, triangle[0]), p1 = row(x, triangle[1]),
+                        p2 = row(x, triangle[2]);
+  Eigen::Vector3d normal = triangle_normal(p0, p1, p2);
+  const double facing = normal.dot(vertex_normals_[body_vertex].normalized());
+  if (std::abs(facing) < 0.2) return std::nullopt;  // degenerate (zero normal) or edge-on
+  if (facing < 0.0) normal = -normal;
+  BodyPiercing piercing;
+  piercing.body_vertex = body_vertex;
+  piercing.cloth_triangle = triangle_index;
+  piercing.barycentric = closest_point_on_triangle(b, p0, p1, p2).barycentric;
+  piercing.normal = normal;
+  piercing.height = (b - p0).dot(normal);
+  piercing.body_velocity = velocities_[body_vertex];
+  return piercing;
+}
+
 std::vector<BodyPiercing> BodyCollider::find_piercings(
     const Eigen::VectorXd& x, const ClothTriangles& cloth, double min_height, double max_height,
-    double unchecked_height, PiercingQueryStats* stats_out) const {
+    double unchecked_height, PiercingQueryStats* stats_out, bool every_triangle) const {
   const std::vector<std::array<int, 3>>& triangles = cloth.triangles;
   PiercingQueryStats stats;
   std::vector<BodyPiercing> result;
@@ -496,7 +517,7 @@ std::vector<BodyPiercing> BodyCollider::find_piercings(
       const Eigen::Vector3d p0 = row(x, triangles[t][0]);
       const double height = (b - p0).dot(normal);
       if (height <= min_height || height >= max_height) continue;
-      if (best && height <= best->height) continue;
+      if (!every_triangle && best && height <= best->height) continue;
       // The closest point of the triangle, not only the projection: a body vertex pushed
       // through a ridge of the cloth (the shared edge of two triangles folded over it) projects
       // outside both triangles, but it is above both planes and its closest points lie on
@@ -531,7 +552,10 @@ std::vector<BodyPiercing> BodyCollider::find_piercings(
       piercing.normal = normal;
       piercing.height = height;
       piercing.body_velocity = velocities_[v];
-      best = piercing;
+      if (every_triangle)
+        result.push_back(piercing);
+      else
+        best = piercing;
     }
     if (best) result.push_back(*best);
   }

@@ -194,11 +194,20 @@ class BodyCollider {
   // is not pierced). Smaller heights are taken as they are: no body part is that thin, and at a
   // sharp tip under tilted cloth the closest point can lie just outside the body. Broad phase: a uniform grid over the cloth triangles' boxes grown by max_height,
   // built per call (the cloth changes every step; cells the size of the longest cloth edge).
-  // Sorted by body vertex; at most one (the highest) per body vertex.
+  // Sorted by body vertex; at most one (the highest) per body vertex, or with `every_triangle`
+  // each triangle in the band (a vertex under a cloth edge is under both its triangles).
+  // The height of one body vertex over one cloth triangle, as find_piercings measures it, with
+  // none of its filters (the band, the open edges, the inside check): for a pair the caller
+  // already follows. Nothing for a degenerate triangle or one edge-on to the body there.
+  std::optional<BodyPiercing> piercing_of_pair(const Eigen::VectorXd& x,
+                                               const std::array<int, 3>& triangle, int triangle_index,
+                                               int body_vertex) const;
+
   std::vector<BodyPiercing> find_piercings(const Eigen::VectorXd& x, const ClothTriangles& cloth,
                                            double min_height, double max_height,
                                            double unchecked_height = 0.0,
-                                           PiercingQueryStats* stats = nullptr) const;
+                                           PiercingQueryStats* stats = nullptr,
+                                           bool every_triangle = false) const;
 
   // Closest point of the current pose within `max_distance` of p (unbounded by default), with
   // the signed distance and outward normal; nothing when the surface is farther than that.

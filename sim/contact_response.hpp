@@ -227,9 +227,11 @@ class ContactResponse {
   double piercing_reach() const;
   // Piercings of x1 whose body vertex is more than `min_height` through the cloth; none when
   // check_body_vertices is off.
-  std::vector<BodyPiercing> find_piercings(const Eigen::VectorXd& x1, double min_height) const;
+  std::vector<BodyPiercing> find_piercings(const Eigen::VectorXd& x1, double min_height,
+                                           bool every_triangle = false) const;
   // The same whether or not the check is on (what count_piercing measures).
-  std::vector<BodyPiercing> piercings_of(const Eigen::VectorXd& x, double min_height) const;
+  std::vector<BodyPiercing> piercings_of(const Eigen::VectorXd& x, double min_height,
+                                         bool every_triangle = false) const;
   // What a set of piercings asks of one cloth vertex: move `distance` (m, signed: negative
   // moves it towards the body vertex) along `normal`, the triangle's normal.
   struct CornerLift {
@@ -323,12 +325,14 @@ class ContactResponse {
   std::vector<unsigned char> pinned_;  // per cloth vertex, pinned in the step's filter
   Eigen::VectorXd mass_;               // per cloth vertex, kg
   double gravity_ = 9.81;              // m/s²
-  // PiercingResponse::spring: per spring of the attempt's StepForces, its body vertex; per body
-  // vertex, the index of its latest spring or −1; the springs' end forces, committed by
-  // accept_step.
+  // PiercingResponse::spring: per spring of the attempt's StepForces, its body vertex; the
+  // springs' end forces and (body vertex, cloth triangle) pairs, committed by accept_step; the
+  // pairs of the last accepted step (followed at the next start even where find_piercings does
+  // not report them: a body vertex in front of a cloth edge).
   std::vector<int> spring_body_vertex_;
-  std::vector<int> spring_index_;
   std::vector<std::pair<int, double>> spring_end_force_;
+  std::vector<std::pair<int, int>> spring_end_pairs_;
+  std::vector<std::pair<int, int>> held_spring_pairs_;
   ContactStepStats stats_;
   std::vector<ActiveContact> accepted_contacts_;
 };
