@@ -28,7 +28,7 @@ constexpr double kReleaseFraction = 0.1;
 // Rounds of re-projection for a vertex whose projected position is still inside (a concave
 // spot where the pushed point lands inside another part of the body).
 constexpr int kProjectionRounds = 3;
-// A cloth triangle a body vertex pokes through is lifted until the vertex is this fraction of
+// A cloth triangle a body vertex pokes through is pushed until the vertex is this fraction of
 // the thickness behind it: clear, but not so far that the triangle's own vertices (held at the
 // thickness by their contacts) are pulled back through the vertex at the next step.
 constexpr double kPiercingClearance = 0.5;
@@ -44,23 +44,12 @@ constexpr double kMinPiercingReach = 0.01;  // m
 // outside by its own contact, and a tip sliding out beside it (measured on the cone test:
 // 3.3 mm, then 8.6 mm the next step) has that vertex as its closest point, outside the body.
 constexpr double kPiercingUncheckedFraction = 0.5;
-// A piercing held last step stays held while the triangle's point over the body vertex would
+// A body vertex with a spring last step keeps it while the triangle's point over the vertex would
 // end the step within the clearance plus this many thicknesses in front of it (the same
 // hysteresis as kHoldMargin for contacts: without it a triangle resting on a tip at the
-// clearance drops out as soon as it ends a hair farther, falls back and is lifted again).
+// clearance drops out as soon as it ends a hair farther, falls back and is pushed again).
 constexpr double kPiercingHoldMargin = 0.25;
-// A piercing constraint on a vertex that already has a contact direction becomes a second
-// direction only when the two differ by more than ~15° (sine above this); closer, the second
-// direction's value (d − d₁ cos θ)/sin θ would amplify small differences, so the contact's
-// direction carries both demands.
-constexpr double kMergeSine = 0.26;
-// m/s: the fastest a piercing correction (start of step, or re-solve) moves a corner. A
-// correction is a displacement the step's velocity inherits (v = Δx/h), so lifting a garment
-// that starts with body vertices a centimetre through it in one step made 1,172 m/s when the
-// step was halved to its minimum; capped, a deep start is lifted over a few steps (0.5 m/s:
-// 8 mm per 1/60 s step).
-constexpr double kMaxPiercingLiftSpeed = 0.5;
-// PiercingResponse::spring: a spring's stiffness and damping are those of its point's effective
+// A spring's stiffness and damping are those of its point's effective
 // mass m (1/Σ w_k²/m_k over the free corners) oscillating at this angular frequency, critically
 // damped: k = m ω², c = 2 m ω. Resolution independent, and at any step size a physical
 // oscillator rather than a jump: a 1 cm gap closes at most at about ω·1 cm/e = 1.5 m/s, however
@@ -194,136 +183,6 @@ std::vector<BodyPiercing> ContactResponse::piercings_of(const Eigen::VectorXd& x
                                   kPiercingUncheckedFraction * reach, nullptr, every_triangle);
 }
 
-std::vector<ContactResponse::CornerLift> ContactResponse::corner_lifts(
-    const std::vector<BodyPiercing>& piercings, const std::vector<double>& deltas,
-    const std::vector<unsigned char>& pinned, int vertices) const {
-  const auto is_pinned = [&](int i) {
-    return i < static_cast<int>(pinned.size()) && pinned[i] != 0;
-  };
-  std::vector<CornerLift> lift(static_cast<std::size_t>(vertices));
-  for (std::size_t p = 0; p < piercings.size(); ++p) {
-    // Move the triangle's point under the body vertex by δ along the normal: corner k moves
-    // w_k δ / Σ w_j² (Bridson et al. 2002's weighting, the least motion that does it), the
-    // pinned corners not at all.
-    const BodyPiercing& piercing = piercings[p];
-    const std::array<int, 3>& t = cloth_.triangles[piercing.cloth_triangle];
-    double weights = 0.0;
-    for (int k = 0; k < 3; ++k)
-      if (!is_pinned(t[k])) weights += piercing.barycentric[k] * piercing.barycentric[k];
-    if (!(weights > 0.0)) continue;
-    for (int k = 0; k < 3; ++k) {
-      if (is_pinned(t[k])) continue;
-      // At most 2δ: when the corners that carry the point are held (pinned, or with three
-      // directions constrained by a squeeze of contacts and piercings), the least motion of a
-      // free corner with a small share w_k is δ / w_k, unbounded (measured: a corner lifted by
-      // 1 m in the arms-lowering drape, a triangle stretched by 24,000 %). The rest of the lift
-      // waits for the next steps.
-      const double distance =
-          piercing.barycentric[k] * deltas[p] / std::max(weights, 0.5 * piercing.barycentric[k]);
-      CornerLift& corner = lift[t[k]];
-      // A vertex under two piercings takes the larger lift.
-      if (corner.set && distance <= corner.distance) continue;
-      corner = {piercing.normal, distance, piercing.body_velocity, true};
-    }
-  }
-  return lift;
-}
-
-void ContactResponse::constrain_corner(ConstraintFilter& filter, int i, const Eigen::Vector3d& n,
-                                       double normal_velocity) {
-  if (filter.direction_count(i) == 0) {
-    filter.constrain_direction(i, n, normal_velocity);
-  } else if (filter.direction_count(i) == 1) {
-    const Eigen::Vector3d& first = filter.first_direction(i);
-    const double cosine = n.dot(first);
-    const double first_velocity = filter.constrained_velocity().segment<3>(3 * i).dot(first);
-    const double sine = std::sqrt(std::max(0.0, 1.0 - cosine * cosine));
-    if (sine >= kMergeSine) {
-      // The filter's second direction is n made orthogonal to the first, e; v·n =
-      // d₁ cos θ + v_e sin θ, so v_e = (d − d₁ cos θ)/sin θ gives v·n = d exactly.
-      filter.constrain_direction(i, n, (normal_velocity - first_velocity * cosine) / sine);
-    } else if (cosine > 0.0) {
-      // Nearly the contact's own direction: moving at s along it moves s cos θ along n.
-      filter.constrain_direction(i, first, std::max(first_velocity, normal_velocity / cosine));
-    } else {
-      return;  // the contact pushes the other way: leave it to the contact
-    }
-  } else {
-    return;  // two directions held already (or pinned): leave it
-  }
-  corner_normal_[i] = n;
-}
-
-std::vector<double> ContactResponse::clearance_deltas(
-    const std::vector<BodyPiercing>& piercings) const {
-  std::vector<double> deltas;
-  deltas.reserve(piercings.size());
-  for (const BodyPiercing& p : piercings)
-    deltas.push_back(p.height + kPiercingClearance * settings_.thickness);
-  return deltas;
-}
-
-void ContactResponse::hold_piercing(const BodyPiercing& piercing, bool released) {
-  int& index = held_index_[piercing.body_vertex];
-  if (index >= 0) {
-    held_piercings_[index] = {piercing, released && held_piercings_[index].released};
-    return;
-  }
-  index = static_cast<int>(held_piercings_.size());
-  held_piercings_.push_back({piercing, released});
-}
-
-void ContactResponse::constrain_start_piercings(const Eigen::VectorXd& x_hat,
-                                                const Eigen::VectorXd& v0, double beta,
-                                                ConstraintFilter& filter, Eigen::VectorXd& y) {
-  if (!settings_.check_body_vertices || cloth_.triangles.empty() || repairing()) return;
-  const int n = static_cast<int>(x_hat.size() / 3);
-  const double clearance = kPiercingClearance * settings_.thickness;
-  const double hold = clearance + kPiercingHoldMargin * settings_.thickness;
-  const Eigen::VectorXd start = x_hat + y;
-  std::vector<BodyPiercing> held;
-  std::vector<double> deltas;
-  // Triangles up to `reach` in front of a body vertex: one falling towards a tip is seen
-  // before it passes it.
-  for (const BodyPiercing& p : find_piercings(start, -piercing_reach())) {
-    const std::array<int, 3>& t = cloth_.triangles[p.cloth_triangle];
-    const auto [with_body, coasting] = end_heights(p, t, v0, beta);
-    const double force = last_piercing_force_[p.body_vertex];
-    const bool was_held = !std::isnan(force);
-    // New: through by more than the tolerance, or about to be. Not at any height: over a
-    // smooth body the chords of the cloth between vertices held at the thickness pass a
-    // fraction of a millimetre under body vertices (a sheet on a sphere), and holding those
-    // would constrain most of a drape twice.
-    if (!was_held && std::max(with_body, coasting) <= settings_.penetration_tolerance) continue;
-    if (was_held && with_body <= -hold) continue;  // it left
-    double release_force = 0.0;
-    for (int k = 0; k < 3; ++k) release_force += p.barycentric[k] * release_force_[t[k]];
-    if (was_held && force < -release_force) {
-      hold_piercing(p, true);
-      ++stats_.piercings_released;
-      continue;
-    }
-    held.push_back(p);
-    deltas.push_back(with_body + clearance);
-  }
-  std::vector<unsigned char> pinned(static_cast<std::size_t>(n), 0);
-  for (int i = 0; i < n; ++i) pinned[i] = filter.is_pinned(i);
-  const std::vector<CornerLift> lifts = corner_lifts(held, deltas, pinned, n);
-  for (int i = 0; i < n; ++i) {
-    const CornerLift& lift = lifts[i];
-    if (!lift.set) continue;
-    // Through (or closer than the clearance): move the start out, like a contact's position
-    // correction; farther: a normal velocity that brings it back to the clearance.
-    if (lift.distance > 0.0)
-      y.segment<3>(3 * i) += std::min(lift.distance, kMaxPiercingLiftSpeed * beta) * lift.normal;
-    const double normal_velocity =
-        lift.body_velocity.dot(lift.normal) + std::min(lift.distance, 0.0) / beta;
-    constrain_corner(filter, i, lift.normal, normal_velocity);
-  }
-  for (const BodyPiercing& p : held) hold_piercing(p, false);
-  stats_.piercings_held = static_cast<int>(held.size());
-}
-
 void ContactResponse::reset_cloth(const Eigen::VectorXd& x, const Eigen::VectorXd& mass,
                                   double gravity) {
   stats_ = ContactStepStats{};
@@ -339,18 +198,14 @@ void ContactResponse::reset_cloth(const Eigen::VectorXd& x, const Eigen::VectorX
   too_deep_.clear();
   end_contacts_.clear();
   accepted_contacts_.clear();
-  // Piercings are remembered by body vertex. A held constraint belonged to a triangle of the old
-  // cloth, and is forgotten; a spring's force is the body vertex's load, and carries over.
-  if (settings_.piercing_response == PiercingResponse::constraint ||
-      last_piercing_force_.size() != static_cast<std::size_t>(collider_.vertex_count()))
+  // A body vertex's spring force is its load and carries over to a new cloth; the pairs it was
+  // held by were the old cloth's triangles.
+  if (last_piercing_force_.size() != static_cast<std::size_t>(collider_.vertex_count()))
     last_piercing_force_.assign(static_cast<std::size_t>(collider_.vertex_count()), kNoImpulse);
-  held_index_.assign(static_cast<std::size_t>(collider_.vertex_count()), -1);
-  held_piercings_.clear();
   spring_body_vertex_.clear();
   spring_end_force_.clear();
   spring_end_pairs_.clear();
-  held_spring_pairs_.clear();  // the triangles were the old cloth's
-  corner_normal_.assign(static_cast<std::size_t>(n), Eigen::Vector3d::Zero());
+  held_spring_pairs_.clear();
   // Plan the push-out on the first cloth, or again (over the remaining steps) when the cloth
   // is renumbered in the middle of one.
   if (!repair_planned_ || repairing()) {
@@ -431,9 +286,6 @@ void ContactResponse::constrain_start(const Eigen::VectorXd& x_hat, const Eigen:
   active_.clear();
   too_deep_.clear();
   end_contacts_.clear();
-  for (const HeldPiercing& h : held_piercings_) held_index_[h.piercing.body_vertex] = -1;
-  held_piercings_.clear();
-  corner_normal_.assign(static_cast<std::size_t>(n), Eigen::Vector3d::Zero());
 
   // Vertices being pushed out of an intersecting start move along their push normal to this
   // step's goal; ordinary contacts leave them alone until the repair is over.
@@ -491,11 +343,8 @@ void ContactResponse::constrain_start(const Eigen::VectorXd& x_hat, const Eigen:
     a.friction_in_solve = true;
     friction.push_back(term);
   }
-  // After the contacts, so that a corner's piercing direction is added to its contact's.
-  if (settings_.piercing_response == PiercingResponse::spring)
-    spring_start_piercings(x_hat + y, v0, beta, filter, extra);
-  else
-    constrain_start_piercings(x_hat, v0, beta, filter, y);
+  // After the contacts: the springs start from the corrected start x̂ + y.
+  spring_start_piercings(x_hat + y, v0, beta, filter, extra);
 }
 
 PointSpring ContactResponse::piercing_spring(const BodyPiercing& p, const Eigen::VectorXd& x,
@@ -696,8 +545,8 @@ int ContactResponse::constrain_deep(const Eigen::VectorXd& x0, const Eigen::Vect
   }
   // Body vertices more than the tolerance through the cloth. Not any height: over a smooth
   // convex body the cloth's chords pass a fraction of a millimetre under body vertices between
-  // cloth vertices held at the thickness; lifting those made a sheet on a sphere re-solve
-  // every step and never come to rest.
+  // cloth vertices held at the thickness; re-solving for those made a sheet on a sphere
+  // re-solve every step and never come to rest.
   piercings_ =
       repair ? std::vector<BodyPiercing>{} : find_piercings(x1, settings_.penetration_tolerance);
   pinned_.assign(x1.size() / 3, 0);
@@ -705,32 +554,10 @@ int ContactResponse::constrain_deep(const Eigen::VectorXd& x0, const Eigen::Vect
   if ((too_deep_.empty() && piercings_.empty()) || stats_.resolves >= settings_.max_resolves)
     return 0;
   for (const BodyContact& c : too_deep_) add_contact(c, x_hat, beta, filter, y, false);
-  if (settings_.piercing_response == PiercingResponse::spring) {
-    const int springs = spring_end_piercings(x1, extra);
-    stats_.piercings_resolved += springs;
-    const int added = static_cast<int>(too_deep_.size()) + springs;
-    if (added > 0) ++stats_.resolves;
-    return added;
-  }
-  // Lifted triangle corners: their normal velocity lands them at x1 + lift along the lift,
-  // and the piercings are held from now on.
-  int added = static_cast<int>(too_deep_.size());
-  const std::vector<CornerLift> lifts = corner_lifts(piercings_, clearance_deltas(piercings_),
-                                                     pinned_, static_cast<int>(x1.size() / 3));
-  for (int i = 0; i < static_cast<int>(lifts.size()); ++i) {
-    const CornerLift& lift = lifts[i];
-    if (!lift.set) continue;
-    // The lift beyond where the solve put the corner, at most kMaxPiercingLiftSpeed · β: the
-    // rest waits for the next steps (and for finish_step's direct lift).
-    const double target = x1.segment<3>(3 * i).dot(lift.normal) +
-                          std::min(lift.distance, kMaxPiercingLiftSpeed * beta);
-    const double start = (x_hat.segment<3>(3 * i) + y.segment<3>(3 * i)).dot(lift.normal);
-    constrain_corner(filter, i, lift.normal, (target - start) / beta);
-    ++added;
-  }
-  for (const BodyPiercing& p : piercings_) hold_piercing(p, false);
-  stats_.piercings_resolved += static_cast<int>(piercings_.size());
-  ++stats_.resolves;
+  const int springs = spring_end_piercings(x1, extra);
+  stats_.piercings_resolved += springs;
+  const int added = static_cast<int>(too_deep_.size()) + springs;
+  if (added > 0) ++stats_.resolves;
   return added;
 }
 
@@ -760,26 +587,9 @@ void ContactResponse::finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v,
   if (stats_.projected > 0)
     spdlog::debug("sim: {} cloth vertices projected out of the body after {} re-solves",
                   stats_.projected, stats_.resolves);
-  // Springs push on from where they ended, next step; nothing is lifted.
-  if (settings_.piercing_response == PiercingResponse::spring) record_spring_forces(x, extra);
-  // Body vertices still through the cloth after the re-solves: lift their triangles (positions,
-  // and the corners' velocity towards the body vertex removed), then measure again.
-  if (!piercings_.empty() && settings_.piercing_response == PiercingResponse::constraint) {
-    const int n = static_cast<int>(x.size() / 3);
-    const std::vector<CornerLift> lifts =
-        corner_lifts(piercings_, clearance_deltas(piercings_), pinned_, n);
-    for (int i = 0; i < n; ++i) {
-      const CornerLift& lift = lifts[i];
-      if (!lift.set) continue;
-      x.segment<3>(3 * i) += lift.distance * lift.normal;
-      auto vi = v.segment<3>(3 * i);
-      const double approach = (vi - lift.body_velocity).dot(lift.normal);
-      if (approach < 0.0) vi -= approach * lift.normal;
-    }
-    for (const BodyPiercing& p : piercings_) hold_piercing(p, false);
-    stats_.piercings_resolved += static_cast<int>(piercings_.size());
-    piercings_ = find_piercings(x, settings_.penetration_tolerance);
-  }
+  // Body vertices still through the cloth after the re-solves stay so until the next step's
+  // springs (carrying the force they ended with) push them out: nothing is lifted.
+  record_spring_forces(x, extra);
   for (const BodyPiercing& p : piercings_) {
     stats_.max_piercing = std::max(stats_.max_piercing, p.height);
     if (p.height > settings_.penetration_tolerance) ++stats_.piercing;
@@ -805,42 +615,11 @@ void ContactResponse::finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v,
 void ContactResponse::record_normal_forces(const Eigen::VectorXd& impulse) {
   std::fill(last_normal_force_.begin(), last_normal_force_.end(), kNoImpulse);
   std::fill(last_piercing_force_.begin(), last_piercing_force_.end(), kNoImpulse);
-  const bool solved = impulse.size() == static_cast<Eigen::Index>(3 * last_normal_force_.size());
-  // The impulse r of a vertex held along unit a and b lies in their span, r = α a + β b (least
-  // squares: the 2×2 Gram system). Closer than kMergeSine the piercing was carried by the
-  // contact's direction (constrain_corner), which then takes all of it.
-  const auto along = [](const Eigen::Vector3d& r, const Eigen::Vector3d& a,
-                        const Eigen::Vector3d& b) {
-    const double cosine = a.dot(b);
-    const double sine2 = 1.0 - cosine * cosine;
-    if (sine2 < kMergeSine * kMergeSine) return r.dot(a);
-    return (r.dot(a) - cosine * r.dot(b)) / sine2;
-  };
-  if (solved)
-    for (const ActiveContact& a : active_) {
-      if (a.released || a.repair) continue;
-      const int i = a.contact.vertex;
-      const Eigen::Vector3d r = impulse.segment<3>(3 * i);
-      const Eigen::Vector3d& piercing = corner_normal_[i];
-      last_normal_force_[i] =
-          (piercing.isZero() ? r.dot(a.contact.normal) : along(r, a.contact.normal, piercing)) /
-          beta_;
-    }
-  for (const HeldPiercing& h : held_piercings_) {
-    if (h.released) continue;
-    // Lifted after the last solve (or no solve): no force known, held as pressing.
-    double force = 0.0;
-    if (solved)
-      for (int k : cloth_.triangles[h.piercing.cloth_triangle]) {
-        if (corner_normal_[k].isZero()) continue;
-        const Eigen::Vector3d r = impulse.segment<3>(3 * k);
-        const int c = active_index_[k];
-        const bool contact = c >= 0 && !active_[c].released && !active_[c].repair;
-        force += (contact ? along(r, corner_normal_[k], active_[c].contact.normal)
-                          : r.dot(corner_normal_[k])) /
-                 beta_;
-      }
-    last_piercing_force_[h.piercing.body_vertex] = force;
+  if (impulse.size() != static_cast<Eigen::Index>(3 * last_normal_force_.size())) return;
+  for (const ActiveContact& a : active_) {
+    if (a.released || a.repair) continue;
+    const int i = a.contact.vertex;
+    last_normal_force_[i] = impulse.segment<3>(3 * i).dot(a.contact.normal) / beta_;
   }
 }
 

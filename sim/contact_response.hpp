@@ -28,15 +28,13 @@
 // features: a cloth triangle can span a cone tip or a shoulder with its three corners
 // outside). A body vertex through a triangle, or about to end the step closer than
 // `kPiercingClearance`·thickness in front of it, pushes the triangle's point over it out to that
-// clearance along the triangle's normal. By default (PiercingResponse::spring) the push is a
-// critically damped spring of the implicit solve on the point's corners (PointSpring), whose end
-// force is carried to the next step while it pushes and raised by the end check's re-solves: soft,
-// so two body parts squeezing the cloth between them cannot ask for opposite motions of one
-// corner, and never a jump in position. PiercingResponse::constraint makes the corners' normal
-// velocities constraints of the filter instead (Bridson et al. 2002's weights w_k / Σ w_j², the
-// least motion that moves the point), held like contacts and released when they pull; the end
-// check lifts what the re-solves left as a position change. It covers a sharp tip at every step
-// but fails where body parts close on the cloth (docs/collision.md).
+// clearance along the triangle's normal. The push is a critically damped spring of the implicit
+// solve on the point's corners (PointSpring), on every triangle near the vertex, whose end force
+// is carried to the next step and raised by the end check's re-solves: soft, so two body parts
+// squeezing the cloth between them cannot ask for opposite motions of one corner, and never a
+// jump in position. (Until 26 November the corners' normal velocities were constraints of the
+// filter and what the re-solves left was lifted as a position change; that response failed
+// where body parts close on the cloth, docs/collision.md.)
 //
 // The simulator (sim/simulation.hpp) drives this; it is separate so that the contact logic
 // reads in one place and can be tested on its own.
@@ -57,17 +55,6 @@
 
 namespace sd::sim {
 
-// How a body vertex poking through the cloth pushes the cloth back (check_body_vertices).
-enum class PiercingResponse {
-  // The corners' normal velocities are constraints of the filter, like contacts; what the
-  // re-solves leave is lifted as a position change at the end of the step.
-  constraint,
-  // A spring from the triangle's point over the body vertex to the clearance in front of it,
-  // part of the implicit solve (StepForces); its force is carried to the next step and raised
-  // by each re-solve, so a held tip ends at the clearance. Never a position change.
-  spring,
-};
-
 struct ContactSettings {
   bool enabled = true;       // with a body set; off: the body is ignored
   double thickness = 0.003;  // m: distance kept between a cloth vertex and the body surface
@@ -86,7 +73,6 @@ struct ContactSettings {
   // elbows, corners). See docs/collision.md, "Body vertices poking through the cloth", for
   // what it does and costs.
   bool check_body_vertices = false;
-  PiercingResponse piercing_response = PiercingResponse::spring;
   // Collider query parameters (see sim/body_collider.hpp, ContactQuery).
   double search_margin = 0.02;
   double max_substep_motion = 0.005;
@@ -120,11 +106,10 @@ struct ContactStepStats {
   int stuck = 0;                 // contacts in the stick regime (or stopped by friction)
   int repairing = 0;             // vertices still being pushed out of an intersecting start
   double max_penetration = 0.0;  // m, deepest vertex inside the body at the end (repair excluded)
-  // Body vertices poking through cloth triangles (sharp features): re-solved like deep
-  // vertices, then the triangles lifted. Measured at the end of the step.
-  int piercings_held = 0;      // body vertices held behind their triangle from the start
-  int piercings_released = 0;  // held last step, left free (their constraint pulled)
-  int piercings_resolved = 0;  // body vertices whose triangles were constrained or lifted
+  // Body vertices poking through cloth triangles (sharp features): springs in the solve,
+  // re-solved like deep vertices. Measured at the end of the step.
+  int piercings_held = 0;      // springs at the start of the step
+  int piercings_resolved = 0;  // springs added or raised by the end check
   int piercing = 0;            // body vertices more than the tolerance through the cloth at the end
   double max_piercing = 0.0;   // m, highest body vertex above the cloth at the end (0: none)
   int penetrating = 0;         // vertices deeper than the tolerance at the end (repair excluded)
@@ -182,19 +167,17 @@ class ContactResponse {
 
   // Step 3: swept check of the path x0 (previous pose) → x1 (current pose). Vertices deeper
   // than the tolerance (or that passed through) become constraints in `filter` (and y for the
-  // ones already too close at x̂); so do the vertices of cloth triangles a body vertex pokes
-  // through (each lifted along the triangle's normal, weighted by its barycentric share, so
-  // the triangle clears the body vertex by half the thickness). Returns how many were added,
-  // 0 when the step is clean.
-  // With PiercingResponse::spring the piercings become (or raise) springs in `extra` instead.
+  // ones already too close at x̂); body vertices more than the tolerance through the cloth get
+  // a spring in `extra`, or raise theirs. Returns how many were added or raised, 0 when the
+  // step is clean.
   int constrain_deep(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1,
                      const Eigen::VectorXd& x_hat, double beta, ConstraintFilter& filter,
                      Eigen::VectorXd& y, StepForces& extra);
 
   // After the last solve: projects the vertices the last end check found too deep onto
-  // point + thickness·normal with the body's normal velocity, lifts the cloth triangles body
-  // vertices still poke through, and measures the penetration and piercing.
-  // `extra`: the step's forces (springs' end forces are remembered for the next step).
+  // point + thickness·normal with the body's normal velocity, remembers the springs' end
+  // forces (`extra`: the step's forces) for the next step, and measures the penetration and
+  // piercing.
   void finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v, const StepForces& extra);
 
   ContactStepStats& step_stats() { return stats_; }
@@ -232,55 +215,22 @@ class ContactResponse {
   // The same whether or not the check is on (what count_piercing measures).
   std::vector<BodyPiercing> piercings_of(const Eigen::VectorXd& x, double min_height,
                                          bool every_triangle = false) const;
-  // What a set of piercings asks of one cloth vertex: move `distance` (m, signed: negative
-  // moves it towards the body vertex) along `normal`, the triangle's normal.
-  struct CornerLift {
-    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-    double distance = 0.0;
-    Eigen::Vector3d body_velocity = Eigen::Vector3d::Zero();  // of the body vertex, m/s
-    bool set = false;
-  };
-  // Per cloth vertex (#V), the motion that moves the point of each piercing's triangle under
-  // its body vertex by deltas[p] along the triangle's normal (Bridson's weighting); a vertex
-  // under several piercings takes the largest. Pinned vertices (per `pinned`, may be empty) do
-  // not move, the others take their share.
-  std::vector<CornerLift> corner_lifts(const std::vector<BodyPiercing>& piercings,
-                                       const std::vector<double>& deltas,
-                                       const std::vector<unsigned char>& pinned,
-                                       int vertices) const;
-  // Start of step: body vertices through the cloth at x̂ + y, or held last step, become
-  // piercing constraints (see the file comment). v0: start velocities (3n).
-  void constrain_start_piercings(const Eigen::VectorXd& x_hat, const Eigen::VectorXd& v0,
-                                 double beta, ConstraintFilter& filter, Eigen::VectorXd& y);
-  // Per piercing, the lift along its normal that leaves its body vertex the clearance behind
-  // the triangle: height + kPiercingClearance·thickness.
-  std::vector<double> clearance_deltas(const std::vector<BodyPiercing>& piercings) const;
-  // Normal forces (N) of the last solve from its constraint impulse (3n, N·s): per cloth
-  // vertex into last_normal_force_, per held body vertex into last_piercing_force_. A vertex
-  // constrained both by its contact and by a piercing has its impulse split between the two
-  // directions.
+  // Normal forces (N) of the last solve's contacts from its constraint impulse (3n, N·s), per
+  // cloth vertex into last_normal_force_.
   void record_normal_forces(const Eigen::VectorXd& impulse);
-  // Constrains the velocity of cloth vertex i along unit n to `normal_velocity` on top of what
-  // the filter already holds for it (a contact): a second direction whose value is chosen so
-  // that the velocity along n itself is right, or, for a direction nearly parallel to the
-  // contact's, the contact's direction with the larger of the two demands.
-  void constrain_corner(ConstraintFilter& filter, int i, const Eigen::Vector3d& n,
-                        double normal_velocity);
-  // Adds `piercing` to this attempt's held piercings (once per body vertex).
-  void hold_piercing(const BodyPiercing& piercing, bool released);
-  // PiercingResponse::spring: the spring that pushes piercing p's triangle to the clearance in
+  // The spring that pushes piercing p's triangle to the clearance in
   // front of its body vertex, from positions x (the body at its end pose), with `preload`.
   PointSpring piercing_spring(const BodyPiercing& p, const Eigen::VectorXd& x,
                               const std::vector<unsigned char>& pinned, double preload) const;
   // The largest preload a spring carries (N): kMaxSpringLoadClothWeights times the cloth's
   // weight.
   double max_spring_preload() const;
-  // Start of step, spring response: body vertices through the cloth at `start` (x̂ + y), about
-  // to be, or held last step, become springs in `extra`.
+  // Start of step: body vertices through the cloth at `start` (x̂ + y), about to be, or held
+  // last step, become springs in `extra`.
   void spring_start_piercings(const Eigen::VectorXd& start, const Eigen::VectorXd& v0,
                               double beta, const ConstraintFilter& filter, StepForces& extra);
-  // End check, spring response: a piercing of x1 gets a spring, or its spring's preload rises
-  // by the spring's force at x1. Returns how many changed.
+  // End check: a piercing of x1 gets a spring, or its spring's preload rises by the springs'
+  // force at x1. Returns how many changed.
   int spring_end_piercings(const Eigen::VectorXd& x1, StepForces& extra);
   // The force (N; negative: it ended pulling) each spring of this attempt ends with at x, to
   // carry to the next step.
@@ -308,24 +258,13 @@ class ContactResponse {
   std::vector<BodyContact> end_contacts_;
   ClothTriangles cloth_;  // the cloth's triangles (set_cloth_triangles)
   std::vector<BodyPiercing> piercings_;  // from the last end check, after the last solve
-  // Body vertices held behind a cloth triangle in this attempt (start or end check).
-  struct HeldPiercing {
-    BodyPiercing piercing;
-    bool released = false;  // within reach but left free: its constraint pulled last step
-  };
-  std::vector<HeldPiercing> held_piercings_;
-  std::vector<int> held_index_;  // per body vertex: index into held_piercings_, or −1
-  // Per cloth vertex, the direction a piercing constrained it along in this attempt (zero:
-  // none); splits its constraint impulse between its contact and the piercing.
-  std::vector<Eigen::Vector3d> corner_normal_;
-  // Per body vertex: the normal force (N, along the triangle's normal; < 0: it pulled the
-  // cloth towards the body) of its piercing constraint in the last accepted step, NaN when it
-  // was not held.
+  // Per body vertex: the force (N, along the triangles' normals; < 0: it ended pulling) its
+  // springs ended the last accepted step with, NaN when it had none.
   std::vector<double> last_piercing_force_;
   std::vector<unsigned char> pinned_;  // per cloth vertex, pinned in the step's filter
   Eigen::VectorXd mass_;               // per cloth vertex, kg
   double gravity_ = 9.81;              // m/s²
-  // PiercingResponse::spring: per spring of the attempt's StepForces, its body vertex; the
+  // Per spring of the attempt's StepForces, its body vertex; the
   // springs' end forces and (body vertex, cloth triangle) pairs, committed by accept_step; the
   // pairs of the last accepted step (followed at the next start even where find_piercings does
   // not report them: a body vertex in front of a cloth edge).

@@ -517,6 +517,20 @@ TEST(BodyCollider, BodyVertexThroughAClothTriangleIsAPiercing) {
   Eigen::VectorXd aside = below;
   for (int k = 0; k < 3; ++k) aside[3 * k] += 0.4;
   EXPECT_TRUE(collider.find_piercings(aside, triangles, 0.0, 0.05).empty());
+
+  // A pair asked for directly is measured the same way, with none of the search's filters: the
+  // reported one has the same height, normal and weights, and the one beside the cloth (what
+  // the simulator follows after a spring pushed it there) its height over the plane, 1 cm, with
+  // weights of the closest point on the triangle's edge.
+  const std::optional<BodyPiercing> pair = collider.piercing_of_pair(below, triangles[0], 0, 0);
+  ASSERT_TRUE(pair.has_value());
+  EXPECT_NEAR(pair->height, p.height, 1e-15);
+  EXPECT_NEAR((pair->normal - p.normal).norm(), 0.0, 1e-15);
+  EXPECT_NEAR((pair->barycentric - p.barycentric).norm(), 0.0, 1e-15);
+  const std::optional<BodyPiercing> beside = collider.piercing_of_pair(aside, triangles[0], 0, 0);
+  ASSERT_TRUE(beside.has_value());
+  EXPECT_NEAR(beside->height, 0.01, 1e-12);
+  EXPECT_NEAR(beside->barycentric.minCoeff(), 0.0, 1e-12);  // on the boundary of the triangle
 }
 
 TEST(BodyCollider, BodyVertexBesideTheClothsOpenEdgeIsNotAPiercing) {
