@@ -96,15 +96,6 @@ EndHeights end_heights(const BodyPiercing& p, const std::array<int, 3>& triangle
   return {p.height - beta * p.body_velocity.dot(p.normal), p.height - beta * point_velocity};
 }
 
-// n·p of a spring's point p = Σ w_k x_k on its triangle's corners.
-double spring_point_along_normal(const PointSpring& spring, const std::array<int, 3>& triangle,
-                                 const Eigen::VectorXd& x) {
-  double along = 0.0;
-  for (int k = 0; k < 3; ++k)
-    along += spring.weights[k] * spring.normal.dot(x.segment<3>(3 * triangle[k]));
-  return along;
-}
-
 void require(bool ok, const char* message) {
   if (!ok) throw InvalidContactSettingsError(message);
 }
@@ -203,9 +194,8 @@ void ContactResponse::reset_cloth(const Eigen::VectorXd& x, const Eigen::VectorX
   if (last_piercing_force_.size() != static_cast<std::size_t>(collider_.vertex_count()))
     last_piercing_force_.assign(static_cast<std::size_t>(collider_.vertex_count()), kNoImpulse);
   spring_body_vertex_.clear();
-  spring_end_force_.clear();
-  spring_end_pairs_.clear();
-  held_spring_pairs_.clear();
+  spring_ends_.clear();
+  held_springs_.clear();
   // Plan the push-out on the first cloth, or again (over the remaining steps) when the cloth
   // is renumbered in the middle of one.
   if (!repair_planned_ || repairing()) {
@@ -355,14 +345,14 @@ PointSpring ContactResponse::piercing_spring(const BodyPiercing& p, const Eigen:
   spring.triangle = p.cloth_triangle;
   spring.weights = p.barycentric;
   spring.normal = p.normal;
-  double inverse_mass = 0.0, along = 0.0;
-  for (int k = 0; k < 3; ++k) {
-    along += p.barycentric[k] * p.normal.dot(x.segment<3>(3 * t[k]));
+  double inverse_mass = 0.0;
+  for (int k = 0; k < 3; ++k)
     if (pinned.empty() || pinned[t[k]] == 0)
       inverse_mass += p.barycentric[k] * p.barycentric[k] / mass_[t[k]];
-  }
-  // The body vertex is at along + height; the point must end the clearance in front of it.
-  spring.target = along + p.height + kPiercingClearance * settings_.thickness;
+  // The body vertex is the height above the point; the point must end the clearance in front of
+  // it.
+  spring.target =
+      along_spring_normal(spring, t, x) + p.height + kPiercingClearance * settings_.thickness;
   spring.reference_velocity = p.body_velocity;
   if (!(inverse_mass > 0.0)) return spring;  // all corners pinned: nothing can move
   const double mass = 1.0 / inverse_mass;
@@ -397,7 +387,8 @@ void ContactResponse::spring_start_piercings(const Eigen::VectorXd& start,
   std::sort(candidates.begin(), candidates.end(), [](const BodyPiercing& a, const BodyPiercing& b) {
     return std::tie(a.body_vertex, a.cloth_triangle) < std::tie(b.body_vertex, b.cloth_triangle);
   });
-  for (const auto& [body_vertex, triangle] : held_spring_pairs_) {
+  for (const SpringEnd& held : held_springs_) {
+    const int body_vertex = held.body_vertex, triangle = held.triangle;
     const auto found = std::lower_bound(
         candidates.begin(), candidates.end(), std::make_pair(body_vertex, triangle),
         [](const BodyPiercing& a, const std::pair<int, int>& key) {
@@ -454,7 +445,7 @@ int ContactResponse::spring_end_piercings(const Eigen::VectorXd& x1, StepForces&
       if (spring_body_vertex_[s] != p.body_vertex) continue;
       const PointSpring& spring = extra.springs[s];
       const double along =
-          spring_point_along_normal(spring, cloth_.triangles[spring.triangle], x1);
+          along_spring_normal(spring, cloth_.triangles[spring.triangle], x1);
       carried += std::max(0.0, spring.preload + spring.stiffness * (spring.target - along));
       if (spring.triangle == p.cloth_triangle) match = s;
     }
@@ -479,15 +470,13 @@ int ContactResponse::spring_end_piercings(const Eigen::VectorXd& x1, StepForces&
 }
 
 void ContactResponse::record_spring_forces(const Eigen::VectorXd& x, const StepForces& extra) {
-  spring_end_force_.clear();
-  spring_end_pairs_.clear();
+  spring_ends_.clear();
   for (std::size_t s = 0; s < spring_body_vertex_.size(); ++s) {
     const PointSpring& spring = extra.springs[s];
-    const double along = spring_point_along_normal(spring, cloth_.triangles[spring.triangle], x);
+    const double along = along_spring_normal(spring, cloth_.triangles[spring.triangle], x);
     const double force = spring.preload + spring.stiffness * (spring.target - along);
-    spring_end_force_.emplace_back(spring_body_vertex_[s],
-                                   std::min(force, max_spring_preload()));
-    spring_end_pairs_.emplace_back(spring_body_vertex_[s], spring.triangle);
+    spring_ends_.push_back({spring_body_vertex_[s], spring.triangle,
+                            std::min(force, max_spring_preload())});
   }
 }
 
@@ -549,8 +538,6 @@ int ContactResponse::constrain_deep(const Eigen::VectorXd& x0, const Eigen::Vect
   // re-solve every step and never come to rest.
   piercings_ =
       repair ? std::vector<BodyPiercing>{} : find_piercings(x1, settings_.penetration_tolerance);
-  pinned_.assign(x1.size() / 3, 0);
-  for (int i = 0; i < static_cast<int>(pinned_.size()); ++i) pinned_[i] = filter.is_pinned(i);
   if ((too_deep_.empty() && piercings_.empty()) || stats_.resolves >= settings_.max_resolves)
     return 0;
   for (const BodyContact& c : too_deep_) add_contact(c, x_hat, beta, filter, y, false);
@@ -625,11 +612,12 @@ void ContactResponse::record_normal_forces(const Eigen::VectorXd& impulse) {
 
 void ContactResponse::accept_step(const Eigen::VectorXd& impulse) {
   record_normal_forces(impulse);
-  held_spring_pairs_ = spring_end_pairs_;
+  held_springs_ = spring_ends_;
   // A body vertex with several springs (under a cloth edge, or the cloth slid over it) carries
   // the sum of their pushes (or, when none pushed, the least pull: it stays held).
-  for (const auto& [body_vertex, force] : spring_end_force_) {
-    double& carried = last_piercing_force_[body_vertex];
+  for (const SpringEnd& end : held_springs_) {
+    const double force = end.force;
+    double& carried = last_piercing_force_[end.body_vertex];
     if (std::isnan(carried))
       carried = force;
     else if (carried > 0.0 || force > 0.0)

@@ -264,14 +264,19 @@ class ContactResponse {
   std::vector<unsigned char> pinned_;  // per cloth vertex, pinned in the step's filter
   Eigen::VectorXd mass_;               // per cloth vertex, kg
   double gravity_ = 9.81;              // m/s²
-  // Per spring of the attempt's StepForces, its body vertex; the
-  // springs' end forces and (body vertex, cloth triangle) pairs, committed by accept_step; the
-  // pairs of the last accepted step (followed at the next start even where find_piercings does
-  // not report them: a body vertex in front of a cloth edge).
+  // Per spring of the attempt's StepForces, its body vertex.
   std::vector<int> spring_body_vertex_;
-  std::vector<std::pair<int, double>> spring_end_force_;
-  std::vector<std::pair<int, int>> spring_end_pairs_;
-  std::vector<std::pair<int, int>> held_spring_pairs_;
+  // How a spring ended a step: its pair and the force (N; negative: it ended pulling).
+  struct SpringEnd {
+    int body_vertex = -1;
+    int triangle = -1;
+    double force = 0.0;
+  };
+  // This attempt's springs at its end (record_spring_forces), and those of the last accepted
+  // step, whose pairs the next start follows even where find_piercings does not report them (a
+  // body vertex in front of a cloth edge).
+  std::vector<SpringEnd> spring_ends_;
+  std::vector<SpringEnd> held_springs_;
   ContactStepStats stats_;
   std::vector<ActiveContact> accepted_contacts_;
 };

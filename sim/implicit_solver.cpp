@@ -21,13 +21,9 @@ void ImplicitSolver::add_extra_force(const ClothModel& model, const StepForces* 
         d.force - d.coefficient * (v.segment<3>(3 * d.vertex) - d.reference_velocity);
   for (const PointSpring& s : extra->springs) {
     const std::array<int, 3>& corners = model.triangles[s.triangle].vertices;
-    double along = 0.0, speed = 0.0;
-    for (int k = 0; k < 3; ++k) {
-      along += s.weights[k] * s.normal.dot(x.segment<3>(3 * corners[k]));
-      speed += s.weights[k] * s.normal.dot(v.segment<3>(3 * corners[k]));
-    }
-    const double f = s.preload + s.stiffness * (s.target - along) -
-                     s.damping * (speed - s.normal.dot(s.reference_velocity));
+    const double f = s.preload + s.stiffness * (s.target - along_spring_normal(s, corners, x)) -
+                     s.damping * (along_spring_normal(s, corners, v) -
+                                  s.normal.dot(s.reference_velocity));
     for (int k = 0; k < 3; ++k) force_.segment<3>(3 * corners[k]) += (s.weights[k] * f) * s.normal;
   }
 }
@@ -84,9 +80,7 @@ void ImplicitSolver::assemble(const ClothModel& model, const ForceSettings& forc
                   w * outer(a, b);
         }
       if (u != nullptr) {
-        double along = 0.0;
-        for (int l = 0; l < 3; ++l)
-          along += s.weights[l] * s.normal.dot(u->segment<3>(3 * t.vertices[l]));
+        const double along = along_spring_normal(s, t.vertices, *u);
         for (int k = 0; k < 3; ++k)
           product_.segment<3>(3 * t.vertices[k]) -= (s.stiffness * s.weights[k] * along) * s.normal;
       }

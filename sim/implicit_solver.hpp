@@ -8,6 +8,7 @@
 // filtered by the constraints and solved by the modified PCG or CHOLMOD.
 
 #include <Eigen/Core>
+#include <array>
 #include <vector>
 
 #include "sim/cholmod_solver.hpp"
@@ -64,6 +65,16 @@ struct PointSpring {
   double damping = 0.0;    // kg/s
   Eigen::Vector3d reference_velocity = Eigen::Vector3d::Zero();  // m/s
 };
+
+// n·Σ_k w_k y_k over the spring's corners (given: its triangle's vertices) for any 3n vector y:
+// the point's height along the normal for positions, its normal speed for velocities.
+inline double along_spring_normal(const PointSpring& spring, const std::array<int, 3>& corners,
+                                  const Eigen::VectorXd& y) {
+  double along = 0.0;
+  for (int k = 0; k < 3; ++k)
+    along += spring.weights[k] * spring.normal.dot(y.segment<3>(3 * corners[k]));
+  return along;
+}
 
 // Forces a step adds to the cloth's own, all implicit (their matrices go into A): contact
 // friction as per-vertex drags, body vertices poking through as point springs.
