@@ -490,7 +490,7 @@ void parse_adaptive(const Reader& r, const json& a, SimulateSpec& sim) {
                  "0.002, ...}");
   r.check_keys(a, path, {"enabled", "refine_threshold", "coarsen_threshold", "steady_rate",
                          "min_lifetime", "min_level", "max_level", "max_vertices",
-                         "merge_batch"});
+                         "merge_batch", "even_levels"});
   AdaptiveSpec& s = sim.adaptive_settings;
   if (a.contains("enabled")) sim.adaptive = r.boolean(a["enabled"], path + "/enabled");
   if (a.contains("refine_threshold"))
@@ -524,6 +524,8 @@ void parse_adaptive(const Reader& r, const json& a, SimulateSpec& sim) {
              "the merge batch is a fraction of the particles (0.05: merges wait until 5 % of "
              "them can go at once); it must be below 1");
   }
+  if (a.contains("even_levels"))
+    s.even_levels = r.boolean(a["even_levels"], path + "/even_levels");
 }
 
 void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {

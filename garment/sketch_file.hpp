@@ -117,6 +117,7 @@ struct AdaptiveSpec {
   std::optional<int> max_level;             // finest level a split makes
   std::optional<int> max_vertices;          // particle budget, 0: none
   std::optional<double> merge_batch;        // fraction of the particles lone merges wait for
+  std::optional<bool> even_levels;          // keep the leaves on even levels
 };
 
 // How the drape is simulated (`sketchdrape run`): plain values with defaults.

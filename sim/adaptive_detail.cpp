@@ -624,6 +624,8 @@ AdaptStats AdaptiveCloth::adapt() {
   if (settings_.coarsen) {
     for (BlockId k : mesh_.mergeable_blocks()) {
       if (mesh_.level(k) < settings_.min_level) continue;
+      // Even levels: the merge of an odd block would leave odd triangles.
+      if (settings_.even_levels && mesh_.level(k) % 2 != 0) continue;
       const std::array<TriangleId, 4> children = mesh_.child_triangles(k);
       bool old_enough = true;
       for (TriangleId t : children)
@@ -697,10 +699,17 @@ AdaptStats AdaptiveCloth::adapt() {
         refinements.emplace_back(errors(r), static_cast<int>(r));
     std::sort(refinements.begin(), refinements.end(), std::greater<>());
   }
+  // Even levels: every complete odd block (only splits make them then; a pending one is the
+  // strip next to a coarser region and stays) is split on this step whatever its estimate.
+  std::vector<BlockId> odd_blocks;
+  if (settings_.refine && settings_.even_levels)
+    for (BlockId k : mesh_.leaf_blocks())
+      if (mesh_.level(k) % 2 != 0 && mesh_.level(k) < settings_.max_level && !mesh_.is_pending(k))
+        odd_blocks.push_back(k);
   stats.estimate_s = seconds_since(estimate_start);
   // Merges on their own wait until enough of them pay for a rebuild (merge_batch); blocks that
   // stay flat and steady are still candidates on the next step.
-  if (refinements.empty() &&
+  if (refinements.empty() && odd_blocks.empty() &&
       static_cast<double>(merges.size()) < settings_.merge_batch * mesh_.vertex_count())
     merges.clear();
 
@@ -739,6 +748,16 @@ AdaptStats AdaptiveCloth::adapt() {
       }
       count_split(mesh_.split(k), state, stats);
     }
+  }
+  for (BlockId k : odd_blocks) {
+    if (settings_.max_vertices > 0 && mesh_.vertex_count() >= settings_.max_vertices) break;
+    // Made or completed by a split above: one level per block per step.
+    if (!mesh_.can_split(k) || touched(k)) continue;
+    if (!split_stays_off_body(k, state.x)) {
+      ++stats.splits_declined_on_body;
+      continue;
+    }
+    count_split(mesh_.split(k), state, stats);
   }
   return finish(state, stats, operations_start);
 }

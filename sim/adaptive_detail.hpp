@@ -54,6 +54,14 @@ struct AdaptiveSettings {
   // analysis) costs about half a step, more than the two or three particles a lone batch of
   // merges frees would save. 0: merge whenever a block qualifies.
   double merge_batch = 0.05;
+  // Keep the leaves on even levels (0, 2, 4, ... of the input mesh): a complete block at an odd
+  // level is split on the step after the split that made it, whatever its estimate, and a
+  // merge is made only when it returns to an even level. The edge directions of a 4-8 mesh turn
+  // by 45° with each level, and where a cloth folds all at once (a sheet landing on a body) the
+  // fold pattern follows them: a mesh that mixes levels of both parities folds unlike any fixed
+  // level (docs/adaptive.md, "Even levels"). Only the strip around a refined region, where the
+  // level rule needs it, stays odd. A region refined by two levels is not coarsened again.
+  bool even_levels = false;
   bool refine = true;
   bool coarsen = true;
   // Measure energies, total mass and linear momentum just before and just after each topology

@@ -140,6 +140,7 @@ sim::AdaptiveSettings adaptive_settings(const garment::Sketch& sketch) {
   s.max_level = spec.max_level.value_or(s.max_level);
   s.max_vertices = spec.max_vertices.value_or(s.max_vertices);
   s.merge_batch = spec.merge_batch.value_or(s.merge_batch);
+  s.even_levels = spec.even_levels.value_or(s.even_levels);
   try {
     s.validate();  // e.g. a coarsen threshold set at or above the default refine threshold
   } catch (const sim::InvalidAdaptiveSettingsError& e) {

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <set>
 
 #include "sim/surface_sampling.hpp"
 #include "tests/sim/adaptive_scenes.hpp"
@@ -478,6 +479,68 @@ TEST(AdaptiveDetail, ChurnStress) {
   std::printf("churn: %d splits, %d merges, %d retries, final %d vertices, max strain %.4f\n",
               splits, merges, cloth.simulation().report().retries, cloth.mesh().vertex_count(),
               strain);
+}
+
+// The complete leaf blocks at an odd level, each named by the rest midpoint of its diagonal
+// (rest positions survive the renumbering of every rebuild), rounded to 0.1 mm.
+std::set<std::array<long, 3>> complete_odd_leaves(const meshing::Mesh48& mesh) {
+  std::set<std::array<long, 3>> out;
+  for (BlockId k : mesh.leaf_blocks()) {
+    if (mesh.level(k) % 2 == 0 || mesh.is_pending(k)) continue;
+    const auto [b, c] = mesh.diagonal(k);
+    const Eigen::Vector3d mid = 0.5 * (mesh.rest_position(b) + mesh.rest_position(c));
+    out.insert({std::lround(mid.x() * 1e4), std::lround(mid.y() * 1e4), std::lround(mid.z() * 1e4)});
+  }
+  return out;
+}
+
+// Even levels: a complete odd block lives one step (it is split on the next, whatever its
+// estimate), so the 3-corner sheet's fold is refined two levels at a time; without the setting
+// such blocks stay. Odd blocks are not merged: a region refined to level 2 stays there.
+TEST(AdaptiveDetail, EvenLevelsRefineTwoLevelsAtATime) {
+  struct Outcome {
+    int odd_blocks_that_stayed = 0;  // complete odd leaf blocks seen after two steps in a row
+    int odd_leaves_not_pending = 0;  // at the end
+    AdaptiveReport report;
+  };
+  const auto run = [](bool even_levels) {
+    AdaptiveSheetSpec spec;
+    spec.duration = 0.75;
+    AdaptiveSettings settings;
+    settings.max_level = 4;
+    settings.even_levels = even_levels;
+    AdaptiveCloth cloth = make_adaptive_sheet(spec, 0, settings);
+    Outcome outcome;
+    std::set<std::array<long, 3>> before = complete_odd_leaves(cloth.mesh());
+    while (cloth.time() < spec.duration - 1e-9) {
+      const StepOutcome step = cloth.step();
+      EXPECT_TRUE(step.accepted) << step.failure_reason;
+      if (!step.accepted) break;
+      const std::set<std::array<long, 3>> now = complete_odd_leaves(cloth.mesh());
+      for (const auto& block : now) outcome.odd_blocks_that_stayed += static_cast<int>(before.count(block));
+      before = now;
+    }
+    const std::vector<std::string> problems = cloth.mesh().validate();
+    EXPECT_TRUE(problems.empty()) << problems.front();
+    for (BlockId k : cloth.mesh().leaf_blocks())
+      if (cloth.mesh().level(k) % 2 != 0 && !cloth.mesh().is_pending(k))
+        ++outcome.odd_leaves_not_pending;
+    outcome.report = cloth.report();
+    return outcome;
+  };
+  const Outcome mixed = run(false);
+  EXPECT_GT(mixed.odd_blocks_that_stayed, 0);  // the check can see them
+  const Outcome even = run(true);
+  std::printf("odd blocks kept a step: mixed %d, even %d; even: %d splits, %d merges, level %d\n",
+              mixed.odd_blocks_that_stayed, even.odd_blocks_that_stayed, even.report.splits,
+              even.report.merges, even.report.max_level_reached);
+  EXPECT_EQ(even.odd_blocks_that_stayed, 0);
+  EXPECT_GT(even.report.splits, 0);
+  EXPECT_EQ(even.report.max_level_reached, 4);
+  // Odd blocks were not merged and complete ones were split: the odd triangles left are the
+  // strips next to coarser ones (a merge of an odd block would leave a complete odd leaf for
+  // at least min_lifetime, the 0.25 s test above would see it too).
+  EXPECT_EQ(even.odd_leaves_not_pending, 0);
 }
 
 TEST(AdaptiveDetail, LevelLimitsAndBudgetHold) {

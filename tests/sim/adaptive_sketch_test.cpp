@@ -40,7 +40,7 @@ TEST(AdaptiveSketch, BoolAndObjectForms) {
   const Sketch s = parse_sketch(
       sketch_with(R"({"enabled": true, "refine_threshold": 0.004, "coarsen_threshold": 0.001,
                       "steady_rate": 0.1, "min_lifetime": 0.5, "min_level": 1, "max_level": 5,
-                      "max_vertices": 800, "merge_batch": 0.1})"),
+                      "max_vertices": 800, "merge_batch": 0.1, "even_levels": true})"),
       "t.json");
   const AdaptiveSpec& a = s.simulate.adaptive_settings;
   EXPECT_TRUE(s.simulate.adaptive);
@@ -52,6 +52,8 @@ TEST(AdaptiveSketch, BoolAndObjectForms) {
   EXPECT_EQ(*a.max_level, 5);
   EXPECT_EQ(*a.max_vertices, 800);
   EXPECT_DOUBLE_EQ(*a.merge_batch, 0.1);
+  EXPECT_TRUE(*a.even_levels);
+  EXPECT_FALSE(defaults.simulate.adaptive_settings.even_levels.has_value());
   EXPECT_FALSE(parse_sketch(sketch_with(R"({"enabled": false})"), "t.json").simulate.adaptive);
 }
 
@@ -74,6 +76,7 @@ TEST(AdaptiveSketch, BadValuesNameTheirPath) {
   EXPECT_EQ(error_of(R"({"merge_batch": -0.1})").rfind("/simulate/adaptive/merge_batch:", 0), 0u);
   EXPECT_EQ(error_of(R"({"steady_rate": -0.1})").rfind("/simulate/adaptive/steady_rate:", 0), 0u);
   EXPECT_EQ(error_of(R"({"enabled": 1})").rfind("/simulate/adaptive/enabled:", 0), 0u);
+  EXPECT_EQ(error_of(R"({"even_levels": "yes"})").rfind("/simulate/adaptive/even_levels:", 0), 0u);
   EXPECT_EQ(error_of(R"({"refine": 0.1})").rfind("/simulate/adaptive", 0), 0u);  // unknown key
   EXPECT_EQ(error_of(R"({"max_vertices": 0})"), "");
 }
