@@ -4,7 +4,7 @@
 //   adaptive_bench [google benchmark flags]   kernels: the error estimate, one adapt() with
 //                                             splits and merges, a model rebuild
 //   adaptive_bench --study=DIR [--quick] [--scene=SCENE] [--only=RUN] [--finest=N]
-//                  [--perturbed=K]
+//                  [--perturbed=K] [--adaptive-start=L] [--even-levels] [--fine-ladder]
 //                                             the work-precision study: the 3-corner and 2-corner
 //                                             sheets, a tablecloth and a sheet dropped on a sphere
 //                                             run fixed at levels N-4, N-2, N
@@ -15,9 +15,13 @@
 //                                             two_corner, tablecloth, sphere); --only: one
 //                                             run (e.g. adaptive_2mm) without the reference
 //                                             (measured against the one a full run kept in
-//                                             DIR, if any), to profile; --finest: N, 4 to 9 (default 6);
+//                                             DIR, if any), to profile; --finest: N, 4 to 11 (default 6);
 //                                             --perturbed: K more runs of fixed level N with
-//                                             the body moved by 1 µm (scenes with a body).
+//                                             the body moved by 1 µm (scenes with a body);
+//                                             --adaptive-start: the adaptive runs' first level
+//                                             (default 0); --even-levels: adaptive runs keep
+//                                             even levels; --fine-ladder: thresholds in steps
+//                                             of √2 instead of 2.
 #include <benchmark/benchmark.h>
 
 #include <chrono>
@@ -51,11 +55,12 @@ AdaptiveSettings fixed_settings() {
   return settings;
 }
 
-AdaptiveSettings adaptive_settings(double refine_threshold, int max_level) {
+AdaptiveSettings adaptive_settings(double refine_threshold, int max_level, bool even_levels = false) {
   AdaptiveSettings settings;
   settings.refine_threshold = refine_threshold;
   settings.coarsen_threshold = 0.25 * refine_threshold;
   settings.max_level = max_level;
+  settings.even_levels = even_levels;
   return settings;
 }
 
@@ -63,10 +68,12 @@ AdaptiveSettings adaptive_settings(double refine_threshold, int max_level) {
 // 0.5 mm · 2^(6 − finest) (4, 2, 1, 0.5 mm at level 6). The sag estimate on a smooth curve halves
 // with each level (θ and w both halve every two), so the threshold that lets the smooth parts
 // reach level N is half the one for level N − 1; the coarser thresholds stay for comparison.
-std::vector<double> refine_thresholds(int finest) {
+// fine_ladder: steps of √2 instead of 2 (4, 2.83, 2, 1.41, 1, 0.707 mm, ...).
+std::vector<double> refine_thresholds(int finest, bool fine_ladder) {
   const double smallest = 0.5e-3 * std::ldexp(1.0, 6 - finest);
   std::vector<double> thresholds;
-  for (double t = 4e-3; t > 0.99 * smallest; t /= 2) thresholds.push_back(t);
+  const double ratio = fine_ladder ? std::sqrt(2.0) : 2.0;
+  for (double t = 4e-3; t > 0.99 * smallest; t /= ratio) thresholds.push_back(t);
   return thresholds;
 }
 
@@ -289,12 +296,25 @@ void errors_against(RunResult& run, const RunResult& reference) {
   run.error_final = rms_distance(run.samples[n - 1], reference.samples[n - 1]);
 }
 
-// only_scene: that scene alone; only: just the runs of this name (e.g. adaptive_2mm) and no
-// reference, for profiling. Empty: all. finest: the finest fixed level and the adaptive max level
-// (the reference is two levels finer). perturbed: runs of the finest fixed level with the body
-// moved by 1 µm, in scenes with a body.
-int run_study(const std::string& dir, bool quick, const std::string& only_scene,
-              const std::string& only, int finest, int perturbed, int adaptive_start) {
+// What the study runs (the command line's options, see the top of the file).
+struct StudyOptions {
+  std::string dir;
+  bool quick = false;      // 1 s instead of 4, reference one level finer
+  std::string only_scene;  // that scene alone; empty: all
+  std::string only;        // just the runs of this name (e.g. adaptive_2mm), no reference
+  int finest = 6;          // finest fixed level and adaptive max level (reference: two finer)
+  int perturbed = 0;       // runs of the finest fixed level with the body moved by 1 µm
+  int adaptive_start = 0;  // level the adaptive runs start from
+  bool even_levels = false;
+  bool fine_ladder = false;  // refine thresholds in steps of √2
+};
+
+int run_study(const StudyOptions& options) {
+  const std::string& dir = options.dir;
+  const std::string& only_scene = options.only_scene;
+  const std::string& only = options.only;
+  const bool quick = options.quick;
+  const int finest = options.finest;
   std::filesystem::create_directories(dir);
   std::ofstream summary(dir + "/summary.csv");
   summary << "scene,run,cpu_s,wall_s,forces_s,solve_s,estimate_s,operations_s,rebuild_s,steps,retries,"
@@ -330,21 +350,21 @@ int run_study(const std::string& dir, bool quick, const std::string& only_scene,
     // Where the drape is sensitive to its start (a sheet landing on a body), the finest fixed run
     // with the body moved by 1 µm: how far a perturbation no mesh can resolve moves the result,
     // the width of the fixed-finest run's own error band.
-    for (int k = 0; k < perturbed && spec.body.face_count() > 0; ++k) {
+    for (int k = 0; k < options.perturbed && spec.body.face_count() > 0; ++k) {
       const std::string name = "fixed_l" + std::to_string(finest) + "_moved_" + std::to_string(k);
       if (!wanted(name)) continue;
       AdaptiveSheetSpec moved = spec;
-      const double angle = 2.0 * std::numbers::pi * (k + 0.5) / perturbed;
+      const double angle = 2.0 * std::numbers::pi * (k + 0.5) / options.perturbed;
       const Eigen::RowVector3d shift(1e-6 * std::cos(angle), 0.0, 1e-6 * std::sin(angle));
       moved.body.vertices.rowwise() += shift;
       runs.push_back(run_case(dir, scene, name, moved, finest, fixed_settings(), points, every));
     }
-    for (double threshold : refine_thresholds(finest)) {
+    for (double threshold : refine_thresholds(finest, options.fine_ladder)) {
       char name[64];
       std::snprintf(name, sizeof name, "adaptive_%gmm", threshold * 1e3);
       if (wanted(name))
-        runs.push_back(run_case(dir, scene, name, spec, adaptive_start,
-                                adaptive_settings(threshold, finest), points, every));
+        runs.push_back(run_case(dir, scene, name, spec, options.adaptive_start,
+                                adaptive_settings(threshold, finest, options.even_levels), points, every));
     }
     if (runs.empty()) continue;
     // The reference last, so that a profiled run is not preceded by it. Its samples are kept in
@@ -393,35 +413,35 @@ int run_study(const std::string& dir, bool quick, const std::string& only_scene,
 
 int main(int argc, char** argv) {
   sd::sim::restart_with_single_threaded_solvers(argv);  // the solvers as sketchdrape runs them
-  std::string study, only_scene, only;
-  bool quick = false;
-  int finest = 6;
-  int perturbed = 0;
-  int adaptive_start = 0;
+  StudyOptions options;
   std::vector<char*> rest;
   for (int i = 0; i < argc; ++i) {
     if (std::strncmp(argv[i], "--study=", 8) == 0)
-      study = argv[i] + 8;
+      options.dir = argv[i] + 8;
     else if (std::strncmp(argv[i], "--scene=", 8) == 0)
-      only_scene = argv[i] + 8;
+      options.only_scene = argv[i] + 8;
     else if (std::strncmp(argv[i], "--only=", 7) == 0)
-      only = argv[i] + 7;
+      options.only = argv[i] + 7;
     else if (std::strncmp(argv[i], "--finest=", 9) == 0)
-      finest = std::atoi(argv[i] + 9);
+      options.finest = std::atoi(argv[i] + 9);
     else if (std::strncmp(argv[i], "--perturbed=", 12) == 0)
-      perturbed = std::atoi(argv[i] + 12);
+      options.perturbed = std::atoi(argv[i] + 12);
     else if (std::strncmp(argv[i], "--adaptive-start=", 17) == 0)
-      adaptive_start = std::atoi(argv[i] + 17);
+      options.adaptive_start = std::atoi(argv[i] + 17);
+    else if (std::strcmp(argv[i], "--even-levels") == 0)
+      options.even_levels = true;
+    else if (std::strcmp(argv[i], "--fine-ladder") == 0)
+      options.fine_ladder = true;
     else if (std::strcmp(argv[i], "--quick") == 0)
-      quick = true;
+      options.quick = true;
     else
       rest.push_back(argv[i]);
   }
-  if (finest < 4 || finest > 9) {
-    std::fprintf(stderr, "--finest must be 4 to 9 (fixed runs at N-4, N-2, N, reference N+2)\n");
+  if (options.finest < 4 || options.finest > 11) {
+    std::fprintf(stderr, "--finest must be 4 to 11 (fixed runs at N-4, N-2, N, reference N+2)\n");
     return 1;
   }
-  if (!study.empty()) return run_study(study, quick, only_scene, only, finest, perturbed, adaptive_start);
+  if (!options.dir.empty()) return run_study(options);
   int count = static_cast<int>(rest.size());
   benchmark::Initialize(&count, rest.data());
   benchmark::RunSpecifiedBenchmarks();
