@@ -209,7 +209,8 @@ Eigen::VectorXd AdaptiveCloth::body_sags() const {
   // Three closest-point queries per edge are most of adaptivity's cost on a body, and the sag
   // under an edge depends only on where its two ends are: an edge whose ends (and the body)
   // moved less than `settle` since its sag was found keeps it. A body point then moved as
-  // little, so the kept sag is off by about 2·settle, the coarsen threshold.
+  // little, so the kept sag is off by about 2·settle, the coarsen threshold. A sag that stays
+  // below the refine threshold by more than twice the motion is kept too (below).
   const double settle = 0.5 * settings_.coarsen_threshold;
   const double body_motion = contact->collider().total_motion();
   body_sag_memory_.resize(static_cast<std::size_t>(edges.rows()));
@@ -223,11 +224,19 @@ Eigen::VectorXd AdaptiveCloth::body_sags() const {
     if (!refinable(r)) continue;
     const BodySagMemory& memory = body_sag_memory_[static_cast<std::size_t>(r)];
     const int i = edges(r, 0), j = edges(r, 1);
-    if (memory.valid && (row3(x, i) - memory.xi).norm() < settle &&
-        (row3(x, j) - memory.xj).norm() < settle && body_motion - memory.body_motion < settle) {
-      sags(r) = memory.sag;
-      ++body_sags_reused_;
-      continue;
+    if (memory.valid) {
+      const double moved = std::max({(row3(x, i) - memory.xi).norm(),
+                                     (row3(x, j) - memory.xj).norm(),
+                                     body_motion - memory.body_motion});
+      // Near enough to where it was found, or so far below the refine threshold that the motion
+      // cannot lift it over (the three body points move as little as what they lie under, so
+      // the sag changes by at most twice the motion): such a sag cannot decide a split, and the
+      // splits and their order are those a fresh one would give.
+      if (moved < settle || memory.sag + 2.0 * moved < settings_.refine_threshold) {
+        sags(r) = memory.sag;
+        ++body_sags_reused_;
+        continue;
+      }
     }
     ++body_sags_computed_;
     stale[static_cast<std::size_t>(r)] = 1;

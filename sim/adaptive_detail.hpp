@@ -215,7 +215,9 @@ class AdaptiveCloth {
   // cloth is still approaching: refining on it gives the cloth the resolution the body's
   // curvature asks for before the contact instead of after it. An edge whose ends and the body
   // moved less than half the coarsen threshold since its sag was found keeps that sag (counted
-  // in AdaptiveReport::body_sags_reused), so a cloth lying still asks the body nothing.
+  // in AdaptiveReport::body_sags_reused), so a cloth lying still asks the body nothing; so does
+  // an edge whose sag plus twice that motion stays below the refine threshold (it cannot decide
+  // a split either way).
   Eigen::VectorXd body_sags() const;
   // Σ m_i v_i, kg·m/s.
   Eigen::Vector3d linear_momentum() const;
