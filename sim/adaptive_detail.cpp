@@ -614,6 +614,172 @@ void AdaptiveCloth::count_split(const std::vector<BlockChange>& changes, Transfe
   }
 }
 
+// Whether split block k (children leaves) may merge now, and how far the merge moves the surface:
+// old enough, flat (|x_E − (x_B + x_C)/2| and the sag of every hinge around E below the coarsen
+// threshold), steady (every hinge around E turns slower than steady_rate), the parent's outer
+// edges flat enough, and no body bulging under its diagonal.
+std::optional<double> AdaptiveCloth::merge_error(BlockId k, const Eigen::VectorXd& x,
+                                                 const Eigen::VectorXd& v, double now) const {
+  const std::array<TriangleId, 4> children = mesh_.child_triangles(k);
+  bool old_enough = true;
+  for (TriangleId t : children)
+    if (t.valid() &&
+        birth_[static_cast<std::size_t>(t.value())] > now - settings_.min_lifetime + 1e-12)
+      old_enough = false;
+  if (!old_enough) return std::nullopt;
+  const auto [b, c] = mesh_.diagonal(k);
+  const VertexId e = mesh_.split_vertex(k);
+  const double error =
+      (row3(x, e.value()) - 0.5 * (row3(x, b.value()) + row3(x, c.value()))).norm();
+  if (!(error < settings_.coarsen_threshold)) return std::nullopt;
+  // Every hinge around E: steady (|dθ/dt| below steady_rate) and with a sag estimate below
+  // coarsen_threshold. E–B and E–C have the width of the parent's diagonal BC, so their sag
+  // is what BC's estimate would be after the merge: a block split for a fold along its
+  // diagonal is not merged back while the fold is there.
+  bool keep = true;
+  for (int p = 0; p < 4 && keep; ++p)
+    for (int q = p + 1; q < 4 && keep; ++q) {
+      if (!children[p].valid() || !children[q].valid()) continue;
+      const auto hinge = hinge_between(mesh_, children[p], children[q]);
+      if (!hinge) continue;
+      const Condition<12> theta =
+          dihedral_angle_condition(row3(x, (*hinge)[0]), row3(x, (*hinge)[1]), row3(x, (*hinge)[2]),
+                                   row3(x, (*hinge)[3]), false);
+      double rate = 0.0;
+      for (int m = 0; m < 4; ++m)
+        rate += theta.gradient.segment<3>(3 * m).dot(row3(v, (*hinge)[m]));
+      keep = std::abs(rate) < settings_.steady_rate &&
+             hinge_sag(*hinge, theta.value) < settings_.coarsen_threshold;
+    }
+  // The block's outer edges after the merge: the parent triangles are twice the children,
+  // so a bend across an outer edge that was fine for the children can have twice their
+  // sag. Below coarsen_threshold too, or a merge next to a fold is split again at once and
+  // the mesh churns every min_lifetime.
+  for (TriangleId t : children) {
+    if (!keep || !t.valid()) continue;
+    const auto& corners = mesh_.vertices(t);
+    const int at_e =
+        static_cast<int>(std::find(corners.begin(), corners.end(), e) - corners.begin());
+    if (at_e > 2) continue;
+    const TriangleId across = mesh_.neighbor(t, at_e);
+    if (!across.valid()) continue;  // a boundary edge: no hinge
+    const VertexId u = corners[static_cast<std::size_t>((at_e + 1) % 3)];
+    const VertexId w = corners[static_cast<std::size_t>((at_e + 2) % 3)];
+    const VertexId third = (u == b || w == b) ? c : b;  // of the parent triangle
+    VertexId opposite;
+    for (VertexId corner : mesh_.vertices(across))
+      if (corner != u && corner != w) opposite = corner;
+    // Element_forces' hinge order: (x0, x1, x2) and (x1, x0, x3) with x0 → x1 along t.
+    const std::array<int, 4> hinge{u.value(), w.value(), third.value(), opposite.value()};
+    const double theta =
+        dihedral_angle(row3(x, hinge[0]), row3(x, hinge[1]), row3(x, hinge[2]), row3(x, hinge[3]));
+    keep = hinge_sag(hinge, theta) < settings_.coarsen_threshold;
+  }
+  // The body sag under the parent's diagonal: merging next to a curved body would make the
+  // next split.
+  if (keep && has_body() && simulation_->settings().contact.enabled)
+    keep = body_sag(row3(x, b.value()), row3(x, c.value())) < settings_.coarsen_threshold;
+  if (!keep) return std::nullopt;
+  return error;
+}
+
+// Even levels: blocks at an even level that can merge together with their split children (two
+// levels at once, so no odd triangles are left but the strips next to finer ones), each with the
+// larger of its own and its children's merge errors. A child is judged as any merge; the block
+// itself as it will be once its children are merged: its split vertex E, diagonal B-C and apexes
+// A, D stay, so the hinges around E and across its outer edges are known before.
+std::vector<std::pair<double, BlockId>> AdaptiveCloth::even_level_merges(const Eigen::VectorXd& x,
+                                                                         const Eigen::VectorXd& v,
+                                                                         double now) const {
+  std::vector<BlockId> candidates;
+  for (BlockId k : mesh_.mergeable_blocks()) {
+    if (mesh_.level(k) % 2 == 0) {
+      candidates.push_back(k);
+      continue;
+    }
+    for (BlockId parent : mesh_.parents(k))
+      if (parent.valid()) candidates.push_back(parent);
+  }
+  std::sort(candidates.begin(), candidates.end());
+  candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+
+  const auto hinge_is_quiet = [&](const std::array<int, 4>& hinge) {
+    const Condition<12> theta = dihedral_angle_condition(
+        row3(x, hinge[0]), row3(x, hinge[1]), row3(x, hinge[2]), row3(x, hinge[3]), false);
+    double rate = 0.0;
+    for (int m = 0; m < 4; ++m) rate += theta.gradient.segment<3>(3 * m).dot(row3(v, hinge[m]));
+    return std::abs(rate) < settings_.steady_rate &&
+           hinge_sag(hinge, theta.value) < settings_.coarsen_threshold;
+  };
+  std::vector<std::pair<double, BlockId>> out;
+  for (BlockId k : candidates) {
+    if (!mesh_.alive(k) || !mesh_.is_split(k) || mesh_.level(k) < settings_.min_level) continue;
+    const auto [b, c] = mesh_.diagonal(k);
+    const auto [a, d] = mesh_.apexes(k);
+    const VertexId e = mesh_.split_vertex(k);
+    double error = (row3(x, e.value()) - 0.5 * (row3(x, b.value()) + row3(x, c.value()))).norm();
+    bool keep = error < settings_.coarsen_threshold;
+    // The children: merged first if split (each a merge of its own), or leaves whose triangle
+    // on this side is old enough.
+    const std::array<BlockId, 4> children = mesh_.children(k);
+    for (BlockId child : children) {
+      if (!keep || !child.valid() || !mesh_.alive(child)) continue;
+      if (mesh_.is_split(child)) {
+        const std::optional<double> child_error =
+            mesh_.can_merge(child) ? merge_error(child, x, v, now) : std::nullopt;
+        keep = child_error.has_value();
+        if (keep) error = std::max(error, *child_error);
+      } else {
+        for (TriangleId t : mesh_.triangles(child))
+          if (t.valid() &&
+              birth_[static_cast<std::size_t>(t.value())] > now - settings_.min_lifetime + 1e-12)
+            keep = false;
+      }
+    }
+    if (!keep) continue;
+    // The hinges around E after the children's merges, between (A, B, E), (A, E, C), (D, C, E)
+    // and (D, E, B) (bending's order: (x0, x1, x2) and (x1, x0, x3), x0 -> x1 along the first).
+    const int ia = a.value(), ib = b.value(), ic = c.value(), ie = e.value();
+    keep = hinge_is_quiet({ia, ie, ic, ib});
+    if (d.valid()) {
+      const int id = d.value();
+      keep = keep && hinge_is_quiet({ie, ic, ia, id}) && hinge_is_quiet({ie, id, ic, ib}) &&
+             hinge_is_quiet({ie, ib, id, ia});
+    }
+    // The outer edges of the merged triangles (A, B, C) and (D, C, B), children() order AB, AC,
+    // DC, DB: the hinge to whatever lies across, the child's other apex (or, across a pending
+    // child, the coarser neighbour's third vertex).
+    const std::array<std::array<VertexId, 3>, 4> sides{
+        {{a, b, c}, {c, a, b}, {d, c, b}, {b, d, c}}};
+    for (int i = 0; i < 4 && keep; ++i) {
+      const BlockId child = children[static_cast<std::size_t>(i)];
+      if (!child.valid() || !mesh_.alive(child)) continue;
+      VertexId across;
+      for (VertexId apex : mesh_.apexes(child))
+        if (apex.valid() && apex != e) across = apex;
+      if (!across.valid() && !mesh_.is_split(child)) {
+        const TriangleId t = mesh_.triangles(child)[0];
+        const TriangleId beyond = t.valid() ? mesh_.neighbor(t, 0) : TriangleId();
+        if (beyond.valid())
+          for (VertexId corner : mesh_.vertices(beyond))
+            if (corner != sides[static_cast<std::size_t>(i)][0] &&
+                corner != sides[static_cast<std::size_t>(i)][1])
+              across = corner;
+      }
+      if (!across.valid()) continue;  // the cloth's border
+      const auto& [u, w, third] = sides[static_cast<std::size_t>(i)];
+      const std::array<int, 4> hinge{u.value(), w.value(), third.value(), across.value()};
+      const double theta = dihedral_angle(row3(x, hinge[0]), row3(x, hinge[1]), row3(x, hinge[2]),
+                                          row3(x, hinge[3]));
+      keep = hinge_sag(hinge, theta) < settings_.coarsen_threshold;
+    }
+    if (keep && has_body() && simulation_->settings().contact.enabled)
+      keep = body_sag(row3(x, ib), row3(x, ic)) < settings_.coarsen_threshold;
+    if (keep) out.emplace_back(error, k);
+  }
+  return out;
+}
+
 AdaptStats AdaptiveCloth::adapt() {
   AdaptStats stats;
   if (!settings_.enabled || !(settings_.refine || settings_.coarsen)) {
@@ -631,70 +797,13 @@ AdaptStats AdaptiveCloth::adapt() {
   // hinge around E turns slower than steady_rate). Flattest first.
   std::vector<std::pair<double, BlockId>> merges;
   if (settings_.coarsen) {
-    for (BlockId k : mesh_.mergeable_blocks()) {
-      if (mesh_.level(k) < settings_.min_level) continue;
-      // Even levels: the merge of an odd block would leave odd triangles.
-      if (settings_.even_levels && mesh_.level(k) % 2 != 0) continue;
-      const std::array<TriangleId, 4> children = mesh_.child_triangles(k);
-      bool old_enough = true;
-      for (TriangleId t : children)
-        if (t.valid() && birth_[static_cast<std::size_t>(t.value())] >
-                             now - settings_.min_lifetime + 1e-12)
-          old_enough = false;
-      if (!old_enough) continue;
-      const auto [b, c] = mesh_.diagonal(k);
-      const VertexId e = mesh_.split_vertex(k);
-      const double error =
-          (row3(x, e.value()) - 0.5 * (row3(x, b.value()) + row3(x, c.value()))).norm();
-      if (!(error < settings_.coarsen_threshold)) continue;
-      // Every hinge around E: steady (|dθ/dt| below steady_rate) and with a sag estimate below
-      // coarsen_threshold. E–B and E–C have the width of the parent's diagonal BC, so their sag
-      // is what BC's estimate would be after the merge: a block split for a fold along its
-      // diagonal is not merged back while the fold is there.
-      bool keep = true;
-      for (int p = 0; p < 4 && keep; ++p)
-        for (int q = p + 1; q < 4 && keep; ++q) {
-          if (!children[p].valid() || !children[q].valid()) continue;
-          const auto hinge = hinge_between(mesh_, children[p], children[q]);
-          if (!hinge) continue;
-          const Condition<12> theta = dihedral_angle_condition(
-              row3(x, (*hinge)[0]), row3(x, (*hinge)[1]), row3(x, (*hinge)[2]),
-              row3(x, (*hinge)[3]), false);
-          double rate = 0.0;
-          for (int m = 0; m < 4; ++m)
-            rate += theta.gradient.segment<3>(3 * m).dot(row3(v, (*hinge)[m]));
-          keep = std::abs(rate) < settings_.steady_rate &&
-                 hinge_sag(*hinge, theta.value) < settings_.coarsen_threshold;
-        }
-      // The block's outer edges after the merge: the parent triangles are twice the children,
-      // so a bend across an outer edge that was fine for the children can have twice their
-      // sag. Below coarsen_threshold too, or a merge next to a fold is split again at once and
-      // the mesh churns every min_lifetime.
-      for (TriangleId t : children) {
-        if (!keep || !t.valid()) continue;
-        const auto& corners = mesh_.vertices(t);
-        const int at_e =
-            static_cast<int>(std::find(corners.begin(), corners.end(), e) - corners.begin());
-        if (at_e > 2) continue;
-        const TriangleId across = mesh_.neighbor(t, at_e);
-        if (!across.valid()) continue;  // a boundary edge: no hinge
-        const VertexId u = corners[static_cast<std::size_t>((at_e + 1) % 3)];
-        const VertexId w = corners[static_cast<std::size_t>((at_e + 2) % 3)];
-        const VertexId third = (u == b || w == b) ? c : b;  // of the parent triangle
-        VertexId opposite;
-        for (VertexId corner : mesh_.vertices(across))
-          if (corner != u && corner != w) opposite = corner;
-        // Element_forces' hinge order: (x0, x1, x2) and (x1, x0, x3) with x0 → x1 along t.
-        const std::array<int, 4> hinge{u.value(), w.value(), third.value(), opposite.value()};
-        const double theta = dihedral_angle(row3(x, hinge[0]), row3(x, hinge[1]),
-                                            row3(x, hinge[2]), row3(x, hinge[3]));
-        keep = hinge_sag(hinge, theta) < settings_.coarsen_threshold;
-      }
-      // The body sag under the parent's diagonal: merging next to a curved body would make the
-      // next split.
-      if (keep && has_body() && simulation_->settings().contact.enabled)
-        keep = body_sag(row3(x, b.value()), row3(x, c.value())) < settings_.coarsen_threshold;
-      if (keep) merges.emplace_back(error, k);
+    if (settings_.even_levels) {
+      merges = even_level_merges(x, v, now);
+    } else {
+      for (BlockId k : mesh_.mergeable_blocks())
+        if (mesh_.level(k) >= settings_.min_level)
+          if (const std::optional<double> error = merge_error(k, x, v, now))
+            merges.emplace_back(*error, k);
     }
     std::sort(merges.begin(), merges.end());
   }
@@ -718,8 +827,13 @@ AdaptStats AdaptiveCloth::adapt() {
   stats.estimate_s = seconds_since(estimate_start);
   // Merges on their own wait until enough of them pay for a rebuild (merge_batch); blocks that
   // stay flat and steady are still candidates on the next step.
+  std::size_t merge_count = merges.size();
+  if (settings_.even_levels)
+    for (const auto& [error, k] : merges)
+      for (BlockId child : mesh_.children(k))
+        if (child.valid() && mesh_.alive(child) && mesh_.is_split(child)) ++merge_count;
   if (refinements.empty() && odd_blocks.empty() &&
-      static_cast<double>(merges.size()) < settings_.merge_batch * mesh_.vertex_count())
+      static_cast<double>(merge_count) < settings_.merge_batch * mesh_.vertex_count())
     merges.clear();
 
   const auto operations_start = Clock::now();
@@ -729,7 +843,22 @@ AdaptStats AdaptiveCloth::adapt() {
     return i < state.touched_blocks.size() && state.touched_blocks[i] != 0;
   };
   for (const auto& [error, k] : merges) {
-    if (!mesh_.can_merge(k) || touched(k)) continue;
+    if (!mesh_.alive(k) || touched(k)) continue;
+    if (settings_.even_levels) {
+      // Its split children first, all or none (a neighbour's merge may have merged one).
+      bool ready = true;
+      for (BlockId child : mesh_.children(k))
+        if (child.valid() && mesh_.alive(child) && mesh_.is_split(child) &&
+            (!mesh_.can_merge(child) || touched(child)))
+          ready = false;
+      if (!ready) continue;
+      for (BlockId child : mesh_.children(k))
+        if (child.valid() && mesh_.alive(child) && mesh_.is_split(child)) {
+          apply(mesh_.merge(child), state);
+          ++stats.merges;
+        }
+    }
+    if (!mesh_.can_merge(k)) continue;
     apply(mesh_.merge(k), state);
     ++stats.merges;
   }
@@ -760,8 +889,9 @@ AdaptStats AdaptiveCloth::adapt() {
   }
   for (BlockId k : odd_blocks) {
     if (settings_.max_vertices > 0 && mesh_.vertex_count() >= settings_.max_vertices) break;
-    // Made or completed by a split above: one level per block per step.
-    if (!mesh_.can_split(k) || touched(k)) continue;
+    // Made or completed by a split above (one level per block per step), or left pending by a
+    // merge above (its split would force the merged block's split back).
+    if (!mesh_.can_split(k) || mesh_.is_pending(k) || touched(k)) continue;
     if (!split_stays_off_body(k, state.x)) {
       ++stats.splits_declined_on_body;
       continue;

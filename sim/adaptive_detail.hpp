@@ -13,6 +13,8 @@
 #include <functional>
 #include <memory>
 #include <stdexcept>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -55,12 +57,13 @@ struct AdaptiveSettings {
   // merges frees would save. 0: merge whenever a block qualifies.
   double merge_batch = 0.05;
   // Keep the leaves on even levels (0, 2, 4, ... of the input mesh): a complete block at an odd
-  // level is split on the step after the split that made it, whatever its estimate, and a
-  // merge is made only when it returns to an even level. The edge directions of a 4-8 mesh turn
+  // level is split on the step after the split that made it, whatever its estimate, and an even
+  // block merges together with its split children (two levels in one step, each merge judged as
+  // usual). The edge directions of a 4-8 mesh turn
   // by 45° with each level, and where a cloth folds all at once (a sheet landing on a body) the
   // fold pattern follows them: a mesh that mixes levels of both parities folds unlike any fixed
   // level (docs/adaptive.md, "Even levels"). Only the strip around a refined region, where the
-  // level rule needs it, stays odd. A region refined by two levels is not coarsened again.
+  // level rule needs it, stays odd.
   bool even_levels = false;
   bool refine = true;
   bool coarsen = true;
@@ -238,6 +241,14 @@ class AdaptiveCloth {
   double body_reach() const;
   // Whether an interior edge (row of the mesh's interior edges) has a triangle below max_level.
   bool refinable(Eigen::Index edge) const;
+  // The merge error |x_E − (x_B + x_C)/2| of split block k (children leaves) if it may merge
+  // now (old enough, flat and steady around E, outer edges flat, no body under its diagonal).
+  std::optional<double> merge_error(meshing::BlockId k, const Eigen::VectorXd& x,
+                                    const Eigen::VectorXd& v, double now) const;
+  // even_levels' merge candidates: even blocks that merge with their split children at once.
+  std::vector<std::pair<double, meshing::BlockId>> even_level_merges(const Eigen::VectorXd& x,
+                                                                     const Eigen::VectorXd& v,
+                                                                     double now) const;
   // After a topology change: keeps the body-sag memory of every edge whose two ends were joined
   // before (old_edges: the interior edges before it; origin: per new vertex, its old id).
   void carry_body_sag_memory(const Eigen::MatrixX4i& old_edges,

@@ -496,7 +496,7 @@ std::set<std::array<long, 3>> complete_odd_leaves(const meshing::Mesh48& mesh) {
 
 // Even levels: a complete odd block lives one step (it is split on the next, whatever its
 // estimate), so the 3-corner sheet's fold is refined two levels at a time; without the setting
-// such blocks stay. Odd blocks are not merged: a region refined to level 2 stays there.
+// such blocks stay. Merges leave none behind either (every odd leaf at the end is pending).
 TEST(AdaptiveDetail, EvenLevelsRefineTwoLevelsAtATime) {
   struct Outcome {
     int odd_blocks_that_stayed = 0;  // complete odd leaf blocks seen after two steps in a row
@@ -537,10 +537,58 @@ TEST(AdaptiveDetail, EvenLevelsRefineTwoLevelsAtATime) {
   EXPECT_EQ(even.odd_blocks_that_stayed, 0);
   EXPECT_GT(even.report.splits, 0);
   EXPECT_EQ(even.report.max_level_reached, 4);
-  // Odd blocks were not merged and complete ones were split: the odd triangles left are the
-  // strips next to coarser ones (a merge of an odd block would leave a complete odd leaf for
-  // at least min_lifetime, the 0.25 s test above would see it too).
+  // Complete odd blocks were split and merges left none: the odd triangles left are the strips
+  // next to coarser ones.
   EXPECT_EQ(even.odd_leaves_not_pending, 0);
+}
+
+// Even levels coarsen two levels at once: a flat, still sheet at level 2 with a patch refined to
+// level 4 returns to level 2 on the first step, the even block merging together with its split
+// children, and no complete odd block is left on the way.
+TEST(AdaptiveDetail, EvenLevelsMergeTwoLevelsAtOnce) {
+  AdaptiveSheetSpec spec;
+  spec.pins = {};
+  testing::AdaptiveSheet sheet = testing::build_adaptive_sheet(spec);
+  SimulationSettings settings = testing::adaptive_sheet_settings(spec);
+  settings.forces.terms.gravity = false;  // flat and still: every refined block may merge
+  AdaptiveSettings adaptive;
+  adaptive.even_levels = true;
+  adaptive.min_lifetime = 0.0;
+  adaptive.merge_batch = 0.0;
+  adaptive.min_level = 2;
+  AdaptiveCloth cloth(std::move(sheet.mesh), sheet.material, {}, sheet.pins, settings, adaptive);
+  cloth.refine_uniformly(2);  // 8 by 8 quads, 81 particles
+  const int coarse = cloth.mesh().vertex_count();
+  const double mass = cloth.masses().sum();
+  // A patch to level 4: six neighbouring level-2 blocks, then every complete level-3 block.
+  std::vector<BlockId> patch = cloth.mesh().leaf_blocks();
+  patch.resize(6);
+  cloth.split_blocks(patch);
+  std::vector<BlockId> odd;
+  for (BlockId k : cloth.mesh().leaf_blocks())
+    if (cloth.mesh().level(k) == 3 && !cloth.mesh().is_pending(k)) odd.push_back(k);
+  ASSERT_FALSE(odd.empty());
+  cloth.split_blocks(odd);
+  ASSERT_EQ(cloth.mesh().max_level(), 4);
+  const int refined = cloth.mesh().vertex_count();
+  const int splits = cloth.report().splits + cloth.report().forced_splits;
+
+  ASSERT_TRUE(cloth.step().accepted);
+  EXPECT_GT(cloth.report().merges, 0);
+  EXPECT_EQ(cloth.mesh().vertex_count(), coarse);  // both levels in the one step
+  EXPECT_EQ(cloth.mesh().max_level(), 2);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(complete_odd_leaves(cloth.mesh()).size(), 0u) << "after step " << i + 1;
+    const std::vector<std::string> problems = cloth.mesh().validate();
+    ASSERT_TRUE(problems.empty()) << problems.front();
+    ASSERT_TRUE(cloth.step().accepted);
+  }
+  EXPECT_EQ(cloth.mesh().vertex_count(), coarse);
+  EXPECT_EQ(cloth.mesh().max_level(), 2);
+  EXPECT_EQ(cloth.report().splits + cloth.report().forced_splits, splits);  // none split back
+  EXPECT_NEAR(cloth.masses().sum(), mass, 1e-12 * mass);
+  std::printf("two-level merges: %d particles -> %d in %d merges\n", refined,
+              cloth.mesh().vertex_count(), cloth.report().merges);
 }
 
 TEST(AdaptiveDetail, LevelLimitsAndBudgetHold) {
