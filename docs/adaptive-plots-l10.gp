@@ -15,6 +15,7 @@ plot dir."/sphere_fixed_l10.csv" u 1:3 w l lw 2 t "fixed L10", \
      dir."/sphere_adaptive_0.707107mm.csv" u 1:3 w l t "adaptive 0.71 mm", \
      dir."/sphere_adaptive_0.5mm.csv" u 1:3 w l t "adaptive 0.5 mm"
 set ylabel "particles"
+set yrange [0:*]
 set key center right
 plot dir."/sphere_fixed_l10.csv" u 1:4 w l lw 2 t "fixed L10", \
      dir."/sphere_fixed_l8.csv" u 1:4 w l lw 2 t "fixed L8", \
