@@ -794,7 +794,8 @@ AdaptStats AdaptiveCloth::adapt() {
 
   // Merge candidates: split blocks whose children are leaves, at or above the coarsest level,
   // old enough, flat (merging moves the surface by |x_E − (x_B + x_C)/2|) and steady (every
-  // hinge around E turns slower than steady_rate). Flattest first.
+  // hinge around E turns slower than steady_rate); with even levels, even blocks together with
+  // their split children. Flattest first.
   std::vector<std::pair<double, BlockId>> merges;
   if (settings_.coarsen) {
     if (settings_.even_levels) {
