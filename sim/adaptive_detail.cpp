@@ -614,6 +614,27 @@ void AdaptiveCloth::count_split(const std::vector<BlockChange>& changes, Transfe
   }
 }
 
+bool AdaptiveCloth::is_young(TriangleId t, double now) const {
+  return t.valid() &&
+         birth_[static_cast<std::size_t>(t.value())] > now - settings_.min_lifetime + 1e-12;
+}
+
+bool AdaptiveCloth::hinge_is_flat(const std::array<int, 4>& hinge, const Eigen::VectorXd& x) const {
+  const double theta =
+      dihedral_angle(row3(x, hinge[0]), row3(x, hinge[1]), row3(x, hinge[2]), row3(x, hinge[3]));
+  return hinge_sag(hinge, theta) < settings_.coarsen_threshold;
+}
+
+bool AdaptiveCloth::hinge_is_quiet(const std::array<int, 4>& hinge, const Eigen::VectorXd& x,
+                                   const Eigen::VectorXd& v) const {
+  const Condition<12> theta = dihedral_angle_condition(row3(x, hinge[0]), row3(x, hinge[1]),
+                                                       row3(x, hinge[2]), row3(x, hinge[3]), false);
+  double rate = 0.0;
+  for (int m = 0; m < 4; ++m) rate += theta.gradient.segment<3>(3 * m).dot(row3(v, hinge[m]));
+  return std::abs(rate) < settings_.steady_rate &&
+         hinge_sag(hinge, theta.value) < settings_.coarsen_threshold;
+}
+
 // Whether split block k (children leaves) may merge now, and how far the merge moves the surface:
 // old enough, flat (|x_E − (x_B + x_C)/2| and the sag of every hinge around E below the coarsen
 // threshold), steady (every hinge around E turns slower than steady_rate), the parent's outer
@@ -621,12 +642,8 @@ void AdaptiveCloth::count_split(const std::vector<BlockChange>& changes, Transfe
 std::optional<double> AdaptiveCloth::merge_error(BlockId k, const Eigen::VectorXd& x,
                                                  const Eigen::VectorXd& v, double now) const {
   const std::array<TriangleId, 4> children = mesh_.child_triangles(k);
-  bool old_enough = true;
   for (TriangleId t : children)
-    if (t.valid() &&
-        birth_[static_cast<std::size_t>(t.value())] > now - settings_.min_lifetime + 1e-12)
-      old_enough = false;
-  if (!old_enough) return std::nullopt;
+    if (is_young(t, now)) return std::nullopt;
   const auto [b, c] = mesh_.diagonal(k);
   const VertexId e = mesh_.split_vertex(k);
   const double error =
@@ -640,16 +657,8 @@ std::optional<double> AdaptiveCloth::merge_error(BlockId k, const Eigen::VectorX
   for (int p = 0; p < 4 && keep; ++p)
     for (int q = p + 1; q < 4 && keep; ++q) {
       if (!children[p].valid() || !children[q].valid()) continue;
-      const auto hinge = hinge_between(mesh_, children[p], children[q]);
-      if (!hinge) continue;
-      const Condition<12> theta =
-          dihedral_angle_condition(row3(x, (*hinge)[0]), row3(x, (*hinge)[1]), row3(x, (*hinge)[2]),
-                                   row3(x, (*hinge)[3]), false);
-      double rate = 0.0;
-      for (int m = 0; m < 4; ++m)
-        rate += theta.gradient.segment<3>(3 * m).dot(row3(v, (*hinge)[m]));
-      keep = std::abs(rate) < settings_.steady_rate &&
-             hinge_sag(*hinge, theta.value) < settings_.coarsen_threshold;
+      if (const auto hinge = hinge_between(mesh_, children[p], children[q]))
+        keep = hinge_is_quiet(*hinge, x, v);
     }
   // The block's outer edges after the merge: the parent triangles are twice the children,
   // so a bend across an outer edge that was fine for the children can have twice their
@@ -670,10 +679,7 @@ std::optional<double> AdaptiveCloth::merge_error(BlockId k, const Eigen::VectorX
     for (VertexId corner : mesh_.vertices(across))
       if (corner != u && corner != w) opposite = corner;
     // Element_forces' hinge order: (x0, x1, x2) and (x1, x0, x3) with x0 → x1 along t.
-    const std::array<int, 4> hinge{u.value(), w.value(), third.value(), opposite.value()};
-    const double theta =
-        dihedral_angle(row3(x, hinge[0]), row3(x, hinge[1]), row3(x, hinge[2]), row3(x, hinge[3]));
-    keep = hinge_sag(hinge, theta) < settings_.coarsen_threshold;
+    keep = hinge_is_flat({u.value(), w.value(), third.value(), opposite.value()}, x);
   }
   // The body sag under the parent's diagonal: merging next to a curved body would make the
   // next split.
@@ -703,14 +709,6 @@ std::vector<std::pair<double, BlockId>> AdaptiveCloth::even_level_merges(const E
   std::sort(candidates.begin(), candidates.end());
   candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
 
-  const auto hinge_is_quiet = [&](const std::array<int, 4>& hinge) {
-    const Condition<12> theta = dihedral_angle_condition(
-        row3(x, hinge[0]), row3(x, hinge[1]), row3(x, hinge[2]), row3(x, hinge[3]), false);
-    double rate = 0.0;
-    for (int m = 0; m < 4; ++m) rate += theta.gradient.segment<3>(3 * m).dot(row3(v, hinge[m]));
-    return std::abs(rate) < settings_.steady_rate &&
-           hinge_sag(hinge, theta.value) < settings_.coarsen_threshold;
-  };
   std::vector<std::pair<double, BlockId>> out;
   for (BlockId k : candidates) {
     if (!mesh_.alive(k) || !mesh_.is_split(k) || mesh_.level(k) < settings_.min_level) continue;
@@ -731,20 +729,18 @@ std::vector<std::pair<double, BlockId>> AdaptiveCloth::even_level_merges(const E
         if (keep) error = std::max(error, *child_error);
       } else {
         for (TriangleId t : mesh_.triangles(child))
-          if (t.valid() &&
-              birth_[static_cast<std::size_t>(t.value())] > now - settings_.min_lifetime + 1e-12)
-            keep = false;
+          if (is_young(t, now)) keep = false;
       }
     }
     if (!keep) continue;
     // The hinges around E after the children's merges, between (A, B, E), (A, E, C), (D, C, E)
     // and (D, E, B) (bending's order: (x0, x1, x2) and (x1, x0, x3), x0 -> x1 along the first).
     const int ia = a.value(), ib = b.value(), ic = c.value(), ie = e.value();
-    keep = hinge_is_quiet({ia, ie, ic, ib});
+    keep = hinge_is_quiet({ia, ie, ic, ib}, x, v);
     if (d.valid()) {
       const int id = d.value();
-      keep = keep && hinge_is_quiet({ie, ic, ia, id}) && hinge_is_quiet({ie, id, ic, ib}) &&
-             hinge_is_quiet({ie, ib, id, ia});
+      keep = keep && hinge_is_quiet({ie, ic, ia, id}, x, v) &&
+             hinge_is_quiet({ie, id, ic, ib}, x, v) && hinge_is_quiet({ie, ib, id, ia}, x, v);
     }
     // The outer edges of the merged triangles (A, B, C) and (D, C, B), children() order AB, AC,
     // DC, DB: the hinge to whatever lies across, the child's other apex (or, across a pending
@@ -768,10 +764,7 @@ std::vector<std::pair<double, BlockId>> AdaptiveCloth::even_level_merges(const E
       }
       if (!across.valid()) continue;  // the cloth's border
       const auto& [u, w, third] = sides[static_cast<std::size_t>(i)];
-      const std::array<int, 4> hinge{u.value(), w.value(), third.value(), across.value()};
-      const double theta = dihedral_angle(row3(x, hinge[0]), row3(x, hinge[1]), row3(x, hinge[2]),
-                                          row3(x, hinge[3]));
-      keep = hinge_sag(hinge, theta) < settings_.coarsen_threshold;
+      keep = hinge_is_flat({u.value(), w.value(), third.value(), across.value()}, x);
     }
     if (keep && has_body() && simulation_->settings().contact.enabled)
       keep = body_sag(row3(x, ib), row3(x, ic)) < settings_.coarsen_threshold;

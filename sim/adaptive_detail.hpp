@@ -241,6 +241,13 @@ class AdaptiveCloth {
   double body_reach() const;
   // Whether an interior edge (row of the mesh's interior edges) has a triangle below max_level.
   bool refinable(Eigen::Index edge) const;
+  // A triangle made less than min_lifetime ago (may not be merged away yet).
+  bool is_young(meshing::TriangleId t, double now) const;
+  // Whether a hinge (bending's vertex order) sags less than the coarsen threshold, and, for
+  // hinge_is_quiet, also turns slower than steady_rate (dθ/dt = Σ ∂θ/∂x_i · v_i).
+  bool hinge_is_flat(const std::array<int, 4>& hinge, const Eigen::VectorXd& x) const;
+  bool hinge_is_quiet(const std::array<int, 4>& hinge, const Eigen::VectorXd& x,
+                      const Eigen::VectorXd& v) const;
   // The merge error |x_E − (x_B + x_C)/2| of split block k (children leaves) if it may merge
   // now (old enough, flat and steady around E, outer edges flat, no body under its diagonal).
   std::optional<double> merge_error(meshing::BlockId k, const Eigen::VectorXd& x,
