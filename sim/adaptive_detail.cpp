@@ -225,9 +225,9 @@ Eigen::VectorXd AdaptiveCloth::body_sags() const {
     const BodySagMemory& memory = body_sag_memory_[static_cast<std::size_t>(r)];
     const int i = edges(r, 0), j = edges(r, 1);
     if (memory.valid) {
-      const double moved = std::max({(row3(x, i) - memory.xi).norm(),
-                                     (row3(x, j) - memory.xj).norm(),
-                                     body_motion - memory.body_motion});
+      const double moved =
+          std::max({(row3(x, i) - memory.xi).norm(), (row3(x, j) - memory.xj).norm(),
+                    body_motion - memory.body_motion});
       // Near enough to where it was found, or so far below the refine threshold that the motion
       // cannot lift it over (the three body points move as little as what they lie under, so
       // the sag changes by at most twice the motion): such a sag cannot decide a split, and the

@@ -15,7 +15,8 @@
 //                                             two_corner, tablecloth, sphere); --only: one
 //                                             run (e.g. adaptive_2mm) without the reference
 //                                             (measured against the one a full run kept in
-//                                             DIR, if any), to profile; --finest: N, 4 to 11 (default 6);
+//                                             DIR, if any), to profile; --finest: N, 4 to 11
+//                                             (default 6);
 //                                             --perturbed: K more runs of fixed level N with
 //                                             the body moved by 1 µm (scenes with a body);
 //                                             --adaptive-start: the adaptive runs' first level
@@ -55,7 +56,8 @@ AdaptiveSettings fixed_settings() {
   return settings;
 }
 
-AdaptiveSettings adaptive_settings(double refine_threshold, int max_level, bool even_levels = false) {
+AdaptiveSettings adaptive_settings(double refine_threshold, int max_level,
+                                   bool even_levels = false) {
   AdaptiveSettings settings;
   settings.refine_threshold = refine_threshold;
   settings.coarsen_threshold = 0.25 * refine_threshold;
@@ -364,7 +366,8 @@ int run_study(const StudyOptions& options) {
       std::snprintf(name, sizeof name, "adaptive_%gmm", threshold * 1e3);
       if (wanted(name))
         runs.push_back(run_case(dir, scene, name, spec, options.adaptive_start,
-                                adaptive_settings(threshold, finest, options.even_levels), points, every));
+                                adaptive_settings(threshold, finest, options.even_levels), points,
+                                every));
     }
     if (runs.empty()) continue;
     // The reference last, so that a profiled run is not preceded by it. Its samples are kept in

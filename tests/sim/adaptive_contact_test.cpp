@@ -284,13 +284,17 @@ TEST(AdaptiveContact, BodySagsAreKeptWhileTheClothLiesStill) {
     for (Eigen::Index r = 0; r < kept_sags.size(); ++r) {
       if (std::abs(kept_sags(r) - fresh_sags(r)) <= adaptive.coarsen_threshold)
         ++close;
-      else if (kept_sags(r) < adaptive.refine_threshold && fresh_sags(r) < adaptive.refine_threshold)
+      else if (kept_sags(r) < adaptive.refine_threshold &&
+               fresh_sags(r) < adaptive.refine_threshold)
         ++below;
       else
-        ADD_FAILURE() << "edge " << r << ": kept sag " << kept_sags(r) << " m, fresh " << fresh_sags(r);
+        ADD_FAILURE() << "edge " << r << ": kept sag " << kept_sags(r) << " m, fresh "
+                      << fresh_sags(r);
     }
-    std::printf("kept sags: %d within the coarsen threshold of a fresh one, %d both below the "
-                "refine threshold\n", close, below);
+    std::printf(
+        "kept sags: %d within the coarsen threshold of a fresh one, %d both below the "
+        "refine threshold\n",
+        close, below);
   };
   compare(kept, fresh);
   // The same while the sheet still slides and swings over the sphere.

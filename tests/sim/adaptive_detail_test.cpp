@@ -489,7 +489,8 @@ std::set<std::array<long, 3>> complete_odd_leaves(const meshing::Mesh48& mesh) {
     if (mesh.level(k) % 2 == 0 || mesh.is_pending(k)) continue;
     const auto [b, c] = mesh.diagonal(k);
     const Eigen::Vector3d mid = 0.5 * (mesh.rest_position(b) + mesh.rest_position(c));
-    out.insert({std::lround(mid.x() * 1e4), std::lround(mid.y() * 1e4), std::lround(mid.z() * 1e4)});
+    out.insert(
+        {std::lround(mid.x() * 1e4), std::lround(mid.y() * 1e4), std::lround(mid.z() * 1e4)});
   }
   return out;
 }
@@ -517,7 +518,8 @@ TEST(AdaptiveDetail, EvenLevelsRefineTwoLevelsAtATime) {
       EXPECT_TRUE(step.accepted) << step.failure_reason;
       if (!step.accepted) break;
       const std::set<std::array<long, 3>> now = complete_odd_leaves(cloth.mesh());
-      for (const auto& block : now) outcome.odd_blocks_that_stayed += static_cast<int>(before.count(block));
+      for (const auto& block : now)
+        outcome.odd_blocks_that_stayed += static_cast<int>(before.count(block));
       before = now;
     }
     const std::vector<std::string> problems = cloth.mesh().validate();
