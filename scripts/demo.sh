@@ -7,7 +7,7 @@
 # Outputs go to out/demo/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-./scripts/setup.sh
+./scripts/setup.sh demo
 
 out=out/demo
 rm -rf "$out"

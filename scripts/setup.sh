@@ -1,21 +1,29 @@
 #!/usr/bin/env bash
 # Shared set-up for demo.sh and test.sh: installs the missing Debian packages, then configures
-# and builds sketchdrape (Release) in build/. Extra arguments go to CMake's configure step.
+# build/ (Release, warnings as errors, tests on) and builds the targets given.
+#   setup.sh demo              packages for the demo; builds the sketchdrape binary only
+#   setup.sh test              every package the tests use; builds everything
+# Both configure build/ the same way, so running demo.sh then test.sh compiles each file once.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+purpose=${1:-test}
 
-# Every Debian package the project builds, tests and demos with (see docs/dependencies.md).
+# The Debian packages the binary builds and runs with (see docs/dependencies.md).
 packages=(
-  cmake g++ make pkg-config
+  cmake g++ make pkg-config ccache
   libeigen3-dev libcgal-dev libassimp-dev assimp-testmodels libsuitesparse-dev
   libopenblas0-pthread libfcl-dev libosmesa6-dev libpng-dev
   libcli11-dev nlohmann-json3-dev libspdlog-dev
   libgtest-dev libbenchmark-dev
-  python3-jsonschema  # tests validate the example sketch files against data/schema/
-  chromium  # tests/batch: the batch contact sheet (index.html) loads in headless Chromium
-  slurmctld slurmd slurm-client munge  # tests/batch/slurm_test.sh: a one-node Slurm cluster
-  gnuplot-nox  # sketchdrape bench: the work-precision plots (optional: the CSV is written without it)
 )
+if [ "$purpose" = test ]; then
+  packages+=(
+    python3-jsonschema  # tests validate the example sketch files against data/schema/
+    chromium  # tests/batch: the batch contact sheet (index.html) loads in headless Chromium
+    slurmctld slurmd slurm-client munge  # tests/batch/slurm_test.sh: a one-node Slurm cluster
+    gnuplot-nox  # sketchdrape bench: the work-precision plots (optional: the CSV is written without it)
+  )
+fi
 
 missing=()
 for p in "${packages[@]}"; do
@@ -33,8 +41,17 @@ if ((${#missing[@]})); then
     "${missing[@]}" >/dev/null
 fi
 
+# ccache keeps compiled objects between builds and between checkouts of the project (paths are
+# taken relative to the checkout), so a rebuild after a pull or in a second worktree is quick.
+export CCACHE_BASEDIR="$PWD"
 jobs=$(nproc 2>/dev/null || echo 2)
 echo "==> configuring build/ (Release)"
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "$@" >/dev/null
-echo "==> building with $jobs jobs"
-cmake --build build -j "$jobs"
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DSD_WERROR=ON -DSD_BUILD_TESTS=ON \
+  -DCMAKE_CXX_COMPILER_LAUNCHER=ccache >/dev/null
+if [ "$purpose" = demo ]; then
+  echo "==> building sketchdrape with $jobs jobs"
+  cmake --build build -j "$jobs" --target sketchdrape
+else
+  echo "==> building everything with $jobs jobs"
+  cmake --build build -j "$jobs"
+fi

@@ -2,7 +2,7 @@
 # Installs what is missing, builds everything with warnings as errors, and runs every test.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-./scripts/setup.sh -DSD_WERROR=ON -DSD_BUILD_TESTS=ON
+./scripts/setup.sh test
 
 # The test executables link the simulator directly: give CHOLMOD's OpenMP loops and OpenBLAS one
 # thread, as `sketchdrape` does for itself (docs/simulator.md, "Threads").
