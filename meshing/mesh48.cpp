@@ -9,6 +9,7 @@
 #include <sstream>
 #include <utility>
 
+#include "meshing/check.hpp"
 #include "meshing/quad_mesh.hpp"
 
 namespace sd::meshing {
@@ -27,6 +28,40 @@ constexpr int kMaxStar = 1 << 16;
 
 double triangle_area(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
   return 0.5 * (b - a).cross(c - a).norm();
+}
+
+// Vertices, triangles and blocks live in slot vectors: a freed slot goes on a LIFO free list and
+// is reused, reset to a fresh record, by the next allocation of its kind. `count` is the number
+// of live slots.
+template <class Record>
+int take_slot(std::vector<Record>& slots, std::vector<int>& free, int& count) {
+  ++count;
+  int id;
+  if (free.empty()) {
+    id = static_cast<int>(slots.size());
+    slots.emplace_back();
+  } else {
+    id = free.back();
+    free.pop_back();
+    slots[id] = Record{};
+  }
+  slots[id].alive = true;
+  return id;
+}
+
+template <class Record>
+void release_slot(std::vector<Record>& slots, std::vector<int>& free, int& count, int id) {
+  slots[id].alive = false;
+  free.push_back(id);
+  --count;
+}
+
+// Debug builds check every invariant of the mesh after each factory and each split or merge.
+void debug_validate([[maybe_unused]] const Mesh48& m, [[maybe_unused]] const char* after) {
+#ifndef NDEBUG
+  const std::vector<std::string> problems = m.validate();
+  SD_DCHECK(problems.empty(), std::string("after ") + after + ": " + problems.front());
+#endif
 }
 
 bool degenerate(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
@@ -201,6 +236,7 @@ Mesh48 Mesh48::build(std::vector<Eigen::Vector3d> rest,
                              " joins two pieces of surface at a single point (non-manifold "
                              "vertex); split it into one vertex per piece first");
   }
+  debug_validate(m, "Mesh48::build");
   return m;
 }
 
@@ -322,6 +358,7 @@ Mesh48 Mesh48::from_triangles_sqrt3(const TriMesh& mesh, Sqrt3Stats* stats) {
   if (stats) *stats = counts;
   Mesh48 m = build(std::move(rest), triangles);
   m.root_source_ = std::move(source);
+  debug_validate(m, "Mesh48::from_triangles_sqrt3");
   return m;
 }
 
@@ -329,64 +366,20 @@ Mesh48 Mesh48::from_triangles_sqrt3(const TriMesh& mesh, Sqrt3Stats* stats) {
 // Slots
 
 VertexId Mesh48::new_vertex() {
-  ++vertex_count_;
-  if (!free_vertices_.empty()) {
-    const int id = free_vertices_.back();
-    free_vertices_.pop_back();
-    vertices_[id] = Vertex{};
-    vertices_[id].alive = true;
-    return VertexId(id);
-  }
-  vertices_.emplace_back();
-  vertices_.back().alive = true;
-  return VertexId(static_cast<int>(vertices_.size()) - 1);
+  return VertexId(take_slot(vertices_, free_vertices_, vertex_count_));
 }
-
 TriangleId Mesh48::new_triangle() {
-  ++triangle_count_;
-  if (!free_triangles_.empty()) {
-    const int id = free_triangles_.back();
-    free_triangles_.pop_back();
-    triangles_[id] = Triangle{};
-    triangles_[id].alive = true;
-    return TriangleId(id);
-  }
-  triangles_.emplace_back();
-  triangles_.back().alive = true;
-  return TriangleId(static_cast<int>(triangles_.size()) - 1);
+  return TriangleId(take_slot(triangles_, free_triangles_, triangle_count_));
 }
-
-BlockId Mesh48::new_block() {
-  ++block_count_;
-  if (!free_blocks_.empty()) {
-    const int id = free_blocks_.back();
-    free_blocks_.pop_back();
-    blocks_[id] = Block{};
-    blocks_[id].alive = true;
-    return BlockId(id);
-  }
-  blocks_.emplace_back();
-  blocks_.back().alive = true;
-  return BlockId(static_cast<int>(blocks_.size()) - 1);
-}
+BlockId Mesh48::new_block() { return BlockId(take_slot(blocks_, free_blocks_, block_count_)); }
 
 void Mesh48::free_vertex(VertexId v) {
-  vertices_[v.value()].alive = false;
-  free_vertices_.push_back(v.value());
-  --vertex_count_;
+  release_slot(vertices_, free_vertices_, vertex_count_, v.value());
 }
-
 void Mesh48::free_triangle(TriangleId t) {
-  triangles_[t.value()].alive = false;
-  free_triangles_.push_back(t.value());
-  --triangle_count_;
+  release_slot(triangles_, free_triangles_, triangle_count_, t.value());
 }
-
-void Mesh48::free_block(BlockId k) {
-  blocks_[k.value()].alive = false;
-  free_blocks_.push_back(k.value());
-  --block_count_;
-}
+void Mesh48::free_block(BlockId k) { release_slot(blocks_, free_blocks_, block_count_, k.value()); }
 
 bool Mesh48::is_compact() const {
   return free_vertices_.empty() && free_triangles_.empty() && free_blocks_.empty();
@@ -653,6 +646,7 @@ std::vector<BlockChange> Mesh48::split(BlockId k) {
                                (alive(k) ? " is already split" : " is not live"));
   std::vector<BlockChange> changes;
   split_recursive(k, false, changes);
+  debug_validate(*this, "Mesh48::split");
   return changes;
 }
 
@@ -905,6 +899,7 @@ BlockChange Mesh48::merge(BlockId k) {
   ch.area_a2 = has_d ? rest_area(t1) : 0.0;
   ch.source_a1 = source_face(t0);
   ch.source_a2 = has_d ? source_face(t1) : -1;
+  debug_validate(*this, "Mesh48::merge");
   return ch;
 }
 
@@ -1021,6 +1016,7 @@ Mesh48Remap Mesh48::compact() {
   free_vertices_.clear();
   free_triangles_.clear();
   free_blocks_.clear();
+  debug_validate(*this, "Mesh48::compact");
   return remap;
 }
 
