@@ -19,6 +19,7 @@
 #include "garment/material_frames.hpp"
 #include "garment/sketch_file.hpp"
 #include "sim/sheet.hpp"
+#include "sim/surface_sampling.hpp"
 #include "src/app/batch_hash.hpp"
 #include "src/app/cloth_scene.hpp"
 
@@ -191,77 +192,6 @@ BenchScene sketch_scene(const std::filesystem::path& file, BenchGrid grid) {
 }
 
 // --- material points -----------------------------------------------------------------------------
-
-struct MaterialLocation {
-  int face = 0;
-  Eigen::Vector3d weights = Eigen::Vector3d::Zero();  // barycentric coordinates
-};
-
-// Barycentric coordinates of the point of triangle (a, b, c) closest to p (Ericson, Real-Time
-// Collision Detection 5.1.5).
-Eigen::Vector3d closest_barycentric(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
-                                    const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
-  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return {1, 0, 0};
-  const Eigen::Vector3d bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return {0, 1, 0};
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
-    const double v = d1 / (d1 - d3);
-    return {1 - v, v, 0};
-  }
-  const Eigen::Vector3d cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return {0, 0, 1};
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
-    const double w = d2 / (d2 - d6);
-    return {1 - w, 0, w};
-  }
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
-    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-    return {0, 1 - w, w};
-  }
-  const double denominator = 1.0 / (va + vb + vc);
-  const double v = vb * denominator, w = vc * denominator;
-  return {1 - v - w, v, w};
-}
-
-// Each material point in the rest triangle closest to it (brute force: P·F, done once per mesh).
-std::vector<MaterialLocation> locate(const Eigen::MatrixX3d& rest, const Eigen::MatrixX3i& faces,
-                                     const Eigen::MatrixX3d& points) {
-  std::vector<MaterialLocation> located(static_cast<size_t>(points.rows()));
-  for (Eigen::Index p = 0; p < points.rows(); ++p) {
-    const Eigen::Vector3d q = points.row(p).transpose();
-    double best = std::numeric_limits<double>::infinity();
-    for (Eigen::Index f = 0; f < faces.rows(); ++f) {
-      const Eigen::Vector3d a = rest.row(faces(f, 0)), b = rest.row(faces(f, 1)),
-                            c = rest.row(faces(f, 2));
-      const Eigen::Vector3d w = closest_barycentric(q, a, b, c);
-      const double d = (w(0) * a + w(1) * b + w(2) * c - q).squaredNorm();
-      if (d < best) {
-        best = d;
-        located[static_cast<size_t>(p)] = {static_cast<int>(f), w};
-      }
-    }
-  }
-  return located;
-}
-
-Eigen::MatrixX3d follow(const std::vector<MaterialLocation>& located, const Eigen::MatrixX3i& faces,
-                        const Eigen::MatrixX3d& positions) {
-  Eigen::MatrixX3d out(static_cast<Eigen::Index>(located.size()), 3);
-  for (size_t p = 0; p < located.size(); ++p) {
-    const MaterialLocation& l = located[p];
-    out.row(static_cast<Eigen::Index>(p)) = l.weights(0) * positions.row(faces(l.face, 0)) +
-                                            l.weights(1) * positions.row(faces(l.face, 1)) +
-                                            l.weights(2) * positions.row(faces(l.face, 2));
-  }
-  return out;
-}
 
 double process_cpu_seconds() {
   timespec t{};
@@ -536,8 +466,8 @@ BenchTrace run_bench_config(const BenchScene& scene, const BenchConfig& config) 
           return outcome;
         },
         [&] {
-          const auto located = locate(cloth.rest_positions(), cloth.faces(), scene.material_points);
-          record(cloth.time(), follow(located, cloth.faces(), cloth.positions()),
+          const auto located = sim::locate_material_points(cloth.rest_positions(), cloth.faces(), scene.material_points);
+          record(cloth.time(), sim::positions_at(located, cloth.faces(), cloth.positions()),
                  cloth.simulation().energy().total());
         });
     const sim::SimulationReport& r = cloth.simulation().report();
@@ -574,7 +504,7 @@ BenchTrace run_bench_config(const BenchScene& scene, const BenchConfig& config) 
   }
   sim::Simulation& simulation = *fixed;
   if (scene.body) simulation.set_body(*scene.body);
-  const auto located = locate(rest, faces, scene.material_points);
+  const auto located = sim::locate_material_points(rest, faces, scene.material_points);
   trace.rss_before_mb = peak_rss_mb();
   drive(
       scene, trace,
@@ -585,7 +515,7 @@ BenchTrace run_bench_config(const BenchScene& scene, const BenchConfig& config) 
       },
       [&] {
         record(simulation.time(),
-               follow(located, faces, sim::unflatten_positions(simulation.positions())),
+               sim::positions_at(located, faces, sim::unflatten_positions(simulation.positions())),
                simulation.energy().total());
       });
   const sim::SimulationReport& r = simulation.report();
