@@ -1,0 +1,289 @@
+#!/usr/bin/env python3
+"""Side by side: the same cloth scenes in sketchdrape and in Blender's cloth solver.
+
+Each scene is a 1 m square of cotton (mass from data/fabrics/cotton.json), horizontal, simulated
+for FRAMES frames at FPS (default 48 at 24 fps, 2 s), either pinned at its two far corners
+("pinned") or dropped from 10 cm onto a sphere of radius 0.3 m ("sphere"), at N x N quads.
+Both programs get the same grid, pins and (for the sphere) the same triangle mesh; each runs
+with its own default settings unless told otherwise (--blender-set, --sketchdrape-set). Blender's
+defaults are its cotton-like material (vertex mass 0.3 kg, tension 15, bending 0.5, air 1):
+its stiffness, damping and air drag are absolute forces, not per unit mass, so they only make
+sense with its default vertex mass. Giving it cotton's real mass instead (0.13 kg/m^2, about half
+a gram a vertex; --blender-mass matched) leaves the sheet overdamped: measured, the centre of
+mass of the pinned 16 x 16 sheet fell 8 mm in 1 s (70 mm without air) where sketchdrape's fell
+0.47 m. The table reports how far each sheet's centre of mass fell, to show the two simulated
+comparable motions.
+
+Measured for each: the simulation's wall time (Blender: the frame evaluations; sketchdrape: the
+report's wall_time_s, the simulator's run without loading and output) and CPU time (Blender:
+the frame evaluations, all threads; sketchdrape: the whole process, loading included),
+and the final stretch: the largest relative elongation of the sheet's grid edges (warp and
+weft; diagonals are shear, not stretch), computed the same way from both programs' final
+positions. Writes results.json and results.md (a Markdown table) to --out.
+
+    scripts/compare_blender.py --sizes 32 64 --scenes pinned sphere -o out/blender
+    scripts/compare_blender.py --blender-threads 0   # Blender on every core (its default)
+
+Needs Debian's blender (apt-get install blender) and a built sketchdrape. Timings mean
+something only on a quiet machine: the table states the load average before and after.
+"""
+import argparse
+import json
+import math
+import os
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+SPHERE_RADIUS = 0.3
+PINNED_HEIGHT = 1.2
+DROP = 0.1  # metres between the sphere's top and the sheet
+
+
+def grid(n, height):
+    """(n+1)^2 vertices of the horizontal 1 m sheet, row by row from the far edge (-z)."""
+    vertices = []
+    for row in range(n + 1):
+        z = -0.5 + row / n
+        for col in range(n + 1):
+            vertices.append([-0.5 + col / n, height, z])
+    quads = []
+    for row in range(n):
+        for col in range(n):
+            a = row * (n + 1) + col
+            quads.append([a, a + 1, a + n + 2, a + n + 1])
+    return vertices, quads
+
+
+def icosphere(radius, centre, subdivisions):
+    t = (1 + math.sqrt(5)) / 2
+    v = [[-1, t, 0], [1, t, 0], [-1, -t, 0], [1, -t, 0], [0, -1, t], [0, 1, t], [0, -1, -t],
+         [0, 1, -t], [t, 0, -1], [t, 0, 1], [-t, 0, -1], [-t, 0, 1]]
+    f = [[0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4],
+         [11, 10, 2], [10, 7, 6], [7, 1, 8], [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8],
+         [3, 8, 9], [4, 9, 5], [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1]]
+    v = [[c / math.sqrt(sum(x * x for x in p)) for c in p] for p in v]
+    for _ in range(subdivisions):
+        cache = {}
+
+        def mid(a, b):
+            key = (min(a, b), max(a, b))
+            if key not in cache:
+                m = [(v[a][i] + v[b][i]) / 2 for i in range(3)]
+                norm = math.sqrt(sum(x * x for x in m))
+                v.append([x / norm for x in m])
+                cache[key] = len(v) - 1
+            return cache[key]
+
+        nf = []
+        for a, b, c in f:
+            ab, bc, ca = mid(a, b), mid(b, c), mid(c, a)
+            nf += [[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]
+        f = nf
+    return [[centre[i] + radius * p[i] for i in range(3)] for p in v], f
+
+
+def grid_edges(quads):
+    edges = set()
+    for q in quads:
+        for k in range(4):
+            a, b = q[k], q[(k + 1) % 4]
+            edges.add((min(a, b), max(a, b)))
+    return sorted(edges)
+
+
+def stretch_max(rest, final, edges):
+    def length(p, a, b):
+        return math.dist(p[a], p[b])
+
+    return max((length(final, a, b) - length(rest, a, b)) / length(rest, a, b) for a, b in edges)
+
+
+def read_obj_vertices(path):
+    with open(path) as f:
+        return [[float(x) for x in line.split()[1:4]] for line in f if line.startswith("v ")]
+
+
+def reorder_to_grid(obj_vertices_rest, grid_vertices):
+    """Index map grid vertex -> OBJ vertex, by position (the OBJ of a run stopped after one
+    0.1 ms step, so every vertex is within micrometres of its grid point)."""
+    key = {}
+    for i, p in enumerate(obj_vertices_rest):
+        key[(round(p[0], 4), round(p[2], 4))] = i
+    mapping = []
+    for p in grid_vertices:
+        k = (round(p[0], 4), round(p[2], 4))
+        if k not in key:
+            raise RuntimeError(f"sketchdrape's sheet has no vertex at grid point {p}")
+        mapping.append(key[k])
+    return mapping
+
+
+def run_sketchdrape(binary, scene, workdir, extra):
+    scene_file = workdir / "scene.json"
+    scene_file.write_text(json.dumps(scene, indent=1))
+    out = workdir / "sketchdrape"
+    command = [str(binary), "run", str(scene_file), "-o", str(out)] + extra
+    start, before = time.perf_counter(), resource.getrusage(resource.RUSAGE_CHILDREN)
+    subprocess.run(command, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    wall, after = time.perf_counter() - start, resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
+    report = json.loads((out / "report.json").read_text())
+    return report, wall, cpu, read_obj_vertices(out / "drape.obj")
+
+
+def run_blender(blender, threads, spec, workdir):
+    spec_file, result_file = workdir / "blender-scene.json", workdir / "blender-result.json"
+    spec_file.write_text(json.dumps(spec))
+    command = [blender, "-b", "--factory-startup", "-noaudio", "--python-exit-code", "1"]
+    if threads is not None:
+        command += ["-t", str(threads)]
+    command += ["-P", str(ROOT / "scripts/blender/cloth_scene.py"), "--", str(spec_file),
+                str(result_file)]
+    start = time.perf_counter()
+    subprocess.run(command, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    wall = time.perf_counter() - start
+    return json.loads(result_file.read_text()), wall
+
+
+def parse_settings(pairs):
+    settings = {}
+    for pair in pairs:
+        key, _, value = pair.partition("=")
+        try:
+            settings[key] = json.loads(value)
+        except json.JSONDecodeError:
+            settings[key] = value
+    return settings
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--binary", default=str(ROOT / "build/sketchdrape"))
+    parser.add_argument("--blender", default="blender")
+    parser.add_argument("--sizes", type=int, nargs="+", default=[32, 64])
+    parser.add_argument("--scenes", nargs="+", default=["pinned", "sphere"],
+                        choices=["pinned", "sphere"])
+    parser.add_argument("--frames", type=int, default=48)
+    parser.add_argument("--fps", type=int, default=24)
+    parser.add_argument("--fabric", default="cotton")
+    parser.add_argument("--blender-threads", type=int, default=1,
+                        help="Blender's -t (0: every core, its default); default 1")
+    parser.add_argument("--blender-mass", choices=["default", "matched"], default="default",
+                        help="Blender's vertex mass: its default, or cotton's real mass")
+    parser.add_argument("--blender-set", nargs="*", default=[], metavar="KEY=VALUE",
+                        help="Blender ClothSettings to change, e.g. tension_stiffness=500")
+    parser.add_argument("--sketchdrape-set", nargs="*", default=[], metavar="KEY=VALUE",
+                        help="keys of the scene's \"simulate\" object, e.g. time_step=0.0333")
+    parser.add_argument("-o", "--out", default=str(ROOT / "out/blender-compare"))
+    args = parser.parse_args()
+
+    density = json.loads((ROOT / f"data/fabrics/{args.fabric}.json").read_text())
+    density = density["area_density"]["value"]
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    load_before = os.getloadavg()[0]
+    rows = []
+    for scene_name in args.scenes:
+        for n in args.sizes:
+            height = PINNED_HEIGHT if scene_name == "pinned" else 2 * SPHERE_RADIUS + DROP
+            vertices, quads = grid(n, height)
+            pinned = [0, n] if scene_name == "pinned" else []
+            duration = args.frames / args.fps
+            simulate = {"duration": duration, "stop_at_rest": False}
+            simulate.update(parse_settings(args.sketchdrape_set))
+            scene = {
+                "format": "sketchdrape/1",
+                "sheet": {"size": [1.0, 1.0], "resolution": [n, n], "orientation": "horizontal",
+                          "centre": [0.0, height, 0.0],
+                          "pins": ["top-left", "top-right"] if pinned else []},
+                "fabric": args.fabric,
+                "simulate": simulate,
+                "output": {"images": [], "mesh": "drape.obj"},
+            }
+            blender_settings = parse_settings(args.blender_set)
+            if args.blender_mass == "matched":
+                blender_settings["mass"] = density * 1.0 / len(vertices)
+            spec = {"vertices": vertices, "quads": quads, "pinned": pinned, "frames": args.frames,
+                    "fps": args.fps, "blender_settings": blender_settings}
+            with tempfile.TemporaryDirectory(dir=out) as tmp:
+                workdir = Path(tmp)
+                if scene_name == "sphere":
+                    body_v, body_f = icosphere(SPHERE_RADIUS, [0.0, SPHERE_RADIUS, 0.0], 4)
+                    with open(workdir / "sphere.obj", "w") as f:
+                        f.writelines(f"v {p[0]} {p[1]} {p[2]}\n" for p in body_v)
+                        f.writelines(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in body_f)
+                    scene["body"] = {"mesh": str(workdir / "sphere.obj")}
+                    spec["body_vertices"], spec["body_faces"] = body_v, body_f
+                # The sheet's vertex order in sketchdrape's output: a run of one 0.1 ms step.
+                first = json.loads(json.dumps(scene))
+                first["simulate"] = {"duration": 1e-4, "time_step": 1e-4, "stop_at_rest": False}
+                _, _, _, rest_obj = run_sketchdrape(args.binary, first, workdir, [])
+                mapping = reorder_to_grid(rest_obj, vertices)
+                report, sd_wall, sd_cpu, final_obj = run_sketchdrape(args.binary, scene, workdir,
+                                                                     [])
+                sd_final = [final_obj[i] for i in mapping]
+                blender, b_wall = run_blender(args.blender, args.blender_threads, spec, workdir)
+            edges = grid_edges(quads)
+            row = {
+                "scene": f"{scene_name} {n}x{n}",
+                "vertices": len(vertices),
+                "blender_s": blender["seconds"],
+                "blender_cpu_s": blender["cpu_seconds"],
+                "blender_wall_s": b_wall,
+                "blender_stretch_max": stretch_max(vertices, blender["positions"], edges),
+                "sketchdrape_s": report["wall_time_s"],
+                "sketchdrape_process_wall_s": sd_wall,
+                "sketchdrape_process_cpu_s": sd_cpu,
+                "sketchdrape_stretch_max": stretch_max(vertices, sd_final, edges),
+                "sketchdrape_settings": report["settings"],
+                "sketchdrape_steps": report["steps"],
+            }
+            # How far the sheet's centre of mass fell: both programs simulated the same thing.
+            row["blender_drop_m"] = height - sum(p[1] for p in blender["positions"]) / len(vertices)
+            row["sketchdrape_drop_m"] = height - sum(p[1] for p in sd_final) / len(vertices)
+            row["speedup"] = row["blender_s"] / row["sketchdrape_s"]
+            row["cpu_speedup"] = row["blender_cpu_s"] / row["sketchdrape_process_cpu_s"]
+            rows.append(row)
+            print(f"{row['scene']}: Blender {row['blender_s']:.2f} s, stretch "
+                  f"{100 * row['blender_stretch_max']:.2f} %; sketchdrape "
+                  f"{row['sketchdrape_s']:.2f} s, stretch "
+                  f"{100 * row['sketchdrape_stretch_max']:.2f} %; ratio {row['speedup']:.2f}; "
+                  f"centre of mass fell {row['blender_drop_m']:.3f} / "
+                  f"{row['sketchdrape_drop_m']:.3f} m",
+                  flush=True)
+    load_after = os.getloadavg()[0]
+    blender_version = blender["program"] if rows else "?"
+    meta = {"blender": blender_version, "blender_threads": args.blender_threads,
+            "frames": args.frames, "fps": args.fps, "fabric": args.fabric,
+            "blender_set": args.blender_set, "blender_mass": args.blender_mass, "sketchdrape_set": args.sketchdrape_set,
+            "load_average_before": load_before, "load_average_after": load_after,
+            "cores": os.cpu_count()}
+    (out / "results.json").write_text(json.dumps({"meta": meta, "rows": rows}, indent=1))
+    lines = [
+        f"{blender_version} (threads: {args.blender_threads or 'all'}) against sketchdrape "
+        f"({', '.join(args.sketchdrape_set) or 'default settings'}); {args.frames} frames at "
+        f"{args.fps} fps, {args.fabric}; load average {load_before:.1f} before, "
+        f"{load_after:.1f} after, {os.cpu_count()} cores.",
+        "",
+        "| scene | Blender | sketchdrape | ratio | CPU: Blender / sketchdrape (ratio) "
+        "| stretch max: Blender / sketchdrape | centre of mass fell: Blender / sketchdrape |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        lines.append(f"| {r['scene']} | {r['blender_s']:.2f} s | {r['sketchdrape_s']:.2f} s | "
+                     f"{r['speedup']:.2f}x | {r['blender_cpu_s']:.2f} s / "
+                     f"{r['sketchdrape_process_cpu_s']:.2f} s ({r['cpu_speedup']:.2f}x) | "
+                     f"{100 * r['blender_stretch_max']:.1f} % / "
+                     f"{100 * r['sketchdrape_stretch_max']:.2f} % | {r['blender_drop_m']:.3f} / "
+                     f"{r['sketchdrape_drop_m']:.3f} m |")
+    (out / "results.md").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    sys.exit(main())
