@@ -1,8 +1,9 @@
 #pragma once
-// SHA-256 (FIPS 180-4) for the batch layer's done markers: a job is redone exactly when the
-// digest of its inputs changes. Written here to avoid a crypto dependency for one function.
+// SHA-256 for the batch layer's done markers and the bench's reference keys: a job is redone
+// exactly when the digest of its inputs changes. The digest itself is OpenSSL's (libcrypto).
 
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <string_view>
 
@@ -12,18 +13,18 @@ namespace sd::app {
 class Sha256 {
  public:
   Sha256();
+  ~Sha256();
+  Sha256(const Sha256&) = delete;
+  Sha256& operator=(const Sha256&) = delete;
   void update(std::string_view bytes);
-  // 64 lowercase hex characters. The object must not be updated afterwards.
+  // 64 lowercase hex characters (the same on later calls). Updating afterwards throws.
   std::string hex_digest();
 
  private:
-  void compress(const unsigned char* block);
-
-  unsigned int state_[8];
-  unsigned char buffer_[64];
-  unsigned long long length_ = 0;  // bytes fed so far
-  size_t buffered_ = 0;
+  struct Context;
+  std::unique_ptr<Context> context_;
   bool finished_ = false;
+  std::string digest_;  // once finished
 };
 
 // Digest of `bytes` as 64 lowercase hex characters.

@@ -36,6 +36,14 @@ TEST(Sha256, IncrementalEqualsOneShotForEverySplit) {
   }
 }
 
+TEST(Sha256, DigestIsFinalAndRepeatable) {
+  Sha256 h;
+  h.update("abc");
+  const std::string first = h.hex_digest();
+  EXPECT_EQ(h.hex_digest(), first);
+  EXPECT_THROW(h.update("more"), std::logic_error);
+}
+
 TEST(Sha256, FileDigestMatchesContentsAndMissingFileThrows) {
   const auto dir = test::fresh_batch_dir("sha_file");
   std::string big(200000, 'x');  // several read blocks
