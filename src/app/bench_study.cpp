@@ -466,7 +466,8 @@ BenchTrace run_bench_config(const BenchScene& scene, const BenchConfig& config) 
           return outcome;
         },
         [&] {
-          const auto located = sim::locate_material_points(cloth.rest_positions(), cloth.faces(), scene.material_points);
+          const auto located = sim::locate_material_points(cloth.rest_positions(), cloth.faces(),
+                                                           scene.material_points);
           record(cloth.time(), sim::positions_at(located, cloth.faces(), cloth.positions()),
                  cloth.simulation().energy().total());
         });

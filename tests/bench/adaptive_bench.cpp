@@ -40,7 +40,7 @@
 #include <vector>
 
 #include "sim/adaptive_detail.hpp"
-#include "sim/solver_threads.hpp"
+#include "src/solver_threads.hpp"
 #include "tests/sim/adaptive_scenes.hpp"
 #include "tests/sim/test_bodies.hpp"
 
@@ -415,7 +415,7 @@ int run_study(const StudyOptions& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  sd::sim::restart_with_single_threaded_solvers(argv);  // the solvers as sketchdrape runs them
+  sd::restart_with_single_threaded_solvers(argv);  // the solvers as sketchdrape runs them
   StudyOptions options;
   std::vector<char*> rest;
   for (int i = 0; i < argc; ++i) {

@@ -1,11 +1,11 @@
 // main() of the simulator's benchmarks: the solvers on one thread, as the program runs them
-// (sim/solver_threads.hpp), then Google Benchmark.
+// (src/solver_threads.hpp), then Google Benchmark.
 #include <benchmark/benchmark.h>
 
-#include "sim/solver_threads.hpp"
+#include "src/solver_threads.hpp"
 
 int main(int argc, char** argv) {
-  sd::sim::restart_with_single_threaded_solvers(argv);
+  sd::restart_with_single_threaded_solvers(argv);
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();
