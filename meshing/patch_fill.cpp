@@ -223,7 +223,11 @@ std::optional<Plan> plan_with_strips(const detail::StripRegion& region, std::spa
   else plan.partition = plan.layout.corners == corner_positions(counts) ? "nasri" : "shifted-corners";
   // A layout without interior irregular vertex (reflex layout vertices allowed), only when it
   // costs strictly less: ties keep the Nasri/shifted-corner layouts and their figures.
-  if (auto rect = detail::best_rectilinear_layout(costs, plan.layout.cost - 1, kRectilinearBudget)) {
+  // Against a rival that does not fold, only what beats its distortion is worth searching.
+  int max_cost = plan.layout.cost - 1;
+  if (rival != nullptr && rival->folded == 0)
+    max_cost = std::min(max_cost, rival->distortion - region.fixed_cost - 1);
+  if (auto rect = detail::best_rectilinear_layout(costs, max_cost, kRectilinearBudget)) {
     int folds = 0;
     for (size_t p = 0; p < rect->turns.size(); ++p)
       folds += rect->turns[p] == 1 && costs.as_corner[p] >= detail::kFoldPenalty ? 1 : 0;

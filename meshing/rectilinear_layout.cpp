@@ -92,8 +92,39 @@ std::optional<RectilinearLayout> best_rectilinear_layout(const PositionCosts& co
   const int given = budget;
   std::vector<int> turns = base;
   std::vector<std::array<int, 2>> points;
+  // The walk's displacement from its turning positions only (O(n + changes)): the base's
+  // turning positions merged with the changed ones (`changed`, increasing); the dense walk,
+  // which also checks that no point is visited twice, only for the few that close.
+  std::vector<int> base_turning, changed;
+  for (int p = 0; p < size; ++p)
+    if (base[static_cast<size_t>(p)] != 0) base_turning.push_back(p);
+  std::vector<int> turning;
+  auto closes = [&] {
+    turning.clear();
+    size_t i = 0, j = 0;
+    while (i < base_turning.size() || j < changed.size()) {
+      int p;
+      if (j == changed.size() || (i < base_turning.size() && base_turning[i] < changed[j])) {
+        p = base_turning[i++];
+      } else {
+        p = changed[j++];
+        if (i < base_turning.size() && base_turning[i] == p) ++i;
+      }
+      if (turns[static_cast<size_t>(p)] != 0) turning.push_back(p);
+    }
+    if (turning.empty()) return false;
+    long x = 0, y = 0;
+    int d = 0;
+    for (size_t k = 0; k < turning.size(); ++k) {
+      d = direction(d + turns[static_cast<size_t>(turning[k])]);
+      const int next = k + 1 < turning.size() ? turning[k + 1] : turning.front() + size;
+      x += static_cast<long>(next - turning[k]) * kStep[static_cast<size_t>(d)][0];
+      y += static_cast<long>(next - turning[k]) * kStep[static_cast<size_t>(d)][1];
+    }
+    return x == 0 && y == 0;
+  };
   auto evaluate = [&](int extra) {
-    if (!lattice_walk(turns, points)) return;
+    if (!closes() || !lattice_walk(turns, points)) return;
     RectilinearLayout layout;
     layout.cost = base_cost + extra;
     layout.shortest = INT_MAX;
@@ -132,9 +163,11 @@ std::optional<RectilinearLayout> best_rectilinear_layout(const PositionCosts& co
       --budget;
       if (c.extra > left || std::abs(need - c.shift) > left - c.extra) continue;
       turns[static_cast<size_t>(c.position)] = c.turn;
+      changed.push_back(c.position);
       size_t next = i + 1;  // one change per position
       while (next < changes.size() && changes[next].position == c.position) ++next;
       self(self, next, left - c.extra, need - c.shift, level);
+      changed.pop_back();
       turns[static_cast<size_t>(c.position)] = base[static_cast<size_t>(c.position)];
     }
   };
