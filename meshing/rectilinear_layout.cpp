@@ -140,13 +140,18 @@ std::optional<RectilinearLayout> best_rectilinear_layout(const PositionCosts& co
         run = 0;
       }
     }
+    for (size_t p = 0; p < points.size(); ++p) {
+      const auto& q = points[(p + 1) % points.size()];
+      layout.cells += points[p][0] * q[1] - q[0] * points[p][1];
+    }
+    layout.cells /= 2;  // shoelace: the walk is counter-clockwise
     for (int p = 0; p < size; ++p) {
       const int t = turns[static_cast<size_t>(p)];
       layout.irregular += turn_cost(costs, static_cast<size_t>(p), t) % kFoldPenalty != 0 ? 1 : 0;
       if (t == 1 && !costs.flat.empty() && costs.flat[static_cast<size_t>(p)]) ++layout.flat;
     }
-    if (!best || std::tuple(layout.irregular, layout.flat, -layout.shortest) <
-                     std::tuple(best->irregular, best->flat, -best->shortest)) {
+    if (!best || std::tuple(layout.irregular, layout.flat, -layout.cells, -layout.shortest) <
+                     std::tuple(best->irregular, best->flat, -best->cells, -best->shortest)) {
       layout.turns = turns;
       best = std::move(layout);
     }

@@ -25,12 +25,13 @@ struct RectilinearLayout {
   int cost = 0;            // Σ of the position costs of the chosen turns
   int irregular = 0;       // positions with a nonzero cost
   int flat = 0;            // layout corners (t = +1) at positions flagged flat
-  int shortest = 0;        // the shortest straight run of the walk, in edges (larger is rounder)
+  int cells = 0;     // quads: for a boundary of S edges, more quads is a rounder lattice polygon
+  int shortest = 0;  // the shortest straight run of the walk, in edges
   int checks = 0;          // closure checks spent
 };
 
 // The cheapest rectilinear layout of the loop whose cost is at most `max_cost` (ties: fewest
-// irregular vertices, fewest flat corners, longest shortest run), searching turn changes from
+// irregular vertices, fewest flat corners, most quads, longest shortest run), searching turn changes from
 // each position's cheapest turn in order of added cost with at most `budget` closure checks.
 // Needs PositionCosts::as_reflex; nullopt when nothing that cheap exists (or was found).
 std::optional<RectilinearLayout> best_rectilinear_layout(const PositionCosts& costs, int max_cost,
