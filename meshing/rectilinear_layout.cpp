@@ -14,7 +14,9 @@ namespace {
 // Unit steps of the four lattice directions, counter-clockwise from +x.
 constexpr std::array<std::array<int, 2>, 4> kStep{{{1, 0}, {0, 1}, {-1, 0}, {0, -1}}};
 
-int direction(int d) { return ((d % 4) + 4) % 4; }
+int direction(int d) {
+  return ((d % 4) + 4) % 4;
+}
 
 // The lattice point of every loop position (position 0 at the origin, the edge leaving it along
 // +x turned by its own turn), and whether the walk closes without visiting a point twice.
@@ -31,8 +33,8 @@ bool lattice_walk(std::span<const int> turns, std::vector<std::array<int, 2>>& p
   if (x != 0 || y != 0) return false;
   std::vector<std::int64_t> keys(size);
   for (size_t p = 0; p < size; ++p)
-    keys[p] = (static_cast<std::int64_t>(points[p][0]) << 32) ^
-              static_cast<std::uint32_t>(points[p][1]);
+    keys[p] =
+        (static_cast<std::int64_t>(points[p][0]) << 32) ^ static_cast<std::uint32_t>(points[p][1]);
   std::sort(keys.begin(), keys.end());
   return std::adjacent_find(keys.begin(), keys.end()) == keys.end();
 }
@@ -243,8 +245,7 @@ void fill_rectilinear(QuadMeshBuilder& builder, std::span<const int> loop,
   for (int y = y0; y < y1; ++y)
     for (int x = x0; x < x1; ++x)
       if (inside[at(x, y)])
-        builder.add_quad(
-            {id[at(x, y)], id[at(x + 1, y)], id[at(x + 1, y + 1)], id[at(x, y + 1)]});
+        builder.add_quad({id[at(x, y)], id[at(x + 1, y)], id[at(x + 1, y + 1)], id[at(x, y + 1)]});
 }
 
 }  // namespace sd::meshing::detail

@@ -27,13 +27,13 @@ struct RectilinearLayout {
   int flat = 0;            // layout corners (t = +1) at positions flagged flat
   int cells = 0;     // quads: for a boundary of S edges, more quads is a rounder lattice polygon
   int shortest = 0;  // the shortest straight run of the walk, in edges
-  int checks = 0;          // closure checks spent
+  int checks = 0;    // closure checks spent
 };
 
 // The cheapest rectilinear layout of the loop whose cost is at most `max_cost` (ties: fewest
-// irregular vertices, fewest flat corners, most quads, longest shortest run), searching turn changes from
-// each position's cheapest turn in order of added cost with at most `budget` closure checks.
-// Needs PositionCosts::as_reflex; nullopt when nothing that cheap exists (or was found).
+// irregular vertices, fewest flat corners, most quads, longest shortest run), searching turn
+// changes from each position's cheapest turn in order of added cost with at most `budget` closure
+// checks. Needs PositionCosts::as_reflex; nullopt when nothing that cheap exists (or was found).
 std::optional<RectilinearLayout> best_rectilinear_layout(const PositionCosts& costs, int max_cost,
                                                          int budget);
 
