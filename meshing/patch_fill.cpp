@@ -30,7 +30,11 @@ constexpr int kPaddedSearchBudget = 4000;
 // Turn changes the rectilinear search may look at per plan (each O(1), a closure check O(S) only
 // when the changes add up): enough for every pair of changes on a loop of 100 positions, the
 // cheapest level that can beat a Nasri/shifted-corner layout of n <= 6 sides of <= 12 edges.
-constexpr int kRectilinearBudget = 40000;
+constexpr int kRectilinearBudget = 12000;
+// ... for each padded plan, and for all padded plans of a fill together (without these caps a
+// one-long-side region of n = 10 took 40 ms: dozens of padded plans, each searching deep levels).
+constexpr int kStripRectilinearBudget = 1000;
+constexpr int kPaddedRectilinearBudget = 4000;
 
 void check_counts(std::span<const int> counts) {
   if (counts.size() < 2)
@@ -200,7 +204,8 @@ detail::StripRegion planning_region(std::span<const int> counts, const BoundaryS
 std::optional<Plan> plan_with_strips(const detail::StripRegion& region, std::span<const int> counts,
                                      std::span<const int> strips, int budget,
                                      const Plan* rival = nullptr,
-                                     std::span<const int> strip_corners = {}) {
+                                     std::span<const int> strip_corners = {},
+                                     int* rectilinear_budget = nullptr) {
   const detail::PositionCosts costs = region.costs();
   if (rival != nullptr) {
     // The plan folds at least region.folded quads and costs at least this much distortion.
@@ -227,7 +232,13 @@ std::optional<Plan> plan_with_strips(const detail::StripRegion& region, std::spa
   int max_cost = plan.layout.cost - 1;
   if (rival != nullptr && rival->folded == 0)
     max_cost = std::min(max_cost, rival->distortion - region.fixed_cost - 1);
-  if (auto rect = detail::best_rectilinear_layout(costs, max_cost, kRectilinearBudget)) {
+  int rect_budget = rectilinear_budget == nullptr
+                        ? kRectilinearBudget
+                        : std::min(kStripRectilinearBudget, *rectilinear_budget);
+  const int rect_given = rect_budget;
+  auto rect = detail::best_rectilinear_layout(costs, max_cost, rect_budget);
+  if (rectilinear_budget != nullptr) *rectilinear_budget -= rect_given - rect_budget;
+  if (rect) {
     int folds = 0;
     for (size_t p = 0; p < rect->turns.size(); ++p)
       folds += rect->turns[p] == 1 && costs.as_corner[p] >= detail::kFoldPenalty ? 1 : 0;
@@ -316,6 +327,7 @@ Plan choose_plan(std::span<const int> counts, const BoundaryShape& shape,
         exposed_sides.push_back(side);
     }
   int padded_budget = kPaddedSearchBudget;
+  int rectilinear_budget = kPaddedRectilinearBudget;
   // Every side and every pair of sides between these corners (the layout may move its
   // promotions elsewhere), and a full ring. A pair's region is its first strip's region with
   // one more strip; when a strip cannot be added, no plan with it exists.
@@ -323,7 +335,7 @@ Plan choose_plan(std::span<const int> counts, const BoundaryShape& shape,
     auto consider = [&](const detail::StripRegion& region, std::span<const int> strips) {
       auto plan =
           plan_with_strips(region, counts, strips, std::min(kStripSearchBudget, padded_budget),
-                           &best, strip_corners);
+                           &best, strip_corners, &rectilinear_budget);
       if (!plan) return;
       padded_budget = std::max(0, padded_budget - plan->layout.checks);
       if (plan->rank(shape.measured) < best.rank(shape.measured) && allowed(*plan))

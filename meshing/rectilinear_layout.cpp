@@ -53,7 +53,7 @@ bool rectilinear_closes(std::span<const int> turns) {
 }
 
 std::optional<RectilinearLayout> best_rectilinear_layout(const PositionCosts& costs, int max_cost,
-                                                         int budget) {
+                                                         int& budget) {
   const auto size = static_cast<int>(costs.as_side.size());
   if (costs.as_reflex.size() != costs.as_side.size() || size < 4) return std::nullopt;
   // Every position starts at its cheapest turn; a layout is a set of changes from there, each
@@ -88,7 +88,7 @@ std::optional<RectilinearLayout> best_rectilinear_layout(const PositionCosts& co
       changes.push_back({p, t, extra, shift});
     }
   const int max_extra = max_cost - base_cost;
-  if (max_extra < std::abs(target)) return std::nullopt;
+  if (max_extra < std::abs(target) || std::abs(target) > kMaxTurnShift) return std::nullopt;
 
   std::optional<RectilinearLayout> best;
   const int given = budget;
@@ -216,31 +216,44 @@ void fill_rectilinear(QuadMeshBuilder& builder, std::span<const int> loop,
       inside[at(x, y)] = in ? 1 : 0;
     }
   }
-  // Nearest boundary point in each of the four directions along the grid lines: the mean of the
-  // two linear interpolations (along the row and along the column) places interior vertices.
-  auto hit = [&](int x, int y, int dx, int dy) {
-    int steps = 0;
-    do {
-      x += dx, y += dy, ++steps;
-    } while (!boundary[at(x, y)]);
-    return std::pair(id[at(x, y)], steps);
-  };
+  // Nearest boundary point in each of the four directions along the grid lines (one sweep per
+  // row and column each way, O(area)): the mean of the two linear interpolations, along the row
+  // and along the column, places the interior vertices.
+  std::vector<int> left(id.size()), right(id.size()), down(id.size()), up(id.size());
+  for (int y = y0; y <= y1; ++y) {
+    for (int x = x0, last = x0; x <= x1; ++x) {
+      if (boundary[at(x, y)]) last = x;
+      left[at(x, y)] = last;
+    }
+    for (int x = x1, last = x1; x >= x0; --x) {
+      if (boundary[at(x, y)]) last = x;
+      right[at(x, y)] = last;
+    }
+  }
+  for (int x = x0; x <= x1; ++x) {
+    for (int y = y0, last = y0; y <= y1; ++y) {
+      if (boundary[at(x, y)]) last = y;
+      down[at(x, y)] = last;
+    }
+    for (int y = y1, last = y1; y >= y0; --y) {
+      if (boundary[at(x, y)]) last = y;
+      up[at(x, y)] = last;
+    }
+  }
   auto cell_inside = [&](int x, int y) {
     return x >= x0 && x < x1 && y >= y0 && y < y1 && inside[at(x, y)];
   };
   for (int y = y0; y <= y1; ++y)
     for (int x = x0; x <= x1; ++x) {
       if (boundary[at(x, y)] || !cell_inside(x, y)) continue;
-      const auto [left, l_steps] = hit(x, y, -1, 0);
-      const auto [right, r_steps] = hit(x, y, 1, 0);
-      const auto [down, d_steps] = hit(x, y, 0, -1);
-      const auto [up, u_steps] = hit(x, y, 0, 1);
-      const double s = static_cast<double>(l_steps) / (l_steps + r_steps);
-      const double t = static_cast<double>(d_steps) / (d_steps + u_steps);
+      const size_t here = at(x, y);
+      const int xl = left[here], xr = right[here], yd = down[here], yu = up[here];
+      const double s = static_cast<double>(x - xl) / (xr - xl);
+      const double t = static_cast<double>(y - yd) / (yu - yd);
       const Eigen::Vector3d position =
-          0.5 * ((1 - s) * builder.position(left) + s * builder.position(right) +
-                 (1 - t) * builder.position(down) + t * builder.position(up));
-      id[at(x, y)] = builder.add_vertex(position);
+          0.5 * ((1 - s) * builder.position(id[at(xl, y)]) + s * builder.position(id[at(xr, y)]) +
+                 (1 - t) * builder.position(id[at(x, yd)]) + t * builder.position(id[at(x, yu)]));
+      id[here] = builder.add_vertex(position);
     }
   for (int y = y0; y < y1; ++y)
     for (int x = x0; x < x1; ++x)

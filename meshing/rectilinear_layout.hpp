@@ -20,6 +20,9 @@
 
 namespace sd::meshing::detail {
 
+// The most quarter turns of change a search looks for (a plain region of n sides needs |4 − n|).
+constexpr int kMaxTurnShift = 4;
+
 struct RectilinearLayout {
   std::vector<int> turns;  // per loop position: +1, 0 or −1; Σ = 4
   int cost = 0;            // Σ of the position costs of the chosen turns
@@ -27,15 +30,17 @@ struct RectilinearLayout {
   int flat = 0;            // layout corners (t = +1) at positions flagged flat
   int cells = 0;     // quads: for a boundary of S edges, more quads is a rounder lattice polygon
   int shortest = 0;  // the shortest straight run of the walk, in edges
-  int checks = 0;    // closure checks spent
+  int checks = 0;    // budget units spent
 };
 
 // The cheapest rectilinear layout of the loop whose cost is at most `max_cost` (ties: fewest
 // irregular vertices, fewest flat corners, most quads, longest shortest run), searching turn
-// changes from each position's cheapest turn in order of added cost with at most `budget` closure
-// checks. Needs PositionCosts::as_reflex; nullopt when nothing that cheap exists (or was found).
+// changes from each position's cheapest turn in order of added cost; every candidate change
+// looked at takes one unit of `budget` (decremented). Regions that need more than
+// kMaxTurnShift quarter turns of change (e.g. n >= 9 plain sides) are not searched. Needs
+// PositionCosts::as_reflex; nullopt when nothing that cheap exists (or was found).
 std::optional<RectilinearLayout> best_rectilinear_layout(const PositionCosts& costs, int max_cost,
-                                                         int budget);
+                                                         int& budget);
 
 // Whether these turns (Σ = 4) walk a closed lattice polygon that does not touch itself.
 bool rectilinear_closes(std::span<const int> turns);
