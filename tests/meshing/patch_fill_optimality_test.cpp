@@ -117,7 +117,9 @@ TEST_P(PatchFillOptimality, FillReachesTheCheapestLayoutOfTheFamily) {
   std::cout << "n = " << n << ": " << vectors << (n == 6 ? " classes" : " vectors")
             << ", at |n-4|: " << at_bound
             << ", |n-4| + 2 with |n-4| impossible: " << proven_by_parity
-            << ", the least of F only: " << family_only << "\n";
+            << ", the least of F only: " << family_only;
+  if (n == 6) std::cout << "; " << rotated << " rotated or reflected vectors fill as their class";
+  std::cout << "\n";
 }
 
 INSTANTIATE_TEST_SUITE_P(UpToSixSides, PatchFillOptimality, ::testing::Range(2, 7));
