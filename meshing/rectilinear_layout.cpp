@@ -45,13 +45,6 @@ int turn_cost(const PositionCosts& costs, size_t p, int turn) {
 
 }  // namespace
 
-bool rectilinear_closes(std::span<const int> turns) {
-  int total = 0;
-  for (const int t : turns) total += t;
-  std::vector<std::array<int, 2>> points;
-  return total == 4 && lattice_walk(turns, points);
-}
-
 std::optional<RectilinearLayout> best_rectilinear_layout(const PositionCosts& costs, int max_cost,
                                                          int& budget) {
   const auto size = static_cast<int>(costs.as_side.size());

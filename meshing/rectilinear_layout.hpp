@@ -42,9 +42,6 @@ struct RectilinearLayout {
 std::optional<RectilinearLayout> best_rectilinear_layout(const PositionCosts& costs, int max_cost,
                                                          int& budget);
 
-// Whether these turns (Σ = 4) walk a closed lattice polygon that does not touch itself.
-bool rectilinear_closes(std::span<const int> turns);
-
 // Fills the polygon whose boundary loop (vertex ids, counter-clockwise) is `loop` with the unit
 // cells of the layout's lattice polygon. Interior vertices start at the mean of the linear
 // interpolations between the boundary vertices their grid row and column end at.
