@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <climits>
 #include <cstdlib>
 #include <functional>
 #include <numeric>
@@ -17,7 +18,7 @@ namespace sd::meshing::test {
 // d_{j−1} + d_{j+1} = arcs_j with every d_j an integer >= 1. The map j -> j + 2 splits the
 // indices into one cycle (m odd) or two (m even); along a cycle d = s v + c with v the start
 // value, and closing the cycle fixes v (s = −1 at the end) or requires c = 0 (s = +1).
-inline bool nasri_feasible(const std::vector<int>& arcs) {
+inline bool nasri_feasible(const std::vector<int>& arcs, int minimum = 1) {
   const auto m = static_cast<int>(arcs.size());
   for (int start = 0; start < (m % 2 == 0 ? 2 : 1); ++start) {
     std::vector<std::pair<int, int>> terms;  // (s, c) of every d on the cycle
@@ -28,20 +29,20 @@ inline bool nasri_feasible(const std::vector<int>& arcs) {
       s = -s;
       j = (j + 2) % m;
     } while (j != start);
-    long low = 1, high = 1L << 40;  // the start value v itself is d_start >= 1
-    if (s == -1) {                  // −v + c = v
+    long low = minimum, high = 1L << 40;  // the start value v itself is d_start >= minimum
+    if (s == -1) {                        // −v + c = v
       if (c % 2 != 0) return false;
       low = high = c / 2;
     } else if (c != 0) {
       return false;
     }
-    for (const auto& [ts, tc] : terms) {  // ts v + tc >= 1
+    for (const auto& [ts, tc] : terms) {  // ts v + tc >= minimum
       if (ts == 1)
-        low = std::max(low, static_cast<long>(1 - tc));
+        low = std::max(low, static_cast<long>(minimum - tc));
       else
-        high = std::min(high, static_cast<long>(tc - 1));
+        high = std::min(high, static_cast<long>(tc - minimum));
     }
-    if (low > high || low < 1) return false;
+    if (low > high || low < minimum) return false;
   }
   return true;
 }
@@ -153,6 +154,52 @@ inline bool family_reaches(const std::vector<int>& counts, int level) {
           if (found) return true;
         }
   return false;
+}
+
+// Takayama, Panozzo & Sorkine-Hornung (2014) describe each pattern by its boundary counts as a
+// base vector plus nonnegative integer parameters; `padding` p_i (a row of quads along side i)
+// adds 1 to sides i − 1 and i + 1. For the patterns whose distortion does not depend on the
+// parameters, the least distortion any applies with, in any rotation or reflection (INT_MAX when
+// none does): 3-0 and 5-0 (one irregular vertex: 1), 4-0 (a grid: 0), 4-1 (base (2,2,1,1), x on
+// sides 0 and 1: two irregular vertices, taken as 2, the least a non-grid quadrilateral can
+// have, which only makes the check stricter), 6-0 (base all ones, x on sides 0 and 3: two
+// corners of valence 3 that padding moves inside as valence-5 vertices, 2). The solver: p_{i−1} +
+// p_{i+1} = l_i − base_i with p >= 0 is the Nasri system with a minimum of 0.
+inline int takayama_pattern_distortion(const std::vector<int>& counts) {
+  const auto n = static_cast<int>(counts.size());
+  struct Pattern {
+    int distortion;
+    std::vector<int> base, x;  // x: the sides the pattern's free parameter x lengthens
+  };
+  std::vector<Pattern> patterns;
+  if (n == 3) patterns.push_back({1, {2, 1, 1}, {0, 0, 0}});
+  if (n == 4) {
+    patterns.push_back({0, {1, 1, 1, 1}, {0, 0, 0, 0}});
+    patterns.push_back({2, {2, 2, 1, 1}, {1, 1, 0, 0}});
+  }
+  if (n == 5) patterns.push_back({1, {2, 1, 1, 1, 1}, {0, 0, 0, 0, 0}});
+  if (n == 6) patterns.push_back({2, {1, 1, 1, 1, 1, 1}, {1, 0, 0, 1, 0, 0}});
+  int best = INT_MAX;
+  std::vector<int> image(static_cast<size_t>(n)), rest(static_cast<size_t>(n));
+  for (const Pattern& pattern : patterns)
+    for (int flip = 0; flip < 2; ++flip)
+      for (int r = 0; r < n; ++r) {
+        for (int k = 0; k < n; ++k)
+          image[static_cast<size_t>(k)] =
+              counts[static_cast<size_t>(flip ? (r + n - k) % n : (r + k) % n)];
+        const bool has_x = std::accumulate(pattern.x.begin(), pattern.x.end(), 0) > 0;
+        for (int x = 0; x <= (has_x ? 24 : 0); ++x) {
+          bool nonnegative = true;
+          for (int k = 0; k < n; ++k) {
+            rest[static_cast<size_t>(k)] = image[static_cast<size_t>(k)] -
+                                           pattern.base[static_cast<size_t>(k)] -
+                                           x * pattern.x[static_cast<size_t>(k)];
+            nonnegative = nonnegative && rest[static_cast<size_t>(k)] >= 0;
+          }
+          if (nonnegative && nasri_feasible(rest, 0)) best = std::min(best, pattern.distortion);
+        }
+      }
+  return best;
 }
 
 }  // namespace sd::meshing::test

@@ -19,6 +19,7 @@
 
 #include <algorithm>
 #include <array>
+#include <climits>
 #include <cstdint>
 #include <functional>
 #include <numeric>
@@ -67,7 +68,7 @@ TEST_P(PatchFillOptimality, FillReachesTheCheapestLayoutOfTheFamily) {
   const int n = GetParam();
   const int bound = std::abs(n - 4);
   std::int64_t vectors = 0, at_bound = 0, proven_by_parity = 0, family_only = 0;
-  std::int64_t index = 0, rotated = 0;
+  std::int64_t index = 0, rotated = 0, pattern_applies = 0;
   for_each_vector(n, [&](const std::vector<int>& counts) {
     if (n == 6 && !is_canonical(counts)) {
       // The reduction to classes holds only if the fill does not depend on where the sides
@@ -90,6 +91,10 @@ TEST_P(PatchFillOptimality, FillReachesTheCheapestLayoutOfTheFamily) {
     }
     ++vectors;
     const int distortion = fill_region(counts).distortion;
+    // Never above what one of Takayama et al.'s patterns gives (those whose distortion is fixed).
+    const int pattern = test::takayama_pattern_distortion(counts);
+    if (pattern != INT_MAX) ++pattern_applies;
+    ASSERT_LE(distortion, pattern) << ::testing::PrintToString(counts);
     const bool family_at_bound = test::family_reaches(counts, bound);
     if (distortion == bound) {
       ++at_bound;
@@ -117,7 +122,8 @@ TEST_P(PatchFillOptimality, FillReachesTheCheapestLayoutOfTheFamily) {
   std::cout << "n = " << n << ": " << vectors << (n == 6 ? " classes" : " vectors")
             << ", at |n-4|: " << at_bound
             << ", |n-4| + 2 with |n-4| impossible: " << proven_by_parity
-            << ", the least of F only: " << family_only;
+            << ", the least of F only: " << family_only
+            << "; a fixed-distortion pattern applies to " << pattern_applies;
   if (n == 6) std::cout << "; " << rotated << " rotated or reflected vectors fill as their class";
   std::cout << "\n";
 }
