@@ -12,6 +12,7 @@
 
 #include "meshing/patch_relaxation.hpp"
 #include "meshing/quad_layout.hpp"
+#include "meshing/rectilinear_layout.hpp"
 #include "meshing/region_partition.hpp"
 
 namespace sd::meshing {
@@ -26,6 +27,14 @@ constexpr int kStripSearchBudget = 400;
 // ... and all padded candidates of one fill together (a skewed fill of n = 10 sides has 56 of
 // them; without this cap its topology took 2 ms).
 constexpr int kPaddedSearchBudget = 4000;
+// Turn changes the rectilinear search may look at per plan (each O(1), a closure check O(S) only
+// when the changes add up): enough for every pair of changes on a loop of 100 positions, the
+// cheapest level that can beat a Nasri/shifted-corner layout of n <= 6 sides of <= 12 edges.
+constexpr int kRectilinearBudget = 12000;
+// ... for each padded plan, and for all padded plans of a fill together (without these caps a
+// one-long-side region of n = 10 took 40 ms: dozens of padded plans, each searching deep levels).
+constexpr int kStripRectilinearBudget = 1000;
+constexpr int kPaddedRectilinearBudget = 4000;
 
 void check_counts(std::span<const int> counts) {
   if (counts.size() < 2)
@@ -146,6 +155,9 @@ struct Plan {
   bool yasseen = false;
   std::vector<int> strips;  // side indices, in the order they are added
   detail::PolygonLayout layout;
+  // Nonempty: the left-over region is filled by this rectilinear layout (a turn per loop
+  // position) instead of `layout`.
+  std::vector<int> turns;
   std::string partition;
   int distortion = 0, irregular_vertices = 0;
   int folded = 0;  // boundary vertices of valence 2 where the boundary is reflex
@@ -192,7 +204,8 @@ detail::StripRegion planning_region(std::span<const int> counts, const BoundaryS
 std::optional<Plan> plan_with_strips(const detail::StripRegion& region, std::span<const int> counts,
                                      std::span<const int> strips, int budget,
                                      const Plan* rival = nullptr,
-                                     std::span<const int> strip_corners = {}) {
+                                     std::span<const int> strip_corners = {},
+                                     int* rectilinear_budget = nullptr) {
   const detail::PositionCosts costs = region.costs();
   if (rival != nullptr) {
     // The plan folds at least region.folded quads and costs at least this much distortion.
@@ -213,6 +226,29 @@ std::optional<Plan> plan_with_strips(const detail::StripRegion& region, std::spa
   plan.flat = region.flat + plan.layout.flat;
   if (!strips.empty()) plan.partition = "padded";
   else plan.partition = plan.layout.corners == corner_positions(counts) ? "nasri" : "shifted-corners";
+  // A layout without interior irregular vertex (reflex layout vertices allowed), only when it
+  // costs strictly less: ties keep the Nasri/shifted-corner layouts and their figures.
+  // Against a rival that does not fold, only what beats its distortion is worth searching.
+  int max_cost = plan.layout.cost - 1;
+  if (rival != nullptr && rival->folded == 0)
+    max_cost = std::min(max_cost, rival->distortion - region.fixed_cost - 1);
+  int rect_budget = rectilinear_budget == nullptr
+                        ? kRectilinearBudget
+                        : std::min(kStripRectilinearBudget, *rectilinear_budget);
+  const int rect_given = rect_budget;
+  auto rect = detail::best_rectilinear_layout(costs, max_cost, rect_budget);
+  if (rectilinear_budget != nullptr) *rectilinear_budget -= rect_given - rect_budget;
+  if (rect) {
+    int folds = 0;
+    for (size_t p = 0; p < rect->turns.size(); ++p)
+      folds += rect->turns[p] == 1 && costs.as_corner[p] >= detail::kFoldPenalty ? 1 : 0;
+    plan.turns = std::move(rect->turns);
+    plan.distortion = region.fixed_cost + rect->cost - detail::kFoldPenalty * folds;
+    plan.irregular_vertices = region.fixed_irregular + rect->irregular;
+    plan.folded = region.folded + folds;
+    plan.flat = region.flat + rect->flat;
+    if (strips.empty()) plan.partition = "rectilinear";
+  }
   return plan;
 }
 
@@ -276,7 +312,13 @@ Plan choose_plan(std::span<const int> counts, const BoundaryShape& shape,
   const std::vector<int> real_corners = corner_positions(counts);
   const auto n = static_cast<int>(counts.size());
   std::vector<int> exposed_sides;  // sides with a promoted corner where the boundary is flat
-  for (const int c : best.layout.corners)
+  std::vector<int> best_corners = best.layout.corners;
+  if (!best.turns.empty()) {
+    best_corners.clear();
+    for (size_t p = 0; p < best.turns.size(); ++p)
+      if (best.turns[p] == 1) best_corners.push_back(static_cast<int>(p));
+  }
+  for (const int c : best_corners)
     if (shape.flat[static_cast<size_t>(c)] &&
         !std::binary_search(real_corners.begin(), real_corners.end(), c)) {
       const int side = static_cast<int>(std::upper_bound(real_corners.begin(), real_corners.end(), c) -
@@ -285,6 +327,7 @@ Plan choose_plan(std::span<const int> counts, const BoundaryShape& shape,
         exposed_sides.push_back(side);
     }
   int padded_budget = kPaddedSearchBudget;
+  int rectilinear_budget = kPaddedRectilinearBudget;
   // Every side and every pair of sides between these corners (the layout may move its
   // promotions elsewhere), and a full ring. A pair's region is its first strip's region with
   // one more strip; when a strip cannot be added, no plan with it exists.
@@ -292,7 +335,7 @@ Plan choose_plan(std::span<const int> counts, const BoundaryShape& shape,
     auto consider = [&](const detail::StripRegion& region, std::span<const int> strips) {
       auto plan =
           plan_with_strips(region, counts, strips, std::min(kStripSearchBudget, padded_budget),
-                           &best, strip_corners);
+                           &best, strip_corners, &rectilinear_budget);
       if (!plan) return;
       padded_budget = std::max(0, padded_budget - plan->layout.checks);
       if (plan->rank(shape.measured) < best.rank(shape.measured) && allowed(*plan))
@@ -359,7 +402,8 @@ Built realize(const Plan& plan, std::span<const int> counts,
       throw std::logic_error("a planned strip cannot be added");
   std::vector<int> loop;
   for (const auto& v : region.loop) loop.push_back(v.id);
-  detail::fill_polygon(built.builder, loop, plan.layout);
+  if (!plan.turns.empty()) detail::fill_rectilinear(built.builder, loop, plan.turns);
+  else detail::fill_polygon(built.builder, loop, plan.layout);
   return built;
 }
 

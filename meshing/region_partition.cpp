@@ -312,12 +312,14 @@ PositionCosts region_costs(std::span<const int> side_counts) {
   const int total = std::accumulate(side_counts.begin(), side_counts.end(), 0);
   PositionCosts costs{std::vector<int>(static_cast<size_t>(total), 1),
                       std::vector<int>(static_cast<size_t>(total), 0),
-                      std::vector<char>(static_cast<size_t>(total), 1)};
+                      std::vector<char>(static_cast<size_t>(total), 1),
+                      std::vector<int>(static_cast<size_t>(total), 1)};
   int p = 0;
   for (const int count : side_counts) {
     costs.as_corner[static_cast<size_t>(p)] = 0;
     costs.as_side[static_cast<size_t>(p)] = 1;
     costs.flat[static_cast<size_t>(p)] = 0;
+    costs.as_reflex[static_cast<size_t>(p)] = 2;  // valence 4 where 2 is regular
     p += count;
   }
   return costs;
@@ -786,6 +788,7 @@ PositionCosts StripRegion::costs() const {
                               (single_quad && v.reflex ? kFoldPenalty : 0));
     costs.as_side.push_back(std::abs(v.outside + 3 - v.regular));
     costs.flat.push_back(single_quad && v.exposed ? 1 : 0);
+    costs.as_reflex.push_back(std::abs(v.outside + 4 - v.regular));
   }
   return costs;
 }

@@ -44,6 +44,9 @@ struct PositionCosts {
   // the boundary's own angle there, flat (180°) or reflex. Among layouts of equal cost the
   // search prefers fewer flagged corners.
   std::vector<char> flat;
+  // Optional (empty = not offered): the cost as a *reflex* layout vertex (gaining two edges into
+  // the polygon, three quads), used only by the rectilinear layouts (rectilinear_layout.hpp).
+  std::vector<int> as_reflex;
 };
 
 // The least costly layout found: cost = |n' − 4| (the centre) + the position costs. Searches

@@ -53,6 +53,22 @@ for n in range(2, 11):
     for _ in range(3):
         add("large", [rng.randint(30, 60) for _ in range(n)])
 
+# Small skewed regions where a layout with a reflex boundary vertex (valence 4) reaches
+# |n - 4| (the two the issue names first), and more at random with sides of 1..5 edges.
+for counts in ([1, 2, 3, 1, 3], [2, 4, 4, 2, 4]):
+    add("skewed-small", counts)
+for n in range(3, 7):
+    for _ in range(5):
+        add("skewed-small", [rng.randint(1, 5) for _ in range(n)])
+
+# Notched regions (tests/meshing/patch_fill_checks.hpp, notched_sides: corner 1 pulled in to
+# a reflex angle, every side bowed in by 2%), filled in 3D: never an inverted quad.
+for n, degrees in ((4, 195), (5, 195), (6, 195), (4, 200), (5, 200)):
+    for _ in range(3):
+        counts = even([rng.randint(5, 10) for _ in range(n)])
+        cases.append({"name": f"notched-n{n}-{degrees}-{_}", "family": "notched", "sides": counts,
+                      "reflex_corner_deg": degrees})
+
 # One case per line, so that a diff shows which figures changed.
 lines = [json.dumps(c) for c in cases]
 sys.stdout.write('{"format": "sketchdrape-meshing-corpus/1",\n "cases": [\n  ' + ",\n  ".join(lines) + "\n ]\n}\n")

@@ -18,6 +18,8 @@ namespace {
 
 using sd::meshing::fill_region;
 
+std::string describe(const std::vector<int>& counts);
+
 // Named inputs, each with Σl <= 200.
 const std::vector<std::vector<int>>& cases() {
   static const std::vector<std::vector<int>> all = {
@@ -65,6 +67,34 @@ void BM_FillGeometry(benchmark::State& state) {
 
 BENCHMARK(BM_FillTopology)->DenseRange(0, 6)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_FillGeometry)->DenseRange(0, 6)->Unit(benchmark::kMicrosecond);
+
+// The small skewed pentagons that take a rectilinear layout (a boundary vertex of valence 4),
+// scaled up to 2,500 quads, next to a fair pentagon of about that size: the 3D fill.
+std::vector<int> scaled(std::vector<int> counts, int factor) {
+  for (int& c : counts) c *= factor;
+  return counts;
+}
+
+const std::vector<std::vector<int>>& rectilinear_cases() {
+  static const std::vector<std::vector<int>> all = {
+      scaled({1, 2, 3, 1, 3}, 4),  scaled({1, 2, 3, 1, 3}, 10), scaled({1, 2, 3, 1, 3}, 25),
+      scaled({2, 4, 4, 2, 4}, 2),  scaled({2, 4, 4, 2, 4}, 6),  scaled({2, 4, 4, 2, 4}, 14),
+      {40, 44, 36, 42, 38},
+  };
+  return all;
+}
+
+void BM_FillGeometrySkewed(benchmark::State& state) {
+  const std::vector<int>& counts = rectilinear_cases()[static_cast<size_t>(state.range(0))];
+  const auto sides = ellipse_sides(counts);
+  const auto filled = fill_region(sides);
+  for (auto _ : state) benchmark::DoNotOptimize(fill_region(sides));
+  state.SetLabel(describe(counts) + ": " + std::to_string(filled.mesh.faces.rows()) + " quads, " +
+                 filled.topology.partition + ", distortion " +
+                 std::to_string(filled.quality.distortion));
+}
+
+BENCHMARK(BM_FillGeometrySkewed)->DenseRange(0, 6)->Unit(benchmark::kMicrosecond);
 
 // Counts proportional to the weights, each >= 1, summing to `total` (largest remainders).
 std::vector<int> counts_from_weights(const std::vector<double>& weights, int total) {

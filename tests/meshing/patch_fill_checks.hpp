@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <vector>
 #include <cstdint>
 #include <set>
 #include <span>
@@ -94,6 +97,62 @@ void for_each_count_vector(int n, Visit&& visit) {
     }
     if (sum % 2 == 0) visit(counts);
   }
+}
+
+// Corner i at `corner_point(i)`, straight sides split evenly (n = 2: two half circles).
+template <class CornerPoint>
+inline std::vector<Eigen::MatrixX3d> straight_sides(std::span<const int> counts,
+                                             const CornerPoint& corner_point) {
+  const auto n = static_cast<int>(counts.size());
+  std::vector<Eigen::MatrixX3d> sides;
+  for (int i = 0; i < n; ++i) {
+    const int count = counts[static_cast<size_t>(i)];
+    Eigen::MatrixX3d side(count + 1, 3);
+    for (int k = 0; k <= count; ++k) {
+      const double t = static_cast<double>(k) / count;
+      if (n == 2) {
+        const double a = std::numbers::pi * (i + t);
+        side.row(k) << std::cos(a), std::sin(a), 0;
+      } else {
+        side.row(k) = ((1 - t) * corner_point(i) + t * corner_point((i + 1) % n)).transpose();
+      }
+    }
+    sides.push_back(side);
+  }
+  for (int i = 0; i < n; ++i) sides[static_cast<size_t>(i)].bottomRows<1>() = sides[static_cast<size_t>((i + 1) % n)].topRows<1>();
+  return sides;
+}
+
+inline Eigen::Vector3d on_circle(int i, int n, double radius = 1) {
+  const double a = 2 * std::numbers::pi * i / n;
+  return {radius * std::cos(a), radius * std::sin(a), 0};
+}
+
+// A regular n-gon (n >= 4) whose corner 1 is pulled inwards along its ray until the boundary's
+// interior angle there is `reflex_deg` (> 180°), every side bowed inwards by kBow of its chord
+// (so every side vertex is reflex too, by 0.5-4°).
+inline constexpr double kBow = 0.02;
+inline std::vector<Eigen::MatrixX3d> notched_sides(std::span<const int> counts, double reflex_deg) {
+  const auto n = static_cast<int>(counts.size());
+  const double step = 2 * std::numbers::pi / n;
+  // Corner 1 at distance r on its ray: the chord of corners 0 and 2 is at cos(step), half of it
+  // sin(step) long, so the angle is 180° + 2 atan((cos(step) − r) / sin(step)).
+  const double radius =
+      std::cos(step) - std::sin(step) * std::tan((reflex_deg - 180) / 2 * std::numbers::pi / 180);
+  auto corner = [n, radius](int i) { return i == 1 ? on_circle(1, n, radius) : on_circle(i, n); };
+  std::vector<Eigen::MatrixX3d> sides = straight_sides(counts, corner);
+  for (int i = 0; i < n; ++i) {
+    auto& side = sides[static_cast<size_t>(i)];
+    const Eigen::RowVector3d a = side.topRows<1>(), b = side.bottomRows<1>();
+    const Eigen::RowVector3d chord = b - a;
+    const Eigen::RowVector3d inward(-chord.y(), chord.x(), 0);  // left of a counter-clockwise side
+    const Eigen::Index count = side.rows() - 1;
+    for (Eigen::Index k = 1; k < count; ++k) {
+      const double t = static_cast<double>(k) / static_cast<double>(count);
+      side.row(k) += 4 * kBow * t * (1 - t) * inward;
+    }
+  }
+  return sides;
 }
 
 }  // namespace sd::meshing::test
