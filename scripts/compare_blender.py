@@ -129,7 +129,9 @@ def run_sketchdrape(binary, scene, workdir, extra):
     out = workdir / "sketchdrape"
     command = [str(binary), "run", str(scene_file), "-o", str(out)] + extra
     start, before = time.perf_counter(), resource.getrusage(resource.RUSAGE_CHILDREN)
-    subprocess.run(command, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    done = subprocess.run(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    if done.returncode != 0:
+        sys.exit(f"sketchdrape failed ({done.returncode}) on {scene_file}:\n{done.stderr}")
     wall, after = time.perf_counter() - start, resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
     report = json.loads((out / "report.json").read_text())
@@ -145,8 +147,10 @@ def run_blender(blender, threads, spec, workdir):
     command += ["-P", str(ROOT / "scripts/blender/cloth_scene.py"), "--", str(spec_file),
                 str(result_file)]
     start = time.perf_counter()
-    subprocess.run(command, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    done = subprocess.run(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     wall = time.perf_counter() - start
+    if done.returncode != 0:
+        sys.exit(f"blender failed ({done.returncode}) on {spec_file}:\n{done.stderr[-2000:]}")
     return json.loads(result_file.read_text()), wall
 
 
@@ -184,7 +188,7 @@ def main():
 
     density = json.loads((ROOT / f"data/fabrics/{args.fabric}.json").read_text())
     density = density["area_density"]["value"]
-    out = Path(args.out)
+    out = Path(args.out).resolve()  # the scene files name the sphere by absolute path
     out.mkdir(parents=True, exist_ok=True)
     load_before = os.getloadavg()[0]
     rows = []
