@@ -301,7 +301,7 @@ std::string where_on_piece(const Eigen::MatrixX2d& uv, const Eigen::Vector2d& p)
   const char* vertical = s.y() > 2.0 / 3 ? "upper" : (s.y() < 1.0 / 3 ? "lower" : "");
   const char* horizontal = s.x() > 2.0 / 3 ? "right" : (s.x() < 1.0 / 3 ? "left" : "");
   if (*vertical == 0 && *horizontal == 0) return "in the middle";
-  if (*vertical == 0) return fmt::format("at the {} edge side", horizontal);
+  if (*vertical == 0) return fmt::format("at the {} side", horizontal);
   if (*horizontal == 0) return fmt::format("in the {} part", vertical);
   return fmt::format("at the {} {}", vertical, horizontal);
 }
