@@ -65,7 +65,7 @@ void add_pattern_command(CLI::App& app, const GlobalOptions& /*global*/) {
   cmd->add_option("-o,--out", options->out, "Output directory (created if needed)");
   cmd->add_option("--fabric-width", options->fabric_width,
                   "Fabric width in metres (default: output.pattern.fabric_width, else 1.5)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(0.1, 10.0));
   cmd->add_option("--seam-allowance", options->seam_allowance,
                   "Seam allowance in metres for pieces without their own (default: "
                   "output.pattern.seam_allowance, else 0.01)")

@@ -4,7 +4,6 @@
 // Run: ./build/tests/bench/pattern_bench
 
 #include <benchmark/benchmark.h>
-
 #include <spdlog/spdlog.h>
 
 #include <filesystem>
