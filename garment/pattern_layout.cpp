@@ -175,35 +175,96 @@ PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOpt
     layout.pieces.push_back(std::move(piece));
   }
 
-  // First-fit decreasing height: tallest pieces first, each into the first shelf with room
-  // across the fabric, else on a new shelf further along the bolt.
-  std::vector<size_t> order(layout.pieces.size());
-  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+  // Bottom-left by skylines on a 2 mm grid across the fabric: pieces one by one, each at the
+  // column offset where its top ends lowest. A piece's column profile (lowest and highest point
+  // of its cutting line in each 2 mm column, widened by half the gap each side) rests on the
+  // fabric's skyline (the highest point placed so far per column) plus the gap, so pieces
+  // interlock (a sleeve in a neckline's hollow) yet never overlap: in each column the placed
+  // intervals are disjoint.
+  constexpr double kCell = 0.002;  // m
+  const int columns = static_cast<int>(std::floor((options.fabric_width - options.gap) / kCell));
+  const int pad = static_cast<int>(std::ceil(0.5 * options.gap / kCell));
+  // Two orders are tried, largest area first and tallest first; the shorter layout is kept.
+  const auto nest = [&](const std::vector<size_t>& order) {
+    std::vector<double> sky(static_cast<size_t>(columns), 0.0);
+    double length = 0;
+    for (const size_t i : order) {
+      PatternPiece& piece = layout.pieces[i];
+      const Eigen::MatrixX2d& p = piece.cutting;
+      const int width = static_cast<int>(std::ceil(piece.size.x() / kCell)) + 1;
+      std::vector<double> low(static_cast<size_t>(width), std::numeric_limits<double>::infinity());
+      std::vector<double> high(static_cast<size_t>(width),
+                               -std::numeric_limits<double>::infinity());
+      // Each edge is linear: over a column's slab its y lies between its values at the slab's ends.
+      for (Eigen::Index k = 0; k < p.rows(); ++k) {
+        const Eigen::Vector2d a = p.row(k), b = p.row((k + 1) % p.rows());
+        const double x0 = std::min(a.x(), b.x()), x1 = std::max(a.x(), b.x());
+        const int c0 = std::clamp(static_cast<int>(std::floor(x0 / kCell)), 0, width - 1);
+        const int c1 = std::clamp(static_cast<int>(std::floor(x1 / kCell)), 0, width - 1);
+        for (int c = c0; c <= c1; ++c) {
+          for (double x : {std::clamp(c * kCell, x0, x1), std::clamp((c + 1) * kCell, x0, x1)}) {
+            const double y =
+                b.x() == a.x() ? a.y() : a.y() + (x - a.x()) / (b.x() - a.x()) * (b.y() - a.y());
+            low[static_cast<size_t>(c)] =
+                std::min({low[static_cast<size_t>(c)], y, b.x() == a.x() ? b.y() : y});
+            high[static_cast<size_t>(c)] =
+                std::max({high[static_cast<size_t>(c)], y, b.x() == a.x() ? b.y() : y});
+          }
+        }
+      }
+      // Widened by `pad` columns each side: column j of the profile is piece column j − pad.
+      const int span = width + 2 * pad;
+      std::vector<double> bottom(static_cast<size_t>(span),
+                                 std::numeric_limits<double>::infinity());
+      std::vector<double> top(static_cast<size_t>(span), -std::numeric_limits<double>::infinity());
+      for (int j = 0; j < span; ++j)
+        for (int c = std::max(0, j - 2 * pad); c <= std::min(width - 1, j); ++c) {
+          bottom[static_cast<size_t>(j)] =
+              std::min(bottom[static_cast<size_t>(j)], low[static_cast<size_t>(c)]);
+          top[static_cast<size_t>(j)] =
+              std::max(top[static_cast<size_t>(j)], high[static_cast<size_t>(c)]);
+        }
+      if (span > columns)
+        throw PatternError(
+            pattern.panels[static_cast<size_t>(piece.panel)].id,
+            fmt::format("the piece of panel '{}' is {:.0f} mm wide with its seam allowance and the "
+                        "gaps beside it; the fabric is {:.0f} mm wide: use a wider fabric or split "
+                        "the panel",
+                        pattern.panels[static_cast<size_t>(piece.panel)].id,
+                        1000 * (piece.size.x() + options.gap), 1000 * options.fabric_width));
+      int best_x = 0;
+      double best_y = 0, best_top = std::numeric_limits<double>::infinity();
+      for (int x = 0; x + span <= columns; ++x) {
+        double y = options.gap;
+        for (int j = 0; j < span; ++j)
+          if (std::isfinite(bottom[static_cast<size_t>(j)]) && sky[static_cast<size_t>(x + j)] > 0)
+            y = std::max(
+                y, sky[static_cast<size_t>(x + j)] + options.gap - bottom[static_cast<size_t>(j)]);
+        if (y + piece.size.y() < best_top - 1e-9) {
+          best_top = y + piece.size.y();
+          best_y = y;
+          best_x = x;
+        }
+      }
+      for (int j = 0; j < span; ++j)
+        if (std::isfinite(top[static_cast<size_t>(j)]))
+          sky[static_cast<size_t>(best_x + j)] =
+              std::max(sky[static_cast<size_t>(best_x + j)], best_y + top[static_cast<size_t>(j)]);
+      piece.placement = {options.gap + (best_x + pad) * kCell, best_y};
+      length = std::max(length, best_top);
+    }
+    return length;
+  };
+  std::vector<size_t> by_area(layout.pieces.size());
+  for (size_t i = 0; i < by_area.size(); ++i) by_area[i] = i;
+  std::vector<size_t> by_height = by_area;
+  std::stable_sort(by_area.begin(), by_area.end(), [&](size_t a, size_t b) {
+    return layout.pieces[a].cut_area > layout.pieces[b].cut_area;
+  });
+  std::stable_sort(by_height.begin(), by_height.end(), [&](size_t a, size_t b) {
     return layout.pieces[a].size.y() > layout.pieces[b].size.y();
   });
-  struct Shelf {
-    double y, height, x;  // start along the bolt, height, next free x across
-  };
-  std::vector<Shelf> shelves;
-  for (const size_t i : order) {
-    PatternPiece& piece = layout.pieces[i];
-    Shelf* shelf = nullptr;
-    for (Shelf& s : shelves)
-      if (s.x + piece.size.x() + options.gap <= options.fabric_width &&
-          piece.size.y() <= s.height) {
-        shelf = &s;
-        break;
-      }
-    if (!shelf) {
-      const double y =
-          shelves.empty() ? options.gap : shelves.back().y + shelves.back().height + options.gap;
-      shelves.push_back({y, piece.size.y(), options.gap});
-      shelf = &shelves.back();
-    }
-    piece.placement = {shelf->x, shelf->y};
-    shelf->x += piece.size.x() + options.gap;
-  }
+  if (nest(by_height) < nest(by_area)) nest(by_height);
   double cut = 0;
   for (const PatternPiece& piece : layout.pieces) {
     layout.length_used = std::max(layout.length_used, piece.placement.y() + piece.size.y());

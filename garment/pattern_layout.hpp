@@ -2,7 +2,7 @@
 // The flat pattern laid out for cutting: each flattened panel scaled by its ease (what is cut),
 // its sewing line offset outwards by the seam allowance into the cutting line (CGAL straight
 // skeleton), notches where seams meet, a grain line along the warp, and the pieces nested on a
-// length of fabric of a given width (first-fit decreasing height shelves, grain along the bolt).
+// length of fabric of a given width (bottom-left on column skylines, grain along the bolt).
 
 #include <Eigen/Core>
 #include <vector>

@@ -5,12 +5,14 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <sstream>
+#include <vector>
 
 #include "src/render/image.hpp"
 #include "tests/cli/run_command.hpp"
@@ -48,6 +50,44 @@ fs::path example(const std::string& name) {
   return fs::path(SD_SOURCE_DIR) / "data/examples" / (name + ".json");
 }
 
+// A piece's cutting line on the fabric (mm).
+std::vector<std::array<double, 2>> outline(const nlohmann::json& piece) {
+  std::vector<std::array<double, 2>> out;
+  for (const auto& p : piece["cutting_line"])
+    out.push_back({p[0].get<double>() + piece["placement_mm"][0].get<double>(),
+                   p[1].get<double>() + piece["placement_mm"][1].get<double>()});
+  return out;
+}
+
+bool inside(const std::vector<std::array<double, 2>>& polygon, const std::array<double, 2>& q) {
+  bool in = false;
+  for (size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++) {
+    const auto& a = polygon[i];
+    const auto& b = polygon[j];
+    if ((a[1] > q[1]) != (b[1] > q[1]) &&
+        q[0] < a[0] + (q[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]))
+      in = !in;
+  }
+  return in;
+}
+
+// Two closed outlines overlap when an edge of one crosses an edge of the other or one holds a
+// vertex of the other.
+bool overlap(const std::vector<std::array<double, 2>>& a,
+             const std::vector<std::array<double, 2>>& b) {
+  const auto cross = [](const std::array<double, 2>& o, const std::array<double, 2>& p,
+                        const std::array<double, 2>& q) {
+    return (p[0] - o[0]) * (q[1] - o[1]) - (p[1] - o[1]) * (q[0] - o[0]);
+  };
+  for (size_t i = 0; i < a.size(); ++i)
+    for (size_t j = 0; j < b.size(); ++j) {
+      const auto &p1 = a[i], &p2 = a[(i + 1) % a.size()], &q1 = b[j], &q2 = b[(j + 1) % b.size()];
+      if (cross(p1, p2, q1) * cross(p1, p2, q2) < 0 && cross(q1, q2, p1) * cross(q1, q2, p2) < 0)
+        return true;
+    }
+  return inside(b, a[0]) || inside(a, b[0]);
+}
+
 size_t count(const std::string& text, const std::string& what) {
   size_t n = 0;
   for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
@@ -78,13 +118,9 @@ TEST(PatternCommand, EveryExampleGivesPiecesThatSewAndDoNotOverlap) {
       EXPECT_GT(a["cut_area_mm2"].get<double>(), a["sewn_area_mm2"].get<double>());
       EXPECT_EQ(a["grain_line"][0][0], a["grain_line"][1][0]);  // grain along +y
       EXPECT_FALSE(a["notches"].empty()) << name << " " << a["id"];
-      for (size_t j = i + 1; j < pieces.size(); ++j) {
-        const auto& b = pieces[j];
-        const double bx = b["placement_mm"][0], by = b["placement_mm"][1];
-        const bool apart = ax + aw <= bx || bx + b["size_mm"][0].get<double>() <= ax ||
-                           ay + ah <= by || by + b["size_mm"][1].get<double>() <= ay;
-        EXPECT_TRUE(apart) << name << ": " << a["id"] << " overlaps " << b["id"];
-      }
+      for (size_t j = i + 1; j < pieces.size(); ++j)
+        EXPECT_FALSE(overlap(outline(a), outline(pieces[j])))
+            << name << ": " << a["id"] << " overlaps " << pieces[j]["id"];
     }
     EXPECT_NEAR(json["efficiency"].get<double>(), cut / (width * length), 1e-9);
     ASSERT_FALSE(json["seams"].empty());
