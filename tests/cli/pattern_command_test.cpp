@@ -312,27 +312,31 @@ TEST(PatternCommand, FlatRestTubeSkirtDrapesLikeShapedRest) {
     return "[" + points + "]";
   };
   const double pi = 3.14159265358979323846;
-  for (const std::string rest : {"shaped", "flat"}) {
-    std::ofstream(dir / (rest + ".json")) << R"({
+  // "mixed": the front alone from its pattern piece (the panel's own "rest").
+  for (const std::string rest : {"shaped", "flat", "mixed"}) {
+    const std::string front_rest = rest == "mixed" ? R"(, "rest": "flat")" : "";
+    std::ofstream(dir / (rest + ".json"))
+        << R"({
   "format": "sketchdrape/1", "body": { "mesh": "builtin" }, "edge_length": 0.03,
   "curves": [
     { "id": "waist_f", "on_body": false, "points3d": )"
-                                          << arc(0.6, -pi / 2, pi / 2) << R"( },
+        << arc(0.6, -pi / 2, pi / 2) << R"( },
     { "id": "waist_b", "on_body": false, "points3d": )"
-                                          << arc(0.6, pi / 2, 3 * pi / 2) << R"( },
+        << arc(0.6, pi / 2, 3 * pi / 2) << R"( },
     { "id": "hem_f", "on_body": false, "points3d": )"
-                                          << arc(0.2, -pi / 2, pi / 2) << R"( },
+        << arc(0.2, -pi / 2, pi / 2) << R"( },
     { "id": "hem_b", "on_body": false, "points3d": )"
-                                          << arc(0.2, pi / 2, 3 * pi / 2) << R"( },
+        << arc(0.2, pi / 2, 3 * pi / 2) << R"( },
     { "id": "side_l", "on_body": false, "points3d": [[0.28, 0.6, 0], [0.28, 0.4, 0], [0.28, 0.2, 0]] },
     { "id": "side_r", "on_body": false, "points3d": [[-0.28, 0.6, 0], [-0.28, 0.4, 0], [-0.28, 0.2, 0]] }
   ],
   "panels": [
-    { "id": "front", "boundary": ["waist_f", "side_l", "hem_f", "side_r"] },
+    { "id": "front", "boundary": ["waist_f", "side_l", "hem_f", "side_r"])"
+        << front_rest << R"( },
     { "id": "back", "boundary": ["waist_b", "side_r", "hem_b", "side_l"] }
   ],
   "simulate": { "adaptive": false, "rest": ")"
-                                          << rest << R"(", "pin_above": 0.599, "duration": 5.0 },
+        << (rest == "mixed" ? "shaped" : rest) << R"(", "pin_above": 0.599, "duration": 5.0 },
   "output": { "images": [], "pattern": true }
 })";
     const CommandResult r = run_sketchdrape("-q run " + (dir / (rest + ".json")).string() + " -o " +
@@ -341,6 +345,10 @@ TEST(PatternCommand, FlatRestTubeSkirtDrapesLikeShapedRest) {
   }
   const auto flat_report = nlohmann::json::parse(read(dir / "flat/report.json"));
   EXPECT_EQ(flat_report["rest"], "flat");
+  const auto mixed_report = nlohmann::json::parse(read(dir / "mixed/report.json"));
+  EXPECT_EQ(mixed_report["rest"], "flat and shaped");
+  EXPECT_TRUE(mixed_report["at_rest"].get<bool>());
+  EXPECT_EQ(nlohmann::json::parse(read(dir / "shaped/report.json"))["rest"], "shaped");
   // The pieces unroll the drawn (nearly cylindrical) tube.
   const auto pattern = nlohmann::json::parse(read(dir / "flat/pattern.json"));
   for (const auto& piece : pattern["pieces"]) {
