@@ -163,7 +163,7 @@ std::string pattern_svg(const PatternSheet& sheet) {
         "<text class=\"label\" x=\"{0:.1f}\" y=\"{4:.1f}\" font-size=\"{5:.1f}\">{6:.0f} × {7:.0f} "
         "mm · {8}</text>\n"
         "<text class=\"label\" x=\"{0:.1f}\" y=\"{9:.1f}\" font-size=\"{5:.1f}\">cut 1 · ease "
-        "{10:g} · stretch ≤ {11:.1f} %</text>\n",
+        "{10:g} · stretch {11:.1f} % (95th pct)</text>\n",
         at.x(), length - at.y(), size, xml_escape(name), length - at.y() + size, 0.75 * size,
         kMm * (piece.size.x() - 2 * piece.allowance), kMm * (piece.size.y() - 2 * piece.allowance),
         xml_escape(fabric), length - at.y() + 1.9 * size, piece.ease,
