@@ -383,8 +383,8 @@ CurveSpec parse_curve(const Reader& r, const json& j, const std::string& path, c
 PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, const Sketch& sk) {
   r.require_object(j, path, "a panel");
   r.check_keys(j, path,
-               {"id", "boundary", "corners", "fabric", "mirror", "edge_length", "ease", "seed", "rest",
-                "seam_allowance"});
+               {"id", "boundary", "corners", "fabric", "mirror", "edge_length", "ease", "seed",
+                "rest", "seam_allowance"});
   PanelSpec panel;
   panel.json_path = path;
   if (!j.contains("id")) r.fail(path, "every panel needs an \"id\"");
@@ -641,7 +641,8 @@ void parse_pattern(const Reader& r, const json& j, OutputSpec& out) {
       r.fail(path + "/seam_allowance",
              fmt::format("seam allowance {} m is outside 0 .. 0.1 m", spec.seam_allowance));
   }
-  if (j.contains("max_stretch")) spec.max_stretch = r.positive(j["max_stretch"], path + "/max_stretch");
+  if (j.contains("max_stretch"))
+    spec.max_stretch = r.positive(j["max_stretch"], path + "/max_stretch");
   out.pattern = spec;
 }
 

@@ -166,7 +166,7 @@ struct ImageSpec {
 struct PatternSpec {
   double fabric_width = 1.5;     // metres across the bolt
   double seam_allowance = 0.01;  // metres, every piece without its own
-  double max_stretch = 0.05;     // flattening stretch (95th percentile) above which a panel is flagged
+  double max_stretch = 0.05;     // flattening stretch (95th percentile) that flags a panel
 };
 
 struct OutputSpec {

@@ -96,8 +96,8 @@ TriangleElement make_triangle(const ClothInput& input, Eigen::Index f, double ex
     d << uv(2) - uv(0), uv(4) - uv(0), uv(3) - uv(1), uv(5) - uv(1);
     t.rest_area = 0.5 * d.determinant();
     if (!(t.rest_area > 1e-14 * extent * extent))
-      throw InvalidClothError(triangle_name(f) +
-                              " has a (nearly) zero or inverted rest triangle in its rest coordinates");
+      throw InvalidClothError(triangle_name(f) + " has a (nearly) zero or inverted rest triangle "
+                                                 "in its rest coordinates");
   } else {
     const Vector3d normal = cross.normalized();
     const Vector3d warp = triangle_warp(input, f, normal);

@@ -56,10 +56,11 @@ ClothScene build_cloth_scene(const garment::Sketch& sketch);
 // body.
 meshing::TriMesh body_at(const ClothScene& scene, double t);
 
-// The simulator's model of the scene's cloth on its fixed mesh: build_cloth_model on the input
-// (flat hinges when bend_rest_flat), then each triangle's rest shape scaled by its panel's ease (lengths by e, so rest area and
+// The simulator's model of the scene's cloth on its fixed mesh: build_cloth_model on the input,
+// then each triangle's rest shape scaled by its panel's ease (lengths by e, so rest area and
 // mass by e²; rest angles do not change under a uniform scale). A waistband with ease below 1
-// is cut smaller than the body it was drawn on and holds the garment up.
+// is cut smaller than the body it was drawn on and holds the garment up. Hinges rest flat when
+// bend_rest_flat.
 sim::ClothModel build_scene_model(const ClothScene& scene);
 
 // The simulator settings of the file's "simulate" section (integrator, solver, step, duration,
