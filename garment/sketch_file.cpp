@@ -383,7 +383,8 @@ CurveSpec parse_curve(const Reader& r, const json& j, const std::string& path, c
 PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, const Sketch& sk) {
   r.require_object(j, path, "a panel");
   r.check_keys(j, path,
-               {"id", "boundary", "corners", "fabric", "mirror", "edge_length", "ease", "seed"});
+               {"id", "boundary", "corners", "fabric", "mirror", "edge_length", "ease", "seed",
+                "rest", "seam_allowance"});
   PanelSpec panel;
   panel.json_path = path;
   if (!j.contains("id")) r.fail(path, "every panel needs an \"id\"");
@@ -475,6 +476,19 @@ PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, c
                                          "designed, 1.05 = 5% looser)",
                                          panel.ease));
   }
+  if (j.contains("rest")) {
+    panel.rest = r.text(j["rest"], path + "/rest");
+    if (*panel.rest != "flat" && *panel.rest != "shaped")
+      r.fail(path + "/rest", fmt::format("unknown rest shape '{}'; use \"flat\" (the flattened "
+                                         "pattern piece) or \"shaped\" (as drawn on the body)",
+                                         *panel.rest));
+  }
+  if (j.contains("seam_allowance")) {
+    panel.seam_allowance = r.number(j["seam_allowance"], path + "/seam_allowance");
+    if (*panel.seam_allowance < 0 || *panel.seam_allowance > 0.1)
+      r.fail(path + "/seam_allowance",
+             fmt::format("seam allowance {} m is outside 0 .. 0.1 m", *panel.seam_allowance));
+  }
   return panel;
 }
 
@@ -532,7 +546,7 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
   const std::string path = "/simulate";
   r.require_object(j, path, "simulate");
   r.check_keys(j, path, {"duration", "adaptive", "time_step", "integrator", "solver",
-                         "stop_at_rest", "gravity", "pin_above", "check_body_vertices"});
+                         "stop_at_rest", "gravity", "pin_above", "check_body_vertices", "rest"});
   if (j.contains("pin_above")) sim.pin_above = r.number(j["pin_above"], path + "/pin_above");
   if (j.contains("duration")) sim.duration = r.positive(j["duration"], path + "/duration");
   if (j.contains("adaptive")) parse_adaptive(r, j["adaptive"], sim);
@@ -554,6 +568,13 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
   if (j.contains("gravity")) sim.gravity = r.vector<3>(j["gravity"], path + "/gravity");
   if (j.contains("check_body_vertices"))
     sim.check_body_vertices = r.boolean(j["check_body_vertices"], path + "/check_body_vertices");
+  if (j.contains("rest")) {
+    sim.rest = r.text(j["rest"], path + "/rest");
+    if (sim.rest != "flat" && sim.rest != "shaped")
+      r.fail(path + "/rest", fmt::format("unknown rest shape '{}'; use \"flat\" (the flattened "
+                                         "pattern pieces) or \"shaped\" (as drawn on the body)",
+                                         sim.rest));
+  }
 }
 
 SheetSpec parse_sheet(const Reader& r, const json& j) {
@@ -602,10 +623,33 @@ SheetSpec parse_sheet(const Reader& r, const json& j) {
   return sheet;
 }
 
+// "pattern": true, false, or an object of settings.
+void parse_pattern(const Reader& r, const json& j, OutputSpec& out) {
+  const std::string path = "/output/pattern";
+  if (j.is_boolean()) {
+    if (j.get<bool>()) out.pattern = PatternSpec{};
+    return;
+  }
+  r.require_object(j, path, "true, false or an object of pattern settings");
+  r.check_keys(j, path, {"fabric_width", "seam_allowance", "max_stretch"});
+  PatternSpec spec;
+  if (j.contains("fabric_width"))
+    spec.fabric_width = r.positive(j["fabric_width"], path + "/fabric_width");
+  if (j.contains("seam_allowance")) {
+    spec.seam_allowance = r.number(j["seam_allowance"], path + "/seam_allowance");
+    if (spec.seam_allowance < 0 || spec.seam_allowance > 0.1)
+      r.fail(path + "/seam_allowance",
+             fmt::format("seam allowance {} m is outside 0 .. 0.1 m", spec.seam_allowance));
+  }
+  if (j.contains("max_stretch"))
+    spec.max_stretch = r.positive(j["max_stretch"], path + "/max_stretch");
+  out.pattern = spec;
+}
+
 void parse_output(const Reader& r, const json& j, OutputSpec& out) {
   const std::string path = "/output";
   r.require_object(j, path, "output");
-  r.check_keys(j, path, {"images", "mesh", "report", "wireframe"});
+  r.check_keys(j, path, {"images", "mesh", "report", "wireframe", "pattern"});
   if (j.contains("mesh")) {
     out.mesh = r.text(j["mesh"], path + "/mesh");
     if (!out.mesh.ends_with(".obj") && !out.mesh.ends_with(".glb"))
@@ -615,6 +659,7 @@ void parse_output(const Reader& r, const json& j, OutputSpec& out) {
   }
   if (j.contains("report")) out.report = r.boolean(j["report"], path + "/report");
   if (j.contains("wireframe")) out.wireframe = r.boolean(j["wireframe"], path + "/wireframe");
+  if (j.contains("pattern")) parse_pattern(r, j["pattern"], out);
   if (j.contains("images")) {
     out.images_listed = true;
     const json& images = j["images"];

@@ -71,6 +71,8 @@ struct PanelSpec {
   bool mirror = false;                     // also make the copy across x = 0
   std::optional<double> edge_length;       // metres
   double ease = 1.0;                       // rest shape scale (1 = as designed)
+  std::optional<std::string> rest;         // "flat" | "shaped"; default: simulate.rest
+  std::optional<double> seam_allowance;    // metres; default: output.pattern.seam_allowance
 };
 
 struct JoinSpec {
@@ -136,6 +138,9 @@ struct SimulateSpec {
   // without it a preview shows the body through the cloth; off saves up to half a drape's
   // time (docs/collision.md).
   bool check_body_vertices = true;
+  // The cloth's rest shape: "shaped" (each triangle as drawn on the body) or "flat" (the
+  // triangle in the panel's flattened pattern piece, docs/pattern.md). Panels may override it.
+  std::string rest = "shaped";
 };
 
 // A rectangular sheet of cloth instead of a garment: scenes for tests and benchmarks.
@@ -157,12 +162,20 @@ struct ImageSpec {
   std::optional<bool> wireframe;           // default: output.wireframe
 };
 
+// "output": {"pattern": true | {...}}: the flat sewing pattern (pattern.svg, .dxf, .json).
+struct PatternSpec {
+  double fabric_width = 1.5;     // metres across the bolt
+  double seam_allowance = 0.01;  // metres, every piece without its own
+  double max_stretch = 0.05;     // flattening stretch (95th percentile) that flags a panel
+};
+
 struct OutputSpec {
   std::vector<ImageSpec> images;
   bool images_listed = false;              // "images" was given (an empty list means none)
   std::string mesh = "garment.obj";        // file name of the stitched garment (.obj or .glb)
   bool report = true;
   bool wireframe = false;
+  std::optional<PatternSpec> pattern;      // absent: no pattern files
 };
 
 struct Sketch {

@@ -20,6 +20,7 @@ if [ "$purpose" = test ]; then
   packages+=(
     python3-jsonschema  # tests validate the example sketch files against data/schema/
     chromium  # tests/batch: the batch contact sheet (index.html) loads in headless Chromium
+    python3-ezdxf  # tests/cli: the sewing pattern's pattern.dxf is read back with a real DXF library
     slurmctld slurmd slurm-client munge  # tests/batch/slurm_test.sh: a one-node Slurm cluster
     gnuplot-nox  # sketchdrape bench: the work-precision plots (optional: the CSV is written without it)
   )

@@ -44,6 +44,14 @@ void check_input(const ClothInput& input) {
     throw InvalidClothError("the cloth mesh has no vertices or no triangles");
   if (!input.rest_positions.allFinite())
     throw InvalidClothError("the cloth rest positions contain a non-finite coordinate");
+  if (input.rest_uv.rows() != 0 &&
+      (input.rest_uv.rows() != input.triangles.rows() || input.rest_uv.cols() != 6))
+    throw InvalidClothError("the rest coordinates must be 6 numbers for every triangle (" +
+                            std::to_string(input.triangles.rows()) + "), got " +
+                            std::to_string(input.rest_uv.rows()) + " by " +
+                            std::to_string(input.rest_uv.cols()));
+  if (input.rest_uv.rows() != 0 && !input.rest_uv.allFinite())
+    throw InvalidClothError("the rest coordinates contain a non-finite number");
   if (input.warp.rows() != 0 && input.warp.rows() != input.triangles.rows())
     throw InvalidClothError("the warp directions must be given for every triangle (" +
                             std::to_string(input.triangles.rows()) + "), got " +
@@ -81,12 +89,21 @@ TriangleElement make_triangle(const ClothInput& input, Eigen::Index f, double ex
   if (!(t.rest_area > 1e-14 * extent * extent) || t.vertices[0] == t.vertices[1] ||
       t.vertices[1] == t.vertices[2] || t.vertices[0] == t.vertices[2])
     throw InvalidClothError(triangle_name(f) + " has (nearly) zero rest area");
-  const Vector3d normal = cross.normalized();
-  const Vector3d warp = triangle_warp(input, f, normal);
-  const Vector3d weft = normal.cross(warp);
   // [w_u w_v] = [x1−x0, x2−x0]·D⁻¹, D = [[Δu1, Δu2], [Δv1, Δv2]] (rest coordinates).
   Eigen::Matrix2d d;
-  d << (p1 - p0).dot(warp), (p2 - p0).dot(warp), (p1 - p0).dot(weft), (p2 - p0).dot(weft);
+  if (input.rest_uv.rows() > 0) {
+    const auto uv = input.rest_uv.row(f);
+    d << uv(2) - uv(0), uv(4) - uv(0), uv(3) - uv(1), uv(5) - uv(1);
+    t.rest_area = 0.5 * d.determinant();
+    if (!(t.rest_area > 1e-14 * extent * extent))
+      throw InvalidClothError(triangle_name(f) + " has a (nearly) zero or inverted rest triangle "
+                                                 "in its rest coordinates");
+  } else {
+    const Vector3d normal = cross.normalized();
+    const Vector3d warp = triangle_warp(input, f, normal);
+    const Vector3d weft = normal.cross(warp);
+    d << (p1 - p0).dot(warp), (p2 - p0).dot(warp), (p1 - p0).dot(weft), (p2 - p0).dot(weft);
+  }
   const Eigen::Matrix2d inverse = d.inverse();
   t.du = Vector3d(-inverse(0, 0) - inverse(1, 0), inverse(0, 0), inverse(1, 0));
   t.dv = Vector3d(-inverse(0, 1) - inverse(1, 1), inverse(0, 1), inverse(1, 1));

@@ -30,6 +30,11 @@ struct ClothInput {
   // or empty: warp is then the in-plane direction closest to `up` (weft = normal × warp).
   Eigen::MatrixX3d warp;
   Eigen::Vector3d up = Eigen::Vector3d::UnitY();
+  // #F by 6 rest (material) coordinates (u0 v0 u1 v1 u2 v2, metres; u along warp, v along weft,
+  // counter-clockwise), or empty: each triangle's shape in rest_positions. A flat pattern piece's
+  // triangles, which no 3D rest shape can hold (seam vertices have one position per piece).
+  // The warp directions are then not used for stretch and shear.
+  Eigen::MatrixXd rest_uv;
 };
 
 enum class BendRestShape {

@@ -37,6 +37,7 @@ int run_cli(int argc, char** argv) {
   add_render_command(app, global);
   add_validate_command(app, global);
   add_mesh_command(app, global);
+  add_pattern_command(app, global);
   add_run_command(app, global);
   add_batch_command(app, global);
   add_stress_command(app, global);

@@ -27,6 +27,7 @@ void add_fill_command(CLI::App& app, const GlobalOptions& global);
 void add_render_command(CLI::App& app, const GlobalOptions& global);
 void add_validate_command(CLI::App& app, const GlobalOptions& global);
 void add_mesh_command(CLI::App& app, const GlobalOptions& global);
+void add_pattern_command(CLI::App& app, const GlobalOptions& global);
 void add_run_command(CLI::App& app, const GlobalOptions& global);
 void add_batch_command(CLI::App& app, const GlobalOptions& global);
 void add_stress_command(CLI::App& app, const GlobalOptions& global);

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
 
 #include "garment/body_surface.hpp"
 #include "garment/material_frames.hpp"
@@ -55,6 +56,70 @@ void build_sheet_scene(const garment::Sketch& sketch, ClothScene& scene) {
   scene.group_names = {"sheet"};
   scene.fabric_name = sketch.fabric;
   scene.fabric = fabric_at(sketch, sketch.fabric, "/fabric");
+}
+
+// "rest": "flat" (the file's or a panel's): the flattened pattern pieces become the rest shape.
+// Each triangle's rest coordinates are its pattern triangle's, with u along the piece's +y (the
+// warp) and v along weft = normal × warp, which is −x on a piece seen from outside; shaped panels
+// keep their drawn triangles. Ease is applied later, as for shaped panels (build_scene_model).
+void flat_rest_shapes(const garment::Sketch& sketch, const garment::Garment& g,
+                      const meshing::Mesh48& m48, ClothScene& scene) {
+  std::vector<bool> flat(g.panels.size(), false);
+  bool any = false, all = true;
+  for (size_t p = 0; p < g.panels.size(); ++p) {
+    const std::string& id = g.panels[p].id;
+    const garment::PanelSpec* spec = sketch.find_panel(id);
+    if (!spec && id.ends_with(".mirror")) spec = sketch.find_panel(id.substr(0, id.size() - 7));
+    const std::string rest = spec && spec->rest ? *spec->rest : sketch.simulate.rest;
+    flat[p] = rest == "flat";
+    any = any || flat[p];
+    all = all && flat[p];
+  }
+  if (!any) return;
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    scene.flat_pattern = garment::flatten_garment(g);
+  } catch (const garment::PatternError& e) {
+    const garment::PanelSpec* spec = sketch.find_panel(e.panel());
+    if (!spec && e.panel().ends_with(".mirror"))
+      spec = sketch.find_panel(e.panel().substr(0, e.panel().size() - 7));
+    sketch.fail(spec ? spec->json_path + "/rest" : "/simulate/rest", e.what());
+  }
+  scene.flattening_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  for (const std::string& warning : scene.flat_pattern->warnings) spdlog::warn("{}", warning);
+  scene.bend_rest_flat = all;
+
+  // Level-0 4-8 vertex rows are the garment's vertices.
+  const meshing::Mesh48Arrays arrays = m48.arrays();
+  if (arrays.rest_positions.rows() != g.mesh.vertex_count() ||
+      !arrays.rest_positions.isApprox(g.mesh.vertices))
+    throw std::runtime_error("flat rest: the 4-8 mesh does not keep the garment's vertices");
+  // Per panel: garment vertex → (u, v) of the pattern piece.
+  const Eigen::Index nv = g.mesh.vertex_count();
+  std::vector<Eigen::MatrixX2d> panel_uv(g.panels.size());
+  for (const garment::FlatPanel& piece : scene.flat_pattern->panels) {
+    Eigen::MatrixX2d& uv = panel_uv[static_cast<size_t>(piece.panel)];
+    uv.setConstant(nv, 2, std::numeric_limits<double>::quiet_NaN());
+    for (size_t l = 0; l < piece.vertices.size(); ++l)
+      uv.row(piece.vertices[l]) << piece.uv(static_cast<Eigen::Index>(l), 1),
+          -piece.uv(static_cast<Eigen::Index>(l), 0);
+  }
+  const garment::MaterialFrames frames = garment::material_frames(g.mesh);
+  meshing::TriMesh drawn{arrays.rest_positions, arrays.faces};
+  Eigen::VectorXi triangle_quad(arrays.faces.rows());
+  for (Eigen::Index t = 0; t < arrays.faces.rows(); ++t)
+    triangle_quad(t) = m48.source_face(arrays.triangle_ids[static_cast<size_t>(t)]);
+  scene.input.rest_uv = garment::triangle_rest_coordinates(
+      drawn, triangle_quad, frames, Eigen::VectorXd::Ones(g.mesh.face_count()));
+  for (Eigen::Index t = 0; t < arrays.faces.rows(); ++t) {
+    const size_t panel = static_cast<size_t>(g.face_panel(triangle_quad(t)));
+    if (!flat[panel]) continue;
+    for (int k = 0; k < 3; ++k)
+      scene.input.rest_uv.block<1, 2>(t, 2 * k) = panel_uv[panel].row(arrays.faces(t, k));
+  }
+  if (!scene.input.rest_uv.allFinite())
+    throw std::runtime_error("flat rest: a triangle's vertex is missing from its pattern piece");
 }
 
 void build_garment_scene(const garment::Sketch& sketch, ClothScene& scene) {
@@ -115,6 +180,7 @@ void build_garment_scene(const garment::Sketch& sketch, ClothScene& scene) {
     for (Eigen::Index q = 0; q < g.mesh.face_count(); ++q)
       scene.mesh48_face_ease(q) = g.panels[static_cast<size_t>(g.face_panel(q))].ease;
   }
+  flat_rest_shapes(sketch, g, m48, scene);
   scene.mesh48 = std::move(m48);
   scene.garment = std::move(g);
 }
@@ -168,7 +234,9 @@ sim::SimulationSettings simulation_settings(const garment::Sketch& sketch) {
 }
 
 sim::ClothModel build_scene_model(const ClothScene& scene) {
-  sim::ClothModel model = sim::build_cloth_model(scene.input, scene.fabric);
+  sim::ClothModelOptions options;
+  if (scene.bend_rest_flat) options.bend_rest = sim::BendRestShape::flat;
+  sim::ClothModel model = sim::build_cloth_model(scene.input, scene.fabric, options);
   if (scene.triangle_ease.size() > 0) sim::scale_rest_shapes(model, scene.triangle_ease);
   return model;
 }

@@ -9,6 +9,7 @@
 
 #include "garment/body.hpp"
 #include "garment/garment_mesh.hpp"
+#include "garment/panel_flattening.hpp"
 #include "garment/sketch_file.hpp"
 #include "meshing/mesh48.hpp"
 #include "sim/cloth_model.hpp"
@@ -39,6 +40,12 @@ struct ClothScene {
   Eigen::VectorXd mesh48_face_ease;
   std::vector<std::string> group_names;
   double meshing_ms = 0;               // time spent building the garment
+  // The garment's flattened panels when a panel drapes from flat cloth ("rest": "flat"); then
+  // input.rest_uv holds every triangle's rest coordinates (the pattern piece's triangle for flat
+  // panels, the drawn triangle for shaped ones) and the hinges rest flat when all panels are flat.
+  std::optional<garment::FlatPattern> flat_pattern;
+  bool bend_rest_flat = false;
+  double flattening_ms = 0;
 };
 
 // Builds the scene. Throws garment::SketchError (with the JSON path) for anything the designer
@@ -52,7 +59,8 @@ meshing::TriMesh body_at(const ClothScene& scene, double t);
 // The simulator's model of the scene's cloth on its fixed mesh: build_cloth_model on the input,
 // then each triangle's rest shape scaled by its panel's ease (lengths by e, so rest area and
 // mass by e²; rest angles do not change under a uniform scale). A waistband with ease below 1
-// is cut smaller than the body it was drawn on and holds the garment up.
+// is cut smaller than the body it was drawn on and holds the garment up. Hinges rest flat when
+// bend_rest_flat.
 sim::ClothModel build_scene_model(const ClothScene& scene);
 
 // The simulator settings of the file's "simulate" section (integrator, solver, step, duration,

@@ -19,6 +19,7 @@
 #include "src/app/atomic_file.hpp"
 #include "src/app/cli.hpp"
 #include "src/app/mesh_export.hpp"
+#include "src/app/pattern_export.hpp"
 #include "src/app/preview_images.hpp"
 #include "src/render/previews.hpp"
 
@@ -159,6 +160,13 @@ void run_mesh(const MeshOptions& options) {
                       {"distortion", distortion},
                       {"irregular_vertices", irregular},
                       {"area_m2", area}};
+
+  // The flat sewing pattern, when the file asks for it.
+  if (sketch.output.pattern) {
+    const PatternSheet sheet = build_pattern_sheet(sketch, g, *sketch.output.pattern);
+    stage_pattern(sheet, dir, outputs);
+    report["pattern"] = pattern_summary(sheet);
+  }
 
   // Images: the 4-8 triangles with each quad's panel colour and the quad edges as wireframe.
   const auto image_start = Clock::now();

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <Eigen/SVD>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -18,6 +19,7 @@
 #include "src/app/cli.hpp"
 #include "src/app/cloth_scene.hpp"
 #include "src/app/mesh_export.hpp"
+#include "src/app/pattern_export.hpp"
 #include "src/app/preview_images.hpp"
 #include "src/app/progress.hpp"
 #include "src/render/scene.hpp"
@@ -128,6 +130,39 @@ nlohmann::json meshing_json(const ClothScene& scene) {
           {"panels", panels}};
 }
 
+// How far the drape is from the cloth's rest shape (the pattern with "rest": "flat"), per group:
+// each triangle's principal stretches σ₁ ≥ σ₂ of [w_u w_v] (Baraff & Witkin's deformation
+// gradient against the model's rest triangle), strain = max(σ₁ − 1, 1 − σ₂); max and
+// rest-area-weighted mean.
+nlohmann::json strain_json(const sim::ClothModel& model, const Eigen::MatrixX3d& positions,
+                           const Eigen::VectorXi& triangle_group,
+                           const std::vector<std::string>& group_names) {
+  std::vector<double> worst(group_names.size(), 0.0), sum(group_names.size(), 0.0),
+      area(group_names.size(), 0.0);
+  for (size_t t = 0; t < model.triangles.size(); ++t) {
+    const sim::TriangleElement& e = model.triangles[t];
+    Eigen::Matrix<double, 3, 2> f = Eigen::Matrix<double, 3, 2>::Zero();
+    for (int k = 0; k < 3; ++k) {
+      f.col(0) += e.du[k] * positions.row(e.vertices[k]).transpose();
+      f.col(1) += e.dv[k] * positions.row(e.vertices[k]).transpose();
+    }
+    const Eigen::Vector2d sigma = Eigen::JacobiSVD<Eigen::Matrix<double, 3, 2>>(f).singularValues();
+    const double strain = std::max(sigma(0) - 1, 1 - sigma(1));
+    const size_t g = t < static_cast<size_t>(triangle_group.size())
+                         ? static_cast<size_t>(triangle_group(static_cast<Eigen::Index>(t)))
+                         : 0;
+    worst[g] = std::max(worst[g], strain);
+    sum[g] += e.rest_area * strain;
+    area[g] += e.rest_area;
+  }
+  nlohmann::json out = nlohmann::json::array();
+  for (size_t g = 0; g < group_names.size(); ++g)
+    out.push_back({{"group", group_names[g]},
+                   {"strain_max", worst[g]},
+                   {"strain_mean", area[g] > 0 ? sum[g] / area[g] : 0.0}});
+  return out;
+}
+
 // The sketch's "simulate": {"adaptive": {...}} over the simulator's defaults.
 sim::AdaptiveSettings adaptive_settings(const garment::Sketch& sketch) {
   const garment::AdaptiveSpec& spec = sketch.simulate.adaptive_settings;
@@ -210,8 +245,13 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   meshing::TriMesh draped;
   Eigen::VectorXi triangle_group = scene.triangle_group;
   Eigen::VectorXd face_levels;
+  nlohmann::json strain = nullptr;
+  const bool flat_rest = scene.input.rest_uv.rows() > 0;
+  if (flat_rest && sketch.simulate.adaptive)
+    spdlog::warn("\"rest\": \"flat\" drapes on the fixed mesh: adaptive detail does not yet carry "
+                 "pattern rest shapes through its splits (docs/pattern.md)");
   try {
-    if (sketch.simulate.adaptive && scene.mesh48) {
+    if (sketch.simulate.adaptive && scene.mesh48 && !flat_rest) {
       sim::AdaptiveMaterial material;
       material.fabric = scene.fabric;
       if (scene.garment) material.source_warp = garment::material_frames(scene.garment->mesh).warp;
@@ -242,6 +282,8 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
       draped.faces = cloth.faces();
       face_levels = cloth.face_levels().cast<double>();
       triangle_group = groups_of(cloth);
+      strain = strain_json(cloth.simulation().model(), draped.vertices, triangle_group,
+                           scene.group_names);
       adaptive_json = {{"splits", adaptive.splits},
                        {"forced_splits", adaptive.forced_splits},
                        {"merges", adaptive.merges},
@@ -272,6 +314,8 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
       });
       draped.vertices = sim::unflatten_positions(simulation.positions());
       draped.faces = scene.input.triangles;
+      strain = strain_json(simulation.model(), draped.vertices, scene.triangle_group,
+                           scene.group_names);
     }
   } catch (const sim::InvalidFabricError& e) {
     sketch.fail("/fabric", e.what());
@@ -319,6 +363,13 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   out["body"] = scene.body ? nlohmann::json(scene.body->raw.source) : nlohmann::json(nullptr);
   out["pinned_vertices"] = scene.pinned.size();
   out["meshing"] = meshing_json(scene);
+  out["rest"] = flat_rest ? (scene.bend_rest_flat ? "flat" : "flat and shaped") : "shaped";
+  out["strain"] = strain;  // per group, against the rest shape (the pattern when flat)
+  if (scene.garment && sketch.output.pattern) {
+    const PatternSheet sheet = build_pattern_sheet(sketch, *scene.garment, *sketch.output.pattern);
+    stage_pattern(sheet, dir, outputs);
+    out["pattern"] = pattern_summary(sheet);
+  }
   out["adaptive"] = adaptive_json;
   out["images"] = images;
   out["frames"] = frames.size();

@@ -99,6 +99,53 @@ TEST(ClothModel, DesignedRestAnglesOrFlat) {
   EXPECT_GT(force.lpNorm<Eigen::Infinity>(), 1e-7);
 }
 
+// Rest coordinates given per triangle (a flat pattern piece): the same numbers as the rest
+// positions would give build the same model, and a pair of triangles folded in 3D whose rest
+// coordinates are their unfolded shape is unstrained when laid flat, strained as folded.
+TEST(ClothModel, RestCoordinatesPerTriangle) {
+  const SheetScene scene = small_sheet();
+  const ClothModel reference = build_cloth_model(scene.input, FabricParameters{});
+  ClothInput given = scene.input;
+  given.rest_uv.resize(given.triangles.rows(), 6);
+  for (Eigen::Index f = 0; f < given.triangles.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      // The vertical sheet's warp is +y and weft = normal × warp = (+z) × (+y) = −x.
+      const Eigen::Vector3d p = given.rest_positions.row(given.triangles(f, k)) -
+                                given.rest_positions.row(given.triangles(f, 0));
+      given.rest_uv(f, 2 * k) = p.y();
+      given.rest_uv(f, 2 * k + 1) = -p.x();
+    }
+  const ClothModel model = build_cloth_model(given, FabricParameters{});
+  ASSERT_EQ(model.triangles.size(), reference.triangles.size());
+  for (size_t t = 0; t < model.triangles.size(); ++t) {
+    EXPECT_NEAR(model.triangles[t].rest_area, reference.triangles[t].rest_area, 1e-15);
+    EXPECT_NEAR((model.triangles[t].du - reference.triangles[t].du).norm(), 0.0, 1e-9);
+    EXPECT_NEAR((model.triangles[t].dv - reference.triangles[t].dv).norm(), 0.0, 1e-9);
+  }
+
+  // Two unit right triangles sharing the edge 0-1, the second folded up by 90°.
+  ClothInput folded;
+  folded.rest_positions.resize(4, 3);
+  folded.rest_positions << 0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 0, 1;
+  folded.triangles.resize(2, 3);
+  folded.triangles << 0, 1, 2, 1, 0, 3;
+  folded.rest_uv.resize(2, 6);
+  folded.rest_uv << 0, 0, 1, 0, 0, 1,  //
+      0, 0, -1, 0, 0, -1;  // (1,0,0) → (0,0), (0,0,0) → (−1,0), (1,0,1) → (0,−1)
+  const ClothModel flat = build_cloth_model(folded, FabricParameters{});
+  EXPECT_NEAR(flat.total_mass(), FabricParameters{}.area_density * 1.0, 1e-12);
+  Eigen::MatrixX3d laid(4, 3);
+  laid << 0, 0, 0, 1, 0, 0, 0, 1, 0, 1, -1, 0;  // the pair unfolded onto the plane z = 0
+  EXPECT_NEAR(max_stretch_strain(flat, flatten_positions(laid)), 0.0, 1e-12);
+  EXPECT_NEAR(max_stretch_strain(flat, flatten_positions(folded.rest_positions)), 0.0, 1e-12);
+  folded.rest_uv(1, 5) = -0.5;  // the second triangle cut half as long across: now strained
+  EXPECT_GT(max_stretch_strain(build_cloth_model(folded, FabricParameters{}),
+                               flatten_positions(folded.rest_positions)),
+            0.5);
+  folded.rest_uv(1, 5) = 1;  // inverted in the pattern
+  EXPECT_THROW(build_cloth_model(folded, FabricParameters{}), InvalidClothError);
+}
+
 TEST(ClothModel, BadMeshesAreRejected) {
   ClothInput input;
   input.rest_positions.resize(3, 3);

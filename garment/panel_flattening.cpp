@@ -1,0 +1,560 @@
+#include "garment/panel_flattening.hpp"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Surface_mesh.h>
+#include <CGAL/Surface_mesh_parameterization/LSCM_parameterizer_3.h>
+#include <CGAL/Surface_mesh_parameterization/parameterize.h>
+#include <fmt/format.h>
+
+#include <Eigen/Geometry>
+#include <Eigen/SparseCholesky>
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <unordered_map>
+
+#include "garment/material_frames.hpp"
+
+namespace sd::garment {
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using SurfaceMesh = CGAL::Surface_mesh<Kernel::Point_3>;
+namespace SMP = CGAL::Surface_mesh_parameterization;
+
+// Singular values σ₁ ≥ σ₂ ≥ 0 of a 2×2 matrix (closed form), and the closest rotation.
+struct Polar2 {
+  double s1 = 1, s2 = 1;
+  Eigen::Matrix2d rotation = Eigen::Matrix2d::Identity();
+};
+Polar2 polar(const Eigen::Matrix2d& j) {
+  const double e = 0.5 * (j(0, 0) + j(1, 1)), f = 0.5 * (j(0, 0) - j(1, 1));
+  const double g = 0.5 * (j(1, 0) + j(0, 1)), h = 0.5 * (j(1, 0) - j(0, 1));
+  const double q = std::hypot(e, h), r = std::hypot(f, g);
+  Polar2 p;
+  p.s1 = q + r;
+  p.s2 = std::abs(q - r);
+  const double angle = std::atan2(h, e);
+  p.rotation << std::cos(angle), -std::sin(angle), std::sin(angle), std::cos(angle);
+  return p;
+}
+
+// A triangle of the 3D mesh in its own plane: gradient operator of the linear map to 2D.
+struct RestTriangle {
+  double area = 0;          // m², 3D
+  Eigen::Matrix2d inverse;  // D⁻¹, D = [x1 − x0, x2 − x0] in the triangle's plane
+  Eigen::Vector3d e1, e2;   // the plane's orthonormal frame (3D)
+  Eigen::Vector3d centroid;
+};
+
+std::vector<RestTriangle> rest_triangles(const Eigen::MatrixX3d& v, const Eigen::MatrixX3i& t,
+                                         const std::string& name) {
+  std::vector<RestTriangle> rest(static_cast<size_t>(t.rows()));
+  for (Eigen::Index f = 0; f < t.rows(); ++f) {
+    const Eigen::Vector3d p0 = v.row(t(f, 0)), p1 = v.row(t(f, 1)), p2 = v.row(t(f, 2));
+    const Eigen::Vector3d n = (p1 - p0).cross(p2 - p0);
+    RestTriangle& r = rest[static_cast<size_t>(f)];
+    r.area = 0.5 * n.norm();
+    if (!(r.area > 0))
+      throw PatternError(name, fmt::format("panel '{}' has a triangle of zero area", name));
+    r.e1 = (p1 - p0).normalized();
+    r.e2 = n.normalized().cross(r.e1);
+    Eigen::Matrix2d d;
+    d << (p1 - p0).dot(r.e1), (p2 - p0).dot(r.e1), 0.0, (p2 - p0).dot(r.e2);
+    r.inverse = d.inverse();
+    r.centroid = (p0 + p1 + p2) / 3;
+  }
+  return rest;
+}
+
+// J = [u1 − u0, u2 − u0]·D⁻¹: the triangle's 3D (plane frame) → 2D map.
+Eigen::Matrix2d jacobian(const Eigen::MatrixX2d& uv, const Eigen::MatrixX3i& t, Eigen::Index f,
+                         const RestTriangle& r) {
+  Eigen::Matrix2d u;
+  u.col(0) = (uv.row(t(f, 1)) - uv.row(t(f, 0))).transpose();
+  u.col(1) = (uv.row(t(f, 2)) - uv.row(t(f, 0))).transpose();
+  return u * r.inverse;
+}
+
+double signed_area_2d(const Eigen::MatrixX2d& uv, const Eigen::MatrixX3i& t, Eigen::Index f) {
+  const Eigen::Vector2d a = uv.row(t(f, 1)) - uv.row(t(f, 0));
+  const Eigen::Vector2d b = uv.row(t(f, 2)) - uv.row(t(f, 0));
+  return 0.5 * (a.x() * b.y() - a.y() * b.x());
+}
+
+int folded_triangles(const Eigen::MatrixX2d& uv, const Eigen::MatrixX3i& t,
+                     const std::vector<RestTriangle>& rest) {
+  int folded = 0;
+  for (Eigen::Index f = 0; f < t.rows(); ++f)
+    if (!(signed_area_2d(uv, t, f) > 1e-9 * rest[static_cast<size_t>(f)].area)) ++folded;
+  return folded;
+}
+
+// The boundary of a disk as one counter-clockwise loop of local vertices; throws PatternError
+// when the triangles do not form a disk (V − E + F ≠ 1, or several boundary loops).
+std::vector<int> disk_boundary(const std::string& name, Eigen::Index vertex_count,
+                               const Eigen::MatrixX3i& t) {
+  std::unordered_map<long long, int> directed;
+  const auto key = [&](int a, int b) { return static_cast<long long>(a) * vertex_count + b; };
+  for (Eigen::Index f = 0; f < t.rows(); ++f)
+    for (int k = 0; k < 3; ++k) ++directed[key(t(f, k), t(f, (k + 1) % 3))];
+  std::vector<int> next(static_cast<size_t>(vertex_count), -1);
+  long long edges = 0;
+  int boundary_edges = 0;
+  for (const auto& [k, count] : directed) {
+    const int a = static_cast<int>(k / vertex_count), b = static_cast<int>(k % vertex_count);
+    if (count > 1 || (directed.count(key(b, a)) > 0 && directed.at(key(b, a)) > 1))
+      throw PatternError(name, fmt::format("panel '{}' has an edge used twice in one direction "
+                                           "(its faces are not consistently oriented)",
+                                           name));
+    const bool interior = directed.count(key(b, a)) > 0;
+    edges += interior ? 1 : 2;  // an interior edge is counted from both sides
+    if (interior) continue;
+    if (next[static_cast<size_t>(a)] >= 0)
+      throw PatternError(name, fmt::format("panel '{}' touches itself at a vertex: it cannot be "
+                                           "laid flat as one piece",
+                                           name));
+    next[static_cast<size_t>(a)] = b;
+    ++boundary_edges;
+  }
+  edges /= 2;
+  const long long euler = vertex_count - edges + t.rows();
+  if (boundary_edges == 0 || euler != 1)
+    throw PatternError(
+        name, fmt::format("panel '{}' is not a disk (it closes around the body like a tube, or has "
+                          "a hole): a flat pattern piece needs it cut open; split it into two "
+                          "panels with a seam",
+                          name));
+  std::vector<int> loop;
+  int start = -1;
+  for (Eigen::Index v = 0; v < vertex_count && start < 0; ++v)
+    if (next[static_cast<size_t>(v)] >= 0) start = static_cast<int>(v);
+  for (int v = start; loop.empty() || v != start; v = next[static_cast<size_t>(v)]) {
+    loop.push_back(v);
+    if (static_cast<int>(loop.size()) > boundary_edges) break;
+  }
+  if (static_cast<int>(loop.size()) != boundary_edges)
+    throw PatternError(name, fmt::format("panel '{}' has more than one boundary loop (a hole): "
+                                         "cut it open with a seam",
+                                         name));
+  return loop;
+}
+
+// LSCM (CGAL, two pinned vertices): a conformal start, scaled to the 3D area and oriented so the
+// triangles keep their counter-clockwise order.
+Eigen::MatrixX2d lscm_start(const std::string& name, const Eigen::MatrixX3d& v,
+                            const Eigen::MatrixX3i& t, double area_3d) {
+  SurfaceMesh mesh;
+  std::vector<SurfaceMesh::Vertex_index> handles;
+  handles.reserve(static_cast<size_t>(v.rows()));
+  for (Eigen::Index i = 0; i < v.rows(); ++i)
+    handles.push_back(mesh.add_vertex(Kernel::Point_3(v(i, 0), v(i, 1), v(i, 2))));
+  for (Eigen::Index f = 0; f < t.rows(); ++f)
+    if (mesh.add_face(handles[static_cast<size_t>(t(f, 0))], handles[static_cast<size_t>(t(f, 1))],
+                      handles[static_cast<size_t>(t(f, 2))]) == SurfaceMesh::null_face())
+      throw PatternError(name, fmt::format("panel '{}' is not a manifold surface", name));
+  auto uvmap = mesh.add_property_map<SurfaceMesh::Vertex_index, Kernel::Point_2>("v:uv").first;
+  // The panel is a disk (checked before): its one border loop starts at any border halfedge.
+  SurfaceMesh::Halfedge_index border;
+  for (const SurfaceMesh::Halfedge_index h : mesh.halfedges())
+    if (mesh.is_border(h)) {
+      border = h;
+      break;
+    }
+  const SMP::Error_code status =
+      SMP::parameterize(mesh, SMP::LSCM_parameterizer_3<SurfaceMesh>(), border, uvmap);
+  if (status != SMP::OK)
+    throw PatternError(name, fmt::format("panel '{}' could not be flattened: {}", name,
+                                         SMP::get_error_message(status)));
+  Eigen::MatrixX2d uv(v.rows(), 2);
+  for (Eigen::Index i = 0; i < v.rows(); ++i) {
+    const Kernel::Point_2& p = uvmap[handles[static_cast<size_t>(i)]];
+    uv.row(i) << p.x(), p.y();
+  }
+  double area_2d = 0;
+  for (Eigen::Index f = 0; f < t.rows(); ++f) area_2d += signed_area_2d(uv, t, f);
+  if (area_2d < 0) {
+    uv.col(0) *= -1;
+    area_2d = -area_2d;
+  }
+  if (!(area_2d > 0)) throw PatternError(name, fmt::format("panel '{}' flattens to nothing", name));
+  uv *= std::sqrt(area_3d / area_2d);
+  return uv;
+}
+
+// As-rigid-as-possible local/global iterations (Liu et al. 2008) on the energy
+//   Σ_t A_t ‖J_t − R_t‖²  +  Σ_boundary w ‖(u_i − u_j) − l_ij·d̂_ij‖²,
+// where l_ij is the edge's 3D length and d̂_ij its current 2D direction: the second term holds
+// the outline at its true length, so both sides of a seam come out as long as the seam is.
+// Returns the sweeps made.
+int arap(Eigen::MatrixX2d& uv, const Eigen::MatrixX3d& v, const Eigen::MatrixX3i& t,
+         const std::vector<RestTriangle>& rest, const std::vector<int>& boundary,
+         const FlatteningOptions& options) {
+  const Eigen::Index n = v.rows();
+  const double w = 0.5 * options.boundary_weight;
+  std::vector<Eigen::Triplet<double>> entries;
+  const auto gradients = [&](Eigen::Index f) {
+    const Eigen::Matrix2d& inv = rest[static_cast<size_t>(f)].inverse;
+    std::array<Eigen::Vector2d, 3> g;
+    g[1] = inv.row(0).transpose();
+    g[2] = inv.row(1).transpose();
+    g[0] = -g[1] - g[2];
+    return g;
+  };
+  for (Eigen::Index f = 0; f < t.rows(); ++f) {
+    const auto g = gradients(f);
+    const double a = rest[static_cast<size_t>(f)].area;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) entries.emplace_back(t(f, i), t(f, j), a * g[i].dot(g[j]));
+  }
+  const size_t nb = boundary.size();
+  std::vector<double> length(nb);
+  for (size_t k = 0; k < nb; ++k) {
+    const int i = boundary[k], j = boundary[(k + 1) % nb];
+    length[k] = (v.row(i) - v.row(j)).norm();
+    entries.emplace_back(i, i, w);
+    entries.emplace_back(j, j, w);
+    entries.emplace_back(i, j, -w);
+    entries.emplace_back(j, i, -w);
+  }
+  // Translation is free: a weak spring holds vertex 0 where it is.
+  const double pin = 1e-6 * w;
+  entries.emplace_back(0, 0, pin);
+  Eigen::SparseMatrix<double> matrix(n, n);
+  matrix.setFromTriplets(entries.begin(), entries.end());
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(matrix);
+  if (solver.info() != Eigen::Success) return 0;
+
+  const double extent = (v.colwise().maxCoeff() - v.colwise().minCoeff()).norm();
+  int sweeps = 0;
+  Eigen::MatrixX2d rhs(n, 2);
+  for (; sweeps < options.max_iterations; ++sweeps) {
+    rhs.setZero();
+    for (Eigen::Index f = 0; f < t.rows(); ++f) {
+      const RestTriangle& r = rest[static_cast<size_t>(f)];
+      const Eigen::Matrix2d rotation = polar(jacobian(uv, t, f, r)).rotation;
+      const auto g = gradients(f);
+      for (int k = 0; k < 3; ++k) rhs.row(t(f, k)) += r.area * (rotation * g[k]).transpose();
+    }
+    for (size_t k = 0; k < nb; ++k) {
+      const int i = boundary[k], j = boundary[(k + 1) % nb];
+      Eigen::RowVector2d d = uv.row(i) - uv.row(j);
+      const double norm = d.norm();
+      if (norm > 0) d *= length[k] / norm;
+      rhs.row(i) += w * d;
+      rhs.row(j) -= w * d;
+    }
+    rhs.row(0) += pin * uv.row(0);
+    const Eigen::MatrixX2d next = solver.solve(rhs);
+    const double move = (next - uv).rowwise().norm().maxCoeff();
+    uv = next;
+    if (move < 1e-7 * extent) {  // 0.1 µm on a 1 m piece
+      ++sweeps;
+      break;
+    }
+  }
+  return sweeps;
+}
+
+FlatDistortion measure(const Eigen::MatrixX2d& uv, const Eigen::MatrixX3i& t,
+                       const std::vector<RestTriangle>& rest) {
+  FlatDistortion d;
+  double total = 0;
+  std::vector<std::pair<double, Eigen::Index>> by_length;  // (length distortion, triangle)
+  for (Eigen::Index f = 0; f < t.rows(); ++f) {
+    const RestTriangle& r = rest[static_cast<size_t>(f)];
+    const Polar2 p = polar(jacobian(uv, t, f, r));
+    const double length = std::max(p.s1 - 1, 1 - p.s2);
+    const double area = std::abs(p.s1 * p.s2 - 1);
+    d.length_max = std::max(d.length_max, length);
+    d.area_max = std::max(d.area_max, area);
+    d.length_mean += r.area * length;
+    d.area_mean += r.area * area;
+    total += r.area;
+    by_length.emplace_back(length, f);
+  }
+  d.length_mean /= total;
+  d.area_mean /= total;
+  // The worst 5 % of the area: its lowest distortion is the 95th percentile, its area-weighted
+  // centroid the place the stretch concentrates.
+  std::sort(by_length.begin(), by_length.end(), std::greater<>());
+  double area = 0;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  Eigen::Vector2d centre_2d = Eigen::Vector2d::Zero();
+  for (const auto& [length, f] : by_length) {
+    const double a = rest[static_cast<size_t>(f)].area;
+    area += a;
+    centre += a * rest[static_cast<size_t>(f)].centroid;
+    centre_2d += a * (uv.row(t(f, 0)) + uv.row(t(f, 1)) + uv.row(t(f, 2))).transpose() / 3;
+    d.length_p95 = length;
+    if (area >= 0.05 * total) break;
+  }
+  d.worst_point = centre / area;
+  d.worst_point_2d = centre_2d / area;
+  return d;
+}
+
+// Where on the piece a 2D point lies, in words ("at the upper left", "in the middle").
+std::string where_on_piece(const Eigen::MatrixX2d& uv, const Eigen::Vector2d& p) {
+  const Eigen::Vector2d lo = uv.colwise().minCoeff(), hi = uv.colwise().maxCoeff();
+  const Eigen::Vector2d s = (p - lo).cwiseQuotient((hi - lo).cwiseMax(1e-12));
+  const char* vertical = s.y() > 2.0 / 3 ? "upper" : (s.y() < 1.0 / 3 ? "lower" : "");
+  const char* horizontal = s.x() > 2.0 / 3 ? "right" : (s.x() < 1.0 / 3 ? "left" : "");
+  if (*vertical == 0 && *horizontal == 0) return "in the middle";
+  if (*vertical == 0) return fmt::format("at the {} side", horizontal);
+  if (*horizontal == 0) return fmt::format("in the {} part", vertical);
+  return fmt::format("at the {} {}", vertical, horizontal);
+}
+
+FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
+                            const Eigen::MatrixX3i& t, const Eigen::MatrixX3d& triangle_warp,
+                            const FlatteningOptions& options) {
+  FlatPanel out;
+  out.id = name;
+  out.triangles = t;
+  out.boundary = disk_boundary(name, v.rows(), t);
+  const std::vector<RestTriangle> rest = rest_triangles(v, t, name);
+  for (const RestTriangle& r : rest) out.area_3d += r.area;
+
+  const Eigen::MatrixX2d start = lscm_start(name, v, t, out.area_3d);
+  Eigen::MatrixX2d uv = start;
+  out.iterations = arap(uv, v, t, rest, out.boundary, options);
+  int folded = folded_triangles(uv, t, rest);
+  if (folded > 0 && folded_triangles(start, t, rest) == 0) {
+    uv = start;  // ARAP folded what LSCM kept unfolded: keep the conformal map
+    folded = 0;
+  }
+  if (folded > 0) {
+    const FlatDistortion d = measure(uv, t, rest);
+    throw PatternError(
+        name, fmt::format("panel '{}' cannot be cut from flat cloth: flattened, {} of its {} "
+                          "triangles fold over (worst near ({:.3f}, {:.3f}, {:.3f}) m); it curves "
+                          "too much, like a nearly closed cap: split it with seams or darts",
+                          name, folded, t.rows(), d.worst_point.x(), d.worst_point.y(),
+                          d.worst_point.z()));
+  }
+
+  // Grain: the mean 2D image of the warp, turned onto +y.
+  Eigen::Vector2d grain = Eigen::Vector2d::Zero();
+  for (Eigen::Index f = 0; f < t.rows(); ++f) {
+    const RestTriangle& r = rest[static_cast<size_t>(f)];
+    const Eigen::Vector3d w3 = triangle_warp.row(triangle_warp.rows() == 1 ? 0 : f).transpose();
+    const Eigen::Vector2d local(w3.dot(r.e1), w3.dot(r.e2));
+    const Eigen::Vector2d image = jacobian(uv, t, f, r) * local;
+    if (image.norm() > 0) grain += r.area * image.normalized();
+  }
+  if (grain.norm() < 1e-12) grain = Eigen::Vector2d::UnitY();
+  const double turn = std::numbers::pi / 2 - std::atan2(grain.y(), grain.x());
+  const Eigen::Matrix2d rotation = Eigen::Rotation2Dd(turn).toRotationMatrix();
+  uv = (uv * rotation.transpose()).eval();
+  uv.rowwise() -= uv.colwise().minCoeff();
+  out.uv = uv;
+  for (Eigen::Index f = 0; f < t.rows(); ++f) out.area_2d += signed_area_2d(uv, t, f);
+  out.distortion = measure(uv, t, rest);
+
+  const FlatDistortion& d = out.distortion;
+  if (d.length_p95 > options.refuse_stretch)
+    throw PatternError(
+        name,
+        fmt::format("panel '{}' cannot be cut from flat cloth: flattened, it must stretch or "
+                    "shrink by {:.0f} % or more over a twentieth of its area, {} of the piece "
+                    "(near ({:.3f}, {:.3f}, {:.3f}) m); it curves too much, like a nearly closed "
+                    "cap: split it with seams or darts",
+                    name, 100 * d.length_p95, where_on_piece(uv, d.worst_point_2d),
+                    d.worst_point.x(), d.worst_point.y(), d.worst_point.z()));
+  if (d.length_p95 > options.warn_stretch)
+    out.warning = fmt::format(
+        "panel '{}': the flat piece is {:.1f} % or more longer or shorter than the surface over a "
+        "twentieth of its area, {} of the piece (near ({:.3f}, {:.3f}, {:.3f}) m; mean {:.2f} %); "
+        "the surface is not developable there: a dart or a seam there would let the cloth lie as "
+        "drawn",
+        name, 100 * d.length_p95, where_on_piece(uv, d.worst_point_2d), d.worst_point.x(),
+        d.worst_point.y(), d.worst_point.z(), 100 * d.length_mean);
+  return out;
+}
+
+// The two triangles of quad (a, b, c, d): split along the diagonal whose triangles have the
+// larger smallest angle.
+std::array<Eigen::Vector3i, 2> split_quad(const Eigen::MatrixX3d& v, const Eigen::Vector4i& q) {
+  const auto min_angle = [&](int a, int b, int c) {
+    double smallest = std::numbers::pi;
+    const std::array<int, 3> idx = {a, b, c};
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d p = v.row(idx[k]);
+      const Eigen::Vector3d u = Eigen::Vector3d(v.row(idx[(k + 1) % 3])) - p;
+      const Eigen::Vector3d w = Eigen::Vector3d(v.row(idx[(k + 2) % 3])) - p;
+      smallest = std::min(smallest, std::atan2(u.cross(w).norm(), u.dot(w)));
+    }
+    return smallest;
+  };
+  const double a02 = std::min(min_angle(q[0], q[1], q[2]), min_angle(q[0], q[2], q[3]));
+  const double a13 = std::min(min_angle(q[0], q[1], q[3]), min_angle(q[1], q[2], q[3]));
+  if (a02 >= a13) return {Eigen::Vector3i(q[0], q[1], q[2]), Eigen::Vector3i(q[0], q[2], q[3])};
+  return {Eigen::Vector3i(q[0], q[1], q[3]), Eigen::Vector3i(q[1], q[2], q[3])};
+}
+
+double polyline_length(const Eigen::MatrixX2d& uv, const std::vector<int>& vertices) {
+  double length = 0;
+  for (size_t k = 1; k < vertices.size(); ++k)
+    length += (uv.row(vertices[k]) - uv.row(vertices[k - 1])).norm();
+  return length;
+}
+
+}  // namespace
+
+double PatternSeam::mismatch() const {
+  const double longest = std::max(length_a, length_b);
+  return longest > 0 ? std::abs(length_a - length_b) / longest : 0.0;
+}
+
+FlatPanel flatten_disk(const std::string& name, const Eigen::MatrixX3d& vertices,
+                       const Eigen::MatrixX3i& triangles, const Eigen::Vector3d& warp,
+                       const FlatteningOptions& options) {
+  Eigen::Vector3d w = warp;
+  if (w.norm() == 0) {
+    const Eigen::Vector3d extent = vertices.colwise().maxCoeff() - vertices.colwise().minCoeff();
+    Eigen::Index axis;
+    extent.maxCoeff(&axis);
+    w = Eigen::Vector3d::Unit(axis);
+  }
+  FlatPanel out = flatten_with_warp(name, vertices, triangles, w.transpose(), options);
+  out.vertices.resize(static_cast<size_t>(vertices.rows()));
+  for (size_t i = 0; i < out.vertices.size(); ++i) out.vertices[i] = static_cast<int>(i);
+  return out;
+}
+
+FlatPattern flatten_garment(const Garment& garment, const FlatteningOptions& options) {
+  const meshing::QuadMesh& mesh = garment.mesh;
+  const MaterialFrames frames = material_frames(mesh);
+  FlatPattern pattern;
+  const Eigen::Index nv = mesh.vertex_count();
+
+  // Per panel: local vertices, triangles, flattening.
+  for (size_t p = 0; p < garment.panels.size(); ++p) {
+    std::vector<int> local(static_cast<size_t>(nv), -1);
+    std::vector<int> global;
+    std::vector<Eigen::Vector3i> tris;
+    std::vector<int> tri_quad;
+    for (Eigen::Index q = 0; q < mesh.face_count(); ++q) {
+      if (garment.face_panel(q) != static_cast<int>(p)) continue;
+      Eigen::Vector4i corners;
+      for (int k = 0; k < 4; ++k) {
+        int& l = local[static_cast<size_t>(mesh.faces(q, k))];
+        if (l < 0) {
+          l = static_cast<int>(global.size());
+          global.push_back(mesh.faces(q, k));
+        }
+        corners[k] = l;
+      }
+      Eigen::MatrixX3d positions(4, 3);
+      for (int k = 0; k < 4; ++k) positions.row(k) = mesh.vertices.row(mesh.faces(q, k));
+      for (const Eigen::Vector3i& tri : split_quad(positions, Eigen::Vector4i(0, 1, 2, 3))) {
+        tris.emplace_back(corners[tri[0]], corners[tri[1]], corners[tri[2]]);
+        tri_quad.push_back(static_cast<int>(q));
+      }
+    }
+    const std::string& name = garment.panels[p].id;
+    if (tris.empty()) throw PatternError(name, fmt::format("panel '{}' has no faces", name));
+    Eigen::MatrixX3d v(static_cast<Eigen::Index>(global.size()), 3);
+    for (size_t i = 0; i < global.size(); ++i)
+      v.row(static_cast<Eigen::Index>(i)) = mesh.vertices.row(global[i]);
+    Eigen::MatrixX3i t(static_cast<Eigen::Index>(tris.size()), 3);
+    Eigen::MatrixX3d warp(t.rows(), 3);
+    Eigen::VectorXi quad_of(t.rows());
+    for (Eigen::Index f = 0; f < t.rows(); ++f) {
+      t.row(f) = tris[static_cast<size_t>(f)].transpose();
+      quad_of(f) = tri_quad[static_cast<size_t>(f)];
+      warp.row(f) = frames.warp.row(quad_of(f));
+    }
+    FlatPanel flat = flatten_with_warp(name, v, t, warp, options);
+    flat.panel = static_cast<int>(p);
+    flat.vertices = std::move(global);
+    flat.triangle_quad = std::move(quad_of);
+    if (!flat.warning.empty()) pattern.warnings.push_back(flat.warning);
+    pattern.panels.push_back(std::move(flat));
+  }
+
+  // Which panel lies across each directed garment edge: the one traversing it backwards.
+  std::unordered_map<long long, int> edge_panel;
+  const auto key = [&](int a, int b) { return static_cast<long long>(a) * nv + b; };
+  for (Eigen::Index q = 0; q < mesh.face_count(); ++q)
+    for (int k = 0; k < 4; ++k)
+      edge_panel[key(mesh.faces(q, k), mesh.faces(q, (k + 1) % 4))] = garment.face_panel(q);
+
+  // Runs of boundary edges with the same panel across; a run's ends are notches.
+  struct Run {
+    int panel, across;
+    std::vector<int> vertices;  // local, in loop order
+  };
+  std::vector<Run> runs;
+  for (size_t p = 0; p < pattern.panels.size(); ++p) {
+    FlatPanel& flat = pattern.panels[p];
+    const std::vector<int>& loop = flat.boundary;
+    const size_t n = loop.size();
+    std::vector<int> across(n);
+    for (size_t k = 0; k < n; ++k) {
+      const int a = flat.vertices[static_cast<size_t>(loop[k])];
+      const int b = flat.vertices[static_cast<size_t>(loop[(k + 1) % n])];
+      const auto it = edge_panel.find(key(b, a));
+      across[k] = it == edge_panel.end() ? -1 : it->second;
+    }
+    size_t first = 0;
+    while (first < n && across[first] == across[(first + n - 1) % n]) ++first;
+    if (first == n) {  // one neighbour (or none) all around: no junctions
+      if (across[0] >= 0) {
+        Run r{static_cast<int>(p), across[0], {}};
+        for (size_t k = 0; k <= n; ++k) r.vertices.push_back(loop[k % n]);
+        runs.push_back(std::move(r));
+      }
+      continue;
+    }
+    for (size_t s = 0; s < n;) {
+      const size_t k0 = (first + s) % n;
+      Run r{static_cast<int>(p), across[k0], {loop[k0]}};
+      flat.notches.push_back(loop[k0]);
+      while (s < n && across[(first + s) % n] == r.across) {
+        r.vertices.push_back(loop[(first + s + 1) % n]);
+        ++s;
+      }
+      if (r.across >= 0) runs.push_back(std::move(r));
+    }
+  }
+
+  // Pair each run with the run on the other panel over the same garment vertices.
+  std::vector<bool> used(runs.size(), false);
+  for (size_t i = 0; i < runs.size(); ++i) {
+    if (used[i]) continue;
+    const Run& a = runs[i];
+    const FlatPanel& fa = pattern.panels[static_cast<size_t>(a.panel)];
+    const int a_first = fa.vertices[static_cast<size_t>(a.vertices.front())];
+    const int a_last = fa.vertices[static_cast<size_t>(a.vertices.back())];
+    for (size_t j = i + 1; j < runs.size(); ++j) {
+      const Run& b = runs[j];
+      if (used[j] || b.panel != a.across || b.across != a.panel ||
+          b.vertices.size() != a.vertices.size())
+        continue;
+      const FlatPanel& fb = pattern.panels[static_cast<size_t>(b.panel)];
+      // The neighbour runs the seam the other way round.
+      if (fb.vertices[static_cast<size_t>(b.vertices.back())] != a_first ||
+          fb.vertices[static_cast<size_t>(b.vertices.front())] != a_last)
+        continue;
+      used[i] = used[j] = true;
+      PatternSeam seam;
+      seam.panel_a = a.panel;
+      seam.panel_b = b.panel;
+      seam.vertices_a = a.vertices;
+      seam.vertices_b.assign(b.vertices.rbegin(), b.vertices.rend());
+      for (size_t k = 1; k < a.vertices.size(); ++k)
+        seam.length_3d += (mesh.vertices.row(fa.vertices[static_cast<size_t>(a.vertices[k])]) -
+                           mesh.vertices.row(fa.vertices[static_cast<size_t>(a.vertices[k - 1])]))
+                              .norm();
+      seam.length_a = polyline_length(fa.uv, seam.vertices_a);
+      seam.length_b = polyline_length(fb.uv, seam.vertices_b);
+      pattern.seams.push_back(std::move(seam));
+      break;
+    }
+  }
+  return pattern;
+}
+
+}  // namespace sd::garment

@@ -1,0 +1,103 @@
+#pragma once
+// Flat patterns: every panel of a stitched garment mapped to the plane with as little distortion
+// as its surface allows (LSCM as the start, then as-rigid-as-possible iterations that also hold
+// every boundary edge at its 3D length, so the two sides of each seam sew), turned so that the
+// warp of the panel's material frame runs along the piece's +y (the grain line), with per-panel
+// distortion figures, seams as pairs of 2D polylines and the seam junctions as notches.
+
+#include <Eigen/Core>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "garment/garment_mesh.hpp"
+
+namespace sd::garment {
+
+// A panel that cannot become a flat pattern piece without folding, or that is not a disk (a tube
+// closed on itself). `panel()` names it; the message says why and what would help.
+class PatternError : public std::runtime_error {
+ public:
+  PatternError(std::string panel, const std::string& message)
+      : std::runtime_error(message), panel_(std::move(panel)) {}
+  const std::string& panel() const { return panel_; }
+
+ private:
+  std::string panel_;
+};
+
+struct FlatteningOptions {
+  // Length distortion (|σ − 1| of the 3D → 2D map, 95th percentile) above which a panel gets a
+  // warning.
+  double warn_stretch = 0.05;
+  // Above this the panel is refused (PatternError): such a piece is no longer cloth cut flat.
+  double refuse_stretch = 0.35;
+  int max_iterations = 200;  // as-rigid-as-possible local/global sweeps at most
+  // Weight of the boundary-length terms against the triangles' rigidity (per edge, relative to
+  // a triangle of area l²/2 next to an edge of length l).
+  double boundary_weight = 200.0;
+};
+
+// Distortion of a flattening: σ₁ ≥ σ₂ are the singular values of each triangle's 3D → 2D map.
+struct FlatDistortion {
+  double length_max = 0;   // max over triangles of max(σ₁ − 1, 1 − σ₂)
+  double length_mean = 0;  // the same, 3D-area-weighted mean
+  // Area-weighted 95th percentile: what the worst twentieth of the piece suffers. Warnings and
+  // refusals use it, not the max, which one sliver triangle of the quad mesh can set.
+  double length_p95 = 0;
+  double area_max = 0;   // max |σ₁σ₂ − 1|
+  double area_mean = 0;  // 3D-area-weighted mean of |σ₁σ₂ − 1|
+  // Area-weighted centroid (3D, and in the piece's 2D frame) of that worst twentieth.
+  Eigen::Vector3d worst_point = Eigen::Vector3d::Zero();
+  Eigen::Vector2d worst_point_2d = Eigen::Vector2d::Zero();
+};
+
+struct FlatPanel {
+  std::string id;
+  int panel = -1;             // index into Garment::panels
+  std::vector<int> vertices;  // #L: garment vertex of each local vertex
+  // #L by 2, metres, as seen from the outside (right side of the fabric up); +y is the warp
+  // (grain line), the piece's bounding box starts at (0, 0). Not scaled by the panel's ease.
+  Eigen::MatrixX2d uv;
+  Eigen::MatrixX3i triangles;     // #T local indices, counter-clockwise in 2D and seen from outside
+  Eigen::VectorXi triangle_quad;  // #T garment quad of each triangle (two per quad)
+  std::vector<int> boundary;      // local vertex loop, counter-clockwise in 2D
+  std::vector<int> notches;       // local boundary vertices where seams meet (loop order)
+  FlatDistortion distortion;
+  double area_3d = 0;   // m²
+  double area_2d = 0;   // m², before ease
+  int iterations = 0;   // ARAP sweeps made
+  std::string warning;  // empty unless the piece stretches more than warn_stretch
+};
+
+// One seam: the same run of garment edges seen from both panels, as local vertex lists in the
+// same order (vertices_a[i] and vertices_b[i] are the same garment vertex).
+struct PatternSeam {
+  int panel_a = -1, panel_b = -1;  // indices into FlatPattern::panels
+  std::vector<int> vertices_a, vertices_b;
+  double length_3d = 0;               // m along the garment
+  double length_a = 0, length_b = 0;  // m in the two pieces (before ease)
+  // |length_a − length_b| / max(length_a, length_b): how well the flattening lets it sew.
+  double mismatch() const;
+};
+
+struct FlatPattern {
+  std::vector<FlatPanel> panels;  // one per garment panel, in the garment's order
+  std::vector<PatternSeam> seams;
+  std::vector<std::string> warnings;
+};
+
+// Flattens every panel of `garment`. Throws PatternError for a panel that is not a disk or that
+// cannot be flattened without folding or beyond refuse_stretch; never returns an inverted 2D
+// triangle.
+FlatPattern flatten_garment(const Garment& garment, const FlatteningOptions& options = {});
+
+// Flattens one disk-shaped triangle mesh (vertices #V by 3, triangles #T by 3, counter-clockwise
+// from the side that should face up in 2D). `warp` (3D, may be zero: then the mesh's longest
+// axis) sets the +y direction. Fills uv, boundary, distortion, areas, iterations; `name` is
+// used in messages. The building block of flatten_garment, public for tests.
+FlatPanel flatten_disk(const std::string& name, const Eigen::MatrixX3d& vertices,
+                       const Eigen::MatrixX3i& triangles, const Eigen::Vector3d& warp,
+                       const FlatteningOptions& options = {});
+
+}  // namespace sd::garment

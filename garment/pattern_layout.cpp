@@ -1,0 +1,278 @@
+#include "garment/pattern_layout.hpp"
+
+// GCC 12 sees a possibly uninitialised value inside CGAL's Polygon_2 simplicity test (a false
+// positive in the library's sweep code).
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_2.h>
+#include <CGAL/create_offset_polygons_2.h>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace sd::garment {
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Polygon = CGAL::Polygon_2<Kernel>;
+
+double signed_area(const Eigen::MatrixX2d& p) {
+  double a = 0;
+  for (Eigen::Index i = 0; i < p.rows(); ++i) {
+    const Eigen::Index j = (i + 1) % p.rows();
+    a += p(i, 0) * p(j, 1) - p(j, 0) * p(i, 1);
+  }
+  return 0.5 * a;
+}
+
+// Douglas-Peucker on a closed polyline: the points kept lie within `tolerance` of the original.
+// Point 0 and the point farthest from it are always kept.
+Eigen::MatrixX2d simplify_closed(const Eigen::MatrixX2d& p, double tolerance) {
+  const Eigen::Index n = p.rows();
+  if (n <= 4) return p;
+  std::vector<bool> keep(static_cast<size_t>(n), false);
+  Eigen::Index far = 0;
+  (p.rowwise() - p.row(0)).rowwise().squaredNorm().maxCoeff(&far);
+  keep[0] = keep[static_cast<size_t>(far)] = true;
+  std::vector<std::pair<Eigen::Index, Eigen::Index>> stack = {{0, far}, {far, n}};
+  while (!stack.empty()) {
+    const auto [a, b] = stack.back();
+    stack.pop_back();
+    const Eigen::Vector2d pa = p.row(a), pb = p.row(b % n);
+    const Eigen::Vector2d d = pb - pa;
+    double worst = -1;
+    Eigen::Index at = -1;
+    for (Eigen::Index i = a + 1; i < b; ++i) {
+      const Eigen::Vector2d q = Eigen::Vector2d(p.row(i)) - pa;
+      const double dist =
+          d.norm() > 0 ? std::abs(d.x() * q.y() - d.y() * q.x()) / d.norm() : q.norm();
+      if (dist > worst) {
+        worst = dist;
+        at = i;
+      }
+    }
+    if (at >= 0 && worst > tolerance) {
+      keep[static_cast<size_t>(at)] = true;
+      stack.emplace_back(a, at);
+      stack.emplace_back(at, b);
+    }
+  }
+  std::vector<Eigen::Index> rows;
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (keep[static_cast<size_t>(i)]) rows.push_back(i);
+  Eigen::MatrixX2d out(static_cast<Eigen::Index>(rows.size()), 2);
+  for (size_t k = 0; k < rows.size(); ++k) out.row(static_cast<Eigen::Index>(k)) = p.row(rows[k]);
+  return out;
+}
+
+// The sewing line offset outwards by `allowance` (straight skeleton: corners stay sharp).
+Eigen::MatrixX2d offset_outwards(const std::string& name, const Eigen::MatrixX2d& sewing,
+                                 double allowance) {
+  if (allowance <= 0) return sewing;
+  // A cutting line needs no finer detail than a tenth of a millimetre; fewer vertices keep the
+  // skeleton quick.
+  const Eigen::MatrixX2d coarse = simplify_closed(sewing, 1e-4);
+  Polygon polygon;
+  for (Eigen::Index i = 0; i < coarse.rows(); ++i)
+    polygon.push_back(Kernel::Point_2(coarse(i, 0), coarse(i, 1)));
+  if (!polygon.is_simple())
+    throw PatternError(name, fmt::format("the flat piece of panel '{}' overlaps itself: it cannot "
+                                         "be cut as one piece; split it with a seam",
+                                         name));
+  const auto result = CGAL::create_exterior_skeleton_and_offset_polygons_2(allowance, polygon);
+  // The result holds the offset of an enclosing frame (counter-clockwise, large) and the offset
+  // of the piece as its hole (clockwise): take the largest clockwise one.
+  const Polygon* best = nullptr;
+  for (const auto& p : result)
+    if (p->orientation() == CGAL::CLOCKWISE && (!best || p->area() < best->area())) best = p.get();
+  if (!best)
+    throw PatternError(name,
+                       fmt::format("the seam allowance of panel '{}' could not be drawn", name));
+  Eigen::MatrixX2d out(static_cast<Eigen::Index>(best->size()), 2);
+  Eigen::Index row = out.rows() - 1;  // reversed: counter-clockwise like the sewing line
+  for (auto v = best->vertices_begin(); v != best->vertices_end(); ++v, --row)
+    out.row(row) << v->x(), v->y();
+  return out;
+}
+
+// Outward unit normal of a counter-clockwise polygon at vertex i (bisector of its two edges).
+Eigen::Vector2d outward_normal(const Eigen::MatrixX2d& p, Eigen::Index i) {
+  const Eigen::Index n = p.rows();
+  const Eigen::Vector2d a = (p.row(i) - p.row((i + n - 1) % n)).transpose().normalized();
+  const Eigen::Vector2d b = (p.row((i + 1) % n) - p.row(i)).transpose().normalized();
+  const Eigen::Vector2d normal = Eigen::Vector2d(a.y(), -a.x()) + Eigen::Vector2d(b.y(), -b.x());
+  return normal.norm() > 1e-12 ? normal.normalized() : Eigen::Vector2d(a.y(), -a.x());
+}
+
+// A grain line along +y through the piece's centroid, inside the piece: the middle 60 % of the
+// stretch of the vertical line that holds the centroid.
+void grain_line(PatternPiece& piece) {
+  const Eigen::MatrixX2d& p = piece.sewing;
+  Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
+  double area = 0;
+  for (Eigen::Index i = 0; i < p.rows(); ++i) {
+    const Eigen::Vector2d a = p.row(i), b = p.row((i + 1) % p.rows());
+    const double cross = a.x() * b.y() - b.x() * a.y();
+    area += cross;
+    centroid += cross * (a + b);
+  }
+  centroid /= 3 * area;
+  std::vector<double> hits;
+  for (Eigen::Index i = 0; i < p.rows(); ++i) {
+    const Eigen::Vector2d a = p.row(i), b = p.row((i + 1) % p.rows());
+    if ((a.x() <= centroid.x()) != (b.x() <= centroid.x()))
+      hits.push_back(a.y() + (centroid.x() - a.x()) / (b.x() - a.x()) * (b.y() - a.y()));
+  }
+  std::sort(hits.begin(), hits.end());
+  double lo = p.col(1).minCoeff(), hi = p.col(1).maxCoeff();
+  for (size_t k = 0; k + 1 < hits.size(); k += 2)
+    if (hits[k] <= centroid.y() && centroid.y() <= hits[k + 1]) {
+      lo = hits[k];
+      hi = hits[k + 1];
+    }
+  piece.grain_start = {centroid.x(), lo + 0.2 * (hi - lo)};
+  piece.grain_end = {centroid.x(), hi - 0.2 * (hi - lo)};
+}
+
+}  // namespace
+
+PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOptions& options) {
+  PatternLayout layout;
+  layout.fabric_width = options.fabric_width;
+  for (size_t p = 0; p < pattern.panels.size(); ++p) {
+    const FlatPanel& flat = pattern.panels[p];
+    PatternPiece piece;
+    piece.panel = static_cast<int>(p);
+    piece.ease = p < options.panel_ease.size() ? options.panel_ease[p] : 1.0;
+    piece.allowance = p < options.panel_allowance.size() && options.panel_allowance[p] >= 0
+                          ? options.panel_allowance[p]
+                          : options.seam_allowance;
+    piece.sewing.resize(static_cast<Eigen::Index>(flat.boundary.size()), 2);
+    for (size_t k = 0; k < flat.boundary.size(); ++k)
+      piece.sewing.row(static_cast<Eigen::Index>(k)) = piece.ease * flat.uv.row(flat.boundary[k]);
+    piece.cutting = offset_outwards(flat.id, piece.sewing, piece.allowance);
+    piece.origin = -piece.cutting.colwise().minCoeff().transpose();
+    piece.sewing.rowwise() += piece.origin.transpose();
+    piece.cutting.rowwise() += piece.origin.transpose();
+    piece.size = piece.cutting.colwise().maxCoeff().transpose();
+    piece.sewn_area = signed_area(piece.sewing);
+    piece.cut_area = signed_area(piece.cutting);
+    for (const int v : flat.notches) {
+      const auto at = std::find(flat.boundary.begin(), flat.boundary.end(), v);
+      const Eigen::Index i = at - flat.boundary.begin();
+      piece.notches.push_back({piece.sewing.row(i).transpose(), outward_normal(piece.sewing, i)});
+    }
+    grain_line(piece);
+    if (piece.size.x() > options.fabric_width - 2 * options.gap)
+      throw PatternError(flat.id,
+                         fmt::format("the piece of panel '{}' is {:.0f} mm wide with its "
+                                     "seam allowance; the fabric is {:.0f} mm wide: use "
+                                     "a wider fabric or split the panel",
+                                     flat.id, 1000 * piece.size.x(), 1000 * options.fabric_width));
+    layout.pieces.push_back(std::move(piece));
+  }
+
+  // Bottom-left by skylines on a 2 mm grid across the fabric: pieces one by one, each at the
+  // column offset where its top ends lowest. A piece's column profile (lowest and highest point
+  // of its cutting line in each 2 mm column, widened by half the gap each side) rests on the
+  // fabric's skyline (the highest point placed so far per column) plus the gap, so pieces
+  // interlock (a sleeve in a neckline's hollow) yet never overlap: in each column the placed
+  // intervals are disjoint.
+  constexpr double kCell = 0.002;  // m
+  const int columns = static_cast<int>(std::floor((options.fabric_width - options.gap) / kCell));
+  const int pad = static_cast<int>(std::ceil(0.5 * options.gap / kCell));
+  // Two orders are tried, largest area first and tallest first; the shorter layout is kept.
+  const auto nest = [&](const std::vector<size_t>& order) {
+    std::vector<double> sky(static_cast<size_t>(columns), 0.0);
+    double length = 0;
+    for (const size_t i : order) {
+      PatternPiece& piece = layout.pieces[i];
+      const Eigen::MatrixX2d& p = piece.cutting;
+      const int width = static_cast<int>(std::ceil(piece.size.x() / kCell)) + 1;
+      std::vector<double> low(static_cast<size_t>(width), std::numeric_limits<double>::infinity());
+      std::vector<double> high(static_cast<size_t>(width),
+                               -std::numeric_limits<double>::infinity());
+      // Each edge is linear: over a column's slab its y lies between its values at the slab's ends.
+      for (Eigen::Index k = 0; k < p.rows(); ++k) {
+        const Eigen::Vector2d a = p.row(k), b = p.row((k + 1) % p.rows());
+        const double x0 = std::min(a.x(), b.x()), x1 = std::max(a.x(), b.x());
+        const int c0 = std::clamp(static_cast<int>(std::floor(x0 / kCell)), 0, width - 1);
+        const int c1 = std::clamp(static_cast<int>(std::floor(x1 / kCell)), 0, width - 1);
+        for (int c = c0; c <= c1; ++c) {
+          for (double x : {std::clamp(c * kCell, x0, x1), std::clamp((c + 1) * kCell, x0, x1)}) {
+            const double y =
+                b.x() == a.x() ? a.y() : a.y() + (x - a.x()) / (b.x() - a.x()) * (b.y() - a.y());
+            low[static_cast<size_t>(c)] =
+                std::min({low[static_cast<size_t>(c)], y, b.x() == a.x() ? b.y() : y});
+            high[static_cast<size_t>(c)] =
+                std::max({high[static_cast<size_t>(c)], y, b.x() == a.x() ? b.y() : y});
+          }
+        }
+      }
+      // Widened by `pad` columns each side: column j of the profile is piece column j − pad.
+      const int span = width + 2 * pad;
+      std::vector<double> bottom(static_cast<size_t>(span),
+                                 std::numeric_limits<double>::infinity());
+      std::vector<double> top(static_cast<size_t>(span), -std::numeric_limits<double>::infinity());
+      for (int j = 0; j < span; ++j)
+        for (int c = std::max(0, j - 2 * pad); c <= std::min(width - 1, j); ++c) {
+          bottom[static_cast<size_t>(j)] =
+              std::min(bottom[static_cast<size_t>(j)], low[static_cast<size_t>(c)]);
+          top[static_cast<size_t>(j)] =
+              std::max(top[static_cast<size_t>(j)], high[static_cast<size_t>(c)]);
+        }
+      if (span > columns)
+        throw PatternError(
+            pattern.panels[static_cast<size_t>(piece.panel)].id,
+            fmt::format("the piece of panel '{}' is {:.0f} mm wide with its seam allowance and the "
+                        "gaps beside it; the fabric is {:.0f} mm wide: use a wider fabric or split "
+                        "the panel",
+                        pattern.panels[static_cast<size_t>(piece.panel)].id,
+                        1000 * (piece.size.x() + options.gap), 1000 * options.fabric_width));
+      int best_x = 0;
+      double best_y = 0, best_top = std::numeric_limits<double>::infinity();
+      for (int x = 0; x + span <= columns; ++x) {
+        double y = options.gap;
+        for (int j = 0; j < span; ++j)
+          if (std::isfinite(bottom[static_cast<size_t>(j)]) && sky[static_cast<size_t>(x + j)] > 0)
+            y = std::max(
+                y, sky[static_cast<size_t>(x + j)] + options.gap - bottom[static_cast<size_t>(j)]);
+        if (y + piece.size.y() < best_top - 1e-9) {
+          best_top = y + piece.size.y();
+          best_y = y;
+          best_x = x;
+        }
+      }
+      for (int j = 0; j < span; ++j)
+        if (std::isfinite(top[static_cast<size_t>(j)]))
+          sky[static_cast<size_t>(best_x + j)] =
+              std::max(sky[static_cast<size_t>(best_x + j)], best_y + top[static_cast<size_t>(j)]);
+      piece.placement = {options.gap + (best_x + pad) * kCell, best_y};
+      length = std::max(length, best_top);
+    }
+    return length;
+  };
+  std::vector<size_t> by_area(layout.pieces.size());
+  for (size_t i = 0; i < by_area.size(); ++i) by_area[i] = i;
+  std::vector<size_t> by_height = by_area;
+  std::stable_sort(by_area.begin(), by_area.end(), [&](size_t a, size_t b) {
+    return layout.pieces[a].cut_area > layout.pieces[b].cut_area;
+  });
+  std::stable_sort(by_height.begin(), by_height.end(), [&](size_t a, size_t b) {
+    return layout.pieces[a].size.y() > layout.pieces[b].size.y();
+  });
+  if (nest(by_height) < nest(by_area)) nest(by_height);
+  double cut = 0;
+  for (const PatternPiece& piece : layout.pieces) {
+    layout.length_used = std::max(layout.length_used, piece.placement.y() + piece.size.y());
+    cut += piece.cut_area;
+  }
+  layout.length_used += options.gap;
+  layout.efficiency = cut / (layout.length_used * layout.fabric_width);
+  return layout;
+}
+
+}  // namespace sd::garment

@@ -1,0 +1,55 @@
+#pragma once
+// The flat pattern laid out for cutting: each flattened panel scaled by its ease (what is cut),
+// its sewing line offset outwards by the seam allowance into the cutting line (CGAL straight
+// skeleton), notches where seams meet, a grain line along the warp, and the pieces nested on a
+// length of fabric of a given width (bottom-left on column skylines, grain along the bolt).
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "garment/panel_flattening.hpp"
+
+namespace sd::garment {
+
+struct PatternLayoutOptions {
+  double fabric_width = 1.5;     // m, across the bolt (selvedge to selvedge)
+  double seam_allowance = 0.01;  // m, for pieces without their own
+  // Per FlatPattern panel (empty: none); a negative entry takes seam_allowance.
+  std::vector<double> panel_allowance;
+  std::vector<double> panel_ease;  // per panel rest-shape scale (empty: 1)
+  double gap = 0.01;               // m between pieces, and from the selvedges and the cut end
+};
+
+// A notch on the sewing line, `normal` pointing out of the piece (unit).
+struct PatternNotch {
+  Eigen::Vector2d point = Eigen::Vector2d::Zero();
+  Eigen::Vector2d normal = Eigen::Vector2d::UnitY();
+};
+
+// One piece in its own frame: piece = ease · FlatPanel::uv + origin (m), warp along +y, the
+// cutting line's bounding box starting at (0, 0). On the fabric it sits at `placement`.
+struct PatternPiece {
+  int panel = -1;  // index into FlatPattern::panels
+  double ease = 1, allowance = 0;
+  Eigen::Vector2d origin = Eigen::Vector2d::Zero();
+  Eigen::MatrixX2d sewing;   // the sewing line, closed (first point not repeated), CCW
+  Eigen::MatrixX2d cutting;  // the sewing line offset out by `allowance`, CCW
+  std::vector<PatternNotch> notches;
+  Eigen::Vector2d grain_start = Eigen::Vector2d::Zero(), grain_end = Eigen::Vector2d::Zero();
+  Eigen::Vector2d size = Eigen::Vector2d::Zero();       // of the cutting line's bounding box
+  Eigen::Vector2d placement = Eigen::Vector2d::Zero();  // on the fabric: x across, y along
+  double sewn_area = 0, cut_area = 0;                   // m²
+};
+
+struct PatternLayout {
+  std::vector<PatternPiece> pieces;  // in FlatPattern order
+  double fabric_width = 0;           // m
+  double length_used = 0;            // m of fabric from the cut end to the last piece (+ gap)
+  double efficiency = 0;             // Σ cut area / (length_used · fabric_width)
+};
+
+// Lays out every piece. Throws PatternError for a piece whose outline crosses itself in 2D or
+// that is wider than the fabric.
+PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOptions& options = {});
+
+}  // namespace sd::garment

@@ -1,0 +1,249 @@
+#include "garment/panel_flattening.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "garment/body.hpp"
+#include "garment/body_surface.hpp"
+#include "garment/garment_mesh.hpp"
+#include "garment/sketch_file.hpp"
+#include "tests/garment/test_helpers.hpp"
+
+namespace sd::garment {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// A one-panel garment: a columns × rows quad grid on the surface point(s, t), s, t in [0, 1],
+// counter-clockwise seen from outside when point's ∂s × ∂t points outwards.
+template <class Point>
+Garment grid_garment(int columns, int rows, Point point, const std::string& id = "piece") {
+  Garment g;
+  g.mesh.vertices.resize((columns + 1) * (rows + 1), 3);
+  for (int j = 0; j <= rows; ++j)
+    for (int i = 0; i <= columns; ++i)
+      g.mesh.vertices.row(j * (columns + 1) + i) =
+          point(static_cast<double>(i) / columns, static_cast<double>(j) / rows).transpose();
+  g.mesh.faces.resize(columns * rows, 4);
+  for (int j = 0; j < rows; ++j)
+    for (int i = 0; i < columns; ++i) {
+      const int a = j * (columns + 1) + i;
+      g.mesh.faces.row(j * columns + i) << a, a + 1, a + columns + 2, a + columns + 1;
+    }
+  g.face_panel = Eigen::VectorXi::Zero(columns * rows);
+  GarmentPanel panel;
+  panel.id = id;
+  g.panels.push_back(panel);
+  return g;
+}
+
+// Radius 0.3 m, 1.5 rad around (front facing +z), 0.5 m tall: developable, quads are planar.
+Garment cylinder_panel(double angle = 1.5) {
+  return grid_garment(24, 10, [angle](double s, double t) {
+    const double a = angle * (s - 0.5);
+    return Eigen::Vector3d(0.3 * std::sin(a), 0.6 + 0.5 * t, 0.3 * std::cos(a));
+  });
+}
+
+// A spherical cap of half-angle `alpha` (rad) around +z, radius 0.2 m: a square grid mapped
+// onto the unit disk (elliptical map, no pole singularity), then onto the sphere by the
+// azimuthal equidistant map (disk radius 1 ↔ geodesic radius R·alpha).
+Garment spherical_cap(double alpha, int n = 20) {
+  return grid_garment(n, n, [alpha](double s, double t) {
+    // Square [−1, 1]² → unit disk (Shirley-Chiu-like elliptical map), then geodesic radius.
+    const double x = 2 * s - 1, y = 2 * t - 1;
+    const double u = x * std::sqrt(1 - 0.5 * y * y), v = y * std::sqrt(1 - 0.5 * x * x);
+    const double r = std::hypot(u, v), theta = alpha * r, phi = std::atan2(v, u);
+    return Eigen::Vector3d(0.2 * std::sin(theta) * std::cos(phi),
+                           1.0 + 0.2 * std::sin(theta) * std::sin(phi), 0.2 * std::cos(theta));
+  });
+}
+
+double edge_length_error(const Garment& g, const FlatPanel& flat) {
+  double worst = 0;
+  for (Eigen::Index f = 0; f < flat.triangles.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = flat.triangles(f, k), b = flat.triangles(f, (k + 1) % 3);
+      const double l3 = (g.mesh.vertices.row(flat.vertices[static_cast<size_t>(a)]) -
+                         g.mesh.vertices.row(flat.vertices[static_cast<size_t>(b)]))
+                            .norm();
+      const double l2 = (flat.uv.row(a) - flat.uv.row(b)).norm();
+      worst = std::max(worst, std::abs(l2 - l3) / l3);
+    }
+  return worst;
+}
+
+int inverted_triangles(const FlatPanel& flat) {
+  int inverted = 0;
+  for (Eigen::Index f = 0; f < flat.triangles.rows(); ++f) {
+    const Eigen::Vector2d a = flat.uv.row(flat.triangles(f, 1)) - flat.uv.row(flat.triangles(f, 0));
+    const Eigen::Vector2d b = flat.uv.row(flat.triangles(f, 2)) - flat.uv.row(flat.triangles(f, 0));
+    if (!(a.x() * b.y() - a.y() * b.x() > 0)) ++inverted;
+  }
+  return inverted;
+}
+
+TEST(PanelFlattening, CylinderPanelFlattensIsometrically) {
+  const Garment g = cylinder_panel();
+  const FlatPattern pattern = flatten_garment(g);
+  ASSERT_EQ(pattern.panels.size(), 1u);
+  const FlatPanel& flat = pattern.panels[0];
+  EXPECT_TRUE(pattern.warnings.empty());
+  EXPECT_EQ(inverted_triangles(flat), 0);
+  // The quads are planar strips between rulings, so the triangle mesh is exactly developable.
+  EXPECT_LT(flat.distortion.length_max, 1e-3);
+  EXPECT_LT(flat.distortion.area_max, 1e-3);
+  EXPECT_LT(edge_length_error(g, flat), 1e-3);
+  EXPECT_NEAR(flat.area_2d, flat.area_3d, 1e-4 * flat.area_3d);
+  EXPECT_LT(flat.iterations, 10);  // LSCM is already isometric here: ARAP stops at once
+  // Unrolled: a 0.45 m by 0.5 m rectangle (chord lengths of the 24 facets), warp (+y, the
+  // cylinder's axis) along the piece's +y: every ruling is vertical in 2D.
+  const double width = 24 * 2 * 0.3 * std::sin(1.5 / 48);
+  const Eigen::Vector2d size = flat.uv.colwise().maxCoeff() - flat.uv.colwise().minCoeff();
+  EXPECT_NEAR(size.x(), width, 1e-4);
+  EXPECT_NEAR(size.y(), 0.5, 1e-4);
+  std::vector<int> local(static_cast<size_t>(g.mesh.vertices.rows()), -1);
+  for (size_t l = 0; l < flat.vertices.size(); ++l)
+    local[static_cast<size_t>(flat.vertices[l])] = static_cast<int>(l);
+  for (size_t i = 0; i <= 24; ++i)
+    EXPECT_NEAR(flat.uv(local[i], 0), flat.uv(local[10 * 25 + i], 0), 1e-5);
+  // The seen-from-outside orientation is kept: s (left to right on the front) runs to +x.
+  EXPECT_LT(flat.uv(local[0], 0), flat.uv(local[24], 0));
+}
+
+TEST(PanelFlattening, CapDistortionGrowsWithItsAngle) {
+  double previous = 0;
+  for (double degrees : {15.0, 30.0, 45.0, 60.0}) {
+    const double alpha = degrees * kPi / 180;
+    FlatteningOptions options;
+    options.warn_stretch = 0.02;
+    const FlatPattern pattern = flatten_garment(spherical_cap(alpha), options);
+    const FlatPanel& flat = pattern.panels[0];
+    EXPECT_EQ(inverted_triangles(flat), 0);
+    // A disk of geodesic radius Rα has the circumference 2πR·sin α instead of 2πRα: no flat
+    // map avoids a relative length change of the order of 1 − sin α / α somewhere; ARAP spreads
+    // it over the piece, so the largest change lies between a tenth of it and all of it (plus
+    // the facets' own ≈1 % quality spread).
+    const double deficit = 1 - std::sin(alpha) / alpha;
+    EXPECT_GT(flat.distortion.length_p95, previous) << degrees;
+    EXPECT_GT(flat.distortion.length_max, 0.1 * deficit) << degrees;
+    EXPECT_LT(flat.distortion.length_max, deficit + 0.02) << degrees;
+    EXPECT_LE(flat.distortion.length_mean, flat.distortion.length_max);
+    previous = flat.distortion.length_p95;
+    // Reported: above 2 % a warning names the panel and suggests a dart or seam.
+    if (flat.distortion.length_p95 > 0.02) {
+      ASSERT_EQ(pattern.warnings.size(), 1u) << degrees;
+      EXPECT_NE(pattern.warnings[0].find("'piece'"), std::string::npos);
+      EXPECT_NE(pattern.warnings[0].find("dart or a seam"), std::string::npos);
+    } else {
+      EXPECT_TRUE(pattern.warnings.empty());
+    }
+  }
+  EXPECT_GT(previous, 0.02);  // the 60° cap is flagged
+}
+
+TEST(PanelFlattening, NearlyClosedCapIsRefusedNeverFolded) {
+  const Garment cap = spherical_cap(170 * kPi / 180, 24);
+  try {
+    const FlatPattern pattern = flatten_garment(cap);
+    ADD_FAILURE() << "a 170° cap was flattened with distortion "
+                  << pattern.panels[0].distortion.length_max;
+    EXPECT_EQ(inverted_triangles(pattern.panels[0]), 0);
+  } catch (const PatternError& e) {
+    EXPECT_EQ(e.panel(), "piece");
+    const std::string message = e.what();
+    EXPECT_NE(message.find("cannot be cut from flat cloth"), std::string::npos) << message;
+    EXPECT_NE(message.find("seams or darts"), std::string::npos) << message;
+  }
+}
+
+TEST(PanelFlattening, TubeIsNotADisk) {
+  // A whole cylinder closed around the body: it must be cut open first.
+  Garment tube = grid_garment(
+      24, 6,
+      [](double s, double t) {
+        const double a = 2 * kPi * s;
+        return Eigen::Vector3d(0.3 * std::sin(a), 0.6 + 0.4 * t, 0.3 * std::cos(a));
+      },
+      "tube");
+  // Close the seam: the last column of vertices is the first.
+  for (Eigen::Index q = 0; q < tube.mesh.faces.rows(); ++q)
+    for (int k = 0; k < 4; ++k)
+      if (tube.mesh.faces(q, k) % 25 == 24) tube.mesh.faces(q, k) -= 24;
+  try {
+    flatten_garment(tube);
+    ADD_FAILURE() << "a tube was flattened";
+  } catch (const PatternError& e) {
+    EXPECT_EQ(e.panel(), "tube");
+    EXPECT_NE(std::string(e.what()).find("not a disk"), std::string::npos) << e.what();
+  }
+}
+
+TEST(PanelFlattening, TwoHalvesOfASkirtSewAlongTheirSeams) {
+  // Front and back halves of a cone (an A-line skirt), two seams at the sides.
+  Garment g = grid_garment(32, 8, [](double s, double t) {
+    const double a = 2 * kPi * s, r = 0.35 - 0.15 * t;
+    return Eigen::Vector3d(r * std::sin(a), 0.5 + 0.5 * t, r * std::cos(a));
+  });
+  for (Eigen::Index q = 0; q < g.mesh.faces.rows(); ++q) {
+    for (int k = 0; k < 4; ++k)
+      if (g.mesh.faces(q, k) % 33 == 32) g.mesh.faces(q, k) -= 32;
+    const int column = static_cast<int>(q % 32);
+    g.face_panel(q) = column >= 8 && column < 24 ? 1 : 0;  // back half: columns 8..23
+  }
+  g.panels.push_back(g.panels[0]);
+  g.panels[0].id = "front";
+  g.panels[1].id = "back";
+  const FlatPattern pattern = flatten_garment(g);
+  ASSERT_EQ(pattern.seams.size(), 2u);
+  for (const PatternSeam& seam : pattern.seams) {
+    EXPECT_NE(seam.panel_a, seam.panel_b);
+    EXPECT_NEAR(seam.length_3d, std::hypot(0.5, 0.15), 1e-9);
+    EXPECT_LE(seam.mismatch(), 0.005);
+    ASSERT_EQ(seam.vertices_a.size(), 9u);
+    for (size_t k = 0; k < seam.vertices_a.size(); ++k)
+      EXPECT_EQ(pattern.panels[static_cast<size_t>(seam.panel_a)]
+                    .vertices[static_cast<size_t>(seam.vertices_a[k])],
+                pattern.panels[static_cast<size_t>(seam.panel_b)]
+                    .vertices[static_cast<size_t>(seam.vertices_b[k])]);
+  }
+  // A cone is developable: each half is a sector of an annulus, flat without stretch.
+  for (const FlatPanel& flat : pattern.panels) {
+    EXPECT_LT(flat.distortion.length_max, 2e-3) << flat.id;
+    EXPECT_EQ(flat.notches.size(), 4u) << flat.id;  // seam ends at waist and hem, both sides
+  }
+}
+
+// Every example garment: flat pieces never fold, both sides of every seam are equally long.
+TEST(PanelFlattening, ExampleSeamsSew) {
+  static const Body body = load_body("builtin");
+  static const BodySurface surface(body.mesh);
+  for (const auto& file : test::example_files()) {
+    const Garment g = build_garment(load_sketch(file), surface);
+    const FlatPattern pattern = flatten_garment(g);
+    ASSERT_EQ(pattern.panels.size(), g.panels.size());
+    EXPECT_FALSE(pattern.seams.empty()) << file;
+    double worst = 0;
+    for (const PatternSeam& seam : pattern.seams) {
+      EXPECT_LE(seam.mismatch(), 0.005)
+          << file << " seam between " << pattern.panels[static_cast<size_t>(seam.panel_a)].id
+          << " and " << pattern.panels[static_cast<size_t>(seam.panel_b)].id;
+      worst = std::max(worst, seam.mismatch());
+    }
+    double stretch = 0;
+    for (const FlatPanel& flat : pattern.panels) {
+      EXPECT_EQ(inverted_triangles(flat), 0) << file << " " << flat.id;
+      stretch = std::max(stretch, flat.distortion.length_p95);
+    }
+    std::printf(
+        "%s: %zu pieces, %zu seams, worst seam mismatch %.3f %%, worst stretch (95th "
+        "percentile) %.2f %%\n",
+        file.filename().c_str(), pattern.panels.size(), pattern.seams.size(), 100 * worst,
+        100 * stretch);
+  }
+}
+
+}  // namespace
+}  // namespace sd::garment
