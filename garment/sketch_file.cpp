@@ -383,7 +383,7 @@ CurveSpec parse_curve(const Reader& r, const json& j, const std::string& path, c
 PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, const Sketch& sk) {
   r.require_object(j, path, "a panel");
   r.check_keys(j, path,
-               {"id", "boundary", "corners", "fabric", "mirror", "edge_length", "ease", "seed"});
+               {"id", "boundary", "corners", "fabric", "mirror", "edge_length", "ease", "seed", "fit"});
   PanelSpec panel;
   panel.json_path = path;
   if (!j.contains("id")) r.fail(path, "every panel needs an \"id\"");
@@ -474,6 +474,17 @@ PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, c
       r.fail(path + "/ease", fmt::format("ease {} is outside 0.5 .. 2 (1 = rest shape as "
                                          "designed, 1.05 = 5% looser)",
                                          panel.ease));
+  }
+  if (j.contains("fit")) {
+    const std::string fit = r.text(j["fit"], path + "/fit");
+    if (fit == "auto") panel.fit = PanelFit::kAuto;
+    else if (fit == "body") panel.fit = PanelFit::kBody;
+    else if (fit == "free") panel.fit = PanelFit::kFree;
+    else
+      r.fail(path + "/fit", fmt::format("\"fit\" is \"auto\", \"body\" (the panel lies on the "
+                                        "body) or \"free\" (spanned by its curves, pushed out of "
+                                        "the body only where it would be inside), not \"{}\"",
+                                        fit));
   }
   return panel;
 }

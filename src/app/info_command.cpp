@@ -3,9 +3,11 @@
 #include <fmt/format.h>
 
 #include <iostream>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include "garment/body.hpp"
+#include "garment/body_landmarks.hpp"
 #include "src/app/cli.hpp"
 
 namespace sd::app {
@@ -59,6 +61,26 @@ void run_info(const InfoOptions& options) {
         {"degenerate_faces", topo.degenerate_faces}}},
       {"warnings", body.warnings},
   };
+  // Landmarks, when the body looks like a standing figure (a mannequin's torso alone has none).
+  std::optional<garment::BodyLandmarks> landmarks;
+  std::string landmark_problem;
+  try {
+    landmarks = garment::find_landmarks(body.mesh);
+  } catch (const std::runtime_error& e) {
+    landmark_problem = e.what();
+  }
+  if (landmarks) {
+    nlohmann::json points = nlohmann::json::object();
+    for (const garment::Landmark& l : landmarks->points)
+      points[l.name] = {l.position.x(), l.position.y(), l.position.z()};
+    out["landmarks"] = points;
+    out["girths_m"] = {{"chest", landmarks->chest_girth},
+                       {"waist", landmarks->waist_girth},
+                       {"hips", landmarks->hip_girth}};
+  } else {
+    out["landmarks"] = nullptr;
+    out["landmarks_problem"] = landmark_problem;
+  }
   if (options.json) {
     std::cout << out.dump(2) << "\n";
     return;
@@ -82,6 +104,17 @@ void run_info(const InfoOptions& options) {
       topo.closed() ? "yes" : "no", topo.edge_manifold() ? "yes" : "no",
       topo.oriented() ? "yes" : "no", topo.components, topo.boundary_edges,
       topo.non_manifold_edges, topo.degenerate_faces);
+  if (!landmarks) {
+    std::cout << fmt::format("landmarks   none: {}\n", landmark_problem);
+    return;
+  }
+  std::cout << "landmarks   (m, normalised frame: x to the body's left, y up, z forward)\n";
+  for (const garment::Landmark& l : landmarks->points)
+    std::cout << fmt::format("  {:<15} [{:7.3f} {:7.3f} {:7.3f}]\n", l.name, l.position.x(),
+                             l.position.y(), l.position.z());
+  std::cout << fmt::format("girths      chest {:.3f} m, waist {:.3f} m, hips {:.3f} m (convex hull of "
+                           "the torso's slice)\n",
+                           landmarks->chest_girth, landmarks->waist_girth, landmarks->hip_girth);
 }
 
 }  // namespace

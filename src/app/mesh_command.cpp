@@ -142,6 +142,8 @@ void run_mesh(const MeshOptions& options) {
                       {"irregular_vertices", p.irregular_vertices},
                       {"quads", p.faces},
                       {"area_m2", p.area},
+                      {"fit", p.fit},
+                      {"span_gap_m", p.span_gap},
                       {"quality", quality_json(p.quality)}});
     distortion += p.distortion;
     irregular += p.irregular_vertices;

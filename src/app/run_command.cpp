@@ -13,6 +13,7 @@
 
 #include "garment/sketch_file.hpp"
 #include "garment/material_frames.hpp"
+#include "meshing/slice_dent.hpp"
 #include "sim/adaptive_detail.hpp"
 #include "sim/simulation.hpp"
 #include "src/app/cli.hpp"
@@ -320,6 +321,13 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   out["pinned_vertices"] = scene.pinned.size();
   out["meshing"] = meshing_json(scene);
   out["adaptive"] = adaptive_json;
+  if (scene.garment) {
+    // How deep the draped cloth dents between supports (a skirt pulled between the legs).
+    const meshing::SliceDent dent = meshing::slice_dent(draped);
+    out["slice_dent"] = {{"depth_m", dent.depth}, {"height_m", dent.height},
+                         {"where", {dent.where.x(), dent.where.y(), dent.where.z()}},
+                         {"from_fraction", 0.1}, {"to_fraction", 0.6}};
+  }
   out["images"] = images;
   out["frames"] = frames.size();
   out["body_motion"] = nullptr;
