@@ -138,6 +138,22 @@ Eigen::Vector3d along(const std::vector<Eigen::Vector3d>& line, double fraction)
 
 }  // namespace
 
+std::vector<SliceOutline> slice_body(const meshing::TriMesh& body, double y) {
+  std::vector<SliceOutline> out;
+  for (const Outline& o : slice(body, y)) {
+    SliceOutline s{o.centroid, o.points.front(), o.points.front(), o.girth};
+    for (const Eigen::Vector3d& p : o.points) {
+      s.min = s.min.cwiseMin(p);
+      s.max = s.max.cwiseMax(p);
+    }
+    out.push_back(s);
+  }
+  std::sort(out.begin(), out.end(), [](const SliceOutline& a, const SliceOutline& b) {
+    return a.centroid.x() < b.centroid.x();
+  });
+  return out;
+}
+
 const std::vector<std::string>& landmark_names() {
   static const std::vector<std::string> names = {
       "neck_base",   "left_shoulder", "right_shoulder", "left_armpit", "right_armpit", "chest",
@@ -228,7 +244,7 @@ BodyLandmarks find_landmarks(const meshing::TriMesh& body) {
   const Level* waist =
       extreme(crotch->y + 0.3 * torso_span, top_of_armpits - 0.2 * torso_span, false);
   if (waist == nullptr) fail("waist");
-  const Level* hips = extreme(crotch->y + 0.02 * torso_span, waist->y, true);
+  const Level* hips = extreme(crotch->y + 0.1 * torso_span, waist->y, true);
   const Level* chest = extreme(waist->y, top_of_armpits - 0.03 * torso_span, true);
   if (hips == nullptr || chest == nullptr) fail("hips or chest");
   const auto front = [&](const Level& l) {

@@ -32,6 +32,16 @@ struct BodyLandmarks {
   const Landmark& nearest(const Eigen::Vector3d& p) const;
 };
 
+// One closed outline of a horizontal slice of the body (a leg, an arm, the torso).
+struct SliceOutline {
+  Eigen::Vector3d centroid;  // mean of the cut points, m
+  Eigen::Vector3d min, max;  // bounding box of the cut points (y = the slice's height)
+  double girth = 0.0;        // m, perimeter of the outline's convex hull (XZ)
+};
+
+// The outlines of the body's slice at height y, ordered by x of their centroids.
+std::vector<SliceOutline> slice_body(const meshing::TriMesh& body, double y);
+
 // The names find_landmarks gives, in order.
 const std::vector<std::string>& landmark_names();
 

@@ -298,6 +298,17 @@ void Simulation::accept(Attempt& attempt, double h) {
   const double kinetic = kinetic_energy(model_, v_);
   // A body still moving (a pose sequence not yet over) is not a scene at rest.
   const bool body_moving = contact_ && contact_->motion() && time_ < contact_->motion()->end_time();
+  rest_history_.push_back({time_, speed, kinetic / mass});
+  std::erase_if(rest_history_, [this](const std::array<double, 3>& r) {
+    return r[0] < time_ - settings_.rest_window - 1e-12;
+  });
+  report_.rest_speed_final = speed;
+  report_.rest_kinetic_per_kg_final = kinetic / mass;
+  report_.rest_speed_window = report_.rest_kinetic_per_kg_window = 0.0;
+  for (const auto& [t, s, k] : rest_history_) {
+    report_.rest_speed_window = std::max(report_.rest_speed_window, s);
+    report_.rest_kinetic_per_kg_window = std::max(report_.rest_kinetic_per_kg_window, k);
+  }
   if (speed < settings_.rest_speed && kinetic / mass < settings_.rest_kinetic_energy && !body_moving)
     rest_time_ += h;
   else

@@ -2,6 +2,7 @@
 // The driver: time stepping with implicit Euler or variable-step BDF2, step control (rollback
 // and halving on failure, growth after easy steps), at-rest detection and the run report.
 
+#include <array>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -121,6 +122,12 @@ struct SimulationReport {
   int projected_vertices = 0;       // vertices projected out after the re-solves (last resort)
   int start_repair_vertices = 0;    // vertices that started inside the body
   double start_repair_depth_m = 0.0;  // deepest of them
+  // The at-rest residual: the largest vertex speed (m/s) and kinetic energy per kilogram
+  // (J/kg) over the accepted steps of the last rest_window seconds, and the last step's.
+  double rest_speed_window = 0.0;
+  double rest_kinetic_per_kg_window = 0.0;
+  double rest_speed_final = 0.0;
+  double rest_kinetic_per_kg_final = 0.0;
   std::vector<EnergySample> energy;
 };
 
@@ -214,6 +221,8 @@ class Simulation {
   double dt_ = 0.0;
   int easy_steps_ = 0;
   double rest_time_ = 0.0;
+  // (time, largest speed, kinetic energy per kg) of the steps in the last rest window.
+  std::vector<std::array<double, 3>> rest_history_;
   ConstraintFilter filter_;
   StepForces contact_forces_;  // friction drags and piercing springs of the current attempt
   ImplicitSolver solver_;

@@ -19,6 +19,7 @@ struct InfoOptions {
   double height = 0;
   double scale = 0;
   bool json = false;
+  std::vector<double> slices;  // heights, m (normalised frame)
 };
 
 nlohmann::json box_json(const meshing::BoundingBox& box) {
@@ -81,6 +82,24 @@ void run_info(const InfoOptions& options) {
     out["landmarks"] = nullptr;
     out["landmarks_problem"] = landmark_problem;
   }
+  nlohmann::json slices = nlohmann::json::array();
+  std::string slice_text;
+  for (const double y : options.slices) {
+    nlohmann::json outlines = nlohmann::json::array();
+    slice_text += fmt::format("slice y = {:.3f} m:\n", y);
+    for (const garment::SliceOutline& o : garment::slice_body(body.mesh, y)) {
+      outlines.push_back({{"centroid", {o.centroid.x(), o.centroid.y(), o.centroid.z()}},
+                          {"x", {o.min.x(), o.max.x()}},
+                          {"z", {o.min.z(), o.max.z()}},
+                          {"girth", o.girth}});
+      slice_text += fmt::format("  outline x {:.3f} .. {:.3f}, z {:.3f} .. {:.3f} m, centre ({:.3f}, "
+                                "{:.3f}), girth {:.3f} m\n",
+                                o.min.x(), o.max.x(), o.min.z(), o.max.z(), o.centroid.x(),
+                                o.centroid.z(), o.girth);
+    }
+    slices.push_back({{"y", y}, {"outlines", outlines}});
+  }
+  if (!options.slices.empty()) out["slices"] = slices;
   if (options.json) {
     std::cout << out.dump(2) << "\n";
     return;
@@ -104,6 +123,7 @@ void run_info(const InfoOptions& options) {
       topo.closed() ? "yes" : "no", topo.edge_manifold() ? "yes" : "no",
       topo.oriented() ? "yes" : "no", topo.components, topo.boundary_edges,
       topo.non_manifold_edges, topo.degenerate_faces);
+  std::cout << slice_text;
   if (!landmarks) {
     std::cout << fmt::format("landmarks   none: {}\n", landmark_problem);
     return;
@@ -130,6 +150,9 @@ void add_info_command(CLI::App& app, const GlobalOptions& /*global*/) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--scale", options->scale, "Metres per file unit")->check(CLI::PositiveNumber);
   cmd->add_flag("--json", options->json, "Print one JSON object instead of text");
+  cmd->add_option("--slice", options->slices,
+                  "Also print the body's outlines at this height (m, normalised frame; repeat for "
+                  "several): where legs, arms and torso are, to place curves");
   cmd->callback([options] { run_info(*options); });
 }
 
