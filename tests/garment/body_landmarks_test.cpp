@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "garment/body.hpp"
+#include "garment/sketch_file.hpp"
 #include "tests/garment/test_helpers.hpp"
 
 namespace sd::garment {
@@ -72,6 +73,30 @@ TEST(BodyLandmarks, SliceOfTheBuiltinBodyAtKneeHeightHasTwoLegs) {
   EXPECT_LT(legs[0].centroid.x(), 0.0);
   EXPECT_GT(legs[1].centroid.x(), 0.0);
   EXPECT_NEAR(legs[0].girth, legs[1].girth, 0.01);
+}
+
+TEST(BodyLandmarks, SketchPointsRelativeToALandmark) {
+  const std::string text = R"({
+    "curves": [ { "id": "c", "points3d": [ {"at": "waist", "offset": [0.05, -0.02, 0]},
+                                           {"at": "left_armpit"}, [0.1, 1.3, 0.1] ] } ],
+    "panels": [ { "id": "p", "boundary": ["c"] } ] })";
+  const Sketch sketch = parse_sketch(text, "landmarks.json", ".");
+  const BodyLandmarks l = find_landmarks(load_body("builtin").mesh);
+  const std::vector<Eigen::Vector3d>& p = sketch.curves.front().points3d;
+  ASSERT_EQ(p.size(), 3u);
+  EXPECT_EQ(p[0], l.find("waist")->position + Eigen::Vector3d(0.05, -0.02, 0));
+  EXPECT_EQ(p[1], l.find("left_armpit")->position);
+  EXPECT_EQ(p[2], Eigen::Vector3d(0.1, 1.3, 0.1));
+  const std::string misspelt = R"({
+    "curves": [ { "id": "c", "points3d": [ {"at": "left_armpt"}, [0.1, 1.3, 0.1] ] } ],
+    "panels": [ { "id": "p", "boundary": ["c"] } ] })";
+  try {
+    parse_sketch(misspelt, "landmarks.json", ".");
+    FAIL() << "an unknown landmark was accepted";
+  } catch (const SketchError& e) {
+    EXPECT_EQ(e.json_path(), "/curves/0/points3d/0/at");
+    EXPECT_NE(std::string(e.what()).find("no landmark 'left_armpt'"), std::string::npos);
+  }
 }
 
 }  // namespace
