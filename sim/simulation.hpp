@@ -93,6 +93,7 @@ struct SimulationReport {
   bool nan_free = true;      // no accepted state had a non-finite value (always, by design)
   bool failed = false;       // a step could not be completed even at min_dt
   std::string failure_reason;
+  int failure_vertex = -1;   // where: the fastest (or first non-finite) vertex of the failed step
   int vertices = 0;
   int triangles = 0;
   int linear_solves = 0;
@@ -139,6 +140,7 @@ struct StepOutcome {
   int newton_iterations = 0;
   int cg_iterations = 0;
   std::string failure_reason;  // when not accepted
+  int failure_vertex = -1;     // when not accepted: the vertex where it broke (fastest)
 };
 
 class Simulation {
@@ -201,6 +203,7 @@ class Simulation {
     int cg_iterations = 0;
     int cg_iterations_max = 0;
     std::string failure;  // empty when the attempt passed every check
+    int failure_vertex = -1;  // the fastest (or first non-finite) vertex of a failed attempt
     bool hard_failure = false;  // non-finite or too fast: never accepted
   };
   Attempt attempt(double h);
