@@ -154,7 +154,7 @@ std::vector<QualityWarning> check_quality(const Garment& garment, const Sketch& 
                      "or end the curves at one junction;",
                      near.count, 1e3 * threshold, 1e3 * near.value));
     emit(size, "quad_size",
-         fmt::format("{} quad(s) have sides outside {:.1f}-{:.1f} times the edge length of {:.1f} "
+         fmt::format("{} quad(s) have sides outside {:.2g}-{:.2g} times the edge length of {:.1f} "
                      "cm (the worst {:.2f} times); the filler could not fit a grid to the sides' "
                      "edge counts: make facing sides' edge counts closer or split the panel;",
                      size.count, limits.size_low, limits.size_high, 100 * target, size.value));
