@@ -37,9 +37,10 @@ void run_validate(const ValidateOptions& options) {
   }
   std::vector<garment::QualityWarning> warnings;
   if (scene.garment && scene.body) warnings = quality_warnings(*scene.garment, sketch, *scene.body);
-  std::cout << fmt::format("{}: {} ({}, fabric {})\n", sketch.file,
-                           warnings.empty() ? "ok" : fmt::format("{} warning(s)", warnings.size()),
-                           what, scene.fabric_name);
+  std::cout << fmt::format("{}: ok ({}, fabric {}){}\n", sketch.file, what, scene.fabric_name,
+                           warnings.empty()
+                               ? ""
+                               : fmt::format("; {} mesh quality warning(s)", warnings.size()));
   if (options.strict && !warnings.empty())
     throw std::runtime_error(fmt::format("{}: {} mesh quality warning(s) and --strict", sketch.file,
                                          warnings.size()));

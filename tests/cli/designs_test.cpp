@@ -103,6 +103,20 @@ TEST_P(DesignDrape, RestsOutsideTheBodyWithoutADentBetweenTheLegs) {
 INSTANTIATE_TEST_SUITE_P(Skirts, DesignDrape,
                          ::testing::Values("pencil-skirt", "straight-skirt-human"), test_name);
 
+// The quality gate: the t-shirt example's back has folded quads at the armpit (docs/garment.md),
+// which validate reports with its place and landmark and --strict turns into exit code 1.
+TEST(QualityGateCli, StrictMakesWarningsFail) {
+  const std::string tshirt = (fs::path(SD_SOURCE_DIR) / "data/examples/tshirt.json").string();
+  const CommandResult plain = run_sketchdrape("validate " + tshirt);
+  EXPECT_EQ(plain.exit_code, 0) << plain.output;
+  EXPECT_NE(plain.output.find("panel 'back': 2 quad(s) fold over"), std::string::npos)
+      << plain.output;
+  EXPECT_NE(plain.output.find("near the left_armpit"), std::string::npos) << plain.output;
+  EXPECT_NE(plain.output.find("mesh quality warning(s)"), std::string::npos) << plain.output;
+  const CommandResult strict = run_sketchdrape("validate --strict " + tshirt);
+  EXPECT_EQ(strict.exit_code, 1) << strict.output;
+}
+
 // A drape that cannot succeed (gravity 30,000 times the Earth's: the first step is too fast even
 // at the smallest step) says where and why and leaves the last accepted state to look at.
 TEST(DesignDrapeFailure, SaysWhereAndWritesTheLastState) {
