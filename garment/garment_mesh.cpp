@@ -8,6 +8,7 @@
 #include <array>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <set>
 #include <stdexcept>
 #include <unordered_map>
@@ -16,6 +17,7 @@
 #include "garment/edge_counts.hpp"
 #include "garment/network_faces.hpp"
 #include "garment/panel_loop.hpp"
+#include "garment/panel_surface.hpp"
 #include "garment/stroke_projection.hpp"
 #include "garment/surface_relaxation.hpp"
 #include "garment/surface_untangle.hpp"
@@ -31,6 +33,9 @@ namespace {
 constexpr int kSurfaceSweeps = 20;
 constexpr double kSurfaceTolerance = 1e-2;  // edge lengths
 constexpr double kSurfaceMaxStep = 0.5;     // edge lengths
+// m: an "auto" panel whose spanned surface stands farther than this off the body's offset
+// surface spans a hollow and is made "free"; otherwise it lies on the body.
+constexpr double kSpanGap = 0.03;
 
 // Global vertices of the garment: node and curve-piece vertices are made once and shared.
 struct VertexPool {
@@ -259,19 +264,65 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
         if (signed_distance < offset + reach) return {s.position + offset * s.normal, s.normal};
         return {p, Eigen::Vector3d::Zero()};
       };
-      if (on_body > 0)
-        options.project = [&lift](const Eigen::Vector3d& p) { return lift(p).position; };
-      const auto normal = [&body](const Eigen::Vector3d& p) -> Eigen::Vector3d { return body.closest_point(p).normal; };
-      meshing::FilledPatch patch;
-      try {
-        patch = meshing::fill_region(side_points, options);
-      } catch (const meshing::FillError& e) {
-        sketch.fail(loop.json_path, fmt::format("panel '{}' cannot be filled with quads: {}", loop.id, e.what()));
+      // The body as an obstacle only: a point inside the offset surface goes to its closest
+      // point on it, any other point stays.
+      const PushOut push_out = [&body, &hints, cell,
+                                offset](const Eigen::Vector3d& p) -> std::optional<Eigen::Vector3d> {
+        const Eigen::Vector3d q = (p / cell).array().floor();
+        const std::int64_t key = (static_cast<std::int64_t>(q.x()) * 73856093) ^
+                                 (static_cast<std::int64_t>(q.y()) * 19349663) ^
+                                 (static_cast<std::int64_t>(q.z()) * 83492791);
+        SurfacePoint& hint = hints[key];
+        const SurfacePoint s = body.closest_point(p, hint);
+        hint = s;
+        if ((p - s.position).dot(s.normal) >= offset) return std::nullopt;
+        return s.position + offset * s.normal;
+      };
+      const auto fill = [&](const meshing::FillGeometryOptions& o) {
+        try {
+          return meshing::fill_region(side_points, o);
+        } catch (const meshing::FillError& e) {
+          sketch.fail(loop.json_path, fmt::format("panel '{}' cannot be filled with quads: {}", loop.id, e.what()));
+        }
+      };
+      // The surface spanned by the boundary decides an "auto" panel: where it stays near or
+      // inside the body the panel lies on it (a t-shirt's front over the chest); where it
+      // stands off by more than kSpanGap it spans a hollow (a skirt across the legs).
+      PanelFit fit = spec.fit;
+      if (on_body == 0) fit = PanelFit::kFree;
+      meshing::FillGeometryOptions free_options = options;
+      free_options.project = nullptr;
+      std::optional<meshing::FilledPatch> spanned;
+      if (fit != PanelFit::kBody) {
+        spanned = fill(free_options);
+        std::vector<char> boundary(static_cast<size_t>(spanned->mesh.vertex_count()), 0);
+        for (const auto& side : spanned->topology.side_vertices)
+          for (int v : side) boundary[static_cast<size_t>(v)] = 1;
+        meshing::QuadMesh membrane = spanned->mesh;
+        span_harmonic(membrane, boundary);
+        for (Eigen::Index v = 0; v < membrane.vertex_count(); ++v) {
+          if (boundary[static_cast<size_t>(v)]) continue;
+          const Eigen::Vector3d p = membrane.vertices.row(v).transpose();
+          const SurfacePoint s = body.closest_point(p);
+          panel.span_gap = std::max(panel.span_gap, (p - s.position).dot(s.normal) - offset);
+        }
+        if (fit == PanelFit::kAuto) fit = panel.span_gap > kSpanGap ? PanelFit::kFree : PanelFit::kBody;
       }
+      panel.fit = fit == PanelFit::kFree ? "free" : "body";
+      if (fit == PanelFit::kBody)
+        options.project = [&lift](const Eigen::Vector3d& p) { return lift(p).position; };
+      else
+        options.project = [&push_out](const Eigen::Vector3d& p) { return push_out(p).value_or(p); };
+      const auto normal = [&body](const Eigen::Vector3d& p) -> Eigen::Vector3d { return body.closest_point(p).normal; };
+      meshing::FilledPatch patch = fit == PanelFit::kBody ? fill(options) : std::move(*spanned);
       std::vector<char> fixed(static_cast<size_t>(patch.mesh.vertex_count()), 0);
       for (const auto& side : patch.topology.side_vertices)
         for (int v : side) fixed[static_cast<size_t>(v)] = 1;
-      if (on_body > 0) {
+      if (fit == PanelFit::kFree) {
+        span_over_obstacle(patch.mesh, fixed, push_out);
+        patch.quality = meshing::measure_quality(patch.mesh, patch.topology.corner_vertices());
+      }
+      if (fit == PanelFit::kBody) {
         // Smooth along the surface (see surface_relaxation.hpp); kept when it leaves fewer
         // folded quads, or as many and a better worst corner.
         meshing::QuadMesh relaxed = patch.mesh;
@@ -357,6 +408,8 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
       panel.irregular_vertices = op.irregular_vertices;
       panel.quality = op.quality;
       panel.faces = op.faces;
+      panel.fit = op.fit;
+      panel.span_gap = op.span_gap;
     }
     garment.panels.push_back(std::move(panel));
   }

@@ -40,6 +40,8 @@ struct GarmentPanel {
   int faces = 0;
   double area = 0;                  // m²
   double max_body_gap = 0;          // m: largest |distance to body − offset| of on-body vertices
+  std::string fit = "body";         // how the interior was shaped: "body" or "free"
+  double span_gap = 0;              // m: farthest the spanned surface stands off the offset surface
 };
 
 struct Garment {

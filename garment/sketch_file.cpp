@@ -7,9 +7,14 @@
 #include <cmath>
 #include <fstream>
 #include <initializer_list>
+#include <map>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
+
+#include "garment/body_landmarks.hpp"
+#include "garment/sketch_inputs.hpp"
 
 namespace sd::garment {
 namespace {
@@ -324,6 +329,42 @@ void parse_body(const Reader& r, const json& j, BodySpec& body) {
   }
 }
 
+// The landmarks of the sketch's body (docs/bodies.md), found once per body and kept: a sketch
+// that places points relative to them loads its body while it is read.
+const BodyLandmarks& sketch_landmarks(const Reader& r, const Sketch& sk, const std::string& path) {
+  static std::mutex mutex;
+  static std::map<std::string, BodyLandmarks> cache;
+  const std::string key = fmt::format("{}|{}|{}|{}", sk.resolve(sk.body.mesh).string(),
+                                      sk.body.height.value_or(0), sk.body.scale.value_or(0),
+                                      sk.body.up.value_or(""));
+  const std::lock_guard lock(mutex);
+  if (const auto it = cache.find(key); it != cache.end()) return it->second;
+  const Body body = load_sketch_body(sk);
+  try {
+    return cache.emplace(key, find_landmarks(body.mesh)).first->second;
+  } catch (const std::runtime_error& e) {
+    r.fail(path, fmt::format("a point is given relative to a landmark, but the body has none: {}",
+                             e.what()));
+  }
+}
+
+// {"at": "left_armpit", "offset": [dx, dy, dz]}: a landmark's position plus an offset (m).
+Eigen::Vector3d landmark_point(const Reader& r, const json& j, const std::string& path,
+                               const Sketch& sk) {
+  r.check_keys(j, path, {"at", "offset"});
+  if (!j.contains("at"))
+    r.fail(path, "a point given by a landmark needs \"at\": its name, e.g. {\"at\": "
+                 "\"left_armpit\", \"offset\": [0.01, -0.03, 0]}");
+  const std::string name = r.text(j["at"], path + "/at");
+  const Eigen::Vector3d offset =
+      j.contains("offset") ? r.vector<3>(j["offset"], path + "/offset") : Eigen::Vector3d::Zero();
+  const BodyLandmarks& landmarks = sketch_landmarks(r, sk, path);
+  if (const Landmark* l = landmarks.find(name)) return l->position + offset;
+  std::string names;
+  for (const std::string& n : landmark_names()) names += (names.empty() ? "" : ", ") + n;
+  r.fail(path + "/at", fmt::format("there is no landmark '{}'; the landmarks are {}", name, names));
+}
+
 CurveSpec parse_curve(const Reader& r, const json& j, const std::string& path, const Sketch& sk) {
   r.require_object(j, path, "a curve");
   r.check_keys(j, path,
@@ -348,7 +389,8 @@ CurveSpec parse_curve(const Reader& r, const json& j, const std::string& path, c
     if (has_2d)
       curve.points.push_back(r.vector<2>(pts[i], ip));
     else
-      curve.points3d.push_back(r.vector<3>(pts[i], ip));
+      curve.points3d.push_back(pts[i].is_object() ? landmark_point(r, pts[i], ip, sk)
+                                                  : r.vector<3>(pts[i], ip));
   }
   if (j.contains("view")) {
     if (has_3d)
@@ -384,7 +426,7 @@ PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, c
   r.require_object(j, path, "a panel");
   r.check_keys(j, path,
                {"id", "boundary", "corners", "fabric", "mirror", "edge_length", "ease", "seed",
-                "rest", "seam_allowance"});
+                "rest", "seam_allowance", "fit"});
   PanelSpec panel;
   panel.json_path = path;
   if (!j.contains("id")) r.fail(path, "every panel needs an \"id\"");
@@ -488,6 +530,17 @@ PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, c
     if (*panel.seam_allowance < 0 || *panel.seam_allowance > 0.1)
       r.fail(path + "/seam_allowance",
              fmt::format("seam allowance {} m is outside 0 .. 0.1 m", *panel.seam_allowance));
+  }
+  if (j.contains("fit")) {
+    const std::string fit = r.text(j["fit"], path + "/fit");
+    if (fit == "auto") panel.fit = PanelFit::kAuto;
+    else if (fit == "body") panel.fit = PanelFit::kBody;
+    else if (fit == "free") panel.fit = PanelFit::kFree;
+    else
+      r.fail(path + "/fit", fmt::format("\"fit\" is \"auto\", \"body\" (the panel lies on the "
+                                        "body) or \"free\" (spanned by its curves, pushed out of "
+                                        "the body only where it would be inside), not \"{}\"",
+                                        fit));
   }
   return panel;
 }

@@ -60,6 +60,12 @@ struct SeedSpec {
   std::optional<Eigen::Vector3d> point3d;  // world metres
 };
 
+// How a panel's interior takes its shape (docs/garment.md, "Panel surfaces"): spanned by its
+// boundary curves and pushed out of the body only where it would be inside ("free"), laid on
+// the body's offset surface ("body"), or chosen from how far the spanned surface is from the
+// body ("auto").
+enum class PanelFit { kAuto, kBody, kFree };
+
 struct PanelSpec {
   std::string id;
   std::string json_path;                   // "/panels/1"
@@ -73,6 +79,7 @@ struct PanelSpec {
   double ease = 1.0;                       // rest shape scale (1 = as designed)
   std::optional<std::string> rest;         // "flat" | "shaped"; default: simulate.rest
   std::optional<double> seam_allowance;    // metres; default: output.pattern.seam_allowance
+  PanelFit fit = PanelFit::kAuto;          // "fit"
 };
 
 struct JoinSpec {

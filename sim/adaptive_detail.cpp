@@ -478,12 +478,14 @@ AdaptiveReport AdaptiveCloth::run(const std::function<void(const AdaptiveCloth&)
   if (energy.empty()) sample();
   bool failed = false, at_rest = false;
   std::string failure;
+  int failure_vertex = -1;
   const double epsilon = 1e-9 * std::max(1.0, settings.duration);
   while (simulation_->time() < settings.duration - epsilon) {
     const StepOutcome outcome = step(settings.duration - simulation_->time());
     if (!outcome.accepted) {
       failed = true;
       failure = outcome.failure_reason;
+      failure_vertex = outcome.failure_vertex;
       break;
     }
     sample();
@@ -525,6 +527,7 @@ AdaptiveReport AdaptiveCloth::run(const std::function<void(const AdaptiveCloth&)
   report_.simulation.at_rest = at_rest;
   report_.simulation.failed = failed;
   report_.simulation.failure_reason = failure;
+  report_.simulation.failure_vertex = failure_vertex;
   const SimulationReport& s = report_.simulation;
   report_.simulation.cg_iterations_mean =
       s.linear_solves > 0 ? static_cast<double>(cg_total_) / s.linear_solves : 0.0;

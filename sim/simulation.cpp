@@ -248,6 +248,16 @@ Simulation::Attempt Simulation::attempt(double h) {
   }
 
   std::ostringstream why;
+  // Where a failing attempt broke: its first non-finite vertex, else its fastest one.
+  for (Eigen::Index i = 0; i < result.v.size() / 3 && result.failure_vertex < 0; ++i)
+    if (!result.x.segment<3>(3 * i).allFinite() || !result.v.segment<3>(3 * i).allFinite())
+      result.failure_vertex = static_cast<int>(i);
+  if (result.failure_vertex < 0 && result.v.size() >= 3) {
+    double fastest = -1.0;
+    for (Eigen::Index i = 0; i < result.v.size() / 3; ++i)
+      if (const double speed = result.v.segment<3>(3 * i).norm(); speed > fastest)
+        fastest = speed, result.failure_vertex = static_cast<int>(i);
+  }
   if (!result.x.allFinite() || !result.v.allFinite()) {
     why << "non-finite positions or velocities";
     result.hard_failure = true;
@@ -298,6 +308,17 @@ void Simulation::accept(Attempt& attempt, double h) {
   const double kinetic = kinetic_energy(model_, v_);
   // A body still moving (a pose sequence not yet over) is not a scene at rest.
   const bool body_moving = contact_ && contact_->motion() && time_ < contact_->motion()->end_time();
+  rest_history_.push_back({time_, speed, kinetic / mass});
+  std::erase_if(rest_history_, [this](const std::array<double, 3>& r) {
+    return r[0] < time_ - settings_.rest_window - 1e-12;
+  });
+  report_.rest_speed_final = speed;
+  report_.rest_kinetic_per_kg_final = kinetic / mass;
+  report_.rest_speed_window = report_.rest_kinetic_per_kg_window = 0.0;
+  for (const auto& [t, s, k] : rest_history_) {
+    report_.rest_speed_window = std::max(report_.rest_speed_window, s);
+    report_.rest_kinetic_per_kg_window = std::max(report_.rest_kinetic_per_kg_window, k);
+  }
   if (speed < settings_.rest_speed && kinetic / mass < settings_.rest_kinetic_energy && !body_moving)
     rest_time_ += h;
   else
@@ -345,6 +366,7 @@ StepOutcome Simulation::step(double max_step) {
       spdlog::error("sim: t = {:.6f} s: step failed at the minimum step {:.3g} s: {}", time_, h,
                     candidate.failure);
       outcome.failure_reason = candidate.failure;
+      outcome.failure_vertex = candidate.failure_vertex;
       outcome.dt = h;
       return outcome;
     }
@@ -399,6 +421,7 @@ SimulationReport Simulation::run(const std::function<void(const Simulation&)>& o
     if (!outcome.accepted) {
       report_.failed = true;
       report_.failure_reason = outcome.failure_reason;
+      report_.failure_vertex = outcome.failure_vertex;
       break;
     }
     sample();

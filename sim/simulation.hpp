@@ -2,6 +2,7 @@
 // The driver: time stepping with implicit Euler or variable-step BDF2, step control (rollback
 // and halving on failure, growth after easy steps), at-rest detection and the run report.
 
+#include <array>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -92,6 +93,7 @@ struct SimulationReport {
   bool nan_free = true;      // no accepted state had a non-finite value (always, by design)
   bool failed = false;       // a step could not be completed even at min_dt
   std::string failure_reason;
+  int failure_vertex = -1;   // where: the fastest (or first non-finite) vertex of the failed step
   int vertices = 0;
   int triangles = 0;
   int linear_solves = 0;
@@ -121,6 +123,12 @@ struct SimulationReport {
   int projected_vertices = 0;       // vertices projected out after the re-solves (last resort)
   int start_repair_vertices = 0;    // vertices that started inside the body
   double start_repair_depth_m = 0.0;  // deepest of them
+  // The at-rest residual: the largest vertex speed (m/s) and kinetic energy per kilogram
+  // (J/kg) over the accepted steps of the last rest_window seconds, and the last step's.
+  double rest_speed_window = 0.0;
+  double rest_kinetic_per_kg_window = 0.0;
+  double rest_speed_final = 0.0;
+  double rest_kinetic_per_kg_final = 0.0;
   std::vector<EnergySample> energy;
 };
 
@@ -132,6 +140,7 @@ struct StepOutcome {
   int newton_iterations = 0;
   int cg_iterations = 0;
   std::string failure_reason;  // when not accepted
+  int failure_vertex = -1;     // when not accepted: the vertex where it broke (fastest)
 };
 
 class Simulation {
@@ -194,6 +203,7 @@ class Simulation {
     int cg_iterations = 0;
     int cg_iterations_max = 0;
     std::string failure;  // empty when the attempt passed every check
+    int failure_vertex = -1;  // the fastest (or first non-finite) vertex of a failed attempt
     bool hard_failure = false;  // non-finite or too fast: never accepted
   };
   Attempt attempt(double h);
@@ -214,6 +224,8 @@ class Simulation {
   double dt_ = 0.0;
   int easy_steps_ = 0;
   double rest_time_ = 0.0;
+  // (time, largest speed, kinetic energy per kg) of the steps in the last rest window.
+  std::vector<std::array<double, 3>> rest_history_;
   ConstraintFilter filter_;
   StepForces contact_forces_;  // friction drags and piercing springs of the current attempt
   ImplicitSolver solver_;

@@ -42,6 +42,7 @@ int run_cli(int argc, char** argv) {
   add_batch_command(app, global);
   add_stress_command(app, global);
   add_bench_command(app, global);
+  add_dent_command(app, global);
 
   try {
     app.parse(argc, argv);

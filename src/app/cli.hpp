@@ -32,5 +32,6 @@ void add_run_command(CLI::App& app, const GlobalOptions& global);
 void add_batch_command(CLI::App& app, const GlobalOptions& global);
 void add_stress_command(CLI::App& app, const GlobalOptions& global);
 void add_bench_command(CLI::App& app, const GlobalOptions& global);
+void add_dent_command(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace sd::app

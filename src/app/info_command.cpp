@@ -3,9 +3,11 @@
 #include <fmt/format.h>
 
 #include <iostream>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include "garment/body.hpp"
+#include "garment/body_landmarks.hpp"
 #include "src/app/cli.hpp"
 
 namespace sd::app {
@@ -17,6 +19,7 @@ struct InfoOptions {
   double height = 0;
   double scale = 0;
   bool json = false;
+  std::vector<double> slices;  // heights, m (normalised frame)
 };
 
 nlohmann::json box_json(const meshing::BoundingBox& box) {
@@ -59,6 +62,44 @@ void run_info(const InfoOptions& options) {
         {"degenerate_faces", topo.degenerate_faces}}},
       {"warnings", body.warnings},
   };
+  // Landmarks, when the body looks like a standing figure (a mannequin's torso alone has none).
+  std::optional<garment::BodyLandmarks> landmarks;
+  std::string landmark_problem;
+  try {
+    landmarks = garment::find_landmarks(body.mesh);
+  } catch (const std::runtime_error& e) {
+    landmark_problem = e.what();
+  }
+  if (landmarks) {
+    nlohmann::json points = nlohmann::json::object();
+    for (const garment::Landmark& l : landmarks->points)
+      points[l.name] = {l.position.x(), l.position.y(), l.position.z()};
+    out["landmarks"] = points;
+    out["girths_m"] = {{"chest", landmarks->chest_girth},
+                       {"waist", landmarks->waist_girth},
+                       {"hips", landmarks->hip_girth}};
+  } else {
+    out["landmarks"] = nullptr;
+    out["landmarks_problem"] = landmark_problem;
+  }
+  nlohmann::json slices = nlohmann::json::array();
+  std::string slice_text;
+  for (const double y : options.slices) {
+    nlohmann::json outlines = nlohmann::json::array();
+    slice_text += fmt::format("slice y = {:.3f} m:\n", y);
+    for (const garment::SliceOutline& o : garment::slice_body(body.mesh, y)) {
+      outlines.push_back({{"centroid", {o.centroid.x(), o.centroid.y(), o.centroid.z()}},
+                          {"x", {o.min.x(), o.max.x()}},
+                          {"z", {o.min.z(), o.max.z()}},
+                          {"girth", o.girth}});
+      slice_text += fmt::format("  outline x {:.3f} .. {:.3f}, z {:.3f} .. {:.3f} m, centre ({:.3f}, "
+                                "{:.3f}), girth {:.3f} m\n",
+                                o.min.x(), o.max.x(), o.min.z(), o.max.z(), o.centroid.x(),
+                                o.centroid.z(), o.girth);
+    }
+    slices.push_back({{"y", y}, {"outlines", outlines}});
+  }
+  if (!options.slices.empty()) out["slices"] = slices;
   if (options.json) {
     std::cout << out.dump(2) << "\n";
     return;
@@ -82,6 +123,18 @@ void run_info(const InfoOptions& options) {
       topo.closed() ? "yes" : "no", topo.edge_manifold() ? "yes" : "no",
       topo.oriented() ? "yes" : "no", topo.components, topo.boundary_edges,
       topo.non_manifold_edges, topo.degenerate_faces);
+  std::cout << slice_text;
+  if (!landmarks) {
+    std::cout << fmt::format("landmarks   none: {}\n", landmark_problem);
+    return;
+  }
+  std::cout << "landmarks   (m, normalised frame: x to the body's left, y up, z forward)\n";
+  for (const garment::Landmark& l : landmarks->points)
+    std::cout << fmt::format("  {:<15} [{:7.3f} {:7.3f} {:7.3f}]\n", l.name, l.position.x(),
+                             l.position.y(), l.position.z());
+  std::cout << fmt::format("girths      chest {:.3f} m, waist {:.3f} m, hips {:.3f} m (convex hull of "
+                           "the torso's slice)\n",
+                           landmarks->chest_girth, landmarks->waist_girth, landmarks->hip_girth);
 }
 
 }  // namespace
@@ -97,6 +150,9 @@ void add_info_command(CLI::App& app, const GlobalOptions& /*global*/) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--scale", options->scale, "Metres per file unit")->check(CLI::PositiveNumber);
   cmd->add_flag("--json", options->json, "Print one JSON object instead of text");
+  cmd->add_option("--slice", options->slices,
+                  "Also print the body's outlines at this height (m, normalised frame; repeat for "
+                  "several): where legs, arms and torso are, to place curves");
   cmd->callback([options] { run_info(*options); });
 }
 

@@ -21,6 +21,7 @@
 #include "src/app/mesh_export.hpp"
 #include "src/app/pattern_export.hpp"
 #include "src/app/preview_images.hpp"
+#include "src/app/quality_warnings.hpp"
 #include "src/render/previews.hpp"
 
 namespace sd::app {
@@ -34,6 +35,7 @@ double ms_since(Clock::time_point t) {
 struct MeshOptions {
   std::string sketch;
   std::string out = ".";
+  bool strict = false;
 };
 
 std::string obj_48(const meshing::Mesh48& m48, const std::vector<int>& block_group,
@@ -105,6 +107,7 @@ void run_mesh(const MeshOptions& options) {
   const auto mesh_start = Clock::now();
   const garment::Garment g = garment::build_garment(sketch, surface);
   const double mesh_ms = ms_since(mesh_start);
+  const std::vector<garment::QualityWarning> warnings = quality_warnings(g, sketch, body);
 
   // Quad mesh with one group per panel (joined panels share their join's group).
   std::vector<std::string> groups;
@@ -143,11 +146,14 @@ void run_mesh(const MeshOptions& options) {
                       {"irregular_vertices", p.irregular_vertices},
                       {"quads", p.faces},
                       {"area_m2", p.area},
+                      {"fit", p.fit},
+                      {"span_gap_m", p.span_gap},
                       {"quality", quality_json(p.quality)}});
     distortion += p.distortion;
     irregular += p.irregular_vertices;
     area += p.area;
   }
+  report["warnings"] = warnings_json(warnings);
   report["body"] = {{"mesh", sketch.body.mesh}, {"source", body.raw.source}, {"triangles", body.mesh.face_count()}};
   report["panels"] = panels;
   report["totals"] = {{"panels", g.panels.size()},
@@ -185,6 +191,9 @@ void run_mesh(const MeshOptions& options) {
   outputs.commit();
   spdlog::info("meshed {} → {}: {} panels, {} quads, distortion {} ({:.0f} ms meshing)", sketch.file,
                dir.string(), g.panels.size(), g.mesh.face_count(), distortion, mesh_ms);
+  if (options.strict && !warnings.empty())
+    throw std::runtime_error(fmt::format("{}: {} mesh quality warning(s) and --strict", sketch.file,
+                                         warnings.size()));
 }
 
 }  // namespace
@@ -196,6 +205,8 @@ void add_mesh_command(CLI::App& app, const GlobalOptions& /*global*/) {
               "images); no simulation");
   cmd->add_option("SKETCH", options->sketch, "Sketch file (format sketchdrape/1)")->required();
   cmd->add_option("-o,--out", options->out, "Output directory (created if needed)");
+  cmd->add_flag("--strict", options->strict,
+                "Exit with code 1 when the quality gate warns (the outputs are still written)");
   cmd->callback([options] { run_mesh(*options); });
 }
 

@@ -23,6 +23,7 @@
 #include <stdexcept>
 
 #include "garment/body.hpp"
+#include "garment/body_landmarks.hpp"
 #include "src/app/atomic_file.hpp"
 #include "src/app/cli.hpp"
 #include "src/app/progress.hpp"
@@ -51,7 +52,33 @@ struct RenderOptions {
   bool wireframe = false;
   bool no_shadows = false;
   bool no_ground = false;
+  bool landmarks = false;
 };
+
+// A small red octahedron (radius 1.5 cm) at every landmark of the body, as one mesh.
+render::SceneMesh landmark_markers(const meshing::TriMesh& body) {
+  const garment::BodyLandmarks landmarks = garment::find_landmarks(body);
+  constexpr double kRadius = 0.015;
+  const int corners[8][3] = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                             {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  const Eigen::Vector3d axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 0, 1}, {0, 0, -1}, {0, 1, 0}, {0, -1, 0}};
+  render::SceneMesh markers;
+  const auto n = static_cast<Eigen::Index>(landmarks.points.size());
+  markers.mesh.vertices.resize(6 * n, 3);
+  markers.mesh.faces.resize(8 * n, 3);
+  for (Eigen::Index l = 0; l < n; ++l) {
+    for (int k = 0; k < 6; ++k)
+      markers.mesh.vertices.row(6 * l + k) =
+          (landmarks.points[static_cast<size_t>(l)].position + kRadius * axes[k]).transpose();
+    for (int f = 0; f < 8; ++f)
+      markers.mesh.faces.row(8 * l + f) << 6 * l + corners[f][0], 6 * l + corners[f][1],
+          6 * l + corners[f][2];
+  }
+  markers.role = render::MeshRole::kCloth;
+  markers.colour = {0.85f, 0.1f, 0.1f};
+  markers.back_colour = {0.85f, 0.1f, 0.1f};
+  return markers;
+}
 
 struct GarmentMesh {
   meshing::TriMesh mesh;
@@ -182,6 +209,11 @@ void run_render(const RenderOptions& options, const GlobalOptions& global) {
     wire.width_px = 1.0f;
     drawn.wireframe = wire;
   }
+  // Markers last, so that the wireframe above stays on the garment (or the body).
+  if (options.landmarks) {
+    render::SceneMesh markers = landmark_markers(scene.meshes.front().mesh);
+    scene.meshes.push_back(std::move(markers));
+  }
 
   const auto start = std::chrono::steady_clock::now();
   render::Renderer renderer;
@@ -237,6 +269,8 @@ void add_render_command(CLI::App& app, const GlobalOptions& global) {
   cmd->add_flag("--wireframe", options->wireframe, "Overlay the triangle edges of MESH");
   cmd->add_flag("--no-shadows", options->no_shadows, "Draw without the key light's shadows");
   cmd->add_flag("--no-ground", options->no_ground, "Draw without the floor");
+  cmd->add_flag("--landmarks", options->landmarks,
+                "Mark the body's landmarks (red; sketchdrape info lists them, docs/bodies.md)");
   cmd->add_option("-o,--output", options->output,
                   "Output directory (one <view>.png each), or a .png file for a single view")
       ->required();

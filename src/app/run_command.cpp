@@ -13,7 +13,9 @@
 #include <nlohmann/json.hpp>
 
 #include "garment/sketch_file.hpp"
+#include "garment/body_landmarks.hpp"
 #include "garment/material_frames.hpp"
+#include "meshing/slice_dent.hpp"
 #include "sim/adaptive_detail.hpp"
 #include "sim/simulation.hpp"
 #include "src/app/cli.hpp"
@@ -89,6 +91,14 @@ nlohmann::json simulation_json(const sim::SimulationReport& r, const sim::Simula
           {"dt_min_used", r.dt_min_used},
           {"dt_max_used", r.dt_max_used},
           {"max_strain", r.max_strain},
+          {"rest",
+           {{"speed_window_m_s", r.rest_speed_window},
+            {"kinetic_per_kg_window_J_kg", r.rest_kinetic_per_kg_window},
+            {"speed_final_m_s", r.rest_speed_final},
+            {"kinetic_per_kg_final_J_kg", r.rest_kinetic_per_kg_final},
+            {"speed_limit_m_s", s.rest_speed},
+            {"kinetic_per_kg_limit_J_kg", s.rest_kinetic_energy},
+            {"window_s", s.rest_window}}},
           {"contacts_max", r.contacts_max},
           {"max_penetration_m", r.max_penetration_m},
           {"penetrating_vertices_final", r.penetrating_vertices_final},
@@ -321,9 +331,68 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
     sketch.fail("/fabric", e.what());
   }
   progress.finish();
-  if (report.failed)
-    throw std::runtime_error(fmt::format("the simulation failed at t = {:.3f} s: {}",
-                                         report.sim_time, report.failure_reason));
+  if (report.failed) {
+    // Where and why, and the last accepted state to look at: drape-failed.obj and images with
+    // a marker (an octahedron 5 cm across, in a colour of its own) where it broke, seen from the
+    // four sides (the place may face any way).
+    const int v = report.failure_vertex;
+    const bool located = v >= 0 && v < draped.vertices.rows();
+    const Eigen::Vector3d where = located ? Eigen::Vector3d(draped.vertices.row(v).transpose())
+                                          : Eigen::Vector3d(draped.vertices.colwise().mean().transpose());
+    std::string panel = "?", landmark;
+    for (Eigen::Index t = 0; t < draped.faces.rows() && located && panel == "?"; ++t)
+      for (int k = 0; k < 3; ++k)
+        if (draped.faces(t, k) == v && t < triangle_group.size() &&
+            triangle_group(t) < static_cast<int>(scene.group_names.size()))
+          panel = scene.group_names[static_cast<size_t>(triangle_group(t))];
+    if (scene.body) {
+      try {
+        landmark = garment::find_landmarks(scene.body->mesh).nearest(where).name;
+      } catch (const std::runtime_error&) {
+        // Not a standing figure: the place is given without a landmark.
+      }
+    }
+    meshing::TriMesh marked = draped;
+    Eigen::VectorXi marked_group(draped.faces.rows() + 8);
+    marked_group << triangle_group, Eigen::VectorXi::Constant(8, static_cast<int>(scene.group_names.size()));
+    const Eigen::Index base = marked.vertices.rows();
+    marked.vertices.conservativeResize(base + 6, 3);
+    marked.faces.conservativeResize(marked.faces.rows() + 8, 3);
+    const double r = 0.025;
+    const Eigen::Vector3d axes[6] = {{r, 0, 0}, {-r, 0, 0}, {0, 0, r}, {0, 0, -r}, {0, r, 0}, {0, -r, 0}};
+    for (int k = 0; k < 6; ++k) marked.vertices.row(base + k) = (where + axes[k]).transpose();
+    const int corners[8][3] = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                               {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+    for (int f = 0; f < 8; ++f)
+      marked.faces.row(draped.faces.rows() + f) << static_cast<int>(base) + corners[f][0],
+          static_cast<int>(base) + corners[f][1], static_cast<int>(base) + corners[f][2];
+    StagedOutputs failed_outputs;
+    failed_outputs.stage(dir / "drape-failed.obj",
+                         to_obj({draped.vertices, draped.faces,
+                                 std::vector<int>(triangle_group.data(),
+                                                  triangle_group.data() + triangle_group.size()),
+                                 scene.group_names},
+                                "drape-failed"));
+    const std::optional<meshing::TriMesh> body_now =
+        scene.body ? std::optional(body_at(scene, report.sim_time)) : std::nullopt;
+    std::vector<garment::ImageSpec> sides;
+    for (const char* view : {"front", "back", "left", "right"}) {
+      garment::ImageSpec image;
+      image.view = view;
+      image.width = 600;
+      image.height = 900;
+      sides.push_back(image);
+    }
+    stage_preview_images(sides, false, body_now ? &*body_now : nullptr,
+                         {marked, marked_group, {}, {}}, "drape-failed", dir, failed_outputs);
+    failed_outputs.commit();
+    throw std::runtime_error(fmt::format(
+        "the simulation failed at t = {:.3f} s in panel '{}' at ({:.3f}, {:.3f}, {:.3f}) m{}: {}; "
+        "the last accepted state is in {} and drape-failed-<view>.png (the place marked)",
+        report.sim_time, panel, where.x(), where.y(), where.z(),
+        landmark.empty() ? "" : fmt::format(", near the {}", landmark), report.failure_reason,
+        (dir / "drape-failed.obj").string()));
+  }
 
   // The draped cloth, one group per panel.
   const ExportMesh mesh{draped.vertices, draped.faces,
@@ -371,6 +440,13 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
     out["pattern"] = pattern_summary(sheet);
   }
   out["adaptive"] = adaptive_json;
+  if (scene.garment) {
+    // How deep the draped cloth dents between supports (a skirt pulled between the legs).
+    const meshing::SliceDent dent = meshing::slice_dent(draped);
+    out["slice_dent"] = {{"depth_m", dent.depth}, {"height_m", dent.height},
+                         {"where", {dent.where.x(), dent.where.y(), dent.where.z()}},
+                         {"from_fraction", 0.1}, {"to_fraction", 0.6}};
+  }
   out["images"] = images;
   out["frames"] = frames.size();
   out["body_motion"] = nullptr;

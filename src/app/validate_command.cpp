@@ -10,12 +10,14 @@
 #include "garment/sketch_file.hpp"
 #include "src/app/cli.hpp"
 #include "src/app/cloth_scene.hpp"
+#include "src/app/quality_warnings.hpp"
 
 namespace sd::app {
 namespace {
 
 struct ValidateOptions {
   std::string sketch;
+  bool strict = false;
 };
 
 void run_validate(const ValidateOptions& options) {
@@ -33,7 +35,15 @@ void run_validate(const ValidateOptions& options) {
                        scene.fabric_name, scene.input.rest_positions.rows(),
                        scene.input.triangles.rows());
   }
-  std::cout << fmt::format("{}: ok ({}, fabric {})\n", sketch.file, what, scene.fabric_name);
+  std::vector<garment::QualityWarning> warnings;
+  if (scene.garment && scene.body) warnings = quality_warnings(*scene.garment, sketch, *scene.body);
+  std::cout << fmt::format("{}: ok ({}, fabric {}){}\n", sketch.file, what, scene.fabric_name,
+                           warnings.empty()
+                               ? ""
+                               : fmt::format("; {} mesh quality warning(s)", warnings.size()));
+  if (options.strict && !warnings.empty())
+    throw std::runtime_error(fmt::format("{}: {} mesh quality warning(s) and --strict", sketch.file,
+                                         warnings.size()));
 }
 
 }  // namespace
@@ -44,6 +54,7 @@ void add_validate_command(CLI::App& app, const GlobalOptions& /*global*/) {
       "validate", "Check a sketch file (fields, body, curves on the body, panels, edge counts); "
                   "writes nothing");
   cmd->add_option("SKETCH", options->sketch, "Sketch file (format sketchdrape/1)")->required();
+  cmd->add_flag("--strict", options->strict, "Exit with code 1 when the quality gate warns");
   cmd->callback([options] { run_validate(*options); });
 }
 

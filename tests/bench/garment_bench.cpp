@@ -20,8 +20,7 @@ const sd::garment::BodySurface& surface() {
   return s;
 }
 
-void mesh_example(benchmark::State& state, const char* name) {
-  const std::filesystem::path file = std::filesystem::path(SD_SOURCE_DIR) / "data/examples" / name;
+void mesh_file(benchmark::State& state, const std::filesystem::path& file) {
   const sd::garment::BodySurface& body = surface();
   long quads = 0;
   for (auto _ : state) {
@@ -31,6 +30,16 @@ void mesh_example(benchmark::State& state, const char* name) {
     benchmark::DoNotOptimize(g.mesh.vertices.data());
   }
   state.counters["quads"] = static_cast<double>(quads);
+}
+
+void mesh_example(benchmark::State& state, const char* name) {
+  mesh_file(state, std::filesystem::path(SD_SOURCE_DIR) / "data/examples" / name);
+}
+
+// The design corpus on the built-in body (data/designs/): the garments' panels spanned by their
+// curves ("fit": "free") cost a harmonic solve per obstacle round.
+void mesh_design(benchmark::State& state, const char* name) {
+  mesh_file(state, std::filesystem::path(SD_SOURCE_DIR) / "data/designs" / name);
 }
 
 void body_surface_build(benchmark::State& state) {
@@ -48,6 +57,9 @@ BENCHMARK_CAPTURE(mesh_example, a_line_skirt, "a-line-skirt.json")->Unit(benchma
 BENCHMARK_CAPTURE(mesh_example, sleeveless_dress, "sleeveless-dress.json")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(mesh_example, shorts, "shorts.json")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(mesh_example, godet_skirt, "godet-skirt.json")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(mesh_design, pencil_skirt, "pencil-skirt.json")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(mesh_design, vest, "vest.json")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(mesh_design, capelet, "capelet.json")->Unit(benchmark::kMillisecond);
 BENCHMARK(body_surface_build)->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();

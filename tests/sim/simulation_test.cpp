@@ -91,6 +91,36 @@ SettledShape settle(int n, Integrator integrator = Integrator::implicit_euler) {
 
 // Birra & Santos §4.2: with energy densities times rest area (k_t·A_t = K) and the bending
 // weight |e|²/(A1+A2), one set of constants gives the same drape at any resolution.
+// The at-rest residual in the report: the last step's largest vertex speed and kinetic energy
+// per kilogram, and their largest values over the last rest window, which a run that stopped
+// at rest has below both thresholds.
+TEST(Simulation, ReportsTheAtRestResidual) {
+  const HangingSheet h = hanging_sheet(6);
+  SimulationSettings settings;
+  settings.dt = 1.0 / 30;
+  settings.duration = 30.0;
+  settings.forces.air_drag = 0.2;
+  Simulation sim = make_simulation(h, settings);
+  double window_speed = 0.0;
+  std::vector<std::pair<double, double>> speeds;  // (time, largest speed) per step
+  const SimulationReport report = sim.run([&](const Simulation& s) {
+    double speed = 0.0;
+    for (Eigen::Index i = 0; i < s.velocities().size() / 3; ++i)
+      speed = std::max(speed, s.velocities().segment<3>(3 * i).norm());
+    speeds.emplace_back(s.time(), speed);
+  });
+  ASSERT_TRUE(report.at_rest);
+  for (const auto& [t, speed] : speeds)
+    if (t >= report.sim_time - settings.rest_window - 1e-12) window_speed = std::max(window_speed, speed);
+  EXPECT_DOUBLE_EQ(report.rest_speed_final, speeds.back().second);
+  EXPECT_DOUBLE_EQ(report.rest_speed_window, window_speed);
+  EXPECT_LT(report.rest_speed_window, settings.rest_speed);
+  EXPECT_LT(report.rest_kinetic_per_kg_window, settings.rest_kinetic_energy);
+  EXPECT_LE(report.rest_kinetic_per_kg_final, report.rest_kinetic_per_kg_window);
+  // ½ v² ≤ ½ max|v|² per kilogram.
+  EXPECT_LE(report.rest_kinetic_per_kg_final, 0.5 * report.rest_speed_final * report.rest_speed_final + 1e-15);
+}
+
 TEST(Simulation, ResolutionInvariance) {
   const SettledShape coarse = settle(8);
   const SettledShape medium = settle(16);

@@ -1,0 +1,352 @@
+#include "garment/body_landmarks.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numeric>
+#include <optional>
+#include <stdexcept>
+
+namespace sd::garment {
+namespace {
+
+// One closed outline of a horizontal slice (a leg, an arm, the torso): its cut points.
+struct Outline {
+  std::vector<Eigen::Vector3d> points;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  double min_x = 0, max_x = 0, max_z = 0;
+  double girth = 0;  // m, perimeter of the convex hull in XZ
+  bool spans_centre() const { return min_x < 0 && max_x > 0; }
+};
+
+double cross2(const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return (a - o).x() * (b - o).y() - (a - o).y() * (b - o).x();
+}
+
+double hull_perimeter(const std::vector<Eigen::Vector3d>& points) {
+  std::vector<Eigen::Vector2d> p;
+  for (const Eigen::Vector3d& q : points) p.emplace_back(q.x(), q.z());
+  std::sort(p.begin(), p.end(), [](const auto& a, const auto& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  if (p.size() < 3) return 0.0;
+  std::vector<Eigen::Vector2d> hull(2 * p.size());
+  size_t k = 0;
+  for (size_t i = 0; i < p.size(); ++i) {
+    while (k >= 2 && cross2(hull[k - 2], hull[k - 1], p[i]) <= 0) --k;
+    hull[k++] = p[i];
+  }
+  for (size_t i = p.size() - 1, t = k + 1; i-- > 0;) {
+    while (k >= t && cross2(hull[k - 2], hull[k - 1], p[i]) <= 0) --k;
+    hull[k++] = p[i];
+  }
+  hull.resize(k - 1);
+  double perimeter = 0;
+  for (size_t h = 0; h < hull.size(); ++h)
+    perimeter += (hull[(h + 1) % hull.size()] - hull[h]).norm();
+  return perimeter;
+}
+
+// The outlines of the slice y = const: cut points of the edges crossing it, grouped by the
+// triangles that join them (each crossing triangle joins two cut points of one outline).
+std::vector<Outline> slice(const meshing::TriMesh& mesh, double y) {
+  std::map<std::pair<int, int>, int> node_of;
+  std::vector<Eigen::Vector3d> nodes;
+  std::vector<int> parent;
+  const auto find = [&](int a) {
+    while (parent[static_cast<size_t>(a)] != a)
+      a = parent[static_cast<size_t>(a)] =
+          parent[static_cast<size_t>(parent[static_cast<size_t>(a)])];
+    return a;
+  };
+  for (Eigen::Index f = 0; f < mesh.face_count(); ++f) {
+    int cut[2], found = 0;
+    for (int k = 0; k < 3 && found < 2; ++k) {
+      int a = mesh.faces(f, k), b = mesh.faces(f, (k + 1) % 3);
+      if (a > b) std::swap(a, b);
+      const double ya = mesh.vertices(a, 1) - y, yb = mesh.vertices(b, 1) - y;
+      if ((ya < 0) == (yb < 0)) continue;  // both below, or both at or above
+      auto [it, inserted] = node_of.try_emplace({a, b}, static_cast<int>(nodes.size()));
+      if (inserted) {
+        const Eigen::Vector3d pa = mesh.vertices.row(a), pb = mesh.vertices.row(b);
+        nodes.push_back(pa + ya / (ya - yb) * (pb - pa));
+        parent.push_back(it->second);
+      }
+      cut[found++] = it->second;
+    }
+    if (found == 2) parent[static_cast<size_t>(find(cut[0]))] = find(cut[1]);
+  }
+  std::map<int, Outline> by_root;
+  for (size_t n = 0; n < nodes.size(); ++n)
+    by_root[find(static_cast<int>(n))].points.push_back(nodes[n]);
+  std::vector<Outline> outlines;
+  for (auto& [root, o] : by_root) {
+    if (o.points.size() < 3) continue;
+    o.min_x = std::numeric_limits<double>::infinity();
+    o.max_x = o.max_z = -std::numeric_limits<double>::infinity();
+    for (const Eigen::Vector3d& p : o.points) {
+      o.centroid += p;
+      o.min_x = std::min(o.min_x, p.x());
+      o.max_x = std::max(o.max_x, p.x());
+      o.max_z = std::max(o.max_z, p.z());
+    }
+    o.centroid /= static_cast<double>(o.points.size());
+    o.girth = hull_perimeter(o.points);
+    outlines.push_back(std::move(o));
+  }
+  return outlines;
+}
+
+const Outline* torso_of(const std::vector<Outline>& outlines) {
+  const Outline* best = nullptr;
+  for (const Outline& o : outlines)
+    if (o.spans_centre() && (best == nullptr || o.girth > best->girth)) best = &o;
+  return best;
+}
+
+// The outline beside the torso on one side (+1 left, −1 right) nearest to it: an arm.
+const Outline* beside(const std::vector<Outline>& outlines, const Outline& torso, int side) {
+  const Outline* best = nullptr;
+  for (const Outline& o : outlines) {
+    if (&o == &torso) continue;
+    const double gap = side > 0 ? o.min_x - torso.max_x : torso.min_x - o.max_x;
+    if (gap <= 0) continue;
+    const double best_gap = best == nullptr ? 0
+                            : side > 0      ? best->min_x - torso.max_x
+                                            : torso.min_x - best->max_x;
+    if (best == nullptr || gap < best_gap) best = &o;
+  }
+  return best;
+}
+
+// A point along a polyline at a fraction of its length.
+Eigen::Vector3d along(const std::vector<Eigen::Vector3d>& line, double fraction) {
+  double total = 0;
+  for (size_t i = 1; i < line.size(); ++i) total += (line[i] - line[i - 1]).norm();
+  double target = fraction * total;
+  for (size_t i = 1; i < line.size(); ++i) {
+    const double d = (line[i] - line[i - 1]).norm();
+    if (target <= d && d > 0) return line[i - 1] + target / d * (line[i] - line[i - 1]);
+    target -= d;
+  }
+  return line.back();
+}
+
+}  // namespace
+
+std::vector<SliceOutline> slice_body(const meshing::TriMesh& body, double y) {
+  std::vector<SliceOutline> out;
+  for (const Outline& o : slice(body, y)) {
+    SliceOutline s{o.centroid, o.points.front(), o.points.front(), o.girth};
+    for (const Eigen::Vector3d& p : o.points) {
+      s.min = s.min.cwiseMin(p);
+      s.max = s.max.cwiseMax(p);
+    }
+    out.push_back(s);
+  }
+  std::sort(out.begin(), out.end(), [](const SliceOutline& a, const SliceOutline& b) {
+    return a.centroid.x() < b.centroid.x();
+  });
+  return out;
+}
+
+const std::vector<std::string>& landmark_names() {
+  static const std::vector<std::string> names = {
+      "neck_base",   "left_shoulder", "right_shoulder", "left_armpit", "right_armpit", "chest",
+      "waist",       "hips",          "crotch",         "left_elbow",  "right_elbow",  "left_wrist",
+      "right_wrist", "left_knee",     "right_knee",     "left_ankle",  "right_ankle"};
+  return names;
+}
+
+const Landmark* BodyLandmarks::find(std::string_view name) const {
+  for (const Landmark& l : points)
+    if (l.name == name) return &l;
+  return nullptr;
+}
+
+const Landmark& BodyLandmarks::nearest(const Eigen::Vector3d& p) const {
+  if (points.empty()) throw std::logic_error("BodyLandmarks::nearest: no landmarks");
+  return *std::min_element(points.begin(), points.end(),
+                           [&p](const Landmark& a, const Landmark& b) {
+                             return (a.position - p).squaredNorm() < (b.position - p).squaredNorm();
+                           });
+}
+
+BodyLandmarks find_landmarks(const meshing::TriMesh& body) {
+  if (body.vertex_count() == 0) throw std::runtime_error("the body has no vertices");
+  const double height = body.vertices.col(1).maxCoeff();
+  // Slices every 0.4 % of the height (7 mm on a 1.75 m figure), offset by a hair so that no
+  // slice passes exactly through a vertex of a file with round coordinates.
+  const double step = 0.004 * height;
+  struct Level {
+    double y;
+    std::vector<Outline> outlines;
+  };
+  std::vector<Level> levels;
+  for (double y = 0.01 * height + 1e-7 * height; y < 0.99 * height; y += step)
+    levels.push_back({y, slice(body, y)});
+  const auto fail = [](const std::string& what) {
+    throw std::runtime_error(fmt::format(
+        "cannot find the body's {}: landmarks need a standing figure, feet on the floor, arms "
+        "apart from the torso",
+        what));
+  };
+
+  // Crotch: the lowest slice above a quarter of the height whose torso outline spans x = 0.
+  const Level* crotch = nullptr;
+  for (const Level& l : levels)
+    if (l.y > 0.25 * height && torso_of(l.outlines) != nullptr) {
+      crotch = &l;
+      break;
+    }
+  if (crotch == nullptr) fail("crotch (where the legs join)");
+  // Armpits: the highest slice below 85 % of the height with an arm beside the torso.
+  std::array<const Level*, 2> armpit_level{nullptr, nullptr};
+  std::array<Eigen::Vector3d, 2> armpit;
+  for (int s = 0; s < 2; ++s) {
+    const int side = s == 0 ? 1 : -1;
+    for (const Level& l : levels) {
+      if (l.y <= crotch->y || l.y > 0.85 * height) continue;
+      const Outline* torso = torso_of(l.outlines);
+      if (torso == nullptr) continue;
+      const Outline* arm = beside(l.outlines, *torso, side);
+      if (arm == nullptr) continue;
+      armpit_level[static_cast<size_t>(s)] = &l;
+      const double x =
+          side > 0 ? 0.5 * (torso->max_x + arm->min_x) : 0.5 * (torso->min_x + arm->max_x);
+      armpit[static_cast<size_t>(s)] = {x, l.y + 0.5 * step, torso->centroid.z()};
+    }
+    if (armpit_level[static_cast<size_t>(s)] == nullptr)
+      fail(s == 0 ? "left armpit" : "right armpit");
+  }
+  const double top_of_armpits = std::max(armpit[0].y(), armpit[1].y());
+
+  // Torso girths: waist the narrowest between the hips and the chest, hips the widest below
+  // the waist, chest the widest between the waist and the armpits.
+  const auto torso_at = [&](const Level& l) { return torso_of(l.outlines); };
+  const auto extreme = [&](double from, double to, bool widest) -> const Level* {
+    const Level* best = nullptr;
+    double value = 0;
+    for (const Level& l : levels) {
+      if (l.y < from || l.y > to) continue;
+      const Outline* t = torso_at(l);
+      if (t == nullptr) continue;
+      if (best == nullptr || (widest ? t->girth > value : t->girth < value))
+        best = &l, value = t->girth;
+    }
+    return best;
+  };
+  const double torso_span = top_of_armpits - crotch->y;
+  const Level* waist =
+      extreme(crotch->y + 0.3 * torso_span, top_of_armpits - 0.2 * torso_span, false);
+  if (waist == nullptr) fail("waist");
+  const Level* hips = extreme(crotch->y + 0.1 * torso_span, waist->y, true);
+  const Level* chest = extreme(waist->y, top_of_armpits - 0.03 * torso_span, true);
+  if (hips == nullptr || chest == nullptr) fail("hips or chest");
+  const auto front = [&](const Level& l) {
+    const Outline& t = *torso_at(l);
+    return Eigen::Vector3d(0.0, l.y, t.max_z);
+  };
+
+  // Neck: the narrowest torso outline between the armpits and 95 % of the height; its base the
+  // lowest slice above the armpits no wider than 1.3 times that.
+  const Level* narrowest = nullptr;
+  for (const Level& l : levels)
+    if (l.y > top_of_armpits && l.y < 0.95 * height && torso_at(l) != nullptr &&
+        (narrowest == nullptr || torso_at(l)->girth < torso_at(*narrowest)->girth))
+      narrowest = &l;
+  if (narrowest == nullptr) fail("neck");
+  const Level* neck_base = narrowest;
+  for (const Level& l : levels)
+    if (l.y > top_of_armpits && l.y < narrowest->y && torso_at(l) != nullptr &&
+        torso_at(l)->girth < 1.3 * torso_at(*narrowest)->girth) {
+      neck_base = &l;
+      break;
+    }
+
+  BodyLandmarks out;
+  out.points.push_back({"neck_base", front(*neck_base)});
+  // Shoulder points: the top of the body straight above each armpit.
+  std::array<Eigen::Vector3d, 2> shoulder;
+  for (int s = 0; s < 2; ++s) {
+    const Eigen::Vector3d a = armpit[static_cast<size_t>(s)];
+    double top = a.y();
+    for (const Level& l : levels)
+      for (const Outline& o : l.outlines)
+        if (l.y > a.y() && o.min_x <= a.x() && o.max_x >= a.x()) top = std::max(top, l.y);
+    shoulder[static_cast<size_t>(s)] = {a.x(), top, a.z()};
+  }
+  out.points.push_back({"left_shoulder", shoulder[0]});
+  out.points.push_back({"right_shoulder", shoulder[1]});
+  out.points.push_back({"left_armpit", armpit[0]});
+  out.points.push_back({"right_armpit", armpit[1]});
+  out.points.push_back({"chest", front(*chest)});
+  out.points.push_back({"waist", front(*waist)});
+  out.points.push_back({"hips", front(*hips)});
+  out.points.push_back({"crotch", {0.0, crotch->y - 0.5 * step, torso_at(*crotch)->centroid.z()}});
+  out.chest_girth = torso_at(*chest)->girth;
+  out.waist_girth = torso_at(*waist)->girth;
+  out.hip_girth = torso_at(*hips)->girth;
+
+  // Arm axis: the shoulder point, then the centres of the arm outlines going down (following
+  // the outline nearest the last centre), to the lowest slice of the arm. Elbow and wrist at
+  // 42 % and 75 % of its length (shoulder to elbow 0.186, elbow to wrist 0.146, hand 0.108 of
+  // the height in standard body-segment proportions).
+  std::array<Eigen::Vector3d, 2> elbow, wrist;
+  for (int s = 0; s < 2; ++s) {
+    std::vector<Eigen::Vector3d> axis = {shoulder[static_cast<size_t>(s)]};
+    Eigen::Vector3d last = armpit[static_cast<size_t>(s)];
+    for (auto l = levels.rbegin(); l != levels.rend(); ++l) {
+      if (l->y >= armpit[static_cast<size_t>(s)].y()) continue;
+      const Outline* torso = torso_at(*l);
+      const Outline* next = nullptr;
+      for (const Outline& o : l->outlines) {
+        if (&o == torso) continue;
+        if ((o.centroid - last).head<1>().norm() > 0.06 * height) continue;  // not this arm
+        if (std::abs(o.centroid.y() - last.y()) > 4 * step) continue;
+        if (next == nullptr || (o.centroid - last).norm() < (next->centroid - last).norm())
+          next = &o;
+      }
+      if (next == nullptr) {
+        if (axis.size() > 1) break;  // the arm ended
+        continue;
+      }
+      last = next->centroid;
+      axis.push_back(last);
+    }
+    elbow[static_cast<size_t>(s)] = along(axis, 0.42);
+    wrist[static_cast<size_t>(s)] = along(axis, 0.75);
+  }
+  out.points.push_back({"left_elbow", elbow[0]});
+  out.points.push_back({"right_elbow", elbow[1]});
+  out.points.push_back({"left_wrist", wrist[0]});
+  out.points.push_back({"right_wrist", wrist[1]});
+
+  // Knees and ankles: centres of the leg outlines at 0.59 and 0.08 of the crotch height (knee
+  // 0.285 and ankle 0.039 of the height against a crotch at 0.485, standard proportions).
+  for (const auto& [name, fraction] : {std::pair{"knee", 0.59}, std::pair{"ankle", 0.08}}) {
+    const double y = fraction * crotch->y;
+    const Level& l = *std::min_element(
+        levels.begin(), levels.end(),
+        [y](const Level& a, const Level& b) { return std::abs(a.y - y) < std::abs(b.y - y); });
+    for (int s = 0; s < 2; ++s) {
+      const int side = s == 0 ? 1 : -1;
+      const Outline* leg = nullptr;
+      for (const Outline& o : l.outlines)
+        if (o.centroid.x() * side > 0 && (leg == nullptr || o.girth > leg->girth)) leg = &o;
+      if (leg == nullptr) fail(fmt::format("{} {}", s == 0 ? "left" : "right", name));
+      out.points.push_back({fmt::format("{}_{}", s == 0 ? "left" : "right", name), leg->centroid});
+    }
+  }
+  // Keep the documented order.
+  std::vector<Landmark> ordered;
+  for (const std::string& name : landmark_names()) ordered.push_back(*out.find(name));
+  out.points = std::move(ordered);
+  return out;
+}
+
+}  // namespace sd::garment

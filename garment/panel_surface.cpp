@@ -1,0 +1,101 @@
+#include "garment/panel_surface.hpp"
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <algorithm>
+#include <stdexcept>
+#include <vector>
+
+namespace sd::garment {
+namespace {
+
+// Unique undirected quad edges (a < b).
+std::vector<std::pair<int, int>> quad_edges(const meshing::QuadMesh& mesh) {
+  std::vector<std::pair<int, int>> edges;
+  edges.reserve(static_cast<size_t>(4 * mesh.face_count()));
+  for (Eigen::Index f = 0; f < mesh.face_count(); ++f)
+    for (int k = 0; k < 4; ++k) {
+      const int a = mesh.faces(f, k), b = mesh.faces(f, (k + 1) % 4);
+      edges.emplace_back(std::min(a, b), std::max(a, b));
+    }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  return edges;
+}
+
+// Solves L x = 0 for the unmarked vertices with the marked ones as boundary values.
+void solve_harmonic(meshing::QuadMesh& mesh, const std::vector<std::pair<int, int>>& edges,
+                    const std::vector<char>& held) {
+  const auto nv = static_cast<size_t>(mesh.vertex_count());
+  std::vector<int> unknown(nv, -1);
+  int n = 0;
+  for (size_t v = 0; v < nv; ++v)
+    if (!held[v]) unknown[v] = n++;
+  if (n == 0) return;
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(edges.size() * 4);
+  Eigen::MatrixX3d rhs = Eigen::MatrixX3d::Zero(n, 3);
+  std::vector<int> degree(static_cast<size_t>(n), 0);
+  for (const auto& [a, b] : edges) {
+    const int ia = unknown[static_cast<size_t>(a)], ib = unknown[static_cast<size_t>(b)];
+    if (ia >= 0) ++degree[static_cast<size_t>(ia)];
+    if (ib >= 0) ++degree[static_cast<size_t>(ib)];
+    if (ia >= 0 && ib >= 0) {
+      triplets.emplace_back(ia, ib, -1.0);
+      triplets.emplace_back(ib, ia, -1.0);
+    } else if (ia >= 0) {
+      rhs.row(ia) += mesh.vertices.row(b);
+    } else if (ib >= 0) {
+      rhs.row(ib) += mesh.vertices.row(a);
+    }
+  }
+  for (int i = 0; i < n; ++i) triplets.emplace_back(i, i, degree[static_cast<size_t>(i)]);
+  Eigen::SparseMatrix<double> laplacian(n, n);
+  laplacian.setFromTriplets(triplets.begin(), triplets.end());
+  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(laplacian);
+  if (solver.info() != Eigen::Success)
+    throw std::invalid_argument("span_harmonic: a part of the free vertices touches no fixed one");
+  const Eigen::MatrixX3d x = solver.solve(rhs);
+  for (size_t v = 0; v < nv; ++v)
+    if (unknown[v] >= 0) mesh.vertices.row(static_cast<Eigen::Index>(v)) = x.row(unknown[v]);
+}
+
+}  // namespace
+
+void span_harmonic(meshing::QuadMesh& mesh, std::span<const char> fixed) {
+  if (static_cast<Eigen::Index>(fixed.size()) != mesh.vertex_count())
+    throw std::invalid_argument("span_harmonic: one fixed flag per vertex is needed");
+  solve_harmonic(mesh, quad_edges(mesh), std::vector<char>(fixed.begin(), fixed.end()));
+}
+
+SpannedSurface span_over_obstacle(meshing::QuadMesh& mesh, std::span<const char> fixed,
+                                  const PushOut& push_out, int max_rounds) {
+  if (static_cast<Eigen::Index>(fixed.size()) != mesh.vertex_count())
+    throw std::invalid_argument("span_over_obstacle: one fixed flag per vertex is needed");
+  const std::vector<std::pair<int, int>> edges = quad_edges(mesh);
+  std::vector<char> held(fixed.begin(), fixed.end());
+  solve_harmonic(mesh, edges, held);
+  SpannedSurface result;
+  for (;;) {
+    int pushed = 0;
+    for (Eigen::Index v = 0; v < mesh.vertex_count(); ++v) {
+      if (held[static_cast<size_t>(v)]) continue;
+      if (const auto out = push_out(mesh.vertices.row(v).transpose())) {
+        mesh.vertices.row(v) = out->transpose();
+        held[static_cast<size_t>(v)] = 1;
+        ++pushed;
+      }
+    }
+    result.contacts += pushed;
+    if (pushed == 0) break;
+    if (result.rounds == max_rounds) {
+      result.settled = false;
+      break;
+    }
+    solve_harmonic(mesh, edges, held);
+    ++result.rounds;
+  }
+  return result;
+}
+
+}  // namespace sd::garment

@@ -1,0 +1,40 @@
+#pragma once
+// A panel's interior spanned by its boundary curves, then kept out of the body. Cloth cut to a
+// panel's outline and sewn along it hangs across hollows (between the legs, under the bust);
+// the body pushes it out where it would be inside but never pulls it in. The spanned surface is
+// the discrete harmonic one over the panel's quad mesh (each interior vertex at the mean of its
+// edge neighbours, boundary fixed): a membrane whose shape the boundary alone decides. The body
+// is an obstacle: vertices inside its offset surface are moved onto it and held there, and the
+// rest of the membrane is solved again, until no vertex is inside (an active-set solve of the
+// obstacle problem in which contacts are only added).
+
+#include <Eigen/Core>
+#include <functional>
+#include <optional>
+#include <span>
+
+#include "meshing/quad_mesh.hpp"
+
+namespace sd::garment {
+
+// Where a point inside the obstacle goes: its closest point on the offset surface; empty when
+// the point is outside (or on) it.
+using PushOut = std::function<std::optional<Eigen::Vector3d>(const Eigen::Vector3d&)>;
+
+struct SpannedSurface {
+  int rounds = 0;       // harmonic solves after the first (each after a batch of new contacts)
+  int contacts = 0;     // vertices held on the offset surface at the end
+  bool settled = true;  // false: the round limit was reached with vertices still inside
+};
+
+// Moves the vertices not marked in `fixed` (#V flags, nonzero = fixed) to the discrete harmonic
+// surface spanned by the fixed ones (uniform edge weights; each connected part of the free
+// vertices must touch a fixed one). Throws std::invalid_argument otherwise.
+void span_harmonic(meshing::QuadMesh& mesh, std::span<const char> fixed);
+
+// span_harmonic, then the obstacle: at most `max_rounds` rounds of pushing every free vertex
+// that `push_out` moves and solving the others again with those held.
+SpannedSurface span_over_obstacle(meshing::QuadMesh& mesh, std::span<const char> fixed,
+                                  const PushOut& push_out, int max_rounds = 30);
+
+}  // namespace sd::garment

@@ -1,0 +1,165 @@
+#include "garment/quality_gate.hpp"
+
+#include <fmt/format.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <unordered_map>
+
+namespace sd::garment {
+namespace {
+
+struct Worst {
+  int count = 0;
+  double value = 0.0;
+  Eigen::Vector3d where = Eigen::Vector3d::Zero();
+  bool set = false;
+  // Keeps the instance with the larger `badness`.
+  void add(double v, double badness, const Eigen::Vector3d& p, double& best_badness) {
+    ++count;
+    if (!set || badness > best_badness) value = v, where = p, best_badness = badness, set = true;
+  }
+};
+
+std::string place(const Eigen::Vector3d& p, const std::string& landmark) {
+  std::string s = fmt::format("at ({:.3f}, {:.3f}, {:.3f}) m", p.x(), p.y(), p.z());
+  if (!landmark.empty()) s += fmt::format(", near the {}", landmark);
+  return s;
+}
+
+}  // namespace
+
+std::vector<QualityWarning> check_quality(const Garment& garment, const Sketch& sketch,
+                                          const BodyLandmarks* landmarks,
+                                          const QualityLimits& limits) {
+  const meshing::QuadMesh& mesh = garment.mesh;
+  const auto vertex = [&](int v) -> Eigen::Vector3d { return mesh.vertices.row(v).transpose(); };
+  // Vertex normals: the sum of the corner cross products around each vertex (as the report's
+  // quality measure), so that a folded quad is one whose corner turns against them.
+  Eigen::MatrixX3d normals = Eigen::MatrixX3d::Zero(mesh.vertex_count(), 3);
+  for (Eigen::Index f = 0; f < mesh.face_count(); ++f)
+    for (int k = 0; k < 4; ++k) {
+      const int a = mesh.faces(f, (k + 3) % 4), b = mesh.faces(f, k),
+                c = mesh.faces(f, (k + 1) % 4);
+      normals.row(b) += (vertex(c) - vertex(b)).cross(vertex(a) - vertex(b)).transpose();
+    }
+
+  const auto target_of = [&](const GarmentPanel& panel) {
+    const std::string base = panel.mirror_copy ? panel.id.substr(0, panel.id.size() - 7) : panel.id;
+    for (const PanelSpec& spec : sketch.panels)
+      if (spec.id == base) return spec.edge_length.value_or(sketch.edge_length);
+    return sketch.edge_length;
+  };
+
+  std::vector<QualityWarning> warnings;
+  for (size_t pi = 0; pi < garment.panels.size(); ++pi) {
+    const GarmentPanel& panel = garment.panels[pi];
+    if (panel.mirror_copy) continue;
+    const double target = target_of(panel);
+    Worst inverted, angle, aspect, size, near;
+    double inverted_bad = 0, angle_bad = 0, aspect_bad = 0, size_bad = 0, near_bad = 0;
+    std::vector<int> vertices;
+    for (Eigen::Index f = 0; f < mesh.face_count(); ++f) {
+      if (garment.face_panel(f) != static_cast<int>(pi)) continue;
+      Eigen::Vector3d centre = Eigen::Vector3d::Zero(), reference = Eigen::Vector3d::Zero();
+      for (int k = 0; k < 4; ++k) {
+        centre += vertex(mesh.faces(f, k)) / 4;
+        reference += normals.row(mesh.faces(f, k)).transpose();
+        vertices.push_back(mesh.faces(f, k));
+      }
+      double smallest = 180, shortest = std::numeric_limits<double>::infinity(), longest = 0,
+             jacobian = 1, perimeter = 0;
+      for (int k = 0; k < 4; ++k) {
+        const Eigen::Vector3d p = vertex(mesh.faces(f, k));
+        const Eigen::Vector3d e1 = vertex(mesh.faces(f, (k + 1) % 4)) - p;
+        const Eigen::Vector3d e2 = vertex(mesh.faces(f, (k + 3) % 4)) - p;
+        const double l1 = e1.norm(), l2 = e2.norm();
+        shortest = std::min(shortest, l1);
+        longest = std::max(longest, l1);
+        perimeter += l1;
+        if (l1 > 0 && l2 > 0) {
+          smallest = std::min(smallest, std::acos(std::clamp(e1.dot(e2) / (l1 * l2), -1.0, 1.0)) *
+                                            180 / std::numbers::pi);
+          if (reference.norm() > 0)
+            jacobian = std::min(jacobian, e1.cross(e2).dot(reference.normalized()) / (l1 * l2));
+        }
+      }
+      if (jacobian < 0) inverted.add(jacobian, -jacobian, centre, inverted_bad);
+      if (smallest < limits.min_angle_deg) angle.add(smallest, -smallest, centre, angle_bad);
+      const double ratio =
+          shortest > 0 ? longest / shortest : std::numeric_limits<double>::infinity();
+      if (ratio >= limits.max_aspect_ratio) aspect.add(ratio, ratio, centre, aspect_bad);
+      const double side = perimeter / 4 / target;
+      if (side < limits.size_low || side > limits.size_high)
+        size.add(side, std::max(side, 1 / std::max(side, 1e-12)), centre, size_bad);
+    }
+    // Near-coincident vertices of the panel: a hash grid of cells the size of the threshold.
+    std::sort(vertices.begin(), vertices.end());
+    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+    const double threshold = limits.near_fraction * target;
+    std::unordered_map<long long, std::vector<int>> cells;
+    const auto key = [&](const Eigen::Vector3d& p, int dx, int dy, int dz) {
+      const Eigen::Vector3d q = (p / threshold).array().floor();
+      return ((static_cast<long long>(q.x()) + dx) * 73856093LL) ^
+             ((static_cast<long long>(q.y()) + dy) * 19349663LL) ^
+             ((static_cast<long long>(q.z()) + dz) * 83492791LL);
+    };
+    for (int v : vertices) cells[key(vertex(v), 0, 0, 0)].push_back(v);
+    for (int v : vertices)
+      for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dz = -1; dz <= 1; ++dz) {
+            const auto it = cells.find(key(vertex(v), dx, dy, dz));
+            if (it == cells.end()) continue;
+            for (int w : it->second) {
+              if (w <= v) continue;
+              const double d = (vertex(v) - vertex(w)).norm();
+              if (d < threshold) near.add(d, -d, 0.5 * (vertex(v) + vertex(w)), near_bad);
+            }
+          }
+
+    const auto emit = [&](const Worst& w, const char* kind, const std::string& sentence) {
+      if (w.count == 0) return;
+      QualityWarning q;
+      q.panel = panel.id;
+      q.kind = kind;
+      q.count = w.count;
+      q.worst = w.value;
+      q.where = w.where;
+      if (landmarks != nullptr) q.landmark = landmarks->nearest(w.where).name;
+      q.message = fmt::format("panel '{}': {} {}", panel.id, sentence, place(w.where, q.landmark));
+      warnings.push_back(std::move(q));
+    };
+    emit(inverted, "inverted_quads",
+         fmt::format("{} quad(s) fold over (the worst corner's scaled Jacobian {:.2f}); make the "
+                     "curves around the panel smoother there, or move a corner so that the sides "
+                     "facing each other have similar edge counts;",
+                     inverted.count, inverted.value));
+    emit(angle, "min_angle",
+         fmt::format("{} quad(s) have a corner below {:.0f}° (the smallest {:.1f}°); a boundary "
+                     "corner there is too sharp or not listed in \"corners\": give it as a corner "
+                     "or round the curves;",
+                     angle.count, limits.min_angle_deg, angle.value));
+    emit(aspect, "aspect_ratio",
+         fmt::format("{} quad(s) are long and thin (the worst {:.1f} times longer than wide); "
+                     "sides facing each other have very different edge counts there: give them "
+                     "similar \"edge_length\" or move a corner;",
+                     aspect.count, aspect.value));
+    emit(near, "near_vertices",
+         fmt::format("{} pair(s) of vertices lie closer than {:.1f} mm (the closest {:.2f} mm); "
+                     "curves meet at a very narrow angle or a curve doubles back: open the angle "
+                     "or end the curves at one junction;",
+                     near.count, 1e3 * threshold, 1e3 * near.value));
+    emit(size, "quad_size",
+         fmt::format("{} quad(s) have sides outside {:.2g}-{:.2g} times the edge length of {:.1f} "
+                     "cm (the worst {:.2f} times); the filler could not fit a grid to the sides' "
+                     "edge counts: make facing sides' edge counts closer or split the panel;",
+                     size.count, limits.size_low, limits.size_high, 100 * target, size.value));
+  }
+  return warnings;
+}
+
+}  // namespace sd::garment

@@ -1,0 +1,44 @@
+#pragma once
+// The quality gate of a meshed garment: per panel, the quads the simulator would struggle with
+// (folded quads, slivers with a tiny corner, long thin quads, vertices almost on top of each
+// other, quads far from the asked size), each reported once per panel and kind with the worst
+// place (a 3D point and the nearest body landmark) and what to change in the sketch.
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "garment/body_landmarks.hpp"
+#include "garment/garment_mesh.hpp"
+#include "garment/sketch_file.hpp"
+
+namespace sd::garment {
+
+struct QualityLimits {
+  double min_angle_deg = 10.0;     // a quad corner below this is a sliver
+  double max_aspect_ratio = 10.0;  // longest over shortest edge of a quad
+  double near_fraction = 0.1;      // vertices closer than this × edge_length are near-coincident
+  double size_low = 0.25;          // a quad's mean side outside [low, high] × edge_length (low:
+                                   // a tapering panel needs small quads near its apex)
+  double size_high = 2.0;
+};
+
+struct QualityWarning {
+  std::string panel;
+  std::string kind;    // "inverted_quads", "min_angle", "aspect_ratio", "near_vertices",
+                       // "quad_size"
+  int count = 0;       // quads (or vertex pairs) of that kind in the panel
+  double worst = 0.0;  // the worst value (degrees, ratio, metres, or size / edge_length)
+  Eigen::Vector3d where = Eigen::Vector3d::Zero();  // m, the worst place
+  std::string landmark;  // the nearest body landmark ("" when the body has none)
+  std::string message;   // one sentence for the designer, with what to change
+};
+
+// Checks every panel of `garment` except mirror copies (the same quads reflected: a warning on
+// the original holds for its copy). `landmarks` may be null (a body that is not a standing
+// figure).
+std::vector<QualityWarning> check_quality(const Garment& garment, const Sketch& sketch,
+                                          const BodyLandmarks* landmarks,
+                                          const QualityLimits& limits = {});
+
+}  // namespace sd::garment

@@ -1,0 +1,103 @@
+#include "garment/body_landmarks.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "garment/body.hpp"
+#include "garment/sketch_file.hpp"
+#include "tests/garment/test_helpers.hpp"
+
+namespace sd::garment {
+namespace {
+
+// Landmarks in the order of a standing figure, left and right mirror images of each other
+// (both test bodies are symmetric to a few mm), and girths in the order waist < chest, hips.
+void expect_plausible(const BodyLandmarks& l, double height) {
+  ASSERT_EQ(l.points.size(), landmark_names().size());
+  const auto y = [&](const char* name) { return l.find(name)->position.y() / height; };
+  EXPECT_LT(y("left_ankle"), y("left_knee"));
+  EXPECT_LT(y("left_knee"), y("crotch"));
+  EXPECT_LT(y("crotch"), y("hips"));
+  EXPECT_LT(y("hips"), y("waist"));
+  EXPECT_LT(y("waist"), y("chest"));
+  EXPECT_LT(y("chest"), y("left_armpit"));
+  EXPECT_LT(y("left_armpit"), y("left_shoulder"));
+  EXPECT_LT(y("left_shoulder"), y("neck_base"));
+  EXPECT_LT(y("left_wrist"), y("left_elbow"));
+  EXPECT_LT(y("left_elbow"), y("left_shoulder"));
+  // Proportions of an adult figure: crotch at 0.42-0.52 of the height, armpits 0.68-0.78.
+  EXPECT_GT(y("crotch"), 0.42);
+  EXPECT_LT(y("crotch"), 0.52);
+  EXPECT_GT(y("left_armpit"), 0.68);
+  EXPECT_LT(y("left_armpit"), 0.78);
+  for (const char* side : {"shoulder", "armpit", "elbow", "wrist", "knee", "ankle"}) {
+    const Eigen::Vector3d left = l.find(std::string("left_") + side)->position;
+    const Eigen::Vector3d right = l.find(std::string("right_") + side)->position;
+    EXPECT_GT(left.x(), 0.0) << side;
+    EXPECT_NEAR(left.x(), -right.x(), 0.01 * height) << side;
+    EXPECT_NEAR(left.y(), right.y(), 0.01 * height) << side;
+  }
+  EXPECT_LT(l.waist_girth, l.chest_girth);
+  EXPECT_LT(l.waist_girth, l.hip_girth);
+  EXPECT_GT(l.waist_girth, 0.3 * height);
+  EXPECT_LT(l.hip_girth, 0.8 * height);
+}
+
+TEST(BodyLandmarks, BuiltinBody) {
+  const Body body = load_body("builtin");
+  const BodyLandmarks l = find_landmarks(body.mesh);
+  expect_plausible(l, 1.75);
+  // docs/sketch-format.md's figures for the built-in body: crotch 0.78, armpits 1.22.
+  EXPECT_NEAR(l.find("crotch")->position.y(), 0.78, 0.02);
+  EXPECT_NEAR(l.find("left_armpit")->position.y(), 1.23, 0.03);
+  EXPECT_EQ(l.nearest({0.3, 1.0, 0.0}).name, "left_wrist");
+}
+
+TEST(BodyLandmarks, ColladaHumanInMetres) {
+  const std::filesystem::path file = "/usr/share/assimp/models/Collada/human.zae";
+  if (!std::filesystem::exists(file))
+    GTEST_SKIP() << "assimp-testmodels' human.zae is not installed";
+  const Body body = load_body(file.string());
+  expect_plausible(find_landmarks(body.mesh), body.mesh.vertices.col(1).maxCoeff());
+}
+
+TEST(BodyLandmarks, ASphereHasNone) {
+  EXPECT_THROW(find_landmarks(test::sphere_mesh(0.5, {0, 0.5, 0}, 3)), std::runtime_error);
+}
+
+TEST(BodyLandmarks, SliceOfTheBuiltinBodyAtKneeHeightHasTwoLegs) {
+  const Body body = load_body("builtin");
+  const std::vector<SliceOutline> legs = slice_body(body.mesh, 0.5);
+  ASSERT_EQ(legs.size(), 2u);
+  EXPECT_LT(legs[0].centroid.x(), 0.0);
+  EXPECT_GT(legs[1].centroid.x(), 0.0);
+  EXPECT_NEAR(legs[0].girth, legs[1].girth, 0.01);
+}
+
+TEST(BodyLandmarks, SketchPointsRelativeToALandmark) {
+  const std::string text = R"({
+    "curves": [ { "id": "c", "points3d": [ {"at": "waist", "offset": [0.05, -0.02, 0]},
+                                           {"at": "left_armpit"}, [0.1, 1.3, 0.1] ] } ],
+    "panels": [ { "id": "p", "boundary": ["c"] } ] })";
+  const Sketch sketch = parse_sketch(text, "landmarks.json", ".");
+  const BodyLandmarks l = find_landmarks(load_body("builtin").mesh);
+  const std::vector<Eigen::Vector3d>& p = sketch.curves.front().points3d;
+  ASSERT_EQ(p.size(), 3u);
+  EXPECT_EQ(p[0], l.find("waist")->position + Eigen::Vector3d(0.05, -0.02, 0));
+  EXPECT_EQ(p[1], l.find("left_armpit")->position);
+  EXPECT_EQ(p[2], Eigen::Vector3d(0.1, 1.3, 0.1));
+  const std::string misspelt = R"({
+    "curves": [ { "id": "c", "points3d": [ {"at": "left_armpt"}, [0.1, 1.3, 0.1] ] } ],
+    "panels": [ { "id": "p", "boundary": ["c"] } ] })";
+  try {
+    parse_sketch(misspelt, "landmarks.json", ".");
+    FAIL() << "an unknown landmark was accepted";
+  } catch (const SketchError& e) {
+    EXPECT_EQ(e.json_path(), "/curves/0/points3d/0/at");
+    EXPECT_NE(std::string(e.what()).find("no landmark 'left_armpt'"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace sd::garment

@@ -1,0 +1,121 @@
+#include "garment/panel_surface.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "garment/body.hpp"
+#include "garment/body_surface.hpp"
+#include "garment/garment_mesh.hpp"
+#include "garment/sketch_file.hpp"
+#include "meshing/slice_dent.hpp"
+#include "tests/garment/quad_grids.hpp"
+#include "tests/garment/test_helpers.hpp"
+
+namespace sd::garment {
+namespace {
+
+TEST(PanelSurface, HarmonicSpanReproducesALinearBoundary) {
+  // Boundary on the plane z = 0.3 x − 0.2 y: the uniform Laplacian of a regular grid is exact
+  // for linear functions, so every interior vertex lands on the plane.
+  const int n = 12;
+  meshing::QuadMesh mesh = test::plane_grid(n);
+  const std::vector<char> fixed = test::grid_boundary(n);
+  for (Eigen::Index v = 0; v < mesh.vertex_count(); ++v)
+    mesh.vertices(v, 2) = fixed[static_cast<size_t>(v)]
+                              ? 0.3 * mesh.vertices(v, 0) - 0.2 * mesh.vertices(v, 1)
+                              : 5.0;  // far off: the span must not depend on the start
+  span_harmonic(mesh, fixed);
+  for (Eigen::Index v = 0; v < mesh.vertex_count(); ++v)
+    EXPECT_NEAR(mesh.vertices(v, 2), 0.3 * mesh.vertices(v, 0) - 0.2 * mesh.vertices(v, 1), 1e-9);
+}
+
+TEST(PanelSurface, ObstacleOnlyPushesOut) {
+  // A flat membrane (z = 0, 12 × 12 units) over a ball of radius 3 whose top pokes 1.5 through
+  // it: vertices over the ball end on its surface, none inside, and far from the ball the
+  // membrane keeps z >= 0 (it is lifted by the tent, never pulled below its boundary's plane).
+  const int n = 12;
+  const double r = 3.0;
+  const Eigen::Vector3d centre(6.0, 6.0, -1.5);
+  meshing::QuadMesh mesh = test::plane_grid(n);
+  const std::vector<char> fixed = test::grid_boundary(n);
+  const PushOut push_out = [&](const Eigen::Vector3d& p) -> std::optional<Eigen::Vector3d> {
+    const Eigen::Vector3d d = p - centre;
+    if (d.norm() >= r) return std::nullopt;
+    return centre + r * d.normalized();
+  };
+  const SpannedSurface result = span_over_obstacle(mesh, fixed, push_out);
+  EXPECT_GT(result.contacts, 0);
+  int on_ball = 0;
+  for (Eigen::Index v = 0; v < mesh.vertex_count(); ++v) {
+    const Eigen::Vector3d p = mesh.vertices.row(v).transpose();
+    EXPECT_GE((p - centre).norm(), r - 1e-9);
+    EXPECT_GE(p.z(), -1e-12);
+    if (std::abs((p - centre).norm() - r) < 1e-9) ++on_ball;
+  }
+  EXPECT_EQ(on_ball, result.contacts);
+  // The ball's top (6, 6, 1.5) is held exactly.
+  EXPECT_NEAR(mesh.vertices(6 * (n + 1) + 6, 2), 1.5, 1e-9);
+}
+
+TEST(PanelSurface, MembraneSpansAGapWithoutSinkingIntoIt) {
+  // Two "legs" (balls) under a membrane with a gap between them: the vertices over the gap
+  // stay above the straight line between the legs' tops instead of following the gap down.
+  const int n = 16;
+  const double r = 2.0;
+  const Eigen::Vector3d left(4.0, 8.0, -1.0), right(12.0, 8.0, -1.0);
+  meshing::QuadMesh mesh = test::plane_grid(n);
+  const std::vector<char> fixed = test::grid_boundary(n);
+  const PushOut push_out = [&](const Eigen::Vector3d& p) -> std::optional<Eigen::Vector3d> {
+    for (const Eigen::Vector3d& c : {left, right})
+      if ((p - c).norm() < r) return c + r * (p - c).normalized();
+    return std::nullopt;
+  };
+  span_over_obstacle(mesh, fixed, push_out);
+  // Between the balls (x = 8) the membrane is lifted by both tents: above its plane.
+  EXPECT_GT(mesh.vertices(8 * (n + 1) + 8, 2), 0.0);
+}
+
+const BodySurface& builtin_surface() {
+  static const Body body = load_body("builtin");
+  static const BodySurface surface(body.mesh);
+  return surface;
+}
+
+TEST(PanelSurface, AutoFitLaysTheTshirtOnTheBodyAndSpansTheSkirt) {
+  const Garment tshirt =
+      build_garment(load_sketch(std::filesystem::path(SD_SOURCE_DIR) / "data/examples/tshirt.json"),
+                    builtin_surface());
+  for (const GarmentPanel& p : tshirt.panels) EXPECT_EQ(p.fit, "body") << p.id;
+  const Garment skirt = build_garment(
+      load_sketch(std::filesystem::path(SD_SOURCE_DIR) / "data/examples/a-line-skirt.json"),
+      builtin_surface());
+  for (const GarmentPanel& p : skirt.panels)
+    EXPECT_EQ(p.fit, p.id.starts_with("skirt") ? "free" : "body") << p.id;
+}
+
+TEST(PanelSurface, FitBodyKeepsTheSkirtOnTheLegs) {
+  // The same skirt with "fit": "body" on every panel is pulled into the hollow between the
+  // legs: its designed shape dents deeper than the spanned one.
+  const Sketch spanned =
+      load_sketch(std::filesystem::path(SD_SOURCE_DIR) / "data/examples/a-line-skirt.json");
+  Sketch glued = spanned;
+  for (PanelSpec& p : glued.panels) p.fit = PanelFit::kBody;
+  const auto dent = [](const Garment& g) {
+    meshing::TriMesh tris;
+    tris.vertices = g.mesh.vertices;
+    tris.faces.resize(2 * g.mesh.face_count(), 3);
+    for (Eigen::Index f = 0; f < g.mesh.face_count(); ++f) {
+      tris.faces.row(2 * f) << g.mesh.faces(f, 0), g.mesh.faces(f, 1), g.mesh.faces(f, 2);
+      tris.faces.row(2 * f + 1) << g.mesh.faces(f, 0), g.mesh.faces(f, 2), g.mesh.faces(f, 3);
+    }
+    return meshing::slice_dent(tris).depth;
+  };
+  const double free_dent = dent(build_garment(spanned, builtin_surface()));
+  const double body_dent = dent(build_garment(glued, builtin_surface()));
+  EXPECT_LT(free_dent, 0.02);
+  EXPECT_GT(body_dent, free_dent + 0.01);
+}
+
+}  // namespace
+}  // namespace sd::garment

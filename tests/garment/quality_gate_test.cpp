@@ -1,0 +1,95 @@
+#include "garment/quality_gate.hpp"
+
+#include <gtest/gtest.h>
+
+#include "tests/garment/quad_grids.hpp"
+
+namespace sd::garment {
+namespace {
+
+// A one-panel garment on an n × n grid of quads with sides of `edge` metres.
+Garment grid_garment(int n, double edge) {
+  Garment g;
+  g.mesh = test::plane_grid(n);
+  g.mesh.vertices *= edge;
+  g.face_panel = Eigen::VectorXi::Zero(g.mesh.face_count());
+  GarmentPanel panel;
+  panel.id = "patch";
+  g.panels.push_back(panel);
+  return g;
+}
+
+Sketch sketch_with_edge(double edge) {
+  Sketch sketch;
+  sketch.edge_length = edge;
+  return sketch;
+}
+
+const QualityWarning* find_kind(const std::vector<QualityWarning>& warnings,
+                                const std::string& kind) {
+  for (const QualityWarning& w : warnings)
+    if (w.kind == kind) return &w;
+  return nullptr;
+}
+
+TEST(QualityGate, ARegularGridIsClean) {
+  EXPECT_TRUE(check_quality(grid_garment(6, 0.03), sketch_with_edge(0.03), nullptr).empty());
+}
+
+TEST(QualityGate, FoldedQuadIsFoundWhereItIs) {
+  // Vertex (2, 2) pushed across its neighbours: the quads around it fold over.
+  Garment g = grid_garment(6, 0.03);
+  const int v = 2 * 7 + 2;
+  g.mesh.vertices.row(v) += Eigen::RowVector3d(0.045, 0.045, 0.0);
+  const std::vector<QualityWarning> warnings = check_quality(g, sketch_with_edge(0.03), nullptr);
+  const QualityWarning* inverted = find_kind(warnings, "inverted_quads");
+  ASSERT_NE(inverted, nullptr);
+  EXPECT_GE(inverted->count, 1);
+  EXPECT_LT(inverted->worst, 0.0);
+  EXPECT_EQ(inverted->panel, "patch");
+  // The worst fold is one of the quads around the moved vertex (within 1.5 quads of it).
+  EXPECT_LT((inverted->where - Eigen::Vector3d(0.06, 0.06, 0.0)).norm(), 0.05);
+  EXPECT_NE(inverted->message.find("panel 'patch'"), std::string::npos);
+}
+
+TEST(QualityGate, SliversLongQuadsAndNearVerticesAreNamed) {
+  // Squash the last column of quads to 1/20 of their width: aspect 20, and the vertices of
+  // the squashed column 1.5 mm apart (below 0.1 × 3 cm).
+  Garment g = grid_garment(6, 0.03);
+  for (Eigen::Index v = 0; v < g.mesh.vertex_count(); ++v)
+    if (g.mesh.vertices(v, 0) > 0.179) g.mesh.vertices(v, 0) = 0.15 + 0.0015;
+  const std::vector<QualityWarning> warnings = check_quality(g, sketch_with_edge(0.03), nullptr);
+  const QualityWarning* aspect = find_kind(warnings, "aspect_ratio");
+  ASSERT_NE(aspect, nullptr);
+  EXPECT_NEAR(aspect->worst, 20.0, 1e-9);
+  EXPECT_EQ(aspect->count, 6);
+  const QualityWarning* near = find_kind(warnings, "near_vertices");
+  ASSERT_NE(near, nullptr);
+  EXPECT_NEAR(near->worst, 0.0015, 1e-12);
+  EXPECT_EQ(near->count, 7);  // one pair per row of the squashed column
+  EXPECT_EQ(find_kind(warnings, "inverted_quads"), nullptr);
+}
+
+TEST(QualityGate, QuadsMuchLargerThanAskedAreFound) {
+  // 3 cm quads where 1 cm is asked: three times the edge length.
+  const std::vector<QualityWarning> warnings =
+      check_quality(grid_garment(4, 0.03), sketch_with_edge(0.01), nullptr);
+  const QualityWarning* size = find_kind(warnings, "quad_size");
+  ASSERT_NE(size, nullptr);
+  EXPECT_EQ(size->count, 16);
+  EXPECT_NEAR(size->worst, 3.0, 1e-9);
+}
+
+TEST(QualityGate, NamesTheNearestLandmark) {
+  Garment g = grid_garment(6, 0.03);
+  g.mesh.vertices.row(2 * 7 + 2) += Eigen::RowVector3d(0.045, 0.045, 0.0);
+  BodyLandmarks landmarks;
+  landmarks.points = {{"waist", {0.06, 0.06, 0.1}}, {"crotch", {1.0, 1.0, 1.0}}};
+  const std::vector<QualityWarning> warnings = check_quality(g, sketch_with_edge(0.03), &landmarks);
+  ASSERT_FALSE(warnings.empty());
+  EXPECT_EQ(warnings.front().landmark, "waist");
+  EXPECT_NE(warnings.front().message.find("near the waist"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace sd::garment
