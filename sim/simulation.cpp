@@ -50,6 +50,11 @@ void SimulationSettings::validate() const {
   } catch (const InvalidContactSettingsError& error) {
     throw InvalidSimulationSettingsError(error.what());
   }
+  try {
+    self_contact.validate();
+  } catch (const std::invalid_argument& error) {
+    throw InvalidSimulationSettingsError(error.what());
+  }
 }
 
 Simulation::Simulation(ClothModel model, Eigen::VectorXd x0, std::vector<Pin> pins,
@@ -85,6 +90,15 @@ void Simulation::replace_model(ClothModel model, Eigen::VectorXd x, Eigen::Vecto
   has_history_ = false;
   report_.vertices = n;
   report_.triangles = static_cast<int>(model_.triangles.size());
+  // A new mesh: the self-contact tree is rebuilt on it.
+  if (settings_.self_contact.enabled) {
+    if (!self_contact_) self_contact_ = std::make_unique<SelfContactResponse>(settings_.self_contact);
+    const auto start = std::chrono::steady_clock::now();
+    self_contact_->set_fabric_friction(model_.fabric.friction);
+    self_contact_->set_cloth(model_, x_);
+    report_.self_collision_s +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
   // New vertex numbering: the contact cache and last step's contacts no longer apply.
   if (contact_) {
     contact_->set_fabric_friction(model_.fabric.friction);
@@ -221,10 +235,24 @@ Simulation::Attempt Simulation::attempt(double h) {
     contact->move_body_to(time_, h);
     contact->constrain_start(x_hat, v_, beta, filter_, y, contact_forces_);
   }
+  // Self-contact (sim/self_contact.hpp): repulsion springs of the layers closer than the
+  // thickness at the start, joining the body's forces in the solve.
+  SelfContactResponse* self = self_contact_.get();
+  std::vector<unsigned char> pinned;
+  if (self != nullptr) {
+    if (contact == nullptr) contact_forces_.clear();
+    pinned.assign(static_cast<std::size_t>(model_.vertex_count), 0);
+    for (int i = 0; i < model_.vertex_count; ++i) pinned[i] = filter_.is_pinned(i);
+    self->add_springs(y.size() == x_.size() ? Eigen::VectorXd(x_ + y) : x_, model_.mass, pinned,
+                      contact_forces_);
+  }
   for (;;) {
     if (contact != nullptr) {
       result.solve = solver_.solve(model_, settings_.forces, filter_, x_hat + y, v_hat, beta,
                                    x_lin + y, v_lin, newton_settings, &contact_forces_);
+    } else if (self != nullptr) {
+      result.solve = solver_.solve(model_, settings_.forces, filter_, x_hat, v_hat, beta, x_lin,
+                                   v_lin, newton_settings, &contact_forces_);
     } else {
       result.solve = solver_.solve(model_, settings_.forces, filter_, x_hat, v_hat, beta, x_lin,
                                    v_lin, newton_settings);
@@ -246,6 +274,13 @@ Simulation::Attempt Simulation::attempt(double h) {
       break;
     }
   }
+
+  // Friction between layers, then the fail-safe on the step's straight paths (impulses, impact
+  // zones): the cloth leaves the step without passing through itself.
+  if (self != nullptr && result.solve.linear_converged && result.x.allFinite() &&
+      result.v.allFinite())
+    self->resolve(y.size() == x_.size() ? Eigen::VectorXd(x_ + y) : x_, result.x, result.v,
+                  beta, model_.mass, pinned, contact_forces_);
 
   std::ostringstream why;
   if (!result.x.allFinite() || !result.v.allFinite()) {
@@ -292,6 +327,16 @@ void Simulation::accept(Attempt& attempt, double h) {
     report_.projected_vertices += stats.projected;
     contact_->accept_step(attempt.solve.constraint_impulse);
   }
+  if (self_contact_) {
+    const SelfContactStepStats& stats = self_contact_->step_stats();
+    report_.self_contacts_max = std::max(report_.self_contacts_max, stats.springs);
+    report_.self_contacts_final = stats.springs;
+    report_.self_collisions += stats.collisions;
+    report_.self_zone_vertices += stats.zone_vertices;
+    if (stats.unresolved) ++report_.self_unresolved_steps;
+    report_.self_culled_triangles += stats.culled_triangles;
+    report_.self_tested_triangles += stats.triangles;
+  }
 
   const double mass = model_.total_mass();
   const double speed = max_speed(v_);
@@ -315,6 +360,7 @@ StepOutcome Simulation::step(double max_step) {
     report_.forces_s += candidate.forces_seconds;
     report_.solve_s += candidate.solve_seconds;
     if (contact_) report_.collision_s += contact_->step_stats().collision_seconds;
+    if (self_contact_) report_.self_collision_s += self_contact_->step_stats().seconds;
     report_.linear_solves += candidate.linear_solves;
     cg_total_ += candidate.cg_iterations;
     report_.cg_iterations_max = std::max(report_.cg_iterations_max, candidate.cg_iterations_max);
@@ -387,6 +433,7 @@ SimulationReport Simulation::run(const std::function<void(const Simulation&)>& o
   const double forces_before = report_.forces_s;
   const double solve_before = report_.solve_s;
   const double collision_before = report_.collision_s;
+  const double self_before = report_.self_collision_s;
   const auto sample = [&] {
     if (!settings_.record_energy) return;
     const EnergyBreakdown e = energy();
@@ -419,13 +466,18 @@ SimulationReport Simulation::run(const std::function<void(const Simulation&)>& o
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   report_.wall_time_s += wall;
   report_.other_s += wall - (report_.forces_s - forces_before) - (report_.solve_s - solve_before) -
-                     (report_.collision_s - collision_before);
+                     (report_.collision_s - collision_before) -
+                     (report_.self_collision_s - self_before);
   report_.cg_iterations_mean =
       report_.linear_solves > 0 ? static_cast<double>(cg_total_) / report_.linear_solves : 0.0;
   report_.newton_iterations_mean =
       report_.steps > 0 ? static_cast<double>(newton_total_) / report_.steps : 0.0;
   report_.max_strain = max_stretch_strain(model_, x_);
   report_.nan_free = x_.allFinite() && v_.allFinite();
+  report_.self_culled_share =
+      report_.self_tested_triangles > 0
+          ? static_cast<double>(report_.self_culled_triangles) / report_.self_tested_triangles
+          : 0.0;
   return report_;
 }
 

@@ -17,6 +17,7 @@
 #include "sim/contact_response.hpp"
 #include "sim/forces.hpp"
 #include "sim/implicit_solver.hpp"
+#include "sim/self_contact.hpp"
 
 namespace sd::sim {
 
@@ -53,6 +54,7 @@ struct SimulationSettings {
   bool record_energy = true;             // energy time series in the report (one sample a step)
   ForceSettings forces;
   ContactSettings contact;               // used once a body is set (set_body, set_body_motion)
+  SelfContactSettings self_contact;      // cloth-cloth contact (off unless enabled)
 
   void validate() const;  // throws InvalidSimulationSettingsError
 };
@@ -121,6 +123,17 @@ struct SimulationReport {
   int projected_vertices = 0;       // vertices projected out after the re-solves (last resort)
   int start_repair_vertices = 0;    // vertices that started inside the body
   double start_repair_depth_m = 0.0;  // deepest of them
+  // Self-contact (zero when off; sim/self_contact.hpp).
+  int self_contacts_max = 0;      // most repulsion springs in one accepted step
+  int self_contacts_final = 0;    // in the last step
+  int self_collisions = 0;        // colliding pairs the continuous test found, summed over steps
+  int self_zone_vertices = 0;     // vertices moved rigidly by impact zones, summed over steps
+  int self_unresolved_steps = 0;  // accepted steps whose fail-safe left a collision
+  double self_collision_s = 0.0;  // wall time of self-contact (detection and response)
+  // Share of the cloth's triangles inside regions the curvature test culled, over all steps.
+  double self_culled_share = 0.0;
+  long long self_culled_triangles = 0;  // summed over accepted steps (for the share)
+  long long self_tested_triangles = 0;
   std::vector<EnergySample> energy;
 };
 
@@ -218,6 +231,7 @@ class Simulation {
   StepForces contact_forces_;  // friction drags and piercing springs of the current attempt
   ImplicitSolver solver_;
   std::unique_ptr<ContactResponse> contact_;
+  std::unique_ptr<SelfContactResponse> self_contact_;  // null when self-contact is off
   SimulationReport report_;
   long long newton_total_ = 0;
   long long cg_total_ = 0;
