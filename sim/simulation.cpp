@@ -276,11 +276,12 @@ Simulation::Attempt Simulation::attempt(double h) {
   }
 
   // Friction between layers, then the fail-safe on the step's straight paths (impulses, impact
-  // zones): the cloth leaves the step without passing through itself.
+  // zones): the cloth leaves the step without passing through itself. The paths start at the
+  // accepted state, before the body's position correction, so that a correction pushing a
+  // vertex out of the body cannot carry it through a layer lying on it unseen.
   if (self != nullptr && result.solve.linear_converged && result.x.allFinite() &&
       result.v.allFinite())
-    self->resolve(y.size() == x_.size() ? Eigen::VectorXd(x_ + y) : x_, result.x, result.v,
-                  beta, model_.mass, pinned, contact_forces_);
+    self->resolve(x_, result.x, result.v, beta, model_.mass, pinned, contact_forces_);
 
   std::ostringstream why;
   if (!result.x.allFinite() || !result.v.allFinite()) {
