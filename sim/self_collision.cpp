@@ -499,4 +499,53 @@ std::vector<SelfPair> SelfCollider::find_collisions(const Eigen::VectorXd& x0,
   return pairs;
 }
 
+namespace {
+
+// Does segment pq cross triangle abc? Orientation signs (touching counts; coplanar does not).
+bool segment_crosses_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q,
+                              const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                              const Eigen::Vector3d& c) {
+  const auto orient = [](const Eigen::Vector3d& u, const Eigen::Vector3d& v,
+                         const Eigen::Vector3d& w,
+                         const Eigen::Vector3d& z) { return (v - u).cross(w - u).dot(z - u); };
+  const double sp = orient(a, b, c, p), sq = orient(a, b, c, q);
+  if ((sp > 0 && sq > 0) || (sp < 0 && sq < 0) || (sp == 0 && sq == 0)) return false;
+  const double s1 = orient(p, q, a, b), s2 = orient(p, q, b, c), s3 = orient(p, q, c, a);
+  return (s1 >= 0 && s2 >= 0 && s3 >= 0) || (s1 <= 0 && s2 <= 0 && s3 <= 0);
+}
+
+}  // namespace
+
+std::vector<std::array<int, 2>> SelfCollider::find_intersections(const Eigen::VectorXd& x) {
+  std::vector<std::array<int, 2>> pairs;
+  if (nodes_.empty()) return pairs;
+  refit(x, x, 0.0);
+  SelfQueryStats stats;
+  auto leaf = [&](int ta, int tb) {
+    const std::array<int, 3>& a = triangles_[ta];
+    const std::array<int, 3>& b = triangles_[tb];
+    int shared = 0;
+    for (int i : a)
+      for (int j : b) shared += i == j;
+    if (shared >= 2) return;  // neighbours across an edge
+    const auto crosses = [&](const std::array<int, 3>& s, const std::array<int, 3>& t) {
+      for (int k = 0; k < 3; ++k) {
+        const int p = s[k], q = s[(k + 1) % 3];
+        // An edge through the shared vertex meets the other triangle there by construction.
+        if (p == t[0] || p == t[1] || p == t[2] || q == t[0] || q == t[1] || q == t[2]) continue;
+        if (segment_crosses_triangle(row(x, p), row(x, q), row(x, t[0]), row(x, t[1]),
+                                     row(x, t[2])))
+          return true;
+      }
+      return false;
+    };
+    if (crosses(a, b) || crosses(b, a)) pairs.push_back({ta, tb});
+  };
+  const bool culling = culling_;
+  culling_ = false;  // a flipped triangle can hide in a flat-looking region
+  self_test(0, x, x, leaf, stats);
+  culling_ = culling;
+  return pairs;
+}
+
 }  // namespace sd::sim

@@ -77,6 +77,10 @@ class SelfCollider {
   // a collision.
   std::vector<SelfPair> find_collisions(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1,
                                         double tolerance, SelfQueryStats* stats = nullptr);
+  // Pairs of triangles that intersect at x (3n) other than along the edge or vertex they share:
+  // an edge of one crosses the other (orientation signs; touching counts). A cloth that starts
+  // this way cannot be untangled by the continuous tests, which keep whatever it starts with.
+  std::vector<std::array<int, 2>> find_intersections(const Eigen::VectorXd& x);
 
  private:
   struct Node {

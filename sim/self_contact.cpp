@@ -98,6 +98,55 @@ void SelfContactResponse::set_cloth(const ClothModel& model, const Eigen::Vector
   collider_.set_culling(settings_.culling);
 }
 
+int SelfContactResponse::untangle(const ClothModel& model, Eigen::VectorXd& x,
+                                  const std::vector<unsigned char>& pinned, int* found,
+                                  int* remaining) {
+  const int n = model.vertex_count;
+  std::vector<std::vector<int>> neighbours(static_cast<std::size_t>(n));
+  for (const TriangleElement& t : model.triangles)
+    for (int k = 0; k < 3; ++k) {
+      neighbours[t.vertices[k]].push_back(t.vertices[(k + 1) % 3]);
+      neighbours[t.vertices[k]].push_back(t.vertices[(k + 2) % 3]);
+    }
+  std::vector<unsigned char> moved(static_cast<std::size_t>(n), 0);
+  std::vector<std::array<int, 2>> pairs = collider_.find_intersections(x);
+  if (found != nullptr) *found = static_cast<int>(pairs.size());
+  constexpr int kRounds = 24;
+  for (int round = 0; round < kRounds && !pairs.empty(); ++round) {
+    // The region: the intersecting triangles' vertices, grown by 1 + round/4 rings.
+    std::vector<unsigned char> in(static_cast<std::size_t>(n), 0);
+    std::vector<int> region;
+    for (const auto& pair : pairs)
+      for (int t : pair)
+        for (int v : model.triangles[t].vertices)
+          if (in[v] == 0) {
+            in[v] = 1;
+            region.push_back(v);
+          }
+    for (int ring = 0; ring < 1 + round / 4; ++ring) {
+      const std::size_t size = region.size();
+      for (std::size_t i = 0; i < size; ++i)
+        for (int w : neighbours[region[i]])
+          if (in[w] == 0) {
+            in[w] = 1;
+            region.push_back(w);
+          }
+    }
+    for (int sweep = 0; sweep < 5; ++sweep)
+      for (int v : region) {
+        if ((!pinned.empty() && pinned[v] != 0) || neighbours[v].empty()) continue;
+        Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+        for (int w : neighbours[v]) mean += row(x, w);
+        mean /= static_cast<double>(neighbours[v].size());
+        x.segment<3>(3 * v) = 0.5 * (row(x, v) + mean);
+        moved[v] = 1;
+      }
+    pairs = collider_.find_intersections(x);
+  }
+  if (remaining != nullptr) *remaining = static_cast<int>(pairs.size());
+  return static_cast<int>(std::count(moved.begin(), moved.end(), 1));
+}
+
 void SelfContactResponse::add_springs(const Eigen::VectorXd& start, const Eigen::VectorXd& mass,
                                       const std::vector<unsigned char>& pinned, StepForces& extra) {
   const auto begin = std::chrono::steady_clock::now();

@@ -66,6 +66,14 @@ class SelfContactResponse {
     return settings_.friction >= 0.0 ? settings_.friction : fabric_friction_;
   }
 
+  // A start that passes through itself (a folded quad of a designed garment): the vertices of
+  // the intersecting triangles and their neighbours are smoothed (each moved halfway to the mean
+  // of its neighbours, pinned ones kept) in growing rings until no pair intersects, at most 24
+  // rounds. Returns the vertices moved; `found`: pairs at the start, `remaining`: after.
+  int untangle(const ClothModel& model, Eigen::VectorXd& x,
+               const std::vector<unsigned char>& pinned, int* found = nullptr,
+               int* remaining = nullptr);
+
   // Step 1: springs of the pairs closer than the thickness at `start` (3n) into extra.
   // pinned: per vertex, 1 when the step's filter pins it.
   void add_springs(const Eigen::VectorXd& start, const Eigen::VectorXd& mass,

@@ -92,10 +92,20 @@ void Simulation::replace_model(ClothModel model, Eigen::VectorXd x, Eigen::Vecto
   report_.triangles = static_cast<int>(model_.triangles.size());
   // A new mesh: the self-contact tree is rebuilt on it.
   if (settings_.self_contact.enabled) {
-    if (!self_contact_) self_contact_ = std::make_unique<SelfContactResponse>(settings_.self_contact);
     const auto start = std::chrono::steady_clock::now();
+    const bool first = !self_contact_;
+    if (first) self_contact_ = std::make_unique<SelfContactResponse>(settings_.self_contact);
     self_contact_->set_fabric_friction(model_.fabric.friction);
     self_contact_->set_cloth(model_, x_);
+    if (first) {
+      // A designed start that passes through itself is smoothed apart once, before anything
+      // moves: the continuous tests would keep the intersections for the whole run.
+      std::vector<unsigned char> pinned(static_cast<std::size_t>(n), 0);
+      for (const Pin& pin : pins_) pinned[pin.vertex] = 1;
+      report_.self_untangled_vertices = self_contact_->untangle(
+          model_, x_, pinned, &report_.self_intersections_start, &report_.self_untangle_left);
+      for (std::size_t k = 0; k < pins_.size(); ++k) pin_rest_[k] = x_.segment<3>(3 * pins_[k].vertex);
+    }
     report_.self_collision_s +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }

@@ -124,6 +124,9 @@ struct SimulationReport {
   int start_repair_vertices = 0;    // vertices that started inside the body
   double start_repair_depth_m = 0.0;  // deepest of them
   // Self-contact (zero when off; sim/self_contact.hpp).
+  int self_intersections_start = 0;  // intersecting triangle pairs of the start
+  int self_untangled_vertices = 0;   // vertices the start's untangling moved
+  int self_untangle_left = 0;        // pairs the untangling could not separate
   int self_contacts_max = 0;      // most repulsion springs in one accepted step
   int self_contacts_final = 0;    // in the last step
   int self_collisions = 0;        // colliding pairs the continuous test found, summed over steps

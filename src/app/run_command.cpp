@@ -95,6 +95,8 @@ nlohmann::json simulation_json(const sim::SimulationReport& r, const sim::Simula
           {"max_piercing_final_m", r.max_piercing_final_m},
           {"contacts_final", r.contacts_final},
           {"self_collision", s.self_contact.enabled},
+          {"self_intersections_start", r.self_intersections_start},
+          {"self_untangled_vertices", r.self_untangled_vertices},
           {"self_contacts_max", r.self_contacts_max},
           {"self_contacts_final", r.self_contacts_final},
           {"self_collisions", r.self_collisions},
