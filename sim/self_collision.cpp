@@ -501,16 +501,23 @@ std::vector<SelfPair> SelfCollider::find_collisions(const Eigen::VectorXd& x0,
 
 namespace {
 
-// Does segment pq cross triangle abc? Orientation signs (touching counts; coplanar does not).
+// Does segment pq cross triangle abc? Orientation signs, with values below 1e-10 of the cube
+// of the configuration's size taken as zero (rounding): touching counts, a segment in the
+// triangle's plane does not (a flat strip of the cloth is no intersection).
 bool segment_crosses_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q,
                               const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                               const Eigen::Vector3d& c) {
-  const auto orient = [](const Eigen::Vector3d& u, const Eigen::Vector3d& v,
-                         const Eigen::Vector3d& w,
-                         const Eigen::Vector3d& z) { return (v - u).cross(w - u).dot(z - u); };
+  const double size = std::max({(q - p).norm(), (b - a).norm(), (c - a).norm(), (p - a).norm()});
+  const double zero = 1e-10 * size * size * size;
+  const auto orient = [zero](const Eigen::Vector3d& u, const Eigen::Vector3d& v,
+                             const Eigen::Vector3d& w, const Eigen::Vector3d& z) {
+    const double value = (v - u).cross(w - u).dot(z - u);
+    return std::abs(value) <= zero ? 0.0 : value;
+  };
   const double sp = orient(a, b, c, p), sq = orient(a, b, c, q);
   if ((sp > 0 && sq > 0) || (sp < 0 && sq < 0) || (sp == 0 && sq == 0)) return false;
   const double s1 = orient(p, q, a, b), s2 = orient(p, q, b, c), s3 = orient(p, q, c, a);
+  if (s1 == 0 && s2 == 0 && s3 == 0) return false;
   return (s1 >= 0 && s2 >= 0 && s3 >= 0) || (s1 <= 0 && s2 <= 0 && s3 <= 0);
 }
 

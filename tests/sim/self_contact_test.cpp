@@ -55,6 +55,37 @@ TEST(SelfContactResponse, FailSafeLeavesNoCollisionAndKeepsMomentum) {
   EXPECT_LT((sheet.x + 0.01 * v1 - x1).lpNorm<Eigen::Infinity>(), 1e-12);
 }
 
+TEST(SelfContactResponse, UntangleSeparatesAStartThatPassesThroughItself) {
+  // The far part of the upper layer of a fold pushed 2 cm through the lower layer.
+  const testing::FoldedSheet sheet = testing::folded_sheet(6, 0.3, 0.01);
+  const ClothModel model = folded_model(testing::folded_sheet(6, 0.3, -1.0));
+  Eigen::VectorXd x = sheet.x;
+  for (int i = 0; i < model.vertex_count; ++i)
+    if (sheet.upper[i] && sheet.x[3 * i] < -0.1) x[3 * i + 1] -= 0.03;
+  const int before = testing::count_intersecting_pairs(sheet.triangles, x);
+  ASSERT_GT(before, 0);
+  SelfContactSettings settings;
+  settings.enabled = true;
+  SelfContactResponse response(settings);
+  response.set_cloth(model, x);
+  // The tree's own test finds at least the pairs the brute-force count finds (it also counts
+  // pairs that share a vertex).
+  EXPECT_GE(static_cast<int>(response.collider().find_intersections(x).size()), before);
+  int found = 0, remaining = -1;
+  const int moved = response.untangle(model, x, {}, &found, &remaining);
+  EXPECT_GE(found, before);
+  EXPECT_EQ(remaining, 0);
+  EXPECT_GT(moved, 0);
+  EXPECT_EQ(testing::count_intersecting_pairs(sheet.triangles, x), 0);
+  EXPECT_TRUE(response.collider().find_intersections(x).empty());
+  // A clean start is left alone.
+  Eigen::VectorXd clean = sheet.x;
+  response.set_cloth(model, clean);
+  EXPECT_EQ(response.untangle(model, clean, {}, &found, &remaining), 0);
+  EXPECT_EQ(found, 0);
+  EXPECT_EQ(clean, sheet.x);
+}
+
 struct FoldRun {
   SimulationReport report;
   Eigen::VectorXd x;
@@ -133,4 +164,19 @@ TEST(SelfContactSimulation, SheetOnASphereWithBodyAndSelfContact) {
 }
 
 }  // namespace
+}  // namespace sd::sim
+namespace sd::sim {
+TEST(SelfDebug, Print) {
+  const testing::FoldedSheet sheet = testing::folded_sheet(6, 0.3, 0.01);
+  SelfCollider c(sheet.triangles, sheet.x);
+  for (auto p : c.find_intersections(sheet.x)) {
+    for (int t : p) {
+      for (int v : sheet.triangles[t])
+        std::printf("%d(%.2f %.3f %.2f) ", v, sheet.x[3 * v], sheet.x[3 * v + 1],
+                    sheet.x[3 * v + 2]);
+      std::printf(" | ");
+    }
+    std::printf("\n");
+  }
+}
 }  // namespace sd::sim
