@@ -171,6 +171,23 @@ void SelfContactResponse::add_springs(const Eigen::VectorXd& start, const Eigen:
     spring.damping = 2.0 * effective * kSpringFrequency;
     extra.pair_springs.push_back(spring);
   }
+  // A vertex inside a pile is near many elements at once; the sum of their springs on it would
+  // be many times one spring's stiffness, and their coupling across the pairs is explicit
+  // (measured: a crumpled strip gained 40 times its energy scale). Each spring is divided by the
+  // square root of the largest number of springs sharing one of its vertices (dividing by the
+  // number itself left too little to hold layers apart: the fail-safe then did the work, 88 %
+  // of the piling sheet's time).
+  std::vector<int> count(static_cast<std::size_t>(mass.size()), 0);
+  for (const PairSpring& spring : extra.pair_springs)
+    for (int k = 0; k < 4; ++k)
+      if (std::abs(spring.weights[k]) > 0.0) ++count[spring.vertices[k]];
+  for (PairSpring& spring : extra.pair_springs) {
+    int most = 1;
+    for (int k = 0; k < 4; ++k)
+      if (std::abs(spring.weights[k]) > 0.0) most = std::max(most, count[spring.vertices[k]]);
+    spring.stiffness /= std::sqrt(static_cast<double>(most));
+    spring.damping /= std::sqrt(static_cast<double>(most));
+  }
   stats_.springs = static_cast<int>(extra.pair_springs.size());
   stats_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
 }
