@@ -347,6 +347,11 @@ void Simulation::accept(Attempt& attempt, double h) {
     if (stats.unresolved) ++report_.self_unresolved_steps;
     report_.self_culled_triangles += stats.culled_triangles;
     report_.self_tested_triangles += stats.triangles;
+    // Kept current here: the adaptive driver steps without run().
+    report_.self_culled_share =
+        report_.self_tested_triangles > 0
+            ? static_cast<double>(report_.self_culled_triangles) / report_.self_tested_triangles
+            : 0.0;
   }
 
   const double mass = model_.total_mass();
@@ -485,10 +490,6 @@ SimulationReport Simulation::run(const std::function<void(const Simulation&)>& o
       report_.steps > 0 ? static_cast<double>(newton_total_) / report_.steps : 0.0;
   report_.max_strain = max_stretch_strain(model_, x_);
   report_.nan_free = x_.allFinite() && v_.allFinite();
-  report_.self_culled_share =
-      report_.self_tested_triangles > 0
-          ? static_cast<double>(report_.self_culled_triangles) / report_.self_tested_triangles
-          : 0.0;
   return report_;
 }
 
