@@ -68,7 +68,7 @@ class SelfContactResponse {
 
   // A start that passes through itself (a folded quad of a designed garment): the vertices of
   // the intersecting triangles and their neighbours are smoothed (each moved halfway to the mean
-  // of its neighbours, pinned ones kept) in growing rings until no pair intersects, at most 24
+  // of its neighbours, pinned ones kept) in growing rings until no pair intersects, at most 120
   // rounds. Returns the vertices moved; `found`: pairs at the start, `remaining`: after.
   int untangle(const ClothModel& model, Eigen::VectorXd& x,
                const std::vector<unsigned char>& pinned, int* found = nullptr,
