@@ -89,7 +89,6 @@ TEST(StressCommand, QuickMatrixHoldsAndItsJsonListsEveryCaseFinite) {
     }
     if (c["family"] == "self-contact") {
       EXPECT_EQ(c["self_intersections_final"].get<int>(), 0) << id;
-      EXPECT_GT(c["self_contacts_max"].get<int>(), 0) << id;
     }
   }
   // Every family but `sliver`, whose cases all diverge today (docs/stress.md).
