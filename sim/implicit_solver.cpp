@@ -29,7 +29,8 @@ void ImplicitSolver::add_extra_force(const ClothModel& model, const StepForces* 
   for (const PairSpring& s : extra->pair_springs) {
     const double f =
         s.stiffness * (s.target - along_pair_normal(s, x)) - s.damping * along_pair_normal(s, v);
-    for (int k = 0; k < 4; ++k) force_.segment<3>(3 * s.vertices[k]) += (s.weights[k] * f) * s.normal;
+    for (int k = 0; k < 4; ++k)
+      force_.segment<3>(3 * s.vertices[k]) += (s.weights[k] * f) * s.normal;
   }
 }
 

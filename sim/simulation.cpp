@@ -99,12 +99,12 @@ void Simulation::replace_model(ClothModel model, Eigen::VectorXd x, Eigen::Vecto
     self_contact_->set_cloth(model_, x_);
     if (first) {
       // A designed start that passes through itself is smoothed apart once, before anything
-      // moves: the continuous tests would keep the intersections for the whole run.
+      // moves: the continuous tests would keep the intersections for the whole run. Pinned
+      // vertices stay where they are.
       std::vector<unsigned char> pinned(static_cast<std::size_t>(n), 0);
       for (const Pin& pin : pins_) pinned[pin.vertex] = 1;
       report_.self_untangled_vertices = self_contact_->untangle(
           model_, x_, pinned, &report_.self_intersections_start, &report_.self_untangle_left);
-      for (std::size_t k = 0; k < pins_.size(); ++k) pin_rest_[k] = x_.segment<3>(3 * pins_[k].vertex);
     }
     report_.self_collision_s +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
