@@ -599,7 +599,8 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
   const std::string path = "/simulate";
   r.require_object(j, path, "simulate");
   r.check_keys(j, path, {"duration", "adaptive", "time_step", "integrator", "solver",
-                         "stop_at_rest", "gravity", "pin_above", "check_body_vertices", "rest"});
+                         "stop_at_rest", "gravity", "pin_above", "check_body_vertices", "rest",
+                         "self_collision"});
   if (j.contains("pin_above")) sim.pin_above = r.number(j["pin_above"], path + "/pin_above");
   if (j.contains("duration")) sim.duration = r.positive(j["duration"], path + "/duration");
   if (j.contains("adaptive")) parse_adaptive(r, j["adaptive"], sim);
@@ -628,13 +629,20 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
                                          "pattern pieces) or \"shaped\" (as drawn on the body)",
                                          sim.rest));
   }
+  if (j.contains("self_collision"))
+    sim.self_collision = r.boolean(j["self_collision"], path + "/self_collision");
 }
 
 SheetSpec parse_sheet(const Reader& r, const json& j) {
   const std::string path = "/sheet";
   r.require_object(j, path, "sheet");
-  r.check_keys(j, path, {"size", "resolution", "orientation", "centre", "pins"});
+  r.check_keys(j, path, {"size", "resolution", "orientation", "centre", "pins", "layers",
+                         "layer_offset", "layer_turn"});
   SheetSpec sheet;
+  if (j.contains("layers")) sheet.layers = r.integer(j["layers"], path + "/layers", 1);
+  if (j.contains("layer_offset"))
+    sheet.layer_offset = r.vector<3>(j["layer_offset"], path + "/layer_offset");
+  if (j.contains("layer_turn")) sheet.layer_turn = r.number(j["layer_turn"], path + "/layer_turn");
   if (j.contains("size")) {
     sheet.size = r.vector<2>(j["size"], path + "/size");
     for (int k = 0; k < 2; ++k)

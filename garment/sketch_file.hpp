@@ -148,6 +148,9 @@ struct SimulateSpec {
   // The cloth's rest shape: "shaped" (each triangle as drawn on the body) or "flat" (the
   // triangle in the panel's flattened pattern piece, docs/pattern.md). Panels may override it.
   std::string rest = "shaped";
+  // Cloth-cloth contact (sim/self_contact.hpp): folds and layers do not pass through each
+  // other. Unset: on for garments, off for sheets.
+  std::optional<bool> self_collision;
 };
 
 // A rectangular sheet of cloth instead of a garment: scenes for tests and benchmarks.
@@ -158,6 +161,12 @@ struct SheetSpec {
   bool horizontal = false;                 // in the XZ plane instead of the XY plane
   Eigen::Vector3d centre{0.0, 1.0, 0.0};   // metres
   std::vector<std::string> pins;           // "top-left", ..., or whole edges "top", "left", ...
+  // Copies of the sheet stacked one over the other (two sheets falling onto each other): layer
+  // k is the first moved by k·layer_offset and turned k·layer_turn degrees about the vertical
+  // through the centre. Pins hold the first layer only.
+  int layers = 1;
+  Eigen::Vector3d layer_offset{0.0, 0.05, 0.0};  // metres
+  double layer_turn = 0.0;                       // degrees
 };
 
 struct ImageSpec {

@@ -4,6 +4,7 @@
 // Building it is cheap (linear in the mesh size), so the adaptive mesh can rebuild it after
 // every topology change.
 
+#include <algorithm>
 #include <array>
 #include <stdexcept>
 #include <vector>
@@ -122,6 +123,15 @@ void scale_rest_shapes(ClothModel& model, const Eigen::VectorXd& scale);
 // Flattens #V by 3 positions into the solver's 3n vector (x0,y0,z0,x1,...) and back.
 Eigen::VectorXd flatten_positions(const Eigen::MatrixX3d& positions);
 Eigen::MatrixX3d unflatten_positions(const Eigen::VectorXd& flat);
+
+// Offset of block (i, j) in the rows of vertex i (what the elements store), −1 when j is not a
+// neighbour of i. A binary search of row 3i.
+inline int block_offset(const SparseMatrixR& matrix, int i, int j) {
+  const int* begin = matrix.innerIndexPtr() + matrix.outerIndexPtr()[3 * i];
+  const int* end = matrix.innerIndexPtr() + matrix.outerIndexPtr()[3 * i + 1];
+  const int* found = std::lower_bound(begin, end, 3 * j);
+  return found != end && *found == 3 * j ? static_cast<int>(found - begin) : -1;
+}
 
 // Value index of entry (a,b) of block `offset` in row-vertex `row_vertex`.
 inline int block_value_index(const SparseMatrixR& matrix, int row_vertex, int offset, int a,

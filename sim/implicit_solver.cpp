@@ -26,6 +26,12 @@ void ImplicitSolver::add_extra_force(const ClothModel& model, const StepForces* 
                                   s.normal.dot(s.reference_velocity));
     for (int k = 0; k < 3; ++k) force_.segment<3>(3 * corners[k]) += (s.weights[k] * f) * s.normal;
   }
+  for (const PairSpring& s : extra->pair_springs) {
+    const double f =
+        s.stiffness * (s.target - along_pair_normal(s, x)) - s.damping * along_pair_normal(s, v);
+    for (int k = 0; k < 4; ++k)
+      force_.segment<3>(3 * s.vertices[k]) += (s.weights[k] * f) * s.normal;
+  }
 }
 
 void ImplicitSolver::assemble(const ClothModel& model, const ForceSettings& forces, double beta,
@@ -83,6 +89,31 @@ void ImplicitSolver::assemble(const ClothModel& model, const ForceSettings& forc
         const double along = along_spring_normal(s, t.vertices, *u);
         for (int k = 0; k < 3; ++k)
           product_.segment<3>(3 * t.vertices[k]) -= (s.stiffness * s.weights[k] * along) * s.normal;
+      }
+    }
+    // Pair springs: the blocks within each side (see PairSpring); the product term is exact.
+    for (const PairSpring& s : extra->pair_springs) {
+      const Eigen::Matrix3d outer = s.normal * s.normal.transpose();
+      const double scale = beta * beta * s.stiffness + beta * s.damping;
+      for (int k = 0; k < 4; ++k)
+        for (int l = 0; l < 4; ++l) {
+          // Same side: both weights of one sign (a face's corners, an edge's ends), always
+          // neighbours in the mesh. The kept blocks are the Jacobian's per-side blocks, each
+          // positive semi-definite, so A stays positive definite.
+          const double w = scale * s.weights[k] * s.weights[l];
+          if (!(w > 0.0)) continue;
+          const int i = s.vertices[k];
+          const int offset = k == l ? model.pattern.diagonal_offsets[i]
+                                    : block_offset(matrix_, i, s.vertices[l]);
+          if (offset < 0) continue;
+          for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < 3; ++b)
+              values[block_value_index(matrix_, i, offset, a, b)] += w * outer(a, b);
+        }
+      if (u != nullptr) {
+        const double along = along_pair_normal(s, *u);
+        for (int k = 0; k < 4; ++k)
+          product_.segment<3>(3 * s.vertices[k]) -= (s.stiffness * s.weights[k] * along) * s.normal;
       }
     }
   }

@@ -76,15 +76,42 @@ inline double along_spring_normal(const PointSpring& spring, const std::array<in
   return along;
 }
 
+// A repulsion spring between two pieces of the same cloth (self-contact, sim/self_contact.hpp):
+// with s = n·Σ_k w_k x_k the separation of the pair (weights signed: + on the first element,
+// − on the second) and ṡ = n·Σ_k w_k v_k, the force
+//     F = stiffness (target − s) − damping ṡ,
+// of which vertex k takes w_k F n. The two elements are not neighbours in the mesh, so the
+// system matrix (whose pattern is the mesh's) takes only the blocks of its Jacobian within each
+// side, (β² k + β c) w_k w_l n nᵀ for k, l on the same element: each side responds implicitly as
+// if the other held still over the step; the coupling between the sides is explicit.
+struct PairSpring {
+  std::array<int, 4> vertices{};
+  Eigen::Vector4d weights = Eigen::Vector4d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitY();
+  double target = 0.0;     // m
+  double stiffness = 0.0;  // N/m
+  double damping = 0.0;    // kg/s
+};
+
+inline double along_pair_normal(const PairSpring& spring, const Eigen::VectorXd& y) {
+  double along = 0.0;
+  for (int k = 0; k < 4; ++k)
+    along += spring.weights[k] * spring.normal.dot(y.segment<3>(3 * spring.vertices[k]));
+  return along;
+}
+
 // Forces a step adds to the cloth's own, all implicit (their matrices go into A): contact
-// friction as per-vertex drags, body vertices poking through as point springs.
+// friction as per-vertex drags, body vertices poking through as point springs, self-contact as
+// pair springs.
 struct StepForces {
   std::vector<VertexDamping> drags;
   std::vector<PointSpring> springs;
+  std::vector<PairSpring> pair_springs;
 
   void clear() {
     drags.clear();
     springs.clear();
+    pair_springs.clear();
   }
 };
 

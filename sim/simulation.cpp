@@ -50,6 +50,11 @@ void SimulationSettings::validate() const {
   } catch (const InvalidContactSettingsError& error) {
     throw InvalidSimulationSettingsError(error.what());
   }
+  try {
+    self_contact.validate();
+  } catch (const std::invalid_argument& error) {
+    throw InvalidSimulationSettingsError(error.what());
+  }
 }
 
 Simulation::Simulation(ClothModel model, Eigen::VectorXd x0, std::vector<Pin> pins,
@@ -85,6 +90,25 @@ void Simulation::replace_model(ClothModel model, Eigen::VectorXd x, Eigen::Vecto
   has_history_ = false;
   report_.vertices = n;
   report_.triangles = static_cast<int>(model_.triangles.size());
+  // A new mesh: the self-contact tree is rebuilt on it.
+  if (settings_.self_contact.enabled) {
+    const auto start = std::chrono::steady_clock::now();
+    const bool first = !self_contact_;
+    if (first) self_contact_ = std::make_unique<SelfContactResponse>(settings_.self_contact);
+    self_contact_->set_fabric_friction(model_.fabric.friction);
+    self_contact_->set_cloth(model_, x_);
+    if (first) {
+      // A designed start that passes through itself is smoothed apart once, before anything
+      // moves: the continuous tests would keep the intersections for the whole run. Pinned
+      // vertices stay where they are.
+      std::vector<unsigned char> pinned(static_cast<std::size_t>(n), 0);
+      for (const Pin& pin : pins_) pinned[pin.vertex] = 1;
+      report_.self_untangled_vertices = self_contact_->untangle(
+          model_, x_, pinned, &report_.self_intersections_start, &report_.self_untangle_left);
+    }
+    report_.self_collision_s +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
   // New vertex numbering: the contact cache and last step's contacts no longer apply.
   if (contact_) {
     contact_->set_fabric_friction(model_.fabric.friction);
@@ -221,10 +245,24 @@ Simulation::Attempt Simulation::attempt(double h) {
     contact->move_body_to(time_, h);
     contact->constrain_start(x_hat, v_, beta, filter_, y, contact_forces_);
   }
+  // Self-contact (sim/self_contact.hpp): repulsion springs of the layers closer than the
+  // thickness at the start, joining the body's forces in the solve.
+  SelfContactResponse* self = self_contact_.get();
+  std::vector<unsigned char> pinned;
+  if (self != nullptr) {
+    if (contact == nullptr) contact_forces_.clear();
+    pinned.assign(static_cast<std::size_t>(model_.vertex_count), 0);
+    for (int i = 0; i < model_.vertex_count; ++i) pinned[i] = filter_.is_pinned(i);
+    self->add_springs(y.size() == x_.size() ? Eigen::VectorXd(x_ + y) : x_, model_.mass, pinned,
+                      contact_forces_);
+  }
   for (;;) {
     if (contact != nullptr) {
       result.solve = solver_.solve(model_, settings_.forces, filter_, x_hat + y, v_hat, beta,
                                    x_lin + y, v_lin, newton_settings, &contact_forces_);
+    } else if (self != nullptr) {
+      result.solve = solver_.solve(model_, settings_.forces, filter_, x_hat, v_hat, beta, x_lin,
+                                   v_lin, newton_settings, &contact_forces_);
     } else {
       result.solve = solver_.solve(model_, settings_.forces, filter_, x_hat, v_hat, beta, x_lin,
                                    v_lin, newton_settings);
@@ -246,6 +284,14 @@ Simulation::Attempt Simulation::attempt(double h) {
       break;
     }
   }
+
+  // Friction between layers, then the fail-safe on the step's straight paths (impulses, impact
+  // zones): the cloth leaves the step without passing through itself. The paths start at the
+  // accepted state, before the body's position correction, so that a correction pushing a
+  // vertex out of the body cannot carry it through a layer lying on it unseen.
+  if (self != nullptr && result.solve.linear_converged && result.x.allFinite() &&
+      result.v.allFinite())
+    self->resolve(x_, result.x, result.v, beta, model_.mass, pinned, contact_forces_);
 
   std::ostringstream why;
   // Where a failing attempt broke: its first non-finite vertex, else its fastest one.
@@ -302,6 +348,21 @@ void Simulation::accept(Attempt& attempt, double h) {
     report_.projected_vertices += stats.projected;
     contact_->accept_step(attempt.solve.constraint_impulse);
   }
+  if (self_contact_) {
+    const SelfContactStepStats& stats = self_contact_->step_stats();
+    report_.self_contacts_max = std::max(report_.self_contacts_max, stats.springs);
+    report_.self_contacts_final = stats.springs;
+    report_.self_collisions += stats.collisions;
+    report_.self_zone_vertices += stats.zone_vertices;
+    if (stats.unresolved) ++report_.self_unresolved_steps;
+    report_.self_culled_triangles += stats.culled_triangles;
+    report_.self_tested_triangles += stats.triangles;
+    // Kept current here: the adaptive driver steps without run().
+    report_.self_culled_share =
+        report_.self_tested_triangles > 0
+            ? static_cast<double>(report_.self_culled_triangles) / report_.self_tested_triangles
+            : 0.0;
+  }
 
   const double mass = model_.total_mass();
   const double speed = max_speed(v_);
@@ -336,6 +397,7 @@ StepOutcome Simulation::step(double max_step) {
     report_.forces_s += candidate.forces_seconds;
     report_.solve_s += candidate.solve_seconds;
     if (contact_) report_.collision_s += contact_->step_stats().collision_seconds;
+    if (self_contact_) report_.self_collision_s += self_contact_->step_stats().seconds;
     report_.linear_solves += candidate.linear_solves;
     cg_total_ += candidate.cg_iterations;
     report_.cg_iterations_max = std::max(report_.cg_iterations_max, candidate.cg_iterations_max);
@@ -409,6 +471,7 @@ SimulationReport Simulation::run(const std::function<void(const Simulation&)>& o
   const double forces_before = report_.forces_s;
   const double solve_before = report_.solve_s;
   const double collision_before = report_.collision_s;
+  const double self_before = report_.self_collision_s;
   const auto sample = [&] {
     if (!settings_.record_energy) return;
     const EnergyBreakdown e = energy();
@@ -442,7 +505,8 @@ SimulationReport Simulation::run(const std::function<void(const Simulation&)>& o
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   report_.wall_time_s += wall;
   report_.other_s += wall - (report_.forces_s - forces_before) - (report_.solve_s - solve_before) -
-                     (report_.collision_s - collision_before);
+                     (report_.collision_s - collision_before) -
+                     (report_.self_collision_s - self_before);
   report_.cg_iterations_mean =
       report_.linear_solves > 0 ? static_cast<double>(cg_total_) / report_.linear_solves : 0.0;
   report_.newton_iterations_mean =

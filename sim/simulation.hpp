@@ -18,6 +18,7 @@
 #include "sim/contact_response.hpp"
 #include "sim/forces.hpp"
 #include "sim/implicit_solver.hpp"
+#include "sim/self_contact.hpp"
 
 namespace sd::sim {
 
@@ -54,6 +55,7 @@ struct SimulationSettings {
   bool record_energy = true;             // energy time series in the report (one sample a step)
   ForceSettings forces;
   ContactSettings contact;               // used once a body is set (set_body, set_body_motion)
+  SelfContactSettings self_contact;      // cloth-cloth contact (off unless enabled)
 
   void validate() const;  // throws InvalidSimulationSettingsError
 };
@@ -129,6 +131,20 @@ struct SimulationReport {
   double rest_kinetic_per_kg_window = 0.0;
   double rest_speed_final = 0.0;
   double rest_kinetic_per_kg_final = 0.0;
+  // Self-contact (zero when off; sim/self_contact.hpp).
+  int self_intersections_start = 0;  // intersecting triangle pairs of the start
+  int self_untangled_vertices = 0;   // vertices the start's untangling moved
+  int self_untangle_left = 0;        // pairs the untangling could not separate
+  int self_contacts_max = 0;      // most repulsion springs in one accepted step
+  int self_contacts_final = 0;    // in the last step
+  int self_collisions = 0;        // colliding pairs the continuous test found, summed over steps
+  int self_zone_vertices = 0;     // vertices moved rigidly by impact zones, summed over steps
+  int self_unresolved_steps = 0;  // accepted steps whose fail-safe left a collision
+  double self_collision_s = 0.0;  // wall time of self-contact (detection and response)
+  // Share of the cloth's triangles inside regions the curvature test culled, over all steps.
+  double self_culled_share = 0.0;
+  long long self_culled_triangles = 0;  // summed over accepted steps (for the share)
+  long long self_tested_triangles = 0;
   std::vector<EnergySample> energy;
 };
 
@@ -230,6 +246,7 @@ class Simulation {
   StepForces contact_forces_;  // friction drags and piercing springs of the current attempt
   ImplicitSolver solver_;
   std::unique_ptr<ContactResponse> contact_;
+  std::unique_ptr<SelfContactResponse> self_contact_;  // null when self-contact is off
   SimulationReport report_;
   long long newton_total_ = 0;
   long long cg_total_ = 0;

@@ -6,6 +6,9 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <numbers>
+
+#include <Eigen/Geometry>
 
 #include "garment/body_surface.hpp"
 #include "garment/material_frames.hpp"
@@ -50,10 +53,41 @@ void build_sheet_scene(const garment::Sketch& sketch, ClothScene& scene) {
   sheet.pins = spec.pins;
   sim::SheetScene built = sim::build_sheet(sheet);
   scene.input = std::move(built.input);
-  scene.start = scene.input.rest_positions;
   scene.pinned = std::move(built.pinned_vertices);
   scene.triangle_group = Eigen::VectorXi::Zero(scene.input.triangles.rows());
   scene.group_names = {"sheet"};
+  if (spec.layers > 1) {
+    // Layer k: the first moved by k·offset and turned k·turn about the vertical through the
+    // centre; one group per layer so that the previews tell them apart.
+    const Eigen::Index nv = scene.input.rest_positions.rows();
+    const Eigen::Index nf = scene.input.triangles.rows();
+    sim::ClothInput layered = scene.input;
+    layered.rest_positions.resize(nv * spec.layers, 3);
+    layered.triangles.resize(nf * spec.layers, 3);
+    if (layered.warp.rows() > 0) layered.warp.resize(nf * spec.layers, 3);
+    scene.triangle_group.resize(nf * spec.layers);
+    for (int k = 0; k < spec.layers; ++k) {
+      const Eigen::Matrix3d turn =
+          Eigen::AngleAxisd(k * spec.layer_turn * std::numbers::pi / 180.0,
+                            Eigen::Vector3d::UnitY())
+              .toRotationMatrix();
+      for (Eigen::Index i = 0; i < nv; ++i)
+        layered.rest_positions.row(k * nv + i) =
+            (turn * (scene.input.rest_positions.row(i).transpose() - spec.centre) + spec.centre +
+             k * spec.layer_offset)
+                .transpose();
+      for (Eigen::Index f = 0; f < nf; ++f) {
+        layered.triangles.row(k * nf + f) =
+            scene.input.triangles.row(f) + Eigen::RowVector3i::Constant(static_cast<int>(k * nv));
+        if (scene.input.warp.rows() > 0)
+          layered.warp.row(k * nf + f) = (turn * scene.input.warp.row(f).transpose()).transpose();
+        scene.triangle_group(k * nf + f) = k;
+      }
+      if (k > 0) scene.group_names.push_back(fmt::format("sheet {}", k + 1));
+    }
+    scene.input = std::move(layered);
+  }
+  scene.start = scene.input.rest_positions;
   scene.fabric_name = sketch.fabric;
   scene.fabric = fabric_at(sketch, sketch.fabric, "/fabric");
 }
@@ -225,6 +259,8 @@ sim::SimulationSettings simulation_settings(const garment::Sketch& sketch) {
   settings.stop_at_rest = spec.stop_at_rest;
   settings.forces.gravity = spec.gravity;
   settings.contact.check_body_vertices = spec.check_body_vertices;
+  // Garments fold onto themselves (a skirt's front and back, a sleeve); a sheet scene asks.
+  settings.self_contact.enabled = spec.self_collision.value_or(!sketch.sheet.has_value());
   try {
     settings.validate();
   } catch (const sim::InvalidSimulationSettingsError& e) {

@@ -22,6 +22,7 @@
 #include "src/app/cloth_scene.hpp"
 #include "src/app/mesh_export.hpp"
 #include "src/app/pattern_export.hpp"
+#include "src/app/self_intersections.hpp"
 #include "src/app/preview_images.hpp"
 #include "src/app/progress.hpp"
 #include "src/render/scene.hpp"
@@ -105,10 +106,21 @@ nlohmann::json simulation_json(const sim::SimulationReport& r, const sim::Simula
           {"piercing_body_vertices_final", r.piercing_body_vertices_final},
           {"max_piercing_final_m", r.max_piercing_final_m},
           {"contacts_final", r.contacts_final},
+          {"self_collision", s.self_contact.enabled},
+          {"self_intersections_start", r.self_intersections_start},
+          {"self_untangled_vertices", r.self_untangled_vertices},
+          {"self_contacts_max", r.self_contacts_max},
+          {"self_contacts_final", r.self_contacts_final},
+          {"self_collisions", r.self_collisions},
+          {"self_zone_vertices", r.self_zone_vertices},
+          {"self_unresolved_steps", r.self_unresolved_steps},
+          {"self_culled_share", r.self_culled_share},
+          {"self_collision_share", r.wall_time_s > 0.0 ? r.self_collision_s / r.wall_time_s : 0.0},
           {"timing_s",
            {{"forces", r.forces_s},
             {"solve", r.solve_s},
             {"collision", r.collision_s},
+            {"self_collision", r.self_collision_s},
             {"other", r.other_s}}},
           {"settings",
            {{"integrator", s.integrator == sim::Integrator::bdf2 ? "bdf2" : "implicit-euler"},
@@ -425,6 +437,8 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   const double image_s = std::chrono::duration<double>(Clock::now() - image_start).count();
 
   nlohmann::json out = simulation_json(report, settings);
+  // Counted whether or not self-collision was on: what a preview would show.
+  out["self_intersections_final"] = count_self_intersections(draped.vertices, draped.faces);
   out["format"] = "sketchdrape/1 run report";
   out["sketch"] = sketch.file;
   out["scene"] = sketch.sheet ? "sheet" : (sketch.garment_mesh ? "imported garment" : "garment");

@@ -123,6 +123,70 @@ StressScene sphere_strike(double speed) {
   return scene;
 }
 
+// Self-contact scenes on a still floor slab (top at y = 0): a strip of 24 × 6 quads
+// (0.6 × 0.15 m, cotton, rest shape flat).
+enum class SelfFold { crumpled, fast, heavy };
+
+StressScene self_contact_scene(SelfFold kind) {
+  constexpr int kColumns = 24, kRows = 6;
+  constexpr double kLength = 0.6, kGap = 0.008;
+  sim::SheetSpec spec;
+  spec.size = {kLength, kLength * kRows / kColumns};
+  spec.columns = kColumns;
+  spec.rows = kRows;
+  spec.orientation = sim::SheetOrientation::horizontal;
+  spec.centre = Vector3d(0.0, 0.0, 0.0);
+  const sim::SheetScene sheet = sim::build_sheet(spec);
+  StressScene scene;
+  scene.model = sim::build_cloth_model(sheet.input, sim::fabric_preset("cotton"));
+  const double dx = kLength / kColumns;
+  Eigen::MatrixX3d start = sheet.input.rest_positions;
+  for (int r = 0; r <= kRows; ++r)
+    for (int c = 0; c <= kColumns; ++c) {
+      const int v = sheet.vertex(r, c);
+      const double z = start(v, 2);
+      Vector3d p(start(v, 0), 0.01, z);
+      if (kind == SelfFold::crumpled) {
+        // An accordion of six layers 8 mm apart, each fold line midway between its two layers.
+        constexpr int kPerLayer = kColumns / 6;
+        const int layer = c / kPerLayer, j = c % kPerLayer;
+        if (j == 0 && c > 0) {
+          p = Vector3d((layer % 2 == 0 ? 0 : kPerLayer) * dx, 0.01 + (layer - 0.5) * kGap, z);
+        } else {
+          p = Vector3d((layer % 2 == 0 ? j : kPerLayer - j) * dx, 0.01 + layer * kGap, z);
+        }
+      } else if (kind == SelfFold::heavy && c > kColumns / 2) {
+        // The right half folded over the left one, 2 cm above it.
+        p = Vector3d(-(c - kColumns / 2) * dx, 0.03, z);
+      }
+      start.row(v) = p.transpose();
+    }
+  scene.x0 = sim::flatten_positions(start);
+  if (kind == SelfFold::fast) {
+    // The right half flips over the middle line at 20 rad/s (its end at 6 m/s).
+    scene.v0 = Eigen::VectorXd::Zero(scene.x0.size());
+    for (int v = 0; v < start.rows(); ++v)
+      if (start(v, 0) > 0.0) scene.v0(3 * v + 1) = 20.0 * start(v, 0);
+  }
+  const meshing::TriMesh floor = [] {
+    meshing::TriMesh box;
+    const Vector3d lo(-1.0, -0.05, -1.0), hi(1.0, 0.0, 1.0);
+    box.vertices.resize(8, 3);
+    for (int i = 0; i < 8; ++i)
+      box.vertices.row(i) << (i & 1 ? hi.x() : lo.x()), (i & 2 ? hi.y() : lo.y()),
+          (i & 4 ? hi.z() : lo.z());
+    box.faces.resize(12, 3);
+    box.faces << 0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4, 2, 6, 7, 2, 7, 3, 0, 4, 6,
+        0, 6, 2, 1, 3, 7, 1, 7, 5;
+    return box;
+  }();
+  scene.body = sim::make_pose_sequence(floor, {0.0, 1.0}, [&](double) {
+    return Eigen::MatrixX3d::Zero(floor.vertex_count(), 3);
+  });
+  scene.length = kLength;
+  return scene;
+}
+
 enum class PinMotion { jump_up, jump_apart, shake };
 
 // The hanging sheet whose pins move: a 10 cm jump upwards at t = 0.1 s (the pin path is
@@ -363,6 +427,29 @@ std::vector<StressCase> stress_matrix(bool quick) {
       const std::string label = combo_label(combo);
       c.quick = (g == 100.0 && label == "ie-cholmod") || (g == 1000.0 && label == "bdf2-pcg");
       c.build = [] { return hanging_sheet(sim::fabric_preset("cotton")); };
+      add(std::move(c));
+    }
+
+  // Self-contact: a crumpled start, a fast fold, a fold under 10 g (docs/collision.md).
+  for (SelfFold kind : {SelfFold::crumpled, SelfFold::fast, SelfFold::heavy})
+    for (const Combo& combo : {kCombos[1], kCombos[2]}) {
+      StressCase c;
+      c.family = "self-contact";
+      const char* name = kind == SelfFold::crumpled ? "crumpled"
+                         : kind == SelfFold::fast   ? "fast-fold"
+                                                    : "fold-10g";
+      c.id = fmt::format("self-{}-{}", name, combo_label(combo));
+      c.condition = kind == SelfFold::crumpled
+                        ? "starts as an accordion of six layers 8 mm apart on the floor"
+                    : kind == SelfFold::fast ? "half the strip flips over the other at 20 rad/s"
+                                             : "a fold 2 cm high collapses under 10 g";
+      c.parameters["self_fold"] = name;
+      c.settings = base_settings(1.0 / 60, combo);
+      c.settings.self_contact.enabled = true;
+      if (kind == SelfFold::heavy) c.settings.forces.gravity *= 10.0;
+      // The crumpled start still gains energy (docs/collision.md): not in the quick matrix.
+      c.quick = combo_label(combo) == "ie-cholmod" && kind != SelfFold::crumpled;
+      c.build = [kind] { return self_contact_scene(kind); };
       add(std::move(c));
     }
 

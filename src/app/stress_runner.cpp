@@ -15,6 +15,7 @@
 #include <stdexcept>
 
 #include "sim/forces.hpp"
+#include "src/app/self_intersections.hpp"
 
 namespace sd::app {
 namespace {
@@ -233,6 +234,27 @@ StressResult run_stress_case(const StressCase& c, const StressOptions& options) 
   r.contacts_max = report.contacts_max;
   r.max_penetration_m = report.max_penetration_m;
   r.vertices = s.model().vertex_count;
+  // Self-contact holds when the cloth ends without passing through itself (an independent
+  // count on the final mesh) and no step's fail-safe left a collision.
+  if (settings.self_contact.enabled) {
+    const sim::ClothModel& model = s.model();
+    Eigen::MatrixX3i faces(static_cast<Eigen::Index>(model.triangles.size()), 3);
+    for (std::size_t t = 0; t < model.triangles.size(); ++t)
+      for (int k = 0; k < 3; ++k)
+        faces(static_cast<Eigen::Index>(t), k) = model.triangles[t].vertices[k];
+    r.self_intersections_final =
+        count_self_intersections(sim::unflatten_positions(s.positions()), faces);
+    r.self_contacts_max = report.self_contacts_max;
+    if (r.status.empty() && r.self_intersections_final > 0)
+      fail(r, "exploded",
+           fmt::format("t = {:.4f} s: {} pairs of triangles pass through each other at the end",
+                       s.time(), r.self_intersections_final));
+    if (r.status.empty() && report.self_unresolved_steps > 0)
+      fail(r, "exploded",
+           fmt::format("{} steps ended with cloth passing through itself (the fail-safe did not "
+                       "resolve them)",
+                       report.self_unresolved_steps));
+  }
   r.ran_to_end = r.status.empty() &&
                  (r.at_rest || r.sim_time >= settings.duration - 1e-9 * std::max(1.0, settings.duration));
   if (r.status.empty()) {
@@ -278,6 +300,8 @@ nlohmann::json stress_result_json(const StressResult& r) {
           {"topology_changes", r.topology_changes},
           {"contacts_max", r.contacts_max},
           {"max_penetration_m", r.max_penetration_m},
+          {"self_intersections_final", r.self_intersections_final},
+          {"self_contacts_max", r.self_contacts_max},
           {"wall_time_s", r.wall_time_s}};
 }
 
@@ -314,6 +338,8 @@ StressResult stress_result_from_json(const nlohmann::json& j) {
   r.topology_changes = j.at("topology_changes");
   r.contacts_max = j.at("contacts_max");
   r.max_penetration_m = j.at("max_penetration_m");
+  r.self_intersections_final = j.value("self_intersections_final", -1);
+  r.self_contacts_max = j.value("self_contacts_max", 0);
   r.wall_time_s = j.at("wall_time_s");
   return r;
 }

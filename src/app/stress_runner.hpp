@@ -51,6 +51,10 @@ struct StressResult {
   int topology_changes = 0;     // adaptive cases: steps that changed the mesh
   int contacts_max = 0;
   double max_penetration_m = 0.0;
+  // Self-contact cases: intersecting triangle pairs of the final mesh (CGAL, independent of the
+  // simulator), −1 when self-contact is off; most repulsion springs in a step.
+  int self_intersections_final = -1;
+  int self_contacts_max = 0;
   double wall_time_s = 0.0;
 };
 

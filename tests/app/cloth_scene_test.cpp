@@ -77,5 +77,36 @@ TEST(ClothScene, PanelEaseScalesRestShapeAndMass) {
   for (size_t h = 0; h < a.hinges.size(); ++h) EXPECT_EQ(a.hinges[h].rest_angle, b.hinges[h].rest_angle);
 }
 
+// A sheet with "layers": copies stacked by layer_offset and turned by layer_turn about the
+// vertical through the centre, one group each; self-collision is off for sheets unless asked and
+// on for garments.
+TEST(ClothScene, SheetLayersAndTheSelfCollisionDefault) {
+  const std::string sheet = R"({
+    "body": { "mesh": "none" },
+    "sheet": { "size": [0.4, 0.4], "resolution": [4, 4], "orientation": "horizontal",
+               "centre": [0, 1, 0], "layers": 3, "layer_offset": [0.01, 0.05, 0],
+               "layer_turn": 90 }
+  })";
+  const garment::Sketch sketch = garment::parse_sketch(sheet, "layers.json");
+  const ClothScene scene = build_cloth_scene(sketch);
+  ASSERT_EQ(scene.input.rest_positions.rows(), 3 * 25);
+  ASSERT_EQ(scene.input.triangles.rows(), 3 * 32);
+  EXPECT_EQ(scene.group_names.size(), 3u);
+  EXPECT_EQ(scene.triangle_group(32), 1);
+  EXPECT_EQ(scene.input.triangles(32, 0), scene.input.triangles(0, 0) + 25);
+  for (int i = 0; i < 25; ++i) {
+    const Eigen::Vector3d p = scene.start.row(i).transpose() - Eigen::Vector3d(0, 1, 0);
+    // Layer 2: turned 180° about y and moved by twice the offset.
+    const Eigen::Vector3d q = scene.start.row(50 + i).transpose() - Eigen::Vector3d(0, 1, 0);
+    EXPECT_TRUE(q.isApprox(Eigen::Vector3d(-p.x() + 0.02, p.y() + 0.1, -p.z()), 1e-12)) << i;
+  }
+  EXPECT_FALSE(simulation_settings(sketch).self_contact.enabled);
+  const std::string asked = R"({
+    "body": { "mesh": "none" }, "sheet": {}, "simulate": { "self_collision": true } })";
+  EXPECT_TRUE(simulation_settings(garment::parse_sketch(asked, "asked.json")).self_contact.enabled);
+  EXPECT_TRUE(simulation_settings(garment::parse_sketch(two_patches(1.0), "garment.json"))
+                  .self_contact.enabled);
+}
+
 }  // namespace
 }  // namespace sd::app

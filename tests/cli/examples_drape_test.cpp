@@ -186,6 +186,12 @@ TEST_P(ExampleDrape, DrapesToRestOutsideTheBodyAndStaysOn) {
   }
   EXPECT_LT(report["max_penetration_m"].get<double>(), kThickness);
   EXPECT_GT(report["contacts_max"].get<int>(), 0) << "the garment never touched the body";
+  // Self-collision is on for garments unless the example turns it off (the arms-lowering
+  // t-shirt, docs/collision.md): no fold passes through another (CGAL's count).
+  if (sketch["simulate"].value("self_collision", true)) {
+    EXPECT_TRUE(report["self_collision"].get<bool>());
+    EXPECT_EQ(report["self_intersections_final"].get<int>(), 0);
+  }
 
   const ShapeSummary designed = summarise(read_obj(dir / "mesh" / "garment48.obj"));
   const ShapeSummary draped = summarise(read_obj(dir / "run" / "drape.obj"));

@@ -120,6 +120,38 @@ TEST(RunCommand, SheetSceneWritesReportMeshAndTrace) {
   EXPECT_FALSE(fs::exists(out / "drape-front.png"));  // "images": [] asks for none
 }
 
+// The self-collision scenes of data/scenes end without the cloth passing through itself (CGAL's
+// count); two sheets falling onto each other without self-collision do pass through.
+TEST(RunCommand, SelfCollisionScenesEndWithoutIntersections) {
+  for (const std::string name : {"sheet-on-ball", "two-sheets"}) {
+    for (const bool self : {true, false}) {
+      if (!self && name != "two-sheets") continue;
+      const fs::path dir = fresh_dir("self-" + name + (self ? "" : "-off"));
+      nlohmann::json sketch = read_json(fs::path(SD_SOURCE_DIR) / "data/scenes" / (name + ".json"));
+      sketch["body"]["mesh"] =
+          (fs::path(SD_SOURCE_DIR) / "data/scenes" / sketch["body"]["mesh"].get<std::string>())
+              .string();
+      sketch["output"] = {{"images", nlohmann::json::array()}};
+      sketch["simulate"]["self_collision"] = self;
+      const fs::path out = dir / "out";
+      const CommandResult r =
+          run_sketchdrape("-q run " + write_sketch(dir, sketch).string() + " -o " + out.string());
+      ASSERT_EQ(r.exit_code, 0) << r.output;
+      const nlohmann::json report = read_json(out / "report.json");
+      EXPECT_EQ(report["self_collision"].get<bool>(), self);
+      if (self) {
+        EXPECT_EQ(report["self_intersections_final"].get<int>(), 0) << name;
+        EXPECT_EQ(report["self_unresolved_steps"].get<int>(), 0) << name;
+        EXPECT_GT(report["self_contacts_max"].get<int>(), 0) << name;
+        EXPECT_GT(report["self_culled_share"].get<double>(), 0.5) << name;
+        EXPECT_GE(report["timing_s"]["self_collision"].get<double>(), 0.0) << name;
+      } else {
+        EXPECT_GT(report["self_intersections_final"].get<int>(), 0) << name;
+      }
+    }
+  }
+}
+
 TEST(RunCommand, PinnedGarmentDrapesWithImages) {
   const fs::path dir = fresh_dir("garment");
   nlohmann::json sketch = read_json(fs::path(SD_SOURCE_DIR) / "data/examples/a-line-skirt.json");

@@ -87,10 +87,13 @@ TEST(StressCommand, QuickMatrixHoldsAndItsJsonListsEveryCaseFinite) {
     if (c["family"] == "body") {
       EXPECT_GT(c["contacts_max"].get<int>(), 0) << id;
     }
+    if (c["family"] == "self-contact") {
+      EXPECT_EQ(c["self_intersections_final"].get<int>(), 0) << id;
+    }
   }
   // Every family but `sliver`, whose cases all diverge today (docs/stress.md).
   EXPECT_EQ(families, (std::set<std::string>{"stiffness", "undamped", "churn", "body", "pins",
-                                             "gravity", "nan", "stretch"}));
+                                             "gravity", "nan", "stretch", "self-contact"}));
 }
 
 // 100 g with a 1/10 s step: the first step's free fall alone (98 m/s) breaks the 50 m/s speed

@@ -1,0 +1,103 @@
+#pragma once
+// Cloth-cloth contact as the simulator handles it (detection in sim/self_collision.hpp). Per
+// step from x0 to x1:
+//
+//  1. Repulsion inside the implicit solve: every vertex-face and edge-edge pair closer than
+//     `thickness` at the step's start becomes a PairSpring pushing the pair apart to `thickness`,
+//     critically damped, its stiffness m ω² sized from the pair's effective mass m = 1/Σ w_k²/m_k
+//     (as the body's piercing springs are), so its strength follows the cloth's resolution.
+//  2. Friction between the layers after the solve (Bridson et al. 2002 §7.2): each spring's normal
+//     impulse J = β F at the end of the step bounds the change of the pair's relative tangential
+//     velocity to μ J / m (Coulomb), μ the fabric's friction.
+//  3. Fail-safe: a continuous test of the straight paths x0 → x1. Every colliding pair gets an
+//     inelastic impulse that lands it `kSeparation`·thickness apart on the side it came from
+//     (Gauss-Seidel over the pairs, `impulse_passes` times); pairs that still collide are merged
+//     into impact zones (Provot 1997; Bridson et al. 2002 §7.4) that move rigidly over the step
+//     (the mass-weighted translation and rotation of their vertices), growing until no path
+//     collides. A cloth that starts the step free of intersections ends it free of them.
+//
+// Pinned vertices are immovable (infinite mass) in the impulses; a zone holding a pinned vertex
+// moves with the pins' mean displacement.
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "sim/cloth_model.hpp"
+#include "sim/implicit_solver.hpp"
+#include "sim/self_collision.hpp"
+
+namespace sd::sim {
+
+struct SelfContactSettings {
+  bool enabled = false;
+  double thickness = 0.002;  // m: distance kept between two layers of the cloth
+  // m: the continuous test's tolerance; paths that come closer than this collide.
+  double collision_tolerance = 1.0e-5;
+  bool culling = true;       // curvature culling of flat regions (sim/self_collision.hpp)
+  int impulse_passes = 3;    // rounds of impulses before impact zones take over
+  int max_zone_passes = 64;  // rounds of zone growth; then the whole cloth moves rigidly
+  // Coulomb coefficient between two layers; negative: the fabric's own friction.
+  double friction = -1.0;
+
+  void validate() const;  // throws std::invalid_argument naming the setting
+};
+
+struct SelfContactStepStats {
+  int springs = 0;          // repulsion springs in the solve
+  int collisions = 0;       // colliding pairs found by the first continuous test
+  int impulse_rounds = 0;   // continuous tests with impulses after the first
+  int zone_rounds = 0;      // rounds of impact-zone growth
+  int zone_vertices = 0;    // vertices moved rigidly
+  bool unresolved = false;  // collisions left after every round (should not happen)
+  int triangles = 0;
+  int culled_triangles = 0;  // in regions the curvature test declared safe (start query)
+  double seconds = 0.0;      // wall time of everything above
+};
+
+class SelfContactResponse {
+ public:
+  explicit SelfContactResponse(SelfContactSettings settings);
+
+  const SelfContactSettings& settings() const { return settings_; }
+  // A new or changed mesh (adaptive refinement renumbers it): rebuilds the tree at x (3n).
+  void set_cloth(const ClothModel& model, const Eigen::VectorXd& x);
+  void set_fabric_friction(double friction) { fabric_friction_ = friction; }
+  double friction() const {
+    return settings_.friction >= 0.0 ? settings_.friction : fabric_friction_;
+  }
+
+  // A start that passes through itself (a folded quad of a designed garment): the vertices of
+  // the intersecting triangles and their neighbours are smoothed (each moved halfway to the mean
+  // of its neighbours, pinned ones kept) in growing rings until no pair intersects, at most 120
+  // rounds. Returns the vertices moved; `found`: pairs at the start, `remaining`: after.
+  int untangle(const ClothModel& model, Eigen::VectorXd& x,
+               const std::vector<unsigned char>& pinned, int* found = nullptr,
+               int* remaining = nullptr);
+
+  // Step 1: springs of the pairs closer than the thickness at `start` (3n) into extra.
+  // pinned: per vertex, 1 when the step's filter pins it.
+  void add_springs(const Eigen::VectorXd& start, const Eigen::VectorXd& mass,
+                   const std::vector<unsigned char>& pinned, StepForces& extra);
+  // Steps 2 and 3 on the solve's result: x1 (3n) and v1 change together (v1 += Δx1 / beta).
+  void resolve(const Eigen::VectorXd& x0, Eigen::VectorXd& x1, Eigen::VectorXd& v1, double beta,
+               const Eigen::VectorXd& mass, const std::vector<unsigned char>& pinned,
+               const StepForces& extra);
+
+  const SelfContactStepStats& step_stats() const { return stats_; }
+  SelfCollider& collider() { return collider_; }
+
+ private:
+  void apply_friction(Eigen::VectorXd& x1, Eigen::VectorXd& v1, double beta,
+                      const Eigen::VectorXd& mass, const std::vector<unsigned char>& pinned,
+                      const StepForces& extra) const;
+  // One Gauss-Seidel round of inelastic impulses over `hits`.
+  void apply_impulses(const std::vector<SelfPair>& hits, Eigen::VectorXd& x1,
+                      const Eigen::VectorXd& mass, const std::vector<unsigned char>& pinned) const;
+
+  SelfContactSettings settings_;
+  SelfCollider collider_;
+  double fabric_friction_ = 0.3;
+  SelfContactStepStats stats_;
+};
+
+}  // namespace sd::sim
