@@ -674,10 +674,26 @@ SheetSpec parse_sheet(const Reader& r, const json& j) {
     for (size_t i = 0; i < pins.size(); ++i) {
       const std::string pp = fmt::format("{}/pins/{}", path, i);
       const std::string name = r.text(pins[i], pp);
-      if (std::find(std::begin(kNames), std::end(kNames), name) == std::end(kNames))
+      // A clamp "top:N" holds N lines of vertices from that edge (a cantilever's clamp).
+      const std::size_t colon = name.find(':');
+      const std::string edge = name.substr(0, colon);
+      const bool clamp = colon != std::string::npos &&
+                         (edge == "top" || edge == "bottom" || edge == "left" || edge == "right");
+      if (clamp) {
+        const std::string digits = name.substr(colon + 1);
+        const int lines = (edge == "top" || edge == "bottom" ? sheet.rows : sheet.columns) + 1;
+        const bool number = !digits.empty() && digits.size() < 7 &&
+                            std::all_of(digits.begin(), digits.end(),
+                                        [](char ch) { return ch >= '0' && ch <= '9'; });
+        if (!number || std::stoi(digits) < 1 || std::stoi(digits) > lines)
+          r.fail(pp, fmt::format("the clamp '{}' must hold 1 to {} lines of vertices ({}:N)", name,
+                                 lines, edge));
+      } else if (std::find(std::begin(kNames), std::end(kNames), name) == std::end(kNames)) {
         r.fail(pp, fmt::format("unknown pin '{}'; use a corner (top-left, top-right, bottom-left, "
-                               "bottom-right) or an edge (top, bottom, left, right)",
+                               "bottom-right), an edge (top, bottom, left, right) or a clamp of "
+                               "several lines of vertices (top:3)",
                                name));
+      }
       sheet.pins.push_back(name);
     }
   }
@@ -851,7 +867,18 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
   }
   if (root.contains("relax_iterations"))
     sketch.relax_iterations = r.integer(root["relax_iterations"], "/relax_iterations", 0);
-  if (root.contains("fabric")) sketch.fabric = r.text(root["fabric"], "/fabric");
+  if (root.contains("fabric")) {
+    // A preset name, a path to a fabric file, or the fabric's constants inline (the presets'
+    // schema, checked when the scene is built).
+    if (root["fabric"].is_object()) {
+      sketch.fabric_inline = root["fabric"].dump();
+      sketch.fabric = root["fabric"].contains("name") && root["fabric"]["name"].is_string()
+                          ? root["fabric"]["name"].get<std::string>()
+                          : "custom";
+    } else {
+      sketch.fabric = r.text(root["fabric"], "/fabric");
+    }
+  }
   if (root.contains("simulate")) parse_simulate(r, root["simulate"], sketch.simulate);
   if (root.contains("output")) parse_output(r, root["output"], sketch.output);
 

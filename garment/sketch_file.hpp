@@ -203,7 +203,8 @@ struct Sketch {
   double junction_tolerance = 0.015;       // metres: endpoints closer than this meet
   double corner_angle_degrees = 35.0;      // a junction turning more than this is a corner
   int relax_iterations = 10;               // interior smoothing sweeps of the quad filler
-  std::string fabric = "jersey";            // a preset of data/fabrics (sketchdrape run checks it)
+  std::string fabric = "jersey";            // a preset of data/fabrics or a fabric .json path (sketchdrape run checks it)
+  std::string fabric_inline;                // "fabric" given as an object: its JSON text (then `fabric` is its name)
   std::optional<std::string> garment_mesh; // triangle garment file: skips sketching and meshing
   std::optional<SheetSpec> sheet;          // a sheet scene: no curves, panels or (unless given) body
   std::vector<CurveSpec> curves;

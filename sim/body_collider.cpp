@@ -446,7 +446,7 @@ std::vector<BodyPiercing> BodyCollider::find_piercings(
       if (t[k] < 0 || 3 * static_cast<Eigen::Index>(t[k]) >= x.size())
         throw std::invalid_argument("a cloth triangle's vertex index is out of range");
   if (triangles.empty() || !(max_height > min_height)) return result;
-  // Cells as large as the longest cloth edge: a triangle's box spans at most two cells per axis.
+  // Cells as large as the longest cloth edge or the reach, whichever is larger (see below).
   Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d high = -low;
   double longest = 0.0;
@@ -462,7 +462,11 @@ std::vector<BodyPiercing> BodyCollider::find_piercings(
   const double reach = std::max({std::abs(min_height), std::abs(max_height), 1e-9});
   low.array() -= reach;
   high.array() += reach;
-  const double cell = longest;
+  // Cells at least as large as the reach too: with cells of the longest edge alone, a fine
+  // cloth (0.15 mm edges) and a reach of centimetres put each triangle in (2·reach/edge)³ cells,
+  // millions each (the 17 GB of a sketched strip's piercing count). With cell ≥ max(edge, reach)
+  // a grown box spans at most 4 cells per axis.
+  const double cell = std::max(longest, reach);
   const Eigen::Vector3d extent = high - low;
   constexpr std::int64_t kMaxCells = 1 << 20;  // per axis, so that a key packs in 63 bits
   if ((extent / cell).maxCoeff() >= static_cast<double>(kMaxCells)) return result;
@@ -490,6 +494,7 @@ std::vector<BodyPiercing> BodyCollider::find_piercings(
         for (int k = c0.z(); k <= c1.z(); ++k) cells.emplace_back(key_of({i, j, k}), t);
   }
   std::sort(cells.begin(), cells.end());
+  stats.grid_entries = static_cast<std::int64_t>(cells.size());
   // Unit normals once per triangle (zero when degenerate), not once per pair.
   std::vector<Eigen::Vector3d> normals(triangles.size());
   for (std::size_t t = 0; t < triangles.size(); ++t)

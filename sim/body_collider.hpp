@@ -92,6 +92,7 @@ struct PiercingQueryStats {
   int pairs = 0;          // vertex-triangle pairs tested
   int inside_checks = 0;  // signed-distance searches to confirm the triangle dips into the body
   int piercings = 0;
+  std::int64_t grid_entries = 0;  // (cell, triangle) entries of the broad-phase grid
 };
 
 struct ContactQuery {

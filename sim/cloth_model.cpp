@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 #include <tuple>
 #include <sstream>
 #include <string>
 #include <utility>
 
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 #include <spdlog/spdlog.h>
 
 #include "sim/element_forces.hpp"
@@ -139,6 +141,113 @@ HingeElement make_hinge(const Eigen::MatrixX3d& rest, const std::array<int, 3>& 
   return h;
 }
 
+// How a hinge's angle responds to a smooth bend, from its rest geometry: for the height field
+// w = ½·pᵀKp over the hinge's (unfolded) plane, interpolated linearly on its two triangles, the
+// linearised dihedral angle is θ = a_nn·nᵀKn + a_tt·tᵀKt + a_nt·tᵀKn (t along the edge, n
+// towards apex x2). Each apex contributes its height above the edge's interpolation over its
+// distance d_i: a_nn = (d2 + d3)/2, a_tt = Σ s_i(s_i − ℓ)/(2 d_i), a_nt = s2 − s3, where s_i
+// is where apex i projects along the edge (from x0) and ℓ the edge length (docs/simulator.md,
+// "Bending on any mesh").
+struct HingeResponse {
+  double a_nn = 0.0, a_tt = 0.0, a_nt = 0.0;
+  double areas = 0.0;  // A1 + A2, m²
+};
+
+HingeResponse hinge_response(const Eigen::MatrixX3d& rest, const HingeElement& h) {
+  const Vector3d p0 = rest.row(h.vertices[0]);
+  const Vector3d p1 = rest.row(h.vertices[1]);
+  const double length = (p1 - p0).norm();
+  const Vector3d t = (p1 - p0) / length;
+  HingeResponse r;
+  double s[2], d[2];
+  for (int i = 0; i < 2; ++i) {
+    const Vector3d q = Vector3d(rest.row(h.vertices[2 + i])) - p0;
+    s[i] = q.dot(t);
+    const Vector3d across = q - s[i] * t;
+    d[i] = across.norm();
+  }
+  r.a_nn = 0.5 * (d[0] + d[1]);
+  r.a_tt = s[0] * (s[0] - length) / (2.0 * d[0]) + s[1] * (s[1] - length) / (2.0 * d[1]);
+  r.a_nt = s[0] - s[1];
+  r.areas = 0.5 * length * (d[0] + d[1]);
+  return r;
+}
+
+// Scales each hinge's weight |e|²/(A1+A2) by a_nn²/(a_nn² + a_tt² + a_nt²/2), the share of
+// the hinge's response that comes from bends across its edge. |e|²/(A1+A2) alone is exact for a
+// bend across the edge (θ = a_nn·κ, ½·B·weight·θ² = ½·B·κ²·(A1+A2)), but a hinge whose apexes
+// are not symmetric about the edge's normal line also bends under bends along the edge (a_tt)
+// and under twist (a_nt): on the 4-8 mesh each hypotenuse hinge bends as much under a bend along
+// it as across, so a bend at 45° to the grid costs 1.5 times the continuum energy. With the
+// factor (1 for the 4-8 legs, ½ for its hypotenuses) the 4-8 mesh's hinges hold ½·B·tr(K²) per
+// area for every smooth curvature K, in either orientation: the legs measure the normal
+// curvatures along the grid, the hypotenuses the twist.
+void calibrate_hinge_weights(const Eigen::MatrixX3d& rest, std::vector<HingeElement>& hinges) {
+  for (HingeElement& h : hinges) {
+    const HingeResponse r = hinge_response(rest, h);
+    const double length2 =
+        (Vector3d(rest.row(h.vertices[1])) - Vector3d(rest.row(h.vertices[0]))).squaredNorm();
+    const double across = r.a_nn * r.a_nn;
+    h.weight = length2 / r.areas * across / (across + r.a_tt * r.a_tt + 0.5 * r.a_nt * r.a_nt);
+  }
+}
+
+// The bend stencils of every vertex whose one-ring has more points than the smooth shapes
+// (1, u, v, u², uv, v² and the rest surface's own height over the tangent plane) constrain:
+// the null space of that 7-row condition matrix, from an SVD.
+std::vector<BendStencil> make_bend_stencils(const Eigen::MatrixX3d& rest,
+                                            const Eigen::MatrixX3i& faces) {
+  const int n = static_cast<int>(rest.rows());
+  std::vector<std::vector<int>> ring(static_cast<std::size_t>(n));
+  std::vector<Vector3d> vertex_normal(static_cast<std::size_t>(n), Vector3d::Zero());
+  std::vector<double> area(static_cast<std::size_t>(n), 0.0);
+  for (Eigen::Index f = 0; f < faces.rows(); ++f) {
+    const Vector3d p0 = rest.row(faces(f, 0));
+    const Vector3d area_normal =
+        (Vector3d(rest.row(faces(f, 1))) - p0).cross(Vector3d(rest.row(faces(f, 2))) - p0);
+    for (int k = 0; k < 3; ++k) {
+      const auto v = static_cast<std::size_t>(faces(f, k));
+      vertex_normal[v] += area_normal;
+      area[v] += area_normal.norm() / 6.0;
+      for (int l = 0; l < 3; ++l) ring[v].push_back(faces(f, l));
+    }
+  }
+  std::vector<BendStencil> stencils;
+  for (int v = 0; v < n; ++v) {
+    std::vector<int>& points = ring[static_cast<std::size_t>(v)];
+    std::sort(points.begin(), points.end());
+    points.erase(std::unique(points.begin(), points.end()), points.end());
+    const int count = static_cast<int>(points.size());
+    if (count < 7) continue;
+    const Vector3d normal = vertex_normal[static_cast<std::size_t>(v)].normalized();
+    const Vector3d centre = rest.row(v);
+    double radius2 = 0.0;
+    for (int j : points) radius2 += (Vector3d(rest.row(j)) - centre).squaredNorm();
+    const double radius = std::sqrt(radius2 / (count - 1));
+    const Vector3d e1 = normal.unitOrthogonal();
+    const Vector3d e2 = normal.cross(e1);
+    Eigen::MatrixXd conditions(7, count);
+    for (int j = 0; j < count; ++j) {
+      const Vector3d d = (Vector3d(rest.row(points[static_cast<std::size_t>(j)])) - centre) / radius;
+      const double u = d.dot(e1), w = d.dot(e2);
+      conditions.col(j) << 1.0, u, w, u * u, u * w, w * w, d.dot(normal);
+    }
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(conditions, Eigen::ComputeFullV);
+    const Eigen::VectorXd& sigma = svd.singularValues();
+    int rank = 0;
+    while (rank < sigma.size() && sigma(rank) > 1e-9 * sigma(0)) ++rank;
+    if (rank >= count) continue;
+    const Eigen::MatrixXd null = svd.matrixV().rightCols(count - rank);  // count × k, orthonormal
+    BendStencil stencil;
+    stencil.vertices = points;
+    const double rho2 = radius2 / (count - 1);  // m², mean squared distance of the ring
+    stencil.coupling = (area[static_cast<std::size_t>(v)] / (rho2 * rho2)) * (null * null.transpose());
+    stencil.blocks.assign(static_cast<std::size_t>(count * count), 0);
+    stencils.push_back(std::move(stencil));
+  }
+  return stencils;
+}
+
 // The vertices adjacent to each vertex (itself included) through triangles and hinges, as one
 // flat array: vertex i's run starts at start[i], its first size[i] entries are the distinct
 // neighbours in increasing order (the rest is room left by duplicates).
@@ -162,13 +271,16 @@ struct Neighbours {
 
 // Room in vertex runs for every element's entries: 1 for itself, 2 per triangle, 3 per hinge.
 std::vector<int> run_starts(int n, const std::vector<TriangleElement>& triangles,
-                            const std::vector<HingeElement>& hinges) {
+                            const std::vector<HingeElement>& hinges,
+                            const std::vector<BendStencil>& stencils) {
   std::vector<int> start(n + 1, 0);
   for (int i = 0; i < n; ++i) start[i + 1] = 1;  // itself
   for (const TriangleElement& t : triangles)
     for (int v : t.vertices) start[v + 1] += 2;
   for (const HingeElement& h : hinges)
     for (int v : h.vertices) start[v + 1] += 3;
+  for (const BendStencil& b : stencils)
+    for (int v : b.vertices) start[v + 1] += static_cast<int>(b.vertices.size()) - 1;
   for (int i = 0; i < n; ++i) start[i + 1] += start[i];
   return start;
 }
@@ -176,7 +288,8 @@ std::vector<int> run_starts(int n, const std::vector<TriangleElement>& triangles
 // Fills the runs of the vertices with wanted[i] (every vertex when empty) from the elements and
 // sorts them.
 void collect_neighbours(Neighbours& neighbours, const std::vector<TriangleElement>& triangles,
-                        const std::vector<HingeElement>& hinges, const std::vector<char>& wanted) {
+                        const std::vector<HingeElement>& hinges,
+                        const std::vector<BendStencil>& stencils, const std::vector<char>& wanted) {
   const int n = static_cast<int>(neighbours.size.size());
   const auto want = [&](int v) { return wanted.empty() || wanted[static_cast<std::size_t>(v)]; };
   std::vector<int> fill(neighbours.start.begin(), neighbours.start.end() - 1);
@@ -191,6 +304,8 @@ void collect_neighbours(Neighbours& neighbours, const std::vector<TriangleElemen
   };
   for (const TriangleElement& t : triangles) connect(t.vertices.data(), 3);
   for (const HingeElement& h : hinges) connect(h.vertices.data(), 4);
+  for (const BendStencil& b : stencils)
+    connect(b.vertices.data(), static_cast<int>(b.vertices.size()));
   for (int i = 0; i < n; ++i)
     if (want(i)) neighbours.sort_run(i);
 }
@@ -233,6 +348,15 @@ void set_block_offsets(ClothModel& model, const Neighbours& neighbours,
       if (want(h.vertices[k]))
         for (int l = 0; l < 4; ++l)
           h.blocks[4 * k + l] = neighbours.offset(h.vertices[k], h.vertices[l]);
+  // Stencils are rebuilt with every model, so all their offsets are set.
+  for (BendStencil& b : model.stencils) {
+    const int count = static_cast<int>(b.vertices.size());
+    for (int k = 0; k < count; ++k)
+      for (int l = 0; l < count; ++l)
+        b.blocks[static_cast<std::size_t>(count * k + l)] =
+            neighbours.offset(b.vertices[static_cast<std::size_t>(k)],
+                              b.vertices[static_cast<std::size_t>(l)]);
+  }
 }
 
 }  // namespace
@@ -328,15 +452,20 @@ ClothModel build_cloth_model(const ClothInput& input, const FabricParameters& fa
   }
   if (non_manifold > 0)
     spdlog::warn("cloth mesh: {} non-manifold edges get no bending stiffness", non_manifold);
+  if (options.bend_weights == BendWeights::calibrated)
+    calibrate_hinge_weights(rest, model.hinges);
+  model.bend_stencil_stiffness = options.bend_stencil_stiffness;
+  if (options.bend_stencil_stiffness > 0.0)
+    model.stencils = make_bend_stencils(rest, input.triangles);
 
   // Block sparsity pattern: vertex adjacency through triangles and hinges, as one flat array
   // (CSR by vertex: room for every element's entries, then each vertex's run sorted and
   // deduplicated in place).
   Neighbours neighbours;
-  neighbours.start = run_starts(n, model.triangles, model.hinges);
+  neighbours.start = run_starts(n, model.triangles, model.hinges, model.stencils);
   neighbours.list.resize(static_cast<std::size_t>(neighbours.start[n]));
   neighbours.size.resize(n);
-  collect_neighbours(neighbours, model.triangles, model.hinges, {});
+  collect_neighbours(neighbours, model.triangles, model.hinges, model.stencils, {});
   model.pattern.zero_matrix = zero_pattern_matrix(neighbours);
   set_block_offsets(model, neighbours, {});
   return model;
@@ -488,6 +617,32 @@ ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse&
   model.hinges.resize(kept_hinges.size() + made_hinges.size());
   std::merge(kept_hinges.begin(), kept_hinges.end(), made_hinges.begin(), made_hinges.end(),
              model.hinges.begin(), by_edge);
+  // Calibrated weights depend on the hinges around both ends: all are recomputed (linear time),
+  // as build_cloth_model does.
+  if (options.bend_weights == BendWeights::calibrated)
+    calibrate_hinge_weights(rest, model.hinges);
+  // Stencils are rebuilt too; a row whose stencils are not all the previous ones (the same
+  // vertices) is rebuilt.
+  model.bend_stencil_stiffness = options.bend_stencil_stiffness;
+  if (options.bend_stencil_stiffness > 0.0)
+    model.stencils = make_bend_stencils(rest, input.triangles);
+  {
+    std::set<std::vector<int>> before, after;
+    for (const BendStencil& b : previous.stencils) before.insert(b.vertices);
+    for (const BendStencil& b : model.stencils) {
+      std::vector<int> key;
+      for (int v : b.vertices) key.push_back(reuse.previous_vertex[static_cast<std::size_t>(v)]);
+      std::sort(key.begin(), key.end());
+      after.insert(key);
+      if (key.front() < 0 || before.count(key) == 0)
+        for (int v : b.vertices) changed_row[static_cast<std::size_t>(v)] = 1;
+    }
+    for (const std::vector<int>& key : before)
+      if (after.count(key) == 0)
+        for (int p : key)
+          if (const int i = next_vertex[static_cast<std::size_t>(p)]; i >= 0)
+            changed_row[static_cast<std::size_t>(i)] = 1;
+  }
 
   // Pattern: unchanged rows are the previous rows renumbered (kept vertices keep their order,
   // so each run stays sorted), the changed ones are collected from the elements and sorted.
@@ -497,7 +652,7 @@ ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse&
     return (old_pattern.outerIndexPtr()[3 * p + 1] - old_pattern.outerIndexPtr()[3 * p]) / 3;
   };
   // A changed row gets room as in build_cloth_model, an unchanged one its previous size.
-  const std::vector<int> room = run_starts(n, model.triangles, model.hinges);
+  const std::vector<int> room = run_starts(n, model.triangles, model.hinges, model.stencils);
   Neighbours neighbours;
   neighbours.start.assign(static_cast<std::size_t>(n) + 1, 0);
   for (int i = 0; i < n; ++i)
@@ -515,7 +670,7 @@ ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse&
           renumber(columns[3 * m] / 3);
     neighbours.size[i] = size;
   }
-  collect_neighbours(neighbours, model.triangles, model.hinges, changed_row);
+  collect_neighbours(neighbours, model.triangles, model.hinges, model.stencils, changed_row);
   model.pattern.zero_matrix = zero_pattern_matrix(neighbours);
   // Offsets in unchanged rows are the previous ones (kept elements brought them along).
   model.pattern.diagonal_offsets.resize(static_cast<std::size_t>(n));

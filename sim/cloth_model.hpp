@@ -43,8 +43,22 @@ enum class BendRestShape {
   flat,      // every rest angle zero
 };
 
+// How the hinges' bending weights are set (docs/simulator.md, "Bending on any mesh").
+enum class BendWeights {
+  // |e|²/(A1+A2)·a_nn²/(a_nn² + a_tt² + a_nt²/2): on the 4-8 mesh every smooth bend then
+  // costs the continuum energy ½·B·tr(K²), in any direction and either orientation.
+  calibrated,
+  edge,  // |e|²/(A1+A2): exact for a bend across the edge only
+};
+
 struct ClothModelOptions {
   BendRestShape bend_rest = BendRestShape::designed;
+  BendWeights bend_weights = BendWeights::edge;
+  // Stiffness of the bend stencils relative to the fabric's B (0: none); see BendStencil.
+  // Off by default: they hold the 4-8 mesh's sublattice mode only away from the boundary
+  // (docs/simulator.md, "Bending on any mesh"). Built from the unscaled rest shape (a panel's
+  // ease does not rescale them).
+  double bend_stencil_stiffness = 0.0;
 };
 
 // Row-major 3n-by-3n matrix, the layout the system matrix and the Jacobians share.
@@ -64,8 +78,20 @@ struct TriangleElement {
 struct HingeElement {
   std::array<int, 4> vertices{};
   double rest_angle = 0.0;  // rad, in (−π, π]
-  double weight = 0.0;      // |e|²/(A1+A2) in the rest shape, dimensionless
+  double weight = 0.0;      // |e|²/(A1+A2) in the rest shape (or calibrated), dimensionless
   std::array<int, 16> blocks{};
+};
+
+// A vertex and its one-ring, with the combinations of their positions that vanish for every
+// smooth (quadratic) shape of the rest surface around the vertex: they measure only the
+// grid-scale zigzag that hinge angles cannot see (on the 4-8 mesh, the two kinds of vertices
+// moving against each other). Energy ½·k·B·Σ_jl coupling(j,l)·x_j·x_l with
+// coupling = A_v·RᵀR (R: the combinations, rows orthonormal, scaled by 1/ρ², ρ the one-ring's
+// rms radius; A_v the vertex's area), zero at the rest shape and for any rigid motion.
+struct BendStencil {
+  std::vector<int> vertices;  // sorted, the centre among them
+  Eigen::MatrixXd coupling;   // #vertices square, 1/m², symmetric positive semi-definite
+  std::vector<int> blocks;    // #vertices², offset of block (j,l), see BlockPattern
 };
 
 // Structurally symmetric block sparsity: rows 3i..3i+2 all hold the columns of the vertices
@@ -81,6 +107,8 @@ struct ClothModel {
   FabricParameters fabric;
   std::vector<TriangleElement> triangles;
   std::vector<HingeElement> hinges;
+  std::vector<BendStencil> stencils;  // with ClothModelOptions::bend_stencil_stiffness > 0
+  double bend_stencil_stiffness = 0.0;
   Eigen::VectorXd mass;         // #V lumped masses, kg
   Eigen::VectorXd vertex_area;  // #V rest area attributed to each vertex (a third of each face)
   BlockPattern pattern;

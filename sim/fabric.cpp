@@ -17,15 +17,15 @@ namespace {
 
 enum class Bound { positive, non_negative };
 
-void check_constant(const std::string& fabric, const char* what, double value, Bound bound,
-                    const char* unit) {
+void check_constant(const std::string& fabric, const char* key, const char* what, double value,
+                    Bound bound, const char* unit) {
   const bool ok = std::isfinite(value) && (bound == Bound::positive ? value > 0.0 : value >= 0.0);
   if (!ok) {
     std::ostringstream message;
     message << "fabric '" << fabric << "': " << what << " is " << value << " " << unit
             << " but must be " << (bound == Bound::positive ? "greater than zero" : "zero or more")
             << " and finite";
-    throw InvalidFabricError(message.str());
+    throw InvalidFabricError(message.str(), std::string("/") + key);
   }
 }
 
@@ -50,15 +50,15 @@ constexpr ConstantSpec kConstants[] = {
 }  // namespace
 
 void FabricParameters::validate() const {
-  check_constant(name, "area density", area_density, Bound::positive, "kg/m^2");
-  check_constant(name, "warp stretch stiffness", stretch_warp, Bound::positive, "N/m");
-  check_constant(name, "weft stretch stiffness", stretch_weft, Bound::positive, "N/m");
-  check_constant(name, "shear stiffness", shear, Bound::non_negative, "N/m");
-  check_constant(name, "bending rigidity", bend, Bound::non_negative, "N*m");
-  check_constant(name, "damping", damping, Bound::non_negative, "s");
-  check_constant(name, "bend damping", bend_damping, Bound::non_negative, "s");
-  check_constant(name, "friction", friction, Bound::non_negative, "");
-  check_constant(name, "thickness", thickness, Bound::positive, "m");
+  check_constant(name, "area_density", "area density", area_density, Bound::positive, "kg/m^2");
+  check_constant(name, "stretch_warp", "warp stretch stiffness", stretch_warp, Bound::positive, "N/m");
+  check_constant(name, "stretch_weft", "weft stretch stiffness", stretch_weft, Bound::positive, "N/m");
+  check_constant(name, "shear", "shear stiffness", shear, Bound::non_negative, "N/m");
+  check_constant(name, "bend", "bending rigidity", bend, Bound::non_negative, "N*m");
+  check_constant(name, "damping", "damping", damping, Bound::non_negative, "s");
+  check_constant(name, "bend_damping", "bend damping", bend_damping, Bound::non_negative, "s");
+  check_constant(name, "friction", "friction", friction, Bound::non_negative, "");
+  check_constant(name, "thickness", "thickness", thickness, Bound::positive, "m");
 }
 
 FabricParameters parse_fabric_json(std::string_view text, const std::string& origin) {
@@ -72,22 +72,28 @@ FabricParameters parse_fabric_json(std::string_view text, const std::string& ori
   FabricParameters fabric;
   if (document.contains("name")) {
     if (!document["name"].is_string())
-      throw InvalidFabricError(origin + ": /name must be a string");
+      throw InvalidFabricError(origin + ": /name must be a string", "/name");
     fabric.name = document["name"].get<std::string>();
   }
   for (const ConstantSpec& spec : kConstants) {
     const std::string pointer = std::string("/") + spec.key;
     if (!document.contains(spec.key))
       throw InvalidFabricError(origin + ": " + pointer + " is missing (expected {\"value\": ..., " +
-                               "\"unit\": \"" + spec.unit + "\"})");
+                                   "\"unit\": \"" + spec.unit + "\"})",
+                               pointer);
     const nlohmann::json& entry = document[spec.key];
     if (!entry.is_object() || !entry.contains("value") || !entry["value"].is_number())
-      throw InvalidFabricError(origin + ": " + pointer + " must be an object with a numeric value");
+      throw InvalidFabricError(origin + ": " + pointer + " must be an object with a numeric value",
+                               pointer);
     if (!entry.contains("unit") || entry["unit"] != spec.unit)
-      throw InvalidFabricError(origin + ": " + pointer + " must be given in " + spec.unit);
+      throw InvalidFabricError(origin + ": " + pointer + " must be given in " + spec.unit, pointer);
     fabric.*spec.field = entry["value"].get<double>();
   }
-  fabric.validate();
+  try {
+    fabric.validate();
+  } catch (const InvalidFabricError& e) {
+    throw InvalidFabricError(origin + ": " + e.what(), e.pointer());
+  }
   return fabric;
 }
 

@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace sd::sim {
@@ -12,7 +13,13 @@ namespace sd::sim {
 // A fabric constant that is missing, negative, zero where it must not be, or not finite.
 class InvalidFabricError : public std::invalid_argument {
  public:
-  using std::invalid_argument::invalid_argument;
+  explicit InvalidFabricError(const std::string& message, std::string pointer = {})
+      : std::invalid_argument(message), pointer_(std::move(pointer)) {}
+  // JSON pointer of the offending value inside the fabric's JSON ("/bend"), empty if none.
+  const std::string& pointer() const { return pointer_; }
+
+ private:
+  std::string pointer_;
 };
 
 // A preset name that is not shipped (the message lists the known names).

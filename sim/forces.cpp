@@ -106,6 +106,43 @@ void evaluate_forces(const ClothModel& model, const ForceSettings& settings,
                     vs.data(), h.blocks.data(), v, force, local_energy.bend, jacobian);
     }
   }
+  if (terms.bend && fabric.bend > 0.0 && model.bend_stencil_stiffness > 0.0) {
+    // Quadratic, so its Hessian is exact in both Jacobian kinds and positive semi-definite:
+    // f_j = −k Σ_l C_jl (x_l + β v_l), ∂f_j/∂x_l = −k C_jl I, ∂f_j/∂v_l = −k β C_jl I.
+    const double k = model.bend_stencil_stiffness * fabric.bend;
+    const double beta = damping_scale * fabric.bend_damping;
+    for (const BendStencil& b : model.stencils) {
+      const int count = static_cast<int>(b.vertices.size());
+      for (int j = 0; j < count; ++j) {
+        Vector3d sum_x = Vector3d::Zero(), sum_v = Vector3d::Zero();
+        for (int l = 0; l < count; ++l) {
+          const double c = b.coupling(j, l);
+          sum_x += c * x.segment<3>(3 * b.vertices[static_cast<std::size_t>(l)]);
+          sum_v += c * v.segment<3>(3 * b.vertices[static_cast<std::size_t>(l)]);
+        }
+        const int vj = b.vertices[static_cast<std::size_t>(j)];
+        local_energy.bend += 0.5 * k * sum_x.dot(x.segment<3>(3 * vj));
+        force.segment<3>(3 * vj) -= k * (sum_x + beta * sum_v);
+        if (jacobian == nullptr) continue;
+        if (jacobian->product_input != nullptr) {
+          Vector3d product = Vector3d::Zero();
+          for (int l = 0; l < count; ++l)
+            product += b.coupling(j, l) *
+                       jacobian->product_input->segment<3>(3 * b.vertices[static_cast<std::size_t>(l)]);
+          jacobian->product_output->segment<3>(3 * vj) -= k * product;
+        }
+        if (jacobian->matrix == nullptr) continue;
+        double* values = jacobian->matrix->valuePtr();
+        for (int l = 0; l < count; ++l) {
+          const double entry =
+              -k * b.coupling(j, l) * (jacobian->dfdx_scale + jacobian->dfdv_scale * beta);
+          const int offset = b.blocks[static_cast<std::size_t>(count * j + l)];
+          for (int a = 0; a < 3; ++a)
+            values[block_value_index(*jacobian->matrix, vj, offset, a, a)] += entry;
+        }
+      }
+    }
+  }
   for (int i = 0; i < n; ++i) {
     if (terms.gravity) {
       force.segment<3>(3 * i) += model.mass[i] * settings.gravity;

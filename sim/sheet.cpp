@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
+#include <string>
 
 namespace sd::sim {
 
@@ -58,10 +60,36 @@ SheetScene build_sheet(const SheetSpec& spec) {
     } else if (name == "left" || name == "right") {
       const int c = name == "left" ? 0 : spec.columns;
       for (int r = 0; r <= spec.rows; ++r) add.push_back(scene.vertex(r, c));
+    } else if (const std::size_t colon = name.find(':'); colon != std::string::npos) {
+      // A clamp: "top:3" holds the top three rows of vertices (the edge and the next two).
+      const std::string edge = name.substr(0, colon);
+      int depth = 0;
+      try {
+        std::size_t used = 0;
+        depth = std::stoi(name.substr(colon + 1), &used);
+        if (used != name.size() - colon - 1) depth = 0;
+      } catch (const std::exception&) {
+        depth = 0;
+      }
+      const bool rows = edge == "top" || edge == "bottom";
+      const int available = (rows ? spec.rows : spec.columns) + 1;
+      if ((!rows && edge != "left" && edge != "right") || depth < 1 || depth > available)
+        throw InvalidSheetError("pin '" + name + "' is not a clamp: use top:N, bottom:N, left:N "
+                                "or right:N with N from 1 to " + std::to_string(available) +
+                                " lines of vertices");
+      for (int k = 0; k < depth; ++k) {
+        if (rows) {
+          const int r = edge == "top" ? k : spec.rows - k;
+          for (int c = 0; c <= spec.columns; ++c) add.push_back(scene.vertex(r, c));
+        } else {
+          const int c = edge == "left" ? k : spec.columns - k;
+          for (int r = 0; r <= spec.rows; ++r) add.push_back(scene.vertex(r, c));
+        }
+      }
     } else {
       throw InvalidSheetError("unknown pin '" + name +
                               "' (use top-left, top-right, bottom-left, bottom-right, top, "
-                              "bottom, left or right)");
+                              "bottom, left, right, or a clamp such as top:3)");
     }
     scene.pinned_vertices.insert(scene.pinned_vertices.end(), add.begin(), add.end());
   }

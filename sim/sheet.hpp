@@ -27,8 +27,8 @@ struct SheetSpec {
   int rows = 16;                    // quads along the height
   SheetOrientation orientation = SheetOrientation::vertical;
   Eigen::Vector3d centre{0.0, 1.0, 0.0};
-  // Corners "top-left", "top-right", "bottom-left", "bottom-right" or whole edges "top",
-  // "bottom", "left", "right".
+  // Corners "top-left", "top-right", "bottom-left", "bottom-right", whole edges "top",
+  // "bottom", "left", "right", or clamps "top:N" (N lines of vertices from that edge, N ≥ 1).
   std::vector<std::string> pins;
 };
 

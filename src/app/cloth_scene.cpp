@@ -19,12 +19,29 @@
 namespace sd::app {
 namespace {
 
-// The preset named at `json_path`, or a SketchError that lists the known ones.
+// The fabric at `json_path`: the sketch's inline fabric object (by its name), a preset name,
+// or a path to a fabric .json file (relative to the sketch); else a SketchError at the JSON
+// path of the bad value ("/fabric/bend" for an inline constant) that lists the known presets.
 sim::FabricParameters fabric_at(const garment::Sketch& sketch, const std::string& name,
                                 const std::string& json_path) {
+  // A panel without its own fabric carries the file's name for it, inline ones included.
+  if (!sketch.fabric_inline.empty() && name == sketch.fabric) {
+    try {
+      return sim::parse_fabric_json(sketch.fabric_inline, "the fabric given inline");
+    } catch (const sim::InvalidFabricError& e) {
+      sketch.fail("/fabric" + e.pointer(), e.what());
+    }
+  }
   try {
     return sim::fabric_preset(name);
   } catch (const sim::UnknownFabricError& e) {
+    if (name.size() < 5 || name.substr(name.size() - 5) != ".json")
+      sketch.fail(json_path, std::string(e.what()) + "; or give a fabric file (.json) or the "
+                                                      "fabric's constants as an object");
+  }
+  try {
+    return sim::load_fabric_file(sketch.resolve(name).string());
+  } catch (const sim::InvalidFabricError& e) {
     sketch.fail(json_path, e.what());
   }
 }
@@ -32,9 +49,10 @@ sim::FabricParameters fabric_at(const garment::Sketch& sketch, const std::string
 // simulate.pin_above: holds every vertex that starts at or above that height.
 void pin_above(const garment::Sketch& sketch, ClothScene& scene) {
   if (!sketch.simulate.pin_above) return;
+  const std::size_t before = scene.pinned.size();  // a sheet's named pins come first
   for (Eigen::Index v = 0; v < scene.start.rows(); ++v)
     if (scene.start(v, 1) >= *sketch.simulate.pin_above) scene.pinned.push_back(static_cast<int>(v));
-  if (scene.pinned.empty())
+  if (scene.pinned.size() == before)
     sketch.fail("/simulate/pin_above",
                 fmt::format("no garment vertex lies at or above {} m (the garment's top is at "
                             "{:.3f} m)",
@@ -54,6 +72,11 @@ void build_sheet_scene(const garment::Sketch& sketch, ClothScene& scene) {
   sim::SheetScene built = sim::build_sheet(sheet);
   scene.input = std::move(built.input);
   scene.pinned = std::move(built.pinned_vertices);
+  // simulate.pin_above holds a sheet too (a clamp of several rows of a hanging sheet), together
+  // with the named pins.
+  pin_above(sketch, scene);
+  std::sort(scene.pinned.begin(), scene.pinned.end());
+  scene.pinned.erase(std::unique(scene.pinned.begin(), scene.pinned.end()), scene.pinned.end());
   scene.triangle_group = Eigen::VectorXi::Zero(scene.input.triangles.rows());
   scene.group_names = {"sheet"};
   if (spec.layers > 1) {

@@ -4,7 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "garment/sketch_file.hpp"
 #include "sim/cloth_model.hpp"
@@ -106,6 +110,108 @@ TEST(ClothScene, SheetLayersAndTheSelfCollisionDefault) {
   EXPECT_TRUE(simulation_settings(garment::parse_sketch(asked, "asked.json")).self_contact.enabled);
   EXPECT_TRUE(simulation_settings(garment::parse_sketch(two_patches(1.0), "garment.json"))
                   .self_contact.enabled);
+}
+
+}  // namespace
+}  // namespace sd::app
+
+namespace sd::app {
+namespace {
+
+// simulate.pin_above is honoured in sheet scenes (it used to be ignored there): a vertical
+// sheet 1 m tall, 10 rows, centred at 1 m, clamped above 1.35 m holds its top two rows of
+// vertices (y = 1.5 and 1.4), 22 vertices, together with a named corner pin; a height above the
+// sheet is an error at /simulate/pin_above.
+TEST(ClothScene, SheetScenesHonourPinAbove) {
+  const auto sheet = [](double height) {
+    return std::string(R"({
+      "sheet": { "size": [1.0, 1.0], "resolution": [10, 10], "centre": [0, 1.0, 0],
+                 "pins": ["bottom-left"] },
+      "simulate": { "pin_above": )") +
+           std::to_string(height) + "} }";
+  };
+  const ClothScene scene = build_cloth_scene(garment::parse_sketch(sheet(1.35), "clamp.json"));
+  ASSERT_EQ(scene.pinned.size(), 23u);
+  for (std::size_t k = 0; k + 1 < scene.pinned.size(); ++k) {
+    EXPECT_LT(scene.pinned[k], scene.pinned[k + 1]);  // sorted, unique
+    EXPECT_GE(scene.start(scene.pinned[k], 1), 1.35);
+  }
+  EXPECT_NEAR(scene.start(scene.pinned.back(), 1), 0.5, 1e-12);  // the bottom-left corner
+  EXPECT_THROW(build_cloth_scene(garment::parse_sketch(sheet(1.6), "above.json")),
+               garment::SketchError);
+}
+
+}  // namespace
+}  // namespace sd::app
+
+namespace sd::app {
+namespace {
+
+// A sheet scene with the given value of "fabric" (JSON text).
+std::string sheet_with_fabric(const std::string& fabric) {
+  return R"({ "sheet": { "size": [0.5, 0.5], "resolution": [4, 4], "pins": ["top"] },
+              "fabric": )" + fabric + "}";
+}
+
+// The presets' own file, with one constant replaced (JSON text of the object).
+std::string silk_with(const std::string& key, const std::string& entry) {
+  nlohmann::json silk = nlohmann::json::parse(R"({
+    "name": "my silk",
+    "area_density": {"value": 0.06, "unit": "kg/m^2"},
+    "stretch_warp": {"value": 12300.0, "unit": "N/m"},
+    "stretch_weft": {"value": 8170.0, "unit": "N/m"},
+    "shear": {"value": 22.5, "unit": "N/m"},
+    "bend": {"value": 1.96e-06, "unit": "N*m"},
+    "damping": {"value": 0.001, "unit": "s"},
+    "bend_damping": {"value": 0.05, "unit": "s"},
+    "friction": {"value": 0.25, "unit": "1"},
+    "thickness": {"value": 0.0001, "unit": "m"}
+  })");
+  if (!key.empty()) silk[key] = nlohmann::json::parse(entry);
+  return silk.dump();
+}
+
+// "fabric" takes a preset name, the constants inline, or a path to a fabric file; a bad
+// constant is reported at its JSON path.
+TEST(ClothScene, FabricIsAPresetAnInlineObjectOrAFile) {
+  const ClothScene preset = build_cloth_scene(garment::parse_sketch(sheet_with_fabric(R"("denim")"), "a.json"));
+  EXPECT_EQ(preset.fabric.name, "denim");
+
+  const ClothScene inline_fabric = build_cloth_scene(
+      garment::parse_sketch(sheet_with_fabric(silk_with("bend", R"({"value": 3e-6, "unit": "N*m"})")),
+                            "b.json"));
+  EXPECT_EQ(inline_fabric.fabric.name, "my silk");
+  EXPECT_EQ(inline_fabric.fabric.bend, 3e-6);
+  EXPECT_EQ(inline_fabric.fabric_name, "my silk");
+
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "sd-fabric-file-test";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "mine.json") << silk_with("shear", R"({"value": 40.0, "unit": "N/m"})");
+  const ClothScene from_file =
+      build_cloth_scene(garment::parse_sketch(sheet_with_fabric(R"("mine.json")"), "c.json", dir));
+  EXPECT_EQ(from_file.fabric.shear, 40.0);
+
+  const auto error_path = [&](const std::string& fabric) {
+    try {
+      build_cloth_scene(garment::parse_sketch(sheet_with_fabric(fabric), "d.json", dir));
+    } catch (const garment::SketchError& e) {
+      return e.json_path() + " | " + e.sentence();
+    }
+    return std::string("no error");
+  };
+  const std::string wrong_unit = error_path(silk_with("bend", R"({"value": 2e-5, "unit": "gf*cm^2/cm"})"));
+  EXPECT_EQ(wrong_unit.substr(0, wrong_unit.find(" | ")), "/fabric/bend") << wrong_unit;
+  EXPECT_NE(wrong_unit.find("N*m"), std::string::npos) << wrong_unit;
+  const std::string negative = error_path(silk_with("area_density", R"({"value": -1, "unit": "kg/m^2"})"));
+  EXPECT_EQ(negative.substr(0, negative.find(" | ")), "/fabric/area_density") << negative;
+  const std::string missing = error_path(R"({"name": "half"})");
+  EXPECT_EQ(missing.substr(0, missing.find(" | ")), "/fabric/area_density") << missing;
+  const std::string unknown = error_path(R"("velvet")");
+  EXPECT_NE(unknown.find("cotton"), std::string::npos) << unknown;
+  const std::string no_file = error_path(R"("nowhere.json")");
+  EXPECT_EQ(no_file.substr(0, no_file.find(" | ")), "/fabric") << no_file;
+  EXPECT_NE(no_file.find("nowhere.json"), std::string::npos) << no_file;
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -241,3 +241,49 @@ TEST(SketchFile, MissingFileIsSketchError) {
 
 }  // namespace
 }  // namespace sd::garment
+
+namespace sd::garment {
+namespace {
+
+// "fabric" may be an object (the constants inline): kept as JSON text for the simulator to check,
+// named by its "name" ("custom" without one).
+TEST(SketchFile, FabricMayBeGivenInline) {
+  const std::string curves =
+      R"("curves": [{"id": "a", "points": [[0, 1], [1, 1]]}], "panels": [{"id": "p", "boundary": ["a"]}])";
+  const Sketch named = parse_sketch(
+      R"({"fabric": {"name": "twill", "bend": {"value": 1e-5, "unit": "N*m"}}, )" + curves + "}",
+      "t.json");
+  EXPECT_EQ(named.fabric, "twill");
+  EXPECT_EQ(named.panels[0].fabric, "twill");
+  EXPECT_NE(named.fabric_inline.find("\"bend\""), std::string::npos);
+  const Sketch unnamed = parse_sketch(R"({"fabric": {}, )" + curves + "}", "t.json");
+  EXPECT_EQ(unnamed.fabric, "custom");
+  const Sketch preset = parse_sketch(R"({"fabric": "silk", )" + curves + "}", "t.json");
+  EXPECT_TRUE(preset.fabric_inline.empty());
+}
+
+}  // namespace
+}  // namespace sd::garment
+
+namespace sd::garment {
+namespace {
+
+// Sheet pins take clamps of several lines of vertices ("top:3"), checked against the resolution.
+TEST(SketchFile, SheetClampPins) {
+  const auto sheet = [](const std::string& pin) {
+    return R"({"sheet": {"resolution": [4, 6], "pins": [")" + pin + R"("]}})";
+  };
+  EXPECT_EQ(parse_sketch(sheet("top:3"), "t.json").sheet->pins.front(), "top:3");
+  EXPECT_EQ(parse_sketch(sheet("left:5"), "t.json").sheet->pins.front(), "left:5");
+  for (const std::string bad : {"top:8", "left:6", "top:0", "top:", "top:1.5", "middle:2"}) {
+    try {
+      parse_sketch(sheet(bad), "t.json");
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const SketchError& e) {
+      EXPECT_EQ(e.json_path(), "/sheet/pins/0") << bad;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace sd::garment

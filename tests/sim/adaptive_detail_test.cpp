@@ -89,6 +89,13 @@ void expect_reference_model(const AdaptiveCloth& cloth, const AdaptiveMaterial& 
     ASSERT_EQ(got.weight, want.weight) << "change " << change << ", hinge " << h;
     ASSERT_EQ(got.blocks, want.blocks) << "change " << change << ", hinge " << h;
   }
+  ASSERT_EQ(model.stencils.size(), reference.stencils.size()) << "change " << change;
+  for (std::size_t b = 0; b < model.stencils.size(); ++b) {
+    const BendStencil &got = model.stencils[b], &want = reference.stencils[b];
+    ASSERT_EQ(got.vertices, want.vertices) << "change " << change << ", stencil " << b;
+    ASSERT_EQ(got.coupling, want.coupling) << "change " << change << ", stencil " << b;
+    ASSERT_EQ(got.blocks, want.blocks) << "change " << change << ", stencil " << b;
+  }
   const SparseMatrixR &got = model.pattern.zero_matrix, &want = reference.pattern.zero_matrix;
   ASSERT_EQ(got.rows(), want.rows()) << "change " << change;
   ASSERT_EQ(got.nonZeros(), want.nonZeros()) << "change " << change;
@@ -110,9 +117,11 @@ void expect_reference_model(const AdaptiveCloth& cloth, const AdaptiveMaterial& 
 
 // 200 random splits and merges on a moving sheet (with their forced splits, and batches of two
 // operations, so that triangle and vertex slots are reused within a batch), with the sheet's
-// warp per input face and panel ease, and without warp (the direction closest to `up`).
+// warp per input face and panel ease, and without warp (the direction closest to `up`); and
+// with the calibrated bending weights and bend stencils, which are rebuilt around every change.
 TEST(AdaptiveDetail, IncrementalModelEqualsTheRebuiltOne) {
-  for (const bool eased : {true, false}) {
+  for (const int variant : {0, 1, 2}) {
+    const bool eased = variant != 1;
     AdaptiveSheetSpec spec;
     spec.quads = 2;
     spec.solver = LinearSolverKind::pcg;
@@ -124,11 +133,18 @@ TEST(AdaptiveDetail, IncrementalModelEqualsTheRebuiltOne) {
     } else {
       sheet.material.source_warp.resize(0, 3);
     }
+    if (variant == 2) {
+      sheet.material.model_options.bend_weights = BendWeights::calibrated;
+      sheet.material.model_options.bend_stencil_stiffness = 50.0;
+    }
     const AdaptiveMaterial material = sheet.material;
     AdaptiveCloth cloth(std::move(sheet.mesh), sheet.material, {}, sheet.pins,
                         testing::adaptive_sheet_settings(spec), fixed());
     expect_reference_model(cloth, material, 0);
-    std::mt19937 rng(eased ? 11 : 12);
+    if (variant == 2) {
+      EXPECT_FALSE(cloth.simulation().model().stencils.empty());
+    }
+    std::mt19937 rng(11 + variant);
     int changes = 0, merges = 0;
     while (changes < 200) {
       const std::vector<BlockId> mergeable = cloth.mesh().mergeable_blocks();

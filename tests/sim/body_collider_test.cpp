@@ -478,6 +478,36 @@ Eigen::VectorXd flat_triangle(double y) {
   return x;
 }
 
+// A cloth of 0.15 mm edges (a sketched strip at a fine resolution) searched with a 5 cm reach:
+// the broad-phase grid used cells of the longest edge, so each triangle's grown box covered
+// (2 * 5 cm / 0.15 mm)^3 ~ 3e8 cells and the query ran out of memory (17 GB). The cells now
+// grow with the reach: at most 4 per axis per triangle, and the piercing is still found.
+TEST(BodyCollider, FineClothWithALongReachKeepsTheGridSmall) {
+  const meshing::TriMesh cone = testing::make_cone(0.1, 0.2, 24);
+  const BodyCollider collider(cone);
+  const int n = 60;  // 60 x 60 cells of 0.15 mm: a 9 mm square centred under the apex
+  const double edge = 1.5e-4;
+  Eigen::VectorXd x(3 * (n + 1) * (n + 1));
+  for (int r = 0; r <= n; ++r)
+    for (int c = 0; c <= n; ++c)
+      x.segment<3>(3 * (r * (n + 1) + c)) =
+          Vector3d((c - 0.5 * n) * edge + 1e-5, 0.19, (r - 0.5 * n) * edge + 2e-5);
+  std::vector<std::array<int, 3>> triangles;
+  for (int r = 0; r < n; ++r)
+    for (int c = 0; c < n; ++c) {
+      const int a = r * (n + 1) + c, b = a + 1, d = a + n + 1, e = d + 1;
+      triangles.push_back({a, b, e});  // counter-clockwise seen from below
+      triangles.push_back({a, e, d});
+    }
+  PiercingQueryStats stats;
+  const std::vector<BodyPiercing> found =
+      collider.find_piercings(x, triangles, 0.0, 0.05, 0.0, &stats);
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found.front().body_vertex, 0);
+  EXPECT_NEAR(found.front().height, 0.01, 1e-12);
+  EXPECT_LE(stats.grid_entries, 64 * static_cast<std::int64_t>(triangles.size()));
+}
+
 TEST(BodyCollider, BodyVertexThroughAClothTriangleIsAPiercing) {
   // A cone apex (a sharp body vertex) 20 cm up, under one large cloth triangle: the cloth's
   // vertices are all far outside the body, so the vertex test cannot see it.

@@ -2,10 +2,15 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
+#include <Eigen/Geometry>
 
+#include <cmath>
+#include <numbers>
+
+#include "sim/element_forces.hpp"
 #include "sim/forces.hpp"
 #include "sim/sheet.hpp"
+#include "tests/sim/strip_meshes.hpp"
 
 namespace sd::sim {
 namespace {
@@ -164,6 +169,117 @@ TEST(ClothModel, BadMeshesAreRejected) {
   FabricParameters fabric;
   fabric.area_density = 0.0;
   EXPECT_THROW(build_cloth_model(input, fabric), InvalidFabricError);
+}
+
+}  // namespace
+}  // namespace sd::sim
+
+namespace sd::sim {
+namespace {
+
+// Bending energy of the hinges whose edge midpoint lies in [lo, hi)² (x, z) of a flat mesh in
+// the XZ plane bent into the height field y = ½·κ·(u·(p − c))², u = (cos φ, sin φ), c the
+// region's centre, relative to the
+// continuum ½·B·κ² times their share (A1+A2)/3 of the area.
+double cylinder_energy_ratio(const ClothModel& model, const Eigen::MatrixX3d& rest, double phi,
+                             double kappa, double lo, double hi) {
+  Eigen::MatrixX3d bent = rest;
+  const Eigen::Vector2d u(std::cos(phi), std::sin(phi));
+  const double centre = 0.5 * (lo + hi);  // slopes stay small: the height field is a cylinder
+  for (Eigen::Index i = 0; i < rest.rows(); ++i) {
+    const double s = u.dot(Eigen::Vector2d(rest(i, 0) - centre, rest(i, 2) - centre));
+    bent(i, 1) = 0.5 * kappa * s * s;
+  }
+  double energy = 0.0, continuum = 0.0;
+  for (const HingeElement& h : model.hinges) {
+    const Eigen::Vector3d mid = 0.5 * (rest.row(h.vertices[0]) + rest.row(h.vertices[1]));
+    if (mid.x() < lo || mid.x() >= hi || mid.z() < lo || mid.z() >= hi) continue;
+    const auto p = [&](int k) { return Eigen::Vector3d(bent.row(h.vertices[k])); };
+    const double theta = dihedral_angle(p(0), p(1), p(2), p(3)) - h.rest_angle;
+    energy += 0.5 * h.weight * theta * theta;
+    const auto q = [&](int k) { return Eigen::Vector3d(rest.row(h.vertices[k])); };
+    const double areas = 0.5 * (q(1) - q(0)).cross(q(2) - q(0)).norm() +
+                         0.5 * (q(1) - q(0)).cross(q(3) - q(0)).norm();
+    continuum += 0.5 * kappa * kappa * areas / 3.0;
+  }
+  return energy / continuum;
+}
+
+// The calibrated weights give every smooth cylinder its continuum energy, in any direction, on
+// the 4-8 mesh in both orientations and on the equilateral mesh (regions of whole periods of
+// the pattern, away from the boundary). The edge weights |e|²/(A1+A2) are exact only for
+// bends across grid lines: on the 4-8 mesh a bend at 45° to them costs 1.5 times as much (the
+// hypotenuse hinges bend under a bend along them as much as across).
+TEST(ClothModel, CalibratedHingeWeightsHoldTheCylinderEnergyInEveryDirection) {
+  struct Case {
+    test::StripMesh mesh;
+    double period;  // in cells
+  };
+  for (const Case c : {Case{test::StripMesh::four_eight, 2.0}, Case{test::StripMesh::four_eight_45, 1.0}}) {
+    const int cells = 30;
+    const double h = 0.01;
+    const test::Strip patch = test::make_strip(c.mesh, cells * h, 32 * h, cells, 32);
+    ClothModelOptions options;
+    options.bend_weights = BendWeights::calibrated;
+    const ClothModel calibrated = build_cloth_model(patch.input, FabricParameters{}, options);
+    options.bend_weights = BendWeights::edge;
+    const ClothModel edge = build_cloth_model(patch.input, FabricParameters{}, options);
+    const double lo = 8 * h, hi = lo + 8 * c.period * h;
+    for (int k = 0; k < 12; ++k) {
+      const double phi = k * std::numbers::pi / 12;
+      EXPECT_NEAR(cylinder_energy_ratio(calibrated, patch.input.rest_positions, phi, 0.001 / h, lo, hi),
+                  1.0, 2e-3)
+          << test::strip_mesh_name(c.mesh) << ", bend direction " << phi;
+    }
+    const double diagonal = c.mesh == test::StripMesh::four_eight ? std::numbers::pi / 4 : 0.0;
+    EXPECT_NEAR(cylinder_energy_ratio(edge, patch.input.rest_positions, diagonal, 0.001 / h, lo, hi),
+                1.5, 3e-3)
+        << test::strip_mesh_name(c.mesh);
+  }
+}
+
+// A bend stencil measures only what is not smooth: zero for every rigid motion and quadratic
+// bend of a flat sheet, and at the rest shape of a curved one; not zero for the 4-8 mesh's
+// zigzag (degree-8 vertices moving against the degree-4 ones).
+TEST(ClothModel, BendStencilsVanishOnSmoothShapes) {
+  const test::Strip patch = test::make_strip(test::StripMesh::four_eight, 0.1, 0.1, 10, 10);
+  ClothModelOptions options;
+  options.bend_stencil_stiffness = 1.0;
+  const ClothModel model = build_cloth_model(patch.input, FabricParameters{}, options);
+  ASSERT_FALSE(model.stencils.empty());
+  const auto stencil_energy = [&](const ClothModel& m, const Eigen::MatrixX3d& shape) {
+    double energy = 0.0;
+    for (const BendStencil& b : m.stencils)
+      for (std::size_t j = 0; j < b.vertices.size(); ++j)
+        for (std::size_t l = 0; l < b.vertices.size(); ++l)
+          energy += 0.5 * b.coupling(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(l)) *
+                    shape.row(b.vertices[j]).dot(shape.row(b.vertices[l]));
+    return energy;
+  };
+  const Eigen::MatrixX3d& rest = patch.input.rest_positions;
+  const Eigen::Matrix3d rotation =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1.0, 2.0, 3.0).normalized()).toRotationMatrix();
+  Eigen::MatrixX3d smooth = rest, zigzag = rest;
+  for (Eigen::Index i = 0; i < rest.rows(); ++i) {
+    const double x = rest(i, 0), z = rest(i, 2);
+    smooth(i, 1) = 3.0 * x * x - 2.0 * x * z + 5.0 * z * z + 0.1 * x;
+    const long r = std::lround(z / 0.01), c = std::lround(x / 0.01);
+    zigzag(i, 1) = (r + c) % 2 == 0 ? 1e-2 : -1e-2;
+  }
+  smooth = (smooth * rotation.transpose()).rowwise() + Eigen::RowVector3d(0.3, -0.2, 1.0);
+  const double scale = stencil_energy(model, zigzag);
+  EXPECT_GT(scale, 0.0);
+  EXPECT_LE(stencil_energy(model, smooth), 1e-9 * scale);  // round-off of positions ~1 m
+  // A curved rest shape (a cylinder of radius 5 cm) is its own zero.
+  Eigen::MatrixX3d curved = rest;
+  for (Eigen::Index i = 0; i < rest.rows(); ++i) {
+    curved(i, 0) = 0.05 * std::sin(rest(i, 0) / 0.05);
+    curved(i, 1) = 0.05 * (1.0 - std::cos(rest(i, 0) / 0.05));
+  }
+  ClothInput input = patch.input;
+  input.rest_positions = curved;
+  const ClothModel bent = build_cloth_model(input, FabricParameters{}, options);
+  EXPECT_LE(stencil_energy(bent, curved), 1e-9 * scale);
 }
 
 }  // namespace

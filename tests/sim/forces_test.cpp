@@ -196,6 +196,65 @@ TEST(Forces, JacobianProductEqualsMatrixProduct) {
   }
 }
 
+// The calibrated hinge weights and the bend stencils (ClothModelOptions): force against the
+// energy's gradient, exact ∂f/∂x and ∂f/∂v against finite differences, and the solve Jacobian
+// symmetric and negative semi-definite, on a sheet with degree-8 vertices (stencils).
+TEST(Forces, BendStencilsMatchFiniteDifferences) {
+  SheetSpec spec;
+  spec.size = {0.3, 0.3};
+  spec.columns = 4;
+  spec.rows = 4;
+  const SheetScene scene = build_sheet(spec);
+  FabricParameters fabric;
+  fabric.bend = 2e-3;
+  fabric.bend_damping = 0.05;
+  ClothModelOptions options;
+  options.bend_weights = BendWeights::calibrated;
+  options.bend_stencil_stiffness = 50.0;
+  const ClothModel model = build_cloth_model(scene.input, fabric, options);
+  ASSERT_EQ(model.stencils.size(), 4u);  // the interior degree-8 vertices of the 4-8 sheet
+  std::mt19937 rng(17);
+  ForceSettings settings;
+  settings.terms = {false, false, true, true, false, false};
+  for (int trial = 0; trial < 5; ++trial) {
+    const Eigen::VectorXd x = testing::random_configuration(scene.input.rest_positions, rng);
+    const Eigen::VectorXd v = Eigen::VectorXd::Random(x.size());
+    const Eigen::MatrixXd dfdx = dense_jacobian(model, settings, x, v, 1, 0, JacobianKind::exact);
+    const Eigen::MatrixXd dfdv = dense_jacobian(model, settings, x, v, 0, 1, JacobianKind::exact);
+    Eigen::MatrixXd fd_x(x.size(), x.size()), fd_v(x.size(), x.size());
+    Eigen::VectorXd grad(x.size()), fp, fm, force;
+    const double h = 1e-6;
+    ForceSettings conservative = settings;
+    conservative.terms.damping = false;
+    for (Eigen::Index j = 0; j < x.size(); ++j) {
+      Eigen::VectorXd plus = x, minus = x;
+      plus[j] += h;
+      minus[j] -= h;
+      evaluate_forces(model, settings, plus, v, fp);
+      evaluate_forces(model, settings, minus, v, fm);
+      fd_x.col(j) = (fp - fm) / (2 * h);
+      EnergyBreakdown ep, em;
+      evaluate_forces(model, conservative, plus, v, fp, &ep);
+      evaluate_forces(model, conservative, minus, v, fm, &em);
+      grad[j] = (ep.bend - em.bend) / (2 * h);
+      Eigen::VectorXd vp = v, vm = v;
+      vp[j] += h;
+      vm[j] -= h;
+      evaluate_forces(model, settings, x, vp, fp);
+      evaluate_forces(model, settings, x, vm, fm);
+      fd_v.col(j) = (fp - fm) / (2 * h);
+    }
+    evaluate_forces(model, conservative, x, v, force);
+    EXPECT_LE((force + grad).norm(), 1e-5 * force.norm()) << "trial " << trial;
+    EXPECT_LE((fd_x - dfdx).norm(), 1e-5 * dfdx.norm()) << "trial " << trial;
+    EXPECT_LE((fd_v - dfdv).norm(), 1e-5 * dfdv.norm()) << "trial " << trial;
+    const Eigen::MatrixXd j = dense_jacobian(model, settings, x, v, 1, 0, JacobianKind::solve);
+    EXPECT_LE((j - j.transpose()).norm(), 1e-12 * j.norm());
+    EXPECT_LE(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(j).eigenvalues().maxCoeff(),
+              1e-9 * j.norm());
+  }
+}
+
 TEST(Forces, BendingEnergyIsResolutionInvariantOnACylinder) {
   // Rolling a sheet onto a cylinder (axis along a grid direction) costs ½·B/R² per unit area in
   // the continuum. Each interior edge along the axis carries ½·B·θ²·|e|²/(A1+A2) = ½·B/R²·ΔxΔy

@@ -4,6 +4,10 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
+#include <string>
+#include <vector>
+
 namespace sd::sim {
 namespace {
 
@@ -51,6 +55,34 @@ TEST(Sheet, BadSpecsAreRejected) {
   spec.columns = 2;
   spec.size = {-1.0, 1.0};
   EXPECT_THROW(build_sheet(spec), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace sd::sim
+
+namespace sd::sim {
+namespace {
+
+// A clamp "top:N" holds N lines of vertices from that edge (a cantilever's clamp, where an edge
+// alone would be a hinge); bad depths are rejected.
+TEST(Sheet, ClampPinsHoldSeveralLines) {
+  SheetSpec spec;
+  spec.columns = 4;
+  spec.rows = 6;
+  spec.pins = {"top:2", "right:1"};
+  const SheetScene scene = build_sheet(spec);
+  std::vector<int> expected;
+  for (int r = 0; r <= 1; ++r)
+    for (int c = 0; c <= 4; ++c) expected.push_back(scene.vertex(r, c));
+  for (int r = 2; r <= 6; ++r) expected.push_back(scene.vertex(r, 4));
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(scene.pinned_vertices, expected);
+  spec.pins = {"bottom:7"};
+  EXPECT_EQ(build_sheet(spec).pinned_vertices.size(), 35u);  // every vertex
+  for (const std::string bad : {"bottom:8", "left:0", "top:x", "top:2x", "middle:2"}) {
+    spec.pins = {bad};
+    EXPECT_THROW(build_sheet(spec), InvalidSheetError) << bad;
+  }
 }
 
 }  // namespace
