@@ -319,7 +319,15 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
       for (const auto& side : patch.topology.side_vertices)
         for (int v : side) fixed[static_cast<size_t>(v)] = 1;
       if (fit == PanelFit::kFree) {
-        span_over_obstacle(patch.mesh, fixed, push_out);
+        // A panel the body does not touch keeps the filler's own interpolation of its boundary
+        // (transfinite, then relaxed), which reproduces a ruled surface such as a tube skirt's
+        // cylinder exactly; the uniform harmonic membrane would flatten it between its curves.
+        // Where the body is in the way, the membrane spans over it.
+        bool touches = false;
+        for (Eigen::Index v = 0; v < patch.mesh.vertex_count() && !touches; ++v)
+          touches = !fixed[static_cast<size_t>(v)] &&
+                    push_out(patch.mesh.vertices.row(v).transpose()).has_value();
+        if (touches) span_over_obstacle(patch.mesh, fixed, push_out);
         patch.quality = meshing::measure_quality(patch.mesh, patch.topology.corner_vertices());
       }
       if (fit == PanelFit::kBody) {

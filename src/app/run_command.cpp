@@ -446,7 +446,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   out["body"] = scene.body ? nlohmann::json(scene.body->raw.source) : nlohmann::json(nullptr);
   out["pinned_vertices"] = scene.pinned.size();
   out["meshing"] = meshing_json(scene);
-  out["rest"] = flat_rest ? (scene.bend_rest_flat ? "flat" : "flat and shaped") : "shaped";
+  out["rest_shape"] = flat_rest ? (scene.bend_rest_flat ? "flat" : "flat and shaped") : "shaped";
   out["strain"] = strain;  // per group, against the rest shape (the pattern when flat)
   if (scene.garment && sketch.output.pattern) {
     const PatternSheet sheet = build_pattern_sheet(sketch, *scene.garment, *sketch.output.pattern);

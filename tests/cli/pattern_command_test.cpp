@@ -344,11 +344,11 @@ TEST(PatternCommand, FlatRestTubeSkirtDrapesLikeShapedRest) {
     ASSERT_EQ(r.exit_code, 0) << r.output;
   }
   const auto flat_report = nlohmann::json::parse(read(dir / "flat/report.json"));
-  EXPECT_EQ(flat_report["rest"], "flat");
+  EXPECT_EQ(flat_report["rest_shape"], "flat");
   const auto mixed_report = nlohmann::json::parse(read(dir / "mixed/report.json"));
-  EXPECT_EQ(mixed_report["rest"], "flat and shaped");
+  EXPECT_EQ(mixed_report["rest_shape"], "flat and shaped");
   EXPECT_TRUE(mixed_report["at_rest"].get<bool>());
-  EXPECT_EQ(nlohmann::json::parse(read(dir / "shaped/report.json"))["rest"], "shaped");
+  EXPECT_EQ(nlohmann::json::parse(read(dir / "shaped/report.json"))["rest_shape"], "shaped");
   // The pieces unroll the drawn (nearly cylindrical) tube.
   const auto pattern = nlohmann::json::parse(read(dir / "flat/pattern.json"));
   for (const auto& piece : pattern["pieces"]) {
