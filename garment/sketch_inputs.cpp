@@ -7,6 +7,9 @@
 #include <sstream>
 #include <vector>
 
+#include "garment/input_checks.hpp"
+#include "garment/sketch_ranges.hpp"
+
 namespace sd::garment {
 
 Body load_sketch_body(const Sketch& sketch) {
@@ -28,6 +31,8 @@ Body load_sketch_body(const Sketch& sketch) {
 meshing::TriMesh load_garment_mesh(const Sketch& sketch) {
   const std::string where = "/garment_mesh";
   const std::filesystem::path path = sketch.resolve(*sketch.garment_mesh);
+  if (const auto problem = input_file_problem(path, kMaxMeshFileBytes))
+    sketch.fail(where, fmt::format("the garment mesh '{}' {}", path.string(), *problem));
   std::ifstream in(path);
   if (!in)
     sketch.fail(where, fmt::format("the garment mesh '{}' {}", path.string(),
@@ -72,6 +77,8 @@ meshing::TriMesh load_garment_mesh(const Sketch& sketch) {
   for (size_t v = 0; v < vertices.size(); ++v) mesh.vertices.row(static_cast<Eigen::Index>(v)) = vertices[v].transpose();
   mesh.faces.resize(static_cast<Eigen::Index>(faces.size()), 3);
   for (size_t f = 0; f < faces.size(); ++f) mesh.faces.row(static_cast<Eigen::Index>(f)) = faces[f].transpose();
+  if (const auto problem = mesh_problem(mesh))
+    sketch.fail(where, fmt::format("the garment mesh '{}' {}", path.filename().string(), *problem));
   return mesh;
 }
 
