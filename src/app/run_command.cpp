@@ -38,8 +38,8 @@ struct RunOptions {
   double max_time_s = 0;           // --max-time, seconds; 0: none
 };
 
-// --max-time passed while the drape runs: nothing is written.
-class MaxTimeExceeded : public std::runtime_error {
+// --max-time passed, or the memory budget, while the drape runs: nothing is written.
+class RunLimitExceeded : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
@@ -207,10 +207,18 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   std::string trace;
   Progress progress("draping", static_cast<long>(std::ceil(settings.duration * 1000)), global.quiet);
   // Called after every accepted step, by either driver.
+  // Adaptive detail can grow the cloth past the estimate: the budget is also checked as it runs.
+  const double memory_budget = memory_budget_bytes(limits);
   const auto on_step = [&](const sim::Simulation& s) {
+    if (const double resident = resident_memory_bytes(); memory_budget > 0 && resident > memory_budget)
+      throw RunLimitExceeded(fmt::format(
+          "stopped at t = {:.3f} s of the drape: it uses {:.1f} GB with {} vertices, more than "
+          "the {:.1f} GB it may take (--max-memory); limit adaptive detail with "
+          "simulate.adaptive.max_vertices or max_level; nothing was written",
+          s.time(), resident / 1e9, s.model().vertex_count, memory_budget / 1e9));
     if (limits.max_time_s &&
         std::chrono::duration<double>(Clock::now() - start).count() > *limits.max_time_s)
-      throw MaxTimeExceeded(fmt::format(
+      throw RunLimitExceeded(fmt::format(
           "stopped at t = {:.3f} s of the drape: --max-time {:g} s passed; nothing was written",
           s.time(), *limits.max_time_s));
     progress.update(static_cast<long>(s.time() * 1000), fmt::format("t = {:.2f} s", s.time()));

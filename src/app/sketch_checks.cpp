@@ -1,6 +1,7 @@
 #include "src/app/sketch_checks.hpp"
 
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <fstream>
@@ -66,6 +67,18 @@ double available_memory_bytes() {
   return 0;
 }
 
+double resident_memory_bytes() {
+  std::ifstream in("/proc/self/statm");
+  double pages = 0, resident = 0;
+  if (!(in >> pages >> resident)) return 0;
+  return resident * static_cast<double>(::sysconf(_SC_PAGESIZE));
+}
+
+double memory_budget_bytes(const RunLimits& limits) {
+  return limits.max_memory_bytes > 0 ? limits.max_memory_bytes
+                                     : kAvailableFraction * available_memory_bytes();
+}
+
 std::optional<double> cloth_vertices_before_building(const garment::Sketch& sketch) {
   if (!sketch.sheet) return std::nullopt;
   return static_cast<double>(sketch.sheet->columns + 1) * (sketch.sheet->rows + 1);
@@ -86,8 +99,7 @@ RunEstimate estimate_run(const garment::Sketch& sketch, double vertices, double 
 void check_run_fits(const garment::Sketch& sketch, const RunEstimate& estimate,
                     const RunLimits& limits, double frames_per_second) {
   const bool given = limits.max_memory_bytes > 0;
-  const double memory =
-      given ? limits.max_memory_bytes : kAvailableFraction * available_memory_bytes();
+  const double memory = memory_budget_bytes(limits);
   if (memory > 0 && estimate.memory_bytes > memory) {
     // The largest vertex count that fits, by bisection on the monotone model.
     double low = 4, high = estimate.vertices;

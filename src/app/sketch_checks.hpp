@@ -25,6 +25,12 @@ struct RunLimits {
 // The memory the system can give a process now (MemAvailable), bytes; 0 when unknown.
 double available_memory_bytes();
 
+// This process's resident memory now (/proc/self/statm), bytes; 0 when unknown.
+double resident_memory_bytes();
+
+// The memory a run may use: --max-memory, else 80 % of the memory available now; 0: unknown.
+double memory_budget_bytes(const RunLimits& limits);
+
 // A drape's cost, estimated before it starts from the cloth's vertex count (the measured cost
 // per vertex of the model, the CHOLMOD factor and the contacts; docs/cli.md, "Limits").
 struct RunEstimate {

@@ -312,7 +312,7 @@ TEST(BatchFaults, DivergingSimulationFailsItsJobOnly) {
                   {"jobs", json::array({{{"sketch", "sheet.json"}, {"id", "calm"}},
                                         {{"sketch", "sheet.json"},
                                          {"id", "diverging"},
-                                         {"set", {{"/simulate/gravity", {0, -1e9, 0}}}}}})}}
+                                         {"set", {{"/simulate/gravity", {0, -1e4, 0}}}}}})}}
                  .dump(2));
   const fs::path out = dir / "out";
   const CommandResult r = run_sketchdrape("batch " + shell_quoted(dir / "m.json") + " -o " +

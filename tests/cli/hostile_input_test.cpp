@@ -226,6 +226,30 @@ TEST(HostileInput, WorkThatDoesNotFitIsRefusedWithWhatWould) {
   fs::remove_all(dir);
 }
 
+// Out of memory is reported as such (it ended as "a vertex reached 50.9 m/s"): under a 700 MB
+// address-space limit, the 201 x 201-vertex sheet's CHOLMOD factorisation cannot be allocated.
+TEST(HostileInput, OutOfMemoryIsReportedAsSuch) {
+  const fs::path dir = fresh_dir("oom");
+  write(dir / "sheet.json", R"({"sheet": {"size": [1, 1], "resolution": [200, 200],
+    "pins": ["top"]}, "simulate": {"duration": 0.02}, "output": {"images": []}})");
+  const std::string command = "ulimit -v 700000; " + std::string(SD_BINARY) + " run " +
+                              (dir / "sheet.json").string() + " -o " + (dir / "out").string() +
+                              " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string output;
+  std::array<char, 4096> buffer{};
+  for (size_t n; (n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0;)
+    output.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  ASSERT_TRUE(WIFEXITED(status)) << output;
+  EXPECT_EQ(WEXITSTATUS(status), 1) << output;
+  EXPECT_NE(output.find("error: out of memory"), std::string::npos) << output;
+  EXPECT_EQ(output.find("m/s"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(dir / "out" / "report.json"));
+  fs::remove_all(dir);
+}
+
 // A closed body whose faces point inward is flipped with a warning that `info` shows; an open
 // body is warned about.
 TEST(HostileInput, InsideOutBodyIsFlippedAndOpenBodyWarned) {
