@@ -732,13 +732,21 @@ std::string position_of(std::string_view text, size_t byte) {
   return fmt::format("line {}, column {}", line, column);
 }
 
+constexpr int kMaxNesting = 64;
+
 // Tracks the JSON path while nlohmann's parser reports events, to reject a key given twice in
 // one object (JSON allows it and keeps the last value, silently dropping the first).
 class DuplicateKeyCheck {
  public:
   explicit DuplicateKeyCheck(const Sketch& sketch) : sketch_(sketch) {}
 
-  bool operator()(int /*depth*/, json::parse_event_t event, json& parsed) {
+  bool operator()(int depth, json::parse_event_t event, json& parsed) {
+    // A sketch file nests a few levels (a point in a list in a curve in the list of curves);
+    // thousands of levels are a damaged or hostile file, and cost time and memory to build.
+    if (depth > kMaxNesting)
+      sketch_.fail(path(), fmt::format("lists and objects are nested more than {} levels deep "
+                                       "here; a sketch file needs fewer than 10",
+                                       kMaxNesting));
     switch (event) {
       case json::parse_event_t::object_start:
       case json::parse_event_t::array_start:

@@ -53,6 +53,11 @@ meshing::TriMesh load_garment_mesh(const Sketch& sketch) {
       if (!(ls >> p.x() >> p.y() >> p.z()) || !p.allFinite())
         sketch.fail(where, fmt::format("line {} of '{}' is not a vertex of three finite numbers",
                                        line_number, path.filename().string()));
+      if (p.cwiseAbs().maxCoeff() > kMaxCoordinate)
+        sketch.fail(where, fmt::format("line {} of '{}': a vertex {}",
+                                       line_number, path.filename().string(),
+                                       out_of_range_sentence(p.cwiseAbs().maxCoeff(), -kMaxCoordinate,
+                                                             kMaxCoordinate, "at")));
       vertices.push_back(p);
     } else if (tag == "f") {
       std::vector<int> ids;

@@ -156,6 +156,14 @@ TEST(HostileInput, EveryCommandAppliesTheSameChecks) {
 
   // Every vertex at one point: refused as a body (info), as a garment (render --body) and as an
   // imported garment (validate), with the same sentence.
+  write(dir / "far.obj", "v 0 0 0\nv 1 0 0\nv 0 1e300 0\nf 1 2 3\n");
+  write(dir / "far.json", "{\"garment_mesh\": \"far.obj\", \"body\": \"none\"}");
+  const CommandResult far = run_sketchdrape("validate " + (dir / "far.json").string());
+  EXPECT_EQ(far.exit_code, 2) << far.output;
+  EXPECT_NE(far.output.find("/garment_mesh: line 3 of 'far.obj': a vertex at 1e+300 m is outside"),
+            std::string::npos)
+      << far.output;
+
   write(dir / "point.obj", "v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n");
   write(dir / "point.json", "{\"garment_mesh\": \"point.obj\", \"body\": \"none\"}");
   const CommandResult as_body = run_sketchdrape("info " + (dir / "point.obj").string());
@@ -187,6 +195,10 @@ TEST(HostileInput, BadNumbersOnTheCommandLineAreRefused) {
     EXPECT_EQ(r.exit_code, 2) << option << "\n" << r.output;
   }
   EXPECT_FALSE(fs::exists("/tmp/sd-never"));
+  // The quad filler's input has the bound of a sketch's panels: 1e8 edges would need gigabytes.
+  const CommandResult fill = run_sketchdrape("fill --sides 100000000,100000000");
+  EXPECT_EQ(fill.exit_code, 2) << fill.output;
+  EXPECT_NE(fill.output.find("at most 2530 edges in all"), std::string::npos) << fill.output;
 }
 
 // Work that does not fit is refused before it starts, with what would fit.

@@ -39,5 +39,35 @@ TEST(BadInput, EveryFileFailsWithPathAndSentence) {
   }
 }
 
+// Hostile text that no file in bad/ holds: 100,000 nested lists (the JSON reader would build
+// them all: seconds and hundreds of MB) and a key given twice deep inside.
+TEST(BadInput, DeepNestingAndNestedDuplicatesAreRefusedAtTheirPath) {
+  const std::string deep =
+      "{\"curves\": " + std::string(100000, '[') + std::string(100000, ']') + "}";
+  try {
+    parse_sketch(deep, "deep.json");
+    ADD_FAILURE() << "accepted";
+  } catch (const SketchError& e) {
+    EXPECT_EQ(e.json_path().rfind("/curves/0/0/", 0), 0u) << e.json_path();
+    EXPECT_NE(e.sentence().find("nested more than 64 levels deep"), std::string::npos) << e.what();
+  }
+  try {
+    parse_sketch(R"({"simulate": {"adaptive": {"max_level": 4, "min_level": 0, "max_level": 5}}})",
+                 "twice.json");
+    ADD_FAILURE() << "accepted";
+  } catch (const SketchError& e) {
+    EXPECT_EQ(e.json_path(), "/simulate/adaptive/max_level");
+    EXPECT_NE(e.sentence().find("given twice"), std::string::npos) << e.what();
+  }
+  // A list of objects: the index is in the path, and equal keys in different objects are fine.
+  try {
+    parse_sketch(R"({"curves": [{"id": "a"}, {"id": "b", "view": "front", "id": "c"}]})",
+                 "list.json");
+    ADD_FAILURE() << "accepted";
+  } catch (const SketchError& e) {
+    EXPECT_EQ(e.json_path(), "/curves/1/id");
+  }
+}
+
 }  // namespace
 }  // namespace sd::garment
