@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds everything with warnings as errors, and runs every test.
 #   test.sh              the whole suite in build/
-#   test.sh --sanitize   the fast unit tests (meshing, garment, app, batch) built with
+#   test.sh --sanitize   the unit tests of the input-facing modules (meshing, garment: the
+#                        sketch reader, the body loader, the quad filler) built with
 #                        AddressSanitizer and UBSan in build-asan/ (docs/cli.md, "Fuzzing")
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -9,7 +10,7 @@ if [ "${1:-}" = --sanitize ]; then
   SD_PACKAGES_ONLY=1 ./scripts/setup.sh test
   export CCACHE_BASEDIR="$PWD"
   jobs=$(nproc 2>/dev/null || echo 2)
-  units=(meshing_tests garment_tests app_tests batch_tests)
+  units=(meshing_tests garment_tests)
   echo "==> configuring build-asan/ (RelWithDebInfo, ASan + UBSan)"
   cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSD_WERROR=ON -DSD_SANITIZE=ON \
     -DSD_BUILD_TESTS=ON -DSD_BUILD_BENCHMARKS=OFF -DCMAKE_CXX_COMPILER_LAUNCHER=ccache >/dev/null

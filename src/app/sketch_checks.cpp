@@ -91,6 +91,9 @@ RunEstimate estimate_run(const garment::Sketch& sketch, double vertices, double 
   e.steps = std::ceil(sketch.simulate.duration / sketch.simulate.time_step);
   e.frames =
       frames_per_second > 0 ? std::floor(sketch.simulate.duration * frames_per_second) + 1 : 0;
+  // The PNG sequence keeps each picture's cloth until the drape ends: positions, triangles and
+  // groups, about 64 bytes per vertex.
+  e.memory_bytes += e.frames * 64.0 * vertices;
   e.seconds = e.steps * vertices * std::log2(std::max(vertices, 2.0)) * kSecondsPerVertexStepLog +
               e.frames * kSecondsPerFrame;
   return e;
