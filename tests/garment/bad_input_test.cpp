@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "garment/body.hpp"
 #include "garment/body_surface.hpp"
 #include "garment/garment_mesh.hpp"
 #include "garment/sketch_file.hpp"
@@ -66,6 +67,18 @@ TEST(BadInput, DeepNestingAndNestedDuplicatesAreRefusedAtTheirPath) {
     ADD_FAILURE() << "accepted";
   } catch (const SketchError& e) {
     EXPECT_EQ(e.json_path(), "/curves/1/id");
+  }
+}
+
+// Findings of the fuzz targets (tests/fuzz/regressions/), each a file that once hung or crashed.
+TEST(BadInput, FuzzFindingsEndWithAClearError) {
+  const std::filesystem::path dir = std::filesystem::path(SD_SOURCE_DIR) / "tests/fuzz/regressions";
+  // A PLY header without end_header: assimp's reader looped for ever (body_loader_fuzz).
+  try {
+    load_body((dir / "body-ply-without-end-header.ply").string());
+    ADD_FAILURE() << "accepted";
+  } catch (const BodyError& e) {
+    EXPECT_NE(std::string(e.what()).find("has no end_header"), std::string::npos) << e.what();
   }
 }
 
