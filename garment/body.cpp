@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <assimp/Importer.hpp>
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
@@ -80,6 +81,27 @@ void check_declared_counts(const std::string& file) {
       throw BodyError(fmt::format("body file '{}' is corrupt: its PLY header has no end_header "
                                   "line{}",
                                   file, header.size() < 65536 ? "" : " in its first 64 KB"));
+    // Nor on some header lines that hold numbers (the second finding: vertex data before
+    // end_header). Free text lines stay allowed (Blender writes one), numbers do not.
+    std::istringstream lines(header);
+    std::string line;
+    std::getline(lines, line);  // "ply"
+    for (int number = 2; std::getline(lines, line); ++number) {
+      std::istringstream first(line);
+      std::string keyword;
+      first >> keyword;
+      if (keyword == "end_header") break;
+      const bool numeric = !keyword.empty() && (std::isdigit(static_cast<unsigned char>(keyword[0])) ||
+                                                keyword[0] == '-' || keyword[0] == '+' ||
+                                                keyword[0] == '.');
+      const bool binary = std::any_of(line.begin(), line.end(), [](char c) {
+        return static_cast<unsigned char>(c) < 0x09 || static_cast<unsigned char>(c) == 0x7f;
+      });
+      if (numeric || binary)
+        throw BodyError(fmt::format("body file '{}' is corrupt: line {} of its PLY header is not "
+                                    "a header line (it holds {} before end_header)",
+                                    file, number, numeric ? "numbers" : "binary bytes"));
+    }
     while (words >> word && word != "end_header") {
       if (word != "element") continue;
       std::string kind;

@@ -80,6 +80,17 @@ TEST(BadInput, FuzzFindingsEndWithAClearError) {
   } catch (const BodyError& e) {
     EXPECT_NE(std::string(e.what()).find("has no end_header"), std::string::npos) << e.what();
   }
+  // A PLY header with lines that are not header lines: the same loop (body_loader_fuzz).
+  try {
+    load_body((dir / "body-ply-unknown-header-line.ply").string());
+    ADD_FAILURE() << "accepted";
+  } catch (const BodyError& e) {
+    EXPECT_NE(std::string(e.what()).find("line 4 of its PLY header is not a header line"),
+              std::string::npos)
+        << e.what();
+  }
+  // Assimp's own PLY test models still load.
+  EXPECT_GT(load_body("/usr/share/assimp/models/PLY/cube.ply").mesh.face_count(), 0);
 }
 
 }  // namespace
