@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <assimp/Importer.hpp>
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
@@ -13,6 +14,9 @@
 #include <sstream>
 #include <numeric>
 #include <fmt/format.h>
+
+#include "garment/input_checks.hpp"
+#include "garment/sketch_ranges.hpp"
 
 namespace sd::garment {
 namespace {
@@ -54,7 +58,7 @@ void collect_meshes(const aiScene& scene, const aiNode& node, const aiMatrix4x4&
 // not fit in the file: every vertex takes at least 6 bytes ("0 0 0\n"), every face at least 8.
 void check_declared_counts(const std::string& file) {
   std::ifstream in(file, std::ios::binary);
-  std::string header(4096, '\0');
+  std::string header(65536, '\0');
   in.read(header.data(), static_cast<std::streamsize>(header.size()));
   header.resize(static_cast<size_t>(in.gcount()));
   std::istringstream words(header);
@@ -71,6 +75,33 @@ void check_declared_counts(const std::string& file) {
       if (counts >> vertices >> faces) break;
     }
   } else if (word == "ply") {
+    // assimp's PLY reader never returns on a header without end_header (found by
+    // tests/fuzz/body_loader_fuzz): such a file is refused before it is read.
+    if (header.find("end_header") == std::string::npos)
+      throw BodyError(fmt::format("body file '{}' is corrupt: its PLY header has no end_header "
+                                  "line{}",
+                                  file, header.size() < 65536 ? "" : " in its first 64 KB"));
+    // Nor on some header lines that hold numbers (the second finding: vertex data before
+    // end_header). Free text lines stay allowed (Blender writes one), numbers do not.
+    std::istringstream lines(header);
+    std::string line;
+    std::getline(lines, line);  // "ply"
+    for (int number = 2; std::getline(lines, line); ++number) {
+      std::istringstream first(line);
+      std::string keyword;
+      first >> keyword;
+      if (keyword == "end_header") break;
+      const bool numeric = !keyword.empty() && (std::isdigit(static_cast<unsigned char>(keyword[0])) ||
+                                                keyword[0] == '-' || keyword[0] == '+' ||
+                                                keyword[0] == '.');
+      const bool binary = std::any_of(line.begin(), line.end(), [](char c) {
+        return static_cast<unsigned char>(c) < 0x09 || static_cast<unsigned char>(c) == 0x7f;
+      });
+      if (numeric || binary)
+        throw BodyError(fmt::format("body file '{}' is corrupt: line {} of its PLY header is not "
+                                    "a header line (it holds {} before end_header)",
+                                    file, number, numeric ? "numbers" : "binary bytes"));
+    }
     while (words >> word && word != "end_header") {
       if (word != "element") continue;
       std::string kind;
@@ -170,8 +201,8 @@ CleanupCounts weld_and_clean(meshing::TriMesh& mesh, double tolerance, double mi
 // The triangles of `file` as assimp reads them, merged, welded and cleaned; file units and axes.
 // Repairs are added to body.warnings, the mesh count to body.raw.meshes.
 meshing::TriMesh read_body_mesh(const std::string& file, Body& body) {
-  if (!std::filesystem::exists(file)) throw BodyError("body file '" + file + "' does not exist");
-  if (std::filesystem::is_directory(file)) throw BodyError("body path '" + file + "' is a folder");
+  if (const auto problem = input_file_problem(file, kMaxMeshFileBytes))
+    throw BodyError("body file '" + file + "' " + *problem);
   check_declared_counts(file);
   Assimp::Importer importer;
   // Only structure validation: assimp's Triangulate step aborts the process (ai_assert) on some
@@ -220,6 +251,20 @@ meshing::TriMesh read_body_mesh(const std::string& file, Body& body) {
   return mesh;
 }
 
+// Volume enclosed by a closed mesh (divergence theorem over the faces), positive when the faces
+// point outward; file units³. Computed about the centroid to keep far-off files accurate.
+double signed_volume(const meshing::TriMesh& mesh) {
+  const Eigen::RowVector3d c = mesh.vertices.colwise().mean();
+  double six_volume = 0;
+  for (Eigen::Index f = 0; f < mesh.face_count(); ++f) {
+    const Eigen::Vector3d a = (mesh.vertices.row(mesh.faces(f, 0)) - c).transpose();
+    const Eigen::Vector3d b = (mesh.vertices.row(mesh.faces(f, 1)) - c).transpose();
+    const Eigen::Vector3d d = (mesh.vertices.row(mesh.faces(f, 2)) - c).transpose();
+    six_volume += a.dot(b.cross(d));
+  }
+  return six_volume / 6.0;
+}
+
 }  // namespace
 
 std::string AxisDirection::name() const {
@@ -257,6 +302,21 @@ Body load_body(const std::string& path, const BodyOptions& options) {
     body.warnings.push_back(fmt::format(
         "{} edge(s) join triangles of opposite orientation; inside/outside tests may be wrong there",
         topo.inconsistent_edges));
+  if (topo.boundary_edges > 0)
+    body.warnings.push_back(fmt::format(
+        "the body is open ({} boundary edge(s)): collision treats the body as a closed surface, "
+        "so cloth may fall through its holes or end on the wrong side near them",
+        topo.boundary_edges));
+  // A closed body whose faces point inward (the file's winding or handedness differs) would put
+  // the cloth's contacts on the inside: its signed volume is negative. Flip it.
+  body.raw.signed_volume = signed_volume(mesh);
+  if (topo.closed() && topo.oriented() && body.raw.signed_volume < 0) {
+    mesh.faces.col(1).swap(mesh.faces.col(2));
+    body.raw.flipped_inside_out = true;
+    body.warnings.push_back(
+        "the body is inside out (its faces point inward: negative volume); its faces were "
+        "flipped to point outward");
+  }
 
   RawBodyInfo& raw = body.raw;
   raw.source = builtin ? "builtin (" + file + ")" : file;
@@ -284,6 +344,12 @@ Body load_body(const std::string& path, const BodyOptions& options) {
   raw.height = extent[raw.up.axis];
   if (!(raw.height > 0)) throw BodyError("body file '" + file + "' is flat along its up axis");
 
+  if (options.height && !(*options.height >= kMinBodyHeight && *options.height <= kMaxBodyHeight))
+    throw BodyError(fmt::format("a body height of {} m is outside {} .. {} m", *options.height,
+                                kMinBodyHeight, kMaxBodyHeight));
+  if (options.scale && !(std::isfinite(*options.scale) && *options.scale > 0))
+    throw BodyError(fmt::format("a scale of {} metres per file unit is not a positive finite number",
+                                *options.scale));
   const double target = options.height.value_or(builtin ? kBuiltinHeight : 0.0);
   if (target > 0) {
     raw.scale = target / raw.height;
@@ -308,6 +374,12 @@ Body load_body(const std::string& path, const BodyOptions& options) {
         "'scale' to choose)", raw.height, kBuiltinHeight));
   }
 
+  const double height_m = raw.height * raw.scale;
+  if (!(height_m >= kMinBodyHeight && height_m <= kMaxBodyHeight))
+    throw BodyError(fmt::format(
+        "the body would be {:.4g} m tall ({:.4g} file units at {:.4g} m per unit), outside {} .. "
+        "{} m: give a 'height' or a 'scale' that makes it a body's size",
+        height_m, raw.height, raw.scale, kMinBodyHeight, kMaxBodyHeight));
   const Eigen::Matrix3d rotation = frame_rotation(raw.up, raw.facing);
   mesh.vertices = (mesh.vertices * rotation.transpose()) * raw.scale;
   const meshing::BoundingBox box = meshing::bounding_box(mesh);
@@ -323,6 +395,7 @@ meshing::TriMesh load_body_pose(const std::string& path, const Body& rest) {
   meshing::TriMesh mesh = read_body_mesh(path, scratch);
   // The same mesh moved: the same triangles over the same vertices, or the poses cannot be
   // interpolated vertex by vertex.
+  if (rest.raw.flipped_inside_out) mesh.faces.col(1).swap(mesh.faces.col(2));  // as the rest body
   const bool same_counts = mesh.vertex_count() == rest.mesh.vertex_count() &&
                            mesh.face_count() == rest.mesh.face_count();
   if (!same_counts || mesh.faces != rest.mesh.faces)

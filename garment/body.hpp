@@ -46,6 +46,9 @@ struct RawBodyInfo {
   std::string scale_rule;           // why that scale ("height 1.75 m given", ...)
   // Added after the rotation and the scale (feet on y = 0, centred on the vertical axis), m.
   Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+  // Enclosed volume as read, file units³ (negative: faces point inward; meaningful when closed).
+  double signed_volume = 0;
+  bool flipped_inside_out = false;  // the faces were reversed to point outward
 };
 
 struct Body {

@@ -18,6 +18,7 @@
 #include "garment/network_faces.hpp"
 #include "garment/panel_loop.hpp"
 #include "garment/panel_surface.hpp"
+#include "garment/sketch_ranges.hpp"
 #include "garment/stroke_projection.hpp"
 #include "garment/surface_relaxation.hpp"
 #include "garment/surface_untangle.hpp"
@@ -105,6 +106,7 @@ BodyPart classify_body_point(const Eigen::Vector3d& p, double height) {
 Garment build_garment(const Sketch& sketch, const BodySurface& body) {
   if (sketch.garment_mesh)
     throw std::logic_error("build_garment: a garment_mesh sketch has no curves to mesh");
+  check_against_body(sketch, body.box());
   const std::vector<ProjectedCurve> projected = project_curves(sketch, body);
   std::set<std::string> mirrored = curves_to_mirror(sketch);
   CurveNetwork net = build_network(sketch, projected, mirrored);
@@ -118,6 +120,18 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
   }
   const std::vector<PanelLoop> loops = resolve_panels(sketch, net, body);
   EdgeCounts counts = compute_edge_counts(sketch, net, loops);
+  {
+    std::vector<double> boundary_edges;
+    std::vector<std::string> paths, ids;
+    for (const PanelLoop& loop : loops) {
+      double edges = 0;
+      for (const LoopEdge& e : loop.edges) edges += counts.counts[static_cast<size_t>(e.edge)];
+      boundary_edges.push_back(edges);
+      paths.push_back(loop.json_path);
+      ids.push_back(loop.id);
+    }
+    check_panel_sizes(sketch, boundary_edges, paths, ids);
+  }
 
   // A curve piece is a seam between at most two panels.
   std::vector<std::vector<int>> users(net.edges.size());

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <initializer_list>
 #include <map>
 #include <mutex>
@@ -15,6 +16,8 @@
 
 #include "garment/body_landmarks.hpp"
 #include "garment/sketch_inputs.hpp"
+#include "garment/input_checks.hpp"
+#include "garment/sketch_ranges.hpp"
 
 namespace sd::garment {
 namespace {
@@ -197,6 +200,30 @@ class Reader {
     return v;
   }
 
+  // A point in the world or in a view plane: within ±kMaxCoordinate metres on every axis.
+  template <int N>
+  Eigen::Matrix<double, N, 1> position(const json& value, const std::string& path) const {
+    const Eigen::Matrix<double, N, 1> v = vector<N>(value, path);
+    for (int k = 0; k < N; ++k)
+      if (std::abs(v[k]) > kMaxCoordinate)
+        fail(fmt::format("{}/{}", path, k),
+             out_of_range_sentence(v[k], -kMaxCoordinate, kMaxCoordinate, "the coordinate"));
+    return v;
+  }
+
+  // An edge length in metres: 2 mm .. 50 cm.
+  double edge_length(const json& value, const std::string& path) const {
+    const double x = positive(value, path);
+    if (x < 0.002 || x > 0.5) fail(path, out_of_range_sentence(x, 0.002, 0.5, "an edge length of"));
+    return x;
+  }
+
+  // A list of at most `most` entries at `path`.
+  void check_count(const json& list, const std::string& path, size_t most, std::string_view what) const {
+    if (list.is_array() && list.size() > most)
+      fail(path, fmt::format("{} {} is more than the {} allowed", list.size(), what, most));
+  }
+
   ViewSpec view(const json& value, const std::string& path) const {
     ViewSpec view;
     if (value.is_string()) {
@@ -226,8 +253,8 @@ class Reader {
     check_keys(cam, cpath, {"eye", "target", "up", "fov"});
     view.kind = ViewKind::kCamera;
     if (!cam.contains("eye")) fail(cpath, "a camera needs an \"eye\" point [x, y, z]");
-    view.camera.eye = vector<3>(cam["eye"], cpath + "/eye");
-    if (cam.contains("target")) view.camera.target = vector<3>(cam["target"], cpath + "/target");
+    view.camera.eye = position<3>(cam["eye"], cpath + "/eye");
+    if (cam.contains("target")) view.camera.target = position<3>(cam["target"], cpath + "/target");
     if (cam.contains("up")) view.camera.up = vector<3>(cam["up"], cpath + "/up");
     if (cam.contains("fov")) {
       view.camera.fov_degrees = positive(cam["fov"], cpath + "/fov");
@@ -288,7 +315,12 @@ void parse_body(const Reader& r, const json& j, BodySpec& body) {
   r.check_keys(j, path, {"mesh", "height", "up", "scale", "motion"});
   if (j.contains("mesh")) body.mesh = r.text(j["mesh"], path + "/mesh");
   if (body.mesh.empty()) r.fail(path + "/mesh", "the body mesh path is empty");
-  if (j.contains("height")) body.height = r.positive(j["height"], path + "/height");
+  if (j.contains("height")) {
+    body.height = r.positive(j["height"], path + "/height");
+    if (*body.height < kMinBodyHeight || *body.height > kMaxBodyHeight)
+      r.fail(path + "/height", out_of_range_sentence(*body.height, kMinBodyHeight, kMaxBodyHeight,
+                                                     "a body height of"));
+  }
   if (j.contains("scale")) body.scale = r.positive(j["scale"], path + "/scale");
   if (j.contains("up")) {
     const std::string up = r.text(j["up"], path + "/up");
@@ -384,13 +416,14 @@ CurveSpec parse_curve(const Reader& r, const json& j, const std::string& path, c
   const std::string ppath = path + "/" + key;
   if (!pts.is_array()) r.fail(ppath, fmt::format("expected a list of points, got {}", type_name(pts)));
   if (pts.size() < 2) r.fail(ppath, fmt::format("curve '{}' needs at least 2 points", curve.id));
+  r.check_count(pts, ppath, kMaxPointsPerCurve, "points");
   for (size_t i = 0; i < pts.size(); ++i) {
     const std::string ip = fmt::format("{}/{}", ppath, i);
     if (has_2d)
-      curve.points.push_back(r.vector<2>(pts[i], ip));
+      curve.points.push_back(r.position<2>(pts[i], ip));
     else
       curve.points3d.push_back(pts[i].is_object() ? landmark_point(r, pts[i], ip, sk)
-                                                  : r.vector<3>(pts[i], ip));
+                                                  : r.position<3>(pts[i], ip));
   }
   if (j.contains("view")) {
     if (has_3d)
@@ -408,8 +441,13 @@ CurveSpec parse_curve(const Reader& r, const json& j, const std::string& path, c
   if (j.contains("closed")) curve.closed = r.boolean(j["closed"], path + "/closed");
   if (curve.closed && pts.size() < 3)
     r.fail(ppath, fmt::format("closed curve '{}' needs at least 3 points", curve.id));
-  if (j.contains("edge_length")) curve.edge_length = r.positive(j["edge_length"], path + "/edge_length");
-  if (j.contains("edges")) curve.edges = r.integer(j["edges"], path + "/edges", 1);
+  if (j.contains("edge_length")) curve.edge_length = r.edge_length(j["edge_length"], path + "/edge_length");
+  if (j.contains("edges")) {
+    curve.edges = r.integer(j["edges"], path + "/edges", 1);
+    if (*curve.edges > kMaxCurveEdges)
+      r.fail(path + "/edges", fmt::format("{} edges on one curve is more than the {} allowed",
+                                          *curve.edges, kMaxCurveEdges));
+  }
   // Repeated consecutive points make a stroke without direction there.
   const size_t n = has_2d ? curve.points.size() : curve.points3d.size();
   for (size_t i = 1; i < n; ++i) {
@@ -483,8 +521,8 @@ PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, c
     if (sj.contains("point") == sj.contains("point3d"))
       r.fail(sp, "a seed needs exactly one of \"point\" ([x, y] in its \"view\") or "
                  "\"point3d\" ([x, y, z])");
-    if (sj.contains("point")) seed.point = r.vector<2>(sj["point"], sp + "/point");
-    if (sj.contains("point3d")) seed.point3d = r.vector<3>(sj["point3d"], sp + "/point3d");
+    if (sj.contains("point")) seed.point = r.position<2>(sj["point"], sp + "/point");
+    if (sj.contains("point3d")) seed.point3d = r.position<3>(sj["point3d"], sp + "/point3d");
     if (sj.contains("view")) {
       if (seed.point3d)
         r.fail(sp + "/view", "a \"view\" only applies to a 2D \"point\"; \"point3d\" is in "
@@ -510,7 +548,7 @@ PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, c
   }
   panel.fabric = j.contains("fabric") ? r.text(j["fabric"], path + "/fabric") : sk.fabric;
   if (j.contains("mirror")) panel.mirror = r.boolean(j["mirror"], path + "/mirror");
-  if (j.contains("edge_length")) panel.edge_length = r.positive(j["edge_length"], path + "/edge_length");
+  if (j.contains("edge_length")) panel.edge_length = r.edge_length(j["edge_length"], path + "/edge_length");
   if (j.contains("ease")) {
     panel.ease = r.positive(j["ease"], path + "/ease");
     if (panel.ease < 0.5 || panel.ease > 2.0)
@@ -602,9 +640,23 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
                          "stop_at_rest", "gravity", "pin_above", "check_body_vertices", "rest",
                          "self_collision"});
   if (j.contains("pin_above")) sim.pin_above = r.number(j["pin_above"], path + "/pin_above");
-  if (j.contains("duration")) sim.duration = r.positive(j["duration"], path + "/duration");
+  if (j.contains("duration")) {
+    sim.duration = r.positive(j["duration"], path + "/duration");
+    if (sim.duration > kMaxDuration)
+      r.fail(path + "/duration",
+             fmt::format("a drape of {:.6g} s is longer than the {:g} s (one hour of simulated "
+                         "time) allowed; a garment settles within seconds",
+                         sim.duration, kMaxDuration));
+  }
   if (j.contains("adaptive")) parse_adaptive(r, j["adaptive"], sim);
-  if (j.contains("time_step")) sim.time_step = r.positive(j["time_step"], path + "/time_step");
+  if (j.contains("time_step")) {
+    sim.time_step = r.positive(j["time_step"], path + "/time_step");
+    if (sim.time_step < kMinTimeStep || sim.time_step > kMaxTimeStep)
+      r.fail(path + "/time_step",
+             fmt::format("a time step of {:.6g} s is outside {:g} .. {:g} s (the step control "
+                         "shortens steps itself when it needs to; 1/60 s is the default)",
+                         sim.time_step, kMinTimeStep, kMaxTimeStep));
+  }
   if (j.contains("integrator")) {
     sim.integrator = r.text(j["integrator"], path + "/integrator");
     if (sim.integrator != "implicit-euler" && sim.integrator != "bdf2")
@@ -619,7 +671,14 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
              fmt::format("unknown solver '{}'; use \"pcg\" or \"cholmod\"", sim.solver));
   }
   if (j.contains("stop_at_rest")) sim.stop_at_rest = r.boolean(j["stop_at_rest"], path + "/stop_at_rest");
-  if (j.contains("gravity")) sim.gravity = r.vector<3>(j["gravity"], path + "/gravity");
+  if (j.contains("gravity")) {
+    sim.gravity = r.vector<3>(j["gravity"], path + "/gravity");
+    for (int k = 0; k < 3; ++k)
+      if (std::abs(sim.gravity[k]) > kMaxGravity)
+        r.fail(fmt::format("{}/gravity/{}", path, k),
+               fmt::format("{:.6g} m/s² is outside ±{:g} m/s² (Earth's gravity is 9.81 m/s²)",
+                           sim.gravity[k], kMaxGravity));
+  }
   if (j.contains("check_body_vertices"))
     sim.check_body_vertices = r.boolean(j["check_body_vertices"], path + "/check_body_vertices");
   if (j.contains("rest")) {
@@ -648,6 +707,10 @@ SheetSpec parse_sheet(const Reader& r, const json& j) {
     for (int k = 0; k < 2; ++k)
       if (!(sheet.size[k] > 0))
         r.fail(fmt::format("{}/size/{}", path, k), "a sheet's width and height must be positive");
+    for (int k = 0; k < 2; ++k)
+      if (sheet.size[k] > kMaxSheetSide)
+        r.fail(fmt::format("{}/size/{}", path, k),
+               out_of_range_sentence(sheet.size[k], 0, kMaxSheetSide, "a sheet side of"));
   }
   if (j.contains("resolution")) {
     const json& res = j["resolution"];
@@ -665,7 +728,7 @@ SheetSpec parse_sheet(const Reader& r, const json& j) {
              fmt::format("unknown orientation '{}'; use \"vertical\" or \"horizontal\"", o));
     sheet.horizontal = o == "horizontal";
   }
-  if (j.contains("centre")) sheet.centre = r.vector<3>(j["centre"], path + "/centre");
+  if (j.contains("centre")) sheet.centre = r.position<3>(j["centre"], path + "/centre");
   if (j.contains("pins")) {
     const json& pins = j["pins"];
     if (!pins.is_array()) r.fail(path + "/pins", "expected a list of corner or edge names");
@@ -741,6 +804,7 @@ void parse_output(const Reader& r, const json& j, OutputSpec& out) {
     out.images_listed = true;
     const json& images = j["images"];
     if (!images.is_array()) r.fail(path + "/images", "expected a list of images");
+    r.check_count(images, path + "/images", kMaxImages, "images");
     for (size_t i = 0; i < images.size(); ++i) {
       const std::string ip = fmt::format("{}/images/{}", path, i);
       const json& im = images[i];
@@ -763,8 +827,10 @@ void parse_output(const Reader& r, const json& j, OutputSpec& out) {
           r.fail(ip + "/size", "expected [width, height] in pixels");
         image.width = r.integer(s[0], ip + "/size/0", 16);
         image.height = r.integer(s[1], ip + "/size/1", 16);
-        if (image.width > 8192 || image.height > 8192)
-          r.fail(ip + "/size", "images are at most 8192 pixels on a side");
+        if (image.width > kMaxImageSide || image.height > kMaxImageSide)
+          r.fail(ip + "/size", fmt::format("images are at most {} pixels on a side (a {}x{} "
+                                           "picture takes half a gigabyte to draw)",
+                                           kMaxImageSide, kMaxImageSide, kMaxImageSide));
       }
       if (im.contains("wireframe")) image.wireframe = r.boolean(im["wireframe"], ip + "/wireframe");
       out.images.push_back(image);
@@ -786,6 +852,79 @@ std::string position_of(std::string_view text, size_t byte) {
   }
   return fmt::format("line {}, column {}", line, column);
 }
+
+constexpr int kMaxNesting = 64;
+
+// Tracks the JSON path while nlohmann's parser reports events, to reject a key given twice in
+// one object (JSON allows it and keeps the last value, silently dropping the first).
+class DuplicateKeyCheck {
+ public:
+  explicit DuplicateKeyCheck(const Sketch& sketch) : sketch_(sketch) {}
+
+  bool operator()(int depth, json::parse_event_t event, json& parsed) {
+    // A sketch file nests a few levels (a point in a list in a curve in the list of curves);
+    // thousands of levels are a damaged or hostile file, and cost time and memory to build.
+    if (depth > kMaxNesting)
+      sketch_.fail(path(), fmt::format("lists and objects are nested more than {} levels deep "
+                                       "here; a sketch file needs fewer than 10",
+                                       kMaxNesting));
+    switch (event) {
+      case json::parse_event_t::object_start:
+      case json::parse_event_t::array_start:
+        enter_element();
+        frames_.push_back({event == json::parse_event_t::array_start, -1, {}, {}});
+        break;
+      case json::parse_event_t::key: {
+        Frame& f = frames_.back();
+        f.key = parsed.get<std::string>();
+        if (!f.keys.insert(f.key).second)
+          sketch_.fail(path(),
+                       fmt::format("the key '{}' is given twice in this object; JSON would keep "
+                                   "only the last one: remove one of them",
+                                   f.key));
+        break;
+      }
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end:
+        frames_.pop_back();
+        break;
+      case json::parse_event_t::value:
+        enter_element();
+        break;
+    }
+    return true;
+  }
+
+ private:
+  struct Frame {
+    bool array = false;
+    long index = -1;
+    std::set<std::string> keys;
+    std::string key;
+  };
+
+  // A value or container begins: in an array it is the next element.
+  void enter_element() {
+    if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
+  }
+
+  // "/a/0/b": keys with JSON Pointer escapes (~0 for ~, ~1 for /).
+  std::string path() const {
+    std::string out;
+    for (const Frame& f : frames_) {
+      if (f.array) {
+        out += "/" + std::to_string(f.index);
+        continue;
+      }
+      out += "/";
+      for (char c : f.key) out += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
+    }
+    return out;
+  }
+
+  const Sketch& sketch_;
+  std::vector<Frame> frames_;
+};
 
 }  // namespace
 
@@ -828,9 +967,15 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
   sketch.base_dir = base_dir;
   const Reader r(sketch);
 
+  // A NUL byte would end the text for the JSON reader, silently dropping the rest.
+  if (const size_t nul = text.find('\0'); nul != std::string_view::npos)
+    r.fail("", fmt::format("{}: the file holds a NUL byte (a zero byte); a sketch file is text: "
+                           "the file is damaged or not a sketch file",
+                           position_of(text, nul + 1)));
   json root;
   try {
-    root = json::parse(mark_overflowing_numbers(text), nullptr, /*allow_exceptions=*/true,
+    DuplicateKeyCheck duplicates(sketch);
+    root = json::parse(mark_overflowing_numbers(text), std::ref(duplicates), /*allow_exceptions=*/true,
                        /*ignore_comments=*/true);
   } catch (const json::parse_error& e) {
     std::string detail = e.what();
@@ -860,6 +1005,10 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
   if (root.contains("offset")) sketch.offset = r.number(root["offset"], "/offset");
   if (root.contains("junction_tolerance"))
     sketch.junction_tolerance = r.positive(root["junction_tolerance"], "/junction_tolerance");
+  if (sketch.junction_tolerance > kMaxJunctionTolerance)
+    r.fail("/junction_tolerance",
+           out_of_range_sentence(sketch.junction_tolerance, 0, kMaxJunctionTolerance,
+                                 "a junction tolerance of"));
   if (root.contains("corner_angle")) {
     sketch.corner_angle_degrees = r.positive(root["corner_angle"], "/corner_angle");
     if (sketch.corner_angle_degrees >= 180)
@@ -867,6 +1016,9 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
   }
   if (root.contains("relax_iterations"))
     sketch.relax_iterations = r.integer(root["relax_iterations"], "/relax_iterations", 0);
+  if (sketch.relax_iterations > kMaxRelaxIterations)
+    r.fail("/relax_iterations", fmt::format("{} sweeps is more than the {} allowed",
+                                            sketch.relax_iterations, kMaxRelaxIterations));
   if (root.contains("fabric")) {
     // A preset name, a path to a fabric file, or the fabric's constants inline (the presets'
     // schema, checked when the scene is built).
@@ -903,6 +1055,7 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
   const json& curves = root["curves"];
   if (!curves.is_array()) r.fail("/curves", "expected a list of curves");
   if (curves.empty()) r.fail("/curves", "the list of curves is empty");
+  r.check_count(curves, "/curves", kMaxCurves, "curves");
   for (size_t i = 0; i < curves.size(); ++i) {
     CurveSpec curve = parse_curve(r, curves[i], fmt::format("/curves/{}", i), sketch);
     if (const CurveSpec* other = sketch.find_curve(curve.id))
@@ -915,6 +1068,7 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
   const json& panels = root["panels"];
   if (!panels.is_array()) r.fail("/panels", "expected a list of panels");
   if (panels.empty()) r.fail("/panels", "the list of panels is empty: a garment needs at least one panel");
+  r.check_count(panels, "/panels", kMaxPanels, "panels");
   for (size_t i = 0; i < panels.size(); ++i) {
     PanelSpec panel = parse_panel(r, panels[i], fmt::format("/panels/{}", i), sketch);
     if (const PanelSpec* other = sketch.find_panel(panel.id))
@@ -959,6 +1113,8 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
 }
 
 Sketch load_sketch(const std::filesystem::path& path) {
+  if (const auto problem = input_file_problem(path, kMaxSketchFileBytes))
+    throw SketchError(path.string(), "", "the sketch file " + *problem);
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     const bool exists = std::filesystem::exists(path);

@@ -7,6 +7,9 @@
 #include <sstream>
 #include <vector>
 
+#include "garment/input_checks.hpp"
+#include "garment/sketch_ranges.hpp"
+
 namespace sd::garment {
 
 Body load_sketch_body(const Sketch& sketch) {
@@ -28,6 +31,8 @@ Body load_sketch_body(const Sketch& sketch) {
 meshing::TriMesh load_garment_mesh(const Sketch& sketch) {
   const std::string where = "/garment_mesh";
   const std::filesystem::path path = sketch.resolve(*sketch.garment_mesh);
+  if (const auto problem = input_file_problem(path, kMaxMeshFileBytes))
+    sketch.fail(where, fmt::format("the garment mesh '{}' {}", path.string(), *problem));
   std::ifstream in(path);
   if (!in)
     sketch.fail(where, fmt::format("the garment mesh '{}' {}", path.string(),
@@ -48,6 +53,11 @@ meshing::TriMesh load_garment_mesh(const Sketch& sketch) {
       if (!(ls >> p.x() >> p.y() >> p.z()) || !p.allFinite())
         sketch.fail(where, fmt::format("line {} of '{}' is not a vertex of three finite numbers",
                                        line_number, path.filename().string()));
+      if (p.cwiseAbs().maxCoeff() > kMaxCoordinate)
+        sketch.fail(where, fmt::format("line {} of '{}': a vertex {}",
+                                       line_number, path.filename().string(),
+                                       out_of_range_sentence(p.cwiseAbs().maxCoeff(), -kMaxCoordinate,
+                                                             kMaxCoordinate, "at")));
       vertices.push_back(p);
     } else if (tag == "f") {
       std::vector<int> ids;
@@ -72,6 +82,8 @@ meshing::TriMesh load_garment_mesh(const Sketch& sketch) {
   for (size_t v = 0; v < vertices.size(); ++v) mesh.vertices.row(static_cast<Eigen::Index>(v)) = vertices[v].transpose();
   mesh.faces.resize(static_cast<Eigen::Index>(faces.size()), 3);
   for (size_t f = 0; f < faces.size(); ++f) mesh.faces.row(static_cast<Eigen::Index>(f)) = faces[f].transpose();
+  if (const auto problem = mesh_problem(mesh))
+    sketch.fail(where, fmt::format("the garment mesh '{}' {}", path.filename().string(), *problem));
   return mesh;
 }
 

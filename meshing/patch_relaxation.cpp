@@ -354,10 +354,13 @@ void relax_interior(std::vector<Eigen::Vector3d>& positions,
     laplacian_step(current, next);
     // A quad whose smallest scaled Jacobian would fall below min(before, kAcceptable) keeps
     // its free vertices where they were; quads around a kept vertex are checked again.
+    // (A reference, not the structured binding itself: clang 14, the fuzz build's compiler,
+    // cannot capture structured bindings in a lambda.)
+    const std::vector<Eigen::Vector3d>& face_normals = normals;
     auto worse = [&](size_t f) {
-      if (quad_at_least(quads[f], normals[f], next, kAcceptable)) return false;
-      return quad_min_jacobian(quads[f], normals[f], next) <
-             quad_min_jacobian(quads[f], normals[f], current) - 1e-12;
+      if (quad_at_least(quads[f], face_normals[f], next, kAcceptable)) return false;
+      return quad_min_jacobian(quads[f], face_normals[f], next) <
+             quad_min_jacobian(quads[f], face_normals[f], current) - 1e-12;
     };
     queue.clear();
     for (size_t f = 0; f < nf; ++f)

@@ -3,6 +3,7 @@
 # build/ (Release, warnings as errors, tests on) and builds the targets given.
 #   setup.sh demo              packages for the demo; builds the sketchdrape binary only
 #   setup.sh test              every package the tests use; builds everything
+#   setup.sh fuzz              with SD_PACKAGES_ONLY=1: also clang and libFuzzer (tests/fuzz)
 # Both configure build/ the same way, so running demo.sh then test.sh compiles each file once.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -25,6 +26,9 @@ if [ "$purpose" = test ]; then
     gnuplot-nox  # sketchdrape bench: the work-precision plots (optional: the CSV is written without it)
   )
 fi
+if [ "$purpose" = fuzz ]; then
+  packages+=(clang-14 libclang-rt-14-dev)  # tests/fuzz/run.sh: libFuzzer with ASan and UBSan
+fi
 
 missing=()
 for p in "${packages[@]}"; do
@@ -41,6 +45,10 @@ if ((${#missing[@]})); then
   DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends \
     "${missing[@]}" >/dev/null
 fi
+
+# SD_PACKAGES_ONLY=1: stop here (test.sh --sanitize and tests/fuzz/run.sh configure their own
+# build folders).
+if [ "${SD_PACKAGES_ONLY:-0}" = 1 ]; then exit 0; fi
 
 # ccache keeps compiled objects between builds and between checkouts of the project (paths are
 # taken relative to the checkout), so a rebuild after a pull or in a second worktree is quick.

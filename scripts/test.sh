@@ -1,7 +1,28 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds everything with warnings as errors, and runs every test.
+#   test.sh              the whole suite in build/
+#   test.sh --sanitize   the unit tests of the input-facing modules (meshing, garment: the
+#                        sketch reader, the body loader, the quad filler) built with
+#                        AddressSanitizer and UBSan in build-asan/ (docs/cli.md, "Fuzzing")
 set -euo pipefail
 cd "$(dirname "$0")/.."
+if [ "${1:-}" = --sanitize ]; then
+  SD_PACKAGES_ONLY=1 ./scripts/setup.sh test
+  export CCACHE_BASEDIR="$PWD"
+  jobs=$(nproc 2>/dev/null || echo 2)
+  units=(meshing_tests garment_tests)
+  echo "==> configuring build-asan/ (RelWithDebInfo, ASan + UBSan)"
+  cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSD_WERROR=ON -DSD_SANITIZE=ON \
+    -DSD_BUILD_TESTS=ON -DSD_BUILD_BENCHMARKS=OFF -DCMAKE_CXX_COMPILER_LAUNCHER=ccache >/dev/null
+  cmake --build build-asan -j "$jobs" --target "${units[@]}"
+  export OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1
+  # Leaks: Mesa and assimp keep process-lifetime allocations; UBSan findings are errors.
+  export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=0} UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+  echo "==> running the sanitized unit tests"
+  ctest --test-dir build-asan --output-on-failure -j "$jobs" --timeout 1200 \
+    -L "^($(IFS='|'; echo "${units[*]}"))$"
+  exit
+fi
 ./scripts/setup.sh test
 
 # The test executables link the simulator directly: give CHOLMOD's OpenMP loops and OpenBLAS one

@@ -1,5 +1,7 @@
 #include "sim/cholmod_solver.hpp"
 
+#include <fmt/format.h>
+
 #include <Eigen/CholmodSupport>
 #include <algorithm>
 #include <cmath>
@@ -81,6 +83,19 @@ CholmodSolver::~CholmodSolver() = default;
 CholmodSolver::CholmodSolver(CholmodSolver&&) noexcept = default;
 CholmodSolver& CholmodSolver::operator=(CholmodSolver&&) noexcept = default;
 
+void CholmodSolver::throw_if_out_of_memory(int rows, const char* stage) {
+  cholmod_common& common = factor_->llt.cholmod();
+  if (common.status != CHOLMOD_OUT_OF_MEMORY && common.status != CHOLMOD_TOO_LARGE) return;
+  common.status = CHOLMOD_OK;
+  factorized_ = false;
+  analyses_ = 0;  // analyse again next time
+  outer_.clear();
+  throw CholmodOutOfMemoryError(fmt::format(
+      "out of memory: CHOLMOD could not allocate the {} of the {} unknowns' system (a factor of "
+      "about {:.2g} GB was needed; {:.2g} GB were in use)",
+      stage, rows, common.lnz * 8.0 / 1e9, static_cast<double>(common.memory_inuse) / 1e9));
+}
+
 bool CholmodSolver::factorize(const SparseMatrixR& a, const ConstraintFilter& filter) {
   const int rows = static_cast<int>(a.rows());
   const int* outer = a.outerIndexPtr();
@@ -130,8 +145,10 @@ bool CholmodSolver::factorize(const SparseMatrixR& a, const ConstraintFilter& fi
       factor_->llt.analyze_with_ordering(filtered_, order);
     ++analyses_;
   }
+  throw_if_out_of_memory(rows, "analysis");
   factor_->llt.factorize(filtered_);
   ++factorizations_;
+  throw_if_out_of_memory(rows, "factorisation");
   factorized_ = factor_->llt.info() == Eigen::Success;
   return factorized_;
 }

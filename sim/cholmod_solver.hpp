@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <memory>
+#include <stdexcept>
 #include <vector>
 
 #include "sim/cloth_model.hpp"
@@ -20,6 +21,12 @@ namespace sd::sim {
 // columns) or simplicial (column by column, no BLAS).
 enum class CholmodMethod { supernodal, simplicial };
 
+// CHOLMOD could not allocate the factor: the machine's memory, not the cloth, is the cause.
+class CholmodOutOfMemoryError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 class CholmodSolver {
  public:
   explicit CholmodSolver(CholmodMethod method = CholmodMethod::supernodal);
@@ -28,7 +35,8 @@ class CholmodSolver {
   CholmodSolver& operator=(CholmodSolver&&) noexcept;
 
   // Factorises S A S + (I − S). Analyses the pattern only when it differs from the last one.
-  // Returns false if the factorisation failed (matrix not positive definite).
+  // Returns false if the factorisation failed (matrix not positive definite). Throws
+  // CholmodOutOfMemoryError when CHOLMOD runs out of memory (analysis or factorisation).
   bool factorize(const SparseMatrixR& a, const ConstraintFilter& filter);
   // Solves with the last factorisation; needs the same A and filter as factorize().
   LinearSolveStats solve(const SparseMatrixR& a, const ConstraintFilter& filter,
@@ -42,6 +50,8 @@ class CholmodSolver {
   // A fill-reducing ordering of the 3n rows that keeps each vertex's three together: AMD on
   // the vertex graph of A's pattern (row-major arrays). Empty if CHOLMOD's AMD failed.
   std::vector<int> block_ordering(const int* outer, const int* inner, int rows);
+  // Throws CholmodOutOfMemoryError when CHOLMOD's last call ran out of memory.
+  void throw_if_out_of_memory(int rows, const char* stage);
 
   struct Factor;
   CholmodMethod method_;

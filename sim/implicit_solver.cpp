@@ -127,13 +127,25 @@ bool ImplicitSolver::linear_solve(const ClothModel& model, const ConstraintFilte
   const auto start = std::chrono::steady_clock::now();
   LinearSolveStats stats;
   if (settings.solver == LinearSolverKind::cholmod) {
-    if (refactor && !cholmod_.factorize(matrix_, filter)) {
-      // No step: callers still add step_, so it must be a zero of the right size.
-      step_.setZero(3 * model.vertex_count);
-      result.solve_seconds += seconds_since(start);
-      return false;
+    if (refactor) {
+      cholmod_failed_ = !cholmod_.factorize(matrix_, filter);
+      if (cholmod_failed_) ++result.cholmod_failures;
     }
-    stats = cholmod_.solve(matrix_, filter, rhs_, z_, step_);
+    if (!cholmod_failed_) {
+      stats = cholmod_.solve(matrix_, filter, rhs_, z_, step_);
+    } else {
+      // The system is not positive definite for CHOLMOD: PCG on the same system, its
+      // preconditioner built afresh. A zero step must never pass for a solution.
+      pcg_.set_preconditioner(settings.pcg_preconditioner);
+      stats = pcg_.solve(matrix_, model.pattern.diagonal_offsets, filter, rhs_, z_, step_,
+                         settings.pcg_tolerance, settings.pcg_max_iterations, refactor);
+      if (!stats.converged || !step_.allFinite()) {
+        result.linear_failure =
+            "the CHOLMOD factorisation failed (the system is not positive definite) and PCG on "
+            "the same system did not converge either";
+        step_.setZero(3 * model.vertex_count);  // callers still add step_
+      }
+    }
   } else {
     pcg_.set_preconditioner(settings.pcg_preconditioner);
     stats = pcg_.solve(matrix_, model.pattern.diagonal_offsets, filter, rhs_, z_, step_,

@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <string>
 #include <vector>
 
 #include "sim/cholmod_solver.hpp"
@@ -124,6 +125,12 @@ struct ImplicitSolveResult {
   int cg_iterations = 0;      // summed over the linear solves
   int cg_iterations_max = 0;  // largest single solve
   bool linear_converged = true;
+  // CHOLMOD factorisations that failed (the system not positive definite); each solve fell
+  // back to PCG on the same system.
+  int cholmod_failures = 0;
+  // Why the linear solve failed when no step can come of it (the factorisation failed and the
+  // PCG fallback did not converge either); empty otherwise.
+  std::string linear_failure;
   bool newton_converged = true;
   double last_update = 0.0;  // β·max|Δv| of the last Newton update, m
   // 3n, N·s: the impulse the constraints applied over the step, (I − S)(A s − b) of the last
@@ -165,6 +172,7 @@ class ImplicitSolver {
   SparseMatrixR matrix_;
   PcgSolver pcg_;
   CholmodSolver cholmod_;
+  bool cholmod_failed_ = false;  // the last factorisation failed: solves go to PCG until the next
   Eigen::VectorXd force_, product_, rhs_, z_, step_;
 };
 

@@ -177,8 +177,14 @@ LinearSolveStats PcgSolver::solve(const SparseMatrixR& a, const std::vector<int>
   double delta = r_.dot(c_);
   const double delta0 = delta;
   const double threshold = tolerance * tolerance * delta0;
-  if (!(delta > threshold) || delta0 <= 0.0) {
-    stats.converged = std::isfinite(delta);
+  if (!(delta0 > 0.0)) {
+    // r·M⁻¹r is zero only for a zero residual (z solves the system); negative or NaN, the
+    // preconditioner is not positive definite and there is no step: never report s = z as one.
+    stats.converged = r_.squaredNorm() == 0.0;
+    return stats;
+  }
+  if (!(delta > threshold)) {
+    stats.converged = true;
     return stats;
   }
   while (stats.iterations < max_iterations) {

@@ -274,6 +274,12 @@ Simulation::Attempt Simulation::attempt(double h) {
     result.cg_iterations_max = std::max(result.cg_iterations_max, result.solve.cg_iterations_max);
     result.x = std::move(result.solve.x);
     result.v = std::move(result.solve.v);
+    if (result.solve.cholmod_failures > 0)
+      spdlog::debug("sim: t = {:.6f} s: the CHOLMOD factorisation failed {} time(s); PCG solved "
+                    "instead{}",
+                    time_, result.solve.cholmod_failures,
+                    result.solve.linear_failure.empty() ? "" : " (and failed)");
+    if (!result.solve.linear_failure.empty()) break;
     if (contact == nullptr || !result.solve.linear_converged || !result.x.allFinite() ||
         !result.v.allFinite())
       break;
@@ -304,7 +310,11 @@ Simulation::Attempt Simulation::attempt(double h) {
       if (const double speed = result.v.segment<3>(3 * i).norm(); speed > fastest)
         fastest = speed, result.failure_vertex = static_cast<int>(i);
   }
-  if (!result.x.allFinite() || !result.v.allFinite()) {
+  if (!result.solve.linear_failure.empty()) {
+    // No step came out of the solve: never accepted, not even at the minimum step.
+    why << result.solve.linear_failure;
+    result.hard_failure = true;
+  } else if (!result.x.allFinite() || !result.v.allFinite()) {
     why << "non-finite positions or velocities";
     result.hard_failure = true;
   } else if (const double speed = max_speed(result.v); speed > settings_.max_speed) {

@@ -15,7 +15,9 @@ namespace sd::app {
 void write_file_atomically(const std::filesystem::path& path, std::string_view bytes);
 
 // A set of output files that appear together or not at all. Files are staged under temporary
-// names; commit() renames them all into place; destruction without commit() removes them.
+// names; commit() renames them all into place; destruction without commit() removes them, and so
+// does SIGINT, SIGTERM or SIGHUP (the process then dies by the signal). Staging in a folder first
+// removes the temporaries that processes gone for ten minutes left there (SIGKILL, a crash).
 class StagedOutputs {
  public:
   StagedOutputs() = default;
@@ -36,6 +38,9 @@ class StagedOutputs {
   std::vector<std::filesystem::path> temps_;
   std::vector<std::filesystem::path> finals_;
   std::vector<std::filesystem::path> created_dirs_;
+  // The same paths as held by the signal handler's registry (null when it was full).
+  std::vector<const char*> held_;
+  std::vector<const char*> held_dirs_;
   bool committed_ = false;
 };
 

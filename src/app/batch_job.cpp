@@ -25,7 +25,8 @@ json record_to_json(const JobRecord& r) {
           {"inputs_hash", r.inputs_hash},
           {"stage", r.stage},
           {"version", r.version},
-          {"finished_at", r.finished_at}};
+          {"finished_at", r.finished_at},
+          {"outputs", r.outputs}};
 }
 
 JobRecord record_from_json(const json& j) {
@@ -38,6 +39,7 @@ JobRecord record_from_json(const json& j) {
   r.stage = j.at("stage").get<std::string>();
   r.version = j.at("version").get<std::string>();
   r.finished_at = j.at("finished_at").get<std::string>();
+  if (j.contains("outputs")) r.outputs = j.at("outputs").get<std::map<std::string, std::string>>();
   return r;
 }
 
@@ -138,7 +140,31 @@ std::optional<JobRecord> read_job_record(const std::filesystem::path& dir) {
 
 bool job_is_done(const std::filesystem::path& dir, const std::string& inputs_hash) {
   const std::optional<JobRecord> record = read_job_record(dir);
-  return record && record->status == "done" && record->inputs_hash == inputs_hash;
+  if (!record || record->status != "done" || record->inputs_hash != inputs_hash) return false;
+  for (const auto& [name, digest] : record->outputs) {
+    try {
+      if (sha256_file(dir / name) != digest) return false;
+    } catch (const std::exception&) {
+      return false;  // gone or unreadable
+    }
+  }
+  return true;
+}
+
+std::map<std::string, std::string> digest_job_outputs(const std::filesystem::path& dir) {
+  std::map<std::string, std::string> digests;
+  std::error_code ec;
+  for (auto it = std::filesystem::recursive_directory_iterator(dir, ec);
+       !ec && it != std::filesystem::recursive_directory_iterator(); it.increment(ec)) {
+    if (!it->is_regular_file()) continue;
+    const std::string name = std::filesystem::relative(it->path(), dir).generic_string();
+    const std::string file = it->path().filename().string();
+    if (file.empty() || file[0] == '.' || name == kDoneMarker || name == kFailedMarker ||
+        name == kJobLog)
+      continue;
+    digests[name] = sha256_file(it->path());
+  }
+  return digests;
 }
 
 void clean_job_folder(const std::filesystem::path& dir) {

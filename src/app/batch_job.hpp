@@ -30,6 +30,9 @@ struct JobRecord {
   std::string stage;         // "mesh", "run", ...
   std::string version;       // sketchdrape version that ran it
   std::string finished_at;   // UTC, ISO 8601
+  // A done job's files (path relative to its folder → sha256), as they were when the job
+  // finished: the marker binds these outputs to inputs_hash (job_is_done checks them).
+  std::map<std::string, std::string> outputs;
 };
 
 nlohmann::json record_to_json(const JobRecord& record);
@@ -71,8 +74,14 @@ std::string job_inputs_hash(std::string_view document_text,
 // The record in <dir>/done, or else <dir>/failed; nullopt when neither exists or parses.
 std::optional<JobRecord> read_job_record(const std::filesystem::path& dir);
 
-// True when <dir>/done exists, parses, says "done" and records `inputs_hash`.
+// True when <dir>/done exists, parses, says "done", records `inputs_hash`, and every output it
+// lists is still there with the digest it recorded (a file written later, by a process that
+// outlived its batch, or edited by hand, makes the job not done).
 bool job_is_done(const std::filesystem::path& dir, const std::string& inputs_hash);
+
+// The digests of a job folder's files (recursively; path relative to `dir` → sha256), but its
+// markers, its log and hidden temporaries.
+std::map<std::string, std::string> digest_job_outputs(const std::filesystem::path& dir);
 
 // Empties a job folder for a fresh attempt (creating it if needed): the markers go first, then
 // everything else (outputs, temporaries of a killed attempt, the old log). The folder itself

@@ -6,6 +6,8 @@
 #include <signal.h>
 #include <spawn.h>
 #include <spdlog/spdlog.h>
+#include <sys/file.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -16,7 +18,9 @@
 #include <cstdio>
 #include <cstring>
 #include <deque>
+#include <cstdlib>
 #include <map>
+#include <optional>
 
 #include "src/app/atomic_file.hpp"
 #include "src/app/progress.hpp"
@@ -118,8 +122,51 @@ std::vector<std::string> child_environment() {
     if (env.back().rfind("OPENBLAS_NUM_THREADS=", 0) == 0) openblas_set = true;
   }
   if (!openblas_set) env.emplace_back("OPENBLAS_NUM_THREADS=1");
+  // The child ends when this batch process does, however it ends (follow_batch_parent).
+  env.push_back(fmt::format("{}={}", kBatchParentVariable, ::getpid()));
   return env;
 }
+
+// An exclusive lock on the output folder (or on one shard of it) for the whole batch: a second
+// batch on the same folder refuses instead of running the same jobs at the same time. flock is
+// released by the kernel when the process ends, however it ends; O_CLOEXEC keeps the children
+// from inheriting it.
+class FolderLock {
+ public:
+  FolderLock(const std::filesystem::path& out, const std::optional<std::pair<int, int>>& shard) {
+    const std::string name =
+        shard ? fmt::format(".batch-lock-shard-{}-of-{}", shard->first, shard->second)
+              : std::string(".batch-lock");
+    const std::filesystem::path path = out / name;
+    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0)
+      throw std::runtime_error(
+          fmt::format("cannot open the lock '{}': {}", path.string(), std::strerror(errno)));
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      char text[32] = {};
+      const ssize_t n = ::pread(fd_, text, sizeof text - 1, 0);
+      const std::string holder = n > 0 ? std::string(text, static_cast<size_t>(n)) : "?";
+      ::close(fd_);
+      throw std::runtime_error(fmt::format(
+          "another batch (process {}) is writing into '{}'{}; wait until it ends, or give this "
+          "one another -o folder",
+          holder.substr(0, holder.find('\n')), out.string(),
+          shard ? fmt::format(" as shard {}/{}", shard->first, shard->second) : ""));
+    }
+    const std::string pid = std::to_string(::getpid()) + "\n";
+    if (::ftruncate(fd_, 0) == 0 && ::pwrite(fd_, pid.data(), pid.size(), 0) < 0) {
+      // The pid is only for the message of a second batch.
+    }
+  }
+  ~FolderLock() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  FolderLock(const FolderLock&) = delete;
+  FolderLock& operator=(const FolderLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
 
 // Starts `exe <args>` with stdout and stderr going to `log` (truncated) and stdin from /dev/null,
 // with default signal mask and dispositions and the child_environment(). Throws
@@ -197,6 +244,16 @@ std::vector<PlannedJob> plan_batch(const BatchOptions& options, BatchPlan* plan)
   return slice;
 }
 
+bool follow_batch_parent() {
+  const char* parent = std::getenv(kBatchParentVariable);
+  if (parent == nullptr) return true;
+  const long pid = std::strtol(parent, nullptr, 10);
+  ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+  // The batch may have died between spawning this process and the line above: then the
+  // signal never comes, and the parent is no longer the batch.
+  return pid <= 0 || ::getppid() == static_cast<pid_t>(pid);
+}
+
 BatchResult run_batch(const BatchOptions& options) {
   if (options.parallel < 1) throw std::invalid_argument("-j must be at least 1");
   if (options.timeout_s < 0) throw std::invalid_argument("--timeout must not be negative");
@@ -210,6 +267,7 @@ BatchResult run_batch(const BatchOptions& options) {
   if (ec)
     throw std::runtime_error(
         fmt::format("cannot create '{}': {}", jobs_dir.string(), ec.message()));
+  const FolderLock lock(options.out, options.shard);
   write_plan(options.out, plan);
 
   BatchResult result;
@@ -223,6 +281,8 @@ BatchResult run_batch(const BatchOptions& options) {
     record.finished_at = utc_timestamp();
     if (write_marker) {
       try {
+        // The marker binds the outputs as they are now to the inputs' digest.
+        if (record.status == "done") record.outputs = digest_job_outputs(jobs_dir / p.job.id);
         write_job_record(jobs_dir / p.job.id, record);
       } catch (const std::exception& e) {
         if (record.status == "done") {

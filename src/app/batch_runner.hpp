@@ -39,6 +39,14 @@ struct BatchResult {
 // other std::invalid_argument) for bad manifests or options before anything runs.
 BatchResult run_batch(const BatchOptions& options);
 
+// The environment variable that tells a child the batch process it belongs to.
+inline constexpr const char* kBatchParentVariable = "SKETCHDRAPE_BATCH_PARENT";
+
+// In a child of a batch (kBatchParentVariable set): asks the kernel to send this process SIGTERM
+// when the batch process dies (PR_SET_PDEATHSIG, kept across exec), and returns false when the
+// batch is already gone (the child must not start). True otherwise.
+bool follow_batch_parent();
+
 // The planned jobs of a batch (all of them, or one shard's) without running anything.
 std::vector<PlannedJob> plan_batch(const BatchOptions& options, BatchPlan* plan = nullptr);
 

@@ -3,7 +3,11 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include <fmt/format.h>
+
+#include <cmath>
 #include <exception>
+#include <new>
 #include <stdexcept>
 
 #include "src/app/version.hpp"
@@ -21,6 +25,25 @@ void configure_logging(const GlobalOptions& global) {
 }
 
 }  // namespace
+
+CLI::Validator finite_range(double low, double high) {
+  return CLI::Validator(
+      [low, high](std::string& text) -> std::string {
+        double value = 0;
+        try {
+          size_t used = 0;
+          value = std::stod(text, &used);
+          if (used != text.size()) return "'" + text + "' is not a number";
+        } catch (const std::exception&) {
+          return "'" + text + "' is not a number";
+        }
+        if (!std::isfinite(value)) return "'" + text + "' is not a finite number";
+        if (value < low || value > high)
+          return fmt::format("{} is outside {:g} .. {:g}", text, low, high);
+        return {};
+      },
+      fmt::format("NUMBER in [{:g}, {:g}]", low, high));
+}
 
 int run_cli(int argc, char** argv) {
   CLI::App app{"sketchdrape: sketch-based garment design — quad meshing, cloth draping, previews"};
@@ -58,6 +81,10 @@ int run_cli(int argc, char** argv) {
   } catch (const std::invalid_argument& e) {
     spdlog::error("{}", e.what());
     return kExitBadInput;
+  } catch (const std::bad_alloc&) {
+    spdlog::error("out of memory: the command needed more memory than the system could give it "
+                  "(run's --max-memory refuses such work before it starts)");
+    return kExitFailure;
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     return kExitFailure;

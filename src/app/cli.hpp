@@ -17,6 +17,10 @@ struct GlobalOptions {
   bool verbose = false;  // debug logs (GL version, timings, solver details)
 };
 
+// A command-line number check: finite (no nan, inf, 1e999) and within [low, high]. CLI11's own
+// range checks let "nan" through (every comparison with NaN is false).
+CLI::Validator finite_range(double low, double high);
+
 // Parses argv, runs the chosen subcommand and maps exceptions to exit codes:
 // std::invalid_argument (bad input) → 2, any other std::exception → 1.
 int run_cli(int argc, char** argv);

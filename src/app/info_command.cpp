@@ -59,7 +59,9 @@ void run_info(const InfoOptions& options) {
         {"components", topo.components},
         {"boundary_edges", topo.boundary_edges},
         {"non_manifold_edges", topo.non_manifold_edges},
-        {"degenerate_faces", topo.degenerate_faces}}},
+        {"degenerate_faces", topo.degenerate_faces},
+        {"signed_volume_raw", raw.signed_volume},
+        {"flipped_inside_out", raw.flipped_inside_out}}},
       {"warnings", body.warnings},
   };
   // Landmarks, when the body looks like a standing figure (a mannequin's torso alone has none).
@@ -123,6 +125,10 @@ void run_info(const InfoOptions& options) {
       topo.closed() ? "yes" : "no", topo.edge_manifold() ? "yes" : "no",
       topo.oriented() ? "yes" : "no", topo.components, topo.boundary_edges,
       topo.non_manifold_edges, topo.degenerate_faces);
+  if (raw.flipped_inside_out)
+    std::cout << fmt::format("orientation inside out in the file (volume {:.4g} units³): faces flipped\n",
+                             raw.signed_volume);
+  for (const std::string& warning : body.warnings) std::cout << "warning     " << warning << "\n";
   std::cout << slice_text;
   if (!landmarks) {
     std::cout << fmt::format("landmarks   none: {}\n", landmark_problem);
@@ -147,8 +153,8 @@ void add_info_command(CLI::App& app, const GlobalOptions& /*global*/) {
       ->required();
   cmd->add_option("--up", options->up, "The file's up axis (x, y, z, -x, ...); inferred if omitted");
   cmd->add_option("--height", options->height, "Scale the body to this height in metres")
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--scale", options->scale, "Metres per file unit")->check(CLI::PositiveNumber);
+      ->check(finite_range(0.1, 5.0));
+  cmd->add_option("--scale", options->scale, "Metres per file unit")->check(finite_range(1e-9, 1e9));
   cmd->add_flag("--json", options->json, "Print one JSON object instead of text");
   cmd->add_option("--slice", options->slices,
                   "Also print the body's outlines at this height (m, normalised frame; repeat for "

@@ -17,6 +17,8 @@
 #include "garment/sketch_inputs.hpp"
 #include "meshing/mesh48.hpp"
 #include "src/app/atomic_file.hpp"
+#include "src/app/cloth_scene.hpp"
+#include "src/app/sketch_checks.hpp"
 #include "src/app/cli.hpp"
 #include "src/app/mesh_export.hpp"
 #include "src/app/pattern_export.hpp"
@@ -66,9 +68,29 @@ nlohmann::json quality_json(const meshing::QuadQuality& q) {
 void run_mesh(const MeshOptions& options) {
   const auto start = Clock::now();
   const garment::Sketch sketch = garment::load_sketch(options.sketch);
+  check_sketch(sketch);  // the fabrics and settings `run` would refuse, refused here too
   const std::filesystem::path dir(options.out);
   StagedOutputs outputs;
   nlohmann::json report = {{"format", "sketchdrape/1 mesh report"}, {"sketch", sketch.file}};
+
+  if (sketch.sheet) {
+    // A sheet scene: its grid of triangles is the mesh `run` simulates (no 4-8 hierarchy: a
+    // sheet runs on its fixed mesh).
+    if (const auto vertices = cloth_vertices_before_building(sketch))
+      check_run_fits(sketch, estimate_run(sketch, *vertices, 0), RunLimits{}, 0);
+    const ClothScene scene = build_cloth_scene(sketch);
+    ExportMesh mesh{scene.input.rest_positions, scene.input.triangles, {}, {"sheet"}};
+    outputs.stage(dir / sketch.output.mesh, sketch.output.mesh.ends_with(".glb") ? to_glb(mesh, "sheet") : to_obj(mesh, "sheet"));
+    report["sheet"] = {{"columns", sketch.sheet->columns}, {"rows", sketch.sheet->rows}};
+    report["totals"] = {{"vertices", scene.input.rest_positions.rows()},
+                        {"triangles", scene.input.triangles.rows()},
+                        {"pinned_vertices", scene.pinned.size()}};
+    if (sketch.output.report) outputs.stage(dir / "report.json", report.dump(2) + "\n");
+    outputs.commit();
+    spdlog::info("meshed {} → {} (a sheet of {} triangles)", sketch.file, dir.string(),
+                 scene.input.triangles.rows());
+    return;
+  }
 
   if (sketch.garment_mesh) {
     // An imported triangle garment: the √3 conversion gives its 4-8 mesh.

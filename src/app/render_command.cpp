@@ -24,6 +24,8 @@
 
 #include "garment/body.hpp"
 #include "garment/body_landmarks.hpp"
+#include "garment/input_checks.hpp"
+#include "garment/sketch_ranges.hpp"
 #include "src/app/atomic_file.hpp"
 #include "src/app/cli.hpp"
 #include "src/app/progress.hpp"
@@ -111,8 +113,8 @@ void collect(const aiScene& scene, const aiNode& node, const aiMatrix4x4& parent
 
 // Reads a garment mesh as it is: no rescaling or re-orientation (it shares the body's frame).
 GarmentMesh load_garment_mesh(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path))
-    throw MeshFileError(fmt::format("garment mesh file '{}' does not exist", path));
+  if (const auto problem = garment::input_file_problem(path, garment::kMaxMeshFileBytes))
+    throw MeshFileError(fmt::format("garment mesh file '{}' {}", path, *problem));
   Assimp::Importer importer;
   const aiScene* scene =
       importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
@@ -138,6 +140,9 @@ GarmentMesh load_garment_mesh(const std::string& path) {
     out.mesh.faces.row(static_cast<Eigen::Index>(i)) = triangles[i].transpose();
     out.panel_ids[static_cast<Eigen::Index>(i)] = panels[i];
   }
+  // The same check as for a body: a mesh without area draws nothing and frames no camera.
+  if (const auto problem = garment::mesh_problem(out.mesh))
+    throw MeshFileError(fmt::format("garment mesh '{}' {}", path, *problem));
   return out;
 }
 
@@ -259,12 +264,15 @@ void add_render_command(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--size", options->size, "Image size WIDTHxHEIGHT in pixels")
       ->capture_default_str();
   cmd->add_option("--eye", options->eye, "Explicit camera position X,Y,Z (metres); adds view 'custom'")
+      ->check(finite_range(-1000, 1000))
       ->expected(3)
       ->delimiter(',');
   cmd->add_option("--target", options->target, "Point the explicit camera looks at, X,Y,Z")
+      ->check(finite_range(-1000, 1000))
       ->expected(3)
       ->delimiter(',');
   cmd->add_option("--fov", options->fov, "Vertical field of view of the explicit camera, degrees")
+      ->check(finite_range(1, 170))
       ->capture_default_str();
   cmd->add_flag("--wireframe", options->wireframe, "Overlay the triangle edges of MESH");
   cmd->add_flag("--no-shadows", options->no_shadows, "Draw without the key light's shadows");

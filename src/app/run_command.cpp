@@ -11,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 
 #include "garment/sketch_file.hpp"
 #include "garment/body_landmarks.hpp"
@@ -25,6 +26,7 @@
 #include "src/app/self_intersections.hpp"
 #include "src/app/preview_images.hpp"
 #include "src/app/progress.hpp"
+#include "src/app/sketch_checks.hpp"
 #include "src/render/scene.hpp"
 
 namespace sd::app {
@@ -37,6 +39,14 @@ struct RunOptions {
   std::string out = ".";
   bool trace = false;
   double frames_per_second = 0.0;  // > 0: also a PNG sequence of the drape (frames/)
+  std::string max_memory;          // --max-memory, e.g. "4G"
+  double max_time_s = 0;           // --max-time, seconds; 0: none
+};
+
+// --max-time passed, or the memory budget, while the drape runs: nothing is written.
+class RunLimitExceeded : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
 };
 
 // One picture of the drape in progress, for the PNG sequence.
@@ -222,8 +232,27 @@ nlohmann::json adaptive_steps_json(const std::vector<sim::AdaptiveStepRecord>& s
 void run_drape(const RunOptions& options, const GlobalOptions& global) {
   const auto start = Clock::now();
   const garment::Sketch sketch = garment::load_sketch(options.sketch);
+  check_sketch(sketch);
   const sim::SimulationSettings settings = simulation_settings(sketch);
+  RunLimits limits;
+  if (!options.max_memory.empty()) limits.max_memory_bytes = parse_memory_size(options.max_memory);
+  if (options.max_time_s > 0) limits.max_time_s = options.max_time_s;
+  // Refused before anything is built when the size is known from the file (a sheet), else once
+  // the cloth is meshed.
+  if (const auto vertices = cloth_vertices_before_building(sketch))
+    check_run_fits(sketch, estimate_run(sketch, *vertices, options.frames_per_second), limits,
+                   options.frames_per_second);
   const ClothScene scene = build_cloth_scene(sketch);
+  const RunEstimate estimate =
+      estimate_run(sketch, static_cast<double>(scene.start.rows()), options.frames_per_second);
+  check_run_fits(sketch, estimate, limits, options.frames_per_second);
+  spdlog::debug("estimate: {:.0f} vertices, {:.2f} GB, at most {:.0f} steps ({:.0f} s), {:.0f} frames",
+                estimate.vertices, estimate.memory_bytes / 1e9, estimate.steps, estimate.seconds,
+                estimate.frames);
+  if (!limits.max_time_s && estimate.seconds > 3600)
+    spdlog::warn("this drape may take up to about {:.1f} h ({:.0f} steps on {:.0f} vertices, by "
+                 "the estimate); --max-time SECONDS stops it",
+                 estimate.seconds / 3600, estimate.steps, estimate.vertices);
   if (scene.pinned.empty() && !scene.body)
     spdlog::warn("nothing holds the cloth (no pins, no body): it will fall for the whole run");
 
@@ -235,7 +264,20 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   std::string trace;
   Progress progress("draping", static_cast<long>(std::ceil(settings.duration * 1000)), global.quiet);
   // Called after every accepted step, by either driver.
+  // Adaptive detail can grow the cloth past the estimate: the budget is also checked as it runs.
+  const double memory_budget = memory_budget_bytes(limits);
   const auto on_step = [&](const sim::Simulation& s) {
+    if (const double resident = resident_memory_bytes(); memory_budget > 0 && resident > memory_budget)
+      throw RunLimitExceeded(fmt::format(
+          "stopped at t = {:.3f} s of the drape: it uses {:.1f} GB with {} vertices, more than "
+          "the {:.1f} GB it may take (--max-memory); limit adaptive detail with "
+          "simulate.adaptive.max_vertices or max_level; nothing was written",
+          s.time(), resident / 1e9, s.model().vertex_count, memory_budget / 1e9));
+    if (limits.max_time_s &&
+        std::chrono::duration<double>(Clock::now() - start).count() > *limits.max_time_s)
+      throw RunLimitExceeded(fmt::format(
+          "stopped at t = {:.3f} s of the drape: --max-time {:g} s passed; nothing was written",
+          s.time(), *limits.max_time_s));
     progress.update(static_cast<long>(s.time() * 1000), fmt::format("t = {:.2f} s", s.time()));
     if (!options.trace) return;
     const sim::SimulationReport& r = s.report();
@@ -499,7 +541,14 @@ void add_run_command(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--frames", options->frames_per_second,
                   "Also write frames/frame-NNNN-<view>.png: this many pictures per simulated "
                   "second (the first image's view, the body at its pose)")
-      ->check(CLI::PositiveNumber);
+      ->check(finite_range(1e-3, 1000));
+  cmd->add_option("--max-memory", options->max_memory,
+                  "Refuse a drape estimated to need more memory than this (e.g. 4G, 512M; "
+                  "default: the memory available)");
+  cmd->add_option("--max-time", options->max_time_s,
+                  "Stop (writing nothing) after this many seconds of wall time; refuse a drape "
+                  "without stop_at_rest estimated to take longer")
+      ->check(finite_range(1e-3, 1e9));
   cmd->callback([options, &global] { run_drape(*options, global); });
 }
 

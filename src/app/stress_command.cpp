@@ -183,7 +183,8 @@ void add_stress_command(CLI::App& app, const GlobalOptions& global) {
                   "Only cases whose id contains this text (repeatable; see --list)");
   cmd->add_option("--min-dt", options->min_dt,
                   "Override every case's minimum step, seconds (capped at its step): how much "
-                  "the cases rely on step control halving");
+                  "the cases rely on step control halving")
+      ->check(finite_range(1e-9, 1.0));
   cmd->add_flag("--list", options->list, "Print the case ids and conditions, run nothing");
   cmd->callback([options, &global] { run_stress(*options, global); });
 }

@@ -11,6 +11,7 @@
 #include "src/app/cli.hpp"
 #include "src/app/cloth_scene.hpp"
 #include "src/app/quality_warnings.hpp"
+#include "src/app/sketch_checks.hpp"
 
 namespace sd::app {
 namespace {
@@ -22,8 +23,13 @@ struct ValidateOptions {
 
 void run_validate(const ValidateOptions& options) {
   const garment::Sketch sketch = garment::load_sketch(options.sketch);
-  (void)simulation_settings(sketch);
+  check_sketch(sketch);
+  // What `run` would refuse for its size, refused here too (a sheet before it is built).
+  if (const auto vertices = cloth_vertices_before_building(sketch))
+    check_run_fits(sketch, estimate_run(sketch, *vertices, 0), RunLimits{}, 0);
   const ClothScene scene = build_cloth_scene(sketch);
+  check_run_fits(sketch, estimate_run(sketch, static_cast<double>(scene.start.rows()), 0),
+                 RunLimits{}, 0);
   std::string what;
   if (scene.garment) {
     int distortion = 0;

@@ -10,6 +10,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -311,7 +312,7 @@ TEST(BatchFaults, DivergingSimulationFailsItsJobOnly) {
                   {"jobs", json::array({{{"sketch", "sheet.json"}, {"id", "calm"}},
                                         {{"sketch", "sheet.json"},
                                          {"id", "diverging"},
-                                         {"set", {{"/simulate/gravity", {0, -1e9, 0}}}}}})}}
+                                         {"set", {{"/simulate/gravity", {0, -1e4, 0}}}}}})}}
                  .dump(2));
   const fs::path out = dir / "out";
   const CommandResult r = run_sketchdrape("batch " + shell_quoted(dir / "m.json") + " -o " +
@@ -521,6 +522,128 @@ TEST(BatchFaults, FullDiskEndsTheJobFailedWithAClearReason) {
 
 // The contact sheet in a real browser: every thumbnail loads from disk (no server), and the
 // table has one row per job. Runs when Debian's chromium is installed (scripts/setup.sh).
+// Width of a PNG from its IHDR chunk (big-endian at byte 16).
+int png_width(const fs::path& png) {
+  const std::string bytes = read_text(png);
+  if (bytes.size() < 24) return -1;
+  int width = 0;
+  for (int i = 16; i < 20; ++i) width = width * 256 + static_cast<unsigned char>(bytes[i]);
+  return width;
+}
+
+// Waits (at most 30 s) until no process of the group `pid` is left; true if none is.
+bool group_ends(pid_t pid) {
+  for (int i = 0; i < 300; ++i) {
+    if (kill(-pid, 0) == -1 && errno == ESRCH) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  return false;
+}
+
+// SIGKILL of the batch alone (not its group): its children die with it (PR_SET_PDEATHSIG), so
+// nothing writes into the folder afterwards; a rerun started at once after editing the manifest
+// gives every job outputs of the new input; a job whose output changed after its done marker
+// (edited by hand, or written late) is redone, never reused.
+TEST(BatchFaults, KillEditRerunLeavesNothingStale) {
+  const fs::path dir = fresh_batch_dir("kill-edit-rerun");
+  const fs::path manifest = wardrobe(dir, {"jersey", "denim"});  // 6 jobs
+  // 24 pictures per job, so that a job is seen half-way through staging them.
+  json slow = read_json(manifest);
+  slow["set"]["/output/images"] = json::array();
+  for (int i = 0; i < 24; ++i)
+    slow["set"]["/output/images"].push_back({{"view", "front"}, {"size", {300, 450}}});
+  write_text(manifest, slow.dump(2));
+  const fs::path out = dir / "out";
+  const pid_t pid = start_in_new_group(
+      {"batch", manifest.string(), "-o", out.string(), "--stage", "mesh", "-j", "2"},
+      dir / "first.log");
+  // A job that is staging its outputs (a hidden temporary is there, its outputs are not).
+  fs::path staging;
+  for (int i = 0; i < 2400 && staging.empty(); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(25));
+    std::error_code ec;
+    for (const auto& d : fs::directory_iterator(out / "jobs", ec))
+      for (const auto& f : fs::directory_iterator(d.path(), ec))
+        if (f.path().filename().string().find(".tmp-") != std::string::npos &&
+            !fs::exists(d.path() / "garment.obj"))
+          staging = d.path();
+  }
+  ASSERT_FALSE(staging.empty()) << read_text(dir / "first.log");
+  ASSERT_EQ(kill(pid, SIGKILL), 0);  // the batch process only
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(group_ends(pid)) << "a child outlived its SIGKILLed batch";
+  // The child ended with its batch: it never committed its outputs, and removed its temporaries.
+  EXPECT_FALSE(fs::exists(staging / "garment.obj")) << staging;
+  EXPECT_FALSE(fs::exists(staging / "done")) << staging;
+  for (const auto& f : fs::directory_iterator(staging))
+    EXPECT_EQ(f.path().filename().string().find(".tmp-"), std::string::npos) << f.path();
+
+  // Edit: every job's image becomes 140 px wide (same job ids, new inputs); rerun at once.
+  json edited = read_json(manifest);
+  edited["set"]["/output/images"] = json::array({{{"view", "front"}, {"size", {140, 210}}}});
+  write_text(manifest, edited.dump(2));
+  const CommandResult rerun = run_sketchdrape("batch " + shell_quoted(manifest) + " -o " +
+                                              shell_quoted(out) + " --stage mesh -j 2");
+  ASSERT_EQ(rerun.exit_code, 0) << rerun.output;
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // a late writer would show now
+  const json summary = read_json(out / "batch.json");
+  ASSERT_EQ(summary["jobs"].size(), 6u);
+  for (const json& j : summary["jobs"]) {
+    const fs::path job = out / "jobs" / j["id"].get<std::string>();
+    EXPECT_EQ(j["status"], "done") << j.dump();
+    EXPECT_EQ(png_width(job / "garment-front.png"), 140) << job;
+    const json marker = read_json(job / "done");
+    EXPECT_TRUE(marker["outputs"].contains("garment-front.png")) << marker.dump();
+    EXPECT_TRUE(marker["outputs"].contains("sketch.json")) << marker.dump();
+  }
+
+  // An output changed after its marker: that job is redone, the others reused.
+  const std::string tampered = summary["jobs"][0]["id"];
+  write_text(out / "jobs" / tampered / "report.json", "{\"stale\": true}");
+  const CommandResult again = run_sketchdrape("batch " + shell_quoted(manifest) + " -o " +
+                                              shell_quoted(out) + " --stage mesh -j 2");
+  ASSERT_EQ(again.exit_code, 0) << again.output;
+  for (const json& j : read_json(out / "batch.json")["jobs"])
+    EXPECT_EQ(j["reused"].get<bool>(), j["id"] != tampered) << j.dump();
+  EXPECT_FALSE(read_json(out / "jobs" / tampered / "report.json").contains("stale"));
+}
+
+// Two batches on one folder: the second refuses with a sentence naming the first; the first
+// finishes every job.
+TEST(BatchFaults, SecondBatchOnTheSameFolderRefuses) {
+  const fs::path dir = fresh_batch_dir("two-batches");
+  const fs::path manifest = wardrobe(dir, {"jersey"});  // 3 jobs
+  const fs::path out = dir / "out";
+  const pid_t first = start_in_new_group(
+      {"batch", manifest.string(), "-o", out.string(), "--stage", "mesh", "-j", "1"},
+      dir / "first.log");
+  bool started = false;
+  for (int i = 0; i < 1200 && !started; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(25));
+    std::error_code ec;
+    for (const auto& d : fs::directory_iterator(out / "jobs", ec))
+      started = started || fs::exists(d.path() / "log.txt");
+  }
+  ASSERT_TRUE(started) << read_text(dir / "first.log");
+  const CommandResult second = run_sketchdrape("batch " + shell_quoted(manifest) + " -o " +
+                                               shell_quoted(out) + " --stage mesh -j 1");
+  EXPECT_EQ(second.exit_code, 1) << second.output;
+  EXPECT_NE(second.output.find("another batch (process " + std::to_string(first) + ")"),
+            std::string::npos)
+      << second.output;
+  int status = 0;
+  waitpid(first, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status)) << read_text(dir / "first.log");
+  EXPECT_EQ(WEXITSTATUS(status), 0) << read_text(dir / "first.log");
+  EXPECT_EQ(read_json(out / "batch.json")["counts"]["done"], 3);
+  // Once the first has ended, the folder is free again: everything is reused.
+  const CommandResult third = run_sketchdrape("batch " + shell_quoted(manifest) + " -o " +
+                                              shell_quoted(out) + " --stage mesh -j 1");
+  EXPECT_EQ(third.exit_code, 0) << third.output;
+  EXPECT_EQ(read_json(out / "batch.json")["counts"]["reused"], 3);
+}
+
 TEST(ContactSheet, LoadsInHeadlessChromium) {
   const char* browser = "/usr/bin/chromium";
   if (!fs::exists(browser))

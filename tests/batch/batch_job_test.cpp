@@ -115,6 +115,34 @@ TEST(DoneMarker, OnlyAValidDoneMarkerWithTheSameDigestCounts) {
   EXPECT_FALSE(job_is_done(dir, "abc"));
 }
 
+// The marker binds the outputs to the inputs: an output changed, removed or listed with
+// another digest after the marker was written makes the job not done; the log, the markers
+// and hidden temporaries are not outputs.
+TEST(DoneMarker, BindsTheOutputsAsTheyWere) {
+  const fs::path dir = test::fresh_batch_dir("marker_outputs");
+  test::write_text(dir / "sketch.json", "{}");
+  test::write_text(dir / "report.json", "{\"quads\": 12}");
+  test::write_text(dir / "frames" / "frame-0000-front.png", "png");
+  test::write_text(dir / kJobLog, "info: meshed");
+  test::write_text(dir / ".report.json.tmp-1-0", "partial");
+  JobRecord done = record("done", "h");
+  done.outputs = digest_job_outputs(dir);
+  ASSERT_EQ(done.outputs.size(), 3u);
+  EXPECT_EQ(done.outputs.count("frames/frame-0000-front.png"), 1u);
+  EXPECT_EQ(done.outputs.at("report.json"), sha256_hex("{\"quads\": 12}"));
+  write_job_record(dir, done);
+  EXPECT_TRUE(job_is_done(dir, "h"));
+  EXPECT_EQ(read_job_record(dir)->outputs, done.outputs);
+  test::write_text(dir / kJobLog, "info: a later line");  // not an output
+  EXPECT_TRUE(job_is_done(dir, "h"));
+  test::write_text(dir / "report.json", "{\"quads\": 13}");  // written after the marker
+  EXPECT_FALSE(job_is_done(dir, "h"));
+  test::write_text(dir / "report.json", "{\"quads\": 12}");
+  EXPECT_TRUE(job_is_done(dir, "h"));
+  fs::remove(dir / "frames" / "frame-0000-front.png");
+  EXPECT_FALSE(job_is_done(dir, "h"));
+}
+
 TEST(DoneMarker, FailedRecordReplacesDoneAndBack) {
   const fs::path dir = test::fresh_batch_dir("marker_swap");
   write_job_record(dir, record("done", "h"));

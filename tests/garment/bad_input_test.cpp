@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "garment/body.hpp"
 #include "garment/body_surface.hpp"
 #include "garment/garment_mesh.hpp"
 #include "garment/sketch_file.hpp"
@@ -37,6 +38,59 @@ TEST(BadInput, EveryFileFailsWithPathAndSentence) {
           << e.what() << "\n  expected: " << c.fragment;
     }
   }
+}
+
+// Hostile text that no file in bad/ holds: 100,000 nested lists (the JSON reader would build
+// them all: seconds and hundreds of MB) and a key given twice deep inside.
+TEST(BadInput, DeepNestingAndNestedDuplicatesAreRefusedAtTheirPath) {
+  const std::string deep =
+      "{\"curves\": " + std::string(100000, '[') + std::string(100000, ']') + "}";
+  try {
+    parse_sketch(deep, "deep.json");
+    ADD_FAILURE() << "accepted";
+  } catch (const SketchError& e) {
+    EXPECT_EQ(e.json_path().rfind("/curves/0/0/", 0), 0u) << e.json_path();
+    EXPECT_NE(e.sentence().find("nested more than 64 levels deep"), std::string::npos) << e.what();
+  }
+  try {
+    parse_sketch(R"({"simulate": {"adaptive": {"max_level": 4, "min_level": 0, "max_level": 5}}})",
+                 "twice.json");
+    ADD_FAILURE() << "accepted";
+  } catch (const SketchError& e) {
+    EXPECT_EQ(e.json_path(), "/simulate/adaptive/max_level");
+    EXPECT_NE(e.sentence().find("given twice"), std::string::npos) << e.what();
+  }
+  // A list of objects: the index is in the path, and equal keys in different objects are fine.
+  try {
+    parse_sketch(R"({"curves": [{"id": "a"}, {"id": "b", "view": "front", "id": "c"}]})",
+                 "list.json");
+    ADD_FAILURE() << "accepted";
+  } catch (const SketchError& e) {
+    EXPECT_EQ(e.json_path(), "/curves/1/id");
+  }
+}
+
+// Findings of the fuzz targets (tests/fuzz/regressions/), each a file that once hung or crashed.
+TEST(BadInput, FuzzFindingsEndWithAClearError) {
+  const std::filesystem::path dir = std::filesystem::path(SD_SOURCE_DIR) / "tests/fuzz/regressions";
+  // A PLY header without end_header: assimp's reader looped for ever (body_loader_fuzz).
+  try {
+    load_body((dir / "body-ply-without-end-header.ply").string());
+    ADD_FAILURE() << "accepted";
+  } catch (const BodyError& e) {
+    EXPECT_NE(std::string(e.what()).find("has no end_header"), std::string::npos) << e.what();
+  }
+  // A PLY header with lines that are not header lines: the same loop (body_loader_fuzz).
+  try {
+    load_body((dir / "body-ply-unknown-header-line.ply").string());
+    ADD_FAILURE() << "accepted";
+  } catch (const BodyError& e) {
+    EXPECT_NE(std::string(e.what()).find("line 4 of its PLY header is not a header line"),
+              std::string::npos)
+        << e.what();
+  }
+  // Assimp's own PLY test models still load.
+  EXPECT_GT(load_body("/usr/share/assimp/models/PLY/cube.ply").mesh.face_count(), 0);
 }
 
 }  // namespace

@@ -80,5 +80,88 @@ TEST(ImplicitSolver, PointSpringStepIsBackwardEulerExactly) {
     }
 }
 
+// A system CHOLMOD cannot factorise (not positive definite: a spring of negative stiffness
+// strong enough to make m + β²k < 0 along the normal) must never yield a zero step taken for a
+// solution (it did: the factorisation failed, the step was zero and, at the minimum step size,
+// accepted). The solve falls back to PCG on the same system; PCG either solves it (then it is
+// backward Euler's answer: the system is nonsingular) or the solve fails with the true cause.
+TEST(ImplicitSolver, FailedCholmodFactorisationFallsBackToPcg) {
+  const testing::SheetSetup s = testing::horizontal_sheet(1, 0.1, Vector3d::Zero());
+  const ClothModel& model = s.model;
+  const double m = model.total_mass() / 2.0;
+  ForceSettings forces;
+  forces.gravity = Vector3d::Zero();
+  forces.air_drag = 0.0;
+  const Vector3d n = Vector3d::UnitY();
+  const Eigen::VectorXd x0 = flatten_positions(s.scene.input.rest_positions);
+  const int vertices = model.vertex_count;
+  const Eigen::VectorXd v0 = Eigen::VectorXd::Zero(3 * vertices);
+  const double beta = 1.0 / 60.0;
+  StepForces extra;
+  const double p0 = x0.segment<3>(0).dot(n);
+  for (int t = 0; t < 2; ++t) {
+    PointSpring spring;
+    spring.triangle = t;
+    spring.weights = Vector3d::Constant(1.0 / 3.0);
+    spring.normal = n;
+    spring.target = p0 + 0.004;
+    spring.stiffness = -4.0 * m / (beta * beta);  // m + β²k = −3m
+    extra.springs.push_back(spring);
+  }
+  const PointSpring& spring = extra.springs[0];
+  const double expected = beta * spring.stiffness * (spring.target - p0) /
+                          (m + beta * beta * spring.stiffness);
+  NewtonSettings settings;
+  settings.solver = LinearSolverKind::cholmod;
+  settings.pcg_tolerance = 1e-12;
+  ImplicitSolver solver;
+  const ConstraintFilter filter(vertices);
+  const ImplicitSolveResult r =
+      solver.solve(model, forces, filter, x0, v0, beta, x0, v0, settings, &extra);
+  EXPECT_GE(r.cholmod_failures, 1);
+  if (!r.linear_failure.empty()) {
+    EXPECT_FALSE(r.linear_converged);
+    EXPECT_NE(r.linear_failure.find("not positive definite"), std::string::npos);
+    return;
+  }
+  ASSERT_TRUE(r.linear_converged);
+  for (int i = 0; i < vertices; ++i)
+    EXPECT_NEAR(r.v.segment<3>(3 * i).dot(n), expected, 1e-8 * std::abs(expected));
+}
+
+// PCG with a preconditioner that is not positive definite (here the system's own negative
+// definite block diagonal: r·M⁻¹r < 0 at the start) returned "converged" with the start as the
+// answer. It must report no convergence.
+TEST(ImplicitSolver, PcgNeverReportsTheStartAsASolutionOfAnIndefiniteSystem) {
+  const testing::SheetSetup s = testing::horizontal_sheet(1, 0.1, Vector3d::Zero());
+  const ClothModel& model = s.model;
+  const double m = model.total_mass() / 2.0;
+  ForceSettings forces;
+  forces.gravity = Vector3d::Zero();
+  forces.air_drag = 0.0;
+  const Eigen::VectorXd x0 = flatten_positions(s.scene.input.rest_positions);
+  const int vertices = model.vertex_count;
+  const Eigen::VectorXd v0 = Eigen::VectorXd::Zero(3 * vertices);
+  const double beta = 1.0 / 60.0;
+  StepForces extra;
+  for (int t = 0; t < 2; ++t) {
+    PointSpring spring;
+    spring.triangle = t;
+    spring.weights = Vector3d::Constant(1.0 / 3.0);
+    spring.normal = Vector3d::UnitY();
+    spring.target = x0[1] + 0.004;
+    spring.stiffness = -40.0 * m / (beta * beta);
+    extra.springs.push_back(spring);
+  }
+  NewtonSettings settings;
+  settings.solver = LinearSolverKind::pcg;
+  settings.pcg_preconditioner = PcgPreconditioner::block_jacobi;
+  ImplicitSolver solver;
+  const ImplicitSolveResult r = solver.solve(model, forces, ConstraintFilter(vertices), x0, v0,
+                                             beta, x0, v0, settings, &extra);
+  EXPECT_FALSE(r.linear_converged && r.v.norm() == 0.0)
+      << "a zero step was reported as the solution";
+}
+
 }  // namespace
 }  // namespace sd::sim

@@ -1,0 +1,59 @@
+#pragma once
+// The checks every command that reads a sketch file runs before it starts (validate, mesh, run),
+// so that no command accepts what another refuses, and the estimate of a drape's memory and work
+// made before any of it is done (docs/cli.md, "Limits").
+
+#include <optional>
+#include <string>
+
+#include "garment/sketch_file.hpp"
+#include "sim/simulation.hpp"
+
+namespace sd::app {
+
+// Every panel's fabric (and the file's) is a known preset, the simulation settings work
+// together, every image can be drawn. Throws garment::SketchError at the value's path.
+void check_sketch(const garment::Sketch& sketch);
+
+// What a run may use: --max-memory (default: 80 % of the memory the system has available now)
+// and --max-time (default: none).
+struct RunLimits {
+  double max_memory_bytes = 0;       // 0: the available memory (/proc/meminfo)
+  std::optional<double> max_time_s;  // wall-clock seconds
+};
+
+// The memory the system can give a process now (MemAvailable), bytes; 0 when unknown.
+double available_memory_bytes();
+
+// This process's resident memory now (/proc/self/statm), bytes; 0 when unknown.
+double resident_memory_bytes();
+
+// The memory a run may use: --max-memory, else 80 % of the memory available now; 0: unknown.
+double memory_budget_bytes(const RunLimits& limits);
+
+// A drape's cost, estimated before it starts from the cloth's vertex count (the measured cost
+// per vertex of the model, the CHOLMOD factor and the contacts; docs/cli.md, "Limits").
+struct RunEstimate {
+  double vertices = 0;
+  double memory_bytes = 0;  // peak resident memory
+  double steps = 0;         // duration / time_step: the most steps the run can take
+  double frames = 0;        // PNG sequence pictures (--frames)
+  double seconds = 0;       // wall time if it runs the whole duration
+};
+RunEstimate estimate_run(const garment::Sketch& sketch, double vertices, double frames_per_second);
+
+// The vertex count of the sketch's cloth when it can be known without building it (a sheet).
+std::optional<double> cloth_vertices_before_building(const garment::Sketch& sketch);
+
+// Refuses (garment::SketchError, at /sheet/resolution, /simulate/duration or the file) a run
+// whose estimate does not fit `limits`, or whose PNG sequence has more than kMaxFrames pictures,
+// with a sentence that says what would fit.
+inline constexpr double kMaxFrames = 10000;
+void check_run_fits(const garment::Sketch& sketch, const RunEstimate& estimate,
+                    const RunLimits& limits, double frames_per_second);
+
+// Parses "4G", "512M", "1.5GB", "2000000" (bytes) for --max-memory; throws
+// std::invalid_argument.
+double parse_memory_size(const std::string& text);
+
+}  // namespace sd::app

@@ -1,0 +1,376 @@
+// Hostile input as a user (or a fuzzer) gives it to the binary: files that are not files,
+// numbers that are not numbers, work that does not fit. Each must end with exit code 2 and a
+// sentence naming the file and the JSON path (or run within the stated limits), and write nothing.
+
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+
+#include "tests/cli/run_command.hpp"
+#include "tests/garment/bad_cases.hpp"
+
+namespace sd::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("sd-hostile-test-" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+void write(const fs::path& path, const std::string& text) {
+  std::ofstream(path) << text;
+}
+
+std::string read(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Runs the binary under a watchdog: a command that blocks is killed after 30 s and fails the
+// test (exit code 124 from timeout(1)) instead of hanging the suite.
+CommandResult run_guarded(const std::string& args) {
+  CommandResult result;
+  const std::string command = "timeout 30 " + std::string(SD_BINARY) + " " + args + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return result;
+  std::array<char, 4096> buffer{};
+  size_t n;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+    result.output.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+const char* kSquare = R"({
+  "curves": [
+    { "id": "top",    "view": "front", "points": [[-0.1, 1.3], [0.1, 1.3]] },
+    { "id": "right",  "view": "front", "points": [[0.1, 1.3], [0.1, 1.1]] },
+    { "id": "bottom", "view": "front", "points": [[0.1, 1.1], [-0.1, 1.1]] },
+    { "id": "left",   "view": "front", "points": [[-0.1, 1.1], [-0.1, 1.3]] }
+  ],
+  "panels": [ { "id": "patch", "boundary": ["top", "right", "bottom", "left"]PANEL } ]BODY
+})";
+
+std::string fmt_name(const std::string& prefix, long pid, int n) {
+  return prefix + std::to_string(pid) + "-" + std::to_string(n);
+}
+
+std::string square(const std::string& panel_extra = "", const std::string& top_extra = "") {
+  std::string text = kSquare;
+  text.replace(text.find("PANEL"), 5, panel_extra);
+  text.replace(text.find("BODY"), 4, top_extra);
+  return text;
+}
+
+// `validate` over the bad-input suite: the same path and sentence as `mesh`
+// (tests/cli/mesh_command_test.cpp), so the range checks hold whatever command reads the file.
+TEST(HostileInput, ValidateRejectsEveryBadFileWithItsPath) {
+  for (const BadCase& c : bad_cases()) {
+    const CommandResult r = run_sketchdrape("validate " + c.file.string());
+    EXPECT_EQ(r.exit_code, 2) << c.file << "\n" << r.output;
+    const std::string expected =
+        c.json_path.empty() ? c.file.string() + ": " : c.file.string() + ": " + c.json_path + ": ";
+    EXPECT_NE(r.output.find(expected), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(c.fragment), std::string::npos) << r.output;
+  }
+}
+
+// A FIFO would block a reader for ever; a loop of links, a device and a folder are not meshes.
+TEST(HostileInput, BodyPathsThatAreNotFilesFailAtOnce) {
+  const fs::path dir = fresh_dir("not-files");
+  ASSERT_EQ(mkfifo((dir / "pipe.obj").c_str(), 0600), 0);
+  fs::create_symlink(dir / "loop-b.obj", dir / "loop-a.obj");
+  fs::create_symlink(dir / "loop-a.obj", dir / "loop-b.obj");
+  fs::create_directory(dir / "folder.obj");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {(dir / "pipe.obj").string(), "is a named pipe (FIFO)"},
+      {(dir / "loop-a.obj").string(), "symbolic link that loops"},
+      {"/dev/null", "is a device, not a file"},
+      {(dir / "folder.obj").string(), "is a folder"}};
+  for (const auto& [path, fragment] : cases) {
+    const CommandResult info = run_guarded("info " + path);
+    EXPECT_EQ(info.exit_code, 2) << path << "\n" << info.output;
+    EXPECT_NE(info.output.find(fragment), std::string::npos) << info.output;
+
+    // The same body named in a sketch: exit 2 at /body/mesh; and as an imported garment.
+    write(dir / "sketch.json", square("", ",\n  \"body\": {\"mesh\": \"" + path + "\"}"));
+    const CommandResult validate = run_guarded("validate " + (dir / "sketch.json").string());
+    EXPECT_EQ(validate.exit_code, 2) << validate.output;
+    EXPECT_NE(validate.output.find("/body/mesh: "), std::string::npos) << validate.output;
+    EXPECT_NE(validate.output.find(fragment), std::string::npos) << validate.output;
+
+    write(dir / "garment.json", "{\"garment_mesh\": \"" + path + "\"}");
+    const CommandResult garment = run_guarded("validate " + (dir / "garment.json").string());
+    EXPECT_EQ(garment.exit_code, 2) << garment.output;
+    EXPECT_NE(garment.output.find("/garment_mesh: "), std::string::npos) << garment.output;
+    EXPECT_NE(garment.output.find(fragment), std::string::npos) << garment.output;
+
+    // And as the sketch file itself.
+    const CommandResult sketch = run_guarded("validate " + path);
+    EXPECT_EQ(sketch.exit_code, 2) << sketch.output;
+    EXPECT_NE(sketch.output.find(fragment), std::string::npos) << sketch.output;
+  }
+  fs::remove_all(dir);
+}
+
+// What `validate` and `run` refuse, `mesh` refuses too; what `mesh` cannot draw, `validate`
+// refuses; a sheet meshes; a mesh without area is refused as body and as garment alike.
+TEST(HostileInput, EveryCommandAppliesTheSameChecks) {
+  const fs::path dir = fresh_dir("same-checks");
+  write(dir / "fabric.json", square(", \"fabric\": \"chainmail\""));
+  for (const char* command : {"validate", "mesh", "run"}) {
+    const std::string out =
+        std::string(command) == "validate" ? "" : " -o " + (dir / "out").string();
+    const CommandResult r =
+        run_sketchdrape(std::string(command) + " " + (dir / "fabric.json").string() + out);
+    EXPECT_EQ(r.exit_code, 2) << command << "\n" << r.output;
+    EXPECT_NE(r.output.find("/panels/0/fabric: "), std::string::npos) << command << r.output;
+    EXPECT_FALSE(fs::exists(dir / "out" / "garment.obj")) << command;
+  }
+
+  write(dir / "sheet.json", R"({"sheet": {"size": [1, 1], "resolution": [4, 3]}})");
+  const CommandResult sheet =
+      run_sketchdrape("mesh " + (dir / "sheet.json").string() + " -o " + (dir / "sheet").string());
+  ASSERT_EQ(sheet.exit_code, 0) << sheet.output;
+  const auto report = nlohmann::json::parse(read(dir / "sheet" / "report.json"));
+  EXPECT_EQ(report["totals"]["vertices"].get<int>(), 5 * 4);
+  EXPECT_EQ(report["totals"]["triangles"].get<int>(), 2 * 4 * 3);
+  EXPECT_TRUE(fs::exists(dir / "sheet" / "garment.obj"));
+
+  // Every vertex at one point: refused as a body (info), as a garment (render --body) and as an
+  // imported garment (validate), with the same sentence.
+  write(dir / "far.obj", "v 0 0 0\nv 1 0 0\nv 0 1e300 0\nf 1 2 3\n");
+  write(dir / "far.json", "{\"garment_mesh\": \"far.obj\", \"body\": \"none\"}");
+  const CommandResult far = run_sketchdrape("validate " + (dir / "far.json").string());
+  EXPECT_EQ(far.exit_code, 2) << far.output;
+  EXPECT_NE(far.output.find("/garment_mesh: line 3 of 'far.obj': a vertex at 1e+300 m is outside"),
+            std::string::npos)
+      << far.output;
+
+  write(dir / "point.obj", "v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n");
+  write(dir / "point.json", "{\"garment_mesh\": \"point.obj\", \"body\": \"none\"}");
+  const CommandResult as_body = run_sketchdrape("info " + (dir / "point.obj").string());
+  const CommandResult as_cloth =
+      run_sketchdrape("render " + (dir / "point.obj").string() + " --body builtin -o " +
+                      (dir / "render.png").string());
+  const CommandResult as_import = run_sketchdrape("validate " + (dir / "point.json").string());
+  for (const CommandResult* r : {&as_body, &as_cloth, &as_import}) {
+    EXPECT_EQ(r->exit_code, 2) << r->output;
+    EXPECT_NE(r->output.find("all its vertices at one point"), std::string::npos) << r->output;
+  }
+  EXPECT_FALSE(fs::exists(dir / "render.png"));
+  fs::remove_all(dir);
+}
+
+// Numbers on the command line: nan, inf and 1e308 are refused with exit code 2, not ignored.
+TEST(HostileInput, BadNumbersOnTheCommandLineAreRefused) {
+  for (const char* args :
+       {"info builtin --height nan", "info builtin --height 1e308", "info builtin --height inf",
+        "info builtin --scale nan", "info builtin --height 17x",
+        "render builtin --fov nan -o /tmp/x.png", "render builtin --eye 0,1e308,3 -o /tmp/x.png"}) {
+    const CommandResult r = run_sketchdrape(args);
+    EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.output;
+  }
+  const std::string sheet = std::string(SD_SOURCE_DIR) + "/data/scenes/hanging-sheet.json";
+  for (const char* option : {"--frames nan", "--frames 1e308", "--frames 100000", "--max-time nan",
+                             "--max-memory lots"}) {
+    const CommandResult r = run_sketchdrape("run " + sheet + " -o /tmp/sd-never " + option);
+    EXPECT_EQ(r.exit_code, 2) << option << "\n" << r.output;
+  }
+  EXPECT_FALSE(fs::exists("/tmp/sd-never"));
+  // The quad filler's input has the bound of a sketch's panels: 1e8 edges would need gigabytes.
+  const CommandResult fill = run_sketchdrape("fill --sides 100000000,100000000");
+  EXPECT_EQ(fill.exit_code, 2) << fill.output;
+  EXPECT_NE(fill.output.find("at most 2530 edges in all"), std::string::npos) << fill.output;
+}
+
+// Work that does not fit is refused before it starts, with what would fit.
+TEST(HostileInput, WorkThatDoesNotFitIsRefusedWithWhatWould) {
+  const fs::path dir = fresh_dir("limits");
+  write(dir / "big-sheet.json", R"({"sheet": {"size": [1, 1], "resolution": [1000, 1000]}})");
+  const CommandResult big = run_sketchdrape("run " + (dir / "big-sheet.json").string() +
+                                            " --max-memory 1G -o " + (dir / "out").string());
+  EXPECT_EQ(big.exit_code, 2) << big.output;
+  EXPECT_NE(big.output.find("/sheet/resolution: "), std::string::npos) << big.output;
+  EXPECT_NE(big.output.find("quads would fit"), std::string::npos) << big.output;
+
+  // 1000 pictures per second (the most --frames takes) over 20 s: 20,001 pictures.
+  write(dir / "frames.json", R"({"sheet": {"size": [1, 1], "resolution": [8, 8]},
+    "simulate": {"duration": 20}})");
+  const CommandResult frames = run_sketchdrape("run " + (dir / "frames.json").string() +
+                                               " --frames 1000 -o " + (dir / "out").string());
+  EXPECT_EQ(frames.exit_code, 2) << frames.output;
+  EXPECT_NE(frames.output.find("per second fit this duration"), std::string::npos) << frames.output;
+
+  write(dir / "long.json", R"({"sheet": {"size": [1, 1], "resolution": [32, 32]},
+    "simulate": {"duration": 3600, "time_step": 0.00001, "stop_at_rest": false}})");
+  const CommandResult time = run_sketchdrape("run " + (dir / "long.json").string() +
+                                             " --max-time 60 -o " + (dir / "out").string());
+  EXPECT_EQ(time.exit_code, 2) << time.output;
+  EXPECT_NE(time.output.find("/simulate/duration: "), std::string::npos) << time.output;
+  EXPECT_NE(time.output.find("would fit"), std::string::npos) << time.output;
+
+  // --max-time also stops a drape that runs longer than expected, writing nothing.
+  write(dir / "slow.json", R"({"sheet": {"size": [1, 1], "resolution": [24, 24]},
+    "simulate": {"duration": 3600, "stop_at_rest": true}})");
+  const CommandResult stopped = run_sketchdrape("run " + (dir / "slow.json").string() +
+                                                " --max-time 0.5 -o " + (dir / "out").string());
+  EXPECT_EQ(stopped.exit_code, 1) << stopped.output;
+  EXPECT_NE(stopped.output.find("--max-time 0.5 s passed"), std::string::npos) << stopped.output;
+  EXPECT_FALSE(fs::exists(dir / "out" / "report.json"));
+  fs::remove_all(dir);
+}
+
+// Out of memory is reported as such (it ended as "a vertex reached 50.9 m/s"): under a 700 MB
+// address-space limit, the 201 x 201-vertex sheet's CHOLMOD factorisation cannot be allocated.
+TEST(HostileInput, OutOfMemoryIsReportedAsSuch) {
+  const fs::path dir = fresh_dir("oom");
+  write(dir / "sheet.json", R"({"sheet": {"size": [1, 1], "resolution": [200, 200],
+    "pins": ["top"]}, "simulate": {"duration": 0.02}, "output": {"images": []}})");
+  const std::string command = "ulimit -v 700000; " + std::string(SD_BINARY) + " run " +
+                              (dir / "sheet.json").string() + " -o " + (dir / "out").string() +
+                              " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string output;
+  std::array<char, 4096> buffer{};
+  for (size_t n; (n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0;)
+    output.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  ASSERT_TRUE(WIFEXITED(status)) << output;
+  EXPECT_EQ(WEXITSTATUS(status), 1) << output;
+  EXPECT_NE(output.find("error: out of memory"), std::string::npos) << output;
+  EXPECT_EQ(output.find("m/s"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(dir / "out" / "report.json"));
+  fs::remove_all(dir);
+}
+
+// A closed body whose faces point inward is flipped with a warning that `info` shows; an open
+// body is warned about.
+TEST(HostileInput, InsideOutBodyIsFlippedAndOpenBodyWarned) {
+  const fs::path dir = fresh_dir("inside-out");
+  // An octahedron 1.7 m tall with every face listed clockwise seen from outside.
+  const std::string vertices =
+      "v 0 0 0\nv 0 1.7 0\nv 0.3 0.85 0\nv -0.3 0.85 0\nv 0 0.85 0.3\nv 0 0.85 -0.3\n";
+  const std::string outward =
+      "f 2 5 3\nf 2 3 6\nf 2 6 4\nf 2 4 5\nf 1 3 5\nf 1 6 3\nf 1 4 6\nf 1 5 4\n";
+  std::string inward;
+  std::istringstream faces(outward);
+  for (std::string f, a, b, c; faces >> f >> a >> b >> c;)
+    inward += "f " + a + " " + c + " " + b + "\n";
+  write(dir / "outward.obj", vertices + outward);
+  write(dir / "inward.obj", vertices + inward);
+  write(dir / "open.obj", vertices + outward.substr(0, outward.rfind("f 1 5 4")));
+
+  const auto info = [&](const char* name) {
+    const CommandResult r = run_sketchdrape("info --json " + (dir / name).string());
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    return nlohmann::json::parse(r.output.substr(r.output.find('{')));
+  };
+  const auto out = info("outward.obj"), in = info("inward.obj"), open = info("open.obj");
+  EXPECT_FALSE(out["topology"]["flipped_inside_out"].get<bool>());
+  EXPECT_GT(out["topology"]["signed_volume_raw"].get<double>(), 0);
+  EXPECT_TRUE(out["warnings"].empty()) << out["warnings"];
+  EXPECT_TRUE(in["topology"]["flipped_inside_out"].get<bool>());
+  // The octahedron's volume: 4/3 · 0.3 · 0.3 · 0.85, read with the sign of the file's winding
+  // (assimp reads single-precision floats: 1e-7 relative).
+  EXPECT_NEAR(in["topology"]["signed_volume_raw"].get<double>(), -4.0 / 3 * 0.3 * 0.3 * 0.85, 1e-6);
+  ASSERT_EQ(in["warnings"].size(), 1u);
+  EXPECT_NE(in["warnings"][0].get<std::string>().find("inside out"), std::string::npos);
+  EXPECT_FALSE(open["topology"]["flipped_inside_out"].get<bool>());
+  ASSERT_EQ(open["warnings"].size(), 1u);
+  EXPECT_NE(open["warnings"][0].get<std::string>().find("the body is open (3 boundary edge(s))"),
+            std::string::npos);
+  const CommandResult text = run_sketchdrape("info " + (dir / "inward.obj").string());
+  EXPECT_NE(text.output.find("faces flipped"), std::string::npos) << text.output;
+  fs::remove_all(dir);
+}
+
+// Hidden temporaries (".frame-0003-front.png.tmp-PID-N") anywhere under `dir`.
+int temporaries_under(const fs::path& dir) {
+  int count = 0;
+  std::error_code ec;
+  for (auto it = fs::recursive_directory_iterator(dir, ec);
+       it != fs::recursive_directory_iterator(); it.increment(ec))
+    if (it->path().filename().string().find(".tmp-") != std::string::npos) ++count;
+  return count;
+}
+
+// SIGTERM and SIGINT while `run --frames` stages its pictures: the temporaries and the folders
+// the run made are removed and the process dies by the signal.
+TEST(HostileInput, InterruptedRunLeavesNothing) {
+  const fs::path dir = fresh_dir("signals");
+  write(dir / "sheet.json", R"({"sheet": {"size": [1, 1], "resolution": [8, 8],
+    "pins": ["top-left", "top-right"]}, "simulate": {"duration": 4, "stop_at_rest": false},
+    "output": {"images": [{"view": "front", "size": [32, 32]}]}})");
+  for (const int sig : {SIGTERM, SIGINT}) {
+    const fs::path out = dir / ("out-" + std::to_string(sig));
+    const std::string sketch = (dir / "sheet.json").string();
+    const std::string out_text = out.string();
+    std::vector<const char*> argv = {SD_BINARY,        "-q",       "run", sketch.c_str(), "-o",
+                                     out_text.c_str(), "--frames", "200", nullptr};
+    pid_t pid = 0;
+    ASSERT_EQ(
+        posix_spawn(&pid, SD_BINARY, nullptr, nullptr, const_cast<char**>(argv.data()), environ),
+        0);
+    // Wait until some pictures are staged (at most a minute), then interrupt.
+    bool staged = false;
+    for (int i = 0; i < 600 && !staged; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      staged = temporaries_under(out) >= 5;
+    }
+    EXPECT_TRUE(staged) << "no temporaries appeared";
+    kill(pid, sig);
+    int status = 0;
+    ASSERT_EQ(waitpid(pid, &status, 0), pid);
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == sig) << status;
+    EXPECT_EQ(temporaries_under(out), 0);
+    EXPECT_FALSE(fs::exists(out)) << "the folders the run made are removed";
+  }
+  fs::remove_all(dir);
+}
+
+// A temporary of a process that is gone (SIGKILL) is removed by the next command that writes
+// into its folder once it is ten minutes old; a fresh one, or one of a live process, is kept.
+TEST(HostileInput, StaleTemporariesOfDeadProcessesAreRemoved) {
+  const fs::path dir = fresh_dir("stale");
+  // A PID that is not alive: a child that has exited and been reaped.
+  pid_t dead = fork();
+  if (dead == 0) _exit(0);
+  waitpid(dead, nullptr, 0);
+  const fs::path old_dead = dir / fmt_name(".garment.obj.tmp-", dead, 0);
+  const fs::path fresh_dead = dir / fmt_name(".report.json.tmp-", dead, 1);
+  const fs::path old_alive = dir / fmt_name(".garment48.obj.tmp-", getpid(), 0);
+  for (const fs::path& p : {old_dead, fresh_dead, old_alive}) write(p, "partial");
+  const auto hour_ago = fs::file_time_type::clock::now() - std::chrono::hours(1);
+  fs::last_write_time(old_dead, hour_ago);
+  fs::last_write_time(old_alive, hour_ago);
+  write(dir / "sheet.json", R"({"sheet": {"size": [1, 1], "resolution": [2, 2]}})");
+  const CommandResult r =
+      run_sketchdrape("mesh " + (dir / "sheet.json").string() + " -o " + dir.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_FALSE(fs::exists(old_dead));
+  EXPECT_TRUE(fs::exists(fresh_dead));
+  EXPECT_TRUE(fs::exists(old_alive));
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace sd::test
