@@ -72,11 +72,6 @@ void build_sheet_scene(const garment::Sketch& sketch, ClothScene& scene) {
   sim::SheetScene built = sim::build_sheet(sheet);
   scene.input = std::move(built.input);
   scene.pinned = std::move(built.pinned_vertices);
-  // simulate.pin_above holds a sheet too (a clamp of several rows of a hanging sheet), together
-  // with the named pins.
-  pin_above(sketch, scene);
-  std::sort(scene.pinned.begin(), scene.pinned.end());
-  scene.pinned.erase(std::unique(scene.pinned.begin(), scene.pinned.end()), scene.pinned.end());
   scene.triangle_group = Eigen::VectorXi::Zero(scene.input.triangles.rows());
   scene.group_names = {"sheet"};
   if (spec.layers > 1) {
@@ -111,6 +106,11 @@ void build_sheet_scene(const garment::Sketch& sketch, ClothScene& scene) {
     scene.input = std::move(layered);
   }
   scene.start = scene.input.rest_positions;
+  // simulate.pin_above holds a sheet too (a clamp of several rows of a hanging sheet, of every
+  // layer), together with the named pins.
+  pin_above(sketch, scene);
+  std::sort(scene.pinned.begin(), scene.pinned.end());
+  scene.pinned.erase(std::unique(scene.pinned.begin(), scene.pinned.end()), scene.pinned.end());
   scene.fabric_name = sketch.fabric;
   scene.fabric = fabric_at(sketch, sketch.fabric, "/fabric");
 }

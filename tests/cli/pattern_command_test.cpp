@@ -254,9 +254,9 @@ TEST(PatternCommand, BadInputExitsTwoWithoutFiles) {
   const fs::path bad = fresh_dir("bad-setting");
   fs::create_directories(bad);
   std::string text = read(example("tshirt"));
-  const size_t at = text.find("\"output\"");
+  const size_t at = text.find("\"simulate\": {");
   ASSERT_NE(at, std::string::npos);
-  text.insert(at, "\"simulate\": { \"rest\": \"flattish\" },\n  ");
+  text.insert(at + std::string("\"simulate\": {").size(), " \"rest\": \"flattish\",");
   std::ofstream(bad / "tshirt.json") << text;
   const CommandResult r = run_sketchdrape("pattern " + (bad / "tshirt.json").string() + " -o " +
                                           (bad / "out").string());
