@@ -265,30 +265,26 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
       // projection (a hash collision only gives a poorer hint, never another answer).
       std::unordered_map<std::int64_t, SurfacePoint> hints;
       const double cell = 0.5 * reach;
-      const SurfaceLift lift = [&body, &hints, cell, offset,
-                                reach](const Eigen::Vector3d& p) -> LiftedPoint {
+      const auto closest = [&body, &hints, cell](const Eigen::Vector3d& p) {
         const Eigen::Vector3d q = (p / cell).array().floor();
         const std::int64_t key = (static_cast<std::int64_t>(q.x()) * 73856093) ^
                                  (static_cast<std::int64_t>(q.y()) * 19349663) ^
                                  (static_cast<std::int64_t>(q.z()) * 83492791);
         SurfacePoint& hint = hints[key];
-        const SurfacePoint s = body.closest_point(p, hint);
-        hint = s;
+        hint = body.closest_point(p, hint);
+        return hint;
+      };
+      const SurfaceLift lift = [&closest, offset, reach](const Eigen::Vector3d& p) -> LiftedPoint {
+        const SurfacePoint s = closest(p);
         const double signed_distance = (p - s.position).dot(s.normal);
         if (signed_distance < offset + reach) return {s.position + offset * s.normal, s.normal};
         return {p, Eigen::Vector3d::Zero()};
       };
       // The body as an obstacle only: a point inside the offset surface goes to its closest
       // point on it, any other point stays.
-      const PushOut push_out = [&body, &hints, cell,
-                                offset](const Eigen::Vector3d& p) -> std::optional<Eigen::Vector3d> {
-        const Eigen::Vector3d q = (p / cell).array().floor();
-        const std::int64_t key = (static_cast<std::int64_t>(q.x()) * 73856093) ^
-                                 (static_cast<std::int64_t>(q.y()) * 19349663) ^
-                                 (static_cast<std::int64_t>(q.z()) * 83492791);
-        SurfacePoint& hint = hints[key];
-        const SurfacePoint s = body.closest_point(p, hint);
-        hint = s;
+      const PushOut push_out =
+          [&closest, offset](const Eigen::Vector3d& p) -> std::optional<Eigen::Vector3d> {
+        const SurfacePoint s = closest(p);
         if ((p - s.position).dot(s.normal) >= offset) return std::nullopt;
         return s.position + offset * s.normal;
       };

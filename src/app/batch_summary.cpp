@@ -1,8 +1,7 @@
 #include "src/app/batch_summary.hpp"
 
-#include <unistd.h>
-
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
@@ -13,6 +12,7 @@
 #include <stdexcept>
 
 #include "src/app/atomic_file.hpp"
+#include "src/app/markup_escape.hpp"
 
 namespace sd::app {
 namespace {
@@ -32,32 +32,6 @@ std::optional<json> read_json_file(const std::filesystem::path& path) {
   json j = json::parse(buffer.str(), nullptr, /*allow_exceptions=*/false);
   if (j.is_discarded()) return std::nullopt;
   return j;
-}
-
-std::string html_escape(std::string_view text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&#39;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
 }
 
 // A relative path as a URL: unreserved characters and '/' stay, everything else is %XX.
@@ -335,8 +309,8 @@ std::string contact_sheet_html(const BatchPlan& plan, const std::vector<JobSumma
   h += "<style>" + std::string(kStyle) + "</style>\n</head>\n";
   h += fmt::format("<body data-jobs=\"{}\">\n<h1>sketchdrape batch</h1>\n", jobs.size());
   h += fmt::format("<p class=\"meta\">stage <b>{}</b> · sketchdrape {} · {} · {} jobs: {}</p>\n",
-                   html_escape(plan.stage), html_escape(plan.version), utc_timestamp(), jobs.size(),
-                   html_escape(fmt::format("{}", fmt::join(count_parts, ", "))));
+                   markup_escape(plan.stage), markup_escape(plan.version), utc_timestamp(),
+                   jobs.size(), markup_escape(fmt::format("{}", fmt::join(count_parts, ", "))));
   h += "<p class=\"meta\" id=\"thumbnails\">loading thumbnails…</p>\n";
   h += "<table id=\"jobs\">\n<thead><tr>";
   h += "<th class=\"sortable\" data-type=\"text\">job</th>";
@@ -344,27 +318,27 @@ std::string contact_sheet_html(const BatchPlan& plan, const std::vector<JobSumma
   h += "<th>images</th>";
   h += "<th class=\"sortable\" data-type=\"num\">wall time (s)</th>";
   for (const std::string& f : figures)
-    h += fmt::format("<th class=\"sortable\" data-type=\"num\">{}</th>", html_escape(f));
+    h += fmt::format("<th class=\"sortable\" data-type=\"num\">{}</th>", markup_escape(f));
   h += "<th class=\"sortable\" data-type=\"text\">reason</th>";
   h += "</tr></thead>\n<tbody>\n";
   for (const JobSummary& j : jobs) {
-    h += fmt::format("<tr class=\"job {}\" data-id=\"{}\">", html_escape(j.status),
-                     html_escape(j.entry.id));
-    h += fmt::format("<td data-sort=\"{0}\"><b>{0}</b>", html_escape(j.entry.id));
+    h += fmt::format("<tr class=\"job {}\" data-id=\"{}\">", markup_escape(j.status),
+                     markup_escape(j.entry.id));
+    h += fmt::format("<td data-sort=\"{0}\"><b>{0}</b>", markup_escape(j.entry.id));
     h += fmt::format("<div class=\"sketch\">{}</div>",
-                     html_escape(std::filesystem::path(j.entry.sketch).filename().string()));
+                     markup_escape(std::filesystem::path(j.entry.sketch).filename().string()));
     const std::string over = overrides_text(j.entry.overrides);
-    if (!over.empty()) h += fmt::format("<div class=\"overrides\">{}</div>", html_escape(over));
+    if (!over.empty()) h += fmt::format("<div class=\"overrides\">{}</div>", markup_escape(over));
     h += "</td>";
     std::string status = j.status;
     if (j.reused && *j.reused) status += " (reused)";
-    h += fmt::format("<td class=\"status\" data-sort=\"{}\">{}</td>", html_escape(j.status),
-                     html_escape(status));
+    h += fmt::format("<td class=\"status\" data-sort=\"{}\">{}</td>", markup_escape(j.status),
+                     markup_escape(status));
     h += "<td class=\"images\">";
     for (const std::string& image : j.images)
       h += fmt::format("<a href=\"{0}\"><img class=\"thumb\" src=\"{0}\" alt=\"{1}\"></a>",
-                       html_escape(url_path(image)),
-                       html_escape(std::filesystem::path(image).filename().string()));
+                       markup_escape(url_path(image)),
+                       markup_escape(std::filesystem::path(image).filename().string()));
     h += "</td>";
     if (j.record)
       h += fmt::format("<td class=\"num\" data-sort=\"{:.6f}\">{:.2f}</td>", j.record->wall_time_s,
@@ -374,17 +348,17 @@ std::string contact_sheet_html(const BatchPlan& plan, const std::vector<JobSumma
     for (const std::string& f : figures) {
       if (j.figures.contains(f))
         h += fmt::format("<td class=\"num\" data-sort=\"{}\">{}</td>",
-                         html_escape(figure_sort_key(j.figures[f])),
-                         html_escape(figure_text(j.figures[f])));
+                         markup_escape(figure_sort_key(j.figures[f])),
+                         markup_escape(figure_text(j.figures[f])));
       else
         h += "<td class=\"num\" data-sort=\"\"></td>";
     }
     const std::string reason =
         j.record ? j.record->reason : "not run yet, or interrupted before it finished";
-    h += fmt::format("<td class=\"reason\" data-sort=\"{0}\">{0}", html_escape(reason));
+    h += fmt::format("<td class=\"reason\" data-sort=\"{0}\">{0}", markup_escape(reason));
     if (!j.log.empty())
       h += fmt::format("{}<a href=\"{}\">log</a>", reason.empty() ? "" : " ",
-                       html_escape(url_path(j.log)));
+                       markup_escape(url_path(j.log)));
     h += "</td></tr>\n";
   }
   h += "</tbody>\n</table>\n<script>" + std::string(kScript) + "</script>\n</body>\n</html>\n";

@@ -7,6 +7,8 @@
 #include <chrono>
 #include <cmath>
 
+#include "src/app/markup_escape.hpp"
+
 namespace sd::app {
 namespace {
 
@@ -23,29 +25,6 @@ const garment::PanelSpec* panel_spec(const garment::Sketch& sketch, const std::s
   const std::string suffix = ".mirror";
   if (id.ends_with(suffix)) return sketch.find_panel(id.substr(0, id.size() - suffix.size()));
   return nullptr;
-}
-
-std::string xml_escape(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
 }
 
 // Piece point (m, piece frame) → fabric point (mm, x across, y along the bolt).
@@ -129,13 +108,13 @@ std::string pattern_svg(const PatternSheet& sheet) {
       ".grain{{stroke:#1f4e9c;stroke-width:0.5;fill:none}}.notch{{stroke:#000;stroke-width:0.6}}"
       ".label{{fill:#222}}.note{{fill:#444}}</style>\n"
       "<rect class=\"fabric\" x=\"0\" y=\"0\" width=\"{0:.1f}\" height=\"{3:.1f}\"/>\n",
-      width, length + footer, xml_escape(sheet.title), length);
+      width, length + footer, markup_escape(sheet.title), length);
   for (const garment::PatternPiece& piece : layout.pieces) {
     const garment::FlatPanel& flat = sheet.pattern.panels[static_cast<size_t>(piece.panel)];
     const std::string name = piece_name(sheet, piece);
     const std::string fabric = sheet.fabrics[static_cast<size_t>(piece.panel)];
-    svg +=
-        fmt::format("<g class=\"piece\" id=\"piece-{0}\" data-panel=\"{0}\">\n", xml_escape(name));
+    svg += fmt::format("<g class=\"piece\" id=\"piece-{0}\" data-panel=\"{0}\">\n",
+                       markup_escape(name));
     svg += fmt::format("<path class=\"cut\" d=\"{}\"/>\n", svg_path(piece, piece.cutting, length));
     svg += fmt::format("<path class=\"sew\" d=\"{}\"/>\n", svg_path(piece, piece.sewing, length));
     const Eigen::Vector2d g0 = on_fabric(piece, piece.grain_start);
@@ -164,9 +143,9 @@ std::string pattern_svg(const PatternSheet& sheet) {
         "mm · {8}</text>\n"
         "<text class=\"label\" x=\"{0:.1f}\" y=\"{9:.1f}\" font-size=\"{5:.1f}\">cut 1 · ease "
         "{10:g} · stretch {11:.1f} % (95th pct)</text>\n",
-        at.x(), length - at.y(), size, xml_escape(name), length - at.y() + size, 0.75 * size,
+        at.x(), length - at.y(), size, markup_escape(name), length - at.y() + size, 0.75 * size,
         kMm * (piece.size.x() - 2 * piece.allowance), kMm * (piece.size.y() - 2 * piece.allowance),
-        xml_escape(fabric), length - at.y() + 1.9 * size, piece.ease,
+        markup_escape(fabric), length - at.y() + 1.9 * size, piece.ease,
         100 * flat.distortion.length_p95);
     svg += "</g>\n";
   }
@@ -189,7 +168,8 @@ std::string pattern_svg(const PatternSheet& sheet) {
       "mm "
       "wide, {:.0f} mm used · efficiency {:.0f} % · seam allowance included · true scale "
       "(mm)</text>\n",
-      y + 4, xml_escape(sheet.title), layout.pieces.size(), width, length, 100 * layout.efficiency);
+      y + 4, markup_escape(sheet.title), layout.pieces.size(), width, length,
+      100 * layout.efficiency);
   svg += "</svg>\n";
   return svg;
 }
