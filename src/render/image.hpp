@@ -1,6 +1,6 @@
 #pragma once
 // Rendered images and their PNG encoding. The renderer never writes files: callers get PNG bytes
-// and write them through the app's atomic output (src/app/atomic_file.hpp).
+// and write them through the app's atomic output (src/app/pipeline/atomic_file.hpp).
 
 #include <cstdint>
 #include <stdexcept>

@@ -1,4 +1,4 @@
-#include "src/app/atomic_file.hpp"
+#include "src/app/pipeline/atomic_file.hpp"
 
 #include <gtest/gtest.h>
 

@@ -12,7 +12,7 @@
 
 #include "garment/sketch_file.hpp"
 #include "sim/cloth_model.hpp"
-#include "src/app/cloth_scene.hpp"
+#include "src/app/pipeline/cloth_scene.hpp"
 
 namespace sd::app {
 namespace {

@@ -1,4 +1,4 @@
-#include "src/app/mesh_export.hpp"
+#include "src/app/pipeline/mesh_export.hpp"
 
 #include <assimp/scene.h>
 #include <gtest/gtest.h>

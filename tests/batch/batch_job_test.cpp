@@ -1,8 +1,8 @@
-#include "src/app/batch_job.hpp"
+#include "src/app/batch/batch_job.hpp"
 
 #include <gtest/gtest.h>
 
-#include "src/app/batch_hash.hpp"
+#include "src/app/pipeline/sha256.hpp"
 #include "tests/batch/batch_test_util.hpp"
 
 namespace sd::app {

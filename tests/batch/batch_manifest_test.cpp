@@ -1,4 +1,4 @@
-#include "src/app/batch_manifest.hpp"
+#include "src/app/batch/batch_manifest.hpp"
 
 #include <gtest/gtest.h>
 

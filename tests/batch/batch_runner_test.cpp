@@ -2,7 +2,7 @@
 // (one OpenBLAS thread per core in each of -j N children oversubscribes the machine), and
 // everything else passed through. The child here is a shell script standing in for the binary.
 
-#include "src/app/batch_runner.hpp"
+#include "src/app/batch/batch_runner.hpp"
 
 #include <gtest/gtest.h>
 #include <stdlib.h>

@@ -1,4 +1,4 @@
-#include "src/app/batch_summary.hpp"
+#include "src/app/batch/batch_summary.hpp"
 
 #include <gtest/gtest.h>
 

@@ -14,7 +14,7 @@
 #include "garment/panel_flattening.hpp"
 #include "garment/pattern_layout.hpp"
 #include "garment/sketch_file.hpp"
-#include "src/app/pattern_export.hpp"
+#include "src/app/pipeline/pattern_export.hpp"
 
 namespace {
 

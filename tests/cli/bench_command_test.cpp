@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "src/app/bench_study.hpp"
+#include "src/app/bench/bench_study.hpp"
 #include "tests/cli/run_command.hpp"
 
 namespace {

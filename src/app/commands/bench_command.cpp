@@ -1,0 +1,638 @@
+// `sketchdrape bench`: the work-precision study (docs/benchmarks.md, "Work-precision study").
+// Every configuration runs in its own child process (this binary with the hidden --worker
+// option), so its CPU time and peak memory come from the kernel (wait4) and cannot leak into
+// the next run; the child writes the material-point positions and energies at the sample times,
+// the parent measures them against the scene's reference, which is computed once (also in a
+// child) and cached on disk under a digest of the scene, the reference settings and the binary.
+// Outputs (bench.csv, bench.json, plots) appear together or not at all.
+
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <signal.h>
+#include <spawn.h>
+#include <spdlog/spdlog.h>
+#include <sys/prctl.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+
+#include "src/app/pipeline/atomic_file.hpp"
+#include "src/app/pipeline/sha256.hpp"
+#include "src/app/bench/bench_study.hpp"
+#include "src/app/commands/cli.hpp"
+#include "src/app/pipeline/progress.hpp"
+#include "src/app/version.hpp"
+
+extern char** environ;
+
+namespace sd::app {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+struct BenchOptions {
+  bool quick = false;
+  std::string grid;  // tiny | quick | full (empty: full, or quick with --quick)
+  std::vector<std::string> scenes;
+  std::string out = "bench";
+  bool json = false;
+  std::string cache;
+  double timeout = 0;  // s per run; 0: the grid's default
+  // Worker side (hidden): run one configuration and write its trace.
+  std::string worker_config;
+  std::string worker_scene;
+  std::string worker_out;
+};
+
+std::string read_file(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+BenchGrid parse_grid(const BenchOptions& options) {
+  const std::string grid = options.grid.empty() ? (options.quick ? "quick" : "full") : options.grid;
+  if (options.quick && grid != "quick")
+    throw std::invalid_argument("--quick and --grid " + grid + " ask for different grids: give one");
+  if (grid == "tiny") return BenchGrid::tiny;
+  if (grid == "quick") return BenchGrid::quick;
+  if (grid == "full") return BenchGrid::full;
+  throw std::invalid_argument("--grid must be tiny, quick or full, not '" + grid + "'");
+}
+
+std::string grid_name(BenchGrid grid) {
+  return grid == BenchGrid::tiny ? "tiny" : grid == BenchGrid::quick ? "quick" : "full";
+}
+
+fs::path default_cache_dir() {
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg != nullptr && *xdg != '\0')
+    return fs::path(xdg) / "sketchdrape/bench";
+  if (const char* home = std::getenv("HOME"); home != nullptr && *home != '\0')
+    return fs::path(home) / ".cache/sketchdrape/bench";
+  return fs::temp_directory_path() / "sketchdrape-bench-cache";
+}
+
+// --- child processes ---------------------------------------------------------------------------
+
+struct ChildResult {
+  std::string status;  // "ok", "failed" (the simulation or the worker), "timeout", "crashed"
+  std::string message;
+  double process_cpu_s = 0.0;  // user + system of the whole child
+  double peak_rss_mb = 0.0;    // the child's peak resident memory
+  double elapsed_s = 0.0;
+  BenchTrace trace;
+};
+
+// Last non-empty line of a worker's log, for messages.
+std::string last_line(const fs::path& log) {
+  std::istringstream in(read_file(log));
+  std::string line, last;
+  while (std::getline(in, line))
+    if (!line.empty()) last = line;
+  return last;
+}
+
+// Runs `exe --quiet bench --worker ...` and waits for it (at most `timeout` seconds).
+ChildResult run_worker(const fs::path& exe, const std::string& scene, BenchGrid grid,
+                       const BenchConfig& config, const fs::path& work, const std::string& tag,
+                       double timeout, Progress& progress, long done, const std::string& note) {
+  const fs::path trace_path = work / (tag + ".trace");
+  const fs::path log_path = work / (tag + ".log");
+  std::vector<std::string> args = {exe.string(), "--quiet",           "bench",
+                                   "--grid",     grid_name(grid),     "--worker",
+                                   config_to_json(config), "--worker-scene", scene,
+                                   "--worker-out", trace_path.string()};
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  // One BLAS/OpenMP thread: the simulator is single-threaded and CPU time stays comparable.
+  std::vector<std::string> env_strings;
+  bool has_openblas = false, has_omp = false;
+  for (char** e = environ; *e != nullptr; ++e) {
+    const std::string entry(*e);
+    has_openblas |= entry.rfind("OPENBLAS_NUM_THREADS=", 0) == 0;
+    has_omp |= entry.rfind("OMP_NUM_THREADS=", 0) == 0;
+    env_strings.push_back(entry);
+  }
+  if (!has_openblas) env_strings.push_back("OPENBLAS_NUM_THREADS=1");
+  if (!has_omp) env_strings.push_back("OMP_NUM_THREADS=1");
+  std::vector<char*> envp;
+  for (std::string& e : env_strings) envp.push_back(e.data());
+  envp.push_back(nullptr);
+
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  pid_t pid = 0;
+  const int spawn_error = posix_spawn(&pid, exe.c_str(), &actions, nullptr, argv.data(), envp.data());
+  posix_spawn_file_actions_destroy(&actions);
+  if (spawn_error != 0)
+    throw std::runtime_error(fmt::format("cannot start {}: {}", exe.string(), std::strerror(spawn_error)));
+
+  ChildResult result;
+  const auto start = Clock::now();
+  int status = 0;
+  rusage usage{};
+  bool timed_out = false;
+  while (true) {
+    const pid_t r = wait4(pid, &status, WNOHANG, &usage);
+    if (r == pid) break;
+    if (r < 0 && errno != EINTR) throw std::runtime_error("waiting for a bench run failed");
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    if (elapsed > timeout && !timed_out) {
+      kill(pid, SIGKILL);
+      timed_out = true;
+    }
+    progress.update(done, fmt::format("{} ({:.0f} s)", note, elapsed));
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  result.elapsed_s = std::chrono::duration<double>(Clock::now() - start).count();
+  result.process_cpu_s = static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+                         1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+  result.peak_rss_mb = static_cast<double>(usage.ru_maxrss) / 1024.0;  // KiB on Linux
+  if (timed_out) {
+    result.status = "timeout";
+    result.message = fmt::format("stopped after {:.0f} s (--timeout)", timeout);
+  } else if (!WIFEXITED(status)) {
+    result.status = "crashed";
+    result.message = fmt::format("killed by signal {}", WTERMSIG(status));
+  } else if (WEXITSTATUS(status) != 0 || !fs::exists(trace_path)) {
+    result.status = "failed";
+    result.message = last_line(log_path);
+  } else {
+    result.trace = deserialize_trace(read_file(trace_path));
+    result.status = result.trace.failed ? "failed" : "ok";
+    result.message = result.trace.failure;
+  }
+  return result;
+}
+
+// --- the study ---------------------------------------------------------------------------------
+
+struct RunRow {
+  BenchConfig config;
+  std::vector<std::string> families;
+  ChildResult child;
+  BenchError error;
+  bool pareto = false;
+};
+
+struct SceneResult {
+  BenchScene scene;
+  BenchPlan plan;
+  std::string key;
+  bool reference_cached = false;
+  ChildResult reference;  // trace from the cache or this run
+  std::vector<RunRow> rows;
+  std::string defaults_note;
+  std::string reference_failure;  // why the reference did not finish (the scene's runs are skipped)
+};
+
+bool usable(const RunRow& row) { return row.child.status == "ok" && row.error.samples > 0; }
+
+// Runs not beaten in both CPU time and RMS error by another run of the scene.
+void mark_pareto(std::vector<RunRow>& rows) {
+  for (RunRow& a : rows) {
+    if (!usable(a)) continue;
+    a.pareto = std::none_of(rows.begin(), rows.end(), [&](const RunRow& b) {
+      return &a != &b && usable(b) && b.child.trace.cpu_s <= a.child.trace.cpu_s &&
+             b.error.rms_m <= a.error.rms_m &&
+             (b.child.trace.cpu_s < a.child.trace.cpu_s || b.error.rms_m < a.error.rms_m);
+    });
+  }
+}
+
+// What the pipeline uses (implicit Euler, CHOLMOD, 1/60 s; sketch "simulate" defaults) against
+// the study: is it on the Pareto front, and if not what beats it.
+std::string defaults_note(const SceneResult& s) {
+  const RunRow* def = nullptr;
+  for (const RunRow& row : s.rows)
+    if (row.config.mesh == BenchMeshKind::fixed &&
+        row.config.integrator == sim::Integrator::implicit_euler &&
+        row.config.solver == sim::LinearSolverKind::cholmod && row.config.steps_per_second == 60 &&
+        (def == nullptr || row.config.level > def->config.level))
+      def = &row;
+  if (def == nullptr || !usable(*def)) return "the default configuration did not run";
+  if (def->pareto)
+    return fmt::format("the pipeline default (IE, CHOLMOD, 1/60 s; {}) is on the Pareto front",
+                       def->config.label());
+  const RunRow* better = nullptr;
+  for (const RunRow& row : s.rows)
+    if (usable(row) && row.pareto && row.error.rms_m <= def->error.rms_m &&
+        (better == nullptr || row.child.trace.cpu_s < better->child.trace.cpu_s))
+      better = &row;
+  if (better == nullptr) return "the pipeline default is not on the Pareto front";
+  return fmt::format(
+      "the pipeline default ({}) is not on the Pareto front: {} reaches {:.2f} mm RMS (default "
+      "{:.2f} mm) in {:.2f} s CPU (default {:.2f} s)",
+      def->config.label(), better->config.label(), 1e3 * better->error.rms_m,
+      1e3 * def->error.rms_m, better->child.trace.cpu_s, def->child.trace.cpu_s);
+}
+
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string quoted = "\"";
+  for (char c : s) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return quoted + "\"";
+}
+
+std::string join(const std::vector<std::string>& parts, const std::string& separator) {
+  std::string out;
+  for (size_t i = 0; i < parts.size(); ++i) out += (i ? separator : "") + parts[i];
+  return out;
+}
+
+std::string number(double value) { return fmt::format("{:.6g}", value); }
+
+const char* kCsvHeader =
+    "scene,run,mesh,level,threshold_mm,integrator,solver,dt_s,families,status,wall_s,cpu_s,"
+    "process_cpu_s,peak_rss_mb,rss_before_run_mb,vertices_max,triangles_max,steps,retries,"
+    "linear_solves,cg_iterations_mean,rms_error_m,max_error_m,final_rms_error_m,energy_error_j,"
+    "energy_error_relative,pareto,note\n";
+
+std::string csv_row(const SceneResult& s, const BenchConfig& c, const std::vector<std::string>& families,
+                    const ChildResult& child, const BenchError* error, bool pareto,
+                    const std::string& note) {
+  const BenchTrace& t = child.trace;
+  const bool measured = child.status == "ok" || child.status == "failed";
+  const bool process = child.peak_rss_mb > 0;
+  std::vector<std::string> f = {
+      csv_field(s.scene.name),
+      c.id(),
+      c.mesh == BenchMeshKind::adaptive ? "adaptive" : "fixed",
+      std::to_string(c.level),
+      c.mesh == BenchMeshKind::adaptive ? number(c.threshold * 1e3) : "",
+      c.integrator == sim::Integrator::bdf2 ? "bdf2" : "implicit-euler",
+      c.solver == sim::LinearSolverKind::pcg ? "pcg" : "cholmod",
+      number(c.dt()),
+      csv_field(join(families, "; ")),
+      child.status,
+      measured ? number(t.wall_s) : "",
+      measured ? number(t.cpu_s) : "",
+      process ? number(child.process_cpu_s) : "",
+      process ? number(child.peak_rss_mb) : "",
+      measured ? number(t.rss_before_mb) : "",
+      measured ? std::to_string(t.vertices_max) : "",
+      measured ? std::to_string(t.triangles_max) : "",
+      measured ? std::to_string(t.steps) : "",
+      measured ? std::to_string(t.retries) : "",
+      measured ? std::to_string(t.linear_solves) : "",
+      measured ? number(t.cg_iterations_mean) : "",
+      error ? number(error->rms_m) : "",
+      error ? number(error->max_m) : "",
+      error ? number(error->final_rms_m) : "",
+      error ? number(error->energy_j) : "",
+      error ? number(error->energy_relative) : "",
+      pareto ? "1" : "0",
+      csv_field(note)};
+  return join(f, ",") + "\n";
+}
+
+nlohmann::json row_json(const RunRow& row) {
+  const BenchTrace& t = row.child.trace;
+  nlohmann::json j = {{"run", row.config.id()},
+                      {"label", row.config.label()},
+                      {"families", row.families},
+                      {"status", row.child.status},
+                      {"message", row.child.message},
+                      {"wall_s", t.wall_s},
+                      {"cpu_s", t.cpu_s},
+                      {"process_cpu_s", row.child.process_cpu_s},
+                      {"peak_rss_mb", row.child.peak_rss_mb},
+                      {"rss_before_run_mb", t.rss_before_mb},
+                      {"vertices_max", t.vertices_max},
+                      {"steps", t.steps},
+                      {"retries", t.retries},
+                      {"pareto", row.pareto}};
+  if (usable(row))
+    j["error"] = {{"rms_m", row.error.rms_m},         {"max_m", row.error.max_m},
+                  {"final_rms_m", row.error.final_rms_m}, {"energy_j", row.error.energy_j},
+                  {"energy_relative", row.error.energy_relative}};
+  return j;
+}
+
+// --- plots ---------------------------------------------------------------------------------------
+
+std::string plot_data(const SceneResult& s) {
+  std::string out;
+  for (const BenchFamily& family : s.plan.families) {
+    out += fmt::format("# {}\n", family.name);
+    for (const BenchConfig& c : family.members)
+      for (const RunRow& row : s.rows)
+        if (row.config.id() == c.id() && usable(row) && row.error.rms_m > 0)
+          out += fmt::format("{:.6g} {:.6g} {:.6g} \"{}\"\n", row.child.trace.cpu_s,
+                             row.error.rms_m, row.child.trace.wall_s, c.id());
+    out += "\n\n";
+  }
+  std::vector<const RunRow*> front;
+  for (const RunRow& row : s.rows)
+    if (row.pareto && row.error.rms_m > 0) front.push_back(&row);
+  std::sort(front.begin(), front.end(), [](const RunRow* a, const RunRow* b) {
+    return a->child.trace.cpu_s < b->child.trace.cpu_s;
+  });
+  out += "# Pareto front\n";
+  for (const RunRow* row : front)
+    out += fmt::format("{:.6g} {:.6g} {:.6g} \"{}\"\n", row->child.trace.cpu_s, row->error.rms_m,
+                       row->child.trace.wall_s, row->config.id());
+  out += "\n\n";
+  return out;
+}
+
+std::string plot_script(const SceneResult& s, const std::string& stem) {
+  std::string plots;
+  const size_t n = s.plan.families.size();
+  for (size_t i = 0; i < n; ++i)
+    plots += fmt::format("'{}.dat' index {} using 1:2 with linespoints lw 2 pt 7 ps 1.2 title \"{}\", ",
+                         stem, i, s.plan.families[i].name);
+  plots += fmt::format(
+      "'{}.dat' index {} using 1:2 with lines dt 2 lc rgb 'black' notitle, "
+      "'{}.dat' index {} using 1:2 with points pt 6 ps 2.6 lw 1.5 lc rgb 'black' title \"Pareto front\"",
+      stem, n, stem, n);
+  const std::string title = fmt::format(
+      "{}: error against the reference ({}) over {:g} s", s.scene.name, s.plan.reference.label(),
+      s.scene.duration);
+  std::string script;
+  for (const auto& [terminal, extension] :
+       {std::pair<std::string, std::string>{"pngcairo size 1100,700 font 'DejaVu Sans,10'", "png"},
+        {"svg size 1100,700 font 'DejaVu Sans,10' background rgb 'white'", "svg"}}) {
+    script += fmt::format(
+        "set terminal {}\nset output '{}.{}'\nset logscale xy\nset grid xtics ytics mxtics mytics\n"
+        "set xlabel 'CPU time of the run (s)'\nset ylabel 'RMS distance at material points (m)'\n"
+        "set title \"{}\" noenhanced\nset key below left Left reverse maxrows 4 noenhanced\nset format y '%.0e'\n"
+        "plot {}\nunset output\n",
+        terminal, stem, extension, title, plots);
+  }
+  return script;
+}
+
+// Writes the plots of every scene with gnuplot into `work` and stages them; false (and a
+// warning) when gnuplot is not installed or fails.
+bool stage_plots(const std::vector<SceneResult>& scenes, const fs::path& work, const fs::path& dir,
+                 StagedOutputs& outputs) {
+  const fs::path plot_dir = work / "plots";
+  fs::create_directories(plot_dir);
+  if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) {
+    spdlog::warn("gnuplot is not installed: bench.csv is written, the plots are not "
+                 "(apt-get install gnuplot-nox, or run ./scripts/setup.sh)");
+    return false;
+  }
+  for (const SceneResult& s : scenes) {
+    if (std::none_of(s.rows.begin(), s.rows.end(), usable)) continue;  // nothing to draw
+    const std::string stem = "bench_" + s.scene.name;
+    const std::string data = plot_data(s);
+    const std::string script = plot_script(s, stem);
+    write_file_atomically(plot_dir / (stem + ".dat"), data);
+    write_file_atomically(plot_dir / (stem + ".gp"), script);
+    const std::string command = fmt::format("cd '{}' && gnuplot '{}.gp' > '{}.log' 2>&1",
+                                            plot_dir.string(), stem, stem);
+    if (std::system(command.c_str()) != 0) {
+      spdlog::warn("gnuplot failed on {}.gp: {}", stem, last_line(plot_dir / (stem + ".log")));
+      return false;
+    }
+    outputs.stage(dir / (stem + ".dat"), data);
+    outputs.stage(dir / (stem + ".gp"), script);
+    outputs.stage(dir / (stem + ".png"), read_file(plot_dir / (stem + ".png")));
+    outputs.stage(dir / (stem + ".svg"), read_file(plot_dir / (stem + ".svg")));
+  }
+  return true;
+}
+
+// --- the summary on stdout ------------------------------------------------------------------------
+
+std::string summary_table(const std::vector<SceneResult>& scenes, bool plots, const fs::path& dir) {
+  std::string out;
+  for (const SceneResult& s : scenes) {
+    out += fmt::format("\n{} ({:g} s simulated; reference: {}, {}{:.1f} s CPU)\n", s.scene.name,
+                       s.scene.duration, s.plan.reference.label(),
+                       s.reference_cached ? "cached, " : "", s.reference.trace.cpu_s);
+    if (!s.reference_failure.empty()) {
+      out += fmt::format("  not measured: {}\n", s.reference_failure);
+      continue;
+    }
+    out += fmt::format("  {:<44} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9}\n", "configuration",
+                       "CPU s", "wall s", "peak MB", "vertices", "RMS mm", "max mm", "energy %");
+    std::vector<const RunRow*> order;
+    for (const RunRow& row : s.rows) order.push_back(&row);
+    std::stable_sort(order.begin(), order.end(), [](const RunRow* a, const RunRow* b) {
+      return a->child.trace.cpu_s < b->child.trace.cpu_s;
+    });
+    for (const RunRow* row : order) {
+      const BenchTrace& t = row->child.trace;
+      if (!usable(*row)) {
+        out += fmt::format("  {:<44} {}: {}\n", row->config.label(), row->child.status,
+                           row->child.message);
+        continue;
+      }
+      out += fmt::format("{} {:<44} {:>8.2f} {:>8.2f} {:>8.0f} {:>8} {:>8.2f} {:>8.2f} {:>9.1f}\n",
+                         row->pareto ? "*" : " ", row->config.label(), t.cpu_s, t.wall_s,
+                         row->child.peak_rss_mb, t.vertices_max, 1e3 * row->error.rms_m,
+                         1e3 * row->error.max_m, 100 * row->error.energy_relative);
+    }
+    out += fmt::format("  * on the Pareto front (no run is both faster and more accurate)\n");
+    out += fmt::format("  defaults: {}\n", s.defaults_note);
+  }
+  out += fmt::format("\nwrote {}{}\n", (dir / "bench.csv").string(),
+                     plots ? fmt::format(" and the plots {}", (dir / "bench_<scene>.png|svg").string())
+                           : std::string(" (no plots: gnuplot missing)"));
+  return out;
+}
+
+// --- the command ----------------------------------------------------------------------------------
+
+void run_worker_side(const BenchOptions& options) {
+  // A worker must not outlive the study (killed parent, Ctrl-C in another terminal).
+  prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (getppid() == 1) return;  // the parent is already gone
+  const BenchGrid grid = parse_grid(options);
+  const BenchScene scene = build_bench_scene(options.worker_scene, grid);
+  const BenchConfig config = config_from_json(options.worker_config);
+  const BenchTrace trace = run_bench_config(scene, config);
+  write_file_atomically(options.worker_out, serialize_trace(trace));
+}
+
+// Removes the work folder of the child processes at the end, whatever happens.
+struct WorkDir {
+  fs::path path;
+  ~WorkDir() {
+    std::error_code ignored;
+    fs::remove_all(path, ignored);
+  }
+};
+
+void run_bench(const BenchOptions& options, const GlobalOptions& global) {
+  if (!options.worker_config.empty()) return run_worker_side(options);
+  const BenchGrid grid = parse_grid(options);
+  if (options.timeout < 0) throw std::invalid_argument("--timeout must be positive (seconds per run)");
+  const double timeout = options.timeout > 0 ? options.timeout
+                         : grid == BenchGrid::full ? 900.0 : 120.0;
+  std::vector<std::string> names = options.scenes;
+  if (names.empty())
+    names = grid == BenchGrid::full ? builtin_bench_scenes() : std::vector<std::string>{"hanging-sheet"};
+
+  // Scenes first: a bad --scene fails before any run.
+  std::vector<SceneResult> scenes;
+  for (const std::string& name : names) {
+    SceneResult s;
+    s.scene = build_bench_scene(name, grid);
+    s.plan = bench_plan(s.scene, grid);
+    for (const SceneResult& other : scenes)
+      if (other.scene.name == s.scene.name)
+        throw std::invalid_argument(fmt::format("scene '{}' is given twice", name));
+    scenes.push_back(std::move(s));
+  }
+
+  const fs::path exe = fs::read_symlink("/proc/self/exe");
+  const std::string binary_digest = sha256_file(exe);
+  const fs::path cache = options.cache.empty() ? default_cache_dir() : fs::path(options.cache);
+  fs::create_directories(cache);
+  WorkDir work{fs::temp_directory_path() / fmt::format("sketchdrape-bench-{}", getpid())};
+  fs::create_directories(work.path);
+
+  long total = 0;
+  for (const SceneResult& s : scenes) total += static_cast<long>(s.plan.runs.size()) + 1;
+  Progress progress("bench", total, global.quiet);
+  long done = 0;
+  for (size_t i = 0; i < scenes.size(); ++i) {
+    SceneResult& s = scenes[i];
+    const std::string scene_arg = names[i];
+    // The reference: from the cache, or computed now and cached.
+    s.key = reference_key(s.scene, s.plan.reference, binary_digest);
+    const fs::path cached = cache / (s.key + ".bin");
+    if (fs::exists(cached)) {
+      try {
+        s.reference.trace = deserialize_trace(read_file(cached));
+        s.reference.status = "ok";
+        s.reference_cached = true;
+      } catch (const std::exception& e) {
+        spdlog::warn("ignoring the unreadable cached reference {}: {}", cached.string(), e.what());
+      }
+    }
+    if (!s.reference_cached) {
+      spdlog::info("{}: computing the reference ({}), cached as {}", s.scene.name,
+                   s.plan.reference.label(), cached.string());
+      s.reference = run_worker(exe, scene_arg, grid, s.plan.reference, work.path,
+                               s.scene.name + "-reference", 4 * timeout, progress, done,
+                               s.scene.name + " reference");
+      if (s.reference.status != "ok") {
+        // Nothing to measure against: the scene's runs are skipped, the other scenes go on.
+        s.reference_failure = fmt::format("the reference run ({}) did not finish ({}): {}",
+                                          s.plan.reference.label(), s.reference.status,
+                                          s.reference.message);
+        spdlog::error("{}: {}", s.scene.name, s.reference_failure);
+        s.defaults_note = "not measured (no reference)";
+        done += static_cast<long>(s.plan.runs.size()) + 1;
+        progress.update(done);
+        continue;
+      }
+      write_file_atomically(cached, serialize_trace(s.reference.trace));
+    }
+    progress.update(++done);
+    for (const BenchConfig& config : s.plan.runs) {
+      RunRow row;
+      row.config = config;
+      for (const BenchFamily& family : s.plan.families)
+        for (const BenchConfig& member : family.members)
+          if (member.id() == config.id()) row.families.push_back(family.name);
+      row.child = run_worker(exe, scene_arg, grid, config, work.path, s.scene.name + "-" + config.id(),
+                             timeout, progress, done, s.scene.name + " " + config.id());
+      if (row.child.status == "ok") row.error = bench_error(row.child.trace, s.reference.trace);
+      if (row.child.status != "ok")
+        spdlog::warn("{} {}: {} ({})", s.scene.name, config.label(), row.child.status, row.child.message);
+      s.rows.push_back(std::move(row));
+      progress.update(++done);
+    }
+    mark_pareto(s.rows);
+    s.defaults_note = defaults_note(s);
+  }
+  progress.finish();
+
+  // Outputs.
+  const fs::path dir(options.out);
+  StagedOutputs outputs;
+  std::string csv = kCsvHeader;
+  nlohmann::json json = {{"format", "sketchdrape/1 bench"},
+                         {"version", kVersion},
+                         {"grid", grid_name(grid)},
+                         {"cache", cache.string()},
+                         {"scenes", nlohmann::json::array()}};
+  for (const SceneResult& s : scenes) {
+    csv += csv_row(s, s.plan.reference, {"reference"}, s.reference, nullptr, false,
+                   !s.reference_failure.empty() ? "reference: " + s.reference_failure
+                   : s.reference_cached         ? "reference (cached)"
+                                                : "reference");
+    for (const RunRow& row : s.rows)
+      csv += csv_row(s, row.config, row.families, row.child, usable(row) ? &row.error : nullptr,
+                     row.pareto, row.child.message);
+    nlohmann::json runs = nlohmann::json::array();
+    for (const RunRow& row : s.rows) runs.push_back(row_json(row));
+    json["scenes"].push_back({{"name", s.scene.name},
+                              {"source", s.scene.source},
+                              {"duration_s", s.scene.duration},
+                              {"sample_every_s", s.scene.sample_every},
+                              {"material_points", s.scene.material_points.rows()},
+                              {"reference",
+                               {{"run", s.plan.reference.id()},
+                                {"label", s.plan.reference.label()},
+                                {"key", s.key},
+                                {"cached", s.reference_cached},
+                                {"failure", s.reference_failure},
+                                {"cpu_s", s.reference.trace.cpu_s},
+                                {"wall_s", s.reference.trace.wall_s}}},
+                              {"runs", runs},
+                              {"defaults", s.defaults_note}});
+  }
+  outputs.stage(dir / "bench.csv", csv);
+  const bool plots = stage_plots(scenes, work.path, dir, outputs);
+  json["plots"] = plots;
+  outputs.stage(dir / "bench.json", json.dump(2) + "\n");
+  outputs.commit();
+  if (options.json)
+    fmt::print("{}\n", json.dump(2));
+  else
+    fmt::print("{}", summary_table(scenes, plots, dir));
+  for (const SceneResult& s : scenes)
+    if (!s.reference_failure.empty())
+      throw std::runtime_error(fmt::format("{}: {} (the other scenes were written)", s.scene.name,
+                                           s.reference_failure));
+}
+
+}  // namespace
+
+void add_bench_command(CLI::App& app, const GlobalOptions& global) {
+  auto options = std::make_shared<BenchOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "bench", "Work-precision study: run time, memory and error against a fine reference for a "
+               "grid of simulator configurations; CSV, plots and a summary table");
+  cmd->add_flag("--quick", options->quick, "The quick grid (under two minutes): the hanging sheet only");
+  cmd->add_option("--grid", options->grid, "tiny (seconds, for tests), quick or full (default)");
+  cmd->add_option("--scene", options->scenes,
+                  "hanging-sheet, sphere-drop, tshirt or a sketch file (sheet or garment); "
+                  "repeat for several (default: all three, or the hanging sheet when quick)");
+  cmd->add_option("-o,--out", options->out, "Output directory (created if needed; default ./bench)");
+  cmd->add_flag("--json", options->json, "Print the results as one JSON object instead of the table");
+  cmd->add_option("--cache", options->cache,
+                  "Where references are cached (default ~/.cache/sketchdrape/bench)");
+  cmd->add_option("--timeout", options->timeout,
+                  "Seconds a run may take before it is stopped (default 900, quick 120)");
+  cmd->add_option("--worker", options->worker_config)->group("");  // internal: one run
+  cmd->add_option("--worker-scene", options->worker_scene)->group("");
+  cmd->add_option("--worker-out", options->worker_out)->group("");
+  cmd->callback([options, &global] { run_bench(*options, global); });
+}
+
+}  // namespace sd::app

@@ -1,0 +1,165 @@
+// `sketchdrape info BODY`: what a body file holds and how it will be normalised.
+
+#include <fmt/format.h>
+
+#include <iostream>
+#include <optional>
+#include <nlohmann/json.hpp>
+
+#include "garment/body.hpp"
+#include "garment/body_landmarks.hpp"
+#include "src/app/commands/cli.hpp"
+
+namespace sd::app {
+namespace {
+
+struct InfoOptions {
+  std::string body;
+  std::string up;
+  double height = 0;
+  double scale = 0;
+  bool json = false;
+  std::vector<double> slices;  // heights, m (normalised frame)
+};
+
+nlohmann::json box_json(const meshing::BoundingBox& box) {
+  return {{"min", {box.min.x(), box.min.y(), box.min.z()}},
+          {"max", {box.max.x(), box.max.y(), box.max.z()}}};
+}
+
+void run_info(const InfoOptions& options) {
+  garment::BodyOptions body_options;
+  if (!options.up.empty()) body_options.up = garment::AxisDirection::parse(options.up);
+  if (options.height > 0) body_options.height = options.height;
+  if (options.scale > 0) body_options.scale = options.scale;
+  const garment::Body body = garment::load_body(options.body, body_options);
+  const meshing::TriMeshTopology topo = meshing::analyse_topology(body.mesh);
+  const meshing::BoundingBox box = meshing::bounding_box(body.mesh);
+  const garment::RawBodyInfo& raw = body.raw;
+
+  nlohmann::json out = {
+      {"source", raw.source},
+      {"meshes", raw.meshes},
+      {"vertices", body.mesh.vertex_count()},
+      {"triangles", body.mesh.face_count()},
+      {"raw",
+       {{"bounding_box", box_json(raw.box)},
+        {"height", raw.height},
+        {"up_axis", raw.up.name()},
+        {"up_axis_inferred", raw.up_inferred},
+        {"facing", raw.facing.name()}}},
+      {"normalisation", {{"scale", raw.scale}, {"scale_rule", raw.scale_rule}}},
+      {"normalised",
+       {{"bounding_box", box_json(box)}, {"height_m", box.extent().y()}, {"up_axis", "+y"},
+        {"facing", "+z"}}},
+      {"topology",
+       {{"closed", topo.closed()},
+        {"edge_manifold", topo.edge_manifold()},
+        {"consistently_oriented", topo.oriented()},
+        {"components", topo.components},
+        {"boundary_edges", topo.boundary_edges},
+        {"non_manifold_edges", topo.non_manifold_edges},
+        {"degenerate_faces", topo.degenerate_faces},
+        {"signed_volume_raw", raw.signed_volume},
+        {"flipped_inside_out", raw.flipped_inside_out}}},
+      {"warnings", body.warnings},
+  };
+  // Landmarks, when the body looks like a standing figure (a mannequin's torso alone has none).
+  std::optional<garment::BodyLandmarks> landmarks;
+  std::string landmark_problem;
+  try {
+    landmarks = garment::find_landmarks(body.mesh);
+  } catch (const std::runtime_error& e) {
+    landmark_problem = e.what();
+  }
+  if (landmarks) {
+    nlohmann::json points = nlohmann::json::object();
+    for (const garment::Landmark& l : landmarks->points)
+      points[l.name] = {l.position.x(), l.position.y(), l.position.z()};
+    out["landmarks"] = points;
+    out["girths_m"] = {{"chest", landmarks->chest_girth},
+                       {"waist", landmarks->waist_girth},
+                       {"hips", landmarks->hip_girth}};
+  } else {
+    out["landmarks"] = nullptr;
+    out["landmarks_problem"] = landmark_problem;
+  }
+  nlohmann::json slices = nlohmann::json::array();
+  std::string slice_text;
+  for (const double y : options.slices) {
+    nlohmann::json outlines = nlohmann::json::array();
+    slice_text += fmt::format("slice y = {:.3f} m:\n", y);
+    for (const garment::SliceOutline& o : garment::slice_body(body.mesh, y)) {
+      outlines.push_back({{"centroid", {o.centroid.x(), o.centroid.y(), o.centroid.z()}},
+                          {"x", {o.min.x(), o.max.x()}},
+                          {"z", {o.min.z(), o.max.z()}},
+                          {"girth", o.girth}});
+      slice_text += fmt::format("  outline x {:.3f} .. {:.3f}, z {:.3f} .. {:.3f} m, centre ({:.3f}, "
+                                "{:.3f}), girth {:.3f} m\n",
+                                o.min.x(), o.max.x(), o.min.z(), o.max.z(), o.centroid.x(),
+                                o.centroid.z(), o.girth);
+    }
+    slices.push_back({{"y", y}, {"outlines", outlines}});
+  }
+  if (!options.slices.empty()) out["slices"] = slices;
+  if (options.json) {
+    std::cout << out.dump(2) << "\n";
+    return;
+  }
+  const auto& b = raw.box;
+  std::cout << fmt::format(
+      "body        {}\n"
+      "vertices    {}\ntriangles   {}\nmeshes      {}\n"
+      "raw file    {:.4g} x {:.4g} x {:.4g} units, bbox [{:.4g} {:.4g} {:.4g}] .. [{:.4g} {:.4g} "
+      "{:.4g}]\n"
+      "up axis     {} ({}), facing {}, height {:.4g} units\n"
+      "normalised  scale {:.6g} ({}), height {:.3f} m, +y up, facing +z, feet at y = 0\n"
+      "            bbox [{:.3f} {:.3f} {:.3f}] .. [{:.3f} {:.3f} {:.3f}] m\n"
+      "topology    closed {}, edge-manifold {}, oriented {}, {} component(s), {} boundary "
+      "edge(s), {} non-manifold edge(s), {} degenerate face(s)\n",
+      raw.source, body.mesh.vertex_count(), body.mesh.face_count(), raw.meshes,
+      b.extent().x(), b.extent().y(), b.extent().z(), b.min.x(), b.min.y(), b.min.z(),
+      b.max.x(), b.max.y(), b.max.z(), raw.up.name(), raw.up_inferred ? "inferred" : "given",
+      raw.facing.name(), raw.height, raw.scale, raw.scale_rule, box.extent().y(), box.min.x(),
+      box.min.y(), box.min.z(), box.max.x(), box.max.y(), box.max.z(),
+      topo.closed() ? "yes" : "no", topo.edge_manifold() ? "yes" : "no",
+      topo.oriented() ? "yes" : "no", topo.components, topo.boundary_edges,
+      topo.non_manifold_edges, topo.degenerate_faces);
+  if (raw.flipped_inside_out)
+    std::cout << fmt::format("orientation inside out in the file (volume {:.4g} units³): faces flipped\n",
+                             raw.signed_volume);
+  for (const std::string& warning : body.warnings) std::cout << "warning     " << warning << "\n";
+  std::cout << slice_text;
+  if (!landmarks) {
+    std::cout << fmt::format("landmarks   none: {}\n", landmark_problem);
+    return;
+  }
+  std::cout << "landmarks   (m, normalised frame: x to the body's left, y up, z forward)\n";
+  for (const garment::Landmark& l : landmarks->points)
+    std::cout << fmt::format("  {:<15} [{:7.3f} {:7.3f} {:7.3f}]\n", l.name, l.position.x(),
+                             l.position.y(), l.position.z());
+  std::cout << fmt::format("girths      chest {:.3f} m, waist {:.3f} m, hips {:.3f} m (convex hull of "
+                           "the torso's slice)\n",
+                           landmarks->chest_girth, landmarks->waist_girth, landmarks->hip_girth);
+}
+
+}  // namespace
+
+void add_info_command(CLI::App& app, const GlobalOptions& /*global*/) {
+  auto options = std::make_shared<InfoOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "info", "Describe a body mesh: size, up axis, topology, and how it will be normalised");
+  cmd->add_option("BODY", options->body, "Body mesh file (any format assimp reads) or 'builtin'")
+      ->required();
+  cmd->add_option("--up", options->up, "The file's up axis (x, y, z, -x, ...); inferred if omitted");
+  cmd->add_option("--height", options->height, "Scale the body to this height in metres")
+      ->check(finite_range(0.1, 5.0));
+  cmd->add_option("--scale", options->scale, "Metres per file unit")->check(finite_range(1e-9, 1e9));
+  cmd->add_flag("--json", options->json, "Print one JSON object instead of text");
+  cmd->add_option("--slice", options->slices,
+                  "Also print the body's outlines at this height (m, normalised frame; repeat for "
+                  "several): where legs, arms and torso are, to place curves");
+  cmd->callback([options] { run_info(*options); });
+}
+
+}  // namespace sd::app

@@ -1,0 +1,76 @@
+// `sketchdrape pattern SKETCH -o DIR`: the sketch's garment as a flat sewing pattern —
+// pattern.svg, pattern.dxf and pattern.json (docs/pattern.md). No simulation. The files appear
+// together or not at all.
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <filesystem>
+#include <iostream>
+
+#include "garment/body_surface.hpp"
+#include "garment/garment_mesh.hpp"
+#include "garment/sketch_file.hpp"
+#include "garment/sketch_inputs.hpp"
+#include "src/app/pipeline/atomic_file.hpp"
+#include "src/app/commands/cli.hpp"
+#include "src/app/pipeline/pattern_export.hpp"
+
+namespace sd::app {
+namespace {
+
+struct PatternOptions {
+  std::string sketch;
+  std::string out = ".";
+  std::optional<double> fabric_width;    // m; default: the file's, else 1.5
+  std::optional<double> seam_allowance;  // m; default: the file's, else 0.01
+};
+
+void run_pattern(const PatternOptions& options) {
+  const garment::Sketch sketch = garment::load_sketch(options.sketch);
+  if (sketch.sheet || sketch.garment_mesh)
+    sketch.fail(sketch.sheet ? "/sheet" : "/garment_mesh",
+                "a pattern is made from drawn panels; this file has none (a sheet or an imported "
+                "garment mesh)");
+  garment::PatternSpec spec = sketch.output.pattern.value_or(garment::PatternSpec{});
+  if (options.fabric_width) spec.fabric_width = *options.fabric_width;
+  if (options.seam_allowance) spec.seam_allowance = *options.seam_allowance;
+  const garment::Body body = garment::load_sketch_body(sketch);
+  const garment::BodySurface surface(body.mesh);
+  const garment::Garment g = garment::build_garment(sketch, surface);
+  const PatternSheet sheet = build_pattern_sheet(sketch, g, spec);
+  StagedOutputs outputs;
+  stage_pattern(sheet, options.out, outputs);
+  outputs.commit();
+  double worst = 0;
+  for (const garment::PatternSeam& seam : sheet.pattern.seams)
+    worst = std::max(worst, seam.mismatch());
+  std::cout << fmt::format(
+      "{} → {}: {} pieces, {:.0f} mm of {:.0f} mm wide fabric, efficiency {:.0f} %, seams within "
+      "{:.2f} %, {} warning(s)\n",
+      sketch.file, options.out, sheet.layout.pieces.size(), 1000 * sheet.layout.length_used,
+      1000 * sheet.layout.fabric_width, 100 * sheet.layout.efficiency, 100 * worst,
+      sheet.pattern.warnings.size());
+}
+
+}  // namespace
+
+void add_pattern_command(CLI::App& app, const GlobalOptions& /*global*/) {
+  auto options = std::make_shared<PatternOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "pattern",
+      "Flatten a sketch file's panels into a sewing pattern (pattern.svg, pattern.dxf, "
+      "pattern.json); no simulation");
+  cmd->add_option("SKETCH", options->sketch, "Sketch file (format sketchdrape/1)")->required();
+  cmd->add_option("-o,--out", options->out, "Output directory (created if needed)");
+  cmd->add_option("--fabric-width", options->fabric_width,
+                  "Fabric width in metres (default: output.pattern.fabric_width, else 1.5)")
+      ->check(CLI::Range(0.1, 10.0));
+  cmd->add_option("--seam-allowance", options->seam_allowance,
+                  "Seam allowance in metres for pieces without their own (default: "
+                  "output.pattern.seam_allowance, else 0.01)")
+      ->check(CLI::Range(0.0, 0.1));
+  cmd->callback([options] { run_pattern(*options); });
+}
+
+}  // namespace sd::app

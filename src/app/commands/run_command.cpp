@@ -1,0 +1,555 @@
+// `sketchdrape run SKETCH -o DIR`: the scene's cloth (a stitched garment or a sheet) draped by
+// the implicit simulator until it is at rest or the duration is over, then the draped mesh
+// (drape.glb and drape.obj), report.json, the images the file asks for and, with --trace, a
+// per-step log. Only the stages the scene needs run; every output appears together or not at all.
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <Eigen/SVD>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+
+#include "garment/sketch_file.hpp"
+#include "garment/body_landmarks.hpp"
+#include "garment/material_frames.hpp"
+#include "meshing/slice_dent.hpp"
+#include "sim/adaptive_detail.hpp"
+#include "sim/simulation.hpp"
+#include "src/app/commands/cli.hpp"
+#include "src/app/pipeline/cloth_scene.hpp"
+#include "src/app/pipeline/mesh_export.hpp"
+#include "src/app/pipeline/pattern_export.hpp"
+#include "src/app/pipeline/self_intersections.hpp"
+#include "src/app/pipeline/preview_images.hpp"
+#include "src/app/pipeline/progress.hpp"
+#include "src/app/pipeline/sketch_checks.hpp"
+#include "src/render/scene.hpp"
+
+namespace sd::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct RunOptions {
+  std::string sketch;
+  std::string out = ".";
+  bool trace = false;
+  double frames_per_second = 0.0;  // > 0: also a PNG sequence of the drape (frames/)
+  std::string max_memory;          // --max-memory, e.g. "4G"
+  double max_time_s = 0;           // --max-time, seconds; 0: none
+};
+
+// --max-time passed, or the memory budget, while the drape runs: nothing is written.
+class RunLimitExceeded : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// One picture of the drape in progress, for the PNG sequence.
+struct Frame {
+  double time = 0.0;
+  meshing::TriMesh cloth;
+  Eigen::VectorXi triangle_group;
+};
+
+// The images of a run: the file's list, or front, back and left when it lists none.
+std::vector<garment::ImageSpec> run_images(const garment::Sketch& sketch) {
+  if (sketch.output.images_listed) return sketch.output.images;
+  std::vector<garment::ImageSpec> images;
+  for (const char* view : {"front", "back", "left"}) {
+    garment::ImageSpec image;
+    image.view = view;
+    image.width = 600;
+    image.height = 900;
+    images.push_back(image);
+  }
+  return images;
+}
+
+nlohmann::json energy_json(const std::vector<sim::EnergySample>& samples) {
+  nlohmann::json series = {{"time", nlohmann::json::array()},    {"stretch", nlohmann::json::array()},
+                           {"shear", nlohmann::json::array()},   {"bend", nlohmann::json::array()},
+                           {"kinetic", nlohmann::json::array()}, {"potential", nlohmann::json::array()}};
+  for (const sim::EnergySample& s : samples) {
+    series["time"].push_back(s.time);
+    series["stretch"].push_back(s.stretch);
+    series["shear"].push_back(s.shear);
+    series["bend"].push_back(s.bend);
+    series["kinetic"].push_back(s.kinetic);
+    series["potential"].push_back(s.potential);
+  }
+  return series;
+}
+
+nlohmann::json simulation_json(const sim::SimulationReport& r, const sim::SimulationSettings& s) {
+  return {{"steps", r.steps},
+          {"sim_time", r.sim_time},
+          {"wall_time_s", r.wall_time_s},
+          {"at_rest", r.at_rest},
+          {"retries", r.retries},
+          {"forced_steps", r.forced_steps},
+          {"nan_free", r.nan_free},
+          {"vertices", r.vertices},
+          {"triangles", r.triangles},
+          {"linear_solves", r.linear_solves},
+          {"cg_iterations_mean", r.cg_iterations_mean},
+          {"cg_iterations_max", r.cg_iterations_max},
+          {"newton_iterations_mean", r.newton_iterations_mean},
+          {"dt_min_used", r.dt_min_used},
+          {"dt_max_used", r.dt_max_used},
+          {"max_strain", r.max_strain},
+          {"rest",
+           {{"speed_window_m_s", r.rest_speed_window},
+            {"kinetic_per_kg_window_J_kg", r.rest_kinetic_per_kg_window},
+            {"speed_final_m_s", r.rest_speed_final},
+            {"kinetic_per_kg_final_J_kg", r.rest_kinetic_per_kg_final},
+            {"speed_limit_m_s", s.rest_speed},
+            {"kinetic_per_kg_limit_J_kg", s.rest_kinetic_energy},
+            {"window_s", s.rest_window}}},
+          {"contacts_max", r.contacts_max},
+          {"max_penetration_m", r.max_penetration_m},
+          {"penetrating_vertices_final", r.penetrating_vertices_final},
+          {"piercing_body_vertices_final", r.piercing_body_vertices_final},
+          {"max_piercing_final_m", r.max_piercing_final_m},
+          {"contacts_final", r.contacts_final},
+          {"self_collision", s.self_contact.enabled},
+          {"self_intersections_start", r.self_intersections_start},
+          {"self_untangled_vertices", r.self_untangled_vertices},
+          {"self_contacts_max", r.self_contacts_max},
+          {"self_contacts_final", r.self_contacts_final},
+          {"self_collisions", r.self_collisions},
+          {"self_zone_vertices", r.self_zone_vertices},
+          {"self_unresolved_steps", r.self_unresolved_steps},
+          {"self_culled_share", r.self_culled_share},
+          {"self_collision_share", r.wall_time_s > 0.0 ? r.self_collision_s / r.wall_time_s : 0.0},
+          {"timing_s",
+           {{"forces", r.forces_s},
+            {"solve", r.solve_s},
+            {"collision", r.collision_s},
+            {"self_collision", r.self_collision_s},
+            {"other", r.other_s}}},
+          {"settings",
+           {{"integrator", s.integrator == sim::Integrator::bdf2 ? "bdf2" : "implicit-euler"},
+            {"solver", s.solver == sim::LinearSolverKind::pcg ? "pcg" : "cholmod"},
+            {"dt", s.dt},
+            {"duration", s.duration},
+            {"stop_at_rest", s.stop_at_rest}}},
+          {"energy", energy_json(r.energy)}};
+}
+
+nlohmann::json meshing_json(const ClothScene& scene) {
+  if (!scene.garment) return nullptr;
+  int distortion = 0, irregular = 0;
+  nlohmann::json panels = nlohmann::json::array();
+  for (const garment::GarmentPanel& p : scene.garment->panels) {
+    distortion += p.distortion;
+    irregular += p.irregular_vertices;
+    panels.push_back({{"id", p.id},
+                      {"sides", p.side_counts.size()},
+                      {"distortion", p.distortion},
+                      {"irregular_vertices", p.irregular_vertices},
+                      {"partition", p.partition},
+                      {"quads", p.faces}});
+  }
+  return {{"distortion", distortion},
+          {"irregular_vertices", irregular},
+          {"quads", scene.garment->mesh.face_count()},
+          {"meshing_ms", scene.meshing_ms},
+          {"panels", panels}};
+}
+
+// How far the drape is from the cloth's rest shape (the pattern with "rest": "flat"), per group:
+// each triangle's principal stretches σ₁ ≥ σ₂ of [w_u w_v] (Baraff & Witkin's deformation
+// gradient against the model's rest triangle), strain = max(σ₁ − 1, 1 − σ₂); max and
+// rest-area-weighted mean.
+nlohmann::json strain_json(const sim::ClothModel& model, const Eigen::MatrixX3d& positions,
+                           const Eigen::VectorXi& triangle_group,
+                           const std::vector<std::string>& group_names) {
+  std::vector<double> worst(group_names.size(), 0.0), sum(group_names.size(), 0.0),
+      area(group_names.size(), 0.0);
+  for (size_t t = 0; t < model.triangles.size(); ++t) {
+    const sim::TriangleElement& e = model.triangles[t];
+    Eigen::Matrix<double, 3, 2> f = Eigen::Matrix<double, 3, 2>::Zero();
+    for (int k = 0; k < 3; ++k) {
+      f.col(0) += e.du[k] * positions.row(e.vertices[k]).transpose();
+      f.col(1) += e.dv[k] * positions.row(e.vertices[k]).transpose();
+    }
+    const Eigen::Vector2d sigma = Eigen::JacobiSVD<Eigen::Matrix<double, 3, 2>>(f).singularValues();
+    const double strain = std::max(sigma(0) - 1, 1 - sigma(1));
+    const size_t g = t < static_cast<size_t>(triangle_group.size())
+                         ? static_cast<size_t>(triangle_group(static_cast<Eigen::Index>(t)))
+                         : 0;
+    worst[g] = std::max(worst[g], strain);
+    sum[g] += e.rest_area * strain;
+    area[g] += e.rest_area;
+  }
+  nlohmann::json out = nlohmann::json::array();
+  for (size_t g = 0; g < group_names.size(); ++g)
+    out.push_back({{"group", group_names[g]},
+                   {"strain_max", worst[g]},
+                   {"strain_mean", area[g] > 0 ? sum[g] / area[g] : 0.0}});
+  return out;
+}
+
+// The sketch's "simulate": {"adaptive": {...}} over the simulator's defaults.
+sim::AdaptiveSettings adaptive_settings(const garment::Sketch& sketch) {
+  const garment::AdaptiveSpec& spec = sketch.simulate.adaptive_settings;
+  sim::AdaptiveSettings s;
+  s.refine_threshold = spec.refine_threshold.value_or(s.refine_threshold);
+  s.coarsen_threshold = spec.coarsen_threshold.value_or(s.coarsen_threshold);
+  s.steady_rate = spec.steady_rate.value_or(s.steady_rate);
+  s.min_lifetime = spec.min_lifetime.value_or(s.min_lifetime);
+  s.min_level = spec.min_level.value_or(s.min_level);
+  s.max_level = spec.max_level.value_or(s.max_level);
+  s.max_vertices = spec.max_vertices.value_or(s.max_vertices);
+  s.merge_batch = spec.merge_batch.value_or(s.merge_batch);
+  s.even_levels = spec.even_levels.value_or(s.even_levels);
+  try {
+    s.validate();  // e.g. a coarsen threshold set at or above the default refine threshold
+  } catch (const sim::InvalidAdaptiveSettingsError& e) {
+    sketch.fail("/simulate/adaptive", e.what());
+  }
+  return s;
+}
+
+// Per accepted step: time, splits (requested and forced), merges and particles after it.
+nlohmann::json adaptive_steps_json(const std::vector<sim::AdaptiveStepRecord>& steps) {
+  nlohmann::json out = {{"time", nlohmann::json::array()}, {"splits", nlohmann::json::array()},
+                        {"merges", nlohmann::json::array()}, {"vertices", nlohmann::json::array()}};
+  for (const sim::AdaptiveStepRecord& step : steps) {
+    out["time"].push_back(step.time);
+    out["splits"].push_back(step.splits + step.forced_splits);
+    out["merges"].push_back(step.merges);
+    out["vertices"].push_back(step.vertices);
+  }
+  return out;
+}
+
+void run_drape(const RunOptions& options, const GlobalOptions& global) {
+  const auto start = Clock::now();
+  const garment::Sketch sketch = garment::load_sketch(options.sketch);
+  check_sketch(sketch);
+  const sim::SimulationSettings settings = simulation_settings(sketch);
+  RunLimits limits;
+  if (!options.max_memory.empty()) limits.max_memory_bytes = parse_memory_size(options.max_memory);
+  if (options.max_time_s > 0) limits.max_time_s = options.max_time_s;
+  // Refused before anything is built when the size is known from the file (a sheet), else once
+  // the cloth is meshed.
+  if (const auto vertices = cloth_vertices_before_building(sketch))
+    check_run_fits(sketch, estimate_run(sketch, *vertices, options.frames_per_second), limits,
+                   options.frames_per_second);
+  const ClothScene scene = build_cloth_scene(sketch);
+  const RunEstimate estimate =
+      estimate_run(sketch, static_cast<double>(scene.start.rows()), options.frames_per_second);
+  check_run_fits(sketch, estimate, limits, options.frames_per_second);
+  spdlog::debug("estimate: {:.0f} vertices, {:.2f} GB, at most {:.0f} steps ({:.0f} s), {:.0f} frames",
+                estimate.vertices, estimate.memory_bytes / 1e9, estimate.steps, estimate.seconds,
+                estimate.frames);
+  if (!limits.max_time_s && estimate.seconds > 3600)
+    spdlog::warn("this drape may take up to about {:.1f} h ({:.0f} steps on {:.0f} vertices, by "
+                 "the estimate); --max-time SECONDS stops it",
+                 estimate.seconds / 3600, estimate.steps, estimate.vertices);
+  if (scene.pinned.empty() && !scene.body)
+    spdlog::warn("nothing holds the cloth (no pins, no body): it will fall for the whole run");
+
+  std::vector<sim::Pin> pins;
+  for (int v : scene.pinned) pins.push_back({v, {}});
+
+  const std::filesystem::path dir(options.out);
+  StagedOutputs outputs;
+  std::string trace;
+  Progress progress("draping", static_cast<long>(std::ceil(settings.duration * 1000)), global.quiet);
+  // Called after every accepted step, by either driver.
+  // Adaptive detail can grow the cloth past the estimate: the budget is also checked as it runs.
+  const double memory_budget = memory_budget_bytes(limits);
+  const auto on_step = [&](const sim::Simulation& s) {
+    if (const double resident = resident_memory_bytes(); memory_budget > 0 && resident > memory_budget)
+      throw RunLimitExceeded(fmt::format(
+          "stopped at t = {:.3f} s of the drape: it uses {:.1f} GB with {} vertices, more than "
+          "the {:.1f} GB it may take (--max-memory); limit adaptive detail with "
+          "simulate.adaptive.max_vertices or max_level; nothing was written",
+          s.time(), resident / 1e9, s.model().vertex_count, memory_budget / 1e9));
+    if (limits.max_time_s &&
+        std::chrono::duration<double>(Clock::now() - start).count() > *limits.max_time_s)
+      throw RunLimitExceeded(fmt::format(
+          "stopped at t = {:.3f} s of the drape: --max-time {:g} s passed; nothing was written",
+          s.time(), *limits.max_time_s));
+    progress.update(static_cast<long>(s.time() * 1000), fmt::format("t = {:.2f} s", s.time()));
+    if (!options.trace) return;
+    const sim::SimulationReport& r = s.report();
+    nlohmann::json line = {{"step", r.steps}, {"time", s.time()}, {"dt", s.current_dt()},
+                           {"retries", r.retries}, {"vertices", s.model().vertex_count}};
+    if (!r.energy.empty()) {
+      const sim::EnergySample& e = r.energy.back();
+      line["energy"] = {{"stretch", e.stretch}, {"shear", e.shear}, {"bend", e.bend},
+                        {"kinetic", e.kinetic}, {"potential", e.potential}};
+    }
+    trace += line.dump() + "\n";
+  };
+
+  // The PNG sequence: a frame at t = 0 and whenever a step reaches the next frame time (the
+  // same state again for every frame time a long step passed, so that the sequence keeps its
+  // rate).
+  std::vector<Frame> frames;
+  const auto frame_due = [&](double t) {
+    return options.frames_per_second > 0.0 &&
+           t >= static_cast<double>(frames.size()) / options.frames_per_second - 1e-9;
+  };
+  if (frame_due(0.0)) {
+    frames.push_back({0.0, {scene.start, scene.input.triangles}, scene.triangle_group});
+  }
+
+  // Adaptive 4-8 detail needs the garment's block hierarchy; a sheet runs on its fixed mesh.
+  sim::SimulationReport report;
+  nlohmann::json adaptive_json = nullptr;
+  meshing::TriMesh draped;
+  Eigen::VectorXi triangle_group = scene.triangle_group;
+  Eigen::VectorXd face_levels;
+  nlohmann::json strain = nullptr;
+  const bool flat_rest = scene.input.rest_uv.rows() > 0;
+  if (flat_rest && sketch.simulate.adaptive)
+    spdlog::warn("\"rest\": \"flat\" drapes on the fixed mesh: adaptive detail does not yet carry "
+                 "pattern rest shapes through its splits (docs/pattern.md)");
+  try {
+    if (sketch.simulate.adaptive && scene.mesh48 && !flat_rest) {
+      sim::AdaptiveMaterial material;
+      material.fabric = scene.fabric;
+      if (scene.garment) material.source_warp = garment::material_frames(scene.garment->mesh).warp;
+      material.source_ease = scene.mesh48_face_ease;
+      sim::AdaptiveCloth cloth(*scene.mesh48, material, scene.start, pins, settings,
+                               adaptive_settings(sketch));
+      // Contacts through every split and merge, with the body still or moving.
+      if (scene.body_motion)
+        cloth.set_body_motion(*scene.body_motion);
+      else if (scene.body)
+        cloth.set_body(scene.body->mesh);
+      // Each triangle keeps the group of the input face (quad) it descends from.
+      const auto groups_of = [&](const sim::AdaptiveCloth& c) {
+        const meshing::Mesh48Arrays arrays = c.mesh().arrays();
+        Eigen::VectorXi groups(arrays.faces.rows());
+        for (Eigen::Index t = 0; t < arrays.faces.rows(); ++t)
+          groups(t) = scene.mesh48_face_group(
+              c.mesh().source_face(arrays.triangle_ids[static_cast<size_t>(t)]));
+        return groups;
+      };
+      const sim::AdaptiveReport adaptive = cloth.run([&](const sim::AdaptiveCloth& c) {
+        on_step(c.simulation());
+        while (frame_due(c.simulation().time()))
+          frames.push_back({c.simulation().time(), {c.positions(), c.faces()}, groups_of(c)});
+      });
+      report = adaptive.simulation;
+      draped.vertices = cloth.positions();
+      draped.faces = cloth.faces();
+      face_levels = cloth.face_levels().cast<double>();
+      triangle_group = groups_of(cloth);
+      strain = strain_json(cloth.simulation().model(), draped.vertices, triangle_group,
+                           scene.group_names);
+      adaptive_json = {{"splits", adaptive.splits},
+                       {"forced_splits", adaptive.forced_splits},
+                       {"merges", adaptive.merges},
+                       {"moved_off_body", adaptive.moved_off_body},
+                       {"splits_declined_on_body", adaptive.splits_declined_on_body},
+                       {"body_sags_computed", adaptive.body_sags_computed},
+                       {"body_sags_reused", adaptive.body_sags_reused},
+                       {"topology_changes", adaptive.topology_changes},
+                       {"vertices_min", adaptive.vertices_min},
+                       {"vertices_max", adaptive.vertices_max},
+                       {"max_level_reached", adaptive.max_level_reached},
+                       {"adaptivity_s", adaptive.adaptivity_s()},
+                       {"steps", adaptive_steps_json(adaptive.steps)}};
+    } else {
+      sim::Simulation simulation(build_scene_model(scene),
+                                 sim::flatten_positions(scene.start), pins, settings);
+      // Contacts and friction, with the body still or moving.
+      if (scene.body_motion)
+        simulation.set_body_motion(*scene.body_motion);
+      else if (scene.body)
+        simulation.set_body(scene.body->mesh);
+      report = simulation.run([&](const sim::Simulation& s) {
+        on_step(s);
+        while (frame_due(s.time()))
+          frames.push_back({s.time(),
+                            {sim::unflatten_positions(s.positions()), scene.input.triangles},
+                            scene.triangle_group});
+      });
+      draped.vertices = sim::unflatten_positions(simulation.positions());
+      draped.faces = scene.input.triangles;
+      strain = strain_json(simulation.model(), draped.vertices, scene.triangle_group,
+                           scene.group_names);
+    }
+  } catch (const sim::InvalidFabricError& e) {
+    sketch.fail("/fabric", e.what());
+  }
+  progress.finish();
+  if (report.failed) {
+    // Where and why, and the last accepted state to look at: drape-failed.obj and images with
+    // a marker (an octahedron 5 cm across, in a colour of its own) where it broke, seen from the
+    // four sides (the place may face any way).
+    const int v = report.failure_vertex;
+    const bool located = v >= 0 && v < draped.vertices.rows();
+    const Eigen::Vector3d where = located ? Eigen::Vector3d(draped.vertices.row(v).transpose())
+                                          : Eigen::Vector3d(draped.vertices.colwise().mean().transpose());
+    std::string panel = "?", landmark;
+    for (Eigen::Index t = 0; t < draped.faces.rows() && located && panel == "?"; ++t)
+      for (int k = 0; k < 3; ++k)
+        if (draped.faces(t, k) == v && t < triangle_group.size() &&
+            triangle_group(t) < static_cast<int>(scene.group_names.size()))
+          panel = scene.group_names[static_cast<size_t>(triangle_group(t))];
+    if (scene.body) {
+      try {
+        landmark = garment::find_landmarks(scene.body->mesh).nearest(where).name;
+      } catch (const std::runtime_error&) {
+        // Not a standing figure: the place is given without a landmark.
+      }
+    }
+    meshing::TriMesh marked = draped;
+    Eigen::VectorXi marked_group(draped.faces.rows() + 8);
+    marked_group << triangle_group, Eigen::VectorXi::Constant(8, static_cast<int>(scene.group_names.size()));
+    const Eigen::Index base = marked.vertices.rows();
+    marked.vertices.conservativeResize(base + 6, 3);
+    marked.faces.conservativeResize(marked.faces.rows() + 8, 3);
+    const double r = 0.025;
+    const Eigen::Vector3d axes[6] = {{r, 0, 0}, {-r, 0, 0}, {0, 0, r}, {0, 0, -r}, {0, r, 0}, {0, -r, 0}};
+    for (int k = 0; k < 6; ++k) marked.vertices.row(base + k) = (where + axes[k]).transpose();
+    const int corners[8][3] = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                               {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+    for (int f = 0; f < 8; ++f)
+      marked.faces.row(draped.faces.rows() + f) << static_cast<int>(base) + corners[f][0],
+          static_cast<int>(base) + corners[f][1], static_cast<int>(base) + corners[f][2];
+    StagedOutputs failed_outputs;
+    failed_outputs.stage(dir / "drape-failed.obj",
+                         to_obj({draped.vertices, draped.faces,
+                                 std::vector<int>(triangle_group.data(),
+                                                  triangle_group.data() + triangle_group.size()),
+                                 scene.group_names},
+                                "drape-failed"));
+    const std::optional<meshing::TriMesh> body_now =
+        scene.body ? std::optional(body_at(scene, report.sim_time)) : std::nullopt;
+    std::vector<garment::ImageSpec> sides;
+    for (const char* view : {"front", "back", "left", "right"}) {
+      garment::ImageSpec image;
+      image.view = view;
+      image.width = 600;
+      image.height = 900;
+      sides.push_back(image);
+    }
+    stage_preview_images(sides, false, body_now ? &*body_now : nullptr,
+                         {marked, marked_group, {}, {}}, "drape-failed", dir, failed_outputs);
+    failed_outputs.commit();
+    throw std::runtime_error(fmt::format(
+        "the simulation failed at t = {:.3f} s in panel '{}' at ({:.3f}, {:.3f}, {:.3f}) m{}: {}; "
+        "the last accepted state is in {} and drape-failed-<view>.png (the place marked)",
+        report.sim_time, panel, where.x(), where.y(), where.z(),
+        landmark.empty() ? "" : fmt::format(", near the {}", landmark), report.failure_reason,
+        (dir / "drape-failed.obj").string()));
+  }
+
+  // The draped cloth, one group per panel.
+  const ExportMesh mesh{draped.vertices, draped.faces,
+                        std::vector<int>(triangle_group.data(),
+                                         triangle_group.data() + triangle_group.size()),
+                        scene.group_names};
+  outputs.stage(dir / "drape.glb", to_glb(mesh, "drape"));
+  outputs.stage(dir / "drape.obj", to_obj(mesh, "drape"));
+
+  const auto image_start = Clock::now();
+  // The body as it stands at the end (its last pose when it moves).
+  const std::optional<meshing::TriMesh> body_end =
+      scene.body ? std::optional(body_at(scene, report.sim_time)) : std::nullopt;
+  const PreviewCloth preview{draped, triangle_group, render::triangle_edges(draped), face_levels};
+  const std::vector<garment::ImageSpec> image_specs = run_images(sketch);
+  const std::vector<std::string> images =
+      stage_preview_images(image_specs, sketch.output.wireframe, body_end ? &*body_end : nullptr,
+                           preview, "drape", dir, outputs);
+  // The sequence: the first image the file asks for (front by default), without edges.
+  std::vector<garment::ImageSpec> frame_image = {image_specs.empty() ? garment::ImageSpec{}
+                                                                     : image_specs.front()};
+  frame_image.front().wireframe = false;
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const std::optional<meshing::TriMesh> body =
+        scene.body ? std::optional(body_at(scene, frames[i].time)) : std::nullopt;
+    stage_preview_images(frame_image, false, body ? &*body : nullptr,
+                         {frames[i].cloth, frames[i].triangle_group, {}, {}},
+                         fmt::format("frame-{:04d}", i), dir / "frames", outputs);
+  }
+  const double image_s = std::chrono::duration<double>(Clock::now() - image_start).count();
+
+  nlohmann::json out = simulation_json(report, settings);
+  // Counted whether or not self-collision was on: what a preview would show.
+  out["self_intersections_final"] = count_self_intersections(draped.vertices, draped.faces);
+  out["format"] = "sketchdrape/1 run report";
+  out["sketch"] = sketch.file;
+  out["scene"] = sketch.sheet ? "sheet" : (sketch.garment_mesh ? "imported garment" : "garment");
+  out["fabric"] = scene.fabric_name;
+  out["body"] = scene.body ? nlohmann::json(scene.body->raw.source) : nlohmann::json(nullptr);
+  out["pinned_vertices"] = scene.pinned.size();
+  out["meshing"] = meshing_json(scene);
+  out["rest_shape"] = flat_rest ? (scene.bend_rest_flat ? "flat" : "flat and shaped") : "shaped";
+  out["strain"] = strain;  // per group, against the rest shape (the pattern when flat)
+  if (scene.garment && sketch.output.pattern) {
+    const PatternSheet sheet = build_pattern_sheet(sketch, *scene.garment, *sketch.output.pattern);
+    stage_pattern(sheet, dir, outputs);
+    out["pattern"] = pattern_summary(sheet);
+  }
+  out["adaptive"] = adaptive_json;
+  if (scene.garment) {
+    // How deep the draped cloth dents between supports (a skirt pulled between the legs).
+    const meshing::SliceDent dent = meshing::slice_dent(draped);
+    out["slice_dent"] = {{"depth_m", dent.depth}, {"height_m", dent.height},
+                         {"where", {dent.where.x(), dent.where.y(), dent.where.z()}},
+                         {"from_fraction", 0.1}, {"to_fraction", 0.6}};
+  }
+  out["images"] = images;
+  out["frames"] = frames.size();
+  out["body_motion"] = nullptr;
+  if (sketch.body.motion && scene.body_motion) {
+    out["body_motion"] = {{"type", sketch.body.motion->type},
+                          {"start", scene.body_motion->start_time()},
+                          {"end", scene.body_motion->end_time()}};
+    if (sketch.body.motion->type == "poses")
+      out["body_motion"]["poses"] = sketch.body.motion->poses.size();
+    else
+      out["body_motion"]["degrees"] = sketch.body.motion->degrees;
+  }
+  // Adaptivity (estimates, splits, merges, model rebuilds) next to the simulator's split.
+  out["timing_s"]["adaptivity"] =
+      adaptive_json.is_null() ? 0.0 : adaptive_json["adaptivity_s"].get<double>();
+  out["timing_s"]["images"] = image_s;
+  out["timing_s"]["total"] = std::chrono::duration<double>(Clock::now() - start).count();
+  if (sketch.output.report) outputs.stage(dir / "report.json", out.dump(2) + "\n");
+  if (options.trace) outputs.stage(dir / "trace.jsonl", trace);
+  outputs.commit();
+  spdlog::info("draped {} → {}: {} steps, {:.2f} s simulated{}, {:.2f} s wall", sketch.file,
+               dir.string(), report.steps, report.sim_time, report.at_rest ? " (at rest)" : "",
+               report.wall_time_s);
+}
+
+}  // namespace
+
+void add_run_command(CLI::App& app, const GlobalOptions& global) {
+  auto options = std::make_shared<RunOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "run", "Drape a sketch's garment (or sheet) with the cloth simulator: draped mesh, report, "
+             "images");
+  cmd->add_option("SKETCH", options->sketch, "Sketch file (format sketchdrape/1)")->required();
+  cmd->add_option("-o,--out", options->out, "Output directory (created if needed)");
+  cmd->add_flag("--trace", options->trace, "Also write trace.jsonl: one JSON line per step");
+  cmd->add_option("--frames", options->frames_per_second,
+                  "Also write frames/frame-NNNN-<view>.png: this many pictures per simulated "
+                  "second (the first image's view, the body at its pose)")
+      ->check(finite_range(1e-3, 1000));
+  cmd->add_option("--max-memory", options->max_memory,
+                  "Refuse a drape estimated to need more memory than this (e.g. 4G, 512M; "
+                  "default: the memory available)");
+  cmd->add_option("--max-time", options->max_time_s,
+                  "Stop (writing nothing) after this many seconds of wall time; refuse a drape "
+                  "without stop_at_rest estimated to take longer")
+      ->check(finite_range(1e-3, 1e9));
+  cmd->callback([options, &global] { run_drape(*options, global); });
+}
+
+}  // namespace sd::app

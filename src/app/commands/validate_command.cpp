@@ -1,0 +1,67 @@
+// `sketchdrape validate SKETCH`: checks a sketch file the way `mesh` and `run` would use it —
+// fields, body, strokes on the body, curve network, panels, edge counts, the quad fill, the
+// fabric and the simulation settings — and writes nothing.
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <iostream>
+
+#include "garment/sketch_file.hpp"
+#include "src/app/commands/cli.hpp"
+#include "src/app/pipeline/cloth_scene.hpp"
+#include "src/app/pipeline/quality_warnings.hpp"
+#include "src/app/pipeline/sketch_checks.hpp"
+
+namespace sd::app {
+namespace {
+
+struct ValidateOptions {
+  std::string sketch;
+  bool strict = false;
+};
+
+void run_validate(const ValidateOptions& options) {
+  const garment::Sketch sketch = garment::load_sketch(options.sketch);
+  check_sketch(sketch);
+  // What `run` would refuse for its size, refused here too (a sheet before it is built).
+  if (const auto vertices = cloth_vertices_before_building(sketch))
+    check_run_fits(sketch, estimate_run(sketch, *vertices, 0), RunLimits{}, 0);
+  const ClothScene scene = build_cloth_scene(sketch);
+  check_run_fits(sketch, estimate_run(sketch, static_cast<double>(scene.start.rows()), 0),
+                 RunLimits{}, 0);
+  std::string what;
+  if (scene.garment) {
+    int distortion = 0;
+    for (const auto& p : scene.garment->panels) distortion += p.distortion;
+    what = fmt::format("{} curves, {} panels, {} quads, distortion {}", sketch.curves.size(),
+                       scene.garment->panels.size(), scene.garment->mesh.face_count(), distortion);
+  } else {
+    what = fmt::format("{} {}: {} vertices, {} triangles", sketch.sheet ? "sheet" : "garment mesh",
+                       scene.fabric_name, scene.input.rest_positions.rows(),
+                       scene.input.triangles.rows());
+  }
+  std::vector<garment::QualityWarning> warnings;
+  if (scene.garment && scene.body) warnings = quality_warnings(*scene.garment, sketch, *scene.body);
+  std::cout << fmt::format("{}: ok ({}, fabric {}){}\n", sketch.file, what, scene.fabric_name,
+                           warnings.empty()
+                               ? ""
+                               : fmt::format("; {} mesh quality warning(s)", warnings.size()));
+  if (options.strict && !warnings.empty())
+    throw std::runtime_error(fmt::format("{}: {} mesh quality warning(s) and --strict", sketch.file,
+                                         warnings.size()));
+}
+
+}  // namespace
+
+void add_validate_command(CLI::App& app, const GlobalOptions& /*global*/) {
+  auto options = std::make_shared<ValidateOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "validate", "Check a sketch file (fields, body, curves on the body, panels, edge counts); "
+                  "writes nothing");
+  cmd->add_option("SKETCH", options->sketch, "Sketch file (format sketchdrape/1)")->required();
+  cmd->add_flag("--strict", options->strict, "Exit with code 1 when the quality gate warns");
+  cmd->callback([options] { run_validate(*options); });
+}
+
+}  // namespace sd::app

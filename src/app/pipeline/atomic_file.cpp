@@ -1,0 +1,195 @@
+#include "src/app/pipeline/atomic_file.hpp"
+
+#include <signal.h>
+#include <unistd.h>
+
+#include <array>
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <mutex>
+#include <set>
+#include <stdexcept>
+#include <system_error>
+
+namespace sd::app {
+namespace {
+
+// The temporaries and folders this process has made and not yet committed, for the SIGINT /
+// SIGTERM / SIGHUP handler: it removes them (unlink and rmdir are async-signal-safe) and dies by
+// the signal as it would have. Lock-free slots, since a signal may arrive in any thread at any
+// time; a path string is never freed once registered (one per staged file: a few hundred KB at
+// most), so the handler never reads freed memory.
+constexpr size_t kTempSlots = 16384;  // above run's 10,000 frames plus the images
+std::array<std::atomic<char*>, kTempSlots> g_temp_slots{};
+constexpr size_t kDirSlots = 64;
+std::array<std::atomic<char*>, kDirSlots> g_dir_slots{};
+std::once_flag g_handlers_installed;
+
+extern "C" void remove_temporaries_and_reraise(int sig) {
+  for (auto& slot : g_temp_slots)
+    if (char* path = slot.load()) ::unlink(path);
+  for (size_t i = kDirSlots; i-- > 0;)  // deepest folders were registered last
+    if (char* path = g_dir_slots[i].load()) ::rmdir(path);
+  ::signal(sig, SIG_DFL);
+  ::raise(sig);
+}
+
+void install_handlers() {
+  std::call_once(g_handlers_installed, [] {
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+      struct sigaction old {};
+      sigaction(sig, nullptr, &old);
+      // Only where nobody else handles it (batch has its own), and an ignored SIGINT (nohup)
+      // stays ignored.
+      if (old.sa_handler != SIG_DFL || (old.sa_flags & SA_SIGINFO) != 0) continue;
+      struct sigaction action {};
+      action.sa_handler = remove_temporaries_and_reraise;
+      sigemptyset(&action.sa_mask);
+      sigaction(sig, &action, nullptr);
+    }
+  });
+}
+
+// Puts `path` in a free slot; returns the slot's string (to release it later), or null when
+// every slot is taken (the file is then only removed by the destructor or a later sweep).
+template <size_t N>
+char* hold(std::array<std::atomic<char*>, N>& slots, const std::filesystem::path& path) {
+  install_handlers();
+  char* copy = ::strdup(path.c_str());
+  if (copy == nullptr) return nullptr;
+  for (auto& slot : slots) {
+    char* expected = nullptr;
+    if (slot.compare_exchange_strong(expected, copy)) return copy;
+  }
+  std::free(copy);
+  return nullptr;
+}
+
+template <size_t N>
+void release(std::array<std::atomic<char*>, N>& slots, const char* held) {
+  if (held == nullptr) return;
+  for (auto& slot : slots) {
+    char* expected = const_cast<char*>(held);
+    if (slot.compare_exchange_strong(expected, nullptr)) return;  // the string is kept (see above)
+  }
+}
+
+// Removes `.NAME.tmp-PID-N` files in `dir` left by processes that are gone (killed with SIGKILL,
+// or crashed): the PID is not alive on this machine and the file has not changed for ten
+// minutes (on a folder shared by a cluster the PID may be another machine's live process; its
+// temporaries are fresh). Once per folder and process.
+void sweep_stale_temporaries(const std::filesystem::path& dir) {
+  static std::mutex mutex;
+  static std::set<std::filesystem::path> swept;
+  {
+    const std::lock_guard<std::mutex> lock(mutex);
+    if (!swept.insert(dir).second) return;
+  }
+  std::error_code ec;
+  const auto now = std::filesystem::file_time_type::clock::now();
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    const size_t tag = name.rfind(".tmp-");
+    if (name.empty() || name[0] != '.' || tag == std::string::npos) continue;
+    const std::string rest = name.substr(tag + 5);  // PID-N
+    const size_t dash = rest.find('-');
+    if (dash == std::string::npos || dash == 0 ||
+        rest.find_first_not_of("0123456789-") != std::string::npos)
+      continue;
+    const long pid = std::strtol(rest.substr(0, dash).c_str(), nullptr, 10);
+    if (pid <= 0 || pid == ::getpid()) continue;
+    if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;  // alive, or not ours
+    std::error_code time_ec;
+    const auto changed = std::filesystem::last_write_time(entry.path(), time_ec);
+    if (time_ec || now - changed < std::chrono::minutes(10)) continue;
+    std::filesystem::remove(entry.path(), time_ec);
+  }
+}
+
+std::filesystem::path temporary_name(const std::filesystem::path& path) {
+  static std::atomic<unsigned> counter{0};
+  return path.parent_path() / ("." + path.filename().string() + ".tmp-" +
+                               std::to_string(::getpid()) + "-" + std::to_string(counter++));
+}
+
+void write_all(const std::filesystem::path& path, std::string_view bytes) {
+  std::FILE* file = std::fopen(path.c_str(), "wb");
+  if (file == nullptr)
+    throw std::runtime_error("cannot write '" + path.string() + "': " + std::strerror(errno));
+  const size_t written = std::fwrite(bytes.data(), 1, bytes.size(), file);
+  const int flushed = std::fflush(file);
+  const int error = errno;
+  const int closed = std::fclose(file);
+  if (written != bytes.size() || flushed != 0 || closed != 0) {
+    std::remove(path.c_str());
+    throw std::runtime_error("cannot write '" + path.string() + "': " + std::strerror(error));
+  }
+}
+
+}  // namespace
+
+void write_file_atomically(const std::filesystem::path& path, std::string_view bytes) {
+  const std::filesystem::path temp = temporary_name(path);
+  char* held = hold(g_temp_slots, temp);
+  write_all(temp, bytes);
+  std::error_code ec;
+  std::filesystem::rename(temp, path, ec);
+  release(g_temp_slots, held);
+  if (ec) {
+    std::filesystem::remove(temp);
+    throw std::runtime_error("cannot write '" + path.string() + "': " + ec.message());
+  }
+}
+
+StagedOutputs::~StagedOutputs() {
+  if (!committed_) {
+    std::error_code ignored;
+    for (const auto& temp : temps_) std::filesystem::remove(temp, ignored);
+    for (auto it = created_dirs_.rbegin(); it != created_dirs_.rend(); ++it)
+      std::filesystem::remove(*it, ignored);  // only removes directories left empty
+  }
+  for (const char* held : held_) release(g_temp_slots, held);
+  for (const char* held : held_dirs_) release(g_dir_slots, held);
+}
+
+void StagedOutputs::stage(const std::filesystem::path& path, std::string_view bytes) {
+  const std::filesystem::path dir = path.parent_path().empty() ? "." : path.parent_path();
+  if (!std::filesystem::exists(dir)) {
+    // Remember every level we create so an abandoned command leaves no empty folders.
+    std::vector<std::filesystem::path> missing;
+    for (auto d = dir; !d.empty() && !std::filesystem::exists(d); d = d.parent_path())
+      missing.push_back(d);
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec) throw std::runtime_error("cannot create folder '" + dir.string() + "': " + ec.message());
+    created_dirs_.insert(created_dirs_.end(), missing.rbegin(), missing.rend());
+    for (auto it = missing.rbegin(); it != missing.rend(); ++it)
+      held_dirs_.push_back(hold(g_dir_slots, *it));
+  }
+  sweep_stale_temporaries(dir);
+  const std::filesystem::path temp = temporary_name(path);
+  held_.push_back(hold(g_temp_slots, temp));  // before the file exists: a signal cannot miss it
+  write_all(temp, bytes);
+  temps_.push_back(temp);
+  finals_.push_back(path);
+}
+
+void StagedOutputs::commit() {
+  for (size_t i = 0; i < temps_.size(); ++i) {
+    std::error_code ec;
+    std::filesystem::rename(temps_[i], finals_[i], ec);
+    if (ec)
+      throw std::runtime_error("cannot write '" + finals_[i].string() + "': " + ec.message());
+  }
+  committed_ = true;
+  for (const char* held : held_) release(g_temp_slots, held);
+  for (const char* held : held_dirs_) release(g_dir_slots, held);
+  held_.clear();
+  held_dirs_.clear();
+}
+
+}  // namespace sd::app

@@ -1,0 +1,350 @@
+#include "src/app/pipeline/cloth_scene.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <limits>
+#include <numbers>
+
+#include <Eigen/Geometry>
+
+#include "garment/body_surface.hpp"
+#include "garment/material_frames.hpp"
+#include "garment/sketch_inputs.hpp"
+#include "sim/sheet.hpp"
+#include "sim/simulation.hpp"
+
+namespace sd::app {
+namespace {
+
+// The fabric at `json_path`: the sketch's inline fabric object (by its name), a preset name,
+// or a path to a fabric .json file (relative to the sketch); else a SketchError at the JSON
+// path of the bad value ("/fabric/bend" for an inline constant) that lists the known presets.
+sim::FabricParameters fabric_at(const garment::Sketch& sketch, const std::string& name,
+                                const std::string& json_path) {
+  // A panel without its own fabric carries the file's name for it, inline ones included.
+  if (!sketch.fabric_inline.empty() && name == sketch.fabric) {
+    try {
+      return sim::parse_fabric_json(sketch.fabric_inline, "the fabric given inline");
+    } catch (const sim::InvalidFabricError& e) {
+      sketch.fail("/fabric" + e.pointer(), e.what());
+    }
+  }
+  try {
+    return sim::fabric_preset(name);
+  } catch (const sim::UnknownFabricError& e) {
+    if (name.size() < 5 || name.substr(name.size() - 5) != ".json")
+      sketch.fail(json_path, std::string(e.what()) + "; or give a fabric file (.json) or the "
+                                                      "fabric's constants as an object");
+  }
+  try {
+    return sim::load_fabric_file(sketch.resolve(name).string());
+  } catch (const sim::InvalidFabricError& e) {
+    sketch.fail(json_path, e.what());
+  }
+}
+
+// simulate.pin_above: holds every vertex that starts at or above that height.
+void pin_above(const garment::Sketch& sketch, ClothScene& scene) {
+  if (!sketch.simulate.pin_above) return;
+  const std::size_t before = scene.pinned.size();  // a sheet's named pins come first
+  for (Eigen::Index v = 0; v < scene.start.rows(); ++v)
+    if (scene.start(v, 1) >= *sketch.simulate.pin_above) scene.pinned.push_back(static_cast<int>(v));
+  if (scene.pinned.size() == before)
+    sketch.fail("/simulate/pin_above",
+                fmt::format("no garment vertex lies at or above {} m (the garment's top is at "
+                            "{:.3f} m)",
+                            *sketch.simulate.pin_above, scene.start.col(1).maxCoeff()));
+}
+
+void build_sheet_scene(const garment::Sketch& sketch, ClothScene& scene) {
+  const garment::SheetSpec& spec = *sketch.sheet;
+  sim::SheetSpec sheet;
+  sheet.size = spec.size;
+  sheet.columns = spec.columns;
+  sheet.rows = spec.rows;
+  sheet.orientation =
+      spec.horizontal ? sim::SheetOrientation::horizontal : sim::SheetOrientation::vertical;
+  sheet.centre = spec.centre;
+  sheet.pins = spec.pins;
+  sim::SheetScene built = sim::build_sheet(sheet);
+  scene.input = std::move(built.input);
+  scene.pinned = std::move(built.pinned_vertices);
+  scene.triangle_group = Eigen::VectorXi::Zero(scene.input.triangles.rows());
+  scene.group_names = {"sheet"};
+  if (spec.layers > 1) {
+    // Layer k: the first moved by k·offset and turned k·turn about the vertical through the
+    // centre; one group per layer so that the previews tell them apart.
+    const Eigen::Index nv = scene.input.rest_positions.rows();
+    const Eigen::Index nf = scene.input.triangles.rows();
+    sim::ClothInput layered = scene.input;
+    layered.rest_positions.resize(nv * spec.layers, 3);
+    layered.triangles.resize(nf * spec.layers, 3);
+    if (layered.warp.rows() > 0) layered.warp.resize(nf * spec.layers, 3);
+    scene.triangle_group.resize(nf * spec.layers);
+    for (int k = 0; k < spec.layers; ++k) {
+      const Eigen::Matrix3d turn =
+          Eigen::AngleAxisd(k * spec.layer_turn * std::numbers::pi / 180.0,
+                            Eigen::Vector3d::UnitY())
+              .toRotationMatrix();
+      for (Eigen::Index i = 0; i < nv; ++i)
+        layered.rest_positions.row(k * nv + i) =
+            (turn * (scene.input.rest_positions.row(i).transpose() - spec.centre) + spec.centre +
+             k * spec.layer_offset)
+                .transpose();
+      for (Eigen::Index f = 0; f < nf; ++f) {
+        layered.triangles.row(k * nf + f) =
+            scene.input.triangles.row(f) + Eigen::RowVector3i::Constant(static_cast<int>(k * nv));
+        if (scene.input.warp.rows() > 0)
+          layered.warp.row(k * nf + f) = (turn * scene.input.warp.row(f).transpose()).transpose();
+        scene.triangle_group(k * nf + f) = k;
+      }
+      if (k > 0) scene.group_names.push_back(fmt::format("sheet {}", k + 1));
+    }
+    scene.input = std::move(layered);
+  }
+  scene.start = scene.input.rest_positions;
+  // simulate.pin_above holds a sheet too (a clamp of several rows of a hanging sheet, of every
+  // layer), together with the named pins.
+  pin_above(sketch, scene);
+  std::sort(scene.pinned.begin(), scene.pinned.end());
+  scene.pinned.erase(std::unique(scene.pinned.begin(), scene.pinned.end()), scene.pinned.end());
+  scene.fabric_name = sketch.fabric;
+  scene.fabric = fabric_at(sketch, sketch.fabric, "/fabric");
+}
+
+// "rest": "flat" (the file's or a panel's): the flattened pattern pieces become the rest shape.
+// Each triangle's rest coordinates are its pattern triangle's, with u along the piece's +y (the
+// warp) and v along weft = normal × warp, which is −x on a piece seen from outside; shaped panels
+// keep their drawn triangles. Ease is applied later, as for shaped panels (build_scene_model).
+void flat_rest_shapes(const garment::Sketch& sketch, const garment::Garment& g,
+                      const meshing::Mesh48& m48, ClothScene& scene) {
+  std::vector<bool> flat(g.panels.size(), false);
+  bool any = false, all = true;
+  for (size_t p = 0; p < g.panels.size(); ++p) {
+    const std::string& id = g.panels[p].id;
+    const garment::PanelSpec* spec = sketch.find_panel(id);
+    if (!spec && id.ends_with(".mirror")) spec = sketch.find_panel(id.substr(0, id.size() - 7));
+    const std::string rest = spec && spec->rest ? *spec->rest : sketch.simulate.rest;
+    flat[p] = rest == "flat";
+    any = any || flat[p];
+    all = all && flat[p];
+  }
+  if (!any) return;
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    scene.flat_pattern = garment::flatten_garment(g);
+  } catch (const garment::PatternError& e) {
+    const garment::PanelSpec* spec = sketch.find_panel(e.panel());
+    if (!spec && e.panel().ends_with(".mirror"))
+      spec = sketch.find_panel(e.panel().substr(0, e.panel().size() - 7));
+    sketch.fail(spec ? spec->json_path + "/rest" : "/simulate/rest", e.what());
+  }
+  scene.flattening_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  for (const std::string& warning : scene.flat_pattern->warnings) spdlog::warn("{}", warning);
+  scene.bend_rest_flat = all;
+
+  // Level-0 4-8 vertex rows are the garment's vertices.
+  const meshing::Mesh48Arrays arrays = m48.arrays();
+  if (arrays.rest_positions.rows() != g.mesh.vertex_count() ||
+      !arrays.rest_positions.isApprox(g.mesh.vertices))
+    throw std::runtime_error("flat rest: the 4-8 mesh does not keep the garment's vertices");
+  // Per panel: garment vertex → (u, v) of the pattern piece.
+  const Eigen::Index nv = g.mesh.vertex_count();
+  std::vector<Eigen::MatrixX2d> panel_uv(g.panels.size());
+  for (const garment::FlatPanel& piece : scene.flat_pattern->panels) {
+    Eigen::MatrixX2d& uv = panel_uv[static_cast<size_t>(piece.panel)];
+    uv.setConstant(nv, 2, std::numeric_limits<double>::quiet_NaN());
+    for (size_t l = 0; l < piece.vertices.size(); ++l)
+      uv.row(piece.vertices[l]) << piece.uv(static_cast<Eigen::Index>(l), 1),
+          -piece.uv(static_cast<Eigen::Index>(l), 0);
+  }
+  const garment::MaterialFrames frames = garment::material_frames(g.mesh);
+  meshing::TriMesh drawn{arrays.rest_positions, arrays.faces};
+  Eigen::VectorXi triangle_quad(arrays.faces.rows());
+  for (Eigen::Index t = 0; t < arrays.faces.rows(); ++t)
+    triangle_quad(t) = m48.source_face(arrays.triangle_ids[static_cast<size_t>(t)]);
+  scene.input.rest_uv = garment::triangle_rest_coordinates(
+      drawn, triangle_quad, frames, Eigen::VectorXd::Ones(g.mesh.face_count()));
+  for (Eigen::Index t = 0; t < arrays.faces.rows(); ++t) {
+    const size_t panel = static_cast<size_t>(g.face_panel(triangle_quad(t)));
+    if (!flat[panel]) continue;
+    for (int k = 0; k < 3; ++k)
+      scene.input.rest_uv.block<1, 2>(t, 2 * k) = panel_uv[panel].row(arrays.faces(t, k));
+  }
+  if (!scene.input.rest_uv.allFinite())
+    throw std::runtime_error("flat rest: a triangle's vertex is missing from its pattern piece");
+}
+
+void build_garment_scene(const garment::Sketch& sketch, ClothScene& scene) {
+  scene.body = garment::load_sketch_body(sketch);
+  const garment::BodySurface surface(scene.body->mesh);
+  const auto start = std::chrono::steady_clock::now();
+  garment::Garment g = garment::build_garment(sketch, surface);
+  scene.meshing_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+
+  // One fabric per simulation for now: the first panel's; others are reported if different.
+  const garment::GarmentPanel& first = g.panels.front();
+  scene.fabric_name = first.fabric;
+  const garment::PanelSpec* first_spec = sketch.find_panel(first.id);
+  scene.fabric = fabric_at(sketch, first.fabric,
+                           first_spec ? first_spec->json_path + "/fabric" : "/fabric");
+  for (const garment::GarmentPanel& p : g.panels)
+    if (p.fabric != first.fabric)
+      spdlog::warn("panel '{}' asks for fabric '{}'; this version simulates a garment in one fabric "
+                   "and uses '{}' (panel '{}') throughout",
+                   p.id, p.fabric, first.fabric, first.id);
+
+  meshing::Mesh48 m48 = meshing::Mesh48::from_quads(g.mesh);
+  const std::vector<std::string> problems = m48.validate();
+  if (!problems.empty()) throw std::runtime_error("4-8 mesh check failed: " + problems.front());
+  const meshing::Mesh48Arrays arrays = m48.arrays();
+  const garment::MaterialFrames frames = garment::material_frames(g.mesh);
+
+  // Groups: a join's panels share its group.
+  std::vector<int> panel_group(g.panels.size());
+  for (size_t p = 0; p < g.panels.size(); ++p) {
+    auto it = std::find(scene.group_names.begin(), scene.group_names.end(), g.panels[p].group);
+    if (it == scene.group_names.end())
+      it = scene.group_names.insert(scene.group_names.end(), g.panels[p].group);
+    panel_group[p] = static_cast<int>(it - scene.group_names.begin());
+  }
+
+  const Eigen::Index triangles = arrays.faces.rows();
+  scene.input.rest_positions = arrays.rest_positions;
+  scene.input.triangles = arrays.faces;
+  scene.input.warp.resize(triangles, 3);
+  scene.triangle_group.resize(triangles);
+  scene.triangle_ease.resize(triangles);
+  for (Eigen::Index t = 0; t < triangles; ++t) {
+    const int quad = m48.source_face(arrays.triangle_ids[static_cast<size_t>(t)]);
+    scene.input.warp.row(t) = frames.warp.row(quad);
+    scene.triangle_group(t) = panel_group[static_cast<size_t>(g.face_panel(quad))];
+    scene.triangle_ease(t) = g.panels[static_cast<size_t>(g.face_panel(quad))].ease;
+  }
+  if ((scene.triangle_ease.array() == 1.0).all()) scene.triangle_ease.resize(0);
+  scene.start = arrays.rest_positions;
+  pin_above(sketch, scene);
+  scene.mesh48_face_group.resize(g.mesh.face_count());
+  for (Eigen::Index q = 0; q < g.mesh.face_count(); ++q)
+    scene.mesh48_face_group(q) = panel_group[static_cast<size_t>(g.face_panel(q))];
+  if (scene.triangle_ease.size() > 0) {
+    scene.mesh48_face_ease.resize(g.mesh.face_count());
+    for (Eigen::Index q = 0; q < g.mesh.face_count(); ++q)
+      scene.mesh48_face_ease(q) = g.panels[static_cast<size_t>(g.face_panel(q))].ease;
+  }
+  flat_rest_shapes(sketch, g, m48, scene);
+  scene.mesh48 = std::move(m48);
+  scene.garment = std::move(g);
+}
+
+// An imported triangle garment: its 4-8 mesh comes from the sqrt3 conversion; warp is the
+// in-plane direction closest to +Y (the simulator's default when no warp is given).
+void build_imported_scene(const garment::Sketch& sketch, ClothScene& scene) {
+  if (sketch.body.mesh != "none") scene.body = garment::load_sketch_body(sketch);
+  const meshing::TriMesh triangles = garment::load_garment_mesh(sketch);
+  meshing::Mesh48 m48 = [&] {
+    try {
+      return meshing::Mesh48::from_triangles_sqrt3(triangles);
+    } catch (const meshing::Mesh48InputError& e) {
+      sketch.fail("/garment_mesh",
+                  fmt::format("the garment mesh cannot become a 4-8 mesh: {}", e.what()));
+    }
+  }();
+  const meshing::Mesh48Arrays arrays = m48.arrays();
+  scene.input.rest_positions = arrays.rest_positions;
+  scene.input.triangles = arrays.faces;
+  scene.start = arrays.rest_positions;
+  scene.triangle_group = Eigen::VectorXi::Zero(arrays.faces.rows());
+  scene.group_names = {"garment"};
+  scene.fabric_name = sketch.fabric;
+  scene.fabric = fabric_at(sketch, sketch.fabric, "/fabric");
+  pin_above(sketch, scene);
+  scene.mesh48_face_group = Eigen::VectorXi::Zero(triangles.face_count());
+  scene.mesh48 = std::move(m48);
+}
+
+}  // namespace
+
+sim::SimulationSettings simulation_settings(const garment::Sketch& sketch) {
+  const garment::SimulateSpec& spec = sketch.simulate;
+  sim::SimulationSettings settings;
+  settings.integrator =
+      spec.integrator == "bdf2" ? sim::Integrator::bdf2 : sim::Integrator::implicit_euler;
+  settings.solver = spec.solver == "pcg" ? sim::LinearSolverKind::pcg : sim::LinearSolverKind::cholmod;
+  settings.dt = spec.time_step;
+  settings.min_dt = std::min(settings.min_dt, spec.time_step / 64);
+  settings.duration = spec.duration;
+  settings.stop_at_rest = spec.stop_at_rest;
+  settings.forces.gravity = spec.gravity;
+  settings.contact.check_body_vertices = spec.check_body_vertices;
+  // Garments fold onto themselves (a skirt's front and back, a sleeve); a sheet scene asks.
+  settings.self_contact.enabled = spec.self_collision.value_or(!sketch.sheet.has_value());
+  try {
+    settings.validate();
+  } catch (const sim::InvalidSimulationSettingsError& e) {
+    sketch.fail("/simulate", e.what());
+  }
+  return settings;
+}
+
+sim::ClothModel build_scene_model(const ClothScene& scene) {
+  sim::ClothModelOptions options;
+  if (scene.bend_rest_flat) options.bend_rest = sim::BendRestShape::flat;
+  sim::ClothModel model = sim::build_cloth_model(scene.input, scene.fabric, options);
+  if (scene.triangle_ease.size() > 0) sim::scale_rest_shapes(model, scene.triangle_ease);
+  return model;
+}
+
+// The motion of the sketch's body: the arms lowering, or the body's own poses at given times
+// (its mesh is the pose at time 0).
+sim::PoseSequence body_motion(const garment::Sketch& sketch, const garment::Body& body) {
+  const garment::BodyMotionSpec& spec = *sketch.body.motion;
+  if (spec.type == "poses") {
+    std::vector<double> times = {0.0};
+    std::vector<Eigen::MatrixX3d> poses = {body.mesh.vertices};
+    for (const garment::BodyPoseSpec& pose : spec.poses) {
+      try {
+        poses.push_back(garment::load_body_pose(sketch.resolve(pose.mesh).string(), body).vertices);
+      } catch (const garment::BodyError& e) {
+        sketch.fail(pose.json_path + "/mesh",
+                    fmt::format("the pose '{}' cannot be used: {}", pose.mesh, e.what()));
+      }
+      times.push_back(pose.time);
+    }
+    try {
+      return sim::PoseSequence(body.mesh.faces, std::move(times), std::move(poses));
+    } catch (const sim::InvalidBodyMotionError& e) {
+      sketch.fail("/body/motion/poses", e.what());
+    }
+  }
+  sim::ArmLoweringOptions options;
+  options.angle_degrees = spec.degrees;
+  options.start = spec.start;
+  options.duration = spec.duration;
+  return sim::make_arm_lowering(body.mesh, options);
+}
+
+ClothScene build_cloth_scene(const garment::Sketch& sketch) {
+  ClothScene scene;
+  if (sketch.sheet) {
+    build_sheet_scene(sketch, scene);
+    if (sketch.body.mesh != "none") scene.body = garment::load_sketch_body(sketch);
+  } else if (sketch.garment_mesh) {
+    build_imported_scene(sketch, scene);
+  } else {
+    build_garment_scene(sketch, scene);
+  }
+  if (scene.body && sketch.body.motion) scene.body_motion = body_motion(sketch, *scene.body);
+  return scene;
+}
+
+meshing::TriMesh body_at(const ClothScene& scene, double t) {
+  return scene.body_motion ? scene.body_motion->mesh_at(t) : scene.body->mesh;
+}
+
+}  // namespace sd::app

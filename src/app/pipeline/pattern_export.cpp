@@ -1,0 +1,404 @@
+#include "src/app/pipeline/pattern_export.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "src/app/pipeline/markup_escape.hpp"
+
+namespace sd::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
+
+constexpr double kMm = 1000.0;  // metres → millimetres
+
+// The sketch's panel a garment panel comes from ("front.mirror" → "front").
+const garment::PanelSpec* panel_spec(const garment::Sketch& sketch, const std::string& id) {
+  if (const garment::PanelSpec* p = sketch.find_panel(id)) return p;
+  const std::string suffix = ".mirror";
+  if (id.ends_with(suffix)) return sketch.find_panel(id.substr(0, id.size() - suffix.size()));
+  return nullptr;
+}
+
+// Piece point (m, piece frame) → fabric point (mm, x across, y along the bolt).
+Eigen::Vector2d on_fabric(const garment::PatternPiece& piece, const Eigen::Vector2d& p) {
+  return kMm * (p + piece.placement);
+}
+
+// A notch: a snip 5 mm deep into the seam allowance from the cutting line, on the sewing line's
+// normal (the whole allowance when it is narrower).
+std::pair<Eigen::Vector2d, Eigen::Vector2d> notch_segment(const garment::PatternPiece& piece,
+                                                          const garment::PatternNotch& n) {
+  const double a = piece.allowance;
+  const double depth = std::min(a, 0.005);
+  if (a <= 0) return {n.point - 0.004 * n.normal, n.point};  // no allowance: a snip inwards
+  return {n.point + a * n.normal, n.point + (a - depth) * n.normal};
+}
+
+std::string piece_name(const PatternSheet& sheet, const garment::PatternPiece& piece) {
+  return sheet.pattern.panels[static_cast<size_t>(piece.panel)].id;
+}
+
+// ------------------------------------------------------------------------------------------------
+// SVG
+
+std::string svg_path(const garment::PatternPiece& piece, const Eigen::MatrixX2d& polygon,
+                     double height) {
+  std::string d;
+  for (Eigen::Index i = 0; i < polygon.rows(); ++i) {
+    const Eigen::Vector2d p = on_fabric(piece, polygon.row(i).transpose());
+    d += fmt::format("{}{:.2f},{:.2f} ", i == 0 ? "M" : "L", p.x(), height - p.y());
+  }
+  return d + "Z";
+}
+
+}  // namespace
+
+PatternSheet build_pattern_sheet(const garment::Sketch& sketch, const garment::Garment& garment,
+                                 const garment::PatternSpec& spec) {
+  PatternSheet sheet;
+  sheet.title = std::filesystem::path(sketch.file).filename().string();
+  garment::FlatteningOptions flattening;
+  flattening.warn_stretch = spec.max_stretch;
+  const auto start = Clock::now();
+  try {
+    sheet.pattern = garment::flatten_garment(garment, flattening);
+    sheet.flatten_ms = ms_since(start);
+    garment::PatternLayoutOptions layout;
+    layout.fabric_width = spec.fabric_width;
+    layout.seam_allowance = spec.seam_allowance;
+    for (const garment::FlatPanel& flat : sheet.pattern.panels) {
+      const garment::GarmentPanel& panel = garment.panels[static_cast<size_t>(flat.panel)];
+      const garment::PanelSpec* ps = panel_spec(sketch, panel.id);
+      layout.panel_allowance.push_back(ps && ps->seam_allowance ? *ps->seam_allowance : -1.0);
+      layout.panel_ease.push_back(panel.ease);
+      sheet.fabrics.push_back(panel.fabric);
+    }
+    const auto layout_start = Clock::now();
+    sheet.layout = garment::lay_out_pattern(sheet.pattern, layout);
+    sheet.layout_ms = ms_since(layout_start);
+  } catch (const garment::PatternError& e) {
+    const garment::PanelSpec* ps = panel_spec(sketch, e.panel());
+    sketch.fail(ps ? ps->json_path : "/panels", e.what());
+  }
+  for (const std::string& warning : sheet.pattern.warnings) spdlog::warn("{}", warning);
+  return sheet;
+}
+
+std::string pattern_svg(const PatternSheet& sheet) {
+  const garment::PatternLayout& layout = sheet.layout;
+  const double width = kMm * layout.fabric_width;
+  const double length = kMm * layout.length_used;
+  const double footer = 40;  // mm below the fabric: title and scale bar
+  std::string svg = fmt::format(
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{0:.1f}mm\" height=\"{1:.1f}mm\" "
+      "viewBox=\"0 0 {0:.1f} {1:.1f}\" font-family=\"sans-serif\">\n"
+      "<title>{2} sewing pattern</title>\n"
+      "<style>.fabric{{fill:#f4efe4;stroke:#8a8170;stroke-width:0.6}}"
+      ".cut{{fill:#ffffff;stroke:#000;stroke-width:0.5}}"
+      ".sew{{fill:none;stroke:#c0392b;stroke-width:0.35;stroke-dasharray:3 1.5}}"
+      ".grain{{stroke:#1f4e9c;stroke-width:0.5;fill:none}}.notch{{stroke:#000;stroke-width:0.6}}"
+      ".label{{fill:#222}}.note{{fill:#444}}</style>\n"
+      "<rect class=\"fabric\" x=\"0\" y=\"0\" width=\"{0:.1f}\" height=\"{3:.1f}\"/>\n",
+      width, length + footer, markup_escape(sheet.title), length);
+  for (const garment::PatternPiece& piece : layout.pieces) {
+    const garment::FlatPanel& flat = sheet.pattern.panels[static_cast<size_t>(piece.panel)];
+    const std::string name = piece_name(sheet, piece);
+    const std::string fabric = sheet.fabrics[static_cast<size_t>(piece.panel)];
+    svg += fmt::format("<g class=\"piece\" id=\"piece-{0}\" data-panel=\"{0}\">\n",
+                       markup_escape(name));
+    svg += fmt::format("<path class=\"cut\" d=\"{}\"/>\n", svg_path(piece, piece.cutting, length));
+    svg += fmt::format("<path class=\"sew\" d=\"{}\"/>\n", svg_path(piece, piece.sewing, length));
+    const Eigen::Vector2d g0 = on_fabric(piece, piece.grain_start);
+    const Eigen::Vector2d g1 = on_fabric(piece, piece.grain_end);
+    const double head = std::min(4.0, 0.2 * (g1 - g0).norm());
+    svg += fmt::format(
+        "<path class=\"grain\" d=\"M{0:.2f},{1:.2f} L{0:.2f},{2:.2f} M{3:.2f},{4:.2f} "
+        "L{0:.2f},{1:.2f} "
+        "L{5:.2f},{4:.2f} M{3:.2f},{6:.2f} L{0:.2f},{2:.2f} L{5:.2f},{6:.2f}\"/>\n",
+        g0.x(), length - g0.y(), length - g1.y(), g0.x() - 0.5 * head, length - g0.y() - head,
+        g0.x() + 0.5 * head, length - g1.y() + head);
+    for (const garment::PatternNotch& n : piece.notches) {
+      const auto [a, b] = notch_segment(piece, n);
+      const Eigen::Vector2d pa = on_fabric(piece, a), pb = on_fabric(piece, b);
+      svg += fmt::format(
+          "<line class=\"notch\" x1=\"{:.2f}\" y1=\"{:.2f}\" x2=\"{:.2f}\" y2=\"{:.2f}\"/>\n",
+          pa.x(), length - pa.y(), pb.x(), length - pb.y());
+    }
+    // Label beside the grain line's middle, sized to the piece.
+    const double size = std::clamp(kMm * std::min(piece.size.x(), piece.size.y()) / 14, 3.0, 9.0);
+    const Eigen::Vector2d at = 0.5 * (g0 + g1) + Eigen::Vector2d(0.6 * size, 0);
+    svg += fmt::format(
+        "<text class=\"label\" x=\"{0:.1f}\" y=\"{1:.1f}\" font-size=\"{2:.1f}\" "
+        "font-weight=\"bold\">{3}</text>\n"
+        "<text class=\"label\" x=\"{0:.1f}\" y=\"{4:.1f}\" font-size=\"{5:.1f}\">{6:.0f} × {7:.0f} "
+        "mm · {8}</text>\n"
+        "<text class=\"label\" x=\"{0:.1f}\" y=\"{9:.1f}\" font-size=\"{5:.1f}\">cut 1 · ease "
+        "{10:g} · stretch {11:.1f} % (95th pct)</text>\n",
+        at.x(), length - at.y(), size, markup_escape(name), length - at.y() + size, 0.75 * size,
+        kMm * (piece.size.x() - 2 * piece.allowance), kMm * (piece.size.y() - 2 * piece.allowance),
+        markup_escape(fabric), length - at.y() + 1.9 * size, piece.ease,
+        100 * flat.distortion.length_p95);
+    svg += "</g>\n";
+  }
+  // Scale bar: 100 mm in 10 mm steps, and the sheet's figures.
+  const double y = length + 12;
+  svg += "<g class=\"scale-bar\">\n";
+  svg += fmt::format(
+      "<rect x=\"10\" y=\"{:.1f}\" width=\"100\" height=\"3\" fill=\"none\" stroke=\"#000\" "
+      "stroke-width=\"0.4\"/>\n",
+      y);
+  for (int k = 0; k < 10; k += 2)
+    svg += fmt::format("<rect x=\"{}\" y=\"{:.1f}\" width=\"10\" height=\"3\" fill=\"#000\"/>\n",
+                       10 + 10 * k, y);
+  svg += fmt::format(
+      "<text x=\"10\" y=\"{:.1f}\" font-size=\"4\">0</text><text x=\"100\" y=\"{:.1f}\" "
+      "font-size=\"4\">100 mm</text>\n</g>\n",
+      y + 8, y + 8);
+  svg += fmt::format(
+      "<text class=\"note\" x=\"130\" y=\"{:.1f}\" font-size=\"5\">{} · {} pieces · fabric {:.0f} "
+      "mm "
+      "wide, {:.0f} mm used · efficiency {:.0f} % · seam allowance included · true scale "
+      "(mm)</text>\n",
+      y + 4, markup_escape(sheet.title), layout.pieces.size(), width, length,
+      100 * layout.efficiency);
+  svg += "</svg>\n";
+  return svg;
+}
+
+std::string pattern_dxf(const PatternSheet& sheet) {
+  // DXF R12 (AC1009) text, the version AAMA/ASTM D6673 exchange files use.
+  std::string dxf;
+  const auto pair = [&](int code, const std::string& value) {
+    dxf += fmt::format("{}\n{}\n", code, value);
+  };
+  const auto num = [&](int code, double value) { pair(code, fmt::format("{:.3f}", value)); };
+  const auto polyline = [&](const std::string& layer, const Eigen::MatrixX2d& p) {
+    pair(0, "POLYLINE");
+    pair(8, layer);
+    pair(66, "1");
+    pair(70, "1");  // closed
+    for (Eigen::Index i = 0; i < p.rows(); ++i) {
+      pair(0, "VERTEX");
+      pair(8, layer);
+      num(10, kMm * p(i, 0));
+      num(20, kMm * p(i, 1));
+    }
+    pair(0, "SEQEND");
+    pair(8, layer);
+  };
+  const auto line = [&](const std::string& layer, const Eigen::Vector2d& a,
+                        const Eigen::Vector2d& b) {
+    pair(0, "LINE");
+    pair(8, layer);
+    num(10, kMm * a.x());
+    num(20, kMm * a.y());
+    num(11, kMm * b.x());
+    num(21, kMm * b.y());
+  };
+  const auto text = [&](const std::string& layer, const Eigen::Vector2d& at, double height,
+                        const std::string& value) {
+    pair(0, "TEXT");
+    pair(8, layer);
+    num(10, kMm * at.x());
+    num(20, kMm * at.y());
+    num(40, height);
+    pair(1, value);
+  };
+  pair(0, "SECTION");
+  pair(2, "HEADER");
+  pair(9, "$ACADVER");
+  pair(1, "AC1009");
+  pair(9, "$INSUNITS");
+  pair(70, "4");  // millimetres
+  pair(9, "$MEASUREMENT");
+  pair(70, "1");  // metric
+  pair(0, "ENDSEC");
+  pair(0, "SECTION");
+  pair(2, "TABLES");
+  pair(0, "TABLE");
+  pair(2, "LAYER");
+  pair(70, "6");
+  for (const char* layer : {"1", "4", "7", "14", "15"}) {
+    pair(0, "LAYER");
+    pair(2, layer);
+    pair(70, "0");
+    pair(62, "7");
+    pair(6, "CONTINUOUS");
+  }
+  pair(0, "ENDTAB");
+  pair(0, "ENDSEC");
+  pair(0, "SECTION");
+  pair(2, "BLOCKS");
+  for (const garment::PatternPiece& piece : sheet.layout.pieces) {
+    const std::string name = piece_name(sheet, piece);
+    pair(0, "BLOCK");
+    pair(8, "0");
+    pair(2, name);
+    pair(70, "0");
+    num(10, 0);
+    num(20, 0);
+    pair(3, name);
+    polyline("1", piece.cutting);  // boundary: the cutting line
+    polyline("14", piece.sewing);  // sewing line
+    line("7", piece.grain_start, piece.grain_end);
+    for (const garment::PatternNotch& n : piece.notches) {
+      const auto [a, b] = notch_segment(piece, n);
+      line("4", a, b);
+    }
+    const Eigen::Vector2d at =
+        0.5 * (piece.grain_start + piece.grain_end) + Eigen::Vector2d(0.01, 0);
+    const double h = 5;  // mm
+    text("1", at, h, "Piece Name: " + name);
+    text("15", at - Eigen::Vector2d(0, 0.008), h,
+         "Material: " + sheet.fabrics[static_cast<size_t>(piece.panel)]);
+    text("15", at - Eigen::Vector2d(0, 0.016), h, "Quantity: 1");
+    text("15", at - Eigen::Vector2d(0, 0.024), h,
+         fmt::format("Seam allowance: {:.0f} mm", kMm * piece.allowance));
+    pair(0, "ENDBLK");
+    pair(8, "0");
+  }
+  pair(0, "ENDSEC");
+  pair(0, "SECTION");
+  pair(2, "ENTITIES");
+  for (const garment::PatternPiece& piece : sheet.layout.pieces) {
+    pair(0, "INSERT");
+    pair(8, "0");
+    pair(2, piece_name(sheet, piece));
+    num(10, kMm * piece.placement.x());
+    num(20, kMm * piece.placement.y());
+  }
+  pair(0, "ENDSEC");
+  pair(0, "EOF");
+  return dxf;
+}
+
+namespace {
+
+nlohmann::json points_mm(const Eigen::MatrixX2d& p) {
+  nlohmann::json out = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < p.rows(); ++i)
+    out.push_back(
+        {std::round(kMm * p(i, 0) * 1000) / 1000, std::round(kMm * p(i, 1) * 1000) / 1000});
+  return out;
+}
+
+nlohmann::json point_mm(const Eigen::Vector2d& p) {
+  return {std::round(kMm * p.x() * 1000) / 1000, std::round(kMm * p.y() * 1000) / 1000};
+}
+
+nlohmann::json distortion_json(const garment::FlatDistortion& d) {
+  return {{"length_max", d.length_max},
+          {"length_mean", d.length_mean},
+          {"length_p95", d.length_p95},
+          {"area_max", d.area_max},
+          {"area_mean", d.area_mean},
+          {"worst_near_m", {d.worst_point.x(), d.worst_point.y(), d.worst_point.z()}}};
+}
+
+// A seam side's polyline in its piece's frame (m, ease applied).
+Eigen::MatrixX2d seam_side(const PatternSheet& sheet, int panel, const std::vector<int>& vertices) {
+  const garment::FlatPanel& flat = sheet.pattern.panels[static_cast<size_t>(panel)];
+  const garment::PatternPiece& piece = sheet.layout.pieces[static_cast<size_t>(panel)];
+  Eigen::MatrixX2d out(static_cast<Eigen::Index>(vertices.size()), 2);
+  for (size_t k = 0; k < vertices.size(); ++k)
+    out.row(static_cast<Eigen::Index>(k)) =
+        piece.ease * flat.uv.row(vertices[k]) + piece.origin.transpose();
+  return out;
+}
+
+double polyline_length(const Eigen::MatrixX2d& p) {
+  double l = 0;
+  for (Eigen::Index i = 1; i < p.rows(); ++i) l += (p.row(i) - p.row(i - 1)).norm();
+  return l;
+}
+
+}  // namespace
+
+nlohmann::json pattern_json(const PatternSheet& sheet) {
+  const garment::PatternLayout& layout = sheet.layout;
+  nlohmann::json pieces = nlohmann::json::array();
+  for (const garment::PatternPiece& piece : layout.pieces) {
+    const garment::FlatPanel& flat = sheet.pattern.panels[static_cast<size_t>(piece.panel)];
+    nlohmann::json notches = nlohmann::json::array();
+    for (const garment::PatternNotch& n : piece.notches)
+      notches.push_back({{"at", point_mm(n.point)}, {"outward", {n.normal.x(), n.normal.y()}}});
+    pieces.push_back({{"id", flat.id},
+                      {"fabric", sheet.fabrics[static_cast<size_t>(piece.panel)]},
+                      {"ease", piece.ease},
+                      {"seam_allowance_mm", kMm * piece.allowance},
+                      {"size_mm", point_mm(piece.size)},
+                      {"placement_mm", point_mm(piece.placement)},
+                      {"sewn_area_mm2", kMm * kMm * piece.sewn_area},
+                      {"cut_area_mm2", kMm * kMm * piece.cut_area},
+                      {"surface_area_mm2", kMm * kMm * flat.area_3d},
+                      {"sewing_line", points_mm(piece.sewing)},
+                      {"cutting_line", points_mm(piece.cutting)},
+                      {"grain_line", {point_mm(piece.grain_start), point_mm(piece.grain_end)}},
+                      {"notches", notches},
+                      {"distortion", distortion_json(flat.distortion)},
+                      {"iterations", flat.iterations},
+                      {"warning", flat.warning}});
+  }
+  nlohmann::json seams = nlohmann::json::array();
+  for (const garment::PatternSeam& seam : sheet.pattern.seams) {
+    const Eigen::MatrixX2d a = seam_side(sheet, seam.panel_a, seam.vertices_a);
+    const Eigen::MatrixX2d b = seam_side(sheet, seam.panel_b, seam.vertices_b);
+    const double la = polyline_length(a), lb = polyline_length(b);
+    seams.push_back({{"a", sheet.pattern.panels[static_cast<size_t>(seam.panel_a)].id},
+                     {"b", sheet.pattern.panels[static_cast<size_t>(seam.panel_b)].id},
+                     {"length_3d_mm", kMm * seam.length_3d},
+                     {"length_a_mm", kMm * la},
+                     {"length_b_mm", kMm * lb},
+                     {"flattening_mismatch", seam.mismatch()},
+                     {"ease_difference", std::abs(la - lb) / std::max(la, lb)},
+                     {"polyline_a", points_mm(a)},
+                     {"polyline_b", points_mm(b)}});
+  }
+  return {{"format", "sketchdrape/1 pattern"},
+          {"sketch", sheet.title},
+          {"units", "mm"},
+          {"frame",
+           "pieces: x across, y along the warp (grain), seen from the right side; fabric: "
+           "x across the width, y along the bolt from the cut end"},
+          {"fabric_width_mm", kMm * layout.fabric_width},
+          {"fabric_length_mm", kMm * layout.length_used},
+          {"efficiency", layout.efficiency},
+          {"pieces", pieces},
+          {"seams", seams},
+          {"warnings", sheet.pattern.warnings}};
+}
+
+nlohmann::json pattern_summary(const PatternSheet& sheet) {
+  nlohmann::json pieces = nlohmann::json::array();
+  for (const garment::FlatPanel& flat : sheet.pattern.panels)
+    pieces.push_back({{"id", flat.id}, {"distortion", distortion_json(flat.distortion)}});
+  double worst = 0;
+  for (const garment::PatternSeam& seam : sheet.pattern.seams)
+    worst = std::max(worst, seam.mismatch());
+  return {{"pieces", pieces},
+          {"seams", sheet.pattern.seams.size()},
+          {"worst_seam_mismatch", worst},
+          {"fabric_width_mm", kMm * sheet.layout.fabric_width},
+          {"fabric_length_mm", kMm * sheet.layout.length_used},
+          {"efficiency", sheet.layout.efficiency},
+          {"warnings", sheet.pattern.warnings},
+          {"timing_ms", {{"flatten", sheet.flatten_ms}, {"layout", sheet.layout_ms}}}};
+}
+
+void stage_pattern(const PatternSheet& sheet, const std::filesystem::path& dir,
+                   StagedOutputs& outputs) {
+  outputs.stage(dir / "pattern.svg", pattern_svg(sheet));
+  outputs.stage(dir / "pattern.dxf", pattern_dxf(sheet));
+  outputs.stage(dir / "pattern.json", pattern_json(sheet).dump(1) + "\n");
+}
+
+}  // namespace sd::app

@@ -1,0 +1,47 @@
+#pragma once
+// The sewing pattern of a garment as files: pattern.svg (true scale, mm; the pieces nested on the
+// fabric, labelled, with sewing and cutting lines, grain lines, notches and a scale bar),
+// pattern.dxf (AAMA/ASTM D6673 style: one block per piece, layers 1 boundary, 4 notches, 7 grain
+// line, 14 sewing line, 15 annotation; mm) and pattern.json (2D polygons, seams as pairs of 2D
+// polylines, distortion figures, fabric used). docs/pattern.md describes them.
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "garment/garment_mesh.hpp"
+#include "garment/panel_flattening.hpp"
+#include "garment/pattern_layout.hpp"
+#include "garment/sketch_file.hpp"
+#include "src/app/pipeline/atomic_file.hpp"
+
+namespace sd::app {
+
+struct PatternSheet {
+  std::string title;  // the sketch file's name
+  garment::FlatPattern pattern;
+  garment::PatternLayout layout;
+  std::vector<std::string> fabrics;  // per panel
+  double flatten_ms = 0, layout_ms = 0;
+};
+
+// Flattens and lays out the garment's panels with the file's pattern settings (`spec`, with each
+// panel's own seam allowance). A panel that cannot be flattened becomes a SketchError at that
+// panel's JSON path; stretch warnings are logged.
+PatternSheet build_pattern_sheet(const garment::Sketch& sketch, const garment::Garment& garment,
+                                 const garment::PatternSpec& spec);
+
+std::string pattern_svg(const PatternSheet& sheet);
+std::string pattern_dxf(const PatternSheet& sheet);
+nlohmann::json pattern_json(const PatternSheet& sheet);
+
+// The figures a run report holds: per piece distortion and size, worst seam mismatch, fabric
+// length and efficiency.
+nlohmann::json pattern_summary(const PatternSheet& sheet);
+
+// Stages pattern.svg, pattern.dxf and pattern.json in `dir`.
+void stage_pattern(const PatternSheet& sheet, const std::filesystem::path& dir,
+                   StagedOutputs& outputs);
+
+}  // namespace sd::app

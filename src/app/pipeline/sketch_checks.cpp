@@ -1,0 +1,176 @@
+#include "src/app/pipeline/sketch_checks.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+
+#include "garment/sketch_ranges.hpp"
+#include "sim/fabric.hpp"
+#include "src/app/pipeline/cloth_scene.hpp"
+#include "src/render/image.hpp"
+
+namespace sd::app {
+namespace {
+
+static_assert(garment::kMaxImageSide == render::kMaxImageSide,
+              "the sketch file's image limit is the renderer's");
+
+// Cost model of a drape, fitted to sheets of 65² to 257² vertices on the CHOLMOD solver (peak
+// RSS 111, 265, 937 MB; docs/cli.md, "Limits"): resident bytes per vertex grow with log2(V) like
+// the fill of the factor; seconds per vertex and step grow likewise (measured on the 2-core
+// machine under a load of 12: 28, 38, 61 µs per vertex and step).
+constexpr double kBaseBytes = 67e6;               // the process before any cloth
+constexpr double kBytesPerVertex = 2800;          // model, forces, contacts
+constexpr double kFactorBytesPerVertexLog = 650;  // the CHOLMOD factor, per vertex per log2(V)
+constexpr double kSecondsPerVertexStepLog = 3e-6;
+constexpr double kSecondsPerFrame = 0.05;  // one picture of the PNG sequence
+// Without --max-memory, a run may use this fraction of the memory available when it starts (the
+// rest for the system, other processes and the estimate's error).
+constexpr double kAvailableFraction = 0.8;
+
+double memory_for(double vertices) {
+  return kBaseBytes + vertices * (kBytesPerVertex +
+                                  kFactorBytesPerVertexLog * std::log2(std::max(vertices, 2.0)));
+}
+
+std::string gigabytes(double bytes) {
+  return fmt::format("{:.1f} GB", bytes / 1e9);
+}
+
+}  // namespace
+
+void check_sketch(const garment::Sketch& sketch) {
+  auto check_fabric = [&](const std::string& name, const std::string& path) {
+    try {
+      (void)sim::fabric_preset(name);
+    } catch (const sim::UnknownFabricError& e) {
+      sketch.fail(path, e.what());
+    }
+  };
+  check_fabric(sketch.fabric, "/fabric");
+  for (const garment::PanelSpec& panel : sketch.panels)
+    if (panel.fabric != sketch.fabric) check_fabric(panel.fabric, panel.json_path + "/fabric");
+  (void)simulation_settings(sketch);
+}
+
+double available_memory_bytes() {
+  std::ifstream in("/proc/meminfo");
+  std::string key;
+  double kb = 0;
+  std::string unit;
+  while (in >> key >> kb >> unit)
+    if (key == "MemAvailable:") return kb * 1024.0;
+  return 0;
+}
+
+double resident_memory_bytes() {
+  std::ifstream in("/proc/self/statm");
+  double pages = 0, resident = 0;
+  if (!(in >> pages >> resident)) return 0;
+  return resident * static_cast<double>(::sysconf(_SC_PAGESIZE));
+}
+
+double memory_budget_bytes(const RunLimits& limits) {
+  return limits.max_memory_bytes > 0 ? limits.max_memory_bytes
+                                     : kAvailableFraction * available_memory_bytes();
+}
+
+std::optional<double> cloth_vertices_before_building(const garment::Sketch& sketch) {
+  if (!sketch.sheet) return std::nullopt;
+  return static_cast<double>(sketch.sheet->columns + 1) * (sketch.sheet->rows + 1);
+}
+
+RunEstimate estimate_run(const garment::Sketch& sketch, double vertices, double frames_per_second) {
+  RunEstimate e;
+  e.vertices = vertices;
+  e.memory_bytes = memory_for(vertices);
+  e.steps = std::ceil(sketch.simulate.duration / sketch.simulate.time_step);
+  e.frames =
+      frames_per_second > 0 ? std::floor(sketch.simulate.duration * frames_per_second) + 1 : 0;
+  // The PNG sequence keeps each picture's cloth until the drape ends: positions, triangles and
+  // groups, about 64 bytes per vertex.
+  e.memory_bytes += e.frames * 64.0 * vertices;
+  e.seconds = e.steps * vertices * std::log2(std::max(vertices, 2.0)) * kSecondsPerVertexStepLog +
+              e.frames * kSecondsPerFrame;
+  return e;
+}
+
+void check_run_fits(const garment::Sketch& sketch, const RunEstimate& estimate,
+                    const RunLimits& limits, double frames_per_second) {
+  const bool given = limits.max_memory_bytes > 0;
+  const double memory = memory_budget_bytes(limits);
+  if (memory > 0 && estimate.memory_bytes > memory) {
+    // The largest vertex count that fits, by bisection on the monotone model.
+    double low = 4, high = estimate.vertices;
+    for (int i = 0; i < 60; ++i) {
+      const double mid = 0.5 * (low + high);
+      (memory_for(mid) <= memory ? low : high) = mid;
+    }
+    const std::string limit =
+        given ? fmt::format("the {} of --max-memory", gigabytes(memory))
+              : fmt::format("the {} a run may take of the memory available now", gigabytes(memory));
+    if (sketch.sheet) {
+      const double side = std::floor(std::sqrt(low)) - 1;
+      sketch.fail("/sheet/resolution",
+                  fmt::format("a sheet of {}x{} quads ({:.0f} vertices) needs about {} to "
+                              "simulate, more than {}; about {:.0f}x{:.0f} quads would fit",
+                              sketch.sheet->columns, sketch.sheet->rows, estimate.vertices,
+                              gigabytes(estimate.memory_bytes), limit, side, side));
+    }
+    sketch.fail("", fmt::format("the cloth has {:.0f} vertices and needs about {} to simulate, "
+                                "more than {}; about {:.0f} vertices would fit (a longer "
+                                "edge_length)",
+                                estimate.vertices, gigabytes(estimate.memory_bytes), limit, low));
+  }
+  if (estimate.frames > kMaxFrames)
+    throw std::invalid_argument(fmt::format(
+        "--frames {:g} over a drape of {:g} s makes {:.0f} pictures, more than the {:.0f} "
+        "allowed; at most {:.4g} per second fit this duration",
+        frames_per_second, sketch.simulate.duration, estimate.frames, kMaxFrames,
+        (kMaxFrames - 1) / sketch.simulate.duration));
+  // Without stop_at_rest the run takes every step up to the duration: its time is known.
+  if (limits.max_time_s && !sketch.simulate.stop_at_rest && estimate.seconds > *limits.max_time_s) {
+    const double fits = *limits.max_time_s / estimate.seconds * sketch.simulate.duration;
+    sketch.fail("/simulate/duration",
+                fmt::format("{:.0f} steps of {:.3g} s on {:.0f} vertices take about {:.0f} s, more "
+                            "than --max-time {:g} s; a duration of about {:.3g} s would fit (or "
+                            "\"stop_at_rest\": true)",
+                            estimate.steps, sketch.simulate.time_step, estimate.vertices,
+                            estimate.seconds, *limits.max_time_s, fits));
+  }
+}
+
+double parse_memory_size(const std::string& text) {
+  size_t used = 0;
+  double value = 0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    throw std::invalid_argument(
+        fmt::format("--max-memory '{}' is not a size like 4G or 512M", text));
+  }
+  std::string unit = text.substr(used);
+  if (!unit.empty() && (unit.back() == 'B' || unit.back() == 'b')) unit.pop_back();
+  double scale = 1;
+  if (unit == "K" || unit == "k")
+    scale = 1e3;
+  else if (unit == "M" || unit == "m")
+    scale = 1e6;
+  else if (unit == "G" || unit == "g")
+    scale = 1e9;
+  else if (unit == "T" || unit == "t")
+    scale = 1e12;
+  else if (!unit.empty())
+    throw std::invalid_argument(
+        fmt::format("--max-memory '{}': unknown unit '{}' (use K, M, G or T)", text, unit));
+  const double bytes = value * scale;
+  if (!std::isfinite(bytes) || bytes < 1e6 || bytes > 1e15)
+    throw std::invalid_argument(fmt::format("--max-memory '{}' is outside 1M .. 1000T", text));
+  return bytes;
+}
+
+}  // namespace sd::app
