@@ -63,7 +63,7 @@ TEST(BodyLandmarks, ColladaHumanInMetres) {
 }
 
 TEST(BodyLandmarks, ASphereHasNone) {
-  EXPECT_THROW(find_landmarks(test::sphere_mesh(0.5, {0, 0.5, 0}, 3)), std::runtime_error);
+  EXPECT_THROW(find_landmarks(meshing::icosphere(0.5, 3, {0, 0.5, 0})), std::runtime_error);
 }
 
 TEST(BodyLandmarks, SliceOfTheBuiltinBodyAtKneeHeightHasTwoLegs) {

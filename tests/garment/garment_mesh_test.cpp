@@ -254,7 +254,7 @@ TEST(Garment, JoinRelabelsGroupsAndSeamOnSphereStitches) {
     "join": [ { "id": "both", "panels": ["l", "r"] } ],
     "edge_length": 0.02
   })", "s.json");
-  const BodySurface sphere(test::sphere_mesh(0.3, {0, 1, 0}, 5));
+  const BodySurface sphere(meshing::icosphere(0.3, 5, {0, 1, 0}));
   const Garment g = build_garment(s, sphere);
   ASSERT_EQ(g.panels.size(), 2u);
   EXPECT_EQ(g.panels[0].group, "both");
@@ -276,7 +276,7 @@ TEST(Garment, ThreePanelsOnOneCurveIsAnError) {
     "panels": [ { "id": "p", "boundary": ["a", "b", "c"] }, { "id": "q", "boundary": ["a", "b", "c"] },
                 { "id": "r", "boundary": ["a", "b", "c"] } ]
   })", "s.json");
-  const BodySurface sphere(test::sphere_mesh(0.3, {0, 1, 0}, 4));
+  const BodySurface sphere(meshing::icosphere(0.3, 4, {0, 1, 0}));
   try {
     build_garment(s, sphere);
     FAIL();
@@ -298,7 +298,7 @@ TEST(Garment, TJunctionSplitsTheCurve) {
                 { "id": "r", "boundary": ["top", "right", "bottom", "mid"] } ],
     "edge_length": 0.02
   })", "s.json");
-  const BodySurface sphere(test::sphere_mesh(0.3, {0, 1, 0}, 5));
+  const BodySurface sphere(meshing::icosphere(0.3, 5, {0, 1, 0}));
   const Garment g = build_garment(s, sphere);
   EXPECT_EQ(g.seam_edges, 11);  // mid: 0.211 m on the offset sphere (see the test above)
   ASSERT_EQ(g.panels[0].side_counts.size(), 4u);

@@ -12,7 +12,7 @@ namespace sd::garment {
 namespace {
 
 const BodySurface& sphere() {
-  static const BodySurface surface(test::sphere_mesh(0.3, {0, 1, 0}, 5));
+  static const BodySurface surface(meshing::icosphere(0.3, 5, {0, 1, 0}));
   return surface;
 }
 

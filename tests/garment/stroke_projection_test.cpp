@@ -23,7 +23,7 @@ Sketch sketch_with(const CurveSpec& curve) {
 }
 
 TEST(StrokeProjection, FrontViewLandsOnOffsetSphere) {
-  const BodySurface body(test::sphere_mesh(kRadius, kCentre, 5));
+  const BodySurface body(meshing::icosphere(kRadius, 5, kCentre));
   CurveSpec c;
   c.id = "c";
   c.json_path = "/curves/0";
@@ -42,7 +42,7 @@ TEST(StrokeProjection, FrontViewLandsOnOffsetSphere) {
 }
 
 TEST(StrokeProjection, EachViewHitsItsOwnSide) {
-  const BodySurface body(test::sphere_mesh(kRadius, kCentre, 4));
+  const BodySurface body(meshing::icosphere(kRadius, 4, kCentre));
   const std::pair<ViewKind, Eigen::Vector3d> views[] = {{ViewKind::kFront, {0, 0, 1}},
                                                         {ViewKind::kBack, {0, 0, -1}},
                                                         {ViewKind::kLeft, {1, 0, 0}},
@@ -63,7 +63,7 @@ TEST(StrokeProjection, EachViewHitsItsOwnSide) {
 }
 
 TEST(StrokeProjection, MissesTakeDepthFromNeighbours) {
-  const BodySurface body(test::sphere_mesh(kRadius, kCentre, 5));
+  const BodySurface body(meshing::icosphere(kRadius, 5, kCentre));
   CurveSpec c;
   c.id = "c";
   c.smooth = false;
@@ -79,7 +79,7 @@ TEST(StrokeProjection, MissesTakeDepthFromNeighbours) {
 }
 
 TEST(StrokeProjection, CurveMissingEverythingIsAnError) {
-  const BodySurface body(test::sphere_mesh(kRadius, kCentre, 3));
+  const BodySurface body(meshing::icosphere(kRadius, 3, kCentre));
   CurveSpec c;
   c.id = "far";
   c.json_path = "/curves/0";
@@ -96,7 +96,7 @@ TEST(StrokeProjection, CurveMissingEverythingIsAnError) {
 }
 
 TEST(StrokeProjection, Points3dSnapToOffsetSurface) {
-  const BodySurface body(test::sphere_mesh(kRadius, kCentre, 5));
+  const BodySurface body(meshing::icosphere(kRadius, 5, kCentre));
   CurveSpec c;
   c.id = "c";
   c.points3d = {{0.5, 1.0, 0.0}, {0.0, 1.0, 0.5}};

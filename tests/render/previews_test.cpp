@@ -84,7 +84,7 @@ TEST_F(PreviewsTest, PatchOrientationIsNotMirrored) {
 
 TEST_F(PreviewsTest, RenderViewsGivesOneImagePerView) {
   Scene scene;
-  scene.meshes.emplace_back().mesh = test::sphere_mesh({0, 0.5, 0}, 0.5, 8, 16);
+  scene.meshes.emplace_back().mesh = meshing::icosphere(0.5, 1, {0, 0.5, 0});
   const std::vector<ViewName> views{ViewName::kFront, ViewName::kLeft, ViewName::kTop};
   std::vector<size_t> done;
   const std::vector<Image> images =

@@ -104,7 +104,7 @@ TEST_F(RendererTest, SyntheticSilhouettesMatchCpuProjection) {
   // An L of two boxes (not mirror-symmetric, so a flipped image would fail) and a sphere.
   const meshing::TriMesh ell = test::merge({test::box_mesh({0, 0, 0}, {1, 0.25, 0.25}),
                                             test::box_mesh({0, 0.25, 0}, {0.25, 0.8, 0.25})});
-  const meshing::TriMesh sphere = test::sphere_mesh({0.2, 0.3, -0.1}, 0.4);
+  const meshing::TriMesh sphere = meshing::icosphere(0.4, 3, {0.2, 0.3, -0.1});
   for (ViewName v : {ViewName::kFront, ViewName::kTop, ViewName::kRight, ViewName::kThreeQuarter}) {
     const ImageSize size{200, 150};
     expect_silhouette_matches(renderer(), ell, frame_view(v, meshing::bounding_box(ell), size.aspect()),

@@ -48,36 +48,6 @@ inline meshing::TriMesh merge(const std::vector<meshing::TriMesh>& parts) {
   return m;
 }
 
-// UV sphere of `radius` around `centre`: `rings` latitude bands, `segments` longitudes.
-inline meshing::TriMesh sphere_mesh(const Eigen::Vector3d& centre, double radius, int rings = 24,
-                                    int segments = 48) {
-  meshing::TriMesh m;
-  m.vertices.resize(2 + (rings - 1) * segments, 3);
-  m.vertices.row(0) = (centre + Eigen::Vector3d(0, radius, 0)).transpose();
-  m.vertices.row(1) = (centre - Eigen::Vector3d(0, radius, 0)).transpose();
-  for (int r = 1; r < rings; ++r)
-    for (int s = 0; s < segments; ++s) {
-      const double theta = std::numbers::pi * r / rings, phi = 2 * std::numbers::pi * s / segments;
-      m.vertices.row(2 + (r - 1) * segments + s) =
-          (centre + radius * Eigen::Vector3d(std::sin(theta) * std::cos(phi), std::cos(theta),
-                                             std::sin(theta) * std::sin(phi)))
-              .transpose();
-    }
-  const auto at = [&](int r, int s) { return 2 + (r - 1) * segments + (s % segments); };
-  std::vector<Eigen::Vector3i> faces;
-  for (int s = 0; s < segments; ++s) {
-    faces.emplace_back(0, at(1, s + 1), at(1, s));
-    faces.emplace_back(1, at(rings - 1, s), at(rings - 1, s + 1));
-    for (int r = 1; r + 1 < rings; ++r) {
-      faces.emplace_back(at(r, s), at(r, s + 1), at(r + 1, s));
-      faces.emplace_back(at(r, s + 1), at(r + 1, s + 1), at(r + 1, s));
-    }
-  }
-  m.faces.resize(static_cast<Eigen::Index>(faces.size()), 3);
-  for (size_t i = 0; i < faces.size(); ++i) m.faces.row(static_cast<Eigen::Index>(i)) = faces[i];
-  return m;
-}
-
 // Pixel coordinates (x right, y down, pixel centres at +0.5) of world point p, from the
 // pinhole model: direction (x, y) in the camera's right/up frame over depth, scaled by
 // tan(fov/2). Returns false if p is behind the camera.
