@@ -1,0 +1,202 @@
+#include "sim/body_collider.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <stdexcept>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+// The other half of body-cloth contact: body vertices that poke through the cloth's triangles
+// (a thin cloth over a sharp body feature), found over a hashed grid of the cloth.
+namespace sd::sim {
+namespace {
+
+Eigen::Vector3d row(const Eigen::VectorXd& x, Eigen::Index vertex) {
+  return x.segment<3>(3 * vertex);
+}
+
+}  // namespace
+
+ClothTriangles::ClothTriangles(std::vector<std::array<int, 3>> list)
+    : triangles(std::move(list)), open_edges(triangles.size(), 0) {
+  std::vector<std::tuple<int, int, int>> edges;  // (smaller vertex, larger vertex, 3t + k)
+  edges.reserve(3 * triangles.size());
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const int a = triangles[t][k], b = triangles[t][(k + 1) % 3];
+      edges.emplace_back(std::min(a, b), std::max(a, b), static_cast<int>(3 * t) + k);
+    }
+  std::sort(edges.begin(), edges.end());
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i + 1;
+    while (j < edges.size() && std::get<0>(edges[j]) == std::get<0>(edges[i]) &&
+           std::get<1>(edges[j]) == std::get<1>(edges[i]))
+      ++j;
+    if (j == i + 1) open_edges[std::get<2>(edges[i]) / 3] |= 1 << (std::get<2>(edges[i]) % 3);
+    i = j;
+  }
+}
+
+std::optional<BodyPiercing> BodyCollider::piercing_of_pair(const Eigen::VectorXd& x,
+                                                          const std::array<int, 3>& triangle,
+                                                          int triangle_index,
+                                                          int body_vertex) const {
+  const Eigen::Vector3d b = corner(body_vertex, 1.0);
+  const Eigen::Vector3d p0 = row(x, triangle[0]), p1 = row(x, triangle[1]),
+                        p2 = row(x, triangle[2]);
+  Eigen::Vector3d normal = triangle_normal(p0, p1, p2);
+  const double facing = normal.dot(vertex_normals_[body_vertex].normalized());
+  if (std::abs(facing) < 0.2) return std::nullopt;  // degenerate (zero normal) or edge-on
+  if (facing < 0.0) normal = -normal;
+  BodyPiercing piercing;
+  piercing.body_vertex = body_vertex;
+  piercing.cloth_triangle = triangle_index;
+  piercing.barycentric = closest_point_on_triangle(b, p0, p1, p2).barycentric;
+  piercing.normal = normal;
+  piercing.height = (b - p0).dot(normal);
+  piercing.body_velocity = velocities_[body_vertex];
+  return piercing;
+}
+
+std::vector<BodyPiercing> BodyCollider::find_piercings(
+    const Eigen::VectorXd& x, const ClothTriangles& cloth, double min_height, double max_height,
+    double unchecked_height, PiercingQueryStats* stats_out, bool every_triangle) const {
+  const std::vector<std::array<int, 3>>& triangles = cloth.triangles;
+  PiercingQueryStats stats;
+  std::vector<BodyPiercing> result;
+  if (x.size() % 3 != 0)
+    throw std::invalid_argument("cloth positions must hold 3 coordinates per vertex");
+  if (!x.allFinite()) throw std::invalid_argument("cloth positions must be finite");
+  for (const auto& t : triangles)
+    for (int k = 0; k < 3; ++k)
+      if (t[k] < 0 || 3 * static_cast<Eigen::Index>(t[k]) >= x.size())
+        throw std::invalid_argument("a cloth triangle's vertex index is out of range");
+  if (triangles.empty() || !(max_height > min_height)) return result;
+  // Cells as large as the longest cloth edge or the reach, whichever is larger (see below).
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d high = -low;
+  double longest = 0.0;
+  for (const auto& t : triangles)
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d a = row(x, t[k]);
+      low = low.cwiseMin(a);
+      high = high.cwiseMax(a);
+      longest = std::max(longest, (row(x, t[(k + 1) % 3]) - a).norm());
+    }
+  if (!(longest > 0.0)) return result;
+  // The grid covers the cloth's box, expanded by the largest height reported.
+  const double reach = std::max({std::abs(min_height), std::abs(max_height), 1e-9});
+  low.array() -= reach;
+  high.array() += reach;
+  // Cells at least as large as the reach too: with cells of the longest edge alone, a fine
+  // cloth (0.15 mm edges) and a reach of centimetres put each triangle in (2·reach/edge)³ cells,
+  // millions each (the 17 GB of a sketched strip's piercing count). With cell ≥ max(edge, reach)
+  // a grown box spans at most 4 cells per axis.
+  const double cell = std::max(longest, reach);
+  const Eigen::Vector3d extent = high - low;
+  constexpr std::int64_t kMaxCells = 1 << 20;  // per axis, so that a key packs in 63 bits
+  if ((extent / cell).maxCoeff() >= static_cast<double>(kMaxCells)) return result;
+  const auto cell_of = [&](const Eigen::Vector3d& p) {
+    return Eigen::Vector3i(static_cast<int>((p.x() - low.x()) / cell),
+                           static_cast<int>((p.y() - low.y()) / cell),
+                           static_cast<int>((p.z() - low.z()) / cell));
+  };
+  const auto key_of = [&](const Eigen::Vector3i& c) {
+    return (static_cast<std::int64_t>(c.x()) * kMaxCells + c.y()) * kMaxCells + c.z();
+  };
+  // (cell key, triangle) for every cell a triangle's box, grown by the reach (where the body
+  // vertices it can cover lie), overlaps; sorted by key.
+  std::vector<std::pair<std::int64_t, int>> cells;
+  cells.reserve(8 * triangles.size());
+  for (int t = 0; t < static_cast<int>(triangles.size()); ++t) {
+    Eigen::Vector3d a = row(x, triangles[t][0]), b = a;
+    for (int k = 1; k < 3; ++k) {
+      a = a.cwiseMin(row(x, triangles[t][k]));
+      b = b.cwiseMax(row(x, triangles[t][k]));
+    }
+    const Eigen::Vector3i c0 = cell_of(a.array() - reach), c1 = cell_of(b.array() + reach);
+    for (int i = c0.x(); i <= c1.x(); ++i)
+      for (int j = c0.y(); j <= c1.y(); ++j)
+        for (int k = c0.z(); k <= c1.z(); ++k) cells.emplace_back(key_of({i, j, k}), t);
+  }
+  std::sort(cells.begin(), cells.end());
+  stats.grid_entries = static_cast<std::int64_t>(cells.size());
+  // Unit normals once per triangle (zero when degenerate), not once per pair.
+  std::vector<Eigen::Vector3d> normals(triangles.size());
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    normals[t] = triangle_normal(row(x, triangles[t][0]), row(x, triangles[t][1]),
+                                 row(x, triangles[t][2]));
+
+  for (int v = 0; v < vertex_count(); ++v) {
+    const Eigen::Vector3d b = corner(v, 1.0);
+    if ((b - low).minCoeff() < 0.0 || (high - b).minCoeff() < 0.0) continue;
+    ++stats.body_vertices;
+    const std::int64_t key = key_of(cell_of(b));
+    auto it = std::lower_bound(cells.begin(), cells.end(), std::make_pair(key, -1));
+    const Eigen::Vector3d body_normal = vertex_normals_[v].normalized();
+    std::optional<BodyPiercing> best;
+    for (; it != cells.end() && it->first == key; ++it) {
+      const int t = it->second;
+      ++stats.pairs;
+      Eigen::Vector3d normal = normals[static_cast<std::size_t>(t)];
+      const double facing = normal.dot(body_normal);
+      // Cloth edge-on to the body surface there (or degenerate): not covering the vertex.
+      if (std::abs(facing) < 0.2) continue;
+      if (facing < 0.0) normal = -normal;
+      // The height over the triangle's closest point is the height over its plane (the closest
+      // point lies in it): the band test needs no closest point.
+      const Eigen::Vector3d p0 = row(x, triangles[t][0]);
+      const double height = (b - p0).dot(normal);
+      if (height <= min_height || height >= max_height) continue;
+      if (!every_triangle && best && height <= best->height) continue;
+      // The closest point of the triangle, not only the projection: a body vertex pushed
+      // through a ridge of the cloth (the shared edge of two triangles folded over it) projects
+      // outside both triangles, but it is above both planes and its closest points lie on
+      // the edge.
+      const TriangleClosestPoint closest =
+          closest_point_on_triangle(b, p0, row(x, triangles[t][1]), row(x, triangles[t][2]));
+      if (closest.squared_distance >= max_height * max_height) continue;
+      // Not through (within the asked band below the cloth): only where the cloth covers the
+      // vertex, its projection inside the triangle.
+      if (height <= 0.0 && closest.feature != TriangleFeature::face) continue;
+      // Closest to the cloth's open edge (or a corner on it): the vertex is beside the cloth,
+      // not under it: a neck beside a neckline, a wrist beside a cuff. Over an inner edge it is
+      // a ridge of the cloth folded over it, which counts.
+      const std::uint8_t open = cloth.open_edges[static_cast<std::size_t>(t)];
+      if (closest.feature == TriangleFeature::edge && (open >> closest.index & 1)) continue;
+      if (closest.feature == TriangleFeature::vertex &&
+          ((open >> closest.index & 1) || (open >> (closest.index + 2) % 3 & 1)))
+        continue;
+      // The triangle must dip into the body under the vertex (for a height above zero): a
+      // cloth triangle lying beyond a body part, or beside it, is not pierced by it.
+      if (height > unchecked_height) {
+        ++stats.inside_checks;
+        const std::optional<BodyProximity> under =
+            nearest(closest.point, 1.0, std::sqrt(closest.squared_distance) + 1e-9);
+        if (!under || under->distance > 0.0) continue;
+      }
+      const Eigen::Vector3d w = closest.barycentric;
+      BodyPiercing piercing;
+      piercing.body_vertex = v;
+      piercing.cloth_triangle = t;
+      piercing.barycentric = w;
+      piercing.normal = normal;
+      piercing.height = height;
+      piercing.body_velocity = velocities_[v];
+      if (every_triangle)
+        result.push_back(piercing);
+      else
+        best = piercing;
+    }
+    if (best) result.push_back(*best);
+  }
+  stats.piercings = static_cast<int>(result.size());
+  if (stats_out != nullptr) *stats_out = stats;
+  return result;
+}
+
+}  // namespace sd::sim
