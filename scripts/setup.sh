@@ -13,7 +13,7 @@ purpose=${1:-test}
 packages=(
   cmake g++ make pkg-config ccache
   libeigen3-dev libcgal-dev libassimp-dev assimp-testmodels libsuitesparse-dev
-  libopenblas0-pthread libfcl-dev libosmesa6-dev libpng-dev
+  libopenblas0-pthread libfcl-dev libtbb-dev libosmesa6-dev libpng-dev
   libcli11-dev nlohmann-json3-dev libspdlog-dev libssl-dev
   libgtest-dev libbenchmark-dev
 )

@@ -22,6 +22,7 @@
 #include <map>
 #include <optional>
 
+#include "sim/parallel.hpp"
 #include "src/app/pipeline/atomic_file.hpp"
 #include "src/app/pipeline/progress.hpp"
 #include "src/app/version.hpp"
@@ -346,6 +347,7 @@ BatchResult run_batch(const BatchOptions& options) {
 
   SignalGate gate;
   std::vector<RunningJob> running;
+  const int child_threads = std::max(1, sim::thread_count() / std::max(1, options.parallel));
   bool stopping = false;
   while (!queue.empty() || !running.empty()) {
     while (!stopping && !queue.empty() && static_cast<int>(running.size()) < options.parallel) {
@@ -357,6 +359,8 @@ BatchResult run_batch(const BatchOptions& options) {
         write_file_atomically(dir / kJobSketch, p.document->dump(2) + "\n");
         std::vector<std::string> args;
         if (options.verbose) args.push_back("-v");
+        // The cores shared out between the jobs running side by side.
+        args.insert(args.end(), {"--threads", std::to_string(child_threads)});
         args.insert(args.end(), {options.stage, (dir / kJobSketch).string(), "-o", dir.string()});
         running.push_back({&p, spawn_child(exe, args, dir / kJobLog), Clock::now()});
         ++result.ran;

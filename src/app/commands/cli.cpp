@@ -10,6 +10,7 @@
 #include <new>
 #include <stdexcept>
 
+#include "sim/parallel.hpp"
 #include "src/app/version.hpp"
 
 namespace sd::app {
@@ -53,7 +54,14 @@ int run_cli(int argc, char** argv) {
   GlobalOptions global;
   app.add_flag("-q,--quiet", global.quiet, "Only print errors; no progress bars");
   app.add_flag("-v,--verbose", global.verbose, "Print debug logs (GL version, timings, ...)");
-  app.parse_complete_callback([&] { configure_logging(global); });
+  app.add_option("--threads", global.threads,
+                 "Threads for the simulator's parallel loops (contact queries); default: every "
+                 "core. Results are the same bits for any count")
+      ->check(CLI::Range(1, 256));
+  app.parse_complete_callback([&] {
+    configure_logging(global);
+    sim::set_thread_count(global.threads);
+  });
 
   add_info_command(app, global);
   add_fill_command(app, global);

@@ -15,6 +15,7 @@ enum ExitCode : int {
 struct GlobalOptions {
   bool quiet = false;    // only errors on stderr, no progress bars
   bool verbose = false;  // debug logs (GL version, timings, solver details)
+  int threads = 0;       // the simulator's parallel loops (sim/parallel.hpp); 0 = every core
 };
 
 // A command-line number check: finite (no nan, inf, 1e999) and within [low, high]. CLI11's own
