@@ -10,6 +10,8 @@
 #include <utility>
 #include <vector>
 
+#include "sim/parallel.hpp"
+
 // The other half of body-cloth contact: body vertices that poke through the cloth's triangles
 // (a thin cloth over a sharp body feature), found over a hashed grid of the cloth.
 namespace sd::sim {
@@ -18,6 +20,9 @@ namespace {
 Eigen::Vector3d row(const Eigen::VectorXd& x, Eigen::Index vertex) {
   return x.segment<3>(3 * vertex);
 }
+
+// Body vertices per chunk at least: most fall outside the cloth's box and cost a comparison.
+constexpr int kBodyVertexGrain = 1024;
 
 }  // namespace
 
@@ -131,68 +136,83 @@ std::vector<BodyPiercing> BodyCollider::find_piercings(
     normals[t] = triangle_normal(row(x, triangles[t][0]), row(x, triangles[t][1]),
                                  row(x, triangles[t][2]));
 
-  for (int v = 0; v < vertex_count(); ++v) {
-    const Eigen::Vector3d b = corner(v, 1.0);
-    if ((b - low).minCoeff() < 0.0 || (high - b).minCoeff() < 0.0) continue;
-    ++stats.body_vertices;
-    const std::int64_t key = key_of(cell_of(b));
-    auto it = std::lower_bound(cells.begin(), cells.end(), std::make_pair(key, -1));
-    const Eigen::Vector3d body_normal = vertex_normals_[v].normalized();
-    std::optional<BodyPiercing> best;
-    for (; it != cells.end() && it->first == key; ++it) {
-      const int t = it->second;
-      ++stats.pairs;
-      Eigen::Vector3d normal = normals[static_cast<std::size_t>(t)];
-      const double facing = normal.dot(body_normal);
-      // Cloth edge-on to the body surface there (or degenerate): not covering the vertex.
-      if (std::abs(facing) < 0.2) continue;
-      if (facing < 0.0) normal = -normal;
-      // The height over the triangle's closest point is the height over its plane (the closest
-      // point lies in it): the band test needs no closest point.
-      const Eigen::Vector3d p0 = row(x, triangles[t][0]);
-      const double height = (b - p0).dot(normal);
-      if (height <= min_height || height >= max_height) continue;
-      if (!every_triangle && best && height <= best->height) continue;
-      // The closest point of the triangle, not only the projection: a body vertex pushed
-      // through a ridge of the cloth (the shared edge of two triangles folded over it) projects
-      // outside both triangles, but it is above both planes and its closest points lie on
-      // the edge.
-      const TriangleClosestPoint closest =
-          closest_point_on_triangle(b, p0, row(x, triangles[t][1]), row(x, triangles[t][2]));
-      if (closest.squared_distance >= max_height * max_height) continue;
-      // Not through (within the asked band below the cloth): only where the cloth covers the
-      // vertex, its projection inside the triangle.
-      if (height <= 0.0 && closest.feature != TriangleFeature::face) continue;
-      // Closest to the cloth's open edge (or a corner on it): the vertex is beside the cloth,
-      // not under it: a neck beside a neckline, a wrist beside a cuff. Over an inner edge it is
-      // a ridge of the cloth folded over it, which counts.
-      const std::uint8_t open = cloth.open_edges[static_cast<std::size_t>(t)];
-      if (closest.feature == TriangleFeature::edge && (open >> closest.index & 1)) continue;
-      if (closest.feature == TriangleFeature::vertex &&
-          ((open >> closest.index & 1) || (open >> (closest.index + 2) % 3 & 1)))
-        continue;
-      // The triangle must dip into the body under the vertex (for a height above zero): a
-      // cloth triangle lying beyond a body part, or beside it, is not pierced by it.
-      if (height > unchecked_height) {
-        ++stats.inside_checks;
-        const std::optional<BodyProximity> under =
-            nearest(closest.point, 1.0, std::sqrt(closest.squared_distance) + 1e-9);
-        if (!under || under->distance > 0.0) continue;
+  // Body vertices in chunks on the simulator's threads, joined in vertex order (the same result
+  // on any thread count, sim/parallel.hpp).
+  const int chunks = chunk_count(vertex_count(), kBodyVertexGrain);
+  std::vector<std::vector<BodyPiercing>> chunk_result(static_cast<std::size_t>(chunks));
+  std::vector<PiercingQueryStats> chunk_stats(static_cast<std::size_t>(chunks));
+  parallel_chunks(vertex_count(), kBodyVertexGrain, [&](int chunk, int first, int last) {
+    std::vector<BodyPiercing>& found = chunk_result[static_cast<std::size_t>(chunk)];
+    PiercingQueryStats& local = chunk_stats[static_cast<std::size_t>(chunk)];
+    for (int v = first; v < last; ++v) {
+      const Eigen::Vector3d b = corner(v, 1.0);
+      if ((b - low).minCoeff() < 0.0 || (high - b).minCoeff() < 0.0) continue;
+      ++local.body_vertices;
+      const std::int64_t key = key_of(cell_of(b));
+      auto it = std::lower_bound(cells.begin(), cells.end(), std::make_pair(key, -1));
+      const Eigen::Vector3d body_normal = vertex_normals_[v].normalized();
+      std::optional<BodyPiercing> best;
+      for (; it != cells.end() && it->first == key; ++it) {
+        const int t = it->second;
+        ++local.pairs;
+        Eigen::Vector3d normal = normals[static_cast<std::size_t>(t)];
+        const double facing = normal.dot(body_normal);
+        // Cloth edge-on to the body surface there (or degenerate): not covering the vertex.
+        if (std::abs(facing) < 0.2) continue;
+        if (facing < 0.0) normal = -normal;
+        // The height over the triangle's closest point is the height over its plane (the closest
+        // point lies in it): the band test needs no closest point.
+        const Eigen::Vector3d p0 = row(x, triangles[t][0]);
+        const double height = (b - p0).dot(normal);
+        if (height <= min_height || height >= max_height) continue;
+        if (!every_triangle && best && height <= best->height) continue;
+        // The closest point of the triangle, not only the projection: a body vertex pushed
+        // through a ridge of the cloth (the shared edge of two triangles folded over it) projects
+        // outside both triangles, but it is above both planes and its closest points lie on
+        // the edge.
+        const TriangleClosestPoint closest =
+            closest_point_on_triangle(b, p0, row(x, triangles[t][1]), row(x, triangles[t][2]));
+        if (closest.squared_distance >= max_height * max_height) continue;
+        // Not through (within the asked band below the cloth): only where the cloth covers the
+        // vertex, its projection inside the triangle.
+        if (height <= 0.0 && closest.feature != TriangleFeature::face) continue;
+        // Closest to the cloth's open edge (or a corner on it): the vertex is beside the cloth,
+        // not under it: a neck beside a neckline, a wrist beside a cuff. Over an inner edge it is
+        // a ridge of the cloth folded over it, which counts.
+        const std::uint8_t open = cloth.open_edges[static_cast<std::size_t>(t)];
+        if (closest.feature == TriangleFeature::edge && (open >> closest.index & 1)) continue;
+        if (closest.feature == TriangleFeature::vertex &&
+            ((open >> closest.index & 1) || (open >> (closest.index + 2) % 3 & 1)))
+          continue;
+        // The triangle must dip into the body under the vertex (for a height above zero): a
+        // cloth triangle lying beyond a body part, or beside it, is not pierced by it.
+        if (height > unchecked_height) {
+          ++local.inside_checks;
+          const std::optional<BodyProximity> under =
+              nearest(closest.point, 1.0, std::sqrt(closest.squared_distance) + 1e-9);
+          if (!under || under->distance > 0.0) continue;
+        }
+        const Eigen::Vector3d w = closest.barycentric;
+        BodyPiercing piercing;
+        piercing.body_vertex = v;
+        piercing.cloth_triangle = t;
+        piercing.barycentric = w;
+        piercing.normal = normal;
+        piercing.height = height;
+        piercing.body_velocity = velocities_[v];
+        if (every_triangle)
+          found.push_back(piercing);
+        else
+          best = piercing;
       }
-      const Eigen::Vector3d w = closest.barycentric;
-      BodyPiercing piercing;
-      piercing.body_vertex = v;
-      piercing.cloth_triangle = t;
-      piercing.barycentric = w;
-      piercing.normal = normal;
-      piercing.height = height;
-      piercing.body_velocity = velocities_[v];
-      if (every_triangle)
-        result.push_back(piercing);
-      else
-        best = piercing;
+      if (best) found.push_back(*best);
     }
-    if (best) result.push_back(*best);
+  });
+  for (std::size_t c = 0; c < chunk_result.size(); ++c) {
+    result.insert(result.end(), chunk_result[c].begin(), chunk_result[c].end());
+    stats.body_vertices += chunk_stats[c].body_vertices;
+    stats.pairs += chunk_stats[c].pairs;
+    stats.inside_checks += chunk_stats[c].inside_checks;
   }
   stats.piercings = static_cast<int>(result.size());
   if (stats_out != nullptr) *stats_out = stats;

@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <atomic>
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -89,6 +91,51 @@ TEST_F(ThreadCount, ContactQueriesAreTheSameOnOneAndManyThreads) {
     EXPECT_EQ(one_stats.sweep_samples, four_stats.sweep_samples);
     EXPECT_EQ(one_stats.crossings, four_stats.crossings);
   }
+}
+
+// Body vertices through a crumpled cloth: the same piercings in the same order on any thread count.
+TEST_F(ThreadCount, PiercingSearchIsTheSameOnOneAndManyThreads) {
+  const BodyCollider body(testing::make_sphere(0.3, 5));  // 10,242 vertices: several chunks
+  // A 40×40 grid of triangles wrapped at radius 0.3 ± 1 cm around the sphere's upper half.
+  constexpr int kN = 40;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> jitter(-0.01, 0.01);
+  Eigen::VectorXd x(3 * (kN + 1) * (kN + 1));
+  for (int i = 0; i <= kN; ++i)
+    for (int j = 0; j <= kN; ++j) {
+      const double theta = 1.4 * i / kN - 0.7, phi = 1.4 * j / kN - 0.7;
+      const Eigen::Vector3d dir(std::sin(theta), std::cos(theta) * std::cos(phi),
+                                std::cos(theta) * std::sin(phi));
+      x.segment<3>(3 * (i * (kN + 1) + j)) = (0.3 + jitter(rng)) * dir.normalized();
+    }
+  std::vector<std::array<int, 3>> triangles;
+  for (int i = 0; i < kN; ++i)
+    for (int j = 0; j < kN; ++j) {
+      const int a = i * (kN + 1) + j, b = a + 1, c = a + kN + 1, d = c + 1;
+      triangles.push_back({a, c, b});
+      triangles.push_back({b, c, d});
+    }
+  const ClothTriangles cloth(triangles);
+  const auto run = [&](int threads) {
+    set_thread_count(threads);
+    PiercingQueryStats stats;
+    std::vector<BodyPiercing> found =
+        body.find_piercings(x, cloth, -0.02, 0.02, 0.0, &stats, /*every_triangle=*/true);
+    return std::make_pair(found, stats);
+  };
+  const auto [one, one_stats] = run(1);
+  const auto [four, four_stats] = run(4);
+  ASSERT_GT(one.size(), 50u) << "the jittered cloth must cover body vertices from both sides";
+  ASSERT_EQ(one.size(), four.size());
+  for (std::size_t k = 0; k < one.size(); ++k) {
+    EXPECT_EQ(one[k].body_vertex, four[k].body_vertex);
+    EXPECT_EQ(one[k].cloth_triangle, four[k].cloth_triangle);
+    EXPECT_EQ(one[k].height, four[k].height);
+  }
+  EXPECT_EQ(one_stats.body_vertices, four_stats.body_vertices);
+  EXPECT_EQ(one_stats.pairs, four_stats.pairs);
+  EXPECT_EQ(one_stats.inside_checks, four_stats.inside_checks);
+  EXPECT_EQ(one_stats.piercings, four_stats.piercings);
 }
 
 }  // namespace
