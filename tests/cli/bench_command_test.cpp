@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "src/app/bench/bench_scaling.hpp"
 #include "src/app/bench/bench_study.hpp"
 #include "tests/cli/run_command.hpp"
 
@@ -253,6 +254,69 @@ TEST(BenchError, ShiftedTraceHasTheShiftAsError) {
   EXPECT_EQ(back.cpu_s, 1.25);
   EXPECT_EQ(back.steps, 17);
   EXPECT_THROW(sd::app::deserialize_trace("not a trace"), std::runtime_error);
+}
+
+// `bench --scaling` on small sheets: every size runs in its own child, the CSV, table and JSON
+// agree, the vertex counts are (N+1)², and each point's time is its report's.
+TEST(BenchScaling, SmallSheetsGiveEveryPointAndAFit) {
+  const fs::path dir = fresh_dir("scaling");
+  const auto result =
+      run_sketchdrape("bench --scaling --sizes 4 8 --steps 2 --json -o " + (dir / "out").string());
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  for (const char* name : {"scaling.csv", "scaling.md", "scaling.json"})
+    EXPECT_TRUE(fs::exists(dir / "out" / name)) << name;
+  const nlohmann::json json = read_json(dir / "out" / "scaling.json");
+  ASSERT_EQ(json.at("points").size(), 4u);  // 2 sizes × 2 solvers
+  for (const auto& p : json.at("points")) {
+    const int n = p.at("quads_per_side").get<int>();
+    EXPECT_EQ(p.at("vertices").get<int>(), (n + 1) * (n + 1));
+    EXPECT_EQ(p.at("status"), "ok") << p.dump();
+    EXPECT_EQ(p.at("steps").get<int>(), 2);
+    EXPECT_GT(p.at("step_s").get<double>(), 0.0);
+    EXPECT_GT(p.at("peak_rss_mb").get<double>(), 1.0);
+  }
+  ASSERT_EQ(json.at("fits").size(), 2u);
+  for (const auto& f : json.at("fits")) {
+    EXPECT_EQ(f.at("points").get<int>(), 2);
+    EXPECT_TRUE(std::isfinite(f.at("exponent").get<double>()));
+  }
+  const auto rows = parse_csv(read_text(dir / "out" / "scaling.csv"));
+  EXPECT_EQ(rows.front().front(), "quads_per_side");
+}
+
+TEST(BenchScaling, BadSizesAndSolversAreRefusedBeforeAnyRun) {
+  const fs::path dir = fresh_dir("scaling-bad");
+  for (const std::string args : {"--sizes 1", "--sizes 4 5000", "--solver lu"}) {
+    const auto result =
+        run_sketchdrape("bench --scaling " + args + " -o " + (dir / "out").string());
+    EXPECT_EQ(result.exit_code, 2) << args << "\n" << result.output;
+    EXPECT_FALSE(fs::exists(dir / "out")) << args;
+  }
+}
+
+// The fit is ordinary least squares in log-log: exact on a power law.
+TEST(BenchScaling, FitRecoversAPowerLawAndTheMemoryPerVertex) {
+  std::vector<sd::app::ScalingPoint> points;
+  for (int n : {32, 64, 128, 256}) {
+    sd::app::ScalingPoint p;
+    p.quads_per_side = n;
+    p.solver = "pcg";
+    p.vertices = (n + 1) * (n + 1);
+    p.status = "ok";
+    p.steps = 10;
+    p.step_s = 2e-3 * std::pow(p.vertices / 1000.0, 1.25);
+    p.peak_rss_mb = 80.0 + 3.0 * p.vertices / 1024.0;  // 3 KB per vertex over 80 MB
+    points.push_back(p);
+  }
+  points.push_back(points.front());
+  points.back().solver = "cholmod";  // one point only: no fit
+  const sd::app::ScalingFit fit = sd::app::fit_scaling("pcg", points);
+  EXPECT_EQ(fit.points, 4);
+  EXPECT_NEAR(fit.exponent, 1.25, 1e-12);
+  EXPECT_NEAR(fit.coefficient_s, 2e-3, 1e-12);
+  EXPECT_NEAR(fit.kb_per_vertex, 3.0, 1e-9);
+  EXPECT_NEAR(fit.base_memory_mb, 80.0, 1e-9);
+  EXPECT_EQ(sd::app::fit_scaling("cholmod", points).points, 1);
 }
 
 }  // namespace

@@ -30,6 +30,7 @@
 
 #include "src/app/pipeline/atomic_file.hpp"
 #include "src/app/pipeline/sha256.hpp"
+#include "src/app/bench/bench_scaling.hpp"
 #include "src/app/bench/bench_study.hpp"
 #include "src/app/commands/cli.hpp"
 #include "src/app/pipeline/progress.hpp"
@@ -55,6 +56,9 @@ struct BenchOptions {
   std::string worker_config;
   std::string worker_scene;
   std::string worker_out;
+  // The scaling study (--scaling) instead of the work-precision grid.
+  bool scaling = false;
+  ScalingOptions scaling_options;
 };
 
 std::string read_file(const fs::path& path) {
@@ -474,8 +478,74 @@ struct WorkDir {
   }
 };
 
+// `bench --scaling`: time per step and memory against the sheet's size, in child runs.
+void run_scaling_study(const BenchOptions& options, const GlobalOptions& global) {
+  ScalingOptions o = options.scaling_options;
+  o.threads = global.threads;  // `sketchdrape --threads N bench --scaling` runs the sizes on N
+  for (int n : o.sizes)
+    if (n < 2 || n > 1024)
+      throw std::invalid_argument(fmt::format("--sizes: {} is not in 2 .. 1024 quads a side", n));
+  for (const std::string& solver : o.solvers)
+    if (solver != "cholmod" && solver != "pcg")
+      throw std::invalid_argument(
+          fmt::format("--solver: '{}' is not a solver (cholmod or pcg)", solver));
+  const fs::path exe = fs::read_symlink("/proc/self/exe");
+  const fs::path dir = options.out;
+  WorkDir work{fs::temp_directory_path() / fmt::format("sketchdrape-scaling-{}", getpid())};
+  fs::create_directories(work.path);
+  Progress progress("bench --scaling", static_cast<long>(o.sizes.size() * o.solvers.size()),
+                    global.quiet);
+  long done = 0;
+  std::string current;
+  const std::vector<ScalingPoint> points = run_scaling(
+      exe, o, work.path, [&](const std::string& line) { progress.update(done++, current = line); },
+      [&](double elapsed) { progress.update(done - 1, fmt::format("{} ({:.0f} s)", current, elapsed)); });
+  progress.finish();
+  std::vector<ScalingFit> fits;
+  nlohmann::json json = {{"format", "sketchdrape/1 bench scaling"},
+                         {"version", kVersion},
+                         {"steps", o.steps},
+                         {"threads", o.threads},
+                         {"points", nlohmann::json::array()},
+                         {"fits", nlohmann::json::array()}};
+  for (const ScalingPoint& p : points)
+    json["points"].push_back({{"quads_per_side", p.quads_per_side}, {"solver", p.solver},
+                              {"vertices", p.vertices},           {"status", p.status},
+                              {"message", p.message},             {"steps", p.steps},
+                              {"step_s", p.step_s},               {"solve_s", p.solve_s},
+                              {"forces_s", p.forces_s},           {"collision_s", p.collision_s},
+                              {"cg_iterations_mean", p.cg_iterations_mean},
+                              {"process_cpu_s", p.process_cpu_s}, {"peak_rss_mb", p.peak_rss_mb}});
+  for (const std::string& solver : o.solvers) {
+    fits.push_back(fit_scaling(solver, points));
+    const ScalingFit& f = fits.back();
+    json["fits"].push_back({{"solver", f.solver},
+                            {"points", f.points},
+                            {"exponent", f.exponent},
+                            {"step_s_at_1000_vertices", f.coefficient_s},
+                            {"kb_per_vertex", f.kb_per_vertex},
+                            {"base_memory_mb", f.base_memory_mb}});
+  }
+  const std::string table = scaling_table(points, fits);
+  StagedOutputs outputs;
+  outputs.stage(dir / "scaling.csv", scaling_csv(points));
+  outputs.stage(dir / "scaling.md", table);
+  outputs.stage(dir / "scaling.json", json.dump(2) + "\n");
+  outputs.commit();
+  if (options.json)
+    fmt::print("{}\n", json.dump(2));
+  else
+    fmt::print("{}", table);
+  for (const ScalingPoint& p : points)
+    if (p.status != "ok")
+      throw std::runtime_error(fmt::format("the {0}×{0} sheet with {1} did not finish: {2} (the "
+                                           "other sizes were written)",
+                                           p.quads_per_side, p.solver, p.message));
+}
+
 void run_bench(const BenchOptions& options, const GlobalOptions& global) {
   if (!options.worker_config.empty()) return run_worker_side(options);
+  if (options.scaling) return run_scaling_study(options, global);
   const BenchGrid grid = parse_grid(options);
   if (options.timeout < 0) throw std::invalid_argument("--timeout must be positive (seconds per run)");
   const double timeout = options.timeout > 0 ? options.timeout
@@ -629,6 +699,16 @@ void add_bench_command(CLI::App& app, const GlobalOptions& global) {
                   "Where references are cached (default ~/.cache/sketchdrape/bench)");
   cmd->add_option("--timeout", options->timeout,
                   "Seconds a run may take before it is stopped (default 900, quick 120)");
+  cmd->add_flag("--scaling", options->scaling,
+                "The scaling study instead: time per step and memory of the pinned sheet from "
+                "32×32 to 256×256 quads (1k to 66k vertices), with the fitted exponent");
+  cmd->add_option("--sizes", options->scaling_options.sizes,
+                  "With --scaling: quads a side (default 32 64 128 256)");
+  cmd->add_option("--solver", options->scaling_options.solvers,
+                  "With --scaling: cholmod, pcg or both (default both)");
+  cmd->add_option("--steps", options->scaling_options.steps,
+                  "With --scaling: steps of 1/60 s per run (default 10)")
+      ->check(CLI::Range(1, 10000));
   cmd->add_option("--worker", options->worker_config)->group("");  // internal: one run
   cmd->add_option("--worker-scene", options->worker_scene)->group("");
   cmd->add_option("--worker-out", options->worker_out)->group("");
