@@ -6,37 +6,29 @@
 // child) and cached on disk under a digest of the scene, the reference settings and the binary.
 // Outputs (bench.csv, bench.json, plots) appear together or not at all.
 
-#include <fcntl.h>
 #include <fmt/format.h>
 #include <signal.h>
-#include <spawn.h>
 #include <spdlog/spdlog.h>
 #include <sys/prctl.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
-#include <thread>
 
 #include "src/app/pipeline/atomic_file.hpp"
+#include "src/app/pipeline/child_process.hpp"
 #include "src/app/pipeline/sha256.hpp"
 #include "src/app/bench/bench_scaling.hpp"
 #include "src/app/bench/bench_study.hpp"
 #include "src/app/commands/cli.hpp"
 #include "src/app/pipeline/progress.hpp"
 #include "src/app/version.hpp"
-
-extern char** environ;
 
 namespace sd::app {
 namespace {
@@ -116,66 +108,24 @@ ChildResult run_worker(const fs::path& exe, const std::string& scene, BenchGrid 
                        double timeout, Progress& progress, long done, const std::string& note) {
   const fs::path trace_path = work / (tag + ".trace");
   const fs::path log_path = work / (tag + ".log");
-  std::vector<std::string> args = {exe.string(), "--quiet",           "bench",
-                                   "--grid",     grid_name(grid),     "--worker",
-                                   config_to_json(config), "--worker-scene", scene,
-                                   "--worker-out", trace_path.string()};
-  std::vector<char*> argv;
-  for (std::string& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  // One BLAS/OpenMP thread: the simulator is single-threaded and CPU time stays comparable.
-  std::vector<std::string> env_strings;
-  bool has_openblas = false, has_omp = false;
-  for (char** e = environ; *e != nullptr; ++e) {
-    const std::string entry(*e);
-    has_openblas |= entry.rfind("OPENBLAS_NUM_THREADS=", 0) == 0;
-    has_omp |= entry.rfind("OMP_NUM_THREADS=", 0) == 0;
-    env_strings.push_back(entry);
-  }
-  if (!has_openblas) env_strings.push_back("OPENBLAS_NUM_THREADS=1");
-  if (!has_omp) env_strings.push_back("OMP_NUM_THREADS=1");
-  std::vector<char*> envp;
-  for (std::string& e : env_strings) envp.push_back(e.data());
-  envp.push_back(nullptr);
-
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 1, log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&actions, 1, 2);
-  pid_t pid = 0;
-  const int spawn_error = posix_spawn(&pid, exe.c_str(), &actions, nullptr, argv.data(), envp.data());
-  posix_spawn_file_actions_destroy(&actions);
-  if (spawn_error != 0)
-    throw std::runtime_error(fmt::format("cannot start {}: {}", exe.string(), std::strerror(spawn_error)));
-
-  ChildResult result;
-  const auto start = Clock::now();
-  int status = 0;
-  rusage usage{};
-  bool timed_out = false;
-  while (true) {
-    const pid_t r = wait4(pid, &status, WNOHANG, &usage);
-    if (r == pid) break;
-    if (r < 0 && errno != EINTR) throw std::runtime_error("waiting for a bench run failed");
-    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-    if (elapsed > timeout && !timed_out) {
-      kill(pid, SIGKILL);
-      timed_out = true;
-    }
+  const std::vector<std::string> args = {"--quiet",       "bench",  "--grid",
+                                         grid_name(grid), "--worker", config_to_json(config),
+                                         "--worker-scene", scene,    "--worker-out",
+                                         trace_path.string()};
+  const ChildRun child = run_child(exe, args, log_path, timeout, [&](double elapsed) {
     progress.update(done, fmt::format("{} ({:.0f} s)", note, elapsed));
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  result.elapsed_s = std::chrono::duration<double>(Clock::now() - start).count();
-  result.process_cpu_s = static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
-                         1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
-  result.peak_rss_mb = static_cast<double>(usage.ru_maxrss) / 1024.0;  // KiB on Linux
-  if (timed_out) {
+  });
+  ChildResult result;
+  result.elapsed_s = child.elapsed_s;
+  result.process_cpu_s = child.cpu_s;
+  result.peak_rss_mb = child.peak_rss_mb;
+  if (child.timed_out) {
     result.status = "timeout";
     result.message = fmt::format("stopped after {:.0f} s (--timeout)", timeout);
-  } else if (!WIFEXITED(status)) {
+  } else if (!child.exited) {
     result.status = "crashed";
-    result.message = fmt::format("killed by signal {}", WTERMSIG(status));
-  } else if (WEXITSTATUS(status) != 0 || !fs::exists(trace_path)) {
+    result.message = fmt::format("killed by signal {}", child.signal);
+  } else if (child.exit_code != 0 || !fs::exists(trace_path)) {
     result.status = "failed";
     result.message = last_line(log_path);
   } else {
