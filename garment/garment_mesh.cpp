@@ -37,6 +37,13 @@ constexpr double kSurfaceMaxStep = 0.5;     // edge lengths
 // m: an "auto" panel whose spanned surface stands farther than this off the body's offset
 // surface spans a hollow and is made "free"; otherwise it lies on the body.
 constexpr double kSpanGap = 0.03;
+// cos of the angle beyond which a closest body point faces away from its panel (100°): the
+// sides of a half-tube are perpendicular to its facing, so only the far side is refused.
+constexpr double kAgainstFacing = -0.17;
+// ... and the surface seen from the panel's side replaces it only when it is at most this many
+// times as far (a point in the middle of a limb is about as far from both sides; a panel that
+// wraps over the shoulder to its front has points much nearer the front than the back).
+constexpr double kSeenReach = 2.0;
 
 // Global vertices of the garment: node and curve-piece vertices are made once and shared.
 struct VertexPool {
@@ -80,6 +87,17 @@ int remove_doublets(std::vector<std::array<int, 4>>& faces, std::vector<int>& fa
   return removed;
 }
 
+
+// The unit vector area of a panel's boundary loop (the sides, corner to corner), or zero.
+Eigen::Vector3d loop_facing(const std::vector<Eigen::MatrixX3d>& side_points) {
+  std::vector<Eigen::Vector3d> loop;
+  for (const auto& side : side_points)
+    for (Eigen::Index r = 0; r + 1 < side.rows(); ++r) loop.emplace_back(side.row(r).transpose());
+  Eigen::Vector3d area = Eigen::Vector3d::Zero();
+  for (size_t k = 0; k < loop.size(); ++k)
+    area += (loop[k] - loop.front()).cross(loop[(k + 1) % loop.size()] - loop.front());
+  return area.norm() > 0 ? Eigen::Vector3d(area.normalized()) : Eigen::Vector3d::Zero();
+}
 
 }  // namespace
 
@@ -265,13 +283,27 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
       // projection (a hash collision only gives a poorer hint, never another answer).
       std::unordered_map<std::int64_t, SurfacePoint> hints;
       const double cell = 0.5 * reach;
-      const auto closest = [&body, &hints, cell](const Eigen::Vector3d& p) {
+      // The panel faces `facing` (its boundary's vector area: the loop runs counter-clockwise
+      // seen from outside). A point whose closest body point faces the other way has crossed
+      // the limb or torso it lies on: the interior of a half-sleeve starts on the chord plane
+      // through the arm, where the far side of the arm can be nearest (a hole in the back of a
+      // long sleeve at the elbow). Such a point goes to the body's first surface seen from the
+      // panel's side instead: a ray from outside the body's box along −facing.
+      const Eigen::Vector3d facing = loop_facing(side_points);
+      const double outside = (body.box().max - body.box().min).norm();
+      const auto closest = [&body, &hints, cell, facing, outside](const Eigen::Vector3d& p) {
         const Eigen::Vector3d q = (p / cell).array().floor();
         const std::int64_t key = (static_cast<std::int64_t>(q.x()) * 73856093) ^
                                  (static_cast<std::int64_t>(q.y()) * 19349663) ^
                                  (static_cast<std::int64_t>(q.z()) * 83492791);
         SurfacePoint& hint = hints[key];
         hint = body.closest_point(p, hint);
+        if (hint.normal.dot(facing) < kAgainstFacing) {
+          if (const auto seen = body.first_hit(p + outside * facing, -facing);
+              seen && seen->normal.dot(facing) > 0 &&
+              (seen->position - p).norm() < kSeenReach * hint.distance)
+            return *seen;
+        }
         return hint;
       };
       const SurfaceLift lift = [&closest, offset, reach](const Eigen::Vector3d& p) -> LiftedPoint {

@@ -471,6 +471,9 @@ FilledPatch fill_with_plan(const Plan& plan, std::span<const int> counts,
 
 // Plans tried by the geometric fill before it settles for the one with fewest inverted quads.
 constexpr int kGeometryAttempts = 4;
+// A plan with fewer quads than this share of the region's area over its mean boundary edge
+// length squared has quads too large for its edges (mean area above 1.33 e², sides ~1.15 e).
+constexpr double kLeastQuadShare = 0.75;
 
 }  // namespace
 
@@ -493,21 +496,78 @@ FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
   for (const auto& side : side_points) counts.push_back(static_cast<int>(side.rows()) - 1);
   check_counts(counts);
   const BoundaryShape shape = measured_shape(side_points);
+  // The plans are ranked by their corners and valences, not by the size of their quads: a plan
+  // with thin spokes can fill the region with a fraction of the quads its edges ask for (a
+  // raglan sleeve of sides (12, 8, 5, 21, 2): 62 quads of ~15 cm² for 3 cm edges, where 108
+  // fit, and counts that jump as edge_length changes). The first fill measures the region's
+  // area A; with the boundary's mean edge length e it asks for about A / e² quads, and a plan
+  // with fewer than kLeastQuadShare of those is passed over for the next ones (found again by
+  // choose_plan with the others excluded), the counts-only plan among them.
+  double boundary_length = 0;
+  for (const auto& side : side_points)
+    for (Eigen::Index r = 0; r + 1 < side.rows(); ++r)
+      boundary_length += (side.row(r + 1) - side.row(r)).norm();
+  const double mean_edge = boundary_length / std::accumulate(counts.begin(), counts.end(), 0);
+  const std::vector<Eigen::MatrixX3d> display = display_sides(counts);
+  const BoundaryShape straight = straight_sided_shape(counts);
+  const auto quads_of = [&](const Plan& plan) {
+    return static_cast<double>(realize(plan, counts, display, straight).builder.faces().size());
+  };
+  std::optional<double> least_quads;  // kLeastQuadShare · A / e², from the first fill
+  const auto same = [](const Plan& x, const Plan& y) {
+    return x.yasseen == y.yasseen && x.strips == y.strips && x.strip_corners == y.strip_corners &&
+           x.partition == y.partition;
+  };
+  // Fewer folds first, then a plan with enough quads.
+  const auto key = [](const FilledPatch& patch, bool coarse) {
+    return std::tuple(patch.quality.inverted_quads, coarse);
+  };
   // When the relaxed mesh still has inverted quads (a layout whose blocks start overlapping
   // near a reflex corner that relaxation and untangling could not undo), the next best plans
   // are tried; the first without inverted quads wins, else the one with fewest.
-  std::vector<Plan> tried;
+  std::vector<Plan> tried, filled;
   std::optional<FilledPatch> best_patch;
-  for (int attempt = 0; attempt < kGeometryAttempts; ++attempt) {
+  bool best_coarse = false;
+  std::optional<Plan> count_plan;  // chosen when first needed
+  for (int choice = 0; choice < 3 * kGeometryAttempts &&
+                       static_cast<int>(filled.size()) < kGeometryAttempts;
+       ++choice) {
     std::optional<Built> yasseen;
-    const Plan plan = choose_plan(counts, shape, side_points, yasseen, tried);
+    Plan plan = choose_plan(counts, shape, side_points, yasseen, tried);
+    if (least_quads && !count_plan) {
+      // After the first fill: the counts-only plan is the first alternative.
+      std::optional<Built> none;
+      count_plan = choose_plan(counts, straight, display, none);
+      if (std::none_of(tried.begin(), tried.end(), [&](const Plan& t) { return same(t, *count_plan); })) {
+        plan = *count_plan;
+        yasseen.reset();
+      }
+    }
     if (plan.folded == std::numeric_limits<int>::max()) break;  // nothing left to try
+    const bool coarse = least_quads && quads_of(plan) < *least_quads;
+    if (coarse) {
+      tried.push_back(plan);  // passed over, not filled
+      continue;
+    }
     FilledPatch patch = fill_with_plan(plan, counts, side_points, shape, yasseen, options);
-    const bool clean = patch.quality.inverted_quads == 0;
-    if (!best_patch || patch.quality.inverted_quads < best_patch->quality.inverted_quads)
+    if (!least_quads) {
+      double area = 0;
+      for (Eigen::Index f = 0; f < patch.mesh.face_count(); ++f) {
+        const auto corner = [&](int k) -> Eigen::Vector3d {
+          return patch.mesh.vertices.row(patch.mesh.faces(f, k)).transpose();
+        };
+        area += 0.5 * (corner(2) - corner(0)).cross(corner(3) - corner(1)).norm();
+      }
+      least_quads = kLeastQuadShare * area / (mean_edge * mean_edge);
+    }
+    const bool too_few = static_cast<double>(patch.mesh.face_count()) < *least_quads;
+    if (!best_patch || key(patch, too_few) < key(*best_patch, best_coarse)) {
       best_patch = std::move(patch);
-    if (clean) break;
+      best_coarse = too_few;
+    }
+    if (best_patch->quality.inverted_quads == 0 && !best_coarse) break;
     tried.push_back(plan);
+    filled.push_back(plan);
   }
   // Every plan tried keeps inverted quads: relax the best of them again with reference normals
   // taken after the unguarded sweeps, which untangle the large overlapping clusters the starting
@@ -517,9 +577,9 @@ FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
   // smoothing turns into a quad of aspect 24). Only the best plan: retrying all of them also
   // cleans 5 more of the 210° chevrons of the concave test (20 instead of 25 of 648 keep a fold)
   // but cost the t-shirt's and the shorts' backs, which no plan cleans, 20 and 9 ms of meshing.
-  if (!tried.empty() && best_patch->quality.inverted_quads > 0) {
+  if (!filled.empty() && best_patch->quality.inverted_quads > 0) {
     std::optional<Built> none;
-    FilledPatch patch = fill_with_plan(tried.front(), counts, side_points, shape, none, options,
+    FilledPatch patch = fill_with_plan(filled.front(), counts, side_points, shape, none, options,
                                        detail::ReferenceNormals::kAfterSweeps);
     if (patch.quality.inverted_quads == 0) best_patch = std::move(patch);
   }
