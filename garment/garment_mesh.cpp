@@ -44,6 +44,8 @@ constexpr double kAgainstFacing = -0.17;
 // times as far (a point in the middle of a limb is about as far from both sides; a panel that
 // wraps over the shoulder to its front has points much nearer the front than the back).
 constexpr double kSeenReach = 2.0;
+// A quad this many times longer than wide is a sliver (the quality gate warns from 10).
+constexpr double kSliverAspect = 10;
 
 // Global vertices of the garment: node and curve-piece vertices are made once and shared.
 struct VertexPool {
@@ -372,31 +374,42 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
         if (touches) span_over_obstacle(patch.mesh, fixed, push_out);
         patch.quality = meshing::measure_quality(patch.mesh, patch.topology.corner_vertices());
       }
+      // Candidates: the fill, its smoothing along the surface (body panels; see
+      // surface_relaxation.hpp), and each of those unfolded against the body's normals when it
+      // folds (surface_untangle.hpp). The best by the quality gate's measures wins: fewest folded
+      // quads, then no sliver (aspect ratio 10 or more: the t-shirt dress's back at 3 cm had a
+      // clean fill with two vertices on one spot at the armpit, and a smoothed mesh with one
+      // fold that unfolding removes), then the best worst corner.
+      const auto rank = [](const meshing::QuadQuality& q) {
+        return std::tuple(q.inverted_quads, q.max_aspect_ratio >= kSliverAspect,
+                          -q.scaled_jacobian_min);
+      };
+      const auto consider = [&](meshing::QuadMesh&& mesh, meshing::FilledPatch& best) {
+        const meshing::QuadQuality quality =
+            meshing::measure_quality(mesh, patch.topology.corner_vertices());
+        if (rank(quality) < rank(best.quality)) {
+          best.mesh = std::move(mesh);
+          best.quality = quality;
+        }
+      };
+      const auto unfold = [&](const meshing::QuadMesh& mesh) {
+        meshing::QuadMesh unfolded = mesh;
+        untangle_on_surface(unfolded, fixed, options.project, normal);
+        return unfolded;
+      };
+      meshing::FilledPatch best = patch;
+      if (patch.quality.inverted_quads > 0) consider(unfold(patch.mesh), best);
       if (fit == PanelFit::kBody) {
-        // Smooth along the surface (see surface_relaxation.hpp); kept when it leaves fewer
-        // folded quads, or as many and a better worst corner.
         meshing::QuadMesh relaxed = patch.mesh;
         relax_on_surface(relaxed, fixed, lift,
                          {kSurfaceSweeps, kSurfaceTolerance * reach, kSurfaceMaxStep * reach});
         const meshing::QuadQuality quality =
             meshing::measure_quality(relaxed, patch.topology.corner_vertices());
-        if (std::pair(quality.inverted_quads, -quality.scaled_jacobian_min) <
-            std::pair(patch.quality.inverted_quads, -patch.quality.scaled_jacobian_min)) {
-          patch.mesh = std::move(relaxed);
-          patch.quality = quality;
-        }
+        if (quality.inverted_quads > 0) consider(unfold(relaxed), best);
+        consider(std::move(relaxed), best);
       }
-      if (patch.quality.inverted_quads > 0) {
-        // Unfold against the body's normals, then measure again as the filler does; kept only
-        // when it leaves fewer folded quads by that measure.
-        meshing::QuadMesh unfolded = patch.mesh;
-        untangle_on_surface(unfolded, fixed, options.project, normal);
-        const meshing::QuadQuality quality = meshing::measure_quality(unfolded, patch.topology.corner_vertices());
-        if (quality.inverted_quads < patch.quality.inverted_quads) {
-          patch.mesh = std::move(unfolded);
-          patch.quality = quality;
-        }
-      }
+      patch.mesh = std::move(best.mesh);
+      patch.quality = best.quality;
       globals.assign(static_cast<size_t>(patch.mesh.vertex_count()), -1);
       for (size_t s = 0; s < patch.topology.side_vertices.size(); ++s)
         for (size_t j = 0; j < patch.topology.side_vertices[s].size(); ++j)

@@ -474,6 +474,9 @@ constexpr int kGeometryAttempts = 4;
 // A plan with fewer quads than this share of the region's area over its mean boundary edge
 // length squared has quads too large for its edges (mean area above 1.33 e², sides ~1.15 e).
 constexpr double kLeastQuadShare = 0.75;
+// A quad this many times longer than wide is a sliver (the quality gate warns from 10): the
+// next plans are tried as for a fold.
+constexpr double kDegenerateAspect = 10;
 
 }  // namespace
 
@@ -518,9 +521,11 @@ FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
     return x.yasseen == y.yasseen && x.strips == y.strips && x.strip_corners == y.strip_corners &&
            x.partition == y.partition;
   };
-  // Fewer folds first, then a plan with enough quads.
+  // Fewer folds first, then no degenerate quad (a sliver the body's shape squeezed), then a plan
+  // with enough quads.
   const auto key = [](const FilledPatch& patch, bool coarse) {
-    return std::tuple(patch.quality.inverted_quads, coarse);
+    return std::tuple(patch.quality.inverted_quads,
+                      patch.quality.max_aspect_ratio >= kDegenerateAspect, coarse);
   };
   // When the relaxed mesh still has inverted quads (a layout whose blocks start overlapping
   // near a reflex corner that relaxation and untangling could not undo), the next best plans
@@ -565,7 +570,7 @@ FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
       best_patch = std::move(patch);
       best_coarse = too_few;
     }
-    if (best_patch->quality.inverted_quads == 0 && !best_coarse) break;
+    if (key(*best_patch, best_coarse) == std::tuple(0, false, false)) break;
     tried.push_back(plan);
     filled.push_back(plan);
   }
