@@ -477,6 +477,9 @@ constexpr double kLeastQuadShare = 0.75;
 // A quad this many times longer than wide is a sliver (the quality gate warns from 10): the
 // next plans are tried as for a fold.
 constexpr double kDegenerateAspect = 10;
+// Sides whose mean edge lengths differ by more than this factor have no single edge length to
+// size quads by.
+constexpr double kEdgeSpread = 1.5;
 
 }  // namespace
 
@@ -506,11 +509,21 @@ FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
   // area A; with the boundary's mean edge length e it asks for about A / e² quads, and a plan
   // with fewer than kLeastQuadShare of those is passed over for the next ones (found again by
   // choose_plan with the others excluded), the counts-only plan among them.
-  double boundary_length = 0;
-  for (const auto& side : side_points)
+  // The target only means something when the boundary's edges have about one length, as a
+  // garment's do (each curve's count is its length over edge_length): sides whose mean edges
+  // differ by more than kEdgeSpread (a regular pentagon with 5 edges on one side and 2 on the
+  // next) ask for no particular count, and no plan is passed over for its quad count.
+  double boundary_length = 0, shortest_edge = 1e300, longest_edge = 0;
+  for (const auto& side : side_points) {
+    double length = 0;
     for (Eigen::Index r = 0; r + 1 < side.rows(); ++r)
-      boundary_length += (side.row(r + 1) - side.row(r)).norm();
+      length += (side.row(r + 1) - side.row(r)).norm();
+    boundary_length += length;
+    shortest_edge = std::min(shortest_edge, length / static_cast<double>(side.rows() - 1));
+    longest_edge = std::max(longest_edge, length / static_cast<double>(side.rows() - 1));
+  }
   const double mean_edge = boundary_length / std::accumulate(counts.begin(), counts.end(), 0);
+  const bool one_edge_length = longest_edge <= kEdgeSpread * shortest_edge;
   const std::vector<Eigen::MatrixX3d> display = display_sides(counts);
   const BoundaryShape straight = straight_sided_shape(counts);
   const auto quads_of = [&](const Plan& plan) {
@@ -523,9 +536,12 @@ FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
   };
   // Fewer folds first, then no degenerate quad (a sliver the body's shape squeezed), then a plan
   // with enough quads.
-  const auto key = [](const FilledPatch& patch, bool coarse) {
+  // with enough quads. (Slivers count only when the edges have one length: with 1 edge on one
+  // side and 6 on the next, aspect ratios of 6 and more belong to the region).
+  const auto key = [&](const FilledPatch& patch, bool coarse) {
     return std::tuple(patch.quality.inverted_quads,
-                      patch.quality.max_aspect_ratio >= kDegenerateAspect, coarse);
+                      one_edge_length && patch.quality.max_aspect_ratio >= kDegenerateAspect,
+                      coarse);
   };
   // When the relaxed mesh still has inverted quads (a layout whose blocks start overlapping
   // near a reflex corner that relaxation and untangling could not undo), the next best plans
@@ -539,7 +555,7 @@ FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
        ++choice) {
     std::optional<Built> yasseen;
     Plan plan = choose_plan(counts, shape, side_points, yasseen, tried);
-    if (least_quads && !count_plan) {
+    if (least_quads && *least_quads > 0 && !count_plan) {
       // After the first fill: the counts-only plan is the first alternative.
       std::optional<Built> none;
       count_plan = choose_plan(counts, straight, display, none);
@@ -563,7 +579,7 @@ FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
         };
         area += 0.5 * (corner(2) - corner(0)).cross(corner(3) - corner(1)).norm();
       }
-      least_quads = kLeastQuadShare * area / (mean_edge * mean_edge);
+      least_quads = one_edge_length ? kLeastQuadShare * area / (mean_edge * mean_edge) : 0.0;
     }
     const bool too_few = static_cast<double>(patch.mesh.face_count()) < *least_quads;
     if (!best_patch || key(patch, too_few) < key(*best_patch, best_coarse)) {
