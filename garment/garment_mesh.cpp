@@ -506,6 +506,59 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
     for (int k = 0; k < 4; ++k) garment.mesh.faces(static_cast<Eigen::Index>(f), k) = faces[f][static_cast<size_t>(k)];
   garment.face_panel = Eigen::Map<const Eigen::VectorXi>(face_panel.data(), static_cast<Eigen::Index>(face_panel.size()));
 
+  // Every vertex's quads must form one fan (joined through edges at the vertex): panels that
+  // touch only at a point are two curves drawn along one seam (the right side of a mirrored
+  // garment drawn again instead of naming the copy 'side.mirror'), and the mesh would not be a
+  // surface there.
+  {
+    std::vector<std::vector<int>> around(pool.positions.size());
+    for (size_t f = 0; f < faces.size(); ++f)
+      for (int v : faces[f]) around[static_cast<size_t>(v)].push_back(static_cast<int>(f));
+    for (size_t v = 0; v < around.size(); ++v) {
+      const std::vector<int>& fan = around[v];
+      if (fan.size() < 2) continue;
+      // The two neighbours of v in face f.
+      auto sides = [&](int f) {
+        const auto& q = faces[static_cast<size_t>(f)];
+        const size_t k = static_cast<size_t>(std::find(q.begin(), q.end(), static_cast<int>(v)) - q.begin());
+        return std::pair(q[(k + 1) % 4], q[(k + 3) % 4]);
+      };
+      std::vector<int> component(fan.size(), -1);
+      int components = 0;
+      for (size_t start = 0; start < fan.size(); ++start) {
+        if (component[start] >= 0) continue;
+        std::vector<size_t> stack{start};
+        component[start] = components;
+        while (!stack.empty()) {
+          const size_t a = stack.back();
+          stack.pop_back();
+          const auto [a1, a2] = sides(fan[a]);
+          for (size_t b = 0; b < fan.size(); ++b) {
+            if (component[b] >= 0) continue;
+            const auto [b1, b2] = sides(fan[b]);
+            if (a1 == b1 || a1 == b2 || a2 == b1 || a2 == b2) {
+              component[b] = components;
+              stack.push_back(b);
+            }
+          }
+        }
+        ++components;
+      }
+      if (components < 2) continue;
+      std::set<std::string> names;
+      for (int f : fan) names.insert(garment.panels[static_cast<size_t>(face_panel[static_cast<size_t>(f)])].id);
+      std::string list;
+      for (const std::string& name : names) list += (list.empty() ? "'" : ", '") + name + "'";
+      const Eigen::Vector3d& p = pool.positions[v];
+      sketch.fail("/panels",
+                  fmt::format("panels {} meet only at the point ({:.3f}, {:.3f}, {:.3f}) m, not along "
+                              "a seam: two curves there run along one seam without being one curve. "
+                              "Give both panels the same curve (on the other side of a mirrored "
+                              "garment, the copy '<curve>.mirror')",
+                              list, p.x(), p.y(), p.z()));
+    }
+  }
+
   // Seams must be traversed in opposite directions by their two panels.
   std::map<std::pair<int, int>, std::pair<int, int>> directed;  // (a, b) → (face, count)
   for (size_t f = 0; f < faces.size(); ++f)
