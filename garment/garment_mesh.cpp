@@ -89,7 +89,6 @@ int remove_doublets(std::vector<std::array<int, 4>>& faces, std::vector<int>& fa
   return removed;
 }
 
-
 // The unit vector area of a panel's boundary loop (the sides, corner to corner), or zero.
 Eigen::Vector3d loop_facing(const std::vector<Eigen::MatrixX3d>& side_points) {
   std::vector<Eigen::Vector3d> loop;
@@ -520,7 +519,8 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
       // The two neighbours of v in face f.
       auto sides = [&](int f) {
         const auto& q = faces[static_cast<size_t>(f)];
-        const size_t k = static_cast<size_t>(std::find(q.begin(), q.end(), static_cast<int>(v)) - q.begin());
+        const size_t k =
+            static_cast<size_t>(std::find(q.begin(), q.end(), static_cast<int>(v)) - q.begin());
         return std::pair(q[(k + 1) % 4], q[(k + 3) % 4]);
       };
       std::vector<int> component(fan.size(), -1);
@@ -546,16 +546,18 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
       }
       if (components < 2) continue;
       std::set<std::string> names;
-      for (int f : fan) names.insert(garment.panels[static_cast<size_t>(face_panel[static_cast<size_t>(f)])].id);
+      for (int f : fan)
+        names.insert(garment.panels[static_cast<size_t>(face_panel[static_cast<size_t>(f)])].id);
       std::string list;
       for (const std::string& name : names) list += (list.empty() ? "'" : ", '") + name + "'";
       const Eigen::Vector3d& p = pool.positions[v];
-      sketch.fail("/panels",
-                  fmt::format("panels {} meet only at the point ({:.3f}, {:.3f}, {:.3f}) m, not along "
-                              "a seam: two curves there run along one seam without being one curve. "
-                              "Give both panels the same curve (on the other side of a mirrored "
-                              "garment, the copy '<curve>.mirror')",
-                              list, p.x(), p.y(), p.z()));
+      sketch.fail(
+          "/panels",
+          fmt::format("panels {} meet only at the point ({:.3f}, {:.3f}, {:.3f}) m, not along "
+                      "a seam: two curves there run along one seam without being one curve. "
+                      "Give both panels the same curve (on the other side of a mirrored "
+                      "garment, the copy '<curve>.mirror')",
+                      list, p.x(), p.y(), p.z()));
     }
   }
 

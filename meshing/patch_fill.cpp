@@ -557,8 +557,8 @@ FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
   std::optional<FilledPatch> best_patch;
   bool best_coarse = false;
   std::optional<Plan> count_plan;  // chosen when first needed
-  for (int choice = 0; choice < 3 * kGeometryAttempts &&
-                       static_cast<int>(filled.size()) < kGeometryAttempts;
+  for (int choice = 0;
+       choice < 3 * kGeometryAttempts && static_cast<int>(filled.size()) < kGeometryAttempts;
        ++choice) {
     std::optional<Built> yasseen;
     Plan plan = choose_plan(counts, shape, side_points, yasseen, tried);
@@ -566,7 +566,8 @@ FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
       // After the first fill: the counts-only plan is the first alternative.
       std::optional<Built> none;
       count_plan = choose_plan(counts, straight, display, none);
-      if (std::none_of(tried.begin(), tried.end(), [&](const Plan& t) { return same(t, *count_plan); })) {
+      if (std::none_of(tried.begin(), tried.end(),
+                       [&](const Plan& t) { return same(t, *count_plan); })) {
         plan = *count_plan;
         yasseen.reset();
       }

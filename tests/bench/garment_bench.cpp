@@ -81,12 +81,16 @@ BENCHMARK_CAPTURE(mesh_example, godet_skirt, "godet-skirt.json")->Unit(benchmark
 BENCHMARK_CAPTURE(mesh_design, pencil_skirt, "pencil-skirt.json")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(mesh_design, vest, "vest.json")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(mesh_design, capelet, "capelet.json")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(mesh_design, one_shoulder_top, "one-shoulder-top.json")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(mesh_design, one_shoulder_top, "one-shoulder-top.json")
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(mesh_design, wrap_skirt, "wrap-skirt.json")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(mesh_design, vest_collar, "vest-collar.json")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(mesh_human_design, trousers_human, "trousers-human.json")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(mesh_human_design, jumpsuit_human, "jumpsuit-human.json")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(mesh_human_design, tee_dress_human, "tee-dress-human.json")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(mesh_human_design, trousers_human, "trousers-human.json")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(mesh_human_design, jumpsuit_human, "jumpsuit-human.json")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(mesh_human_design, tee_dress_human, "tee-dress-human.json")
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(body_surface_build)->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();
