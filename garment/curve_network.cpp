@@ -97,6 +97,24 @@ double arc_to(const Eigen::MatrixX3d& pts, bool closed, double param) {
   return length + (point_at(pts, closed, param) - pts.row(whole % pts.rows()).transpose()).norm();
 }
 
+// A curve whose every point is written at x = 0 (3D points, or a stroke in the front or back
+// view) is meant to lie on the plane of symmetry, however far its snap onto the body strays
+// from it: a centre seam snapped into the crotch of a body that is not exactly symmetric (the
+// Collada human) lands up to a centimetre to one side, and without its own mirror the panel and
+// its copy were not sewn along it (a mesh that touched itself at one vertex).
+bool written_on_plane(const Sketch& sketch, const std::string& id) {
+  for (const CurveSpec& spec : sketch.curves) {
+    if (spec.id != id) continue;
+    if (spec.is_3d())
+      return std::all_of(spec.points3d.begin(), spec.points3d.end(),
+                         [](const Eigen::Vector3d& p) { return p.x() == 0; });
+    const bool frontal = spec.view.kind == ViewKind::kFront || spec.view.kind == ViewKind::kBack;
+    return frontal && std::all_of(spec.points.begin(), spec.points.end(),
+                                  [](const Eigen::Vector2d& p) { return p.x() == 0; });
+  }
+  return false;
+}
+
 }  // namespace
 
 double polyline_length(const Eigen::MatrixX3d& points) {
@@ -152,7 +170,8 @@ CurveNetwork build_network(const Sketch& sketch, const std::vector<ProjectedCurv
     // On the plane means within a quarter of the junction tolerance everywhere (a stroke drawn
     // at x = 0 lands within a millimetre or two); a curve near the plane but off it (an inseam
     // along the inner thigh) keeps its own mirror copy.
-    if (w.mirrored && w.points.col(0).cwiseAbs().maxCoeff() < kOnPlaneFraction * tol) {
+    if (w.mirrored && (w.points.col(0).cwiseAbs().maxCoeff() < kOnPlaneFraction * tol ||
+                       written_on_plane(sketch, curves[c].id))) {
       w.on_plane = true;
       w.points.col(0).setZero();
     }

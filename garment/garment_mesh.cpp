@@ -37,6 +37,15 @@ constexpr double kSurfaceMaxStep = 0.5;     // edge lengths
 // m: an "auto" panel whose spanned surface stands farther than this off the body's offset
 // surface spans a hollow and is made "free"; otherwise it lies on the body.
 constexpr double kSpanGap = 0.03;
+// cos of the angle beyond which a closest body point faces away from its panel (100°): the
+// sides of a half-tube are perpendicular to its facing, so only the far side is refused.
+constexpr double kAgainstFacing = -0.17;
+// ... and the surface seen from the panel's side replaces it only when it is at most this many
+// times as far (a point in the middle of a limb is about as far from both sides; a panel that
+// wraps over the shoulder to its front has points much nearer the front than the back).
+constexpr double kSeenReach = 2.0;
+// A quad this many times longer than wide is a sliver (the quality gate warns from 10).
+constexpr double kSliverAspect = 10;
 
 // Global vertices of the garment: node and curve-piece vertices are made once and shared.
 struct VertexPool {
@@ -80,6 +89,16 @@ int remove_doublets(std::vector<std::array<int, 4>>& faces, std::vector<int>& fa
   return removed;
 }
 
+// The unit vector area of a panel's boundary loop (the sides, corner to corner), or zero.
+Eigen::Vector3d loop_facing(const std::vector<Eigen::MatrixX3d>& side_points) {
+  std::vector<Eigen::Vector3d> loop;
+  for (const auto& side : side_points)
+    for (Eigen::Index r = 0; r + 1 < side.rows(); ++r) loop.emplace_back(side.row(r).transpose());
+  Eigen::Vector3d area = Eigen::Vector3d::Zero();
+  for (size_t k = 0; k < loop.size(); ++k)
+    area += (loop[k] - loop.front()).cross(loop[(k + 1) % loop.size()] - loop.front());
+  return area.norm() > 0 ? Eigen::Vector3d(area.normalized()) : Eigen::Vector3d::Zero();
+}
 
 }  // namespace
 
@@ -265,13 +284,27 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
       // projection (a hash collision only gives a poorer hint, never another answer).
       std::unordered_map<std::int64_t, SurfacePoint> hints;
       const double cell = 0.5 * reach;
-      const auto closest = [&body, &hints, cell](const Eigen::Vector3d& p) {
+      // The panel faces `facing` (its boundary's vector area: the loop runs counter-clockwise
+      // seen from outside). A point whose closest body point faces the other way has crossed
+      // the limb or torso it lies on: the interior of a half-sleeve starts on the chord plane
+      // through the arm, where the far side of the arm can be nearest (a hole in the back of a
+      // long sleeve at the elbow). Such a point goes to the body's first surface seen from the
+      // panel's side instead: a ray from outside the body's box along −facing.
+      const Eigen::Vector3d facing = loop_facing(side_points);
+      const double outside = (body.box().max - body.box().min).norm();
+      const auto closest = [&body, &hints, cell, facing, outside](const Eigen::Vector3d& p) {
         const Eigen::Vector3d q = (p / cell).array().floor();
         const std::int64_t key = (static_cast<std::int64_t>(q.x()) * 73856093) ^
                                  (static_cast<std::int64_t>(q.y()) * 19349663) ^
                                  (static_cast<std::int64_t>(q.z()) * 83492791);
         SurfacePoint& hint = hints[key];
         hint = body.closest_point(p, hint);
+        if (hint.normal.dot(facing) < kAgainstFacing) {
+          if (const auto seen = body.first_hit(p + outside * facing, -facing);
+              seen && seen->normal.dot(facing) > 0 &&
+              (seen->position - p).norm() < kSeenReach * hint.distance)
+            return *seen;
+        }
         return hint;
       };
       const SurfaceLift lift = [&closest, offset, reach](const Eigen::Vector3d& p) -> LiftedPoint {
@@ -340,31 +373,42 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
         if (touches) span_over_obstacle(patch.mesh, fixed, push_out);
         patch.quality = meshing::measure_quality(patch.mesh, patch.topology.corner_vertices());
       }
+      // Candidates: the fill, its smoothing along the surface (body panels; see
+      // surface_relaxation.hpp), and each of those unfolded against the body's normals when it
+      // folds (surface_untangle.hpp). The best by the quality gate's measures wins: fewest folded
+      // quads, then no sliver (aspect ratio 10 or more: the t-shirt dress's back at 3 cm had a
+      // clean fill with two vertices on one spot at the armpit, and a smoothed mesh with one
+      // fold that unfolding removes), then the best worst corner.
+      const auto rank = [](const meshing::QuadQuality& q) {
+        return std::tuple(q.inverted_quads, q.max_aspect_ratio >= kSliverAspect,
+                          -q.scaled_jacobian_min);
+      };
+      const auto consider = [&](meshing::QuadMesh&& mesh, meshing::FilledPatch& best) {
+        const meshing::QuadQuality quality =
+            meshing::measure_quality(mesh, patch.topology.corner_vertices());
+        if (rank(quality) < rank(best.quality)) {
+          best.mesh = std::move(mesh);
+          best.quality = quality;
+        }
+      };
+      const auto unfold = [&](const meshing::QuadMesh& mesh) {
+        meshing::QuadMesh unfolded = mesh;
+        untangle_on_surface(unfolded, fixed, options.project, normal);
+        return unfolded;
+      };
+      meshing::FilledPatch best = patch;
+      if (patch.quality.inverted_quads > 0) consider(unfold(patch.mesh), best);
       if (fit == PanelFit::kBody) {
-        // Smooth along the surface (see surface_relaxation.hpp); kept when it leaves fewer
-        // folded quads, or as many and a better worst corner.
         meshing::QuadMesh relaxed = patch.mesh;
         relax_on_surface(relaxed, fixed, lift,
                          {kSurfaceSweeps, kSurfaceTolerance * reach, kSurfaceMaxStep * reach});
         const meshing::QuadQuality quality =
             meshing::measure_quality(relaxed, patch.topology.corner_vertices());
-        if (std::pair(quality.inverted_quads, -quality.scaled_jacobian_min) <
-            std::pair(patch.quality.inverted_quads, -patch.quality.scaled_jacobian_min)) {
-          patch.mesh = std::move(relaxed);
-          patch.quality = quality;
-        }
+        if (quality.inverted_quads > 0) consider(unfold(relaxed), best);
+        consider(std::move(relaxed), best);
       }
-      if (patch.quality.inverted_quads > 0) {
-        // Unfold against the body's normals, then measure again as the filler does; kept only
-        // when it leaves fewer folded quads by that measure.
-        meshing::QuadMesh unfolded = patch.mesh;
-        untangle_on_surface(unfolded, fixed, options.project, normal);
-        const meshing::QuadQuality quality = meshing::measure_quality(unfolded, patch.topology.corner_vertices());
-        if (quality.inverted_quads < patch.quality.inverted_quads) {
-          patch.mesh = std::move(unfolded);
-          patch.quality = quality;
-        }
-      }
+      patch.mesh = std::move(best.mesh);
+      patch.quality = best.quality;
       globals.assign(static_cast<size_t>(patch.mesh.vertex_count()), -1);
       for (size_t s = 0; s < patch.topology.side_vertices.size(); ++s)
         for (size_t j = 0; j < patch.topology.side_vertices[s].size(); ++j)
@@ -460,6 +504,62 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
   for (size_t f = 0; f < faces.size(); ++f)
     for (int k = 0; k < 4; ++k) garment.mesh.faces(static_cast<Eigen::Index>(f), k) = faces[f][static_cast<size_t>(k)];
   garment.face_panel = Eigen::Map<const Eigen::VectorXi>(face_panel.data(), static_cast<Eigen::Index>(face_panel.size()));
+
+  // Every vertex's quads must form one fan (joined through edges at the vertex): panels that
+  // touch only at a point are two curves drawn along one seam (the right side of a mirrored
+  // garment drawn again instead of naming the copy 'side.mirror'), and the mesh would not be a
+  // surface there.
+  {
+    std::vector<std::vector<int>> around(pool.positions.size());
+    for (size_t f = 0; f < faces.size(); ++f)
+      for (int v : faces[f]) around[static_cast<size_t>(v)].push_back(static_cast<int>(f));
+    for (size_t v = 0; v < around.size(); ++v) {
+      const std::vector<int>& fan = around[v];
+      if (fan.size() < 2) continue;
+      // The two neighbours of v in face f.
+      auto sides = [&](int f) {
+        const auto& q = faces[static_cast<size_t>(f)];
+        const size_t k =
+            static_cast<size_t>(std::find(q.begin(), q.end(), static_cast<int>(v)) - q.begin());
+        return std::pair(q[(k + 1) % 4], q[(k + 3) % 4]);
+      };
+      std::vector<int> component(fan.size(), -1);
+      int components = 0;
+      for (size_t start = 0; start < fan.size(); ++start) {
+        if (component[start] >= 0) continue;
+        std::vector<size_t> stack{start};
+        component[start] = components;
+        while (!stack.empty()) {
+          const size_t a = stack.back();
+          stack.pop_back();
+          const auto [a1, a2] = sides(fan[a]);
+          for (size_t b = 0; b < fan.size(); ++b) {
+            if (component[b] >= 0) continue;
+            const auto [b1, b2] = sides(fan[b]);
+            if (a1 == b1 || a1 == b2 || a2 == b1 || a2 == b2) {
+              component[b] = components;
+              stack.push_back(b);
+            }
+          }
+        }
+        ++components;
+      }
+      if (components < 2) continue;
+      std::set<std::string> names;
+      for (int f : fan)
+        names.insert(garment.panels[static_cast<size_t>(face_panel[static_cast<size_t>(f)])].id);
+      std::string list;
+      for (const std::string& name : names) list += (list.empty() ? "'" : ", '") + name + "'";
+      const Eigen::Vector3d& p = pool.positions[v];
+      sketch.fail(
+          "/panels",
+          fmt::format("panels {} meet only at the point ({:.3f}, {:.3f}, {:.3f}) m, not along "
+                      "a seam: two curves there run along one seam without being one curve. "
+                      "Give both panels the same curve (on the other side of a mirrored "
+                      "garment, the copy '<curve>.mirror')",
+                      list, p.x(), p.y(), p.z()));
+    }
+  }
 
   // Seams must be traversed in opposite directions by their two panels.
   std::map<std::pair<int, int>, std::pair<int, int>> directed;  // (a, b) → (face, count)

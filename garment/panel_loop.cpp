@@ -206,9 +206,12 @@ std::vector<PanelLoop> resolve_panels(const Sketch& sketch, const CurveNetwork& 
     }
     const size_t m = loop.edges.size();
 
-    // Orientation: counter-clockwise seen from outside, i.e. the loop's vector area agrees with
-    // the body normals at the boundary.
-    Eigen::Vector3d area = Eigen::Vector3d::Zero(), outward = Eigen::Vector3d::Zero();
+    // Orientation: counter-clockwise seen from outside, i.e. the panel is on the left of its
+    // boundary, n × t, at the body normal n: the sum of (n × t) · (c − p) over the boundary points
+    // p (c their centroid) is positive. (The loop's vector area against the summed normals, used
+    // before, has no reliable sign for a long twisted half-tube: a long sleeve down a forearm
+    // turned forward came out reversed against its armhole.)
+    double left = 0;
     std::vector<Eigen::Vector3d> boundary;
     for (const LoopEdge& e : loop.edges) {
       const Eigen::MatrixX3d pts = ordered_points(net, e);
@@ -217,11 +220,12 @@ std::vector<PanelLoop> resolve_panels(const Sketch& sketch, const CurveNetwork& 
     Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
     for (const auto& q : boundary) centroid += q;
     centroid /= static_cast<double>(boundary.size());
-    for (size_t k = 0; k < boundary.size(); ++k) {
-      area += (boundary[k] - centroid).cross(boundary[(k + 1) % boundary.size()] - centroid);
-      if (k % 4 == 0) outward += body.closest_point(boundary[k]).normal;
+    for (size_t k = 0; k < boundary.size(); k += 4) {
+      const Eigen::Vector3d n = body.closest_point(boundary[k]).normal;
+      const Eigen::Vector3d t = boundary[(k + 1) % boundary.size()] - boundary[k];
+      left += n.cross(t).dot(centroid - boundary[k]);
     }
-    if (area.dot(outward) < 0) {
+    if (left < 0) {
       std::reverse(loop.edges.begin(), loop.edges.end());
       for (LoopEdge& e : loop.edges) e.forward = !e.forward;
     }

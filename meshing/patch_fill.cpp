@@ -471,6 +471,18 @@ FilledPatch fill_with_plan(const Plan& plan, std::span<const int> counts,
 
 // Plans tried by the geometric fill before it settles for the one with fewest inverted quads.
 constexpr int kGeometryAttempts = 4;
+// A plan with fewer quads than this share of the region's area over its mean boundary edge
+// length squared has quads too large for its edges (mean area above 1.33 e², sides ~1.15 e).
+constexpr double kLeastQuadShare = 0.75;
+// ... and one with more than this share has quads too small (a padded plan with a ring too many:
+// the one-shoulder top's back, 408 quads at 2.5 cm against 401 at 2 cm).
+constexpr double kMostQuadShare = 1.4;
+// A quad this many times longer than wide is a sliver (the quality gate warns from 10): the
+// next plans are tried as for a fold.
+constexpr double kDegenerateAspect = 10;
+// Sides whose mean edge lengths differ by more than this factor have no single edge length to
+// size quads by.
+constexpr double kEdgeSpread = 1.5;
 
 }  // namespace
 
@@ -493,21 +505,98 @@ FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
   for (const auto& side : side_points) counts.push_back(static_cast<int>(side.rows()) - 1);
   check_counts(counts);
   const BoundaryShape shape = measured_shape(side_points);
+  // The plans are ranked by their corners and valences, not by the size of their quads: a plan
+  // with thin spokes can fill the region with a fraction of the quads its edges ask for (a
+  // raglan sleeve of sides (12, 8, 5, 21, 2): 62 quads of ~15 cm² for 3 cm edges, where 108
+  // fit, and counts that jump as edge_length changes). The first fill measures the region's
+  // area A; with the boundary's mean edge length e it asks for about A / e² quads, and a plan
+  // with fewer than kLeastQuadShare of those (or more than kMostQuadShare) is passed over for
+  // the next ones (found again by
+  // choose_plan with the others excluded), the counts-only plan among them.
+  // The target only means something when the boundary's edges have about one length, as a
+  // garment's do (each curve's count is its length over edge_length): sides whose mean edges
+  // differ by more than kEdgeSpread (a regular pentagon with 5 edges on one side and 2 on the
+  // next) ask for no particular count, and no plan is passed over for its quad count.
+  double boundary_length = 0, shortest_edge = 1e300, longest_edge = 0;
+  for (const auto& side : side_points) {
+    double length = 0;
+    for (Eigen::Index r = 0; r + 1 < side.rows(); ++r)
+      length += (side.row(r + 1) - side.row(r)).norm();
+    boundary_length += length;
+    shortest_edge = std::min(shortest_edge, length / static_cast<double>(side.rows() - 1));
+    longest_edge = std::max(longest_edge, length / static_cast<double>(side.rows() - 1));
+  }
+  const double mean_edge = boundary_length / std::accumulate(counts.begin(), counts.end(), 0);
+  const bool one_edge_length = longest_edge <= kEdgeSpread * shortest_edge;
+  const std::vector<Eigen::MatrixX3d> display = display_sides(counts);
+  const BoundaryShape straight = straight_sided_shape(counts);
+  const auto quads_of = [&](const Plan& plan) {
+    return static_cast<double>(realize(plan, counts, display, straight).builder.faces().size());
+  };
+  std::optional<double> asked;  // A / e², from the first fill (0: no single edge length)
+  const auto off_count = [&](double quads) {
+    return *asked > 0 && (quads < kLeastQuadShare * *asked || quads > kMostQuadShare * *asked);
+  };
+  const auto same = [](const Plan& x, const Plan& y) {
+    return x.yasseen == y.yasseen && x.strips == y.strips && x.strip_corners == y.strip_corners &&
+           x.partition == y.partition;
+  };
+  // Fewer folds first, then no degenerate quad (a sliver the body's shape squeezed), then a plan
+  // with enough quads.
+  // with enough quads. (Slivers count only when the edges have one length: with 1 edge on one
+  // side and 6 on the next, aspect ratios of 6 and more belong to the region).
+  const auto key = [&](const FilledPatch& patch, bool coarse) {
+    return std::tuple(patch.quality.inverted_quads,
+                      one_edge_length && patch.quality.max_aspect_ratio >= kDegenerateAspect,
+                      coarse);
+  };
   // When the relaxed mesh still has inverted quads (a layout whose blocks start overlapping
   // near a reflex corner that relaxation and untangling could not undo), the next best plans
   // are tried; the first without inverted quads wins, else the one with fewest.
-  std::vector<Plan> tried;
+  std::vector<Plan> tried, filled;
   std::optional<FilledPatch> best_patch;
-  for (int attempt = 0; attempt < kGeometryAttempts; ++attempt) {
+  bool best_coarse = false;
+  std::optional<Plan> count_plan;  // chosen when first needed
+  for (int choice = 0;
+       choice < 3 * kGeometryAttempts && static_cast<int>(filled.size()) < kGeometryAttempts;
+       ++choice) {
     std::optional<Built> yasseen;
-    const Plan plan = choose_plan(counts, shape, side_points, yasseen, tried);
+    Plan plan = choose_plan(counts, shape, side_points, yasseen, tried);
+    if (asked && *asked > 0 && !count_plan) {
+      // After the first fill: the counts-only plan is the first alternative.
+      std::optional<Built> none;
+      count_plan = choose_plan(counts, straight, display, none);
+      if (std::none_of(tried.begin(), tried.end(),
+                       [&](const Plan& t) { return same(t, *count_plan); })) {
+        plan = *count_plan;
+        yasseen.reset();
+      }
+    }
     if (plan.folded == std::numeric_limits<int>::max()) break;  // nothing left to try
+    const bool coarse = asked && off_count(quads_of(plan));
+    if (coarse) {
+      tried.push_back(plan);  // passed over, not filled
+      continue;
+    }
     FilledPatch patch = fill_with_plan(plan, counts, side_points, shape, yasseen, options);
-    const bool clean = patch.quality.inverted_quads == 0;
-    if (!best_patch || patch.quality.inverted_quads < best_patch->quality.inverted_quads)
+    if (!asked) {
+      double area = 0;
+      for (Eigen::Index f = 0; f < patch.mesh.face_count(); ++f) {
+        const auto corner = [&](int k) -> Eigen::Vector3d {
+          return patch.mesh.vertices.row(patch.mesh.faces(f, k)).transpose();
+        };
+        area += 0.5 * (corner(2) - corner(0)).cross(corner(3) - corner(1)).norm();
+      }
+      asked = one_edge_length ? area / (mean_edge * mean_edge) : 0.0;
+    }
+    const bool too_few = off_count(static_cast<double>(patch.mesh.face_count()));
+    if (!best_patch || key(patch, too_few) < key(*best_patch, best_coarse)) {
       best_patch = std::move(patch);
-    if (clean) break;
+      best_coarse = too_few;
+    }
+    if (key(*best_patch, best_coarse) == std::tuple(0, false, false)) break;
     tried.push_back(plan);
+    filled.push_back(plan);
   }
   // Every plan tried keeps inverted quads: relax the best of them again with reference normals
   // taken after the unguarded sweeps, which untangle the large overlapping clusters the starting
@@ -517,9 +606,9 @@ FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
   // smoothing turns into a quad of aspect 24). Only the best plan: retrying all of them also
   // cleans 5 more of the 210° chevrons of the concave test (20 instead of 25 of 648 keep a fold)
   // but cost the t-shirt's and the shorts' backs, which no plan cleans, 20 and 9 ms of meshing.
-  if (!tried.empty() && best_patch->quality.inverted_quads > 0) {
+  if (!filled.empty() && best_patch->quality.inverted_quads > 0) {
     std::optional<Built> none;
-    FilledPatch patch = fill_with_plan(tried.front(), counts, side_points, shape, none, options,
+    FilledPatch patch = fill_with_plan(filled.front(), counts, side_points, shape, none, options,
                                        detail::ReferenceNormals::kAfterSweeps);
     if (patch.quality.inverted_quads == 0) best_patch = std::move(patch);
   }

@@ -11,6 +11,7 @@
 #include "garment/body_surface.hpp"
 #include "garment/garment_mesh.hpp"
 #include "garment/sketch_file.hpp"
+#include "garment/sketch_inputs.hpp"
 
 namespace {
 
@@ -42,6 +43,26 @@ void mesh_design(benchmark::State& state, const char* name) {
   mesh_file(state, std::filesystem::path(SD_SOURCE_DIR) / "data/designs" / name);
 }
 
+// The designs on the second body, Debian's Collada human (skipped when it is not installed).
+void mesh_human_design(benchmark::State& state, const char* name) {
+  const std::filesystem::path file = std::filesystem::path(SD_SOURCE_DIR) / "data/designs" / name;
+  const sd::garment::Sketch sketch = sd::garment::load_sketch(file);
+  if (!std::filesystem::exists(sketch.resolve(sketch.body.mesh))) {
+    state.SkipWithError("the Collada human (assimp-testmodels) is not installed");
+    return;
+  }
+  static const sd::garment::Body body = sd::garment::load_sketch_body(sketch);
+  static const sd::garment::BodySurface human(body.mesh);
+  long quads = 0;
+  for (auto _ : state) {
+    const sd::garment::Sketch parsed = sd::garment::load_sketch(file);
+    const sd::garment::Garment g = sd::garment::build_garment(parsed, human);
+    quads = static_cast<long>(g.mesh.face_count());
+    benchmark::DoNotOptimize(g.mesh.vertices.data());
+  }
+  state.counters["quads"] = static_cast<double>(quads);
+}
+
 void body_surface_build(benchmark::State& state) {
   static const sd::garment::Body body = sd::garment::load_body("builtin");
   for (auto _ : state) {
@@ -60,6 +81,16 @@ BENCHMARK_CAPTURE(mesh_example, godet_skirt, "godet-skirt.json")->Unit(benchmark
 BENCHMARK_CAPTURE(mesh_design, pencil_skirt, "pencil-skirt.json")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(mesh_design, vest, "vest.json")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(mesh_design, capelet, "capelet.json")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(mesh_design, one_shoulder_top, "one-shoulder-top.json")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(mesh_design, wrap_skirt, "wrap-skirt.json")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(mesh_design, vest_collar, "vest-collar.json")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(mesh_human_design, trousers_human, "trousers-human.json")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(mesh_human_design, jumpsuit_human, "jumpsuit-human.json")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(mesh_human_design, tee_dress_human, "tee-dress-human.json")
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(body_surface_build)->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();

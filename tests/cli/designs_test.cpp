@@ -1,8 +1,9 @@
 // The design corpus (data/designs/): garments written from the docs, on the built-in body and
 // on a second one (Debian's Collada human). Each meshes under `mesh --strict` (no quality
-// warning) with no folded quad and every quad's aspect ratio below 10; a subset drapes to rest
-// with no cloth vertex inside the body, and the skirts that span the legs have no slice dent
-// deeper than 3 cm (docs/garment.md, "Panel surfaces").
+// warning) with no folded quad and every quad's aspect ratio below 10; most drape to rest with
+// no cloth vertex inside the body, and the skirts that span the legs have no slice dent deeper
+// than 3 cm (docs/garment.md, "Panel surfaces"). data/designs/repro/ (not read here) holds the
+// attempts that do not pass the gate and the simulator's reproducers.
 
 #include <gtest/gtest.h>
 
@@ -80,40 +81,76 @@ TEST_P(Design, MeshesWithoutQualityWarnings) {
 
 INSTANTIATE_TEST_SUITE_P(Corpus, Design, ::testing::ValuesIn(design_names()), test_name);
 
-// Drapes of a subset (each a few seconds): one skirt per body.
+// Drapes: the two straight skirts (which also must not dent between the legs) and the designs
+// added with them, each to rest with no cloth vertex inside the body. Wall time of each drape,
+// measured on the 2-core machine loaded by parallel builds (26 November 2026): pencil 6 s,
+// straight-skirt-human 10 s, one-shoulder-top 4 s, trousers-human 6 s, wrap-skirt 7 s,
+// long-sleeve-tee 10 s, jumpsuit-human 8 s, vest-collar 8 s, tee-dress-human 14 s: about 75 s
+// in all. Not draped here
+// (docs/garment.md, "Design corpus"; they rest, left out for CI time): capelet 7 s,
+// circle-skirt 13 s, vest 7 s, vest-human 5 s.
 class DesignDrape : public ::testing::TestWithParam<std::string> {};
 
-TEST_P(DesignDrape, RestsOutsideTheBodyWithoutADentBetweenTheLegs) {
-  const std::string& name = GetParam();
-  if (!body_available(name)) GTEST_SKIP() << "the design's body is not installed";
+nlohmann::json drape(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / "sd_designs_drape" / name;
   const fs::path sketch = staged_design(name, dir);
   const CommandResult ran =
       run_sketchdrape("-q run " + sketch.string() + " -o " + (dir / "run").string());
-  ASSERT_EQ(ran.exit_code, 0) << ran.output;
-  const nlohmann::json report = read_json(dir / "run" / "report.json");
+  EXPECT_EQ(ran.exit_code, 0) << ran.output;
+  nlohmann::json report =
+      ran.exit_code == 0 ? read_json(dir / "run" / "report.json") : nlohmann::json();
+  fs::remove_all(dir);
+  return report;
+}
+
+void expect_at_rest_outside_the_body(const nlohmann::json& report) {
+  ASSERT_FALSE(report.is_null());
   EXPECT_TRUE(report["at_rest"].get<bool>());
   EXPECT_EQ(report["penetrating_vertices_final"].get<int>(), 0);
   EXPECT_LT(report["rest"]["speed_window_m_s"].get<double>(),
             report["rest"]["speed_limit_m_s"].get<double>());
-  EXPECT_LE(report["slice_dent"]["depth_m"].get<double>(), 0.03);
-  fs::remove_all(dir);
+}
+
+TEST_P(DesignDrape, RestsOutsideTheBodyWithoutADentBetweenTheLegs) {
+  const std::string& name = GetParam();
+  if (!body_available(name)) GTEST_SKIP() << "the design's body is not installed";
+  const nlohmann::json report = drape(name);
+  expect_at_rest_outside_the_body(report);
+  if (!report.is_null()) {
+    EXPECT_LE(report["slice_dent"]["depth_m"].get<double>(), 0.03);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Skirts, DesignDrape,
-                         ::testing::Values("pencil-skirt", "straight-skirt-human"), test_name);
+                         ::testing::Values("pencil-skirt", "straight-skirt-human", "wrap-skirt"),
+                         test_name);
 
-// The quality gate: the t-shirt example's back has folded quads at the armpit (docs/garment.md),
-// which validate reports with its place and landmark and --strict turns into exit code 1.
+class DesignDrapeTop : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(DesignDrapeTop, RestsOutsideTheBody) {
+  const std::string& name = GetParam();
+  if (!body_available(name)) GTEST_SKIP() << "the design's body is not installed";
+  expect_at_rest_outside_the_body(drape(name));
+}
+
+// Trousers and the jumpsuit dent between the legs by design (they go round each leg), and the
+// dress's bodice is a top: only rest and penetration are checked.
+INSTANTIATE_TEST_SUITE_P(Corpus, DesignDrapeTop,
+                         ::testing::Values("one-shoulder-top", "long-sleeve-tee", "trousers-human",
+                                           "jumpsuit-human", "vest-collar", "tee-dress-human"),
+                         test_name);
+
+// The quality gate: the shorts example's back has a folded quad (docs/garment.md), which
+// validate reports with its place and landmark and --strict turns into exit code 1.
 TEST(QualityGateCli, StrictMakesWarningsFail) {
-  const std::string tshirt = (fs::path(SD_SOURCE_DIR) / "data/examples/tshirt.json").string();
-  const CommandResult plain = run_sketchdrape("validate " + tshirt);
+  const std::string shorts = (fs::path(SD_SOURCE_DIR) / "data/examples/shorts.json").string();
+  const CommandResult plain = run_sketchdrape("validate " + shorts);
   EXPECT_EQ(plain.exit_code, 0) << plain.output;
-  EXPECT_NE(plain.output.find("panel 'back': 2 quad(s) fold over"), std::string::npos)
+  EXPECT_NE(plain.output.find("panel 'back': 1 quad(s) fold over"), std::string::npos)
       << plain.output;
-  EXPECT_NE(plain.output.find("near the left_armpit"), std::string::npos) << plain.output;
+  EXPECT_NE(plain.output.find("near the "), std::string::npos) << plain.output;
   EXPECT_NE(plain.output.find("mesh quality warning(s)"), std::string::npos) << plain.output;
-  const CommandResult strict = run_sketchdrape("validate --strict " + tshirt);
+  const CommandResult strict = run_sketchdrape("validate --strict " + shorts);
   EXPECT_EQ(strict.exit_code, 1) << strict.output;
 }
 
