@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -103,6 +104,11 @@ struct BoundaryShape {
   std::vector<char> reflex;  // interior angle above 180°: one quad there is folded
   std::vector<char> flat;    // interior angle above kFlatDegrees (reflex included)
   bool measured = false;     // from real side points (not the count-only assumption)
+  // Every boundary vertex within 1e-9 of the boundary's extent from the plane through the
+  // first one square to `normal`: a fill without projection then lies in that plane, and a
+  // quad turning the wrong way about `normal` is folded even when its neighbours turned with
+  // it (measure_quality's vertex normals cannot see such a cluster).
+  bool planar = false;
 };
 
 // A quad corner wider than this is treated as flat (a side vertex of valence 2 on a straight
@@ -135,6 +141,12 @@ BoundaryShape measured_shape(const std::vector<Eigen::MatrixX3d>& side_points) {
     newell += (loop[k] - origin).cross(loop[(k + 1) % size] - origin);
   if (newell.norm() > 0) shape.normal = newell.normalized();
   shape.measured = true;
+  double extent = 0, off_plane = 0;
+  for (const Eigen::Vector3d& p : loop) {
+    extent = std::max(extent, (p - origin).norm());
+    off_plane = std::max(off_plane, std::abs((p - origin).dot(shape.normal)));
+  }
+  shape.planar = newell.norm() > 0 && off_plane <= 1e-9 * extent;
   shape.reflex.assign(size, 0);
   shape.flat.assign(size, 0);
   for (size_t k = 0; k < size; ++k) {
@@ -469,8 +481,54 @@ FilledPatch fill_with_plan(const Plan& plan, std::span<const int> counts,
                            const FillGeometryOptions& options,
                            detail::ReferenceNormals reference = detail::ReferenceNormals::kStart);
 
+// Quads with a corner turning clockwise about `normal` (beyond rounding: a sine below −1e-9).
+int quads_turned_against(const QuadMesh& mesh, const Eigen::Vector3d& normal) {
+  int turned = 0;
+  for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f) {
+    bool against = false;
+    for (int k = 0; k < 4 && !against; ++k) {
+      const Eigen::Vector3d p = mesh.vertices.row(mesh.faces(f, k)).transpose();
+      const Eigen::Vector3d a = mesh.vertices.row(mesh.faces(f, (k + 1) % 4)).transpose() - p;
+      const Eigen::Vector3d b = mesh.vertices.row(mesh.faces(f, (k + 3) % 4)).transpose() - p;
+      against = normal.dot(a.cross(b)) < -1e-9 * a.norm() * b.norm();
+    }
+    turned += against ? 1 : 0;
+  }
+  return turned;
+}
+
 // Plans tried by the geometric fill before it settles for the one with fewest inverted quads.
 constexpr int kGeometryAttempts = 4;
+
+// The foldover-free placement of a patch's interior in the plane square to `normal` (then
+// projected, when the options project); true, with the patch updated, when no quad is
+// inverted afterwards.
+bool untangle_planar(FilledPatch& patch, const Eigen::Vector3d& normal,
+                     const FillGeometryOptions& options) {
+  const auto nv = static_cast<size_t>(patch.mesh.vertices.rows());
+  std::vector<Eigen::Vector3d> positions(nv);
+  for (size_t v = 0; v < nv; ++v)
+    positions[v] = patch.mesh.vertices.row(static_cast<Eigen::Index>(v)).transpose();
+  std::vector<std::array<int, 4>> quads(static_cast<size_t>(patch.mesh.faces.rows()));
+  for (size_t f = 0; f < quads.size(); ++f)
+    for (int k = 0; k < 4; ++k)
+      quads[f][static_cast<size_t>(k)] = patch.mesh.faces(static_cast<Eigen::Index>(f), k);
+  std::vector<char> fixed(nv, 0);
+  for (const auto& side : patch.topology.side_vertices)
+    for (const int v : side) fixed[static_cast<size_t>(v)] = 1;
+  if (!detail::untangle_in_plane(positions, quads, fixed, normal)) return false;
+  QuadMesh mesh = patch.mesh;
+  for (size_t v = 0; v < nv; ++v) {
+    if (!fixed[v] && options.project) positions[v] = options.project(positions[v]);
+    mesh.vertices.row(static_cast<Eigen::Index>(v)) = positions[v].transpose();
+  }
+  QuadQuality quality = measure_quality(mesh, patch.topology.corner_vertices());
+  if (quality.inverted_quads > 0 || (!options.project && quads_turned_against(mesh, normal) > 0))
+    return false;
+  patch.mesh = std::move(mesh);
+  patch.quality = quality;
+  return true;
+}
 
 }  // namespace
 
@@ -523,6 +581,22 @@ FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
                                        detail::ReferenceNormals::kAfterSweeps);
     if (patch.quality.inverted_quads == 0) best_patch = std::move(patch);
   }
+  // Still folded: a foldover-free placement of the same connectivity in the boundary's plane
+  // (a barrier on every quad corner's signed area, detail::untangle_in_plane), on the best
+  // patch first and then on the other plans tried. Relaxation and the pattern search above
+  // only ever look at one vertex or one sweep at a time; a thin chevron next to a 210° reflex
+  // corner needs a whole row to move together. Last, so that no fill that comes out clean
+  // before changes; taken only when it comes out clean.
+  if (best_patch->quality.inverted_quads > 0) {
+    std::vector<FilledPatch> candidates;
+    candidates.push_back(*best_patch);
+    for (const Plan& plan : tried) {
+      std::optional<Built> none;
+      candidates.push_back(fill_with_plan(plan, counts, side_points, shape, none, options));
+    }
+    for (FilledPatch& candidate : candidates)
+      if (untangle_planar(candidate, shape.normal, options)) return std::move(candidate);
+  }
   return std::move(*best_patch);
 }
 
@@ -551,6 +625,9 @@ FilledPatch fill_with_plan(const Plan& plan, std::span<const int> counts,
   if (patch.mesh.faces != patch.topology.mesh.faces)
     throw std::logic_error("the fill's connectivity depends on geometry");
   patch.quality = measure_quality(patch.mesh, patch.topology.corner_vertices());
+  if (shape.planar && !options.project)
+    patch.quality.inverted_quads =
+        std::max(patch.quality.inverted_quads, quads_turned_against(patch.mesh, shape.normal));
   return patch;
 }
 

@@ -172,7 +172,8 @@ TEST_P(PatchFillNotched, NoCountVectorFolds) {
 }
 
 INSTANTIATE_TEST_SUITE_P(SharpReflexCorner, PatchFillNotched,
-                         ::testing::Values(std::tuple(4, 200.0), std::tuple(5, 200.0)));
+                         ::testing::Values(std::tuple(4, 200.0), std::tuple(5, 200.0),
+                                           std::tuple(4, 210.0), std::tuple(5, 210.0)));
 
 }  // namespace
 }  // namespace sd::meshing
