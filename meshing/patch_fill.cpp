@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 #include <tuple>
+#include <utility>
 
 #include "meshing/patch_relaxation.hpp"
 #include "meshing/quad_layout.hpp"
@@ -497,6 +498,152 @@ int quads_turned_against(const QuadMesh& mesh, const Eigen::Vector3d& normal) {
   return turned;
 }
 
+// Thin quads on a flat boundary: the barrier placement below, on the quads with a corner under
+// kThinQuadDeg and kThinQuadRings rings of free vertices around them. Laplacian relaxation
+// settles on thin quads where a short side meets a long one or next to a reflex corner; the
+// placement's energy is smallest for square corners and infinite for folded ones.
+constexpr double kThinQuadDeg = 15;
+constexpr int kThinQuadRings = 2;
+
+// Smallest corner angle of each quad about `normal`, in degrees (negative turns give < 0).
+std::vector<double> quad_min_angles(const QuadMesh& mesh, const Eigen::Vector3d& normal) {
+  std::vector<double> angles(static_cast<size_t>(mesh.faces.rows()), 180);
+  for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f)
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector3d p = mesh.vertices.row(mesh.faces(f, k)).transpose();
+      const Eigen::Vector3d a = mesh.vertices.row(mesh.faces(f, (k + 1) % 4)).transpose() - p;
+      const Eigen::Vector3d b = mesh.vertices.row(mesh.faces(f, (k + 3) % 4)).transpose() - p;
+      const double degrees = std::atan2(normal.dot(a.cross(b)), a.dot(b)) * 180 / std::numbers::pi;
+      angles[static_cast<size_t>(f)] = std::min(angles[static_cast<size_t>(f)], degrees);
+    }
+  return angles;
+}
+
+// On a clean fill of a flat boundary without projection, moves the free vertices near its
+// thinnest quads to the barrier placement of the quads around them (the rest fixed); kept only
+// when the smallest angle of the whole patch rises and nothing folds.
+void widen_thin_quads(FilledPatch& patch, const Eigen::Vector3d& normal) {
+  const QuadMesh& mesh = patch.mesh;
+  const auto nv = static_cast<size_t>(mesh.vertices.rows());
+  const std::vector<double> angles = quad_min_angles(mesh, normal);
+  const double before = *std::min_element(angles.begin(), angles.end());
+  if (before >= kThinQuadDeg) return;
+  std::vector<char> boundary(nv, 0);
+  for (const auto& side : patch.topology.side_vertices)
+    for (const int v : side) boundary[static_cast<size_t>(v)] = 1;
+  std::vector<std::vector<int>> faces_at(nv);
+  for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f)
+    for (int k = 0; k < 4; ++k)
+      faces_at[static_cast<size_t>(mesh.faces(f, k))].push_back(static_cast<int>(f));
+  std::vector<char> moving(nv, 0);
+  std::vector<int> front;
+  auto take = [&](int f) {
+    for (int k = 0; k < 4; ++k) {
+      const auto v = static_cast<size_t>(mesh.faces(f, k));
+      if (!boundary[v] && !moving[v]) {
+        moving[v] = 1;
+        front.push_back(static_cast<int>(v));
+      }
+    }
+  };
+  for (size_t f = 0; f < angles.size(); ++f)
+    if (angles[f] < kThinQuadDeg) take(static_cast<int>(f));
+  for (int ring = 0; ring < kThinQuadRings; ++ring) {
+    const std::vector<int> last = std::move(front);
+    front.clear();
+    for (const int v : last)
+      for (const int f : faces_at[static_cast<size_t>(v)]) take(f);
+  }
+  std::vector<std::array<int, 4>> window;
+  std::vector<char> window_face(static_cast<size_t>(mesh.faces.rows()), 0);
+  for (size_t v = 0; v < nv; ++v)
+    if (moving[v])
+      for (const int f : faces_at[v])
+        if (!std::exchange(window_face[static_cast<size_t>(f)], 1))
+          window.push_back(
+              {mesh.faces(f, 0), mesh.faces(f, 1), mesh.faces(f, 2), mesh.faces(f, 3)});
+  if (window.empty()) return;  // the thin quads have no free vertex
+  std::vector<Eigen::Vector3d> positions(nv);
+  for (size_t v = 0; v < nv; ++v)
+    positions[v] = mesh.vertices.row(static_cast<Eigen::Index>(v)).transpose();
+  std::vector<char> fixed(nv);
+  for (size_t v = 0; v < nv; ++v) fixed[v] = moving[v] ? 0 : 1;
+  // The figure to raise: the smallest corner angle, and at interior vertices also
+  // 180° minus the largest (a corner near 180° is as degenerate; on the boundary it is the
+  // boundary's own angle where a side vertex has one quad).
+  auto corner_score = [&](int f, int k) {
+    const auto at = static_cast<size_t>(mesh.faces(f, k));
+    const Eigen::Vector3d& p = positions[at];
+    const Eigen::Vector3d a = positions[static_cast<size_t>(mesh.faces(f, (k + 1) % 4))] - p;
+    const Eigen::Vector3d b = positions[static_cast<size_t>(mesh.faces(f, (k + 3) % 4))] - p;
+    const double angle = std::atan2(normal.dot(a.cross(b)), a.dot(b));
+    return boundary[at] ? angle : std::min(angle, std::numbers::pi - angle);
+  };
+  auto smallest_at = [&](size_t v) {
+    double smallest = std::numbers::pi;
+    for (const int f : faces_at[v])
+      for (int k = 0; k < 4; ++k) smallest = std::min(smallest, corner_score(f, k));
+    return smallest;
+  };
+  auto smallest_overall = [&] {
+    double smallest = std::numbers::pi;
+    for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f)
+      for (int k = 0; k < 4; ++k)
+        smallest = std::min(smallest, corner_score(static_cast<int>(f), k));
+    return smallest;
+  };
+  const double score_before = smallest_overall();
+  if (!detail::untangle_in_plane(positions, window, fixed, normal)) return;
+  // Then raise that figure itself: each moving vertex by a pattern search (8 directions, step
+  // halving) that accepts a move only when the figure over its quads rises.
+  const Eigen::Vector3d t1 = normal.unitOrthogonal(), t2 = normal.cross(t1);
+  for (int pass = 0; pass < 20; ++pass) {
+    bool moved = false;
+    for (size_t v = 0; v < nv; ++v) {
+      if (!moving[v]) continue;
+      double length = 0;
+      int edges = 0;
+      for (const int f : faces_at[v])
+        for (int k = 0; k < 4; ++k)
+          if (static_cast<size_t>(mesh.faces(f, k)) == v) {
+            length +=
+                (positions[static_cast<size_t>(mesh.faces(f, (k + 1) % 4))] - positions[v]).norm();
+            ++edges;
+          }
+      double step = 0.25 * length / std::max(edges, 1), current = smallest_at(v);
+      for (int halving = 0; halving < 8; ++halving) {
+        const Eigen::Vector3d start = positions[v];
+        Eigen::Vector3d best_position = start;
+        double best = current;
+        for (int k = 0; k < 8; ++k) {
+          const double angle = k * std::numbers::pi / 4;
+          positions[v] = start + step * (std::cos(angle) * t1 + std::sin(angle) * t2);
+          if (const double value = smallest_at(v); value > best + 1e-9) {
+            best = value;
+            best_position = positions[v];
+          }
+        }
+        positions[v] = best_position;
+        if (best > current) {
+          moved = moved || best > current + 1e-4;
+          current = best;
+        } else {
+          step *= 0.5;
+        }
+      }
+    }
+    if (!moved) break;
+  }
+  if (smallest_overall() <= score_before) return;
+  QuadMesh widened = mesh;
+  for (size_t v = 0; v < nv; ++v)
+    widened.vertices.row(static_cast<Eigen::Index>(v)) = positions[v].transpose();
+  QuadQuality quality = measure_quality(widened, patch.topology.corner_vertices());
+  if (quality.inverted_quads > 0) return;
+  patch.mesh = std::move(widened);
+  patch.quality = quality;
+}
+
 // Plans tried by the geometric fill before it settles for the one with fewest inverted quads.
 constexpr int kGeometryAttempts = 4;
 
@@ -595,8 +742,13 @@ FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
       candidates.push_back(fill_with_plan(plan, counts, side_points, shape, none, options));
     }
     for (FilledPatch& candidate : candidates)
-      if (untangle_planar(candidate, shape.normal, options)) return std::move(candidate);
+      if (untangle_planar(candidate, shape.normal, options)) {
+        best_patch = std::move(candidate);
+        break;
+      }
   }
+  if (shape.planar && !options.project && best_patch->quality.inverted_quads == 0)
+    widen_thin_quads(*best_patch, shape.normal);
   return std::move(*best_patch);
 }
 
