@@ -532,7 +532,7 @@ double untangling_energy(std::span<const Eigen::Vector2d> x,
 
 bool untangle_in_plane(std::vector<Eigen::Vector3d>& positions,
                        std::span<const std::array<int, 4>> quads, std::span<const char> fixed,
-                       const Eigen::Vector3d& normal) {
+                       const Eigen::Vector3d& normal, int rounds, int steps) {
   if (quads.empty()) return true;
   const Eigen::Vector3d u = normal.unitOrthogonal(), w = normal.cross(u);
   std::vector<Eigen::Vector2d> x(positions.size());
@@ -554,11 +554,10 @@ bool untangle_in_plane(std::vector<Eigen::Vector3d>& positions,
   // decrease of the energy; a small ε once every corner is positive.
   double worst = smallest_corner(x, quads, h);
   double epsilon = std::sqrt(1e-8 + 0.04 * std::pow(std::min(worst, 0.0), 2));
-  constexpr int kRounds = 60, kSteps = 200;
   bool clean = false;
-  for (int round = 0; round < kRounds; ++round) {
+  for (int round = 0; round < rounds; ++round) {
     const double before = untangling_energy(x, quads, h, epsilon);
-    minimise(x, quads, free, h, epsilon, kSteps);
+    minimise(x, quads, free, h, epsilon, steps);
     const double after = untangling_energy(x, quads, h, epsilon);
     worst = smallest_corner(x, quads, h);
     const double sigma = std::max(1 - after / before, 0.1);

@@ -54,9 +54,11 @@ void relax_interior(std::vector<Eigen::Vector3d>& positions,
 // they stay so. Each vertex keeps its height along `normal`. Returns true, with the positions
 // moved, when every corner ends with det J > 0 (every quad strictly convex and unfolded);
 // false leaves the positions as they were.
+// `rounds` bounds the minimisations and `steps` the L-BFGS steps of each: 60 of 200 to untangle;
+// a start without folds needs far fewer to settle.
 bool untangle_in_plane(std::vector<Eigen::Vector3d>& positions,
                        std::span<const std::array<int, 4>> quads, std::span<const char> fixed,
-                       const Eigen::Vector3d& normal);
+                       const Eigen::Vector3d& normal, int rounds = 60, int steps = 200);
 
 // The energy above for 2D positions (#V), and its gradient (#V, fixed vertices included) when
 // `gradient` is given; exposed for the finite-difference test.

@@ -19,16 +19,17 @@ namespace {
 
 // Smallest quad angle on a straight-sided regular polygon (and the circle for n = 2), and the
 // largest one below 180° by as much. Was 12° before the rectilinear layouts: their lower
-// distortion sometimes forces thinner quads (n = 6: 11.6°, n = 7: 8.8°, n = 8: 10.8°; e.g. the
-// heptagon (3,1,2,4,1,1,6) at distortion 3 = |n − 4| is a strip one quad wide).
+// distortion sometimes forces thinner quads, and widening thin quads cannot help where all four
+// vertices are on the boundary: the n = 7 minimum, 8.8° in (3,3,2,6,1,6,5), and the n = 8 one,
+// 10.8° in (2,1,3,3,6,1,5,1), are such quads (strips one quad wide at the least distortion).
 constexpr double kMinAngleConvexDeg = 8.5;
 // In a quad at a flat vertex (180°), the other three angles share 180°.
 constexpr double kMinAngleAtFlatDeg = 8;
 // On the notched shapes below: concave sides and a reflex corner. Was 10° before the
-// rectilinear layouts, 8.5° with them (n = 7 reached 9.98°, n = 4 at 210° 0.9°); 11° since fills
-// of flat boundaries widen their thin quads (n = 4 at 200° and 210°: 11.0°, 11.2°; the rest 12.0°
-// and above).
-constexpr double kMinAngleConcaveDeg = 11;
+// rectilinear layouts, 8.5° with them (n = 7 reached 9.98°, n = 4 at 210° 0.9°); 10° again since
+// flat fills widen their thin quads (n = 4 at 210°: 10.5°, at 195°: 11.5°, the rest 12.5° and
+// above).
+constexpr double kMinAngleConcaveDeg = 10;
 
 // Quad angles of a flat (z = 0) patch, split by whether the quad has a *flat vertex*: a side
 // vertex of valence 2, whose one quad takes the boundary's own angle (180° on a straight side).
