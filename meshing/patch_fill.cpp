@@ -732,19 +732,16 @@ FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
   // only ever look at one vertex or one sweep at a time; a thin chevron next to a 210° reflex
   // corner needs a whole row to move together. Last, so that no fill that comes out clean
   // before changes; taken only when it comes out clean.
-  if (best_patch->quality.inverted_quads > 0) {
-    std::vector<FilledPatch> candidates;
-    candidates.push_back(*best_patch);
-    for (const Plan& plan : tried) {
+  if (best_patch->quality.inverted_quads > 0 &&
+      !untangle_planar(*best_patch, shape.normal, options))
+    for (const Plan& plan : tried) {  // built again only when the best patch cannot be placed
       std::optional<Built> none;
-      candidates.push_back(fill_with_plan(plan, counts, side_points, shape, none, options));
-    }
-    for (FilledPatch& candidate : candidates)
+      FilledPatch candidate = fill_with_plan(plan, counts, side_points, shape, none, options);
       if (untangle_planar(candidate, shape.normal, options)) {
         best_patch = std::move(candidate);
         break;
       }
-  }
+    }
   if (shape.planar && !options.project && best_patch->quality.inverted_quads == 0 &&
       best_patch->mesh.faces.rows() <= kThinQuadMaxQuads)
     widen_thin_quads(*best_patch, shape.normal);
