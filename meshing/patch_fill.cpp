@@ -504,6 +504,9 @@ int quads_turned_against(const QuadMesh& mesh, const Eigen::Vector3d& normal) {
 // placement's energy is smallest for square corners and infinite for folded ones.
 constexpr double kThinQuadDeg = 15;
 constexpr int kThinQuadRings = 2;
+// Minimisation rounds and L-BFGS steps of that placement: it starts unfolded and only has to
+// settle (untangling allows 60 rounds of 200).
+constexpr int kThinQuadRounds = 4, kThinQuadSteps = 100;
 // Only on patches of at most this many quads: on a flat 2,500-quad fill with thin quads
 // ((25,50,75,25,75) on a circle) widening took 1.1 ms of CPU, more than the fill itself.
 constexpr Eigen::Index kThinQuadMaxQuads = 1000;
@@ -572,6 +575,7 @@ void widen_thin_quads(FilledPatch& patch, const Eigen::Vector3d& normal) {
     for (const int v : last)
       for (const int f : faces_at[static_cast<size_t>(v)]) take(f);
   }
+  if (searched.empty()) searched = moving;  // kThinQuadRings = 1
   std::vector<std::array<int, 4>> window;
   std::vector<char> window_face(static_cast<size_t>(nf), 0);
   for (size_t v = 0; v < nv; ++v)
@@ -583,7 +587,8 @@ void widen_thin_quads(FilledPatch& patch, const Eigen::Vector3d& normal) {
   if (window.empty()) return;  // the thin quads have no free vertex
   std::vector<char> fixed(nv);
   for (size_t v = 0; v < nv; ++v) fixed[v] = moving[v] ? 0 : 1;
-  if (!detail::untangle_in_plane(positions, window, fixed, normal, 4, 100)) return;
+  if (!detail::untangle_in_plane(positions, window, fixed, normal, kThinQuadRounds, kThinQuadSteps))
+    return;
   // Then a pattern search on the thin quads' free vertices and one ring more: 8 directions,
   // step halving, a move kept only when the smallest figure of the vertex's quads rises.
   auto figure_at = [&](size_t v) {
