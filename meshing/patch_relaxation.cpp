@@ -396,12 +396,14 @@ void relax_interior(std::vector<Eigen::Vector3d>& positions,
 
 namespace {
 
-// Weight of the area term against the shape term (Garanzha et al. use a small one: the shape
-// term alone is scale-free, the area term keeps quads from growing or shrinking without bound).
+// Weight θ of the area term against the shape term: small, since the shape term is what makes
+// corners square; it is scale-free, and the area term keeps quads from growing or shrinking
+// without bound.
 constexpr double kAreaWeight = 0.1;
 
 // χ(d, ε) = (d + √(ε² + d²)) / 2, for d < 0 as ε² / (2 (√(ε² + d²) − d)): the same value
-// without the cancellation (a folded corner at small ε has χ ~ ε² / 4|d|, far below d).
+// without the cancellation (a folded corner at small ε has χ ~ ε² / 4|d|, far below |d|, which
+// d + √(ε² + d²) would lose to rounding).
 double chi(double d, double epsilon) {
   const double root = std::sqrt(epsilon * epsilon + d * d);
   return d >= 0 ? 0.5 * (d + root) : 0.5 * epsilon * epsilon / (root - d);
