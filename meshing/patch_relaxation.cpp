@@ -394,6 +394,191 @@ void relax_interior(std::vector<Eigen::Vector3d>& positions,
   positions = current;
 }
 
+namespace {
+
+// Weight θ of the area term against the shape term: small, since the shape term is what makes
+// corners square; it is scale-free, and the area term keeps quads from growing or shrinking
+// without bound.
+constexpr double kAreaWeight = 0.1;
+
+// χ(d, ε) = (d + √(ε² + d²)) / 2, for d < 0 as ε² / (2 (√(ε² + d²) − d)): the same value
+// without the cancellation (a folded corner at small ε has χ ~ ε² / 4|d|, far below |d|, which
+// d + √(ε² + d²) would lose to rounding).
+double chi(double d, double epsilon) {
+  const double root = std::sqrt(epsilon * epsilon + d * d);
+  return d >= 0 ? 0.5 * (d + root) : 0.5 * epsilon * epsilon / (root - d);
+}
+
+// Smallest det J over all quad corners (ideal square corner: 1).
+double smallest_corner(std::span<const Eigen::Vector2d> x, std::span<const Quad> quads, double h) {
+  double smallest = std::numeric_limits<double>::infinity();
+  for (const Quad& q : quads)
+    for (size_t k = 0; k < 4; ++k) {
+      const Eigen::Vector2d& p = x[static_cast<size_t>(q[k])];
+      const Eigen::Vector2d a = x[static_cast<size_t>(q[(k + 1) % 4])] - p;
+      const Eigen::Vector2d b = x[static_cast<size_t>(q[(k + 3) % 4])] - p;
+      smallest = std::min(smallest, (a.x() * b.y() - a.y() * b.x()) / (h * h));
+    }
+  return smallest;
+}
+
+// Limited-memory BFGS (Nocedal & Wright 2006, algorithm 7.4) with Armijo backtracking over the
+// free coordinates `free` of x, at most `iterations` steps.
+void minimise(std::vector<Eigen::Vector2d>& x, std::span<const Quad> quads,
+              const std::vector<size_t>& free, double h, double epsilon, int iterations) {
+  constexpr int kMemory = 7;
+  const auto n = static_cast<Eigen::Index>(2 * free.size());
+  std::vector<Eigen::Vector2d> gradient;
+  auto evaluate = [&](const std::vector<Eigen::Vector2d>& at, Eigen::VectorXd& g) {
+    const double e = detail::untangling_energy(at, quads, h, epsilon, &gradient);
+    g.resize(n);
+    for (size_t i = 0; i < free.size(); ++i)
+      g.segment<2>(static_cast<Eigen::Index>(2 * i)) = gradient[free[i]];
+    return e;
+  };
+  Eigen::VectorXd g, g_next, direction;
+  double energy = evaluate(x, g);
+  std::vector<Eigen::VectorXd> s_history, y_history;
+  std::vector<double> rho;
+  std::vector<Eigen::Vector2d> trial = x;
+  for (int iteration = 0; iteration < iterations; ++iteration) {
+    // Two-loop recursion: direction = −H g.
+    direction = -g;
+    std::vector<double> alpha(s_history.size());
+    for (size_t i = s_history.size(); i-- > 0;) {
+      alpha[i] = rho[i] * s_history[i].dot(direction);
+      direction -= alpha[i] * y_history[i];
+    }
+    if (!s_history.empty())
+      direction *= s_history.back().dot(y_history.back()) / y_history.back().squaredNorm();
+    for (size_t i = 0; i < s_history.size(); ++i) {
+      const double beta = rho[i] * y_history[i].dot(direction);
+      direction += (alpha[i] - beta) * s_history[i];
+    }
+    double slope = g.dot(direction);
+    if (slope >= 0) {  // not a descent direction: restart from steepest descent
+      s_history.clear();
+      y_history.clear();
+      rho.clear();
+      direction = -g;
+      slope = -g.squaredNorm();
+    }
+    if (slope > -1e-30) return;  // stationary
+    double step = s_history.empty() ? std::min(1.0, h / std::sqrt(-slope)) : 1.0;
+    double next = energy;
+    bool accepted = false;
+    for (int halving = 0; halving < 40; ++halving, step *= 0.5) {
+      for (size_t i = 0; i < free.size(); ++i)
+        trial[free[i]] = x[free[i]] + step * direction.segment<2>(static_cast<Eigen::Index>(2 * i));
+      next = evaluate(trial, g_next);
+      if (next <= energy + 1e-4 * step * slope) {
+        accepted = true;
+        break;
+      }
+    }
+    if (!accepted) return;
+    Eigen::VectorXd s = step * direction, y = g_next - g;
+    const double sy = s.dot(y);
+    if (sy > 1e-16 * s.norm() * y.norm()) {
+      if (static_cast<int>(s_history.size()) == kMemory) {
+        s_history.erase(s_history.begin());
+        y_history.erase(y_history.begin());
+        rho.erase(rho.begin());
+      }
+      s_history.push_back(std::move(s));
+      y_history.push_back(std::move(y));
+      rho.push_back(1 / sy);
+    }
+    for (const size_t v : free) x[v] = trial[v];
+    const double decrease = energy - next;
+    energy = next;
+    g.swap(g_next);
+    if (decrease <= 1e-10 * std::abs(energy)) return;
+  }
+}
+
+}  // namespace
+
+double untangling_energy(std::span<const Eigen::Vector2d> x,
+                         std::span<const std::array<int, 4>> quads, double h, double epsilon,
+                         std::vector<Eigen::Vector2d>* gradient) {
+  if (gradient) gradient->assign(x.size(), Eigen::Vector2d::Zero());
+  double energy = 0;
+  const double inv_h = 1 / h;
+  for (const Quad& q : quads)
+    for (size_t k = 0; k < 4; ++k) {
+      const auto i = static_cast<size_t>(q[k]), j = static_cast<size_t>(q[(k + 1) % 4]),
+                 l = static_cast<size_t>(q[(k + 3) % 4]);
+      const Eigen::Vector2d a = (x[j] - x[i]) * inv_h, b = (x[l] - x[i]) * inv_h;
+      const double d = a.x() * b.y() - a.y() * b.x();
+      const double root = std::sqrt(epsilon * epsilon + d * d);
+      const double c = chi(d, epsilon);
+      const double numerator =
+          (1 - kAreaWeight) * (a.squaredNorm() + b.squaredNorm()) + kAreaWeight * (d * d + 1);
+      energy += numerator / c;
+      if (!gradient) continue;
+      // f = N / c: ∂f = ∂N / c − N c' ∂d / c², c' = (1 + d / root) / 2 = c / root,
+      // ∂d/∂a = (b_y, −b_x), ∂d/∂b = (−a_y, a_x).
+      const double dc = c / root;
+      const double df_dd = (2 * kAreaWeight * d) / c - numerator * dc / (c * c);
+      const Eigen::Vector2d ga =
+          (2 * (1 - kAreaWeight) / c) * a + df_dd * Eigen::Vector2d(b.y(), -b.x());
+      const Eigen::Vector2d gb =
+          (2 * (1 - kAreaWeight) / c) * b + df_dd * Eigen::Vector2d(-a.y(), a.x());
+      (*gradient)[j] += ga * inv_h;
+      (*gradient)[l] += gb * inv_h;
+      (*gradient)[i] -= (ga + gb) * inv_h;
+    }
+  return energy;
+}
+
+bool untangle_in_plane(std::vector<Eigen::Vector3d>& positions,
+                       std::span<const std::array<int, 4>> quads, std::span<const char> fixed,
+                       const Eigen::Vector3d& normal, int rounds, int steps) {
+  if (quads.empty()) return true;
+  const Eigen::Vector3d u = normal.unitOrthogonal(), w = normal.cross(u);
+  std::vector<Eigen::Vector2d> x(positions.size());
+  for (size_t v = 0; v < positions.size(); ++v) x[v] = {positions[v].dot(u), positions[v].dot(w)};
+  // The quads' signed areas add up to the area the boundary encloses, folded or not.
+  double area = 0;
+  for (const Quad& q : quads) {
+    const Eigen::Vector2d d1 = x[static_cast<size_t>(q[2])] - x[static_cast<size_t>(q[0])];
+    const Eigen::Vector2d d2 = x[static_cast<size_t>(q[3])] - x[static_cast<size_t>(q[1])];
+    area += 0.5 * (d1.x() * d2.y() - d1.y() * d2.x());
+  }
+  if (!(area > 0)) return false;  // not counter-clockwise about `normal`
+  const double h = std::sqrt(area / static_cast<double>(quads.size()));
+  std::vector<size_t> free;
+  for (size_t v = 0; v < positions.size(); ++v)
+    if (!fixed[v]) free.push_back(v);
+  // ε schedule of Garanzha et al.: start at a fraction of the worst corner, then after each
+  // minimisation set it so that χ(worst, ε) stays near (1 − σ) of its value, σ the relative
+  // decrease of the energy; a small ε once every corner is positive.
+  double worst = smallest_corner(x, quads, h);
+  double epsilon = std::sqrt(1e-8 + 0.04 * std::pow(std::min(worst, 0.0), 2));
+  bool clean = false;
+  for (int round = 0; round < rounds; ++round) {
+    const double before = untangling_energy(x, quads, h, epsilon);
+    minimise(x, quads, free, h, epsilon, steps);
+    const double after = untangling_energy(x, quads, h, epsilon);
+    worst = smallest_corner(x, quads, h);
+    const double sigma = std::max(1 - after / before, 0.1);
+    const double mu = (1 - sigma) * chi(worst, epsilon);
+    epsilon = worst < mu ? 2 * std::sqrt(mu * (mu - worst)) : 1e-10;
+    if (worst > 0) {
+      clean = true;
+      if (std::abs(before - after) <= 1e-5 * after) break;
+    }
+  }
+  worst = smallest_corner(x, quads, h);
+  if (!clean || !(worst > 0)) return false;
+  for (const size_t v : free) {
+    const Eigen::Vector2d old(positions[v].dot(u), positions[v].dot(w));
+    positions[v] += (x[v].x() - old.x()) * u + (x[v].y() - old.y()) * w;
+  }
+  return true;
+}
+
 }  // namespace detail
 
 }  // namespace sd::meshing

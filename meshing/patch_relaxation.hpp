@@ -43,6 +43,29 @@ void relax_interior(std::vector<Eigen::Vector3d>& positions,
                     const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& project = {},
                     ReferenceNormals reference = ReferenceNormals::kStart);
 
+// Foldover-free placement in a plane, after Garanzha, Kaporin, Kudryavtseva, Protais, Ray and
+// Sokolov (2021), "Foldover-free maps in 50 lines of code": the free vertices of #Q
+// counter-clockwise quads (about `normal`, unit) move in the plane square to `normal` to
+// minimise Σ over quad corners of
+//     ((1 − θ) |J|² + θ (det J² + 1)) / χ(det J, ε),   χ(D, ε) = (D + √(ε² + D²)) / 2,
+// J the corner's two edges divided by h = √(area / #Q) (an ideal square corner has J = I), with
+// ε lowered from the worst corner's |det J| towards 0 between minimisations (L-BFGS). As ε → 0
+// the energy becomes a barrier on every corner's signed area, so once all corners are positive
+// they stay so. Each vertex keeps its height along `normal`. Returns true, with the positions
+// moved, when every corner ends with det J > 0 (every quad strictly convex and unfolded);
+// false leaves the positions as they were.
+// `rounds` bounds the minimisations and `steps` the L-BFGS steps of each: 60 of 200 to untangle;
+// a start without folds needs far fewer to settle.
+bool untangle_in_plane(std::vector<Eigen::Vector3d>& positions,
+                       std::span<const std::array<int, 4>> quads, std::span<const char> fixed,
+                       const Eigen::Vector3d& normal, int rounds = 60, int steps = 200);
+
+// The energy above for 2D positions (#V), and its gradient (#V, fixed vertices included) when
+// `gradient` is given; exposed for the finite-difference test.
+double untangling_energy(std::span<const Eigen::Vector2d> x,
+                         std::span<const std::array<int, 4>> quads, double h, double epsilon,
+                         std::vector<Eigen::Vector2d>* gradient = nullptr);
+
 }  // namespace detail
 
 }  // namespace sd::meshing

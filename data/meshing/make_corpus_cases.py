@@ -69,6 +69,27 @@ for n, degrees in ((4, 195), (5, 195), (6, 195), (4, 200), (5, 200)):
         cases.append({"name": f"notched-n{n}-{degrees}-{_}", "family": "notched", "sides": counts,
                       "reflex_corner_deg": degrees})
 
+# Chevrons at 210 deg (issue 22): every quadrilateral and pentagon of the concave test's range
+# that still folded before the foldover-free placement, the one whose folded cluster went
+# unseen ((5,10,6,5)), the thinnest since ((10,6,6,8)), and three more at random per n.
+folded_at_210 = [
+    [5, 10, 6, 5], [8, 5, 9, 6], [10, 6, 10, 6], [9, 7, 10, 6], [10, 10, 10, 6], [5, 8, 8, 7],
+    [6, 8, 9, 7], [10, 5, 10, 7], [10, 5, 5, 8], [9, 5, 8, 8], [8, 6, 8, 8], [6, 8, 8, 8],
+    [9, 6, 9, 8], [7, 8, 9, 8], [6, 9, 9, 8], [5, 10, 9, 8], [6, 10, 10, 8], [8, 6, 7, 9],
+    [10, 6, 7, 9], [5, 10, 8, 9], [7, 9, 9, 9], [6, 10, 9, 9], [10, 6, 8, 10], [8, 9, 9, 10],
+    [9, 9, 10, 10], [8, 10, 10, 10], [10, 10, 5, 8, 5], [10, 10, 5, 10, 5], [10, 10, 6, 8, 6],
+]
+for i, counts in enumerate(folded_at_210):
+    cases.append({"name": f"notched-n{len(counts)}-210-folded-{i}", "family": "notched",
+                  "sides": counts, "reflex_corner_deg": 210})
+cases.append({"name": "notched-n4-210-thinnest", "family": "notched", "sides": [10, 6, 6, 8],
+              "reflex_corner_deg": 210})
+for n in (4, 5):
+    for _ in range(3):
+        counts = even([rng.randint(5, 10) for _ in range(n)])
+        cases.append({"name": f"notched-n{n}-210-{_}", "family": "notched", "sides": counts,
+                      "reflex_corner_deg": 210})
+
 # One case per line, so that a diff shows which figures changed.
 lines = [json.dumps(c) for c in cases]
 sys.stdout.write('{"format": "sketchdrape-meshing-corpus/1",\n "cases": [\n  ' + ",\n  ".join(lines) + "\n ]\n}\n")

@@ -27,7 +27,9 @@
 #include <vector>
 
 #include "meshing/patch_fill.hpp"
+#include "meshing/quad_quality.hpp"
 #include "tests/meshing/layout_family.hpp"
+#include "tests/meshing/patchgen_patterns.hpp"
 
 namespace sd::meshing {
 namespace {
@@ -68,7 +70,7 @@ TEST_P(PatchFillOptimality, FillReachesTheCheapestLayoutOfTheFamily) {
   const int n = GetParam();
   const int bound = std::abs(n - 4);
   std::int64_t vectors = 0, at_bound = 0, proven_by_parity = 0, family_only = 0;
-  std::int64_t index = 0, rotated = 0, pattern_applies = 0;
+  std::int64_t index = 0, rotated = 0, patchgen_equal = 0, patchgen_worse = 0;
   for_each_vector(n, [&](const std::vector<int>& counts) {
     if (n == 6 && !is_canonical(counts)) {
       // The reduction to classes holds only if the fill does not depend on where the sides
@@ -91,10 +93,16 @@ TEST_P(PatchFillOptimality, FillReachesTheCheapestLayoutOfTheFamily) {
     }
     ++vectors;
     const int distortion = fill_region(counts).distortion;
-    // Never above what one of Takayama et al.'s patterns gives (those whose distortion is fixed).
-    const int pattern = test::takayama_pattern_distortion(counts);
-    if (pattern != INT_MAX) ++pattern_applies;
-    ASSERT_LE(distortion, pattern) << ::testing::PrintToString(counts);
+    // Never above any of patchgen's patterns (Takayama et al. 2014, every variant): none of
+    // those below the fill's distortion fits, and the least that fits is tallied.
+    const char* fitting = "";
+    const int pattern = test::patchgen_distortion(counts, distortion + 1, &fitting);
+    ASSERT_GE(pattern, distortion) << ::testing::PrintToString(counts) << ": patchgen's " << fitting
+                                   << " is less distorted than " << distortion;
+    if (pattern == distortion)
+      ++patchgen_equal;
+    else
+      ++patchgen_worse;
     const bool family_at_bound = test::family_reaches(counts, bound);
     if (distortion == bound) {
       ++at_bound;
@@ -123,12 +131,63 @@ TEST_P(PatchFillOptimality, FillReachesTheCheapestLayoutOfTheFamily) {
             << ", at |n-4|: " << at_bound
             << ", |n-4| + 2 with |n-4| impossible: " << proven_by_parity
             << ", the least of F only: " << family_only
-            << "; a fixed-distortion pattern applies to " << pattern_applies;
+            << "; patchgen's least pattern as distorted: " << patchgen_equal
+            << ", more distorted or none fits: " << patchgen_worse;
   if (n == 6) std::cout << "; " << rotated << " rotated or reflected vectors fill as their class";
   std::cout << "\n";
 }
 
 INSTANTIATE_TEST_SUITE_P(UpToSixSides, PatchFillOptimality, ::testing::Range(2, 7));
+
+// The pattern table the comparison rests on (tests/meshing/patchgen_patterns.hpp): each pattern's
+// coarse quads form a valid disk whose sides between the corners C_0..C_n−1 run through the
+// listed side vertices and have the base counts, and whose measured distortion is the one the
+// table states.
+TEST(PatchgenPatterns, CoarseQuadsMatchTheirBaseCountsAndDistortion) {
+  for (const test::PatchgenPattern& pattern : test::patchgen_patterns()) {
+    SCOPED_TRACE(pattern.name);
+    const auto n = static_cast<int>(pattern.base.size());
+    int vertex_count = 0;
+    for (const auto& quad : pattern.quads)
+      for (const int v : quad) vertex_count = std::max(vertex_count, v + 1);
+    QuadMesh mesh;
+    mesh.vertices = Eigen::MatrixX3d::Zero(vertex_count, 3);
+    mesh.faces.resize(static_cast<Eigen::Index>(pattern.quads.size()), 4);
+    for (size_t f = 0; f < pattern.quads.size(); ++f)
+      for (int k = 0; k < 4; ++k)
+        mesh.faces(static_cast<Eigen::Index>(f), k) = pattern.quads[f][static_cast<size_t>(k)];
+    ASSERT_TRUE(validate(mesh).ok()) << validate(mesh).problems.front();
+    std::vector<int> loop = boundary_loop(mesh);
+    std::rotate(loop.begin(), std::find(loop.begin(), loop.end(), 0), loop.end());
+    std::vector<int> expected;
+    for (int i = 0; i < n; ++i) {
+      expected.push_back(i);
+      const auto& side = pattern.side_vertices[static_cast<size_t>(i)];
+      expected.insert(expected.end(), side.begin(), side.end());
+      EXPECT_EQ(static_cast<int>(side.size()) + 1, pattern.base[static_cast<size_t>(i)]);
+    }
+    EXPECT_EQ(loop, expected);
+    std::vector<int> corners(static_cast<size_t>(n));
+    std::iota(corners.begin(), corners.end(), 0);
+    EXPECT_EQ(measure_valence(mesh, corners).distortion, pattern.distortion);
+    for (const auto& term : pattern.terms) {  // every parameter lengthens some side
+      EXPECT_EQ(static_cast<int>(term.size()), n);
+      EXPECT_GT(std::accumulate(term.begin(), term.end(), 0), 0);
+    }
+  }
+  // The solver, on values worked by hand: 5-0 (base (2,1,1,1,1)) fits (2,2,1,1,2) with p_0 = 1,
+  // and the (1,2,3,1,3) rotated to (2,3,1,3,1) with p_2 = 2 (the centre on the boundary);
+  // not (1,1,1,1,4), whose one padding row would have to add 2 to a single side.
+  const test::PatchgenPattern& five_zero = test::patchgen_patterns()[11];
+  ASSERT_STREQ(five_zero.name, "5-0");
+  EXPECT_TRUE(test::pattern_fits(five_zero, {2, 2, 1, 1, 2}));
+  EXPECT_TRUE(test::pattern_fits(five_zero, {1, 2, 3, 1, 3}));
+  EXPECT_FALSE(test::pattern_fits(five_zero, {1, 1, 1, 1, 4}));
+  EXPECT_EQ(test::patchgen_distortion({1, 2, 3, 1, 3}), 1);
+  EXPECT_EQ(test::patchgen_distortion({4, 4, 4, 4}), 0);
+  EXPECT_EQ(test::patchgen_distortion({2, 2, 2, 2, 2, 2}), 2);
+  EXPECT_EQ(test::patchgen_distortion({2, 6}), 2);
+}
 
 }  // namespace
 }  // namespace sd::meshing
