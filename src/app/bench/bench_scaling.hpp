@@ -2,8 +2,10 @@
 // The scaling study of `sketchdrape bench --scaling` (docs/benchmarks.md, "Scaling"): the pinned
 // 1 m cotton sheet at N×N quads (N = 32 … 256: 1,089 to 66,049 vertices), a fixed number of
 // steps per solver, each size in its own child process (`sketchdrape run`), so the time per step
-// comes from the run's report and the peak memory from the kernel. The fit gives the exponent k
-// of time per step ∝ vertices^k and the memory each further vertex costs.
+// comes from the run's report and the peak memory from the kernel. The CPU time per step is the
+// difference between that run and a one-step run of the same scene (the set-up cancels), which
+// other programs on the machine barely change; the wall time per step is the report's. The fit
+// gives the exponent k of CPU time per step ∝ vertices^k and the memory each further vertex costs.
 
 #include <filesystem>
 #include <functional>
@@ -28,7 +30,8 @@ struct ScalingPoint {
   std::string message;
   int steps = 0;              // accepted steps (retries excluded)
   double simulation_s = 0.0;  // wall time of the stepping (the report's wall_time_s)
-  double step_s = 0.0;        // simulation_s / steps
+  double step_s = 0.0;        // simulation_s / steps (wall)
+  double cpu_step_s = 0.0;    // (CPU of this run − CPU of a one-step run) / (steps − 1)
   double solve_s = 0.0, forces_s = 0.0, collision_s = 0.0;  // per run
   double cg_iterations_mean = 0.0;                          // PCG only
   double process_cpu_s = 0.0;                               // the whole child

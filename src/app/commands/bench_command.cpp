@@ -462,7 +462,8 @@ void run_scaling_study(const BenchOptions& options, const GlobalOptions& global)
     json["points"].push_back({{"quads_per_side", p.quads_per_side}, {"solver", p.solver},
                               {"vertices", p.vertices},           {"status", p.status},
                               {"message", p.message},             {"steps", p.steps},
-                              {"step_s", p.step_s},               {"solve_s", p.solve_s},
+                              {"step_s", p.step_s},               {"cpu_step_s", p.cpu_step_s},
+                              {"solve_s", p.solve_s},
                               {"forces_s", p.forces_s},           {"collision_s", p.collision_s},
                               {"cg_iterations_mean", p.cg_iterations_mean},
                               {"process_cpu_s", p.process_cpu_s}, {"peak_rss_mb", p.peak_rss_mb}});
@@ -658,7 +659,7 @@ void add_bench_command(CLI::App& app, const GlobalOptions& global) {
                   "With --scaling: cholmod, pcg or both (default both)");
   cmd->add_option("--steps", options->scaling_options.steps,
                   "With --scaling: steps of 1/60 s per run (default 10)")
-      ->check(CLI::Range(1, 10000));
+      ->check(CLI::Range(2, 10000));
   cmd->add_option("--worker", options->worker_config)->group("");  // internal: one run
   cmd->add_option("--worker-scene", options->worker_scene)->group("");
   cmd->add_option("--worker-out", options->worker_out)->group("");
