@@ -62,6 +62,9 @@ AdaptiveCloth::AdaptiveCloth(meshing::Mesh48 mesh, AdaptiveMaterial material,
     : mesh_(std::move(mesh)), material_(std::move(material)), settings_(adaptive) {
   settings_.validate();
   simulation.validate();
+  if (material_.rest_uv.rows() > 0 && settings_.enabled)
+    throw InvalidAdaptiveSettingsError(
+        "pattern rest shapes (rest_uv) need a fixed mesh: turn adaptive detail off");
   if (!mesh_.is_compact())
     throw std::invalid_argument("the adaptive cloth needs a compact 4-8 mesh (call compact())");
   arrays_ = mesh_.arrays();
@@ -144,6 +147,8 @@ const ContactResponse* AdaptiveCloth::active_contact() const {
 }
 
 AdaptiveTransfer AdaptiveCloth::begin_transfer() const {
+  if (material_.rest_uv.rows() > 0)
+    throw std::logic_error("a cloth with pattern rest shapes (rest_uv) cannot be split or merged");
   return sim::begin_transfer(mesh_, positions(), velocities(), masses_, birth_, pins_,
                              simulation_->time());
 }
@@ -194,6 +199,7 @@ double AdaptiveCloth::rebuild(AdaptiveTransfer& state, const SimulationSettings*
   input.rest_positions = arrays_.rest_positions;
   input.triangles = arrays_.faces;
   input.up = material_.up;
+  input.rest_uv = material_.rest_uv;  // empty, or the unchanged first mesh's (see begin_transfer)
   if (material_.source_warp.rows() > 0) {
     input.warp.resize(arrays_.faces.rows(), 3);
     for (Eigen::Index f = 0; f < arrays_.faces.rows(); ++f) {

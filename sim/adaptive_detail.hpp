@@ -47,6 +47,10 @@ struct AdaptiveMaterial {
   // Children inherit their input face's, so an eased panel keeps its ease at every level; mass
   // moves between triangles at the eased density ρ·e².
   Eigen::VectorXd source_ease;
+  // Rest coordinates of each triangle of the mesh as given (ClothInput::rest_uv: a flattened
+  // pattern's), or empty. Only for a mesh that never changes: with them the driver refuses
+  // adaptivity and every split or merge (children have no pattern coordinates of their own yet).
+  Eigen::MatrixXd rest_uv;
 };
 
 // What one call of adapt() (or of the explicit operations) did.

@@ -2,16 +2,25 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 namespace sd::sim {
 
 ClothDriver::ClothDriver(ClothModel model, Eigen::VectorXd x0, std::vector<Pin> pins,
-                         SimulationSettings settings) {
-  fixed_faces_.resize(static_cast<Eigen::Index>(model.triangles.size()), 3);
-  for (std::size_t t = 0; t < model.triangles.size(); ++t)
+                         SimulationSettings settings, Eigen::VectorXi source_faces) {
+  const auto triangles = static_cast<Eigen::Index>(model.triangles.size());
+  fixed_faces_.resize(triangles, 3);
+  for (Eigen::Index t = 0; t < triangles; ++t)
     for (int k = 0; k < 3; ++k)
-      fixed_faces_(static_cast<Eigen::Index>(t), k) = model.triangles[t].vertices[k];
+      fixed_faces_(t, k) = model.triangles[static_cast<std::size_t>(t)].vertices[k];
+  if (source_faces.size() == 0)
+    source_faces = Eigen::VectorXi::LinSpaced(triangles, 0, static_cast<int>(triangles) - 1);
+  if (source_faces.size() != triangles)
+    throw std::invalid_argument("the input faces must be given for every triangle (" +
+                                std::to_string(source_faces.size()) + " given, " +
+                                std::to_string(triangles) + " triangles)");
+  fixed_sources_ = std::move(source_faces);
   fixed_ = std::make_unique<Simulation>(std::move(model), std::move(x0), std::move(pins),
                                         std::move(settings));
 }
@@ -79,9 +88,7 @@ const Eigen::MatrixX3i& ClothDriver::faces() const {
 }
 
 Eigen::VectorXi ClothDriver::source_faces() const {
-  if (adaptive_) return adaptive_->source_faces();
-  return Eigen::VectorXi::LinSpaced(fixed_faces_.rows(), 0,
-                                    static_cast<int>(fixed_faces_.rows()) - 1);
+  return adaptive_ ? adaptive_->source_faces() : fixed_sources_;
 }
 
 Eigen::VectorXi ClothDriver::face_levels() const {

@@ -37,10 +37,11 @@ struct ClothObserver {
 
 class ClothDriver {
  public:
-  // A fixed mesh: the model as given, x0 its 3n start positions (flatten_positions). Throws as
-  // Simulation's constructor.
+  // A fixed mesh: the model as given, x0 its 3n start positions (flatten_positions), and
+  // optionally the input face each triangle belongs to (a sheet's quad; empty: each triangle is
+  // its own). Throws as Simulation's constructor.
   ClothDriver(ClothModel model, Eigen::VectorXd x0, std::vector<Pin> pins,
-              SimulationSettings settings);
+              SimulationSettings settings, Eigen::VectorXi source_faces = {});
   // A 4-8 mesh (see AdaptiveCloth's constructor), adapting when adaptive.enabled.
   ClothDriver(meshing::Mesh48 mesh, AdaptiveMaterial material, Eigen::MatrixX3d positions,
               std::vector<Pin> pins, SimulationSettings settings, AdaptiveSettings adaptive);
@@ -72,7 +73,7 @@ class ClothDriver {
   Eigen::MatrixX3d positions() const;
   const Eigen::MatrixX3i& faces() const;
   // #F: the input face each triangle descends from (a 4-8 mesh's quad or triangle); for a model
-  // given as is, each triangle is its own input face (0, 1, ..., #F − 1).
+  // given as is, the constructor's (by default each triangle its own: 0, 1, ..., #F − 1).
   Eigen::VectorXi source_faces() const;
   // #F: each triangle's 4-8 level; empty for a model given as is.
   Eigen::VectorXi face_levels() const;
@@ -81,6 +82,7 @@ class ClothDriver {
   std::unique_ptr<Simulation> fixed_;        // a model given as is
   std::unique_ptr<AdaptiveCloth> adaptive_;  // a 4-8 mesh
   Eigen::MatrixX3i fixed_faces_;             // the fixed model's triangles
+  Eigen::VectorXi fixed_sources_;            // and their input faces
 };
 
 }  // namespace sd::sim

@@ -16,7 +16,6 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
-#include "garment/material_frames.hpp"
 #include "garment/sketch_file.hpp"
 #include "sim/cloth_driver.hpp"
 #include "sim/sheet.hpp"
@@ -157,8 +156,8 @@ BenchScene sketch_scene(const std::filesystem::path& file, BenchGrid grid) {
     ClothScene cloth = build_cloth_scene(sketch);
     scene.mesh = std::move(*cloth.mesh48);
     scene.material.fabric = cloth.fabric;
-    scene.material.source_warp = garment::material_frames(cloth.garment->mesh).warp;
-    scene.material.source_ease = cloth.mesh48_face_ease;  // panel ease, as `run` applies it
+    scene.material.source_warp = cloth.face_warp;
+    scene.material.source_ease = cloth.face_ease;  // panel ease, as `run` applies it
     scene.start = cloth.start;
     scene.pinned = cloth.pinned;
     if (cloth.body) scene.body = cloth.body->mesh;

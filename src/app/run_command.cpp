@@ -15,7 +15,6 @@
 
 #include "garment/sketch_file.hpp"
 #include "garment/body_landmarks.hpp"
-#include "garment/material_frames.hpp"
 #include "meshing/slice_dent.hpp"
 #include "sim/adaptive_detail.hpp"
 #include "sim/cloth_driver.hpp"
@@ -257,9 +256,6 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   if (scene.pinned.empty() && !scene.body)
     spdlog::warn("nothing holds the cloth (no pins, no body): it will fall for the whole run");
 
-  std::vector<sim::Pin> pins;
-  for (int v : scene.pinned) pins.push_back({v, {}});
-
   const std::filesystem::path dir(options.out);
   StagedOutputs outputs;
   std::string trace;
@@ -301,14 +297,16 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
            t >= static_cast<double>(frames.size()) / options.frames_per_second - 1e-9;
   };
   if (frame_due(0.0)) {
-    frames.push_back({0.0, {scene.start, scene.input.triangles}, scene.triangle_group});
+    frames.push_back(
+        {0.0, {scene.start, scene.input.triangles}, triangle_groups(scene, scene.triangle_face)});
   }
 
-  // Adaptive 4-8 detail needs the garment's block hierarchy; a sheet runs on its fixed mesh.
+  // One driver: the cloth's 4-8 mesh, adapting or not (a sheet that does not adapt drapes on its
+  // own triangles).
   sim::SimulationReport report;
   nlohmann::json adaptive_json = nullptr;
   meshing::TriMesh draped;
-  Eigen::VectorXi triangle_group = scene.triangle_group;
+  Eigen::VectorXi triangle_group;
   Eigen::VectorXd face_levels;
   nlohmann::json strain = nullptr;
   const bool flat_rest = scene.input.rest_uv.rows() > 0;
@@ -316,19 +314,12 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
     spdlog::warn("\"rest\": \"flat\" drapes on the fixed mesh: adaptive detail does not yet carry "
                  "pattern rest shapes through its splits (docs/pattern.md)");
   try {
-    // One driver either way: the garment's 4-8 mesh when it adapts, else the fixed mesh's model.
-    const bool adaptive = sketch.simulate.adaptive && scene.mesh48 && !flat_rest;
-    sim::ClothDriver driver = [&] {
-      if (!adaptive)
-        return sim::ClothDriver(build_scene_model(scene), sim::flatten_positions(scene.start), pins,
-                                settings);
-      sim::AdaptiveMaterial material;
-      material.fabric = scene.fabric;
-      if (scene.garment) material.source_warp = garment::material_frames(scene.garment->mesh).warp;
-      material.source_ease = scene.mesh48_face_ease;
-      return sim::ClothDriver(*scene.mesh48, material, scene.start, pins, settings,
-                              adaptive_settings(sketch));
-    }();
+    // A garment adapts unless the file says "adaptive": false; a sheet only when it asks.
+    const bool adaptive = sketch.simulate.adaptive &&
+                          (!sketch.sheet || sketch.simulate.adaptive_given) && !flat_rest;
+    sim::ClothDriver driver =
+        scene_driver(scene, settings,
+                     adaptive ? std::optional(adaptive_settings(sketch)) : std::nullopt);
     // Contacts and friction (through every split and merge), with the body still or moving.
     if (scene.body_motion)
       driver.set_body_motion(*scene.body_motion);
@@ -336,12 +327,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
       driver.set_body(scene.body->mesh);
     // Each triangle keeps the group of the input face it descends from.
     const auto groups_of = [&](const sim::ClothDriver& d) {
-      const Eigen::VectorXi source = d.source_faces();
-      const Eigen::VectorXi& face_group =
-          d.adaptive() ? scene.mesh48_face_group : scene.triangle_group;
-      Eigen::VectorXi groups(source.size());
-      for (Eigen::Index t = 0; t < source.size(); ++t) groups(t) = face_group(source(t));
-      return groups;
+      return triangle_groups(scene, d.source_faces());
     };
     sim::ClothObserver observer;
     observer.after_step = [&](const sim::ClothDriver& d, const sim::StepOutcome& outcome) {

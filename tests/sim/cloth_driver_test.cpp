@@ -92,6 +92,47 @@ TEST(ClothDriver, ObserverSeesEveryStepCapsItAndStopsTheRun) {
   EXPECT_EQ(static_cast<int>(driver.adaptive_report()->steps.size()), report.steps);
 }
 
+// Pattern rest coordinates (a flat rest) belong to the mesh as given: the driver drapes them on
+// the fixed 4-8 mesh exactly as the simulator on the same input, and refuses adaptivity and
+// every split (children would have no pattern coordinates).
+TEST(ClothDriver, PatternRestShapesNeedTheFixedMesh) {
+  const AdaptiveSheetSpec spec = short_sheet();
+  AdaptiveSheet sheet = build_adaptive_sheet(spec);
+  const meshing::Mesh48Arrays arrays = sheet.mesh.arrays();
+  // Each triangle's rest coordinates: its (x, −z) in the horizontal sheet, stretched 10 % along
+  // x, so that the rest shape is not the drawn one.
+  sheet.material.rest_uv.resize(arrays.faces.rows(), 6);
+  for (Eigen::Index t = 0; t < arrays.faces.rows(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::RowVector3d p = arrays.rest_positions.row(arrays.faces(t, k));
+      sheet.material.rest_uv(t, 2 * k) = 1.1 * p.x();
+      sheet.material.rest_uv(t, 2 * k + 1) = -p.z();
+    }
+  const SimulationSettings settings = adaptive_sheet_settings(spec);
+  EXPECT_THROW(
+      ClothDriver(sheet.mesh, sheet.material, {}, sheet.pins, settings, AdaptiveSettings{}),
+      InvalidAdaptiveSettingsError);
+  ClothDriver driver(sheet.mesh, sheet.material, {}, sheet.pins, settings, off());
+  EXPECT_THROW(driver.adaptive()->refine_uniformly(1), std::logic_error);
+
+  ClothInput input;
+  input.rest_positions = arrays.rest_positions;
+  input.triangles = arrays.faces;
+  input.up = sheet.material.up;
+  input.warp = Eigen::MatrixX3d(arrays.faces.rows(), 3);
+  for (Eigen::Index t = 0; t < arrays.faces.rows(); ++t)
+    input.warp.row(t) = sheet.material.source_warp.row(
+        sheet.mesh.source_face(arrays.triangle_ids[static_cast<std::size_t>(t)]));
+  input.rest_uv = sheet.material.rest_uv;
+  const ClothModel model = build_cloth_model(input, sheet.material.fabric);
+  EXPECT_EQ(driver.simulation().model().mass, model.mass);
+  Simulation plain(model, flatten_positions(arrays.rest_positions), sheet.pins, settings);
+  plain.run();
+  driver.run();
+  EXPECT_EQ((driver.positions() - unflatten_positions(plain.positions())).cwiseAbs().maxCoeff(),
+            0.0);
+}
+
 TEST(ClothDriver, ModelGivenAsIsKeepsItsTriangles) {
   SheetSpec spec;
   spec.columns = spec.rows = 3;
