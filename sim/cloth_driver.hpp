@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 #include <functional>
 #include <memory>
+#include <vector>
 
 #include "meshing/mesh48.hpp"
 #include "meshing/tri_mesh.hpp"
