@@ -586,6 +586,7 @@ PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, c
 // "adaptive": true | false | {"enabled": ..., "refine_threshold": ..., ...}.
 void parse_adaptive(const Reader& r, const json& a, SimulateSpec& sim) {
   const std::string path = "/simulate/adaptive";
+  sim.adaptive_given = true;
   if (a.is_boolean()) {
     sim.adaptive = a.get<bool>();
     return;

@@ -133,6 +133,7 @@ struct AdaptiveSpec {
 struct SimulateSpec {
   double duration = 3.0;                   // seconds of simulated time at most
   bool adaptive = true;                    // 4-8 refinement/coarsening
+  bool adaptive_given = false;             // the file says "adaptive" (a sheet adapts only then)
   AdaptiveSpec adaptive_settings;          // "adaptive": {...} (with "enabled" for the bool)
   double time_step = 1.0 / 60.0;           // seconds, the largest step
   std::string integrator = "implicit-euler";  // "implicit-euler" | "bdf2"

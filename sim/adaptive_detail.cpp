@@ -62,6 +62,9 @@ AdaptiveCloth::AdaptiveCloth(meshing::Mesh48 mesh, AdaptiveMaterial material,
     : mesh_(std::move(mesh)), material_(std::move(material)), settings_(adaptive) {
   settings_.validate();
   simulation.validate();
+  if (material_.rest_uv.rows() > 0 && settings_.enabled)
+    throw InvalidAdaptiveSettingsError(
+        "pattern rest shapes (rest_uv) need a fixed mesh: turn adaptive detail off");
   if (!mesh_.is_compact())
     throw std::invalid_argument("the adaptive cloth needs a compact 4-8 mesh (call compact())");
   arrays_ = mesh_.arrays();
@@ -97,6 +100,13 @@ Eigen::MatrixX3d AdaptiveCloth::positions() const {
 
 Eigen::MatrixX3d AdaptiveCloth::velocities() const {
   return unflatten_positions(simulation_->velocities());
+}
+
+Eigen::VectorXi AdaptiveCloth::source_faces() const {
+  Eigen::VectorXi source(arrays_.faces.rows());
+  for (Eigen::Index f = 0; f < source.size(); ++f)
+    source(f) = mesh_.source_face(arrays_.triangle_ids[static_cast<std::size_t>(f)]);
+  return source;
 }
 
 Eigen::Vector3d AdaptiveCloth::linear_momentum() const {
@@ -137,6 +147,8 @@ const ContactResponse* AdaptiveCloth::active_contact() const {
 }
 
 AdaptiveTransfer AdaptiveCloth::begin_transfer() const {
+  if (material_.rest_uv.rows() > 0)
+    throw std::logic_error("a cloth with pattern rest shapes (rest_uv) cannot be split or merged");
   return sim::begin_transfer(mesh_, positions(), velocities(), masses_, birth_, pins_,
                              simulation_->time());
 }
@@ -187,6 +199,7 @@ double AdaptiveCloth::rebuild(AdaptiveTransfer& state, const SimulationSettings*
   input.rest_positions = arrays_.rest_positions;
   input.triangles = arrays_.faces;
   input.up = material_.up;
+  input.rest_uv = material_.rest_uv;  // empty, or the unchanged first mesh's (see begin_transfer)
   if (material_.source_warp.rows() > 0) {
     input.warp.resize(arrays_.faces.rows(), 3);
     for (Eigen::Index f = 0; f < arrays_.faces.rows(); ++f) {
@@ -459,84 +472,25 @@ void AdaptiveCloth::record(const StepOutcome& outcome, const AdaptStats& stats) 
 StepOutcome AdaptiveCloth::step(double max_step) {
   const StepOutcome outcome = simulation_->step(max_step);
   if (!outcome.accepted) return outcome;
-  newton_total_ += outcome.newton_iterations;
-  cg_total_ += outcome.cg_iterations;
   record(outcome, adapt());
   return outcome;
 }
 
 AdaptiveReport AdaptiveCloth::run(const std::function<void(const AdaptiveCloth&)>& on_step) {
-  const auto start = Clock::now();
-  const SimulationSettings& settings = simulation_->settings();
-  const SimulationReport before = simulation_->report();
-  std::vector<EnergySample>& energy = report_.simulation.energy;
-  const auto sample = [&] {
-    if (!settings.record_energy) return;
-    const EnergyBreakdown e = simulation_->energy();
-    energy.push_back({simulation_->time(), e.stretch, e.shear, e.bend, e.kinetic, e.potential});
-  };
-  if (energy.empty()) sample();
-  bool failed = false, at_rest = false;
-  std::string failure;
-  int failure_vertex = -1;
-  const double epsilon = 1e-9 * std::max(1.0, settings.duration);
-  while (simulation_->time() < settings.duration - epsilon) {
-    const StepOutcome outcome = step(settings.duration - simulation_->time());
-    if (!outcome.accepted) {
-      failed = true;
-      failure = outcome.failure_reason;
-      failure_vertex = outcome.failure_vertex;
-      break;
-    }
-    sample();
-    if (on_step) on_step(*this);
-    if (settings.stop_at_rest && simulation_->at_rest()) {
-      at_rest = true;
-      break;
-    }
-  }
-  // As Simulation::run: what is still inside the body, or through the cloth, at the end (after
-  // the last adaptation).
-  int penetrating = 0;
-  int piercing = 0;
-  double highest_piercing = 0.0;
-  double query_s = 0.0;
-  if (const ContactResponse* contact = simulation_->contact();
-      contact != nullptr && settings.contact.enabled) {
-    const auto query_start = Clock::now();
-    penetrating = contact->count_penetrating(simulation_->positions());
-    piercing = contact->count_piercing(simulation_->positions(), &highest_piercing);
-    query_s = seconds_since(query_start);
-  }
-  const double wall = seconds_since(start);
-  // The simulation's own counters (steps, solves, timings) plus what its run() would add.
-  std::vector<EnergySample> series = std::move(energy);
-  const double wall_before = report_.simulation.wall_time_s;
-  const double other_before = report_.simulation.other_s;
-  report_.simulation = simulation_->report();
-  report_.simulation.energy = std::move(series);
-  report_.simulation.wall_time_s = wall_before + wall;
-  report_.simulation.collision_s += query_s;
-  report_.simulation.penetrating_vertices_final = penetrating;
-  report_.simulation.piercing_body_vertices_final = piercing;
-  report_.simulation.max_piercing_final_m = highest_piercing;
-  report_.simulation.other_s = other_before + wall -
-                               (report_.simulation.forces_s - before.forces_s) -
-                               (report_.simulation.solve_s - before.solve_s) -
-                               (report_.simulation.collision_s - before.collision_s);
-  report_.simulation.at_rest = at_rest;
-  report_.simulation.failed = failed;
-  report_.simulation.failure_reason = failure;
-  report_.simulation.failure_vertex = failure_vertex;
-  const SimulationReport& s = report_.simulation;
-  report_.simulation.cg_iterations_mean =
-      s.linear_solves > 0 ? static_cast<double>(cg_total_) / s.linear_solves : 0.0;
-  report_.simulation.newton_iterations_mean =
-      s.steps > 0 ? static_cast<double>(newton_total_) / s.steps : 0.0;
-  report_.simulation.max_strain =
-      max_stretch_strain(simulation_->model(), simulation_->positions());
-  report_.simulation.nan_free =
-      simulation_->positions().allFinite() && simulation_->velocities().allFinite();
+  Simulation::RunHooks hooks;
+  if (on_step)
+    hooks.after_step = [&](const StepOutcome& outcome) {
+      if (outcome.accepted) on_step(*this);
+      return true;
+    };
+  return run(hooks);
+}
+
+AdaptiveReport AdaptiveCloth::run(const Simulation::RunHooks& hooks) {
+  // The simulation's own loop and report; each of its steps is this driver's (step, then adapt).
+  Simulation::RunHooks adaptive = hooks;
+  if (!adaptive.step) adaptive.step = [this](double max_step) { return step(max_step); };
+  report_.simulation = simulation_->run(adaptive);
   return report_;
 }
 

@@ -47,6 +47,10 @@ struct AdaptiveMaterial {
   // Children inherit their input face's, so an eased panel keeps its ease at every level; mass
   // moves between triangles at the eased density ρ·e².
   Eigen::VectorXd source_ease;
+  // Rest coordinates of each triangle of the mesh as given (ClothInput::rest_uv: a flattened
+  // pattern's), or empty. Only for a mesh that never changes: with them the driver refuses
+  // adaptivity and every split or merge (children have no pattern coordinates of their own yet).
+  Eigen::MatrixXd rest_uv;
 };
 
 // What one call of adapt() (or of the explicit operations) did.
@@ -115,8 +119,12 @@ class AdaptiveCloth {
 
   // One accepted simulation step (see Simulation::step), then adapt() if it was accepted.
   StepOutcome step(double max_step = 1e300);
-  // Steps until the duration, at rest or failure (as Simulation::run), adapting after each.
+  // Steps until the duration, at rest or failure (Simulation::run's loop and report), adapting
+  // after each step.
   AdaptiveReport run(const std::function<void(const AdaptiveCloth&)>& on_step = {});
+  // The same with the loop's hooks (Simulation::RunHooks); hooks.step, when given, must take
+  // its step through step() above (e.g. to stop at sample times, or change the mesh first).
+  AdaptiveReport run(const Simulation::RunHooks& hooks);
 
   // Error estimates, then merges (flattest first) and splits (largest first) as the settings
   // allow; rebuilds the model only if something changed. Called by step().
@@ -156,6 +164,8 @@ class AdaptiveCloth {
   const Eigen::VectorXd& masses() const { return masses_; }
   const Eigen::MatrixX3i& faces() const { return arrays_.faces; }      // #F by 3
   const Eigen::VectorXi& face_levels() const { return arrays_.face_level; }  // #F, for rendering
+  // #F: the input face (quad) each triangle descends from (Mesh48::source_face).
+  Eigen::VectorXi source_faces() const;
   const Eigen::MatrixX3d& rest_positions() const { return arrays_.rest_positions; }
   // Sag estimate ε per interior edge of the current mesh (rows of mesh().arrays().interior_edges)
   // for the current positions, metres: the larger of the bend sag |θ − θ0|·w/8 and, with a body
@@ -209,8 +219,6 @@ class AdaptiveCloth {
   EdgeRestGeometry edge_rest_;   // per interior edge (rows of arrays_.interior_edges)
   BodySagCache body_sag_cache_;  // carried through topology changes by rebuild
   AdaptiveReport report_;
-  long long newton_total_ = 0;
-  long long cg_total_ = 0;
 };
 
 }  // namespace sd::sim

@@ -31,11 +31,13 @@ SheetScene build_sheet(const SheetSpec& spec) {
   const int nf = 2 * spec.rows * spec.columns;
   scene.input.triangles.resize(nf, 3);
   scene.input.warp.resize(nf, 3);
+  scene.quads.resize(spec.rows * spec.columns, 4);
   int f = 0;
   for (int r = 0; r < spec.rows; ++r)
     for (int c = 0; c < spec.columns; ++c) {
       const int tl = scene.vertex(r, c), tr = scene.vertex(r, c + 1);
       const int bl = scene.vertex(r + 1, c), br = scene.vertex(r + 1, c + 1);
+      scene.quads.row(r * spec.columns + c) << bl, br, tr, tl;
       // Counter-clockwise seen from +Z (vertical) or +Y (horizontal).
       if ((r + c) % 2 == 0) {
         scene.input.triangles.row(f++) << bl, br, tr;
@@ -97,6 +99,17 @@ SheetScene build_sheet(const SheetSpec& spec) {
   scene.pinned_vertices.erase(std::unique(scene.pinned_vertices.begin(), scene.pinned_vertices.end()),
                               scene.pinned_vertices.end());
   return scene;
+}
+
+meshing::Mesh48 sheet_mesh48(const SheetScene& scene) {
+  return meshing::Mesh48::from_quads(scene.input.rest_positions, scene.quads);
+}
+
+Eigen::MatrixX3d sheet_quad_warp(const SheetScene& scene) {
+  // Quad q is split into triangles 2q and 2q + 1, which share its warp.
+  Eigen::MatrixX3d warp(scene.quads.rows(), 3);
+  for (Eigen::Index q = 0; q < warp.rows(); ++q) warp.row(q) = scene.input.warp.row(2 * q);
+  return warp;
 }
 
 }  // namespace sd::sim

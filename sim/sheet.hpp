@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 
+#include "meshing/mesh48.hpp"
 #include "sim/cloth_model.hpp"
 
 namespace sd::sim {
@@ -35,6 +36,10 @@ struct SheetSpec {
 struct SheetScene {
   ClothInput input;                  // warp runs from the bottom edge to the top edge
   std::vector<int> pinned_vertices;  // sorted, unique
+  // rows·columns by 4: the grid's quads (bottom-left, bottom-right, top-right, top-left: counter-
+  // clockwise seen from the sheet's normal side), row by row from the top; the input of the
+  // sheet's 4-8 mesh (Mesh48::from_quads, which picks each quad's diagonal itself).
+  Eigen::MatrixX4i quads;
   int columns = 0;
   int rows = 0;
   // Vertex index of grid point (row r from the top, column c from the left).
@@ -45,5 +50,11 @@ struct SheetScene {
 // alternating diagonals so the mesh has no preferred shear direction). Throws InvalidSheetError
 // for a non-positive size or resolution or an unknown pin name.
 SheetScene build_sheet(const SheetSpec& spec);
+
+// The sheet as a 4-8 mesh: its quads through Mesh48::from_quads (vertex ids = grid ids; each
+// quad's diagonal is the 4-8 rule's, not the alternating one of the sheet's own triangles).
+meshing::Mesh48 sheet_mesh48(const SheetScene& scene);
+// #Q by 3: the warp of each quad (its triangles'), for AdaptiveMaterial::source_warp.
+Eigen::MatrixX3d sheet_quad_warp(const SheetScene& scene);
 
 }  // namespace sd::sim

@@ -477,6 +477,16 @@ StepOutcome Simulation::step(double max_step) {
 }
 
 SimulationReport Simulation::run(const std::function<void(const Simulation&)>& on_step) {
+  RunHooks hooks;
+  if (on_step)
+    hooks.after_step = [&](const StepOutcome& outcome) {
+      if (outcome.accepted) on_step(*this);
+      return true;
+    };
+  return run(hooks);
+}
+
+SimulationReport Simulation::run(const RunHooks& hooks) {
   const auto start = std::chrono::steady_clock::now();
   const double forces_before = report_.forces_s;
   const double solve_before = report_.solve_s;
@@ -490,15 +500,17 @@ SimulationReport Simulation::run(const std::function<void(const Simulation&)>& o
   if (report_.energy.empty()) sample();
   const double epsilon = 1e-9 * std::max(1.0, settings_.duration);
   while (time_ < settings_.duration - epsilon) {
-    const StepOutcome outcome = step(settings_.duration - time_);
+    const double max_step = settings_.duration - time_;
+    const StepOutcome outcome = hooks.step ? hooks.step(max_step) : step(max_step);
     if (!outcome.accepted) {
       report_.failed = true;
       report_.failure_reason = outcome.failure_reason;
       report_.failure_vertex = outcome.failure_vertex;
+      if (hooks.after_step) hooks.after_step(outcome);
       break;
     }
     sample();
-    if (on_step) on_step(*this);
+    if (hooks.after_step && !hooks.after_step(outcome)) break;
     if (settings_.stop_at_rest && at_rest()) {
       report_.at_rest = true;
       break;

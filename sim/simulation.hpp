@@ -170,6 +170,16 @@ class Simulation {
   StepOutcome step(double max_step = 1e300);
   // Steps until `duration` (or at rest, or failure); calls on_step after each accepted step.
   SimulationReport run(const std::function<void(const Simulation&)>& on_step = {});
+  // The run loop itself, for a driver that does more per step (sim/cloth_driver.hpp adapts the
+  // mesh after each one): hooks.step takes one step of at most max_step (empty: step()), then,
+  // for an accepted step, the energy is sampled and hooks.after_step is called; it is also
+  // called with the failed outcome that ends the run. after_step returning false stops the run
+  // after that step (the report is finished as for a run that reached its end).
+  struct RunHooks {
+    std::function<StepOutcome(double max_step)> step;
+    std::function<bool(const StepOutcome&)> after_step;
+  };
+  SimulationReport run(const RunHooks& hooks);
 
   // Replaces the mesh (after an adaptive refine/coarsen) with matching 3n state; the BDF2
   // history restarts with an implicit Euler step.

@@ -43,8 +43,9 @@ TEST(ClothScene, PanelEaseScalesRestShapeAndMass) {
   const ClothScene eased = build_cloth_scene(garment::parse_sketch(two_patches(kEase), "eased.json"));
   const ClothScene plain = build_cloth_scene(garment::parse_sketch(two_patches(1.0), "plain.json"));
   ASSERT_EQ(eased.input.triangles.rows(), plain.input.triangles.rows());
-  ASSERT_EQ(eased.triangle_ease.size(), eased.input.triangles.rows());
-  EXPECT_EQ(plain.triangle_ease.size(), 0) << "no ease recorded when every panel is as drawn";
+  ASSERT_EQ(eased.face_ease.size(), eased.mesh48->arrays().faces.rows() / 2) << "one per quad";
+  ASSERT_EQ(eased.triangle_face.size(), eased.input.triangles.rows());
+  EXPECT_EQ(plain.face_ease.size(), 0) << "no ease recorded when every panel is as drawn";
 
   const sim::ClothModel a = build_scene_model(eased);
   const sim::ClothModel b = build_scene_model(plain);
@@ -55,7 +56,7 @@ TEST(ClothScene, PanelEaseScalesRestShapeAndMass) {
   int eased_triangles = 0;
   double left_area = 0.0, right_area = 0.0;
   for (size_t t = 0; t < a.triangles.size(); ++t) {
-    const double e = eased.triangle_ease(static_cast<Eigen::Index>(t));
+    const double e = eased.face_ease(eased.triangle_face(static_cast<Eigen::Index>(t)));
     ASSERT_TRUE(e == kEase || e == 1.0) << e;
     const sim::TriangleElement& x = a.triangles[t];
     const sim::TriangleElement& y = b.triangles[t];
@@ -96,7 +97,22 @@ TEST(ClothScene, SheetLayersAndTheSelfCollisionDefault) {
   ASSERT_EQ(scene.input.rest_positions.rows(), 3 * 25);
   ASSERT_EQ(scene.input.triangles.rows(), 3 * 32);
   EXPECT_EQ(scene.group_names.size(), 3u);
-  EXPECT_EQ(scene.triangle_group(32), 1);
+  EXPECT_EQ(triangle_groups(scene, scene.triangle_face)(32), 1);
+  // The 4-8 mesh of the three layers' quads: the same vertices, 2 triangles a quad, each
+  // triangle in its layer's group and lying in the quad it comes from.
+  const meshing::Mesh48Arrays arrays = scene.mesh48->arrays();
+  EXPECT_EQ(arrays.rest_positions, scene.input.rest_positions);
+  ASSERT_EQ(arrays.faces.rows(), 3 * 32);
+  ASSERT_EQ(scene.face_group.size(), 3 * 16);
+  ASSERT_EQ(scene.face_warp.rows(), 3 * 16);
+  for (Eigen::Index t = 0; t < arrays.faces.rows(); ++t) {
+    const int quad = scene.mesh48->source_face(arrays.triangle_ids[static_cast<size_t>(t)]);
+    EXPECT_EQ(scene.face_group(quad), quad / 16);
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(arrays.faces(t, k) / 25, quad / 16) << "triangle " << t;
+  }
+  // Layer 1 is turned 90° about y: its warp (−Z on the first layer) is −X.
+  EXPECT_TRUE(Eigen::Vector3d(scene.face_warp.row(16)).isApprox(Eigen::Vector3d(-1, 0, 0), 1e-12))
+      << scene.face_warp.row(16);
   EXPECT_EQ(scene.input.triangles(32, 0), scene.input.triangles(0, 0) + 25);
   for (int i = 0; i < 25; ++i) {
     const Eigen::Vector3d p = scene.start.row(i).transpose() - Eigen::Vector3d(0, 1, 0);

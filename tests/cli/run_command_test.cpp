@@ -120,6 +120,44 @@ TEST(RunCommand, SheetSceneWritesReportMeshAndTrace) {
   EXPECT_FALSE(fs::exists(out / "drape-front.png"));  // "images": [] asks for none
 }
 
+// A sheet drapes on its own fixed triangles unless the file asks for adaptive detail (the
+// garments' default does not apply to sheets); asked, it drapes on the 4-8 mesh of its quads,
+// which refines where the falling sheet bends.
+TEST(RunCommand, SheetAdaptsOnlyWhenAsked) {
+  const fs::path dir = fresh_dir("adaptive-sheet");
+  nlohmann::json sketch = small_sheet();
+  const CommandResult fixed = run_sketchdrape("-q run " + write_sketch(dir, sketch).string() +
+                                              " -o " + (dir / "fixed").string());
+  ASSERT_EQ(fixed.exit_code, 0) << fixed.output;
+  EXPECT_TRUE(read_json(dir / "fixed" / "report.json")["adaptive"].is_null());
+
+  sketch["simulate"]["adaptive"] = {
+      {"max_level", 3}, {"refine_threshold", 0.0005}, {"coarsen_threshold", 0.0001}};
+  const CommandResult r = run_sketchdrape("-q run " + write_sketch(dir, sketch).string() +
+                                          " -o " + (dir / "adaptive").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json report = read_json(dir / "adaptive" / "report.json");
+  ASSERT_TRUE(report["adaptive"].is_object()) << report.dump(2);
+  EXPECT_GT(report["adaptive"]["splits"].get<int>(), 0);
+  EXPECT_EQ(report["adaptive"]["vertices_min"], 49);
+  EXPECT_GT(report["adaptive"]["vertices_max"].get<int>(), 49);
+  EXPECT_GE(report["adaptive"]["max_level_reached"].get<int>(), 1);
+  EXPECT_LE(report["adaptive"]["max_level_reached"].get<int>(), 3);
+  EXPECT_TRUE(report["nan_free"].get<bool>());
+  EXPECT_NEAR(report["sim_time"].get<double>(), 0.5, 1e-9);
+  // The drape is written on the final 4-8 mesh.
+  std::ifstream obj(dir / "adaptive" / "drape.obj");
+  std::string line;
+  int vertices = 0, faces = 0;
+  while (std::getline(obj, line)) {
+    vertices += line.starts_with("v ");
+    faces += line.starts_with("f ");
+  }
+  EXPECT_EQ(vertices, report["vertices"].get<int>());
+  EXPECT_EQ(faces, report["triangles"].get<int>());
+  EXPECT_GT(faces, 72);
+}
+
 // The self-collision scenes of data/scenes end without the cloth passing through itself (CGAL's
 // count); two sheets falling onto each other without self-collision do pass through.
 TEST(RunCommand, SelfCollisionScenesEndWithoutIntersections) {

@@ -60,17 +60,9 @@ inline AdaptiveSheet build_adaptive_sheet(const AdaptiveSheetSpec& spec) {
   sheet_spec.orientation = SheetOrientation::horizontal;
   sheet_spec.pins = spec.pins;
   const SheetScene scene = build_sheet(sheet_spec);
-  Eigen::MatrixX4i quads(spec.quads * spec.quads, 4);
-  int q = 0;
-  for (int r = 0; r < spec.quads; ++r)
-    for (int c = 0; c < spec.quads; ++c)
-      quads.row(q++) << scene.vertex(r + 1, c), scene.vertex(r + 1, c + 1), scene.vertex(r, c + 1),
-          scene.vertex(r, c);
-  AdaptiveSheet out{meshing::Mesh48::from_quads(scene.input.rest_positions, quads), {}, {}};
+  AdaptiveSheet out{sheet_mesh48(scene), {}, {}};
   out.material.fabric = adaptive_sheet_fabric();
-  out.material.source_warp = Eigen::MatrixX3d(quads.rows(), 3);
-  for (Eigen::Index f = 0; f < quads.rows(); ++f)
-    out.material.source_warp.row(f) = Eigen::RowVector3d(0.0, 0.0, -1.0);  // towards the top
+  out.material.source_warp = sheet_quad_warp(scene);  // towards the top: −Z
   out.material.up = scene.input.up;
   for (int v : scene.pinned_vertices) out.pins.push_back({v, {}});
   return out;

@@ -16,8 +16,8 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
-#include "garment/material_frames.hpp"
 #include "garment/sketch_file.hpp"
+#include "sim/cloth_driver.hpp"
 #include "sim/sheet.hpp"
 #include "sim/surface_sampling.hpp"
 #include "src/app/pipeline/sha256.hpp"
@@ -32,29 +32,14 @@ constexpr bool kAdaptiveWithBody = true;
 
 // --- scenes ------------------------------------------------------------------------------------
 
-// Quads of a sheet grid, counter-clockwise seen from the sheet's normal side (as the 4-8 tests).
-Eigen::MatrixX4i sheet_quads(const sim::SheetScene& scene) {
-  Eigen::MatrixX4i quads(scene.rows * scene.columns, 4);
-  int q = 0;
-  for (int r = 0; r < scene.rows; ++r)
-    for (int c = 0; c < scene.columns; ++c)
-      quads.row(q++) << scene.vertex(r + 1, c), scene.vertex(r + 1, c + 1),
-          scene.vertex(r, c + 1), scene.vertex(r, c);
-  return quads;
-}
-
 // A sheet of 4 by 4 level-0 quads: the fixed runs refine it uniformly (level 8 = 64 by 64 quads).
 void set_sheet(BenchScene& scene, sim::SheetSpec spec) {
   spec.columns = spec.rows = 4;
   scene.sheet = true;
   const sim::SheetScene sheet = sim::build_sheet(spec);
-  const Eigen::MatrixX4i quads = sheet_quads(sheet);
-  scene.mesh = meshing::Mesh48::from_quads(sheet.input.rest_positions, quads);
+  scene.mesh = sim::sheet_mesh48(sheet);
   // Warp runs from the bottom edge to the top edge: +Y for a vertical sheet, −Z when horizontal.
-  const Eigen::RowVector3d warp = spec.orientation == sim::SheetOrientation::vertical
-                                      ? Eigen::RowVector3d(0, 1, 0)
-                                      : Eigen::RowVector3d(0, 0, -1);
-  scene.material.source_warp = warp.replicate(quads.rows(), 1);
+  scene.material.source_warp = sim::sheet_quad_warp(sheet);
   scene.material.up = sheet.input.up;
   scene.start = sheet.input.rest_positions;
   scene.pinned = sheet.pinned_vertices;
@@ -171,8 +156,8 @@ BenchScene sketch_scene(const std::filesystem::path& file, BenchGrid grid) {
     ClothScene cloth = build_cloth_scene(sketch);
     scene.mesh = std::move(*cloth.mesh48);
     scene.material.fabric = cloth.fabric;
-    scene.material.source_warp = garment::material_frames(cloth.garment->mesh).warp;
-    scene.material.source_ease = cloth.mesh48_face_ease;  // panel ease, as `run` applies it
+    scene.material.source_warp = cloth.face_warp;
+    scene.material.source_ease = cloth.face_ease;  // panel ease, as `run` applies it
     scene.start = cloth.start;
     scene.pinned = cloth.pinned;
     if (cloth.body) scene.body = cloth.body->mesh;
@@ -215,33 +200,6 @@ sim::SimulationSettings run_settings(const BenchScene& scene, const BenchConfig&
   settings.stop_at_rest = false;  // every run covers the same simulated time
   settings.record_energy = false;
   return settings;
-}
-
-// The stepping loop shared by both drivers: steps that land on every sample time, the sample
-// taken there (outside the timed part).
-template <class Step, class Sample>
-void drive(const BenchScene& scene, BenchTrace& trace, Step&& step, Sample&& sample) {
-  const double epsilon = 1e-9;
-  double time = 0.0;
-  double next = scene.sample_every;
-  sample();
-  while (time < scene.duration - epsilon) {
-    const double until = std::min(scene.duration, next) - time;
-    const auto wall_start = std::chrono::steady_clock::now();
-    const double cpu_start = process_cpu_seconds();
-    const sim::StepOutcome outcome = step(until, time);
-    trace.cpu_s += process_cpu_seconds() - cpu_start;
-    trace.wall_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-    if (!outcome.accepted) {
-      trace.failed = true;
-      trace.failure = fmt::format("step at t = {:.4f} s failed: {}", time, outcome.failure_reason);
-      return;
-    }
-    if (time >= next - epsilon) {
-      sample();
-      next += scene.sample_every;
-    }
-  }
 }
 
 }  // namespace
@@ -441,91 +399,95 @@ BenchTrace run_bench_config(const BenchScene& scene, const BenchConfig& config) 
   const sim::SimulationSettings settings = run_settings(scene, config);
   std::vector<sim::Pin> pins;
   for (int v : scene.pinned) pins.push_back({v, {}});
-  const auto record = [&](double time, const Eigen::MatrixX3d& points, double energy) {
-    trace.times.push_back(time);
-    trace.positions.push_back(points);
-    trace.energy.push_back(energy);
-  };
 
+  // Fixed: the scene's 4-8 mesh refined uniformly to the level, then draped with adaptivity off
+  // (warp, panel ease and masses as in an adaptive run). Adaptive: refined to the scene's start
+  // level, then refining and coarsening as it goes.
+  sim::AdaptiveSettings adaptive;
   if (config.mesh == BenchMeshKind::adaptive) {
-    sim::AdaptiveSettings adaptive;
     adaptive.refine_threshold = config.threshold;
     adaptive.coarsen_threshold = 0.25 * config.threshold;
     adaptive.max_level = config.level;
-    sim::AdaptiveCloth cloth(*scene.mesh, scene.material, scene.start, pins, settings, adaptive);
-    if (scene.start_level > 0) cloth.refine_uniformly(scene.start_level);
-    if (scene.body) cloth.set_body(*scene.body);
-    trace.rss_before_mb = peak_rss_mb();
-    drive(
-        scene, trace,
-        [&](double until, double& time) {
-          const sim::StepOutcome outcome = cloth.step(until);
-          time = cloth.time();
-          trace.vertices_max = std::max(trace.vertices_max, cloth.mesh().vertex_count());
-          trace.triangles_max = std::max(trace.triangles_max, cloth.mesh().triangle_count());
-          return outcome;
-        },
-        [&] {
-          const auto located = sim::locate_material_points(cloth.rest_positions(), cloth.faces(),
-                                                           scene.material_points);
-          record(cloth.time(), sim::positions_at(located, cloth.faces(), cloth.positions()),
-                 cloth.simulation().energy().total());
-        });
-    const sim::SimulationReport& r = cloth.simulation().report();
-    trace.steps = r.steps;
-    trace.retries = r.retries;
-    trace.linear_solves = r.linear_solves;
-    trace.cg_iterations_mean = r.cg_iterations_mean;
-    trace.splits = cloth.report().splits + cloth.report().forced_splits;
-    trace.merges = cloth.report().merges;
-    trace.vertices_final = cloth.mesh().vertex_count();
-    return trace;
+  } else {
+    adaptive.enabled = false;
   }
-
-  // Fixed: the scene's 4-8 mesh refined uniformly, draped by the plain simulator (with the body)
-  // on the model the refined cloth built (warp, panel ease and masses as in an adaptive run).
-  Eigen::MatrixX3d rest;
-  Eigen::MatrixX3i faces;
-  std::optional<sim::Simulation> fixed;
-  {
-    sim::AdaptiveSettings off;
-    off.enabled = false;
-    sim::AdaptiveCloth refined(*scene.mesh, scene.material, scene.start, pins, settings, off);
+  sim::ClothDriver driver(*scene.mesh, scene.material, scene.start, pins, settings, adaptive);
+  sim::AdaptiveCloth& cloth = *driver.adaptive();
+  const int start_level = config.mesh == BenchMeshKind::adaptive ? scene.start_level : config.level;
+  if (config.mesh == BenchMeshKind::adaptive) {
+    if (start_level > 0) cloth.refine_uniformly(start_level);
+    if (scene.body) driver.set_body(*scene.body);
+  } else {
     // With the body, split vertices that a chord puts inside the contact thickness are moved out
     // to it, as in an adaptive run. Without, a garment refined on the body starts with chord
     // midpoints inside it (the t-shirt at L2: the start repair then blew up within 5 steps).
-    if (scene.body) refined.set_body(*scene.body);
-    if (config.level > 0) refined.refine_uniformly(config.level);
-    rest = refined.rest_positions();
-    faces = refined.faces();
-    std::vector<sim::Pin> fixed_pins;
-    for (int v : refined.pinned_vertices()) fixed_pins.push_back({v, {}});
-    fixed.emplace(refined.simulation().model(), sim::flatten_positions(refined.positions()),
-                  std::move(fixed_pins), settings);
+    if (scene.body) driver.set_body(*scene.body);
+    if (start_level > 0) cloth.refine_uniformly(start_level);
   }
-  sim::Simulation& simulation = *fixed;
-  if (scene.body) simulation.set_body(*scene.body);
-  const auto located = sim::locate_material_points(rest, faces, scene.material_points);
+
+  // Material points located once per mesh (the fixed mesh never changes).
+  std::optional<std::vector<sim::MaterialLocation>> fixed_located;
+  const auto sample = [&] {
+    if (config.mesh == BenchMeshKind::fixed && !fixed_located)
+      fixed_located =
+          sim::locate_material_points(cloth.rest_positions(), cloth.faces(), scene.material_points);
+    const std::vector<sim::MaterialLocation> located =
+        fixed_located ? *fixed_located
+                      : sim::locate_material_points(cloth.rest_positions(), cloth.faces(),
+                                                    scene.material_points);
+    trace.times.push_back(cloth.time());
+    trace.positions.push_back(sim::positions_at(located, cloth.faces(), cloth.positions()));
+    trace.energy.push_back(cloth.simulation().energy().total());
+  };
+  const auto count_mesh = [&] {
+    trace.vertices_max = std::max(trace.vertices_max, cloth.mesh().vertex_count());
+    trace.triangles_max = std::max(trace.triangles_max, cloth.mesh().triangle_count());
+  };
+  count_mesh();
   trace.rss_before_mb = peak_rss_mb();
-  drive(
-      scene, trace,
-      [&](double until, double& time) {
-        const sim::StepOutcome outcome = simulation.step(until);
-        time = simulation.time();
-        return outcome;
-      },
-      [&] {
-        record(simulation.time(),
-               sim::positions_at(located, faces, sim::unflatten_positions(simulation.positions())),
-               simulation.energy().total());
-      });
-  const sim::SimulationReport& r = simulation.report();
+
+  // Steps land on every sample time; the sample taken there is outside the timed part.
+  const double epsilon = 1e-9;
+  double next = scene.sample_every;
+  auto wall_start = std::chrono::steady_clock::now();
+  double cpu_start = 0.0;
+  sim::ClothObserver observer;
+  observer.max_step = [&](const sim::ClothDriver& d) {
+    return std::min(scene.duration, next) - d.time();
+  };
+  observer.before_step = [&](sim::ClothDriver&) {
+    wall_start = std::chrono::steady_clock::now();
+    cpu_start = process_cpu_seconds();
+  };
+  observer.after_step = [&](const sim::ClothDriver& d, const sim::StepOutcome& outcome) {
+    trace.cpu_s += process_cpu_seconds() - cpu_start;
+    trace.wall_s +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    if (!outcome.accepted) {
+      trace.failed = true;
+      trace.failure =
+          fmt::format("step at t = {:.4f} s failed: {}", d.time(), outcome.failure_reason);
+      return false;
+    }
+    count_mesh();
+    if (d.time() >= next - epsilon) {
+      sample();
+      next += scene.sample_every;
+    }
+    return true;
+  };
+  sample();
+  driver.run(observer);
+
+  const sim::SimulationReport& r = cloth.simulation().report();
   trace.steps = r.steps;
   trace.retries = r.retries;
   trace.linear_solves = r.linear_solves;
   trace.cg_iterations_mean = r.cg_iterations_mean;
-  trace.vertices_max = trace.vertices_final = simulation.model().vertex_count;
-  trace.triangles_max = static_cast<int>(faces.rows());
+  trace.splits = cloth.report().splits + cloth.report().forced_splits;
+  trace.merges = cloth.report().merges;
+  trace.vertices_final = cloth.mesh().vertex_count();
+  if (config.mesh == BenchMeshKind::fixed) trace.splits = trace.merges = 0;
   return trace;
 }
 

@@ -74,8 +74,8 @@ void run_mesh(const MeshOptions& options) {
   nlohmann::json report = {{"format", "sketchdrape/1 mesh report"}, {"sketch", sketch.file}};
 
   if (sketch.sheet) {
-    // A sheet scene: its grid of triangles is the mesh `run` simulates (no 4-8 hierarchy: a
-    // sheet runs on its fixed mesh).
+    // A sheet scene: its grid of triangles is the fixed mesh `run` simulates (a sheet that asks
+    // for adaptive detail drapes on the 4-8 mesh of its quads instead).
     if (const auto vertices = cloth_vertices_before_building(sketch))
       check_run_fits(sketch, estimate_run(sketch, *vertices, 0), RunLimits{}, 0);
     const ClothScene scene = build_cloth_scene(sketch);

@@ -15,9 +15,9 @@
 
 #include "garment/sketch_file.hpp"
 #include "garment/body_landmarks.hpp"
-#include "garment/material_frames.hpp"
 #include "meshing/slice_dent.hpp"
 #include "sim/adaptive_detail.hpp"
+#include "sim/cloth_driver.hpp"
 #include "sim/simulation.hpp"
 #include "src/app/commands/cli.hpp"
 #include "src/app/pipeline/cloth_scene.hpp"
@@ -256,9 +256,6 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   if (scene.pinned.empty() && !scene.body)
     spdlog::warn("nothing holds the cloth (no pins, no body): it will fall for the whole run");
 
-  std::vector<sim::Pin> pins;
-  for (int v : scene.pinned) pins.push_back({v, {}});
-
   const std::filesystem::path dir(options.out);
   StagedOutputs outputs;
   std::string trace;
@@ -300,14 +297,16 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
            t >= static_cast<double>(frames.size()) / options.frames_per_second - 1e-9;
   };
   if (frame_due(0.0)) {
-    frames.push_back({0.0, {scene.start, scene.input.triangles}, scene.triangle_group});
+    frames.push_back(
+        {0.0, {scene.start, scene.input.triangles}, triangle_groups(scene, scene.triangle_face)});
   }
 
-  // Adaptive 4-8 detail needs the garment's block hierarchy; a sheet runs on its fixed mesh.
+  // One driver: the cloth's 4-8 mesh, adapting or not (a sheet that does not adapt drapes on its
+  // own triangles).
   sim::SimulationReport report;
   nlohmann::json adaptive_json = nullptr;
   meshing::TriMesh draped;
-  Eigen::VectorXi triangle_group = scene.triangle_group;
+  Eigen::VectorXi triangle_group;
   Eigen::VectorXd face_levels;
   nlohmann::json strain = nullptr;
   const bool flat_rest = scene.input.rest_uv.rows() > 0;
@@ -315,71 +314,51 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
     spdlog::warn("\"rest\": \"flat\" drapes on the fixed mesh: adaptive detail does not yet carry "
                  "pattern rest shapes through its splits (docs/pattern.md)");
   try {
-    if (sketch.simulate.adaptive && scene.mesh48 && !flat_rest) {
-      sim::AdaptiveMaterial material;
-      material.fabric = scene.fabric;
-      if (scene.garment) material.source_warp = garment::material_frames(scene.garment->mesh).warp;
-      material.source_ease = scene.mesh48_face_ease;
-      sim::AdaptiveCloth cloth(*scene.mesh48, material, scene.start, pins, settings,
-                               adaptive_settings(sketch));
-      // Contacts through every split and merge, with the body still or moving.
-      if (scene.body_motion)
-        cloth.set_body_motion(*scene.body_motion);
-      else if (scene.body)
-        cloth.set_body(scene.body->mesh);
-      // Each triangle keeps the group of the input face (quad) it descends from.
-      const auto groups_of = [&](const sim::AdaptiveCloth& c) {
-        const meshing::Mesh48Arrays arrays = c.mesh().arrays();
-        Eigen::VectorXi groups(arrays.faces.rows());
-        for (Eigen::Index t = 0; t < arrays.faces.rows(); ++t)
-          groups(t) = scene.mesh48_face_group(
-              c.mesh().source_face(arrays.triangle_ids[static_cast<size_t>(t)]));
-        return groups;
-      };
-      const sim::AdaptiveReport adaptive = cloth.run([&](const sim::AdaptiveCloth& c) {
-        on_step(c.simulation());
-        while (frame_due(c.simulation().time()))
-          frames.push_back({c.simulation().time(), {c.positions(), c.faces()}, groups_of(c)});
-      });
-      report = adaptive.simulation;
-      draped.vertices = cloth.positions();
-      draped.faces = cloth.faces();
-      face_levels = cloth.face_levels().cast<double>();
-      triangle_group = groups_of(cloth);
-      strain = strain_json(cloth.simulation().model(), draped.vertices, triangle_group,
-                           scene.group_names);
-      adaptive_json = {{"splits", adaptive.splits},
-                       {"forced_splits", adaptive.forced_splits},
-                       {"merges", adaptive.merges},
-                       {"moved_off_body", adaptive.moved_off_body},
-                       {"splits_declined_on_body", adaptive.splits_declined_on_body},
-                       {"body_sags_computed", adaptive.body_sags_computed},
-                       {"body_sags_reused", adaptive.body_sags_reused},
-                       {"topology_changes", adaptive.topology_changes},
-                       {"vertices_min", adaptive.vertices_min},
-                       {"vertices_max", adaptive.vertices_max},
-                       {"max_level_reached", adaptive.max_level_reached},
-                       {"adaptivity_s", adaptive.adaptivity_s()},
-                       {"steps", adaptive_steps_json(adaptive.steps)}};
-    } else {
-      sim::Simulation simulation(build_scene_model(scene),
-                                 sim::flatten_positions(scene.start), pins, settings);
-      // Contacts and friction, with the body still or moving.
-      if (scene.body_motion)
-        simulation.set_body_motion(*scene.body_motion);
-      else if (scene.body)
-        simulation.set_body(scene.body->mesh);
-      report = simulation.run([&](const sim::Simulation& s) {
-        on_step(s);
-        while (frame_due(s.time()))
-          frames.push_back({s.time(),
-                            {sim::unflatten_positions(s.positions()), scene.input.triangles},
-                            scene.triangle_group});
-      });
-      draped.vertices = sim::unflatten_positions(simulation.positions());
-      draped.faces = scene.input.triangles;
-      strain = strain_json(simulation.model(), draped.vertices, scene.triangle_group,
-                           scene.group_names);
+    // A garment adapts unless the file says "adaptive": false; a sheet only when it asks.
+    const bool adaptive = sketch.simulate.adaptive &&
+                          (!sketch.sheet || sketch.simulate.adaptive_given) && !flat_rest;
+    sim::ClothDriver driver =
+        scene_driver(scene, settings,
+                     adaptive ? std::optional(adaptive_settings(sketch)) : std::nullopt);
+    // Contacts and friction (through every split and merge), with the body still or moving.
+    if (scene.body_motion)
+      driver.set_body_motion(*scene.body_motion);
+    else if (scene.body)
+      driver.set_body(scene.body->mesh);
+    // Each triangle keeps the group of the input face it descends from.
+    const auto groups_of = [&](const sim::ClothDriver& d) {
+      return triangle_groups(scene, d.source_faces());
+    };
+    sim::ClothObserver observer;
+    observer.after_step = [&](const sim::ClothDriver& d, const sim::StepOutcome& outcome) {
+      if (!outcome.accepted) return false;
+      on_step(d.simulation());
+      while (frame_due(d.time()))
+        frames.push_back({d.time(), {d.positions(), d.faces()}, groups_of(d)});
+      return true;
+    };
+    report = driver.run(observer);
+    draped.vertices = driver.positions();
+    draped.faces = driver.faces();
+    face_levels = driver.face_levels().cast<double>();
+    triangle_group = groups_of(driver);
+    strain = strain_json(driver.simulation().model(), draped.vertices, triangle_group,
+                         scene.group_names);
+    if (adaptive) {
+      const sim::AdaptiveReport& a = *driver.adaptive_report();
+      adaptive_json = {{"splits", a.splits},
+                       {"forced_splits", a.forced_splits},
+                       {"merges", a.merges},
+                       {"moved_off_body", a.moved_off_body},
+                       {"splits_declined_on_body", a.splits_declined_on_body},
+                       {"body_sags_computed", a.body_sags_computed},
+                       {"body_sags_reused", a.body_sags_reused},
+                       {"topology_changes", a.topology_changes},
+                       {"vertices_min", a.vertices_min},
+                       {"vertices_max", a.vertices_max},
+                       {"max_level_reached", a.max_level_reached},
+                       {"adaptivity_s", a.adaptivity_s()},
+                       {"steps", adaptive_steps_json(a.steps)}};
     }
   } catch (const sim::InvalidFabricError& e) {
     sketch.fail("/fabric", e.what());

@@ -70,20 +70,26 @@ void build_sheet_scene(const garment::Sketch& sketch, ClothScene& scene) {
   sheet.centre = spec.centre;
   sheet.pins = spec.pins;
   sim::SheetScene built = sim::build_sheet(sheet);
+  scene.sheet = true;
+  Eigen::MatrixX4i quads = built.quads;
+  scene.face_warp = sim::sheet_quad_warp(built);
   scene.input = std::move(built.input);
   scene.pinned = std::move(built.pinned_vertices);
-  scene.triangle_group = Eigen::VectorXi::Zero(scene.input.triangles.rows());
+  scene.face_group = Eigen::VectorXi::Zero(quads.rows());
   scene.group_names = {"sheet"};
   if (spec.layers > 1) {
     // Layer k: the first moved by k·offset and turned k·turn about the vertical through the
     // centre; one group per layer so that the previews tell them apart.
     const Eigen::Index nv = scene.input.rest_positions.rows();
     const Eigen::Index nf = scene.input.triangles.rows();
+    const Eigen::Index nq = quads.rows();
     sim::ClothInput layered = scene.input;
     layered.rest_positions.resize(nv * spec.layers, 3);
     layered.triangles.resize(nf * spec.layers, 3);
     if (layered.warp.rows() > 0) layered.warp.resize(nf * spec.layers, 3);
-    scene.triangle_group.resize(nf * spec.layers);
+    Eigen::MatrixX4i layered_quads(nq * spec.layers, 4);
+    Eigen::MatrixX3d layered_warp(nq * spec.layers, 3);
+    scene.face_group.resize(nq * spec.layers);
     for (int k = 0; k < spec.layers; ++k) {
       const Eigen::Matrix3d turn =
           Eigen::AngleAxisd(k * spec.layer_turn * std::numbers::pi / 180.0,
@@ -99,12 +105,24 @@ void build_sheet_scene(const garment::Sketch& sketch, ClothScene& scene) {
             scene.input.triangles.row(f) + Eigen::RowVector3i::Constant(static_cast<int>(k * nv));
         if (scene.input.warp.rows() > 0)
           layered.warp.row(k * nf + f) = (turn * scene.input.warp.row(f).transpose()).transpose();
-        scene.triangle_group(k * nf + f) = k;
+      }
+      for (Eigen::Index q = 0; q < nq; ++q) {
+        layered_quads.row(k * nq + q) =
+            quads.row(q) + Eigen::RowVector4i::Constant(static_cast<int>(k * nv));
+        layered_warp.row(k * nq + q) = (turn * scene.face_warp.row(q).transpose()).transpose();
+        scene.face_group(k * nq + q) = k;
       }
       if (k > 0) scene.group_names.push_back(fmt::format("sheet {}", k + 1));
     }
     scene.input = std::move(layered);
+    quads = std::move(layered_quads);
+    scene.face_warp = std::move(layered_warp);
   }
+  // Quad q of every layer is split into triangles 2q and 2q + 1 (sim::build_sheet).
+  scene.triangle_face.resize(scene.input.triangles.rows());
+  for (Eigen::Index t = 0; t < scene.triangle_face.size(); ++t)
+    scene.triangle_face(t) = static_cast<int>(t / 2);
+  scene.mesh48 = meshing::Mesh48::from_quads(scene.input.rest_positions, quads);
   scene.start = scene.input.rest_positions;
   // simulate.pin_above holds a sheet too (a clamp of several rows of a hanging sheet, of every
   // layer), together with the named pins.
@@ -120,7 +138,8 @@ void build_sheet_scene(const garment::Sketch& sketch, ClothScene& scene) {
 // warp) and v along weft = normal × warp, which is −x on a piece seen from outside; shaped panels
 // keep their drawn triangles. Ease is applied later, as for shaped panels (build_scene_model).
 void flat_rest_shapes(const garment::Sketch& sketch, const garment::Garment& g,
-                      const meshing::Mesh48& m48, ClothScene& scene) {
+                      const meshing::Mesh48& m48, const garment::MaterialFrames& frames,
+                      ClothScene& scene) {
   std::vector<bool> flat(g.panels.size(), false);
   bool any = false, all = true;
   for (size_t p = 0; p < g.panels.size(); ++p) {
@@ -162,11 +181,8 @@ void flat_rest_shapes(const garment::Sketch& sketch, const garment::Garment& g,
       uv.row(piece.vertices[l]) << piece.uv(static_cast<Eigen::Index>(l), 1),
           -piece.uv(static_cast<Eigen::Index>(l), 0);
   }
-  const garment::MaterialFrames frames = garment::material_frames(g.mesh);
   meshing::TriMesh drawn{arrays.rest_positions, arrays.faces};
-  Eigen::VectorXi triangle_quad(arrays.faces.rows());
-  for (Eigen::Index t = 0; t < arrays.faces.rows(); ++t)
-    triangle_quad(t) = m48.source_face(arrays.triangle_ids[static_cast<size_t>(t)]);
+  const Eigen::VectorXi& triangle_quad = scene.triangle_face;
   scene.input.rest_uv = garment::triangle_rest_coordinates(
       drawn, triangle_quad, frames, Eigen::VectorXd::Ones(g.mesh.face_count()));
   for (Eigen::Index t = 0; t < arrays.faces.rows(); ++t) {
@@ -214,30 +230,30 @@ void build_garment_scene(const garment::Sketch& sketch, ClothScene& scene) {
     panel_group[p] = static_cast<int>(it - scene.group_names.begin());
   }
 
+  // Per quad: group, ease and warp (the material frames, computed once here).
+  const Eigen::Index quads = g.mesh.face_count();
+  scene.face_group.resize(quads);
+  scene.face_ease.resize(quads);
+  for (Eigen::Index q = 0; q < quads; ++q) {
+    const auto panel = static_cast<size_t>(g.face_panel(static_cast<int>(q)));
+    scene.face_group(q) = panel_group[panel];
+    scene.face_ease(q) = g.panels[panel].ease;
+  }
+  if ((scene.face_ease.array() == 1.0).all()) scene.face_ease.resize(0);
+  scene.face_warp = frames.warp;
+
   const Eigen::Index triangles = arrays.faces.rows();
   scene.input.rest_positions = arrays.rest_positions;
   scene.input.triangles = arrays.faces;
   scene.input.warp.resize(triangles, 3);
-  scene.triangle_group.resize(triangles);
-  scene.triangle_ease.resize(triangles);
+  scene.triangle_face.resize(triangles);
   for (Eigen::Index t = 0; t < triangles; ++t) {
-    const int quad = m48.source_face(arrays.triangle_ids[static_cast<size_t>(t)]);
-    scene.input.warp.row(t) = frames.warp.row(quad);
-    scene.triangle_group(t) = panel_group[static_cast<size_t>(g.face_panel(quad))];
-    scene.triangle_ease(t) = g.panels[static_cast<size_t>(g.face_panel(quad))].ease;
+    scene.triangle_face(t) = m48.source_face(arrays.triangle_ids[static_cast<size_t>(t)]);
+    scene.input.warp.row(t) = frames.warp.row(scene.triangle_face(t));
   }
-  if ((scene.triangle_ease.array() == 1.0).all()) scene.triangle_ease.resize(0);
   scene.start = arrays.rest_positions;
   pin_above(sketch, scene);
-  scene.mesh48_face_group.resize(g.mesh.face_count());
-  for (Eigen::Index q = 0; q < g.mesh.face_count(); ++q)
-    scene.mesh48_face_group(q) = panel_group[static_cast<size_t>(g.face_panel(q))];
-  if (scene.triangle_ease.size() > 0) {
-    scene.mesh48_face_ease.resize(g.mesh.face_count());
-    for (Eigen::Index q = 0; q < g.mesh.face_count(); ++q)
-      scene.mesh48_face_ease(q) = g.panels[static_cast<size_t>(g.face_panel(q))].ease;
-  }
-  flat_rest_shapes(sketch, g, m48, scene);
+  flat_rest_shapes(sketch, g, m48, frames, scene);
   scene.mesh48 = std::move(m48);
   scene.garment = std::move(g);
 }
@@ -258,13 +274,15 @@ void build_imported_scene(const garment::Sketch& sketch, ClothScene& scene) {
   const meshing::Mesh48Arrays arrays = m48.arrays();
   scene.input.rest_positions = arrays.rest_positions;
   scene.input.triangles = arrays.faces;
+  scene.triangle_face.resize(arrays.faces.rows());
+  for (Eigen::Index t = 0; t < arrays.faces.rows(); ++t)
+    scene.triangle_face(t) = m48.source_face(arrays.triangle_ids[static_cast<size_t>(t)]);
   scene.start = arrays.rest_positions;
-  scene.triangle_group = Eigen::VectorXi::Zero(arrays.faces.rows());
+  scene.face_group = Eigen::VectorXi::Zero(triangles.face_count());
   scene.group_names = {"garment"};
   scene.fabric_name = sketch.fabric;
   scene.fabric = fabric_at(sketch, sketch.fabric, "/fabric");
   pin_above(sketch, scene);
-  scene.mesh48_face_group = Eigen::VectorXi::Zero(triangles.face_count());
   scene.mesh48 = std::move(m48);
 }
 
@@ -296,8 +314,43 @@ sim::ClothModel build_scene_model(const ClothScene& scene) {
   sim::ClothModelOptions options;
   if (scene.bend_rest_flat) options.bend_rest = sim::BendRestShape::flat;
   sim::ClothModel model = sim::build_cloth_model(scene.input, scene.fabric, options);
-  if (scene.triangle_ease.size() > 0) sim::scale_rest_shapes(model, scene.triangle_ease);
+  if (scene.face_ease.size() > 0) {
+    Eigen::VectorXd triangle_ease(scene.triangle_face.size());
+    for (Eigen::Index t = 0; t < triangle_ease.size(); ++t)
+      triangle_ease(t) = scene.face_ease(scene.triangle_face(t));
+    sim::scale_rest_shapes(model, triangle_ease);
+  }
   return model;
+}
+
+sim::AdaptiveMaterial scene_material(const ClothScene& scene) {
+  sim::AdaptiveMaterial material;
+  material.fabric = scene.fabric;
+  if (scene.bend_rest_flat) material.model_options.bend_rest = sim::BendRestShape::flat;
+  material.source_warp = scene.face_warp;
+  material.up = scene.input.up;
+  material.source_ease = scene.face_ease;
+  material.rest_uv = scene.input.rest_uv;
+  return material;
+}
+
+sim::ClothDriver scene_driver(const ClothScene& scene, const sim::SimulationSettings& settings,
+                              const std::optional<sim::AdaptiveSettings>& adaptive) {
+  std::vector<sim::Pin> pins;
+  for (int v : scene.pinned) pins.push_back({v, {}});
+  if (scene.sheet && !adaptive)
+    return sim::ClothDriver(build_scene_model(scene), sim::flatten_positions(scene.start),
+                            std::move(pins), settings, scene.triangle_face);
+  sim::AdaptiveSettings off;
+  off.enabled = false;
+  return sim::ClothDriver(*scene.mesh48, scene_material(scene), scene.start, std::move(pins),
+                          settings, adaptive ? *adaptive : off);
+}
+
+Eigen::VectorXi triangle_groups(const ClothScene& scene, const Eigen::VectorXi& source_faces) {
+  Eigen::VectorXi groups(source_faces.size());
+  for (Eigen::Index t = 0; t < groups.size(); ++t) groups(t) = scene.face_group(source_faces(t));
+  return groups;
 }
 
 // The motion of the sketch's body: the arms lowering, or the body's own poses at given times

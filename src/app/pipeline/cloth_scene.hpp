@@ -15,12 +15,29 @@
 #include "sim/cloth_model.hpp"
 #include "sim/fabric.hpp"
 #include "sim/body_motion.hpp"
+#include "sim/cloth_driver.hpp"
 #include "sim/simulation.hpp"
 
 namespace sd::app {
 
+// The cloth is a 4-8 mesh plus attributes of its input faces (a garment's quads, an imported
+// garment's sqrt3 triangles, a sheet's quads): every triangle, at any level, takes its group,
+// ease and warp from the input face it descends from.
 struct ClothScene {
-  sim::ClothInput input;               // rest shape (the designed garment), triangles, warp
+  // Rest positions in metres; vertex ids = rows of `start`. Always set by build_cloth_scene
+  // (optional only because a Mesh48 is made by its factories).
+  std::optional<meshing::Mesh48> mesh48;
+  // Per input face of mesh48:
+  Eigen::VectorXi face_group;          // group (panel or join; a sheet's layer), into group_names
+  Eigen::VectorXd face_ease;           // the panel's `ease` (rest shape scale); empty: all 1
+  Eigen::MatrixX3d face_warp;          // warp direction; empty: the in-plane one closest to +Y
+  // The fixed mesh as simulator input (rest shape, triangles, per-triangle warp and, with
+  // "rest": "flat", rest_uv): mesh48's level-0 triangles, except for a sheet, whose own
+  // triangles alternate their diagonals (mesh48 splits every square quad along the same one;
+  // see scene_driver).
+  sim::ClothInput input;
+  Eigen::VectorXi triangle_face;       // #F of input: the input face each triangle lies in
+  bool sheet = false;
   Eigen::MatrixX3d start;              // #V by 3 start positions, metres
   std::vector<int> pinned;             // vertex indices held in place
   std::string fabric_name;
@@ -28,16 +45,7 @@ struct ClothScene {
   std::optional<garment::Body> body;   // absent for a sheet without a body
   // The body's poses over the drape ("body": {"motion": ...}); absent for a still body.
   std::optional<sim::PoseSequence> body_motion;
-  std::optional<meshing::Mesh48> mesh48;  // the garment's 4-8 hierarchy (absent for sheets)
   std::optional<garment::Garment> garment;
-  Eigen::VectorXi triangle_group;      // #F: group (panel or join) of each triangle
-  // #F: the `ease` of each triangle's panel (rest shape scale, 1 = as designed); empty when
-  // every triangle is as designed (sheets, imported garments).
-  Eigen::VectorXd triangle_ease;
-  Eigen::VectorXi mesh48_face_group;   // group of each input face of mesh48 (quad or triangle)
-  // The ease of each input face of mesh48 (what adaptive detail needs at every level); empty
-  // exactly when triangle_ease is.
-  Eigen::VectorXd mesh48_face_ease;
   std::vector<std::string> group_names;
   double meshing_ms = 0;               // time spent building the garment
   // The garment's flattened panels when a panel drapes from flat cloth ("rest": "flat"); then
@@ -62,6 +70,20 @@ meshing::TriMesh body_at(const ClothScene& scene, double t);
 // is cut smaller than the body it was drawn on and holds the garment up. Hinges rest flat when
 // bend_rest_flat.
 sim::ClothModel build_scene_model(const ClothScene& scene);
+
+// What the cloth is made of for the 4-8 driver: fabric, bending rest shape, and the warp, ease
+// and (flat rest) pattern coordinates of the scene's input faces.
+sim::AdaptiveMaterial scene_material(const ClothScene& scene);
+
+// The driver of the scene's cloth (pins held where they start): its 4-8 mesh adapting when
+// `adaptive` is given, else the fixed mesh: the 4-8 mesh with adaptivity off (a garment: its
+// level-0 triangles are `input`'s), or a sheet's own triangles as a model. Throws
+// sim::InvalidFabricError and the simulator's setting errors.
+sim::ClothDriver scene_driver(const ClothScene& scene, const sim::SimulationSettings& settings,
+                              const std::optional<sim::AdaptiveSettings>& adaptive);
+
+// #F: the group of each triangle, given the input face each descends from.
+Eigen::VectorXi triangle_groups(const ClothScene& scene, const Eigen::VectorXi& source_faces);
 
 // The simulator settings of the file's "simulate" section (integrator, solver, step, duration,
 // gravity). Throws garment::SketchError at /simulate when they cannot work together.

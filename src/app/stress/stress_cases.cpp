@@ -242,16 +242,9 @@ StressScene stretched_sheet(double factor) {
 StressAdaptive adaptive_sheet() {
   constexpr int kQuads = 4;
   const sim::SheetScene sheet = horizontal_sheet(kQuads, kSheetSize, {"top-left", "top-right"});
-  Eigen::MatrixX4i quads(kQuads * kQuads, 4);
-  int q = 0;
-  for (int r = 0; r < kQuads; ++r)
-    for (int c = 0; c < kQuads; ++c)
-      quads.row(q++) << sheet.vertex(r + 1, c), sheet.vertex(r + 1, c + 1), sheet.vertex(r, c + 1),
-          sheet.vertex(r, c);
-  StressAdaptive a{meshing::Mesh48::from_quads(sheet.input.rest_positions, quads), {}, {}, {}};
+  StressAdaptive a{sim::sheet_mesh48(sheet), {}, {}, {}};
   a.material.fabric = sim::fabric_preset("cotton");
-  a.material.source_warp = Eigen::MatrixX3d(quads.rows(), 3);
-  for (Eigen::Index f = 0; f < quads.rows(); ++f) a.material.source_warp.row(f) = Vector3d(0, 0, -1);
+  a.material.source_warp = sim::sheet_quad_warp(sheet);
   a.material.up = sheet.input.up;
   a.pins = fixed_pins(sheet.pinned_vertices);
   return a;

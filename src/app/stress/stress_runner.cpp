@@ -11,9 +11,11 @@
 #include <csignal>
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <random>
 #include <stdexcept>
 
+#include "sim/cloth_driver.hpp"
 #include "sim/forces.hpp"
 #include "src/app/pipeline/self_intersections.hpp"
 
@@ -28,63 +30,45 @@ double max_vertex_speed(const Eigen::VectorXd& v) {
   return speed;
 }
 
-// The cloth being stressed: a Simulation on a fixed mesh or an AdaptiveCloth, behind one face.
-class StressDriver {
- public:
-  StressDriver(StressScene& scene, const sim::SimulationSettings& settings) {
-    if (scene.adaptive) {
-      StressAdaptive& a = *scene.adaptive;
-      Eigen::MatrixX3d start;
-      if (scene.x0.size() > 0) start = sim::unflatten_positions(scene.x0);
-      adaptive_ = std::make_unique<sim::AdaptiveCloth>(std::move(a.mesh), a.material, start, a.pins,
-                                                       settings, a.settings);
-      if (a.start_level > 0) adaptive_->refine_uniformly(a.start_level);
-      forced_churn_ = a.forced_churn;
-      churn_max_level_ = a.churn_max_level;
-    } else {
-      fixed_ = std::make_unique<sim::Simulation>(std::move(scene.model), scene.x0, scene.pins,
-                                                 settings);
-      if (scene.body) fixed_->set_body_motion(std::move(*scene.body));
-    }
-    if (scene.v0.size() > 0) {
-      if (adaptive_) throw std::invalid_argument("start velocities are not supported for adaptive cases");
-      fixed_->set_velocities(scene.v0);
-    }
+// The cloth being stressed: a fixed model or an adaptive 4-8 mesh, in one driver.
+sim::ClothDriver make_driver(StressScene& scene, const sim::SimulationSettings& settings) {
+  if (!scene.adaptive) {
+    sim::ClothDriver driver(std::move(scene.model), scene.x0, scene.pins, settings);
+    if (scene.body) driver.set_body_motion(std::move(*scene.body));
+    if (scene.v0.size() > 0) driver.set_velocities(scene.v0);
+    return driver;
   }
+  StressAdaptive& a = *scene.adaptive;
+  if (scene.v0.size() > 0)
+    throw std::invalid_argument("start velocities are not supported for adaptive cases");
+  Eigen::MatrixX3d start;
+  if (scene.x0.size() > 0) start = sim::unflatten_positions(scene.x0);
+  sim::ClothDriver driver(std::move(a.mesh), a.material, start, a.pins, settings, a.settings);
+  if (a.start_level > 0) driver.adaptive()->refine_uniformly(a.start_level);
+  return driver;
+}
 
-  const sim::Simulation& simulation() const { return adaptive_ ? adaptive_->simulation() : *fixed_; }
-
-  // One step; with forced churn, a random split or merge first. `changed`: the mesh changed.
-  sim::StepOutcome step(double max_step, bool& changed) {
-    changed = false;
-    if (!adaptive_) return fixed_->step(max_step);
-    if (forced_churn_) {
-      const meshing::Mesh48& mesh = adaptive_->mesh();
-      const std::vector<meshing::BlockId> mergeable = mesh.mergeable_blocks();
-      std::vector<meshing::BlockId> splittable;
-      for (meshing::BlockId k : mesh.leaf_blocks())
-        if (mesh.level(k) < churn_max_level_) splittable.push_back(k);
-      const bool merge = !mergeable.empty() && (splittable.empty() || rng_() % 2 == 0);
-      const sim::AdaptStats stats =
-          merge ? adaptive_->merge_blocks({mergeable[rng_() % mergeable.size()]})
-                : (splittable.empty() ? sim::AdaptStats{}
-                                      : adaptive_->split_blocks({splittable[rng_() % splittable.size()]}));
-      changed = stats.changed();
-    }
-    const size_t records = adaptive_->report().steps.size();
-    const sim::StepOutcome outcome = adaptive_->step(max_step);
-    if (adaptive_->report().steps.size() > records) {
-      const sim::AdaptiveStepRecord& r = adaptive_->report().steps.back();
-      changed = changed || r.splits + r.forced_splits + r.merges > 0;
-    }
-    return outcome;
+// Forced churn: one random block (fixed seed) split or merged before every step. Returns whether
+// the mesh changed.
+class Churner {
+ public:
+  explicit Churner(int max_level) : max_level_(max_level) {}
+  bool churn(sim::AdaptiveCloth& cloth) {
+    const meshing::Mesh48& mesh = cloth.mesh();
+    const std::vector<meshing::BlockId> mergeable = mesh.mergeable_blocks();
+    std::vector<meshing::BlockId> splittable;
+    for (meshing::BlockId k : mesh.leaf_blocks())
+      if (mesh.level(k) < max_level_) splittable.push_back(k);
+    const bool merge = !mergeable.empty() && (splittable.empty() || rng_() % 2 == 0);
+    const sim::AdaptStats stats =
+        merge ? cloth.merge_blocks({mergeable[rng_() % mergeable.size()]})
+              : (splittable.empty() ? sim::AdaptStats{}
+                                    : cloth.split_blocks({splittable[rng_() % splittable.size()]}));
+    return stats.changed();
   }
 
  private:
-  std::unique_ptr<sim::Simulation> fixed_;
-  std::unique_ptr<sim::AdaptiveCloth> adaptive_;
-  bool forced_churn_ = false;
-  int churn_max_level_ = 5;
+  int max_level_;
   std::mt19937 rng_{20261122};
 };
 
@@ -114,11 +98,13 @@ StressResult run_stress_case(const StressCase& c, const StressOptions& options) 
     return r;
   };
 
-  std::unique_ptr<StressDriver> driver;
+  std::optional<sim::ClothDriver> driver;
   StressScene scene;
+  // The driver's own energy series is not needed: the bounds read the energy themselves.
+  settings.record_energy = false;
   try {
     scene = c.build();
-    driver = std::make_unique<StressDriver>(scene, settings);
+    driver.emplace(make_driver(scene, settings));
   } catch (const std::invalid_argument& e) {
     r.finite = true;
     if (c.expect_rejection) {
@@ -166,55 +152,68 @@ StressResult run_stress_case(const StressCase& c, const StressOptions& options) 
     r.energy_final_growth = e.total() - reference;
   };
 
+  std::optional<Churner> churner;
+  if (scene.adaptive && scene.adaptive->forced_churn)
+    churner.emplace(scene.adaptive->churn_max_level);
+  bool changed = false;  // the mesh changed before or after the current step
+  std::size_t records = 0;
+  sim::ClothObserver observer;
+  observer.before_step = [&](sim::ClothDriver& d) {
+    changed = churner && churner->churn(*d.adaptive());
+    if (d.adaptive()) records = d.adaptive_report()->steps.size();
+  };
+  observer.after_step = [&](const sim::ClothDriver& d, const sim::StepOutcome& outcome) {
+    r.attempts += 1 + outcome.retries;
+    if (!outcome.accepted) {
+      fail(r, "failed",
+           fmt::format("t = {:.4f} s (step {}): the simulator gave up at a step of {:.3g} s: {}",
+                       d.time(), r.steps + 1, outcome.dt, outcome.failure_reason));
+      return false;
+    }
+    ++r.steps;
+    if (const sim::AdaptiveReport* a = d.adaptive_report(); a && a->steps.size() > records) {
+      const sim::AdaptiveStepRecord& last = a->steps.back();
+      changed = changed || last.splits + last.forced_splits + last.merges > 0;
+    }
+    if (changed) ++r.topology_changes;
+    const sim::Simulation& now = d.simulation();
+    const Eigen::VectorXd& x = now.positions();
+    const Eigen::VectorXd& v = now.velocities();
+    if (!x.allFinite() || !v.allFinite()) {
+      r.finite = false;
+      fail(r, "exploded",
+           fmt::format("t = {:.4f} s (step {}): non-finite state", now.time(), r.steps));
+      return false;
+    }
+    const double strain = strain_now();
+    const double speed = max_vertex_speed(v);
+    r.max_strain = std::max(r.max_strain, strain);
+    r.max_speed = std::max(r.max_speed, speed);
+    observe_energy();
+    if (strain > r.strain_bound) {
+      fail(r, "exploded",
+           fmt::format("t = {:.4f} s (step {}): stretch strain {:.3g} above the bound {:.3g}",
+                       now.time(), r.steps, strain, r.strain_bound));
+      return false;
+    }
+    if (speed > r.speed_bound) {
+      fail(r, "exploded",
+           fmt::format("t = {:.4f} s (step {}): a vertex at {:.3g} m/s, above {:.3g}", now.time(),
+                       r.steps, speed, r.speed_bound));
+      return false;
+    }
+    if (r.attempts > kStressMaxAttempts) {
+      fail(r, "stalled",
+           fmt::format("t = {:.4f} s: {} step attempts spent (budget {}), last step {:.3g} s",
+                       now.time(), r.attempts, kStressMaxAttempts, outcome.dt));
+      return false;
+    }
+    return true;
+  };
   try {
     observe_energy();
-    const double epsilon = 1e-9 * std::max(1.0, settings.duration);
-    while (driver->simulation().time() < settings.duration - epsilon) {
-      const sim::Simulation& s = driver->simulation();
-      bool changed = false;
-      const sim::StepOutcome outcome = driver->step(settings.duration - s.time(), changed);
-      r.attempts += 1 + outcome.retries;
-      if (!outcome.accepted) {
-        fail(r, "failed",
-             fmt::format("t = {:.4f} s (step {}): the simulator gave up at a step of {:.3g} s: {}",
-                         s.time(), r.steps + 1, outcome.dt, outcome.failure_reason));
-        break;
-      }
-      ++r.steps;
-      if (changed) ++r.topology_changes;
-      const sim::Simulation& now = driver->simulation();
-      const Eigen::VectorXd& x = now.positions();
-      const Eigen::VectorXd& v = now.velocities();
-      if (!x.allFinite() || !v.allFinite()) {
-        r.finite = false;
-        fail(r, "exploded", fmt::format("t = {:.4f} s (step {}): non-finite state", now.time(), r.steps));
-        break;
-      }
-      const double strain = strain_now();
-      const double speed = max_vertex_speed(v);
-      r.max_strain = std::max(r.max_strain, strain);
-      r.max_speed = std::max(r.max_speed, speed);
-      observe_energy();
-      if (strain > r.strain_bound) {
-        fail(r, "exploded", fmt::format("t = {:.4f} s (step {}): stretch strain {:.3g} above the bound {:.3g}",
-                                        now.time(), r.steps, strain, r.strain_bound));
-        break;
-      }
-      if (speed > r.speed_bound) {
-        fail(r, "exploded", fmt::format("t = {:.4f} s (step {}): a vertex at {:.3g} m/s, above {:.3g}",
-                                        now.time(), r.steps, speed, r.speed_bound));
-        break;
-      }
-      if (r.attempts > kStressMaxAttempts) {
-        fail(r, "stalled", fmt::format("t = {:.4f} s: {} step attempts spent (budget {}), last step {:.3g} s",
-                                       now.time(), r.attempts, kStressMaxAttempts, outcome.dt));
-        break;
-      }
-      if (settings.stop_at_rest && now.at_rest()) {
-        r.at_rest = true;
-        break;
-      }
-    }
+    const sim::SimulationReport report = driver->run(observer);
+    r.at_rest = report.at_rest;
   } catch (const std::exception& e) {
     fail(r, "error", fmt::format("t = {:.4f} s: {}", driver->simulation().time(), e.what()));
   }
