@@ -70,6 +70,21 @@ std::vector<BodyContact> join_chunks(std::vector<std::vector<BodyContact>>& chun
   return contacts;
 }
 
+// visit(i, contacts, stats) for every cloth vertex i < n, in chunks on the simulator's threads;
+// the contacts in vertex order and the summed counts in `total`.
+template <class Visit>
+std::vector<BodyContact> contacts_by_vertex(int n, ContactQueryStats& total, Visit visit) {
+  std::vector<ContactQueryStats> chunk_stats(
+      static_cast<std::size_t>(chunk_count(n, kVertexGrain)));
+  std::vector<std::vector<BodyContact>> chunk_contacts(chunk_stats.size());
+  parallel_chunks(n, kVertexGrain, [&](int chunk, int first, int last) {
+    for (int i = first; i < last; ++i)
+      visit(i, chunk_contacts[static_cast<std::size_t>(chunk)],
+            chunk_stats[static_cast<std::size_t>(chunk)]);
+  });
+  return join_chunks(chunk_contacts, chunk_stats, total);
+}
+
 }  // namespace
 
 // Adjacency for pseudo-normals at arbitrary pose times (CSR lists).
@@ -494,32 +509,25 @@ std::vector<BodyContact> BodyCollider::find_contacts(const Eigen::VectorXd& x,
     throw std::invalid_argument("the collision thickness and search margin must be >= 0");
   const int n = static_cast<int>(x.size() / 3);
   prepare_cache(cache, n);
-  std::vector<ContactQueryStats> chunk_stats(
-      static_cast<std::size_t>(chunk_count(n, kVertexGrain)));
-  std::vector<std::vector<BodyContact>> chunk_contacts(chunk_stats.size());
-  parallel_chunks(n, kVertexGrain, [&](int chunk, int first, int last) {
-    ContactQueryStats& local = chunk_stats[static_cast<std::size_t>(chunk)];
-    std::vector<BodyContact>& contacts = chunk_contacts[static_cast<std::size_t>(chunk)];
-    for (int i = first; i < last; ++i) {
-      const Eigen::Vector3d p = row(x, i);
-      ++local.vertices;
-      ContactCache::Entry* entry = cache != nullptr ? &cache->entries_[i] : nullptr;
-      bool known_outside = false;
-      double lower_bound = 0.0;
-      if (entry != nullptr && entry->state == ContactCache::State::outside) {
-        lower_bound = entry->clearance - (p - entry->position).norm() -
-                      std::abs(total_motion_ - entry->stamp);
-        known_outside = lower_bound > 0.0;
-      }
-      classify_current(i, p, known_outside, lower_bound, query, cache != nullptr, entry, contacts,
-                       local);
-    }
-  });
-  ContactQueryStats local;
-  std::vector<BodyContact> contacts = join_chunks(chunk_contacts, chunk_stats, local);
-  local.contacts = static_cast<int>(contacts.size());
-  if (stats != nullptr) *stats = local;
-  return contacts;
+  ContactQueryStats totals;
+  std::vector<BodyContact> found = contacts_by_vertex(
+      n, totals, [&](int i, std::vector<BodyContact>& contacts, ContactQueryStats& local) {
+        const Eigen::Vector3d p = row(x, i);
+        ++local.vertices;
+        ContactCache::Entry* entry = cache != nullptr ? &cache->entries_[i] : nullptr;
+        bool known_outside = false;
+        double lower_bound = 0.0;
+        if (entry != nullptr && entry->state == ContactCache::State::outside) {
+          lower_bound = entry->clearance - (p - entry->position).norm() -
+                        std::abs(total_motion_ - entry->stamp);
+          known_outside = lower_bound > 0.0;
+        }
+        classify_current(i, p, known_outside, lower_bound, query, cache != nullptr, entry, contacts,
+                         local);
+      });
+  totals.contacts = static_cast<int>(found.size());
+  if (stats != nullptr) *stats = totals;
+  return found;
 }
 
 std::vector<BodyContact> BodyCollider::find_contacts_swept(const Eigen::VectorXd& x0,
@@ -542,138 +550,132 @@ std::vector<BodyContact> BodyCollider::find_contacts_swept(const Eigen::VectorXd
   const int n = static_cast<int>(x1.size() / 3);
   prepare_cache(cache, n);
   const double stamp_before = total_motion_ - last_motion_;  // cache stamp of the previous pose
-  std::vector<ContactQueryStats> chunk_stats(
-      static_cast<std::size_t>(chunk_count(n, kVertexGrain)));
-  std::vector<std::vector<BodyContact>> chunk_contacts(chunk_stats.size());
-  parallel_chunks(n, kVertexGrain, [&](int chunk, int first, int last) {
-    ContactQueryStats& local = chunk_stats[static_cast<std::size_t>(chunk)];
-    std::vector<BodyContact>& contacts = chunk_contacts[static_cast<std::size_t>(chunk)];
-    for (int i = first; i < last; ++i) {
-      const Eigen::Vector3d p0 = row(x0, i);
-      const Eigen::Vector3d p1 = row(x1, i);
-      ++local.vertices;
-      ContactCache::Entry* entry = cache != nullptr ? &cache->entries_[i] : nullptr;
-      // Bound on how fast the vertex-to-body distance can change over the step (per unit of t).
-      const double relative_motion = (p1 - p0).norm() + last_motion_;
+  ContactQueryStats totals;
+  std::vector<BodyContact> found = contacts_by_vertex(
+      n, totals, [&](int i, std::vector<BodyContact>& contacts, ContactQueryStats& local) {
+        const Eigen::Vector3d p0 = row(x0, i);
+        const Eigen::Vector3d p1 = row(x1, i);
+        ++local.vertices;
+        ContactCache::Entry* entry = cache != nullptr ? &cache->entries_[i] : nullptr;
+        // Bound on how fast the vertex-to-body distance can change over the step (per unit of t).
+        const double relative_motion = (p1 - p0).norm() + last_motion_;
 
-      // 1. The start of the path: outside, and with what clearance?
-      bool outside_at_start = false;
-      bool sign_known = false;
-      double clearance = 0.0;
-      if (entry != nullptr && entry->state == State::outside) {
-        const double lower_bound = entry->clearance - (p0 - entry->position).norm() -
-                                   std::abs(stamp_before - entry->stamp);
-        if (lower_bound > 0.0) {
-          outside_at_start = sign_known = true;
-          clearance = lower_bound;
-        }
-      }
-      if (!sign_known && relative_motion > 0.0) {
-        const std::optional<BodyProximity> start = nearest(p0, 0.0, relative_motion);
-        ++local.bounded_searches;
-        if (start) {
-          sign_known = true;
-          outside_at_start = start->distance >= 0.0;
-          clearance = std::abs(start->distance);
-        }
-        // Nothing within reach: the surface cannot meet the path this step, whichever side.
-      }
-
-      // 2. Walk the path while a crossing is possible: samples at t = k/K, skipping samples the
-      //    clearance of the last one already rules out.
-      bool known_outside_at_end = false;
-      double end_lower_bound = 0.0;
-      std::optional<BodyProximity> entry_point;
-      if (sign_known && outside_at_start) {
-        if (clearance > relative_motion) {
-          known_outside_at_end = true;
-          end_lower_bound = clearance - relative_motion;
-        } else {
-          const int samples =
-              std::clamp(static_cast<int>(std::ceil(relative_motion / query.max_substep_motion)), 1,
-                         query.max_substeps);
-          double t_last = 0.0;
-          double clearance_last = clearance;
-          bool clear_to_end = false;
-          for (int k = 1; k <= samples; ++k) {
-            const double t = static_cast<double>(k) / samples;
-            if (clearance_last - relative_motion * (t - t_last) > 0.0) continue;
-            // Deep enough to catch a point that crossed since the last clear sample, far enough to
-            // clear the rest of the step when nothing is found.
-            const double bound =
-                std::max(relative_motion / samples, relative_motion * (1.0 - t)) + query.thickness;
-            const std::optional<BodyProximity> sample = nearest(p0 + t * (p1 - p0), t, bound);
-            ++local.sweep_samples;
-            if (!sample) {
-              clear_to_end = true;
-              end_lower_bound = bound - relative_motion * (1.0 - t);
-              break;
-            }
-            if (sample->distance < 0.0) {
-              entry_point = sample;
-              break;
-            }
-            clearance_last = sample->distance;
-            t_last = t;
+        // 1. The start of the path: outside, and with what clearance?
+        bool outside_at_start = false;
+        bool sign_known = false;
+        double clearance = 0.0;
+        if (entry != nullptr && entry->state == State::outside) {
+          const double lower_bound = entry->clearance - (p0 - entry->position).norm() -
+                                     std::abs(stamp_before - entry->stamp);
+          if (lower_bound > 0.0) {
+            outside_at_start = sign_known = true;
+            clearance = lower_bound;
           }
-          if (!entry_point) {
+        }
+        if (!sign_known && relative_motion > 0.0) {
+          const std::optional<BodyProximity> start = nearest(p0, 0.0, relative_motion);
+          ++local.bounded_searches;
+          if (start) {
+            sign_known = true;
+            outside_at_start = start->distance >= 0.0;
+            clearance = std::abs(start->distance);
+          }
+          // Nothing within reach: the surface cannot meet the path this step, whichever side.
+        }
+
+        // 2. Walk the path while a crossing is possible: samples at t = k/K, skipping samples the
+        //    clearance of the last one already rules out.
+        bool known_outside_at_end = false;
+        double end_lower_bound = 0.0;
+        std::optional<BodyProximity> entry_point;
+        if (sign_known && outside_at_start) {
+          if (clearance > relative_motion) {
             known_outside_at_end = true;
-            if (!clear_to_end)
-              end_lower_bound = std::max(0.0, clearance_last - relative_motion * (1.0 - t_last));
+            end_lower_bound = clearance - relative_motion;
+          } else {
+            const int samples =
+                std::clamp(static_cast<int>(std::ceil(relative_motion / query.max_substep_motion)),
+                           1, query.max_substeps);
+            double t_last = 0.0;
+            double clearance_last = clearance;
+            bool clear_to_end = false;
+            for (int k = 1; k <= samples; ++k) {
+              const double t = static_cast<double>(k) / samples;
+              if (clearance_last - relative_motion * (t - t_last) > 0.0) continue;
+              // Deep enough to catch a point that crossed since the last clear sample, far enough
+              // to clear the rest of the step when nothing is found.
+              const double bound =
+                  std::max(relative_motion / samples, relative_motion * (1.0 - t)) +
+                  query.thickness;
+              const std::optional<BodyProximity> sample = nearest(p0 + t * (p1 - p0), t, bound);
+              ++local.sweep_samples;
+              if (!sample) {
+                clear_to_end = true;
+                end_lower_bound = bound - relative_motion * (1.0 - t);
+                break;
+              }
+              if (sample->distance < 0.0) {
+                entry_point = sample;
+                break;
+              }
+              clearance_last = sample->distance;
+              t_last = t;
+            }
+            if (!entry_point) {
+              known_outside_at_end = true;
+              if (!clear_to_end)
+                end_lower_bound = std::max(0.0, clearance_last - relative_motion * (1.0 - t_last));
+            }
           }
         }
-      }
 
-      // 3. A vertex that went in: carry the entry point to the current pose and decide whether
-      //    it is still behind the surface it entered.
-      if (entry_point) {
-        const Eigen::Vector3d& w = entry_point->barycentric;
-        const int f = entry_point->triangle;
-        const Eigen::Vector3d point = w[0] * corner(faces_(f, 0), 1.0) +
-                                      w[1] * corner(faces_(f, 1), 1.0) +
-                                      w[2] * corner(faces_(f, 2), 1.0);
-        Eigen::Vector3d normal =
-            feature_normal(f, entry_point->feature, entry_point->feature_index, 1.0);
-        if (!(normal.squaredNorm() > 0.0)) normal = face_normals_[f];
-        normal.normalize();
-        const double behind = (p1 - point).dot(normal);
-        const BodyProximity end = *nearest(p1, 1.0, infinity);
-        ++local.full_searches;
-        // Came back out on the entry side, or ended inside with the nearest surface facing the
-        // way it came in: the ordinary contact is right. Otherwise it tunnelled.
-        const bool tunnelled =
-            behind < 0.0 && (end.distance >= 0.0 || end.normal.dot(normal) < 0.0);
-        if (tunnelled) {
-          BodyContact contact;
-          contact.vertex = i;
-          contact.triangle = f;
-          contact.point = point;
-          contact.normal = normal;
-          contact.distance = behind;
-          contact.body_velocity = surface_velocity(f, w);
-          contact.crossed = true;
-          contacts.push_back(contact);
-          ++local.crossings;
-          if (entry != nullptr) *entry = ContactCache::Entry{};
-        } else {
-          if (end.distance < query.thickness) contacts.push_back(make_contact(i, end));
-          if (entry != nullptr)
-            *entry = {p1, std::abs(end.distance), total_motion_,
-                      end.distance >= 0.0 ? State::outside : State::inside};
+        // 3. A vertex that went in: carry the entry point to the current pose and decide whether
+        //    it is still behind the surface it entered.
+        if (entry_point) {
+          const Eigen::Vector3d& w = entry_point->barycentric;
+          const int f = entry_point->triangle;
+          const Eigen::Vector3d point = w[0] * corner(faces_(f, 0), 1.0) +
+                                        w[1] * corner(faces_(f, 1), 1.0) +
+                                        w[2] * corner(faces_(f, 2), 1.0);
+          Eigen::Vector3d normal =
+              feature_normal(f, entry_point->feature, entry_point->feature_index, 1.0);
+          if (!(normal.squaredNorm() > 0.0)) normal = face_normals_[f];
+          normal.normalize();
+          const double behind = (p1 - point).dot(normal);
+          const BodyProximity end = *nearest(p1, 1.0, infinity);
+          ++local.full_searches;
+          // Came back out on the entry side, or ended inside with the nearest surface facing the
+          // way it came in: the ordinary contact is right. Otherwise it tunnelled.
+          const bool tunnelled =
+              behind < 0.0 && (end.distance >= 0.0 || end.normal.dot(normal) < 0.0);
+          if (tunnelled) {
+            BodyContact contact;
+            contact.vertex = i;
+            contact.triangle = f;
+            contact.point = point;
+            contact.normal = normal;
+            contact.distance = behind;
+            contact.body_velocity = surface_velocity(f, w);
+            contact.crossed = true;
+            contacts.push_back(contact);
+            ++local.crossings;
+            if (entry != nullptr) *entry = ContactCache::Entry{};
+          } else {
+            if (end.distance < query.thickness) contacts.push_back(make_contact(i, end));
+            if (entry != nullptr)
+              *entry = {p1, std::abs(end.distance), total_motion_,
+                        end.distance >= 0.0 ? State::outside : State::inside};
+          }
+          return;
         }
-        continue;
-      }
 
-      // 4. Everything else: the discrete test at the end of the step.
-      classify_current(i, p1, known_outside_at_end, end_lower_bound, query, cache != nullptr, entry,
-                       contacts, local);
-    }
-  });
-  ContactQueryStats local;
-  std::vector<BodyContact> contacts = join_chunks(chunk_contacts, chunk_stats, local);
-  local.contacts = static_cast<int>(contacts.size());
-  if (stats != nullptr) *stats = local;
-  return contacts;
+        // 4. Everything else: the discrete test at the end of the step.
+        classify_current(i, p1, known_outside_at_end, end_lower_bound, query, cache != nullptr,
+                         entry, contacts, local);
+      });
+  totals.contacts = static_cast<int>(found.size());
+  if (stats != nullptr) *stats = totals;
+  return found;
 }
 
 }  // namespace sd::sim

@@ -5,6 +5,16 @@
 #include <cmath>
 
 namespace sd::sim {
+
+std::string_view solver_name(LinearSolverKind solver) {
+  return solver == LinearSolverKind::pcg ? "pcg" : "cholmod";
+}
+
+std::optional<LinearSolverKind> parse_solver(std::string_view name) {
+  if (name == "pcg") return LinearSolverKind::pcg;
+  if (name == "cholmod") return LinearSolverKind::cholmod;
+  return std::nullopt;
+}
 namespace {
 
 double seconds_since(std::chrono::steady_clock::time_point start) {

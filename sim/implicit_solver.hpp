@@ -9,7 +9,9 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "sim/cholmod_solver.hpp"
@@ -21,6 +23,10 @@
 namespace sd::sim {
 
 enum class LinearSolverKind { pcg, cholmod };
+
+// The solver's name in sketch files and reports ("pcg", "cholmod"), and the enum from it.
+std::string_view solver_name(LinearSolverKind solver);
+std::optional<LinearSolverKind> parse_solver(std::string_view name);
 
 struct NewtonSettings {
   // 1 = a single linearised step (Baraff & Witkin's implicit Euler). More iterations run an

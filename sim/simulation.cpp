@@ -10,6 +10,20 @@
 #include <spdlog/spdlog.h>
 
 namespace sd::sim {
+
+std::string_view integrator_name(Integrator integrator) {
+  return integrator == Integrator::bdf2 ? "bdf2" : "implicit-euler";
+}
+
+std::string_view integrator_short_name(Integrator integrator) {
+  return integrator == Integrator::bdf2 ? "bdf2" : "ie";
+}
+
+std::optional<Integrator> parse_integrator(std::string_view name) {
+  if (name == "implicit-euler" || name == "ie") return Integrator::implicit_euler;
+  if (name == "bdf2") return Integrator::bdf2;
+  return std::nullopt;
+}
 namespace {
 
 void require(bool ok, const std::string& message) {

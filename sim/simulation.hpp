@@ -2,15 +2,15 @@
 // The driver: time stepping with implicit Euler or variable-step BDF2, step control (rollback
 // and halving on failure, growth after easy steps), at-rest detection and the run report.
 
+#include <Eigen/Core>
 #include <array>
 #include <functional>
 #include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "meshing/tri_mesh.hpp"
 #include "sim/body_motion.hpp"
@@ -29,6 +29,12 @@ class InvalidSimulationSettingsError : public std::invalid_argument {
 };
 
 enum class Integrator { implicit_euler, bdf2 };
+
+// The integrator's name in sketch files and reports ("implicit-euler", "bdf2"), its short form in
+// run ids ("ie", "bdf2"), and the enum from either (nothing for another string).
+std::string_view integrator_name(Integrator integrator);
+std::string_view integrator_short_name(Integrator integrator);
+std::optional<Integrator> parse_integrator(std::string_view name);
 
 struct SimulationSettings {
   Integrator integrator = Integrator::implicit_euler;

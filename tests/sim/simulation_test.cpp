@@ -27,6 +27,21 @@ Simulation make_simulation(const HangingSheet& h, const SimulationSettings& sett
                     testing::fixed_pins(h.scene), settings);
 }
 
+// The simulator owns the names of its integrators and solvers: one spelling everywhere (sketch
+// files, reports, bench and stress ids), read back to the same enum.
+TEST(Simulation, IntegratorAndSolverNamesRoundTrip) {
+  for (Integrator i : {Integrator::implicit_euler, Integrator::bdf2}) {
+    EXPECT_EQ(parse_integrator(integrator_name(i)), i);
+    EXPECT_EQ(parse_integrator(integrator_short_name(i)), i);
+  }
+  EXPECT_EQ(integrator_name(Integrator::implicit_euler), "implicit-euler");
+  EXPECT_EQ(integrator_short_name(Integrator::implicit_euler), "ie");
+  EXPECT_FALSE(parse_integrator("euler"));
+  for (LinearSolverKind k : {LinearSolverKind::pcg, LinearSolverKind::cholmod})
+    EXPECT_EQ(parse_solver(solver_name(k)), k);
+  EXPECT_FALSE(parse_solver("PCG"));
+}
+
 TEST(Simulation, HangingSheetReachesStaticEquilibrium) {
   for (Integrator integrator : {Integrator::implicit_euler, Integrator::bdf2}) {
     const HangingSheet h = hanging_sheet(8);

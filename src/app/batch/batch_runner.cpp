@@ -359,9 +359,10 @@ BatchResult run_batch(const BatchOptions& options) {
         write_file_atomically(dir / kJobSketch, p.document->dump(2) + "\n");
         std::vector<std::string> args;
         if (options.verbose) args.push_back("-v");
-        // The cores shared out between the jobs running side by side.
-        args.insert(args.end(), {"--threads", std::to_string(child_threads)});
         args.insert(args.end(), {options.stage, (dir / kJobSketch).string(), "-o", dir.string()});
+        // The cores shared out between the jobs running side by side (a global option; last, so
+        // the job's own arguments keep their places).
+        args.insert(args.end(), {"--threads", std::to_string(child_threads)});
         running.push_back({&p, spawn_child(exe, args, dir / kJobLog), Clock::now()});
         ++result.ran;
       } catch (const std::exception& e) {

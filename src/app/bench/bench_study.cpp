@@ -207,8 +207,8 @@ sim::SimulationSettings run_settings(const BenchScene& scene, const BenchConfig&
 // --- configurations --------------------------------------------------------------------------------
 
 std::string BenchConfig::id() const {
-  const std::string integ = integrator == sim::Integrator::bdf2 ? "bdf2" : "ie";
-  const std::string solv = solver == sim::LinearSolverKind::pcg ? "pcg" : "cholmod";
+  const std::string integ(sim::integrator_short_name(integrator));
+  const std::string solv(sim::solver_name(solver));
   if (mesh == BenchMeshKind::adaptive)
     return fmt::format("adaptive-{:g}mm-L{}-{}-{}-{}", threshold * 1e3, level, integ, solv,
                        steps_per_second);
@@ -613,8 +613,8 @@ std::string config_to_json(const BenchConfig& c) {
   return nlohmann::json{{"mesh", c.mesh == BenchMeshKind::adaptive ? "adaptive" : "fixed"},
                         {"level", c.level},
                         {"threshold", c.threshold},
-                        {"integrator", c.integrator == sim::Integrator::bdf2 ? "bdf2" : "ie"},
-                        {"solver", c.solver == sim::LinearSolverKind::pcg ? "pcg" : "cholmod"},
+                        {"integrator", sim::integrator_short_name(c.integrator)},
+                        {"solver", sim::solver_name(c.solver)},
                         {"steps_per_second", c.steps_per_second}}
       .dump();
 }
@@ -625,8 +625,10 @@ BenchConfig config_from_json(const std::string& text) {
   c.mesh = j.at("mesh") == "adaptive" ? BenchMeshKind::adaptive : BenchMeshKind::fixed;
   c.level = j.at("level");
   c.threshold = j.at("threshold");
-  c.integrator = j.at("integrator") == "bdf2" ? sim::Integrator::bdf2 : sim::Integrator::implicit_euler;
-  c.solver = j.at("solver") == "pcg" ? sim::LinearSolverKind::pcg : sim::LinearSolverKind::cholmod;
+  c.integrator = sim::parse_integrator(j.at("integrator").get<std::string>())
+                     .value_or(sim::Integrator::implicit_euler);
+  c.solver =
+      sim::parse_solver(j.at("solver").get<std::string>()).value_or(sim::LinearSolverKind::cholmod);
   c.steps_per_second = j.at("steps_per_second");
   return c;
 }

@@ -225,35 +225,34 @@ std::string csv_row(const SceneResult& s, const BenchConfig& c, const std::vecto
   const BenchTrace& t = child.trace;
   const bool measured = child.status == "ok" || child.status == "failed";
   const bool process = child.peak_rss_mb > 0;
-  std::vector<std::string> f = {
-      csv_field(s.scene.name),
-      c.id(),
-      c.mesh == BenchMeshKind::adaptive ? "adaptive" : "fixed",
-      std::to_string(c.level),
-      c.mesh == BenchMeshKind::adaptive ? number(c.threshold * 1e3) : "",
-      c.integrator == sim::Integrator::bdf2 ? "bdf2" : "implicit-euler",
-      c.solver == sim::LinearSolverKind::pcg ? "pcg" : "cholmod",
-      number(c.dt()),
-      csv_field(join(families, "; ")),
-      child.status,
-      measured ? number(t.wall_s) : "",
-      measured ? number(t.cpu_s) : "",
-      process ? number(child.process_cpu_s) : "",
-      process ? number(child.peak_rss_mb) : "",
-      measured ? number(t.rss_before_mb) : "",
-      measured ? std::to_string(t.vertices_max) : "",
-      measured ? std::to_string(t.triangles_max) : "",
-      measured ? std::to_string(t.steps) : "",
-      measured ? std::to_string(t.retries) : "",
-      measured ? std::to_string(t.linear_solves) : "",
-      measured ? number(t.cg_iterations_mean) : "",
-      error ? number(error->rms_m) : "",
-      error ? number(error->max_m) : "",
-      error ? number(error->final_rms_m) : "",
-      error ? number(error->energy_j) : "",
-      error ? number(error->energy_relative) : "",
-      pareto ? "1" : "0",
-      csv_field(note)};
+  std::vector<std::string> f = {csv_field(s.scene.name),
+                                c.id(),
+                                c.mesh == BenchMeshKind::adaptive ? "adaptive" : "fixed",
+                                std::to_string(c.level),
+                                c.mesh == BenchMeshKind::adaptive ? number(c.threshold * 1e3) : "",
+                                std::string(sim::integrator_name(c.integrator)),
+                                std::string(sim::solver_name(c.solver)),
+                                number(c.dt()),
+                                csv_field(join(families, "; ")),
+                                child.status,
+                                measured ? number(t.wall_s) : "",
+                                measured ? number(t.cpu_s) : "",
+                                process ? number(child.process_cpu_s) : "",
+                                process ? number(child.peak_rss_mb) : "",
+                                measured ? number(t.rss_before_mb) : "",
+                                measured ? std::to_string(t.vertices_max) : "",
+                                measured ? std::to_string(t.triangles_max) : "",
+                                measured ? std::to_string(t.steps) : "",
+                                measured ? std::to_string(t.retries) : "",
+                                measured ? std::to_string(t.linear_solves) : "",
+                                measured ? number(t.cg_iterations_mean) : "",
+                                error ? number(error->rms_m) : "",
+                                error ? number(error->max_m) : "",
+                                error ? number(error->final_rms_m) : "",
+                                error ? number(error->energy_j) : "",
+                                error ? number(error->energy_relative) : "",
+                                pareto ? "1" : "0",
+                                csv_field(note)};
   return join(f, ",") + "\n";
 }
 
@@ -436,7 +435,7 @@ void run_scaling_study(const BenchOptions& options, const GlobalOptions& global)
     if (n < 2 || n > 1024)
       throw std::invalid_argument(fmt::format("--sizes: {} is not in 2 .. 1024 quads a side", n));
   for (const std::string& solver : o.solvers)
-    if (solver != "cholmod" && solver != "pcg")
+    if (!sim::parse_solver(solver))
       throw std::invalid_argument(
           fmt::format("--solver: '{}' is not a solver (cholmod or pcg)", solver));
   const fs::path exe = fs::read_symlink("/proc/self/exe");

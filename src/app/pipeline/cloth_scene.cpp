@@ -292,8 +292,8 @@ sim::SimulationSettings simulation_settings(const garment::Sketch& sketch) {
   const garment::SimulateSpec& spec = sketch.simulate;
   sim::SimulationSettings settings;
   settings.integrator =
-      spec.integrator == "bdf2" ? sim::Integrator::bdf2 : sim::Integrator::implicit_euler;
-  settings.solver = spec.solver == "pcg" ? sim::LinearSolverKind::pcg : sim::LinearSolverKind::cholmod;
+      sim::parse_integrator(spec.integrator).value_or(sim::Integrator::implicit_euler);
+  settings.solver = sim::parse_solver(spec.solver).value_or(sim::LinearSolverKind::cholmod);
   settings.dt = spec.time_step;
   settings.min_dt = std::min(settings.min_dt, spec.time_step / 64);
   settings.duration = spec.duration;

@@ -32,8 +32,7 @@ constexpr std::array<Combo, 4> kCombos = {{
 }};
 
 std::string combo_label(const Combo& c) {
-  return fmt::format("{}-{}", c.integrator == sim::Integrator::bdf2 ? "bdf2" : "ie",
-                     c.solver == sim::LinearSolverKind::pcg ? "pcg" : "cholmod");
+  return fmt::format("{}-{}", sim::integrator_short_name(c.integrator), sim::solver_name(c.solver));
 }
 
 sim::SimulationSettings base_settings(double dt, const Combo& combo) {
@@ -288,9 +287,8 @@ std::string step_label(double dt) {
 std::vector<StressCase> stress_matrix(bool quick) {
   std::vector<StressCase> cases;
   const auto add = [&](StressCase c) {
-    c.parameters["integrator"] =
-        c.settings.integrator == sim::Integrator::bdf2 ? "bdf2" : "implicit-euler";
-    c.parameters["solver"] = c.settings.solver == sim::LinearSolverKind::pcg ? "pcg" : "cholmod";
+    c.parameters["integrator"] = sim::integrator_name(c.settings.integrator);
+    c.parameters["solver"] = sim::solver_name(c.settings.solver);
     c.parameters["dt"] = c.settings.dt;
     c.parameters["duration"] = c.settings.duration;
     if (!quick || c.quick) cases.push_back(std::move(c));
