@@ -167,33 +167,37 @@ void add_vertex_bend(const VertexBendElement& b, double bend, double beta, const
   const bool exact = want && jacobian->kind == JacobianKind::exact;
   const Eigen::MatrixXd g_v = exact && beta > 0.0 ? area_vector_jacobian(b, vs) : Eigen::MatrixXd();
   Eigen::VectorXd local_force = Eigen::VectorXd::Zero(3 * m);
-  Eigen::MatrixXd gauss_newton, dfdx;
-  if (want) {
-    gauss_newton = Eigen::MatrixXd::Zero(3 * m, 3 * m);
-    dfdx = Eigen::MatrixXd::Zero(3 * m, 3 * m);
-  }
+  // The three rows' Jacobians stacked, each scaled by √(k·s_k): Σ_k k·s_k·J_kᵀJ_k = SᵀS.
+  Eigen::MatrixXd stacked(9, 3 * m);
+  Eigen::MatrixXd dfdx;
+  if (exact) dfdx = Eigen::MatrixXd::Zero(3 * m, 3 * m);
   Eigen::VectorXd local_v(3 * m);
   for (Eigen::Index j = 0; j < m; ++j) local_v.segment<3>(3 * j) = vs.row(j).transpose();
   for (int row = 0; row < 3; ++row) {
     const double c = b.rest_normal(row);
     const double weight = k * kRowScale[row];
     const Vector3d r = r_lin.row(row).transpose() - c * area_vector;
-    Eigen::MatrixXd jac = -c * g_x;
-    for (Eigen::Index j = 0; j < m; ++j)
-      jac.block<3, 3>(0, 3 * j).diagonal().array() += b.rows(row, j);
+    auto jac = stacked.middleRows<3>(3 * row);
+    jac = -c * g_x;
+    for (Eigen::Index j = 0; j < m; ++j) jac.block<3, 3>(0, 3 * j).diagonal().array() += b.rows(row, j);
     const Vector3d r_dot = jac * local_v;
     energy += 0.5 * weight * r.squaredNorm();
-    local_force -= weight * jac.transpose() * (r + beta * r_dot);
-    if (!want) continue;
-    const Eigen::MatrixXd outer = weight * jac.transpose() * jac;
-    gauss_newton += outer;
-    dfdx -= outer;
+    local_force.noalias() -= weight * (jac.transpose() * (r + beta * r_dot));
     if (exact) {
       // ∇²E_k = w(JᵀJ − c·∇²(r·N)); damping: ∂(JᵀJv)/∂x = −c·∇²(ṙ·N) − c·Jᵀ·G(v).
       dfdx += weight * c * area_vector_hessian(b, r);
       if (beta > 0.0)
         dfdx += beta * weight * c * (area_vector_hessian(b, r_dot) + jac.transpose() * g_v);
     }
+    jac *= std::sqrt(weight);
+  }
+  Eigen::MatrixXd gauss_newton;
+  if (want) {
+    gauss_newton.noalias() = stacked.transpose() * stacked;
+    if (exact)
+      dfdx -= gauss_newton;
+    else
+      dfdx = -gauss_newton;
   }
   for (Eigen::Index j = 0; j < m; ++j)
     force.segment<3>(3 * b.vertices[static_cast<std::size_t>(j)]) += local_force.segment<3>(3 * j);
