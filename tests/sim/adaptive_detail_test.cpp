@@ -142,6 +142,7 @@ TEST(AdaptiveDetail, IncrementalModelEqualsTheRebuiltOne) {
       sheet.material.source_warp.resize(0, 3);
     }
     if (variant == 2) {
+      sheet.material.model_options.bend_model = BendModel::hinges;
       sheet.material.model_options.bend_weights = BendWeights::calibrated;
       sheet.material.model_options.bend_stencil_stiffness = 50.0;
     }

@@ -209,6 +209,7 @@ TEST(Forces, BendStencilsMatchFiniteDifferences) {
   fabric.bend = 2e-3;
   fabric.bend_damping = 0.05;
   ClothModelOptions options;
+  options.bend_model = BendModel::hinges;
   options.bend_weights = BendWeights::calibrated;
   options.bend_stencil_stiffness = 50.0;
   const ClothModel model = build_cloth_model(scene.input, fabric, options);
