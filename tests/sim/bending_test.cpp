@@ -12,7 +12,6 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <numbers>
 #include <random>
 
@@ -190,7 +189,8 @@ TEST(QuadraticBending, RestShapesAndRigidMotionsCostNothing) {
 // direction, free edges included (their flux completes the boundary vertices' Laplacian): a strip
 // rolled onto a cylinder of radius R (isometric) with its axis at 0..165° to the strip. The
 // discrete energy differs from the continuum one by O(h²/R²) and by the boundary's O(h/R) chord
-// errors; R = 4 widths here.
+// errors; R = 4 widths here. On the irregular mesh the quadrature of the energy (Σ A_v·density
+// with mixed areas) errs by up to 2 %.
 TEST(QuadraticBending, CylindersCostTheContinuumEnergyOnEveryMesh) {
   FabricParameters fabric;
   fabric.bend = 1e-5;
@@ -217,11 +217,10 @@ TEST(QuadraticBending, CylindersCostTheContinuumEnergyOnEveryMesh) {
       EnergyBreakdown energy;
       evaluate_forces(model, settings, x, Eigen::VectorXd::Zero(x.size()), force, &energy);
       const double continuum = 0.5 * fabric.bend / (radius * radius) * area;
-      EXPECT_NEAR(energy.bend / continuum, 1.0, 0.02)
+      // Measured: within 3e-4 on the regular meshes, 1.9 % on the irregular one.
+      const double tolerance = mesh == test::StripMesh::irregular ? 0.025 : 1e-3;
+      EXPECT_NEAR(energy.bend / continuum, 1.0, tolerance)
           << test::strip_mesh_name(mesh) << " at " << 15 * step << " deg";
-      if (std::getenv("SD_BENDING_STUDY") != nullptr)
-        std::printf("%-28s %3d deg: %.4f\n", test::strip_mesh_name(mesh).c_str(), 15 * step,
-                    energy.bend / continuum);
     }
   }
 }
