@@ -179,7 +179,8 @@ void add_vertex_bend(const VertexBendElement& b, double bend, double beta, const
     const Vector3d r = r_lin.row(row).transpose() - c * area_vector;
     auto jac = stacked.middleRows<3>(3 * row);
     jac = -c * g_x;
-    for (Eigen::Index j = 0; j < m; ++j) jac.block<3, 3>(0, 3 * j).diagonal().array() += b.rows(row, j);
+    for (Eigen::Index j = 0; j < m; ++j)
+      jac.block<3, 3>(0, 3 * j).diagonal().array() += b.rows(row, j);
     const Vector3d r_dot = jac * local_v;
     energy += 0.5 * weight * r.squaredNorm();
     local_force.noalias() -= weight * (jac.transpose() * (r + beta * r_dot));
