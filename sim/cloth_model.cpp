@@ -1,16 +1,17 @@
 #include "sim/cloth_model.hpp"
 
+#include <spdlog/spdlog.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <set>
-#include <tuple>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <utility>
-
-#include <Eigen/Geometry>
-#include <Eigen/SVD>
-#include <spdlog/spdlog.h>
 
 #include "sim/element_forces.hpp"
 
@@ -248,6 +249,265 @@ std::vector<BendStencil> make_bend_stencils(const Eigen::MatrixX3d& rest,
   return stencils;
 }
 
+// The quadratic bending elements of every vertex that has a triangle (VertexBendElement).
+// Per triangle: the cotangent weights ½·cot(opposite angle) of its edges and Meyer's mixed
+// areas; per boundary edge (one triangle): (|e|/2)·∇φ_q·n̄ for each corner q of its triangle,
+// added to both ends' rows (n̄ the outward conormal in the rest triangle's plane).
+std::vector<VertexBendElement> make_vertex_bends(const Eigen::MatrixX3d& rest,
+                                                 const Eigen::MatrixX3i& faces,
+                                                 BendRestShape bend_rest) {
+  const int n = static_cast<int>(rest.rows());
+  std::vector<std::vector<std::pair<int, double>>> row(static_cast<std::size_t>(n));
+  std::vector<double> area(static_cast<std::size_t>(n), 0.0);
+  const auto add = [&](int i, int j, double w) {
+    row[static_cast<std::size_t>(i)].emplace_back(j, w);
+  };
+  // Edges (low, high) with the face and corner of the apex opposite, to find boundary edges.
+  struct FaceEdge {
+    int low, high, face, apex;
+  };
+  std::vector<FaceEdge> edges;
+  edges.reserve(static_cast<std::size_t>(3 * faces.rows()));
+  for (Eigen::Index f = 0; f < faces.rows(); ++f) {
+    const std::array<int, 3> v{faces(f, 0), faces(f, 1), faces(f, 2)};
+    std::array<Vector3d, 3> p;
+    for (int k = 0; k < 3; ++k) p[k] = rest.row(v[k]);
+    const double twice_area = (p[1] - p[0]).cross(p[2] - p[0]).norm();
+    double cot[3];
+    bool obtuse[3];
+    for (int k = 0; k < 3; ++k) {
+      const Vector3d a = p[(k + 1) % 3] - p[k], b = p[(k + 2) % 3] - p[k];
+      cot[k] = a.dot(b) / twice_area;
+      obtuse[k] = a.dot(b) < -1e-9 * a.norm() * b.norm();  // right angles stay Voronoi
+    }
+    for (int k = 0; k < 3; ++k) {
+      const int a = v[(k + 1) % 3], b = v[(k + 2) % 3];  // the edge opposite corner k
+      const double w = 0.5 * cot[k];
+      add(a, b, w), add(a, a, -w), add(b, a, w), add(b, b, -w);
+      edges.push_back({std::min(a, b), std::max(a, b), static_cast<int>(f), k});
+    }
+    const bool any_obtuse = obtuse[0] || obtuse[1] || obtuse[2];
+    for (int k = 0; k < 3; ++k) {
+      double a_k;
+      if (!any_obtuse) {
+        a_k = 0.125 * ((p[(k + 1) % 3] - p[k]).squaredNorm() * cot[(k + 2) % 3] +
+                       (p[(k + 2) % 3] - p[k]).squaredNorm() * cot[(k + 1) % 3]);
+      } else {
+        a_k = 0.5 * twice_area * (obtuse[k] ? 0.5 : 0.25);  // Meyer et al.: A/2, A/4
+      }
+      area[static_cast<std::size_t>(v[k])] += a_k;
+    }
+  }
+  std::sort(edges.begin(), edges.end(), [](const FaceEdge& a, const FaceEdge& b) {
+    return std::tie(a.low, a.high, a.face) < std::tie(b.low, b.high, b.face);
+  });
+  for (std::size_t e = 0; e < edges.size(); ++e) {
+    const bool single =
+        (e == 0 || edges[e - 1].low != edges[e].low || edges[e - 1].high != edges[e].high) &&
+        (e + 1 == edges.size() || edges[e + 1].low != edges[e].low ||
+         edges[e + 1].high != edges[e].high);
+    if (!single) continue;
+    const int f = edges[e].face, k = edges[e].apex;
+    const std::array<int, 3> v{faces(f, 0), faces(f, 1), faces(f, 2)};
+    std::array<Vector3d, 3> p;
+    for (int c = 0; c < 3; ++c) p[c] = rest.row(v[c]);
+    const Vector3d normal = (p[1] - p[0]).cross(p[2] - p[0]);
+    const double twice_area = normal.norm();
+    const Vector3d unit_normal = normal / twice_area;
+    const Vector3d edge = p[(k + 2) % 3] - p[(k + 1) % 3];
+    // Outward conormal: in the plane, perpendicular to the edge, away from the apex.
+    Vector3d conormal = edge.cross(unit_normal).normalized();
+    if (conormal.dot(p[(k + 1) % 3] - p[k]) < 0.0) conormal = -conormal;
+    for (int q = 0; q < 3; ++q) {
+      // ∇φ_q = n̂ × (p_{q+2} − p_{q+1}) / (2A) for the counter-clockwise corners.
+      const Vector3d gradient = unit_normal.cross(p[(q + 2) % 3] - p[(q + 1) % 3]) / twice_area;
+      const double w = 0.5 * edge.norm() * gradient.dot(conormal);
+      add(v[(k + 1) % 3], v[q], w);
+      add(v[(k + 2) % 3], v[q], w);
+    }
+  }
+  // Per vertex, three rows: row 0, the Laplacian, is the cotangent row, made exact for
+  // quadratics (Σ_j w_j·q(p_j) = A_v·Δq for q = 1, u, v, u², uv, v², u and v in the rest tangent
+  // plane) by its least-norm change; rows 1 and 2 are A_v·(x_uu − x_vv) and A_v·x_uv of the
+  // least-squares quadratic. Each row uses the smallest neighbourhood that determines it: the
+  // one-ring, else the two-ring (the tangent frame is aligned with an edge, so on the 4-8 mesh
+  // a degree-4 vertex's one-ring determines x_uu − x_vv and only the twist needs the two-ring).
+  // Narrow rows matter where the curvature jumps (at a clamp). The cotangent row needs the
+  // change where it is not consistent: on irregular meshes (whose cotangent Laplacian does not
+  // converge pointwise), and at boundary vertices, whose flux uses one triangle's gradient, half
+  // a cell inside. On the 4-8 and equilateral meshes the interior Laplacian rows are the 5- and
+  // 7-point stencils, which also hold the grid-scale zigzags least-squares rows cannot see.
+  std::vector<std::vector<int>> ring(static_cast<std::size_t>(n));
+  std::vector<Vector3d> normal(static_cast<std::size_t>(n), Vector3d::Zero());
+  std::vector<std::vector<std::array<int, 2>>> fans(static_cast<std::size_t>(n));
+  for (Eigen::Index f = 0; f < faces.rows(); ++f) {
+    const Vector3d p0 = rest.row(faces(f, 0));
+    const Vector3d a =
+        (Vector3d(rest.row(faces(f, 1))) - p0).cross(Vector3d(rest.row(faces(f, 2))) - p0);
+    for (int k = 0; k < 3; ++k) {
+      const auto v = static_cast<std::size_t>(faces(f, k));
+      normal[v] += a;
+      fans[v].push_back({faces(f, (k + 1) % 3), faces(f, (k + 2) % 3)});
+      for (int l = 0; l < 3; ++l)
+        if (k != l) ring[v].push_back(faces(f, l));
+    }
+  }
+  for (auto& r : ring) {
+    std::sort(r.begin(), r.end());
+    r.erase(std::unique(r.begin(), r.end()), r.end());
+  }
+  std::vector<VertexBendElement> elements;
+  elements.reserve(static_cast<std::size_t>(n));
+  for (int v = 0; v < n; ++v) {
+    auto& entries = row[static_cast<std::size_t>(v)];
+    if (entries.empty() || !(area[static_cast<std::size_t>(v)] > 0.0)) continue;
+    const double vertex_area = area[static_cast<std::size_t>(v)];
+    const Vector3d unit = normal[static_cast<std::size_t>(v)].normalized();
+    const Vector3d centre = rest.row(v);
+    const std::vector<int>& one_ring = ring[static_cast<std::size_t>(v)];
+    Vector3d e1 = Vector3d(rest.row(one_ring.front())) - centre;
+    e1 = (e1 - e1.dot(unit) * unit).normalized();
+    if (!e1.allFinite()) e1 = unit.unitOrthogonal();
+    const Vector3d e2 = unit.cross(e1);
+    // The two neighbourhoods: [0] the vertex and its one-ring, [1] with the one-ring's rings.
+    std::array<std::vector<int>, 2> hood;
+    hood[0] = one_ring;
+    hood[0].push_back(v);
+    std::sort(hood[0].begin(), hood[0].end());
+    hood[1] = hood[0];
+    for (int j : one_ring)
+      hood[1].insert(hood[1].end(), ring[static_cast<std::size_t>(j)].begin(),
+                     ring[static_cast<std::size_t>(j)].end());
+    std::sort(hood[1].begin(), hood[1].end());
+    hood[1].erase(std::unique(hood[1].begin(), hood[1].end()), hood[1].end());
+    const std::vector<int>& points = hood[1];
+    const int count = static_cast<int>(points.size());
+    const auto local = [&](int j) {
+      return static_cast<int>(std::lower_bound(points.begin(), points.end(), j) - points.begin());
+    };
+    double radius2 = 0.0;
+    for (int j : points)
+      radius2 = std::max(radius2, (Vector3d(rest.row(j)) - centre).squaredNorm());
+    const double radius = std::sqrt(radius2);
+    // The quadratics at the points of a neighbourhood (u and v in units of the two-ring's radius)
+    // and their pseudo-inverse (6 × #points; rank-truncated).
+    struct Fit {
+      Eigen::MatrixXd basis, inverse;
+      Eigen::MatrixXd null;  // coefficient directions no data determines (6 × k)
+    };
+    std::array<Fit, 2> fits;
+    for (int h = 0; h < 2; ++h) {
+      const int size = static_cast<int>(hood[h].size());
+      Fit& fit = fits[static_cast<std::size_t>(h)];
+      fit.basis.resize(size, 6);
+      for (int j = 0; j < size; ++j) {
+        const Vector3d d =
+            (Vector3d(rest.row(hood[h][static_cast<std::size_t>(j)])) - centre) / radius;
+        const double u = d.dot(e1), w = d.dot(e2);
+        fit.basis.row(j) << 1.0, u, w, u * u, u * w, w * w;
+      }
+      const Eigen::JacobiSVD<Eigen::MatrixXd> svd(fit.basis,
+                                                  Eigen::ComputeFullU | Eigen::ComputeFullV);
+      const Eigen::VectorXd& sigma = svd.singularValues();
+      int rank = 0;
+      while (rank < sigma.size() && sigma(rank) > 1e-8 * sigma(0)) ++rank;
+      fit.inverse = Eigen::MatrixXd::Zero(6, size);
+      for (int r = 0; r < rank; ++r)
+        fit.inverse += svd.matrixV().col(r) * svd.matrixU().col(r).transpose() / sigma(r);
+      fit.null = svd.matrixV().rightCols(6 - rank);
+    }
+    // Row of a functional c ↦ f·c of the fitted coefficients, from the smallest neighbourhood
+    // that determines it (f orthogonal to the undetermined directions); false if none does.
+    const auto functional_row = [&](const Eigen::Matrix<double, 6, 1>& f, Eigen::RowVectorXd& out) {
+      for (int h = 0; h < 2; ++h) {
+        const Fit& fit = fits[static_cast<std::size_t>(h)];
+        if (fit.null.cols() > 0 && (fit.null.transpose() * f).norm() > 1e-8 * f.norm()) continue;
+        const Eigen::RowVectorXd values = f.transpose() * fit.inverse;
+        out = Eigen::RowVectorXd::Zero(count);
+        for (std::size_t j = 0; j < hood[h].size(); ++j)
+          out(local(hood[h][j])) = values(static_cast<Eigen::Index>(j));
+        return true;
+      }
+      return false;
+    };
+    VertexBendElement element;
+    element.vertices = points;
+    element.centre = local(v);
+    element.inverse_area = 1.0 / vertex_area;
+    element.rows = Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, count);
+    for (const auto& [j, w] : entries) element.rows(0, local(j)) += w;
+    const double scale = vertex_area / radius2;  // A_v per (unit of the fit's coordinates)²
+    {
+      // The least-norm change of the Laplacian row that makes it exact, on the smallest
+      // neighbourhood where one exists.
+      Eigen::Matrix<double, 6, 1> target;
+      target << 0.0, 0.0, 0.0, 2.0 * scale, 0.0, 2.0 * scale;
+      for (int h = 0; h < 2; ++h) {
+        const Fit& fit = fits[static_cast<std::size_t>(h)];
+        Eigen::VectorXd current(hood[h].size());
+        for (std::size_t j = 0; j < hood[h].size(); ++j)
+          current(static_cast<Eigen::Index>(j)) = element.rows(0, local(hood[h][j]));
+        const Eigen::Matrix<double, 6, 1> defect = target - fit.basis.transpose() * current;
+        if (defect.norm() <= 1e-9 * target.norm()) break;
+        // δ = B·c with Bᵀ·B·c = defect: δ = (B⁺)ᵀ·defect when defect is in range(Bᵀ).
+        if (fit.null.cols() > 0 && (fit.null.transpose() * defect).norm() > 1e-8 * target.norm())
+          continue;
+        const Eigen::VectorXd change = fit.inverse.transpose() * defect;
+        for (std::size_t j = 0; j < hood[h].size(); ++j)
+          element.rows(0, local(hood[h][j])) += change(static_cast<Eigen::Index>(j));
+        break;
+      }
+    }
+    Eigen::RowVectorXd out;
+    Eigen::Matrix<double, 6, 1> f;
+    f << 0.0, 0.0, 0.0, 2.0 * scale, 0.0, -2.0 * scale;  // x_uu − x_vv = 2c₃ − 2c₅
+    if (functional_row(f, out)) element.rows.row(1) = out;
+    f << 0.0, 0.0, 0.0, 0.0, scale, 0.0;  // x_uv = c₄
+    if (functional_row(f, out)) element.rows.row(2) = out;
+    if (bend_rest == BendRestShape::designed) {
+      // Each row's rest vector b̄ = Σ w_j x̄_j: its tangential part (mesh irregularity, and the
+      // tangent plane's own curvature terms) is written as a least-norm combination
+      // Σ α_j (x̄_j − x̄_v) of the points and moved into the row; the rest, along N̄, becomes
+      // rest_normal·N(x).
+      Vector3d area_vector = Vector3d::Zero();
+      for (const auto& [b, c] : fans[static_cast<std::size_t>(v)])
+        area_vector += 0.5 * (Vector3d(rest.row(b)) - centre).cross(Vector3d(rest.row(c)) - centre);
+      Eigen::MatrixX3d offsets(count, 3);
+      double reach2 = 0.0;
+      for (int j = 0; j < count; ++j) {
+        offsets.row(j) = rest.row(points[static_cast<std::size_t>(j)]) - centre.transpose();
+        reach2 = std::max(reach2, offsets.row(j).squaredNorm());
+      }
+      const Eigen::Matrix<double, 3, 3> rest_vectors = element.rows * offsets;  // row k: b̄_k
+      if (rest_vectors.norm() > 1e-9 * std::sqrt(reach2) && area_vector.norm() > 0.0) {
+        const Vector3d an = area_vector.normalized();
+        const Vector3d t1 = an.unitOrthogonal(), t2 = an.cross(t1);
+        Eigen::MatrixXd tangent(2, count);
+        for (int j = 0; j < count; ++j)
+          tangent.col(j) << offsets.row(j).dot(t1), offsets.row(j).dot(t2);
+        const Eigen::Matrix2d tgram = tangent * tangent.transpose();
+        const bool spans = std::abs(tgram.determinant()) > 1e-12 * tgram.squaredNorm();
+        for (int k = 0; k < 3; ++k) {
+          const Vector3d b = rest_vectors.row(k).transpose();
+          if (spans) {
+            const Eigen::VectorXd alpha =
+                tangent.transpose() * tgram.inverse() * Eigen::Vector2d(b.dot(t1), b.dot(t2));
+            element.rows.row(k) -= alpha.transpose();
+            element.rows(k, element.centre) += alpha.sum();
+          }
+          const Vector3d corrected = (element.rows.row(k) * offsets).transpose();
+          element.rest_normal(k) = corrected.dot(area_vector) / area_vector.squaredNorm();
+        }
+        for (const auto& [b, c] : fans[static_cast<std::size_t>(v)])
+          element.fan.push_back({local(b), local(c)});
+      }
+    }
+    element.blocks.assign(static_cast<std::size_t>(count * count), 0);
+    elements.push_back(std::move(element));
+  }
+  return elements;
+}
+
 // The vertices adjacent to each vertex (itself included) through triangles and hinges, as one
 // flat array: vertex i's run starts at start[i], its first size[i] entries are the distinct
 // neighbours in increasing order (the rest is room left by duplicates).
@@ -272,7 +532,8 @@ struct Neighbours {
 // Room in vertex runs for every element's entries: 1 for itself, 2 per triangle, 3 per hinge.
 std::vector<int> run_starts(int n, const std::vector<TriangleElement>& triangles,
                             const std::vector<HingeElement>& hinges,
-                            const std::vector<BendStencil>& stencils) {
+                            const std::vector<BendStencil>& stencils,
+                            const std::vector<VertexBendElement>& vertex_bends) {
   std::vector<int> start(n + 1, 0);
   for (int i = 0; i < n; ++i) start[i + 1] = 1;  // itself
   for (const TriangleElement& t : triangles)
@@ -280,6 +541,8 @@ std::vector<int> run_starts(int n, const std::vector<TriangleElement>& triangles
   for (const HingeElement& h : hinges)
     for (int v : h.vertices) start[v + 1] += 3;
   for (const BendStencil& b : stencils)
+    for (int v : b.vertices) start[v + 1] += static_cast<int>(b.vertices.size()) - 1;
+  for (const VertexBendElement& b : vertex_bends)
     for (int v : b.vertices) start[v + 1] += static_cast<int>(b.vertices.size()) - 1;
   for (int i = 0; i < n; ++i) start[i + 1] += start[i];
   return start;
@@ -289,7 +552,9 @@ std::vector<int> run_starts(int n, const std::vector<TriangleElement>& triangles
 // sorts them.
 void collect_neighbours(Neighbours& neighbours, const std::vector<TriangleElement>& triangles,
                         const std::vector<HingeElement>& hinges,
-                        const std::vector<BendStencil>& stencils, const std::vector<char>& wanted) {
+                        const std::vector<BendStencil>& stencils,
+                        const std::vector<VertexBendElement>& vertex_bends,
+                        const std::vector<char>& wanted) {
   const int n = static_cast<int>(neighbours.size.size());
   const auto want = [&](int v) { return wanted.empty() || wanted[static_cast<std::size_t>(v)]; };
   std::vector<int> fill(neighbours.start.begin(), neighbours.start.end() - 1);
@@ -305,6 +570,8 @@ void collect_neighbours(Neighbours& neighbours, const std::vector<TriangleElemen
   for (const TriangleElement& t : triangles) connect(t.vertices.data(), 3);
   for (const HingeElement& h : hinges) connect(h.vertices.data(), 4);
   for (const BendStencil& b : stencils)
+    connect(b.vertices.data(), static_cast<int>(b.vertices.size()));
+  for (const VertexBendElement& b : vertex_bends)
     connect(b.vertices.data(), static_cast<int>(b.vertices.size()));
   for (int i = 0; i < n; ++i)
     if (want(i)) neighbours.sort_run(i);
@@ -348,7 +615,14 @@ void set_block_offsets(ClothModel& model, const Neighbours& neighbours,
       if (want(h.vertices[k]))
         for (int l = 0; l < 4; ++l)
           h.blocks[4 * k + l] = neighbours.offset(h.vertices[k], h.vertices[l]);
-  // Stencils are rebuilt with every model, so all their offsets are set.
+  // Stencils and vertex bends are rebuilt with every model, so all their offsets are set.
+  for (VertexBendElement& b : model.vertex_bends) {
+    const int count = static_cast<int>(b.vertices.size());
+    for (int k = 0; k < count; ++k)
+      for (int l = 0; l < count; ++l)
+        b.blocks[static_cast<std::size_t>(count * k + l)] = neighbours.offset(
+            b.vertices[static_cast<std::size_t>(k)], b.vertices[static_cast<std::size_t>(l)]);
+  }
   for (BendStencil& b : model.stencils) {
     const int count = static_cast<int>(b.vertices.size());
     for (int k = 0; k < count; ++k)
@@ -375,6 +649,23 @@ void scale_rest_shapes(ClothModel& model, const Eigen::VectorXd& scale) {
       model.vertex_area[v] += element.rest_area / 3.0;
       model.mass[v] += model.fabric.area_density * element.rest_area / 3.0;
     }
+  }
+}
+
+void clamp_bending(ClothModel& model, const std::vector<int>& pinned) {
+  const auto n = static_cast<std::size_t>(model.vertex_count);
+  std::vector<char> is_pinned(n, 0), in_pinned_triangle(n, 0), in_free_triangle(n, 0);
+  for (int v : pinned)
+    if (v >= 0 && static_cast<std::size_t>(v) < n) is_pinned[static_cast<std::size_t>(v)] = 1;
+  for (const TriangleElement& t : model.triangles) {
+    bool all = true;
+    for (int v : t.vertices) all = all && is_pinned[static_cast<std::size_t>(v)];
+    for (int v : t.vertices)
+      (all ? in_pinned_triangle : in_free_triangle)[static_cast<std::size_t>(v)] = 1;
+  }
+  for (VertexBendElement& b : model.vertex_bends) {
+    const auto v = static_cast<std::size_t>(b.vertices[static_cast<std::size_t>(b.centre)]);
+    if (is_pinned[v] && in_pinned_triangle[v] && in_free_triangle[v]) b.inverse_area *= 2.0;
   }
 }
 
@@ -457,15 +748,20 @@ ClothModel build_cloth_model(const ClothInput& input, const FabricParameters& fa
   model.bend_stencil_stiffness = options.bend_stencil_stiffness;
   if (options.bend_stencil_stiffness > 0.0)
     model.stencils = make_bend_stencils(rest, input.triangles);
+  model.bend_model = options.bend_model;
+  if (options.bend_model == BendModel::quadratic)
+    model.vertex_bends = make_vertex_bends(rest, input.triangles, options.bend_rest);
 
   // Block sparsity pattern: vertex adjacency through triangles and hinges, as one flat array
   // (CSR by vertex: room for every element's entries, then each vertex's run sorted and
   // deduplicated in place).
   Neighbours neighbours;
-  neighbours.start = run_starts(n, model.triangles, model.hinges, model.stencils);
+  neighbours.start =
+      run_starts(n, model.triangles, model.hinges, model.stencils, model.vertex_bends);
   neighbours.list.resize(static_cast<std::size_t>(neighbours.start[n]));
   neighbours.size.resize(n);
-  collect_neighbours(neighbours, model.triangles, model.hinges, model.stencils, {});
+  collect_neighbours(neighbours, model.triangles, model.hinges, model.stencils, model.vertex_bends,
+                     {});
   model.pattern.zero_matrix = zero_pattern_matrix(neighbours);
   set_block_offsets(model, neighbours, {});
   return model;
@@ -643,6 +939,28 @@ ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse&
           if (const int i = next_vertex[static_cast<std::size_t>(p)]; i >= 0)
             changed_row[static_cast<std::size_t>(i)] = 1;
   }
+  // Vertex bends likewise: rebuilt (linear time); a row is rebuilt when a vertex bend over it is
+  // not one of the previous ones (the same vertices).
+  model.bend_model = options.bend_model;
+  if (options.bend_model == BendModel::quadratic)
+    model.vertex_bends = make_vertex_bends(rest, input.triangles, options.bend_rest);
+  {
+    std::set<std::vector<int>> before, after;
+    for (const VertexBendElement& b : previous.vertex_bends) before.insert(b.vertices);
+    for (const VertexBendElement& b : model.vertex_bends) {
+      std::vector<int> key;
+      for (int v : b.vertices) key.push_back(reuse.previous_vertex[static_cast<std::size_t>(v)]);
+      std::sort(key.begin(), key.end());
+      after.insert(key);
+      if (key.front() < 0 || before.count(key) == 0)
+        for (int v : b.vertices) changed_row[static_cast<std::size_t>(v)] = 1;
+    }
+    for (const std::vector<int>& key : before)
+      if (after.count(key) == 0)
+        for (int p : key)
+          if (const int i = next_vertex[static_cast<std::size_t>(p)]; i >= 0)
+            changed_row[static_cast<std::size_t>(i)] = 1;
+  }
 
   // Pattern: unchanged rows are the previous rows renumbered (kept vertices keep their order,
   // so each run stays sorted), the changed ones are collected from the elements and sorted.
@@ -652,7 +970,8 @@ ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse&
     return (old_pattern.outerIndexPtr()[3 * p + 1] - old_pattern.outerIndexPtr()[3 * p]) / 3;
   };
   // A changed row gets room as in build_cloth_model, an unchanged one its previous size.
-  const std::vector<int> room = run_starts(n, model.triangles, model.hinges, model.stencils);
+  const std::vector<int> room =
+      run_starts(n, model.triangles, model.hinges, model.stencils, model.vertex_bends);
   Neighbours neighbours;
   neighbours.start.assign(static_cast<std::size_t>(n) + 1, 0);
   for (int i = 0; i < n; ++i)
@@ -670,7 +989,8 @@ ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse&
           renumber(columns[3 * m] / 3);
     neighbours.size[i] = size;
   }
-  collect_neighbours(neighbours, model.triangles, model.hinges, model.stencils, changed_row);
+  collect_neighbours(neighbours, model.triangles, model.hinges, model.stencils, model.vertex_bends,
+                     changed_row);
   model.pattern.zero_matrix = zero_pattern_matrix(neighbours);
   // Offsets in unchanged rows are the previous ones (kept elements brought them along).
   model.pattern.diagonal_offsets.resize(static_cast<std::size_t>(n));

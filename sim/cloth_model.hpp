@@ -51,8 +51,21 @@ enum class BendWeights {
   edge,  // |e|²/(A1+A2): exact for a bend across the edge only
 };
 
+// Which discrete bending energy the cloth uses (docs/simulator.md, "Bending on any mesh").
+enum class BendModel {
+  // Per vertex ½·B·|L̃x − c·N(x)|²/A_v: the cotangent Laplacian of the positions, completed at
+  // free boundaries by the boundary's own flux, against the rest curvature (VertexBendElement;
+  // the quadratic isometric bending of Bergou et al. 2006). Consistent on any triangulation:
+  // ½·B·∫(κ1 + κ2)² dA, which for isometric bending is ½·B·∫tr K² dA.
+  quadratic,
+  // Per interior edge ½·B·weight·(θ − θ0)² (discrete shells), with the weights and stencils
+  // below: on the 4-8 mesh too soft and orientation-dependent.
+  hinges,
+};
+
 struct ClothModelOptions {
   BendRestShape bend_rest = BendRestShape::designed;
+  BendModel bend_model = BendModel::quadratic;
   BendWeights bend_weights = BendWeights::edge;
   // Stiffness of the bend stencils relative to the fabric's B (0: none); see BendStencil.
   // Off by default: they hold the 4-8 mesh's sublattice mode only away from the boundary
@@ -94,6 +107,29 @@ struct BendStencil {
   std::vector<int> blocks;    // #vertices², offset of block (j,l), see BlockPattern
 };
 
+// The bending element of one vertex v for BendModel::quadratic: three curvature vectors
+// r_k(x) = Σ_j rows(k, j)·x_j − rest_normal(k)·N(x) and the energy
+// ½·B·inverse_area·(½|r_0|² + ½|r_1|² + 2|r_2|²), which for r_0 ≈ A_v·Δx, r_1 ≈ A_v·(x_uu − x_vv)
+// and r_2 ≈ A_v·x_uv (u, v rest tangent coordinates) is ½·B·A_v·(|x_uu|² + 2|x_uv|² + |x_vv|²):
+// ½·B·tr K²·A_v for isometric bending, the continuum energy of a plate with Poisson ratio 0,
+// in every direction. (Δx alone, the quadratic model of Bergou et al. 2006, is ν = 1: a narrow
+// strip bends almost for free into a saddle.) Every row is zero for an affine map of a flat rest
+// and exact for quadratic shapes, up to free edges (docs/simulator.md, "Bending on any mesh").
+// N(x) = ½·Σ_fan (x_b − x_v)×(x_c − x_v) is the area vector of the vertex's triangles;
+// rest_normal·N(x̄) is the rest shape's curvature vector, so a shaped panel is at rest in its
+// designed shape and the target turns with the surface. Flat rest: rest_normal = 0, the r_k are
+// linear and the energy quadratic (constant Hessian).
+struct VertexBendElement {
+  std::vector<int> vertices;                      // sorted, the centre among them
+  int centre = 0;                                 // index of v in `vertices`
+  Eigen::Matrix<double, 3, Eigen::Dynamic> rows;  // 3 × #vertices, m² per m² of curvature
+  double inverse_area = 0.0;  // 1/A_v (the mixed Voronoi area of Meyer et al. 2003), 1/m²
+  Eigen::Vector3d rest_normal = Eigen::Vector3d::Zero();  // 1/m
+  std::vector<std::array<int, 2>> fan;  // (b, c) indices into `vertices` of each triangle
+                                        // (v, b, c); only when rest_normal != 0
+  std::vector<int> blocks;              // #vertices², offset of block (j,l), see BlockPattern
+};
+
 // Structurally symmetric block sparsity: rows 3i..3i+2 all hold the columns of the vertices
 // adjacent to i (itself included), in increasing order. Block (i,j), entry (a,b) is at value
 // index outer[3i+a] + offset(i,j) + b, where offset(i,j) is what the elements store.
@@ -106,7 +142,9 @@ struct ClothModel {
   int vertex_count = 0;
   FabricParameters fabric;
   std::vector<TriangleElement> triangles;
-  std::vector<HingeElement> hinges;
+  std::vector<HingeElement> hinges;  // built for both bend models, used by BendModel::hinges
+  BendModel bend_model = BendModel::quadratic;
+  std::vector<VertexBendElement> vertex_bends;  // with BendModel::quadratic
   std::vector<BendStencil> stencils;  // with ClothModelOptions::bend_stencil_stiffness > 0
   double bend_stencil_stiffness = 0.0;
   Eigen::VectorXd mass;         // #V lumped masses, kg
@@ -147,6 +185,16 @@ ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse&
 // areas from the scaled areas. Rest angles, and the bending weights |e|²/(A1+A2), do not change
 // under a uniform scale. `scale` is #triangles, every entry positive.
 void scale_rest_shapes(ClothModel& model, const Eigen::VectorXd& scale);
+
+// Makes the bending of BendModel::quadratic see the edge of a clamp. Where cloth leaves a clamp
+// (a region of pinned vertices held flat) its curvature jumps from 0 to κ0, and the element of a
+// vertex on the clamp's edge, whose stencil straddles the edge, measures the average κ0/2 over a
+// dual cell of which only half is free cloth: h·(κ0/2)² instead of (h/2)·κ0². The one-sided
+// curvature with the clamp's slope is twice the centred one (the ghost-point treatment of a
+// clamped beam), over half the area, so those elements carry twice their energy. A clamp-edge
+// vertex: pinned, in a triangle whose vertices are all pinned and in one with a free vertex.
+// `pinned`: vertex indices. Without it the rigidity near a clamp converges only as O(h).
+void clamp_bending(ClothModel& model, const std::vector<int>& pinned);
 
 // Flattens #V by 3 positions into the solver's 3n vector (x0,y0,z0,x1,...) and back.
 Eigen::VectorXd flatten_positions(const Eigen::MatrixX3d& positions);

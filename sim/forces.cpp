@@ -1,7 +1,10 @@
 #include "sim/forces.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <utility>
 
 #include "sim/element_forces.hpp"
 
@@ -59,6 +62,173 @@ void add_condition(const Condition<N>& c, double rest_value, double stiffness, d
     }
 }
 
+// [a]_×: the matrix of a × ·.
+Eigen::Matrix3d cross_matrix(const Vector3d& a) {
+  Eigen::Matrix3d m;
+  m << 0.0, -a.z(), a.y(), a.z(), 0.0, -a.x(), -a.y(), a.x(), 0.0;
+  return m;
+}
+
+// G(y) = ∂N/∂x of the element's area vector N(x) = ½·Σ_fan (x_b − x_v)×(x_c − x_v), evaluated
+// with the positions y (3 by 3·#vertices). N is a symmetric bilinear form Q(x, x), so
+// G(x)·u = 2Q(x, u) and ∂(G(x)·u)/∂x = G(u).
+Eigen::MatrixXd area_vector_jacobian(const VertexBendElement& b, const Eigen::MatrixX3d& y) {
+  Eigen::MatrixXd g = Eigen::MatrixXd::Zero(3, 3 * static_cast<Eigen::Index>(b.vertices.size()));
+  const int v = b.centre;
+  for (const auto& [pb, pc] : b.fan) {
+    const Vector3d p = (y.row(pb) - y.row(v)).transpose(), q = (y.row(pc) - y.row(v)).transpose();
+    // ∂(½ p×q)/∂p = −½[q]_×, ∂/∂q = ½[p]_×; p = x_b − x_v, q = x_c − x_v.
+    g.block<3, 3>(0, 3 * pb) -= 0.5 * cross_matrix(q);
+    g.block<3, 3>(0, 3 * pc) += 0.5 * cross_matrix(p);
+    g.block<3, 3>(0, 3 * v) += 0.5 * (cross_matrix(q) - cross_matrix(p));
+  }
+  return g;
+}
+
+// ∇²(s·N(x)) for a fixed vector s (3·#vertices square, constant): from ½·s·(p×q),
+// ∂²/∂p∂qᵀ = −½[s]_× and ∂²/∂q∂pᵀ = ½[s]_×.
+Eigen::MatrixXd area_vector_hessian(const VertexBendElement& b, const Vector3d& s) {
+  const auto m = static_cast<Eigen::Index>(b.vertices.size());
+  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(3 * m, 3 * m);
+  const Eigen::Matrix3d pq = -0.5 * cross_matrix(s);
+  const int v = b.centre;
+  for (const auto& [pb, pc] : b.fan) {
+    const std::array<std::pair<int, double>, 2> p{{{pb, 1.0}, {v, -1.0}}};
+    const std::array<std::pair<int, double>, 2> q{{{pc, 1.0}, {v, -1.0}}};
+    for (const auto& [i, si] : p)
+      for (const auto& [j, sj] : q) {
+        h.block<3, 3>(3 * i, 3 * j) += si * sj * pq;
+        h.block<3, 3>(3 * j, 3 * i) += si * sj * pq.transpose();
+      }
+  }
+  return h;
+}
+
+// The quadratic bending of one vertex (VertexBendElement): energy ½·k·Σ_k s_k|r_k|², force
+// −k·Σ_k s_k·J_kᵀ(r_k + β·ṙ_k) with J_k = ∂r_k/∂x = rows_k ⊗ I − c_k·G(x), ṙ_k = J_k·v,
+// k = B/A_v and s = (½, ½, 2).
+void add_vertex_bend(const VertexBendElement& b, double bend, double beta, const Eigen::VectorXd& x,
+                     const Eigen::VectorXd& v, Eigen::VectorXd& force, double& energy,
+                     const JacobianTarget* jacobian) {
+  static constexpr std::array<double, 3> kRowScale{0.5, 0.5, 2.0};
+  const auto m = static_cast<Eigen::Index>(b.vertices.size());
+  const double k = bend * b.inverse_area;
+  Eigen::MatrixX3d xs(m, 3), vs(m, 3);
+  for (Eigen::Index j = 0; j < m; ++j) {
+    xs.row(j) = x.segment<3>(3 * b.vertices[static_cast<std::size_t>(j)]).transpose();
+    vs.row(j) = v.segment<3>(3 * b.vertices[static_cast<std::size_t>(j)]).transpose();
+  }
+  const Eigen::Matrix3d r_lin = b.rows * xs;  // row k: Σ_j rows(k, j)·x_j
+  const Eigen::Matrix3d r_dot_lin = b.rows * vs;
+  if (b.fan.empty()) {
+    // r_k linear: every 3×3 block of Σ s_k J_kᵀJ_k is (Σ_k s_k·rows(k,j)·rows(k,l))·I.
+    Eigen::Matrix3d pull;  // row k: k·s_k·(r_k + β ṙ_k)
+    for (int row = 0; row < 3; ++row) {
+      energy += 0.5 * k * kRowScale[row] * r_lin.row(row).squaredNorm();
+      pull.row(row) = k * kRowScale[row] * (r_lin.row(row) + beta * r_dot_lin.row(row));
+    }
+    const Eigen::MatrixX3d local_force = -b.rows.transpose() * pull;  // m × 3
+    for (Eigen::Index j = 0; j < m; ++j)
+      force.segment<3>(3 * b.vertices[static_cast<std::size_t>(j)]) +=
+          local_force.row(j).transpose();
+    if (jacobian == nullptr) return;
+    const Eigen::Vector3d scales(kRowScale[0], kRowScale[1], kRowScale[2]);
+    const Eigen::MatrixXd coupling = b.rows.transpose() * scales.asDiagonal() * b.rows;  // m × m
+    if (jacobian->product_input != nullptr) {
+      Eigen::MatrixX3d us(m, 3);
+      for (Eigen::Index j = 0; j < m; ++j)
+        us.row(j) = jacobian->product_input->segment<3>(3 * b.vertices[static_cast<std::size_t>(j)])
+                        .transpose();
+      const Eigen::MatrixX3d product = -k * coupling * us;
+      for (Eigen::Index j = 0; j < m; ++j)
+        jacobian->product_output->segment<3>(3 * b.vertices[static_cast<std::size_t>(j)]) +=
+            product.row(j).transpose();
+    }
+    if (jacobian->matrix == nullptr) return;
+    double* values = jacobian->matrix->valuePtr();
+    const double scale = -k * (jacobian->dfdx_scale + jacobian->dfdv_scale * beta);
+    for (Eigen::Index j = 0; j < m; ++j)
+      for (Eigen::Index l = 0; l < m; ++l) {
+        const double entry = scale * coupling(j, l);
+        const int offset = b.blocks[static_cast<std::size_t>(m * j + l)];
+        for (int a = 0; a < 3; ++a)
+          values[block_value_index(*jacobian->matrix, b.vertices[static_cast<std::size_t>(j)],
+                                   offset, a, a)] += entry;
+      }
+    return;
+  }
+  Vector3d area_vector = Vector3d::Zero();
+  for (const auto& [pb, pc] : b.fan)
+    area_vector += 0.5 * (xs.row(pb) - xs.row(b.centre))
+                             .transpose()
+                             .cross((xs.row(pc) - xs.row(b.centre)).transpose());
+  const Eigen::MatrixXd g_x = area_vector_jacobian(b, xs);
+  const bool want = jacobian != nullptr;
+  const bool exact = want && jacobian->kind == JacobianKind::exact;
+  const Eigen::MatrixXd g_v = exact && beta > 0.0 ? area_vector_jacobian(b, vs) : Eigen::MatrixXd();
+  Eigen::VectorXd local_force = Eigen::VectorXd::Zero(3 * m);
+  // The three rows' Jacobians stacked, each scaled by √(k·s_k): Σ_k k·s_k·J_kᵀJ_k = SᵀS.
+  Eigen::MatrixXd stacked(9, 3 * m);
+  Eigen::MatrixXd dfdx;
+  if (exact) dfdx = Eigen::MatrixXd::Zero(3 * m, 3 * m);
+  Eigen::VectorXd local_v(3 * m);
+  for (Eigen::Index j = 0; j < m; ++j) local_v.segment<3>(3 * j) = vs.row(j).transpose();
+  for (int row = 0; row < 3; ++row) {
+    const double c = b.rest_normal(row);
+    const double weight = k * kRowScale[row];
+    const Vector3d r = r_lin.row(row).transpose() - c * area_vector;
+    auto jac = stacked.middleRows<3>(3 * row);
+    jac = -c * g_x;
+    for (Eigen::Index j = 0; j < m; ++j)
+      jac.block<3, 3>(0, 3 * j).diagonal().array() += b.rows(row, j);
+    const Vector3d r_dot = jac * local_v;
+    energy += 0.5 * weight * r.squaredNorm();
+    local_force.noalias() -= weight * (jac.transpose() * (r + beta * r_dot));
+    if (exact) {
+      // ∇²E_k = w(JᵀJ − c·∇²(r·N)); damping: ∂(JᵀJv)/∂x = −c·∇²(ṙ·N) − c·Jᵀ·G(v).
+      dfdx += weight * c * area_vector_hessian(b, r);
+      if (beta > 0.0)
+        dfdx += beta * weight * c * (area_vector_hessian(b, r_dot) + jac.transpose() * g_v);
+    }
+    jac *= std::sqrt(weight);
+  }
+  Eigen::MatrixXd gauss_newton;
+  if (want) {
+    gauss_newton.noalias() = stacked.transpose() * stacked;
+    if (exact)
+      dfdx -= gauss_newton;
+    else
+      dfdx = -gauss_newton;
+  }
+  for (Eigen::Index j = 0; j < m; ++j)
+    force.segment<3>(3 * b.vertices[static_cast<std::size_t>(j)]) += local_force.segment<3>(3 * j);
+  if (!want) return;
+  if (jacobian->product_input != nullptr) {
+    Eigen::VectorXd local_u(3 * m);
+    for (Eigen::Index j = 0; j < m; ++j)
+      local_u.segment<3>(3 * j) =
+          jacobian->product_input->segment<3>(3 * b.vertices[static_cast<std::size_t>(j)]);
+    const Eigen::VectorXd product = dfdx * local_u;
+    for (Eigen::Index j = 0; j < m; ++j)
+      jacobian->product_output->segment<3>(3 * b.vertices[static_cast<std::size_t>(j)]) +=
+          product.segment<3>(3 * j);
+  }
+  if (jacobian->matrix == nullptr) return;
+  const Eigen::MatrixXd local =
+      jacobian->dfdx_scale * dfdx - (jacobian->dfdv_scale * beta) * gauss_newton;
+  double* values = jacobian->matrix->valuePtr();
+  for (Eigen::Index j = 0; j < m; ++j)
+    for (Eigen::Index l = 0; l < m; ++l) {
+      const int offset = b.blocks[static_cast<std::size_t>(m * j + l)];
+      for (int a = 0; a < 3; ++a) {
+        double* row =
+            values + block_value_index(*jacobian->matrix, b.vertices[static_cast<std::size_t>(j)],
+                                       offset, a, 0);
+        for (int e = 0; e < 3; ++e) row[e] += local(3 * j + a, 3 * l + e);
+      }
+    }
+}
+
 }  // namespace
 
 void evaluate_forces(const ClothModel& model, const ForceSettings& settings,
@@ -94,7 +264,12 @@ void evaluate_forces(const ClothModel& model, const ForceSettings& settings,
       }
     }
   }
-  if (terms.bend && fabric.bend > 0.0) {
+  if (terms.bend && fabric.bend > 0.0 && model.bend_model == BendModel::quadratic) {
+    const double beta = damping_scale * fabric.bend_damping;
+    for (const VertexBendElement& b : model.vertex_bends)
+      add_vertex_bend(b, fabric.bend, beta, x, v, force, local_energy.bend, jacobian);
+  }
+  if (terms.bend && fabric.bend > 0.0 && model.bend_model == BendModel::hinges) {
     // The bend Hessian is only needed for the exact Jacobian: the solve uses −k·∇θ∇θᵀ.
     for (const HingeElement& h : model.hinges) {
       const auto& vs = h.vertices;
@@ -106,7 +281,8 @@ void evaluate_forces(const ClothModel& model, const ForceSettings& settings,
                     vs.data(), h.blocks.data(), v, force, local_energy.bend, jacobian);
     }
   }
-  if (terms.bend && fabric.bend > 0.0 && model.bend_stencil_stiffness > 0.0) {
+  if (terms.bend && fabric.bend > 0.0 && model.bend_model == BendModel::hinges &&
+      model.bend_stencil_stiffness > 0.0) {
     // Quadratic, so its Hessian is exact in both Jacobian kinds and positive semi-definite:
     // f_j = −k Σ_l C_jl (x_l + β v_l), ∂f_j/∂x_l = −k C_jl I, ∂f_j/∂v_l = −k β C_jl I.
     const double k = model.bend_stencil_stiffness * fabric.bend;

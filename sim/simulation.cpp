@@ -95,6 +95,12 @@ void Simulation::replace_model(ClothModel model, Eigen::VectorXd x, Eigen::Vecto
                                   " is not a cloth vertex (the cloth has " + std::to_string(n) +
                                   ")");
   model_ = std::move(model);
+  {  // fixed pins that hold a region flat are clamps for the bending (issue 21)
+    std::vector<int> fixed;
+    for (const Pin& pin : pins)
+      if (!pin.path) fixed.push_back(pin.vertex);
+    clamp_bending(model_, fixed);
+  }
   x_ = std::move(x);
   v_ = std::move(v);
   pins_ = std::move(pins);

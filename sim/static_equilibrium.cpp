@@ -62,8 +62,10 @@ SparseMatrixC free_stiffness(const ClothModel& model, const ForceSettings& setti
 
 }  // namespace
 
-StaticResult solve_static(const ClothModel& model, Eigen::VectorXd& x,
+StaticResult solve_static(const ClothModel& unclamped, Eigen::VectorXd& x,
                           const std::vector<int>& pinned, const StaticOptions& options) {
+  ClothModel model = unclamped;
+  clamp_bending(model, pinned);
   const int n = model.vertex_count;
   std::vector<int> free_index(static_cast<std::size_t>(3 * n), 0);
   for (int v : pinned)
