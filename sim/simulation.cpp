@@ -254,7 +254,7 @@ Simulation::Attempt Simulation::attempt(double h) {
     pinned.assign(static_cast<std::size_t>(model_.vertex_count), 0);
     for (int i = 0; i < model_.vertex_count; ++i) pinned[i] = filter_.is_pinned(i);
     self->add_springs(y.size() == x_.size() ? Eigen::VectorXd(x_ + y) : x_, model_.mass, pinned,
-                      contact_forces_);
+                      contact_forces_, &v_, beta);
   }
   for (;;) {
     if (contact != nullptr) {
