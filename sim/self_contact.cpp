@@ -30,8 +30,14 @@ Eigen::Vector3d row(const Eigen::VectorXd& x, int i) {
   return x.segment<3>(3 * i);
 }
 
+// A vertex the body's contact holds (kHeldByBody) weighs this many times its mass in the
+// fail-safe's impulses: the free side of a pair gives way, not the side against the body.
+constexpr double kHeldMassFactor = 1000.0;
+
 double inverse_mass(int vertex, const Eigen::VectorXd& mass,
                     const std::vector<unsigned char>& pinned) {
+  if (!pinned.empty() && pinned[vertex] == kHeldByBody)
+    return 1.0 / (kHeldMassFactor * mass[vertex]);
   if (!pinned.empty() && pinned[vertex] != 0) return 0.0;
   return 1.0 / mass[vertex];
 }
@@ -44,14 +50,15 @@ void move_rigidly(const std::vector<int>& members, const Eigen::VectorXd& x0, Ei
   Eigen::Vector3d pin_shift = Eigen::Vector3d::Zero();
   int pins = 0;
   for (int i : members)
-    if (!pinned.empty() && pinned[i] != 0) {
+    if (!pinned.empty() && pinned[i] != 0 && pinned[i] != kHeldByBody) {
       pin_shift += row(x1, i) - row(x0, i);
       ++pins;
     }
   if (pins > 0) {
     pin_shift /= pins;
     for (int i : members)
-      if (pinned.empty() || pinned[i] == 0) x1.segment<3>(3 * i) = row(x0, i) + pin_shift;
+      if (pinned.empty() || pinned[i] == 0 || pinned[i] == kHeldByBody)
+        x1.segment<3>(3 * i) = row(x0, i) + pin_shift;
     return;
   }
   double total = 0.0;

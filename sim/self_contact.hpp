@@ -18,7 +18,8 @@
 //     collides. A cloth that starts the step free of intersections ends it free of them.
 //
 // Pinned vertices are immovable (infinite mass) in the impulses; a zone holding a pinned vertex
-// moves with the pins' mean displacement.
+// moves with the pins' mean displacement. Vertices the body's contact holds are heavy, so that
+// cloth pinched between cloth and body gives way on its free side rather than into the body.
 
 #include <Eigen/Core>
 #include <vector>
@@ -28,6 +29,9 @@
 #include "sim/self_collision.hpp"
 
 namespace sd::sim {
+
+// resolve()'s mark of a vertex the body's contact constrains this step.
+constexpr unsigned char kHeldByBody = 2;
 
 struct SelfContactSettings {
   bool enabled = false;
@@ -83,6 +87,8 @@ class SelfContactResponse {
                    const std::vector<unsigned char>& pinned, StepForces& extra,
                    const Eigen::VectorXd* velocity = nullptr, double beta = 0.0);
   // Steps 2 and 3 on the solve's result: x1 (3n) and v1 change together (v1 += Δx1 / beta).
+  // pinned: per vertex, 0 free, kHeldByBody for a vertex the body's contact constrains (it
+  // weighs a thousand times its mass in the impulses and moves with its zone), else pinned.
   void resolve(const Eigen::VectorXd& x0, Eigen::VectorXd& x1, Eigen::VectorXd& v1, double beta,
                const Eigen::VectorXd& mass, const std::vector<unsigned char>& pinned,
                const StepForces& extra);

@@ -296,8 +296,13 @@ Simulation::Attempt Simulation::attempt(double h) {
   // accepted state, before the body's position correction, so that a correction pushing a
   // vertex out of the body cannot carry it through a layer lying on it unseen.
   if (self != nullptr && result.solve.linear_converged && result.x.allFinite() &&
-      result.v.allFinite())
+      result.v.allFinite()) {
+    // In the fail-safe, vertices the body's contact constrains are heavy: cloth pinched between
+    // cloth and body gives way on its free side rather than into the body.
+    for (int i = 0; i < model_.vertex_count; ++i)
+      if (pinned[i] == 0 && !filter_.is_free(i)) pinned[i] = kHeldByBody;
     self->resolve(x_, result.x, result.v, beta, model_.mass, pinned, contact_forces_);
+  }
 
   std::ostringstream why;
   // Where a failing attempt broke: its first non-finite vertex, else its fastest one.
