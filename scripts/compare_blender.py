@@ -157,6 +157,12 @@ def count_intersections(positions, triangles):
     return len(found)
 
 
+def read_obj_triangles(path):
+    with open(path) as f:
+        return [tuple(int(x.split("/")[0]) - 1 for x in line.split()[1:4])
+                for line in f if line.startswith("f ")]
+
+
 def read_obj_vertices(path):
     with open(path) as f:
         return [[float(x) for x in line.split()[1:4]] for line in f if line.startswith("v ")]
@@ -281,7 +287,7 @@ def main():
                     with open(workdir / "sphere.obj", "w") as f:
                         f.writelines(f"v {p[0]} {p[1]} {p[2]}\n" for p in body_v)
                         f.writelines(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in body_f)
-                    scene["body"] = {"mesh": str(workdir / "sphere.obj")}
+                    scene["body"] = {"mesh": str(workdir / "sphere.obj"), "scale": 1.0}
                     spec["body_vertices"], spec["body_faces"] = body_v, body_f
                 # The sheet's vertex order in sketchdrape's output: a run of one 0.1 ms step.
                 first = json.loads(json.dumps(scene))
@@ -292,6 +298,7 @@ def main():
                 report, sd_wall, sd_cpu, final_obj = run_sketchdrape(args.binary, scene, workdir,
                                                                      [])
                 sd_final = [final_obj[i] for i in mapping]
+                sd_triangles = read_obj_triangles(workdir / "sketchdrape" / "drape.obj")
                 blender, b_wall = run_blender(args.blender, args.blender_threads, spec, workdir)
             edges = grid_edges(quads)
             row = {
@@ -312,11 +319,14 @@ def main():
             row["blender_drop_m"] = height - sum(p[1] for p in blender["positions"]) / len(vertices)
             row["sketchdrape_drop_m"] = height - sum(p[1] for p in sd_final) / len(vertices)
             if args.self_collision:
-                # Both final sheets counted by the same test on the same triangles (each grid
-                # quad split along one diagonal), and sketchdrape's own CGAL count of its mesh.
+                # Each final sheet counted by the same test on the triangles its program
+                # simulated: Blender's quads split along their first diagonal (as its cloth
+                # tessellates a convex quad), sketchdrape's own 4-8 triangles; and sketchdrape's
+                # CGAL count of its mesh.
                 triangles = [t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))]
                 row["blender_intersections"] = count_intersections(blender["positions"], triangles)
-                row["sketchdrape_intersections"] = count_intersections(sd_final, triangles)
+                row["sketchdrape_intersections"] = count_intersections(
+                    final_obj, sd_triangles)
                 row["sketchdrape_intersections_cgal"] = report["self_intersections_final"]
                 row["sketchdrape_self_collision_share"] = report["self_collision_share"]
             row["speedup"] = row["blender_s"] / row["sketchdrape_s"]
