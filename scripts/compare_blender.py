@@ -23,6 +23,7 @@ positions. Writes results.json and results.md (a Markdown table) to --out.
 
     scripts/compare_blender.py --sizes 32 64 --scenes pinned sphere -o out/blender
     scripts/compare_blender.py --blender-threads 0   # Blender on every core (its default)
+    scripts/compare_blender.py --scenes ball --sizes 32 --self-collision   # a folding scene
 
 Needs Debian's blender (apt-get install blender) and a built sketchdrape. Timings mean
 something only on a quiet machine: the table states the load average before and after.
@@ -40,6 +41,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 SPHERE_RADIUS = 0.3
+BALL_RADIUS = 0.1  # the folding scene ("ball"): a 1 m sheet hangs around a 10 cm ball
 PINNED_HEIGHT = 1.2
 DROP = 0.1  # metres between the sphere's top and the sheet
 
@@ -101,6 +103,64 @@ def stretch_max(rest, final, edges):
         return math.dist(p[a], p[b])
 
     return max((length(final, a, b) - length(rest, a, b)) / length(rest, a, b) for a, b in edges)
+
+
+def count_intersections(positions, triangles):
+    """Pairs of triangles not sharing an edge that intersect: an edge of one (not through a
+    shared vertex) crosses the other (orientation signs, rounding-level values as zero; a uniform
+    grid of cells the size of the largest triangle finds the candidates)."""
+    def sub(a, b):
+        return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+    def orient(a, b, c, d):
+        u, v, w = sub(b, a), sub(c, a), sub(d, a)
+        return (u[1] * v[2] - u[2] * v[1]) * w[0] + (u[2] * v[0] - u[0] * v[2]) * w[1] + \
+            (u[0] * v[1] - u[1] * v[0]) * w[2]
+
+    def crosses(p, q, a, b, c):
+        eps = 1e-10 * max(math.dist(p, q), math.dist(a, b), math.dist(a, c)) ** 3
+        d1, d2 = orient(a, b, c, p), orient(a, b, c, q)
+        if (d1 > eps and d2 > eps) or (d1 < -eps and d2 < -eps) or (abs(d1) <= eps and abs(d2) <= eps):
+            return False
+        e = (orient(p, q, a, b), orient(p, q, b, c), orient(p, q, c, a))
+        return all(x >= -eps for x in e) or all(x <= eps for x in e)
+
+    boxes = [(tuple(min(positions[k][a] for k in t) for a in range(3)),
+              tuple(max(positions[k][a] for k in t) for a in range(3))) for t in triangles]
+    cell = max(max(hi[a] - lo[a] for a in range(3)) for lo, hi in boxes) + 1e-12
+    grid = {}
+    for i, (lo, hi) in enumerate(boxes):
+        ranges = [range(math.floor(lo[a] / cell), math.floor(hi[a] / cell) + 1) for a in range(3)]
+        for x in ranges[0]:
+            for y in ranges[1]:
+                for z in ranges[2]:
+                    grid.setdefault((x, y, z), []).append(i)
+    found = set()
+    for members in grid.values():
+        for m, i in enumerate(members):
+            for j in members[m + 1:]:
+                key = (min(i, j), max(i, j))
+                if key in found:
+                    continue
+                (li, hi_), (lj, hj) = boxes[i], boxes[j]
+                if any(hi_[a] < lj[a] or hj[a] < li[a] for a in range(3)):
+                    continue
+                ti, tj = triangles[i], triangles[j]
+                if len(set(ti) & set(tj)) >= 2:
+                    continue
+                for t, u in ((ti, tj), (tj, ti)):
+                    if any(crosses(positions[t[k]], positions[t[(k + 1) % 3]], positions[u[0]],
+                                   positions[u[1]], positions[u[2]])
+                           for k in range(3) if t[k] not in u and t[(k + 1) % 3] not in u):
+                        found.add(key)
+                        break
+    return len(found)
+
+
+def read_obj_triangles(path):
+    with open(path) as f:
+        return [tuple(int(x.split("/")[0]) - 1 for x in line.split()[1:4])
+                for line in f if line.startswith("f ")]
 
 
 def read_obj_vertices(path):
@@ -171,7 +231,10 @@ def main():
     parser.add_argument("--blender", default="blender")
     parser.add_argument("--sizes", type=int, nargs="+", default=[32, 64])
     parser.add_argument("--scenes", nargs="+", default=["pinned", "sphere"],
-                        choices=["pinned", "sphere"])
+                        choices=["pinned", "sphere", "ball"])
+    parser.add_argument("--self-collision", action="store_true",
+                        help="self-collision on in both programs; the table adds intersecting "
+                             "triangle pairs of each final sheet")
     parser.add_argument("--frames", type=int, default=48)
     parser.add_argument("--fps", type=int, default=24)
     parser.add_argument("--fabric", default="cotton")
@@ -194,11 +257,13 @@ def main():
     rows = []
     for scene_name in args.scenes:
         for n in args.sizes:
-            height = PINNED_HEIGHT if scene_name == "pinned" else 2 * SPHERE_RADIUS + DROP
+            radius = BALL_RADIUS if scene_name == "ball" else SPHERE_RADIUS
+            height = PINNED_HEIGHT if scene_name == "pinned" else 2 * radius + DROP
             vertices, quads = grid(n, height)
             pinned = [0, n] if scene_name == "pinned" else []
             duration = args.frames / args.fps
-            simulate = {"duration": duration, "stop_at_rest": False}
+            simulate = {"duration": duration, "stop_at_rest": False,
+                        "self_collision": args.self_collision}
             simulate.update(parse_settings(args.sketchdrape_set))
             scene = {
                 "format": "sketchdrape/1",
@@ -213,24 +278,27 @@ def main():
             if args.blender_mass == "matched":
                 blender_settings["mass"] = density * 1.0 / len(vertices)
             spec = {"vertices": vertices, "quads": quads, "pinned": pinned, "frames": args.frames,
-                    "fps": args.fps, "blender_settings": blender_settings}
+                    "fps": args.fps, "blender_settings": blender_settings,
+                    "self_collision": args.self_collision}
             with tempfile.TemporaryDirectory(dir=out) as tmp:
                 workdir = Path(tmp)
-                if scene_name == "sphere":
-                    body_v, body_f = icosphere(SPHERE_RADIUS, [0.0, SPHERE_RADIUS, 0.0], 4)
+                if scene_name in ("sphere", "ball"):
+                    body_v, body_f = icosphere(radius, [0.0, radius, 0.0], 4)
                     with open(workdir / "sphere.obj", "w") as f:
                         f.writelines(f"v {p[0]} {p[1]} {p[2]}\n" for p in body_v)
                         f.writelines(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in body_f)
-                    scene["body"] = {"mesh": str(workdir / "sphere.obj")}
+                    scene["body"] = {"mesh": str(workdir / "sphere.obj"), "scale": 1.0}
                     spec["body_vertices"], spec["body_faces"] = body_v, body_f
                 # The sheet's vertex order in sketchdrape's output: a run of one 0.1 ms step.
                 first = json.loads(json.dumps(scene))
-                first["simulate"] = {"duration": 1e-4, "time_step": 1e-4, "stop_at_rest": False}
+                first["simulate"] = {"duration": 1e-4, "time_step": 1e-4, "stop_at_rest": False,
+                                     "self_collision": False}
                 _, _, _, rest_obj = run_sketchdrape(args.binary, first, workdir, [])
                 mapping = reorder_to_grid(rest_obj, vertices)
                 report, sd_wall, sd_cpu, final_obj = run_sketchdrape(args.binary, scene, workdir,
                                                                      [])
                 sd_final = [final_obj[i] for i in mapping]
+                sd_triangles = read_obj_triangles(workdir / "sketchdrape" / "drape.obj")
                 blender, b_wall = run_blender(args.blender, args.blender_threads, spec, workdir)
             edges = grid_edges(quads)
             row = {
@@ -250,6 +318,17 @@ def main():
             # How far the sheet's centre of mass fell: both programs simulated the same thing.
             row["blender_drop_m"] = height - sum(p[1] for p in blender["positions"]) / len(vertices)
             row["sketchdrape_drop_m"] = height - sum(p[1] for p in sd_final) / len(vertices)
+            if args.self_collision:
+                # Each final sheet counted by the same test on the triangles its program
+                # simulated: Blender's quads split along their first diagonal (as its cloth
+                # tessellates a convex quad), sketchdrape's own 4-8 triangles; and sketchdrape's
+                # CGAL count of its mesh.
+                triangles = [t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))]
+                row["blender_intersections"] = count_intersections(blender["positions"], triangles)
+                row["sketchdrape_intersections"] = count_intersections(
+                    final_obj, sd_triangles)
+                row["sketchdrape_intersections_cgal"] = report["self_intersections_final"]
+                row["sketchdrape_self_collision_share"] = report["self_collision_share"]
             row["speedup"] = row["blender_s"] / row["sketchdrape_s"]
             row["cpu_speedup"] = row["blender_cpu_s"] / row["sketchdrape_process_cpu_s"]
             rows.append(row)
@@ -264,7 +343,7 @@ def main():
     blender_version = blender["program"] if rows else "?"
     meta = {"blender": blender_version, "blender_threads": args.blender_threads,
             "frames": args.frames, "fps": args.fps, "fabric": args.fabric,
-            "blender_set": args.blender_set, "blender_mass": args.blender_mass, "sketchdrape_set": args.sketchdrape_set,
+            "blender_set": args.blender_set, "self_collision": args.self_collision, "blender_mass": args.blender_mass, "sketchdrape_set": args.sketchdrape_set,
             "load_average_before": load_before, "load_average_after": load_after,
             "cores": os.cpu_count()}
     (out / "results.json").write_text(json.dumps({"meta": meta, "rows": rows}, indent=1))
@@ -285,6 +364,13 @@ def main():
                      f"{100 * r['blender_stretch_max']:.1f} % / "
                      f"{100 * r['sketchdrape_stretch_max']:.2f} % | {r['blender_drop_m']:.3f} / "
                      f"{r['sketchdrape_drop_m']:.3f} m |")
+    if args.self_collision:
+        lines += ["", "| scene | intersecting triangle pairs: Blender / sketchdrape (its CGAL "
+                  "count) | sketchdrape's self-collision share |", "|---|---|---|"]
+        for r in rows:
+            lines.append(f"| {r['scene']} | {r['blender_intersections']} / "
+                         f"{r['sketchdrape_intersections']} ({r['sketchdrape_intersections_cgal']}) "
+                         f"| {100 * r['sketchdrape_self_collision_share']:.0f} % |")
     (out / "results.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 

@@ -101,21 +101,19 @@ void ImplicitSolver::assemble(const ClothModel& model, const ForceSettings& forc
           product_.segment<3>(3 * t.vertices[k]) -= (s.stiffness * s.weights[k] * along) * s.normal;
       }
     }
-    // Pair springs: the blocks within each side (see PairSpring); the product term is exact.
+    // Pair springs: the blocks between neighbours in the mesh (each side's own, and across the
+    // pair where the two happen to be neighbours) go into matrix_; add_cross_blocks adds the
+    // others on a widened pattern. The product term is exact.
     for (const PairSpring& s : extra->pair_springs) {
       const Eigen::Matrix3d outer = s.normal * s.normal.transpose();
       const double scale = beta * beta * s.stiffness + beta * s.damping;
       for (int k = 0; k < 4; ++k)
         for (int l = 0; l < 4; ++l) {
-          // Same side: both weights of one sign (a face's corners, an edge's ends), always
-          // neighbours in the mesh. The kept blocks are the Jacobian's per-side blocks, each
-          // positive semi-definite, so A stays positive definite.
-          const double w = scale * s.weights[k] * s.weights[l];
-          if (!(w > 0.0)) continue;
           const int i = s.vertices[k];
           const int offset = k == l ? model.pattern.diagonal_offsets[i]
                                     : block_offset(matrix_, i, s.vertices[l]);
           if (offset < 0) continue;
+          const double w = scale * s.weights[k] * s.weights[l];
           for (int a = 0; a < 3; ++a)
             for (int b = 0; b < 3; ++b)
               values[block_value_index(matrix_, i, offset, a, b)] += w * outer(a, b);
@@ -128,7 +126,87 @@ void ImplicitSolver::assemble(const ClothModel& model, const ForceSettings& forc
     }
   }
   add_extra_force(model, extra, x, v);
+  add_cross_blocks(model, beta, extra);
   result.forces_seconds += seconds_since(start);
+}
+
+void ImplicitSolver::add_cross_blocks(const ClothModel& model, double beta,
+                                      const StepForces* extra) {
+  widened_ = false;
+  if (extra == nullptr || extra->pair_springs.empty()) return;
+  struct Block {
+    int row = 0;  // vertices
+    int column = 0;
+    Eigen::Matrix3d value;
+  };
+  std::vector<Block> blocks;
+  for (const PairSpring& s : extra->pair_springs) {
+    const Eigen::Matrix3d outer = s.normal * s.normal.transpose();
+    const double scale = beta * beta * s.stiffness + beta * s.damping;
+    for (int k = 0; k < 4; ++k)
+      for (int l = 0; l < 4; ++l) {
+        const int i = s.vertices[k], j = s.vertices[l];
+        if (k == l || i == j || block_offset(matrix_, i, j) >= 0) continue;
+        blocks.push_back({i, j, (scale * s.weights[k] * s.weights[l]) * outer});
+      }
+  }
+  if (blocks.empty()) return;
+  std::sort(blocks.begin(), blocks.end(), [](const Block& a, const Block& b) {
+    return a.row != b.row ? a.row < b.row : a.column < b.column;
+  });
+  // One block per (row, column): several springs can join the same two vertices.
+  std::size_t kept = 0;
+  for (std::size_t b = 1; b < blocks.size(); ++b) {
+    if (blocks[b].row == blocks[kept].row && blocks[b].column == blocks[kept].column)
+      blocks[kept].value += blocks[b].value;
+    else
+      blocks[++kept] = blocks[b];
+  }
+  blocks.resize(kept + 1);
+
+  // Merge each vertex's rows with its cross blocks' columns (both sorted). Every row of a vertex
+  // holds the same block columns, so the block structure (and offset(i, j)) stays per vertex.
+  const int n = model.vertex_count;
+  const int* outer = matrix_.outerIndexPtr();
+  const int* inner = matrix_.innerIndexPtr();
+  const double* values = matrix_.valuePtr();
+  std::vector<int> new_outer(3 * static_cast<std::size_t>(n) + 1, 0);
+  std::vector<int> new_inner;
+  std::vector<double> new_values;
+  new_inner.reserve(static_cast<std::size_t>(matrix_.nonZeros()) + 9 * blocks.size());
+  new_values.reserve(new_inner.capacity());
+  coupled_diagonal_.assign(static_cast<std::size_t>(n), -1);
+  std::size_t first = 0;
+  for (int i = 0; i < n; ++i) {
+    std::size_t last = first;
+    while (last < blocks.size() && blocks[last].row == i) ++last;
+    for (int a = 0; a < 3; ++a) {
+      const int r = 3 * i + a;
+      const int row_begin = static_cast<int>(new_inner.size());
+      int p = outer[r];
+      std::size_t q = first;
+      while (p < outer[r + 1] || q < last) {
+        if (q == last || (p < outer[r + 1] && inner[p] < 3 * blocks[q].column)) {
+          if (a == 0 && inner[p] == 3 * i)
+            coupled_diagonal_[i] = static_cast<int>(new_inner.size()) - row_begin;
+          new_inner.push_back(inner[p]);
+          new_values.push_back(values[p]);
+          ++p;
+        } else {
+          for (int b = 0; b < 3; ++b) {
+            new_inner.push_back(3 * blocks[q].column + b);
+            new_values.push_back(blocks[q].value(a, b));
+          }
+          ++q;
+        }
+      }
+      new_outer[r + 1] = static_cast<int>(new_inner.size());
+    }
+    first = last;
+  }
+  coupled_ = Eigen::Map<const SparseMatrixR>(3 * n, 3 * n, static_cast<int>(new_inner.size()),
+                                             new_outer.data(), new_inner.data(), new_values.data());
+  widened_ = true;
 }
 
 bool ImplicitSolver::linear_solve(const ClothModel& model, const ConstraintFilter& filter,
@@ -138,16 +216,16 @@ bool ImplicitSolver::linear_solve(const ClothModel& model, const ConstraintFilte
   LinearSolveStats stats;
   if (settings.solver == LinearSolverKind::cholmod) {
     if (refactor) {
-      cholmod_failed_ = !cholmod_.factorize(matrix_, filter);
+      cholmod_failed_ = !cholmod_.factorize(system(), filter);
       if (cholmod_failed_) ++result.cholmod_failures;
     }
     if (!cholmod_failed_) {
-      stats = cholmod_.solve(matrix_, filter, rhs_, z_, step_);
+      stats = cholmod_.solve(system(), filter, rhs_, z_, step_);
     } else {
       // The system is not positive definite for CHOLMOD: PCG on the same system, its
       // preconditioner built afresh. A zero step must never pass for a solution.
       pcg_.set_preconditioner(settings.pcg_preconditioner);
-      stats = pcg_.solve(matrix_, model.pattern.diagonal_offsets, filter, rhs_, z_, step_,
+      stats = pcg_.solve(system(), system_diagonal(model), filter, rhs_, z_, step_,
                          settings.pcg_tolerance, settings.pcg_max_iterations, refactor);
       if (!stats.converged || !step_.allFinite()) {
         result.linear_failure =
@@ -158,7 +236,7 @@ bool ImplicitSolver::linear_solve(const ClothModel& model, const ConstraintFilte
     }
   } else {
     pcg_.set_preconditioner(settings.pcg_preconditioner);
-    stats = pcg_.solve(matrix_, model.pattern.diagonal_offsets, filter, rhs_, z_, step_,
+    stats = pcg_.solve(system(), system_diagonal(model), filter, rhs_, z_, step_,
                        settings.pcg_tolerance, settings.pcg_max_iterations, refactor);
   }
   ++result.linear_solves;
@@ -176,7 +254,7 @@ void ImplicitSolver::record_constraint_impulse(const ConstraintFilter& filter,
   }
   // A s − b is zero in the free directions (up to the solver's tolerance) and, in the
   // constrained ones, the impulse the constraint had to add: keep only that part.
-  Eigen::VectorXd residual = matrix_ * step_ - rhs_;
+  Eigen::VectorXd residual = system() * step_ - rhs_;
   Eigen::VectorXd free_part = residual;
   filter.apply(free_part);
   result.constraint_impulse = residual - free_part;

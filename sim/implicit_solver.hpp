@@ -87,10 +87,13 @@ inline double along_spring_normal(const PointSpring& spring, const std::array<in
 // with s = n·Σ_k w_k x_k the separation of the pair (weights signed: + on the first element,
 // − on the second) and ṡ = n·Σ_k w_k v_k, the force
 //     F = stiffness (target − s) − damping ṡ,
-// of which vertex k takes w_k F n. The two elements are not neighbours in the mesh, so the
-// system matrix (whose pattern is the mesh's) takes only the blocks of its Jacobian within each
-// side, (β² k + β c) w_k w_l n nᵀ for k, l on the same element: each side responds implicitly as
-// if the other held still over the step; the coupling between the sides is explicit.
+// of which vertex k takes w_k F n. The whole Jacobian goes into the system matrix: block (k, l)
+// gains (β² k + β c) w_k w_l n nᵀ, a rank-one positive semi-definite term. The two elements are
+// not neighbours in the mesh, so the blocks across the pair (k, l on different elements) are
+// outside the mesh's pattern: the solver widens the pattern by them for the steps that have
+// such springs (CHOLMOD then analyses the widened pattern again). With only the blocks within
+// each side, the coupling across a pair was explicit and a compressed stack of layers gained
+// energy (docs/collision.md).
 struct PairSpring {
   std::array<int, 4> vertices{};
   Eigen::Vector4d weights = Eigen::Vector4d::Zero();
@@ -160,8 +163,9 @@ class ImplicitSolver {
                             const Eigen::VectorXd& v_lin, const NewtonSettings& settings,
                             const StepForces* extra = nullptr);
 
-  // The system matrix of the last assembly (for tests and benchmarks).
-  const SparseMatrixR& matrix() const { return matrix_; }
+  // The system matrix of the last assembly (for tests and benchmarks): the mesh's pattern,
+  // widened by the pair springs' blocks across their pairs when a step has them.
+  const SparseMatrixR& matrix() const { return widened_ ? coupled_ : matrix_; }
   const CholmodSolver& cholmod() const { return cholmod_; }
 
  private:
@@ -171,11 +175,22 @@ class ImplicitSolver {
   // force_ += the drags' and springs' forces at (x, v).
   void add_extra_force(const ClothModel& model, const StepForces* extra, const Eigen::VectorXd& x,
                        const Eigen::VectorXd& v);
+  // The pair springs' blocks between vertices that are not neighbours in the mesh: coupled_
+  // becomes matrix_ on the widened pattern plus those blocks (widened_ set); else widened_ is
+  // cleared and the solve uses matrix_.
+  void add_cross_blocks(const ClothModel& model, double beta, const StepForces* extra);
+  const SparseMatrixR& system() const { return widened_ ? coupled_ : matrix_; }
+  const std::vector<int>& system_diagonal(const ClothModel& model) const {
+    return widened_ ? coupled_diagonal_ : model.pattern.diagonal_offsets;
+  }
   bool linear_solve(const ClothModel& model, const ConstraintFilter& filter,
                     const NewtonSettings& settings, bool refactor, ImplicitSolveResult& result);
   void record_constraint_impulse(const ConstraintFilter& filter, ImplicitSolveResult& result);
 
   SparseMatrixR matrix_;
+  SparseMatrixR coupled_;              // matrix_ widened by the cross-pair blocks
+  std::vector<int> coupled_diagonal_;  // offset(i, i) in coupled_, #V
+  bool widened_ = false;
   PcgSolver pcg_;
   CholmodSolver cholmod_;
   bool cholmod_failed_ = false;  // the last factorisation failed: solves go to PCG until the next

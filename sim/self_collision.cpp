@@ -327,7 +327,7 @@ template <class LeafTest>
 void SelfCollider::self_test(int index, const Eigen::VectorXd& x0, const Eigen::VectorXd& x1,
                              LeafTest& leaf, SelfQueryStats& stats) {
   const Node& node = nodes_[index];
-  if (node.left < 0) return;
+  if (node.left < 0 || (!dirty_.empty() && dirty_[index] == 0)) return;
   if (culling_ && region_is_safe(node, x0, x1)) {
     stats.culled_triangles += node.end - node.begin;
     return;
@@ -339,6 +339,7 @@ void SelfCollider::self_test(int index, const Eigen::VectorXd& x0, const Eigen::
 
 template <class LeafTest>
 void SelfCollider::pair_test(int a, int b, LeafTest& leaf, SelfQueryStats& stats) {
+  if (!dirty_.empty() && dirty_[a] == 0 && dirty_[b] == 0) return;
   ++stats.node_pairs;
   const Node& na = nodes_[a];
   const Node& nb = nodes_[b];
@@ -436,7 +437,8 @@ std::vector<SelfPair> SelfCollider::find_proximities(const Eigen::VectorXd& x, d
 
 std::vector<SelfPair> SelfCollider::find_collisions(const Eigen::VectorXd& x0,
                                                     const Eigen::VectorXd& x1, double tolerance,
-                                                    SelfQueryStats* stats) {
+                                                    SelfQueryStats* stats,
+                                                    const std::vector<unsigned char>* moved) {
   SelfQueryStats local;
   SelfQueryStats& s = stats != nullptr ? *stats : local;
   s = SelfQueryStats{};
@@ -444,6 +446,19 @@ std::vector<SelfPair> SelfCollider::find_collisions(const Eigen::VectorXd& x0,
   std::vector<SelfPair> pairs;
   if (nodes_.empty()) return pairs;
   refit(x0, x1, 0.5 * tolerance);
+  if (moved != nullptr) {
+    // Every element pair with a moved vertex is tested at a triangle pair holding a moved
+    // triangle (an element's owner holds the element), so pruning node pairs with none is exact.
+    dirty_.assign(nodes_.size(), 0);
+    for (int i = static_cast<int>(nodes_.size()) - 1; i >= 0; --i) {
+      const Node& node = nodes_[i];
+      if (node.left < 0) {
+        for (int v : triangles_[order_[node.begin]]) dirty_[i] |= (*moved)[v];
+      } else {
+        dirty_[i] = dirty_[node.left] | dirty_[node.right];
+      }
+    }
+  }
   const auto gather = [&](const std::array<int, 4>& v, const Eigen::VectorXd& x) {
     return std::array<Eigen::Vector3d, 4>{row(x, v[0]), row(x, v[1]), row(x, v[2]), row(x, v[3])};
   };
@@ -495,6 +510,7 @@ std::vector<SelfPair> SelfCollider::find_collisions(const Eigen::VectorXd& x0,
     }
   };
   self_test(0, x0, x1, leaf, s);
+  dirty_.clear();
   s.pairs_found = static_cast<int>(pairs.size());
   return pairs;
 }

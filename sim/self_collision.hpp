@@ -75,8 +75,11 @@ class SelfCollider {
   // Pairs that come within `tolerance` (m) while the cloth moves linearly from x0 to x1, with the
   // time they first do; a pair already within the tolerance at t = 0 and not approaching is not
   // a collision.
+  // With `moved` (#V flags), only the pairs with at least one flagged vertex: the others are as
+  // the last query found them when only those vertices changed (the fail-safe's later rounds).
   std::vector<SelfPair> find_collisions(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1,
-                                        double tolerance, SelfQueryStats* stats = nullptr);
+                                        double tolerance, SelfQueryStats* stats = nullptr,
+                                        const std::vector<unsigned char>* moved = nullptr);
   // Pairs of triangles that intersect at x (3n) other than along the edge or vertex they share:
   // an edge of one crosses the other (orientation signs; touching counts). A cloth that starts
   // this way cannot be untangled by the continuous tests, which keep whatever it starts with.
@@ -112,6 +115,9 @@ class SelfCollider {
   std::vector<int> order_;     // triangles in tree order
   std::vector<int> position_;  // inverse of order_
   std::vector<Node> nodes_;    // preorder: children after their parent
+  // A query restricted to moved vertices: per node, whether one of its triangles has one; empty
+  // for a full query.
+  std::vector<unsigned char> dirty_;
   bool culling_ = true;
 };
 

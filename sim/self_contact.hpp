@@ -3,7 +3,8 @@
 // step from x0 to x1:
 //
 //  1. Repulsion inside the implicit solve: every vertex-face and edge-edge pair closer than
-//     `thickness` at the step's start becomes a PairSpring pushing the pair apart to `thickness`,
+//     `thickness` at the step's start and not already separating becomes a PairSpring pushing it
+//     a tenth of the way to `thickness` (a bounded repulsion, as Bridson et al. 2002 §7.2),
 //     critically damped, its stiffness m ω² sized from the pair's effective mass m = 1/Σ w_k²/m_k
 //     (as the body's piercing springs are), so its strength follows the cloth's resolution.
 //  2. Friction between the layers after the solve (Bridson et al. 2002 §7.2): each spring's normal
@@ -17,7 +18,8 @@
 //     collides. A cloth that starts the step free of intersections ends it free of them.
 //
 // Pinned vertices are immovable (infinite mass) in the impulses; a zone holding a pinned vertex
-// moves with the pins' mean displacement.
+// moves with the pins' mean displacement. Vertices the body's contact holds are heavy, so that
+// cloth pinched between cloth and body gives way on its free side rather than into the body.
 
 #include <Eigen/Core>
 #include <vector>
@@ -27,6 +29,9 @@
 #include "sim/self_collision.hpp"
 
 namespace sd::sim {
+
+// resolve()'s mark of a vertex the body's contact constrains this step.
+constexpr unsigned char kHeldByBody = 2;
 
 struct SelfContactSettings {
   bool enabled = false;
@@ -74,11 +79,16 @@ class SelfContactResponse {
                const std::vector<unsigned char>& pinned, int* found = nullptr,
                int* remaining = nullptr);
 
-  // Step 1: springs of the pairs closer than the thickness at `start` (3n) into extra.
+  // Step 1: springs of the pairs closer than the thickness at `start` (3n) into extra, each
+  // pushing its pair a tenth of the way to the thickness; with `velocity` (3n, the step's start)
+  // none for pairs already separating faster than a fifth of that push over the step (beta, s).
   // pinned: per vertex, 1 when the step's filter pins it.
   void add_springs(const Eigen::VectorXd& start, const Eigen::VectorXd& mass,
-                   const std::vector<unsigned char>& pinned, StepForces& extra);
+                   const std::vector<unsigned char>& pinned, StepForces& extra,
+                   const Eigen::VectorXd* velocity = nullptr, double beta = 0.0);
   // Steps 2 and 3 on the solve's result: x1 (3n) and v1 change together (v1 += Δx1 / beta).
+  // pinned: per vertex, 0 free, kHeldByBody for a vertex the body's contact constrains (it
+  // weighs a thousand times its mass in the impulses and moves with its zone), else pinned.
   void resolve(const Eigen::VectorXd& x0, Eigen::VectorXd& x1, Eigen::VectorXd& v1, double beta,
                const Eigen::VectorXd& mass, const std::vector<unsigned char>& pinned,
                const StepForces& extra);

@@ -274,7 +274,7 @@ Simulation::Attempt Simulation::attempt(double h) {
     pinned.assign(static_cast<std::size_t>(model_.vertex_count), 0);
     for (int i = 0; i < model_.vertex_count; ++i) pinned[i] = filter_.is_pinned(i);
     self->add_springs(y.size() == x_.size() ? Eigen::VectorXd(x_ + y) : x_, model_.mass, pinned,
-                      contact_forces_);
+                      contact_forces_, &v_, beta);
   }
   for (;;) {
     if (contact != nullptr) {
@@ -316,8 +316,13 @@ Simulation::Attempt Simulation::attempt(double h) {
   // accepted state, before the body's position correction, so that a correction pushing a
   // vertex out of the body cannot carry it through a layer lying on it unseen.
   if (self != nullptr && result.solve.linear_converged && result.x.allFinite() &&
-      result.v.allFinite())
+      result.v.allFinite()) {
+    // In the fail-safe, vertices the body's contact constrains are heavy: cloth pinched between
+    // cloth and body gives way on its free side rather than into the body.
+    for (int i = 0; i < model_.vertex_count; ++i)
+      if (pinned[i] == 0 && !filter_.is_free(i)) pinned[i] = kHeldByBody;
     self->resolve(x_, result.x, result.v, beta, model_.mass, pinned, contact_forces_);
+  }
 
   std::ostringstream why;
   // Where a failing attempt broke: its first non-finite vertex, else its fastest one.
