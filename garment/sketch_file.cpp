@@ -637,7 +637,7 @@ void parse_adaptive(const Reader& r, const json& a, SimulateSpec& sim) {
 void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
   const std::string path = "/simulate";
   r.require_object(j, path, "simulate");
-  r.check_keys(j, path, {"duration", "adaptive", "time_step", "integrator", "solver",
+  r.check_keys(j, path, {"duration", "adaptive", "time_step", "integrator", "solver", "bending",
                          "stop_at_rest", "gravity", "pin_above", "check_body_vertices", "rest",
                          "self_collision"});
   if (j.contains("pin_above")) sim.pin_above = r.number(j["pin_above"], path + "/pin_above");
@@ -670,6 +670,13 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
     if (sim.solver != "pcg" && sim.solver != "cholmod")
       r.fail(path + "/solver",
              fmt::format("unknown solver '{}'; use \"pcg\" or \"cholmod\"", sim.solver));
+  }
+  if (j.contains("bending")) {
+    sim.bending = r.text(j["bending"], path + "/bending");
+    if (sim.bending != "hinges" && sim.bending != "quadratic")
+      r.fail(path + "/bending",
+             fmt::format("unknown bending model '{}'; use \"hinges\" or \"quadratic\"",
+                         sim.bending));
   }
   if (j.contains("stop_at_rest")) sim.stop_at_rest = r.boolean(j["stop_at_rest"], path + "/stop_at_rest");
   if (j.contains("gravity")) {

@@ -138,6 +138,10 @@ struct SimulateSpec {
   double time_step = 1.0 / 60.0;           // seconds, the largest step
   std::string integrator = "implicit-euler";  // "implicit-euler" | "bdf2"
   std::string solver = "cholmod";          // "pcg" | "cholmod"
+  // "hinges" | "quadratic": the discrete bending energy (docs/simulator.md, "Bending on any
+  // mesh"). Hinges by default until the quadratic model is as fast and every design rests with
+  // it (docs/fabrics.md).
+  std::string bending = "hinges";
   bool stop_at_rest = true;
   Eigen::Vector3d gravity{0.0, -9.81, 0.0};
   std::optional<double> pin_above;         // metres: garment vertices designed at y >= this are pinned

@@ -16,6 +16,16 @@
 #include "sim/element_forces.hpp"
 
 namespace sd::sim {
+
+std::string_view bend_model_name(BendModel model) {
+  return model == BendModel::hinges ? "hinges" : "quadratic";
+}
+
+std::optional<BendModel> parse_bend_model(std::string_view name) {
+  if (name == "quadratic") return BendModel::quadratic;
+  if (name == "hinges") return BendModel::hinges;
+  return std::nullopt;
+}
 namespace {
 
 using Eigen::Vector3d;

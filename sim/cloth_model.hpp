@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <array>
 #include <stdexcept>
+#include <optional>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
@@ -62,6 +64,10 @@ enum class BendModel {
   // below: on the 4-8 mesh too soft and orientation-dependent.
   hinges,
 };
+
+// The bend model's name in sketch files ("quadratic", "hinges") and the model from it.
+std::string_view bend_model_name(BendModel model);
+std::optional<BendModel> parse_bend_model(std::string_view name);
 
 struct ClothModelOptions {
   BendRestShape bend_rest = BendRestShape::designed;

@@ -467,6 +467,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   out["body"] = scene.body ? nlohmann::json(scene.body->raw.source) : nlohmann::json(nullptr);
   out["pinned_vertices"] = scene.pinned.size();
   out["meshing"] = meshing_json(scene);
+  out["bending"] = std::string(sim::bend_model_name(scene.bend_model));
   out["rest_shape"] = flat_rest ? (scene.bend_rest_flat ? "flat" : "flat and shaped") : "shaped";
   out["strain"] = strain;  // per group, against the rest shape (the pattern when flat)
   if (scene.garment && sketch.output.pattern) {

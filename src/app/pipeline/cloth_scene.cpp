@@ -131,6 +131,7 @@ void build_sheet_scene(const garment::Sketch& sketch, ClothScene& scene) {
   scene.pinned.erase(std::unique(scene.pinned.begin(), scene.pinned.end()), scene.pinned.end());
   scene.fabric_name = sketch.fabric;
   scene.fabric = fabric_at(sketch, sketch.fabric, "/fabric");
+  scene.bend_model = sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::hinges);
 }
 
 // "rest": "flat" (the file's or a panel's): the flattened pattern pieces become the rest shape.
@@ -206,6 +207,7 @@ void build_garment_scene(const garment::Sketch& sketch, ClothScene& scene) {
   // One fabric per simulation for now: the first panel's; others are reported if different.
   const garment::GarmentPanel& first = g.panels.front();
   scene.fabric_name = first.fabric;
+  scene.bend_model = sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::hinges);
   const garment::PanelSpec* first_spec = sketch.find_panel(first.id);
   scene.fabric = fabric_at(sketch, first.fabric,
                            first_spec ? first_spec->json_path + "/fabric" : "/fabric");
@@ -282,6 +284,7 @@ void build_imported_scene(const garment::Sketch& sketch, ClothScene& scene) {
   scene.group_names = {"garment"};
   scene.fabric_name = sketch.fabric;
   scene.fabric = fabric_at(sketch, sketch.fabric, "/fabric");
+  scene.bend_model = sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::hinges);
   pin_above(sketch, scene);
   scene.mesh48 = std::move(m48);
 }
@@ -312,6 +315,7 @@ sim::SimulationSettings simulation_settings(const garment::Sketch& sketch) {
 
 sim::ClothModel build_scene_model(const ClothScene& scene) {
   sim::ClothModelOptions options;
+  options.bend_model = scene.bend_model;
   if (scene.bend_rest_flat) options.bend_rest = sim::BendRestShape::flat;
   sim::ClothModel model = sim::build_cloth_model(scene.input, scene.fabric, options);
   if (scene.face_ease.size() > 0) {
@@ -326,6 +330,7 @@ sim::ClothModel build_scene_model(const ClothScene& scene) {
 sim::AdaptiveMaterial scene_material(const ClothScene& scene) {
   sim::AdaptiveMaterial material;
   material.fabric = scene.fabric;
+  material.model_options.bend_model = scene.bend_model;
   if (scene.bend_rest_flat) material.model_options.bend_rest = sim::BendRestShape::flat;
   material.source_warp = scene.face_warp;
   material.up = scene.input.up;

@@ -53,6 +53,7 @@ struct ClothScene {
   // panels, the drawn triangle for shaped ones) and the hinges rest flat when all panels are flat.
   std::optional<garment::FlatPattern> flat_pattern;
   bool bend_rest_flat = false;
+  sim::BendModel bend_model = sim::BendModel::hinges;  // simulate.bending
   double flattening_ms = 0;
 };
 
