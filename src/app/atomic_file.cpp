@@ -158,6 +158,24 @@ StagedOutputs::~StagedOutputs() {
 
 void StagedOutputs::stage(const std::filesystem::path& path, std::string_view bytes) {
   const std::filesystem::path dir = path.parent_path().empty() ? "." : path.parent_path();
+  // What the user can fix (exit code 2), found before any output is renamed into place: a
+  // folder (or a device, a FIFO) where a file goes, a file where the output folder goes.
+  std::error_code status_ec;
+  for (auto d = dir; !d.empty() && d != d.parent_path(); d = d.parent_path()) {
+    const auto status = std::filesystem::status(d, status_ec);
+    if (!std::filesystem::exists(status)) continue;
+    if (!std::filesystem::is_directory(status))
+      throw std::invalid_argument("cannot write '" + path.string() + "': '" + d.string() +
+                                  "' is a file, not a folder; remove it or choose another "
+                                  "output folder (-o)");
+    break;
+  }
+  if (const auto status = std::filesystem::status(path, status_ec);
+      std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
+    throw std::invalid_argument(
+        "cannot write '" + path.string() + "': " +
+        (std::filesystem::is_directory(status) ? "a folder" : "something that is not a file") +
+        " of that name is in the way; remove it or choose another output folder (-o)");
   if (!std::filesystem::exists(dir)) {
     // Remember every level we create so an abandoned command leaves no empty folders.
     std::vector<std::filesystem::path> missing;

@@ -239,16 +239,18 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   if (options.max_time_s > 0) limits.max_time_s = options.max_time_s;
   // Refused before anything is built when the size is known from the file (a sheet), else once
   // the cloth is meshed.
-  if (const auto vertices = cloth_vertices_before_building(sketch))
-    check_run_fits(sketch, estimate_run(sketch, *vertices, options.frames_per_second), limits,
-                   options.frames_per_second);
+  if (const auto before = estimate_before_building(sketch, options.frames_per_second))
+    check_run_fits(sketch, *before, limits, options.frames_per_second);
   const ClothScene scene = build_cloth_scene(sketch);
   const RunEstimate estimate =
-      estimate_run(sketch, static_cast<double>(scene.start.rows()), options.frames_per_second);
+      estimate_run(sketch, scene.input.triangles, static_cast<int>(scene.start.rows()),
+                   options.frames_per_second);
   check_run_fits(sketch, estimate, limits, options.frames_per_second);
-  spdlog::debug("estimate: {:.0f} vertices, {:.2f} GB, at most {:.0f} steps ({:.0f} s), {:.0f} frames",
-                estimate.vertices, estimate.memory_bytes / 1e9, estimate.steps, estimate.seconds,
-                estimate.frames);
+  spdlog::debug(
+      "estimate: {:.0f} vertices, {:.2f} GB ({:.2f} GB the factor), at most {:.0f} steps ({:.0f} "
+      "s), {:.0f} frames",
+      estimate.vertices, estimate.memory_bytes / 1e9, estimate.factor_bytes / 1e9, estimate.steps,
+      estimate.seconds, estimate.frames);
   if (!limits.max_time_s && estimate.seconds > 3600)
     spdlog::warn("this drape may take up to about {:.1f} h ({:.0f} steps on {:.0f} vertices, by "
                  "the estimate); --max-time SECONDS stops it",
