@@ -1,5 +1,6 @@
 #include "src/app/atomic_file.hpp"
 
+#include <pthread.h>
 #include <signal.h>
 #include <unistd.h>
 
@@ -29,7 +30,17 @@ constexpr size_t kDirSlots = 64;
 std::array<std::atomic<char*>, kDirSlots> g_dir_slots{};
 std::once_flag g_handlers_installed;
 
+// The thread that stages (installs the handlers on its first stage()). A signal sent to the
+// process may be delivered to any thread that does not block it, such as a renderer's worker:
+// cleaning up there would race with the staging thread, which could create a temporary after
+// the loop below passed its slot. The signal is passed on to the staging thread instead.
+pthread_t g_staging_thread;
+
 extern "C" void remove_temporaries_and_reraise(int sig) {
+  if (!pthread_equal(pthread_self(), g_staging_thread)) {
+    pthread_kill(g_staging_thread, sig);
+    return;
+  }
   for (auto& slot : g_temp_slots)
     if (char* path = slot.load()) ::unlink(path);
   for (size_t i = kDirSlots; i-- > 0;)  // deepest folders were registered last
@@ -40,6 +51,7 @@ extern "C" void remove_temporaries_and_reraise(int sig) {
 
 void install_handlers() {
   std::call_once(g_handlers_installed, [] {
+    g_staging_thread = pthread_self();
     for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
       struct sigaction old {};
       sigaction(sig, nullptr, &old);
