@@ -229,6 +229,11 @@ nlohmann::json adaptive_steps_json(const std::vector<sim::AdaptiveStepRecord>& s
   return out;
 }
 
+// "1.2 GB", or "74 MB" below a gigabyte (where one decimal of GB says too little).
+std::string memory_text(double bytes) {
+  return bytes >= 1e9 ? fmt::format("{:.1f} GB", bytes / 1e9) : fmt::format("{:.0f} MB", bytes / 1e6);
+}
+
 void run_drape(const RunOptions& options, const GlobalOptions& global) {
   const auto start = Clock::now();
   const garment::Sketch sketch = garment::load_sketch(options.sketch);
@@ -271,10 +276,10 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   const auto on_step = [&](const sim::Simulation& s) {
     if (const double resident = resident_memory_bytes(); memory_budget > 0 && resident > memory_budget)
       throw RunLimitExceeded(fmt::format(
-          "stopped at t = {:.3f} s of the drape: it uses {:.1f} GB with {} vertices, more than "
-          "the {:.1f} GB it may take (--max-memory); limit adaptive detail with "
+          "stopped at t = {:.3f} s of the drape: it uses {} with {} vertices, more than "
+          "the {} it may take (--max-memory); limit adaptive detail with "
           "simulate.adaptive.max_vertices or max_level; nothing was written",
-          s.time(), resident / 1e9, s.model().vertex_count, memory_budget / 1e9));
+          s.time(), memory_text(resident), s.model().vertex_count, memory_text(memory_budget)));
     if (limits.max_time_s &&
         std::chrono::duration<double>(Clock::now() - start).count() > *limits.max_time_s)
       throw RunLimitExceeded(fmt::format(
