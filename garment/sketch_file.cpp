@@ -975,6 +975,20 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
   sketch.base_dir = base_dir;
   const Reader r(sketch);
 
+  // UTF-16 (what some Windows editors save): a byte-order mark, or ASCII text whose every
+  // other byte is zero.
+  const auto utf16 = [&] {
+    if (text.starts_with("\xff\xfe") || text.starts_with("\xfe\xff")) return true;
+    if (text.size() < 4) return false;
+    const size_t zero = text[0] == '\0' ? 0 : 1;  // big- or little-endian
+    for (size_t i = 0; i + 1 < std::min<size_t>(text.size(), 64); i += 2)
+      if (text[i + zero] != '\0' || text[i + 1 - zero] == '\0') return false;
+    return true;
+  };
+  if (utf16())
+    r.fail("",
+           "the file is UTF-16 text; this program reads sketch files in UTF-8 (save it as "
+           "UTF-8 in the editor)");
   // A NUL byte would end the text for the JSON reader, silently dropping the rest.
   if (const size_t nul = text.find('\0'); nul != std::string_view::npos)
     r.fail("", fmt::format("{}: the file holds a NUL byte (a zero byte); a sketch file is text: "

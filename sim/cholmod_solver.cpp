@@ -17,6 +17,9 @@ namespace {
 // give (CHOLMOD_GIVEN), which Eigen's analyzePattern cannot pass on.
 class OrderedCholmod : public Eigen::CholmodDecomposition<ColMatrix, Eigen::Upper> {
  public:
+  // The factor as the last analysis (or factorisation) left it; null before any.
+  const cholmod_factor* factor() const { return m_cholmodFactor; }
+
   void analyze_with_ordering(const ColMatrix& a, std::vector<int>& permutation) {
     if (m_cholmodFactor != nullptr) {
       cholmod_free_factor(&m_cholmodFactor, &this->cholmod());
@@ -96,6 +99,20 @@ void CholmodSolver::throw_if_out_of_memory(int rows, const char* stage) {
       stage, rows, common.lnz * 8.0 / 1e9, static_cast<double>(common.memory_inuse) / 1e9));
 }
 
+void CholmodSolver::record_analysed_size() {
+  const cholmod_common& common = factor_->llt.cholmod();
+  const cholmod_factor* factor = factor_->llt.factor();
+  analysed_size_ = {};
+  if (factor == nullptr) return;
+  analysed_size_.nonzeros = common.lnz;
+  analysed_size_.flops = common.fl;
+  analysed_size_.bytes =
+      factor->is_super
+          ? 8.0 * (static_cast<double>(factor->xsize) + static_cast<double>(factor->maxcsize)) +
+                static_cast<double>(sizeof(int)) * static_cast<double>(factor->ssize)
+          : (8.0 + sizeof(int)) * common.lnz;
+}
+
 bool CholmodSolver::factorize(const SparseMatrixR& a, const ConstraintFilter& filter) {
   const int rows = static_cast<int>(a.rows());
   const int* outer = a.outerIndexPtr();
@@ -144,8 +161,9 @@ bool CholmodSolver::factorize(const SparseMatrixR& a, const ConstraintFilter& fi
     else
       factor_->llt.analyze_with_ordering(filtered_, order);
     ++analyses_;
+    throw_if_out_of_memory(rows, "analysis");
+    record_analysed_size();
   }
-  throw_if_out_of_memory(rows, "analysis");
   factor_->llt.factorize(filtered_);
   ++factorizations_;
   throw_if_out_of_memory(rows, "factorisation");

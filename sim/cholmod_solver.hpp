@@ -13,6 +13,7 @@
 
 #include "sim/cloth_model.hpp"
 #include "sim/constraint_filter.hpp"
+#include "sim/factor_size.hpp"
 #include "sim/pcg_solver.hpp"
 
 namespace sd::sim {
@@ -43,6 +44,9 @@ class CholmodSolver {
                          const Eigen::VectorXd& b, const Eigen::VectorXd& z, Eigen::VectorXd& s);
 
   int symbolic_analyses() const { return analyses_; }
+  // The factor of the last symbolic analysis, as predict_factor_size() reports it (for tests
+  // and the memory estimate's check).
+  const FactorSize& analysed_size() const { return analysed_size_; }
   int numeric_factorizations() const { return factorizations_; }
   CholmodMethod method() const { return method_; }
 
@@ -52,6 +56,7 @@ class CholmodSolver {
   std::vector<int> block_ordering(const int* outer, const int* inner, int rows);
   // Throws CholmodOutOfMemoryError when CHOLMOD's last call ran out of memory.
   void throw_if_out_of_memory(int rows, const char* stage);
+  void record_analysed_size();
 
   struct Factor;
   CholmodMethod method_;
@@ -62,6 +67,7 @@ class CholmodSolver {
   bool factorized_ = false;
   int analyses_ = 0;
   int factorizations_ = 0;
+  FactorSize analysed_size_;
 };
 
 }  // namespace sd::sim

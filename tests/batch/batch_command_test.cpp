@@ -644,6 +644,51 @@ TEST(BatchFaults, SecondBatchOnTheSameFolderRefuses) {
   EXPECT_EQ(read_json(out / "batch.json")["counts"]["reused"], 3);
 }
 
+// Shards of one folder with different counts (or a whole batch beside a shard) have overlapping
+// slices: while shard 1/2 runs, 1/3 and an unsharded batch refuse with a sentence naming the
+// running one and the count to use; 2/2 shares the folder; all is done in the end.
+TEST(BatchFaults, ShardsOfAnotherCountOnTheSameFolderRefuse) {
+  const fs::path dir = fresh_batch_dir("shard-counts");
+  const fs::path manifest = wardrobe(dir, {"jersey", "denim"});  // 6 jobs, 3 per shard of 2
+  const fs::path out = dir / "out";
+  const pid_t first = start_in_new_group({"batch", manifest.string(), "-o", out.string(), "--stage",
+                                          "mesh", "-j", "1", "--shard", "1/2"},
+                                         dir / "first.log");
+  bool started = false;
+  for (int i = 0; i < 1200 && !started; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(25));
+    std::error_code ec;
+    for (const auto& d : fs::directory_iterator(out / "jobs", ec))
+      started = started || fs::exists(d.path() / "log.txt");
+  }
+  ASSERT_TRUE(started) << read_text(dir / "first.log");
+  const std::string batch =
+      "batch " + shell_quoted(manifest) + " -o " + shell_quoted(out) + " --stage mesh -j 1";
+  const CommandResult thirds = run_sketchdrape(batch + " --shard 1/3");
+  EXPECT_EQ(thirds.exit_code, 1) << thirds.output;
+  EXPECT_NE(thirds.output.find("a batch in 2 shards is writing into"), std::string::npos)
+      << thirds.output;
+  EXPECT_NE(thirds.output.find("process " + std::to_string(first)), std::string::npos)
+      << thirds.output;
+  EXPECT_NE(thirds.output.find("--shard I/2"), std::string::npos) << thirds.output;
+  const CommandResult whole = run_sketchdrape(batch);
+  EXPECT_EQ(whole.exit_code, 1) << whole.output;
+  EXPECT_NE(whole.output.find("a batch in 2 shards"), std::string::npos) << whole.output;
+  // The other shard of the same count runs beside it.
+  const CommandResult second = run_sketchdrape(batch + " --shard 2/2");
+  EXPECT_EQ(second.exit_code, 0) << second.output;
+  int status = 0;
+  waitpid(first, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status)) << read_text(dir / "first.log");
+  EXPECT_EQ(WEXITSTATUS(status), 0) << read_text(dir / "first.log");
+  // Once both have ended, any count may run on the folder: everything is reused.
+  const CommandResult after = run_sketchdrape(batch + " --shard 1/3");
+  EXPECT_EQ(after.exit_code, 0) << after.output;
+  const CommandResult collected = run_sketchdrape("batch --collect " + shell_quoted(out));
+  EXPECT_EQ(collected.exit_code, 0) << collected.output;
+  EXPECT_EQ(read_json(out / "batch.json")["counts"]["done"], 6);
+}
+
 TEST(ContactSheet, LoadsInHeadlessChromium) {
   const char* browser = "/usr/bin/chromium";
   if (!fs::exists(browser))

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
+#include <vector>
 
 #include "tests/cli/run_command.hpp"
 #include "tests/garment/bad_cases.hpp"
@@ -210,6 +211,27 @@ TEST(HostileInput, WorkThatDoesNotFitIsRefusedWithWhatWould) {
   EXPECT_EQ(big.exit_code, 2) << big.output;
   EXPECT_NE(big.output.find("/sheet/resolution: "), std::string::npos) << big.output;
   EXPECT_NE(big.output.find("quads would fit"), std::string::npos) << big.output;
+  // The factor's size is CHOLMOD's symbolic analysis of this grid (12.2 GB), not a fit.
+  EXPECT_NE(big.output.find("needs about 18.1 GB to simulate (12.2 GB of it the solver's factor)"),
+            std::string::npos)
+      << big.output;
+
+  // A 128 x 128 sheet: 67 MB + 16,641 vertices x 5.8 kB + its analysed factor (103 MB) = 267 MB:
+  // refused under 200M, and drapes under 1G.
+  write(dir / "mid-sheet.json", R"({"sheet": {"size": [1, 1], "resolution": [128, 128],
+    "pins": ["top"]}, "simulate": {"duration": 0.01}, "output": {"images": []}})");
+  const CommandResult tight = run_sketchdrape("run " + (dir / "mid-sheet.json").string() +
+                                              " --max-memory 200M -o " + (dir / "out").string());
+  EXPECT_EQ(tight.exit_code, 2) << tight.output;
+  EXPECT_NE(tight.output.find("needs about 0.3 GB to simulate (0.1 GB of it the solver's factor), "
+                              "more than the 0.2 GB of --max-memory"),
+            std::string::npos)
+      << tight.output;
+  const CommandResult fits = run_sketchdrape("run " + (dir / "mid-sheet.json").string() +
+                                             " --max-memory 1G -o " + (dir / "out").string());
+  EXPECT_EQ(fits.exit_code, 0) << fits.output;
+  EXPECT_TRUE(fs::exists(dir / "out" / "report.json"));
+  fs::remove_all(dir / "out");
 
   // 1000 pictures per second (the most --frames takes) over 20 s: 20,001 pictures.
   write(dir / "frames.json", R"({"sheet": {"size": [1, 1], "resolution": [8, 8]},
@@ -235,6 +257,51 @@ TEST(HostileInput, WorkThatDoesNotFitIsRefusedWithWhatWould) {
   EXPECT_EQ(stopped.exit_code, 1) << stopped.output;
   EXPECT_NE(stopped.output.find("--max-time 0.5 s passed"), std::string::npos) << stopped.output;
   EXPECT_FALSE(fs::exists(dir / "out" / "report.json"));
+  fs::remove_all(dir);
+}
+
+// The budget is also checked while the drape runs (adaptive detail can grow the cloth past the
+// estimate). An 8 x 8 sheet is estimated at 67.5 MB (the process before any cloth, 81 vertices,
+// its factor), while the process holds over 70 MB once its libraries are loaded (73.5 MB peak
+// measured): under --max-memory 68M the estimate passes and the first step stops the run.
+TEST(HostileInput, MemoryBudgetIsCheckedWhileDraping) {
+  const fs::path dir = fresh_dir("budget-while-draping");
+  write(dir / "tiny.json", R"({"sheet": {"size": [1, 1], "resolution": [8, 8], "pins": ["top"]},
+    "simulate": {"duration": 0.05}, "output": {"images": []}})");
+  const CommandResult r = run_sketchdrape("run " + (dir / "tiny.json").string() +
+                                          " --max-memory 68M -o " + (dir / "out").string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("stopped at t = "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("with 81 vertices, more than the 68 MB it may take (--max-memory)"),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+  fs::remove_all(dir);
+}
+
+// An output whose name is taken by a folder (or whose output folder is a file) is refused with
+// exit code 2 before any output is renamed into place: no garment.obj without its picture.
+TEST(HostileInput, OutputPathsInTheWayLeaveNothing) {
+  const fs::path dir = fresh_dir("in-the-way");
+  write(dir / "sketch.json",
+        square("", ",\n  \"output\": {\"images\": [{\"view\": \"front\", \"size\": [64, 96]}]}"));
+  fs::create_directories(dir / "out" / "garment-front.png");
+  const CommandResult folder =
+      run_sketchdrape("mesh " + (dir / "sketch.json").string() + " -o " + (dir / "out").string());
+  EXPECT_EQ(folder.exit_code, 2) << folder.output;
+  EXPECT_NE(folder.output.find("garment-front.png': a folder of that name is in the way"),
+            std::string::npos)
+      << folder.output;
+  std::vector<std::string> left;
+  for (const auto& entry : fs::directory_iterator(dir / "out"))
+    left.push_back(entry.path().filename().string());
+  EXPECT_EQ(left, std::vector<std::string>{"garment-front.png"});
+
+  write(dir / "a-file", "");
+  const CommandResult file = run_sketchdrape("mesh " + (dir / "sketch.json").string() + " -o " +
+                                             (dir / "a-file" / "sub").string());
+  EXPECT_EQ(file.exit_code, 2) << file.output;
+  EXPECT_NE(file.output.find("a-file' is a file, not a folder"), std::string::npos) << file.output;
   fs::remove_all(dir);
 }
 

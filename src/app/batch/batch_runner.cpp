@@ -128,45 +128,119 @@ std::vector<std::string> child_environment() {
   return env;
 }
 
-// An exclusive lock on the output folder (or on one shard of it) for the whole batch: a second
-// batch on the same folder refuses instead of running the same jobs at the same time. flock is
+// The locks of a batch on its output folder, held for the whole batch: a second batch on the
+// same folder refuses instead of running the same jobs at the same time. Each batch holds
+//   .batch-lock (unsharded) or .batch-lock-shard-I-of-N  exclusive: one process per slice
+//   .batch-lock-count-N (N = 1 unsharded)                  shared: the shards of one count
+// and, while it starts, tests that no .batch-lock-count-M of another count is held: shards of
+// different counts (or a whole batch and a shard) have overlapping slices and would run the
+// same jobs at once. The test and the shared lock are made under .batch-lock-gate (exclusive,
+// held for milliseconds), so two batches that start together cannot both pass it. flock is
 // released by the kernel when the process ends, however it ends; O_CLOEXEC keeps the children
 // from inheriting it.
 class FolderLock {
  public:
   FolderLock(const std::filesystem::path& out, const std::optional<std::pair<int, int>>& shard) {
-    const std::string name =
-        shard ? fmt::format(".batch-lock-shard-{}-of-{}", shard->first, shard->second)
-              : std::string(".batch-lock");
-    const std::filesystem::path path = out / name;
-    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (fd_ < 0)
+    const int count = shard ? shard->second : 1;
+    const std::string mine =
+        shard ? fmt::format(" as shard {}/{}", shard->first, shard->second) : std::string();
+    // --shard 1/1 is the whole batch: the same lock.
+    slice_fd_ = open_lock(
+        out / (count > 1 ? fmt::format(".batch-lock-shard-{}-of-{}", shard->first, shard->second)
+                         : std::string(".batch-lock")));
+    if (::flock(slice_fd_, LOCK_EX | LOCK_NB) != 0) {
+      const std::string holder = lock_holder(slice_fd_);
+      close_all();
       throw std::runtime_error(
-          fmt::format("cannot open the lock '{}': {}", path.string(), std::strerror(errno)));
-    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
-      char text[32] = {};
-      const ssize_t n = ::pread(fd_, text, sizeof text - 1, 0);
-      const std::string holder = n > 0 ? std::string(text, static_cast<size_t>(n)) : "?";
-      ::close(fd_);
-      throw std::runtime_error(fmt::format(
-          "another batch (process {}) is writing into '{}'{}; wait until it ends, or give this "
-          "one another -o folder",
-          holder.substr(0, holder.find('\n')), out.string(),
-          shard ? fmt::format(" as shard {}/{}", shard->first, shard->second) : ""));
+          fmt::format("another batch (process {}) is writing into '{}'{}; wait until it ends, or "
+                      "give this one another -o folder",
+                      holder, out.string(), mine));
     }
     const std::string pid = std::to_string(::getpid()) + "\n";
-    if (::ftruncate(fd_, 0) == 0 && ::pwrite(fd_, pid.data(), pid.size(), 0) < 0) {
+    if (::ftruncate(slice_fd_, 0) == 0 && ::pwrite(slice_fd_, pid.data(), pid.size(), 0) < 0) {
       // The pid is only for the message of a second batch.
     }
+
+    const int gate = open_lock(out / ".batch-lock-gate");
+    while (::flock(gate, LOCK_EX) != 0 && errno == EINTR) {
+    }
+    std::error_code ec;
+    for (const auto& entry : std::filesystem::directory_iterator(out, ec)) {
+      const std::string name = entry.path().filename().string();
+      int other = 0;
+      if (std::sscanf(name.c_str(), ".batch-lock-count-%d", &other) != 1 || other == count)
+        continue;
+      const int fd = ::open(entry.path().c_str(), O_RDWR | O_CLOEXEC);
+      if (fd < 0) continue;
+      const bool held = ::flock(fd, LOCK_EX | LOCK_NB) != 0;  // a probe, released at close
+      ::close(fd);
+      if (!held) continue;
+      ::close(gate);
+      close_all();
+      const std::string running = other == 1 ? std::string("a whole batch (no --shard)")
+                                             : fmt::format("a batch in {} shards", other);
+      throw std::runtime_error(fmt::format(
+          "{} is writing into '{}' ({}); this one{} would run some of the same jobs at the same "
+          "time. Shards of one folder must all use the same count: wait until it ends, or use "
+          "--shard I/{}",
+          running, out.string(), holders_of(out, other),
+          shard ? mine : std::string(" (without --shard)"), other));
+    }
+    count_fd_ = open_lock(out / fmt::format(".batch-lock-count-{}", count));
+    while (::flock(count_fd_, LOCK_SH) != 0 && errno == EINTR) {
+    }
+    ::close(gate);
   }
-  ~FolderLock() {
-    if (fd_ >= 0) ::close(fd_);
-  }
+  ~FolderLock() { close_all(); }
   FolderLock(const FolderLock&) = delete;
   FolderLock& operator=(const FolderLock&) = delete;
 
  private:
-  int fd_ = -1;
+  static int open_lock(const std::filesystem::path& path) {
+    const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd < 0)
+      throw std::runtime_error(
+          fmt::format("cannot open the lock '{}': {}", path.string(), std::strerror(errno)));
+    return fd;
+  }
+  // The pid written in a lock file ("?" when there is none).
+  static std::string lock_holder(int fd) {
+    char text[32] = {};
+    const ssize_t n = ::pread(fd, text, sizeof text - 1, 0);
+    const std::string holder = n > 0 ? std::string(text, static_cast<size_t>(n)) : "?";
+    return holder.substr(0, holder.find('\n'));
+  }
+  // "process P" (or "processes P, Q") of the slices of a `count`-shard batch that are held.
+  static std::string holders_of(const std::filesystem::path& out, int count) {
+    std::vector<std::string> pids;
+    std::error_code ec;
+    for (const auto& entry : std::filesystem::directory_iterator(out, ec)) {
+      const std::string name = entry.path().filename().string();
+      int index = 0, of = 0;
+      const bool slice =
+          count == 1 ? name == ".batch-lock"
+                     : std::sscanf(name.c_str(), ".batch-lock-shard-%d-of-%d", &index, &of) == 2 &&
+                           of == count;
+      if (!slice) continue;
+      const int fd = ::open(entry.path().c_str(), O_RDWR | O_CLOEXEC);
+      if (fd < 0) continue;
+      if (::flock(fd, LOCK_EX | LOCK_NB) != 0) pids.push_back(lock_holder(fd));
+      ::close(fd);
+    }
+    if (pids.empty()) return "a process that is starting";
+    std::sort(pids.begin(), pids.end());
+    std::string list;
+    for (const std::string& p : pids) list += (list.empty() ? "" : ", ") + p;
+    return (pids.size() == 1 ? "process " : "processes ") + list;
+  }
+  void close_all() {
+    if (slice_fd_ >= 0) ::close(slice_fd_);
+    if (count_fd_ >= 0) ::close(count_fd_);
+    slice_fd_ = count_fd_ = -1;
+  }
+
+  int slice_fd_ = -1;
+  int count_fd_ = -1;
 };
 
 // Starts `exe <args>` with stdout and stderr going to `log` (truncated) and stdin from /dev/null,

@@ -76,8 +76,8 @@ void run_mesh(const MeshOptions& options) {
   if (sketch.sheet) {
     // A sheet scene: its grid of triangles is the fixed mesh `run` simulates (a sheet that asks
     // for adaptive detail drapes on the 4-8 mesh of its quads instead).
-    if (const auto vertices = cloth_vertices_before_building(sketch))
-      check_run_fits(sketch, estimate_run(sketch, *vertices, 0), RunLimits{}, 0);
+    if (const auto estimate = estimate_before_building(sketch, 0))
+      check_run_fits(sketch, *estimate, RunLimits{}, 0);
     const ClothScene scene = build_cloth_scene(sketch);
     ExportMesh mesh{scene.input.rest_positions, scene.input.triangles, {}, {"sheet"}};
     outputs.stage(dir / sketch.output.mesh, sketch.output.mesh.ends_with(".glb") ? to_glb(mesh, "sheet") : to_obj(mesh, "sheet"));

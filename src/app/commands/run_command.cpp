@@ -229,6 +229,11 @@ nlohmann::json adaptive_steps_json(const std::vector<sim::AdaptiveStepRecord>& s
   return out;
 }
 
+// "1.2 GB", or "74 MB" below a gigabyte (where one decimal of GB says too little).
+std::string memory_text(double bytes) {
+  return bytes >= 1e9 ? fmt::format("{:.1f} GB", bytes / 1e9) : fmt::format("{:.0f} MB", bytes / 1e6);
+}
+
 void run_drape(const RunOptions& options, const GlobalOptions& global) {
   const auto start = Clock::now();
   const garment::Sketch sketch = garment::load_sketch(options.sketch);
@@ -239,16 +244,18 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   if (options.max_time_s > 0) limits.max_time_s = options.max_time_s;
   // Refused before anything is built when the size is known from the file (a sheet), else once
   // the cloth is meshed.
-  if (const auto vertices = cloth_vertices_before_building(sketch))
-    check_run_fits(sketch, estimate_run(sketch, *vertices, options.frames_per_second), limits,
-                   options.frames_per_second);
+  if (const auto before = estimate_before_building(sketch, options.frames_per_second))
+    check_run_fits(sketch, *before, limits, options.frames_per_second);
   const ClothScene scene = build_cloth_scene(sketch);
   const RunEstimate estimate =
-      estimate_run(sketch, static_cast<double>(scene.start.rows()), options.frames_per_second);
+      estimate_run(sketch, scene.input.triangles, static_cast<int>(scene.start.rows()),
+                   options.frames_per_second);
   check_run_fits(sketch, estimate, limits, options.frames_per_second);
-  spdlog::debug("estimate: {:.0f} vertices, {:.2f} GB, at most {:.0f} steps ({:.0f} s), {:.0f} frames",
-                estimate.vertices, estimate.memory_bytes / 1e9, estimate.steps, estimate.seconds,
-                estimate.frames);
+  spdlog::debug(
+      "estimate: {:.0f} vertices, {:.2f} GB ({:.2f} GB the factor), at most {:.0f} steps ({:.0f} "
+      "s), {:.0f} frames",
+      estimate.vertices, estimate.memory_bytes / 1e9, estimate.factor_bytes / 1e9, estimate.steps,
+      estimate.seconds, estimate.frames);
   if (!limits.max_time_s && estimate.seconds > 3600)
     spdlog::warn("this drape may take up to about {:.1f} h ({:.0f} steps on {:.0f} vertices, by "
                  "the estimate); --max-time SECONDS stops it",
@@ -266,10 +273,10 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   const auto on_step = [&](const sim::Simulation& s) {
     if (const double resident = resident_memory_bytes(); memory_budget > 0 && resident > memory_budget)
       throw RunLimitExceeded(fmt::format(
-          "stopped at t = {:.3f} s of the drape: it uses {:.1f} GB with {} vertices, more than "
-          "the {:.1f} GB it may take (--max-memory); limit adaptive detail with "
+          "stopped at t = {:.3f} s of the drape: it uses {} with {} vertices, more than "
+          "the {} it may take (--max-memory); limit adaptive detail with "
           "simulate.adaptive.max_vertices or max_level; nothing was written",
-          s.time(), resident / 1e9, s.model().vertex_count, memory_budget / 1e9));
+          s.time(), memory_text(resident), s.model().vertex_count, memory_text(memory_budget)));
     if (limits.max_time_s &&
         std::chrono::duration<double>(Clock::now() - start).count() > *limits.max_time_s)
       throw RunLimitExceeded(fmt::format(

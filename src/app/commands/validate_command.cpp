@@ -25,11 +25,12 @@ void run_validate(const ValidateOptions& options) {
   const garment::Sketch sketch = garment::load_sketch(options.sketch);
   check_sketch(sketch);
   // What `run` would refuse for its size, refused here too (a sheet before it is built).
-  if (const auto vertices = cloth_vertices_before_building(sketch))
-    check_run_fits(sketch, estimate_run(sketch, *vertices, 0), RunLimits{}, 0);
+  if (const auto estimate = estimate_before_building(sketch, 0))
+    check_run_fits(sketch, *estimate, RunLimits{}, 0);
   const ClothScene scene = build_cloth_scene(sketch);
-  check_run_fits(sketch, estimate_run(sketch, static_cast<double>(scene.start.rows()), 0),
-                 RunLimits{}, 0);
+  check_run_fits(
+      sketch, estimate_run(sketch, scene.input.triangles, static_cast<int>(scene.start.rows()), 0),
+      RunLimits{}, 0);
   std::string what;
   if (scene.garment) {
     int distortion = 0;

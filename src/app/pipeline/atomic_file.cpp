@@ -1,5 +1,6 @@
 #include "src/app/pipeline/atomic_file.hpp"
 
+#include <pthread.h>
 #include <signal.h>
 #include <unistd.h>
 
@@ -29,7 +30,17 @@ constexpr size_t kDirSlots = 64;
 std::array<std::atomic<char*>, kDirSlots> g_dir_slots{};
 std::once_flag g_handlers_installed;
 
+// The thread that stages (installs the handlers on its first stage()). A signal sent to the
+// process may be delivered to any thread that does not block it, such as a renderer's worker:
+// cleaning up there would race with the staging thread, which could create a temporary after
+// the loop below passed its slot. The signal is passed on to the staging thread instead.
+pthread_t g_staging_thread;
+
 extern "C" void remove_temporaries_and_reraise(int sig) {
+  if (!pthread_equal(pthread_self(), g_staging_thread)) {
+    pthread_kill(g_staging_thread, sig);
+    return;
+  }
   for (auto& slot : g_temp_slots)
     if (char* path = slot.load()) ::unlink(path);
   for (size_t i = kDirSlots; i-- > 0;)  // deepest folders were registered last
@@ -40,6 +51,7 @@ extern "C" void remove_temporaries_and_reraise(int sig) {
 
 void install_handlers() {
   std::call_once(g_handlers_installed, [] {
+    g_staging_thread = pthread_self();
     for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
       struct sigaction old {};
       sigaction(sig, nullptr, &old);
@@ -158,6 +170,24 @@ StagedOutputs::~StagedOutputs() {
 
 void StagedOutputs::stage(const std::filesystem::path& path, std::string_view bytes) {
   const std::filesystem::path dir = path.parent_path().empty() ? "." : path.parent_path();
+  // What the user can fix (exit code 2), found before any output is renamed into place: a
+  // folder (or a device, a FIFO) where a file goes, a file where the output folder goes.
+  std::error_code status_ec;
+  for (auto d = dir; !d.empty() && d != d.parent_path(); d = d.parent_path()) {
+    const auto status = std::filesystem::status(d, status_ec);
+    if (!std::filesystem::exists(status)) continue;
+    if (!std::filesystem::is_directory(status))
+      throw std::invalid_argument("cannot write '" + path.string() + "': '" + d.string() +
+                                  "' is a file, not a folder; remove it or choose another "
+                                  "output folder (-o)");
+    break;
+  }
+  if (const auto status = std::filesystem::status(path, status_ec);
+      std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
+    throw std::invalid_argument(
+        "cannot write '" + path.string() + "': " +
+        (std::filesystem::is_directory(status) ? "a folder" : "something that is not a file") +
+        " of that name is in the way; remove it or choose another output folder (-o)");
   if (!std::filesystem::exists(dir)) {
     // Remember every level we create so an abandoned command leaves no empty folders.
     std::vector<std::filesystem::path> missing;

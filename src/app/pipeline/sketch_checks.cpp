@@ -10,6 +10,8 @@
 
 #include "garment/sketch_ranges.hpp"
 #include "sim/fabric.hpp"
+#include "sim/factor_size.hpp"
+#include "sim/sheet.hpp"
 #include "src/app/pipeline/cloth_scene.hpp"
 #include "src/render/image.hpp"
 
@@ -19,22 +21,30 @@ namespace {
 static_assert(garment::kMaxImageSide == render::kMaxImageSide,
               "the sketch file's image limit is the renderer's");
 
-// Cost model of a drape, fitted to sheets of 65² to 257² vertices on the CHOLMOD solver (peak
-// RSS 111, 265, 937 MB; docs/cli.md, "Limits"): resident bytes per vertex grow with log2(V) like
-// the fill of the factor; seconds per vertex and step grow likewise (measured on the 2-core
-// machine under a load of 12: 28, 38, 61 µs per vertex and step).
-constexpr double kBaseBytes = 67e6;               // the process before any cloth
-constexpr double kBytesPerVertex = 2800;          // model, forces, contacts
-constexpr double kFactorBytesPerVertexLog = 650;  // the CHOLMOD factor, per vertex per log2(V)
+// Cost model of a drape. The CHOLMOD factor (and its workspace) comes from the symbolic
+// analysis of the cloth's mesh (sim::predict_factor_size: 20, 103, 517 MB for sheets of 65²,
+// 129², 257² vertices); the rest was fitted to the peak RSS of drapes of those sheets on the
+// CHOLMOD solver (111, 265, 937 MB; docs/cli.md, "Limits"): the process before any cloth plus
+// 5.8 kB per vertex (model, forces, the system matrix and its filtered and permuted copies of
+// about 1.4 kB each, contacts); the fit is within 3 % of all three. Seconds per vertex and step
+// grow with log2(V) like the fill of the factor (measured on the 2-core machine under a load of
+// 12: 28, 38, 61 µs per vertex and step).
+constexpr double kBaseBytes = 67e6;       // the process before any cloth
+constexpr double kBytesPerVertex = 5800;  // model, forces, system matrices, contacts
 constexpr double kSecondsPerVertexStepLog = 3e-6;
 constexpr double kSecondsPerFrame = 0.05;  // one picture of the PNG sequence
 // Without --max-memory, a run may use this fraction of the memory available when it starts (the
 // rest for the system, other processes and the estimate's error).
 constexpr double kAvailableFraction = 0.8;
 
-double memory_for(double vertices) {
-  return kBaseBytes + vertices * (kBytesPerVertex +
-                                  kFactorBytesPerVertexLog * std::log2(std::max(vertices, 2.0)));
+// The memory of a cloth of `vertices` vertices, scaled from an estimate of another size: the
+// factor per vertex grows like log2(V), as the fill of a mesh's factor under nested dissection.
+double memory_scaled(const RunEstimate& e, double vertices) {
+  const double factor_per_vertex = e.factor_bytes / std::max(e.vertices, 1.0) *
+                                   std::log2(std::max(vertices, 2.0)) /
+                                   std::log2(std::max(e.vertices, 2.0));
+  const double frames_per_vertex = 64.0 * e.frames;
+  return kBaseBytes + vertices * (kBytesPerVertex + factor_per_vertex + frames_per_vertex);
 }
 
 std::string gigabytes(double bytes) {
@@ -79,23 +89,33 @@ double memory_budget_bytes(const RunLimits& limits) {
                                      : kAvailableFraction * available_memory_bytes();
 }
 
-std::optional<double> cloth_vertices_before_building(const garment::Sketch& sketch) {
+std::optional<RunEstimate> estimate_before_building(const garment::Sketch& sketch,
+                                                    double frames_per_second) {
   if (!sketch.sheet) return std::nullopt;
-  return static_cast<double>(sketch.sheet->columns + 1) * (sketch.sheet->rows + 1);
+  // The grid's triangles only (its size and place do not change the factor).
+  sim::SheetSpec spec;
+  spec.columns = sketch.sheet->columns;
+  spec.rows = sketch.sheet->rows;
+  const sim::SheetScene sheet = sim::build_sheet(spec);
+  return estimate_run(sketch, sheet.input.triangles,
+                      static_cast<int>(sheet.input.rest_positions.rows()), frames_per_second);
 }
 
-RunEstimate estimate_run(const garment::Sketch& sketch, double vertices, double frames_per_second) {
+RunEstimate estimate_run(const garment::Sketch& sketch, const Eigen::MatrixX3i& triangles,
+                         int vertices, double frames_per_second) {
   RunEstimate e;
   e.vertices = vertices;
-  e.memory_bytes = memory_for(vertices);
+  e.factor_bytes = sim::predict_factor_size(triangles, vertices).bytes;
+  e.memory_bytes = kBaseBytes + e.vertices * kBytesPerVertex + e.factor_bytes;
   e.steps = std::ceil(sketch.simulate.duration / sketch.simulate.time_step);
   e.frames =
       frames_per_second > 0 ? std::floor(sketch.simulate.duration * frames_per_second) + 1 : 0;
   // The PNG sequence keeps each picture's cloth until the drape ends: positions, triangles and
   // groups, about 64 bytes per vertex.
-  e.memory_bytes += e.frames * 64.0 * vertices;
-  e.seconds = e.steps * vertices * std::log2(std::max(vertices, 2.0)) * kSecondsPerVertexStepLog +
-              e.frames * kSecondsPerFrame;
+  e.memory_bytes += e.frames * 64.0 * e.vertices;
+  e.seconds =
+      e.steps * e.vertices * std::log2(std::max(e.vertices, 2.0)) * kSecondsPerVertexStepLog +
+      e.frames * kSecondsPerFrame;
   return e;
 }
 
@@ -104,11 +124,11 @@ void check_run_fits(const garment::Sketch& sketch, const RunEstimate& estimate,
   const bool given = limits.max_memory_bytes > 0;
   const double memory = memory_budget_bytes(limits);
   if (memory > 0 && estimate.memory_bytes > memory) {
-    // The largest vertex count that fits, by bisection on the monotone model.
+    // The largest vertex count that fits, by bisection on the estimate scaled to other sizes.
     double low = 4, high = estimate.vertices;
     for (int i = 0; i < 60; ++i) {
       const double mid = 0.5 * (low + high);
-      (memory_for(mid) <= memory ? low : high) = mid;
+      (memory_scaled(estimate, mid) <= memory ? low : high) = mid;
     }
     const std::string limit =
         given ? fmt::format("the {} of --max-memory", gigabytes(memory))
@@ -117,14 +137,17 @@ void check_run_fits(const garment::Sketch& sketch, const RunEstimate& estimate,
       const double side = std::floor(std::sqrt(low)) - 1;
       sketch.fail("/sheet/resolution",
                   fmt::format("a sheet of {}x{} quads ({:.0f} vertices) needs about {} to "
-                              "simulate, more than {}; about {:.0f}x{:.0f} quads would fit",
+                              "simulate ({} of it the solver's factor), more than {}; about "
+                              "{:.0f}x{:.0f} quads would fit",
                               sketch.sheet->columns, sketch.sheet->rows, estimate.vertices,
-                              gigabytes(estimate.memory_bytes), limit, side, side));
+                              gigabytes(estimate.memory_bytes), gigabytes(estimate.factor_bytes),
+                              limit, side, side));
     }
-    sketch.fail("", fmt::format("the cloth has {:.0f} vertices and needs about {} to simulate, "
-                                "more than {}; about {:.0f} vertices would fit (a longer "
-                                "edge_length)",
-                                estimate.vertices, gigabytes(estimate.memory_bytes), limit, low));
+    sketch.fail("", fmt::format("the cloth has {:.0f} vertices and needs about {} to simulate "
+                                "({} of it the solver's factor), more than {}; about {:.0f} "
+                                "vertices would fit (a longer edge_length)",
+                                estimate.vertices, gigabytes(estimate.memory_bytes),
+                                gigabytes(estimate.factor_bytes), limit, low));
   }
   if (estimate.frames > kMaxFrames)
     throw std::invalid_argument(fmt::format(

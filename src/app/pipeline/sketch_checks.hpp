@@ -3,6 +3,7 @@
 // so that no command accepts what another refuses, and the estimate of a drape's memory and work
 // made before any of it is done (docs/cli.md, "Limits").
 
+#include <Eigen/Core>
 #include <optional>
 #include <string>
 
@@ -31,19 +32,25 @@ double resident_memory_bytes();
 // The memory a run may use: --max-memory, else 80 % of the memory available now; 0: unknown.
 double memory_budget_bytes(const RunLimits& limits);
 
-// A drape's cost, estimated before it starts from the cloth's vertex count (the measured cost
-// per vertex of the model, the CHOLMOD factor and the contacts; docs/cli.md, "Limits").
+// A drape's cost, estimated before it starts: the CHOLMOD factor's size from the symbolic
+// analysis of the cloth's mesh (sim::predict_factor_size), plus the measured cost per vertex of
+// the model, the forces and the contacts (docs/cli.md, "Limits").
 struct RunEstimate {
   double vertices = 0;
   double memory_bytes = 0;  // peak resident memory
+  double factor_bytes = 0;  // of which the CHOLMOD factor and its workspace
   double steps = 0;         // duration / time_step: the most steps the run can take
   double frames = 0;        // PNG sequence pictures (--frames)
   double seconds = 0;       // wall time if it runs the whole duration
 };
-RunEstimate estimate_run(const garment::Sketch& sketch, double vertices, double frames_per_second);
+// `triangles`: the cloth's #F×3 triangles into `vertices` vertices.
+RunEstimate estimate_run(const garment::Sketch& sketch, const Eigen::MatrixX3i& triangles,
+                         int vertices, double frames_per_second);
 
-// The vertex count of the sketch's cloth when it can be known without building it (a sheet).
-std::optional<double> cloth_vertices_before_building(const garment::Sketch& sketch);
+// The estimate of a cloth whose mesh is known without building the scene (a sheet: its grid of
+// triangles, without the body or the model); nullopt for a garment.
+std::optional<RunEstimate> estimate_before_building(const garment::Sketch& sketch,
+                                                    double frames_per_second);
 
 // Refuses (garment::SketchError, at /sheet/resolution, /simulate/duration or the file) a run
 // whose estimate does not fit `limits`, or whose PNG sequence has more than kMaxFrames pictures,

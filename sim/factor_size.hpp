@@ -1,0 +1,28 @@
+#pragma once
+// The size of the Cholesky factor CHOLMOD makes of a cloth's 3n×3n system, known from the
+// symbolic analysis alone, before any number is factorised: a drape that cannot fit the machine
+// is refused before it allocates the factor (docs/cli.md, "Limits").
+
+#include <Eigen/Core>
+
+namespace sd::sim {
+
+struct FactorSize {
+  double nonzeros = 0;  // entries of L (lower triangle with the diagonal), CHOLMOD's Common->lnz
+  double flops = 0;     // floating-point operations of one numeric factorisation, Common->fl
+  // Bytes the numeric factorisation allocates: L's values and row indices (supernodal: Lx and
+  // Ls, zeros of relaxed supernodes included) and its largest update block (maxcsize doubles).
+  double bytes = 0;
+};
+
+// The factor of the system of a cloth with these triangles (#F×3 vertex indices into
+// `vertex_count` vertices): the symbolic analysis of its vertex graph (vertices sharing a
+// triangle, and the two far corners of each edge's two triangles, as the bending hinges couple
+// them: the block pattern of ClothModel), each vertex's three rows kept together as
+// CholmodSolver orders them, expanded to the 3n scalar rows: every off-diagonal vertex entry of
+// L is a 3×3 block, every diagonal one a lower triangle of 6. Cost: AMD and the analysis on the
+// n-vertex graph (about a ninth of the scalar pattern), no values. Throws std::bad_alloc when
+// CHOLMOD runs out of memory.
+FactorSize predict_factor_size(const Eigen::MatrixX3i& triangles, int vertex_count);
+
+}  // namespace sd::sim
