@@ -932,10 +932,12 @@ ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse&
   model.bend_stencil_stiffness = options.bend_stencil_stiffness;
   if (options.bend_stencil_stiffness > 0.0)
     model.stencils = make_bend_stencils(rest, input.triangles);
-  {
+  // Marks the rows of the elements over several vertices (stencils, vertex bends) that are not
+  // one of the previous ones over the same vertices, and the rows a vanished one covered.
+  const auto mark_changed_rows = [&](const auto& previous_elements, const auto& elements) {
     std::set<std::vector<int>> before, after;
-    for (const BendStencil& b : previous.stencils) before.insert(b.vertices);
-    for (const BendStencil& b : model.stencils) {
+    for (const auto& b : previous_elements) before.insert(b.vertices);
+    for (const auto& b : elements) {
       std::vector<int> key;
       for (int v : b.vertices) key.push_back(reuse.previous_vertex[static_cast<std::size_t>(v)]);
       std::sort(key.begin(), key.end());
@@ -948,29 +950,14 @@ ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse&
         for (int p : key)
           if (const int i = next_vertex[static_cast<std::size_t>(p)]; i >= 0)
             changed_row[static_cast<std::size_t>(i)] = 1;
-  }
+  };
+  mark_changed_rows(previous.stencils, model.stencils);
   // Vertex bends likewise: rebuilt (linear time); a row is rebuilt when a vertex bend over it is
   // not one of the previous ones (the same vertices).
   model.bend_model = options.bend_model;
   if (options.bend_model == BendModel::quadratic)
     model.vertex_bends = make_vertex_bends(rest, input.triangles, options.bend_rest);
-  {
-    std::set<std::vector<int>> before, after;
-    for (const VertexBendElement& b : previous.vertex_bends) before.insert(b.vertices);
-    for (const VertexBendElement& b : model.vertex_bends) {
-      std::vector<int> key;
-      for (int v : b.vertices) key.push_back(reuse.previous_vertex[static_cast<std::size_t>(v)]);
-      std::sort(key.begin(), key.end());
-      after.insert(key);
-      if (key.front() < 0 || before.count(key) == 0)
-        for (int v : b.vertices) changed_row[static_cast<std::size_t>(v)] = 1;
-    }
-    for (const std::vector<int>& key : before)
-      if (after.count(key) == 0)
-        for (int p : key)
-          if (const int i = next_vertex[static_cast<std::size_t>(p)]; i >= 0)
-            changed_row[static_cast<std::size_t>(i)] = 1;
-  }
+  mark_changed_rows(previous.vertex_bends, model.vertex_bends);
 
   // Pattern: unchanged rows are the previous rows renumbered (kept vertices keep their order,
   // so each run stays sorted), the changed ones are collected from the elements and sorted.
