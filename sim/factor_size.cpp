@@ -66,7 +66,8 @@ VertexGraph vertex_graph(const Eigen::MatrixX3i& triangles, int n) {
 
 }  // namespace
 
-FactorSize predict_factor_size(const Eigen::MatrixX3i& triangles, int vertex_count) {
+FactorSize predict_factor_size(const Eigen::MatrixX3i& triangles, int vertex_count,
+                               BendModel bend_model) {
   FactorSize size;
   if (vertex_count <= 0) return size;
   VertexGraph graph = vertex_graph(triangles, vertex_count);
@@ -111,6 +112,11 @@ FactorSize predict_factor_size(const Eigen::MatrixX3i& triangles, int vertex_cou
   }
   cholmod_free_factor(&factor, &common);
   cholmod_finish(&common);
+  if (bend_model == BendModel::quadratic) {
+    size.nonzeros *= kQuadraticBendingFactorScale;
+    size.flops *= kQuadraticBendingFactorScale * kQuadraticBendingFactorScale;
+    size.bytes *= kQuadraticBendingFactorScale;
+  }
   return size;
 }
 

@@ -5,6 +5,8 @@
 
 #include <Eigen/Core>
 
+#include "sim/cloth_model.hpp"
+
 namespace sd::sim {
 
 struct FactorSize {
@@ -23,6 +25,15 @@ struct FactorSize {
 // L is a 3×3 block, every diagonal one a lower triangle of 6. Cost: AMD and the analysis on the
 // n-vertex graph (about a ninth of the scalar pattern), no values. Throws std::bad_alloc when
 // CHOLMOD runs out of memory.
-FactorSize predict_factor_size(const Eigen::MatrixX3i& triangles, int vertex_count);
+//
+// That is the pattern of the hinge bending (BendModel::hinges). The quadratic bending couples
+// every pair of vertices in a vertex's stencil (up to its two-ring), a pattern this graph does
+// not hold and which would cost hundreds of pairs per vertex to list; for it the prediction is
+// scaled by kQuadraticBendingFactorScale, an upper bound measured on sheets and tubes (the
+// solver's analysis was 3.1–3.9× the hinge pattern's; tests/sim/factor_size_test.cpp).
+FactorSize predict_factor_size(const Eigen::MatrixX3i& triangles, int vertex_count,
+                               BendModel bend_model = BendModel::hinges);
+
+inline constexpr double kQuadraticBendingFactorScale = 5.0;
 
 }  // namespace sd::sim

@@ -14,8 +14,10 @@ namespace {
 // What CholmodSolver's own analysis of a cloth's 3n×3n system reports, on the model's pattern
 // (values: the identity on the diagonal, so the numeric factorisation succeeds; the analysis
 // reads only the pattern).
-FactorSize analysed_by_solver(const ClothInput& input) {
-  const ClothModel model = build_cloth_model(input, fabric_preset("cotton"));
+FactorSize analysed_by_solver(const ClothInput& input, BendModel bend_model = BendModel::hinges) {
+  ClothModelOptions options;
+  options.bend_model = bend_model;
+  const ClothModel model = build_cloth_model(input, fabric_preset("cotton"), options);
   SparseMatrixR a = model.pattern.zero_matrix;
   for (int i = 0; i < model.vertex_count; ++i)
     for (int k = 0; k < 3; ++k) a.coeffRef(3 * i + k, 3 * i + k) = 1.0;
@@ -24,7 +26,8 @@ FactorSize analysed_by_solver(const ClothInput& input) {
   return solver.analysed_size();
 }
 
-// The prediction from the vertex graph is the solver's analysis of the scalar system: the same
+// The prediction from the vertex graph is the solver's analysis of the scalar system of the hinge
+// bending (the sketch default): the same
 // entries of L exactly (the same AMD ordering of the same vertex graph, each vertex a 3×3
 // block), flops and bytes close (CHOLMOD relaxes supernodes by column counts, which differ
 // between the vertex and the scalar analysis).
@@ -38,6 +41,21 @@ void expect_prediction_matches(const ClothInput& input) {
   // Over, never much under: the check refuses on it.
   EXPECT_GE(predicted.bytes / analysed.bytes, 0.95);
   EXPECT_LE(predicted.bytes / analysed.bytes, 1.5);
+}
+
+// With the quadratic bending the prediction is a bound: never under the solver's analysis, and
+// not more than twice it.
+TEST(FactorSize, QuadraticBendingIsBoundedFromAbove) {
+  SheetSpec spec;
+  spec.columns = 40;
+  spec.rows = 30;
+  const ClothInput input = build_sheet(spec).input;
+  const FactorSize predicted = predict_factor_size(
+      input.triangles, static_cast<int>(input.rest_positions.rows()), BendModel::quadratic);
+  const FactorSize analysed = analysed_by_solver(input, BendModel::quadratic);
+  EXPECT_GE(predicted.bytes, analysed.bytes);
+  EXPECT_LE(predicted.bytes, 2.0 * analysed.bytes);
+  EXPECT_GE(predicted.nonzeros, analysed.nonzeros);
 }
 
 TEST(FactorSize, PredictionOfASheetIsTheSolversAnalysis) {
