@@ -20,6 +20,7 @@
 #include "sim/sheet.hpp"
 #include "sim/static_equilibrium.hpp"
 #include "tests/sim/cantilever_elastica.hpp"
+#include "tests/sim/force_differences.hpp"
 #include "tests/sim/strip_meshes.hpp"
 #include "tests/sim/test_scenes.hpp"
 
@@ -109,35 +110,16 @@ TEST(QuadraticBending, ForcesAndJacobiansMatchFiniteDifferences) {
     EXPECT_EQ(any_curved, curved);
     ForceSettings settings;
     settings.terms = {false, false, true, true, false, false};
-    ForceSettings conservative = settings;
-    conservative.terms.damping = false;
     for (int trial = 0; trial < 3; ++trial) {
       const Eigen::VectorXd x = testing::random_configuration(input.rest_positions, rng);
       const Eigen::VectorXd v = Eigen::VectorXd::Random(x.size());
       const Eigen::MatrixXd dfdx = dense_jacobian(model, settings, x, v, 1, 0, JacobianKind::exact);
       const Eigen::MatrixXd dfdv = dense_jacobian(model, settings, x, v, 0, 1, JacobianKind::exact);
-      Eigen::MatrixXd fd_x(x.size(), x.size()), fd_v(x.size(), x.size());
-      Eigen::VectorXd grad(x.size()), fp, fm, force;
-      const double h = 1e-6;
-      for (Eigen::Index j = 0; j < x.size(); ++j) {
-        Eigen::VectorXd plus = x, minus = x;
-        plus[j] += h;
-        minus[j] -= h;
-        evaluate_forces(model, settings, plus, v, fp);
-        evaluate_forces(model, settings, minus, v, fm);
-        fd_x.col(j) = (fp - fm) / (2 * h);
-        EnergyBreakdown ep, em;
-        evaluate_forces(model, conservative, plus, v, fp, &ep);
-        evaluate_forces(model, conservative, minus, v, fm, &em);
-        grad[j] = (ep.bend - em.bend) / (2 * h);
-        Eigen::VectorXd vp = v, vm = v;
-        vp[j] += h;
-        vm[j] -= h;
-        evaluate_forces(model, settings, x, vp, fp);
-        evaluate_forces(model, settings, x, vm, fm);
-        fd_v.col(j) = (fp - fm) / (2 * h);
-      }
-      evaluate_forces(model, conservative, x, v, force);
+      const testing::ForceDifferences d = testing::force_differences(model, settings, x, v);
+      const Eigen::MatrixXd& fd_x = d.dfdx;
+      const Eigen::MatrixXd& fd_v = d.dfdv;
+      const Eigen::VectorXd& grad = d.bend_gradient;
+      const Eigen::VectorXd& force = d.conservative_force;
       EXPECT_LE((force + grad).norm(), 1e-6 * force.norm()) << curved << " trial " << trial;
       EXPECT_LE((fd_x - dfdx).norm(), 1e-6 * dfdx.norm()) << curved << " trial " << trial;
       EXPECT_LE((fd_v - dfdv).norm(), 1e-6 * dfdv.norm()) << curved << " trial " << trial;

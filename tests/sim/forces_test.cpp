@@ -12,6 +12,7 @@
 #include <string>
 
 #include "test_scenes.hpp"
+#include "tests/sim/force_differences.hpp"
 
 namespace sd::sim {
 namespace {
@@ -222,30 +223,11 @@ TEST(Forces, BendStencilsMatchFiniteDifferences) {
     const Eigen::VectorXd v = Eigen::VectorXd::Random(x.size());
     const Eigen::MatrixXd dfdx = dense_jacobian(model, settings, x, v, 1, 0, JacobianKind::exact);
     const Eigen::MatrixXd dfdv = dense_jacobian(model, settings, x, v, 0, 1, JacobianKind::exact);
-    Eigen::MatrixXd fd_x(x.size(), x.size()), fd_v(x.size(), x.size());
-    Eigen::VectorXd grad(x.size()), fp, fm, force;
-    const double h = 1e-6;
-    ForceSettings conservative = settings;
-    conservative.terms.damping = false;
-    for (Eigen::Index j = 0; j < x.size(); ++j) {
-      Eigen::VectorXd plus = x, minus = x;
-      plus[j] += h;
-      minus[j] -= h;
-      evaluate_forces(model, settings, plus, v, fp);
-      evaluate_forces(model, settings, minus, v, fm);
-      fd_x.col(j) = (fp - fm) / (2 * h);
-      EnergyBreakdown ep, em;
-      evaluate_forces(model, conservative, plus, v, fp, &ep);
-      evaluate_forces(model, conservative, minus, v, fm, &em);
-      grad[j] = (ep.bend - em.bend) / (2 * h);
-      Eigen::VectorXd vp = v, vm = v;
-      vp[j] += h;
-      vm[j] -= h;
-      evaluate_forces(model, settings, x, vp, fp);
-      evaluate_forces(model, settings, x, vm, fm);
-      fd_v.col(j) = (fp - fm) / (2 * h);
-    }
-    evaluate_forces(model, conservative, x, v, force);
+    const testing::ForceDifferences d = testing::force_differences(model, settings, x, v);
+    const Eigen::MatrixXd& fd_x = d.dfdx;
+    const Eigen::MatrixXd& fd_v = d.dfdv;
+    const Eigen::VectorXd& grad = d.bend_gradient;
+    const Eigen::VectorXd& force = d.conservative_force;
     EXPECT_LE((force + grad).norm(), 1e-5 * force.norm()) << "trial " << trial;
     EXPECT_LE((fd_x - dfdx).norm(), 1e-5 * dfdx.norm()) << "trial " << trial;
     EXPECT_LE((fd_v - dfdv).norm(), 1e-5 * dfdv.norm()) << "trial " << trial;
