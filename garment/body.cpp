@@ -2,18 +2,18 @@
 
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <Eigen/Geometry>
-#include <assimp/Importer.hpp>
 #include <algorithm>
+#include <assimp/Importer.hpp>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <numeric>
-#include <fmt/format.h>
+#include <sstream>
 
 #include "garment/input_checks.hpp"
 #include "garment/sketch_ranges.hpp"
@@ -80,9 +80,10 @@ void check_declared_counts(const std::string& file) {
     // assimp's PLY reader never returns on a header without end_header (found by
     // tests/fuzz/body_loader_fuzz): such a file is refused before it is read.
     if (header.find("end_header") == std::string::npos)
-      throw BodyError(fmt::format("body file '{}' is corrupt: its PLY header has no end_header "
-                                  "line{}",
-                                  file, header.size() < 65536 ? "" : " in its first 64 KB"));
+      throw BodyError(
+          fmt::format("body file '{}' is corrupt: its PLY header has no end_header "
+                      "line{}",
+                      file, header.size() < 65536 ? "" : " in its first 64 KB"));
     // Nor on some header lines that hold numbers (the second finding: vertex data before
     // end_header). Free text lines stay allowed (Blender writes one), numbers do not.
     std::istringstream lines(header);
@@ -93,16 +94,17 @@ void check_declared_counts(const std::string& file) {
       std::string keyword;
       first >> keyword;
       if (keyword == "end_header") break;
-      const bool numeric = !keyword.empty() && (std::isdigit(static_cast<unsigned char>(keyword[0])) ||
-                                                keyword[0] == '-' || keyword[0] == '+' ||
-                                                keyword[0] == '.');
+      const bool numeric =
+          !keyword.empty() && (std::isdigit(static_cast<unsigned char>(keyword[0])) ||
+                               keyword[0] == '-' || keyword[0] == '+' || keyword[0] == '.');
       const bool binary = std::any_of(line.begin(), line.end(), [](char c) {
         return static_cast<unsigned char>(c) < 0x09 || static_cast<unsigned char>(c) == 0x7f;
       });
       if (numeric || binary)
-        throw BodyError(fmt::format("body file '{}' is corrupt: line {} of its PLY header is not "
-                                    "a header line (it holds {} before end_header)",
-                                    file, number, numeric ? "numbers" : "binary bytes"));
+        throw BodyError(
+            fmt::format("body file '{}' is corrupt: line {} of its PLY header is not "
+                        "a header line (it holds {} before end_header)",
+                        file, number, numeric ? "numbers" : "binary bytes"));
     }
     while (words >> word && word != "end_header") {
       if (word != "element") continue;
@@ -119,7 +121,8 @@ void check_declared_counts(const std::string& file) {
   if (vertices < 0 || faces < 0 || 6 * vertices + 8 * faces > size)
     throw BodyError(fmt::format(
         "body file '{}' is corrupt: its header declares {:.0f} vertices and {:.0f} faces, more "
-        "than its {:.0f} bytes can hold", file, vertices, faces, size));
+        "than its {:.0f} bytes can hold",
+        file, vertices, faces, size));
 }
 
 // Rotation taking the file's `up` to +Y and its facing direction to +Z (proper rotation).
@@ -239,13 +242,15 @@ meshing::TriMesh read_body_mesh(const std::string& file, Body& body) {
     mesh.faces.row(static_cast<Eigen::Index>(i)) = tris[i].transpose();
 
   const double diagonal = meshing::bounding_box(mesh).extent().norm();
-  if (!(diagonal > 0)) throw BodyError("body file '" + file + "' has all its vertices at one point");
+  if (!(diagonal > 0))
+    throw BodyError("body file '" + file + "' has all its vertices at one point");
   const CleanupCounts cleanup = weld_and_clean(mesh, 1e-6 * diagonal, 1e-12 * diagonal * diagonal);
   if (mesh.face_count() == 0)
     throw BodyError("body file '" + file + "' has no triangle with a non-zero area");
   if (cleanup.dropped_faces > 0)
-    body.warnings.push_back(fmt::format("dropped {} degenerate triangle(s) (zero area or repeated corners)",
-                                        cleanup.dropped_faces));
+    body.warnings.push_back(
+        fmt::format("dropped {} degenerate triangle(s) (zero area or repeated corners)",
+                    cleanup.dropped_faces));
   if (cleanup.unused_vertices > 0)
     spdlog::debug("removed {} vertices no triangle uses", cleanup.unused_vertices);
   if (cleanup.merged_vertices > 0)
@@ -285,7 +290,9 @@ AxisDirection AxisDirection::parse(const std::string& text) {
   return d;
 }
 
-std::string builtin_body_path() { return kBuiltinPath; }
+std::string builtin_body_path() {
+  return kBuiltinPath;
+}
 
 Body load_body(const std::string& path, const BodyOptions& options) {
   const bool builtin = path == "builtin";
@@ -301,9 +308,10 @@ Body load_body(const std::string& path, const BodyOptions& options) {
         "{} edge(s) are shared by more than two triangles; collision may be unreliable there",
         topo.non_manifold_edges));
   if (!topo.oriented())
-    body.warnings.push_back(fmt::format(
-        "{} edge(s) join triangles of opposite orientation; inside/outside tests may be wrong there",
-        topo.inconsistent_edges));
+    body.warnings.push_back(
+        fmt::format("{} edge(s) join triangles of opposite orientation; inside/outside tests may "
+                    "be wrong there",
+                    topo.inconsistent_edges));
   if (topo.boundary_edges > 0)
     body.warnings.push_back(fmt::format(
         "the body is open ({} boundary edge(s)): collision treats the body as a closed surface, "
@@ -350,12 +358,13 @@ Body load_body(const std::string& path, const BodyOptions& options) {
     throw BodyError(fmt::format("a body height of {} m is outside {} .. {} m", *options.height,
                                 kMinBodyHeight, kMaxBodyHeight));
   if (options.scale && !(std::isfinite(*options.scale) && *options.scale > 0))
-    throw BodyError(fmt::format("a scale of {} metres per file unit is not a positive finite number",
-                                *options.scale));
+    throw BodyError(fmt::format(
+        "a scale of {} metres per file unit is not a positive finite number", *options.scale));
   const double target = options.height.value_or(builtin ? kBuiltinHeight : 0.0);
   if (target > 0) {
     raw.scale = target / raw.height;
-    raw.scale_rule = fmt::format("height {:.3f} m {}", target, options.height ? "given" : "of the built-in body");
+    raw.scale_rule = fmt::format("height {:.3f} m {}", target,
+                                 options.height ? "given" : "of the built-in body");
   } else if (options.scale) {
     raw.scale = *options.scale;
     raw.scale_rule = "scale given";
@@ -373,7 +382,8 @@ Body load_body(const std::string& path, const BodyOptions& options) {
     raw.scale_rule = fmt::format("unknown units: scaled to {:.2f} m", kBuiltinHeight);
     body.warnings.push_back(fmt::format(
         "body height {:.4g} is not plausible in m, cm or mm; scaled to {:.2f} m (give 'height' or "
-        "'scale' to choose)", raw.height, kBuiltinHeight));
+        "'scale' to choose)",
+        raw.height, kBuiltinHeight));
   }
 
   const double height_m = raw.height * raw.scale;

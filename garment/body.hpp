@@ -20,8 +20,8 @@ class BodyError : public std::invalid_argument {
 
 // One of the six axis directions, e.g. "+z" or "-y".
 struct AxisDirection {
-  int axis = 1;    // 0 = x, 1 = y, 2 = z
-  int sign = 1;    // +1 or -1
+  int axis = 1;  // 0 = x, 1 = y, 2 = z
+  int sign = 1;  // +1 or -1
   std::string name() const;
   // Parses "x", "+y", "-z" (case-insensitive); throws BodyError on anything else.
   static AxisDirection parse(const std::string& text);
@@ -35,15 +35,15 @@ struct BodyOptions {
 
 // What the file held before normalisation, and what was done to it.
 struct RawBodyInfo {
-  std::string source;               // path, or "builtin (<path>)"
-  Eigen::Index meshes = 0;          // meshes merged from the scene
-  meshing::BoundingBox box;         // in file units and file axes
-  AxisDirection up;                 // up axis used
-  bool up_inferred = true;          // chosen by the rule rather than given
-  AxisDirection facing;             // direction the figure faces in the file
-  double height = 0;                // extent along up, file units
-  double scale = 1;                 // applied: metres per file unit
-  std::string scale_rule;           // why that scale ("height 1.75 m given", ...)
+  std::string source;        // path, or "builtin (<path>)"
+  Eigen::Index meshes = 0;   // meshes merged from the scene
+  meshing::BoundingBox box;  // in file units and file axes
+  AxisDirection up;          // up axis used
+  bool up_inferred = true;   // chosen by the rule rather than given
+  AxisDirection facing;      // direction the figure faces in the file
+  double height = 0;         // extent along up, file units
+  double scale = 1;          // applied: metres per file unit
+  std::string scale_rule;    // why that scale ("height 1.75 m given", ...)
   // Added after the rotation and the scale (feet on y = 0, centred on the vertical axis), m.
   Eigen::Vector3d shift = Eigen::Vector3d::Zero();
   // Enclosed volume as read, file units³ (negative: faces point inward; meaningful when closed).
@@ -52,7 +52,7 @@ struct RawBodyInfo {
 };
 
 struct Body {
-  meshing::TriMesh mesh;            // metres, +Y up, facing +Z
+  meshing::TriMesh mesh;  // metres, +Y up, facing +Z
   RawBodyInfo raw;
   std::vector<std::string> warnings;  // repairs made while loading
 };

@@ -17,7 +17,9 @@ struct UnionFind {
     std::iota(parent.begin(), parent.end(), 0);
   }
   int find(int a) {
-    while (parent[static_cast<size_t>(a)] != a) a = parent[static_cast<size_t>(a)] = parent[static_cast<size_t>(parent[static_cast<size_t>(a)])];
+    while (parent[static_cast<size_t>(a)] != a)
+      a = parent[static_cast<size_t>(a)] =
+          parent[static_cast<size_t>(parent[static_cast<size_t>(a)])];
     return a;
   }
   void unite(int a, int b) { parent[static_cast<size_t>(find(a))] = find(b); }
@@ -40,8 +42,8 @@ struct WorkCurve {
 
 Eigen::Vector3d point_at(const Eigen::MatrixX3d& pts, bool closed, double param) {
   const Eigen::Index n = pts.rows();
-  const Eigen::Index s = std::min<Eigen::Index>(static_cast<Eigen::Index>(std::floor(param)),
-                                                closed ? n - 1 : n - 2);
+  const Eigen::Index s =
+      std::min<Eigen::Index>(static_cast<Eigen::Index>(std::floor(param)), closed ? n - 1 : n - 2);
   const double t = param - static_cast<double>(s);
   return (1 - t) * pts.row(s).transpose() + t * pts.row((s + 1) % n).transpose();
 }
@@ -54,7 +56,8 @@ Eigen::MatrixX3d extract_piece(const Eigen::MatrixX3d& pts, bool closed, double 
   auto wrap = [&](double p) { return closed ? std::fmod(p, static_cast<double>(n)) : p; };
   std::vector<Eigen::Vector3d> out;
   out.push_back(point_at(pts, closed, wrap(a)));
-  for (Eigen::Index k = static_cast<Eigen::Index>(std::floor(a)) + 1; static_cast<double>(k) < b; ++k)
+  for (Eigen::Index k = static_cast<Eigen::Index>(std::floor(a)) + 1; static_cast<double>(k) < b;
+       ++k)
     if (static_cast<double>(k) > a + 1e-9 && static_cast<double>(k) < b - 1e-9)
       out.push_back(pts.row(k % n).transpose());
   out.push_back(point_at(pts, closed, wrap(b)));
@@ -81,7 +84,8 @@ std::pair<double, double> closest_param(const Eigen::MatrixX3d& pts, bool closed
   for (Eigen::Index s = 0; s < segments; ++s) {
     const Eigen::Vector3d a = pts.row(s).transpose(), b = pts.row((s + 1) % n).transpose();
     const Eigen::Vector3d ab = b - a;
-    const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+    const double t =
+        ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
     const double d = (a + t * ab - p).norm();
     if (d < best) best = d, best_param = static_cast<double>(s) + t;
   }
@@ -119,7 +123,8 @@ bool written_on_plane(const Sketch& sketch, const std::string& id) {
 
 double polyline_length(const Eigen::MatrixX3d& points) {
   double length = 0;
-  for (Eigen::Index k = 1; k < points.rows(); ++k) length += (points.row(k) - points.row(k - 1)).norm();
+  for (Eigen::Index k = 1; k < points.rows(); ++k)
+    length += (points.row(k) - points.row(k - 1)).norm();
   return length;
 }
 
@@ -190,7 +195,8 @@ CurveNetwork build_network(const Sketch& sketch, const std::vector<ProjectedCurv
   UnionFind clusters(static_cast<int>(ends.size()));
   for (size_t a = 0; a < ends.size(); ++a)
     for (size_t b = a + 1; b < ends.size(); ++b)
-      if ((end_points[a] - end_points[b]).norm() < tol) clusters.unite(static_cast<int>(a), static_cast<int>(b));
+      if ((end_points[a] - end_points[b]).norm() < tol)
+        clusters.unite(static_cast<int>(a), static_cast<int>(b));
   CurveNetwork net;
   std::vector<int> node_of_cluster(ends.size(), -1);
   std::vector<int> members;
@@ -205,14 +211,16 @@ CurveNetwork build_network(const Sketch& sketch, const std::vector<ProjectedCurv
     }
     node_members[static_cast<size_t>(node)].push_back(static_cast<int>(a));
     const auto [c, which] = ends[a];
-    (which == 0 ? work[static_cast<size_t>(c)].start_node : work[static_cast<size_t>(c)].end_node) = node;
+    (which == 0 ? work[static_cast<size_t>(c)].start_node : work[static_cast<size_t>(c)].end_node) =
+        node;
   }
   std::vector<bool> node_mirrored(net.nodes.size(), false);
   for (size_t node = 0; node < net.nodes.size(); ++node) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     for (int a : node_members[node]) {
       sum += end_points[static_cast<size_t>(a)];
-      if (work[static_cast<size_t>(ends[static_cast<size_t>(a)].first)].mirrored) node_mirrored[node] = true;
+      if (work[static_cast<size_t>(ends[static_cast<size_t>(a)].first)].mirrored)
+        node_mirrored[node] = true;
     }
     net.nodes[node] = sum / static_cast<double>(node_members[node].size());
   }
@@ -284,7 +292,8 @@ CurveNetwork build_network(const Sketch& sketch, const std::vector<ProjectedCurv
     curve.spec = static_cast<int>(c);
     curve.closed = w.closed;
     std::vector<Split> splits = w.splits;
-    std::sort(splits.begin(), splits.end(), [](const Split& a, const Split& b) { return a.param < b.param; });
+    std::sort(splits.begin(), splits.end(),
+              [](const Split& a, const Split& b) { return a.param < b.param; });
     const double n = static_cast<double>(w.points.rows());
     if (!w.closed) {
       splits.insert(splits.begin(), {0.0, w.start_node});
@@ -310,8 +319,9 @@ CurveNetwork build_network(const Sketch& sketch, const std::vector<ProjectedCurv
       if (w.on_plane) edge.points.col(0).setZero();
       edge.length = polyline_length(edge.points);
       if (edge.length < 1e-4)
-        sketch.fail(curves[c].json_path,
-                    fmt::format("two junctions on curve '{}' are closer than 0.1 mm", curves[c].id));
+        sketch.fail(
+            curves[c].json_path,
+            fmt::format("two junctions on curve '{}' are closer than 0.1 mm", curves[c].id));
       edge.orbit = static_cast<int>(net.edges.size());
       curve.nodes.push_back(a.node);
       curve.edges.push_back(static_cast<int>(net.edges.size()));
@@ -330,7 +340,8 @@ CurveNetwork build_network(const Sketch& sketch, const std::vector<ProjectedCurv
     copy.spec = net.curves[c].spec;
     copy.mirror_copy = true;
     copy.closed = net.curves[c].closed;
-    for (int node : net.curves[c].nodes) copy.nodes.push_back(mirror_node[static_cast<size_t>(node)]);
+    for (int node : net.curves[c].nodes)
+      copy.nodes.push_back(mirror_node[static_cast<size_t>(node)]);
     for (int e : net.curves[c].edges) {
       const NetworkEdge& original = net.edges[static_cast<size_t>(e)];
       NetworkEdge edge;

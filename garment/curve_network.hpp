@@ -15,20 +15,20 @@
 namespace sd::garment {
 
 struct NetworkEdge {
-  int curve = -1;            // NetworkCurve index
-  int from = -1, to = -1;    // node indices
-  Eigen::MatrixX3d points;   // #P by 3 polyline from node `from` to node `to` (exact ends)
-  double length = 0;         // metres
-  int orbit = -1;            // the original edge of a mirror copy; itself for originals
+  int curve = -1;           // NetworkCurve index
+  int from = -1, to = -1;   // node indices
+  Eigen::MatrixX3d points;  // #P by 3 polyline from node `from` to node `to` (exact ends)
+  double length = 0;        // metres
+  int orbit = -1;           // the original edge of a mirror copy; itself for originals
 };
 
 struct NetworkCurve {
-  std::string id;            // "side_l", or "side_l.mirror" for a copy
-  int spec = -1;             // index into Sketch::curves
+  std::string id;  // "side_l", or "side_l.mirror" for a copy
+  int spec = -1;   // index into Sketch::curves
   bool mirror_copy = false;
   bool closed = false;
-  std::vector<int> edges;    // in curve order
-  std::vector<int> nodes;    // edges.size() + 1 nodes along the curve (closed: first == last)
+  std::vector<int> edges;  // in curve order
+  std::vector<int> nodes;  // edges.size() + 1 nodes along the curve (closed: first == last)
 };
 
 struct CurveNetwork {
@@ -59,6 +59,8 @@ inline constexpr double kJunctionTangentArc = 0.02;
 Eigen::Vector3d polyline_end_tangent(const Eigen::MatrixX3d& points, bool at_start, double reach);
 
 // Mirror image across x = 0.
-inline Eigen::Vector3d mirror_point(const Eigen::Vector3d& p) { return {-p.x(), p.y(), p.z()}; }
+inline Eigen::Vector3d mirror_point(const Eigen::Vector3d& p) {
+  return {-p.x(), p.y(), p.z()};
+}
 
 }  // namespace sd::garment

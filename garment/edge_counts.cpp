@@ -63,10 +63,13 @@ std::optional<std::vector<int>> t_join(int nodes, const std::vector<int>& termin
                                        const std::vector<std::pair<int, int>>& edges,
                                        const std::vector<double>& costs) {
   const size_t k = terminals.size();
-  std::vector<std::vector<std::pair<int, int>>> adjacent(static_cast<size_t>(nodes));  // (node, edge)
+  std::vector<std::vector<std::pair<int, int>>> adjacent(
+      static_cast<size_t>(nodes));  // (node, edge)
   for (size_t e = 0; e < edges.size(); ++e) {
-    adjacent[static_cast<size_t>(edges[e].first)].emplace_back(edges[e].second, static_cast<int>(e));
-    adjacent[static_cast<size_t>(edges[e].second)].emplace_back(edges[e].first, static_cast<int>(e));
+    adjacent[static_cast<size_t>(edges[e].first)].emplace_back(edges[e].second,
+                                                               static_cast<int>(e));
+    adjacent[static_cast<size_t>(edges[e].second)].emplace_back(edges[e].first,
+                                                                static_cast<int>(e));
   }
   // Shortest paths from every terminal (Dijkstra), with the edge each node was reached by.
   std::vector<std::vector<double>> dist(k);
@@ -100,7 +103,8 @@ std::optional<std::vector<int>> t_join(int nodes, const std::vector<int>& termin
     const int i = std::countr_zero(s);
     for (size_t j = static_cast<size_t>(i) + 1; j < k; ++j) {
       if (!(s >> j & 1)) continue;
-      const double c = best[s & ~(size_t{1} << i) & ~(size_t{1} << j)] + dist[static_cast<size_t>(i)][static_cast<size_t>(terminals[j])];
+      const double c = best[s & ~(size_t{1} << i) & ~(size_t{1} << j)] +
+                       dist[static_cast<size_t>(i)][static_cast<size_t>(terminals[j])];
       if (c < best[s]) best[s] = c, partner[s] = static_cast<int>(j);
     }
   }
@@ -111,7 +115,8 @@ std::optional<std::vector<int>> t_join(int nodes, const std::vector<int>& termin
     for (int node = terminals[j]; node != terminals[i];) {  // walk back from j to i
       const int e = via[i][static_cast<size_t>(node)];
       used[static_cast<size_t>(e)] ^= 1;  // a shared stretch of two paths cancels
-      node = edges[static_cast<size_t>(e)].first == node ? edges[static_cast<size_t>(e)].second : edges[static_cast<size_t>(e)].first;
+      node = edges[static_cast<size_t>(e)].first == node ? edges[static_cast<size_t>(e)].second
+                                                         : edges[static_cast<size_t>(e)].first;
     }
     s &= ~(size_t{1} << i) & ~(size_t{1} << j);
   }
@@ -122,7 +127,8 @@ std::optional<std::vector<int>> t_join(int nodes, const std::vector<int>& termin
 }
 
 // Any solution by Gaussian elimination over GF(2) (rows = constraints, columns = variables).
-std::optional<std::vector<int>> eliminate(const std::vector<int>& group, const std::vector<bool>& odd,
+std::optional<std::vector<int>> eliminate(const std::vector<int>& group,
+                                          const std::vector<bool>& odd,
                                           const std::vector<std::vector<int>>& columns) {
   const size_t rows = group.size(), cols = columns.size();
   std::vector<std::vector<bool>> a(rows, std::vector<bool>(cols + 1, false));
@@ -158,7 +164,9 @@ std::optional<std::vector<int>> solve_parity(int constraint_count, const std::ve
   std::vector<int> parent(static_cast<size_t>(constraint_count));
   std::iota(parent.begin(), parent.end(), 0);
   std::function<int(int)> find = [&](int a) {
-    return parent[static_cast<size_t>(a)] == a ? a : parent[static_cast<size_t>(a)] = find(parent[static_cast<size_t>(a)]);
+    return parent[static_cast<size_t>(a)] == a
+               ? a
+               : parent[static_cast<size_t>(a)] = find(parent[static_cast<size_t>(a)]);
   };
   for (const ParityVariable& v : variables)
     for (size_t k = 1; k < v.constraints.size(); ++k)
@@ -168,7 +176,8 @@ std::optional<std::vector<int>> solve_parity(int constraint_count, const std::ve
 
   std::vector<int> chosen;
   for (const auto& [root, group] : groups) {
-    const bool any_odd = std::any_of(group.begin(), group.end(), [&](int c) { return odd[static_cast<size_t>(c)]; });
+    const bool any_odd =
+        std::any_of(group.begin(), group.end(), [&](int c) { return odd[static_cast<size_t>(c)]; });
     if (!any_odd) continue;
     std::map<int, int> local;
     for (size_t k = 0; k < group.size(); ++k) local[group[k]] = static_cast<int>(k);
@@ -182,8 +191,10 @@ std::optional<std::vector<int>> solve_parity(int constraint_count, const std::ve
       columns.push_back(rows);
     }
     std::optional<std::vector<int>> solution;
-    const bool graph = std::all_of(columns.begin(), columns.end(), [](const std::vector<int>& c) { return c.size() <= 2; });
-    const int odd_count = static_cast<int>(std::count_if(group.begin(), group.end(), [&](int c) { return odd[static_cast<size_t>(c)]; }));
+    const bool graph = std::all_of(columns.begin(), columns.end(),
+                                   [](const std::vector<int>& c) { return c.size() <= 2; });
+    const int odd_count = static_cast<int>(std::count_if(
+        group.begin(), group.end(), [&](int c) { return odd[static_cast<size_t>(c)]; }));
     if (graph && odd_count + 1 <= kExactParityOdd) {
       const int outside = static_cast<int>(group.size());
       std::vector<int> terminals;
@@ -212,10 +223,11 @@ std::optional<std::vector<int>> solve_parity(int constraint_count, const std::ve
       solution = exact_group(static_cast<int>(group.size()), start, masks, costs);
     } else {
       solution = eliminate(group, odd, columns);
-      spdlog::warn("parity fix: {} connected panels ({} with an odd total) and curve pieces "
-                   "shared by more than two panels; the edge-count change is feasible but not "
-                   "guaranteed minimal",
-                   group.size(), odd_count);
+      spdlog::warn(
+          "parity fix: {} connected panels ({} with an odd total) and curve pieces "
+          "shared by more than two panels; the edge-count change is feasible but not "
+          "guaranteed minimal",
+          group.size(), odd_count);
     }
     if (!solution) {
       if (unfixable)
@@ -258,7 +270,8 @@ EdgeCounts compute_edge_counts(const Sketch& sketch, const CurveNetwork& net,
     if (spec.edge_length)
       for (int e : curve.edges) target[static_cast<size_t>(e)] = *spec.edge_length;
     for (int e : curve.edges) {
-      const double ideal = net.edges[static_cast<size_t>(e)].length / target[static_cast<size_t>(e)];
+      const double ideal =
+          net.edges[static_cast<size_t>(e)].length / target[static_cast<size_t>(e)];
       result.ideal[static_cast<size_t>(e)] = ideal;
       result.counts[static_cast<size_t>(e)] = std::max(1, static_cast<int>(std::lround(ideal)));
     }
@@ -276,14 +289,16 @@ EdgeCounts compute_edge_counts(const Sketch& sketch, const CurveNetwork& net,
       std::vector<std::pair<double, int>> remainders;
       int assigned = 0;
       for (int e : curve.edges) {
-        const double share = 1 + (total - pieces) * net.edges[static_cast<size_t>(e)].length / length;
+        const double share =
+            1 + (total - pieces) * net.edges[static_cast<size_t>(e)].length / length;
         const int whole = static_cast<int>(std::floor(share));
         result.counts[static_cast<size_t>(e)] = whole;
         assigned += whole;
         remainders.emplace_back(share - whole, e);
       }
       std::sort(remainders.rbegin(), remainders.rend());
-      for (int k = 0; assigned < total; ++k, ++assigned) ++result.counts[static_cast<size_t>(remainders[static_cast<size_t>(k)].second)];
+      for (int k = 0; assigned < total; ++k, ++assigned)
+        ++result.counts[static_cast<size_t>(remainders[static_cast<size_t>(k)].second)];
       for (int e : curve.edges) fixed[static_cast<size_t>(e)] = true;
     }
   }
@@ -309,7 +324,8 @@ EdgeCounts compute_edge_counts(const Sketch& sketch, const CurveNetwork& net,
   std::map<int, std::map<int, int>> uses;  // orbit → constraint → occurrences
   for (int c = 0; c < constraints; ++c) {
     int total = 0;
-    for (const LoopEdge& e : loops[static_cast<size_t>(constraint_loop[static_cast<size_t>(c)])].edges) {
+    for (const LoopEdge& e :
+         loops[static_cast<size_t>(constraint_loop[static_cast<size_t>(c)])].edges) {
       total += result.counts[static_cast<size_t>(e.edge)];
       ++uses[net.edges[static_cast<size_t>(e.edge)].orbit][c];
     }
@@ -339,7 +355,8 @@ EdgeCounts compute_edge_counts(const Sketch& sketch, const CurveNetwork& net,
   int unfixable = -1;
   const auto chosen = solve_parity(constraints, odd, variables, &unfixable);
   if (!chosen) {
-    const PanelLoop& loop = loops[static_cast<size_t>(constraint_loop[static_cast<size_t>(unfixable)])];
+    const PanelLoop& loop =
+        loops[static_cast<size_t>(constraint_loop[static_cast<size_t>(unfixable)])];
     int total = 0;
     for (const LoopEdge& e : loop.edges) total += result.counts[static_cast<size_t>(e.edge)];
     sketch.fail(loop.json_path,

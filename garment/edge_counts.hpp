@@ -13,9 +13,9 @@
 namespace sd::garment {
 
 struct EdgeCounts {
-  std::vector<int> counts;        // per network edge; a mirror copy equals its original
-  std::vector<double> ideal;      // length / edge_length per edge
-  std::vector<int> changed;       // original edges whose count parity changed (±1)
+  std::vector<int> counts;    // per network edge; a mirror copy equals its original
+  std::vector<double> ideal;  // length / edge_length per edge
+  std::vector<int> changed;   // original edges whose count parity changed (±1)
 };
 
 // One unknown of the parity problem: flipping it toggles the parity of `constraints` (each

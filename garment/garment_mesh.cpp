@@ -56,7 +56,6 @@ struct VertexPool {
   }
 };
 
-
 // A seam vertex where both panels have a side vertex of valence 2 (the filler may move a corner
 // of a region along its boundary, and a mirrored panel and its copy do it at the same place)
 // becomes an interior vertex of valence 2: quads F1 = (b, c, x, a) and F2 = (b, a, y, c) folded
@@ -104,12 +103,18 @@ Eigen::Vector3d loop_facing(const std::vector<Eigen::MatrixX3d>& side_points) {
 
 std::string body_part_name(BodyPart part) {
   switch (part) {
-    case BodyPart::kHead: return "head";
-    case BodyPart::kTorso: return "torso";
-    case BodyPart::kLeftArm: return "left_arm";
-    case BodyPart::kRightArm: return "right_arm";
-    case BodyPart::kLeftLeg: return "left_leg";
-    case BodyPart::kRightLeg: return "right_leg";
+    case BodyPart::kHead:
+      return "head";
+    case BodyPart::kTorso:
+      return "torso";
+    case BodyPart::kLeftArm:
+      return "left_arm";
+    case BodyPart::kRightArm:
+      return "right_arm";
+    case BodyPart::kLeftLeg:
+      return "left_leg";
+    case BodyPart::kRightLeg:
+      return "right_leg";
   }
   return "torso";
 }
@@ -158,7 +163,8 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
     for (const LoopEdge& e : loops[l].edges) {
       auto& u = users[static_cast<size_t>(e.edge)];
       if (u.size() == 2) {
-        const std::string& curve = net.curves[static_cast<size_t>(net.edges[static_cast<size_t>(e.edge)].curve)].id;
+        const std::string& curve =
+            net.curves[static_cast<size_t>(net.edges[static_cast<size_t>(e.edge)].curve)].id;
         sketch.fail(loops[l].json_path + "/boundary",
                     fmt::format("curve '{}' already joins panels '{}' and '{}'; a seam joins "
                                 "exactly two panels, so '{}' cannot use it too",
@@ -184,8 +190,10 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
       p = meshing::resample_by_arc_length(edge.points, n);
       if (edge.points.col(0).cwiseAbs().maxCoeff() == 0) p.col(0).setZero();
     } else {
-      Eigen::MatrixX3d original = meshing::resample_by_arc_length(net.edges[static_cast<size_t>(orbit)].points, n);
-      if (net.edges[static_cast<size_t>(orbit)].points.col(0).cwiseAbs().maxCoeff() == 0) original.col(0).setZero();
+      Eigen::MatrixX3d original =
+          meshing::resample_by_arc_length(net.edges[static_cast<size_t>(orbit)].points, n);
+      if (net.edges[static_cast<size_t>(orbit)].points.col(0).cwiseAbs().maxCoeff() == 0)
+        original.col(0).setZero();
       original.col(0) *= -1.0;
       p = original;
     }
@@ -226,7 +234,8 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
     panel.mirror_copy = loop.mirror_copy;
     panel.ease = spec.ease;
     for (const LoopEdge& e : loop.edges)
-      panel.curves.push_back(net.curves[static_cast<size_t>(net.edges[static_cast<size_t>(e.edge)].curve)].id);
+      panel.curves.push_back(
+          net.curves[static_cast<size_t>(net.edges[static_cast<size_t>(e.edge)].curve)].id);
 
     // Sides: points and global ids from corner i to corner i+1.
     std::vector<Eigen::MatrixX3d> side_points;
@@ -251,7 +260,8 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
           }
         }
         Eigen::MatrixX3d m(static_cast<Eigen::Index>(pts.size()), 3);
-        for (size_t j = 0; j < pts.size(); ++j) m.row(static_cast<Eigen::Index>(j)) = pts[j].transpose();
+        for (size_t j = 0; j < pts.size(); ++j)
+          m.row(static_cast<Eigen::Index>(j)) = pts[j].transpose();
         side_points.push_back(std::move(m));
         side_ids.push_back(std::move(ids));
         panel.side_counts.push_back(static_cast<int>(side_ids.back().size()) - 1);
@@ -270,7 +280,8 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
       double offset = 0;
       int on_body = 0;
       for (const LoopEdge& e : loop.edges) {
-        const CurveSpec& cs = sketch.curves[static_cast<size_t>(net.curves[static_cast<size_t>(net.edges[static_cast<size_t>(e.edge)].curve)].spec)];
+        const CurveSpec& cs = sketch.curves[static_cast<size_t>(
+            net.curves[static_cast<size_t>(net.edges[static_cast<size_t>(e.edge)].curve)].spec)];
         if (!cs.on_body) continue;
         offset += cs.offset;
         ++on_body;
@@ -325,7 +336,8 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
         try {
           return meshing::fill_region(side_points, o);
         } catch (const meshing::FillError& e) {
-          sketch.fail(loop.json_path, fmt::format("panel '{}' cannot be filled with quads: {}", loop.id, e.what()));
+          sketch.fail(loop.json_path,
+                      fmt::format("panel '{}' cannot be filled with quads: {}", loop.id, e.what()));
         }
       };
       // The surface spanned by the boundary decides an "auto" panel: where it stays near or
@@ -349,14 +361,17 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
           const SurfacePoint s = body.closest_point(p);
           panel.span_gap = std::max(panel.span_gap, (p - s.position).dot(s.normal) - offset);
         }
-        if (fit == PanelFit::kAuto) fit = panel.span_gap > kSpanGap ? PanelFit::kFree : PanelFit::kBody;
+        if (fit == PanelFit::kAuto)
+          fit = panel.span_gap > kSpanGap ? PanelFit::kFree : PanelFit::kBody;
       }
       panel.fit = fit == PanelFit::kFree ? "free" : "body";
       if (fit == PanelFit::kBody)
         options.project = [&lift](const Eigen::Vector3d& p) { return lift(p).position; };
       else
         options.project = [&push_out](const Eigen::Vector3d& p) { return push_out(p).value_or(p); };
-      const auto normal = [&body](const Eigen::Vector3d& p) -> Eigen::Vector3d { return body.closest_point(p).normal; };
+      const auto normal = [&body](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+        return body.closest_point(p).normal;
+      };
       meshing::FilledPatch patch = fit == PanelFit::kBody ? fill(options) : std::move(*spanned);
       std::vector<char> fixed(static_cast<size_t>(patch.mesh.vertex_count()), 0);
       for (const auto& side : patch.topology.side_vertices)
@@ -414,10 +429,12 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
         for (size_t j = 0; j < patch.topology.side_vertices[s].size(); ++j)
           globals[static_cast<size_t>(patch.topology.side_vertices[s][j])] = side_ids[s][j];
       for (size_t v = 0; v < globals.size(); ++v)
-        if (globals[v] < 0) globals[v] = pool.add(patch.mesh.vertices.row(static_cast<Eigen::Index>(v)).transpose());
+        if (globals[v] < 0)
+          globals[v] = pool.add(patch.mesh.vertices.row(static_cast<Eigen::Index>(v)).transpose());
       for (Eigen::Index f = 0; f < patch.mesh.face_count(); ++f) {
         std::array<int, 4> q;
-        for (int k = 0; k < 4; ++k) q[static_cast<size_t>(k)] = globals[static_cast<size_t>(patch.mesh.faces(f, k))];
+        for (int k = 0; k < 4; ++k)
+          q[static_cast<size_t>(k)] = globals[static_cast<size_t>(patch.mesh.faces(f, k))];
         faces.push_back(q);
         face_panel.push_back(panel_index);
       }
@@ -444,9 +461,11 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
           const NetworkEdge& ce = net.edges[static_cast<size_t>(c.edge)];
           const NetworkEdge& ae = net.edges[static_cast<size_t>(a.edge)];
           const bool same_orbit = ce.orbit == ae.orbit;
-          if (same_orbit && (c.edge != a.edge || ce.points.col(0).cwiseAbs().maxCoeff() == 0)) b = &c;
+          if (same_orbit && (c.edge != a.edge || ce.points.col(0).cwiseAbs().maxCoeff() == 0))
+            b = &c;
         }
-        if (b == nullptr) throw std::runtime_error("mirror copy lost a boundary edge of " + original.id);
+        if (b == nullptr)
+          throw std::runtime_error("mirror copy lost a boundary edge of " + original.id);
         const std::vector<int>& ga = ids_of(a.edge);
         const std::vector<int>& gb = ids_of(b->edge);
         for (size_t j = 0; j < ga.size(); ++j) image[ga[j]] = gb[j];
@@ -456,12 +475,14 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
         const auto it = image.find(og[v]);
         globals[v] = it != image.end()
                          ? it->second
-                         : pool.add(mirror_point(patch.mesh.vertices.row(static_cast<Eigen::Index>(v)).transpose()));
+                         : pool.add(mirror_point(
+                               patch.mesh.vertices.row(static_cast<Eigen::Index>(v)).transpose()));
       }
       for (Eigen::Index f = 0; f < patch.mesh.face_count(); ++f) {
         const auto& pf = patch.mesh.faces;
-        faces.push_back({globals[static_cast<size_t>(pf(f, 0))], globals[static_cast<size_t>(pf(f, 3))],
-                         globals[static_cast<size_t>(pf(f, 2))], globals[static_cast<size_t>(pf(f, 1))]});
+        faces.push_back(
+            {globals[static_cast<size_t>(pf(f, 0))], globals[static_cast<size_t>(pf(f, 3))],
+             globals[static_cast<size_t>(pf(f, 2))], globals[static_cast<size_t>(pf(f, 1))]});
         face_panel.push_back(panel_index);
       }
       const GarmentPanel& op = garment.panels[static_cast<size_t>(loop.original)];
@@ -478,9 +499,10 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
 
   garment.merged_doublets = remove_doublets(faces, face_panel, pool.positions.size());
   if (const int doublets = garment.merged_doublets; doublets > 0)
-    spdlog::warn("{} seam vertex(es) had only two quads folded onto each other; merged them into "
-                 "one quad each (the seam steps one vertex aside there)",
-                 doublets);
+    spdlog::warn(
+        "{} seam vertex(es) had only two quads folded onto each other; merged them into "
+        "one quad each (the seam steps one vertex aside there)",
+        doublets);
   for (GarmentPanel& p : garment.panels) p.faces = 0;
   for (int p : face_panel) ++garment.panels[static_cast<size_t>(p)].faces;
   // Drop vertices no face uses (the centres of removed doublets), keeping order.
@@ -499,11 +521,14 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
     pool.positions = std::move(kept);
   }
   garment.mesh.vertices.resize(static_cast<Eigen::Index>(pool.positions.size()), 3);
-  for (size_t v = 0; v < pool.positions.size(); ++v) garment.mesh.vertices.row(static_cast<Eigen::Index>(v)) = pool.positions[v].transpose();
+  for (size_t v = 0; v < pool.positions.size(); ++v)
+    garment.mesh.vertices.row(static_cast<Eigen::Index>(v)) = pool.positions[v].transpose();
   garment.mesh.faces.resize(static_cast<Eigen::Index>(faces.size()), 4);
   for (size_t f = 0; f < faces.size(); ++f)
-    for (int k = 0; k < 4; ++k) garment.mesh.faces(static_cast<Eigen::Index>(f), k) = faces[f][static_cast<size_t>(k)];
-  garment.face_panel = Eigen::Map<const Eigen::VectorXi>(face_panel.data(), static_cast<Eigen::Index>(face_panel.size()));
+    for (int k = 0; k < 4; ++k)
+      garment.mesh.faces(static_cast<Eigen::Index>(f), k) = faces[f][static_cast<size_t>(k)];
+  garment.face_panel = Eigen::Map<const Eigen::VectorXi>(
+      face_panel.data(), static_cast<Eigen::Index>(face_panel.size()));
 
   // Every vertex's quads must form one fan (joined through edges at the vertex): panels that
   // touch only at a point are two curves drawn along one seam (the right side of a mirrored
@@ -565,10 +590,12 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
   std::map<std::pair<int, int>, std::pair<int, int>> directed;  // (a, b) → (face, count)
   for (size_t f = 0; f < faces.size(); ++f)
     for (int k = 0; k < 4; ++k) {
-      const int a = faces[f][static_cast<size_t>(k)], b = faces[f][static_cast<size_t>((k + 1) % 4)];
+      const int a = faces[f][static_cast<size_t>(k)],
+                b = faces[f][static_cast<size_t>((k + 1) % 4)];
       auto [it, inserted] = directed.try_emplace({a, b}, static_cast<int>(f), 0);
       if (!inserted) {
-        const GarmentPanel& p1 = garment.panels[static_cast<size_t>(face_panel[static_cast<size_t>(it->second.first)])];
+        const GarmentPanel& p1 =
+            garment.panels[static_cast<size_t>(face_panel[static_cast<size_t>(it->second.first)])];
         const GarmentPanel& p2 = garment.panels[static_cast<size_t>(face_panel[f])];
         sketch.fail("/panels",
                     fmt::format("panels '{}' and '{}' face opposite ways along their shared seam; "
@@ -578,7 +605,8 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
     }
   for (const auto& [edge, face] : directed)
     if (edge.first < edge.second && directed.contains({edge.second, edge.first}) &&
-        face_panel[static_cast<size_t>(face.first)] != face_panel[static_cast<size_t>(directed.at({edge.second, edge.first}).first)])
+        face_panel[static_cast<size_t>(face.first)] !=
+            face_panel[static_cast<size_t>(directed.at({edge.second, edge.first}).first)])
       ++garment.seam_edges;
 
   // Joins relabel their panels' group.
@@ -597,12 +625,16 @@ Garment build_garment(const Sketch& sketch, const BodySurface& body) {
       Eigen::Vector3d c = Eigen::Vector3d::Zero();
       for (int v : faces[f]) c += pool.positions[static_cast<size_t>(v)];
       c /= 4;
-      const Eigen::Vector3d a = pool.positions[static_cast<size_t>(faces[f][0])], b = pool.positions[static_cast<size_t>(faces[f][1])],
-                            cc = pool.positions[static_cast<size_t>(faces[f][2])], d = pool.positions[static_cast<size_t>(faces[f][3])];
+      const Eigen::Vector3d a = pool.positions[static_cast<size_t>(faces[f][0])],
+                            b = pool.positions[static_cast<size_t>(faces[f][1])],
+                            cc = pool.positions[static_cast<size_t>(faces[f][2])],
+                            d = pool.positions[static_cast<size_t>(faces[f][3])];
       panel.area += 0.5 * (cc - a).cross(d - b).norm();
-      if (f % 3 == 0) ++votes[static_cast<size_t>(classify_body_point(body.closest_point(c).position, height))];
+      if (f % 3 == 0)
+        ++votes[static_cast<size_t>(classify_body_point(body.closest_point(c).position, height))];
     }
-    panel.body_part = body_part_name(static_cast<BodyPart>(std::max_element(votes.begin(), votes.end()) - votes.begin()));
+    panel.body_part = body_part_name(
+        static_cast<BodyPart>(std::max_element(votes.begin(), votes.end()) - votes.begin()));
   }
   garment.parity_changes = static_cast<int>(counts.changed.size());
   for (const auto& u : users) garment.curve_pieces += u.empty() ? 0 : 1;

@@ -25,10 +25,10 @@ std::string body_part_name(BodyPart part);
 BodyPart classify_body_point(const Eigen::Vector3d& p, double height);
 
 struct GarmentPanel {
-  std::string id;              // "front", "front.mirror"
-  std::string group;           // the join it belongs to, else its id
+  std::string id;     // "front", "front.mirror"
+  std::string group;  // the join it belongs to, else its id
   std::string fabric;
-  std::string body_part;       // nearest body region (majority over its faces)
+  std::string body_part;  // nearest body region (majority over its faces)
   bool mirror_copy = false;
   double ease = 1.0;
   std::vector<std::string> curves;  // boundary curves in loop order (pieces repeat their curve)
@@ -38,19 +38,19 @@ struct GarmentPanel {
   int irregular_vertices = 0;
   meshing::QuadQuality quality;
   int faces = 0;
-  double area = 0;                  // m²
-  double max_body_gap = 0;          // m: largest |distance to body − offset| of on-body vertices
-  std::string fit = "body";         // how the interior was shaped: "body" or "free"
-  double span_gap = 0;              // m: farthest the spanned surface stands off the offset surface
+  double area = 0;           // m²
+  double max_body_gap = 0;   // m: largest |distance to body − offset| of on-body vertices
+  std::string fit = "body";  // how the interior was shaped: "body" or "free"
+  double span_gap = 0;       // m: farthest the spanned surface stands off the offset surface
 };
 
 struct Garment {
-  meshing::QuadMesh mesh;           // one conforming mesh, outward orientation
-  Eigen::VectorXi face_panel;       // #Q: index into panels
+  meshing::QuadMesh mesh;      // one conforming mesh, outward orientation
+  Eigen::VectorXi face_panel;  // #Q: index into panels
   std::vector<GarmentPanel> panels;
-  int seam_edges = 0;               // mesh edges shared by two panels
-  int parity_changes = 0;           // curve pieces whose count the parity fix changed
-  int curve_pieces = 0;             // network edges used by panels
+  int seam_edges = 0;      // mesh edges shared by two panels
+  int parity_changes = 0;  // curve pieces whose count the parity fix changed
+  int curve_pieces = 0;    // network edges used by panels
   // Seam vertices left inside only two quads folded onto each other, merged away (warned): a
   // side vertex of one quad on a seam a panel shares with its own mirror copy (the shorts' centre
   // front has one).

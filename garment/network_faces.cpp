@@ -24,26 +24,32 @@ struct Dart {
 };
 
 // Half-edge run away from the node along a dart: forward when the dart is the edge's start.
-int half_edge_of(const Dart& d) { return 2 * d.edge + (d.at_start ? 0 : 1); }
+int half_edge_of(const Dart& d) {
+  return 2 * d.edge + (d.at_start ? 0 : 1);
+}
 
 // Orthonormal tangent basis (e1, e2 = n × e1) of a unit normal: angles measured from e1 towards
 // e2 turn counter-clockwise seen from outside.
 std::pair<Eigen::Vector3d, Eigen::Vector3d> tangent_basis(const Eigen::Vector3d& n) {
-  const Eigen::Vector3d helper = std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d helper =
+      std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
   const Eigen::Vector3d e1 = (helper - helper.dot(n) * n).normalized();
   return {e1, n.cross(e1)};
 }
 
-double angle_in(const std::pair<Eigen::Vector3d, Eigen::Vector3d>& basis, const Eigen::Vector3d& d) {
+double angle_in(const std::pair<Eigen::Vector3d, Eigen::Vector3d>& basis,
+                const Eigen::Vector3d& d) {
   return std::atan2(d.dot(basis.second), d.dot(basis.first));
 }
 
 // Darts around every node, sorted counter-clockwise seen from outside the body.
-std::vector<std::vector<Dart>> sorted_darts(const CurveNetwork& net, const BodySurface& body,
-                                            std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>& bases) {
+std::vector<std::vector<Dart>> sorted_darts(
+    const CurveNetwork& net, const BodySurface& body,
+    std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>& bases) {
   std::vector<std::vector<Dart>> around(net.nodes.size());
   bases.clear();
-  for (const Eigen::Vector3d& p : net.nodes) bases.push_back(tangent_basis(body.closest_point(p).normal));
+  for (const Eigen::Vector3d& p : net.nodes)
+    bases.push_back(tangent_basis(body.closest_point(p).normal));
   for (size_t e = 0; e < net.edges.size(); ++e) {
     const NetworkEdge& edge = net.edges[e];
     const Eigen::Vector3d out = polyline_end_tangent(edge.points, true, kJunctionTangentArc);
@@ -53,7 +59,8 @@ std::vector<std::vector<Dart>> sorted_darts(const CurveNetwork& net, const BodyS
     around[to].push_back({static_cast<int>(e), false, angle_in(bases[to], back)});
   }
   for (auto& darts : around)
-    std::sort(darts.begin(), darts.end(), [](const Dart& a, const Dart& b) { return a.angle < b.angle; });
+    std::sort(darts.begin(), darts.end(),
+              [](const Dart& a, const Dart& b) { return a.angle < b.angle; });
   return around;
 }
 
@@ -66,7 +73,9 @@ std::vector<int> edge_components(const CurveNetwork& net) {
   std::vector<int> parent(net.nodes.size());
   std::iota(parent.begin(), parent.end(), 0);
   auto find = [&](int a) {
-    while (parent[static_cast<size_t>(a)] != a) a = parent[static_cast<size_t>(a)] = parent[static_cast<size_t>(parent[static_cast<size_t>(a)])];
+    while (parent[static_cast<size_t>(a)] != a)
+      a = parent[static_cast<size_t>(a)] =
+          parent[static_cast<size_t>(parent[static_cast<size_t>(a)])];
     return a;
   };
   for (const NetworkEdge& e : net.edges) parent[static_cast<size_t>(find(e.from))] = find(e.to);
@@ -118,7 +127,8 @@ int face_at(const CurveNetwork& net, const NetworkFaces& faces, const BodySurfac
             const Nearest& near, const Eigen::Vector3d& p) {
   if (near.node >= 0) {
     const std::vector<Dart>& darts = around[static_cast<size_t>(near.node)];
-    const double a = angle_in(bases[static_cast<size_t>(near.node)], p - net.nodes[static_cast<size_t>(near.node)]);
+    const double a = angle_in(bases[static_cast<size_t>(near.node)],
+                              p - net.nodes[static_cast<size_t>(near.node)]);
     // The sector [dart k, dart k+1) holding a lies on the left of the half-edge leaving along k.
     size_t k = darts.size() - 1;
     for (size_t i = 0; i < darts.size(); ++i)
@@ -162,7 +172,8 @@ NetworkFaces trace_faces(const CurveNetwork& net, const BodySurface& body) {
   return result;
 }
 
-Eigen::Vector3d seed_position(const Sketch& sketch, const PanelSpec& panel, const BodySurface& body) {
+Eigen::Vector3d seed_position(const Sketch& sketch, const PanelSpec& panel,
+                              const BodySurface& body) {
   const SeedSpec& seed = *panel.seed;
   if (seed.point3d) return *seed.point3d;
   const ViewFrame frame = view_frame(seed.view);
@@ -201,21 +212,23 @@ std::vector<LoopEdge> auto_panel_loop(const Sketch& sketch, const CurveNetwork& 
   // A curve with the face on both sides is not a boundary: it ends inside the region (or only
   // links two loops), and no disk has that boundary.
   for (const LoopEdge& e : loop)
-    if (faces.face_left[static_cast<size_t>(2 * e.edge)] == faces.face_left[static_cast<size_t>(2 * e.edge + 1)]) {
+    if (faces.face_left[static_cast<size_t>(2 * e.edge)] ==
+        faces.face_left[static_cast<size_t>(2 * e.edge + 1)]) {
       const NetworkEdge& edge = net.edges[static_cast<size_t>(e.edge)];
-      const bool free_end = around[static_cast<size_t>(edge.from)].size() == 1 || around[static_cast<size_t>(edge.to)].size() == 1;
-      const Eigen::Vector3d at = net.nodes[static_cast<size_t>(around[static_cast<size_t>(edge.from)].size() == 1 ? edge.from : edge.to)];
-      sketch.fail(path,
-                  free_end
-                      ? fmt::format("the region around the seed of panel '{}' is not closed: "
-                                    "curve '{}' ends inside it at ({:.3f}, {:.3f}, {:.3f}) "
-                                    "without meeting another curve; end it on a curve (or "
-                                    "remove it), or list the panel's curves",
-                                    panel.id, curve_name(net, e.edge), at.x(), at.y(), at.z())
-                      : fmt::format("the region around the seed of panel '{}' is not one closed "
-                                    "loop: curve '{}' has the region on both of its sides; list "
-                                    "the panel's curves instead",
-                                    panel.id, curve_name(net, e.edge)));
+      const bool free_end = around[static_cast<size_t>(edge.from)].size() == 1 ||
+                            around[static_cast<size_t>(edge.to)].size() == 1;
+      const Eigen::Vector3d at = net.nodes[static_cast<size_t>(
+          around[static_cast<size_t>(edge.from)].size() == 1 ? edge.from : edge.to)];
+      sketch.fail(
+          path, free_end ? fmt::format("the region around the seed of panel '{}' is not closed: "
+                                       "curve '{}' ends inside it at ({:.3f}, {:.3f}, {:.3f}) "
+                                       "without meeting another curve; end it on a curve (or "
+                                       "remove it), or list the panel's curves",
+                                       panel.id, curve_name(net, e.edge), at.x(), at.y(), at.z())
+                         : fmt::format("the region around the seed of panel '{}' is not one closed "
+                                       "loop: curve '{}' has the region on both of its sides; list "
+                                       "the panel's curves instead",
+                                       panel.id, curve_name(net, e.edge)));
     }
 
   // Curves inside the region that do not touch its boundary would make it a disk with holes.
@@ -245,7 +258,8 @@ std::set<std::string> auto_panel_curves_to_mirror(const Sketch& sketch, const Cu
   for (const PanelSpec& panel : sketch.panels) {
     if (!panel.auto_boundary || !panel.mirror) continue;
     for (const LoopEdge& e : auto_panel_loop(sketch, net, faces, body, panel)) {
-      const NetworkCurve& curve = net.curves[static_cast<size_t>(net.edges[static_cast<size_t>(e.edge)].curve)];
+      const NetworkCurve& curve =
+          net.curves[static_cast<size_t>(net.edges[static_cast<size_t>(e.edge)].curve)];
       ids.insert(sketch.curves[static_cast<size_t>(curve.spec)].id);
     }
   }

@@ -31,7 +31,8 @@ NetworkFaces trace_faces(const CurveNetwork& net, const BodySurface& body);
 
 // The seed of an "auto" panel in world coordinates: a view point cast onto the body along its
 // view ray (the first hit), or point3d as written. Throws SketchError when the ray misses.
-Eigen::Vector3d seed_position(const Sketch& sketch, const PanelSpec& panel, const BodySurface& body);
+Eigen::Vector3d seed_position(const Sketch& sketch, const PanelSpec& panel,
+                              const BodySurface& body);
 
 // The loop of an "auto" panel: the face containing its seed. Throws SketchError (at the seed's
 // path) when the seed lies on a curve, or the face is not one closed loop (a curve with a free

@@ -15,7 +15,6 @@
 namespace sd::garment {
 namespace {
 
-
 // Points of a loop edge in traversal order.
 Eigen::MatrixX3d ordered_points(const CurveNetwork& net, const LoopEdge& e) {
   const Eigen::MatrixX3d& p = net.edges[static_cast<size_t>(e.edge)].points;
@@ -67,7 +66,8 @@ double node_gap(const CurveNetwork& net, int a, int b) {
   double best = std::numeric_limits<double>::infinity();
   for (int x : net.curves[static_cast<size_t>(a)].nodes)
     for (int y : net.curves[static_cast<size_t>(b)].nodes)
-      best = std::min(best, (net.nodes[static_cast<size_t>(x)] - net.nodes[static_cast<size_t>(y)]).norm());
+      best = std::min(
+          best, (net.nodes[static_cast<size_t>(x)] - net.nodes[static_cast<size_t>(y)]).norm());
   return best;
 }
 
@@ -88,7 +88,8 @@ std::vector<LoopEdge> resolve_explicit(const Sketch& sketch, const CurveNetwork&
     const int a = curve_ids[i], b = curve_ids[(i + 1) % k];
     if (k == 1) break;
     bool meet = false;
-    for (int node : net.curves[static_cast<size_t>(a)].nodes) meet = meet || curve_has_node(net, b, node);
+    for (int node : net.curves[static_cast<size_t>(a)].nodes)
+      meet = meet || curve_has_node(net, b, node);
     if (meet) continue;
     const double gap = node_gap(net, a, b);
     if (i + 1 == k)
@@ -142,7 +143,8 @@ std::vector<LoopEdge> resolve_explicit(const Sketch& sketch, const CurveNetwork&
 }  // namespace
 
 int PanelLoop::side_end(int i) const {
-  return i + 1 < side_count() ? side_begin[static_cast<size_t>(i + 1)] : static_cast<int>(edges.size());
+  return i + 1 < side_count() ? side_begin[static_cast<size_t>(i + 1)]
+                              : static_cast<int>(edges.size());
 }
 
 int loop_start_node(const CurveNetwork& net, const LoopEdge& e) {
@@ -182,7 +184,7 @@ std::vector<PanelLoop> resolve_panels(const Sketch& sketch, const CurveNetwork& 
       mirror_edge[e] = static_cast<int>(e);
 
   const double corner_cos = std::cos(sketch.corner_angle_degrees * std::numbers::pi / 180);
-  std::optional<NetworkFaces> faces;  // traced when a panel is "auto"
+  std::optional<NetworkFaces> faces;      // traced when a panel is "auto"
   std::map<int, std::string> auto_faces;  // face → the auto panel that picked it
   std::vector<PanelLoop> loops;
   for (size_t p = 0; p < sketch.panels.size(); ++p) {
@@ -194,7 +196,8 @@ std::vector<PanelLoop> resolve_panels(const Sketch& sketch, const CurveNetwork& 
     if (spec.auto_boundary) {
       if (!faces) faces = trace_faces(net, body);
       loop.edges = auto_panel_loop(sketch, net, *faces, body, spec);
-      const int face = faces->face_left[static_cast<size_t>(2 * loop.edges.front().edge + (loop.edges.front().forward ? 0 : 1))];
+      const int face = faces->face_left[static_cast<size_t>(2 * loop.edges.front().edge +
+                                                            (loop.edges.front().forward ? 0 : 1))];
       const auto [it, fresh] = auto_faces.try_emplace(face, spec.id);
       if (!fresh)
         sketch.fail(spec.seed->json_path,
@@ -233,8 +236,10 @@ std::vector<PanelLoop> resolve_panels(const Sketch& sketch, const CurveNetwork& 
     // Turning angle at the start of each edge.
     loop.turning_deg.resize(m);
     for (size_t k = 0; k < m; ++k) {
-      const Eigen::Vector3d in = polyline_end_tangent(ordered_points(net, loop.edges[(k + m - 1) % m]), false, kJunctionTangentArc);
-      const Eigen::Vector3d out = polyline_end_tangent(ordered_points(net, loop.edges[k]), true, kJunctionTangentArc);
+      const Eigen::Vector3d in = polyline_end_tangent(
+          ordered_points(net, loop.edges[(k + m - 1) % m]), false, kJunctionTangentArc);
+      const Eigen::Vector3d out =
+          polyline_end_tangent(ordered_points(net, loop.edges[k]), true, kJunctionTangentArc);
       loop.turning_deg[k] = std::acos(std::clamp(in.dot(out), -1.0, 1.0)) * 180 / std::numbers::pi;
     }
     std::vector<bool> corner(m, false);
@@ -268,9 +273,12 @@ std::vector<PanelLoop> resolve_panels(const Sketch& sketch, const CurveNetwork& 
       ++corners;
     }
     // Rotate so the loop starts at a corner; sides run between consecutive corners.
-    const size_t first = static_cast<size_t>(std::find(corner.begin(), corner.end(), true) - corner.begin());
-    std::rotate(loop.edges.begin(), loop.edges.begin() + static_cast<long>(first), loop.edges.end());
-    std::rotate(loop.turning_deg.begin(), loop.turning_deg.begin() + static_cast<long>(first), loop.turning_deg.end());
+    const size_t first =
+        static_cast<size_t>(std::find(corner.begin(), corner.end(), true) - corner.begin());
+    std::rotate(loop.edges.begin(), loop.edges.begin() + static_cast<long>(first),
+                loop.edges.end());
+    std::rotate(loop.turning_deg.begin(), loop.turning_deg.begin() + static_cast<long>(first),
+                loop.turning_deg.end());
     std::rotate(corner.begin(), corner.begin() + static_cast<long>(first), corner.end());
     for (size_t k = 0; k < m; ++k)
       if (corner[k]) loop.side_begin.push_back(static_cast<int>(k));
@@ -289,9 +297,12 @@ std::vector<PanelLoop> resolve_panels(const Sketch& sketch, const CurveNetwork& 
         const LoopEdge& e = loop.edges[k];
         const int image = mirror_edge[static_cast<size_t>(e.edge)];
         if (image < 0)
-          sketch.fail(spec.json_path + "/mirror",
-                      fmt::format("panel '{}' cannot be mirrored: curve '{}' has no mirror copy",
-                                  spec.id, net.curves[static_cast<size_t>(net.edges[static_cast<size_t>(e.edge)].curve)].id));
+          sketch.fail(
+              spec.json_path + "/mirror",
+              fmt::format(
+                  "panel '{}' cannot be mirrored: curve '{}' has no mirror copy", spec.id,
+                  net.curves[static_cast<size_t>(net.edges[static_cast<size_t>(e.edge)].curve)]
+                      .id));
         copy.edges.push_back({image, !e.forward, e.boundary});
       }
       // Corner at the start of original edge k is at the start of copy edge (m - k) mod m.
@@ -305,7 +316,8 @@ std::vector<PanelLoop> resolve_panels(const Sketch& sketch, const CurveNetwork& 
       // Start at a corner.
       const int shift = copy.side_begin.front();
       std::rotate(copy.edges.begin(), copy.edges.begin() + shift, copy.edges.end());
-      std::rotate(copy.turning_deg.begin(), copy.turning_deg.begin() + shift, copy.turning_deg.end());
+      std::rotate(copy.turning_deg.begin(), copy.turning_deg.begin() + shift,
+                  copy.turning_deg.end());
       for (int& s : copy.side_begin) s -= shift;
       loops.push_back(std::move(copy));
     }

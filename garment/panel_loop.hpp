@@ -14,20 +14,20 @@
 namespace sd::garment {
 
 struct LoopEdge {
-  int edge = -1;         // NetworkEdge index
-  bool forward = true;   // traversed from edge.from to edge.to
-  int boundary = -1;     // position in the panel's boundary list (-1 for "auto" loops)
+  int edge = -1;        // NetworkEdge index
+  bool forward = true;  // traversed from edge.from to edge.to
+  int boundary = -1;    // position in the panel's boundary list (-1 for "auto" loops)
 };
 
 struct PanelLoop {
-  std::string id;            // "front", or "front.mirror" for a copy
-  std::string json_path;     // of the panel spec
-  int spec = -1;             // index into Sketch::panels
+  std::string id;         // "front", or "front.mirror" for a copy
+  std::string json_path;  // of the panel spec
+  int spec = -1;          // index into Sketch::panels
   bool mirror_copy = false;
-  int original = -1;         // PanelLoop index of the panel a copy mirrors; itself otherwise
-  std::vector<LoopEdge> edges;        // loop order, starting at corner 0
-  std::vector<int> side_begin;        // index into edges where side i starts (side_begin[0] = 0)
-  std::vector<double> turning_deg;    // turning angle at the start of each edge, degrees
+  int original = -1;                // PanelLoop index of the panel a copy mirrors; itself otherwise
+  std::vector<LoopEdge> edges;      // loop order, starting at corner 0
+  std::vector<int> side_begin;      // index into edges where side i starts (side_begin[0] = 0)
+  std::vector<double> turning_deg;  // turning angle at the start of each edge, degrees
 
   int side_count() const { return static_cast<int>(side_begin.size()); }
   // Edges of side i: [side_begin[i], side_begin[i+1]) (wrapping to edges.size()).

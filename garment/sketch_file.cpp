@@ -15,8 +15,8 @@
 #include <sstream>
 
 #include "garment/body_landmarks.hpp"
-#include "garment/sketch_inputs.hpp"
 #include "garment/input_checks.hpp"
+#include "garment/sketch_inputs.hpp"
 #include "garment/sketch_ranges.hpp"
 
 namespace sd::garment {
@@ -74,13 +74,15 @@ std::string mark_overflowing_numbers(std::string_view text) {
       i = j;
     } else if (c == '-' || (c >= '0' && c <= '9')) {
       size_t j = i + 1;
-      while (j < text.size() && (std::isdigit(static_cast<unsigned char>(text[j])) || text[j] == '.' ||
-                                 text[j] == 'e' || text[j] == 'E' || text[j] == '+' || text[j] == '-'))
+      while (j < text.size() &&
+             (std::isdigit(static_cast<unsigned char>(text[j])) || text[j] == '.' ||
+              text[j] == 'e' || text[j] == 'E' || text[j] == '+' || text[j] == '-'))
         ++j;
       const std::string token(text.substr(i, j - i));
       const double value = std::strtod(token.c_str(), nullptr);
       if (std::isinf(value))
-        out += fmt::format("\"\\u0001sketchdrape-overflow:{}\"", token);  // JSON escape of the marker
+        out +=
+            fmt::format("\"\\u0001sketchdrape-overflow:{}\"", token);  // JSON escape of the marker
       else
         out += token;
       i = j;
@@ -128,9 +130,10 @@ class Reader {
 
   double number(const json& value, const std::string& path) const {
     if (value.is_string() && value.get<std::string>().starts_with(kOverflowMarker)) {
-      fail(path, fmt::format("the number {} is not finite (too large for a double); coordinates "
-                             "and sizes must be finite numbers",
-                             value.get<std::string>().substr(std::string_view(kOverflowMarker).size())));
+      fail(path,
+           fmt::format("the number {} is not finite (too large for a double); coordinates "
+                       "and sizes must be finite numbers",
+                       value.get<std::string>().substr(std::string_view(kOverflowMarker).size())));
     }
     if (value.is_string()) {
       fail(path, fmt::format("expected a number, got {}; JSON numbers are written without quotes "
@@ -161,8 +164,8 @@ class Reader {
   int integer(const json& value, const std::string& path, int min_value) const {
     const double x = number(value, path);
     if (x != std::floor(x) || x < min_value || x > 1e7)
-      fail(path, fmt::format("expected a whole number of at least {}, got {}", min_value,
-                             value.dump()));
+      fail(path,
+           fmt::format("expected a whole number of at least {}, got {}", min_value, value.dump()));
     return static_cast<int>(x);
   }
 
@@ -173,7 +176,8 @@ class Reader {
   }
 
   std::string text(const json& value, const std::string& path) const {
-    if (!value.is_string()) fail(path, fmt::format("expected text in quotes, got {}", type_name(value)));
+    if (!value.is_string())
+      fail(path, fmt::format("expected text in quotes, got {}", type_name(value)));
     return value.get<std::string>();
   }
 
@@ -183,18 +187,17 @@ class Reader {
     const bool ok = std::all_of(id.begin(), id.end(), [](char c) {
       return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
     });
-    if (!ok)
-      fail(path, fmt::format("id '{}' may only use letters, digits, '_' and '-'", id));
+    if (!ok) fail(path, fmt::format("id '{}' may only use letters, digits, '_' and '-'", id));
     return id;
   }
 
   template <int N>
   Eigen::Matrix<double, N, 1> vector(const json& value, const std::string& path) const {
     if (!value.is_array() || value.size() != N)
-      fail(path, fmt::format("expected a point of {} numbers [{}], got {}", N,
-                             N == 2 ? "x, y" : "x, y, z",
-                             value.is_array() ? fmt::format("{} numbers", value.size())
-                                              : type_name(value)));
+      fail(path,
+           fmt::format(
+               "expected a point of {} numbers [{}], got {}", N, N == 2 ? "x, y" : "x, y, z",
+               value.is_array() ? fmt::format("{} numbers", value.size()) : type_name(value)));
     Eigen::Matrix<double, N, 1> v;
     for (int k = 0; k < N; ++k) v[k] = number(value[k], fmt::format("{}/{}", path, k));
     return v;
@@ -219,7 +222,8 @@ class Reader {
   }
 
   // A list of at most `most` entries at `path`.
-  void check_count(const json& list, const std::string& path, size_t most, std::string_view what) const {
+  void check_count(const json& list, const std::string& path, size_t most,
+                   std::string_view what) const {
     if (list.is_array() && list.size() > most)
       fail(path, fmt::format("{} {} is more than the {} allowed", list.size(), what, most));
   }
@@ -258,7 +262,8 @@ class Reader {
     if (cam.contains("up")) view.camera.up = vector<3>(cam["up"], cpath + "/up");
     if (cam.contains("fov")) {
       view.camera.fov_degrees = positive(cam["fov"], cpath + "/fov");
-      if (view.camera.fov_degrees >= 170) fail(cpath + "/fov", "the field of view must be below 170 degrees");
+      if (view.camera.fov_degrees >= 170)
+        fail(cpath + "/fov", "the field of view must be below 170 degrees");
     }
     const Eigen::Vector3d dir = view.camera.target - view.camera.eye;
     if (dir.norm() < 1e-6) fail(cpath, "the camera's eye and target are the same point");
@@ -275,15 +280,17 @@ class Reader {
 void parse_body_poses(const Reader& r, const json& m, const std::string& mpath,
                       const BodySpec& body, BodyMotionSpec& motion) {
   if (!m.contains("poses"))
-    r.fail(mpath, "a \"poses\" motion needs \"poses\": [{\"time\": 1.0, \"mesh\": "
-                  "\"pose.obj\"}, ...], the body's mesh in other poses");
+    r.fail(mpath,
+           "a \"poses\" motion needs \"poses\": [{\"time\": 1.0, \"mesh\": "
+           "\"pose.obj\"}, ...], the body's mesh in other poses");
   const json& list = m["poses"];
   const std::string lpath = mpath + "/poses";
   if (!list.is_array() || list.empty())
     r.fail(lpath, "expected a list of at least one pose {\"time\": seconds, \"mesh\": file}");
   if (body.mesh == "builtin")
-    r.fail(lpath, "the poses must be meshes of the same body: give the body's own file as "
-                  "\"mesh\" (the pose at time 0) instead of \"builtin\"");
+    r.fail(lpath,
+           "the poses must be meshes of the same body: give the body's own file as "
+           "\"mesh\" (the pose at time 0) instead of \"builtin\"");
   for (std::size_t k = 0; k < list.size(); ++k) {
     const std::string ppath = lpath + "/" + std::to_string(k);
     const json& p = list[k];
@@ -366,9 +373,9 @@ void parse_body(const Reader& r, const json& j, BodySpec& body) {
 const BodyLandmarks& sketch_landmarks(const Reader& r, const Sketch& sk, const std::string& path) {
   static std::mutex mutex;
   static std::map<std::string, BodyLandmarks> cache;
-  const std::string key = fmt::format("{}|{}|{}|{}", sk.resolve(sk.body.mesh).string(),
-                                      sk.body.height.value_or(0), sk.body.scale.value_or(0),
-                                      sk.body.up.value_or(""));
+  const std::string key =
+      fmt::format("{}|{}|{}|{}", sk.resolve(sk.body.mesh).string(), sk.body.height.value_or(0),
+                  sk.body.scale.value_or(0), sk.body.up.value_or(""));
   const std::lock_guard lock(mutex);
   if (const auto it = cache.find(key); it != cache.end()) return it->second;
   const Body body = load_sketch_body(sk);
@@ -385,8 +392,9 @@ Eigen::Vector3d landmark_point(const Reader& r, const json& j, const std::string
                                const Sketch& sk) {
   r.check_keys(j, path, {"at", "offset"});
   if (!j.contains("at"))
-    r.fail(path, "a point given by a landmark needs \"at\": its name, e.g. {\"at\": "
-                 "\"left_armpit\", \"offset\": [0.01, -0.03, 0]}");
+    r.fail(path,
+           "a point given by a landmark needs \"at\": its name, e.g. {\"at\": "
+           "\"left_armpit\", \"offset\": [0.01, -0.03, 0]}");
   const std::string name = r.text(j["at"], path + "/at");
   const Eigen::Vector3d offset =
       j.contains("offset") ? r.vector<3>(j["offset"], path + "/offset") : Eigen::Vector3d::Zero();
@@ -414,7 +422,8 @@ CurveSpec parse_curve(const Reader& r, const json& j, const std::string& path, c
   const std::string key = has_2d ? "points" : "points3d";
   const json& pts = j[key];
   const std::string ppath = path + "/" + key;
-  if (!pts.is_array()) r.fail(ppath, fmt::format("expected a list of points, got {}", type_name(pts)));
+  if (!pts.is_array())
+    r.fail(ppath, fmt::format("expected a list of points, got {}", type_name(pts)));
   if (pts.size() < 2) r.fail(ppath, fmt::format("curve '{}' needs at least 2 points", curve.id));
   r.check_count(pts, ppath, kMaxPointsPerCurve, "points");
   for (size_t i = 0; i < pts.size(); ++i) {
@@ -427,8 +436,9 @@ CurveSpec parse_curve(const Reader& r, const json& j, const std::string& path, c
   }
   if (j.contains("view")) {
     if (has_3d)
-      r.fail(path + "/view", "a \"view\" only applies to 2D \"points\"; \"points3d\" are world "
-                             "coordinates");
+      r.fail(path + "/view",
+             "a \"view\" only applies to 2D \"points\"; \"points3d\" are world "
+             "coordinates");
     curve.view = r.view(j["view"], path + "/view");
   }
   curve.offset = j.contains("offset") ? r.number(j["offset"], path + "/offset") : sk.offset;
@@ -441,7 +451,8 @@ CurveSpec parse_curve(const Reader& r, const json& j, const std::string& path, c
   if (j.contains("closed")) curve.closed = r.boolean(j["closed"], path + "/closed");
   if (curve.closed && pts.size() < 3)
     r.fail(ppath, fmt::format("closed curve '{}' needs at least 3 points", curve.id));
-  if (j.contains("edge_length")) curve.edge_length = r.edge_length(j["edge_length"], path + "/edge_length");
+  if (j.contains("edge_length"))
+    curve.edge_length = r.edge_length(j["edge_length"], path + "/edge_length");
   if (j.contains("edges")) {
     curve.edges = r.integer(j["edges"], path + "/edges", 1);
     if (*curve.edges > kMaxCurveEdges)
@@ -489,7 +500,8 @@ PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, c
   } else {
     if (!b.is_array())
       r.fail(path + "/boundary", fmt::format("expected a list of curve ids, got {}", type_name(b)));
-    if (b.empty()) r.fail(path + "/boundary", fmt::format("panel '{}' has no boundary curves", panel.id));
+    if (b.empty())
+      r.fail(path + "/boundary", fmt::format("panel '{}' has no boundary curves", panel.id));
     for (size_t i = 0; i < b.size(); ++i) {
       const std::string ip = fmt::format("{}/boundary/{}", path, i);
       std::string id = r.text(b[i], ip);
@@ -511,22 +523,25 @@ PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, c
   if (j.contains("seed")) {
     const std::string sp = path + "/seed";
     if (!panel.auto_boundary)
-      r.fail(sp, "a \"seed\" only picks the region of a \"boundary\": \"auto\" panel; this "
-                 "panel lists its curves");
+      r.fail(sp,
+             "a \"seed\" only picks the region of a \"boundary\": \"auto\" panel; this "
+             "panel lists its curves");
     const json& sj = j["seed"];
     r.require_object(sj, sp, "a seed");
     r.check_keys(sj, sp, {"view", "point", "point3d"});
     SeedSpec seed;
     seed.json_path = sp;
     if (sj.contains("point") == sj.contains("point3d"))
-      r.fail(sp, "a seed needs exactly one of \"point\" ([x, y] in its \"view\") or "
-                 "\"point3d\" ([x, y, z])");
+      r.fail(sp,
+             "a seed needs exactly one of \"point\" ([x, y] in its \"view\") or "
+             "\"point3d\" ([x, y, z])");
     if (sj.contains("point")) seed.point = r.position<2>(sj["point"], sp + "/point");
     if (sj.contains("point3d")) seed.point3d = r.position<3>(sj["point3d"], sp + "/point3d");
     if (sj.contains("view")) {
       if (seed.point3d)
-        r.fail(sp + "/view", "a \"view\" only applies to a 2D \"point\"; \"point3d\" is in "
-                             "world coordinates");
+        r.fail(sp + "/view",
+               "a \"view\" only applies to a 2D \"point\"; \"point3d\" is in "
+               "world coordinates");
       seed.view = r.view(sj["view"], sp + "/view");
     }
     panel.seed = seed;
@@ -548,7 +563,8 @@ PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, c
   }
   panel.fabric = j.contains("fabric") ? r.text(j["fabric"], path + "/fabric") : sk.fabric;
   if (j.contains("mirror")) panel.mirror = r.boolean(j["mirror"], path + "/mirror");
-  if (j.contains("edge_length")) panel.edge_length = r.edge_length(j["edge_length"], path + "/edge_length");
+  if (j.contains("edge_length"))
+    panel.edge_length = r.edge_length(j["edge_length"], path + "/edge_length");
   if (j.contains("ease")) {
     panel.ease = r.positive(j["ease"], path + "/ease");
     if (panel.ease < 0.5 || panel.ease > 2.0)
@@ -571,9 +587,12 @@ PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, c
   }
   if (j.contains("fit")) {
     const std::string fit = r.text(j["fit"], path + "/fit");
-    if (fit == "auto") panel.fit = PanelFit::kAuto;
-    else if (fit == "body") panel.fit = PanelFit::kBody;
-    else if (fit == "free") panel.fit = PanelFit::kFree;
+    if (fit == "auto")
+      panel.fit = PanelFit::kAuto;
+    else if (fit == "body")
+      panel.fit = PanelFit::kBody;
+    else if (fit == "free")
+      panel.fit = PanelFit::kFree;
     else
       r.fail(path + "/fit", fmt::format("\"fit\" is \"auto\", \"body\" (the panel lies on the "
                                         "body) or \"free\" (spanned by its curves, pushed out of "
@@ -592,11 +611,12 @@ void parse_adaptive(const Reader& r, const json& a, SimulateSpec& sim) {
     return;
   }
   if (!a.is_object())
-    r.fail(path, "expected true, false or an object of adaptive settings {\"refine_threshold\": "
-                 "0.002, ...}");
-  r.check_keys(a, path, {"enabled", "refine_threshold", "coarsen_threshold", "steady_rate",
-                         "min_lifetime", "min_level", "max_level", "max_vertices",
-                         "merge_batch", "even_levels"});
+    r.fail(path,
+           "expected true, false or an object of adaptive settings {\"refine_threshold\": "
+           "0.002, ...}");
+  r.check_keys(a, path,
+               {"enabled", "refine_threshold", "coarsen_threshold", "steady_rate", "min_lifetime",
+                "min_level", "max_level", "max_vertices", "merge_batch", "even_levels"});
   AdaptiveSpec& s = sim.adaptive_settings;
   if (a.contains("enabled")) sim.adaptive = r.boolean(a["enabled"], path + "/enabled");
   if (a.contains("refine_threshold"))
@@ -612,8 +632,8 @@ void parse_adaptive(const Reader& r, const json& a, SimulateSpec& sim) {
     s.steady_rate = r.non_negative(a["steady_rate"], path + "/steady_rate");
   if (a.contains("min_lifetime"))
     s.min_lifetime = r.non_negative(a["min_lifetime"], path + "/min_lifetime");
-  for (const auto& [key, level] : {std::pair{"min_level", &s.min_level},
-                                   std::pair{"max_level", &s.max_level}}) {
+  for (const auto& [key, level] :
+       {std::pair{"min_level", &s.min_level}, std::pair{"max_level", &s.max_level}}) {
     if (!a.contains(key)) continue;
     *level = r.integer(a[key], path + "/" + key, 0);
     if (**level > 30) r.fail(path + "/" + key, "levels go from 0 (the input's blocks) to 30");
@@ -630,16 +650,16 @@ void parse_adaptive(const Reader& r, const json& a, SimulateSpec& sim) {
              "the merge batch is a fraction of the particles (0.05: merges wait until 5 % of "
              "them can go at once); it must be below 1");
   }
-  if (a.contains("even_levels"))
-    s.even_levels = r.boolean(a["even_levels"], path + "/even_levels");
+  if (a.contains("even_levels")) s.even_levels = r.boolean(a["even_levels"], path + "/even_levels");
 }
 
 void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
   const std::string path = "/simulate";
   r.require_object(j, path, "simulate");
-  r.check_keys(j, path, {"duration", "adaptive", "time_step", "integrator", "solver", "bending",
-                         "stop_at_rest", "gravity", "pin_above", "check_body_vertices", "rest",
-                         "self_collision"});
+  r.check_keys(
+      j, path,
+      {"duration", "adaptive", "time_step", "integrator", "solver", "bending", "stop_at_rest",
+       "gravity", "pin_above", "check_body_vertices", "rest", "self_collision"});
   if (j.contains("pin_above")) sim.pin_above = r.number(j["pin_above"], path + "/pin_above");
   if (j.contains("duration")) {
     sim.duration = r.positive(j["duration"], path + "/duration");
@@ -674,11 +694,12 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
   if (j.contains("bending")) {
     sim.bending = r.text(j["bending"], path + "/bending");
     if (sim.bending != "hinges" && sim.bending != "quadratic")
-      r.fail(path + "/bending",
-             fmt::format("unknown bending model '{}'; use \"hinges\" or \"quadratic\"",
-                         sim.bending));
+      r.fail(
+          path + "/bending",
+          fmt::format("unknown bending model '{}'; use \"hinges\" or \"quadratic\"", sim.bending));
   }
-  if (j.contains("stop_at_rest")) sim.stop_at_rest = r.boolean(j["stop_at_rest"], path + "/stop_at_rest");
+  if (j.contains("stop_at_rest"))
+    sim.stop_at_rest = r.boolean(j["stop_at_rest"], path + "/stop_at_rest");
   if (j.contains("gravity")) {
     sim.gravity = r.vector<3>(j["gravity"], path + "/gravity");
     for (int k = 0; k < 3; ++k)
@@ -703,8 +724,9 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
 SheetSpec parse_sheet(const Reader& r, const json& j) {
   const std::string path = "/sheet";
   r.require_object(j, path, "sheet");
-  r.check_keys(j, path, {"size", "resolution", "orientation", "centre", "pins", "layers",
-                         "layer_offset", "layer_turn"});
+  r.check_keys(j, path,
+               {"size", "resolution", "orientation", "centre", "pins", "layers", "layer_offset",
+                "layer_turn"});
   SheetSpec sheet;
   if (j.contains("layers")) sheet.layers = r.integer(j["layers"], path + "/layers", 1);
   if (j.contains("layer_offset"))
@@ -740,8 +762,8 @@ SheetSpec parse_sheet(const Reader& r, const json& j) {
   if (j.contains("pins")) {
     const json& pins = j["pins"];
     if (!pins.is_array()) r.fail(path + "/pins", "expected a list of corner or edge names");
-    static constexpr std::string_view kNames[] = {"top-left", "top-right", "bottom-left",
-                                                  "bottom-right", "top", "bottom", "left", "right"};
+    static constexpr std::string_view kNames[] = {
+        "top-left", "top-right", "bottom-left", "bottom-right", "top", "bottom", "left", "right"};
     for (size_t i = 0; i < pins.size(); ++i) {
       const std::string pp = fmt::format("{}/pins/{}", path, i);
       const std::string name = r.text(pins[i], pp);
@@ -938,11 +960,16 @@ class DuplicateKeyCheck {
 
 std::string ViewSpec::name() const {
   switch (kind) {
-    case ViewKind::kFront: return "front";
-    case ViewKind::kBack: return "back";
-    case ViewKind::kLeft: return "left";
-    case ViewKind::kRight: return "right";
-    case ViewKind::kCamera: return "camera";
+    case ViewKind::kFront:
+      return "front";
+    case ViewKind::kBack:
+      return "back";
+    case ViewKind::kLeft:
+      return "left";
+    case ViewKind::kRight:
+      return "right";
+    case ViewKind::kCamera:
+      return "camera";
   }
   return "?";
 }
@@ -997,14 +1024,15 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
   json root;
   try {
     DuplicateKeyCheck duplicates(sketch);
-    root = json::parse(mark_overflowing_numbers(text), std::ref(duplicates), /*allow_exceptions=*/true,
-                       /*ignore_comments=*/true);
+    root =
+        json::parse(mark_overflowing_numbers(text), std::ref(duplicates), /*allow_exceptions=*/true,
+                    /*ignore_comments=*/true);
   } catch (const json::parse_error& e) {
     std::string detail = e.what();
     const size_t colon = detail.find("error while parsing");
     if (colon != std::string::npos) detail = detail.substr(colon);
-    r.fail("", fmt::format("{}: the file is not valid JSON ({})", position_of(text, e.byte),
-                           detail));
+    r.fail("",
+           fmt::format("{}: the file is not valid JSON ({})", position_of(text, e.byte), detail));
   }
   r.require_object(root, "", "a sketch file");
   r.check_keys(root, "",
@@ -1014,15 +1042,15 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
   if (root.contains("format")) {
     const std::string format = r.text(root["format"], "/format");
     if (format != kSketchFormat)
-      r.fail("/format", fmt::format("this program reads format \"{}\", not \"{}\"", kSketchFormat,
-                                    format));
+      r.fail("/format",
+             fmt::format("this program reads format \"{}\", not \"{}\"", kSketchFormat, format));
   }
   if (root.contains("body")) parse_body(r, root["body"], sketch.body);
   if (root.contains("edge_length")) {
     sketch.edge_length = r.positive(root["edge_length"], "/edge_length");
     if (sketch.edge_length < 0.002 || sketch.edge_length > 0.5)
-      r.fail("/edge_length", fmt::format("an edge length of {} m is outside 2 mm .. 50 cm",
-                                         sketch.edge_length));
+      r.fail("/edge_length",
+             fmt::format("an edge length of {} m is outside 2 mm .. 50 cm", sketch.edge_length));
   }
   if (root.contains("offset")) sketch.offset = r.number(root["offset"], "/offset");
   if (root.contains("junction_tolerance"))
@@ -1061,15 +1089,17 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
     for (const char* key : {"curves", "panels", "garment_mesh", "join"})
       if (root.contains(key))
         r.fail("/sheet", fmt::format("a sheet scene has no \"{}\": remove one or the other", key));
-    if (!root.contains("body")) sketch.body.mesh = "none";  // a sheet falls freely unless given a body
+    if (!root.contains("body"))
+      sketch.body.mesh = "none";  // a sheet falls freely unless given a body
     return sketch;
   }
 
   if (root.contains("garment_mesh")) {
     sketch.garment_mesh = r.text(root["garment_mesh"], "/garment_mesh");
     if (root.contains("curves") || root.contains("panels"))
-      r.fail("/garment_mesh", "a file with \"garment_mesh\" skips sketching: remove \"curves\" "
-                              "and \"panels\" (or remove \"garment_mesh\")");
+      r.fail("/garment_mesh",
+             "a file with \"garment_mesh\" skips sketching: remove \"curves\" "
+             "and \"panels\" (or remove \"garment_mesh\")");
     return sketch;
   }
 
@@ -1089,7 +1119,8 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
   if (!root.contains("panels")) r.fail("", "the file has no \"panels\"");
   const json& panels = root["panels"];
   if (!panels.is_array()) r.fail("/panels", "expected a list of panels");
-  if (panels.empty()) r.fail("/panels", "the list of panels is empty: a garment needs at least one panel");
+  if (panels.empty())
+    r.fail("/panels", "the list of panels is empty: a garment needs at least one panel");
   r.check_count(panels, "/panels", kMaxPanels, "panels");
   for (size_t i = 0; i < panels.size(); ++i) {
     PanelSpec panel = parse_panel(r, panels[i], fmt::format("/panels/{}", i), sketch);
@@ -1120,14 +1151,15 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
         const PanelSpec* p = sketch.find_panel(is_copy ? id.substr(0, id.size() - 7) : id);
         if (p == nullptr) r.fail(kp, fmt::format("panel '{}' is not defined", id));
         if (is_copy && !p->mirror)
-          r.fail(kp, fmt::format("panel '{}' has no mirror copy (set \"mirror\": true on '{}')",
-                                 id, p->id));
+          r.fail(kp, fmt::format("panel '{}' has no mirror copy (set \"mirror\": true on '{}')", id,
+                                 p->id));
         if (!joined.insert(id).second)
           r.fail(kp, fmt::format("panel '{}' is already part of a join", id));
         join.panels.push_back(id);
       }
       for (const JoinSpec& other : sketch.joins)
-        if (other.id == join.id) r.fail(ip + "/id", fmt::format("two joins have the id '{}'", join.id));
+        if (other.id == join.id)
+          r.fail(ip + "/id", fmt::format("two joins have the id '{}'", join.id));
       sketch.joins.push_back(std::move(join));
     }
   }

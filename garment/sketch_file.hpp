@@ -37,16 +37,16 @@ struct ViewSpec {
 
 struct CurveSpec {
   std::string id;
-  std::string json_path;                   // "/curves/3"
-  ViewSpec view;                           // the view `points` were drawn in
-  std::vector<Eigen::Vector2d> points;     // view-plane metres; empty when points3d is given
-  std::vector<Eigen::Vector3d> points3d;   // world metres; empty when points is given
-  double offset = 0.0;                     // metres along the body normal (default: file's)
-  bool on_body = true;                     // project/snap onto the body's offset surface
-  bool smooth = true;                      // Catmull-Rom through the points (false: polyline)
-  bool closed = false;                     // the last point joins the first
-  std::optional<double> edge_length;       // metres; overrides panel and global
-  std::optional<int> edges;                // fixed edge count (parity may not change it)
+  std::string json_path;                  // "/curves/3"
+  ViewSpec view;                          // the view `points` were drawn in
+  std::vector<Eigen::Vector2d> points;    // view-plane metres; empty when points3d is given
+  std::vector<Eigen::Vector3d> points3d;  // world metres; empty when points is given
+  double offset = 0.0;                    // metres along the body normal (default: file's)
+  bool on_body = true;                    // project/snap onto the body's offset surface
+  bool smooth = true;                     // Catmull-Rom through the points (false: polyline)
+  bool closed = false;                    // the last point joins the first
+  std::optional<double> edge_length;      // metres; overrides panel and global
+  std::optional<int> edges;               // fixed edge count (parity may not change it)
 
   bool is_3d() const { return !points3d.empty(); }
 };
@@ -68,18 +68,18 @@ enum class PanelFit { kAuto, kBody, kFree };
 
 struct PanelSpec {
   std::string id;
-  std::string json_path;                   // "/panels/1"
-  std::vector<std::string> boundary;       // curve ids in order around the panel
-  bool auto_boundary = false;              // "boundary": "auto"
-  std::optional<SeedSpec> seed;            // "auto": which region of the curve network
-  std::vector<std::string> corners;        // curves whose start (along the loop) is a corner
-  std::string fabric;                      // default: the file's fabric
-  bool mirror = false;                     // also make the copy across x = 0
-  std::optional<double> edge_length;       // metres
-  double ease = 1.0;                       // rest shape scale (1 = as designed)
-  std::optional<std::string> rest;         // "flat" | "shaped"; default: simulate.rest
-  std::optional<double> seam_allowance;    // metres; default: output.pattern.seam_allowance
-  PanelFit fit = PanelFit::kAuto;          // "fit"
+  std::string json_path;                 // "/panels/1"
+  std::vector<std::string> boundary;     // curve ids in order around the panel
+  bool auto_boundary = false;            // "boundary": "auto"
+  std::optional<SeedSpec> seed;          // "auto": which region of the curve network
+  std::vector<std::string> corners;      // curves whose start (along the loop) is a corner
+  std::string fabric;                    // default: the file's fabric
+  bool mirror = false;                   // also make the copy across x = 0
+  std::optional<double> edge_length;     // metres
+  double ease = 1.0;                     // rest shape scale (1 = as designed)
+  std::optional<std::string> rest;       // "flat" | "shaped"; default: simulate.rest
+  std::optional<double> seam_allowance;  // metres; default: output.pattern.seam_allowance
+  PanelFit fit = PanelFit::kAuto;        // "fit"
 };
 
 struct JoinSpec {
@@ -101,18 +101,18 @@ struct BodyPoseSpec {
 // times, interpolated linearly in between (sim::PoseSequence).
 struct BodyMotionSpec {
   std::string type = "arms-lowering";
-  double degrees = 10.0;   // arms-lowering: rotation at the end; negative raises the arms
-  double start = 0.0;      // arms-lowering: s, the arms start moving at this time of the drape
-  double duration = 1.0;   // arms-lowering: s from start to end
+  double degrees = 10.0;  // arms-lowering: rotation at the end; negative raises the arms
+  double start = 0.0;     // arms-lowering: s, the arms start moving at this time of the drape
+  double duration = 1.0;  // arms-lowering: s from start to end
   std::vector<BodyPoseSpec> poses;  // poses: strictly increasing times
 };
 
 struct BodySpec {
-  std::string mesh = "builtin";            // "builtin", "none", or a path relative to the sketch file
-  std::optional<double> height;            // metres
-  std::optional<double> scale;             // metres per file unit
-  std::optional<std::string> up;           // "+z", "y", ...
-  std::optional<BodyMotionSpec> motion;    // a still body when absent
+  std::string mesh = "builtin";          // "builtin", "none", or a path relative to the sketch file
+  std::optional<double> height;          // metres
+  std::optional<double> scale;           // metres per file unit
+  std::optional<std::string> up;         // "+z", "y", ...
+  std::optional<BodyMotionSpec> motion;  // a still body when absent
 };
 
 // "simulate": {"adaptive": {...}}: the adaptive 4-8 detail's settings. Unset values take the
@@ -131,20 +131,20 @@ struct AdaptiveSpec {
 
 // How the drape is simulated (`sketchdrape run`): plain values with defaults.
 struct SimulateSpec {
-  double duration = 3.0;                   // seconds of simulated time at most
-  bool adaptive = true;                    // 4-8 refinement/coarsening
-  bool adaptive_given = false;             // the file says "adaptive" (a sheet adapts only then)
-  AdaptiveSpec adaptive_settings;          // "adaptive": {...} (with "enabled" for the bool)
-  double time_step = 1.0 / 60.0;           // seconds, the largest step
+  double duration = 3.0;                      // seconds of simulated time at most
+  bool adaptive = true;                       // 4-8 refinement/coarsening
+  bool adaptive_given = false;                // the file says "adaptive" (a sheet adapts only then)
+  AdaptiveSpec adaptive_settings;             // "adaptive": {...} (with "enabled" for the bool)
+  double time_step = 1.0 / 60.0;              // seconds, the largest step
   std::string integrator = "implicit-euler";  // "implicit-euler" | "bdf2"
-  std::string solver = "cholmod";          // "pcg" | "cholmod"
+  std::string solver = "cholmod";             // "pcg" | "cholmod"
   // "hinges" | "quadratic": the discrete bending energy (docs/simulator.md, "Bending on any
   // mesh"). Hinges by default until the quadratic model is as fast and every design rests with
   // it (docs/fabrics.md).
   std::string bending = "hinges";
   bool stop_at_rest = true;
   Eigen::Vector3d gravity{0.0, -9.81, 0.0};
-  std::optional<double> pin_above;         // metres: garment vertices designed at y >= this are pinned
+  std::optional<double> pin_above;  // metres: garment vertices designed at y >= this are pinned
   // Also keep the body's vertices from poking through cloth triangles (sharp features: a dress
   // form's edges, shoulder tips, the front of a shoulder under 3 cm triangles). On by default:
   // without it a preview shows the body through the cloth; off saves up to half a drape's
@@ -160,12 +160,12 @@ struct SimulateSpec {
 
 // A rectangular sheet of cloth instead of a garment: scenes for tests and benchmarks.
 struct SheetSpec {
-  Eigen::Vector2d size{1.0, 1.0};          // metres: width (x) and height (y, or z when horizontal)
-  int columns = 16;                        // quads along the width
-  int rows = 16;                           // quads along the height
-  bool horizontal = false;                 // in the XZ plane instead of the XY plane
-  Eigen::Vector3d centre{0.0, 1.0, 0.0};   // metres
-  std::vector<std::string> pins;           // "top-left", ..., or whole edges "top", "left", ...
+  Eigen::Vector2d size{1.0, 1.0};         // metres: width (x) and height (y, or z when horizontal)
+  int columns = 16;                       // quads along the width
+  int rows = 16;                          // quads along the height
+  bool horizontal = false;                // in the XZ plane instead of the XY plane
+  Eigen::Vector3d centre{0.0, 1.0, 0.0};  // metres
+  std::vector<std::string> pins;          // "top-left", ..., or whole edges "top", "left", ...
   // Copies of the sheet stacked one over the other (two sheets falling onto each other): layer
   // k is the first moved by k·layer_offset and turned k·layer_turn degrees about the vertical
   // through the centre. Pins hold the first layer only.
@@ -180,7 +180,7 @@ struct ImageSpec {
   CameraSpec camera;
   int width = 800;
   int height = 1200;
-  std::optional<bool> wireframe;           // default: output.wireframe
+  std::optional<bool> wireframe;  // default: output.wireframe
 };
 
 // "output": {"pattern": true | {...}}: the flat sewing pattern (pattern.svg, .dxf, .json).
@@ -192,26 +192,28 @@ struct PatternSpec {
 
 struct OutputSpec {
   std::vector<ImageSpec> images;
-  bool images_listed = false;              // "images" was given (an empty list means none)
-  std::string mesh = "garment.obj";        // file name of the stitched garment (.obj or .glb)
+  bool images_listed = false;        // "images" was given (an empty list means none)
+  std::string mesh = "garment.obj";  // file name of the stitched garment (.obj or .glb)
   bool report = true;
   bool wireframe = false;
-  std::optional<PatternSpec> pattern;      // absent: no pattern files
+  std::optional<PatternSpec> pattern;  // absent: no pattern files
 };
 
 struct Sketch {
-  std::string file;                        // as given, for messages
-  std::filesystem::path base_dir;          // relative paths resolve here
+  std::string file;                // as given, for messages
+  std::filesystem::path base_dir;  // relative paths resolve here
   BodySpec body;
-  double edge_length = 0.03;               // metres
-  double offset = 0.01;                    // default curve offset, metres
-  double junction_tolerance = 0.015;       // metres: endpoints closer than this meet
-  double corner_angle_degrees = 35.0;      // a junction turning more than this is a corner
-  int relax_iterations = 10;               // interior smoothing sweeps of the quad filler
-  std::string fabric = "jersey";            // a preset of data/fabrics or a fabric .json path (sketchdrape run checks it)
-  std::string fabric_inline;                // "fabric" given as an object: its JSON text (then `fabric` is its name)
-  std::optional<std::string> garment_mesh; // triangle garment file: skips sketching and meshing
-  std::optional<SheetSpec> sheet;          // a sheet scene: no curves, panels or (unless given) body
+  double edge_length = 0.03;           // metres
+  double offset = 0.01;                // default curve offset, metres
+  double junction_tolerance = 0.015;   // metres: endpoints closer than this meet
+  double corner_angle_degrees = 35.0;  // a junction turning more than this is a corner
+  int relax_iterations = 10;           // interior smoothing sweeps of the quad filler
+  std::string fabric =
+      "jersey";  // a preset of data/fabrics or a fabric .json path (sketchdrape run checks it)
+  std::string
+      fabric_inline;  // "fabric" given as an object: its JSON text (then `fabric` is its name)
+  std::optional<std::string> garment_mesh;  // triangle garment file: skips sketching and meshing
+  std::optional<SheetSpec> sheet;  // a sheet scene: no curves, panels or (unless given) body
   std::vector<CurveSpec> curves;
   std::vector<PanelSpec> panels;
   std::vector<JoinSpec> joins;

@@ -14,17 +14,20 @@ namespace sd::garment {
 
 Body load_sketch_body(const Sketch& sketch) {
   if (sketch.body.mesh == "none")
-    sketch.fail("/body/mesh", "a garment is designed on a body: give \"builtin\" or a body mesh "
-                              "file instead of \"none\"");
+    sketch.fail("/body/mesh",
+                "a garment is designed on a body: give \"builtin\" or a body mesh "
+                "file instead of \"none\"");
   BodyOptions options;
   options.height = sketch.body.height;
   options.scale = sketch.body.scale;
-  const std::string path = sketch.body.mesh == "builtin" ? "builtin" : sketch.resolve(sketch.body.mesh).string();
+  const std::string path =
+      sketch.body.mesh == "builtin" ? "builtin" : sketch.resolve(sketch.body.mesh).string();
   try {
     if (sketch.body.up) options.up = AxisDirection::parse(*sketch.body.up);
     return load_body(path, options);
   } catch (const BodyError& e) {
-    sketch.fail("/body/mesh", fmt::format("the body '{}' cannot be used: {}", sketch.body.mesh, e.what()));
+    sketch.fail("/body/mesh",
+                fmt::format("the body '{}' cannot be used: {}", sketch.body.mesh, e.what()));
   }
 }
 
@@ -35,8 +38,9 @@ meshing::TriMesh load_garment_mesh(const Sketch& sketch) {
     sketch.fail(where, fmt::format("the garment mesh '{}' {}", path.string(), *problem));
   std::ifstream in(path);
   if (!in)
-    sketch.fail(where, fmt::format("the garment mesh '{}' {}", path.string(),
-                                   std::filesystem::exists(path) ? "cannot be read" : "does not exist"));
+    sketch.fail(where,
+                fmt::format("the garment mesh '{}' {}", path.string(),
+                            std::filesystem::exists(path) ? "cannot be read" : "does not exist"));
   if (path.extension() != ".obj")
     sketch.fail(where, "a garment mesh must be a Wavefront .obj file");
   std::vector<Eigen::Vector3d> vertices;
@@ -54,10 +58,11 @@ meshing::TriMesh load_garment_mesh(const Sketch& sketch) {
         sketch.fail(where, fmt::format("line {} of '{}' is not a vertex of three finite numbers",
                                        line_number, path.filename().string()));
       if (p.cwiseAbs().maxCoeff() > kMaxCoordinate)
-        sketch.fail(where, fmt::format("line {} of '{}': a vertex {}",
-                                       line_number, path.filename().string(),
-                                       out_of_range_sentence(p.cwiseAbs().maxCoeff(), -kMaxCoordinate,
-                                                             kMaxCoordinate, "at")));
+        sketch.fail(
+            where,
+            fmt::format("line {} of '{}': a vertex {}", line_number, path.filename().string(),
+                        out_of_range_sentence(p.cwiseAbs().maxCoeff(), -kMaxCoordinate,
+                                              kMaxCoordinate, "at")));
       vertices.push_back(p);
     } else if (tag == "f") {
       std::vector<int> ids;
@@ -79,9 +84,11 @@ meshing::TriMesh load_garment_mesh(const Sketch& sketch) {
   if (faces.empty()) sketch.fail(where, fmt::format("'{}' has no faces", path.filename().string()));
   meshing::TriMesh mesh;
   mesh.vertices.resize(static_cast<Eigen::Index>(vertices.size()), 3);
-  for (size_t v = 0; v < vertices.size(); ++v) mesh.vertices.row(static_cast<Eigen::Index>(v)) = vertices[v].transpose();
+  for (size_t v = 0; v < vertices.size(); ++v)
+    mesh.vertices.row(static_cast<Eigen::Index>(v)) = vertices[v].transpose();
   mesh.faces.resize(static_cast<Eigen::Index>(faces.size()), 3);
-  for (size_t f = 0; f < faces.size(); ++f) mesh.faces.row(static_cast<Eigen::Index>(f)) = faces[f].transpose();
+  for (size_t f = 0; f < faces.size(); ++f)
+    mesh.faces.row(static_cast<Eigen::Index>(f)) = faces[f].transpose();
   if (const auto problem = mesh_problem(mesh))
     sketch.fail(where, fmt::format("the garment mesh '{}' {}", path.filename().string(), *problem));
   return mesh;

@@ -25,12 +25,13 @@ inline constexpr int kMaxPanels = 1000;
 inline constexpr int kMaxPointsPerCurve = 10000;
 inline constexpr int kMaxCurveEdges = 20000;  // "edges" of one curve
 inline constexpr int kMaxRelaxIterations = 1000;
-inline constexpr int kMaxImages = 64;           // output.images entries
-inline constexpr int kMaxImageSide = 4096;      // px; render::kMaxImageSide (checked in src/app)
-inline constexpr double kMaxGravity = 10000.0;  // m/s² per component (1000 g, as far as stress goes)
-inline constexpr double kMinTimeStep = 1e-5;    // s
-inline constexpr double kMaxTimeStep = 0.1;     // s
-inline constexpr double kMaxDuration = 3600.0;  // s of simulated time
+inline constexpr int kMaxImages = 64;       // output.images entries
+inline constexpr int kMaxImageSide = 4096;  // px; render::kMaxImageSide (checked in src/app)
+inline constexpr double kMaxGravity =
+    10000.0;                                  // m/s² per component (1000 g, as far as stress goes)
+inline constexpr double kMinTimeStep = 1e-5;  // s
+inline constexpr double kMaxTimeStep = 0.1;   // s
+inline constexpr double kMaxDuration = 3600.0;                     // s of simulated time
 inline constexpr std::uintmax_t kMaxSketchFileBytes = 16'000'000;  // a sketch file
 inline constexpr std::uintmax_t kMaxMeshFileBytes = 512'000'000;   // a body or garment mesh
 

@@ -144,7 +144,8 @@ std::vector<Vec<D>> sample_stroke(const std::vector<Vec<D>>& points, bool closed
     const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / spacing)));
     for (int k = 0; k < steps; ++k) {
       const double u = static_cast<double>(k) / steps;
-      out.push_back(smooth && n > 2 ? catmull_rom<D>(before, a, b, after, u) : Vec<D>(a + u * (b - a)));
+      out.push_back(smooth && n > 2 ? catmull_rom<D>(before, a, b, after, u)
+                                    : Vec<D>(a + u * (b - a)));
     }
   }
   if (!closed) out.push_back(points.back());
@@ -161,8 +162,9 @@ std::pair<int, int> find_self_intersection(const std::vector<Eigen::Vector2d>& p
   for (int i = 0; i < segments; ++i)
     for (int j = i + 2; j < segments; ++j) {
       if (closed && i == 0 && j == segments - 1) continue;  // neighbours through the wrap
-      if (segments_cross(polyline[static_cast<size_t>(i)], polyline[static_cast<size_t>((i + 1) % n)],
-                         polyline[static_cast<size_t>(j)], polyline[static_cast<size_t>((j + 1) % n)]))
+      if (segments_cross(
+              polyline[static_cast<size_t>(i)], polyline[static_cast<size_t>((i + 1) % n)],
+              polyline[static_cast<size_t>(j)], polyline[static_cast<size_t>((j + 1) % n)]))
         return {i, j};
     }
   return {-1, -1};
@@ -175,14 +177,15 @@ std::pair<int, int> find_self_intersection(const Eigen::MatrixX3d& polyline, boo
   for (int i = 0; i < segments; ++i)
     for (int j = i + 3; j < segments; ++j) {
       if (closed && (i + segments - j) < 3) continue;
-      const double d = segment_distance(polyline.row(i), polyline.row((i + 1) % n),
-                                        polyline.row(j), polyline.row((j + 1) % n));
+      const double d = segment_distance(polyline.row(i), polyline.row((i + 1) % n), polyline.row(j),
+                                        polyline.row((j + 1) % n));
       if (d < tolerance) return {i, j};
     }
   return {-1, -1};
 }
 
-ProjectedCurve project_curve(const Sketch& sketch, const CurveSpec& curve, const BodySurface* body) {
+ProjectedCurve project_curve(const Sketch& sketch, const CurveSpec& curve,
+                             const BodySurface* body) {
   ProjectedCurve out;
   out.id = curve.id;
   out.json_path = curve.json_path;
@@ -192,7 +195,8 @@ ProjectedCurve project_curve(const Sketch& sketch, const CurveSpec& curve, const
   const std::string points_path = curve.json_path + (curve.is_3d() ? "/points3d" : "/points");
 
   if (curve.is_3d()) {
-    const auto dense = sample_stroke<3>(curve.points3d, curve.closed, curve.smooth, kCurveSampleSpacing);
+    const auto dense =
+        sample_stroke<3>(curve.points3d, curve.closed, curve.smooth, kCurveSampleSpacing);
     out.points.resize(static_cast<Eigen::Index>(dense.size()), 3);
     for (size_t i = 0; i < dense.size(); ++i) {
       Eigen::Vector3d p = dense[i];
@@ -200,7 +204,8 @@ ProjectedCurve project_curve(const Sketch& sketch, const CurveSpec& curve, const
       out.points.row(static_cast<Eigen::Index>(i)) = p.transpose();
     }
   } else {
-    const auto dense = sample_stroke<2>(curve.points, curve.closed, curve.smooth, kCurveSampleSpacing);
+    const auto dense =
+        sample_stroke<2>(curve.points, curve.closed, curve.smooth, kCurveSampleSpacing);
     const auto [i, j] = find_self_intersection(dense, curve.closed);
     if (i >= 0) {
       const Eigen::Vector2d where = dense[static_cast<size_t>(i)];

@@ -18,12 +18,12 @@ inline constexpr double kCurveSampleSpacing = 0.005;
 
 // How a view maps its 2D plane points (metres) to rays in the world.
 struct ViewFrame {
-  Eigen::Vector3d right;       // world direction of the plane's +x
-  Eigen::Vector3d up;          // world direction of the plane's +y
-  Eigen::Vector3d direction;   // viewing direction (into the scene), unit
+  Eigen::Vector3d right;         // world direction of the plane's +x
+  Eigen::Vector3d up;            // world direction of the plane's +y
+  Eigen::Vector3d direction;     // viewing direction (into the scene), unit
   Eigen::Vector3d plane_origin;  // world point of plane coordinates (0, 0)
   bool perspective = false;
-  Eigen::Vector3d eye;         // perspective only
+  Eigen::Vector3d eye;  // perspective only
 
   // The world point of plane coordinates (u, v).
   Eigen::Vector3d plane_point(const Eigen::Vector2d& uv) const;
@@ -39,12 +39,12 @@ ViewFrame view_frame(const ViewSpec& view);
 
 struct ProjectedCurve {
   std::string id;
-  std::string json_path;           // of the curve spec
-  Eigen::MatrixX3d points;         // #P by 3 world metres, spacing ~kCurveSampleSpacing
-  bool closed = false;             // points wrap around (the last point is not repeated)
+  std::string json_path;    // of the curve spec
+  Eigen::MatrixX3d points;  // #P by 3 world metres, spacing ~kCurveSampleSpacing
+  bool closed = false;      // points wrap around (the last point is not repeated)
   double offset = 0;
   bool on_body = true;
-  int misses = 0;                  // samples whose ray missed the body (depth interpolated)
+  int misses = 0;  // samples whose ray missed the body (depth interpolated)
 };
 
 // Samples a Catmull-Rom spline (centripetal) through `points` (or the polyline when !smooth) at

@@ -22,8 +22,10 @@ double worst_corner(const meshing::QuadMesh& mesh, const Face& f, const Eigen::V
   double worst = std::numeric_limits<double>::infinity();
   for (int k = 0; k < 4; ++k) {
     const Eigen::Vector3d p = mesh.vertices.row(f[static_cast<size_t>(k)]).transpose();
-    const Eigen::Vector3d e1 = mesh.vertices.row(f[static_cast<size_t>((k + 1) % 4)]).transpose() - p;
-    const Eigen::Vector3d e2 = mesh.vertices.row(f[static_cast<size_t>((k + 3) % 4)]).transpose() - p;
+    const Eigen::Vector3d e1 =
+        mesh.vertices.row(f[static_cast<size_t>((k + 1) % 4)]).transpose() - p;
+    const Eigen::Vector3d e2 =
+        mesh.vertices.row(f[static_cast<size_t>((k + 3) % 4)]).transpose() - p;
     const double scale = e1.norm() * e2.norm();
     worst = std::min(worst, scale > 0 ? e1.cross(e2).dot(n) / scale : -1.0);
   }
@@ -32,17 +34,18 @@ double worst_corner(const meshing::QuadMesh& mesh, const Face& f, const Eigen::V
 
 }  // namespace
 
-UntangleResult untangle_on_surface(meshing::QuadMesh& mesh, std::span<const char> fixed,
-                                   const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& project,
-                                   const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& normal,
-                                   int sweeps) {
+UntangleResult untangle_on_surface(
+    meshing::QuadMesh& mesh, std::span<const char> fixed,
+    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& project,
+    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& normal, int sweeps) {
   const size_t vertex_count = static_cast<size_t>(mesh.vertex_count());
   std::vector<Face> faces(static_cast<size_t>(mesh.face_count()));
   std::vector<std::vector<int>> incident(vertex_count);
   for (size_t f = 0; f < faces.size(); ++f)
     for (int k = 0; k < 4; ++k) {
       faces[f][static_cast<size_t>(k)] = mesh.faces(static_cast<Eigen::Index>(f), k);
-      incident[static_cast<size_t>(faces[f][static_cast<size_t>(k)])].push_back(static_cast<int>(f));
+      incident[static_cast<size_t>(faces[f][static_cast<size_t>(k)])].push_back(
+          static_cast<int>(f));
     }
   auto centre = [&](const Face& f) {
     Eigen::Vector3d c = Eigen::Vector3d::Zero();
@@ -55,7 +58,8 @@ UntangleResult untangle_on_surface(meshing::QuadMesh& mesh, std::span<const char
   for (size_t f = 0; f < faces.size(); ++f) normals[f] = normal(centre(faces[f]));
   auto count_folded = [&] {
     int folded = 0;
-    for (size_t f = 0; f < faces.size(); ++f) folded += worst_corner(mesh, faces[f], normals[f]) < kFolded ? 1 : 0;
+    for (size_t f = 0; f < faces.size(); ++f)
+      folded += worst_corner(mesh, faces[f], normals[f]) < kFolded ? 1 : 0;
     return folded;
   };
 
@@ -73,7 +77,9 @@ UntangleResult untangle_on_surface(meshing::QuadMesh& mesh, std::span<const char
       const auto& around = incident[static_cast<size_t>(v)];
       auto local = [&] {
         double worst = std::numeric_limits<double>::infinity();
-        for (int f : around) worst = std::min(worst, worst_corner(mesh, faces[static_cast<size_t>(f)], normals[static_cast<size_t>(f)]));
+        for (int f : around)
+          worst = std::min(worst, worst_corner(mesh, faces[static_cast<size_t>(f)],
+                                               normals[static_cast<size_t>(f)]));
         return worst;
       };
       // Candidates: the parallelogram completion a + c − b of each quad (a, c its neighbours
@@ -82,9 +88,12 @@ UntangleResult untangle_on_surface(meshing::QuadMesh& mesh, std::span<const char
       for (int f : around) {
         const Face& q = faces[static_cast<size_t>(f)];
         const int k = static_cast<int>(std::find(q.begin(), q.end(), v) - q.begin());
-        const Eigen::Vector3d a = mesh.vertices.row(q[static_cast<size_t>((k + 1) % 4)]).transpose();
-        const Eigen::Vector3d b = mesh.vertices.row(q[static_cast<size_t>((k + 2) % 4)]).transpose();
-        const Eigen::Vector3d c = mesh.vertices.row(q[static_cast<size_t>((k + 3) % 4)]).transpose();
+        const Eigen::Vector3d a =
+            mesh.vertices.row(q[static_cast<size_t>((k + 1) % 4)]).transpose();
+        const Eigen::Vector3d b =
+            mesh.vertices.row(q[static_cast<size_t>((k + 2) % 4)]).transpose();
+        const Eigen::Vector3d c =
+            mesh.vertices.row(q[static_cast<size_t>((k + 3) % 4)]).transpose();
         parallelogram += a + c - b;
         neighbours += 0.5 * (a + c);
       }

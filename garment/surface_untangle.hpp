@@ -18,15 +18,15 @@ namespace sd::garment {
 struct UntangleResult {
   int folded_before = 0;  // quads with a corner below zero, against the surface normal
   int folded_after = 0;
-  int moves = 0;          // accepted vertex moves
+  int moves = 0;  // accepted vertex moves
 };
 
 // `fixed` (#V flags, nonzero = fixed) marks the boundary; `project` maps a point onto the
 // surface (may be empty: then candidates are used as they are); `normal` gives the unit
 // outward surface normal near a point. At most `sweeps` passes over the folded quads.
-UntangleResult untangle_on_surface(meshing::QuadMesh& mesh, std::span<const char> fixed,
-                                   const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& project,
-                                   const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& normal,
-                                   int sweeps = 50);
+UntangleResult untangle_on_surface(
+    meshing::QuadMesh& mesh, std::span<const char> fixed,
+    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& project,
+    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& normal, int sweeps = 50);
 
 }  // namespace sd::garment

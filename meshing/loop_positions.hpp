@@ -8,7 +8,9 @@
 namespace sd::meshing::detail {
 
 // i modulo n, in [0, n) for negative i too.
-inline int wrap(int i, int n) { return ((i % n) + n) % n; }
+inline int wrap(int i, int n) {
+  return ((i % n) + n) % n;
+}
 
 // The loop's entries from position `from` to position `to` (inclusive), walking forward.
 inline std::vector<int> loop_segment(std::span<const int> loop, int from, int to) {

@@ -10,8 +10,8 @@
 #include <utility>
 
 #include "meshing/check.hpp"
-#include "meshing/quad_mesh.hpp"
 #include "meshing/mesh48_internal.hpp"
+#include "meshing/quad_mesh.hpp"
 
 namespace sd::meshing {
 namespace {
@@ -68,7 +68,6 @@ double min_angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen
   const Eigen::Vector3d u = q - p, w = r - p;
   return std::atan2(u.cross(w).norm(), u.dot(w));
 }
-
 
 }  // namespace
 
@@ -308,7 +307,9 @@ VertexId Mesh48::new_vertex() {
 TriangleId Mesh48::new_triangle() {
   return TriangleId(take_slot(triangles_, free_triangles_, triangle_count_));
 }
-BlockId Mesh48::new_block() { return BlockId(take_slot(blocks_, free_blocks_, block_count_)); }
+BlockId Mesh48::new_block() {
+  return BlockId(take_slot(blocks_, free_blocks_, block_count_));
+}
 
 void Mesh48::free_vertex(VertexId v) {
   release_slot(vertices_, free_vertices_, vertex_count_, v.value());
@@ -316,7 +317,9 @@ void Mesh48::free_vertex(VertexId v) {
 void Mesh48::free_triangle(TriangleId t) {
   release_slot(triangles_, free_triangles_, triangle_count_, t.value());
 }
-void Mesh48::free_block(BlockId k) { release_slot(blocks_, free_blocks_, block_count_, k.value()); }
+void Mesh48::free_block(BlockId k) {
+  release_slot(blocks_, free_blocks_, block_count_, k.value());
+}
 
 bool Mesh48::is_compact() const {
   return free_vertices_.empty() && free_triangles_.empty() && free_blocks_.empty();

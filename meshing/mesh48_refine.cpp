@@ -1,14 +1,13 @@
 // Mesh48's changes of topology: splitting and merging blocks (4-8 refinement and its inverse),
 // exporting the live mesh as arrays and compacting the slot vectors.
 
-#include "meshing/mesh48.hpp"
-
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "meshing/mesh48.hpp"
 #include "meshing/mesh48_internal.hpp"
 
 namespace sd::meshing {

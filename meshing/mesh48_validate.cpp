@@ -1,12 +1,11 @@
 // Mesh48::validate: every invariant of the 4-8 mesh checked from scratch.
 
-#include "meshing/mesh48.hpp"
-
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <string>
 #include <vector>
 
+#include "meshing/mesh48.hpp"
 #include "meshing/mesh48_internal.hpp"
 
 namespace sd::meshing {

@@ -53,8 +53,9 @@ void check_counts(std::span<const int> counts) {
     throw FillError("the sides have " + std::to_string(total) +
                     " edges in total; a quad mesh needs an even total (change one side by 1)");
   if (total < 4)
-    throw FillError("the sides have only 2 edges in total, both joining the same two corners; "
-                    "a quad mesh needs at least 4 boundary edges");
+    throw FillError(
+        "the sides have only 2 edges in total, both joining the same two corners; "
+        "a quad mesh needs at least 4 boundary edges");
 }
 
 struct Built {
@@ -237,8 +238,10 @@ std::optional<Plan> plan_with_strips(const detail::StripRegion& region, std::spa
   plan.irregular_vertices = region.fixed_irregular + plan.layout.irregular;
   plan.folded = region.folded + layout_folds;
   plan.flat = region.flat + plan.layout.flat;
-  if (!strips.empty()) plan.partition = "padded";
-  else plan.partition = plan.layout.corners == corner_positions(counts) ? "nasri" : "shifted-corners";
+  if (!strips.empty())
+    plan.partition = "padded";
+  else
+    plan.partition = plan.layout.corners == corner_positions(counts) ? "nasri" : "shifted-corners";
   // A layout without interior irregular vertex (reflex layout vertices allowed), only when it
   // costs strictly less: ties keep the Nasri/shifted-corner layouts and their figures.
   // Against a rival that does not fold, only what beats its distortion is worth searching.
@@ -334,8 +337,10 @@ Plan choose_plan(std::span<const int> counts, const BoundaryShape& shape,
   for (const int c : best_corners)
     if (shape.flat[static_cast<size_t>(c)] &&
         !std::binary_search(real_corners.begin(), real_corners.end(), c)) {
-      const int side = static_cast<int>(std::upper_bound(real_corners.begin(), real_corners.end(), c) -
-                                        real_corners.begin()) - 1;
+      const int side =
+          static_cast<int>(std::upper_bound(real_corners.begin(), real_corners.end(), c) -
+                           real_corners.begin()) -
+          1;
       if (std::find(exposed_sides.begin(), exposed_sides.end(), side) == exposed_sides.end())
         exposed_sides.push_back(side);
     }
@@ -415,8 +420,10 @@ Built realize(const Plan& plan, std::span<const int> counts,
       throw std::logic_error("a planned strip cannot be added");
   std::vector<int> loop;
   for (const auto& v : region.loop) loop.push_back(v.id);
-  if (!plan.turns.empty()) detail::fill_rectilinear(built.builder, loop, plan.turns);
-  else detail::fill_polygon(built.builder, loop, plan.layout);
+  if (!plan.turns.empty())
+    detail::fill_rectilinear(built.builder, loop, plan.turns);
+  else
+    detail::fill_polygon(built.builder, loop, plan.layout);
   return built;
 }
 
@@ -690,7 +697,9 @@ bool untangle_planar(FilledPatch& patch, const Eigen::Vector3d& normal) {
 
 }  // namespace
 
-std::vector<int> PatchTopology::corner_vertices() const { return corners_of(side_vertices); }
+std::vector<int> PatchTopology::corner_vertices() const {
+  return corners_of(side_vertices);
+}
 
 PatchTopology fill_region(std::span<const int> side_counts) {
   check_counts(side_counts);
@@ -850,8 +859,8 @@ FilledPatch fill_with_plan(const Plan& plan, std::span<const int> counts,
   FilledPatch patch;
   Built built = yasseen ? std::move(*yasseen) : realize(plan, counts, side_points, shape);
   // The same connectivity laid out flat for display.
-  patch.topology = to_topology(
-      realize(plan, counts, display_sides(counts), straight_sided_shape(counts)), plan);
+  patch.topology =
+      to_topology(realize(plan, counts, display_sides(counts), straight_sided_shape(counts)), plan);
   // Projection and relaxation work on the builder's arrays; the mesh is built once, after.
   std::vector<Eigen::Vector3d>& positions = built.builder.positions();
   std::vector<char> fixed(positions.size(), 0);

@@ -190,7 +190,8 @@ void untangle(std::vector<Eigen::Vector3d>& x, std::span<const Quad> quads,
       if (quad_min_jacobian_at_least(quads[f], normals[f], x, kUntangleTarget)) return;
       for (const int v : quads[f]) {
         choose(static_cast<size_t>(v));
-        for (int i = adj.neighbour_start[static_cast<size_t>(v)]; i < adj.neighbour_start[static_cast<size_t>(v) + 1]; ++i)
+        for (int i = adj.neighbour_start[static_cast<size_t>(v)];
+             i < adj.neighbour_start[static_cast<size_t>(v) + 1]; ++i)
           choose(static_cast<size_t>(adj.neighbours[static_cast<size_t>(i)]));
       }
     };
@@ -308,7 +309,8 @@ void relax_interior(std::vector<Eigen::Vector3d>& positions,
       to[v] = project ? project(mean) : mean;
     }
   };
-  auto largest_move = [&](const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b) {
+  auto largest_move = [&](const std::vector<Eigen::Vector3d>& a,
+                          const std::vector<Eigen::Vector3d>& b) {
     double largest = 0;
     for (const size_t v : movers) largest = std::max(largest, (a[v] - b[v]).squaredNorm());
     return largest;
@@ -377,7 +379,8 @@ void relax_interior(std::vector<Eigen::Vector3d>& positions,
         }
       queue.clear();
       for (const int v : reverted)
-        for (int c = adj.corner_start[static_cast<size_t>(v)]; c < adj.corner_start[static_cast<size_t>(v) + 1]; ++c) {
+        for (int c = adj.corner_start[static_cast<size_t>(v)];
+             c < adj.corner_start[static_cast<size_t>(v) + 1]; ++c) {
           const auto f = static_cast<size_t>(adj.corners[static_cast<size_t>(c)] / 4);
           if (!bad[f] && worse(f)) {
             bad[f] = 1;

@@ -55,10 +55,10 @@ void QuadMeshBuilder::add_grid(std::span<const int> bottom, std::span<const int>
     for (int i = 1; i < a; ++i) {
       const double u = static_cast<double>(i) / a, v = static_cast<double>(j) / b;
       // Bilinearly blended Coons patch of the four sides.
-      const Eigen::Vector3d p = (1 - v) * position(at(i, 0)) + v * position(at(i, b)) +
-                                (1 - u) * position(at(0, j)) + u * position(at(a, j)) -
-                                ((1 - u) * (1 - v) * c0 + u * (1 - v) * c1 + u * v * c2 +
-                                 (1 - u) * v * c3);
+      const Eigen::Vector3d p =
+          (1 - v) * position(at(i, 0)) + v * position(at(i, b)) + (1 - u) * position(at(0, j)) +
+          u * position(at(a, j)) -
+          ((1 - u) * (1 - v) * c0 + u * (1 - v) * c1 + u * v * c2 + (1 - u) * v * c3);
       at(i, j) = add_vertex(p);
     }
   for (int j = 0; j < b; ++j)

@@ -71,7 +71,7 @@ std::vector<int> boundary_loop(const QuadMesh& mesh) {
   if (!indices_in_range(mesh)) throw std::invalid_argument("a face refers to a missing vertex");
   const CornerEdges edges = corner_edges(mesh);
   const auto nv = static_cast<size_t>(mesh.vertices.rows());
-  std::vector<int> next(nv, -1);  // boundary edge from → to, in face orientation
+  std::vector<int> next(nv, -1);    // boundary edge from → to, in face orientation
   std::vector<int> enters(nv, -1);  // enters[w] == v: some face has the edge w → v
   size_t boundary_edges = 0;
   for (int v = 0; v < static_cast<int>(nv); ++v) {
@@ -115,7 +115,8 @@ MeshCheck validate(const QuadMesh& mesh) {
     for (int a = 0; a < 4; ++a)
       for (int b = a + 1; b < 4; ++b)
         if (q(a) == q(b))
-          problems.push_back("face " + std::to_string(f) + " repeats vertex " + std::to_string(q(a)));
+          problems.push_back("face " + std::to_string(f) + " repeats vertex " +
+                             std::to_string(q(a)));
   }
   const CornerEdges edges = corner_edges(mesh);
   auto uses = [&](int from, int to) {
@@ -162,7 +163,8 @@ MeshCheck validate(const QuadMesh& mesh) {
   if (problems.empty()) {
     const auto euler = mesh.vertices.rows() - undirected_edges + mesh.faces.rows();
     if (euler != 1)
-      problems.push_back("Euler characteristic is " + std::to_string(euler) + ", not 1 (not a disk)");
+      problems.push_back("Euler characteristic is " + std::to_string(euler) +
+                         ", not 1 (not a disk)");
   }
   const Eigen::RowVector3d lo = mesh.vertices.colwise().minCoeff();
   const Eigen::RowVector3d hi = mesh.vertices.colwise().maxCoeff();

@@ -57,7 +57,8 @@ QuadQuality measure_quality(const QuadMesh& mesh, std::span<const int> corner_ve
     }
   }
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  double convex_cos_min = kInf, convex_cos_max = -kInf, reflex_cos_min = kInf, reflex_cos_max = -kInf;
+  double convex_cos_min = kInf, convex_cos_max = -kInf, reflex_cos_min = kInf,
+         reflex_cos_max = -kInf;
   double max_aspect = 0, jac_min = std::numeric_limits<double>::infinity(), jac_sum = 0;
   for (Eigen::Index f = 0; f < q.cols(); ++f) {
     double quad_jac = std::numeric_limits<double>::infinity();
@@ -76,7 +77,8 @@ QuadQuality measure_quality(const QuadMesh& mesh, std::span<const int> corner_ve
       const double l1 = length[k], l2 = length[(k + 3) % 4];
       shortest = std::min(shortest, l1);
       longest = std::max(longest, l1);
-      const double cosine = (l1 > 0 && l2 > 0) ? std::clamp(e1.dot(e2) / (l1 * l2), -1.0, 1.0) : 1.0;
+      const double cosine =
+          (l1 > 0 && l2 > 0) ? std::clamp(e1.dot(e2) / (l1 * l2), -1.0, 1.0) : 1.0;
       const double jac =
           (l1 > 0 && l2 > 0 && nn > 0) ? e1.cross(e2).dot(unit_normal) / (l1 * l2) : 0.0;
       // A corner whose scaled Jacobian is negative is reflex or folded: its angle is
@@ -91,8 +93,8 @@ QuadQuality measure_quality(const QuadMesh& mesh, std::span<const int> corner_ve
       }
       quad_jac = std::min(quad_jac, jac);
     }
-    max_aspect = std::max(max_aspect, shortest > 0 ? longest / shortest
-                                                   : std::numeric_limits<double>::infinity());
+    max_aspect = std::max(
+        max_aspect, shortest > 0 ? longest / shortest : std::numeric_limits<double>::infinity());
     jac_min = std::min(jac_min, quad_jac);
     jac_sum += quad_jac;
     // A corner of exactly 180° (a quad at a side vertex of valence 2) is flat, not folded.
@@ -106,8 +108,10 @@ QuadQuality measure_quality(const QuadMesh& mesh, std::span<const int> corner_ve
       max_angle = std::acos(convex_cos_min) * kDegrees;
     }
     if (reflex_cos_max > -kInf) {
-      min_angle = std::min(min_angle, (2 * std::numbers::pi - std::acos(reflex_cos_min)) * kDegrees);
-      max_angle = std::max(max_angle, (2 * std::numbers::pi - std::acos(reflex_cos_max)) * kDegrees);
+      min_angle =
+          std::min(min_angle, (2 * std::numbers::pi - std::acos(reflex_cos_min)) * kDegrees);
+      max_angle =
+          std::max(max_angle, (2 * std::numbers::pi - std::acos(reflex_cos_max)) * kDegrees);
     }
     quality.min_angle_deg = min_angle;
     quality.max_angle_deg = max_angle;

@@ -13,10 +13,10 @@ struct QuadQuality {
   int irregular_vertices = 0;  // vertices whose valence is not the regular one
   double min_angle_deg = 0;    // smallest / largest corner angle over all quads
   double max_angle_deg = 0;
-  double max_aspect_ratio = 0;       // over quads: longest edge / shortest edge
-  double scaled_jacobian_min = 0;    // over all quad corners; 1 for a square, ≤ 0 when inverted
-  double scaled_jacobian_mean = 0;   // mean over quads of each quad's minimum corner value
-  int inverted_quads = 0;            // quads with a corner whose scaled Jacobian is < 0
+  double max_aspect_ratio = 0;      // over quads: longest edge / shortest edge
+  double scaled_jacobian_min = 0;   // over all quad corners; 1 for a square, ≤ 0 when inverted
+  double scaled_jacobian_mean = 0;  // mean over quads of each quad's minimum corner value
+  int inverted_quads = 0;           // quads with a corner whose scaled Jacobian is < 0
 };
 
 // Valence figures only (cheap, no geometry): distortion and irregular_vertices.

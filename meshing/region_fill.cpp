@@ -1,5 +1,3 @@
-#include "meshing/region_partition.hpp"
-
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
@@ -8,6 +6,7 @@
 #include <vector>
 
 #include "meshing/loop_positions.hpp"
+#include "meshing/region_partition.hpp"
 
 // The second half of the region partition: filling a chosen layout (the polygon's grids, the
 // Yasseen partition) and the strip regions.
@@ -54,8 +53,11 @@ bool fill_yasseen(QuadMeshBuilder& builder, const std::vector<std::vector<int>>&
   const auto n = static_cast<int>(sides.size());
   if (n < 3 || n % 4 == 0) return false;
   std::vector<int> l(static_cast<size_t>(n));
-  for (int i = 0; i < n; ++i) l[static_cast<size_t>(i)] = static_cast<int>(sides[static_cast<size_t>(i)].size()) - 1;
-  auto at = [n](auto& v, int i) -> auto& { return v[static_cast<size_t>(wrap(i, n))]; };
+  for (int i = 0; i < n; ++i)
+    l[static_cast<size_t>(i)] = static_cast<int>(sides[static_cast<size_t>(i)].size()) - 1;
+  auto at = [n](auto& v, int i) -> auto& {
+    return v[static_cast<size_t>(wrap(i, n))];
+  };
   const std::vector<int> doubled = nasri_distances_doubled(l);
   std::vector<int> d(static_cast<size_t>(n));
   bool any_short = false;
@@ -102,8 +104,10 @@ bool fill_yasseen(QuadMeshBuilder& builder, const std::vector<std::vector<int>>&
           changed = true;
         }
       };
-      if (at(known, i - 1)) settle(i - 1, i + 1);
-      else if (at(known, i + 1)) settle(i + 1, i - 1);
+      if (at(known, i - 1))
+        settle(i - 1, i + 1);
+      else if (at(known, i + 1))
+        settle(i + 1, i - 1);
       else {
         at(d, i - 1) = at(l, i) / 2;
         at(d, i + 1) = at(l, i) - at(l, i) / 2;
@@ -120,9 +124,12 @@ bool fill_yasseen(QuadMeshBuilder& builder, const std::vector<std::vector<int>>&
   for (int i = 0; i < n; ++i) {
     if (at(l, i) < 2) return false;
     int split;
-    if (!at(large, i)) split = at(d, i - 1);
-    else if (at(distorted, i) && !at(distorted, i + 1)) split = at(l, i) - at(d, i + 1);
-    else if (!at(distorted, i) && at(distorted, i + 1)) split = at(d, i - 1);
+    if (!at(large, i))
+      split = at(d, i - 1);
+    else if (at(distorted, i) && !at(distorted, i + 1))
+      split = at(l, i) - at(d, i + 1);
+    else if (!at(distorted, i) && at(distorted, i + 1))
+      split = at(d, i - 1);
     else
       split = static_cast<int>(std::lround(static_cast<double>(at(l, i)) * at(d, i - 1) /
                                            (at(d, i - 1) + at(d, i + 1))));
@@ -130,17 +137,20 @@ bool fill_yasseen(QuadMeshBuilder& builder, const std::vector<std::vector<int>>&
   }
   // A region that is not an exact rectangle is distorted too.
   for (int i = 0; i < n; ++i)
-    if (at(l, i - 1) - at(x, i - 1) != at(d, i) || at(x, i) != at(d, i - 1)) at(distorted, i) = true;
+    if (at(l, i - 1) - at(x, i - 1) != at(d, i) || at(x, i) != at(d, i - 1))
+      at(distorted, i) = true;
   if (std::all_of(distorted.begin(), distorted.end(), [](char b) { return b != 0; })) return false;
   // Runs of consecutive distorted regions are merged; each run must have an even perimeter.
-  const int start = static_cast<int>(std::find(distorted.begin(), distorted.end(), 0) -
-                                     distorted.begin());
+  const int start =
+      static_cast<int>(std::find(distorted.begin(), distorted.end(), 0) - distorted.begin());
   std::vector<std::pair<int, int>> runs;  // first and last region of each run
   for (int k = 1; k <= n; ++k) {
     const int i = start + k;
     if (!at(distorted, i)) continue;
-    if (!runs.empty() && runs.back().second == i - 1) runs.back().second = i;
-    else runs.emplace_back(i, i);
+    if (!runs.empty() && runs.back().second == i - 1)
+      runs.back().second = i;
+    else
+      runs.emplace_back(i, i);
   }
   for (const auto& [a, b] : runs) {
     int perimeter = (at(l, a - 1) - at(x, a - 1)) + at(x, b) + at(d, b) + at(d, a - 1);
@@ -155,7 +165,8 @@ bool fill_yasseen(QuadMeshBuilder& builder, const std::vector<std::vector<int>>&
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   int boundary_count = 0;
   for (const auto& side : sides)
-    for (size_t k = 0; k + 1 < side.size(); ++k, ++boundary_count) centre += builder.position(side[k]);
+    for (size_t k = 0; k + 1 < side.size(); ++k, ++boundary_count)
+      centre += builder.position(side[k]);
   const int g = builder.add_vertex(centre / boundary_count);
   std::vector<std::vector<int>> spoke(static_cast<size_t>(n));  // G → E_i
   for (int i = 0; i < n; ++i)
@@ -176,7 +187,8 @@ bool fill_yasseen(QuadMeshBuilder& builder, const std::vector<std::vector<int>>&
   std::vector<int> regular(static_cast<size_t>(builder.vertex_count()), 4);
   for (int i = 0; i < n; ++i)
     for (size_t k = 0; k < sides[static_cast<size_t>(i)].size(); ++k)
-      regular[static_cast<size_t>(sides[static_cast<size_t>(i)][k])] = k == 0 ? 2 : (k + 1 == sides[static_cast<size_t>(i)].size() ? 2 : 3);
+      regular[static_cast<size_t>(sides[static_cast<size_t>(i)][k])] =
+          k == 0 ? 2 : (k + 1 == sides[static_cast<size_t>(i)].size() ? 2 : 3);
   for (const auto& [a, b] : runs) {
     // Loop, counter-clockwise: E_{a-1} → corner a → … → E_b → G → E_{a-1}.
     std::vector<int> loop = side_part(a - 1, at(x, a - 1), at(l, a - 1));
@@ -246,7 +258,8 @@ bool StripRegion::strip(int side, QuadMeshBuilder* builder, const Eigen::Vector3
     auto inner = [&](int k) {
       return k == 0 ? at(a - 1).id : k == l ? at(b + 1).id : chain[static_cast<size_t>(k - 1)].id;
     };
-    for (int k = 0; k < l; ++k) builder->add_quad({at(a + k).id, at(a + k + 1).id, inner(k + 1), inner(k)});
+    for (int k = 0; k < l; ++k)
+      builder->add_quad({at(a + k).id, at(a + k + 1).id, inner(k + 1), inner(k)});
   }
   at(a - 1).outside += 1;
   at(b + 1).outside += 1;
@@ -261,9 +274,12 @@ bool StripRegion::strip(int side, QuadMeshBuilder* builder, const Eigen::Vector3
   next.insert(next.end(), chain.begin(), chain.end());
   for (int i = 0; i < n; ++i) {
     int& c = corners[static_cast<size_t>(i)];
-    if (i == wrap(side, n)) c = last_kept;
-    else if (i == wrap(side + 1, n)) c = 0;
-    else c = position_of[static_cast<size_t>(c)];
+    if (i == wrap(side, n))
+      c = last_kept;
+    else if (i == wrap(side + 1, n))
+      c = 0;
+    else
+      c = position_of[static_cast<size_t>(c)];
   }
   loop = std::move(next);
   return true;

@@ -20,9 +20,8 @@ std::vector<int> corner_arcs(std::span<const int> corners, int loop_size) {
   const auto m = static_cast<int>(corners.size());
   std::vector<int> arcs(static_cast<size_t>(m));
   for (int j = 0; j < m; ++j)
-    arcs[static_cast<size_t>(j)] =
-        wrap(corners[static_cast<size_t>(wrap(j + 1, m))] - corners[static_cast<size_t>(j)],
-             loop_size);
+    arcs[static_cast<size_t>(j)] = wrap(
+        corners[static_cast<size_t>(wrap(j + 1, m))] - corners[static_cast<size_t>(j)], loop_size);
   if (m == 1) arcs[0] = loop_size;
   return arcs;
 }
@@ -317,12 +316,13 @@ PositionCosts region_costs(std::span<const int> side_counts) {
 PolygonLayout best_layout(const PositionCosts& costs, int budget) {
   const int given = budget;
   const auto size = static_cast<int>(costs.as_side.size());
-  if (size < 4 || size % 2 != 0) throw std::logic_error("a quad-fillable loop has an even size >= 4");
+  if (size < 4 || size % 2 != 0)
+    throw std::logic_error("a quad-fillable loop has an even size >= 4");
   std::vector<int> naturals, others;  // positions that would rather be corners / the rest
   others.reserve(static_cast<size_t>(size));
   for (int p = 0; p < size; ++p)
     (costs.as_corner[static_cast<size_t>(p)] < costs.as_side[static_cast<size_t>(p)] ? naturals
-                                                                                      : others)
+                                                                                     : others)
         .push_back(p);
   const PolygonLayout fallback = fallback_layout(size, naturals, costs);
   auto delta = [&](int p) {

@@ -60,8 +60,7 @@ PolygonLayout best_layout(const PositionCosts& costs, int budget);
 int layout_cost_lower_bound(const PositionCosts& costs);
 
 // Fills the polygon whose boundary loop (vertex ids, counter-clockwise) is `loop`.
-void fill_polygon(QuadMeshBuilder& builder, std::span<const int> loop,
-                  const PolygonLayout& layout);
+void fill_polygon(QuadMeshBuilder& builder, std::span<const int> loop, const PolygonLayout& layout);
 
 // Position costs of a region's own boundary: real corners want to stay corners. Every side
 // vertex is flagged flat (straight sides); real corners are not.
@@ -77,9 +76,9 @@ PositionCosts region_costs(std::span<const int> side_counts);
 // interior vertex of valence 3 instead of a boundary vertex of valence 2 (flat or folded
 // quad). Strips on all sides make a full padding ring.
 struct LoopVertex {
-  int id = -1;        // vertex id in the builder (or -1 when only planning)
-  int outside = 0;    // edges it has outside the current region
-  int regular = 3;    // its regular valence in the whole fill
+  int id = -1;           // vertex id in the builder (or -1 when only planning)
+  int outside = 0;       // edges it has outside the current region
+  int regular = 3;       // its regular valence in the whole fill
   bool exposed = false;  // on the region's boundary with a flat or reflex angle: valence 2 here
                          // would leave one quad with that angle
   bool reflex = false;   // ... and that quad would be folded
@@ -94,8 +93,9 @@ struct StripRegion {
   int flat = 0;    // ... flat or reflex
 
   // Adds a strip along side `side`; false (nothing changed) when a neighbouring side has fewer
-  // than 2 edges or the loop would shrink below 4 vertices. With a builder, creates the chain's vertices (one edge length inwards of the
-  // side about `normal`, parallelogram points next to the corners) and the strip's quads.
+  // than 2 edges or the loop would shrink below 4 vertices. With a builder, creates the chain's
+  // vertices (one edge length inwards of the side about `normal`, parallelogram points next to the
+  // corners) and the strip's quads.
   bool strip(int side, QuadMeshBuilder* builder = nullptr,
              const Eigen::Vector3d& normal = Eigen::Vector3d::UnitZ());
 
@@ -112,7 +112,6 @@ constexpr int kFoldPenalty = 64;
 // regions filled by best_layout. `sides[i]` are the vertex ids of side i (corner i to corner
 // i+1). Returns false (builder untouched) when the partition does not apply: n divisible by 4,
 // every d_i already >= 1, half-integer distances, or nothing left but distorted regions.
-bool fill_yasseen(QuadMeshBuilder& builder, const std::vector<std::vector<int>>& sides,
-                  int budget);
+bool fill_yasseen(QuadMeshBuilder& builder, const std::vector<std::vector<int>>& sides, int budget);
 
 }  // namespace sd::meshing::detail

@@ -26,12 +26,12 @@ struct BoundingBox {
 BoundingBox bounding_box(const TriMesh& mesh);
 
 struct TriMeshTopology {
-  Eigen::Index boundary_edges = 0;       // edges with one incident face
-  Eigen::Index non_manifold_edges = 0;   // edges with three or more incident faces
-  Eigen::Index inconsistent_edges = 0;   // edges whose two faces traverse them the same way
-  Eigen::Index degenerate_faces = 0;     // repeated vertex index or area below 1e-12 of bbox²
-  Eigen::Index isolated_vertices = 0;    // vertices used by no face
-  Eigen::Index components = 0;           // connected pieces (through shared vertices)
+  Eigen::Index boundary_edges = 0;      // edges with one incident face
+  Eigen::Index non_manifold_edges = 0;  // edges with three or more incident faces
+  Eigen::Index inconsistent_edges = 0;  // edges whose two faces traverse them the same way
+  Eigen::Index degenerate_faces = 0;    // repeated vertex index or area below 1e-12 of bbox²
+  Eigen::Index isolated_vertices = 0;   // vertices used by no face
+  Eigen::Index components = 0;          // connected pieces (through shared vertices)
 
   bool closed() const { return boundary_edges == 0 && non_manifold_edges == 0; }
   bool edge_manifold() const { return non_manifold_edges == 0; }

@@ -23,6 +23,7 @@ if [ "$purpose" = test ]; then
     chromium  # tests/batch: the batch contact sheet (index.html) loads in headless Chromium
     python3-ezdxf  # tests/cli: the sewing pattern's pattern.dxf is read back with a real DXF library
     slurmctld slurmd slurm-client munge  # tests/batch/slurm_test.sh: a one-node Slurm cluster
+    clang-format  # scripts/check_format.sh: test.sh fails on C++ that .clang-format would change
     gnuplot-nox  # sketchdrape bench: the work-precision plots (optional: the CSV is written without it)
   )
 fi

@@ -29,6 +29,7 @@ if [ "${1:-}" = --sanitize ]; then
   exit
 fi
 ./scripts/setup.sh test
+./scripts/check_format.sh
 
 # The test executables link the simulator directly: give CHOLMOD's OpenMP loops and OpenBLAS one
 # thread, as `sketchdrape` does for itself (docs/simulator.md, "Threads").

@@ -1,5 +1,8 @@
 #include "sim/adaptive_detail.hpp"
 
+#include <spdlog/spdlog.h>
+
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -12,9 +15,6 @@
 #include <string>
 #include <unordered_map>
 #include <utility>
-
-#include <Eigen/Geometry>
-#include <spdlog/spdlog.h>
 
 #include "meshing/mesh48_transfer.hpp"
 #include "sim/element_forces.hpp"
@@ -36,7 +36,9 @@ void require(bool ok, const std::string& message) {
   if (!ok) throw InvalidAdaptiveSettingsError(message);
 }
 
-Eigen::Vector3d row3(const Eigen::VectorXd& flat, int i) { return flat.segment<3>(3 * i); }
+Eigen::Vector3d row3(const Eigen::VectorXd& flat, int i) {
+  return flat.segment<3>(3 * i);
+}
 
 }  // namespace
 
@@ -224,8 +226,8 @@ double AdaptiveCloth::rebuild(AdaptiveTransfer& state, const SimulationSettings*
     model = build_cloth_model(input, material_.fabric, material_.model_options);
     if (ease_scale.size() > 0) scale_rest_shapes(model, ease_scale);
   } else {
-    model = update_cloth_model(simulation_->model(), reuse, input, ease_scale,
-                               material_.model_options);
+    model =
+        update_cloth_model(simulation_->model(), reuse, input, ease_scale, material_.model_options);
   }
   if (first) {
     state.m = model.mass;
@@ -361,7 +363,8 @@ AdaptStats AdaptiveCloth::adapt() {
     // or merged away in this batch waits for the next step: one level per block per step).
     std::array<BlockId, 2> blocks;
     for (int side = 0; side < 2; ++side) {
-      const TriangleId t = arrays_.triangle_ids[static_cast<std::size_t>(arrays_.edge_faces(r, side))];
+      const TriangleId t =
+          arrays_.triangle_ids[static_cast<std::size_t>(arrays_.edge_faces(r, side))];
       if (!mesh_.alive(t)) continue;
       const auto& corners = mesh_.vertices(t);
       const bool has_edge = std::find(corners.begin(), corners.end(), i) != corners.end() &&

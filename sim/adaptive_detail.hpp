@@ -58,9 +58,9 @@ struct AdaptStats {
   int splits = 0;         // requested splits made
   int forced_splits = 0;  // splits the 4-8 rules forced first
   int merges = 0;
-  int moved_off_body = 0;  // split vertices moved out to the contact thickness
+  int moved_off_body = 0;           // split vertices moved out to the contact thickness
   int splits_declined_on_body = 0;  // requests not made: lifting E off the body would stretch
-  int vertices = 0;       // after the change
+  int vertices = 0;                 // after the change
   int triangles = 0;
   double estimate_s = 0.0;    // wall time: error estimates and merge candidates
   double operations_s = 0.0;  // splits, merges, mass/velocity/pin transfer
@@ -89,8 +89,8 @@ struct AdaptiveReport {
   int splits = 0;
   int forced_splits = 0;
   int merges = 0;
-  int topology_changes = 0;  // steps on which the mesh changed (and the model was rebuilt)
-  int moved_off_body = 0;    // split vertices moved out to the contact thickness
+  int topology_changes = 0;         // steps on which the mesh changed (and the model was rebuilt)
+  int moved_off_body = 0;           // split vertices moved out to the contact thickness
   int splits_declined_on_body = 0;  // per step, see split_stays_off_body
   int vertices_min = 0, vertices_max = 0;
   int max_level_reached = 0;
@@ -162,7 +162,7 @@ class AdaptiveCloth {
   Eigen::MatrixX3d velocities() const;
   // The masses carried through every split and merge (what the model uses), #V.
   const Eigen::VectorXd& masses() const { return masses_; }
-  const Eigen::MatrixX3i& faces() const { return arrays_.faces; }      // #F by 3
+  const Eigen::MatrixX3i& faces() const { return arrays_.faces; }            // #F by 3
   const Eigen::VectorXi& face_levels() const { return arrays_.face_level; }  // #F, for rendering
   // #F: the input face (quad) each triangle descends from (Mesh48::source_face).
   Eigen::VectorXi source_faces() const;
@@ -213,8 +213,8 @@ class AdaptiveCloth {
   AdaptiveSettings settings_;
   std::unique_ptr<Simulation> simulation_;
   meshing::Mesh48Arrays arrays_;
-  Eigen::VectorXd masses_;        // #V, by vertex id
-  std::vector<double> birth_;     // #F, simulated time each triangle was made
+  Eigen::VectorXd masses_;     // #V, by vertex id
+  std::vector<double> birth_;  // #F, simulated time each triangle was made
   std::vector<PinRecord> pins_;
   EdgeRestGeometry edge_rest_;   // per interior edge (rows of arrays_.interior_edges)
   BodySagCache body_sag_cache_;  // carried through topology changes by rebuild

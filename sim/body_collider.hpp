@@ -193,16 +193,17 @@ class BodyCollider {
   // triangle; a height above `unchecked_height` only when that closest point lies inside the
   // body (a cloth triangle beyond a body part, such as the far side of a sleeve, or beside it
   // is not pierced). Smaller heights are taken as they are: no body part is that thin, and at a
-  // sharp tip under tilted cloth the closest point can lie just outside the body. Broad phase: a uniform grid over the cloth triangles' boxes grown by max_height,
-  // built per call (the cloth changes every step; cells the size of the longest cloth edge).
-  // Sorted by body vertex; at most one (the highest) per body vertex, or with `every_triangle`
-  // each triangle in the band (a vertex under a cloth edge is under both its triangles).
-  // The height of one body vertex over one cloth triangle, as find_piercings measures it, with
-  // none of its filters (the band, the open edges, the inside check): for a pair the caller
-  // already follows. Nothing for a degenerate triangle or one edge-on to the body there.
+  // sharp tip under tilted cloth the closest point can lie just outside the body. Broad phase: a
+  // uniform grid over the cloth triangles' boxes grown by max_height, built per call (the cloth
+  // changes every step; cells the size of the longest cloth edge). Sorted by body vertex; at most
+  // one (the highest) per body vertex, or with `every_triangle` each triangle in the band (a vertex
+  // under a cloth edge is under both its triangles). The height of one body vertex over one cloth
+  // triangle, as find_piercings measures it, with none of its filters (the band, the open edges,
+  // the inside check): for a pair the caller already follows. Nothing for a degenerate triangle or
+  // one edge-on to the body there.
   std::optional<BodyPiercing> piercing_of_pair(const Eigen::VectorXd& x,
-                                               const std::array<int, 3>& triangle, int triangle_index,
-                                               int body_vertex) const;
+                                               const std::array<int, 3>& triangle,
+                                               int triangle_index, int body_vertex) const;
 
   std::vector<BodyPiercing> find_piercings(const Eigen::VectorXd& x, const ClothTriangles& cloth,
                                            double min_height, double max_height,

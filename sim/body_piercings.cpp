@@ -1,5 +1,3 @@
-#include "sim/body_collider.hpp"
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -10,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "sim/body_collider.hpp"
 #include "sim/parallel.hpp"
 
 // The other half of body-cloth contact: body vertices that poke through the cloth's triangles
@@ -47,9 +46,9 @@ ClothTriangles::ClothTriangles(std::vector<std::array<int, 3>> list)
 }
 
 std::optional<BodyPiercing> BodyCollider::piercing_of_pair(const Eigen::VectorXd& x,
-                                                          const std::array<int, 3>& triangle,
-                                                          int triangle_index,
-                                                          int body_vertex) const {
+                                                           const std::array<int, 3>& triangle,
+                                                           int triangle_index,
+                                                           int body_vertex) const {
   const Eigen::Vector3d b = corner(body_vertex, 1.0);
   const Eigen::Vector3d p0 = row(x, triangle[0]), p1 = row(x, triangle[1]),
                         p2 = row(x, triangle[2]);
@@ -133,8 +132,8 @@ std::vector<BodyPiercing> BodyCollider::find_piercings(
   // Unit normals once per triangle (zero when degenerate), not once per pair.
   std::vector<Eigen::Vector3d> normals(triangles.size());
   for (std::size_t t = 0; t < triangles.size(); ++t)
-    normals[t] = triangle_normal(row(x, triangles[t][0]), row(x, triangles[t][1]),
-                                 row(x, triangles[t][2]));
+    normals[t] =
+        triangle_normal(row(x, triangles[t][0]), row(x, triangles[t][1]), row(x, triangles[t][2]));
 
   // Body vertices in chunks on the simulator's threads, joined in vertex order (the same result
   // on any thread count, sim/parallel.hpp).

@@ -30,7 +30,9 @@ namespace {
 
 using Eigen::Vector3d;
 
-std::string triangle_name(Eigen::Index f) { return "triangle " + std::to_string(f); }
+std::string triangle_name(Eigen::Index f) {
+  return "triangle " + std::to_string(f);
+}
 
 // Warp direction of one triangle in its plane, unit length.
 Vector3d triangle_warp(const ClothInput& input, Eigen::Index f, const Vector3d& normal) {
@@ -44,7 +46,8 @@ Vector3d triangle_warp(const ClothInput& input, Eigen::Index f, const Vector3d& 
   }
   // The in-plane direction closest to `up`; a triangle facing up (horizontal cloth) has none,
   // then the projection of −Z (away from the viewer of a front view) is used, then +X.
-  for (const Vector3d& candidate : {input.up, Vector3d(-Vector3d::UnitZ()), Vector3d(Vector3d::UnitX())}) {
+  for (const Vector3d& candidate :
+       {input.up, Vector3d(-Vector3d::UnitZ()), Vector3d(Vector3d::UnitX())}) {
     const Vector3d warp = in_plane(candidate);
     if (warp.norm() > 1e-3 * candidate.norm()) return warp.normalized();
   }
@@ -109,8 +112,9 @@ TriangleElement make_triangle(const ClothInput& input, Eigen::Index f, double ex
     d << uv(2) - uv(0), uv(4) - uv(0), uv(3) - uv(1), uv(5) - uv(1);
     t.rest_area = 0.5 * d.determinant();
     if (!(t.rest_area > 1e-14 * extent * extent))
-      throw InvalidClothError(triangle_name(f) + " has a (nearly) zero or inverted rest triangle "
-                                                 "in its rest coordinates");
+      throw InvalidClothError(triangle_name(f) +
+                              " has a (nearly) zero or inverted rest triangle "
+                              "in its rest coordinates");
   } else {
     const Vector3d normal = cross.normalized();
     const Vector3d warp = triangle_warp(input, f, normal);
@@ -239,7 +243,8 @@ std::vector<BendStencil> make_bend_stencils(const Eigen::MatrixX3d& rest,
     const Vector3d e2 = normal.cross(e1);
     Eigen::MatrixXd conditions(7, count);
     for (int j = 0; j < count; ++j) {
-      const Vector3d d = (Vector3d(rest.row(points[static_cast<std::size_t>(j)])) - centre) / radius;
+      const Vector3d d =
+          (Vector3d(rest.row(points[static_cast<std::size_t>(j)])) - centre) / radius;
       const double u = d.dot(e1), w = d.dot(e2);
       conditions.col(j) << 1.0, u, w, u * u, u * w, w * w, d.dot(normal);
     }
@@ -252,7 +257,8 @@ std::vector<BendStencil> make_bend_stencils(const Eigen::MatrixX3d& rest,
     BendStencil stencil;
     stencil.vertices = points;
     const double rho2 = radius2 / (count - 1);  // m², mean squared distance of the ring
-    stencil.coupling = (area[static_cast<std::size_t>(v)] / (rho2 * rho2)) * (null * null.transpose());
+    stencil.coupling =
+        (area[static_cast<std::size_t>(v)] / (rho2 * rho2)) * (null * null.transpose());
     stencil.blocks.assign(static_cast<std::size_t>(count * count), 0);
     stencils.push_back(std::move(stencil));
   }
@@ -527,9 +533,8 @@ struct Neighbours {
   // offset(i,j) of BlockPattern: where block (i,j) starts in row i's columns.
   int offset(int i, int j) const {
     const auto first = list.begin() + start[static_cast<std::size_t>(i)];
-    return 3 * static_cast<int>(std::lower_bound(first, first + size[static_cast<std::size_t>(i)],
-                                                 j) -
-                                first);
+    return 3 * static_cast<int>(
+                   std::lower_bound(first, first + size[static_cast<std::size_t>(i)], j) - first);
   }
   void sort_run(int i) {
     const auto first = list.begin() + start[static_cast<std::size_t>(i)];
@@ -602,8 +607,8 @@ SparseMatrixR zero_pattern_matrix(const Neighbours& neighbours) {
     }
   }
   const std::vector<double> zeros(inner.size(), 0.0);
-  return Eigen::Map<const SparseMatrixR>(3 * n, 3 * n, static_cast<int>(inner.size()),
-                                         outer.data(), inner.data(), zeros.data());
+  return Eigen::Map<const SparseMatrixR>(3 * n, 3 * n, static_cast<int>(inner.size()), outer.data(),
+                                         inner.data(), zeros.data());
 }
 
 // The elements' block offsets and the diagonal offsets of the rows with wanted[i] (every row
@@ -637,9 +642,8 @@ void set_block_offsets(ClothModel& model, const Neighbours& neighbours,
     const int count = static_cast<int>(b.vertices.size());
     for (int k = 0; k < count; ++k)
       for (int l = 0; l < count; ++l)
-        b.blocks[static_cast<std::size_t>(count * k + l)] =
-            neighbours.offset(b.vertices[static_cast<std::size_t>(k)],
-                              b.vertices[static_cast<std::size_t>(l)]);
+        b.blocks[static_cast<std::size_t>(count * k + l)] = neighbours.offset(
+            b.vertices[static_cast<std::size_t>(k)], b.vertices[static_cast<std::size_t>(l)]);
   }
 }
 
@@ -748,13 +752,12 @@ ClothModel build_cloth_model(const ClothInput& input, const FabricParameters& fa
     }
     const TriangleElement& first = model.triangles[e0.face];
     const TriangleElement& second = model.triangles[e1.face];
-    model.hinges.push_back(make_hinge(rest, first.vertices, e0.corner, second.vertices,
-                                      e1.corner, first.rest_area + second.rest_area, options));
+    model.hinges.push_back(make_hinge(rest, first.vertices, e0.corner, second.vertices, e1.corner,
+                                      first.rest_area + second.rest_area, options));
   }
   if (non_manifold > 0)
     spdlog::warn("cloth mesh: {} non-manifold edges get no bending stiffness", non_manifold);
-  if (options.bend_weights == BendWeights::calibrated)
-    calibrate_hinge_weights(rest, model.hinges);
+  if (options.bend_weights == BendWeights::calibrated) calibrate_hinge_weights(rest, model.hinges);
   model.bend_stencil_stiffness = options.bend_stencil_stiffness;
   if (options.bend_stencil_stiffness > 0.0)
     model.stencils = make_bend_stencils(rest, input.triangles);
@@ -907,9 +910,8 @@ ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse&
       if (count != 1 || (new_face[other] && other < f)) continue;
       const std::array<int, 3>& ov = model.triangles[static_cast<std::size_t>(other)].vertices;
       const double areas = unscaled_rest_area(rest, fv) + unscaled_rest_area(rest, ov);
-      made_hinges.push_back(f < other
-                                ? make_hinge(rest, fv, k, ov, other_corner, areas, options)
-                                : make_hinge(rest, ov, other_corner, fv, k, areas, options));
+      made_hinges.push_back(f < other ? make_hinge(rest, fv, k, ov, other_corner, areas, options)
+                                      : make_hinge(rest, ov, other_corner, fv, k, areas, options));
       for (int v : made_hinges.back().vertices) changed_row[static_cast<std::size_t>(v)] = 1;
     }
   }
@@ -925,8 +927,7 @@ ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse&
              model.hinges.begin(), by_edge);
   // Calibrated weights depend on the hinges around both ends: all are recomputed (linear time),
   // as build_cloth_model does.
-  if (options.bend_weights == BendWeights::calibrated)
-    calibrate_hinge_weights(rest, model.hinges);
+  if (options.bend_weights == BendWeights::calibrated) calibrate_hinge_weights(rest, model.hinges);
   // Stencils are rebuilt too; a row whose stencils are not all the previous ones (the same
   // vertices) is rebuilt.
   model.bend_stencil_stiffness = options.bend_stencil_stiffness;

@@ -4,15 +4,14 @@
 // Building it is cheap (linear in the mesh size), so the adaptive mesh can rebuild it after
 // every topology change.
 
-#include <algorithm>
-#include <array>
-#include <stdexcept>
-#include <optional>
-#include <string_view>
-#include <vector>
-
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <algorithm>
+#include <array>
+#include <optional>
+#include <stdexcept>
+#include <string_view>
+#include <vector>
 
 #include "sim/fabric.hpp"
 

@@ -151,7 +151,9 @@ SegmentClosestPoints closest_points_on_segments(const Eigen::Vector3d& p0,
 
 namespace {
 
-int sign_of(double value, double zero) { return value > zero ? 1 : (value < -zero ? -1 : 0); }
+int sign_of(double value, double zero) {
+  return value > zero ? 1 : (value < -zero ? -1 : 0);
+}
 
 }  // namespace
 
@@ -170,8 +172,8 @@ CoplanarTimes coplanar_times(const std::array<Eigen::Vector3d, 4>& x0,
   const auto f = [&](double t) { return ((c[3] * t + c[2]) * t + c[1]) * t + c[0]; };
   // Rounding of f is about 1e-15 of the product of three lengths of the configuration.
   double scale = 0.0;
-  for (const Eigen::Vector3d& v : {u0, w0, z0, Eigen::Vector3d(u0 + du), Eigen::Vector3d(w0 + dw),
-                                   Eigen::Vector3d(z0 + dz)})
+  for (const Eigen::Vector3d& v :
+       {u0, w0, z0, Eigen::Vector3d(u0 + du), Eigen::Vector3d(w0 + dw), Eigen::Vector3d(z0 + dz)})
     scale = std::max(scale, v.norm());
   const double zero = 1e-12 * scale * scale * scale;
 

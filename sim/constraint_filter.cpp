@@ -1,10 +1,9 @@
 #include "sim/constraint_filter.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
-
-#include <Eigen/Geometry>
 
 namespace sd::sim {
 
@@ -59,13 +58,16 @@ void ConstraintFilter::constrain_direction(int vertex, const Eigen::Vector3d& no
 
 Eigen::Matrix3d ConstraintFilter::filter_matrix(int vertex) const {
   switch (kind_[vertex]) {
-    case 0: return Eigen::Matrix3d::Identity();
-    case 1: return Eigen::Matrix3d::Identity() - first_[vertex] * first_[vertex].transpose();
+    case 0:
+      return Eigen::Matrix3d::Identity();
+    case 1:
+      return Eigen::Matrix3d::Identity() - first_[vertex] * first_[vertex].transpose();
     case 2: {
       const Eigen::Vector3d t = first_[vertex].cross(second_[vertex]);
       return t * t.transpose();
     }
-    default: return Eigen::Matrix3d::Zero();
+    default:
+      return Eigen::Matrix3d::Zero();
   }
 }
 
@@ -74,14 +76,18 @@ void ConstraintFilter::apply(Eigen::VectorXd& r) const {
   for (int i = 0; i < vertex_count(); ++i) {
     auto ri = r.segment<3>(3 * i);
     switch (kind_[i]) {
-      case 0: break;
-      case 1: ri -= first_[i].dot(ri) * first_[i]; break;
+      case 0:
+        break;
+      case 1:
+        ri -= first_[i].dot(ri) * first_[i];
+        break;
       case 2: {
         const Eigen::Vector3d t = first_[i].cross(second_[i]);
         ri = t.dot(ri) * t;
         break;
       }
-      default: ri.setZero();
+      default:
+        ri.setZero();
     }
   }
 }

@@ -165,13 +165,12 @@ std::vector<BodyPiercing> ContactResponse::find_piercings(const Eigen::VectorXd&
   return piercings_of(x1, min_height, every_triangle);
 }
 
-std::vector<BodyPiercing> ContactResponse::piercings_of(const Eigen::VectorXd& x,
-                                                        double min_height,
+std::vector<BodyPiercing> ContactResponse::piercings_of(const Eigen::VectorXd& x, double min_height,
                                                         bool every_triangle) const {
   if (cloth_.triangles.empty()) return {};
   const double reach = piercing_reach();
-  return collider_.find_piercings(x, cloth_, min_height, reach,
-                                  kPiercingUncheckedFraction * reach, nullptr, every_triangle);
+  return collider_.find_piercings(x, cloth_, min_height, reach, kPiercingUncheckedFraction * reach,
+                                  nullptr, every_triangle);
 }
 
 void ContactResponse::reset_cloth(const Eigen::VectorXd& x, const Eigen::VectorXd& mass,
@@ -403,8 +402,7 @@ void ContactResponse::spring_start_piercings(const Eigen::VectorXd& start,
   }
   std::vector<BodyPiercing> springs;
   for (const BodyPiercing& p : candidates) {
-    const auto [with_body, coasting] =
-        end_heights(p, cloth_.triangles[p.cloth_triangle], v0, beta);
+    const auto [with_body, coasting] = end_heights(p, cloth_.triangles[p.cloth_triangle], v0, beta);
     const bool held = !std::isnan(last_piercing_force_[p.body_vertex]);
     // A spring only where it would push: the point ends within the clearance of the body vertex
     // (or through), or the vertex had a spring last step and the cloth has not left its reach
@@ -419,8 +417,7 @@ void ContactResponse::spring_start_piercings(const Eigen::VectorXd& start,
   // under a face (with full springs on both triangles the pair overshot past the hold distance,
   // was dropped and fell back, and the sheet on the sphere never settled).
   for (std::size_t first = 0, last = 0; first < springs.size(); first = last) {
-    while (last < springs.size() && springs[last].body_vertex == springs[first].body_vertex)
-      ++last;
+    while (last < springs.size() && springs[last].body_vertex == springs[first].body_vertex) ++last;
     const double force = last_piercing_force_[springs[first].body_vertex];
     const double share = std::isnan(force) ? 0.0 : std::max(force, 0.0) / (last - first);
     for (std::size_t k = first; k < last; ++k) {
@@ -444,8 +441,7 @@ int ContactResponse::spring_end_piercings(const Eigen::VectorXd& x1, StepForces&
     for (std::size_t s = 0; s < springs; ++s) {
       if (spring_body_vertex_[s] != p.body_vertex) continue;
       const PointSpring& spring = extra.springs[s];
-      const double along =
-          along_spring_normal(spring, cloth_.triangles[spring.triangle], x1);
+      const double along = along_spring_normal(spring, cloth_.triangles[spring.triangle], x1);
       carried += std::max(0.0, spring.preload + spring.stiffness * (spring.target - along));
       if (spring.triangle == p.cloth_triangle) match = s;
     }
@@ -475,8 +471,8 @@ void ContactResponse::record_spring_forces(const Eigen::VectorXd& x, const StepF
     const PointSpring& spring = extra.springs[s];
     const double along = along_spring_normal(spring, cloth_.triangles[spring.triangle], x);
     const double force = spring.preload + spring.stiffness * (spring.target - along);
-    spring_ends_.push_back({spring_body_vertex_[s], spring.triangle,
-                            std::min(force, max_spring_preload())});
+    spring_ends_.push_back(
+        {spring_body_vertex_[s], spring.triangle, std::min(force, max_spring_preload())});
   }
 }
 
@@ -548,8 +544,7 @@ int ContactResponse::constrain_deep(const Eigen::VectorXd& x0, const Eigen::Vect
   return added;
 }
 
-void ContactResponse::finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v,
-                                  const StepForces& extra) {
+void ContactResponse::finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v, const StepForces& extra) {
   Stopwatch watch(stats_.collision_seconds);
   // Last resort for what the re-solves did not fix: onto the surface, with the body's normal
   // velocity (the approaching part of the relative velocity removed).

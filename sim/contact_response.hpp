@@ -227,8 +227,8 @@ class ContactResponse {
   double max_spring_preload() const;
   // Start of step: body vertices through the cloth at `start` (x̂ + y), about to be, or held
   // last step, become springs in `extra`.
-  void spring_start_piercings(const Eigen::VectorXd& start, const Eigen::VectorXd& v0,
-                              double beta, const ConstraintFilter& filter, StepForces& extra);
+  void spring_start_piercings(const Eigen::VectorXd& start, const Eigen::VectorXd& v0, double beta,
+                              const ConstraintFilter& filter, StepForces& extra);
   // End check: a piercing of x1 gets a spring, or its spring's preload rises by the springs'
   // force at x1. Returns how many changed.
   int spring_end_piercings(const Eigen::VectorXd& x1, StepForces& extra);
@@ -256,7 +256,7 @@ class ContactResponse {
   std::vector<int> active_index_;      // per vertex: index into active_, or −1
   std::vector<BodyContact> too_deep_;  // from the last end check, after the last solve
   std::vector<BodyContact> end_contacts_;
-  ClothTriangles cloth_;  // the cloth's triangles (set_cloth_triangles)
+  ClothTriangles cloth_;                 // the cloth's triangles (set_cloth_triangles)
   std::vector<BodyPiercing> piercings_;  // from the last end check, after the last solve
   // Per body vertex: the force (N, along the triangles' normals; < 0: it ended pulling) its
   // springs ended the last accepted step with, NaN when it had none.

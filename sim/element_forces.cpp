@@ -1,8 +1,7 @@
 #include "sim/element_forces.hpp"
 
-#include <cmath>
-
 #include <Eigen/Geometry>
+#include <cmath>
 
 namespace sd::sim {
 namespace {
@@ -70,9 +69,8 @@ double dihedral_angle(const Vector3d& x0, const Vector3d& x1, const Vector3d& x2
 
 // Chain rule through three layers: x (12) → p = (e, a, b) = (x1−x0, x2−x0, x3−x0) →
 // q = (N1, N2, e) → θ = atan2(Y, X) with X = N1·N2, Y = Z/|e|, Z = (N1×N2)·e.
-Condition<12> dihedral_angle_condition(const Vector3d& x0, const Vector3d& x1,
-                                       const Vector3d& x2, const Vector3d& x3,
-                                       bool with_hessian) {
+Condition<12> dihedral_angle_condition(const Vector3d& x0, const Vector3d& x1, const Vector3d& x2,
+                                       const Vector3d& x3, bool with_hessian) {
   Condition<12> c;
   const Vector3d e = x1 - x0;
   const Vector3d a = x2 - x0;
@@ -138,8 +136,7 @@ Condition<12> dihedral_angle_condition(const Vector3d& x0, const Vector3d& x1,
   const double l2 = length * length;
   const Matrix9d hess_y = hess_z / length -
                           (grad_z * grad_l.transpose() + grad_l * grad_z.transpose()) / l2 +
-                          2.0 * z * grad_l * grad_l.transpose() / (l2 * length) -
-                          z * hess_l / l2;
+                          2.0 * z * grad_l * grad_l.transpose() / (l2 * length) - z * hess_l / l2;
   const double r4 = r2 * r2;
   const double theta_xx = 2.0 * x * y / r4;
   const double theta_yy = -theta_xx;

@@ -3,10 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <utility>
-
-#include <nlohmann/json.hpp>
 
 namespace sd::sim {
 namespace detail {
@@ -51,8 +50,10 @@ constexpr ConstantSpec kConstants[] = {
 
 void FabricParameters::validate() const {
   check_constant(name, "area_density", "area density", area_density, Bound::positive, "kg/m^2");
-  check_constant(name, "stretch_warp", "warp stretch stiffness", stretch_warp, Bound::positive, "N/m");
-  check_constant(name, "stretch_weft", "weft stretch stiffness", stretch_weft, Bound::positive, "N/m");
+  check_constant(name, "stretch_warp", "warp stretch stiffness", stretch_warp, Bound::positive,
+                 "N/m");
+  check_constant(name, "stretch_weft", "weft stretch stiffness", stretch_weft, Bound::positive,
+                 "N/m");
   check_constant(name, "shear", "shear stiffness", shear, Bound::non_negative, "N/m");
   check_constant(name, "bend", "bending rigidity", bend, Bound::non_negative, "N*m");
   check_constant(name, "damping", "damping", damping, Bound::non_negative, "s");
@@ -109,7 +110,8 @@ FabricParameters fabric_preset(std::string_view name) {
   for (const auto& [preset, text] : detail::embedded_fabric_presets())
     if (preset == name) return parse_fabric_json(text, "fabric preset '" + std::string(name) + "'");
   std::string known;
-  for (const std::string& preset : fabric_preset_names()) known += (known.empty() ? "" : ", ") + preset;
+  for (const std::string& preset : fabric_preset_names())
+    known += (known.empty() ? "" : ", ") + preset;
   throw UnknownFabricError("unknown fabric '" + std::string(name) + "' (known fabrics: " + known +
                            ")");
 }

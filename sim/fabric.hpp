@@ -34,15 +34,15 @@ class UnknownFabricError : public std::invalid_argument {
 //   bend energy of an edge             = ½ · bend · |e|²/(A1+A2) · (θ − θ0)².
 struct FabricParameters {
   std::string name = "custom";
-  double area_density = 0.15;     // kg/m²
-  double stretch_warp = 5.0e3;    // N/m, membrane stiffness along the warp (u)
-  double stretch_weft = 5.0e3;    // N/m, along the weft (v)
-  double shear = 50.0;            // N/m, in-plane shear stiffness (per unit shear strain)
-  double bend = 1.0e-5;           // N·m, bending rigidity (moment per unit width per curvature)
-  double damping = 2.0e-3;        // s, stiffness-proportional damping of stretch and shear
-  double bend_damping = 2.0e-2;   // s, stiffness-proportional damping of bending
-  double friction = 0.3;          // Coulomb coefficient against the body (contacts, later)
-  double thickness = 5.0e-4;      // m, collision thickness
+  double area_density = 0.15;    // kg/m²
+  double stretch_warp = 5.0e3;   // N/m, membrane stiffness along the warp (u)
+  double stretch_weft = 5.0e3;   // N/m, along the weft (v)
+  double shear = 50.0;           // N/m, in-plane shear stiffness (per unit shear strain)
+  double bend = 1.0e-5;          // N·m, bending rigidity (moment per unit width per curvature)
+  double damping = 2.0e-3;       // s, stiffness-proportional damping of stretch and shear
+  double bend_damping = 2.0e-2;  // s, stiffness-proportional damping of bending
+  double friction = 0.3;         // Coulomb coefficient against the body (contacts, later)
+  double thickness = 5.0e-4;     // m, collision thickness
 
   // Throws InvalidFabricError naming the first bad constant.
   void validate() const;

@@ -25,7 +25,8 @@ void add_condition(const Condition<N>& c, double rest_value, double stiffness, d
   using MatrixN = Eigen::Matrix<double, N, N>;
   const double c_value = c.value - rest_value;
   VectorN local_v;
-  for (int k = 0; k < kVertices; ++k) local_v.template segment<3>(3 * k) = v.segment<3>(3 * vertices[k]);
+  for (int k = 0; k < kVertices; ++k)
+    local_v.template segment<3>(3 * k) = v.segment<3>(3 * vertices[k]);
   const double c_dot = damping > 0.0 ? c.gradient.dot(local_v) : 0.0;
   energy += 0.5 * stiffness * c_value * c_value;
   const VectorN local_force = -(stiffness * c_value + damping * c_dot) * c.gradient;
@@ -38,8 +39,8 @@ void add_condition(const Condition<N>& c, double rest_value, double stiffness, d
   MatrixN dfdx = -stiffness * outer;
   if (exact || (keep_curvature_in_solve && c_value > 0.0)) dfdx -= stiffness * c_value * c.hessian;
   if (exact && damping > 0.0) {
-    dfdx -= damping * (c_dot * c.hessian +
-                       c.gradient * (c.hessian.transpose() * local_v).transpose());
+    dfdx -=
+        damping * (c_dot * c.hessian + c.gradient * (c.hessian.transpose() * local_v).transpose());
   }
   if (jacobian->product_input != nullptr) {
     VectorN local_u;
@@ -273,9 +274,9 @@ void evaluate_forces(const ClothModel& model, const ForceSettings& settings,
     // The bend Hessian is only needed for the exact Jacobian: the solve uses −k·∇θ∇θᵀ.
     for (const HingeElement& h : model.hinges) {
       const auto& vs = h.vertices;
-      const Condition<12> c = dihedral_angle_condition(
-          x.segment<3>(3 * vs[0]), x.segment<3>(3 * vs[1]), x.segment<3>(3 * vs[2]),
-          x.segment<3>(3 * vs[3]), exact);
+      const Condition<12> c =
+          dihedral_angle_condition(x.segment<3>(3 * vs[0]), x.segment<3>(3 * vs[1]),
+                                   x.segment<3>(3 * vs[2]), x.segment<3>(3 * vs[3]), exact);
       const double k_b = fabric.bend * h.weight;
       add_condition(c, h.rest_angle, k_b, damping_scale * fabric.bend_damping * k_b, false,
                     vs.data(), h.blocks.data(), v, force, local_energy.bend, jacobian);
@@ -303,8 +304,8 @@ void evaluate_forces(const ClothModel& model, const ForceSettings& settings,
         if (jacobian->product_input != nullptr) {
           Vector3d product = Vector3d::Zero();
           for (int l = 0; l < count; ++l)
-            product += b.coupling(j, l) *
-                       jacobian->product_input->segment<3>(3 * b.vertices[static_cast<std::size_t>(l)]);
+            product += b.coupling(j, l) * jacobian->product_input->segment<3>(
+                                              3 * b.vertices[static_cast<std::size_t>(l)]);
           jacobian->product_output->segment<3>(3 * vj) -= k * product;
         }
         if (jacobian->matrix == nullptr) continue;

@@ -15,11 +15,11 @@ struct ForceTerms {
   bool bend = true;
   bool damping = true;  // the damping of stretch, shear and bend along their gradients
   bool gravity = true;
-  bool drag = true;     // linear air drag towards the wind velocity (only if air_drag > 0)
+  bool drag = true;  // linear air drag towards the wind velocity (only if air_drag > 0)
 };
 
 struct ForceSettings {
-  Eigen::Vector3d gravity{0.0, -9.81, 0.0};  // m/s²
+  Eigen::Vector3d gravity{0.0, -9.81, 0.0};        // m/s²
   Eigen::Vector3d wind = Eigen::Vector3d::Zero();  // m/s, velocity of the air
   double air_drag = 0.0;  // kg/(m²·s): f_i = air_drag · A_i · (wind − v_i), A_i vertex rest area
   ForceTerms terms;

@@ -31,9 +31,9 @@ void ImplicitSolver::add_extra_force(const ClothModel& model, const StepForces* 
         d.force - d.coefficient * (v.segment<3>(3 * d.vertex) - d.reference_velocity);
   for (const PointSpring& s : extra->springs) {
     const std::array<int, 3>& corners = model.triangles[s.triangle].vertices;
-    const double f = s.preload + s.stiffness * (s.target - along_spring_normal(s, corners, x)) -
-                     s.damping * (along_spring_normal(s, corners, v) -
-                                  s.normal.dot(s.reference_velocity));
+    const double f =
+        s.preload + s.stiffness * (s.target - along_spring_normal(s, corners, x)) -
+        s.damping * (along_spring_normal(s, corners, v) - s.normal.dot(s.reference_velocity));
     for (int k = 0; k < 3; ++k) force_.segment<3>(3 * corners[k]) += (s.weights[k] * f) * s.normal;
   }
   for (const PairSpring& s : extra->pair_springs) {
@@ -110,8 +110,8 @@ void ImplicitSolver::assemble(const ClothModel& model, const ForceSettings& forc
       for (int k = 0; k < 4; ++k)
         for (int l = 0; l < 4; ++l) {
           const int i = s.vertices[k];
-          const int offset = k == l ? model.pattern.diagonal_offsets[i]
-                                    : block_offset(matrix_, i, s.vertices[l]);
+          const int offset =
+              k == l ? model.pattern.diagonal_offsets[i] : block_offset(matrix_, i, s.vertices[l]);
           if (offset < 0) continue;
           const double w = scale * s.weights[k] * s.weights[l];
           for (int a = 0; a < 3; ++a)
@@ -260,11 +260,13 @@ void ImplicitSolver::record_constraint_impulse(const ConstraintFilter& filter,
   result.constraint_impulse = residual - free_part;
 }
 
-ImplicitSolveResult ImplicitSolver::solve(
-    const ClothModel& model, const ForceSettings& forces, const ConstraintFilter& filter,
-    const Eigen::VectorXd& x_hat, const Eigen::VectorXd& v_hat, double beta,
-    const Eigen::VectorXd& x_lin, const Eigen::VectorXd& v_lin, const NewtonSettings& settings,
-    const StepForces* extra) {
+ImplicitSolveResult ImplicitSolver::solve(const ClothModel& model, const ForceSettings& forces,
+                                          const ConstraintFilter& filter,
+                                          const Eigen::VectorXd& x_hat,
+                                          const Eigen::VectorXd& v_hat, double beta,
+                                          const Eigen::VectorXd& x_lin,
+                                          const Eigen::VectorXd& v_lin,
+                                          const NewtonSettings& settings, const StepForces* extra) {
   ImplicitSolveResult result;
   const int n = model.vertex_count;
   const auto mass_times = [&](const Eigen::VectorXd& w) {

@@ -66,10 +66,10 @@ struct PointSpring {
   int triangle = 0;  // model element, for its corners and matrix blocks
   Eigen::Vector3d weights = Eigen::Vector3d::Zero();
   Eigen::Vector3d normal = Eigen::Vector3d::UnitY();
-  double target = 0.0;     // m, along normal
-  double preload = 0.0;    // N
-  double stiffness = 0.0;  // N/m
-  double damping = 0.0;    // kg/s
+  double target = 0.0;                                           // m, along normal
+  double preload = 0.0;                                          // N
+  double stiffness = 0.0;                                        // N/m
+  double damping = 0.0;                                          // kg/s
   Eigen::Vector3d reference_velocity = Eigen::Vector3d::Zero();  // m/s
 };
 

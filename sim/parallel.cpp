@@ -13,7 +13,9 @@ namespace {
 
 std::atomic<int> requested_threads{0};  // 0: every core
 
-int machine_cores() { return std::max(1, tbb::info::default_concurrency()); }
+int machine_cores() {
+  return std::max(1, tbb::info::default_concurrency());
+}
 
 }  // namespace
 
@@ -22,7 +24,9 @@ int thread_count() {
   return n > 0 ? n : machine_cores();
 }
 
-void set_thread_count(int n) { requested_threads.store(n > 0 ? n : 0); }
+void set_thread_count(int n) {
+  requested_threads.store(n > 0 ? n : 0);
+}
 
 void parallel_chunks(int n, int grain, const std::function<void(int, int, int)>& chunk) {
   const int chunks = chunk_count(n, grain);
@@ -48,9 +52,7 @@ void parallel_chunks(int n, int grain, const std::function<void(int, int, int)>&
     if (!slot) slot = std::make_unique<tbb::task_arena>(std::min(threads, 64));
     arena = slot.get();
   }
-  arena->execute([&] {
-    tbb::parallel_for(0, chunks, 1, [&](int c) { run(c); });
-  });
+  arena->execute([&] { tbb::parallel_for(0, chunks, 1, [&](int c) { run(c); }); });
 }
 
 }  // namespace sd::sim

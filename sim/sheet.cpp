@@ -20,7 +20,8 @@ SheetScene build_sheet(const SheetSpec& spec) {
   const bool vertical = spec.orientation == SheetOrientation::vertical;
   // In-sheet axes: "right" (+X) and "up" (towards the top edge).
   const Eigen::Vector3d right = Eigen::Vector3d::UnitX();
-  const Eigen::Vector3d up = vertical ? Eigen::Vector3d::UnitY() : Eigen::Vector3d(-Eigen::Vector3d::UnitZ());
+  const Eigen::Vector3d up =
+      vertical ? Eigen::Vector3d::UnitY() : Eigen::Vector3d(-Eigen::Vector3d::UnitZ());
   scene.input.rest_positions.resize(nv, 3);
   for (int r = 0; r <= spec.rows; ++r)
     for (int c = 0; c <= spec.columns; ++c) {
@@ -52,10 +53,14 @@ SheetScene build_sheet(const SheetSpec& spec) {
 
   for (const std::string& name : spec.pins) {
     std::vector<int> add;
-    if (name == "top-left") add = {scene.vertex(0, 0)};
-    else if (name == "top-right") add = {scene.vertex(0, spec.columns)};
-    else if (name == "bottom-left") add = {scene.vertex(spec.rows, 0)};
-    else if (name == "bottom-right") add = {scene.vertex(spec.rows, spec.columns)};
+    if (name == "top-left")
+      add = {scene.vertex(0, 0)};
+    else if (name == "top-right")
+      add = {scene.vertex(0, spec.columns)};
+    else if (name == "bottom-left")
+      add = {scene.vertex(spec.rows, 0)};
+    else if (name == "bottom-right")
+      add = {scene.vertex(spec.rows, spec.columns)};
     else if (name == "top" || name == "bottom") {
       const int r = name == "top" ? 0 : spec.rows;
       for (int c = 0; c <= spec.columns; ++c) add.push_back(scene.vertex(r, c));
@@ -76,9 +81,10 @@ SheetScene build_sheet(const SheetSpec& spec) {
       const bool rows = edge == "top" || edge == "bottom";
       const int available = (rows ? spec.rows : spec.columns) + 1;
       if ((!rows && edge != "left" && edge != "right") || depth < 1 || depth > available)
-        throw InvalidSheetError("pin '" + name + "' is not a clamp: use top:N, bottom:N, left:N "
-                                "or right:N with N from 1 to " + std::to_string(available) +
-                                " lines of vertices");
+        throw InvalidSheetError("pin '" + name +
+                                "' is not a clamp: use top:N, bottom:N, left:N "
+                                "or right:N with N from 1 to " +
+                                std::to_string(available) + " lines of vertices");
       for (int k = 0; k < depth; ++k) {
         if (rows) {
           const int r = edge == "top" ? k : spec.rows - k;
@@ -96,8 +102,9 @@ SheetScene build_sheet(const SheetSpec& spec) {
     scene.pinned_vertices.insert(scene.pinned_vertices.end(), add.begin(), add.end());
   }
   std::sort(scene.pinned_vertices.begin(), scene.pinned_vertices.end());
-  scene.pinned_vertices.erase(std::unique(scene.pinned_vertices.begin(), scene.pinned_vertices.end()),
-                              scene.pinned_vertices.end());
+  scene.pinned_vertices.erase(
+      std::unique(scene.pinned_vertices.begin(), scene.pinned_vertices.end()),
+      scene.pinned_vertices.end());
   return scene;
 }
 

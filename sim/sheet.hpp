@@ -1,11 +1,10 @@
 #pragma once
 // A rectangular sheet as plain simulator input, for tests, benchmarks and sheet scenes.
 
+#include <Eigen/Core>
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "meshing/mesh48.hpp"
 #include "sim/cloth_model.hpp"
@@ -23,9 +22,9 @@ enum class SheetOrientation {
 };
 
 struct SheetSpec {
-  Eigen::Vector2d size{1.0, 1.0};   // m: width (X) and height (Y, or Z when horizontal)
-  int columns = 16;                 // quads along the width
-  int rows = 16;                    // quads along the height
+  Eigen::Vector2d size{1.0, 1.0};  // m: width (X) and height (Y, or Z when horizontal)
+  int columns = 16;                // quads along the width
+  int rows = 16;                   // quads along the height
   SheetOrientation orientation = SheetOrientation::vertical;
   Eigen::Vector3d centre{0.0, 1.0, 0.0};
   // Corners "top-left", "top-right", "bottom-left", "bottom-right", whole edges "top",

@@ -1,13 +1,13 @@
 #include "sim/simulation.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <sstream>
 #include <utility>
-
-#include <spdlog/spdlog.h>
 
 namespace sd::sim {
 
@@ -32,7 +32,8 @@ void require(bool ok, const std::string& message) {
 
 double max_speed(const Eigen::VectorXd& v) {
   double speed = 0.0;
-  for (Eigen::Index i = 0; i < v.size() / 3; ++i) speed = std::max(speed, v.segment<3>(3 * i).norm());
+  for (Eigen::Index i = 0; i < v.size() / 3; ++i)
+    speed = std::max(speed, v.segment<3>(3 * i).norm());
   return speed;
 }
 
@@ -53,11 +54,11 @@ void SimulationSettings::validate() const {
   require(positive(max_speed), "the speed limit must be positive");
   require(easy_steps_to_grow >= 1, "easy_steps_to_grow must be at least 1");
   require(std::isfinite(grow_factor) && grow_factor >= 1.0, "the growth factor must be at least 1");
-  require(positive(rest_speed) && positive(rest_kinetic_energy) &&
-              std::isfinite(rest_window) && rest_window >= 0.0,
+  require(positive(rest_speed) && positive(rest_kinetic_energy) && std::isfinite(rest_window) &&
+              rest_window >= 0.0,
           "the at-rest thresholds must be positive and the window zero or more");
-  require(forces.gravity.allFinite() && forces.wind.allFinite() &&
-              std::isfinite(forces.air_drag) && forces.air_drag >= 0.0,
+  require(forces.gravity.allFinite() && forces.wind.allFinite() && std::isfinite(forces.air_drag) &&
+              forces.air_drag >= 0.0,
           "gravity, wind and air drag must be finite (air drag zero or more)");
   try {
     contact.validate();
@@ -176,7 +177,9 @@ void Simulation::set_body_motion(PoseSequence motion) {
   start_body();
 }
 
-void Simulation::clear_body() { contact_.reset(); }
+void Simulation::clear_body() {
+  contact_.reset();
+}
 
 void Simulation::start_body() {
   contact_->set_fabric_friction(model_.fabric.friction);
@@ -214,9 +217,8 @@ double Simulation::residual_force() const {
 Simulation::Attempt Simulation::attempt(double h) {
   Attempt result;
   const bool bdf2 = settings_.integrator == Integrator::bdf2;
-  const int newton = fallback_ || linearised_steps_ > 0
-                         ? 1
-                         : settings_.newton_iterations.value_or(bdf2 ? 8 : 1);
+  const int newton =
+      fallback_ || linearised_steps_ > 0 ? 1 : settings_.newton_iterations.value_or(bdf2 ? 8 : 1);
   NewtonSettings newton_settings;
   newton_settings.max_iterations = newton;
   newton_settings.tolerance = settings_.newton_tolerance;
@@ -295,16 +297,17 @@ Simulation::Attempt Simulation::attempt(double h) {
     result.x = std::move(result.solve.x);
     result.v = std::move(result.solve.v);
     if (result.solve.cholmod_failures > 0)
-      spdlog::debug("sim: t = {:.6f} s: the CHOLMOD factorisation failed {} time(s); PCG solved "
-                    "instead{}",
-                    time_, result.solve.cholmod_failures,
-                    result.solve.linear_failure.empty() ? "" : " (and failed)");
+      spdlog::debug(
+          "sim: t = {:.6f} s: the CHOLMOD factorisation failed {} time(s); PCG solved "
+          "instead{}",
+          time_, result.solve.cholmod_failures,
+          result.solve.linear_failure.empty() ? "" : " (and failed)");
     if (!result.solve.linear_failure.empty()) break;
     if (contact == nullptr || !result.solve.linear_converged || !result.x.allFinite() ||
         !result.v.allFinite())
       break;
-    contact->apply_friction(result.solve.constraint_impulse, model_.mass, x_hat + y, beta,
-                            result.v, result.x);
+    contact->apply_friction(result.solve.constraint_impulse, model_.mass, x_hat + y, beta, result.v,
+                            result.x);
     if (contact->constrain_deep(x_, result.x, x_hat, beta, filter_, y, contact_forces_) == 0) {
       contact->finish_step(result.x, result.v, contact_forces_);
       break;
@@ -349,8 +352,8 @@ Simulation::Attempt Simulation::attempt(double h) {
     why << (settings_.solver == LinearSolverKind::pcg ? "PCG did not converge"
                                                       : "CHOLMOD factorisation failed");
   } else if (!result.solve.newton_converged) {
-    why << "Newton did not converge in " << result.solve.newton_iterations << " iterations (last update "
-        << result.solve.last_update << " m)";
+    why << "Newton did not converge in " << result.solve.newton_iterations
+        << " iterations (last update " << result.solve.last_update << " m)";
   } else if (const double strain = max_stretch_strain(model_, result.x);
              strain > settings_.max_strain) {
     why << "stretch strain " << strain << " above the limit " << settings_.max_strain;
@@ -415,7 +418,8 @@ void Simulation::accept(Attempt& attempt, double h) {
     report_.rest_speed_window = std::max(report_.rest_speed_window, s);
     report_.rest_kinetic_per_kg_window = std::max(report_.rest_kinetic_per_kg_window, k);
   }
-  if (speed < settings_.rest_speed && kinetic / mass < settings_.rest_kinetic_energy && !body_moving)
+  if (speed < settings_.rest_speed && kinetic / mass < settings_.rest_kinetic_energy &&
+      !body_moving)
     rest_time_ += h;
   else
     rest_time_ = 0.0;
@@ -485,8 +489,8 @@ StepOutcome Simulation::step(double max_step) {
   accept(candidate, h);
 
   // Grow back after a run of easy steps: no retry and Newton converging in a few iterations.
-  const int newton_budget = settings_.newton_iterations.value_or(
-      settings_.integrator == Integrator::bdf2 ? 8 : 1);
+  const int newton_budget =
+      settings_.newton_iterations.value_or(settings_.integrator == Integrator::bdf2 ? 8 : 1);
   const bool easy = outcome.retries == 0 && !outcome.forced &&
                     outcome.newton_iterations <= std::max(1, (newton_budget + 1) / 2);
   easy_steps_ = easy ? easy_steps_ + 1 : 0;
@@ -549,7 +553,8 @@ SimulationReport Simulation::run(const RunHooks& hooks) {
     report_.collision_s +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - query_start).count();
   }
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   report_.wall_time_s += wall;
   report_.other_s += wall - (report_.forces_s - forces_before) - (report_.solve_s - solve_before) -
                      (report_.collision_s - collision_before) -

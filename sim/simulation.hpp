@@ -39,9 +39,9 @@ std::optional<Integrator> parse_integrator(std::string_view name);
 struct SimulationSettings {
   Integrator integrator = Integrator::implicit_euler;
   LinearSolverKind solver = LinearSolverKind::pcg;
-  double dt = 1.0 / 60.0;     // s, the largest step (and the step the run starts with)
-  double min_dt = 1.0e-5;     // s, halving stops here
-  double duration = 2.0;      // s of simulated time
+  double dt = 1.0 / 60.0;  // s, the largest step (and the step the run starts with)
+  double min_dt = 1.0e-5;  // s, halving stops here
+  double duration = 2.0;   // s of simulated time
   // Newton iterations per step; empty: 1 for implicit Euler (the linearised step), 8 for BDF2.
   std::optional<int> newton_iterations;
   double newton_tolerance = 1.0e-6;  // m, see NewtonSettings
@@ -50,18 +50,18 @@ struct SimulationSettings {
   // Block IC(0) needs 6-12x fewer iterations than block Jacobi on stiff woven cloth and makes
   // the PCG step 4x faster (docs/benchmarks.md, "Simulator"); block Jacobi is kept to compare.
   PcgPreconditioner pcg_preconditioner = PcgPreconditioner::block_incomplete_cholesky;
-  double max_strain = 1.0;    // a step that stretches any triangle by more (100 %) fails
-  double max_speed = 50.0;    // m/s, a step with a faster vertex fails
-  int easy_steps_to_grow = 4; // consecutive steps without trouble before the step grows
-  double grow_factor = 2.0;   // capped at 2 for BDF2 (zero-stability needs ω < 1 + √2)
+  double max_strain = 1.0;     // a step that stretches any triangle by more (100 %) fails
+  double max_speed = 50.0;     // m/s, a step with a faster vertex fails
+  int easy_steps_to_grow = 4;  // consecutive steps without trouble before the step grows
+  double grow_factor = 2.0;    // capped at 2 for BDF2 (zero-stability needs ω < 1 + √2)
   bool stop_at_rest = true;
-  double rest_speed = 5.0e-3;            // m/s, maximum vertex speed at rest
-  double rest_kinetic_energy = 1.0e-6;   // J/kg, kinetic energy per unit mass at rest
-  double rest_window = 0.25;             // s the two must stay below their thresholds
-  bool record_energy = true;             // energy time series in the report (one sample a step)
+  double rest_speed = 5.0e-3;           // m/s, maximum vertex speed at rest
+  double rest_kinetic_energy = 1.0e-6;  // J/kg, kinetic energy per unit mass at rest
+  double rest_window = 0.25;            // s the two must stay below their thresholds
+  bool record_energy = true;            // energy time series in the report (one sample a step)
   ForceSettings forces;
-  ContactSettings contact;               // used once a body is set (set_body, set_body_motion)
-  SelfContactSettings self_contact;      // cloth-cloth contact (off unless enabled)
+  ContactSettings contact;           // used once a body is set (set_body, set_body_motion)
+  SelfContactSettings self_contact;  // cloth-cloth contact (off unless enabled)
 
   void validate() const;  // throws InvalidSimulationSettingsError
 };
@@ -90,18 +90,18 @@ struct EnergySample {
 };
 
 struct SimulationReport {
-  int steps = 0;             // accepted steps
-  double sim_time = 0.0;     // s simulated
+  int steps = 0;          // accepted steps
+  double sim_time = 0.0;  // s simulated
   double wall_time_s = 0.0;
-  bool at_rest = false;      // the run stopped early because the cloth was at rest
-  int retries = 0;           // rejected attempts (each one halved the step or, for BDF2, was
-                             // retried at the same step linearised: a fallback)
+  bool at_rest = false;          // the run stopped early because the cloth was at rest
+  int retries = 0;               // rejected attempts (each one halved the step or, for BDF2, was
+                                 // retried at the same step linearised: a fallback)
   int integrator_fallbacks = 0;  // BDF2 steps retried as one linearised solve
-  int forced_steps = 0;      // steps accepted at min_dt despite a soft failure (logged)
-  bool nan_free = true;      // no accepted state had a non-finite value (always, by design)
-  bool failed = false;       // a step could not be completed even at min_dt
+  int forced_steps = 0;          // steps accepted at min_dt despite a soft failure (logged)
+  bool nan_free = true;          // no accepted state had a non-finite value (always, by design)
+  bool failed = false;           // a step could not be completed even at min_dt
   std::string failure_reason;
-  int failure_vertex = -1;   // where: the fastest (or first non-finite) vertex of the failed step
+  int failure_vertex = -1;  // where: the fastest (or first non-finite) vertex of the failed step
   int vertices = 0;
   int triangles = 0;
   int linear_solves = 0;
@@ -118,18 +118,18 @@ struct SimulationReport {
   // Body contact (zero without a body). Penetration is depth inside the body (negative signed
   // distance), measured after every accepted step; vertices still being pushed out of an
   // intersecting start are left out of it until their repair is over.
-  int contacts_max = 0;             // most constrained contacts in one accepted step
-  int contacts_final = 0;           // constrained contacts in the last step
-  double max_penetration_m = 0.0;   // deepest penetration at the end of any accepted step
+  int contacts_max = 0;                // most constrained contacts in one accepted step
+  int contacts_final = 0;              // constrained contacts in the last step
+  double max_penetration_m = 0.0;      // deepest penetration at the end of any accepted step
   int penetrating_vertices_final = 0;  // vertices deeper than the tolerance at the end
   // Body vertices more than the tolerance through the cloth's triangles at the end (a body
   // feature narrower than the cloth's triangles showing through), and the highest, m.
   // Measured whether or not ContactSettings::check_body_vertices keeps them out.
   int piercing_body_vertices_final = 0;
   double max_piercing_final_m = 0.0;
-  int contact_resolves = 0;         // extra solves for vertices that ended a solve too deep
-  int projected_vertices = 0;       // vertices projected out after the re-solves (last resort)
-  int start_repair_vertices = 0;    // vertices that started inside the body
+  int contact_resolves = 0;           // extra solves for vertices that ended a solve too deep
+  int projected_vertices = 0;         // vertices projected out after the re-solves (last resort)
+  int start_repair_vertices = 0;      // vertices that started inside the body
   double start_repair_depth_m = 0.0;  // deepest of them
   // The at-rest residual: the largest vertex speed (m/s) and kinetic energy per kilogram
   // (J/kg) over the accepted steps of the last rest_window seconds, and the last step's.
@@ -141,12 +141,12 @@ struct SimulationReport {
   int self_intersections_start = 0;  // intersecting triangle pairs of the start
   int self_untangled_vertices = 0;   // vertices the start's untangling moved
   int self_untangle_left = 0;        // pairs the untangling could not separate
-  int self_contacts_max = 0;      // most repulsion springs in one accepted step
-  int self_contacts_final = 0;    // in the last step
-  int self_collisions = 0;        // colliding pairs the continuous test found, summed over steps
-  int self_zone_vertices = 0;     // vertices moved rigidly by impact zones, summed over steps
-  int self_unresolved_steps = 0;  // accepted steps whose fail-safe left a collision
-  double self_collision_s = 0.0;  // wall time of self-contact (detection and response)
+  int self_contacts_max = 0;         // most repulsion springs in one accepted step
+  int self_contacts_final = 0;       // in the last step
+  int self_collisions = 0;           // colliding pairs the continuous test found, summed over steps
+  int self_zone_vertices = 0;        // vertices moved rigidly by impact zones, summed over steps
+  int self_unresolved_steps = 0;     // accepted steps whose fail-safe left a collision
+  double self_collision_s = 0.0;     // wall time of self-contact (detection and response)
   // Share of the cloth's triangles inside regions the curvature test culled, over all steps.
   double self_culled_share = 0.0;
   long long self_culled_triangles = 0;  // summed over accepted steps (for the share)
@@ -156,9 +156,9 @@ struct SimulationReport {
 
 struct StepOutcome {
   bool accepted = false;
-  double dt = 0.0;        // the step that was taken
+  double dt = 0.0;  // the step that was taken
   int retries = 0;
-  bool forced = false;    // accepted at min_dt despite a soft failure
+  bool forced = false;  // accepted at min_dt despite a soft failure
   int newton_iterations = 0;
   int cg_iterations = 0;
   std::string failure_reason;  // when not accepted
@@ -189,15 +189,14 @@ class Simulation {
 
   // Replaces the mesh (after an adaptive refine/coarsen) with matching 3n state; the BDF2
   // history restarts with an implicit Euler step.
-  void replace_model(ClothModel model, Eigen::VectorXd x, Eigen::VectorXd v,
-                     std::vector<Pin> pins);
+  void replace_model(ClothModel model, Eigen::VectorXd x, Eigen::VectorXd v, std::vector<Pin> pins);
   // The same for a mesh refined or coarsened from the current one, origin[i] naming where new
   // vertex i comes from: the body contacts' memory of the last step (which contacts pressed
   // and how hard, per unit mass) carries over to the same particles, and to a vertex made
   // between two pressed ones, so that held contacts and friction do not restart at every
   // topology change.
-  void replace_model(ClothModel model, Eigen::VectorXd x, Eigen::VectorXd v,
-                     std::vector<Pin> pins, const std::vector<VertexOrigin>& origin);
+  void replace_model(ClothModel model, Eigen::VectorXd x, Eigen::VectorXd v, std::vector<Pin> pins,
+                     const std::vector<VertexOrigin>& origin);
   void set_velocities(const Eigen::VectorXd& v);
 
   // The body the cloth rests on and cannot enter: a still mesh (metres, closed, counter-
@@ -226,7 +225,7 @@ class Simulation {
  private:
   struct Attempt {
     Eigen::VectorXd x, v;
-    ImplicitSolveResult solve;  // the last solve
+    ImplicitSolveResult solve;   // the last solve
     Eigen::VectorXd correction;  // 3n contact position correction of the start (or empty)
     // Summed over the attempt's solves (more than one when contacts are re-solved).
     double forces_seconds = 0.0;
@@ -234,8 +233,8 @@ class Simulation {
     int linear_solves = 0;
     int cg_iterations = 0;
     int cg_iterations_max = 0;
-    std::string failure;  // empty when the attempt passed every check
-    int failure_vertex = -1;  // the fastest (or first non-finite) vertex of a failed attempt
+    std::string failure;        // empty when the attempt passed every check
+    int failure_vertex = -1;    // the fastest (or first non-finite) vertex of a failed attempt
     bool hard_failure = false;  // non-finite or too fast: never accepted
   };
   Attempt attempt(double h);
@@ -249,7 +248,7 @@ class Simulation {
   Eigen::VectorXd x_, v_;
   Eigen::VectorXd x_previous_, v_previous_;
   bool has_history_ = false;
-  bool fallback_ = false;  // the next attempt is one linearised solve (BDF2's Newton failed)
+  bool fallback_ = false;     // the next attempt is one linearised solve (BDF2's Newton failed)
   int linearised_steps_ = 0;  // BDF2 steps still to take linearised after a fallback
   double h_previous_ = 0.0;
   double time_ = 0.0;

@@ -1,8 +1,8 @@
 #include <cstdio>
 
-#include "src/solver_threads.hpp"
 #include "src/app/batch/batch_runner.hpp"
 #include "src/app/commands/cli.hpp"
+#include "src/solver_threads.hpp"
 
 int main(int argc, char** argv) {
   // A batch's child dies with its batch (a SIGKILLed batch must not leave jobs that write into

@@ -1,10 +1,11 @@
 #include "src/render/camera.hpp"
 
+#include <fmt/format.h>
+
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <fmt/format.h>
 #include <numbers>
 
 namespace sd::render {
@@ -13,7 +14,9 @@ namespace {
 constexpr std::array kViews{ViewName::kFront, ViewName::kBack,         ViewName::kLeft,
                             ViewName::kRight, ViewName::kThreeQuarter, ViewName::kTop};
 
-double radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
+double radians(double degrees) {
+  return degrees * std::numbers::pi / 180.0;
+}
 
 std::array<Eigen::Vector3d, 8> corners(const meshing::BoundingBox& box) {
   std::array<Eigen::Vector3d, 8> out;
@@ -30,23 +33,31 @@ ViewName parse_view_name(std::string_view text) {
   std::replace(t.begin(), t.end(), '_', '-');
   for (ViewName v : kViews)
     if (view_name(v) == t) return v;
-  throw ViewError(fmt::format(
-      "unknown view '{}': use front, back, left, right, three-quarter or top", text));
+  throw ViewError(
+      fmt::format("unknown view '{}': use front, back, left, right, three-quarter or top", text));
 }
 
 std::string view_name(ViewName view) {
   switch (view) {
-    case ViewName::kFront: return "front";
-    case ViewName::kBack: return "back";
-    case ViewName::kLeft: return "left";
-    case ViewName::kRight: return "right";
-    case ViewName::kThreeQuarter: return "three-quarter";
-    case ViewName::kTop: return "top";
+    case ViewName::kFront:
+      return "front";
+    case ViewName::kBack:
+      return "back";
+    case ViewName::kLeft:
+      return "left";
+    case ViewName::kRight:
+      return "right";
+    case ViewName::kThreeQuarter:
+      return "three-quarter";
+    case ViewName::kTop:
+      return "top";
   }
   return "front";
 }
 
-std::span<const ViewName> all_views() { return kViews; }
+std::span<const ViewName> all_views() {
+  return kViews;
+}
 
 void validate_camera(const Camera& camera) {
   if (!camera.eye.allFinite() || !camera.target.allFinite() || !camera.up.allFinite())
@@ -94,8 +105,8 @@ Camera frame_direction(const Eigen::Vector3d& forward_in, const Eigen::Vector3d&
       const Eigen::Vector3d d = c - target;
       const double depth = d.dot(forward);  // toward the far side is positive
       // Corner inside the frustum when |x| <= tx (distance + depth), likewise y.
-      distance = std::max({distance, std::abs(d.dot(right)) / tx - depth,
-                           std::abs(d.dot(up)) / ty - depth});
+      distance = std::max(
+          {distance, std::abs(d.dot(right)) / tx - depth, std::abs(d.dot(up)) / ty - depth});
     }
     distance = std::max(distance, 0.05 * radius);
     if (pass == 1) break;

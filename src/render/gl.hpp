@@ -6,5 +6,6 @@
 #ifndef GL_GLEXT_PROTOTYPES
 #define GL_GLEXT_PROTOTYPES 1
 #endif
-#include <GL/osmesa.h>
+#include <GL/gl.h>  // before glext.h, which needs its types (sorted first by name too)
 #include <GL/glext.h>
+#include <GL/osmesa.h>

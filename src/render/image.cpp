@@ -1,11 +1,11 @@
 #include "src/render/image.hpp"
 
+#include <fmt/format.h>
 #include <png.h>
 
 #include <charconv>
 #include <cstring>
 #include <memory>
-#include <fmt/format.h>
 
 namespace sd::render {
 namespace {

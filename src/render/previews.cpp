@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include <Eigen/Geometry>
-
 #include <stdexcept>
 
 namespace sd::render {
@@ -34,8 +33,8 @@ Scene cloth_over_body_scene(const meshing::TriMesh& body, const meshing::TriMesh
   SceneMesh& c = scene.meshes.emplace_back();
   c.mesh = cloth;
   c.role = MeshRole::kCloth;
-  c.face_colours = panel_colours(panel_ids.size() ? panel_ids
-                                                  : Eigen::VectorXi::Zero(cloth.face_count()));
+  c.face_colours =
+      panel_colours(panel_ids.size() ? panel_ids : Eigen::VectorXi::Zero(cloth.face_count()));
   return scene;
 }
 
@@ -43,8 +42,8 @@ Image render_quad_patch(Renderer& renderer, const Eigen::MatrixX3d& vertices,
                         const Eigen::MatrixX4i& quads, ImageSize size, const PatchStyle& style) {
   if (quads.rows() == 0) throw std::invalid_argument("the patch has no quads to draw");
   if (style.quad_colours.rows() != 0 && style.quad_colours.rows() != quads.rows())
-    throw std::invalid_argument(fmt::format("{} quad colours for {} quads",
-                                            style.quad_colours.rows(), quads.rows()));
+    throw std::invalid_argument(
+        fmt::format("{} quad colours for {} quads", style.quad_colours.rows(), quads.rows()));
   Scene scene;
   scene.ground = false;
   scene.shadows = false;
@@ -73,8 +72,8 @@ Image render_quad_patch(Renderer& renderer, const Eigen::MatrixX3d& vertices,
     normal += 0.5 * (vertices.row(quads(q, 2)) - vertices.row(quads(q, 0)))
                         .cross(vertices.row(quads(q, 3)) - vertices.row(quads(q, 1)))
                         .transpose();
-  Eigen::Vector3d forward = normal.norm() > 0 ? Eigen::Vector3d(-normal.normalized())
-                                              : Eigen::Vector3d(0, -1, 0);
+  Eigen::Vector3d forward =
+      normal.norm() > 0 ? Eigen::Vector3d(-normal.normalized()) : Eigen::Vector3d(0, -1, 0);
   // Image up: +Y where it is not (nearly) the viewing axis, else -Z as in the `top` view.
   Eigen::Vector3d up = Eigen::Vector3d::UnitY();
   if (std::abs(forward.dot(up)) > 0.99) up = -Eigen::Vector3d::UnitZ();

@@ -28,7 +28,7 @@ Scene cloth_over_body_scene(const meshing::TriMesh& body, const meshing::TriMesh
                             const Eigen::VectorXi& panel_ids = {});
 
 struct PatchStyle {
-  Eigen::MatrixX3f quad_colours;            // optional #Q by 3 sRGB; else `colour`
+  Eigen::MatrixX3f quad_colours;  // optional #Q by 3 sRGB; else `colour`
   Eigen::Vector3f colour{0.62f, 0.76f, 0.90f};
   Eigen::Vector3f edge_colour{0.10f, 0.12f, 0.16f};
   float edge_width_px = 1.2f;

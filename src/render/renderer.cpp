@@ -1,12 +1,12 @@
 #include "src/render/renderer.hpp"
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <fmt/format.h>
 #include <limits>
 #include <numbers>
 
@@ -49,7 +49,9 @@ void check_framebuffer(const char* what) {
     throw RenderError(fmt::format("framebuffer for {} is incomplete (0x{:04x})", what, status));
 }
 
-double radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
+double radians(double degrees) {
+  return degrees * std::numbers::pi / 180.0;
+}
 
 // Unit vector toward a light at `azimuth` (counter-clockwise seen from above, from the
 // camera's backward horizontal direction) and `elevation`.
@@ -171,7 +173,8 @@ struct Renderer::Impl {
     renderer_name = text(GL_RENDERER);
     GLint max_samples = 1;
     glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
-    samples = options.antialiasing == Antialiasing::kMsaa4 ? std::min(4, std::max(1, max_samples)) : 1;
+    samples =
+        options.antialiasing == Antialiasing::kMsaa4 ? std::min(4, std::max(1, max_samples)) : 1;
     spdlog::debug("OpenGL {} on {}, GLSL {}, {} sample(s) per pixel", version, renderer_name,
                   text(GL_SHADING_LANGUAGE_VERSION), samples);
   }
@@ -291,7 +294,8 @@ struct PreparedScene::Data {
     if (ground)
       for (int i = 0; i < 4; ++i)
         points.push_back(ground_centre + Eigen::Vector3d((i & 1) ? ground_radius : -ground_radius,
-                                                         0, (i & 2) ? ground_radius : -ground_radius));
+                                                         0,
+                                                         (i & 2) ? ground_radius : -ground_radius));
     return points;
   }
 };
@@ -300,7 +304,9 @@ PreparedScene::PreparedScene(std::unique_ptr<Data> data) : data_(std::move(data)
 PreparedScene::PreparedScene(PreparedScene&&) noexcept = default;
 PreparedScene& PreparedScene::operator=(PreparedScene&&) noexcept = default;
 PreparedScene::~PreparedScene() = default;
-const meshing::BoundingBox& PreparedScene::bounds() const { return data_->bounds; }
+const meshing::BoundingBox& PreparedScene::bounds() const {
+  return data_->bounds;
+}
 
 namespace {
 
@@ -318,7 +324,8 @@ void upload_surface(GpuMesh& gpu, const meshing::TriMesh& mesh, const Eigen::Mat
 
   glGenVertexArrays(1, &gpu.vao);
   glBindVertexArray(gpu.vao);
-  gpu.vertex_buffer = make_buffer(GL_ARRAY_BUFFER, vertices.size() * sizeof(float), vertices.data());
+  gpu.vertex_buffer =
+      make_buffer(GL_ARRAY_BUFFER, vertices.size() * sizeof(float), vertices.data());
   glEnableVertexAttribArray(0);
   glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
   glEnableVertexAttribArray(1);
@@ -337,7 +344,8 @@ void upload_surface(GpuMesh& gpu, const meshing::TriMesh& mesh, const Eigen::Mat
 // Two vertices per edge, position + sRGB colour, in attribute locations 0 and 1.
 void upload_wireframe(GpuMesh& gpu, const meshing::TriMesh& mesh, const Wireframe& wire) {
   Eigen::VectorXd values = wire.edge_values;
-  if (wire.face_values.size() > 0) values = edge_values_from_faces(mesh, wire.edges, wire.face_values);
+  if (wire.face_values.size() > 0)
+    values = edge_values_from_faces(mesh, wire.edges, wire.face_values);
   double lo = wire.min_value, hi = wire.max_value;
   if (!(lo < hi) && values.size() > 0) {
     lo = std::numeric_limits<double>::infinity();
@@ -347,7 +355,8 @@ void upload_wireframe(GpuMesh& gpu, const meshing::TriMesh& mesh, const Wirefram
   }
   const auto colour_of = [&](Eigen::Index e) -> Eigen::Vector3f {
     if (values.size() == 0 || !std::isfinite(values[e])) return wire.colour;
-    if (wire.colour_map == ColourMap::kLevels) return colour_map(ColourMap::kLevels, values[e] - lo);
+    if (wire.colour_map == ColourMap::kLevels)
+      return colour_map(ColourMap::kLevels, values[e] - lo);
     return colour_map(ColourMap::kViridis, hi > lo ? (values[e] - lo) / (hi - lo) : 0.0);
   };
   Eigen::Matrix<float, Eigen::Dynamic, 6, Eigen::RowMajor> vertices(2 * wire.edges.rows(), 6);
@@ -401,15 +410,15 @@ Renderer::Renderer(const RendererOptions& options) : impl_(std::make_shared<Impl
         fmt::format("shadow map size {} is outside [64, 8192]", options.shadow_map_size));
   impl_->options = options;
   impl_->create_context();
-  impl_->mesh_program = std::make_unique<ShaderProgram>(
-      std::vector<std::pair<GLenum, std::string_view>>{{GL_VERTEX_SHADER, "mesh.vert"},
-                                                       {GL_FRAGMENT_SHADER, "mesh.frag"}});
-  impl_->ground_program = std::make_unique<ShaderProgram>(
-      std::vector<std::pair<GLenum, std::string_view>>{{GL_VERTEX_SHADER, "mesh.vert"},
-                                                       {GL_FRAGMENT_SHADER, "ground.frag"}});
-  impl_->shadow_program = std::make_unique<ShaderProgram>(
-      std::vector<std::pair<GLenum, std::string_view>>{{GL_VERTEX_SHADER, "shadow.vert"},
-                                                       {GL_FRAGMENT_SHADER, "shadow.frag"}});
+  impl_->mesh_program =
+      std::make_unique<ShaderProgram>(std::vector<std::pair<GLenum, std::string_view>>{
+          {GL_VERTEX_SHADER, "mesh.vert"}, {GL_FRAGMENT_SHADER, "mesh.frag"}});
+  impl_->ground_program =
+      std::make_unique<ShaderProgram>(std::vector<std::pair<GLenum, std::string_view>>{
+          {GL_VERTEX_SHADER, "mesh.vert"}, {GL_FRAGMENT_SHADER, "ground.frag"}});
+  impl_->shadow_program =
+      std::make_unique<ShaderProgram>(std::vector<std::pair<GLenum, std::string_view>>{
+          {GL_VERTEX_SHADER, "shadow.vert"}, {GL_FRAGMENT_SHADER, "shadow.frag"}});
   impl_->line_program = std::make_unique<ShaderProgram>(
       std::vector<std::pair<GLenum, std::string_view>>{{GL_VERTEX_SHADER, "line.vert"},
                                                        {GL_GEOMETRY_SHADER, "line.geom"},
@@ -421,9 +430,15 @@ Renderer::~Renderer() = default;
 Renderer::Renderer(Renderer&&) noexcept = default;
 Renderer& Renderer::operator=(Renderer&&) noexcept = default;
 
-const std::string& Renderer::gl_version() const { return impl_->version; }
-const std::string& Renderer::gl_renderer() const { return impl_->renderer_name; }
-const RendererOptions& Renderer::options() const { return impl_->options; }
+const std::string& Renderer::gl_version() const {
+  return impl_->version;
+}
+const std::string& Renderer::gl_renderer() const {
+  return impl_->renderer_name;
+}
+const RendererOptions& Renderer::options() const {
+  return impl_->options;
+}
 
 PreparedScene Renderer::prepare(const Scene& scene) {
   validate_scene(scene);
@@ -611,7 +626,8 @@ Image Renderer::render(const PreparedScene& prepared, const Camera& camera, Imag
 
   gl.line_program->use();
   gl.line_program->set("u_view_proj", view_proj);
-  gl.line_program->set("u_viewport", Eigen::Vector2f(static_cast<float>(width), static_cast<float>(height)));
+  gl.line_program->set("u_viewport",
+                       Eigen::Vector2f(static_cast<float>(width), static_cast<float>(height)));
   for (const GpuMesh& m : scene.meshes) {
     if (m.line_vertex_count == 0) continue;
     gl.line_program->set("u_width_px", m.line_width * static_cast<float>(factor));

@@ -1,9 +1,10 @@
 #include "src/render/scene.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <fmt/format.h>
 #include <limits>
 #include <stdexcept>
 #include <unordered_map>
@@ -51,7 +52,9 @@ constexpr std::array<std::array<float, 3>, 8> kPanelColours{{
     {0.66f, 0.50f, 0.42f},
 }};
 
-Eigen::Vector3f to_vector(const std::array<float, 3>& c) { return {c[0], c[1], c[2]}; }
+Eigen::Vector3f to_vector(const std::array<float, 3>& c) {
+  return {c[0], c[1], c[2]};
+}
 
 std::uint64_t edge_key(int a, int b) {
   if (a > b) std::swap(a, b);
@@ -65,7 +68,8 @@ Eigen::MatrixX2i unique_edges(std::vector<std::pair<int, int>> edges) {
   std::sort(edges.begin(), edges.end());
   edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
   Eigen::MatrixX2i out(static_cast<Eigen::Index>(edges.size()), 2);
-  for (size_t i = 0; i < edges.size(); ++i) out.row(static_cast<Eigen::Index>(i)) << edges[i].first, edges[i].second;
+  for (size_t i = 0; i < edges.size(); ++i)
+    out.row(static_cast<Eigen::Index>(i)) << edges[i].first, edges[i].second;
   return out;
 }
 
@@ -86,7 +90,8 @@ Eigen::MatrixX3f panel_colours(const Eigen::VectorXi& panel_ids) {
   Eigen::MatrixX3f out(panel_ids.size(), 3);
   for (Eigen::Index f = 0; f < panel_ids.size(); ++f) {
     if (panel_ids[f] < 0)
-      throw std::invalid_argument(fmt::format("panel id {} of face {} is negative", panel_ids[f], f));
+      throw std::invalid_argument(
+          fmt::format("panel id {} of face {} is negative", panel_ids[f], f));
     out.row(f) = to_vector(kPanelColours[static_cast<size_t>(panel_ids[f]) % kPanelColours.size()])
                      .transpose();
   }
@@ -127,8 +132,8 @@ Eigen::VectorXd edge_values_from_faces(const meshing::TriMesh& mesh, const Eigen
   largest.reserve(static_cast<size_t>(mesh.face_count()) * 3);
   for (Eigen::Index f = 0; f < mesh.face_count(); ++f)
     for (int k = 0; k < 3; ++k) {
-      const auto [it, inserted] =
-          largest.try_emplace(edge_key(mesh.faces(f, k), mesh.faces(f, (k + 1) % 3)), face_values[f]);
+      const auto [it, inserted] = largest.try_emplace(
+          edge_key(mesh.faces(f, k), mesh.faces(f, (k + 1) % 3)), face_values[f]);
       if (!inserted) it->second = std::max(it->second, face_values[f]);
     }
   Eigen::VectorXd out(edges.rows());

@@ -48,8 +48,8 @@ struct Wireframe {
 struct SceneMesh {
   meshing::TriMesh mesh;  // metres; faces counter-clockwise seen from the front side
   MeshRole role = MeshRole::kBody;
-  Eigen::Vector3f colour{0.80f, 0.74f, 0.68f};  // used when face_colours is empty
-  Eigen::MatrixX3f face_colours;                // optional, #F by 3
+  Eigen::Vector3f colour{0.80f, 0.74f, 0.68f};       // used when face_colours is empty
+  Eigen::MatrixX3f face_colours;                     // optional, #F by 3
   Eigen::Vector3f back_colour{0.55f, 0.55f, 0.60f};  // cloth back faces
   std::optional<Wireframe> wireframe;
 };

@@ -94,8 +94,12 @@ GLint ShaderProgram::location(const char* name) {
   return loc;
 }
 
-void ShaderProgram::set(const char* name, int value) { glUniform1i(location(name), value); }
-void ShaderProgram::set(const char* name, float value) { glUniform1f(location(name), value); }
+void ShaderProgram::set(const char* name, int value) {
+  glUniform1i(location(name), value);
+}
+void ShaderProgram::set(const char* name, float value) {
+  glUniform1f(location(name), value);
+}
 void ShaderProgram::set(const char* name, const Eigen::Vector2f& value) {
   glUniform2fv(location(name), 1, value.data());
 }

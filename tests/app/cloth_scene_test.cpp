@@ -2,17 +2,17 @@
 // cut smaller than drawn has shorter rest lengths (its gradient operators grow by 1/ease) and
 // less cloth (rest area and mass by ease²); a panel with ease 1 is exactly build_cloth_model.
 
+#include "src/app/pipeline/cloth_scene.hpp"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "garment/sketch_file.hpp"
 #include "sim/cloth_model.hpp"
-#include "src/app/pipeline/cloth_scene.hpp"
 
 namespace sd::app {
 namespace {
@@ -40,7 +40,8 @@ std::string two_patches(double ease) {
 
 TEST(ClothScene, PanelEaseScalesRestShapeAndMass) {
   constexpr double kEase = 0.9;
-  const ClothScene eased = build_cloth_scene(garment::parse_sketch(two_patches(kEase), "eased.json"));
+  const ClothScene eased =
+      build_cloth_scene(garment::parse_sketch(two_patches(kEase), "eased.json"));
   const ClothScene plain = build_cloth_scene(garment::parse_sketch(two_patches(1.0), "plain.json"));
   ASSERT_EQ(eased.input.triangles.rows(), plain.input.triangles.rows());
   ASSERT_EQ(eased.face_ease.size(), eased.mesh48->arrays().faces.rows() / 2) << "one per quad";
@@ -79,7 +80,8 @@ TEST(ClothScene, PanelEaseScalesRestShapeAndMass) {
   EXPECT_NEAR(b.mass.sum(), density * (left_area + right_area), 1e-12);
   // Bending is scale-free: hinge rest angles and weights do not change.
   ASSERT_EQ(a.hinges.size(), b.hinges.size());
-  for (size_t h = 0; h < a.hinges.size(); ++h) EXPECT_EQ(a.hinges[h].rest_angle, b.hinges[h].rest_angle);
+  for (size_t h = 0; h < a.hinges.size(); ++h)
+    EXPECT_EQ(a.hinges[h].rest_angle, b.hinges[h].rest_angle);
 }
 
 // A sheet with "layers": copies stacked by layer_offset and turned by layer_turn about the
@@ -166,7 +168,8 @@ namespace {
 // A sheet scene with the given value of "fabric" (JSON text).
 std::string sheet_with_fabric(const std::string& fabric) {
   return R"({ "sheet": { "size": [0.5, 0.5], "resolution": [4, 4], "pins": ["top"] },
-              "fabric": )" + fabric + "}";
+              "fabric": )" +
+         fabric + "}";
 }
 
 // The presets' own file, with one constant replaced (JSON text of the object).
@@ -190,12 +193,12 @@ std::string silk_with(const std::string& key, const std::string& entry) {
 // "fabric" takes a preset name, the constants inline, or a path to a fabric file; a bad
 // constant is reported at its JSON path.
 TEST(ClothScene, FabricIsAPresetAnInlineObjectOrAFile) {
-  const ClothScene preset = build_cloth_scene(garment::parse_sketch(sheet_with_fabric(R"("denim")"), "a.json"));
+  const ClothScene preset =
+      build_cloth_scene(garment::parse_sketch(sheet_with_fabric(R"("denim")"), "a.json"));
   EXPECT_EQ(preset.fabric.name, "denim");
 
-  const ClothScene inline_fabric = build_cloth_scene(
-      garment::parse_sketch(sheet_with_fabric(silk_with("bend", R"({"value": 3e-6, "unit": "N*m"})")),
-                            "b.json"));
+  const ClothScene inline_fabric = build_cloth_scene(garment::parse_sketch(
+      sheet_with_fabric(silk_with("bend", R"({"value": 3e-6, "unit": "N*m"})")), "b.json"));
   EXPECT_EQ(inline_fabric.fabric.name, "my silk");
   EXPECT_EQ(inline_fabric.fabric.bend, 3e-6);
   EXPECT_EQ(inline_fabric.fabric_name, "my silk");
@@ -215,10 +218,12 @@ TEST(ClothScene, FabricIsAPresetAnInlineObjectOrAFile) {
     }
     return std::string("no error");
   };
-  const std::string wrong_unit = error_path(silk_with("bend", R"({"value": 2e-5, "unit": "gf*cm^2/cm"})"));
+  const std::string wrong_unit =
+      error_path(silk_with("bend", R"({"value": 2e-5, "unit": "gf*cm^2/cm"})"));
   EXPECT_EQ(wrong_unit.substr(0, wrong_unit.find(" | ")), "/fabric/bend") << wrong_unit;
   EXPECT_NE(wrong_unit.find("N*m"), std::string::npos) << wrong_unit;
-  const std::string negative = error_path(silk_with("area_density", R"({"value": -1, "unit": "kg/m^2"})"));
+  const std::string negative =
+      error_path(silk_with("area_density", R"({"value": -1, "unit": "kg/m^2"})"));
   EXPECT_EQ(negative.substr(0, negative.find(" | ")), "/fabric/area_density") << negative;
   const std::string missing = error_path(R"({"name": "half"})");
   EXPECT_EQ(missing.substr(0, missing.find(" | ")), "/fabric/area_density") << missing;

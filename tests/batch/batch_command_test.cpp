@@ -298,14 +298,15 @@ TEST(BatchFaults, DivergingSimulationFailsItsJobOnly) {
   if (run_sketchdrape("run --help").exit_code != 0)
     GTEST_SKIP() << "SKIPPED: this build has no `run` command";
   const fs::path dir = fresh_batch_dir("diverging");
-  const json sheet = {
-      {"format", "sketchdrape/1"},
-      {"sheet",
-       {{"size", {0.3, 0.3}}, {"resolution", {4, 4}}, {"orientation", "horizontal"},
-        {"pins", {"top-left", "top-right"}}}},
-      {"fabric", "cotton"},
-      {"simulate", {{"duration", 0.2}, {"solver", "cholmod"}}},
-      {"output", {{"images", json::array()}}}};
+  const json sheet = {{"format", "sketchdrape/1"},
+                      {"sheet",
+                       {{"size", {0.3, 0.3}},
+                        {"resolution", {4, 4}},
+                        {"orientation", "horizontal"},
+                        {"pins", {"top-left", "top-right"}}}},
+                      {"fabric", "cotton"},
+                      {"simulate", {{"duration", 0.2}, {"solver", "cholmod"}}},
+                      {"output", {{"images", json::array()}}}};
   write_text(dir / "sheet.json", sheet.dump(2));
   write_text(dir / "m.json",
              json{{"format", "sketchdrape-batch/1"},

@@ -68,7 +68,8 @@ TEST(BatchChildren, GetOneOpenBlasThreadUnlessTheUserChoseOtherwise) {
   {
     const ScopedEnv unset("OPENBLAS_NUM_THREADS", std::nullopt);
     EXPECT_EQ(child_sees(fresh_batch_dir("openblas_default")), "1 passed");
-    EXPECT_EQ(::getenv("OPENBLAS_NUM_THREADS"), nullptr) << "the batch's own environment is unchanged";
+    EXPECT_EQ(::getenv("OPENBLAS_NUM_THREADS"), nullptr)
+        << "the batch's own environment is unchanged";
   }
   {
     const ScopedEnv chosen("OPENBLAS_NUM_THREADS", "3");

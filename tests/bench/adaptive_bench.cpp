@@ -28,14 +28,14 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <numbers>
 #include <cstdio>
 #include <cstdlib>
-#include <ctime>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -117,7 +117,8 @@ void BM_SplitMergeRebuild(benchmark::State& state) {
   state.counters["changes"] = benchmark::Counter(changes, benchmark::Counter::kAvgIterations);
   state.counters["operations_ms"] =
       benchmark::Counter(1e3 * operations, benchmark::Counter::kAvgIterations);
-  state.counters["rebuild_ms"] = benchmark::Counter(1e3 * rebuild, benchmark::Counter::kAvgIterations);
+  state.counters["rebuild_ms"] =
+      benchmark::Counter(1e3 * rebuild, benchmark::Counter::kAvgIterations);
 }
 BENCHMARK(BM_SplitMergeRebuild)->Unit(benchmark::kMillisecond);
 
@@ -126,7 +127,8 @@ BENCHMARK(BM_SplitMergeRebuild)->Unit(benchmark::kMillisecond);
 // export, build, replace_model).
 void BM_Rebuild(benchmark::State& state) {
   AdaptiveSheetSpec spec;
-  AdaptiveCloth cloth = make_adaptive_sheet(spec, static_cast<int>(state.range(0)), fixed_settings());
+  AdaptiveCloth cloth =
+      make_adaptive_sheet(spec, static_cast<int>(state.range(0)), fixed_settings());
   const sd::meshing::Mesh48Arrays arrays = cloth.mesh().arrays();
   ClothInput input;
   input.rest_positions = arrays.rest_positions;
@@ -164,8 +166,8 @@ BENCHMARK(BM_AdaptiveStep)->Unit(benchmark::kMillisecond)->Iterations(30);
 
 struct RunResult {
   std::string name;
-  double wall_s = 0;       // stepping only (sampling for the error excluded)
-  double cpu_s = 0;        // process CPU time of the stepping (single-threaded BLAS/OpenMP)
+  double wall_s = 0;  // stepping only (sampling for the error excluded)
+  double cpu_s = 0;   // process CPU time of the stepping (single-threaded BLAS/OpenMP)
   double solve_s = 0;
   double forces_s = 0;
   double adaptivity_s = 0;  // estimates + operations + rebuild
@@ -200,7 +202,8 @@ RunResult run_case(const std::string& dir, const std::string& scene, const std::
   RunResult result;
   result.name = name;
   std::ofstream csv(dir + "/" + scene + "_" + name + ".csv");
-  csv << "time,wall_s,cpu_s,vertices,triangles,splits,merges,stretch,shear,bend,kinetic,potential\n";
+  csv << "time,wall_s,cpu_s,vertices,triangles,splits,merges,stretch,shear,bend,kinetic,"
+         "potential\n";
   double wall = 0.0;
   double next_sample = 0.0;
   const auto write_row = [&](const AdaptiveCloth& c, int splits, int merges) {
@@ -227,7 +230,8 @@ RunResult run_case(const std::string& dir, const std::string& scene, const std::
     }
     const AdaptiveStepRecord& record = cloth.report().steps.back();
     write_row(cloth, record.splits + record.forced_splits, record.merges);
-    if (std::abs(cloth.time() - 1.0) < epsilon) write_mesh(dir + "/" + scene + "_" + name + "_t1.dat", cloth);
+    if (std::abs(cloth.time() - 1.0) < epsilon)
+      write_mesh(dir + "/" + scene + "_" + name + "_t1.dat", cloth);
     if (cloth.time() >= next_sample - epsilon) {
       result.samples.push_back(material_positions(cloth, points));
       next_sample += sample_every;
@@ -319,9 +323,10 @@ int run_study(const StudyOptions& options) {
   const int finest = options.finest;
   std::filesystem::create_directories(dir);
   std::ofstream summary(dir + "/summary.csv");
-  summary << "scene,run,cpu_s,wall_s,forces_s,solve_s,estimate_s,operations_s,rebuild_s,steps,retries,"
-             "vertices_final,vertices_max,splits,forced_splits,merges,topology_changes,"
-             "error_final_m,error_trajectory_m,lowest_m,extent_x,extent_y,extent_z,finest_level\n";
+  summary
+      << "scene,run,cpu_s,wall_s,forces_s,solve_s,estimate_s,operations_s,rebuild_s,steps,retries,"
+         "vertices_final,vertices_max,splits,forced_splits,merges,topology_changes,"
+         "error_final_m,error_trajectory_m,lowest_m,extent_x,extent_y,extent_z,finest_level\n";
   std::vector<std::pair<std::string, AdaptiveSheetSpec>> scenes(4);
   scenes[0].first = "three_corner";
   scenes[0].second.pins = {"top-left", "top-right", "bottom-left"};
@@ -375,8 +380,8 @@ int run_study(const StudyOptions& options) {
     // reference each run is measured against itself (errors 0).
     const int reference_level = quick ? finest + 1 : finest + 2;
     const std::string reference_name = "fixed_l" + std::to_string(reference_level);
-    const std::string kept = dir + "/" + scene + "_" + reference_name +
-                             (quick ? "_quick" : "") + "_samples.bin";
+    const std::string kept =
+        dir + "/" + scene + "_" + reference_name + (quick ? "_quick" : "") + "_samples.bin";
     RunResult reference;
     if (only.empty()) {
       runs.push_back(run_case(dir, scene, reference_name, spec, reference_level, fixed_settings(),
@@ -390,21 +395,22 @@ int run_study(const StudyOptions& options) {
     }
     for (RunResult& run : runs) {
       errors_against(run, reference);
-      summary << scene << ',' << run.name << ',' << run.cpu_s << ',' << run.wall_s << ',' << run.forces_s << ','
-              << run.solve_s << ',' << run.estimate_s << ',' << run.operations_s << ','
-              << run.rebuild_s << ',' << run.steps << ',' << run.retries << ','
-              << run.vertices_final << ',' << run.vertices_max << ',' << run.splits << ','
+      summary << scene << ',' << run.name << ',' << run.cpu_s << ',' << run.wall_s << ','
+              << run.forces_s << ',' << run.solve_s << ',' << run.estimate_s << ','
+              << run.operations_s << ',' << run.rebuild_s << ',' << run.steps << ',' << run.retries
+              << ',' << run.vertices_final << ',' << run.vertices_max << ',' << run.splits << ','
               << run.forced << ',' << run.merges << ',' << run.changes << ',' << run.error_final
               << ',' << run.error_trajectory << ',' << run.shape.lowest << ','
               << run.shape.extent.x() << ',' << run.shape.extent.y() << ',' << run.shape.extent.z()
               << ',' << finest << '\n';
       std::printf(
-          "%-13s %-16s cpu %7.2f s wall %7.2f s (forces %6.2f solve %6.2f adapt %5.3f = est %5.3f + ops %5.3f "
+          "%-13s %-16s cpu %7.2f s wall %7.2f s (forces %6.2f solve %6.2f adapt %5.3f = est %5.3f "
+          "+ ops %5.3f "
           "+ rebuild %5.3f) steps %4d retries %3d verts %5d (max %5d) splits %5d+%4d merges %5d "
           "error final %.2f mm trajectory %.2f mm lowest %.4f\n",
           scene.c_str(), run.name.c_str(), run.cpu_s, run.wall_s, run.forces_s, run.solve_s,
-          run.adaptivity_s, run.estimate_s, run.operations_s, run.rebuild_s, run.steps,
-          run.retries, run.vertices_final, run.vertices_max, run.splits, run.forced, run.merges,
+          run.adaptivity_s, run.estimate_s, run.operations_s, run.rebuild_s, run.steps, run.retries,
+          run.vertices_final, run.vertices_max, run.splits, run.forced, run.merges,
           1e3 * run.error_final, 1e3 * run.error_trajectory, run.shape.lowest);
       std::fflush(stdout);
     }

@@ -75,7 +75,8 @@ void body_surface_build(benchmark::State& state) {
 
 BENCHMARK_CAPTURE(mesh_example, tshirt, "tshirt.json")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(mesh_example, a_line_skirt, "a-line-skirt.json")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(mesh_example, sleeveless_dress, "sleeveless-dress.json")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(mesh_example, sleeveless_dress, "sleeveless-dress.json")
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(mesh_example, shorts, "shorts.json")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(mesh_example, godet_skirt, "godet-skirt.json")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(mesh_design, pencil_skirt, "pencil-skirt.json")->Unit(benchmark::kMillisecond);

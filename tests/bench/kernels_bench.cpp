@@ -9,9 +9,8 @@
 
 #include <benchmark/benchmark.h>
 
-#include <vector>
-
 #include <Eigen/Core>
+#include <vector>
 
 #include "sim/cholmod_solver.hpp"
 #include "sim/cloth_model.hpp"
@@ -46,8 +45,9 @@ System sheet_system(int n) {
   s.a = s.model.pattern.zero_matrix;
   for (int i = 0; i < s.model.vertex_count; ++i)
     for (int k = 0; k < 3; ++k)
-      s.a.valuePtr()[block_value_index(s.a, i, s.model.pattern.diagonal_offsets[static_cast<size_t>(i)],
-                                       k, k)] = s.model.mass[i];
+      s.a.valuePtr()[block_value_index(
+          s.a, i, s.model.pattern.diagonal_offsets[static_cast<size_t>(i)], k, k)] =
+          s.model.mass[i];
   const double h = 1.0 / 60;
   JacobianTarget target;
   target.matrix = &s.a;
@@ -79,9 +79,9 @@ void BM_SpMV(benchmark::State& state) {
   state.SetBytesProcessed(static_cast<int64_t>(state.iterations() * spmv_bytes(s.a)));
   state.counters["vertices"] = s.model.vertex_count;
   state.counters["matrix_MB"] = spmv_bytes(s.a) / 1e6;
-  state.counters["ns_per_vertex"] = benchmark::Counter(
-      static_cast<double>(state.iterations()) * s.model.vertex_count * 1e-9,
-      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["ns_per_vertex"] =
+      benchmark::Counter(static_cast<double>(state.iterations()) * s.model.vertex_count * 1e-9,
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_SpMV)->Arg(64)->Arg(128)->Unit(benchmark::kMicrosecond);
 

@@ -7,9 +7,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <string>
 #include <numbers>
 #include <numeric>
+#include <string>
 #include <vector>
 
 #include "meshing/patch_fill.hpp"
@@ -23,13 +23,13 @@ std::string describe(const std::vector<int>& counts);
 // Named inputs, each with Σl <= 200.
 const std::vector<std::vector<int>>& cases() {
   static const std::vector<std::vector<int>> all = {
-      {5, 6, 3, 6, 4},                  // the paper's pentagon, Σ 24
-      {50, 50, 50, 50},                 // grid, Σ 200
-      {40, 44, 36, 42, 38},             // fair pentagon, Σ 200
+      {5, 6, 3, 6, 4},                   // the paper's pentagon, Σ 24
+      {50, 50, 50, 50},                  // grid, Σ 200
+      {40, 44, 36, 42, 38},              // fair pentagon, Σ 200
       {26, 24, 24, 26, 24, 26, 24, 26},  // octagon, Σ 200
-      {120, 20, 20, 20, 20},            // one very long side, Σ 200
-      {60, 8, 60, 8, 60, 4},            // alternating long/short, Σ 200
-      {2, 8, 4},                        // Takayama's (2,8,4)
+      {120, 20, 20, 20, 20},             // one very long side, Σ 200
+      {60, 8, 60, 8, 60, 4},             // alternating long/short, Σ 200
+      {2, 8, 4},                         // Takayama's (2,8,4)
   };
   return all;
 }
@@ -77,8 +77,8 @@ std::vector<int> scaled(std::vector<int> counts, int factor) {
 
 const std::vector<std::vector<int>>& rectilinear_cases() {
   static const std::vector<std::vector<int>> all = {
-      scaled({1, 2, 3, 1, 3}, 4),  scaled({1, 2, 3, 1, 3}, 10), scaled({1, 2, 3, 1, 3}, 25),
-      scaled({2, 4, 4, 2, 4}, 2),  scaled({2, 4, 4, 2, 4}, 6),  scaled({2, 4, 4, 2, 4}, 14),
+      scaled({1, 2, 3, 1, 3}, 4), scaled({1, 2, 3, 1, 3}, 10), scaled({1, 2, 3, 1, 3}, 25),
+      scaled({2, 4, 4, 2, 4}, 2), scaled({2, 4, 4, 2, 4}, 6),  scaled({2, 4, 4, 2, 4}, 14),
       {40, 44, 36, 42, 38},
   };
   return all;
@@ -159,14 +159,16 @@ int main(int argc, char** argv) {
     const std::vector<int> counts = sweep_case.counts;
     benchmark::RegisterBenchmark(("BM_SweepTopology/" + sweep_case.name).c_str(),
                                  [counts](benchmark::State& state) {
-                                   for (auto _ : state) benchmark::DoNotOptimize(fill_region(counts));
+                                   for (auto _ : state)
+                                     benchmark::DoNotOptimize(fill_region(counts));
                                    state.SetLabel(describe(counts));
                                  })
         ->Unit(benchmark::kMicrosecond);
     const auto sides = ellipse_sides(counts);
     benchmark::RegisterBenchmark(("BM_SweepGeometry/" + sweep_case.name).c_str(),
                                  [sides, counts](benchmark::State& state) {
-                                   for (auto _ : state) benchmark::DoNotOptimize(fill_region(sides));
+                                   for (auto _ : state)
+                                     benchmark::DoNotOptimize(fill_region(sides));
                                    state.SetLabel(describe(counts));
                                  })
         ->Unit(benchmark::kMicrosecond);

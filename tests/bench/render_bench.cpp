@@ -29,9 +29,17 @@ Scene body_scene(bool shadows) {
 void BM_ContextCreation(benchmark::State& state) {
   std::vector<unsigned char> buffer(16 * 16 * 4);
   for (auto _ : state) {
-    const int attributes[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 0,
-                              OSMESA_PROFILE, OSMESA_CORE_PROFILE, OSMESA_CONTEXT_MAJOR_VERSION, 4,
-                              OSMESA_CONTEXT_MINOR_VERSION, 5, 0};
+    const int attributes[] = {OSMESA_FORMAT,
+                              OSMESA_RGBA,
+                              OSMESA_DEPTH_BITS,
+                              0,
+                              OSMESA_PROFILE,
+                              OSMESA_CORE_PROFILE,
+                              OSMESA_CONTEXT_MAJOR_VERSION,
+                              4,
+                              OSMESA_CONTEXT_MINOR_VERSION,
+                              5,
+                              0};
     OSMesaContext context = OSMesaCreateContextAttribs(attributes, nullptr);
     if (context == nullptr) {
       state.SkipWithError("no OSMesa context");
@@ -42,7 +50,10 @@ void BM_ContextCreation(benchmark::State& state) {
     OSMesaDestroyContext(context);
   }
 }
-BENCHMARK(BM_ContextCreation)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime();
+BENCHMARK(BM_ContextCreation)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
 
 // Context + compiling and linking the four shader programs + the shadow map.
 void BM_RendererStartup(benchmark::State& state) {
@@ -51,7 +62,10 @@ void BM_RendererStartup(benchmark::State& state) {
     benchmark::DoNotOptimize(renderer.gl_version().data());
   }
 }
-BENCHMARK(BM_RendererStartup)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime();
+BENCHMARK(BM_RendererStartup)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
 
 // Vertex normals + uploading the body (4.3k vertices, 8.6k triangles) and its face colours.
 void BM_PrepareBody(benchmark::State& state) {
@@ -97,9 +111,13 @@ void BM_ViewFrameAndPng(benchmark::State& state) {
   Renderer renderer;
   const PreparedScene prepared = renderer.prepare(body_scene(true));
   const Camera camera = frame_view(ViewName::kFront, prepared.bounds(), kSize.aspect());
-  for (auto _ : state) benchmark::DoNotOptimize(encode_png(renderer.render(prepared, camera, kSize)));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(encode_png(renderer.render(prepared, camera, kSize)));
 }
-BENCHMARK(BM_ViewFrameAndPng)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime();
+BENCHMARK(BM_ViewFrameAndPng)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
 
 // A first view from nothing: context, shaders, upload, frame, PNG.
 void BM_FirstViewFromScratch(benchmark::State& state) {
@@ -111,7 +129,10 @@ void BM_FirstViewFromScratch(benchmark::State& state) {
     benchmark::DoNotOptimize(encode_png(renderer.render(prepared, camera, kSize)));
   }
 }
-BENCHMARK(BM_FirstViewFromScratch)->Unit(benchmark::kMillisecond)->UseRealTime()->MeasureProcessCPUTime();
+BENCHMARK(BM_FirstViewFromScratch)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime();
 
 }  // namespace
 }  // namespace sd::render

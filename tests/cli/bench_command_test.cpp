@@ -38,7 +38,9 @@ std::string read_text(const fs::path& path) {
   return s.str();
 }
 
-nlohmann::json read_json(const fs::path& path) { return nlohmann::json::parse(read_text(path)); }
+nlohmann::json read_json(const fs::path& path) {
+  return nlohmann::json::parse(read_text(path));
+}
 
 // CSV with quoted fields ("a, b" and "" escapes), one vector per line.
 std::vector<std::vector<std::string>> parse_csv(const std::string& text) {
@@ -80,12 +82,14 @@ std::map<std::string, std::map<std::string, std::string>> csv_by_run(const fs::p
   for (size_t r = 1; r < rows.size(); ++r) {
     std::map<std::string, std::string> row;
     for (size_t c = 0; c < rows[0].size() && c < rows[r].size(); ++c) row[rows[0][c]] = rows[r][c];
-    out[row["scene"] + "/" + (row["note"].rfind("reference", 0) == 0 ? "reference" : row["run"])] = row;
+    out[row["scene"] + "/" + (row["note"].rfind("reference", 0) == 0 ? "reference" : row["run"])] =
+        row;
   }
   return out;
 }
 
-double rms(const std::map<std::string, std::map<std::string, std::string>>& runs, const std::string& id) {
+double rms(const std::map<std::string, std::map<std::string, std::string>>& runs,
+           const std::string& id) {
   const auto it = runs.find("hanging-sheet/" + id);
   if (it == runs.end()) {
     ADD_FAILURE() << "no row " << id;
@@ -95,19 +99,43 @@ double rms(const std::map<std::string, std::map<std::string, std::string>>& runs
   return std::stod(it->second.at("rms_error_m"));
 }
 
-bool has_gnuplot() { return std::system("command -v gnuplot >/dev/null 2>&1") == 0; }
+bool has_gnuplot() {
+  return std::system("command -v gnuplot >/dev/null 2>&1") == 0;
+}
 
-const std::vector<std::string> kColumns = {
-    "scene", "run", "mesh", "level", "threshold_mm", "integrator", "solver", "dt_s", "families",
-    "status", "wall_s", "cpu_s", "process_cpu_s", "peak_rss_mb", "rss_before_run_mb",
-    "vertices_max", "triangles_max", "steps", "retries", "linear_solves", "cg_iterations_mean",
-    "rms_error_m", "max_error_m", "final_rms_error_m", "energy_error_j", "energy_error_relative",
-    "pareto", "note"};
+const std::vector<std::string> kColumns = {"scene",
+                                           "run",
+                                           "mesh",
+                                           "level",
+                                           "threshold_mm",
+                                           "integrator",
+                                           "solver",
+                                           "dt_s",
+                                           "families",
+                                           "status",
+                                           "wall_s",
+                                           "cpu_s",
+                                           "process_cpu_s",
+                                           "peak_rss_mb",
+                                           "rss_before_run_mb",
+                                           "vertices_max",
+                                           "triangles_max",
+                                           "steps",
+                                           "retries",
+                                           "linear_solves",
+                                           "cg_iterations_mean",
+                                           "rms_error_m",
+                                           "max_error_m",
+                                           "final_rms_error_m",
+                                           "energy_error_j",
+                                           "energy_error_relative",
+                                           "pareto",
+                                           "note"};
 
 TEST(BenchCommand, TinyGridMeasuresErrorsAndReusesTheCachedReference) {
   const fs::path dir = fresh_dir("tiny");
-  const std::string args = "-q bench --grid tiny -o " + (dir / "out").string() + " --cache " +
-                           (dir / "cache").string();
+  const std::string args =
+      "-q bench --grid tiny -o " + (dir / "out").string() + " --cache " + (dir / "cache").string();
   const auto first = run_sketchdrape(args);
   ASSERT_EQ(first.exit_code, 0) << first.output;
 
@@ -115,7 +143,8 @@ TEST(BenchCommand, TinyGridMeasuresErrorsAndReusesTheCachedReference) {
   const auto rows = parse_csv(read_text(dir / "out/bench.csv"));
   ASSERT_FALSE(rows.empty());
   EXPECT_EQ(rows[0], kColumns);
-  const sd::app::BenchScene scene = sd::app::build_bench_scene("hanging-sheet", sd::app::BenchGrid::tiny);
+  const sd::app::BenchScene scene =
+      sd::app::build_bench_scene("hanging-sheet", sd::app::BenchGrid::tiny);
   const sd::app::BenchPlan plan = sd::app::bench_plan(scene, sd::app::BenchGrid::tiny);
   EXPECT_EQ(rows.size(), plan.runs.size() + 2);  // header + reference + runs
   for (size_t r = 1; r < rows.size(); ++r) EXPECT_EQ(rows[r].size(), kColumns.size()) << r;
@@ -187,7 +216,8 @@ TEST(BenchCommand, SketchSceneReferenceIsRecomputedWhenTheSceneChanges) {
   const fs::path sketch = dir / "sheet.json";
   std::ofstream(sketch) << sheet_sketch("cotton").dump(2);
   const std::string args = "-q bench --grid tiny --scene " + sketch.string() + " -o " +
-                           (dir / "out").string() + " --cache " + (dir / "cache").string() + " --json";
+                           (dir / "out").string() + " --cache " + (dir / "cache").string() +
+                           " --json";
   const auto cached_flag = [&] {
     const auto result = run_sketchdrape(args);
     EXPECT_EQ(result.exit_code, 0) << result.output;
@@ -209,12 +239,15 @@ TEST(BenchCommand, SketchSceneReferenceIsRecomputedWhenTheSceneChanges) {
 
 TEST(BenchCommand, BadInputExitsWithTwoAndWritesNothing) {
   const fs::path dir = fresh_dir("bad");
-  const auto unknown = run_sketchdrape("bench --grid tiny --scene no-such-scene -o " + (dir / "out").string());
+  const auto unknown =
+      run_sketchdrape("bench --grid tiny --scene no-such-scene -o " + (dir / "out").string());
   EXPECT_EQ(unknown.exit_code, 2) << unknown.output;
-  EXPECT_NE(unknown.output.find("unknown scene 'no-such-scene'"), std::string::npos) << unknown.output;
+  EXPECT_NE(unknown.output.find("unknown scene 'no-such-scene'"), std::string::npos)
+      << unknown.output;
   const auto grid = run_sketchdrape("bench --grid huge -o " + (dir / "out").string());
   EXPECT_EQ(grid.exit_code, 2) << grid.output;
-  EXPECT_NE(grid.output.find("--grid must be tiny, quick or full"), std::string::npos) << grid.output;
+  EXPECT_NE(grid.output.find("--grid must be tiny, quick or full"), std::string::npos)
+      << grid.output;
   const auto both = run_sketchdrape("bench --quick --grid full -o " + (dir / "out").string());
   EXPECT_EQ(both.exit_code, 2) << both.output;
   EXPECT_FALSE(fs::exists(dir / "out"));

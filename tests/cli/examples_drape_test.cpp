@@ -257,8 +257,8 @@ INSTANTIATE_TEST_SUITE_P(Examples, ExampleDrape, ::testing::ValuesIn(kExamples),
 // The same garments with adaptive detail on the body: the t-shirt's first adaptive drape failed
 // at 0.05 s when a split of a flat block under the arm lifted its new vertex 14 mm out of the
 // body and stretched its children by 340 % (AdaptiveCloth::split_stays_off_body now declines it).
-INSTANTIATE_TEST_SUITE_P(AdaptiveExamples, ExampleDrape,
-                         ::testing::ValuesIn(adaptive_examples()), test_name);
+INSTANTIATE_TEST_SUITE_P(AdaptiveExamples, ExampleDrape, ::testing::ValuesIn(adaptive_examples()),
+                         test_name);
 // Two levels deep: the t-shirt failed at 0.055 s (a vertex at 50 m/s after landing on the
 // shoulders) until the body sag refined it before landing and its back panel lost its crease.
 INSTANTIATE_TEST_SUITE_P(DeepAdaptiveExamples, ExampleDrape,

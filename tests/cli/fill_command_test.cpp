@@ -3,7 +3,6 @@
 // sentence and write nothing.
 
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <cmath>
@@ -90,8 +89,7 @@ TEST_F(FillCommand, JsonFieldsMatchTheLibrary) {
 
 TEST_F(FillCommand, ObjHasTheReportedFaces) {
   const fs::path obj = dir_ / "patch.obj";
-  const CommandResult run =
-      run_sketchdrape("fill --sides 6,4,4,2 --json --obj " + obj.string());
+  const CommandResult run = run_sketchdrape("fill --sides 6,4,4,2 --json --obj " + obj.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json report = nlohmann::json::parse(run.output);
   std::ifstream in(obj);
@@ -134,15 +132,16 @@ TEST_F(FillCommand, PngIsWritten) {
   EXPECT_EQ(image.height, 150);
   // Not blank: the patch and its edges differ from the background.
   bool varied = false;
-  for (size_t i = 4; i < image.rgba.size() && !varied; i += 4) varied = image.rgba[i] != image.rgba[0];
+  for (size_t i = 4; i < image.rgba.size() && !varied; i += 4)
+    varied = image.rgba[i] != image.rgba[0];
   EXPECT_TRUE(varied);
 }
 
 TEST_F(FillCommand, BadSidesExitTwoWithASentenceAndWriteNothing) {
   for (const std::string sides : {"--sides 3,3,3", "--sides 0,2", "--sides a,b", ""}) {
     const fs::path obj = dir_ / "bad.obj", png = dir_ / "bad.png";
-    const CommandResult run = run_sketchdrape("fill " + sides + " --obj " + obj.string() +
-                                              " --png " + png.string());
+    const CommandResult run =
+        run_sketchdrape("fill " + sides + " --obj " + obj.string() + " --png " + png.string());
     EXPECT_EQ(run.exit_code, 2) << sides << ": " << run.output;
     EXPECT_GT(run.output.size(), 20u) << sides;  // a sentence, not a bare code
     EXPECT_FALSE(fs::exists(obj)) << sides;

@@ -65,7 +65,8 @@ TEST(MeshCommand, TshirtWritesMeshesReportAndImages) {
   EXPECT_EQ(faces, quads);
   int triangles = 0;
   std::istringstream lines48(read(out / "garment48.obj"));
-  for (std::string line; std::getline(lines48, line);) triangles += line.rfind("f ", 0) == 0 ? 1 : 0;
+  for (std::string line; std::getline(lines48, line);)
+    triangles += line.rfind("f ", 0) == 0 ? 1 : 0;
   EXPECT_EQ(triangles, 2 * quads);
   fs::remove_all(out);
 }
@@ -82,8 +83,8 @@ TEST(MeshCommand, EveryExampleMeshesAndValidates) {
 TEST(MeshCommand, ValidateWritesNothing) {
   const fs::path dir = fresh_dir("validate");
   fs::create_directories(dir);
-  const CommandResult v = run_sketchdrape("validate " + std::string(SD_SOURCE_DIR) +
-                                          "/data/examples/shorts.json");
+  const CommandResult v =
+      run_sketchdrape("validate " + std::string(SD_SOURCE_DIR) + "/data/examples/shorts.json");
   EXPECT_EQ(v.exit_code, 0) << v.output;
   EXPECT_TRUE(fs::is_empty(dir));
   fs::remove_all(dir);
@@ -94,8 +95,8 @@ TEST(MeshCommand, BadInputExitsTwoWithOneLineAndNoFiles) {
     const fs::path out = fresh_dir("bad-" + c.file.stem().string());
     const CommandResult r = run_sketchdrape("mesh " + c.file.string() + " -o " + out.string());
     EXPECT_EQ(r.exit_code, 2) << c.file << "\n" << r.output;
-    const std::string expected = c.json_path.empty() ? c.file.string() + ": "
-                                                     : c.file.string() + ": " + c.json_path + ": ";
+    const std::string expected =
+        c.json_path.empty() ? c.file.string() + ": " : c.file.string() + ": " + c.json_path + ": ";
     EXPECT_NE(r.output.find(expected), std::string::npos) << r.output;
     EXPECT_NE(r.output.find(c.fragment), std::string::npos) << r.output;
     EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;

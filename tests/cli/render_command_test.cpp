@@ -1,14 +1,13 @@
 // `sketchdrape render`: outputs appear together or not at all, bad input exits with 2.
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
 #include <sstream>
-
-#include <unistd.h>
 
 #include "src/render/image.hpp"
 #include "tests/cli/run_command.hpp"
@@ -37,8 +36,8 @@ class RenderCommand : public ::testing::Test {
   }
   static size_t file_count(const fs::path& dir) {
     if (!fs::exists(dir)) return 0;
-    return static_cast<size_t>(std::distance(fs::recursive_directory_iterator(dir),
-                                             fs::recursive_directory_iterator()));
+    return static_cast<size_t>(
+        std::distance(fs::recursive_directory_iterator(dir), fs::recursive_directory_iterator()));
   }
 
   fs::path dir_;
@@ -46,21 +45,24 @@ class RenderCommand : public ::testing::Test {
 
 TEST_F(RenderCommand, WritesOnePngPerViewIntoADirectory) {
   const fs::path out = dir_ / "views";
-  const CommandResult r = run_sketchdrape("render builtin --view front --view three-quarter "
-                                          "--view left --size 90x120 -o " + out.string());
+  const CommandResult r = run_sketchdrape(
+      "render builtin --view front --view three-quarter "
+      "--view left --size 90x120 -o " +
+      out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   for (const char* view : {"front", "three-quarter", "left"}) {
     const render::Image image = read_png(out / (std::string(view) + ".png"));
     EXPECT_EQ(image.width, 90);
     EXPECT_EQ(image.height, 120);
   }
-  EXPECT_EQ(file_count(out), 3u);  // no temporary files left
+  EXPECT_EQ(file_count(out), 3u);                            // no temporary files left
   EXPECT_NE(r.output.find("front.png"), std::string::npos);  // paths printed
 }
 
 TEST_F(RenderCommand, APngOutputNamesTheFileForOneView) {
   const fs::path out = dir_ / "one.png";
-  const CommandResult r = run_sketchdrape("render builtin --view back --size 40x60 -o " + out.string());
+  const CommandResult r =
+      run_sketchdrape("render builtin --view back --size 40x60 -o " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(read_png(out).width, 40);
   // Several views cannot go to one file: usage error, nothing written.
@@ -124,7 +126,8 @@ TEST_F(RenderCommand, DrawsAGarmentOverABody) {
   const fs::path out = dir_ / "dressed";
   const CommandResult r = run_sketchdrape("render " + obj.string() +
                                           " --body builtin --wireframe --view front --view back "
-                                          "--size 80x120 -o " + out.string());
+                                          "--size 80x120 -o " +
+                                          out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const render::Image front = read_png(out / "front.png");
   const render::Image back = read_png(out / "back.png");
@@ -138,8 +141,8 @@ TEST_F(RenderCommand, ExplicitCamera) {
       "render builtin --eye 0,1.6,3 --target 0,1.5,0 --fov 20 --size 50x50 -o " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_TRUE(fs::exists(out / "custom.png"));
-  const CommandResult bad = run_sketchdrape(
-      "render builtin --eye 0,1,0 --target 0,1,0 -o " + (dir_ / "cam2").string());
+  const CommandResult bad =
+      run_sketchdrape("render builtin --eye 0,1,0 --target 0,1,0 -o " + (dir_ / "cam2").string());
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
 }
 

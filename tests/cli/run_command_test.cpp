@@ -1,6 +1,8 @@
 // `sketchdrape run` as a user runs it: a sheet scene and a pinned garment drape and write their
 // outputs; mistakes exit 2 and write nothing.
 
+#include "tests/cli/run_command.hpp"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -10,8 +12,6 @@
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include "tests/cli/run_command.hpp"
 
 namespace sd::test {
 namespace {
@@ -78,13 +78,13 @@ TEST(RunCommand, FramesWriteAPictureSequenceOfTheDrape) {
 TEST(RunCommand, SheetSceneWritesReportMeshAndTrace) {
   const fs::path dir = fresh_dir("sheet");
   const fs::path out = dir / "out";
-  const CommandResult r =
-      run_sketchdrape("-q run " + write_sketch(dir, small_sheet()).string() + " -o " + out.string() + " --trace");
+  const CommandResult r = run_sketchdrape("-q run " + write_sketch(dir, small_sheet()).string() +
+                                          " -o " + out.string() + " --trace");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json report = read_json(out / "report.json");
-  for (const char* key : {"steps", "sim_time", "wall_time_s", "at_rest", "retries", "nan_free",
-                          "vertices", "triangles", "cg_iterations_mean", "cg_iterations_max",
-                          "timing_s", "energy"})
+  for (const char* key :
+       {"steps", "sim_time", "wall_time_s", "at_rest", "retries", "nan_free", "vertices",
+        "triangles", "cg_iterations_mean", "cg_iterations_max", "timing_s", "energy"})
     EXPECT_TRUE(report.contains(key)) << key;
   EXPECT_EQ(report["vertices"], 49);
   EXPECT_EQ(report["triangles"], 72);
@@ -114,7 +114,8 @@ TEST(RunCommand, SheetSceneWritesReportMeshAndTrace) {
   std::stringstream text;
   text << obj.rdbuf();
   size_t faces = 0;
-  for (size_t at = text.str().find("\nf "); at != std::string::npos; at = text.str().find("\nf ", at + 1))
+  for (size_t at = text.str().find("\nf "); at != std::string::npos;
+       at = text.str().find("\nf ", at + 1))
     ++faces;
   EXPECT_EQ(faces, 72u);
   EXPECT_FALSE(fs::exists(out / "drape-front.png"));  // "images": [] asks for none
@@ -133,8 +134,8 @@ TEST(RunCommand, SheetAdaptsOnlyWhenAsked) {
 
   sketch["simulate"]["adaptive"] = {
       {"max_level", 3}, {"refine_threshold", 0.0005}, {"coarsen_threshold", 0.0001}};
-  const CommandResult r = run_sketchdrape("-q run " + write_sketch(dir, sketch).string() +
-                                          " -o " + (dir / "adaptive").string());
+  const CommandResult r = run_sketchdrape("-q run " + write_sketch(dir, sketch).string() + " -o " +
+                                          (dir / "adaptive").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json report = read_json(dir / "adaptive" / "report.json");
   ASSERT_TRUE(report["adaptive"].is_object()) << report.dump(2);
@@ -238,11 +239,12 @@ TEST(RunCommand, BodyPosesFromFilesMoveTheBody) {
                      {"resolution", {8, 8}},
                      {"orientation", "horizontal"},
                      {"centre", {0.0, 0.91, 0.0}}};
-  sketch["body"] = {{"mesh", "box.obj"},
-                    {"motion",
-                     {{"type", "poses"},
-                      {"poses", {{{"time", 0.2}, {"mesh", "box.obj"}},
-                                 {{"time", 0.6}, {"mesh", "box-raised.obj"}}}}}}};
+  sketch["body"] = {
+      {"mesh", "box.obj"},
+      {"motion",
+       {{"type", "poses"},
+        {"poses",
+         {{{"time", 0.2}, {"mesh", "box.obj"}}, {{"time", 0.6}, {"mesh", "box-raised.obj"}}}}}}};
   sketch["simulate"] = {{"duration", 1.0}, {"stop_at_rest", false}};
   const fs::path out = dir / "out";
   const CommandResult r =

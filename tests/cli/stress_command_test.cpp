@@ -72,7 +72,8 @@ TEST(StressCommand, QuickMatrixHoldsAndItsJsonListsEveryCaseFinite) {
     EXPECT_LE(c["max_strain"].get<double>(), c["strain_bound"].get<double>()) << id;
     EXPECT_LE(c["max_speed"].get<double>(), c["speed_bound"].get<double>()) << id;
     EXPECT_LE(c["energy_final_growth_j"].get<double>(), c["energy_bound_j"].get<double>()) << id;
-    EXPECT_GE(c["energy_peak_growth_j"].get<double>(), c["energy_final_growth_j"].get<double>()) << id;
+    EXPECT_GE(c["energy_peak_growth_j"].get<double>(), c["energy_final_growth_j"].get<double>())
+        << id;
     EXPECT_GT(c["energy_scale_j"].get<double>(), 0.0) << id;
     EXPECT_GE(c["dt_min_used"].get<double>(), c["min_dt"].get<double>() * (1 - 1e-12)) << id;
     EXPECT_LE(c["dt_min_used"].get<double>(), c["dt"].get<double>() * (1 + 1e-12)) << id;

@@ -21,7 +21,8 @@ std::string write_temp(const std::string& name, const std::string& text) {
 // An OBJ tetrahedron (closed, outward) with optional extra lines appended.
 std::string tetrahedron_obj(const std::string& extra = "") {
   return "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
-         "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n" + extra;
+         "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n" +
+         extra;
 }
 
 // Message of the BodyError thrown by load_body(path), or "" when none is thrown.
@@ -69,8 +70,8 @@ TEST(Body, BuiltinFacesPlusZ) {
   const Body body = load_body("builtin");
   const auto throat = midline_z_range(body.mesh, 1.505, 1.52);
   const auto chin = midline_z_range(body.mesh, 1.545, 1.56);
-  EXPECT_GT(chin.second - throat.second, 0.03);                // +z: throat to chin
-  EXPECT_LT(std::abs(chin.first - throat.first), 0.01);        // -z: back of the neck
+  EXPECT_GT(chin.second - throat.second, 0.03);          // +z: throat to chin
+  EXPECT_LT(std::abs(chin.first - throat.first), 0.01);  // -z: back of the neck
 }
 
 TEST(Body, HeightOptionWins) {
@@ -125,8 +126,9 @@ TEST(Body, PoseKeepsTheRestBodysFrame) {
 
 TEST(Body, UnitsAreInferredFromHeight) {
   // 170 units tall reads as centimetres.
-  const std::string obj = "v 0 0 0\nv 30 0 0\nv 0 170 0\nv 0 0 20\n"
-                          "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  const std::string obj =
+      "v 0 0 0\nv 30 0 0\nv 0 170 0\nv 0 0 20\n"
+      "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
   const Body body = load_body(write_temp("cm.obj", obj));
   EXPECT_DOUBLE_EQ(body.raw.scale, 0.01);
   EXPECT_EQ(body.raw.up.name(), "+y");
@@ -136,15 +138,15 @@ TEST(Body, UnitsAreInferredFromHeight) {
 TEST(Body, BadFilesGiveASentence) {
   EXPECT_NE(body_error(write_temp("empty.obj", "")).find("cannot read"), std::string::npos);
   EXPECT_NE(body_error(write_temp("points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n")), "");
-  EXPECT_NE(body_error(write_temp("lines.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\nl 2 3\n")),
-            "");
+  EXPECT_NE(body_error(write_temp("lines.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\nl 2 3\n")), "");
   EXPECT_NE(body_error(write_temp("body.unknownformat", "hello")), "");
   // A PNG header in a file that claims to be an OBJ.
   EXPECT_NE(body_error(write_temp("fake.obj", std::string("\x89PNG\r\n\x1a\n\0\0\0\rIHDR", 16))),
             "");
   EXPECT_NE(body_error(std::filesystem::temp_directory_path().string()).find("folder"),
             std::string::npos);
-  const std::string nan_obj = "v nan 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  const std::string nan_obj =
+      "v nan 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
   const std::string nan_error = body_error(write_temp("nan.obj", nan_obj));
   EXPECT_NE(nan_error, "");
 }
@@ -207,8 +209,9 @@ TEST(Body, CorruptHeaderIsRejectedBeforeReading) {
   // Debian's invalid/OutOfMemory.off declares 353535235358 vertices in a 309-byte file.
   const std::string error = body_error("/usr/share/assimp/models/invalid/OutOfMemory.off");
   EXPECT_NE(error.find("corrupt"), std::string::npos) << error;
-  EXPECT_NE(body_error(write_temp("huge.ply", "ply\nformat ascii 1.0\nelement vertex 99999999\n"
-                                              "property float x\nend_header\n0 0 0\n")),
+  EXPECT_NE(body_error(write_temp("huge.ply",
+                                  "ply\nformat ascii 1.0\nelement vertex 99999999\n"
+                                  "property float x\nend_header\n0 0 0\n")),
             "");
 }
 

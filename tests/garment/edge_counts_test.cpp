@@ -10,7 +10,8 @@ namespace sd::garment {
 namespace {
 
 // Cheapest subset by enumeration (variables ≤ 16), or -1 when none makes every parity even.
-double brute_force(int constraints, const std::vector<bool>& odd, const std::vector<ParityVariable>& vars) {
+double brute_force(int constraints, const std::vector<bool>& odd,
+                   const std::vector<ParityVariable>& vars) {
   double best = -1;
   for (unsigned subset = 0; subset < (1u << vars.size()); ++subset) {
     std::vector<bool> parity = odd;
@@ -18,7 +19,8 @@ double brute_force(int constraints, const std::vector<bool>& odd, const std::vec
     for (size_t v = 0; v < vars.size(); ++v)
       if (subset & (1u << v)) {
         cost += vars[v].cost;
-        for (int c : vars[v].constraints) parity[static_cast<size_t>(c)] = !parity[static_cast<size_t>(c)];
+        for (int c : vars[v].constraints)
+          parity[static_cast<size_t>(c)] = !parity[static_cast<size_t>(c)];
       }
     bool even = true;
     for (int c = 0; c < constraints; ++c) even = even && !parity[static_cast<size_t>(c)];
@@ -39,7 +41,8 @@ TEST(Parity, ExactAgainstBruteForceOnRandomNetworks) {
       const int touches = 1 + static_cast<int>(rng() % 3);
       for (int k = 0; k < touches; ++k) {
         const int c = static_cast<int>(rng() % static_cast<unsigned>(constraints));
-        if (std::find(v.constraints.begin(), v.constraints.end(), c) == v.constraints.end()) v.constraints.push_back(c);
+        if (std::find(v.constraints.begin(), v.constraints.end(), c) == v.constraints.end())
+          v.constraints.push_back(c);
       }
       v.cost = 1.0 + 0.01 * static_cast<double>(rng() % 50);
     }
@@ -60,7 +63,8 @@ TEST(Parity, ExactAgainstBruteForceOnRandomNetworks) {
     double cost = 0;
     for (int v : *chosen) {
       cost += vars[static_cast<size_t>(v)].cost;
-      for (int c : vars[static_cast<size_t>(v)].constraints) parity[static_cast<size_t>(c)] = !parity[static_cast<size_t>(c)];
+      for (int c : vars[static_cast<size_t>(v)].constraints)
+        parity[static_cast<size_t>(c)] = !parity[static_cast<size_t>(c)];
     }
     for (int c = 0; c < constraints; ++c) EXPECT_FALSE(parity[static_cast<size_t>(c)]);
     EXPECT_NEAR(cost, expected, 1e-9) << "trial " << trial;
@@ -80,7 +84,8 @@ TEST(Parity, ClosedNetworkOfSeamsPairsOddPanels) {
 
 // Cheapest cost by Dijkstra over all 2^constraints parity states (an independent reference for
 // groups too large to enumerate subsets of variables; constraints ≤ 20).
-double state_search(int constraints, const std::vector<bool>& odd, const std::vector<ParityVariable>& vars) {
+double state_search(int constraints, const std::vector<bool>& odd,
+                    const std::vector<ParityVariable>& vars) {
   std::uint32_t start = 0;
   for (int c = 0; c < constraints; ++c)
     if (odd[static_cast<size_t>(c)]) start |= 1u << c;
@@ -109,15 +114,17 @@ double state_search(int constraints, const std::vector<bool>& odd, const std::ve
   return -1;
 }
 
-double checked_cost(int constraints, const std::vector<bool>& odd, const std::vector<ParityVariable>& vars,
-                    const std::vector<int>& chosen) {
+double checked_cost(int constraints, const std::vector<bool>& odd,
+                    const std::vector<ParityVariable>& vars, const std::vector<int>& chosen) {
   std::vector<bool> parity = odd;
   double cost = 0;
   for (int v : chosen) {
     cost += vars[static_cast<size_t>(v)].cost;
-    for (int c : vars[static_cast<size_t>(v)].constraints) parity[static_cast<size_t>(c)] = !parity[static_cast<size_t>(c)];
+    for (int c : vars[static_cast<size_t>(v)].constraints)
+      parity[static_cast<size_t>(c)] = !parity[static_cast<size_t>(c)];
   }
-  for (int c = 0; c < constraints; ++c) EXPECT_FALSE(parity[static_cast<size_t>(c)]) << "constraint " << c;
+  for (int c = 0; c < constraints; ++c)
+    EXPECT_FALSE(parity[static_cast<size_t>(c)]) << "constraint " << c;
   return cost;
 }
 
@@ -140,7 +147,8 @@ TEST(Parity, GridsOfTwentyPanelsMatchTheStateSearch) {
     for (auto&& o : odd) o = rng() % 2 == 1;
     const auto chosen = solve_parity(n, odd, vars);
     ASSERT_TRUE(chosen.has_value());
-    EXPECT_NEAR(checked_cost(n, odd, vars, *chosen), state_search(n, odd, vars), 1e-9) << "trial " << trial;
+    EXPECT_NEAR(checked_cost(n, odd, vars, *chosen), state_search(n, odd, vars), 1e-9)
+        << "trial " << trial;
   }
 }
 

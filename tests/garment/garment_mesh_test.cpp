@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-
 #include <map>
 #include <set>
 
@@ -96,21 +95,27 @@ TEST_P(ExampleGarment, IsOneStitchedConformingMesh) {
   // Every example is mirrored across x = 0: the vertex set is symmetric.
   std::set<std::array<long long, 3>> keys;
   auto key = [](double x, double y, double z) {
-    return std::array<long long, 3>{std::llround(x * 1e7), std::llround(y * 1e7), std::llround(z * 1e7)};
+    return std::array<long long, 3>{std::llround(x * 1e7), std::llround(y * 1e7),
+                                    std::llround(z * 1e7)};
   };
   for (Eigen::Index v = 0; v < g.mesh.vertex_count(); ++v)
     keys.insert(key(g.mesh.vertices(v, 0), g.mesh.vertices(v, 1), g.mesh.vertices(v, 2)));
   int asymmetric = 0;
   for (Eigen::Index v = 0; v < g.mesh.vertex_count(); ++v)
-    asymmetric += keys.contains(key(-g.mesh.vertices(v, 0), g.mesh.vertices(v, 1), g.mesh.vertices(v, 2))) ? 0 : 1;
+    asymmetric +=
+        keys.contains(key(-g.mesh.vertices(v, 0), g.mesh.vertices(v, 1), g.mesh.vertices(v, 2)))
+            ? 0
+            : 1;
   EXPECT_EQ(asymmetric, 0);
 
   // The outside of the garment faces away from the body: most face normals point away from the
   // nearest body point.
   int outward = 0;
   for (Eigen::Index f = 0; f < g.mesh.face_count(); ++f) {
-    const Eigen::Vector3d a = g.mesh.vertices.row(g.mesh.faces(f, 0)), b = g.mesh.vertices.row(g.mesh.faces(f, 1)),
-                          c = g.mesh.vertices.row(g.mesh.faces(f, 2)), d = g.mesh.vertices.row(g.mesh.faces(f, 3));
+    const Eigen::Vector3d a = g.mesh.vertices.row(g.mesh.faces(f, 0)),
+                          b = g.mesh.vertices.row(g.mesh.faces(f, 1)),
+                          c = g.mesh.vertices.row(g.mesh.faces(f, 2)),
+                          d = g.mesh.vertices.row(g.mesh.faces(f, 3));
     const Eigen::Vector3d centre = (a + b + c + d) / 4, n = (c - a).cross(d - b);
     outward += n.dot(builtin_surface().closest_point(centre).normal) > 0 ? 1 : 0;
   }
@@ -140,7 +145,8 @@ TEST_P(ExampleGarment, MaterialFramesAndRestShape) {
   const Eigen::VectorXd ease = Eigen::VectorXd::Constant(g.mesh.face_count(), 1.1);
   const Eigen::MatrixXd rest = triangle_rest_coordinates(tris, tri_quad, frames, ease);
   for (Eigen::Index t = 0; t < tris.face_count(); t += 7) {
-    const Eigen::Vector3d p0 = tris.vertices.row(tris.faces(t, 0)), p1 = tris.vertices.row(tris.faces(t, 1)),
+    const Eigen::Vector3d p0 = tris.vertices.row(tris.faces(t, 0)),
+                          p1 = tris.vertices.row(tris.faces(t, 1)),
                           p2 = tris.vertices.row(tris.faces(t, 2));
     const Eigen::Vector2d u1(rest(t, 2), rest(t, 3)), u2(rest(t, 4), rest(t, 5));
     EXPECT_NEAR(u1.norm(), 1.1 * (p1 - p0).norm(), 1e-12);
@@ -221,8 +227,9 @@ TEST(Garment, ExamplesHaveNoFoldedQuadsBeyondTheRecordedFew) {
 }
 
 TEST(Garment, BodyPartsOfTheTshirt) {
-  const Garment g = build_garment(load_sketch(std::filesystem::path(SD_SOURCE_DIR) / "data/examples/tshirt.json"),
-                                  builtin_surface());
+  const Garment g =
+      build_garment(load_sketch(std::filesystem::path(SD_SOURCE_DIR) / "data/examples/tshirt.json"),
+                    builtin_surface());
   std::map<std::string, std::string> part;
   for (const GarmentPanel& p : g.panels) part[p.id] = p.body_part;
   EXPECT_EQ(part["front"], "torso");
@@ -253,7 +260,8 @@ TEST(Garment, JoinRelabelsGroupsAndSeamOnSphereStitches) {
                 { "id": "r", "boundary": ["top_r", "right", "bot_r", "mid"] } ],
     "join": [ { "id": "both", "panels": ["l", "r"] } ],
     "edge_length": 0.02
-  })", "s.json");
+  })",
+                          "s.json");
   const BodySurface sphere(meshing::icosphere(0.3, 5, {0, 1, 0}));
   const Garment g = build_garment(s, sphere);
   ASSERT_EQ(g.panels.size(), 2u);
@@ -275,14 +283,16 @@ TEST(Garment, ThreePanelsOnOneCurveIsAnError) {
                 { "id": "c", "points": [[0, 0.9], [-0.1, 1.1]] } ],
     "panels": [ { "id": "p", "boundary": ["a", "b", "c"] }, { "id": "q", "boundary": ["a", "b", "c"] },
                 { "id": "r", "boundary": ["a", "b", "c"] } ]
-  })", "s.json");
+  })",
+                          "s.json");
   const BodySurface sphere(meshing::icosphere(0.3, 4, {0, 1, 0}));
   try {
     build_garment(s, sphere);
     FAIL();
   } catch (const SketchError& e) {
     EXPECT_EQ(e.json_path(), "/panels/2/boundary");
-    EXPECT_NE(std::string(e.what()).find("already joins panels 'p' and 'q'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("already joins panels 'p' and 'q'"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -297,7 +307,8 @@ TEST(Garment, TJunctionSplitsTheCurve) {
     "panels": [ { "id": "l", "boundary": ["top", "mid", "bottom", "left"] },
                 { "id": "r", "boundary": ["top", "right", "bottom", "mid"] } ],
     "edge_length": 0.02
-  })", "s.json");
+  })",
+                          "s.json");
   const BodySurface sphere(meshing::icosphere(0.3, 5, {0, 1, 0}));
   const Garment g = build_garment(s, sphere);
   EXPECT_EQ(g.seam_edges, 11);  // mid: 0.211 m on the offset sphere (see the test above)

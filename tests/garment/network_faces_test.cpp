@@ -1,11 +1,11 @@
 #include "garment/network_faces.hpp"
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 
@@ -73,7 +73,8 @@ TEST(NetworkFaces, GridOnSphereHasFourCellsAndTheRest) {
     for (size_t k = 0; k < loop.size(); ++k) {
       ++seen[static_cast<size_t>(2 * loop[k].edge + (loop[k].forward ? 0 : 1))];
       EXPECT_EQ(loop_end_node(net, loop[k]), loop_start_node(net, loop[(k + 1) % loop.size()]));
-      EXPECT_EQ(faces.face_left[static_cast<size_t>(2 * loop[k].edge + (loop[k].forward ? 0 : 1))], static_cast<int>(f));
+      EXPECT_EQ(faces.face_left[static_cast<size_t>(2 * loop[k].edge + (loop[k].forward ? 0 : 1))],
+                static_cast<int>(f));
     }
   }
   for (int n : seen) EXPECT_EQ(n, 1);
@@ -110,7 +111,8 @@ TEST(NetworkFaces, SeedsPickTheirCells) {
 
 // The explicit and the "auto" forms of the A-line skirt give the same panels.
 TEST(NetworkFaces, AutoSkirtMatchesTheListedSkirt) {
-  const std::filesystem::path file = std::filesystem::path(SD_SOURCE_DIR) / "data/examples/a-line-skirt.json";
+  const std::filesystem::path file =
+      std::filesystem::path(SD_SOURCE_DIR) / "data/examples/a-line-skirt.json";
   std::ifstream in(file);
   std::stringstream text;
   text << in.rdbuf();
@@ -149,7 +151,8 @@ TEST(NetworkFaces, AutoSkirtMatchesTheListedSkirt) {
   EXPECT_EQ(a.seam_edges, b.seam_edges);
 }
 
-std::string error_of(const std::string& text, const BodySurface& body, std::string* path = nullptr) {
+std::string error_of(const std::string& text, const BodySurface& body,
+                     std::string* path = nullptr) {
   try {
     build_garment(parse_sketch(text, "bad.json"), body);
   } catch (const SketchError& e) {
@@ -173,51 +176,69 @@ std::string grid_with(const std::string& panels, const std::string& extra_curve 
 TEST(NetworkFaces, DesignerMistakes) {
   std::string path;
   // A seed on a curve.
-  EXPECT_NE(error_of(grid_with(R"([{ "id": "p", "boundary": "auto", "seed": { "point": [0.0, 1.06] } }])"), sphere(), &path)
-                .find("lies on curve 'centre'"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(
+          grid_with(R"([{ "id": "p", "boundary": "auto", "seed": { "point": [0.0, 1.06] } }])"),
+          sphere(), &path)
+          .find("lies on curve 'centre'"),
+      std::string::npos);
   EXPECT_EQ(path, "/panels/0/seed");
   // Two seeds in one cell.
-  EXPECT_NE(error_of(grid_with(R"([{ "id": "p", "boundary": "auto", "seed": { "point": [0.05, 1.05] } },
+  EXPECT_NE(
+      error_of(grid_with(R"([{ "id": "p", "boundary": "auto", "seed": { "point": [0.05, 1.05] } },
                                    { "id": "q", "boundary": "auto", "seed": { "point": [0.07, 1.07] } }])"),
-                     sphere(), &path)
-                .find("panels 'p' and 'q' lie in the same region"),
-            std::string::npos);
+               sphere(), &path)
+          .find("panels 'p' and 'q' lie in the same region"),
+      std::string::npos);
   EXPECT_EQ(path, "/panels/1/seed");
   // A curve sticking into the cell with a free end.
   const std::string dangling = R"({ "id": "dart", "points": [[0.06, 1.12], [0.06, 1.05]] })";
-  EXPECT_NE(error_of(grid_with(R"([{ "id": "p", "boundary": "auto", "seed": { "point": [0.03, 1.03] } }])", dangling),
-                     sphere(), &path)
-                .find("curve 'dart' ends inside it"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(
+          grid_with(R"([{ "id": "p", "boundary": "auto", "seed": { "point": [0.03, 1.03] } }])",
+                    dangling),
+          sphere(), &path)
+          .find("curve 'dart' ends inside it"),
+      std::string::npos);
   EXPECT_EQ(path, "/panels/0/seed");
   // A loop floating inside a cell, not connected to it.
-  const std::string island = R"({ "id": "island", "closed": true, "points": [[0.05, 1.05], [0.08, 1.05], [0.065, 1.08]] })";
-  EXPECT_NE(error_of(grid_with(R"([{ "id": "p", "boundary": "auto", "seed": { "point": [0.02, 1.02] } }])", island),
-                     sphere())
-                .find("has curve 'island' inside it"),
-            std::string::npos);
+  const std::string island =
+      R"({ "id": "island", "closed": true, "points": [[0.05, 1.05], [0.08, 1.05], [0.065, 1.08]] })";
+  EXPECT_NE(
+      error_of(
+          grid_with(R"([{ "id": "p", "boundary": "auto", "seed": { "point": [0.02, 1.02] } }])",
+                    island),
+          sphere())
+          .find("has curve 'island' inside it"),
+      std::string::npos);
   // A seed that misses the sphere.
-  EXPECT_NE(error_of(grid_with(R"([{ "id": "p", "boundary": "auto", "seed": { "point": [0.5, 1.0] } }])"), sphere(), &path)
-                .find("misses the body in the front view"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(grid_with(R"([{ "id": "p", "boundary": "auto", "seed": { "point": [0.5, 1.0] } }])"),
+               sphere(), &path)
+          .find("misses the body in the front view"),
+      std::string::npos);
   EXPECT_EQ(path, "/panels/0/seed/point");
   // "auto" needs a seed, a listed boundary takes none.
-  EXPECT_NE(error_of(grid_with(R"([{ "id": "p", "boundary": "auto" }])"), sphere(), &path).find("no \"seed\""),
+  EXPECT_NE(error_of(grid_with(R"([{ "id": "p", "boundary": "auto" }])"), sphere(), &path)
+                .find("no \"seed\""),
             std::string::npos);
   EXPECT_EQ(path, "/panels/0/boundary");
-  EXPECT_NE(error_of(grid_with(R"([{ "id": "p", "boundary": ["top", "right", "bottom", "left"], "seed": { "point": [0, 1] } }])"),
-                     sphere(), &path)
-                .find("only picks the region"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(
+          grid_with(
+              R"([{ "id": "p", "boundary": ["top", "right", "bottom", "left"], "seed": { "point": [0, 1] } }])"),
+          sphere(), &path)
+          .find("only picks the region"),
+      std::string::npos);
   EXPECT_EQ(path, "/panels/0/seed");
 }
 
 TEST(NetworkFaces, TheOuterRegionIsAPanelToo) {
   // On a closed surface there is no unbounded face: a seed outside the grid picks the region
   // around it, bounded by the grid's 8 outer pieces (the sphere minus the grid).
-  const Sketch s = parse_sketch(grid_with(R"([{ "id": "rest", "boundary": "auto", "seed": { "point3d": [0, 1, -0.3] } }])"),
-                                "rest.json");
+  const Sketch s = parse_sketch(
+      grid_with(R"([{ "id": "rest", "boundary": "auto", "seed": { "point3d": [0, 1, -0.3] } }])"),
+      "rest.json");
   const CurveNetwork net = build_network(s, project_curves(s, sphere()), {});
   const NetworkFaces faces = trace_faces(net, sphere());
   const std::vector<LoopEdge> loop = auto_panel_loop(s, net, faces, sphere(), s.panels[0]);

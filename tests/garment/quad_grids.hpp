@@ -7,7 +7,9 @@
 namespace sd::test {
 
 // An n × n grid of unit-spaced quads in the plane z = 0, counter-clockwise seen from +z.
-inline meshing::QuadMesh plane_grid(int n) { return quad_grid(n, n); }
+inline meshing::QuadMesh plane_grid(int n) {
+  return quad_grid(n, n);
+}
 
 // The same grid spanning `span` across, centred on +z and pushed radially onto the sphere of
 // radius r around the origin (facing out).

@@ -59,7 +59,8 @@ TEST(SketchFile, SheetSceneNeedsNoCurvesAndHasNoBody) {
               "centre": [0, 1.5, 0], "pins": ["top-left", "right"]},
     "simulate": {"pin_above": 1.4},
     "output": {"images": []}
-  })", "sheet.json");
+  })",
+                                "sheet.json");
   ASSERT_TRUE(s.sheet.has_value());
   EXPECT_EQ(s.sheet->size, Eigen::Vector2d(0.5, 2));
   EXPECT_EQ(s.sheet->columns, 8);
@@ -81,11 +82,14 @@ TEST(SketchFile, SheetMistakesNameTheirPath) {
     }
     return std::string("no error");
   };
-  EXPECT_EQ(error_of(R"({"sheet": {"pins": ["middle"]}})").rfind("/sheet/pins/0: unknown pin", 0), 0u);
+  EXPECT_EQ(error_of(R"({"sheet": {"pins": ["middle"]}})").rfind("/sheet/pins/0: unknown pin", 0),
+            0u);
   EXPECT_EQ(error_of(R"({"sheet": {"resolution": [0, 4]}})").rfind("/sheet/resolution/0", 0), 0u);
   EXPECT_EQ(error_of(R"({"sheet": {"size": [1, -1]}})").rfind("/sheet/size/1", 0), 0u);
-  EXPECT_EQ(error_of(R"({"sheet": {}, "panels": []})").rfind("/sheet: a sheet scene has no", 0), 0u);
-  EXPECT_EQ(error_of(R"({"sheet": {"orientation": "diagonal"}})").rfind("/sheet/orientation", 0), 0u);
+  EXPECT_EQ(error_of(R"({"sheet": {}, "panels": []})").rfind("/sheet: a sheet scene has no", 0),
+            0u);
+  EXPECT_EQ(error_of(R"({"sheet": {"orientation": "diagonal"}})").rfind("/sheet/orientation", 0),
+            0u);
   EXPECT_EQ(error_of(R"({"body": {"motion": {"duration": 0}}})").rfind("/body/motion/duration", 0),
             0u);
   EXPECT_EQ(error_of(R"({"body": {"motion": {"start": -1}}})").rfind("/body/motion/start", 0), 0u);
@@ -116,9 +120,8 @@ TEST(SketchFile, SheetMistakesNameTheirPath) {
                                                "poses": [{"time": 1, "mesh": "p.obj"}]}}})")
                 .rfind("/body/motion/poses: the poses must be meshes of the same body", 0),
             0u);
-  EXPECT_EQ(
-      poses(R"({"type": "walk"})").rfind("/body/motion/type: 'walk' is not a body motion", 0),
-      0u);
+  EXPECT_EQ(poses(R"({"type": "walk"})").rfind("/body/motion/type: 'walk' is not a body motion", 0),
+            0u);
 }
 
 TEST(SketchFile, ReadsEverySection) {
@@ -140,7 +143,8 @@ TEST(SketchFile, ReadsEverySection) {
     "output": { "images": [ { "view": "back", "size": [640, 480], "wireframe": true },
                             { "view": "three-quarter" } ],
                 "mesh": "g.glb", "report": false, "wireframe": true }
-  })", "x.json", "/base");
+  })",
+                                "x.json", "/base");
   EXPECT_EQ(s.resolve(s.body.mesh), std::filesystem::path("/base/b.obj"));
   EXPECT_DOUBLE_EQ(*s.body.height, 1.6);
   ASSERT_TRUE(s.body.motion.has_value());
@@ -149,7 +153,8 @@ TEST(SketchFile, ReadsEverySection) {
   EXPECT_DOUBLE_EQ(s.body.motion->duration, 2);
   const Sketch posed = parse_sketch(R"({"format": "sketchdrape/1", "sheet": {},
     "body": {"mesh": "rest.obj", "motion": {"type": "poses", "poses": [
-      {"time": 0.5, "mesh": "up.obj"}, {"time": 1.5, "mesh": "down.obj"}]}}})", "x.json", "/base");
+      {"time": 0.5, "mesh": "up.obj"}, {"time": 1.5, "mesh": "down.obj"}]}}})",
+                                    "x.json", "/base");
   ASSERT_TRUE(posed.body.motion.has_value());
   EXPECT_EQ(posed.body.motion->type, "poses");
   ASSERT_EQ(posed.body.motion->poses.size(), 2u);
@@ -211,7 +216,8 @@ TEST(SketchFile, ErrorsCarryFilePathAndSentence) {
     EXPECT_EQ(e.file(), "test.json") << c.text;
     EXPECT_EQ(e.json_path(), c.path) << e.what();
     EXPECT_NE(std::string(e.what()).find(c.fragment), std::string::npos) << e.what();
-    EXPECT_EQ(std::string(e.what()).rfind(std::string("test.json: ") + c.path + ": ", 0), 0u) << e.what();
+    EXPECT_EQ(std::string(e.what()).rfind(std::string("test.json: ") + c.path + ": ", 0), 0u)
+        << e.what();
   }
 }
 

@@ -17,7 +17,8 @@
 namespace sd::test {
 namespace {
 
-const std::filesystem::path kSchema = std::filesystem::path(SD_SOURCE_DIR) / "data/schema/sketchdrape-1.schema.json";
+const std::filesystem::path kSchema =
+    std::filesystem::path(SD_SOURCE_DIR) / "data/schema/sketchdrape-1.schema.json";
 
 // A Python with jsonschema: Debian's first (scripts/setup.sh installs python3-jsonschema).
 std::string python_with_jsonschema() {
@@ -34,12 +35,15 @@ int validate_against_schema(const std::filesystem::path& file, const std::string
   std::stringstream text;
   text << in.rdbuf();
   const nlohmann::json doc = nlohmann::json::parse(text.str(), nullptr, true, true);
-  const std::filesystem::path plain = std::filesystem::temp_directory_path() / ("sd-schema-" + file.filename().string());
+  const std::filesystem::path plain =
+      std::filesystem::temp_directory_path() / ("sd-schema-" + file.filename().string());
   std::ofstream(plain) << doc.dump(1);
-  const std::string command = python + " -c 'import json, sys, jsonschema; "
-                              "jsonschema.validate(json.load(open(sys.argv[1])), json.load(open(sys.argv[2])), "
-                              "cls=jsonschema.Draft202012Validator)' " +
-                              plain.string() + " " + kSchema.string() + " > /dev/null 2>&1";
+  const std::string command =
+      python +
+      " -c 'import json, sys, jsonschema; "
+      "jsonschema.validate(json.load(open(sys.argv[1])), json.load(open(sys.argv[2])), "
+      "cls=jsonschema.Draft202012Validator)' " +
+      plain.string() + " " + kSchema.string() + " > /dev/null 2>&1";
   const int status = std::system(command.c_str());
   std::filesystem::remove(plain);
   return status;
@@ -48,9 +52,11 @@ int validate_against_schema(const std::filesystem::path& file, const std::string
 TEST(SketchSchema, SchemaIsAValidDraft202012Schema) {
   const std::string python = python_with_jsonschema();
   ASSERT_FALSE(python.empty()) << "python3-jsonschema is missing: run scripts/setup.sh";
-  const std::string command = python + " -c 'import json, sys, jsonschema; "
-                              "jsonschema.Draft202012Validator.check_schema(json.load(open(sys.argv[1])))' " +
-                              kSchema.string();
+  const std::string command =
+      python +
+      " -c 'import json, sys, jsonschema; "
+      "jsonschema.Draft202012Validator.check_schema(json.load(open(sys.argv[1])))' " +
+      kSchema.string();
   EXPECT_EQ(std::system(command.c_str()), 0);
 }
 
@@ -66,7 +72,8 @@ TEST(SketchSchema, ShapeErrorsAreRejected) {
   const std::string python = python_with_jsonschema();
   ASSERT_FALSE(python.empty()) << "python3-jsonschema is missing: run scripts/setup.sh";
   // Errors of shape (not of geometry) must be caught by the schema as well.
-  for (const char* name : {"unknown-key.json", "nan-string.json", "unknown-view.json", "empty-panels.json"}) {
+  for (const char* name :
+       {"unknown-key.json", "nan-string.json", "unknown-view.json", "empty-panels.json"}) {
     const auto file = std::filesystem::path(SD_SOURCE_DIR) / "tests/garment/bad" / name;
     EXPECT_NE(validate_against_schema(file, python), 0) << name;
   }

@@ -17,11 +17,15 @@ TEST(SurfaceUntangle, UnfoldsDraggedVerticesOnASphere) {
   const double r = 0.3;
   meshing::QuadMesh mesh = sphere_grid(n, r, 0.3);
   const std::vector<char> fixed = grid_boundary(n);
-  const auto project = [r](const Eigen::Vector3d& p) -> Eigen::Vector3d { return r * p.normalized(); };
+  const auto project = [r](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+    return r * p.normalized();
+  };
   const auto normal = [](const Eigen::Vector3d& p) -> Eigen::Vector3d { return p.normalized(); };
   // Drag two inner vertices across their neighbours (on the sphere), folding their quads.
-  for (const auto& [v, to] : {std::pair{3 * (n + 1) + 3, 3 * (n + 1) + 6}, std::pair{5 * (n + 1) + 5, 2 * (n + 1) + 5}}) {
-    const Eigen::Vector3d target = mesh.vertices.row(to).transpose() + Eigen::Vector3d(0.004, 0.003, 0);
+  for (const auto& [v, to] :
+       {std::pair{3 * (n + 1) + 3, 3 * (n + 1) + 6}, std::pair{5 * (n + 1) + 5, 2 * (n + 1) + 5}}) {
+    const Eigen::Vector3d target =
+        mesh.vertices.row(to).transpose() + Eigen::Vector3d(0.004, 0.003, 0);
     mesh.vertices.row(v) = project(target).transpose();
   }
   const UntangleResult result = untangle_on_surface(mesh, fixed, project, normal);
@@ -37,7 +41,8 @@ TEST(SurfaceUntangle, UnfoldsDraggedVerticesOnASphere) {
       const Eigen::Vector3d e2 = mesh.vertices.row(mesh.faces(f, (k + 3) % 4)).transpose() - p;
       EXPECT_GT(e1.cross(e2).dot(p.normalized()), 0) << "quad " << f << " corner " << k;
     }
-  for (Eigen::Index v = 0; v < mesh.vertex_count(); ++v) EXPECT_NEAR(mesh.vertices.row(v).norm(), r, 1e-12);
+  for (Eigen::Index v = 0; v < mesh.vertex_count(); ++v)
+    EXPECT_NEAR(mesh.vertices.row(v).norm(), r, 1e-12);
 }
 
 TEST(SurfaceUntangle, LeavesAGoodMeshAlone) {

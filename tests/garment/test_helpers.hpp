@@ -12,7 +12,8 @@ namespace sd::test {
 
 inline std::vector<std::filesystem::path> example_files() {
   std::vector<std::filesystem::path> files;
-  for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::path(SD_SOURCE_DIR) / "data/examples"))
+  for (const auto& entry :
+       std::filesystem::directory_iterator(std::filesystem::path(SD_SOURCE_DIR) / "data/examples"))
     if (entry.path().extension() == ".json") files.push_back(entry.path());
   std::sort(files.begin(), files.end());
   return files;

@@ -56,8 +56,10 @@ Angles measure_angles(const FilledPatch& patch) {
     for (int k = 0; k < 4; ++k) has_flat = has_flat || flat[static_cast<size_t>(mesh.faces(f, k))];
     for (int k = 0; k < 4; ++k) {
       const Eigen::Vector2d p = mesh.vertices.row(mesh.faces(f, k)).head<2>();
-      const Eigen::Vector2d e1 = Eigen::Vector2d(mesh.vertices.row(mesh.faces(f, (k + 1) % 4)).head<2>()) - p;
-      const Eigen::Vector2d e2 = Eigen::Vector2d(mesh.vertices.row(mesh.faces(f, (k + 3) % 4)).head<2>()) - p;
+      const Eigen::Vector2d e1 =
+          Eigen::Vector2d(mesh.vertices.row(mesh.faces(f, (k + 1) % 4)).head<2>()) - p;
+      const Eigen::Vector2d e2 =
+          Eigen::Vector2d(mesh.vertices.row(mesh.faces(f, (k + 3) % 4)).head<2>()) - p;
       const double cross = e1.x() * e2.y() - e1.y() * e2.x();
       // Counter-clockwise quads have angles in (0, 180]; a flat one (collinear edges, cross
       // product at rounding level) is 180, not -180.
@@ -105,8 +107,9 @@ TEST_P(PatchFillAngles, RegularPolygonsHaveNoInvertedOrThinQuads) {
   std::string used;
   for (const auto& [name, count] : partitions) used += " " + name + ": " + std::to_string(count);
   std::cout << "n = " << n << ", " << fills << " fills, angles " << worst.min_deg << ".."
-            << worst.max_deg << " deg; " << with_flat << " with a flat vertex, smallest angle there "
-            << worst.min_deg_at_flat << ";" << used << "\n";
+            << worst.max_deg << " deg; " << with_flat
+            << " with a flat vertex, smallest angle there " << worst.min_deg_at_flat << ";" << used
+            << "\n";
 }
 
 INSTANTIATE_TEST_SUITE_P(AllSideCounts, PatchFillAngles, ::testing::Range(2, 9));

@@ -5,13 +5,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
-#include <vector>
 #include <cstdint>
+#include <numbers>
 #include <set>
 #include <span>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "meshing/patch_fill.hpp"
 
@@ -28,23 +28,24 @@ inline std::string describe(std::span<const int> counts) {
 inline ::testing::AssertionResult well_formed(const PatchTopology& topo,
                                               std::span<const int> counts) {
   const MeshCheck check = validate(topo.mesh);
-  if (!check.ok()) return ::testing::AssertionFailure() << describe(counts) << ": " << check.problems.front();
+  if (!check.ok())
+    return ::testing::AssertionFailure() << describe(counts) << ": " << check.problems.front();
   if (topo.side_vertices.size() != counts.size())
     return ::testing::AssertionFailure() << describe(counts) << ": wrong side count";
   std::vector<int> expected_loop;
   for (size_t i = 0; i < counts.size(); ++i) {
     const auto& side = topo.side_vertices[i];
     if (static_cast<int>(side.size()) != counts[i] + 1)
-      return ::testing::AssertionFailure() << describe(counts) << ": side " << i << " has "
-                                           << side.size() - 1 << " edges";
+      return ::testing::AssertionFailure()
+             << describe(counts) << ": side " << i << " has " << side.size() - 1 << " edges";
     if (side.back() != topo.side_vertices[(i + 1) % counts.size()].front())
       return ::testing::AssertionFailure() << describe(counts) << ": sides do not meet";
     expected_loop.insert(expected_loop.end(), side.begin(), side.end() - 1);
   }
   std::vector<int> loop = boundary_loop(topo.mesh);
   if (loop.size() != expected_loop.size())
-    return ::testing::AssertionFailure() << describe(counts) << ": boundary has " << loop.size()
-                                         << " vertices";
+    return ::testing::AssertionFailure()
+           << describe(counts) << ": boundary has " << loop.size() << " vertices";
   const auto start = std::find(loop.begin(), loop.end(), expected_loop.front());
   if (start == loop.end()) return ::testing::AssertionFailure() << "corner 0 not on the boundary";
   std::rotate(loop.begin(), start, loop.end());
@@ -54,8 +55,8 @@ inline ::testing::AssertionResult well_formed(const PatchTopology& topo,
   for (Eigen::Index f = 0; f < topo.mesh.faces.rows(); ++f)
     for (int k = 0; k < 4; ++k)
       edges.insert(std::minmax(topo.mesh.faces(f, k), topo.mesh.faces(f, (k + 1) % 4)));
-  const auto euler = topo.mesh.vertices.rows() - static_cast<Eigen::Index>(edges.size()) +
-                     topo.mesh.faces.rows();
+  const auto euler =
+      topo.mesh.vertices.rows() - static_cast<Eigen::Index>(edges.size()) + topo.mesh.faces.rows();
   if (euler != 1) return ::testing::AssertionFailure() << describe(counts) << ": Euler " << euler;
   const QuadQuality q = measure_valence(topo.mesh, topo.corner_vertices());
   if (q.distortion != topo.distortion || q.irregular_vertices != topo.irregular_vertices)
@@ -102,7 +103,7 @@ void for_each_count_vector(int n, Visit&& visit) {
 // Corner i at `corner_point(i)`, straight sides split evenly (n = 2: two half circles).
 template <class CornerPoint>
 inline std::vector<Eigen::MatrixX3d> straight_sides(std::span<const int> counts,
-                                             const CornerPoint& corner_point) {
+                                                    const CornerPoint& corner_point) {
   const auto n = static_cast<int>(counts.size());
   std::vector<Eigen::MatrixX3d> sides;
   for (int i = 0; i < n; ++i) {
@@ -119,7 +120,9 @@ inline std::vector<Eigen::MatrixX3d> straight_sides(std::span<const int> counts,
     }
     sides.push_back(side);
   }
-  for (int i = 0; i < n; ++i) sides[static_cast<size_t>(i)].bottomRows<1>() = sides[static_cast<size_t>((i + 1) % n)].topRows<1>();
+  for (int i = 0; i < n; ++i)
+    sides[static_cast<size_t>(i)].bottomRows<1>() =
+        sides[static_cast<size_t>((i + 1) % n)].topRows<1>();
   return sides;
 }
 

@@ -8,8 +8,8 @@
 
 #include <cstdlib>
 #include <fstream>
-#include <optional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "meshing/patch_fill.hpp"
@@ -49,7 +49,8 @@ TEST(MeshingCorpus, NoCaseGetsWorse) {
       // family, complete at |n − 4| there, has nothing that cheap (docs/meshing.md).
       const int bound = std::abs(n - 4);
       std::optional<int> minimum;
-      if (topo.distortion == bound) minimum = bound;
+      if (topo.distortion == bound)
+        minimum = bound;
       else if (topo.distortion == bound + 2 && n <= 5 && !test::family_reaches(counts, bound))
         minimum = bound + 2;
       else if (n <= 5 && topo.distortion > bound + 2 && test::family_reaches(counts, bound + 2))
@@ -79,8 +80,8 @@ TEST(MeshingCorpus, NoCaseGetsWorse) {
       } else if (now < then) {
         ++improved;
         std::cout << "improved: " << name << " " << test::describe(counts) << " distortion "
-                  << distortion << " -> " << topo.distortion << ", irregular vertices "
-                  << irregular << " -> " << topo.irregular_vertices << "\n";
+                  << distortion << " -> " << topo.distortion << ", irregular vertices " << irregular
+                  << " -> " << topo.irregular_vertices << "\n";
       } else {
         ++unchanged;
       }
@@ -105,7 +106,8 @@ TEST(MeshingCorpus, NoCaseGetsWorse) {
   } else {
     EXPECT_EQ(missing, 0) << "cases without expected figures: run with SD_UPDATE_MESHING_CORPUS=1";
     if (improved > 0)
-      std::cout << improved << " case(s) improved: update the corpus with "
+      std::cout << improved
+                << " case(s) improved: update the corpus with "
                    "SD_UPDATE_MESHING_CORPUS=1 so that they cannot regress\n";
   }
 }

@@ -35,7 +35,8 @@ TEST_P(PatchFillProperty, EveryCountVectorGivesAValidMeshWithinTheBound) {
   std::string summary;
   for (const auto& [excess, count] : distortion_histogram)
     summary += " +" + std::to_string(excess) + ": " + std::to_string(count);
-  std::cout << "n = " << n << ", " << filled << " fills, distortion above |n-4|:" << summary << "\n";
+  std::cout << "n = " << n << ", " << filled << " fills, distortion above |n-4|:" << summary
+            << "\n";
 }
 
 INSTANTIATE_TEST_SUITE_P(AllSideCounts, PatchFillProperty, ::testing::Range(2, 9));

@@ -23,7 +23,7 @@ struct Reference {
 // never be worse.
 TEST(PatchFill, NeverWorseThanTakayama2014) {
   const std::vector<Reference> references = {
-      {{3, 3, 4}, 1},    {{5, 5, 6}, 1},    {{5, 6, 3, 6, 4}, 1},    {{3, 3, 3, 3, 4}, 1},
+      {{3, 3, 4}, 1},    {{5, 5, 6}, 1},     {{5, 6, 3, 6, 4}, 1},    {{3, 3, 3, 3, 4}, 1},
       {{6, 4, 4, 2}, 2}, {{10, 4, 4, 2}, 2}, {{2, 2, 2, 2, 2, 2}, 2}, {{4, 3, 3, 4, 3, 3}, 2},
       {{2, 8, 4}, 3},    {{4, 4, 4, 4}, 0}};
   for (const auto& [sides, distortion] : references) {
@@ -78,10 +78,17 @@ TEST(PatchFill, GridWhenOppositeSidesMatch) {
 
 TEST(PatchFill, SmallAndDegenerateCounts) {
   for (const std::vector<int>& counts :
-       std::vector<std::vector<int>>{{1, 3}, {2, 2}, {3, 1}, {1, 1, 2}, {1, 1, 1, 1},
-                                      {1, 1, 1, 1, 1, 1}, {1, 1, 1, 1, 1, 1, 1, 1}, {59, 1},
-                                      {1, 1, 1, 1, 1, 1, 1, 1, 1, 1}, {60, 1, 1, 1, 1},
-                                      {1, 60, 1}}) {
+       std::vector<std::vector<int>>{{1, 3},
+                                     {2, 2},
+                                     {3, 1},
+                                     {1, 1, 2},
+                                     {1, 1, 1, 1},
+                                     {1, 1, 1, 1, 1, 1},
+                                     {1, 1, 1, 1, 1, 1, 1, 1},
+                                     {59, 1},
+                                     {1, 1, 1, 1, 1, 1, 1, 1, 1, 1},
+                                     {60, 1, 1, 1, 1},
+                                     {1, 60, 1}}) {
     const PatchTopology topo = fill_region(counts);
     EXPECT_TRUE(well_formed(topo, counts));
     EXPECT_TRUE(test::within_bounds(topo, counts));
@@ -144,7 +151,8 @@ std::vector<Eigen::MatrixX3d> bowed_sides(std::span<const int> counts, double bo
     Eigen::MatrixX3d side(count + 1, 3);
     for (int k = 0; k <= count; ++k) {
       const double t = static_cast<double>(k) / count;
-      side.row(k) = ((1 - t) * a + t * b + 4 * bow * (b - a).norm() * t * (1 - t) * inward).transpose();
+      side.row(k) =
+          ((1 - t) * a + t * b + 4 * bow * (b - a).norm() * t * (1 - t) * inward).transpose();
     }
     side.row(0) = a.transpose();
     side.row(count) = b.transpose();
@@ -168,10 +176,16 @@ TEST(PatchFillGeometry, BoundaryVerticesAreTheGivenPointsBitwise) {
 }
 
 TEST(PatchFillGeometry, NoInvertedQuadsOnConvexBoundaries) {
-  for (const std::vector<int>& counts :
-       std::vector<std::vector<int>>{{3, 3, 4}, {6, 4, 4, 2}, {10, 4, 4, 2}, {2, 8, 4},
-                                      {5, 6, 3, 6, 4}, {12, 12, 12, 12}, {30, 4, 4, 4, 4},
-                                      {8, 8, 8, 8, 8, 8, 8, 8}, {20, 2, 20, 4}, {1, 1, 1, 1, 1, 1}}) {
+  for (const std::vector<int>& counts : std::vector<std::vector<int>>{{3, 3, 4},
+                                                                      {6, 4, 4, 2},
+                                                                      {10, 4, 4, 2},
+                                                                      {2, 8, 4},
+                                                                      {5, 6, 3, 6, 4},
+                                                                      {12, 12, 12, 12},
+                                                                      {30, 4, 4, 4, 4},
+                                                                      {8, 8, 8, 8, 8, 8, 8, 8},
+                                                                      {20, 2, 20, 4},
+                                                                      {1, 1, 1, 1, 1, 1}}) {
     const FilledPatch patch = fill_region(sides_on(ellipse, counts));
     EXPECT_TRUE(validate(patch.mesh).ok()) << test::describe(counts);
     EXPECT_EQ(patch.quality.inverted_quads, 0) << test::describe(counts);
@@ -180,10 +194,14 @@ TEST(PatchFillGeometry, NoInvertedQuadsOnConvexBoundaries) {
 }
 
 TEST(PatchFillGeometry, NoInvertedQuadsOnMildlyConcaveBoundaries) {
-  for (const std::vector<int>& counts :
-       std::vector<std::vector<int>>{{8, 8, 8, 8}, {6, 6, 6, 6, 6}, {10, 6, 10, 6}, {7, 9, 8},
-                                      {6, 6, 6, 6, 6, 6}, {5, 6, 3, 6, 4}, {12, 10, 9, 11},
-                                      {9, 7, 8, 6, 9, 7, 8}}) {
+  for (const std::vector<int>& counts : std::vector<std::vector<int>>{{8, 8, 8, 8},
+                                                                      {6, 6, 6, 6, 6},
+                                                                      {10, 6, 10, 6},
+                                                                      {7, 9, 8},
+                                                                      {6, 6, 6, 6, 6, 6},
+                                                                      {5, 6, 3, 6, 4},
+                                                                      {12, 10, 9, 11},
+                                                                      {9, 7, 8, 6, 9, 7, 8}}) {
     const FilledPatch patch = fill_region(bowed_sides(counts, 0.08));
     EXPECT_TRUE(validate(patch.mesh).ok()) << test::describe(counts);
     EXPECT_EQ(patch.quality.inverted_quads, 0) << test::describe(counts);
@@ -238,7 +256,8 @@ TEST(PatchFillGeometry, PolylinesAreResampledByArcLength) {
   const std::vector<int> counts{4, 2, 4, 2};
   const FilledPatch patch = fill_region(polylines, counts);
   const auto& side0 = patch.topology.side_vertices[0];
-  for (int k = 0; k <= 4; ++k) EXPECT_NEAR(patch.mesh.vertices(side0[static_cast<size_t>(k)], 0), k, 1e-12);
+  for (int k = 0; k <= 4; ++k)
+    EXPECT_NEAR(patch.mesh.vertices(side0[static_cast<size_t>(k)], 0), k, 1e-12);
   EXPECT_EQ(patch.quality.distortion, 0);
   // A plain grid stays a plain grid: every quad a 1 by 2 rectangle.
   EXPECT_NEAR(patch.quality.min_angle_deg, 90, 1e-6);

@@ -10,8 +10,8 @@ namespace {
 TEST(Image, ParsesSizes) {
   EXPECT_EQ(parse_image_size("800x1200"), (ImageSize{800, 1200}));
   EXPECT_EQ(parse_image_size("1X1"), (ImageSize{1, 1}));
-  for (const char* bad : {"", "800", "800x", "x600", "0x10", "-5x10", "10x10x10", "4097x10",
-                          "ax b", "80 0x10"})
+  for (const char* bad :
+       {"", "800", "800x", "x600", "0x10", "-5x10", "10x10x10", "4097x10", "ax b", "80 0x10"})
     EXPECT_THROW(parse_image_size(bad), ImageSizeError) << bad;
 }
 

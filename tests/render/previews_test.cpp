@@ -54,7 +54,8 @@ TEST_F(PreviewsTest, FlatPatchShowsItsQuadEdges) {
   Eigen::MatrixX3d v;
   Eigen::MatrixX4i q;
   // Quads (0, 1, n+2, n+1) run counter-clockwise seen from +Y when u goes to +X and v to -Z.
-  grid(4, [](double u, double w) { return Eigen::Vector3d(u, 0.3, -w); }, v, q);
+  grid(
+      4, [](double u, double w) { return Eigen::Vector3d(u, 0.3, -w); }, v, q);
   const Image image = render_quad_patch(renderer(), v, q, {200, 200});
   // Through quad centres (rows/columns at 1/8, 3/8, ... of the patch) so no horizontal edge is
   // crossed along a row; the patch fills the framed square, centred.
@@ -71,7 +72,8 @@ TEST_F(PreviewsTest, FlatPatchShowsItsQuadEdges) {
 TEST_F(PreviewsTest, PatchOrientationIsNotMirrored) {
   Eigen::MatrixX3d v;
   Eigen::MatrixX4i q;
-  grid(2, [](double u, double w) { return Eigen::Vector3d(u, w, 0); }, v, q);
+  grid(
+      2, [](double u, double w) { return Eigen::Vector3d(u, w, 0); }, v, q);
   PatchStyle style;
   style.quad_colours = Eigen::MatrixX3f::Constant(4, 3, 0.8f);
   style.quad_colours.row(3) << 0.9f, 0.1f, 0.1f;  // the quad at +X, +Y

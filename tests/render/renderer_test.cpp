@@ -107,11 +107,12 @@ TEST_F(RendererTest, SyntheticSilhouettesMatchCpuProjection) {
   const meshing::TriMesh sphere = meshing::icosphere(0.4, 3, {0.2, 0.3, -0.1});
   for (ViewName v : {ViewName::kFront, ViewName::kTop, ViewName::kRight, ViewName::kThreeQuarter}) {
     const ImageSize size{200, 150};
-    expect_silhouette_matches(renderer(), ell, frame_view(v, meshing::bounding_box(ell), size.aspect()),
-                              size, 0.1, "ell " + view_name(v));
+    expect_silhouette_matches(renderer(), ell,
+                              frame_view(v, meshing::bounding_box(ell), size.aspect()), size, 0.1,
+                              "ell " + view_name(v));
     expect_silhouette_matches(renderer(), sphere,
-                              frame_view(v, meshing::bounding_box(sphere), size.aspect()), size, 0.2,
-                              "sphere " + view_name(v));
+                              frame_view(v, meshing::bounding_box(sphere), size.aspect()), size,
+                              0.2, "sphere " + view_name(v));
   }
   // An explicit camera off the axes, with a narrow field of view.
   Camera c;
@@ -130,8 +131,10 @@ TEST_F(RendererTest, FrontCameraSeesThePlusZSide) {
   m.face_colours.middleRows(2, 2).rowwise() = Eigen::RowVector3f(0.9f, 0.1f, 0.1f);
   const ImageSize size{64, 64};
   const PreparedScene prepared = renderer().prepare(scene);
-  const Image front = renderer().render(prepared, frame_view(ViewName::kFront, prepared.bounds(), 1), size);
-  const Image back = renderer().render(prepared, frame_view(ViewName::kBack, prepared.bounds(), 1), size);
+  const Image front =
+      renderer().render(prepared, frame_view(ViewName::kFront, prepared.bounds(), 1), size);
+  const Image back =
+      renderer().render(prepared, frame_view(ViewName::kBack, prepared.bounds(), 1), size);
   const std::uint8_t* f = front.pixel(32, 36);
   const std::uint8_t* b = back.pixel(32, 36);
   EXPECT_GT(f[0], 2 * f[2]) << "front view should show the red +Z face";
@@ -143,8 +146,10 @@ TEST_F(RendererTest, FrontAndBackOfTheBodyDiffer) {
   scene.meshes.emplace_back().mesh = body();
   const ImageSize size{160, 240};
   const PreparedScene prepared = renderer().prepare(scene);
-  const Image front = renderer().render(prepared, frame_view(ViewName::kFront, prepared.bounds(), size.aspect()), size);
-  const Image back = renderer().render(prepared, frame_view(ViewName::kBack, prepared.bounds(), size.aspect()), size);
+  const Image front = renderer().render(
+      prepared, frame_view(ViewName::kFront, prepared.bounds(), size.aspect()), size);
+  const Image back = renderer().render(
+      prepared, frame_view(ViewName::kBack, prepared.bounds(), size.aspect()), size);
   // Compare the front with the mirrored back: the figure is left-right symmetric, so the
   // silhouettes nearly coincide and what differs is the face, chest and feet against the back
   // of the head, shoulder blades and heels.
@@ -174,7 +179,8 @@ TEST_F(RendererTest, ShadowDarkensTheGroundUnderTheBody) {
     const Image without = renderer().render(unshadowed, camera, size);
     // Floor pixels: away from the body's silhouette (and its one-pixel band).
     const std::vector<unsigned char> silhouette = test::cpu_silhouette(body(), camera, size);
-    const std::vector<unsigned char> band = test::mask_boundary(silhouette, size.width, size.height);
+    const std::vector<unsigned char> band =
+        test::mask_boundary(silhouette, size.width, size.height);
     long darker = 0, brighter = 0;
     double centroid_x = 0;
     for (int y = 0; y < size.height; ++y)
@@ -258,20 +264,23 @@ TEST_F(RendererTest, WireframeDrawsExactlyTheGivenEdgesInTheirLevelColours) {
     EXPECT_GT(test::channel_difference(a, b, px.x(), px.y()), 40) << "edge " << e;
     // Vertical edges inside row r have level 4 + r; the line is 3 px wide, so its centre
     // pixel is fully covered and shows the map's colour (lines are unlit).
-    const bool vertical = std::abs(grid.vertices(w.edges(e, 0), 0) - grid.vertices(w.edges(e, 1), 0)) < 1e-9;
+    const bool vertical =
+        std::abs(grid.vertices(w.edges(e, 0), 0) - grid.vertices(w.edges(e, 1), 0)) < 1e-9;
     if (vertical) {
       const int row = static_cast<int>(mid.y() * n);
       const Eigen::Vector3f expected = colour_map(ColourMap::kLevels, row) * 255.0f;
       for (int c = 0; c < 3; ++c)
-        EXPECT_NEAR(b.pixel(px.x(), px.y())[c], expected[c], 2.0) << "edge " << e << " channel " << c;
+        EXPECT_NEAR(b.pixel(px.x(), px.y())[c], expected[c], 2.0)
+            << "edge " << e << " channel " << c;
     }
   }
   // The triangulation's diagonals are not edges: quad centres and points along the diagonals
   // are untouched.
   for (Eigen::Index q = 0; q < grid.quads.rows(); ++q)
     for (double s : {0.3, 0.5, 0.7}) {
-      const Eigen::Vector3d p = ((1 - s) * grid.vertices.row(grid.quads(q, 0)) +
-                                 s * grid.vertices.row(grid.quads(q, 2))).transpose();
+      const Eigen::Vector3d p =
+          ((1 - s) * grid.vertices.row(grid.quads(q, 0)) + s * grid.vertices.row(grid.quads(q, 2)))
+              .transpose();
       const Eigen::Vector2i px = pixel_at(p);
       EXPECT_LE(test::channel_difference(a, b, px.x(), px.y()), 1) << "quad " << q << " at " << s;
     }
@@ -453,7 +462,8 @@ TEST_F(RendererTest, GoldenSkirtOverBody) {
   Wireframe w;
   w.edges = quad_edges(quads);
   w.face_values.resize(skirt.face_count());
-  for (Eigen::Index t = 0; t < w.face_values.size(); ++t) w.face_values[t] = 4 + (t / 2) / segments % 5;
+  for (Eigen::Index t = 0; t < w.face_values.size(); ++t)
+    w.face_values[t] = 4 + (t / 2) / segments % 5;
   w.colour_map = ColourMap::kLevels;
   scene.meshes[1].wireframe = w;
   const ImageSize size{160, 240};

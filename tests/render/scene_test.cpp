@@ -69,7 +69,8 @@ TEST(Scene, ColourMaps) {
   // Ten distinct level colours; levels 4..8 must be told apart.
   for (int a = 0; a < 10; ++a)
     for (int b = a + 1; b < 10; ++b)
-      EXPECT_GT((colour_map(ColourMap::kLevels, a) - colour_map(ColourMap::kLevels, b)).norm(), 0.1);
+      EXPECT_GT((colour_map(ColourMap::kLevels, a) - colour_map(ColourMap::kLevels, b)).norm(),
+                0.1);
   EXPECT_TRUE(colour_map(ColourMap::kLevels, 3.4).isApprox(colour_map(ColourMap::kLevels, 3)));
 }
 

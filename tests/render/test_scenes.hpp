@@ -70,7 +70,8 @@ inline bool project(const render::Camera& c, const Eigen::Vector3d& p, render::I
 inline std::vector<unsigned char> cpu_silhouette(const meshing::TriMesh& mesh,
                                                  const render::Camera& c, render::ImageSize size) {
   std::vector<unsigned char> mask(static_cast<size_t>(size.width) * size.height, 0);
-  std::vector<Eigen::Vector2d> px(static_cast<size_t>(mesh.vertex_count()), Eigen::Vector2d::Zero());
+  std::vector<Eigen::Vector2d> px(static_cast<size_t>(mesh.vertex_count()),
+                                  Eigen::Vector2d::Zero());
   for (Eigen::Index v = 0; v < mesh.vertex_count(); ++v)
     project(c, mesh.vertices.row(v).transpose(), size, px[static_cast<size_t>(v)]);
   for (Eigen::Index f = 0; f < mesh.face_count(); ++f) {
@@ -79,9 +80,11 @@ inline std::vector<unsigned char> cpu_silhouette(const meshing::TriMesh& mesh,
     const double area = (b - a).x() * (d - a).y() - (b - a).y() * (d - a).x();
     if (std::abs(area) < 1e-12) continue;
     const int x0 = std::max(0, static_cast<int>(std::floor(std::min({a.x(), b.x(), d.x()}))));
-    const int x1 = std::min(size.width - 1, static_cast<int>(std::ceil(std::max({a.x(), b.x(), d.x()}))));
+    const int x1 =
+        std::min(size.width - 1, static_cast<int>(std::ceil(std::max({a.x(), b.x(), d.x()}))));
     const int y0 = std::max(0, static_cast<int>(std::floor(std::min({a.y(), b.y(), d.y()}))));
-    const int y1 = std::min(size.height - 1, static_cast<int>(std::ceil(std::max({a.y(), b.y(), d.y()}))));
+    const int y1 =
+        std::min(size.height - 1, static_cast<int>(std::ceil(std::max({a.y(), b.y(), d.y()}))));
     for (int y = y0; y <= y1; ++y)
       for (int x = x0; x <= x1; ++x) {
         const Eigen::Vector2d p(x + 0.5, y + 0.5);

@@ -3,8 +3,6 @@
 // than the penetration tolerance, the drape comes to rest, mass and momentum are carried
 // exactly through every split and merge, and the detail goes to the folds rather than to the
 // cloth lying on the body.
-#include "sim/adaptive_detail.hpp"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -12,6 +10,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "sim/adaptive_detail.hpp"
 #include "sim/body_collider.hpp"
 #include "tests/sim/adaptive_scenes.hpp"
 #include "tests/sim/test_bodies.hpp"
@@ -186,8 +185,7 @@ TEST(AdaptiveContact, SheetDropsOnASphereAdaptivelyAndDrapesOutside) {
       .rowwise()
       .squaredNorm()
       .minCoeff(&middle);
-  EXPECT_NEAR(cloth.positions()(middle, 1), centre.y() + radius + settings.contact.thickness,
-              5e-4);
+  EXPECT_NEAR(cloth.positions()(middle, 1), centre.y() + radius + settings.contact.thickness, 5e-4);
   EXPECT_LT(cloth.positions().col(1).minCoeff(), centre.y());
   // The detail went to the folds of the hanging rim: the cloth lying on the sphere (which needs
   // only what its curvature asks for, about level 4-5 at 2 mm sag) is coarser on average, few

@@ -6,7 +6,6 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -107,11 +106,11 @@ void expect_reference_model(const AdaptiveCloth& cloth, const AdaptiveMaterial& 
   const SparseMatrixR &got = model.pattern.zero_matrix, &want = reference.pattern.zero_matrix;
   ASSERT_EQ(got.rows(), want.rows()) << "change " << change;
   ASSERT_EQ(got.nonZeros(), want.nonZeros()) << "change " << change;
-  ASSERT_TRUE(std::equal(got.outerIndexPtr(), got.outerIndexPtr() + got.rows() + 1,
-                         want.outerIndexPtr()))
+  ASSERT_TRUE(
+      std::equal(got.outerIndexPtr(), got.outerIndexPtr() + got.rows() + 1, want.outerIndexPtr()))
       << "change " << change;
-  ASSERT_TRUE(std::equal(got.innerIndexPtr(), got.innerIndexPtr() + got.nonZeros(),
-                         want.innerIndexPtr()))
+  ASSERT_TRUE(
+      std::equal(got.innerIndexPtr(), got.innerIndexPtr() + got.nonZeros(), want.innerIndexPtr()))
       << "change " << change;
   ASSERT_EQ(model.pattern.diagonal_offsets, reference.pattern.diagonal_offsets)
       << "change " << change;
@@ -167,8 +166,8 @@ TEST(AdaptiveDetail, IncrementalModelEqualsTheRebuiltOne) {
                                        mergeable[rng() % mergeable.size()]};
         stats = cloth.merge_blocks(blocks);
       } else {
-        stats = cloth.split_blocks({splittable[rng() % splittable.size()],
-                                    splittable[rng() % splittable.size()]});
+        stats = cloth.split_blocks(
+            {splittable[rng() % splittable.size()], splittable[rng() % splittable.size()]});
       }
       if (!stats.changed()) continue;
       ++changes;
@@ -197,8 +196,9 @@ TEST(AdaptiveDetail, RejectsBadSettings) {
   };
   EXPECT_THROW(bad([](AdaptiveSettings& s) { s.refine_threshold = -1; }).validate(),
                InvalidAdaptiveSettingsError);
-  EXPECT_THROW(bad([](AdaptiveSettings& s) { s.coarsen_threshold = s.refine_threshold; }).validate(),
-               InvalidAdaptiveSettingsError);
+  EXPECT_THROW(
+      bad([](AdaptiveSettings& s) { s.coarsen_threshold = s.refine_threshold; }).validate(),
+      InvalidAdaptiveSettingsError);
   EXPECT_THROW(bad([](AdaptiveSettings& s) { s.steady_rate = NAN; }).validate(),
                InvalidAdaptiveSettingsError);
   EXPECT_THROW(bad([](AdaptiveSettings& s) { s.min_lifetime = -0.1; }).validate(),
@@ -364,8 +364,8 @@ TEST(AdaptiveDetail, PinsFollowSplitsAndMerges) {
   for (int i = 0; i < 10; ++i) ASSERT_TRUE(cloth.step().accepted);
   const Eigen::MatrixX3d x = cloth.positions();
   for (int v : cloth.pinned_vertices()) {
-    const Eigen::Vector3d expected = cloth.rest_positions().row(v).transpose() +
-                                     Eigen::Vector3d(0.0, 0.2 * cloth.time(), 0.0);
+    const Eigen::Vector3d expected =
+        cloth.rest_positions().row(v).transpose() + Eigen::Vector3d(0.0, 0.2 * cloth.time(), 0.0);
     EXPECT_LE((x.row(v).transpose() - expected).norm(), 1e-9) << "vertex " << v;
   }
   // Merge everything that can be merged: pinned midpoints go, the three original pins stay.
@@ -399,8 +399,8 @@ TEST(AdaptiveDetail, FlatHangingSheetIsNotRefined) {
   for (int v : scene.pinned_vertices) pins.push_back({v, {}});
   SimulationSettings settings = testing::adaptive_sheet_settings(spec);
   settings.duration = 1.0;
-  AdaptiveCloth cloth(meshing::Mesh48::from_quads(scene.input.rest_positions, quads), material,
-                      {}, pins, settings, AdaptiveSettings{});
+  AdaptiveCloth cloth(meshing::Mesh48::from_quads(scene.input.rest_positions, quads), material, {},
+                      pins, settings, AdaptiveSettings{});
   const AdaptiveReport report = cloth.run();
   EXPECT_FALSE(report.simulation.failed);
   EXPECT_EQ(report.splits + report.forced_splits + report.merges, 0);

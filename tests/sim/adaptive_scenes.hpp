@@ -3,11 +3,10 @@
 // quads (Birra & Santos' fig. 5 experiment: hung by 3 of its 4 corners), material points to
 // compare runs on different meshes, and the shape figures the comparison uses.
 
+#include <Eigen/Core>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "meshing/mesh48.hpp"
 #include "sim/adaptive_detail.hpp"

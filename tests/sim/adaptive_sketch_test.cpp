@@ -60,16 +60,17 @@ TEST(AdaptiveSketch, BoolAndObjectForms) {
 TEST(AdaptiveSketch, BadValuesNameTheirPath) {
   EXPECT_EQ(error_of(R"("yes")").rfind("/simulate/adaptive: expected true, false or an object", 0),
             0u);
-  EXPECT_EQ(error_of(R"({"refine_threshold": -1})").rfind("/simulate/adaptive/refine_threshold:", 0),
-            0u);
+  EXPECT_EQ(
+      error_of(R"({"refine_threshold": -1})").rfind("/simulate/adaptive/refine_threshold:", 0), 0u);
   EXPECT_EQ(error_of(R"({"refine_threshold": 0.001, "coarsen_threshold": 0.002})")
                 .rfind("/simulate/adaptive/coarsen_threshold: the coarsen threshold", 0),
             0u);
   EXPECT_EQ(error_of(R"({"max_level": 2.5})").rfind("/simulate/adaptive/max_level:", 0), 0u);
   EXPECT_EQ(error_of(R"({"max_level": 31})").rfind("/simulate/adaptive/max_level: levels go", 0),
             0u);
-  EXPECT_EQ(error_of(R"({"min_level": 4, "max_level": 3})").rfind("/simulate/adaptive/max_level:", 0),
-            0u);
+  EXPECT_EQ(
+      error_of(R"({"min_level": 4, "max_level": 3})").rfind("/simulate/adaptive/max_level:", 0),
+      0u);
   EXPECT_EQ(error_of(R"({"max_vertices": -3})").rfind("/simulate/adaptive/max_vertices:", 0), 0u);
   EXPECT_EQ(error_of(R"({"merge_batch": 1})").rfind("/simulate/adaptive/merge_batch: the merge", 0),
             0u);

@@ -519,7 +519,8 @@ TEST(BodyCollider, BodyVertexThroughAClothTriangleIsAPiercing) {
   strict.thickness = 0.0;
   ASSERT_TRUE(collider.find_contacts(below, strict).empty());  // the premise
   PiercingQueryStats stats;
-  const std::vector<BodyPiercing> found = collider.find_piercings(below, triangles, 0.0, 0.05, 0.0, &stats);
+  const std::vector<BodyPiercing> found =
+      collider.find_piercings(below, triangles, 0.0, 0.05, 0.0, &stats);
   ASSERT_EQ(found.size(), 1u);
   const BodyPiercing& p = found.front();
   EXPECT_EQ(p.body_vertex, 0);

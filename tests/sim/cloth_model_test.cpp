@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-
 #include <cmath>
 #include <numbers>
 
@@ -215,7 +214,8 @@ TEST(ClothModel, CalibratedHingeWeightsHoldTheCylinderEnergyInEveryDirection) {
     test::StripMesh mesh;
     double period;  // in cells
   };
-  for (const Case c : {Case{test::StripMesh::four_eight, 2.0}, Case{test::StripMesh::four_eight_45, 1.0}}) {
+  for (const Case c :
+       {Case{test::StripMesh::four_eight, 2.0}, Case{test::StripMesh::four_eight_45, 1.0}}) {
     const int cells = 30;
     const double h = 0.01;
     const test::Strip patch = test::make_strip(c.mesh, cells * h, 32 * h, cells, 32);
@@ -227,13 +227,15 @@ TEST(ClothModel, CalibratedHingeWeightsHoldTheCylinderEnergyInEveryDirection) {
     const double lo = 8 * h, hi = lo + 8 * c.period * h;
     for (int k = 0; k < 12; ++k) {
       const double phi = k * std::numbers::pi / 12;
-      EXPECT_NEAR(cylinder_energy_ratio(calibrated, patch.input.rest_positions, phi, 0.001 / h, lo, hi),
-                  1.0, 2e-3)
+      EXPECT_NEAR(
+          cylinder_energy_ratio(calibrated, patch.input.rest_positions, phi, 0.001 / h, lo, hi),
+          1.0, 2e-3)
           << test::strip_mesh_name(c.mesh) << ", bend direction " << phi;
     }
     const double diagonal = c.mesh == test::StripMesh::four_eight ? std::numbers::pi / 4 : 0.0;
-    EXPECT_NEAR(cylinder_energy_ratio(edge, patch.input.rest_positions, diagonal, 0.001 / h, lo, hi),
-                1.5, 3e-3)
+    EXPECT_NEAR(
+        cylinder_energy_ratio(edge, patch.input.rest_positions, diagonal, 0.001 / h, lo, hi), 1.5,
+        3e-3)
         << test::strip_mesh_name(c.mesh);
   }
 }

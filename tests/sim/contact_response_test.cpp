@@ -16,9 +16,9 @@
 #include "sim/body_collider.hpp"
 #include "sim/collision_geometry.hpp"
 #include "sim/sheet.hpp"
-#include "tests/sim/test_scenes.hpp"
 #include "sim/simulation.hpp"
 #include "test_bodies.hpp"
+#include "tests/sim/test_scenes.hpp"
 
 namespace sd::sim {
 namespace {

@@ -4,10 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <random>
-
-#include <Eigen/Geometry>
 
 namespace sd::sim {
 namespace {
@@ -51,8 +50,8 @@ TEST(ElementForces, TriangleConditionsMatchFiniteDifferences) {
       check_derivatives<9>(
           x,
           [&](const Eigen::Matrix<double, 9, 1>& y, bool hessian) {
-            const TriangleConditions c = triangle_conditions(
-                t, y.segment<3>(0), y.segment<3>(3), y.segment<3>(6), hessian);
+            const TriangleConditions c =
+                triangle_conditions(t, y.segment<3>(0), y.segment<3>(3), y.segment<3>(6), hessian);
             return which == 0 ? c.warp : which == 1 ? c.weft : c.shear;
           },
           1e-7, 1e-5);
@@ -90,15 +89,15 @@ TEST(ElementForces, DihedralAngleMatchesFiniteDifferencesAndGeometry) {
   // Rigid motions do not change it.
   const Eigen::Matrix3d rotation =
       Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
-  const double rotated = dihedral_angle(rotation * Eigen::Vector3d(0, 0, 0),
-                                        rotation * Eigen::Vector3d(1, 0, 0),
-                                        rotation * Eigen::Vector3d(0.5, 1, 0),
-                                        rotation * Eigen::Vector3d(0.5, 0, 1));
+  const double rotated =
+      dihedral_angle(rotation * Eigen::Vector3d(0, 0, 0), rotation * Eigen::Vector3d(1, 0, 0),
+                     rotation * Eigen::Vector3d(0.5, 1, 0), rotation * Eigen::Vector3d(0.5, 0, 1));
   EXPECT_NEAR(rotated, theta, 1e-12);
 }
 
 TEST(ElementForces, DegenerateElementsGiveFiniteZeroDerivatives) {
-  const Condition<12> c = dihedral_angle_condition({0, 0, 0}, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, true);
+  const Condition<12> c =
+      dihedral_angle_condition({0, 0, 0}, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, true);
   EXPECT_EQ(c.value, 0.0);
   EXPECT_TRUE(c.gradient.allFinite());
   EXPECT_TRUE(c.hessian.allFinite());

@@ -128,8 +128,10 @@ TEST(Forces, ExactJacobiansMatchFiniteDifferences) {
       const Eigen::VectorXd x = testing::random_configuration(f.scene.input.rest_positions, rng);
       Eigen::VectorXd v(x.size());
       for (Eigen::Index j = 0; j < v.size(); ++j) v[j] = normal(rng);
-      const Eigen::MatrixXd dfdx = dense_jacobian(f.model, settings, x, v, 1, 0, JacobianKind::exact);
-      const Eigen::MatrixXd dfdv = dense_jacobian(f.model, settings, x, v, 0, 1, JacobianKind::exact);
+      const Eigen::MatrixXd dfdx =
+          dense_jacobian(f.model, settings, x, v, 1, 0, JacobianKind::exact);
+      const Eigen::MatrixXd dfdv =
+          dense_jacobian(f.model, settings, x, v, 0, 1, JacobianKind::exact);
       Eigen::MatrixXd fd_x(x.size(), x.size()), fd_v(x.size(), x.size());
       const double h = 1e-6;
       Eigen::VectorXd fp, fm;
@@ -172,7 +174,8 @@ TEST(Forces, SolveJacobianIsSymmetricNegativeSemidefinite) {
       const Eigen::MatrixXd j =
           dense_jacobian(f.model, settings, x, v, xs, 1.0 - xs, JacobianKind::solve);
       EXPECT_LE((j - j.transpose()).norm(), 1e-12 * j.norm());
-      const Eigen::VectorXd eigenvalues = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(j).eigenvalues();
+      const Eigen::VectorXd eigenvalues =
+          Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(j).eigenvalues();
       EXPECT_LE(eigenvalues.maxCoeff(), 1e-9 * j.norm()) << "trial " << trial;
     }
   }

@@ -74,8 +74,7 @@ TEST(ImplicitSolver, PointSpringStepIsBackwardEulerExactly) {
       ASSERT_TRUE(r.linear_converged);
       for (int i = 0; i < vertices; ++i) {
         EXPECT_NEAR(r.v.segment<3>(3 * i).dot(n), expected, 1e-9 * std::abs(expected));
-        EXPECT_NEAR((r.v.segment<3>(3 * i) - r.v.segment<3>(3 * i).dot(n) * n).norm(), 0.0,
-                    1e-10);
+        EXPECT_NEAR((r.v.segment<3>(3 * i) - r.v.segment<3>(3 * i).dot(n) * n).norm(), 0.0, 1e-10);
       }
     }
 }
@@ -172,8 +171,8 @@ TEST(ImplicitSolver, FailedCholmodFactorisationFallsBackToPcg) {
     extra.springs.push_back(spring);
   }
   const PointSpring& spring = extra.springs[0];
-  const double expected = beta * spring.stiffness * (spring.target - p0) /
-                          (m + beta * beta * spring.stiffness);
+  const double expected =
+      beta * spring.stiffness * (spring.target - p0) / (m + beta * beta * spring.stiffness);
   NewtonSettings settings;
   settings.solver = LinearSolverKind::cholmod;
   settings.pcg_tolerance = 1e-12;

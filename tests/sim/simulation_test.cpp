@@ -2,8 +2,8 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <random>
 #include <string>
@@ -58,11 +58,15 @@ TEST(Simulation, HangingSheetReachesStaticEquilibrium) {
     Simulation sim = make_simulation(h, settings);
     const SimulationReport report = sim.run();
     const double weight = h.model.total_mass() * 9.81 / h.model.vertex_count;
-    const auto box = meshing::bounding_box(meshing::TriMesh{unflatten_positions(sim.positions()), h.scene.input.triangles});
-    std::printf("box %.4f %.4f %.4f  min y %.4f\n", box.extent().x(), box.extent().y(), box.extent().z(), box.min.y());
-    std::printf("equilibrium (%s): t = %.2f s, steps %d, retries %d, residual %.3g N (%.3g of a vertex weight)\n",
-                integrator == Integrator::bdf2 ? "BDF2" : "implicit Euler", report.sim_time,
-                report.steps, report.retries, sim.residual_force(), sim.residual_force() / weight);
+    const auto box = meshing::bounding_box(
+        meshing::TriMesh{unflatten_positions(sim.positions()), h.scene.input.triangles});
+    std::printf("box %.4f %.4f %.4f  min y %.4f\n", box.extent().x(), box.extent().y(),
+                box.extent().z(), box.min.y());
+    std::printf(
+        "equilibrium (%s): t = %.2f s, steps %d, retries %d, residual %.3g N (%.3g of a vertex "
+        "weight)\n",
+        integrator == Integrator::bdf2 ? "BDF2" : "implicit Euler", report.sim_time, report.steps,
+        report.retries, sim.residual_force(), sim.residual_force() / weight);
     EXPECT_TRUE(report.at_rest);
     EXPECT_FALSE(report.failed);
     EXPECT_TRUE(report.nan_free);
@@ -73,7 +77,6 @@ TEST(Simulation, HangingSheetReachesStaticEquilibrium) {
     EXPECT_LT(sim.positions()[3 * h.scene.vertex(8, 0) + 1], 1.0 - 0.3);
   }
 }
-
 
 struct SettledShape {
   double lowest = 0.0;
@@ -126,14 +129,16 @@ TEST(Simulation, ReportsTheAtRestResidual) {
   });
   ASSERT_TRUE(report.at_rest);
   for (const auto& [t, speed] : speeds)
-    if (t >= report.sim_time - settings.rest_window - 1e-12) window_speed = std::max(window_speed, speed);
+    if (t >= report.sim_time - settings.rest_window - 1e-12)
+      window_speed = std::max(window_speed, speed);
   EXPECT_DOUBLE_EQ(report.rest_speed_final, speeds.back().second);
   EXPECT_DOUBLE_EQ(report.rest_speed_window, window_speed);
   EXPECT_LT(report.rest_speed_window, settings.rest_speed);
   EXPECT_LT(report.rest_kinetic_per_kg_window, settings.rest_kinetic_energy);
   EXPECT_LE(report.rest_kinetic_per_kg_final, report.rest_kinetic_per_kg_window);
   // ½ v² ≤ ½ max|v|² per kilogram.
-  EXPECT_LE(report.rest_kinetic_per_kg_final, 0.5 * report.rest_speed_final * report.rest_speed_final + 1e-15);
+  EXPECT_LE(report.rest_kinetic_per_kg_final,
+            0.5 * report.rest_speed_final * report.rest_speed_final + 1e-15);
 }
 
 TEST(Simulation, ResolutionInvariance) {
@@ -141,9 +146,10 @@ TEST(Simulation, ResolutionInvariance) {
   const SettledShape medium = settle(16);
   const SettledShape fine = settle(32);
   for (const SettledShape* s : {&coarse, &medium, &fine})
-    std::printf("resolution: lowest %.4f m, box %.4f x %.4f x %.4f m, bend %.3g J, potential %.4f J\n",
-                s->lowest, s->extent.x(), s->extent.y(), s->extent.z(), s->energy.bend,
-                s->energy.potential);
+    std::printf(
+        "resolution: lowest %.4f m, box %.4f x %.4f x %.4f m, bend %.3g J, potential %.4f J\n",
+        s->lowest, s->extent.x(), s->extent.y(), s->extent.z(), s->energy.bend,
+        s->energy.potential);
   for (const SettledShape* s : {&coarse, &medium}) {
     // Drop of the lowest point below the pins (1 m) and the box, within a few percent.
     EXPECT_NEAR((1.0 - s->lowest) / (1.0 - fine.lowest), 1.0, 0.03);
@@ -157,14 +163,17 @@ TEST(Simulation, ResolutionInvariance) {
   // The energy curves agree too: potential energy through the fall, sampled at common times.
   double worst = 0.0;
   for (const EnergySample& sample : coarse.series) {
-    const auto match = std::find_if(fine.series.begin(), fine.series.end(), [&](const EnergySample& f) {
-      return std::abs(f.time - sample.time) < 1e-9;
-    });
+    const auto match =
+        std::find_if(fine.series.begin(), fine.series.end(),
+                     [&](const EnergySample& f) { return std::abs(f.time - sample.time) < 1e-9; });
     if (match == fine.series.end() || sample.time == 0.0) continue;
-    worst = std::max(worst, std::abs(sample.potential - match->potential) /
-                                std::abs(fine.series.back().potential - fine.series.front().potential));
+    worst =
+        std::max(worst, std::abs(sample.potential - match->potential) /
+                            std::abs(fine.series.back().potential - fine.series.front().potential));
   }
-  std::printf("resolution: largest potential-energy curve gap 8x8 vs 32x32: %.3f of the total drop\n", worst);
+  std::printf(
+      "resolution: largest potential-energy curve gap 8x8 vs 32x32: %.3f of the total drop\n",
+      worst);
   EXPECT_LT(worst, 0.05);
 }
 
@@ -196,8 +205,8 @@ double observed_order(Integrator integrator, int bdf2_newton = 20) {
     settings.newton_iterations = method == Integrator::bdf2 ? newton : 1;
     settings.newton_tolerance = 1e-13;
     settings.easy_steps_to_grow = 1000000;
-    Simulation sim(model, flatten_positions(scene.input.rest_positions),
-                   testing::fixed_pins(scene), settings);
+    Simulation sim(model, flatten_positions(scene.input.rest_positions), testing::fixed_pins(scene),
+                   settings);
     const SimulationReport report = sim.run();
     EXPECT_EQ(report.retries, 0);
     EXPECT_EQ(report.forced_steps, 0);
@@ -208,11 +217,9 @@ double observed_order(Integrator integrator, int bdf2_newton = 20) {
   const double e2 = (run(0.2 / 80, integrator, bdf2_newton) - reference).lpNorm<Eigen::Infinity>();
   const double e3 = (run(0.2 / 160, integrator, bdf2_newton) - reference).lpNorm<Eigen::Infinity>();
   std::printf("convergence (%s): errors %.3g %.3g %.3g m, orders %.2f %.2f\n",
-              integrator == Integrator::bdf2
-                  ? (bdf2_newton == 1 ? "linearised BDF2" : "BDF2")
-                  : "implicit Euler",
-              e1, e2, e3,
-              std::log2(e1 / e2), std::log2(e2 / e3));
+              integrator == Integrator::bdf2 ? (bdf2_newton == 1 ? "linearised BDF2" : "BDF2")
+                                             : "implicit Euler",
+              e1, e2, e3, std::log2(e1 / e2), std::log2(e2 / e3));
   return std::log2(e2 / e3);
 }
 
@@ -250,7 +257,8 @@ TEST(Simulation, EnergyDoesNotGrowWithoutDampingOrForcing) {
     fabric.damping = fabric.bend_damping = 0.0;
     const ClothModel model = build_cloth_model(scene.input, fabric);
     std::mt19937 rng(21);
-    const Eigen::VectorXd x0 = testing::random_configuration(scene.input.rest_positions, rng, 0.005);
+    const Eigen::VectorXd x0 =
+        testing::random_configuration(scene.input.rest_positions, rng, 0.005);
     SimulationSettings settings;
     settings.integrator = integrator;
     settings.dt = 1.0 / 200;
@@ -262,7 +270,9 @@ TEST(Simulation, EnergyDoesNotGrowWithoutDampingOrForcing) {
     Simulation sim(model, x0, {}, settings);
     const SimulationReport report = sim.run();
     ASSERT_FALSE(report.failed);
-    const auto total = [](const EnergySample& e) { return e.stretch + e.shear + e.bend + e.kinetic; };
+    const auto total = [](const EnergySample& e) {
+      return e.stretch + e.shear + e.bend + e.kinetic;
+    };
     const double initial = total(report.energy.front());
     double largest = 0.0;
     for (const EnergySample& e : report.energy) largest = std::max(largest, total(e));
@@ -297,7 +307,8 @@ TEST(Simulation, StressStiffnessStepIntegratorSolver) {
           const SimulationReport report =
               sim.run([&](const Simulation& s) { observed_retries = s.report().retries; });
           const std::string label = "stiffness x" + std::to_string(stiffness) + " dt " +
-                                    std::to_string(dt) + (integrator == Integrator::bdf2 ? " BDF2" : " IE") +
+                                    std::to_string(dt) +
+                                    (integrator == Integrator::bdf2 ? " BDF2" : " IE") +
                                     (solver == LinearSolverKind::pcg ? " PCG" : " CHOLMOD");
           EXPECT_FALSE(report.failed) << label << ": " << report.failure_reason;
           EXPECT_TRUE(report.nan_free) << label;
@@ -338,12 +349,15 @@ TEST(Simulation, PcgToleranceErrorIsSmallAgainstTheTimeStepError) {
   const Eigen::VectorXd half = drape(LinearSolverKind::cholmod, {}, step / 2);
   const Eigen::VectorXd ic =
       drape(LinearSolverKind::pcg, PcgPreconditioner::block_incomplete_cholesky, step);
-  const Eigen::VectorXd jacobi = drape(LinearSolverKind::pcg, PcgPreconditioner::block_jacobi, step);
+  const Eigen::VectorXd jacobi =
+      drape(LinearSolverKind::pcg, PcgPreconditioner::block_jacobi, step);
   const double time_error = (exact - half).lpNorm<Eigen::Infinity>();
   const double ic_error = (ic - exact).lpNorm<Eigen::Infinity>();
   const double jacobi_error = (jacobi - exact).lpNorm<Eigen::Infinity>();
-  std::printf("PCG tolerance 1e-3 after 1 s: IC(0) %.3g m, block Jacobi %.3g m; time step h vs "
-              "h/2 %.3g m\n", ic_error, jacobi_error, time_error);
+  std::printf(
+      "PCG tolerance 1e-3 after 1 s: IC(0) %.3g m, block Jacobi %.3g m; time step h vs "
+      "h/2 %.3g m\n",
+      ic_error, jacobi_error, time_error);
   EXPECT_GT(time_error, 1e-3);  // a real swing: the comparison is not against noise
   EXPECT_LT(ic_error, 0.1 * time_error);
 }
@@ -366,15 +380,15 @@ TEST(Simulation, Bdf2FinishesAStiffSheetAtFilmSteps) {
     settings.forces.air_drag = 0.1;
     Simulation sim = make_simulation(h, settings);
     const SimulationReport report = sim.run();
-    std::printf("BDF2 32x32 at 1/24 s (%s): steps %d, retries %d (fallbacks %d), Newton %.2f "
-                "per step, max strain %.4f\n",
-                solver == LinearSolverKind::pcg ? "PCG" : "CHOLMOD", report.steps,
-                report.retries, report.integrator_fallbacks, report.newton_iterations_mean,
-                report.max_strain);
+    std::printf(
+        "BDF2 32x32 at 1/24 s (%s): steps %d, retries %d (fallbacks %d), Newton %.2f "
+        "per step, max strain %.4f\n",
+        solver == LinearSolverKind::pcg ? "PCG" : "CHOLMOD", report.steps, report.retries,
+        report.integrator_fallbacks, report.newton_iterations_mean, report.max_strain);
     EXPECT_FALSE(report.failed) << report.failure_reason;
     EXPECT_NEAR(report.sim_time, settings.duration, 1e-9);
     EXPECT_EQ(report.forced_steps, 0);
-    EXPECT_LE(report.steps, 2 * 24);       // at most twice the frames
+    EXPECT_LE(report.steps, 2 * 24);  // at most twice the frames
     EXPECT_LE(report.retries, report.steps / 2);
     EXPECT_LT(report.max_strain, 0.05);
   }
@@ -395,7 +409,8 @@ TEST(Simulation, FailedStepsAreRolledBackHalvedAndCounted) {
   EXPECT_TRUE(report.nan_free);
   EXPECT_TRUE(sim.positions().allFinite());
   double speed = 0.0;
-  for (int i = 0; i < h.model.vertex_count; ++i) speed = std::max(speed, sim.velocities().segment<3>(3 * i).norm());
+  for (int i = 0; i < h.model.vertex_count; ++i)
+    speed = std::max(speed, sim.velocities().segment<3>(3 * i).norm());
   EXPECT_LE(speed, settings.max_speed);  // the rejected state never leaked out
 
   // A PCG that cannot converge forces halving down to min_dt, then a logged forced step.
@@ -449,7 +464,9 @@ TEST(Simulation, DrivenPinsFollowTheirPath) {
   HangingSheet h = hanging_sheet(4, 0.4);
   std::vector<Pin> pins = testing::fixed_pins(h.scene);
   const Eigen::Vector3d start = h.scene.input.rest_positions.row(pins[0].vertex);
-  pins[0].path = [start](double t) { return Eigen::Vector3d(start + Eigen::Vector3d(0.1 * t, 0.05 * t * t, 0)); };
+  pins[0].path = [start](double t) {
+    return Eigen::Vector3d(start + Eigen::Vector3d(0.1 * t, 0.05 * t * t, 0));
+  };
   SimulationSettings settings;
   settings.integrator = Integrator::bdf2;
   settings.duration = 0.5;
@@ -459,7 +476,9 @@ TEST(Simulation, DrivenPinsFollowTheirPath) {
   const Eigen::Vector3d expected = start + Eigen::Vector3d(0.05, 0.0125, 0);
   EXPECT_LE((sim.positions().segment<3>(3 * pins[0].vertex) - expected).norm(), 1e-9);
   EXPECT_LE((sim.positions().segment<3>(3 * pins[1].vertex) -
-             h.scene.input.rest_positions.row(pins[1].vertex).transpose()).norm(), 1e-12);
+             h.scene.input.rest_positions.row(pins[1].vertex).transpose())
+                .norm(),
+            1e-12);
 }
 
 TEST(Simulation, BadSettingsAreRejected) {

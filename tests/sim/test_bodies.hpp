@@ -1,14 +1,13 @@
 #pragma once
 // Closed body meshes for the contact tests: an icosphere and a box, outward-facing.
 
+#include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
 #include <vector>
-
-#include <Eigen/Core>
-#include <Eigen/Geometry>
 
 #include "meshing/tri_mesh.hpp"
 
@@ -64,13 +63,14 @@ inline meshing::TriMesh make_cone(double radius, double height, int segments,
   for (int k = 0; k < segments; ++k) {
     const double a = 2.0 * std::numbers::pi * k / segments;
     mesh.vertices.row(2 + k) =
-        (base_centre + Eigen::Vector3d(radius * std::cos(a), 0.0, radius * std::sin(a))).transpose();
+        (base_centre + Eigen::Vector3d(radius * std::cos(a), 0.0, radius * std::sin(a)))
+            .transpose();
   }
   mesh.faces.resize(2 * segments, 3);
   for (int k = 0; k < segments; ++k) {
     const int a = 2 + k, b = 2 + (k + 1) % segments;
-    mesh.faces.row(k) << 0, b, a;                // side, seen from outside counter-clockwise
-    mesh.faces.row(segments + k) << 1, a, b;     // base, facing down
+    mesh.faces.row(k) << 0, b, a;             // side, seen from outside counter-clockwise
+    mesh.faces.row(segments + k) << 1, a, b;  // base, facing down
   }
   return mesh;
 }

@@ -1,11 +1,10 @@
 #pragma once
 // Small scenes shared by the simulator tests.
 
+#include <Eigen/Core>
 #include <random>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "sim/cloth_model.hpp"
 #include "sim/fabric.hpp"

@@ -20,8 +20,8 @@
 #include "sim/cloth_driver.hpp"
 #include "sim/sheet.hpp"
 #include "sim/surface_sampling.hpp"
-#include "src/app/pipeline/sha256.hpp"
 #include "src/app/pipeline/cloth_scene.hpp"
+#include "src/app/pipeline/sha256.hpp"
 
 namespace sd::app {
 namespace {
@@ -58,12 +58,14 @@ void set_sheet(BenchScene& scene, sim::SheetSpec spec) {
     }
 }
 
-
 double grid_duration(BenchGrid grid, bool garment) {
   switch (grid) {
-    case BenchGrid::tiny: return 0.5;
-    case BenchGrid::quick: return 1.0;
-    case BenchGrid::full: return garment ? 1.0 : 2.0;
+    case BenchGrid::tiny:
+      return 0.5;
+    case BenchGrid::quick:
+      return 1.0;
+    case BenchGrid::full:
+      return garment ? 1.0 : 2.0;
   }
   return 1.0;
 }
@@ -204,7 +206,8 @@ sim::SimulationSettings run_settings(const BenchScene& scene, const BenchConfig&
 
 }  // namespace
 
-// --- configurations --------------------------------------------------------------------------------
+// --- configurations
+// --------------------------------------------------------------------------------
 
 std::string BenchConfig::id() const {
   const std::string integ(sim::integrator_short_name(integrator));
@@ -224,7 +227,9 @@ std::string BenchConfig::label() const {
   return fmt::format("fixed L{}, {}, {}, 1/{} s", level, integ, solv, steps_per_second);
 }
 
-std::vector<std::string> builtin_bench_scenes() { return {"hanging-sheet", "sphere-drop", "tshirt"}; }
+std::vector<std::string> builtin_bench_scenes() {
+  return {"hanging-sheet", "sphere-drop", "tshirt"};
+}
 
 BenchScene build_bench_scene(const std::string& name_or_file, BenchGrid grid) {
   if (name_or_file == "hanging-sheet") return hanging_sheet(grid);
@@ -301,8 +306,8 @@ BenchPlan bench_plan(const BenchScene& scene, BenchGrid grid) {
   const auto step_family = [&](const std::string& name, Integrator integ) {
     BenchFamily family{name, {}};
     for (int rate : rates)
-      family.members.push_back(config(BenchMeshKind::fixed, step_level, integ,
-                                      LinearSolverKind::cholmod, rate));
+      family.members.push_back(
+          config(BenchMeshKind::fixed, step_level, integ, LinearSolverKind::cholmod, rate));
     plan.families.push_back(family);
   };
   resolution_family("fixed, IE, CHOLMOD, 1/60 s: levels", Integrator::implicit_euler,
@@ -345,7 +350,8 @@ BenchPlan bench_plan(const BenchScene& scene, BenchGrid grid) {
   return plan;
 }
 
-// --- keys ------------------------------------------------------------------------------------------
+// --- keys
+// ------------------------------------------------------------------------------------------
 
 namespace {
 
@@ -392,7 +398,8 @@ std::string reference_key(const BenchScene& scene, const BenchConfig& reference,
   return hash.hex_digest();
 }
 
-// --- one run -----------------------------------------------------------------------------------------
+// --- one run
+// -----------------------------------------------------------------------------------------
 
 BenchTrace run_bench_config(const BenchScene& scene, const BenchConfig& config) {
   BenchTrace trace;
@@ -491,7 +498,8 @@ BenchTrace run_bench_config(const BenchScene& scene, const BenchConfig& config) 
   return trace;
 }
 
-// --- serialisation ---------------------------------------------------------------------------------
+// --- serialisation
+// ---------------------------------------------------------------------------------
 
 namespace {
 
@@ -513,14 +521,20 @@ T take(const std::string& in, size_t& at) {
 }  // namespace
 
 std::string serialize_trace(const BenchTrace& t) {
-  const nlohmann::json header = {
-      {"failed", t.failed},          {"failure", t.failure},
-      {"wall_s", t.wall_s},          {"cpu_s", t.cpu_s},
-      {"rss_before_mb", t.rss_before_mb}, {"steps", t.steps},
-      {"retries", t.retries},        {"linear_solves", t.linear_solves},
-      {"cg_iterations_mean", t.cg_iterations_mean}, {"vertices_max", t.vertices_max},
-      {"triangles_max", t.triangles_max}, {"vertices_final", t.vertices_final},
-      {"splits", t.splits},          {"merges", t.merges}};
+  const nlohmann::json header = {{"failed", t.failed},
+                                 {"failure", t.failure},
+                                 {"wall_s", t.wall_s},
+                                 {"cpu_s", t.cpu_s},
+                                 {"rss_before_mb", t.rss_before_mb},
+                                 {"steps", t.steps},
+                                 {"retries", t.retries},
+                                 {"linear_solves", t.linear_solves},
+                                 {"cg_iterations_mean", t.cg_iterations_mean},
+                                 {"vertices_max", t.vertices_max},
+                                 {"triangles_max", t.triangles_max},
+                                 {"vertices_final", t.vertices_final},
+                                 {"splits", t.splits},
+                                 {"merges", t.merges}};
   const std::string text = header.dump();
   std::string out(kTraceMagic, sizeof kTraceMagic);
   const uint64_t text_size = text.size();
@@ -543,7 +557,8 @@ std::string serialize_trace(const BenchTrace& t) {
 }
 
 BenchTrace deserialize_trace(const std::string& bytes) {
-  if (bytes.size() < sizeof kTraceMagic || std::memcmp(bytes.data(), kTraceMagic, sizeof kTraceMagic) != 0)
+  if (bytes.size() < sizeof kTraceMagic ||
+      std::memcmp(bytes.data(), kTraceMagic, sizeof kTraceMagic) != 0)
     throw std::runtime_error("not a sketchdrape bench trace");
   size_t at = sizeof kTraceMagic;
   const auto text_size = take<uint64_t>(bytes, at);
@@ -580,7 +595,8 @@ BenchTrace deserialize_trace(const std::string& bytes) {
   return t;
 }
 
-// --- error -----------------------------------------------------------------------------------------
+// --- error
+// -----------------------------------------------------------------------------------------
 
 BenchError bench_error(const BenchTrace& run, const BenchTrace& reference) {
   BenchError error;

@@ -11,11 +11,10 @@
 // and followed in the draped mesh; positions are compared with the reference's at fixed sample
 // times.
 
+#include <Eigen/Core>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "meshing/mesh48.hpp"
 #include "meshing/tri_mesh.hpp"
@@ -36,19 +35,19 @@ enum class BenchGrid { tiny, quick, full };
 
 // What a scene simulates, ready to be refined and run.
 struct BenchScene {
-  std::string name;                 // "hanging-sheet", "sphere-drop", "tshirt" or the file's stem
-  std::string source;               // "built-in" or the sketch file path
+  std::string name;    // "hanging-sheet", "sphere-drop", "tshirt" or the file's stem
+  std::string source;  // "built-in" or the sketch file path
   std::optional<meshing::Mesh48> mesh;  // level-0 4-8 mesh, rest positions in metres (always set)
-  sim::AdaptiveMaterial material;   // fabric and warp per input face
-  Eigen::MatrixX3d start;           // #V by 3 start positions (rows = vertex ids of `mesh`)
-  std::vector<int> pinned;          // vertex ids held where they start
+  sim::AdaptiveMaterial material;       // fabric and warp per input face
+  Eigen::MatrixX3d start;               // #V by 3 start positions (rows = vertex ids of `mesh`)
+  std::vector<int> pinned;              // vertex ids held where they start
   std::optional<meshing::TriMesh> body;
-  sim::SimulationSettings settings; // forces and contact; integrator, solver, dt set per run
-  double duration = 2.0;            // s simulated by every run
-  double sample_every = 0.1;        // s between the times positions and energies are compared
-  Eigen::MatrixX3d material_points; // #P by 3, on the rest surface
-  int start_level = 0;              // level adaptive runs start from
-  bool sheet = false;               // 4 by 4 level-0 quads (levels as for a sheet)
+  sim::SimulationSettings settings;  // forces and contact; integrator, solver, dt set per run
+  double duration = 2.0;             // s simulated by every run
+  double sample_every = 0.1;         // s between the times positions and energies are compared
+  Eigen::MatrixX3d material_points;  // #P by 3, on the rest surface
+  int start_level = 0;               // level adaptive runs start from
+  bool sheet = false;                // 4 by 4 level-0 quads (levels as for a sheet)
 };
 
 enum class BenchMeshKind { fixed, adaptive };
@@ -56,27 +55,27 @@ enum class BenchMeshKind { fixed, adaptive };
 // One configuration of the grid.
 struct BenchConfig {
   BenchMeshKind mesh = BenchMeshKind::fixed;
-  int level = 0;                    // fixed: uniform level; adaptive: finest level allowed
-  double threshold = 0.0;           // adaptive: refine threshold, m (coarsen at a quarter)
+  int level = 0;           // fixed: uniform level; adaptive: finest level allowed
+  double threshold = 0.0;  // adaptive: refine threshold, m (coarsen at a quarter)
   sim::Integrator integrator = sim::Integrator::implicit_euler;
   sim::LinearSolverKind solver = sim::LinearSolverKind::cholmod;
-  int steps_per_second = 60;        // dt = 1 / steps_per_second
+  int steps_per_second = 60;  // dt = 1 / steps_per_second
 
   double dt() const { return 1.0 / steps_per_second; }
-  std::string id() const;           // "fixed-L4-ie-cholmod-60", unique in a grid
-  std::string label() const;        // "fixed L4, implicit Euler, CHOLMOD, 1/60 s"
+  std::string id() const;     // "fixed-L4-ie-cholmod-60", unique in a grid
+  std::string label() const;  // "fixed L4, implicit Euler, CHOLMOD, 1/60 s"
 };
 
 // A family is one curve of the plot: configurations that differ in one parameter.
 struct BenchFamily {
-  std::string name;                 // "fixed, IE, CHOLMOD, 1/60 s (resolution)"
-  std::vector<BenchConfig> members; // in curve order
+  std::string name;                  // "fixed, IE, CHOLMOD, 1/60 s (resolution)"
+  std::vector<BenchConfig> members;  // in curve order
 };
 
 struct BenchPlan {
-  BenchConfig reference;            // much finer mesh and much smaller step
+  BenchConfig reference;  // much finer mesh and much smaller step
   std::vector<BenchFamily> families;
-  std::vector<BenchConfig> runs;    // the union of the families' members, each once
+  std::vector<BenchConfig> runs;  // the union of the families' members, each once
 };
 
 // Names of the built-in scenes.
@@ -98,13 +97,13 @@ std::string reference_key(const BenchScene& scene, const BenchConfig& reference,
 // What one run produced: positions of the material points and the energy at each sample time,
 // and its own figures.
 struct BenchTrace {
-  std::vector<double> times;                 // s, the sample times reached (0 included)
-  std::vector<Eigen::MatrixX3d> positions;   // per sample time, #P by 3
-  std::vector<double> energy;                // J, total energy (elastic + kinetic + potential)
+  std::vector<double> times;                // s, the sample times reached (0 included)
+  std::vector<Eigen::MatrixX3d> positions;  // per sample time, #P by 3
+  std::vector<double> energy;               // J, total energy (elastic + kinetic + potential)
   bool failed = false;
   std::string failure;
-  double wall_s = 0.0;       // stepping only (sampling excluded), wall time
-  double cpu_s = 0.0;        // stepping only, CPU time of the process
+  double wall_s = 0.0;         // stepping only (sampling excluded), wall time
+  double cpu_s = 0.0;          // stepping only, CPU time of the process
   double rss_before_mb = 0.0;  // peak resident memory before the first step (scene, mesh, model)
   int steps = 0, retries = 0, linear_solves = 0;
   double cg_iterations_mean = 0.0;
@@ -122,12 +121,12 @@ BenchTrace deserialize_trace(const std::string& bytes);
 
 // Error of a run against the reference, over the sample times both reached (t > 0).
 struct BenchError {
-  double rms_m = 0.0;          // RMS distance over all material points and sample times
-  double max_m = 0.0;          // largest distance of any point at any sample time
-  double final_rms_m = 0.0;    // RMS distance at the last sample time
-  double energy_j = 0.0;       // max over sample times of |E_run − E_ref|
+  double rms_m = 0.0;            // RMS distance over all material points and sample times
+  double max_m = 0.0;            // largest distance of any point at any sample time
+  double final_rms_m = 0.0;      // RMS distance at the last sample time
+  double energy_j = 0.0;         // max over sample times of |E_run − E_ref|
   double energy_relative = 0.0;  // energy_j over the range (max − min) of E_ref
-  int samples = 0;             // sample times compared
+  int samples = 0;               // sample times compared
 };
 BenchError bench_error(const BenchTrace& run, const BenchTrace& reference);
 

@@ -21,13 +21,13 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "src/app/pipeline/atomic_file.hpp"
-#include "src/app/pipeline/child_process.hpp"
-#include "src/app/pipeline/sha256.hpp"
 #include "src/app/bench/bench_scaling.hpp"
 #include "src/app/bench/bench_study.hpp"
 #include "src/app/commands/cli.hpp"
+#include "src/app/pipeline/atomic_file.hpp"
+#include "src/app/pipeline/child_process.hpp"
 #include "src/app/pipeline/progress.hpp"
+#include "src/app/pipeline/sha256.hpp"
 #include "src/app/version.hpp"
 
 namespace sd::app {
@@ -63,7 +63,8 @@ std::string read_file(const fs::path& path) {
 BenchGrid parse_grid(const BenchOptions& options) {
   const std::string grid = options.grid.empty() ? (options.quick ? "quick" : "full") : options.grid;
   if (options.quick && grid != "quick")
-    throw std::invalid_argument("--quick and --grid " + grid + " ask for different grids: give one");
+    throw std::invalid_argument("--quick and --grid " + grid +
+                                " ask for different grids: give one");
   if (grid == "tiny") return BenchGrid::tiny;
   if (grid == "quick") return BenchGrid::quick;
   if (grid == "full") return BenchGrid::full;
@@ -108,9 +109,9 @@ ChildResult run_worker(const fs::path& exe, const std::string& scene, BenchGrid 
                        double timeout, Progress& progress, long done, const std::string& note) {
   const fs::path trace_path = work / (tag + ".trace");
   const fs::path log_path = work / (tag + ".log");
-  const std::vector<std::string> args = {"--quiet",       "bench",  "--grid",
-                                         grid_name(grid), "--worker", config_to_json(config),
-                                         "--worker-scene", scene,    "--worker-out",
+  const std::vector<std::string> args = {"--quiet",          "bench",    "--grid",
+                                         grid_name(grid),    "--worker", config_to_json(config),
+                                         "--worker-scene",   scene,      "--worker-out",
                                          trace_path.string()};
   const ChildRun child = run_child(exe, args, log_path, timeout, [&](double elapsed) {
     progress.update(done, fmt::format("{} ({:.0f} s)", note, elapsed));
@@ -157,7 +158,9 @@ struct SceneResult {
   std::string reference_failure;  // why the reference did not finish (the scene's runs are skipped)
 };
 
-bool usable(const RunRow& row) { return row.child.status == "ok" && row.error.samples > 0; }
+bool usable(const RunRow& row) {
+  return row.child.status == "ok" && row.error.samples > 0;
+}
 
 // Runs not beaten in both CPU time and RMS error by another run of the scene.
 void mark_pareto(std::vector<RunRow>& rows) {
@@ -211,7 +214,9 @@ std::string join(const std::vector<std::string>& parts, const std::string& separ
   return out;
 }
 
-std::string number(double value) { return fmt::format("{:.6g}", value); }
+std::string number(double value) {
+  return fmt::format("{:.6g}", value);
+}
 
 const char* kCsvHeader =
     "scene,run,mesh,level,threshold_mm,integrator,solver,dt_s,families,status,wall_s,cpu_s,"
@@ -219,9 +224,9 @@ const char* kCsvHeader =
     "linear_solves,cg_iterations_mean,rms_error_m,max_error_m,final_rms_error_m,energy_error_j,"
     "energy_error_relative,pareto,note\n";
 
-std::string csv_row(const SceneResult& s, const BenchConfig& c, const std::vector<std::string>& families,
-                    const ChildResult& child, const BenchError* error, bool pareto,
-                    const std::string& note) {
+std::string csv_row(const SceneResult& s, const BenchConfig& c,
+                    const std::vector<std::string>& families, const ChildResult& child,
+                    const BenchError* error, bool pareto, const std::string& note) {
   const BenchTrace& t = child.trace;
   const bool measured = child.status == "ok" || child.status == "failed";
   const bool process = child.peak_rss_mb > 0;
@@ -273,8 +278,10 @@ nlohmann::json row_json(const RunRow& row) {
                       {"retries", t.retries},
                       {"pareto", row.pareto}};
   if (usable(row))
-    j["error"] = {{"rms_m", row.error.rms_m},         {"max_m", row.error.max_m},
-                  {"final_rms_m", row.error.final_rms_m}, {"energy_j", row.error.energy_j},
+    j["error"] = {{"rms_m", row.error.rms_m},
+                  {"max_m", row.error.max_m},
+                  {"final_rms_m", row.error.final_rms_m},
+                  {"energy_j", row.error.energy_j},
                   {"energy_relative", row.error.energy_relative}};
   return j;
 }
@@ -310,15 +317,16 @@ std::string plot_script(const SceneResult& s, const std::string& stem) {
   std::string plots;
   const size_t n = s.plan.families.size();
   for (size_t i = 0; i < n; ++i)
-    plots += fmt::format("'{}.dat' index {} using 1:2 with linespoints lw 2 pt 7 ps 1.2 title \"{}\", ",
-                         stem, i, s.plan.families[i].name);
+    plots +=
+        fmt::format("'{}.dat' index {} using 1:2 with linespoints lw 2 pt 7 ps 1.2 title \"{}\", ",
+                    stem, i, s.plan.families[i].name);
   plots += fmt::format(
       "'{}.dat' index {} using 1:2 with lines dt 2 lc rgb 'black' notitle, "
-      "'{}.dat' index {} using 1:2 with points pt 6 ps 2.6 lw 1.5 lc rgb 'black' title \"Pareto front\"",
+      "'{}.dat' index {} using 1:2 with points pt 6 ps 2.6 lw 1.5 lc rgb 'black' title \"Pareto "
+      "front\"",
       stem, n, stem, n);
-  const std::string title = fmt::format(
-      "{}: error against the reference ({}) over {:g} s", s.scene.name, s.plan.reference.label(),
-      s.scene.duration);
+  const std::string title = fmt::format("{}: error against the reference ({}) over {:g} s",
+                                        s.scene.name, s.plan.reference.label(), s.scene.duration);
   std::string script;
   for (const auto& [terminal, extension] :
        {std::pair<std::string, std::string>{"pngcairo size 1100,700 font 'DejaVu Sans,10'", "png"},
@@ -326,7 +334,8 @@ std::string plot_script(const SceneResult& s, const std::string& stem) {
     script += fmt::format(
         "set terminal {}\nset output '{}.{}'\nset logscale xy\nset grid xtics ytics mxtics mytics\n"
         "set xlabel 'CPU time of the run (s)'\nset ylabel 'RMS distance at material points (m)'\n"
-        "set title \"{}\" noenhanced\nset key below left Left reverse maxrows 4 noenhanced\nset format y '%.0e'\n"
+        "set title \"{}\" noenhanced\nset key below left Left reverse maxrows 4 noenhanced\nset "
+        "format y '%.0e'\n"
         "plot {}\nunset output\n",
         terminal, stem, extension, title, plots);
   }
@@ -340,8 +349,9 @@ bool stage_plots(const std::vector<SceneResult>& scenes, const fs::path& work, c
   const fs::path plot_dir = work / "plots";
   fs::create_directories(plot_dir);
   if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) {
-    spdlog::warn("gnuplot is not installed: bench.csv is written, the plots are not "
-                 "(apt-get install gnuplot-nox, or run ./scripts/setup.sh)");
+    spdlog::warn(
+        "gnuplot is not installed: bench.csv is written, the plots are not "
+        "(apt-get install gnuplot-nox, or run ./scripts/setup.sh)");
     return false;
   }
   for (const SceneResult& s : scenes) {
@@ -351,8 +361,8 @@ bool stage_plots(const std::vector<SceneResult>& scenes, const fs::path& work, c
     const std::string script = plot_script(s, stem);
     write_file_atomically(plot_dir / (stem + ".dat"), data);
     write_file_atomically(plot_dir / (stem + ".gp"), script);
-    const std::string command = fmt::format("cd '{}' && gnuplot '{}.gp' > '{}.log' 2>&1",
-                                            plot_dir.string(), stem, stem);
+    const std::string command =
+        fmt::format("cd '{}' && gnuplot '{}.gp' > '{}.log' 2>&1", plot_dir.string(), stem, stem);
     if (std::system(command.c_str()) != 0) {
       spdlog::warn("gnuplot failed on {}.gp: {}", stem, last_line(plot_dir / (stem + ".log")));
       return false;
@@ -365,7 +375,8 @@ bool stage_plots(const std::vector<SceneResult>& scenes, const fs::path& work, c
   return true;
 }
 
-// --- the summary on stdout ------------------------------------------------------------------------
+// --- the summary on stdout
+// ------------------------------------------------------------------------
 
 std::string summary_table(const std::vector<SceneResult>& scenes, bool plots, const fs::path& dir) {
   std::string out;
@@ -399,13 +410,15 @@ std::string summary_table(const std::vector<SceneResult>& scenes, bool plots, co
     out += fmt::format("  * on the Pareto front (no run is both faster and more accurate)\n");
     out += fmt::format("  defaults: {}\n", s.defaults_note);
   }
-  out += fmt::format("\nwrote {}{}\n", (dir / "bench.csv").string(),
-                     plots ? fmt::format(" and the plots {}", (dir / "bench_<scene>.png|svg").string())
-                           : std::string(" (no plots: gnuplot missing)"));
+  out +=
+      fmt::format("\nwrote {}{}\n", (dir / "bench.csv").string(),
+                  plots ? fmt::format(" and the plots {}", (dir / "bench_<scene>.png|svg").string())
+                        : std::string(" (no plots: gnuplot missing)"));
   return out;
 }
 
-// --- the command ----------------------------------------------------------------------------------
+// --- the command
+// ----------------------------------------------------------------------------------
 
 void run_worker_side(const BenchOptions& options) {
   // A worker must not outlive the study (killed parent, Ctrl-C in another terminal).
@@ -448,7 +461,9 @@ void run_scaling_study(const BenchOptions& options, const GlobalOptions& global)
   std::string current;
   const std::vector<ScalingPoint> points = run_scaling(
       exe, o, work.path, [&](const std::string& line) { progress.update(done++, current = line); },
-      [&](double elapsed) { progress.update(done - 1, fmt::format("{} ({:.0f} s)", current, elapsed)); });
+      [&](double elapsed) {
+        progress.update(done - 1, fmt::format("{} ({:.0f} s)", current, elapsed));
+      });
   progress.finish();
   std::vector<ScalingFit> fits;
   nlohmann::json json = {{"format", "sketchdrape/1 bench scaling"},
@@ -458,14 +473,20 @@ void run_scaling_study(const BenchOptions& options, const GlobalOptions& global)
                          {"points", nlohmann::json::array()},
                          {"fits", nlohmann::json::array()}};
   for (const ScalingPoint& p : points)
-    json["points"].push_back({{"quads_per_side", p.quads_per_side}, {"solver", p.solver},
-                              {"vertices", p.vertices},           {"status", p.status},
-                              {"message", p.message},             {"steps", p.steps},
-                              {"step_s", p.step_s},               {"cpu_step_s", p.cpu_step_s},
+    json["points"].push_back({{"quads_per_side", p.quads_per_side},
+                              {"solver", p.solver},
+                              {"vertices", p.vertices},
+                              {"status", p.status},
+                              {"message", p.message},
+                              {"steps", p.steps},
+                              {"step_s", p.step_s},
+                              {"cpu_step_s", p.cpu_step_s},
                               {"solve_s", p.solve_s},
-                              {"forces_s", p.forces_s},           {"collision_s", p.collision_s},
+                              {"forces_s", p.forces_s},
+                              {"collision_s", p.collision_s},
                               {"cg_iterations_mean", p.cg_iterations_mean},
-                              {"process_cpu_s", p.process_cpu_s}, {"peak_rss_mb", p.peak_rss_mb}});
+                              {"process_cpu_s", p.process_cpu_s},
+                              {"peak_rss_mb", p.peak_rss_mb}});
   for (const std::string& solver : o.solvers) {
     fits.push_back(fit_scaling(solver, points));
     const ScalingFit& f = fits.back();
@@ -488,21 +509,25 @@ void run_scaling_study(const BenchOptions& options, const GlobalOptions& global)
     fmt::print("{}", table);
   for (const ScalingPoint& p : points)
     if (p.status != "ok")
-      throw std::runtime_error(fmt::format("the {0}×{0} sheet with {1} did not finish: {2} (the "
-                                           "other sizes were written)",
-                                           p.quads_per_side, p.solver, p.message));
+      throw std::runtime_error(
+          fmt::format("the {0}×{0} sheet with {1} did not finish: {2} (the "
+                      "other sizes were written)",
+                      p.quads_per_side, p.solver, p.message));
 }
 
 void run_bench(const BenchOptions& options, const GlobalOptions& global) {
   if (!options.worker_config.empty()) return run_worker_side(options);
   if (options.scaling) return run_scaling_study(options, global);
   const BenchGrid grid = parse_grid(options);
-  if (options.timeout < 0) throw std::invalid_argument("--timeout must be positive (seconds per run)");
-  const double timeout = options.timeout > 0 ? options.timeout
-                         : grid == BenchGrid::full ? 900.0 : 120.0;
+  if (options.timeout < 0)
+    throw std::invalid_argument("--timeout must be positive (seconds per run)");
+  const double timeout = options.timeout > 0       ? options.timeout
+                         : grid == BenchGrid::full ? 900.0
+                                                   : 120.0;
   std::vector<std::string> names = options.scenes;
   if (names.empty())
-    names = grid == BenchGrid::full ? builtin_bench_scenes() : std::vector<std::string>{"hanging-sheet"};
+    names = grid == BenchGrid::full ? builtin_bench_scenes()
+                                    : std::vector<std::string>{"hanging-sheet"};
 
   // Scenes first: a bad --scene fails before any run.
   std::vector<SceneResult> scenes;
@@ -545,14 +570,14 @@ void run_bench(const BenchOptions& options, const GlobalOptions& global) {
     if (!s.reference_cached) {
       spdlog::info("{}: computing the reference ({}), cached as {}", s.scene.name,
                    s.plan.reference.label(), cached.string());
-      s.reference = run_worker(exe, scene_arg, grid, s.plan.reference, work.path,
-                               s.scene.name + "-reference", 4 * timeout, progress, done,
-                               s.scene.name + " reference");
+      s.reference =
+          run_worker(exe, scene_arg, grid, s.plan.reference, work.path, s.scene.name + "-reference",
+                     4 * timeout, progress, done, s.scene.name + " reference");
       if (s.reference.status != "ok") {
         // Nothing to measure against: the scene's runs are skipped, the other scenes go on.
-        s.reference_failure = fmt::format("the reference run ({}) did not finish ({}): {}",
-                                          s.plan.reference.label(), s.reference.status,
-                                          s.reference.message);
+        s.reference_failure =
+            fmt::format("the reference run ({}) did not finish ({}): {}", s.plan.reference.label(),
+                        s.reference.status, s.reference.message);
         spdlog::error("{}: {}", s.scene.name, s.reference_failure);
         s.defaults_note = "not measured (no reference)";
         done += static_cast<long>(s.plan.runs.size()) + 1;
@@ -568,11 +593,13 @@ void run_bench(const BenchOptions& options, const GlobalOptions& global) {
       for (const BenchFamily& family : s.plan.families)
         for (const BenchConfig& member : family.members)
           if (member.id() == config.id()) row.families.push_back(family.name);
-      row.child = run_worker(exe, scene_arg, grid, config, work.path, s.scene.name + "-" + config.id(),
-                             timeout, progress, done, s.scene.name + " " + config.id());
+      row.child =
+          run_worker(exe, scene_arg, grid, config, work.path, s.scene.name + "-" + config.id(),
+                     timeout, progress, done, s.scene.name + " " + config.id());
       if (row.child.status == "ok") row.error = bench_error(row.child.trace, s.reference.trace);
       if (row.child.status != "ok")
-        spdlog::warn("{} {}: {} ({})", s.scene.name, config.label(), row.child.status, row.child.message);
+        spdlog::warn("{} {}: {} ({})", s.scene.name, config.label(), row.child.status,
+                     row.child.message);
       s.rows.push_back(std::move(row));
       progress.update(++done);
     }
@@ -627,8 +654,8 @@ void run_bench(const BenchOptions& options, const GlobalOptions& global) {
     fmt::print("{}", summary_table(scenes, plots, dir));
   for (const SceneResult& s : scenes)
     if (!s.reference_failure.empty())
-      throw std::runtime_error(fmt::format("{}: {} (the other scenes were written)", s.scene.name,
-                                           s.reference_failure));
+      throw std::runtime_error(
+          fmt::format("{}: {} (the other scenes were written)", s.scene.name, s.reference_failure));
 }
 
 }  // namespace
@@ -636,15 +663,19 @@ void run_bench(const BenchOptions& options, const GlobalOptions& global) {
 void add_bench_command(CLI::App& app, const GlobalOptions& global) {
   auto options = std::make_shared<BenchOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "bench", "Work-precision study: run time, memory and error against a fine reference for a "
-               "grid of simulator configurations; CSV, plots and a summary table");
-  cmd->add_flag("--quick", options->quick, "The quick grid (under two minutes): the hanging sheet only");
+      "bench",
+      "Work-precision study: run time, memory and error against a fine reference for a "
+      "grid of simulator configurations; CSV, plots and a summary table");
+  cmd->add_flag("--quick", options->quick,
+                "The quick grid (under two minutes): the hanging sheet only");
   cmd->add_option("--grid", options->grid, "tiny (seconds, for tests), quick or full (default)");
   cmd->add_option("--scene", options->scenes,
                   "hanging-sheet, sphere-drop, tshirt or a sketch file (sheet or garment); "
                   "repeat for several (default: all three, or the hanging sheet when quick)");
-  cmd->add_option("-o,--out", options->out, "Output directory (created if needed; default ./bench)");
-  cmd->add_flag("--json", options->json, "Print the results as one JSON object instead of the table");
+  cmd->add_option("-o,--out", options->out,
+                  "Output directory (created if needed; default ./bench)");
+  cmd->add_flag("--json", options->json,
+                "Print the results as one JSON object instead of the table");
   cmd->add_option("--cache", options->cache,
                   "Where references are cached (default ~/.cache/sketchdrape/bench)");
   cmd->add_option("--timeout", options->timeout,

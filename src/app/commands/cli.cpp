@@ -1,9 +1,8 @@
 #include "src/app/commands/cli.hpp"
 
+#include <fmt/format.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
-
-#include <fmt/format.h>
 
 #include <cmath>
 #include <exception>
@@ -90,8 +89,9 @@ int run_cli(int argc, char** argv) {
     spdlog::error("{}", e.what());
     return kExitBadInput;
   } catch (const std::bad_alloc&) {
-    spdlog::error("out of memory: the command needed more memory than the system could give it "
-                  "(run's --max-memory refuses such work before it starts)");
+    spdlog::error(
+        "out of memory: the command needed more memory than the system could give it "
+        "(run's --max-memory refuses such work before it starts)");
     return kExitFailure;
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());

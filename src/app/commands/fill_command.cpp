@@ -17,8 +17,8 @@
 
 #include "garment/sketch_ranges.hpp"
 #include "meshing/patch_fill.hpp"
-#include "src/app/pipeline/atomic_file.hpp"
 #include "src/app/commands/cli.hpp"
+#include "src/app/pipeline/atomic_file.hpp"
 #include "src/render/image.hpp"
 #include "src/render/previews.hpp"
 #include "src/render/renderer.hpp"
@@ -176,7 +176,8 @@ void run_fill(const FillOptions& options) {
       q.distortion, q.irregular_vertices, check.ok() ? "yes" : "no", q.min_angle_deg,
       q.max_angle_deg, q.max_aspect_ratio, q.scaled_jacobian_min, q.scaled_jacobian_mean,
       q.inverted_quads);
-  for (const auto& path : outputs.paths()) std::cout << "wrote               " << path.string() << "\n";
+  for (const auto& path : outputs.paths())
+    std::cout << "wrote               " << path.string() << "\n";
 }
 
 }  // namespace

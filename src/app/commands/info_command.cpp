@@ -3,8 +3,8 @@
 #include <fmt/format.h>
 
 #include <iostream>
-#include <optional>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "garment/body.hpp"
 #include "garment/body_landmarks.hpp"
@@ -50,7 +50,9 @@ void run_info(const InfoOptions& options) {
         {"facing", raw.facing.name()}}},
       {"normalisation", {{"scale", raw.scale}, {"scale_rule", raw.scale_rule}}},
       {"normalised",
-       {{"bounding_box", box_json(box)}, {"height_m", box.extent().y()}, {"up_axis", "+y"},
+       {{"bounding_box", box_json(box)},
+        {"height_m", box.extent().y()},
+        {"up_axis", "+y"},
         {"facing", "+z"}}},
       {"topology",
        {{"closed", topo.closed()},
@@ -94,10 +96,10 @@ void run_info(const InfoOptions& options) {
                           {"x", {o.min.x(), o.max.x()}},
                           {"z", {o.min.z(), o.max.z()}},
                           {"girth", o.girth}});
-      slice_text += fmt::format("  outline x {:.3f} .. {:.3f}, z {:.3f} .. {:.3f} m, centre ({:.3f}, "
-                                "{:.3f}), girth {:.3f} m\n",
-                                o.min.x(), o.max.x(), o.min.z(), o.max.z(), o.centroid.x(),
-                                o.centroid.z(), o.girth);
+      slice_text += fmt::format(
+          "  outline x {:.3f} .. {:.3f}, z {:.3f} .. {:.3f} m, centre ({:.3f}, "
+          "{:.3f}), girth {:.3f} m\n",
+          o.min.x(), o.max.x(), o.min.z(), o.max.z(), o.centroid.x(), o.centroid.z(), o.girth);
     }
     slices.push_back({{"y", y}, {"outlines", outlines}});
   }
@@ -117,17 +119,17 @@ void run_info(const InfoOptions& options) {
       "            bbox [{:.3f} {:.3f} {:.3f}] .. [{:.3f} {:.3f} {:.3f}] m\n"
       "topology    closed {}, edge-manifold {}, oriented {}, {} component(s), {} boundary "
       "edge(s), {} non-manifold edge(s), {} degenerate face(s)\n",
-      raw.source, body.mesh.vertex_count(), body.mesh.face_count(), raw.meshes,
-      b.extent().x(), b.extent().y(), b.extent().z(), b.min.x(), b.min.y(), b.min.z(),
-      b.max.x(), b.max.y(), b.max.z(), raw.up.name(), raw.up_inferred ? "inferred" : "given",
-      raw.facing.name(), raw.height, raw.scale, raw.scale_rule, box.extent().y(), box.min.x(),
-      box.min.y(), box.min.z(), box.max.x(), box.max.y(), box.max.z(),
-      topo.closed() ? "yes" : "no", topo.edge_manifold() ? "yes" : "no",
-      topo.oriented() ? "yes" : "no", topo.components, topo.boundary_edges,
-      topo.non_manifold_edges, topo.degenerate_faces);
+      raw.source, body.mesh.vertex_count(), body.mesh.face_count(), raw.meshes, b.extent().x(),
+      b.extent().y(), b.extent().z(), b.min.x(), b.min.y(), b.min.z(), b.max.x(), b.max.y(),
+      b.max.z(), raw.up.name(), raw.up_inferred ? "inferred" : "given", raw.facing.name(),
+      raw.height, raw.scale, raw.scale_rule, box.extent().y(), box.min.x(), box.min.y(),
+      box.min.z(), box.max.x(), box.max.y(), box.max.z(), topo.closed() ? "yes" : "no",
+      topo.edge_manifold() ? "yes" : "no", topo.oriented() ? "yes" : "no", topo.components,
+      topo.boundary_edges, topo.non_manifold_edges, topo.degenerate_faces);
   if (raw.flipped_inside_out)
-    std::cout << fmt::format("orientation inside out in the file (volume {:.4g} units³): faces flipped\n",
-                             raw.signed_volume);
+    std::cout << fmt::format(
+        "orientation inside out in the file (volume {:.4g} units³): faces flipped\n",
+        raw.signed_volume);
   for (const std::string& warning : body.warnings) std::cout << "warning     " << warning << "\n";
   std::cout << slice_text;
   if (!landmarks) {
@@ -138,9 +140,10 @@ void run_info(const InfoOptions& options) {
   for (const garment::Landmark& l : landmarks->points)
     std::cout << fmt::format("  {:<15} [{:7.3f} {:7.3f} {:7.3f}]\n", l.name, l.position.x(),
                              l.position.y(), l.position.z());
-  std::cout << fmt::format("girths      chest {:.3f} m, waist {:.3f} m, hips {:.3f} m (convex hull of "
-                           "the torso's slice)\n",
-                           landmarks->chest_girth, landmarks->waist_girth, landmarks->hip_girth);
+  std::cout << fmt::format(
+      "girths      chest {:.3f} m, waist {:.3f} m, hips {:.3f} m (convex hull of "
+      "the torso's slice)\n",
+      landmarks->chest_girth, landmarks->waist_girth, landmarks->hip_girth);
 }
 
 }  // namespace
@@ -151,10 +154,12 @@ void add_info_command(CLI::App& app, const GlobalOptions& /*global*/) {
       "info", "Describe a body mesh: size, up axis, topology, and how it will be normalised");
   cmd->add_option("BODY", options->body, "Body mesh file (any format assimp reads) or 'builtin'")
       ->required();
-  cmd->add_option("--up", options->up, "The file's up axis (x, y, z, -x, ...); inferred if omitted");
+  cmd->add_option("--up", options->up,
+                  "The file's up axis (x, y, z, -x, ...); inferred if omitted");
   cmd->add_option("--height", options->height, "Scale the body to this height in metres")
       ->check(finite_range(0.1, 5.0));
-  cmd->add_option("--scale", options->scale, "Metres per file unit")->check(finite_range(1e-9, 1e9));
+  cmd->add_option("--scale", options->scale, "Metres per file unit")
+      ->check(finite_range(1e-9, 1e9));
   cmd->add_flag("--json", options->json, "Print one JSON object instead of text");
   cmd->add_option("--slice", options->slices,
                   "Also print the body's outlines at this height (m, normalised frame; repeat for "

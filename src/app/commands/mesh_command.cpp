@@ -16,14 +16,14 @@
 #include "garment/sketch_file.hpp"
 #include "garment/sketch_inputs.hpp"
 #include "meshing/mesh48.hpp"
+#include "src/app/commands/cli.hpp"
 #include "src/app/pipeline/atomic_file.hpp"
 #include "src/app/pipeline/cloth_scene.hpp"
-#include "src/app/pipeline/sketch_checks.hpp"
-#include "src/app/commands/cli.hpp"
 #include "src/app/pipeline/mesh_export.hpp"
 #include "src/app/pipeline/pattern_export.hpp"
 #include "src/app/pipeline/preview_images.hpp"
 #include "src/app/pipeline/quality_warnings.hpp"
+#include "src/app/pipeline/sketch_checks.hpp"
 #include "src/render/previews.hpp"
 
 namespace sd::app {
@@ -80,7 +80,9 @@ void run_mesh(const MeshOptions& options) {
       check_run_fits(sketch, *estimate, RunLimits{}, 0);
     const ClothScene scene = build_cloth_scene(sketch);
     ExportMesh mesh{scene.input.rest_positions, scene.input.triangles, {}, {"sheet"}};
-    outputs.stage(dir / sketch.output.mesh, sketch.output.mesh.ends_with(".glb") ? to_glb(mesh, "sheet") : to_obj(mesh, "sheet"));
+    outputs.stage(dir / sketch.output.mesh, sketch.output.mesh.ends_with(".glb")
+                                                ? to_glb(mesh, "sheet")
+                                                : to_obj(mesh, "sheet"));
     report["sheet"] = {{"columns", sketch.sheet->columns}, {"rows", sketch.sheet->rows}};
     report["totals"] = {{"vertices", scene.input.rest_positions.rows()},
                         {"triangles", scene.input.triangles.rows()},
@@ -100,13 +102,16 @@ void run_mesh(const MeshOptions& options) {
       try {
         return meshing::Mesh48::from_triangles_sqrt3(tris, &stats);
       } catch (const meshing::Mesh48InputError& e) {
-        sketch.fail("/garment_mesh", fmt::format("the garment mesh cannot become a 4-8 mesh: {}", e.what()));
+        sketch.fail("/garment_mesh",
+                    fmt::format("the garment mesh cannot become a 4-8 mesh: {}", e.what()));
       }
     }();
     const std::vector<std::string> problems = m48.validate();
     if (!problems.empty()) throw std::runtime_error("4-8 mesh check failed: " + problems.front());
     ExportMesh mesh{tris.vertices, tris.faces, {}, {"garment"}};
-    outputs.stage(dir / sketch.output.mesh, sketch.output.mesh.ends_with(".glb") ? to_glb(mesh, "garment") : to_obj(mesh, "garment"));
+    outputs.stage(dir / sketch.output.mesh, sketch.output.mesh.ends_with(".glb")
+                                                ? to_glb(mesh, "garment")
+                                                : to_obj(mesh, "garment"));
     outputs.stage(dir / "garment48.obj", obj_48(m48, {}, {}));
     report["garment_mesh"] = sketch.resolve(*sketch.garment_mesh).string();
     report["totals"] = {{"vertices", tris.vertex_count()},
@@ -140,14 +145,18 @@ void run_mesh(const MeshOptions& options) {
     panel_group[p] = static_cast<int>(it - groups.begin());
   }
   ExportMesh quads{g.mesh.vertices, g.mesh.faces, {}, groups};
-  for (Eigen::Index f = 0; f < g.face_panel.size(); ++f) quads.face_groups.push_back(panel_group[static_cast<size_t>(g.face_panel(f))]);
-  outputs.stage(dir / sketch.output.mesh, sketch.output.mesh.ends_with(".glb") ? to_glb(quads, "garment") : to_obj(quads, "garment"));
+  for (Eigen::Index f = 0; f < g.face_panel.size(); ++f)
+    quads.face_groups.push_back(panel_group[static_cast<size_t>(g.face_panel(f))]);
+  outputs.stage(dir / sketch.output.mesh, sketch.output.mesh.ends_with(".glb")
+                                              ? to_glb(quads, "garment")
+                                              : to_obj(quads, "garment"));
 
   meshing::Mesh48 m48 = meshing::Mesh48::from_quads(g.mesh);
   const std::vector<std::string> problems = m48.validate();
   if (!problems.empty()) throw std::runtime_error("4-8 mesh check failed: " + problems.front());
   std::vector<int> block_group(static_cast<size_t>(g.mesh.face_count()));
-  for (Eigen::Index f = 0; f < g.mesh.face_count(); ++f) block_group[static_cast<size_t>(f)] = panel_group[static_cast<size_t>(g.face_panel(f))];
+  for (Eigen::Index f = 0; f < g.mesh.face_count(); ++f)
+    block_group[static_cast<size_t>(f)] = panel_group[static_cast<size_t>(g.face_panel(f))];
   outputs.stage(dir / "garment48.obj", obj_48(m48, block_group, groups));
 
   nlohmann::json panels = nlohmann::json::array();
@@ -176,18 +185,15 @@ void run_mesh(const MeshOptions& options) {
     area += p.area;
   }
   report["warnings"] = warnings_json(warnings);
-  report["body"] = {{"mesh", sketch.body.mesh}, {"source", body.raw.source}, {"triangles", body.mesh.face_count()}};
+  report["body"] = {{"mesh", sketch.body.mesh},
+                    {"source", body.raw.source},
+                    {"triangles", body.mesh.face_count()}};
   report["panels"] = panels;
-  report["totals"] = {{"panels", g.panels.size()},
-                      {"vertices", g.mesh.vertex_count()},
-                      {"quads", g.mesh.face_count()},
-                      {"triangles_48", m48.triangle_count()},
-                      {"seam_edges", g.seam_edges},
-                      {"curve_pieces", g.curve_pieces},
-                      {"parity_changes", g.parity_changes},
-                      {"distortion", distortion},
-                      {"irregular_vertices", irregular},
-                      {"area_m2", area}};
+  report["totals"] = {{"panels", g.panels.size()},          {"vertices", g.mesh.vertex_count()},
+                      {"quads", g.mesh.face_count()},       {"triangles_48", m48.triangle_count()},
+                      {"seam_edges", g.seam_edges},         {"curve_pieces", g.curve_pieces},
+                      {"parity_changes", g.parity_changes}, {"distortion", distortion},
+                      {"irregular_vertices", irregular},    {"area_m2", area}};
 
   // The flat sewing pattern, when the file asks for it.
   if (sketch.output.pattern) {
@@ -203,19 +209,24 @@ void run_mesh(const MeshOptions& options) {
     cloth.vertices = g.mesh.vertices;
     cloth.faces = render::triangulate_quads(g.mesh.faces);
     Eigen::VectorXi tri_panel(2 * g.face_panel.size());
-    for (Eigen::Index f = 0; f < g.face_panel.size(); ++f) tri_panel(2 * f) = tri_panel(2 * f + 1) = g.face_panel(f);
+    for (Eigen::Index f = 0; f < g.face_panel.size(); ++f)
+      tri_panel(2 * f) = tri_panel(2 * f + 1) = g.face_panel(f);
     const PreviewCloth preview{cloth, tri_panel, render::quad_edges(g.mesh.faces), {}};
     stage_preview_images(sketch.output.images, sketch.output.wireframe, &body.mesh, preview,
                          "garment", dir, outputs);
   }
-  report["timing_ms"] = {{"body", body_ms}, {"meshing", mesh_ms}, {"images", ms_since(image_start)}, {"total", ms_since(start)}};
+  report["timing_ms"] = {{"body", body_ms},
+                         {"meshing", mesh_ms},
+                         {"images", ms_since(image_start)},
+                         {"total", ms_since(start)}};
   if (sketch.output.report) outputs.stage(dir / "report.json", report.dump(2) + "\n");
   outputs.commit();
-  spdlog::info("meshed {} → {}: {} panels, {} quads, distortion {} ({:.0f} ms meshing)", sketch.file,
-               dir.string(), g.panels.size(), g.mesh.face_count(), distortion, mesh_ms);
+  spdlog::info("meshed {} → {}: {} panels, {} quads, distortion {} ({:.0f} ms meshing)",
+               sketch.file, dir.string(), g.panels.size(), g.mesh.face_count(), distortion,
+               mesh_ms);
   if (options.strict && !warnings.empty())
-    throw std::runtime_error(fmt::format("{}: {} mesh quality warning(s) and --strict", sketch.file,
-                                         warnings.size()));
+    throw std::runtime_error(
+        fmt::format("{}: {} mesh quality warning(s) and --strict", sketch.file, warnings.size()));
 }
 
 }  // namespace
@@ -223,8 +234,9 @@ void run_mesh(const MeshOptions& options) {
 void add_mesh_command(CLI::App& app, const GlobalOptions& /*global*/) {
   auto options = std::make_shared<MeshOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "mesh", "Mesh a sketch file's panels into one stitched garment (quad and 4-8 meshes, report, "
-              "images); no simulation");
+      "mesh",
+      "Mesh a sketch file's panels into one stitched garment (quad and 4-8 meshes, report, "
+      "images); no simulation");
   cmd->add_option("SKETCH", options->sketch, "Sketch file (format sketchdrape/1)")->required();
   cmd->add_option("-o,--out", options->out, "Output directory (created if needed)");
   cmd->add_flag("--strict", options->strict,

@@ -26,8 +26,8 @@
 #include "garment/body_landmarks.hpp"
 #include "garment/input_checks.hpp"
 #include "garment/sketch_ranges.hpp"
-#include "src/app/pipeline/atomic_file.hpp"
 #include "src/app/commands/cli.hpp"
+#include "src/app/pipeline/atomic_file.hpp"
 #include "src/app/pipeline/progress.hpp"
 #include "src/render/camera.hpp"
 #include "src/render/image.hpp"
@@ -63,7 +63,8 @@ render::SceneMesh landmark_markers(const meshing::TriMesh& body) {
   constexpr double kRadius = 0.015;
   const int corners[8][3] = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
                              {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
-  const Eigen::Vector3d axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 0, 1}, {0, 0, -1}, {0, 1, 0}, {0, -1, 0}};
+  const Eigen::Vector3d axes[6] = {{1, 0, 0},  {-1, 0, 0}, {0, 0, 1},
+                                   {0, 0, -1}, {0, 1, 0},  {0, -1, 0}};
   render::SceneMesh markers;
   const auto n = static_cast<Eigen::Index>(landmarks.points.size());
   markers.mesh.vertices.resize(6 * n, 3);
@@ -160,9 +161,9 @@ bool names_png_file(const std::string& path) {
 }
 
 struct ViewJob {
-  std::string name;                    // file stem: a view name or "custom"
+  std::string name;  // file stem: a view name or "custom"
   std::optional<render::ViewName> preset;
-  render::Camera camera;               // used when preset is empty
+  render::Camera camera;  // used when preset is empty
 };
 
 void run_render(const RenderOptions& options, const GlobalOptions& global) {
@@ -263,7 +264,8 @@ void add_render_command(CLI::App& app, const GlobalOptions& global) {
                   "front)");
   cmd->add_option("--size", options->size, "Image size WIDTHxHEIGHT in pixels")
       ->capture_default_str();
-  cmd->add_option("--eye", options->eye, "Explicit camera position X,Y,Z (metres); adds view 'custom'")
+  cmd->add_option("--eye", options->eye,
+                  "Explicit camera position X,Y,Z (metres); adds view 'custom'")
       ->check(finite_range(-1000, 1000))
       ->expected(3)
       ->delimiter(',');

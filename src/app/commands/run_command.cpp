@@ -13,8 +13,8 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
-#include "garment/sketch_file.hpp"
 #include "garment/body_landmarks.hpp"
+#include "garment/sketch_file.hpp"
 #include "meshing/slice_dent.hpp"
 #include "sim/adaptive_detail.hpp"
 #include "sim/cloth_driver.hpp"
@@ -23,9 +23,9 @@
 #include "src/app/pipeline/cloth_scene.hpp"
 #include "src/app/pipeline/mesh_export.hpp"
 #include "src/app/pipeline/pattern_export.hpp"
-#include "src/app/pipeline/self_intersections.hpp"
 #include "src/app/pipeline/preview_images.hpp"
 #include "src/app/pipeline/progress.hpp"
+#include "src/app/pipeline/self_intersections.hpp"
 #include "src/app/pipeline/sketch_checks.hpp"
 #include "src/render/scene.hpp"
 
@@ -71,9 +71,10 @@ std::vector<garment::ImageSpec> run_images(const garment::Sketch& sketch) {
 }
 
 nlohmann::json energy_json(const std::vector<sim::EnergySample>& samples) {
-  nlohmann::json series = {{"time", nlohmann::json::array()},    {"stretch", nlohmann::json::array()},
-                           {"shear", nlohmann::json::array()},   {"bend", nlohmann::json::array()},
-                           {"kinetic", nlohmann::json::array()}, {"potential", nlohmann::json::array()}};
+  nlohmann::json series = {
+      {"time", nlohmann::json::array()},    {"stretch", nlohmann::json::array()},
+      {"shear", nlohmann::json::array()},   {"bend", nlohmann::json::array()},
+      {"kinetic", nlohmann::json::array()}, {"potential", nlohmann::json::array()}};
   for (const sim::EnergySample& s : samples) {
     series["time"].push_back(s.time);
     series["stretch"].push_back(s.stretch);
@@ -218,8 +219,10 @@ sim::AdaptiveSettings adaptive_settings(const garment::Sketch& sketch) {
 
 // Per accepted step: time, splits (requested and forced), merges and particles after it.
 nlohmann::json adaptive_steps_json(const std::vector<sim::AdaptiveStepRecord>& steps) {
-  nlohmann::json out = {{"time", nlohmann::json::array()}, {"splits", nlohmann::json::array()},
-                        {"merges", nlohmann::json::array()}, {"vertices", nlohmann::json::array()}};
+  nlohmann::json out = {{"time", nlohmann::json::array()},
+                        {"splits", nlohmann::json::array()},
+                        {"merges", nlohmann::json::array()},
+                        {"vertices", nlohmann::json::array()}};
   for (const sim::AdaptiveStepRecord& step : steps) {
     out["time"].push_back(step.time);
     out["splits"].push_back(step.splits + step.forced_splits);
@@ -231,7 +234,8 @@ nlohmann::json adaptive_steps_json(const std::vector<sim::AdaptiveStepRecord>& s
 
 // "1.2 GB", or "74 MB" below a gigabyte (where one decimal of GB says too little).
 std::string memory_text(double bytes) {
-  return bytes >= 1e9 ? fmt::format("{:.1f} GB", bytes / 1e9) : fmt::format("{:.0f} MB", bytes / 1e6);
+  return bytes >= 1e9 ? fmt::format("{:.1f} GB", bytes / 1e9)
+                      : fmt::format("{:.0f} MB", bytes / 1e6);
 }
 
 void run_drape(const RunOptions& options, const GlobalOptions& global) {
@@ -257,21 +261,24 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
       estimate.vertices, estimate.memory_bytes / 1e9, estimate.factor_bytes / 1e9, estimate.steps,
       estimate.seconds, estimate.frames);
   if (!limits.max_time_s && estimate.seconds > 3600)
-    spdlog::warn("this drape may take up to about {:.1f} h ({:.0f} steps on {:.0f} vertices, by "
-                 "the estimate); --max-time SECONDS stops it",
-                 estimate.seconds / 3600, estimate.steps, estimate.vertices);
+    spdlog::warn(
+        "this drape may take up to about {:.1f} h ({:.0f} steps on {:.0f} vertices, by "
+        "the estimate); --max-time SECONDS stops it",
+        estimate.seconds / 3600, estimate.steps, estimate.vertices);
   if (scene.pinned.empty() && !scene.body)
     spdlog::warn("nothing holds the cloth (no pins, no body): it will fall for the whole run");
 
   const std::filesystem::path dir(options.out);
   StagedOutputs outputs;
   std::string trace;
-  Progress progress("draping", static_cast<long>(std::ceil(settings.duration * 1000)), global.quiet);
+  Progress progress("draping", static_cast<long>(std::ceil(settings.duration * 1000)),
+                    global.quiet);
   // Called after every accepted step, by either driver.
   // Adaptive detail can grow the cloth past the estimate: the budget is also checked as it runs.
   const double memory_budget = memory_budget_bytes(limits);
   const auto on_step = [&](const sim::Simulation& s) {
-    if (const double resident = resident_memory_bytes(); memory_budget > 0 && resident > memory_budget)
+    if (const double resident = resident_memory_bytes();
+        memory_budget > 0 && resident > memory_budget)
       throw RunLimitExceeded(fmt::format(
           "stopped at t = {:.3f} s of the drape: it uses {} with {} vertices, more than "
           "the {} it may take (--max-memory); limit adaptive detail with "
@@ -285,12 +292,18 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
     progress.update(static_cast<long>(s.time() * 1000), fmt::format("t = {:.2f} s", s.time()));
     if (!options.trace) return;
     const sim::SimulationReport& r = s.report();
-    nlohmann::json line = {{"step", r.steps}, {"time", s.time()}, {"dt", s.current_dt()},
-                           {"retries", r.retries}, {"vertices", s.model().vertex_count}};
+    nlohmann::json line = {{"step", r.steps},
+                           {"time", s.time()},
+                           {"dt", s.current_dt()},
+                           {"retries", r.retries},
+                           {"vertices", s.model().vertex_count}};
     if (!r.energy.empty()) {
       const sim::EnergySample& e = r.energy.back();
-      line["energy"] = {{"stretch", e.stretch}, {"shear", e.shear}, {"bend", e.bend},
-                        {"kinetic", e.kinetic}, {"potential", e.potential}};
+      line["energy"] = {{"stretch", e.stretch},
+                        {"shear", e.shear},
+                        {"bend", e.bend},
+                        {"kinetic", e.kinetic},
+                        {"potential", e.potential}};
     }
     trace += line.dump() + "\n";
   };
@@ -318,15 +331,15 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   nlohmann::json strain = nullptr;
   const bool flat_rest = scene.input.rest_uv.rows() > 0;
   if (flat_rest && sketch.simulate.adaptive)
-    spdlog::warn("\"rest\": \"flat\" drapes on the fixed mesh: adaptive detail does not yet carry "
-                 "pattern rest shapes through its splits (docs/pattern.md)");
+    spdlog::warn(
+        "\"rest\": \"flat\" drapes on the fixed mesh: adaptive detail does not yet carry "
+        "pattern rest shapes through its splits (docs/pattern.md)");
   try {
     // A garment adapts unless the file says "adaptive": false; a sheet only when it asks.
-    const bool adaptive = sketch.simulate.adaptive &&
-                          (!sketch.sheet || sketch.simulate.adaptive_given) && !flat_rest;
-    sim::ClothDriver driver =
-        scene_driver(scene, settings,
-                     adaptive ? std::optional(adaptive_settings(sketch)) : std::nullopt);
+    const bool adaptive =
+        sketch.simulate.adaptive && (!sketch.sheet || sketch.simulate.adaptive_given) && !flat_rest;
+    sim::ClothDriver driver = scene_driver(
+        scene, settings, adaptive ? std::optional(adaptive_settings(sketch)) : std::nullopt);
     // Contacts and friction (through every split and merge), with the body still or moving.
     if (scene.body_motion)
       driver.set_body_motion(*scene.body_motion);
@@ -377,8 +390,9 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
     // four sides (the place may face any way).
     const int v = report.failure_vertex;
     const bool located = v >= 0 && v < draped.vertices.rows();
-    const Eigen::Vector3d where = located ? Eigen::Vector3d(draped.vertices.row(v).transpose())
-                                          : Eigen::Vector3d(draped.vertices.colwise().mean().transpose());
+    const Eigen::Vector3d where =
+        located ? Eigen::Vector3d(draped.vertices.row(v).transpose())
+                : Eigen::Vector3d(draped.vertices.colwise().mean().transpose());
     std::string panel = "?", landmark;
     for (Eigen::Index t = 0; t < draped.faces.rows() && located && panel == "?"; ++t)
       for (int k = 0; k < 3; ++k)
@@ -394,12 +408,14 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
     }
     meshing::TriMesh marked = draped;
     Eigen::VectorXi marked_group(draped.faces.rows() + 8);
-    marked_group << triangle_group, Eigen::VectorXi::Constant(8, static_cast<int>(scene.group_names.size()));
+    marked_group << triangle_group,
+        Eigen::VectorXi::Constant(8, static_cast<int>(scene.group_names.size()));
     const Eigen::Index base = marked.vertices.rows();
     marked.vertices.conservativeResize(base + 6, 3);
     marked.faces.conservativeResize(marked.faces.rows() + 8, 3);
     const double r = 0.025;
-    const Eigen::Vector3d axes[6] = {{r, 0, 0}, {-r, 0, 0}, {0, 0, r}, {0, 0, -r}, {0, r, 0}, {0, -r, 0}};
+    const Eigen::Vector3d axes[6] = {{r, 0, 0},  {-r, 0, 0}, {0, 0, r},
+                                     {0, 0, -r}, {0, r, 0},  {0, -r, 0}};
     for (int k = 0; k < 6; ++k) marked.vertices.row(base + k) = (where + axes[k]).transpose();
     const int corners[8][3] = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
                                {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
@@ -435,10 +451,10 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   }
 
   // The draped cloth, one group per panel.
-  const ExportMesh mesh{draped.vertices, draped.faces,
-                        std::vector<int>(triangle_group.data(),
-                                         triangle_group.data() + triangle_group.size()),
-                        scene.group_names};
+  const ExportMesh mesh{
+      draped.vertices, draped.faces,
+      std::vector<int>(triangle_group.data(), triangle_group.data() + triangle_group.size()),
+      scene.group_names};
   outputs.stage(dir / "drape.glb", to_glb(mesh, "drape"));
   outputs.stage(dir / "drape.obj", to_obj(mesh, "drape"));
 
@@ -486,9 +502,11 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   if (scene.garment) {
     // How deep the draped cloth dents between supports (a skirt pulled between the legs).
     const meshing::SliceDent dent = meshing::slice_dent(draped);
-    out["slice_dent"] = {{"depth_m", dent.depth}, {"height_m", dent.height},
+    out["slice_dent"] = {{"depth_m", dent.depth},
+                         {"height_m", dent.height},
                          {"where", {dent.where.x(), dent.where.y(), dent.where.z()}},
-                         {"from_fraction", 0.1}, {"to_fraction", 0.6}};
+                         {"from_fraction", 0.1},
+                         {"to_fraction", 0.6}};
   }
   out["images"] = images;
   out["frames"] = frames.size();
@@ -520,8 +538,9 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
 void add_run_command(CLI::App& app, const GlobalOptions& global) {
   auto options = std::make_shared<RunOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "run", "Drape a sketch's garment (or sheet) with the cloth simulator: draped mesh, report, "
-             "images");
+      "run",
+      "Drape a sketch's garment (or sheet) with the cloth simulator: draped mesh, report, "
+      "images");
   cmd->add_option("SKETCH", options->sketch, "Sketch file (format sketchdrape/1)")->required();
   cmd->add_option("-o,--out", options->out, "Output directory (created if needed)");
   cmd->add_flag("--trace", options->trace, "Also write trace.jsonl: one JSON line per step");

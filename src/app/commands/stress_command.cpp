@@ -1,6 +1,6 @@
 // `sketchdrape stress [--quick] [-o DIR | --json] [--case TEXT]... [--min-dt S] [--list]`: runs
-// the matrix of hostile conditions (src/app/stress/stress_cases.hpp) through the simulator, prints a
-// table, writes stress.json, and exits 1 when any case diverged (docs/stress.md).
+// the matrix of hostile conditions (src/app/stress/stress_cases.hpp) through the simulator, prints
+// a table, writes stress.json, and exits 1 when any case diverged (docs/stress.md).
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -13,8 +13,8 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
-#include "src/app/pipeline/atomic_file.hpp"
 #include "src/app/commands/cli.hpp"
+#include "src/app/pipeline/atomic_file.hpp"
 #include "src/app/pipeline/progress.hpp"
 #include "src/app/stress/stress_runner.hpp"
 #include "src/app/version.hpp"
@@ -40,9 +40,9 @@ std::vector<StressCase> selected_cases(const StressCommandOptions& options) {
                     [&](const std::string& text) { return c.id.find(text) != std::string::npos; }))
       chosen.push_back(std::move(c));
   if (chosen.empty())
-    throw std::invalid_argument(fmt::format(
-        "no stress case id contains {}; `sketchdrape stress --list{}` prints them",
-        fmt::join(options.cases, " or "), options.quick ? " --quick" : ""));
+    throw std::invalid_argument(
+        fmt::format("no stress case id contains {}; `sketchdrape stress --list{}` prints them",
+                    fmt::join(options.cases, " or "), options.quick ? " --quick" : ""));
   return chosen;
 }
 
@@ -89,7 +89,8 @@ void run_stress(const StressCommandOptions& options, const GlobalOptions& global
   if (options.min_dt < 0.0 || !std::isfinite(options.min_dt))
     throw std::invalid_argument("--min-dt must be a positive number of seconds");
   if (options.json && !options.out.empty())
-    throw std::invalid_argument("give either -o DIR (writes DIR/stress.json) or --json (stdout), not both");
+    throw std::invalid_argument(
+        "give either -o DIR (writes DIR/stress.json) or --json (stdout), not both");
   const std::vector<StressCase> cases = selected_cases(options);
   if (options.list) {
     for (const StressCase& c : cases)
@@ -139,16 +140,17 @@ void run_stress(const StressCommandOptions& options, const GlobalOptions& global
     wall += r.wall_time_s;
     if (!r.ok) bad.push_back(r.id);
   }
-  nlohmann::json out = {{"format", "sketchdrape/1 stress report"},
-                        {"version", kVersion},
-                        {"matrix", options.quick ? "quick" : "full"},
-                        {"selection", options.cases},
-                        {"min_dt_override", options.min_dt > 0.0 ? nlohmann::json(options.min_dt) : nullptr},
-                        {"bounds", bounds_json()},
-                        {"counts", counts},
-                        {"diverged", bad},
-                        {"wall_time_s", wall},
-                        {"cases", nlohmann::json::array()}};
+  nlohmann::json out = {
+      {"format", "sketchdrape/1 stress report"},
+      {"version", kVersion},
+      {"matrix", options.quick ? "quick" : "full"},
+      {"selection", options.cases},
+      {"min_dt_override", options.min_dt > 0.0 ? nlohmann::json(options.min_dt) : nullptr},
+      {"bounds", bounds_json()},
+      {"counts", counts},
+      {"diverged", bad},
+      {"wall_time_s", wall},
+      {"cases", nlohmann::json::array()}};
   for (const StressResult& r : results) out["cases"].push_back(stress_result_json(r));
 
   if (options.json) {
@@ -165,7 +167,8 @@ void run_stress(const StressCommandOptions& options, const GlobalOptions& global
   const std::string summary = fmt::format("{} of {} stress cases held ({:.1f} s)",
                                           results.size() - bad.size(), results.size(), wall);
   if (!bad.empty())
-    throw std::runtime_error(fmt::format("{}; diverged or failed: {}", summary, fmt::join(bad, ", ")));
+    throw std::runtime_error(
+        fmt::format("{}; diverged or failed: {}", summary, fmt::join(bad, ", ")));
   spdlog::info("{}", summary);
 }
 
@@ -174,8 +177,9 @@ void run_stress(const StressCommandOptions& options, const GlobalOptions& global
 void add_stress_command(CLI::App& app, const GlobalOptions& global) {
   auto options = std::make_shared<StressCommandOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "stress", "Run the simulator through a matrix of hostile conditions; exit 1 if any case "
-                "diverges (docs/stress.md)");
+      "stress",
+      "Run the simulator through a matrix of hostile conditions; exit 1 if any case "
+      "diverges (docs/stress.md)");
   cmd->add_flag("--quick", options->quick, "The reduced matrix CI runs (under a minute)");
   cmd->add_option("-o,--out", options->out, "Write DIR/stress.json");
   cmd->add_flag("--json", options->json, "Print the JSON report on stdout instead of the table");

@@ -44,13 +44,12 @@ void run_validate(const ValidateOptions& options) {
   }
   std::vector<garment::QualityWarning> warnings;
   if (scene.garment && scene.body) warnings = quality_warnings(*scene.garment, sketch, *scene.body);
-  std::cout << fmt::format("{}: ok ({}, fabric {}){}\n", sketch.file, what, scene.fabric_name,
-                           warnings.empty()
-                               ? ""
-                               : fmt::format("; {} mesh quality warning(s)", warnings.size()));
+  std::cout << fmt::format(
+      "{}: ok ({}, fabric {}){}\n", sketch.file, what, scene.fabric_name,
+      warnings.empty() ? "" : fmt::format("; {} mesh quality warning(s)", warnings.size()));
   if (options.strict && !warnings.empty())
-    throw std::runtime_error(fmt::format("{}: {} mesh quality warning(s) and --strict", sketch.file,
-                                         warnings.size()));
+    throw std::runtime_error(
+        fmt::format("{}: {} mesh quality warning(s) and --strict", sketch.file, warnings.size()));
 }
 
 }  // namespace
@@ -58,8 +57,9 @@ void run_validate(const ValidateOptions& options) {
 void add_validate_command(CLI::App& app, const GlobalOptions& /*global*/) {
   auto options = std::make_shared<ValidateOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "validate", "Check a sketch file (fields, body, curves on the body, panels, edge counts); "
-                  "writes nothing");
+      "validate",
+      "Check a sketch file (fields, body, curves on the body, panels, edge counts); "
+      "writes nothing");
   cmd->add_option("SKETCH", options->sketch, "Sketch file (format sketchdrape/1)")->required();
   cmd->add_flag("--strict", options->strict, "Exit with code 1 when the quality gate warns");
   cmd->callback([options] { run_validate(*options); });

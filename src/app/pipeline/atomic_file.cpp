@@ -195,7 +195,8 @@ void StagedOutputs::stage(const std::filesystem::path& path, std::string_view by
       missing.push_back(d);
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);
-    if (ec) throw std::runtime_error("cannot create folder '" + dir.string() + "': " + ec.message());
+    if (ec)
+      throw std::runtime_error("cannot create folder '" + dir.string() + "': " + ec.message());
     created_dirs_.insert(created_dirs_.end(), missing.rbegin(), missing.rend());
     for (auto it = missing.rbegin(); it != missing.rend(); ++it)
       held_dirs_.push_back(hold(g_dir_slots, *it));
@@ -212,8 +213,7 @@ void StagedOutputs::commit() {
   for (size_t i = 0; i < temps_.size(); ++i) {
     std::error_code ec;
     std::filesystem::rename(temps_[i], finals_[i], ec);
-    if (ec)
-      throw std::runtime_error("cannot write '" + finals_[i].string() + "': " + ec.message());
+    if (ec) throw std::runtime_error("cannot write '" + finals_[i].string() + "': " + ec.message());
   }
   committed_ = true;
   for (const char* held : held_) release(g_temp_slots, held);

@@ -3,12 +3,11 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
 #include <limits>
 #include <numbers>
-
-#include <Eigen/Geometry>
 
 #include "garment/body_surface.hpp"
 #include "garment/material_frames.hpp"
@@ -36,8 +35,9 @@ sim::FabricParameters fabric_at(const garment::Sketch& sketch, const std::string
     return sim::fabric_preset(name);
   } catch (const sim::UnknownFabricError& e) {
     if (name.size() < 5 || name.substr(name.size() - 5) != ".json")
-      sketch.fail(json_path, std::string(e.what()) + "; or give a fabric file (.json) or the "
-                                                      "fabric's constants as an object");
+      sketch.fail(json_path, std::string(e.what()) +
+                                 "; or give a fabric file (.json) or the "
+                                 "fabric's constants as an object");
   }
   try {
     return sim::load_fabric_file(sketch.resolve(name).string());
@@ -51,7 +51,8 @@ void pin_above(const garment::Sketch& sketch, ClothScene& scene) {
   if (!sketch.simulate.pin_above) return;
   const std::size_t before = scene.pinned.size();  // a sheet's named pins come first
   for (Eigen::Index v = 0; v < scene.start.rows(); ++v)
-    if (scene.start(v, 1) >= *sketch.simulate.pin_above) scene.pinned.push_back(static_cast<int>(v));
+    if (scene.start(v, 1) >= *sketch.simulate.pin_above)
+      scene.pinned.push_back(static_cast<int>(v));
   if (scene.pinned.size() == before)
     sketch.fail("/simulate/pin_above",
                 fmt::format("no garment vertex lies at or above {} m (the garment's top is at "
@@ -91,10 +92,9 @@ void build_sheet_scene(const garment::Sketch& sketch, ClothScene& scene) {
     Eigen::MatrixX3d layered_warp(nq * spec.layers, 3);
     scene.face_group.resize(nq * spec.layers);
     for (int k = 0; k < spec.layers; ++k) {
-      const Eigen::Matrix3d turn =
-          Eigen::AngleAxisd(k * spec.layer_turn * std::numbers::pi / 180.0,
-                            Eigen::Vector3d::UnitY())
-              .toRotationMatrix();
+      const Eigen::Matrix3d turn = Eigen::AngleAxisd(k * spec.layer_turn * std::numbers::pi / 180.0,
+                                                     Eigen::Vector3d::UnitY())
+                                       .toRotationMatrix();
       for (Eigen::Index i = 0; i < nv; ++i)
         layered.rest_positions.row(k * nv + i) =
             (turn * (scene.input.rest_positions.row(i).transpose() - spec.centre) + spec.centre +
@@ -131,7 +131,8 @@ void build_sheet_scene(const garment::Sketch& sketch, ClothScene& scene) {
   scene.pinned.erase(std::unique(scene.pinned.begin(), scene.pinned.end()), scene.pinned.end());
   scene.fabric_name = sketch.fabric;
   scene.fabric = fabric_at(sketch, sketch.fabric, "/fabric");
-  scene.bend_model = sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::hinges);
+  scene.bend_model =
+      sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::hinges);
 }
 
 // "rest": "flat" (the file's or a panel's): the flattened pattern pieces become the rest shape.
@@ -207,15 +208,17 @@ void build_garment_scene(const garment::Sketch& sketch, ClothScene& scene) {
   // One fabric per simulation for now: the first panel's; others are reported if different.
   const garment::GarmentPanel& first = g.panels.front();
   scene.fabric_name = first.fabric;
-  scene.bend_model = sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::hinges);
+  scene.bend_model =
+      sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::hinges);
   const garment::PanelSpec* first_spec = sketch.find_panel(first.id);
-  scene.fabric = fabric_at(sketch, first.fabric,
-                           first_spec ? first_spec->json_path + "/fabric" : "/fabric");
+  scene.fabric =
+      fabric_at(sketch, first.fabric, first_spec ? first_spec->json_path + "/fabric" : "/fabric");
   for (const garment::GarmentPanel& p : g.panels)
     if (p.fabric != first.fabric)
-      spdlog::warn("panel '{}' asks for fabric '{}'; this version simulates a garment in one fabric "
-                   "and uses '{}' (panel '{}') throughout",
-                   p.id, p.fabric, first.fabric, first.id);
+      spdlog::warn(
+          "panel '{}' asks for fabric '{}'; this version simulates a garment in one fabric "
+          "and uses '{}' (panel '{}') throughout",
+          p.id, p.fabric, first.fabric, first.id);
 
   meshing::Mesh48 m48 = meshing::Mesh48::from_quads(g.mesh);
   const std::vector<std::string> problems = m48.validate();
@@ -284,7 +287,8 @@ void build_imported_scene(const garment::Sketch& sketch, ClothScene& scene) {
   scene.group_names = {"garment"};
   scene.fabric_name = sketch.fabric;
   scene.fabric = fabric_at(sketch, sketch.fabric, "/fabric");
-  scene.bend_model = sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::hinges);
+  scene.bend_model =
+      sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::hinges);
   pin_above(sketch, scene);
   scene.mesh48 = std::move(m48);
 }

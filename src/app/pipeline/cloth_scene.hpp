@@ -12,10 +12,10 @@
 #include "garment/panel_flattening.hpp"
 #include "garment/sketch_file.hpp"
 #include "meshing/mesh48.hpp"
-#include "sim/cloth_model.hpp"
-#include "sim/fabric.hpp"
 #include "sim/body_motion.hpp"
 #include "sim/cloth_driver.hpp"
+#include "sim/cloth_model.hpp"
+#include "sim/fabric.hpp"
 #include "sim/simulation.hpp"
 
 namespace sd::app {
@@ -28,26 +28,26 @@ struct ClothScene {
   // (optional only because a Mesh48 is made by its factories).
   std::optional<meshing::Mesh48> mesh48;
   // Per input face of mesh48:
-  Eigen::VectorXi face_group;          // group (panel or join; a sheet's layer), into group_names
-  Eigen::VectorXd face_ease;           // the panel's `ease` (rest shape scale); empty: all 1
-  Eigen::MatrixX3d face_warp;          // warp direction; empty: the in-plane one closest to +Y
+  Eigen::VectorXi face_group;  // group (panel or join; a sheet's layer), into group_names
+  Eigen::VectorXd face_ease;   // the panel's `ease` (rest shape scale); empty: all 1
+  Eigen::MatrixX3d face_warp;  // warp direction; empty: the in-plane one closest to +Y
   // The fixed mesh as simulator input (rest shape, triangles, per-triangle warp and, with
   // "rest": "flat", rest_uv): mesh48's level-0 triangles, except for a sheet, whose own
   // triangles alternate their diagonals (mesh48 splits every square quad along the same one;
   // see scene_driver).
   sim::ClothInput input;
-  Eigen::VectorXi triangle_face;       // #F of input: the input face each triangle lies in
+  Eigen::VectorXi triangle_face;  // #F of input: the input face each triangle lies in
   bool sheet = false;
-  Eigen::MatrixX3d start;              // #V by 3 start positions, metres
-  std::vector<int> pinned;             // vertex indices held in place
+  Eigen::MatrixX3d start;   // #V by 3 start positions, metres
+  std::vector<int> pinned;  // vertex indices held in place
   std::string fabric_name;
   sim::FabricParameters fabric;
-  std::optional<garment::Body> body;   // absent for a sheet without a body
+  std::optional<garment::Body> body;  // absent for a sheet without a body
   // The body's poses over the drape ("body": {"motion": ...}); absent for a still body.
   std::optional<sim::PoseSequence> body_motion;
   std::optional<garment::Garment> garment;
   std::vector<std::string> group_names;
-  double meshing_ms = 0;               // time spent building the garment
+  double meshing_ms = 0;  // time spent building the garment
   // The garment's flattened panels when a panel drapes from flat cloth ("rest": "flat"); then
   // input.rest_uv holds every triangle's rest coordinates (the pattern piece's triangle for flat
   // panels, the drawn triangle for shaped ones) and the hinges rest flat when all panels are flat.

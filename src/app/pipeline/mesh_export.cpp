@@ -49,7 +49,8 @@ std::string to_obj(const ExportMesh& mesh, const std::string& object_name) {
     for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f) {
       if (group_of(mesh, f) != g) continue;
       out += "f";
-      for (Eigen::Index k = 0; k < mesh.faces.cols(); ++k) out += fmt::format(" {}", mesh.faces(f, k) + 1);
+      for (Eigen::Index k = 0; k < mesh.faces.cols(); ++k)
+        out += fmt::format(" {}", mesh.faces(f, k) + 1);
       out += "\n";
     }
   }

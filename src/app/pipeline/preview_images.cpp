@@ -18,8 +18,9 @@ render::Scene preview_scene(const meshing::TriMesh* body, const PreviewCloth& cl
     render::SceneMesh& c = scene.meshes.emplace_back();
     c.mesh = cloth.mesh;
     c.role = render::MeshRole::kCloth;
-    c.face_colours = render::panel_colours(
-        cloth.face_panel.size() ? cloth.face_panel : Eigen::VectorXi::Zero(cloth.mesh.face_count()));
+    c.face_colours = render::panel_colours(cloth.face_panel.size()
+                                               ? cloth.face_panel
+                                               : Eigen::VectorXi::Zero(cloth.mesh.face_count()));
   }
   if (wireframe) {
     render::Wireframe wire;
@@ -45,7 +46,8 @@ std::vector<std::string> stage_preview_images(const std::vector<garment::ImageSp
   render::Renderer renderer;
   std::map<std::string, int> used_names;
   for (const garment::ImageSpec& spec : images) {
-    const render::Scene scene = preview_scene(body, cloth, spec.wireframe.value_or(default_wireframe));
+    const render::Scene scene =
+        preview_scene(body, cloth, spec.wireframe.value_or(default_wireframe));
     const render::ImageSize size{spec.width, spec.height};
     render::Camera camera;
     std::string name;

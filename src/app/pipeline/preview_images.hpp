@@ -13,10 +13,10 @@
 namespace sd::app {
 
 struct PreviewCloth {
-  meshing::TriMesh mesh;            // triangles to draw
-  Eigen::VectorXi face_panel;       // #F panel (colour) index, or empty for one colour
-  Eigen::MatrixX2i wire_edges;      // #E by 2 edges drawn when a wireframe is asked for
-  Eigen::VectorXd face_levels;      // optional #F values (4-8 levels) colouring the wireframe
+  meshing::TriMesh mesh;        // triangles to draw
+  Eigen::VectorXi face_panel;   // #F panel (colour) index, or empty for one colour
+  Eigen::MatrixX2i wire_edges;  // #E by 2 edges drawn when a wireframe is asked for
+  Eigen::VectorXd face_levels;  // optional #F values (4-8 levels) colouring the wireframe
 };
 
 // Renders each image of `images` (one GL context for all) and stages it as

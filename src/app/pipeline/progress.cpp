@@ -10,7 +10,9 @@ namespace sd::app {
 Progress::Progress(std::string label, long total, bool quiet)
     : label_(std::move(label)), total_(std::max(total, 1L)), visible_(!quiet && ::isatty(2)) {}
 
-Progress::~Progress() { finish(); }
+Progress::~Progress() {
+  finish();
+}
 
 void Progress::update(long done, const std::string& note) {
   if (!visible_ || finished_) return;

@@ -108,9 +108,9 @@ RunEstimate estimate_run(const garment::Sketch& sketch, const Eigen::MatrixX3i& 
   RunEstimate e;
   e.vertices = vertices;
   e.factor_bytes =
-      sim::predict_factor_size(triangles, vertices,
-                               sim::parse_bend_model(sketch.simulate.bending)
-                                   .value_or(sim::BendModel::hinges))
+      sim::predict_factor_size(
+          triangles, vertices,
+          sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::hinges))
           .bytes;
   e.memory_bytes = kBaseBytes + e.vertices * kBytesPerVertex + e.factor_bytes;
   e.steps = std::ceil(sketch.simulate.duration / sketch.simulate.time_step);

@@ -65,7 +65,8 @@ sim::SheetScene horizontal_sheet(int quads, double size, std::vector<std::string
 // The workhorse: a 0.5 m cotton sheet held horizontally by its two far corners; it falls,
 // swings and hangs.
 StressScene hanging_sheet(const sim::FabricParameters& fabric) {
-  const sim::SheetScene sheet = horizontal_sheet(kSheetQuads, kSheetSize, {"top-left", "top-right"});
+  const sim::SheetScene sheet =
+      horizontal_sheet(kSheetQuads, kSheetSize, {"top-left", "top-right"});
   StressScene scene;
   scene.model = sim::build_cloth_model(sheet.input, fabric);
   scene.x0 = sim::flatten_positions(sheet.input.rest_positions);
@@ -90,7 +91,8 @@ StressScene sliver_sheet(double ratio) {
   const int sliver = kSheetQuads / 2;
   const double width = kSheetSize / (kSheetQuads - 1 + ratio);
   std::vector<double> x(kSheetQuads + 1, -0.5 * kSheetSize);
-  for (int c = 1; c <= kSheetQuads; ++c) x[c] = x[c - 1] + (c - 1 == sliver ? ratio * width : width);
+  for (int c = 1; c <= kSheetQuads; ++c)
+    x[c] = x[c - 1] + (c - 1 == sliver ? ratio * width : width);
   for (int r = 0; r <= kSheetQuads; ++r)
     for (int c = 0; c <= kSheetQuads; ++c) sheet.input.rest_positions(sheet.vertex(r, c), 0) = x[c];
   StressScene scene;
@@ -101,7 +103,6 @@ StressScene sliver_sheet(double ratio) {
   return scene;
 }
 
-
 // A free 0.6 m sheet at y = 1 m and a 15 cm sphere that starts 30 cm below it and moves up at
 // `speed` for `travel` metres, hitting the falling sheet, then stops: the sheet drapes on it.
 StressScene sphere_strike(double speed) {
@@ -110,7 +111,8 @@ StressScene sphere_strike(double speed) {
   StressScene scene;
   scene.model = sim::build_cloth_model(sheet.input, sim::fabric_preset("cotton"));
   scene.x0 = sim::flatten_positions(sheet.input.rest_positions);
-  const meshing::TriMesh sphere = meshing::icosphere(kRadius, 3, Vector3d(0.0, 1.0 - kRadius - 0.3, 0.0));
+  const meshing::TriMesh sphere =
+      meshing::icosphere(kRadius, 3, Vector3d(0.0, 1.0 - kRadius - 0.3, 0.0));
   const double end = kTravel / speed;
   scene.body = sim::make_pose_sequence(sphere, {0.0, end}, [&](double t) {
     Eigen::MatrixX3d d = Eigen::MatrixX3d::Zero(sphere.vertex_count(), 3);
@@ -180,13 +182,12 @@ StressScene self_contact_scene(SelfFold kind) {
       box.vertices.row(i) << (i & 1 ? hi.x() : lo.x()), (i & 2 ? hi.y() : lo.y()),
           (i & 4 ? hi.z() : lo.z());
     box.faces.resize(12, 3);
-    box.faces << 0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4, 2, 6, 7, 2, 7, 3, 0, 4, 6,
-        0, 6, 2, 1, 3, 7, 1, 7, 5;
+    box.faces << 0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4, 2, 6, 7, 2, 7, 3, 0, 4, 6, 0,
+        6, 2, 1, 3, 7, 1, 7, 5;
     return box;
   }();
-  scene.body = sim::make_pose_sequence(floor, {0.0, 1.0}, [&](double) {
-    return Eigen::MatrixX3d::Zero(floor.vertex_count(), 3);
-  });
+  scene.body = sim::make_pose_sequence(
+      floor, {0.0, 1.0}, [&](double) { return Eigen::MatrixX3d::Zero(floor.vertex_count(), 3); });
   scene.length = kLength;
   return scene;
 }
@@ -278,7 +279,9 @@ StressScene churning_sheet(Churn churn) {
   return scene;
 }
 
-std::string exponent_label(int decade) { return decade == 0 ? "1" : fmt::format("1e{}", decade); }
+std::string exponent_label(int decade) {
+  return decade == 0 ? "1" : fmt::format("1e{}", decade);
+}
 
 }  // namespace
 
@@ -326,7 +329,8 @@ std::vector<StressCase> stress_matrix(bool quick) {
       StressCase c;
       c.family = "undamped";
       c.id = fmt::format("undamped-h{}-{}", step_label(dt), combo_label(combo));
-      c.condition = fmt::format("no stretch, shear or bend damping, no drag, step {} s", step_label(dt));
+      c.condition =
+          fmt::format("no stretch, shear or bend damping, no drag, step {} s", step_label(dt));
       c.settings = base_settings(dt, combo);
       c.quick = dt == 1.0 / 10 && combo.integrator == sim::Integrator::bdf2;
       c.build = [] {
@@ -345,7 +349,8 @@ std::vector<StressCase> stress_matrix(bool quick) {
       StressCase c;
       c.family = "sliver";
       c.id = fmt::format("sliver-1e-6-h{}-{}", step_label(dt), combo_label(combo));
-      c.condition = fmt::format("a column of triangles with area ratio 1e-6, step {} s", step_label(dt));
+      c.condition =
+          fmt::format("a column of triangles with area ratio 1e-6, step {} s", step_label(dt));
       c.parameters["area_ratio"] = kRatio;
       c.settings = base_settings(dt, combo);
       c.quick = false;  // every combination diverges today (docs/stress.md)
@@ -394,9 +399,10 @@ std::vector<StressCase> stress_matrix(bool quick) {
                          : motion == PinMotion::jump_apart ? "jump-apart"
                                                            : "shake";
       c.id = fmt::format("pins-{}-{}", name, combo_label(combo));
-      c.condition = motion == PinMotion::jump_up      ? "both pins jump 10 cm up in one step at 0.1 s"
-                    : motion == PinMotion::jump_apart ? "each pin jumps 5 cm outwards at 0.1 s (20 % at once)"
-                                                      : "pins shaken +-5 cm at 10 Hz for 0.5 s";
+      c.condition = motion == PinMotion::jump_up ? "both pins jump 10 cm up in one step at 0.1 s"
+                    : motion == PinMotion::jump_apart
+                        ? "each pin jumps 5 cm outwards at 0.1 s (20 % at once)"
+                        : "pins shaken +-5 cm at 10 Hz for 0.5 s";
       c.parameters["pin_motion"] = name;
       c.settings = base_settings(1.0 / 24, combo);
       const std::string label = combo_label(combo);
@@ -499,8 +505,8 @@ std::vector<StressCase> stress_matrix(bool quick) {
       StressCase c;
       c.family = "stretch";
       c.id = fmt::format("stretch-x{:g}-{}", factor, combo_label(combo));
-      c.condition = fmt::format("starts stretched x{:g} in its plane ({:g} % strain), free",
-                                factor, 100 * (factor - 1));
+      c.condition = fmt::format("starts stretched x{:g} in its plane ({:g} % strain), free", factor,
+                                100 * (factor - 1));
       c.parameters["start_stretch"] = factor;
       c.settings = base_settings(1.0 / 24, combo);
       const std::string label = combo_label(combo);

@@ -5,13 +5,12 @@
 // near-degenerate triangles, adaptivity churn, a fast body, pins moved abruptly, huge gravity,
 // non-finite start states (which must be rejected) and large start stretch.
 
+#include <Eigen/Core>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <nlohmann/json.hpp>
 
 #include "meshing/mesh48.hpp"
 #include "sim/adaptive_detail.hpp"
@@ -37,9 +36,9 @@ struct StressAdaptive {
 // What one case simulates. Built by the case's recipe right before it runs; a recipe may throw
 // std::invalid_argument (that is what a non-finite start must do).
 struct StressScene {
-  sim::ClothModel model;               // fixed-mesh runs (ignored when `adaptive` is set)
-  Eigen::VectorXd x0;                  // 3n start positions
-  Eigen::VectorXd v0;                  // 3n start velocities; empty: at rest
+  sim::ClothModel model;  // fixed-mesh runs (ignored when `adaptive` is set)
+  Eigen::VectorXd x0;     // 3n start positions
+  Eigen::VectorXd v0;     // 3n start velocities; empty: at rest
   std::vector<sim::Pin> pins;
   std::optional<sim::PoseSequence> body;  // a body the cloth collides with (possibly moving)
   std::optional<StressAdaptive> adaptive;

@@ -26,7 +26,8 @@ using Clock = std::chrono::steady_clock;
 
 double max_vertex_speed(const Eigen::VectorXd& v) {
   double speed = 0.0;
-  for (Eigen::Index i = 0; i < v.size() / 3; ++i) speed = std::max(speed, v.segment<3>(3 * i).norm());
+  for (Eigen::Index i = 0; i < v.size() / 3; ++i)
+    speed = std::max(speed, v.segment<3>(3 * i).norm());
   return speed;
 }
 
@@ -142,8 +143,8 @@ StressResult run_stress_case(const StressCase& c, const StressOptions& options) 
       if (s.time() < scene.drive_end - 1e-12) return;
       have_reference = true;
       reference = e.total();
-      r.energy_scale = model_of().total_mass() * gravity * scene.length + std::abs(e.elastic()) +
-                       e.kinetic;
+      r.energy_scale =
+          model_of().total_mass() * gravity * scene.length + std::abs(e.elastic()) + e.kinetic;
       r.energy_bound = kStressEnergyTolerance * r.energy_scale;
       r.energy_growth = 0.0;
       return;
@@ -254,8 +255,9 @@ StressResult run_stress_case(const StressCase& c, const StressOptions& options) 
                        "resolve them)",
                        report.self_unresolved_steps));
   }
-  r.ran_to_end = r.status.empty() &&
-                 (r.at_rest || r.sim_time >= settings.duration - 1e-9 * std::max(1.0, settings.duration));
+  r.ran_to_end =
+      r.status.empty() &&
+      (r.at_rest || r.sim_time >= settings.duration - 1e-9 * std::max(1.0, settings.duration));
   if (r.status.empty()) {
     if (r.ran_to_end) {
       r.status = "stable";
@@ -406,11 +408,13 @@ StressResult run_stress_case_isolated(const StressCase& c, const StressOptions& 
   if (WIFSIGNALED(status)) {
     const int sig = WTERMSIG(status);
     const char* name = ::strsignal(sig);
-    fail(r, "crashed", fmt::format("the simulation process was killed by signal {} ({})", sig,
-                                   name != nullptr ? name : "unknown"));
+    fail(r, "crashed",
+         fmt::format("the simulation process was killed by signal {} ({})", sig,
+                     name != nullptr ? name : "unknown"));
   } else {
-    fail(r, "crashed", fmt::format("the simulation process exited with code {} without a result",
-                                   WIFEXITED(status) ? WEXITSTATUS(status) : -1));
+    fail(r, "crashed",
+         fmt::format("the simulation process exited with code {} without a result",
+                     WIFEXITED(status) ? WEXITSTATUS(status) : -1));
   }
   r.wall_time_s = std::chrono::duration<double>(Clock::now() - start).count();
   return r;

@@ -3,10 +3,9 @@
 // finite and bounded (docs/stress.md, "Bounds"): strain, speed, and the total energy once
 // nothing drives the cloth any more.
 
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
-
-#include <nlohmann/json.hpp>
 
 #include "src/app/stress/stress_cases.hpp"
 
@@ -33,9 +32,9 @@ struct StressResult {
   // exploded (a bound broken) | stalled (step budget spent) | crashed (the process died) |
   // error (unexpected exception, or an invalid input that was not refused)
   std::string status;
-  bool ok = false;     // stable, or rejected when the case expects it
-  std::string reason;  // why not ok; for rejected cases, the error message
-  bool finite = true;  // every accepted state finite
+  bool ok = false;          // stable, or rejected when the case expects it
+  std::string reason;       // why not ok; for rejected cases, the error message
+  bool finite = true;       // every accepted state finite
   bool ran_to_end = false;  // reached the duration or rest
   bool at_rest = false;
   double duration = 0.0, sim_time = 0.0;
@@ -43,12 +42,12 @@ struct StressResult {
   double dt = 0.0, min_dt = 0.0, dt_min_used = 0.0;
   double max_strain = 0.0, strain_bound = 0.0;  // largest stretch strain of any accepted state
   double max_speed = 0.0, speed_bound = 0.0;    // m/s
-  double energy_scale = 0.0;    // J
-  double energy_growth = 0.0;   // J: peak E(t) − E(ref) once undriven (0: never above E(ref))
+  double energy_scale = 0.0;                    // J
+  double energy_growth = 0.0;  // J: peak E(t) − E(ref) once undriven (0: never above E(ref))
   double energy_final_growth = 0.0;  // J: E(end) − E(ref), what the bound applies to
-  double energy_bound = 0.0;    // J: kStressEnergyTolerance · energy_scale
+  double energy_bound = 0.0;         // J: kStressEnergyTolerance · energy_scale
   int vertices = 0;
-  int topology_changes = 0;     // adaptive cases: steps that changed the mesh
+  int topology_changes = 0;  // adaptive cases: steps that changed the mesh
   int contacts_max = 0;
   double max_penetration_m = 0.0;
   // Self-contact cases: intersecting triangle pairs of the final mesh (CGAL, independent of the
