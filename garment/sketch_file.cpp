@@ -670,7 +670,14 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
                          sim.duration, kMaxDuration));
   }
   if (j.contains("adaptive")) parse_adaptive(r, j["adaptive"], sim);
-  if (j.contains("time_step")) {
+  if (j.contains("time_step") && j["time_step"].is_string()) {
+    if (r.text(j["time_step"], path + "/time_step") != "auto")
+      r.fail(path + "/time_step",
+             "a time step is a number of seconds (1/60 s is 0.0167) or \"auto\" (the default: "
+             "chosen from the scene)");
+    sim.time_step_auto = true;
+  } else if (j.contains("time_step")) {
+    sim.time_step_auto = false;
     sim.time_step = r.positive(j["time_step"], path + "/time_step");
     if (sim.time_step < kMinTimeStep || sim.time_step > kMaxTimeStep)
       r.fail(path + "/time_step",
@@ -687,9 +694,10 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
   }
   if (j.contains("solver")) {
     sim.solver = r.text(j["solver"], path + "/solver");
-    if (sim.solver != "pcg" && sim.solver != "cholmod")
-      r.fail(path + "/solver",
-             fmt::format("unknown solver '{}'; use \"pcg\" or \"cholmod\"", sim.solver));
+    if (sim.solver != "pcg" && sim.solver != "cholmod" && sim.solver != "auto")
+      r.fail(path + "/solver", fmt::format("unknown solver '{}'; use \"auto\" (the default), "
+                                           "\"pcg\" or \"cholmod\"",
+                                           sim.solver));
   }
   if (j.contains("bending")) {
     sim.bending = r.text(j["bending"], path + "/bending");

@@ -137,7 +137,10 @@ struct SimulateSpec {
   AdaptiveSpec adaptive_settings;             // "adaptive": {...} (with "enabled" for the bool)
   double time_step = 1.0 / 60.0;              // seconds, the largest step
   std::string integrator = "implicit-euler";  // "implicit-euler" | "bdf2"
-  std::string solver = "cholmod";             // "pcg" | "cholmod"
+  std::string solver = "auto";                // "auto" (the default) | "pcg" | "cholmod"
+  // "time_step": "auto" (the default): the step, like an "auto" solver, is chosen from the scene
+  // (sim/automatic_settings.hpp); time_step is then what estimates assume before it is built.
+  bool time_step_auto = true;
   // "hinges" | "quadratic": the discrete bending energy (docs/simulator.md, "Bending on any
   // mesh"). Hinges by default until the quadratic model is as fast and every design rests with
   // it (docs/fabrics.md).

@@ -242,7 +242,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   const auto start = Clock::now();
   const garment::Sketch sketch = garment::load_sketch(options.sketch);
   check_sketch(sketch);
-  const sim::SimulationSettings settings = simulation_settings(sketch);
+  sim::SimulationSettings settings = simulation_settings(sketch);
   RunLimits limits;
   if (!options.max_memory.empty()) limits.max_memory_bytes = parse_memory_size(options.max_memory);
   if (options.max_time_s > 0) limits.max_time_s = options.max_time_s;
@@ -251,6 +251,9 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   if (const auto before = estimate_before_building(sketch, options.frames_per_second))
     check_run_fits(sketch, *before, limits, options.frames_per_second);
   const ClothScene scene = build_cloth_scene(sketch);
+  // "solver"/"time_step": "auto" (the defaults): chosen now that the scene's size is known.
+  const sim::AutomaticChoice automatic = apply_automatic_settings(sketch, scene, settings);
+  spdlog::debug("settings: {}", automatic.reason);
   const RunEstimate estimate =
       estimate_run(sketch, scene.input.triangles, static_cast<int>(scene.start.rows()),
                    options.frames_per_second);
@@ -481,6 +484,15 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   const double image_s = std::chrono::duration<double>(Clock::now() - image_start).count();
 
   nlohmann::json out = simulation_json(report, settings);
+  // Which settings the rule chose, and why (null when the file set both solver and step).
+  out["settings"]["preconditioner"] =
+      settings.solver == sim::LinearSolverKind::pcg
+          ? (settings.pcg_preconditioner == sim::PcgPreconditioner::block_jacobi ? "block-jacobi"
+                                                                                 : "block-ic0")
+          : "none";
+  out["settings"]["automatic"] = sketch.simulate.solver == "auto" || sketch.simulate.time_step_auto
+                                     ? nlohmann::json(automatic.reason)
+                                     : nlohmann::json(nullptr);
   // Counted whether or not self-collision was on: what a preview would show.
   out["self_intersections_final"] = count_self_intersections(draped.vertices, draped.faces);
   out["format"] = "sketchdrape/1 run report";

@@ -317,6 +317,21 @@ sim::SimulationSettings simulation_settings(const garment::Sketch& sketch) {
   return settings;
 }
 
+sim::AutomaticChoice apply_automatic_settings(const garment::Sketch& sketch,
+                                              const ClothScene& scene,
+                                              sim::SimulationSettings& settings) {
+  const garment::SimulateSpec& spec = sketch.simulate;
+  sim::SceneTraits traits;
+  traits.vertices = static_cast<int>(scene.start.rows());
+  const bool adaptive =
+      spec.adaptive && (!scene.sheet || spec.adaptive_given) && scene.input.rest_uv.rows() == 0;
+  if (adaptive) traits.max_vertices = spec.adaptive_settings.max_vertices.value_or(0);
+  traits.self_contact = settings.self_contact.enabled;
+  const sim::AutomaticChoice choice = sim::choose_settings(traits);
+  sim::apply_choice(choice, spec.solver == "auto", spec.time_step_auto, settings);
+  return choice;
+}
+
 sim::ClothModel build_scene_model(const ClothScene& scene) {
   sim::ClothModelOptions options;
   options.bend_model = scene.bend_model;

@@ -12,6 +12,7 @@
 #include "garment/panel_flattening.hpp"
 #include "garment/sketch_file.hpp"
 #include "meshing/mesh48.hpp"
+#include "sim/automatic_settings.hpp"
 #include "sim/body_motion.hpp"
 #include "sim/cloth_driver.hpp"
 #include "sim/cloth_model.hpp"
@@ -89,5 +90,12 @@ Eigen::VectorXi triangle_groups(const ClothScene& scene, const Eigen::VectorXi& 
 // The simulator settings of the file's "simulate" section (integrator, solver, step, duration,
 // gravity). Throws garment::SketchError at /simulate when they cannot work together.
 sim::SimulationSettings simulation_settings(const garment::Sketch& sketch);
+
+// The file's "solver": "auto" and "time_step": "auto" (the defaults) resolved for the built
+// scene (sim/automatic_settings.hpp: its size and self-contact); settings the file gives are
+// kept. Returns the rule's choice (its `reason` for the report).
+sim::AutomaticChoice apply_automatic_settings(const garment::Sketch& sketch,
+                                              const ClothScene& scene,
+                                              sim::SimulationSettings& settings);
 
 }  // namespace sd::app

@@ -1,0 +1,41 @@
+#pragma once
+// The settings `"solver": "auto"` and `"time_step": "auto"` stand for (the sketch defaults): the
+// integrator, linear solver, preconditioner and largest step chosen from what the scene is, by
+// a rule read off the work-precision front (docs/simulator.md, "Automatic settings", has the
+// measurements behind every threshold).
+
+#include <string>
+
+#include "sim/implicit_solver.hpp"
+#include "sim/simulation.hpp"
+
+namespace sd::sim {
+
+// What the rule looks at: plain facts about the scene, known before the first step.
+struct SceneTraits {
+  int vertices = 0;      // at the start
+  int max_vertices = 0;  // an adaptive cloth's particle budget (it may grow); 0: none
+  // Cloth-cloth contact on (garments by default): cloth that can fold onto itself.
+  bool self_contact = false;
+};
+
+struct AutomaticChoice {
+  Integrator integrator = Integrator::implicit_euler;
+  LinearSolverKind solver = LinearSolverKind::pcg;
+  PcgPreconditioner preconditioner = PcgPreconditioner::block_incomplete_cholesky;
+  double dt = 1.0 / 60.0;  // s, the largest step
+  std::string reason;      // one sentence for report.json and logs
+};
+
+// Above this many vertices CHOLMOD is cheaper than the IC(0) PCG, whose iterations grow with
+// the resolution (docs/benchmarks.md, "Scaling").
+inline constexpr int kAutomaticCholmodVertices = 8000;
+
+AutomaticChoice choose_settings(const SceneTraits& scene);
+
+// Fills the solver, preconditioner and dt of `settings` from `choice`, for the parts
+// the caller left automatic; min_dt stays below dt.
+void apply_choice(const AutomaticChoice& choice, bool solver_automatic, bool step_automatic,
+                  SimulationSettings& settings);
+
+}  // namespace sd::sim
