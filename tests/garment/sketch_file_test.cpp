@@ -41,7 +41,8 @@ TEST(SketchFile, MinimalFileGetsDefaults) {
   EXPECT_TRUE(s.panels[0].mirror);
   EXPECT_DOUBLE_EQ(s.simulate.duration, 3.0);
   EXPECT_EQ(s.simulate.integrator, "implicit-euler");
-  EXPECT_EQ(s.simulate.solver, "cholmod");
+  EXPECT_EQ(s.simulate.solver, "auto");  // chosen from the scene (sim/automatic_settings.hpp)
+  EXPECT_TRUE(s.simulate.time_step_auto);
   EXPECT_FALSE(s.simulate.pin_above.has_value());
   EXPECT_TRUE(s.simulate.check_body_vertices);
   EXPECT_FALSE(s.body.motion.has_value());
@@ -169,6 +170,8 @@ TEST(SketchFile, ReadsEverySection) {
   EXPECT_DOUBLE_EQ(s.panels[0].ease, 1.1);
   EXPECT_EQ(s.joins[0].panels.size(), 2u);
   EXPECT_EQ(s.simulate.solver, "cholmod");
+  EXPECT_FALSE(s.simulate.time_step_auto);  // the file's 0.01 s
+  EXPECT_DOUBLE_EQ(s.simulate.time_step, 0.01);
   EXPECT_DOUBLE_EQ(s.simulate.gravity.y(), -9.8);
   EXPECT_FALSE(s.simulate.check_body_vertices);  // the default is on
   ASSERT_EQ(s.output.images.size(), 2u);
@@ -176,6 +179,22 @@ TEST(SketchFile, ReadsEverySection) {
   EXPECT_EQ(s.output.images[0].width, 640);
   EXPECT_EQ(s.output.images[1].view, "three-quarter");
   EXPECT_EQ(s.output.mesh, "g.glb");
+}
+
+TEST(SketchFile, SolverAndStepMayBeAutomatic) {
+  const Sketch s = parse_sketch(R"({"format": "sketchdrape/1",
+      "sheet": {"size": [1, 1], "resolution": [4, 4]},
+      "simulate": {"solver": "auto", "time_step": "auto"}})",
+                                "auto.json");
+  EXPECT_EQ(s.simulate.solver, "auto");
+  EXPECT_TRUE(s.simulate.time_step_auto);
+  const Sketch given = parse_sketch(R"({"format": "sketchdrape/1",
+      "sheet": {"size": [1, 1], "resolution": [4, 4]},
+      "simulate": {"solver": "pcg", "time_step": 0.02}})",
+                                    "given.json");
+  EXPECT_EQ(given.simulate.solver, "pcg");
+  EXPECT_FALSE(given.simulate.time_step_auto);
+  EXPECT_DOUBLE_EQ(given.simulate.time_step, 0.02);
 }
 
 TEST(SketchFile, ErrorsCarryFilePathAndSentence) {
@@ -210,6 +229,10 @@ TEST(SketchFile, ErrorsCarryFilePathAndSentence) {
       {R"({"curves": [{"id": "a", "points": [[0, 1], [1, 1]]}], "panels": [{"id": "p", "boundary": ["a"]}],
           "join": [{"id": "j", "panels": ["p", "p.mirror"]}]})",
        "/join/0/panels/1", "has no mirror copy"},
+      {R"({"sheet": {"size": [1, 1], "resolution": [4, 4]}, "simulate": {"time_step": "fast"}})",
+       "/simulate/time_step", "or \"auto\""},
+      {R"({"sheet": {"size": [1, 1], "resolution": [4, 4]}, "simulate": {"solver": "lu"}})",
+       "/simulate/solver", "use \"auto\" (the default), \"pcg\" or \"cholmod\""},
   };
   for (const Case& c : cases) {
     const SketchError e = error_of(c.text);

@@ -1,0 +1,57 @@
+#include "sim/automatic_settings.hpp"
+
+#include <gtest/gtest.h>
+
+namespace sd::sim {
+namespace {
+
+TEST(AutomaticSettings, PcgUpToTheThresholdThenCholmod) {
+  SceneTraits scene;
+  scene.vertices = kAutomaticCholmodVertices;
+  AutomaticChoice choice = choose_settings(scene);
+  EXPECT_EQ(choice.integrator, Integrator::implicit_euler);
+  EXPECT_EQ(choice.solver, LinearSolverKind::pcg);
+  EXPECT_EQ(choice.preconditioner, PcgPreconditioner::block_incomplete_cholesky);
+  scene.vertices = kAutomaticCholmodVertices + 1;
+  EXPECT_EQ(choose_settings(scene).solver, LinearSolverKind::cholmod);
+  // An adaptive cloth is judged by the most it may grow to.
+  scene.vertices = 1000;
+  scene.max_vertices = 20000;
+  EXPECT_EQ(choose_settings(scene).solver, LinearSolverKind::cholmod);
+}
+
+TEST(AutomaticSettings, SelfContactTakesShorterSteps) {
+  SceneTraits scene;
+  scene.vertices = 1089;
+  EXPECT_DOUBLE_EQ(choose_settings(scene).dt, 1.0 / 20.0);
+  scene.self_contact = true;
+  const AutomaticChoice choice = choose_settings(scene);
+  EXPECT_DOUBLE_EQ(choice.dt, 1.0 / 60.0);
+  EXPECT_NE(choice.reason.find("1/60 s"), std::string::npos) << choice.reason;
+  EXPECT_NE(choice.reason.find("1089 vertices"), std::string::npos) << choice.reason;
+}
+
+TEST(AutomaticSettings, SettingsTheFileGivesAreKept) {
+  SceneTraits scene;
+  scene.vertices = 500;
+  const AutomaticChoice choice = choose_settings(scene);
+  SimulationSettings given;
+  given.solver = LinearSolverKind::cholmod;
+  given.integrator = Integrator::bdf2;
+  given.dt = 0.01;
+  SimulationSettings settings = given;
+  apply_choice(choice, false, false, settings);
+  EXPECT_EQ(settings.solver, LinearSolverKind::cholmod);
+  EXPECT_DOUBLE_EQ(settings.dt, 0.01);
+  apply_choice(choice, true, false, settings);
+  EXPECT_EQ(settings.solver, LinearSolverKind::pcg);
+  EXPECT_EQ(settings.integrator, Integrator::bdf2);  // the file's integrator stays
+  EXPECT_DOUBLE_EQ(settings.dt, 0.01);
+  apply_choice(choice, false, true, settings);
+  EXPECT_DOUBLE_EQ(settings.dt, 1.0 / 20.0);
+  EXPECT_LE(settings.min_dt, settings.dt / 64);
+  EXPECT_NO_THROW(settings.validate());
+}
+
+}  // namespace
+}  // namespace sd::sim
