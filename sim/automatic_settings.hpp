@@ -28,7 +28,7 @@ struct AutomaticChoice {
 };
 
 // Above this many vertices CHOLMOD is cheaper than the IC(0) PCG, whose iterations grow with
-// the resolution (docs/benchmarks.md, "Scaling").
+// the resolution (docs/benchmarks.md, "Scaling"); cloth with self-contact always uses CHOLMOD.
 inline constexpr int kAutomaticCholmodVertices = 8000;
 
 AutomaticChoice choose_settings(const SceneTraits& scene);

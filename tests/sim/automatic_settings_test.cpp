@@ -20,12 +20,13 @@ TEST(AutomaticSettings, PcgUpToTheThresholdThenCholmod) {
   EXPECT_EQ(choose_settings(scene).solver, LinearSolverKind::cholmod);
 }
 
-TEST(AutomaticSettings, SelfContactTakesShorterSteps) {
+TEST(AutomaticSettings, SelfContactTakesCholmodAndShorterSteps) {
   SceneTraits scene;
   scene.vertices = 1089;
   EXPECT_DOUBLE_EQ(choose_settings(scene).dt, 1.0 / 20.0);
   scene.self_contact = true;
   const AutomaticChoice choice = choose_settings(scene);
+  EXPECT_EQ(choice.solver, LinearSolverKind::cholmod);
   EXPECT_DOUBLE_EQ(choice.dt, 1.0 / 60.0);
   EXPECT_NE(choice.reason.find("1/60 s"), std::string::npos) << choice.reason;
   EXPECT_NE(choice.reason.find("1089 vertices"), std::string::npos) << choice.reason;

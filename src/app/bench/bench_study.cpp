@@ -17,6 +17,7 @@
 #include <optional>
 
 #include "garment/sketch_file.hpp"
+#include "sim/automatic_settings.hpp"
 #include "sim/cloth_driver.hpp"
 #include "sim/sheet.hpp"
 #include "sim/surface_sampling.hpp"
@@ -330,6 +331,21 @@ BenchPlan bench_plan(const BenchScene& scene, BenchGrid grid) {
     plan.families.push_back(family);
   };
   if (adaptive) adaptive_family(60);
+  // What "solver": "auto" and "time_step": "auto" (the sketch defaults) choose at each level
+  // (sim/automatic_settings.hpp), so that the summary shows where the default sits on the front.
+  // A level roughly doubles the vertices (each doubles the triangles).
+  {
+    BenchFamily family{"automatic (the sketch default): levels", {}};
+    for (int level : levels) {
+      sim::SceneTraits traits;
+      traits.vertices = scene.mesh->vertex_count() << level;
+      traits.self_contact = scene.settings.self_contact.enabled;
+      const sim::AutomaticChoice choice = sim::choose_settings(traits);
+      family.members.push_back(config(BenchMeshKind::fixed, level, choice.integrator, choice.solver,
+                                      static_cast<int>(std::lround(1.0 / choice.dt))));
+    }
+    plan.families.push_back(family);
+  }
   // At 1/60 s the step's error hides the mesh's (every level within a few per cent on the
   // sheets): the full grid repeats the levels and the adaptive family at its smallest step,
   // where refinement shows and adaptive detail can pay.
