@@ -17,6 +17,8 @@ struct SceneTraits {
   int max_vertices = 0;  // an adaptive cloth's particle budget (it may grow); 0: none
   // Cloth-cloth contact on (garments by default): cloth that can fold onto itself.
   bool self_contact = false;
+  // Sewn panels worn on a body (not a sheet scene), with or without self-contact.
+  bool garment = false;
 };
 
 struct AutomaticChoice {
@@ -28,7 +30,8 @@ struct AutomaticChoice {
 };
 
 // Above this many vertices CHOLMOD is cheaper than the IC(0) PCG, whose iterations grow with
-// the resolution (docs/benchmarks.md, "Scaling"); cloth with self-contact always uses CHOLMOD.
+// the resolution (docs/benchmarks.md, "Scaling"); garments and cloth with self-contact always
+// use CHOLMOD.
 inline constexpr int kAutomaticCholmodVertices = 8000;
 
 AutomaticChoice choose_settings(const SceneTraits& scene);

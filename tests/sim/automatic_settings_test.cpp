@@ -30,6 +30,11 @@ TEST(AutomaticSettings, SelfContactTakesCholmodAndShorterSteps) {
   EXPECT_DOUBLE_EQ(choice.dt, 1.0 / 60.0);
   EXPECT_NE(choice.reason.find("1/60 s"), std::string::npos) << choice.reason;
   EXPECT_NE(choice.reason.find("1089 vertices"), std::string::npos) << choice.reason;
+  // A garment without self-contact too.
+  scene.self_contact = false;
+  scene.garment = true;
+  EXPECT_EQ(choose_settings(scene).solver, LinearSolverKind::cholmod);
+  EXPECT_DOUBLE_EQ(choose_settings(scene).dt, 1.0 / 60.0);
 }
 
 TEST(AutomaticSettings, SettingsTheFileGivesAreKept) {

@@ -340,6 +340,7 @@ BenchPlan bench_plan(const BenchScene& scene, BenchGrid grid) {
       sim::SceneTraits traits;
       traits.vertices = scene.mesh->vertex_count() << level;
       traits.self_contact = scene.settings.self_contact.enabled;
+      traits.garment = !scene.sheet;
       const sim::AutomaticChoice choice = sim::choose_settings(traits);
       family.members.push_back(config(BenchMeshKind::fixed, level, choice.integrator, choice.solver,
                                       static_cast<int>(std::lround(1.0 / choice.dt))));

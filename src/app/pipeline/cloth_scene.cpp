@@ -327,6 +327,7 @@ sim::AutomaticChoice apply_automatic_settings(const garment::Sketch& sketch,
       spec.adaptive && (!scene.sheet || spec.adaptive_given) && scene.input.rest_uv.rows() == 0;
   if (adaptive) traits.max_vertices = spec.adaptive_settings.max_vertices.value_or(0);
   traits.self_contact = settings.self_contact.enabled;
+  traits.garment = !scene.sheet;
   const sim::AutomaticChoice choice = sim::choose_settings(traits);
   sim::apply_choice(choice, spec.solver == "auto", spec.time_step_auto, settings);
   return choice;

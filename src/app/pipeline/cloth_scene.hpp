@@ -92,8 +92,8 @@ Eigen::VectorXi triangle_groups(const ClothScene& scene, const Eigen::VectorXi& 
 sim::SimulationSettings simulation_settings(const garment::Sketch& sketch);
 
 // The file's "solver": "auto" and "time_step": "auto" (the defaults) resolved for the built
-// scene (sim/automatic_settings.hpp: its size and self-contact); settings the file gives are
-// kept. Returns the rule's choice (its `reason` for the report).
+// scene (sim/automatic_settings.hpp: its size, garment or sheet, self-contact); settings the
+// file gives are kept. Returns the rule's choice (its `reason` for the report).
 sim::AutomaticChoice apply_automatic_settings(const garment::Sketch& sketch,
                                               const ClothScene& scene,
                                               sim::SimulationSettings& settings);
