@@ -173,6 +173,12 @@ TEST(BenchCommand, TinyGridMeasuresErrorsAndReusesTheCachedReference) {
   const std::string key = report["scenes"][0]["reference"]["key"];
   EXPECT_TRUE(fs::exists(dir / "cache" / (key + ".bin")));
   EXPECT_NE(first.output.find("defaults:"), std::string::npos) << first.output;
+  // The sketch default is run (the automatic rule: a sheet without self-contact gets the IC(0)
+  // PCG at 1/20 s) and placed against the front.
+  EXPECT_EQ(runs["hanging-sheet/fixed-L3-ie-pcg-20"].at("status"), "ok");
+  EXPECT_NE(first.output.find("the sketch default (automatic: fixed L3, IE, PCG, 1/20 s"),
+            std::string::npos)
+      << first.output;
 
   if (has_gnuplot()) {
     const std::string png = read_text(dir / "out/bench_hanging-sheet.png");
