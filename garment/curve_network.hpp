@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "garment/sketch_file.hpp"
 #include "garment/stroke_projection.hpp"
+#include "scene/sketch_file.hpp"
 
 namespace sd::garment {
 

@@ -9,9 +9,9 @@
 #include <vector>
 
 #include "garment/body_surface.hpp"
-#include "garment/sketch_file.hpp"
 #include "meshing/quad_mesh.hpp"
 #include "meshing/quad_quality.hpp"
+#include "scene/sketch_file.hpp"
 
 namespace sd::garment {
 

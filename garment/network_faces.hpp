@@ -15,7 +15,7 @@
 #include "garment/body_surface.hpp"
 #include "garment/curve_network.hpp"
 #include "garment/panel_loop.hpp"
-#include "garment/sketch_file.hpp"
+#include "scene/sketch_file.hpp"
 
 namespace sd::garment {
 

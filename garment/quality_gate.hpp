@@ -10,7 +10,7 @@
 
 #include "garment/body_landmarks.hpp"
 #include "garment/garment_mesh.hpp"
-#include "garment/sketch_file.hpp"
+#include "scene/sketch_file.hpp"
 
 namespace sd::garment {
 

@@ -3,8 +3,8 @@
 // name the sketch file and the JSON path of the reference.
 
 #include "garment/body.hpp"
-#include "garment/sketch_file.hpp"
 #include "meshing/tri_mesh.hpp"
+#include "scene/sketch_file.hpp"
 
 namespace sd::garment {
 

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "garment/sketch_file.hpp"
 #include "meshing/tri_mesh.hpp"
+#include "scene/sketch_file.hpp"
 
 namespace sd::garment {
 

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "garment/body_surface.hpp"
-#include "garment/sketch_file.hpp"
+#include "scene/sketch_file.hpp"
 
 namespace sd::garment {
 

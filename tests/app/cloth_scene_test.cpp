@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "garment/sketch_file.hpp"
+#include "scene/sketch_file.hpp"
 #include "sim/cloth_model.hpp"
 
 namespace sd::app {

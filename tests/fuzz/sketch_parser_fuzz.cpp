@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <string_view>
 
-#include "garment/sketch_file.hpp"
 #include "garment/sketch_ranges.hpp"
+#include "scene/sketch_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);

@@ -5,7 +5,7 @@
 #include <filesystem>
 
 #include "garment/body.hpp"
-#include "garment/sketch_file.hpp"
+#include "scene/sketch_file.hpp"
 #include "tests/garment/test_helpers.hpp"
 
 namespace sd::garment {

@@ -1,4 +1,4 @@
-#include "garment/sketch_file.hpp"
+#include "scene/sketch_file.hpp"
 
 #include <gtest/gtest.h>
 

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "garment/sketch_file.hpp"
+#include "scene/sketch_file.hpp"
 
 namespace sd::garment {
 namespace {

@@ -8,7 +8,7 @@
 #include <system_error>
 #include <vector>
 
-#include "garment/sketch_file.hpp"
+#include "scene/sketch_file.hpp"
 #include "src/app/pipeline/atomic_file.hpp"
 #include "src/app/pipeline/sha256.hpp"
 

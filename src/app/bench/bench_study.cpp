@@ -16,7 +16,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
-#include "garment/sketch_file.hpp"
+#include "scene/sketch_file.hpp"
 #include "sim/cloth_driver.hpp"
 #include "sim/sheet.hpp"
 #include "sim/surface_sampling.hpp"

@@ -13,9 +13,9 @@
 
 #include "garment/body_surface.hpp"
 #include "garment/garment_mesh.hpp"
-#include "garment/sketch_file.hpp"
 #include "garment/sketch_inputs.hpp"
 #include "meshing/mesh48.hpp"
+#include "scene/sketch_file.hpp"
 #include "src/app/commands/cli.hpp"
 #include "src/app/pipeline/atomic_file.hpp"
 #include "src/app/pipeline/cloth_scene.hpp"

@@ -10,8 +10,8 @@
 
 #include "garment/body_surface.hpp"
 #include "garment/garment_mesh.hpp"
-#include "garment/sketch_file.hpp"
 #include "garment/sketch_inputs.hpp"
+#include "scene/sketch_file.hpp"
 #include "src/app/commands/cli.hpp"
 #include "src/app/pipeline/atomic_file.hpp"
 #include "src/app/pipeline/pattern_export.hpp"

@@ -14,8 +14,8 @@
 #include <stdexcept>
 
 #include "garment/body_landmarks.hpp"
-#include "garment/sketch_file.hpp"
 #include "meshing/slice_dent.hpp"
+#include "scene/sketch_file.hpp"
 #include "sim/adaptive_detail.hpp"
 #include "sim/cloth_driver.hpp"
 #include "sim/simulation.hpp"

@@ -7,7 +7,7 @@
 
 #include <iostream>
 
-#include "garment/sketch_file.hpp"
+#include "scene/sketch_file.hpp"
 #include "src/app/commands/cli.hpp"
 #include "src/app/pipeline/cloth_scene.hpp"
 #include "src/app/pipeline/quality_warnings.hpp"

@@ -13,7 +13,7 @@
 #include "garment/garment_mesh.hpp"
 #include "garment/panel_flattening.hpp"
 #include "garment/pattern_layout.hpp"
-#include "garment/sketch_file.hpp"
+#include "scene/sketch_file.hpp"
 #include "src/app/pipeline/atomic_file.hpp"
 
 namespace sd::app {

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "garment/sketch_file.hpp"
 #include "meshing/tri_mesh.hpp"
+#include "scene/sketch_file.hpp"
 #include "src/app/pipeline/atomic_file.hpp"
 
 namespace sd::app {

@@ -7,7 +7,7 @@
 #include <optional>
 #include <string>
 
-#include "garment/sketch_file.hpp"
+#include "scene/sketch_file.hpp"
 #include "sim/simulation.hpp"
 
 namespace sd::app {
