@@ -127,7 +127,7 @@ BodyPart classify_body_point(const Eigen::Vector3d& p, double height) {
   return BodyPart::kTorso;
 }
 
-Garment build_garment(const Sketch& sketch, const BodySurface& body) {
+Garment build_garment(const GarmentRequest& sketch, const BodySurface& body) {
   if (sketch.garment_mesh)
     throw std::logic_error("build_garment: a garment_mesh sketch has no curves to mesh");
   check_against_body(sketch, body.box());

@@ -9,9 +9,9 @@
 #include <vector>
 
 #include "garment/body_surface.hpp"
+#include "garment/garment_request.hpp"
 #include "meshing/quad_mesh.hpp"
 #include "meshing/quad_quality.hpp"
-#include "scene/sketch_file.hpp"
 
 namespace sd::garment {
 
@@ -59,6 +59,6 @@ struct Garment {
 
 // The whole meshing pipeline for a sketch with curves and panels. Throws SketchError for
 // anything the designer can fix (with the JSON path), std::runtime_error for internal failures.
-Garment build_garment(const Sketch& sketch, const BodySurface& body);
+Garment build_garment(const GarmentRequest& sketch, const BodySurface& body);
 
 }  // namespace sd::garment

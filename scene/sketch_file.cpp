@@ -19,7 +19,10 @@
 #include "garment/sketch_inputs.hpp"
 #include "garment/sketch_ranges.hpp"
 
-namespace sd::garment {
+namespace sd::scene {
+// The garment request's types and the input limits (garment/sketch_ranges.hpp) by name.
+using namespace garment;
+
 namespace {
 
 using nlohmann::json;
@@ -617,17 +620,20 @@ void parse_adaptive(const Reader& r, const json& a, SimulateSpec& sim) {
   r.check_keys(a, path,
                {"enabled", "refine_threshold", "coarsen_threshold", "steady_rate", "min_lifetime",
                 "min_level", "max_level", "max_vertices", "merge_batch", "even_levels"});
-  AdaptiveSpec& s = sim.adaptive_settings;
+  sim::AdaptiveSettings& s = sim.adaptive_settings;  // the simulator's defaults where unset
   if (a.contains("enabled")) sim.adaptive = r.boolean(a["enabled"], path + "/enabled");
   if (a.contains("refine_threshold"))
     s.refine_threshold = r.positive(a["refine_threshold"], path + "/refine_threshold");
   if (a.contains("coarsen_threshold"))
     s.coarsen_threshold = r.positive(a["coarsen_threshold"], path + "/coarsen_threshold");
-  if (s.refine_threshold && s.coarsen_threshold && !(*s.coarsen_threshold < *s.refine_threshold))
+  // Two values the file gives are checked against each other here; a value against a default
+  // is checked by run (sim::AdaptiveSettings::validate, at /simulate/adaptive).
+  if (a.contains("refine_threshold") && a.contains("coarsen_threshold") &&
+      !(s.coarsen_threshold < s.refine_threshold))
     r.fail(path + "/coarsen_threshold",
            fmt::format("the coarsen threshold ({} m) must be below the refine threshold ({} m): "
                        "the gap keeps a merged block from being split again at once",
-                       *s.coarsen_threshold, *s.refine_threshold));
+                       s.coarsen_threshold, s.refine_threshold));
   if (a.contains("steady_rate"))
     s.steady_rate = r.non_negative(a["steady_rate"], path + "/steady_rate");
   if (a.contains("min_lifetime"))
@@ -636,16 +642,16 @@ void parse_adaptive(const Reader& r, const json& a, SimulateSpec& sim) {
        {std::pair{"min_level", &s.min_level}, std::pair{"max_level", &s.max_level}}) {
     if (!a.contains(key)) continue;
     *level = r.integer(a[key], path + "/" + key, 0);
-    if (**level > 30) r.fail(path + "/" + key, "levels go from 0 (the input's blocks) to 30");
+    if (*level > 30) r.fail(path + "/" + key, "levels go from 0 (the input's blocks) to 30");
   }
-  if (s.min_level && s.max_level && *s.max_level < *s.min_level)
+  if (a.contains("min_level") && a.contains("max_level") && s.max_level < s.min_level)
     r.fail(path + "/max_level", fmt::format("max_level ({}) must not be below min_level ({})",
-                                            *s.max_level, *s.min_level));
+                                            s.max_level, s.min_level));
   if (a.contains("max_vertices"))
     s.max_vertices = r.integer(a["max_vertices"], path + "/max_vertices", 0);
   if (a.contains("merge_batch")) {
     s.merge_batch = r.non_negative(a["merge_batch"], path + "/merge_batch");
-    if (!(*s.merge_batch < 1.0))
+    if (!(s.merge_batch < 1.0))
       r.fail(path + "/merge_batch",
              "the merge batch is a fraction of the particles (0.05: merges wait until 5 % of "
              "them can go at once); it must be below 1");
@@ -958,43 +964,6 @@ class DuplicateKeyCheck {
 
 }  // namespace
 
-std::string ViewSpec::name() const {
-  switch (kind) {
-    case ViewKind::kFront:
-      return "front";
-    case ViewKind::kBack:
-      return "back";
-    case ViewKind::kLeft:
-      return "left";
-    case ViewKind::kRight:
-      return "right";
-    case ViewKind::kCamera:
-      return "camera";
-  }
-  return "?";
-}
-
-void Sketch::fail(const std::string& json_path, const std::string& sentence) const {
-  throw SketchError(file, json_path, sentence);
-}
-
-const CurveSpec* Sketch::find_curve(std::string_view id) const {
-  for (const CurveSpec& c : curves)
-    if (c.id == id) return &c;
-  return nullptr;
-}
-
-const PanelSpec* Sketch::find_panel(std::string_view id) const {
-  for (const PanelSpec& p : panels)
-    if (p.id == id) return &p;
-  return nullptr;
-}
-
-std::filesystem::path Sketch::resolve(const std::string& relative) const {
-  const std::filesystem::path p(relative);
-  return p.is_absolute() ? p : base_dir / p;
-}
-
 Sketch parse_sketch(std::string_view text, const std::string& file,
                     const std::filesystem::path& base_dir) {
   Sketch sketch;
@@ -1180,4 +1149,4 @@ Sketch load_sketch(const std::filesystem::path& path) {
   return parse_sketch(buffer.str(), path.string(), path.parent_path());
 }
 
-}  // namespace sd::garment
+}  // namespace sd::scene

@@ -1,9 +1,17 @@
 #pragma once
-// The sketch file (format "sketchdrape/1", docs/sketch-format.md): a plain model of what the
-// designer wrote, every value validated, with defaults filled in. Units are metres, +Y up, the
-// mannequin faces +Z. Parsing checks each field on its own; whether curves meet, panels close
-// and strokes land on the body is checked later (curve network, projection), with the same
-// SketchError and JSON paths.
+// The scene layer's sketch file (format "sketchdrape/1", docs/sketch-format.md): it reads and
+// validates the file once and hands each module its own plain inputs: the garment request
+// (garment::GarmentRequest, the base of Sketch), the simulator's settings (SimulateSpec, whose
+// adaptive settings are sim's own type) and the render specs (OutputSpec's images). Units are
+// metres, +Y up, the mannequin faces +Z. Parsing checks each field on its own; whether curves
+// meet, panels close and strokes land on the body is checked later (curve network, projection),
+// with the same SketchError and JSON paths.
+//
+// Where a new field goes: a garment field (curve, panel, join, meshing setting) in
+// garment/garment_request.hpp and its parser in scene/sketch_garment.cpp; a "simulate" field in
+// SimulateSpec below (an adaptive one in sim::AdaptiveSettings) and its parser in
+// scene/sketch_settings.cpp; an "output" or "sheet" field below, parsed in
+// scene/sketch_settings.cpp.
 
 #include <Eigen/Core>
 #include <filesystem>
@@ -12,129 +20,22 @@
 #include <string_view>
 #include <vector>
 
+#include "garment/garment_request.hpp"
 #include "garment/sketch_error.hpp"
+#include "sim/adaptive_settings.hpp"
 
-namespace sd::garment {
+namespace sd::scene {
 
 inline constexpr const char* kSketchFormat = "sketchdrape/1";
 
-enum class ViewKind { kFront, kBack, kLeft, kRight, kCamera };
-
-// A perspective camera; 2D stroke points are metres in the plane through `target` that faces
-// the camera (x to the camera's right, y to its up).
-struct CameraSpec {
-  Eigen::Vector3d eye{0.0, 1.3, 3.0};
-  Eigen::Vector3d target{0.0, 1.0, 0.0};
-  Eigen::Vector3d up{0.0, 1.0, 0.0};
-  double fov_degrees = 35.0;  // vertical field of view (images only)
-};
-
-struct ViewSpec {
-  ViewKind kind = ViewKind::kFront;
-  CameraSpec camera;  // used when kind == kCamera
-  std::string name() const;
-};
-
-struct CurveSpec {
-  std::string id;
-  std::string json_path;                  // "/curves/3"
-  ViewSpec view;                          // the view `points` were drawn in
-  std::vector<Eigen::Vector2d> points;    // view-plane metres; empty when points3d is given
-  std::vector<Eigen::Vector3d> points3d;  // world metres; empty when points is given
-  double offset = 0.0;                    // metres along the body normal (default: file's)
-  bool on_body = true;                    // project/snap onto the body's offset surface
-  bool smooth = true;                     // Catmull-Rom through the points (false: polyline)
-  bool closed = false;                    // the last point joins the first
-  std::optional<double> edge_length;      // metres; overrides panel and global
-  std::optional<int> edges;               // fixed edge count (parity may not change it)
-
-  bool is_3d() const { return !points3d.empty(); }
-};
-
-// A point inside an "auto" panel: drawn in a view (`point`, projected onto the body like a
-// stroke point) or given in the world (`point3d`, used as written).
-struct SeedSpec {
-  std::string json_path;                   // "/panels/1/seed"
-  ViewSpec view;                           // the view `point` was drawn in
-  std::optional<Eigen::Vector2d> point;    // view-plane metres
-  std::optional<Eigen::Vector3d> point3d;  // world metres
-};
-
-// How a panel's interior takes its shape (docs/garment.md, "Panel surfaces"): spanned by its
-// boundary curves and pushed out of the body only where it would be inside ("free"), laid on
-// the body's offset surface ("body"), or chosen from how far the spanned surface is from the
-// body ("auto").
-enum class PanelFit { kAuto, kBody, kFree };
-
-struct PanelSpec {
-  std::string id;
-  std::string json_path;                 // "/panels/1"
-  std::vector<std::string> boundary;     // curve ids in order around the panel
-  bool auto_boundary = false;            // "boundary": "auto"
-  std::optional<SeedSpec> seed;          // "auto": which region of the curve network
-  std::vector<std::string> corners;      // curves whose start (along the loop) is a corner
-  std::string fabric;                    // default: the file's fabric
-  bool mirror = false;                   // also make the copy across x = 0
-  std::optional<double> edge_length;     // metres
-  double ease = 1.0;                     // rest shape scale (1 = as designed)
-  std::optional<std::string> rest;       // "flat" | "shaped"; default: simulate.rest
-  std::optional<double> seam_allowance;  // metres; default: output.pattern.seam_allowance
-  PanelFit fit = PanelFit::kAuto;        // "fit"
-};
-
-struct JoinSpec {
-  std::string id;
-  std::string json_path;
-  std::vector<std::string> panels;
-};
-
-// One keyframe of a "poses" motion: the body file of that pose and when the body is in it.
-struct BodyPoseSpec {
-  double time = 0.0;  // s of the drape, > 0 (the body's own mesh is the pose at 0)
-  std::string mesh;   // path relative to the sketch file
-  std::string json_path;
-};
-
-// "body": {"motion": {...}}: the body moving during the drape. Two kinds: "arms-lowering", the
-// A-pose mannequin's arms turning towards the body about the shoulders
-// (sim::make_arm_lowering), and "poses", meshes of the same body in other poses at given
-// times, interpolated linearly in between (sim::PoseSequence).
-struct BodyMotionSpec {
-  std::string type = "arms-lowering";
-  double degrees = 10.0;  // arms-lowering: rotation at the end; negative raises the arms
-  double start = 0.0;     // arms-lowering: s, the arms start moving at this time of the drape
-  double duration = 1.0;  // arms-lowering: s from start to end
-  std::vector<BodyPoseSpec> poses;  // poses: strictly increasing times
-};
-
-struct BodySpec {
-  std::string mesh = "builtin";          // "builtin", "none", or a path relative to the sketch file
-  std::optional<double> height;          // metres
-  std::optional<double> scale;           // metres per file unit
-  std::optional<std::string> up;         // "+z", "y", ...
-  std::optional<BodyMotionSpec> motion;  // a still body when absent
-};
-
-// "simulate": {"adaptive": {...}}: the adaptive 4-8 detail's settings. Unset values take the
-// simulator's defaults (sim::AdaptiveSettings, docs/adaptive.md).
-struct AdaptiveSpec {
-  std::optional<double> refine_threshold;   // m of sag above which an edge is split
-  std::optional<double> coarsen_threshold;  // m of sag below which a block may be merged
-  std::optional<double> steady_rate;        // rad/s: hinges turning faster are not merged
-  std::optional<double> min_lifetime;       // s a triangle lives before it may be merged
-  std::optional<int> min_level;             // coarsest level a merge returns to
-  std::optional<int> max_level;             // finest level a split makes
-  std::optional<int> max_vertices;          // particle budget, 0: none
-  std::optional<double> merge_batch;        // fraction of the particles lone merges wait for
-  std::optional<bool> even_levels;          // keep the leaves on even levels
-};
-
 // How the drape is simulated (`sketchdrape run`): plain values with defaults.
 struct SimulateSpec {
-  double duration = 3.0;                      // seconds of simulated time at most
-  bool adaptive = true;                       // 4-8 refinement/coarsening
-  bool adaptive_given = false;                // the file says "adaptive" (a sheet adapts only then)
-  AdaptiveSpec adaptive_settings;             // "adaptive": {...} (with "enabled" for the bool)
+  double duration = 3.0;        // seconds of simulated time at most
+  bool adaptive = true;         // 4-8 refinement/coarsening
+  bool adaptive_given = false;  // the file says "adaptive" (a sheet adapts only then)
+  // "adaptive": {...} (with "enabled" for the bool): the simulator's own settings, its defaults
+  // where the file says nothing (docs/adaptive.md); checked together by run (validate()).
+  sim::AdaptiveSettings adaptive_settings;
   double time_step = 1.0 / 60.0;              // seconds, the largest step
   std::string integrator = "implicit-euler";  // "implicit-euler" | "bdf2"
   std::string solver = "cholmod";             // "pcg" | "cholmod"
@@ -177,7 +78,7 @@ struct SheetSpec {
 struct ImageSpec {
   // "front", "back", "left", "right", "three-quarter", or "camera" (then `camera` is used).
   std::string view = "front";
-  CameraSpec camera;
+  garment::CameraSpec camera;
   int width = 800;
   int height = 1200;
   std::optional<bool> wireframe;  // default: output.wireframe
@@ -199,32 +100,17 @@ struct OutputSpec {
   std::optional<PatternSpec> pattern;  // absent: no pattern files
 };
 
-struct Sketch {
-  std::string file;                // as given, for messages
-  std::filesystem::path base_dir;  // relative paths resolve here
-  BodySpec body;
-  double edge_length = 0.03;           // metres
-  double offset = 0.01;                // default curve offset, metres
-  double junction_tolerance = 0.015;   // metres: endpoints closer than this meet
-  double corner_angle_degrees = 35.0;  // a junction turning more than this is a corner
-  int relax_iterations = 10;           // interior smoothing sweeps of the quad filler
+// The whole file. The garment request is its base rather than a member: garment/ takes it as
+// `const garment::GarmentRequest&`, and the app and the tests keep reading `sketch.curves`,
+// `sketch.body`, ... where they always did (fields other branches add keep their place).
+struct Sketch : garment::GarmentRequest {
   std::string fabric =
       "jersey";  // a preset of data/fabrics or a fabric .json path (sketchdrape run checks it)
   std::string
       fabric_inline;  // "fabric" given as an object: its JSON text (then `fabric` is its name)
-  std::optional<std::string> garment_mesh;  // triangle garment file: skips sketching and meshing
   std::optional<SheetSpec> sheet;  // a sheet scene: no curves, panels or (unless given) body
-  std::vector<CurveSpec> curves;
-  std::vector<PanelSpec> panels;
-  std::vector<JoinSpec> joins;
   SimulateSpec simulate;
   OutputSpec output;
-
-  // Throws SketchError(file, json_path, sentence).
-  [[noreturn]] void fail(const std::string& json_path, const std::string& sentence) const;
-  const CurveSpec* find_curve(std::string_view id) const;
-  const PanelSpec* find_panel(std::string_view id) const;
-  std::filesystem::path resolve(const std::string& relative) const;
 };
 
 // Parses and validates the text of a sketch file; `file` names it in errors, `base_dir` is where
@@ -235,4 +121,4 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
 // Reads and parses a sketch file. Throws SketchError (also when the file cannot be read).
 Sketch load_sketch(const std::filesystem::path& path);
 
-}  // namespace sd::garment
+}  // namespace sd::scene

@@ -14,6 +14,11 @@
 #include "tests/garment/bad_cases.hpp"
 
 namespace sd::garment {
+// The tests read sketch files through the scene layer.
+using scene::load_sketch;
+using scene::parse_sketch;
+using scene::Sketch;
+
 namespace {
 
 TEST(BadInput, EveryFileFailsWithPathAndSentence) {

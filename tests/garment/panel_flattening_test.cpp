@@ -12,6 +12,9 @@
 #include "tests/garment/test_helpers.hpp"
 
 namespace sd::garment {
+// The tests read sketch files through the scene layer.
+using scene::load_sketch;
+
 namespace {
 
 constexpr double kPi = std::numbers::pi;

@@ -13,6 +13,10 @@
 #include "tests/garment/test_helpers.hpp"
 
 namespace sd::garment {
+// The tests read sketch files through the scene layer.
+using scene::load_sketch;
+using scene::Sketch;
+
 namespace {
 
 TEST(PanelSurface, HarmonicSpanReproducesALinearBoundary) {

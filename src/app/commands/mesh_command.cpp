@@ -67,7 +67,7 @@ nlohmann::json quality_json(const meshing::QuadQuality& q) {
 
 void run_mesh(const MeshOptions& options) {
   const auto start = Clock::now();
-  const garment::Sketch sketch = garment::load_sketch(options.sketch);
+  const scene::Sketch sketch = scene::load_sketch(options.sketch);
   check_sketch(sketch);  // the fabrics and settings `run` would refuse, refused here too
   const std::filesystem::path dir(options.out);
   StagedOutputs outputs;

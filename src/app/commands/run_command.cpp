@@ -57,11 +57,11 @@ struct Frame {
 };
 
 // The images of a run: the file's list, or front, back and left when it lists none.
-std::vector<garment::ImageSpec> run_images(const garment::Sketch& sketch) {
+std::vector<scene::ImageSpec> run_images(const scene::Sketch& sketch) {
   if (sketch.output.images_listed) return sketch.output.images;
-  std::vector<garment::ImageSpec> images;
+  std::vector<scene::ImageSpec> images;
   for (const char* view : {"front", "back", "left"}) {
-    garment::ImageSpec image;
+    scene::ImageSpec image;
     image.view = view;
     image.width = 600;
     image.height = 900;
@@ -196,25 +196,16 @@ nlohmann::json strain_json(const sim::ClothModel& model, const Eigen::MatrixX3d&
   return out;
 }
 
-// The sketch's "simulate": {"adaptive": {...}} over the simulator's defaults.
-sim::AdaptiveSettings adaptive_settings(const garment::Sketch& sketch) {
-  const garment::AdaptiveSpec& spec = sketch.simulate.adaptive_settings;
-  sim::AdaptiveSettings s;
-  s.refine_threshold = spec.refine_threshold.value_or(s.refine_threshold);
-  s.coarsen_threshold = spec.coarsen_threshold.value_or(s.coarsen_threshold);
-  s.steady_rate = spec.steady_rate.value_or(s.steady_rate);
-  s.min_lifetime = spec.min_lifetime.value_or(s.min_lifetime);
-  s.min_level = spec.min_level.value_or(s.min_level);
-  s.max_level = spec.max_level.value_or(s.max_level);
-  s.max_vertices = spec.max_vertices.value_or(s.max_vertices);
-  s.merge_batch = spec.merge_batch.value_or(s.merge_batch);
-  s.even_levels = spec.even_levels.value_or(s.even_levels);
+// The sketch's "simulate": {"adaptive": {...}} (the simulator's own settings), checked together
+// here: a value the file gives against a default (a coarsen threshold at or above the default
+// refine threshold) is refused at /simulate/adaptive.
+sim::AdaptiveSettings adaptive_settings(const scene::Sketch& sketch) {
   try {
-    s.validate();  // e.g. a coarsen threshold set at or above the default refine threshold
+    sketch.simulate.adaptive_settings.validate();
   } catch (const sim::InvalidAdaptiveSettingsError& e) {
     sketch.fail("/simulate/adaptive", e.what());
   }
-  return s;
+  return sketch.simulate.adaptive_settings;
 }
 
 // Per accepted step: time, splits (requested and forced), merges and particles after it.
@@ -240,7 +231,7 @@ std::string memory_text(double bytes) {
 
 void run_drape(const RunOptions& options, const GlobalOptions& global) {
   const auto start = Clock::now();
-  const garment::Sketch sketch = garment::load_sketch(options.sketch);
+  const scene::Sketch sketch = scene::load_sketch(options.sketch);
   check_sketch(sketch);
   const sim::SimulationSettings settings = simulation_settings(sketch);
   RunLimits limits;
@@ -431,9 +422,9 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
                                 "drape-failed"));
     const std::optional<meshing::TriMesh> body_now =
         scene.body ? std::optional(body_at(scene, report.sim_time)) : std::nullopt;
-    std::vector<garment::ImageSpec> sides;
+    std::vector<scene::ImageSpec> sides;
     for (const char* view : {"front", "back", "left", "right"}) {
-      garment::ImageSpec image;
+      scene::ImageSpec image;
       image.view = view;
       image.width = 600;
       image.height = 900;
@@ -463,13 +454,13 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   const std::optional<meshing::TriMesh> body_end =
       scene.body ? std::optional(body_at(scene, report.sim_time)) : std::nullopt;
   const PreviewCloth preview{draped, triangle_group, render::triangle_edges(draped), face_levels};
-  const std::vector<garment::ImageSpec> image_specs = run_images(sketch);
+  const std::vector<scene::ImageSpec> image_specs = run_images(sketch);
   const std::vector<std::string> images =
       stage_preview_images(image_specs, sketch.output.wireframe, body_end ? &*body_end : nullptr,
                            preview, "drape", dir, outputs);
   // The sequence: the first image the file asks for (front by default), without edges.
-  std::vector<garment::ImageSpec> frame_image = {image_specs.empty() ? garment::ImageSpec{}
-                                                                     : image_specs.front()};
+  std::vector<scene::ImageSpec> frame_image = {image_specs.empty() ? scene::ImageSpec{}
+                                                                   : image_specs.front()};
   frame_image.front().wireframe = false;
   for (std::size_t i = 0; i < frames.size(); ++i) {
     const std::optional<meshing::TriMesh> body =

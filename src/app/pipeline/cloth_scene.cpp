@@ -21,7 +21,7 @@ namespace {
 // The fabric at `json_path`: the sketch's inline fabric object (by its name), a preset name,
 // or a path to a fabric .json file (relative to the sketch); else a SketchError at the JSON
 // path of the bad value ("/fabric/bend" for an inline constant) that lists the known presets.
-sim::FabricParameters fabric_at(const garment::Sketch& sketch, const std::string& name,
+sim::FabricParameters fabric_at(const scene::Sketch& sketch, const std::string& name,
                                 const std::string& json_path) {
   // A panel without its own fabric carries the file's name for it, inline ones included.
   if (!sketch.fabric_inline.empty() && name == sketch.fabric) {
@@ -47,7 +47,7 @@ sim::FabricParameters fabric_at(const garment::Sketch& sketch, const std::string
 }
 
 // simulate.pin_above: holds every vertex that starts at or above that height.
-void pin_above(const garment::Sketch& sketch, ClothScene& scene) {
+void pin_above(const scene::Sketch& sketch, ClothScene& scene) {
   if (!sketch.simulate.pin_above) return;
   const std::size_t before = scene.pinned.size();  // a sheet's named pins come first
   for (Eigen::Index v = 0; v < scene.start.rows(); ++v)
@@ -60,8 +60,8 @@ void pin_above(const garment::Sketch& sketch, ClothScene& scene) {
                             *sketch.simulate.pin_above, scene.start.col(1).maxCoeff()));
 }
 
-void build_sheet_scene(const garment::Sketch& sketch, ClothScene& scene) {
-  const garment::SheetSpec& spec = *sketch.sheet;
+void build_sheet_scene(const scene::Sketch& sketch, ClothScene& scene) {
+  const scene::SheetSpec& spec = *sketch.sheet;
   sim::SheetSpec sheet;
   sheet.size = spec.size;
   sheet.columns = spec.columns;
@@ -139,7 +139,7 @@ void build_sheet_scene(const garment::Sketch& sketch, ClothScene& scene) {
 // Each triangle's rest coordinates are its pattern triangle's, with u along the piece's +y (the
 // warp) and v along weft = normal × warp, which is −x on a piece seen from outside; shaped panels
 // keep their drawn triangles. Ease is applied later, as for shaped panels (build_scene_model).
-void flat_rest_shapes(const garment::Sketch& sketch, const garment::Garment& g,
+void flat_rest_shapes(const scene::Sketch& sketch, const garment::Garment& g,
                       const meshing::Mesh48& m48, const garment::MaterialFrames& frames,
                       ClothScene& scene) {
   std::vector<bool> flat(g.panels.size(), false);
@@ -197,7 +197,7 @@ void flat_rest_shapes(const garment::Sketch& sketch, const garment::Garment& g,
     throw std::runtime_error("flat rest: a triangle's vertex is missing from its pattern piece");
 }
 
-void build_garment_scene(const garment::Sketch& sketch, ClothScene& scene) {
+void build_garment_scene(const scene::Sketch& sketch, ClothScene& scene) {
   scene.body = garment::load_sketch_body(sketch);
   const garment::BodySurface surface(scene.body->mesh);
   const auto start = std::chrono::steady_clock::now();
@@ -265,7 +265,7 @@ void build_garment_scene(const garment::Sketch& sketch, ClothScene& scene) {
 
 // An imported triangle garment: its 4-8 mesh comes from the sqrt3 conversion; warp is the
 // in-plane direction closest to +Y (the simulator's default when no warp is given).
-void build_imported_scene(const garment::Sketch& sketch, ClothScene& scene) {
+void build_imported_scene(const scene::Sketch& sketch, ClothScene& scene) {
   if (sketch.body.mesh != "none") scene.body = garment::load_sketch_body(sketch);
   const meshing::TriMesh triangles = garment::load_garment_mesh(sketch);
   meshing::Mesh48 m48 = [&] {
@@ -295,8 +295,8 @@ void build_imported_scene(const garment::Sketch& sketch, ClothScene& scene) {
 
 }  // namespace
 
-sim::SimulationSettings simulation_settings(const garment::Sketch& sketch) {
-  const garment::SimulateSpec& spec = sketch.simulate;
+sim::SimulationSettings simulation_settings(const scene::Sketch& sketch) {
+  const scene::SimulateSpec& spec = sketch.simulate;
   sim::SimulationSettings settings;
   settings.integrator =
       sim::parse_integrator(spec.integrator).value_or(sim::Integrator::implicit_euler);
@@ -364,7 +364,7 @@ Eigen::VectorXi triangle_groups(const ClothScene& scene, const Eigen::VectorXi& 
 
 // The motion of the sketch's body: the arms lowering, or the body's own poses at given times
 // (its mesh is the pose at time 0).
-sim::PoseSequence body_motion(const garment::Sketch& sketch, const garment::Body& body) {
+sim::PoseSequence body_motion(const scene::Sketch& sketch, const garment::Body& body) {
   const garment::BodyMotionSpec& spec = *sketch.body.motion;
   if (spec.type == "poses") {
     std::vector<double> times = {0.0};
@@ -391,7 +391,7 @@ sim::PoseSequence body_motion(const garment::Sketch& sketch, const garment::Body
   return sim::make_arm_lowering(body.mesh, options);
 }
 
-ClothScene build_cloth_scene(const garment::Sketch& sketch) {
+ClothScene build_cloth_scene(const scene::Sketch& sketch) {
   ClothScene scene;
   if (sketch.sheet) {
     build_sheet_scene(sketch, scene);

@@ -59,7 +59,7 @@ struct ClothScene {
 
 // Builds the scene. Throws garment::SketchError (with the JSON path) for anything the designer
 // can fix: an unknown fabric, a body that will not load, panels that do not close, ...
-ClothScene build_cloth_scene(const garment::Sketch& sketch);
+ClothScene build_cloth_scene(const scene::Sketch& sketch);
 
 // The body as it stands at time t of the drape (its pose when it moves). The scene must have a
 // body.
@@ -88,6 +88,6 @@ Eigen::VectorXi triangle_groups(const ClothScene& scene, const Eigen::VectorXi& 
 
 // The simulator settings of the file's "simulate" section (integrator, solver, step, duration,
 // gravity). Throws garment::SketchError at /simulate when they cannot work together.
-sim::SimulationSettings simulation_settings(const garment::Sketch& sketch);
+sim::SimulationSettings simulation_settings(const scene::Sketch& sketch);
 
 }  // namespace sd::app
