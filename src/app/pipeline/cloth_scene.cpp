@@ -9,11 +9,11 @@
 #include <limits>
 #include <numbers>
 
-#include "garment/body_surface.hpp"
 #include "garment/material_frames.hpp"
 #include "garment/sketch_inputs.hpp"
 #include "sim/sheet.hpp"
 #include "sim/simulation.hpp"
+#include "src/app/pipeline/garment_stage.hpp"
 
 namespace sd::app {
 namespace {
@@ -198,12 +198,10 @@ void flat_rest_shapes(const scene::Sketch& sketch, const garment::Garment& g,
 }
 
 void build_garment_scene(const scene::Sketch& sketch, ClothScene& scene) {
-  scene.body = garment::load_sketch_body(sketch);
-  const garment::BodySurface surface(scene.body->mesh);
-  const auto start = std::chrono::steady_clock::now();
-  garment::Garment g = garment::build_garment(sketch, surface);
-  scene.meshing_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  MeshedGarment meshed = mesh_garment(sketch);  // the stage `mesh` writes out
+  scene.body = std::move(meshed.body);
+  scene.meshing_ms = meshed.meshing_ms;
+  garment::Garment& g = meshed.garment;
 
   // One fabric per simulation for now: the first panel's; others are reported if different.
   const garment::GarmentPanel& first = g.panels.front();
@@ -220,20 +218,11 @@ void build_garment_scene(const scene::Sketch& sketch, ClothScene& scene) {
           "and uses '{}' (panel '{}') throughout",
           p.id, p.fabric, first.fabric, first.id);
 
-  meshing::Mesh48 m48 = meshing::Mesh48::from_quads(g.mesh);
-  const std::vector<std::string> problems = m48.validate();
-  if (!problems.empty()) throw std::runtime_error("4-8 mesh check failed: " + problems.front());
+  meshing::Mesh48& m48 = meshed.mesh48;
   const meshing::Mesh48Arrays arrays = m48.arrays();
   const garment::MaterialFrames frames = garment::material_frames(g.mesh);
-
-  // Groups: a join's panels share its group.
-  std::vector<int> panel_group(g.panels.size());
-  for (size_t p = 0; p < g.panels.size(); ++p) {
-    auto it = std::find(scene.group_names.begin(), scene.group_names.end(), g.panels[p].group);
-    if (it == scene.group_names.end())
-      it = scene.group_names.insert(scene.group_names.end(), g.panels[p].group);
-    panel_group[p] = static_cast<int>(it - scene.group_names.begin());
-  }
+  scene.group_names = meshed.group_names;
+  const std::vector<int>& panel_group = meshed.panel_group;
 
   // Per quad: group, ease and warp (the material frames, computed once here).
   const Eigen::Index quads = g.mesh.face_count();
@@ -267,15 +256,9 @@ void build_garment_scene(const scene::Sketch& sketch, ClothScene& scene) {
 // in-plane direction closest to +Y (the simulator's default when no warp is given).
 void build_imported_scene(const scene::Sketch& sketch, ClothScene& scene) {
   if (sketch.body.mesh != "none") scene.body = garment::load_sketch_body(sketch);
-  const meshing::TriMesh triangles = garment::load_garment_mesh(sketch);
-  meshing::Mesh48 m48 = [&] {
-    try {
-      return meshing::Mesh48::from_triangles_sqrt3(triangles);
-    } catch (const meshing::Mesh48InputError& e) {
-      sketch.fail("/garment_mesh",
-                  fmt::format("the garment mesh cannot become a 4-8 mesh: {}", e.what()));
-    }
-  }();
+  ImportedGarment imported = import_garment(sketch);  // the stage `mesh` writes out
+  const meshing::TriMesh& triangles = imported.triangles;
+  meshing::Mesh48& m48 = imported.mesh48;
   const meshing::Mesh48Arrays arrays = m48.arrays();
   scene.input.rest_positions = arrays.rest_positions;
   scene.input.triangles = arrays.faces;
