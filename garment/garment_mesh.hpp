@@ -1,8 +1,14 @@
 #pragma once
-// From a sketch to one stitched garment: strokes projected on the body, the curve network, panel
-// loops, edge counts with the parity fix, boundary vertices placed once per curve piece (shared
-// by the panels on both sides), every panel filled with quads and projected onto the body's
-// offset surface, mirror copies made by reflecting the filled original.
+// From a garment request to one stitched garment, in named stages (garment_mesh.cpp):
+// 1. resolve_network: strokes projected on the body, the curve network, panel loops, edge counts
+//    with the parity fix, panel sizes checked;
+// 2. seam_users: each curve piece a seam between at most two panels;
+// 3. per panel: boundary vertices placed once per curve piece (BoundaryVertices, shared by the
+//    panels on both sides), the panel filled with quads on the body's offset surface or across
+//    a hollow (fill_panel, panel_fill.hpp), mirror copies made by reflecting the filled original;
+// 4. assemble_mesh: doublets merged, unused vertices dropped, one quad mesh;
+// 5. check_fans, check_seam_directions: the panels meet along seams, facing the same way;
+// 6. label_panels: join groups, body parts, areas.
 
 #include <Eigen/Core>
 #include <string>
