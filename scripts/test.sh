@@ -30,6 +30,7 @@ if [ "${1:-}" = --sanitize ]; then
 fi
 ./scripts/setup.sh test
 ./scripts/check_format.sh
+./scripts/check_layering.sh
 
 # The test executables link the simulator directly: give CHOLMOD's OpenMP loops and OpenBLAS one
 # thread, as `sketchdrape` does for itself (docs/simulator.md, "Threads").
