@@ -106,7 +106,7 @@ double arc_to(const Eigen::MatrixX3d& pts, bool closed, double param) {
 // from it: a centre seam snapped into the crotch of a body that is not exactly symmetric (the
 // Collada human) lands up to a centimetre to one side, and without its own mirror the panel and
 // its copy were not sewn along it (a mesh that touched itself at one vertex).
-bool written_on_plane(const Sketch& sketch, const std::string& id) {
+bool written_on_plane(const GarmentRequest& sketch, const std::string& id) {
   for (const CurveSpec& spec : sketch.curves) {
     if (spec.id != id) continue;
     if (spec.is_3d())
@@ -163,7 +163,7 @@ int CurveNetwork::find_curve(const std::string& id) const {
   return -1;
 }
 
-CurveNetwork build_network(const Sketch& sketch, const std::vector<ProjectedCurve>& curves,
+CurveNetwork build_network(const GarmentRequest& sketch, const std::vector<ProjectedCurve>& curves,
                            const std::set<std::string>& mirrored) {
   const double tol = sketch.junction_tolerance;
   std::vector<WorkCurve> work(curves.size());

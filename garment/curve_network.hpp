@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "garment/sketch_file.hpp"
+#include "garment/garment_request.hpp"
 #include "garment/stroke_projection.hpp"
 
 namespace sd::garment {
@@ -44,7 +44,7 @@ struct CurveNetwork {
 // Builds the network. `mirrored` holds the ids of the curves that need mirror copies.
 // Curves within `tolerance` of x = 0 at an end (or entirely) are snapped onto the plane when
 // mirrored, so their copies meet them there exactly.
-CurveNetwork build_network(const Sketch& sketch, const std::vector<ProjectedCurve>& curves,
+CurveNetwork build_network(const GarmentRequest& sketch, const std::vector<ProjectedCurve>& curves,
                            const std::set<std::string>& mirrored);
 
 // Polyline length, metres.

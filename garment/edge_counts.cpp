@@ -244,7 +244,7 @@ std::optional<std::vector<int>> solve_parity(int constraint_count, const std::ve
   return chosen;
 }
 
-EdgeCounts compute_edge_counts(const Sketch& sketch, const CurveNetwork& net,
+EdgeCounts compute_edge_counts(const GarmentRequest& sketch, const CurveNetwork& net,
                                const std::vector<PanelLoop>& loops) {
   const size_t edge_count = net.edges.size();
   EdgeCounts result;

@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "garment/curve_network.hpp"
+#include "garment/garment_request.hpp"
 #include "garment/panel_loop.hpp"
-#include "garment/sketch_file.hpp"
 
 namespace sd::garment {
 
@@ -41,7 +41,7 @@ std::optional<std::vector<int>> solve_parity(int constraint_count, const std::ve
 
 // Counts for every edge used by a panel (others get their rounded count). Throws SketchError
 // when a fixed "edges" cannot be honoured or a panel's total cannot be made even.
-EdgeCounts compute_edge_counts(const Sketch& sketch, const CurveNetwork& net,
+EdgeCounts compute_edge_counts(const GarmentRequest& sketch, const CurveNetwork& net,
                                const std::vector<PanelLoop>& loops);
 
 }  // namespace sd::garment

@@ -1,15 +1,21 @@
 #pragma once
-// From a sketch to one stitched garment: strokes projected on the body, the curve network, panel
-// loops, edge counts with the parity fix, boundary vertices placed once per curve piece (shared
-// by the panels on both sides), every panel filled with quads and projected onto the body's
-// offset surface, mirror copies made by reflecting the filled original.
+// From a garment request to one stitched garment, in named stages (garment_mesh.cpp):
+// 1. resolve_network: strokes projected on the body, the curve network, panel loops, edge counts
+//    with the parity fix, panel sizes checked;
+// 2. seam_users: each curve piece a seam between at most two panels;
+// 3. per panel: boundary vertices placed once per curve piece (BoundaryVertices, shared by the
+//    panels on both sides), the panel filled with quads on the body's offset surface or across
+//    a hollow (fill_panel, panel_fill.hpp), mirror copies made by reflecting the filled original;
+// 4. assemble_mesh: doublets merged, unused vertices dropped, one quad mesh;
+// 5. check_fans, check_seam_directions: the panels meet along seams, facing the same way;
+// 6. label_panels: join groups, body parts, areas.
 
 #include <Eigen/Core>
 #include <string>
 #include <vector>
 
 #include "garment/body_surface.hpp"
-#include "garment/sketch_file.hpp"
+#include "garment/garment_request.hpp"
 #include "meshing/quad_mesh.hpp"
 #include "meshing/quad_quality.hpp"
 
@@ -59,6 +65,6 @@ struct Garment {
 
 // The whole meshing pipeline for a sketch with curves and panels. Throws SketchError for
 // anything the designer can fix (with the JSON path), std::runtime_error for internal failures.
-Garment build_garment(const Sketch& sketch, const BodySurface& body);
+Garment build_garment(const GarmentRequest& sketch, const BodySurface& body);
 
 }  // namespace sd::garment

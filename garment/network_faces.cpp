@@ -172,7 +172,7 @@ NetworkFaces trace_faces(const CurveNetwork& net, const BodySurface& body) {
   return result;
 }
 
-Eigen::Vector3d seed_position(const Sketch& sketch, const PanelSpec& panel,
+Eigen::Vector3d seed_position(const GarmentRequest& sketch, const PanelSpec& panel,
                               const BodySurface& body) {
   const SeedSpec& seed = *panel.seed;
   if (seed.point3d) return *seed.point3d;
@@ -188,7 +188,7 @@ Eigen::Vector3d seed_position(const Sketch& sketch, const PanelSpec& panel,
   return hit->position;
 }
 
-std::vector<LoopEdge> auto_panel_loop(const Sketch& sketch, const CurveNetwork& net,
+std::vector<LoopEdge> auto_panel_loop(const GarmentRequest& sketch, const CurveNetwork& net,
                                       const NetworkFaces& faces, const BodySurface& body,
                                       const PanelSpec& panel) {
   const Eigen::Vector3d seed = seed_position(sketch, panel, body);
@@ -248,7 +248,8 @@ std::vector<LoopEdge> auto_panel_loop(const Sketch& sketch, const CurveNetwork& 
   return loop;
 }
 
-std::set<std::string> auto_panel_curves_to_mirror(const Sketch& sketch, const CurveNetwork& net,
+std::set<std::string> auto_panel_curves_to_mirror(const GarmentRequest& sketch,
+                                                  const CurveNetwork& net,
                                                   const BodySurface& body) {
   std::set<std::string> ids;
   const bool any = std::any_of(sketch.panels.begin(), sketch.panels.end(),

@@ -14,8 +14,8 @@
 
 #include "garment/body_surface.hpp"
 #include "garment/curve_network.hpp"
+#include "garment/garment_request.hpp"
 #include "garment/panel_loop.hpp"
-#include "garment/sketch_file.hpp"
 
 namespace sd::garment {
 
@@ -31,19 +31,19 @@ NetworkFaces trace_faces(const CurveNetwork& net, const BodySurface& body);
 
 // The seed of an "auto" panel in world coordinates: a view point cast onto the body along its
 // view ray (the first hit), or point3d as written. Throws SketchError when the ray misses.
-Eigen::Vector3d seed_position(const Sketch& sketch, const PanelSpec& panel,
+Eigen::Vector3d seed_position(const GarmentRequest& sketch, const PanelSpec& panel,
                               const BodySurface& body);
 
 // The loop of an "auto" panel: the face containing its seed. Throws SketchError (at the seed's
 // path) when the seed lies on a curve, or the face is not one closed loop (a curve with a free
 // end inside it, or curves inside it not connected to its boundary).
-std::vector<LoopEdge> auto_panel_loop(const Sketch& sketch, const CurveNetwork& net,
+std::vector<LoopEdge> auto_panel_loop(const GarmentRequest& sketch, const CurveNetwork& net,
                                       const NetworkFaces& faces, const BodySurface& body,
                                       const PanelSpec& panel);
 
 // Base ids of the curves used by the loops of mirrored "auto" panels (they need mirror copies,
 // which the network only makes for curves it knows to be mirrored).
-std::set<std::string> auto_panel_curves_to_mirror(const Sketch& sketch, const CurveNetwork& net,
-                                                  const BodySurface& body);
+std::set<std::string> auto_panel_curves_to_mirror(const GarmentRequest& sketch,
+                                                  const CurveNetwork& net, const BodySurface& body);
 
 }  // namespace sd::garment

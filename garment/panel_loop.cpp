@@ -72,7 +72,7 @@ double node_gap(const CurveNetwork& net, int a, int b) {
 }
 
 // Explicit boundary list → loop edges (unoriented), or a SketchError.
-std::vector<LoopEdge> resolve_explicit(const Sketch& sketch, const CurveNetwork& net,
+std::vector<LoopEdge> resolve_explicit(const GarmentRequest& sketch, const CurveNetwork& net,
                                        const PanelSpec& panel) {
   std::vector<int> curve_ids;
   for (size_t i = 0; i < panel.boundary.size(); ++i) {
@@ -157,7 +157,7 @@ int loop_end_node(const CurveNetwork& net, const LoopEdge& e) {
   return e.forward ? edge.to : edge.from;
 }
 
-std::set<std::string> curves_to_mirror(const Sketch& sketch) {
+std::set<std::string> curves_to_mirror(const GarmentRequest& sketch) {
   std::set<std::string> ids;
   for (const PanelSpec& p : sketch.panels)
     for (const std::string& id : p.boundary) {
@@ -168,7 +168,7 @@ std::set<std::string> curves_to_mirror(const Sketch& sketch) {
   return ids;
 }
 
-std::vector<PanelLoop> resolve_panels(const Sketch& sketch, const CurveNetwork& net,
+std::vector<PanelLoop> resolve_panels(const GarmentRequest& sketch, const CurveNetwork& net,
                                       const BodySurface& body) {
   // Edge mirror map: copies point at their originals and back; on-plane edges at themselves.
   std::vector<int> mirror_edge(net.edges.size(), -1);

@@ -9,7 +9,7 @@
 
 #include "garment/body_surface.hpp"
 #include "garment/curve_network.hpp"
-#include "garment/sketch_file.hpp"
+#include "garment/garment_request.hpp"
 
 namespace sd::garment {
 
@@ -43,11 +43,11 @@ int loop_end_node(const CurveNetwork& net, const LoopEdge& e);
 // panel's explicit corners; at least 3 (the sharpest junctions are promoted). Throws
 // SketchError with the panel's path when curves do not meet, the loop does not close or a
 // panel has fewer than 3 junctions.
-std::vector<PanelLoop> resolve_panels(const Sketch& sketch, const CurveNetwork& net,
+std::vector<PanelLoop> resolve_panels(const GarmentRequest& sketch, const CurveNetwork& net,
                                       const BodySurface& body);
 
 // Ids of curves that need mirror copies: those of mirrored panels and every "<id>.mirror"
 // reference, by base id.
-std::set<std::string> curves_to_mirror(const Sketch& sketch);
+std::set<std::string> curves_to_mirror(const GarmentRequest& sketch);
 
 }  // namespace sd::garment

@@ -32,7 +32,7 @@ std::string place(const Eigen::Vector3d& p, const std::string& landmark) {
 
 }  // namespace
 
-std::vector<QualityWarning> check_quality(const Garment& garment, const Sketch& sketch,
+std::vector<QualityWarning> check_quality(const Garment& garment, const GarmentRequest& sketch,
                                           const BodyLandmarks* landmarks,
                                           const QualityLimits& limits) {
   const meshing::QuadMesh& mesh = garment.mesh;

@@ -10,7 +10,7 @@
 
 #include "garment/body_landmarks.hpp"
 #include "garment/garment_mesh.hpp"
-#include "garment/sketch_file.hpp"
+#include "garment/garment_request.hpp"
 
 namespace sd::garment {
 
@@ -37,7 +37,7 @@ struct QualityWarning {
 // Checks every panel of `garment` except mirror copies (the same quads reflected: a warning on
 // the original holds for its copy). `landmarks` may be null (a body that is not a standing
 // figure).
-std::vector<QualityWarning> check_quality(const Garment& garment, const Sketch& sketch,
+std::vector<QualityWarning> check_quality(const Garment& garment, const GarmentRequest& sketch,
                                           const BodyLandmarks* landmarks,
                                           const QualityLimits& limits = {});
 

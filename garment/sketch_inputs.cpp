@@ -12,7 +12,7 @@
 
 namespace sd::garment {
 
-Body load_sketch_body(const Sketch& sketch) {
+Body load_sketch_body(const GarmentRequest& sketch) {
   if (sketch.body.mesh == "none")
     sketch.fail("/body/mesh",
                 "a garment is designed on a body: give \"builtin\" or a body mesh "
@@ -31,7 +31,7 @@ Body load_sketch_body(const Sketch& sketch) {
   }
 }
 
-meshing::TriMesh load_garment_mesh(const Sketch& sketch) {
+meshing::TriMesh load_garment_mesh(const GarmentRequest& sketch) {
   const std::string where = "/garment_mesh";
   const std::filesystem::path path = sketch.resolve(*sketch.garment_mesh);
   if (const auto problem = input_file_problem(path, kMaxMeshFileBytes))

@@ -3,18 +3,18 @@
 // name the sketch file and the JSON path of the reference.
 
 #include "garment/body.hpp"
-#include "garment/sketch_file.hpp"
+#include "garment/garment_request.hpp"
 #include "meshing/tri_mesh.hpp"
 
 namespace sd::garment {
 
 // The sketch's body (builtin or a path relative to the sketch file) with its height, scale and
 // up axis. A body that cannot be loaded throws SketchError at /body/mesh.
-Body load_sketch_body(const Sketch& sketch);
+Body load_sketch_body(const GarmentRequest& sketch);
 
 // The triangle garment of "garment_mesh" (Wavefront OBJ; polygons are fan-triangulated), in
 // metres as written. Throws SketchError at /garment_mesh when it is missing, unreadable or has
 // no faces or non-finite or out-of-range values.
-meshing::TriMesh load_garment_mesh(const Sketch& sketch);
+meshing::TriMesh load_garment_mesh(const GarmentRequest& sketch);
 
 }  // namespace sd::garment

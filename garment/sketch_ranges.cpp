@@ -71,7 +71,7 @@ std::string out_of_range_sentence(double value, double low, double high, const s
   return sentence;
 }
 
-void check_against_body(const Sketch& sketch, const meshing::BoundingBox& body_box) {
+void check_against_body(const GarmentRequest& sketch, const meshing::BoundingBox& body_box) {
   Reach reach;
   reach.height = body_box.extent().y();
   const double margin = kBodyMarginHeights * reach.height;
@@ -154,7 +154,7 @@ double estimated_quads(double boundary_edges) {
   return boundary_edges * boundary_edges / 16.0;
 }
 
-void check_panel_sizes(const Sketch& sketch, const std::vector<double>& boundary_edges,
+void check_panel_sizes(const GarmentRequest& sketch, const std::vector<double>& boundary_edges,
                        const std::vector<std::string>& panel_paths,
                        const std::vector<std::string>& panel_ids) {
   double total = 0;

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "garment/sketch_file.hpp"
+#include "garment/garment_request.hpp"
 #include "meshing/tri_mesh.hpp"
 
 namespace sd::garment {
@@ -53,7 +53,7 @@ std::string out_of_range_sentence(double value, double low, double high, const s
 // Every point, seed and camera of the sketch against the body's bounding box (metres, after
 // normalisation): within kBodyMarginHeights body heights of it; every curve's control polygon
 // at most kMaxCurveLengthHeights body heights long. Throws SketchError.
-void check_against_body(const Sketch& sketch, const meshing::BoundingBox& body_box);
+void check_against_body(const GarmentRequest& sketch, const meshing::BoundingBox& body_box);
 
 // The quads a panel whose boundary has `boundary_edges` edges can hold at most (a square region
 // of that perimeter): (B/4)².
@@ -62,7 +62,7 @@ double estimated_quads(double boundary_edges);
 // Before filling: the garment's estimated quads (sum over panels) must stay below
 // kMaxGarmentQuads. `boundary_edges[p]` and `panel_paths[p]` per panel. Throws SketchError at the
 // largest panel's path, with the edge length that would fit.
-void check_panel_sizes(const Sketch& sketch, const std::vector<double>& boundary_edges,
+void check_panel_sizes(const GarmentRequest& sketch, const std::vector<double>& boundary_edges,
                        const std::vector<std::string>& panel_paths,
                        const std::vector<std::string>& panel_ids);
 

@@ -184,7 +184,7 @@ std::pair<int, int> find_self_intersection(const Eigen::MatrixX3d& polyline, boo
   return {-1, -1};
 }
 
-ProjectedCurve project_curve(const Sketch& sketch, const CurveSpec& curve,
+ProjectedCurve project_curve(const GarmentRequest& sketch, const CurveSpec& curve,
                              const BodySurface* body) {
   ProjectedCurve out;
   out.id = curve.id;
@@ -301,7 +301,7 @@ ProjectedCurve project_curve(const Sketch& sketch, const CurveSpec& curve,
   return out;
 }
 
-std::vector<ProjectedCurve> project_curves(const Sketch& sketch, const BodySurface& body) {
+std::vector<ProjectedCurve> project_curves(const GarmentRequest& sketch, const BodySurface& body) {
   std::vector<ProjectedCurve> curves;
   curves.reserve(sketch.curves.size());
   for (const CurveSpec& c : sketch.curves) curves.push_back(project_curve(sketch, c, &body));

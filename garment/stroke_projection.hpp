@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "garment/body_surface.hpp"
-#include "garment/sketch_file.hpp"
+#include "garment/garment_request.hpp"
 
 namespace sd::garment {
 
@@ -56,10 +56,11 @@ std::vector<Eigen::Matrix<double, D, 1>> sample_stroke(
 
 // Projects one curve (body may be null only for points3d curves with on_body false).
 // Throws SketchError when the curve crosses itself or misses the body entirely.
-ProjectedCurve project_curve(const Sketch& sketch, const CurveSpec& curve, const BodySurface* body);
+ProjectedCurve project_curve(const GarmentRequest& sketch, const CurveSpec& curve,
+                             const BodySurface* body);
 
 // All curves of the sketch, in file order.
-std::vector<ProjectedCurve> project_curves(const Sketch& sketch, const BodySurface& body);
+std::vector<ProjectedCurve> project_curves(const GarmentRequest& sketch, const BodySurface& body);
 
 // Index pair (i, j) of the first two non-adjacent segments of a polyline that cross (2D) or come
 // closer than `tolerance` (3D); {-1, -1} when none do.

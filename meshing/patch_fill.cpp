@@ -1,3 +1,7 @@
+// Over 700 lines on purpose, for now: the topology plan (BoundaryShape, Plan, choose_plan,
+// realize) and the geometric fill (fill_with_plan, untangle_planar, widen_thin_quads) share the
+// private Plan and Built types, and issue 18 edits the geometric fill in parallel. Once it is
+// merged, the plan goes behind a detail header of its own (patch_plan).
 #include "meshing/patch_fill.hpp"
 
 #include <Eigen/Geometry>

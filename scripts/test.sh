@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds everything with warnings as errors, and runs every test.
 #   test.sh              the whole suite in build/
-#   test.sh --sanitize   the unit tests of the input-facing modules (meshing, garment: the
+#   test.sh --sanitize   the unit tests of the input-facing modules (meshing, garment, scene: the
 #                        sketch reader, the body loader, the quad filler) built with
 #                        AddressSanitizer and UBSan in build-asan/ (docs/cli.md, "Fuzzing")
 set -euo pipefail
@@ -10,7 +10,7 @@ if [ "${1:-}" = --sanitize ]; then
   SD_PACKAGES_ONLY=1 ./scripts/setup.sh test
   export CCACHE_BASEDIR="$PWD"
   jobs=$(nproc 2>/dev/null || echo 2)
-  units=(meshing_tests garment_tests)
+  units=(meshing_tests garment_tests scene_tests)
   # -O1 -g1 (line tables): what ASan needs for its reports; -O2 -g took 2.4 times the CPU and
   # 1.6 times the memory on garment's CGAL files (docs/cli.md, "Fuzzing and sanitizers").
   echo "==> configuring build-asan/ (-O1 -g1, ASan + UBSan)"
@@ -30,6 +30,7 @@ if [ "${1:-}" = --sanitize ]; then
 fi
 ./scripts/setup.sh test
 ./scripts/check_format.sh
+./scripts/check_layering.sh
 
 # The test executables link the simulator directly: give CHOLMOD's OpenMP loops and OpenBLAS one
 # thread, as `sketchdrape` does for itself (docs/simulator.md, "Threads").

@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "garment/sketch_file.hpp"
+#include "scene/sketch_file.hpp"
 #include "sim/cloth_model.hpp"
 
 namespace sd::app {
@@ -40,9 +40,8 @@ std::string two_patches(double ease) {
 
 TEST(ClothScene, PanelEaseScalesRestShapeAndMass) {
   constexpr double kEase = 0.9;
-  const ClothScene eased =
-      build_cloth_scene(garment::parse_sketch(two_patches(kEase), "eased.json"));
-  const ClothScene plain = build_cloth_scene(garment::parse_sketch(two_patches(1.0), "plain.json"));
+  const ClothScene eased = build_cloth_scene(scene::parse_sketch(two_patches(kEase), "eased.json"));
+  const ClothScene plain = build_cloth_scene(scene::parse_sketch(two_patches(1.0), "plain.json"));
   ASSERT_EQ(eased.input.triangles.rows(), plain.input.triangles.rows());
   ASSERT_EQ(eased.face_ease.size(), eased.mesh48->arrays().faces.rows() / 2) << "one per quad";
   ASSERT_EQ(eased.triangle_face.size(), eased.input.triangles.rows());
@@ -94,7 +93,7 @@ TEST(ClothScene, SheetLayersAndTheSelfCollisionDefault) {
                "centre": [0, 1, 0], "layers": 3, "layer_offset": [0.01, 0.05, 0],
                "layer_turn": 90 }
   })";
-  const garment::Sketch sketch = garment::parse_sketch(sheet, "layers.json");
+  const scene::Sketch sketch = scene::parse_sketch(sheet, "layers.json");
   const ClothScene scene = build_cloth_scene(sketch);
   ASSERT_EQ(scene.input.rest_positions.rows(), 3 * 25);
   ASSERT_EQ(scene.input.triangles.rows(), 3 * 32);
@@ -125,8 +124,8 @@ TEST(ClothScene, SheetLayersAndTheSelfCollisionDefault) {
   EXPECT_FALSE(simulation_settings(sketch).self_contact.enabled);
   const std::string asked = R"({
     "body": { "mesh": "none" }, "sheet": {}, "simulate": { "self_collision": true } })";
-  EXPECT_TRUE(simulation_settings(garment::parse_sketch(asked, "asked.json")).self_contact.enabled);
-  EXPECT_TRUE(simulation_settings(garment::parse_sketch(two_patches(1.0), "garment.json"))
+  EXPECT_TRUE(simulation_settings(scene::parse_sketch(asked, "asked.json")).self_contact.enabled);
+  EXPECT_TRUE(simulation_settings(scene::parse_sketch(two_patches(1.0), "garment.json"))
                   .self_contact.enabled);
 }
 
@@ -148,14 +147,14 @@ TEST(ClothScene, SheetScenesHonourPinAbove) {
       "simulate": { "pin_above": )") +
            std::to_string(height) + "} }";
   };
-  const ClothScene scene = build_cloth_scene(garment::parse_sketch(sheet(1.35), "clamp.json"));
+  const ClothScene scene = build_cloth_scene(scene::parse_sketch(sheet(1.35), "clamp.json"));
   ASSERT_EQ(scene.pinned.size(), 23u);
   for (std::size_t k = 0; k + 1 < scene.pinned.size(); ++k) {
     EXPECT_LT(scene.pinned[k], scene.pinned[k + 1]);  // sorted, unique
     EXPECT_GE(scene.start(scene.pinned[k], 1), 1.35);
   }
   EXPECT_NEAR(scene.start(scene.pinned.back(), 1), 0.5, 1e-12);  // the bottom-left corner
-  EXPECT_THROW(build_cloth_scene(garment::parse_sketch(sheet(1.6), "above.json")),
+  EXPECT_THROW(build_cloth_scene(scene::parse_sketch(sheet(1.6), "above.json")),
                garment::SketchError);
 }
 
@@ -194,10 +193,10 @@ std::string silk_with(const std::string& key, const std::string& entry) {
 // constant is reported at its JSON path.
 TEST(ClothScene, FabricIsAPresetAnInlineObjectOrAFile) {
   const ClothScene preset =
-      build_cloth_scene(garment::parse_sketch(sheet_with_fabric(R"("denim")"), "a.json"));
+      build_cloth_scene(scene::parse_sketch(sheet_with_fabric(R"("denim")"), "a.json"));
   EXPECT_EQ(preset.fabric.name, "denim");
 
-  const ClothScene inline_fabric = build_cloth_scene(garment::parse_sketch(
+  const ClothScene inline_fabric = build_cloth_scene(scene::parse_sketch(
       sheet_with_fabric(silk_with("bend", R"({"value": 3e-6, "unit": "N*m"})")), "b.json"));
   EXPECT_EQ(inline_fabric.fabric.name, "my silk");
   EXPECT_EQ(inline_fabric.fabric.bend, 3e-6);
@@ -207,12 +206,12 @@ TEST(ClothScene, FabricIsAPresetAnInlineObjectOrAFile) {
   std::filesystem::create_directories(dir);
   std::ofstream(dir / "mine.json") << silk_with("shear", R"({"value": 40.0, "unit": "N/m"})");
   const ClothScene from_file =
-      build_cloth_scene(garment::parse_sketch(sheet_with_fabric(R"("mine.json")"), "c.json", dir));
+      build_cloth_scene(scene::parse_sketch(sheet_with_fabric(R"("mine.json")"), "c.json", dir));
   EXPECT_EQ(from_file.fabric.shear, 40.0);
 
   const auto error_path = [&](const std::string& fabric) {
     try {
-      build_cloth_scene(garment::parse_sketch(sheet_with_fabric(fabric), "d.json", dir));
+      build_cloth_scene(scene::parse_sketch(sheet_with_fabric(fabric), "d.json", dir));
     } catch (const garment::SketchError& e) {
       return e.json_path() + " | " + e.sentence();
     }

@@ -10,8 +10,8 @@
 #include "garment/body.hpp"
 #include "garment/body_surface.hpp"
 #include "garment/garment_mesh.hpp"
-#include "garment/sketch_file.hpp"
 #include "garment/sketch_inputs.hpp"
+#include "scene/sketch_file.hpp"
 
 namespace {
 
@@ -25,7 +25,7 @@ void mesh_file(benchmark::State& state, const std::filesystem::path& file) {
   const sd::garment::BodySurface& body = surface();
   long quads = 0;
   for (auto _ : state) {
-    const sd::garment::Sketch sketch = sd::garment::load_sketch(file);
+    const sd::scene::Sketch sketch = sd::scene::load_sketch(file);
     const sd::garment::Garment g = sd::garment::build_garment(sketch, body);
     quads = static_cast<long>(g.mesh.face_count());
     benchmark::DoNotOptimize(g.mesh.vertices.data());
@@ -46,7 +46,7 @@ void mesh_design(benchmark::State& state, const char* name) {
 // The designs on the second body, Debian's Collada human (skipped when it is not installed).
 void mesh_human_design(benchmark::State& state, const char* name) {
   const std::filesystem::path file = std::filesystem::path(SD_SOURCE_DIR) / "data/designs" / name;
-  const sd::garment::Sketch sketch = sd::garment::load_sketch(file);
+  const sd::scene::Sketch sketch = sd::scene::load_sketch(file);
   if (!std::filesystem::exists(sketch.resolve(sketch.body.mesh))) {
     state.SkipWithError("the Collada human (assimp-testmodels) is not installed");
     return;
@@ -55,7 +55,7 @@ void mesh_human_design(benchmark::State& state, const char* name) {
   static const sd::garment::BodySurface human(body.mesh);
   long quads = 0;
   for (auto _ : state) {
-    const sd::garment::Sketch parsed = sd::garment::load_sketch(file);
+    const sd::scene::Sketch parsed = sd::scene::load_sketch(file);
     const sd::garment::Garment g = sd::garment::build_garment(parsed, human);
     quads = static_cast<long>(g.mesh.face_count());
     benchmark::DoNotOptimize(g.mesh.vertices.data());

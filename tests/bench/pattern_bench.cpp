@@ -13,13 +13,13 @@
 #include "garment/garment_mesh.hpp"
 #include "garment/panel_flattening.hpp"
 #include "garment/pattern_layout.hpp"
-#include "garment/sketch_file.hpp"
+#include "scene/sketch_file.hpp"
 #include "src/app/pipeline/pattern_export.hpp"
 
 namespace {
 
 struct Example {
-  sd::garment::Sketch sketch;
+  sd::scene::Sketch sketch;
   sd::garment::Garment garment;
 };
 
@@ -27,9 +27,9 @@ const Example& tshirt() {
   static const Example example = [] {
     const sd::garment::Body body = sd::garment::load_body("builtin");
     const sd::garment::BodySurface surface(body.mesh);
-    Example e{sd::garment::load_sketch(std::filesystem::path(SD_SOURCE_DIR) /
-                                       "data/examples/tshirt.json"),
-              {}};
+    Example e{
+        sd::scene::load_sketch(std::filesystem::path(SD_SOURCE_DIR) / "data/examples/tshirt.json"),
+        {}};
     e.garment = sd::garment::build_garment(e.sketch, surface);
     return e;
   }();
@@ -51,7 +51,7 @@ void pattern_tshirt(benchmark::State& state) {
   size_t bytes = 0;
   for (auto _ : state) {
     const sd::app::PatternSheet sheet =
-        sd::app::build_pattern_sheet(e.sketch, e.garment, sd::garment::PatternSpec{});
+        sd::app::build_pattern_sheet(e.sketch, e.garment, sd::scene::PatternSpec{});
     bytes = sd::app::pattern_svg(sheet).size() + sd::app::pattern_dxf(sheet).size() +
             sd::app::pattern_json(sheet).dump(1).size();
     benchmark::DoNotOptimize(bytes);

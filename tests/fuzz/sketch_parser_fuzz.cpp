@@ -6,13 +6,13 @@
 #include <cstdint>
 #include <string_view>
 
-#include "garment/sketch_file.hpp"
 #include "garment/sketch_ranges.hpp"
+#include "scene/sketch_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   try {
-    const sd::garment::Sketch sketch = sd::garment::parse_sketch(text, "fuzz.json", "/nonexistent");
+    const sd::scene::Sketch sketch = sd::scene::parse_sketch(text, "fuzz.json", "/nonexistent");
     // The built-in body's normalised box (docs/bodies.md).
     sd::meshing::BoundingBox box;
     box.min = Eigen::Vector3d(-0.383, 0.0, -0.129);

@@ -9,11 +9,16 @@
 #include "garment/body.hpp"
 #include "garment/body_surface.hpp"
 #include "garment/garment_mesh.hpp"
-#include "garment/sketch_file.hpp"
 #include "garment/sketch_inputs.hpp"
+#include "scene/sketch_file.hpp"
 #include "tests/garment/bad_cases.hpp"
 
 namespace sd::garment {
+// The tests read sketch files through the scene layer.
+using scene::load_sketch;
+using scene::parse_sketch;
+using scene::Sketch;
+
 namespace {
 
 TEST(BadInput, EveryFileFailsWithPathAndSentence) {

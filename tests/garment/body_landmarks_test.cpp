@@ -5,10 +5,14 @@
 #include <filesystem>
 
 #include "garment/body.hpp"
-#include "garment/sketch_file.hpp"
+#include "scene/sketch_file.hpp"
 #include "tests/garment/test_helpers.hpp"
 
 namespace sd::garment {
+// The tests read sketch files through the scene layer.
+using scene::parse_sketch;
+using scene::Sketch;
+
 namespace {
 
 // Landmarks in the order of a standing figure, left and right mirror images of each other

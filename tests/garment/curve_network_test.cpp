@@ -7,9 +7,14 @@
 
 #include "garment/body_surface.hpp"
 #include "garment/stroke_projection.hpp"
+#include "scene/sketch_file.hpp"
 #include "tests/garment/test_helpers.hpp"
 
 namespace sd::garment {
+// The tests read sketch files through the scene layer.
+using scene::parse_sketch;
+using scene::Sketch;
+
 namespace {
 
 const BodySurface& sphere() {

@@ -10,9 +10,15 @@
 #include "garment/material_frames.hpp"
 #include "garment/sketch_inputs.hpp"
 #include "meshing/quad_mesh.hpp"
+#include "scene/sketch_file.hpp"
 #include "tests/garment/test_helpers.hpp"
 
 namespace sd::garment {
+// The tests read sketch files through the scene layer.
+using scene::load_sketch;
+using scene::parse_sketch;
+using scene::Sketch;
+
 namespace {
 
 const BodySurface& builtin_surface() {

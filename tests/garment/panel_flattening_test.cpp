@@ -8,10 +8,13 @@
 #include "garment/body.hpp"
 #include "garment/body_surface.hpp"
 #include "garment/garment_mesh.hpp"
-#include "garment/sketch_file.hpp"
+#include "scene/sketch_file.hpp"
 #include "tests/garment/test_helpers.hpp"
 
 namespace sd::garment {
+// The tests read sketch files through the scene layer.
+using scene::load_sketch;
+
 namespace {
 
 constexpr double kPi = std::numbers::pi;

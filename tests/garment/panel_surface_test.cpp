@@ -7,12 +7,16 @@
 #include "garment/body.hpp"
 #include "garment/body_surface.hpp"
 #include "garment/garment_mesh.hpp"
-#include "garment/sketch_file.hpp"
 #include "meshing/slice_dent.hpp"
+#include "scene/sketch_file.hpp"
 #include "tests/garment/quad_grids.hpp"
 #include "tests/garment/test_helpers.hpp"
 
 namespace sd::garment {
+// The tests read sketch files through the scene layer.
+using scene::load_sketch;
+using scene::Sketch;
+
 namespace {
 
 TEST(PanelSurface, HarmonicSpanReproducesALinearBoundary) {

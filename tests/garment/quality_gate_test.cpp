@@ -19,8 +19,8 @@ Garment grid_garment(int n, double edge) {
   return g;
 }
 
-Sketch sketch_with_edge(double edge) {
-  Sketch sketch;
+GarmentRequest sketch_with_edge(double edge) {
+  GarmentRequest sketch;
   sketch.edge_length = edge;
   return sketch;
 }

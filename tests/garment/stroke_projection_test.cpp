@@ -15,8 +15,8 @@ const Eigen::Vector3d kCentre(0, 1, 0);
 // Sag of a level-5 octahedral sphere is below 4e-4 R; 5e-4 m bounds it for R = 0.3 m.
 constexpr double kFacetTolerance = 5e-4;
 
-Sketch sketch_with(const CurveSpec& curve) {
-  Sketch s;
+GarmentRequest sketch_with(const CurveSpec& curve) {
+  GarmentRequest s;
   s.file = "t.json";
   s.curves.push_back(curve);
   return s;

@@ -8,7 +8,7 @@
 #include <system_error>
 #include <vector>
 
-#include "garment/sketch_file.hpp"
+#include "scene/sketch_file.hpp"
 #include "src/app/pipeline/atomic_file.hpp"
 #include "src/app/pipeline/sha256.hpp"
 
@@ -95,7 +95,7 @@ PlannedJob plan_job(const BatchJob& job, std::string_view stage, std::string_vie
       // The sketch parser's message names the line and column of the syntax error.
       planned.input_error = fmt::format("{}: the file is not valid JSON", job.sketch.string());
       try {
-        garment::parse_sketch(text, job.sketch.string(), job.sketch.parent_path());
+        scene::parse_sketch(text, job.sketch.string(), job.sketch.parent_path());
       } catch (const std::exception& e) {
         planned.input_error = e.what();
       }

@@ -16,7 +16,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
-#include "garment/sketch_file.hpp"
+#include "scene/sketch_file.hpp"
 #include "sim/automatic_settings.hpp"
 #include "sim/cloth_driver.hpp"
 #include "sim/sheet.hpp"
@@ -129,7 +129,7 @@ std::filesystem::path find_example(const std::string& file) {
 }
 
 BenchScene sketch_scene(const std::filesystem::path& file, BenchGrid grid) {
-  const garment::Sketch sketch = garment::load_sketch(file);
+  const scene::Sketch sketch = scene::load_sketch(file);
   if (sketch.garment_mesh)
     throw BenchSceneError(fmt::format(
         "{}: bench runs sheets and sketched garments; an imported garment mesh is not supported",
@@ -141,7 +141,7 @@ BenchScene sketch_scene(const std::filesystem::path& file, BenchGrid grid) {
   scene.settings.forces = settings.forces;
   if (sketch.sheet) {
     // The bench chooses the resolution: the sheet's size, place, pins, fabric and body are kept.
-    const garment::SheetSpec& given = *sketch.sheet;
+    const scene::SheetSpec& given = *sketch.sheet;
     sim::SheetSpec spec;
     spec.size = given.size;
     spec.orientation =

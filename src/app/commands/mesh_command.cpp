@@ -11,14 +11,13 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
-#include "garment/body_surface.hpp"
 #include "garment/garment_mesh.hpp"
-#include "garment/sketch_file.hpp"
-#include "garment/sketch_inputs.hpp"
 #include "meshing/mesh48.hpp"
+#include "scene/sketch_file.hpp"
 #include "src/app/commands/cli.hpp"
 #include "src/app/pipeline/atomic_file.hpp"
 #include "src/app/pipeline/cloth_scene.hpp"
+#include "src/app/pipeline/garment_stage.hpp"
 #include "src/app/pipeline/mesh_export.hpp"
 #include "src/app/pipeline/pattern_export.hpp"
 #include "src/app/pipeline/preview_images.hpp"
@@ -67,7 +66,7 @@ nlohmann::json quality_json(const meshing::QuadQuality& q) {
 
 void run_mesh(const MeshOptions& options) {
   const auto start = Clock::now();
-  const garment::Sketch sketch = garment::load_sketch(options.sketch);
+  const scene::Sketch sketch = scene::load_sketch(options.sketch);
   check_sketch(sketch);  // the fabrics and settings `run` would refuse, refused here too
   const std::filesystem::path dir(options.out);
   StagedOutputs outputs;
@@ -95,19 +94,11 @@ void run_mesh(const MeshOptions& options) {
   }
 
   if (sketch.garment_mesh) {
-    // An imported triangle garment: the √3 conversion gives its 4-8 mesh.
-    const meshing::TriMesh tris = garment::load_garment_mesh(sketch);
-    meshing::Sqrt3Stats stats;
-    meshing::Mesh48 m48 = [&] {
-      try {
-        return meshing::Mesh48::from_triangles_sqrt3(tris, &stats);
-      } catch (const meshing::Mesh48InputError& e) {
-        sketch.fail("/garment_mesh",
-                    fmt::format("the garment mesh cannot become a 4-8 mesh: {}", e.what()));
-      }
-    }();
-    const std::vector<std::string> problems = m48.validate();
-    if (!problems.empty()) throw std::runtime_error("4-8 mesh check failed: " + problems.front());
+    // An imported triangle garment: the √3 conversion gives its 4-8 mesh (as `run` drapes it).
+    const ImportedGarment imported = import_garment(sketch);
+    const meshing::TriMesh& tris = imported.triangles;
+    const meshing::Sqrt3Stats& stats = imported.stats;
+    const meshing::Mesh48& m48 = imported.mesh48;
     ExportMesh mesh{tris.vertices, tris.faces, {}, {"garment"}};
     outputs.stage(dir / sketch.output.mesh, sketch.output.mesh.ends_with(".glb")
                                                 ? to_glb(mesh, "garment")
@@ -127,23 +118,17 @@ void run_mesh(const MeshOptions& options) {
     return;
   }
 
-  const auto body_start = Clock::now();
-  const garment::Body body = garment::load_sketch_body(sketch);
-  const garment::BodySurface surface(body.mesh);
-  const double body_ms = ms_since(body_start);
-  const auto mesh_start = Clock::now();
-  const garment::Garment g = garment::build_garment(sketch, surface);
-  const double mesh_ms = ms_since(mesh_start);
+  // The garment as `run` drapes it: body, stitched quads, panel groups, checked 4-8 mesh.
+  const MeshedGarment meshed = mesh_garment(sketch);
+  const garment::Body& body = meshed.body;
+  const garment::Garment& g = meshed.garment;
+  const double body_ms = meshed.body_ms;
+  const double mesh_ms = meshed.meshing_ms;
   const std::vector<garment::QualityWarning> warnings = quality_warnings(g, sketch, body);
 
   // Quad mesh with one group per panel (joined panels share their join's group).
-  std::vector<std::string> groups;
-  std::vector<int> panel_group(g.panels.size());
-  for (size_t p = 0; p < g.panels.size(); ++p) {
-    auto it = std::find(groups.begin(), groups.end(), g.panels[p].group);
-    if (it == groups.end()) it = groups.insert(groups.end(), g.panels[p].group);
-    panel_group[p] = static_cast<int>(it - groups.begin());
-  }
+  const std::vector<std::string>& groups = meshed.group_names;
+  const std::vector<int>& panel_group = meshed.panel_group;
   ExportMesh quads{g.mesh.vertices, g.mesh.faces, {}, groups};
   for (Eigen::Index f = 0; f < g.face_panel.size(); ++f)
     quads.face_groups.push_back(panel_group[static_cast<size_t>(g.face_panel(f))]);
@@ -151,9 +136,7 @@ void run_mesh(const MeshOptions& options) {
                                               ? to_glb(quads, "garment")
                                               : to_obj(quads, "garment"));
 
-  meshing::Mesh48 m48 = meshing::Mesh48::from_quads(g.mesh);
-  const std::vector<std::string> problems = m48.validate();
-  if (!problems.empty()) throw std::runtime_error("4-8 mesh check failed: " + problems.front());
+  const meshing::Mesh48& m48 = meshed.mesh48;
   std::vector<int> block_group(static_cast<size_t>(g.mesh.face_count()));
   for (Eigen::Index f = 0; f < g.mesh.face_count(); ++f)
     block_group[static_cast<size_t>(f)] = panel_group[static_cast<size_t>(g.face_panel(f))];

@@ -10,8 +10,8 @@
 
 #include "garment/body_surface.hpp"
 #include "garment/garment_mesh.hpp"
-#include "garment/sketch_file.hpp"
 #include "garment/sketch_inputs.hpp"
+#include "scene/sketch_file.hpp"
 #include "src/app/commands/cli.hpp"
 #include "src/app/pipeline/atomic_file.hpp"
 #include "src/app/pipeline/pattern_export.hpp"
@@ -27,12 +27,12 @@ struct PatternOptions {
 };
 
 void run_pattern(const PatternOptions& options) {
-  const garment::Sketch sketch = garment::load_sketch(options.sketch);
+  const scene::Sketch sketch = scene::load_sketch(options.sketch);
   if (sketch.sheet || sketch.garment_mesh)
     sketch.fail(sketch.sheet ? "/sheet" : "/garment_mesh",
                 "a pattern is made from drawn panels; this file has none (a sheet or an imported "
                 "garment mesh)");
-  garment::PatternSpec spec = sketch.output.pattern.value_or(garment::PatternSpec{});
+  scene::PatternSpec spec = sketch.output.pattern.value_or(scene::PatternSpec{});
   if (options.fabric_width) spec.fabric_width = *options.fabric_width;
   if (options.seam_allowance) spec.seam_allowance = *options.seam_allowance;
   const garment::Body body = garment::load_sketch_body(sketch);

@@ -6,7 +6,6 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include <Eigen/SVD>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -14,8 +13,8 @@
 #include <stdexcept>
 
 #include "garment/body_landmarks.hpp"
-#include "garment/sketch_file.hpp"
 #include "meshing/slice_dent.hpp"
+#include "scene/sketch_file.hpp"
 #include "sim/adaptive_detail.hpp"
 #include "sim/cloth_driver.hpp"
 #include "sim/simulation.hpp"
@@ -25,6 +24,7 @@
 #include "src/app/pipeline/pattern_export.hpp"
 #include "src/app/pipeline/preview_images.hpp"
 #include "src/app/pipeline/progress.hpp"
+#include "src/app/pipeline/run_report.hpp"
 #include "src/app/pipeline/self_intersections.hpp"
 #include "src/app/pipeline/sketch_checks.hpp"
 #include "src/render/scene.hpp"
@@ -57,11 +57,11 @@ struct Frame {
 };
 
 // The images of a run: the file's list, or front, back and left when it lists none.
-std::vector<garment::ImageSpec> run_images(const garment::Sketch& sketch) {
+std::vector<scene::ImageSpec> run_images(const scene::Sketch& sketch) {
   if (sketch.output.images_listed) return sketch.output.images;
-  std::vector<garment::ImageSpec> images;
+  std::vector<scene::ImageSpec> images;
   for (const char* view : {"front", "back", "left"}) {
-    garment::ImageSpec image;
+    scene::ImageSpec image;
     image.view = view;
     image.width = 600;
     image.height = 900;
@@ -70,166 +70,16 @@ std::vector<garment::ImageSpec> run_images(const garment::Sketch& sketch) {
   return images;
 }
 
-nlohmann::json energy_json(const std::vector<sim::EnergySample>& samples) {
-  nlohmann::json series = {
-      {"time", nlohmann::json::array()},    {"stretch", nlohmann::json::array()},
-      {"shear", nlohmann::json::array()},   {"bend", nlohmann::json::array()},
-      {"kinetic", nlohmann::json::array()}, {"potential", nlohmann::json::array()}};
-  for (const sim::EnergySample& s : samples) {
-    series["time"].push_back(s.time);
-    series["stretch"].push_back(s.stretch);
-    series["shear"].push_back(s.shear);
-    series["bend"].push_back(s.bend);
-    series["kinetic"].push_back(s.kinetic);
-    series["potential"].push_back(s.potential);
-  }
-  return series;
-}
-
-nlohmann::json simulation_json(const sim::SimulationReport& r, const sim::SimulationSettings& s) {
-  return {{"steps", r.steps},
-          {"sim_time", r.sim_time},
-          {"wall_time_s", r.wall_time_s},
-          {"at_rest", r.at_rest},
-          {"retries", r.retries},
-          {"forced_steps", r.forced_steps},
-          {"nan_free", r.nan_free},
-          {"vertices", r.vertices},
-          {"triangles", r.triangles},
-          {"linear_solves", r.linear_solves},
-          {"cg_iterations_mean", r.cg_iterations_mean},
-          {"cg_iterations_max", r.cg_iterations_max},
-          {"newton_iterations_mean", r.newton_iterations_mean},
-          {"dt_min_used", r.dt_min_used},
-          {"dt_max_used", r.dt_max_used},
-          {"max_strain", r.max_strain},
-          {"rest",
-           {{"speed_window_m_s", r.rest_speed_window},
-            {"kinetic_per_kg_window_J_kg", r.rest_kinetic_per_kg_window},
-            {"speed_final_m_s", r.rest_speed_final},
-            {"kinetic_per_kg_final_J_kg", r.rest_kinetic_per_kg_final},
-            {"speed_limit_m_s", s.rest_speed},
-            {"kinetic_per_kg_limit_J_kg", s.rest_kinetic_energy},
-            {"window_s", s.rest_window}}},
-          {"contacts_max", r.contacts_max},
-          {"max_penetration_m", r.max_penetration_m},
-          {"penetrating_vertices_final", r.penetrating_vertices_final},
-          {"piercing_body_vertices_final", r.piercing_body_vertices_final},
-          {"max_piercing_final_m", r.max_piercing_final_m},
-          {"contacts_final", r.contacts_final},
-          {"self_collision", s.self_contact.enabled},
-          {"self_intersections_start", r.self_intersections_start},
-          {"self_untangled_vertices", r.self_untangled_vertices},
-          {"self_contacts_max", r.self_contacts_max},
-          {"self_contacts_final", r.self_contacts_final},
-          {"self_collisions", r.self_collisions},
-          {"self_zone_vertices", r.self_zone_vertices},
-          {"self_unresolved_steps", r.self_unresolved_steps},
-          {"self_culled_share", r.self_culled_share},
-          {"self_collision_share", r.wall_time_s > 0.0 ? r.self_collision_s / r.wall_time_s : 0.0},
-          {"timing_s",
-           {{"forces", r.forces_s},
-            {"solve", r.solve_s},
-            {"collision", r.collision_s},
-            {"self_collision", r.self_collision_s},
-            {"other", r.other_s}}},
-          {"settings",
-           {{"integrator", sim::integrator_name(s.integrator)},
-            {"solver", sim::solver_name(s.solver)},
-            {"dt", s.dt},
-            {"duration", s.duration},
-            {"stop_at_rest", s.stop_at_rest}}},
-          {"energy", energy_json(r.energy)}};
-}
-
-nlohmann::json meshing_json(const ClothScene& scene) {
-  if (!scene.garment) return nullptr;
-  int distortion = 0, irregular = 0;
-  nlohmann::json panels = nlohmann::json::array();
-  for (const garment::GarmentPanel& p : scene.garment->panels) {
-    distortion += p.distortion;
-    irregular += p.irregular_vertices;
-    panels.push_back({{"id", p.id},
-                      {"sides", p.side_counts.size()},
-                      {"distortion", p.distortion},
-                      {"irregular_vertices", p.irregular_vertices},
-                      {"partition", p.partition},
-                      {"quads", p.faces}});
-  }
-  return {{"distortion", distortion},
-          {"irregular_vertices", irregular},
-          {"quads", scene.garment->mesh.face_count()},
-          {"meshing_ms", scene.meshing_ms},
-          {"panels", panels}};
-}
-
-// How far the drape is from the cloth's rest shape (the pattern with "rest": "flat"), per group:
-// each triangle's principal stretches σ₁ ≥ σ₂ of [w_u w_v] (Baraff & Witkin's deformation
-// gradient against the model's rest triangle), strain = max(σ₁ − 1, 1 − σ₂); max and
-// rest-area-weighted mean.
-nlohmann::json strain_json(const sim::ClothModel& model, const Eigen::MatrixX3d& positions,
-                           const Eigen::VectorXi& triangle_group,
-                           const std::vector<std::string>& group_names) {
-  std::vector<double> worst(group_names.size(), 0.0), sum(group_names.size(), 0.0),
-      area(group_names.size(), 0.0);
-  for (size_t t = 0; t < model.triangles.size(); ++t) {
-    const sim::TriangleElement& e = model.triangles[t];
-    Eigen::Matrix<double, 3, 2> f = Eigen::Matrix<double, 3, 2>::Zero();
-    for (int k = 0; k < 3; ++k) {
-      f.col(0) += e.du[k] * positions.row(e.vertices[k]).transpose();
-      f.col(1) += e.dv[k] * positions.row(e.vertices[k]).transpose();
-    }
-    const Eigen::Vector2d sigma = Eigen::JacobiSVD<Eigen::Matrix<double, 3, 2>>(f).singularValues();
-    const double strain = std::max(sigma(0) - 1, 1 - sigma(1));
-    const size_t g = t < static_cast<size_t>(triangle_group.size())
-                         ? static_cast<size_t>(triangle_group(static_cast<Eigen::Index>(t)))
-                         : 0;
-    worst[g] = std::max(worst[g], strain);
-    sum[g] += e.rest_area * strain;
-    area[g] += e.rest_area;
-  }
-  nlohmann::json out = nlohmann::json::array();
-  for (size_t g = 0; g < group_names.size(); ++g)
-    out.push_back({{"group", group_names[g]},
-                   {"strain_max", worst[g]},
-                   {"strain_mean", area[g] > 0 ? sum[g] / area[g] : 0.0}});
-  return out;
-}
-
-// The sketch's "simulate": {"adaptive": {...}} over the simulator's defaults.
-sim::AdaptiveSettings adaptive_settings(const garment::Sketch& sketch) {
-  const garment::AdaptiveSpec& spec = sketch.simulate.adaptive_settings;
-  sim::AdaptiveSettings s;
-  s.refine_threshold = spec.refine_threshold.value_or(s.refine_threshold);
-  s.coarsen_threshold = spec.coarsen_threshold.value_or(s.coarsen_threshold);
-  s.steady_rate = spec.steady_rate.value_or(s.steady_rate);
-  s.min_lifetime = spec.min_lifetime.value_or(s.min_lifetime);
-  s.min_level = spec.min_level.value_or(s.min_level);
-  s.max_level = spec.max_level.value_or(s.max_level);
-  s.max_vertices = spec.max_vertices.value_or(s.max_vertices);
-  s.merge_batch = spec.merge_batch.value_or(s.merge_batch);
-  s.even_levels = spec.even_levels.value_or(s.even_levels);
+// The sketch's "simulate": {"adaptive": {...}} (the simulator's own settings), checked together
+// here: a value the file gives against a default (a coarsen threshold at or above the default
+// refine threshold) is refused at /simulate/adaptive.
+sim::AdaptiveSettings adaptive_settings(const scene::Sketch& sketch) {
   try {
-    s.validate();  // e.g. a coarsen threshold set at or above the default refine threshold
+    sketch.simulate.adaptive_settings.validate();
   } catch (const sim::InvalidAdaptiveSettingsError& e) {
     sketch.fail("/simulate/adaptive", e.what());
   }
-  return s;
-}
-
-// Per accepted step: time, splits (requested and forced), merges and particles after it.
-nlohmann::json adaptive_steps_json(const std::vector<sim::AdaptiveStepRecord>& steps) {
-  nlohmann::json out = {{"time", nlohmann::json::array()},
-                        {"splits", nlohmann::json::array()},
-                        {"merges", nlohmann::json::array()},
-                        {"vertices", nlohmann::json::array()}};
-  for (const sim::AdaptiveStepRecord& step : steps) {
-    out["time"].push_back(step.time);
-    out["splits"].push_back(step.splits + step.forced_splits);
-    out["merges"].push_back(step.merges);
-    out["vertices"].push_back(step.vertices);
-  }
-  return out;
+  return sketch.simulate.adaptive_settings;
 }
 
 // "1.2 GB", or "74 MB" below a gigabyte (where one decimal of GB says too little).
@@ -240,7 +90,7 @@ std::string memory_text(double bytes) {
 
 void run_drape(const RunOptions& options, const GlobalOptions& global) {
   const auto start = Clock::now();
-  const garment::Sketch sketch = garment::load_sketch(options.sketch);
+  const scene::Sketch sketch = scene::load_sketch(options.sketch);
   check_sketch(sketch);
   sim::SimulationSettings settings = simulation_settings(sketch);
   RunLimits limits;
@@ -326,12 +176,12 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
 
   // One driver: the cloth's 4-8 mesh, adapting or not (a sheet that does not adapt drapes on its
   // own triangles).
-  sim::SimulationReport report;
-  nlohmann::json adaptive_json = nullptr;
+  RunReport out;  // report.json, filled as the drape goes
+  sim::SimulationReport& report = out.simulation;
+  out.settings = settings;
   meshing::TriMesh draped;
   Eigen::VectorXi triangle_group;
   Eigen::VectorXd face_levels;
-  nlohmann::json strain = nullptr;
   const bool flat_rest = scene.input.rest_uv.rows() > 0;
   if (flat_rest && sketch.simulate.adaptive)
     spdlog::warn(
@@ -365,24 +215,9 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
     draped.faces = driver.faces();
     face_levels = driver.face_levels().cast<double>();
     triangle_group = groups_of(driver);
-    strain = strain_json(driver.simulation().model(), draped.vertices, triangle_group,
-                         scene.group_names);
-    if (adaptive) {
-      const sim::AdaptiveReport& a = *driver.adaptive_report();
-      adaptive_json = {{"splits", a.splits},
-                       {"forced_splits", a.forced_splits},
-                       {"merges", a.merges},
-                       {"moved_off_body", a.moved_off_body},
-                       {"splits_declined_on_body", a.splits_declined_on_body},
-                       {"body_sags_computed", a.body_sags_computed},
-                       {"body_sags_reused", a.body_sags_reused},
-                       {"topology_changes", a.topology_changes},
-                       {"vertices_min", a.vertices_min},
-                       {"vertices_max", a.vertices_max},
-                       {"max_level_reached", a.max_level_reached},
-                       {"adaptivity_s", a.adaptivity_s()},
-                       {"steps", adaptive_steps_json(a.steps)}};
-    }
+    out.strain = group_strains(driver.simulation().model(), draped.vertices, triangle_group,
+                               scene.group_names);
+    if (adaptive) out.adaptive = *driver.adaptive_report();
   } catch (const sim::InvalidFabricError& e) {
     sketch.fail("/fabric", e.what());
   }
@@ -434,9 +269,9 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
                                 "drape-failed"));
     const std::optional<meshing::TriMesh> body_now =
         scene.body ? std::optional(body_at(scene, report.sim_time)) : std::nullopt;
-    std::vector<garment::ImageSpec> sides;
+    std::vector<scene::ImageSpec> sides;
     for (const char* view : {"front", "back", "left", "right"}) {
-      garment::ImageSpec image;
+      scene::ImageSpec image;
       image.view = view;
       image.width = 600;
       image.height = 900;
@@ -466,13 +301,13 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   const std::optional<meshing::TriMesh> body_end =
       scene.body ? std::optional(body_at(scene, report.sim_time)) : std::nullopt;
   const PreviewCloth preview{draped, triangle_group, render::triangle_edges(draped), face_levels};
-  const std::vector<garment::ImageSpec> image_specs = run_images(sketch);
+  const std::vector<scene::ImageSpec> image_specs = run_images(sketch);
   const std::vector<std::string> images =
       stage_preview_images(image_specs, sketch.output.wireframe, body_end ? &*body_end : nullptr,
                            preview, "drape", dir, outputs);
   // The sequence: the first image the file asks for (front by default), without edges.
-  std::vector<garment::ImageSpec> frame_image = {image_specs.empty() ? garment::ImageSpec{}
-                                                                     : image_specs.front()};
+  std::vector<scene::ImageSpec> frame_image = {image_specs.empty() ? scene::ImageSpec{}
+                                                                   : image_specs.front()};
   frame_image.front().wireframe = false;
   for (std::size_t i = 0; i < frames.size(); ++i) {
     const std::optional<meshing::TriMesh> body =
@@ -483,61 +318,38 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   }
   const double image_s = std::chrono::duration<double>(Clock::now() - image_start).count();
 
-  nlohmann::json out = simulation_json(report, settings);
-  // Which settings the rule chose, and why (null when the file set both solver and step).
-  out["settings"]["preconditioner"] =
-      settings.solver == sim::LinearSolverKind::pcg
-          ? (settings.pcg_preconditioner == sim::PcgPreconditioner::block_jacobi ? "block-jacobi"
-                                                                                 : "block-ic0")
-          : "none";
-  out["settings"]["automatic"] = sketch.simulate.solver == "auto" || sketch.simulate.time_step_auto
-                                     ? nlohmann::json(automatic.reason)
-                                     : nlohmann::json(nullptr);
-  // Counted whether or not self-collision was on: what a preview would show.
-  out["self_intersections_final"] = count_self_intersections(draped.vertices, draped.faces);
-  out["format"] = "sketchdrape/1 run report";
-  out["sketch"] = sketch.file;
-  out["scene"] = sketch.sheet ? "sheet" : (sketch.garment_mesh ? "imported garment" : "garment");
-  out["fabric"] = scene.fabric_name;
-  out["body"] = scene.body ? nlohmann::json(scene.body->raw.source) : nlohmann::json(nullptr);
-  out["pinned_vertices"] = scene.pinned.size();
-  out["meshing"] = meshing_json(scene);
-  out["bending"] = std::string(sim::bend_model_name(scene.bend_model));
-  out["rest_shape"] = flat_rest ? (scene.bend_rest_flat ? "flat" : "flat and shaped") : "shaped";
-  out["strain"] = strain;  // per group, against the rest shape (the pattern when flat)
+  if (sketch.simulate.solver == "auto" || sketch.simulate.time_step_auto)
+    out.automatic = automatic.reason;
+  out.self_intersections_final = count_self_intersections(draped.vertices, draped.faces);
+  out.sketch = sketch.file;
+  out.scene = sketch.sheet ? "sheet" : (sketch.garment_mesh ? "imported garment" : "garment");
+  out.fabric = scene.fabric_name;
+  if (scene.body) out.body = scene.body->raw.source;
+  out.pinned_vertices = scene.pinned.size();
+  out.meshing = meshing_summary(scene);
+  out.bending = sim::bend_model_name(scene.bend_model);
+  out.rest_shape = flat_rest ? (scene.bend_rest_flat ? "flat" : "flat and shaped") : "shaped";
   if (scene.garment && sketch.output.pattern) {
     const PatternSheet sheet = build_pattern_sheet(sketch, *scene.garment, *sketch.output.pattern);
     stage_pattern(sheet, dir, outputs);
-    out["pattern"] = pattern_summary(sheet);
+    out.pattern = pattern_summary(sheet);
   }
-  out["adaptive"] = adaptive_json;
-  if (scene.garment) {
-    // How deep the draped cloth dents between supports (a skirt pulled between the legs).
-    const meshing::SliceDent dent = meshing::slice_dent(draped);
-    out["slice_dent"] = {{"depth_m", dent.depth},
-                         {"height_m", dent.height},
-                         {"where", {dent.where.x(), dent.where.y(), dent.where.z()}},
-                         {"from_fraction", 0.1},
-                         {"to_fraction", 0.6}};
-  }
-  out["images"] = images;
-  out["frames"] = frames.size();
-  out["body_motion"] = nullptr;
+  // How deep the draped cloth dents between supports (a skirt pulled between the legs).
+  if (scene.garment) out.slice_dent = meshing::slice_dent(draped);
+  out.images = images;
+  out.frames = frames.size();
   if (sketch.body.motion && scene.body_motion) {
-    out["body_motion"] = {{"type", sketch.body.motion->type},
-                          {"start", scene.body_motion->start_time()},
-                          {"end", scene.body_motion->end_time()}};
-    if (sketch.body.motion->type == "poses")
-      out["body_motion"]["poses"] = sketch.body.motion->poses.size();
+    const garment::BodyMotionSpec& motion = *sketch.body.motion;
+    out.body_motion = {motion.type, scene.body_motion->start_time(), scene.body_motion->end_time(),
+                       std::nullopt, std::nullopt};
+    if (motion.type == "poses")
+      out.body_motion->poses = motion.poses.size();
     else
-      out["body_motion"]["degrees"] = sketch.body.motion->degrees;
+      out.body_motion->degrees = motion.degrees;
   }
-  // Adaptivity (estimates, splits, merges, model rebuilds) next to the simulator's split.
-  out["timing_s"]["adaptivity"] =
-      adaptive_json.is_null() ? 0.0 : adaptive_json["adaptivity_s"].get<double>();
-  out["timing_s"]["images"] = image_s;
-  out["timing_s"]["total"] = std::chrono::duration<double>(Clock::now() - start).count();
-  if (sketch.output.report) outputs.stage(dir / "report.json", out.dump(2) + "\n");
+  out.images_s = image_s;
+  out.total_s = std::chrono::duration<double>(Clock::now() - start).count();
+  if (sketch.output.report) outputs.stage(dir / "report.json", run_report_json(out).dump(2) + "\n");
   if (options.trace) outputs.stage(dir / "trace.jsonl", trace);
   outputs.commit();
   spdlog::info("draped {} → {}: {} steps, {:.2f} s simulated{}, {:.2f} s wall", sketch.file,

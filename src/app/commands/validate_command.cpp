@@ -7,7 +7,7 @@
 
 #include <iostream>
 
-#include "garment/sketch_file.hpp"
+#include "scene/sketch_file.hpp"
 #include "src/app/commands/cli.hpp"
 #include "src/app/pipeline/cloth_scene.hpp"
 #include "src/app/pipeline/quality_warnings.hpp"
@@ -22,7 +22,7 @@ struct ValidateOptions {
 };
 
 void run_validate(const ValidateOptions& options) {
-  const garment::Sketch sketch = garment::load_sketch(options.sketch);
+  const scene::Sketch sketch = scene::load_sketch(options.sketch);
   check_sketch(sketch);
   // What `run` would refuse for its size, refused here too (a sheet before it is built).
   if (const auto estimate = estimate_before_building(sketch, 0))

@@ -9,11 +9,11 @@
 #include <limits>
 #include <numbers>
 
-#include "garment/body_surface.hpp"
 #include "garment/material_frames.hpp"
 #include "garment/sketch_inputs.hpp"
 #include "sim/sheet.hpp"
 #include "sim/simulation.hpp"
+#include "src/app/pipeline/garment_stage.hpp"
 
 namespace sd::app {
 namespace {
@@ -21,7 +21,7 @@ namespace {
 // The fabric at `json_path`: the sketch's inline fabric object (by its name), a preset name,
 // or a path to a fabric .json file (relative to the sketch); else a SketchError at the JSON
 // path of the bad value ("/fabric/bend" for an inline constant) that lists the known presets.
-sim::FabricParameters fabric_at(const garment::Sketch& sketch, const std::string& name,
+sim::FabricParameters fabric_at(const scene::Sketch& sketch, const std::string& name,
                                 const std::string& json_path) {
   // A panel without its own fabric carries the file's name for it, inline ones included.
   if (!sketch.fabric_inline.empty() && name == sketch.fabric) {
@@ -47,7 +47,7 @@ sim::FabricParameters fabric_at(const garment::Sketch& sketch, const std::string
 }
 
 // simulate.pin_above: holds every vertex that starts at or above that height.
-void pin_above(const garment::Sketch& sketch, ClothScene& scene) {
+void pin_above(const scene::Sketch& sketch, ClothScene& scene) {
   if (!sketch.simulate.pin_above) return;
   const std::size_t before = scene.pinned.size();  // a sheet's named pins come first
   for (Eigen::Index v = 0; v < scene.start.rows(); ++v)
@@ -60,8 +60,8 @@ void pin_above(const garment::Sketch& sketch, ClothScene& scene) {
                             *sketch.simulate.pin_above, scene.start.col(1).maxCoeff()));
 }
 
-void build_sheet_scene(const garment::Sketch& sketch, ClothScene& scene) {
-  const garment::SheetSpec& spec = *sketch.sheet;
+void build_sheet_scene(const scene::Sketch& sketch, ClothScene& scene) {
+  const scene::SheetSpec& spec = *sketch.sheet;
   sim::SheetSpec sheet;
   sheet.size = spec.size;
   sheet.columns = spec.columns;
@@ -139,7 +139,7 @@ void build_sheet_scene(const garment::Sketch& sketch, ClothScene& scene) {
 // Each triangle's rest coordinates are its pattern triangle's, with u along the piece's +y (the
 // warp) and v along weft = normal × warp, which is −x on a piece seen from outside; shaped panels
 // keep their drawn triangles. Ease is applied later, as for shaped panels (build_scene_model).
-void flat_rest_shapes(const garment::Sketch& sketch, const garment::Garment& g,
+void flat_rest_shapes(const scene::Sketch& sketch, const garment::Garment& g,
                       const meshing::Mesh48& m48, const garment::MaterialFrames& frames,
                       ClothScene& scene) {
   std::vector<bool> flat(g.panels.size(), false);
@@ -197,13 +197,11 @@ void flat_rest_shapes(const garment::Sketch& sketch, const garment::Garment& g,
     throw std::runtime_error("flat rest: a triangle's vertex is missing from its pattern piece");
 }
 
-void build_garment_scene(const garment::Sketch& sketch, ClothScene& scene) {
-  scene.body = garment::load_sketch_body(sketch);
-  const garment::BodySurface surface(scene.body->mesh);
-  const auto start = std::chrono::steady_clock::now();
-  garment::Garment g = garment::build_garment(sketch, surface);
-  scene.meshing_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+void build_garment_scene(const scene::Sketch& sketch, ClothScene& scene) {
+  MeshedGarment meshed = mesh_garment(sketch);  // the stage `mesh` writes out
+  scene.body = std::move(meshed.body);
+  scene.meshing_ms = meshed.meshing_ms;
+  garment::Garment& g = meshed.garment;
 
   // One fabric per simulation for now: the first panel's; others are reported if different.
   const garment::GarmentPanel& first = g.panels.front();
@@ -220,20 +218,11 @@ void build_garment_scene(const garment::Sketch& sketch, ClothScene& scene) {
           "and uses '{}' (panel '{}') throughout",
           p.id, p.fabric, first.fabric, first.id);
 
-  meshing::Mesh48 m48 = meshing::Mesh48::from_quads(g.mesh);
-  const std::vector<std::string> problems = m48.validate();
-  if (!problems.empty()) throw std::runtime_error("4-8 mesh check failed: " + problems.front());
+  meshing::Mesh48& m48 = meshed.mesh48;
   const meshing::Mesh48Arrays arrays = m48.arrays();
   const garment::MaterialFrames frames = garment::material_frames(g.mesh);
-
-  // Groups: a join's panels share its group.
-  std::vector<int> panel_group(g.panels.size());
-  for (size_t p = 0; p < g.panels.size(); ++p) {
-    auto it = std::find(scene.group_names.begin(), scene.group_names.end(), g.panels[p].group);
-    if (it == scene.group_names.end())
-      it = scene.group_names.insert(scene.group_names.end(), g.panels[p].group);
-    panel_group[p] = static_cast<int>(it - scene.group_names.begin());
-  }
+  scene.group_names = meshed.group_names;
+  const std::vector<int>& panel_group = meshed.panel_group;
 
   // Per quad: group, ease and warp (the material frames, computed once here).
   const Eigen::Index quads = g.mesh.face_count();
@@ -265,17 +254,11 @@ void build_garment_scene(const garment::Sketch& sketch, ClothScene& scene) {
 
 // An imported triangle garment: its 4-8 mesh comes from the sqrt3 conversion; warp is the
 // in-plane direction closest to +Y (the simulator's default when no warp is given).
-void build_imported_scene(const garment::Sketch& sketch, ClothScene& scene) {
+void build_imported_scene(const scene::Sketch& sketch, ClothScene& scene) {
   if (sketch.body.mesh != "none") scene.body = garment::load_sketch_body(sketch);
-  const meshing::TriMesh triangles = garment::load_garment_mesh(sketch);
-  meshing::Mesh48 m48 = [&] {
-    try {
-      return meshing::Mesh48::from_triangles_sqrt3(triangles);
-    } catch (const meshing::Mesh48InputError& e) {
-      sketch.fail("/garment_mesh",
-                  fmt::format("the garment mesh cannot become a 4-8 mesh: {}", e.what()));
-    }
-  }();
+  ImportedGarment imported = import_garment(sketch);  // the stage `mesh` writes out
+  const meshing::TriMesh& triangles = imported.triangles;
+  meshing::Mesh48& m48 = imported.mesh48;
   const meshing::Mesh48Arrays arrays = m48.arrays();
   scene.input.rest_positions = arrays.rest_positions;
   scene.input.triangles = arrays.faces;
@@ -295,8 +278,8 @@ void build_imported_scene(const garment::Sketch& sketch, ClothScene& scene) {
 
 }  // namespace
 
-sim::SimulationSettings simulation_settings(const garment::Sketch& sketch) {
-  const garment::SimulateSpec& spec = sketch.simulate;
+sim::SimulationSettings simulation_settings(const scene::Sketch& sketch) {
+  const scene::SimulateSpec& spec = sketch.simulate;
   sim::SimulationSettings settings;
   settings.integrator =
       sim::parse_integrator(spec.integrator).value_or(sim::Integrator::implicit_euler);
@@ -317,15 +300,14 @@ sim::SimulationSettings simulation_settings(const garment::Sketch& sketch) {
   return settings;
 }
 
-sim::AutomaticChoice apply_automatic_settings(const garment::Sketch& sketch,
-                                              const ClothScene& scene,
+sim::AutomaticChoice apply_automatic_settings(const scene::Sketch& sketch, const ClothScene& scene,
                                               sim::SimulationSettings& settings) {
-  const garment::SimulateSpec& spec = sketch.simulate;
+  const scene::SimulateSpec& spec = sketch.simulate;
   sim::SceneTraits traits;
   traits.vertices = static_cast<int>(scene.start.rows());
   const bool adaptive =
       spec.adaptive && (!scene.sheet || spec.adaptive_given) && scene.input.rest_uv.rows() == 0;
-  if (adaptive) traits.max_vertices = spec.adaptive_settings.max_vertices.value_or(0);
+  if (adaptive) traits.max_vertices = spec.adaptive_settings.max_vertices;
   traits.self_contact = settings.self_contact.enabled;
   traits.garment = !scene.sheet;
   const sim::AutomaticChoice choice = sim::choose_settings(traits);
@@ -380,7 +362,7 @@ Eigen::VectorXi triangle_groups(const ClothScene& scene, const Eigen::VectorXi& 
 
 // The motion of the sketch's body: the arms lowering, or the body's own poses at given times
 // (its mesh is the pose at time 0).
-sim::PoseSequence body_motion(const garment::Sketch& sketch, const garment::Body& body) {
+sim::PoseSequence body_motion(const scene::Sketch& sketch, const garment::Body& body) {
   const garment::BodyMotionSpec& spec = *sketch.body.motion;
   if (spec.type == "poses") {
     std::vector<double> times = {0.0};
@@ -407,7 +389,7 @@ sim::PoseSequence body_motion(const garment::Sketch& sketch, const garment::Body
   return sim::make_arm_lowering(body.mesh, options);
 }
 
-ClothScene build_cloth_scene(const garment::Sketch& sketch) {
+ClothScene build_cloth_scene(const scene::Sketch& sketch) {
   ClothScene scene;
   if (sketch.sheet) {
     build_sheet_scene(sketch, scene);

@@ -10,8 +10,8 @@
 #include "garment/body.hpp"
 #include "garment/garment_mesh.hpp"
 #include "garment/panel_flattening.hpp"
-#include "garment/sketch_file.hpp"
 #include "meshing/mesh48.hpp"
+#include "scene/sketch_file.hpp"
 #include "sim/automatic_settings.hpp"
 #include "sim/body_motion.hpp"
 #include "sim/cloth_driver.hpp"
@@ -60,7 +60,7 @@ struct ClothScene {
 
 // Builds the scene. Throws garment::SketchError (with the JSON path) for anything the designer
 // can fix: an unknown fabric, a body that will not load, panels that do not close, ...
-ClothScene build_cloth_scene(const garment::Sketch& sketch);
+ClothScene build_cloth_scene(const scene::Sketch& sketch);
 
 // The body as it stands at time t of the drape (its pose when it moves). The scene must have a
 // body.
@@ -89,13 +89,12 @@ Eigen::VectorXi triangle_groups(const ClothScene& scene, const Eigen::VectorXi& 
 
 // The simulator settings of the file's "simulate" section (integrator, solver, step, duration,
 // gravity). Throws garment::SketchError at /simulate when they cannot work together.
-sim::SimulationSettings simulation_settings(const garment::Sketch& sketch);
+sim::SimulationSettings simulation_settings(const scene::Sketch& sketch);
 
 // The file's "solver": "auto" and "time_step": "auto" (the defaults) resolved for the built
 // scene (sim/automatic_settings.hpp: its size, garment or sheet, self-contact); settings the
 // file gives are kept. Returns the rule's choice (its `reason` for the report).
-sim::AutomaticChoice apply_automatic_settings(const garment::Sketch& sketch,
-                                              const ClothScene& scene,
+sim::AutomaticChoice apply_automatic_settings(const scene::Sketch& sketch, const ClothScene& scene,
                                               sim::SimulationSettings& settings);
 
 }  // namespace sd::app

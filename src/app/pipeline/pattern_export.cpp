@@ -20,7 +20,7 @@ double ms_since(Clock::time_point t) {
 constexpr double kMm = 1000.0;  // metres → millimetres
 
 // The sketch's panel a garment panel comes from ("front.mirror" → "front").
-const garment::PanelSpec* panel_spec(const garment::Sketch& sketch, const std::string& id) {
+const garment::PanelSpec* panel_spec(const scene::Sketch& sketch, const std::string& id) {
   if (const garment::PanelSpec* p = sketch.find_panel(id)) return p;
   const std::string suffix = ".mirror";
   if (id.ends_with(suffix)) return sketch.find_panel(id.substr(0, id.size() - suffix.size()));
@@ -61,8 +61,8 @@ std::string svg_path(const garment::PatternPiece& piece, const Eigen::MatrixX2d&
 
 }  // namespace
 
-PatternSheet build_pattern_sheet(const garment::Sketch& sketch, const garment::Garment& garment,
-                                 const garment::PatternSpec& spec) {
+PatternSheet build_pattern_sheet(const scene::Sketch& sketch, const garment::Garment& garment,
+                                 const scene::PatternSpec& spec) {
   PatternSheet sheet;
   sheet.title = std::filesystem::path(sketch.file).filename().string();
   garment::FlatteningOptions flattening;

@@ -13,7 +13,7 @@
 #include "garment/garment_mesh.hpp"
 #include "garment/panel_flattening.hpp"
 #include "garment/pattern_layout.hpp"
-#include "garment/sketch_file.hpp"
+#include "scene/sketch_file.hpp"
 #include "src/app/pipeline/atomic_file.hpp"
 
 namespace sd::app {
@@ -29,8 +29,8 @@ struct PatternSheet {
 // Flattens and lays out the garment's panels with the file's pattern settings (`spec`, with each
 // panel's own seam allowance). A panel that cannot be flattened becomes a SketchError at that
 // panel's JSON path; stretch warnings are logged.
-PatternSheet build_pattern_sheet(const garment::Sketch& sketch, const garment::Garment& garment,
-                                 const garment::PatternSpec& spec);
+PatternSheet build_pattern_sheet(const scene::Sketch& sketch, const garment::Garment& garment,
+                                 const scene::PatternSpec& spec);
 
 std::string pattern_svg(const PatternSheet& sheet);
 std::string pattern_dxf(const PatternSheet& sheet);

@@ -36,7 +36,7 @@ render::Scene preview_scene(const meshing::TriMesh* body, const PreviewCloth& cl
 
 }  // namespace
 
-std::vector<std::string> stage_preview_images(const std::vector<garment::ImageSpec>& images,
+std::vector<std::string> stage_preview_images(const std::vector<scene::ImageSpec>& images,
                                               bool default_wireframe, const meshing::TriMesh* body,
                                               const PreviewCloth& cloth, const std::string& prefix,
                                               const std::filesystem::path& dir,
@@ -45,7 +45,7 @@ std::vector<std::string> stage_preview_images(const std::vector<garment::ImageSp
   if (images.empty()) return files;
   render::Renderer renderer;
   std::map<std::string, int> used_names;
-  for (const garment::ImageSpec& spec : images) {
+  for (const scene::ImageSpec& spec : images) {
     const render::Scene scene =
         preview_scene(body, cloth, spec.wireframe.value_or(default_wireframe));
     const render::ImageSize size{spec.width, spec.height};

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "garment/sketch_file.hpp"
 #include "meshing/tri_mesh.hpp"
+#include "scene/sketch_file.hpp"
 #include "src/app/pipeline/atomic_file.hpp"
 
 namespace sd::app {
@@ -22,7 +22,7 @@ struct PreviewCloth {
 // Renders each image of `images` (one GL context for all) and stages it as
 // `<prefix>-<view>.png` in `dir` (a repeated view gets `-2`, `-3`, ...). `body` may be null.
 // Returns the file names staged.
-std::vector<std::string> stage_preview_images(const std::vector<garment::ImageSpec>& images,
+std::vector<std::string> stage_preview_images(const std::vector<scene::ImageSpec>& images,
                                               bool default_wireframe, const meshing::TriMesh* body,
                                               const PreviewCloth& cloth, const std::string& prefix,
                                               const std::filesystem::path& dir,

@@ -8,7 +8,7 @@
 namespace sd::app {
 
 std::vector<garment::QualityWarning> quality_warnings(const garment::Garment& garment,
-                                                      const garment::Sketch& sketch,
+                                                      const garment::GarmentRequest& sketch,
                                                       const garment::Body& body) {
   std::optional<garment::BodyLandmarks> landmarks;
   try {

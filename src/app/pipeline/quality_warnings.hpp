@@ -13,7 +13,7 @@ namespace sd::app {
 // Runs the gate with the body's landmarks (none when the body is not a standing figure) and
 // logs each warning.
 std::vector<garment::QualityWarning> quality_warnings(const garment::Garment& garment,
-                                                      const garment::Sketch& sketch,
+                                                      const garment::GarmentRequest& sketch,
                                                       const garment::Body& body);
 
 nlohmann::json warnings_json(const std::vector<garment::QualityWarning>& warnings);

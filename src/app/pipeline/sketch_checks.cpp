@@ -55,7 +55,7 @@ std::string gigabytes(double bytes) {
 
 }  // namespace
 
-void check_sketch(const garment::Sketch& sketch) {
+void check_sketch(const scene::Sketch& sketch) {
   auto check_fabric = [&](const std::string& name, const std::string& path) {
     try {
       (void)sim::fabric_preset(name);
@@ -91,7 +91,7 @@ double memory_budget_bytes(const RunLimits& limits) {
                                      : kAvailableFraction * available_memory_bytes();
 }
 
-std::optional<RunEstimate> estimate_before_building(const garment::Sketch& sketch,
+std::optional<RunEstimate> estimate_before_building(const scene::Sketch& sketch,
                                                     double frames_per_second) {
   if (!sketch.sheet) return std::nullopt;
   // The grid's triangles only (its size and place do not change the factor).
@@ -103,7 +103,7 @@ std::optional<RunEstimate> estimate_before_building(const garment::Sketch& sketc
                       static_cast<int>(sheet.input.rest_positions.rows()), frames_per_second);
 }
 
-RunEstimate estimate_run(const garment::Sketch& sketch, const Eigen::MatrixX3i& triangles,
+RunEstimate estimate_run(const scene::Sketch& sketch, const Eigen::MatrixX3i& triangles,
                          int vertices, double frames_per_second) {
   RunEstimate e;
   e.vertices = vertices;
@@ -125,7 +125,7 @@ RunEstimate estimate_run(const garment::Sketch& sketch, const Eigen::MatrixX3i& 
   return e;
 }
 
-void check_run_fits(const garment::Sketch& sketch, const RunEstimate& estimate,
+void check_run_fits(const scene::Sketch& sketch, const RunEstimate& estimate,
                     const RunLimits& limits, double frames_per_second) {
   const bool given = limits.max_memory_bytes > 0;
   const double memory = memory_budget_bytes(limits);

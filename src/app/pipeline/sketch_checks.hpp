@@ -7,14 +7,14 @@
 #include <optional>
 #include <string>
 
-#include "garment/sketch_file.hpp"
+#include "scene/sketch_file.hpp"
 #include "sim/simulation.hpp"
 
 namespace sd::app {
 
 // Every panel's fabric (and the file's) is a known preset, the simulation settings work
 // together, every image can be drawn. Throws garment::SketchError at the value's path.
-void check_sketch(const garment::Sketch& sketch);
+void check_sketch(const scene::Sketch& sketch);
 
 // What a run may use: --max-memory (default: 80 % of the memory the system has available now)
 // and --max-time (default: none).
@@ -44,19 +44,19 @@ struct RunEstimate {
   double seconds = 0;       // wall time if it runs the whole duration
 };
 // `triangles`: the cloth's #F×3 triangles into `vertices` vertices.
-RunEstimate estimate_run(const garment::Sketch& sketch, const Eigen::MatrixX3i& triangles,
+RunEstimate estimate_run(const scene::Sketch& sketch, const Eigen::MatrixX3i& triangles,
                          int vertices, double frames_per_second);
 
 // The estimate of a cloth whose mesh is known without building the scene (a sheet: its grid of
 // triangles, without the body or the model); nullopt for a garment.
-std::optional<RunEstimate> estimate_before_building(const garment::Sketch& sketch,
+std::optional<RunEstimate> estimate_before_building(const scene::Sketch& sketch,
                                                     double frames_per_second);
 
 // Refuses (garment::SketchError, at /sheet/resolution, /simulate/duration or the file) a run
 // whose estimate does not fit `limits`, or whose PNG sequence has more than kMaxFrames pictures,
 // with a sentence that says what would fit.
 inline constexpr double kMaxFrames = 10000;
-void check_run_fits(const garment::Sketch& sketch, const RunEstimate& estimate,
+void check_run_fits(const scene::Sketch& sketch, const RunEstimate& estimate,
                     const RunLimits& limits, double frames_per_second);
 
 // Parses "4G", "512M", "1.5GB", "2000000" (bytes) for --max-memory; throws

@@ -1,10 +1,12 @@
-#include "garment/sketch_file.hpp"
+#include "scene/sketch_file.hpp"
 
 #include <gtest/gtest.h>
 
 #include <string>
 
-namespace sd::garment {
+namespace sd::scene {
+using namespace garment;  // the garment request's types and SketchError
+
 namespace {
 
 const char* kMinimal = R"({
@@ -269,9 +271,9 @@ TEST(SketchFile, MissingFileIsSketchError) {
 }
 
 }  // namespace
-}  // namespace sd::garment
+}  // namespace sd::scene
 
-namespace sd::garment {
+namespace sd::scene {
 namespace {
 
 // "fabric" may be an object (the constants inline): kept as JSON text for the simulator to check,
@@ -292,9 +294,9 @@ TEST(SketchFile, FabricMayBeGivenInline) {
 }
 
 }  // namespace
-}  // namespace sd::garment
+}  // namespace sd::scene
 
-namespace sd::garment {
+namespace sd::scene {
 namespace {
 
 // Sheet pins take clamps of several lines of vertices ("top:3"), checked against the resolution.
@@ -315,4 +317,4 @@ TEST(SketchFile, SheetClampPins) {
 }
 
 }  // namespace
-}  // namespace sd::garment
+}  // namespace sd::scene

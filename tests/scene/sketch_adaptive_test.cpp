@@ -1,13 +1,15 @@
 // The sketch file's adaptive settings: "simulate": {"adaptive": true | false | {...}} parses into
-// garment::SimulateSpec (bool kept, object values optional over the simulator's defaults) and
+// scene::SimulateSpec (bool kept, object values over sim::AdaptiveSettings's defaults) and
 // bad values fail with their JSON path.
 #include <gtest/gtest.h>
 
 #include <string>
 
-#include "garment/sketch_file.hpp"
+#include "scene/sketch_file.hpp"
 
-namespace sd::garment {
+namespace sd::scene {
+using namespace garment;  // the garment request's types and SketchError
+
 namespace {
 
 // A minimal sketch (as tests/garment) with the given "adaptive" value.
@@ -35,25 +37,34 @@ TEST(AdaptiveSketch, BoolAndObjectForms) {
   EXPECT_FALSE(parse_sketch(sketch_with("false"), "t.json").simulate.adaptive);
   const Sketch defaults = parse_sketch(sketch_with("{}"), "t.json");
   EXPECT_TRUE(defaults.simulate.adaptive);
-  EXPECT_FALSE(defaults.simulate.adaptive_settings.refine_threshold.has_value());
-  EXPECT_FALSE(defaults.simulate.adaptive_settings.max_level.has_value());
+  // Unset values are the simulator's defaults (the settings are sim's own type).
+  const sim::AdaptiveSettings sim_defaults;
+  const sim::AdaptiveSettings& d = defaults.simulate.adaptive_settings;
+  EXPECT_EQ(d.refine_threshold, sim_defaults.refine_threshold);
+  EXPECT_EQ(d.coarsen_threshold, sim_defaults.coarsen_threshold);
+  EXPECT_EQ(d.steady_rate, sim_defaults.steady_rate);
+  EXPECT_EQ(d.min_lifetime, sim_defaults.min_lifetime);
+  EXPECT_EQ(d.min_level, sim_defaults.min_level);
+  EXPECT_EQ(d.max_level, sim_defaults.max_level);
+  EXPECT_EQ(d.max_vertices, sim_defaults.max_vertices);
+  EXPECT_EQ(d.merge_batch, sim_defaults.merge_batch);
+  EXPECT_EQ(d.even_levels, sim_defaults.even_levels);
   const Sketch s = parse_sketch(
       sketch_with(R"({"enabled": true, "refine_threshold": 0.004, "coarsen_threshold": 0.001,
                       "steady_rate": 0.1, "min_lifetime": 0.5, "min_level": 1, "max_level": 5,
                       "max_vertices": 800, "merge_batch": 0.1, "even_levels": true})"),
       "t.json");
-  const AdaptiveSpec& a = s.simulate.adaptive_settings;
+  const sim::AdaptiveSettings& a = s.simulate.adaptive_settings;
   EXPECT_TRUE(s.simulate.adaptive);
-  EXPECT_DOUBLE_EQ(*a.refine_threshold, 0.004);
-  EXPECT_DOUBLE_EQ(*a.coarsen_threshold, 0.001);
-  EXPECT_DOUBLE_EQ(*a.steady_rate, 0.1);
-  EXPECT_DOUBLE_EQ(*a.min_lifetime, 0.5);
-  EXPECT_EQ(*a.min_level, 1);
-  EXPECT_EQ(*a.max_level, 5);
-  EXPECT_EQ(*a.max_vertices, 800);
-  EXPECT_DOUBLE_EQ(*a.merge_batch, 0.1);
-  EXPECT_TRUE(*a.even_levels);
-  EXPECT_FALSE(defaults.simulate.adaptive_settings.even_levels.has_value());
+  EXPECT_DOUBLE_EQ(a.refine_threshold, 0.004);
+  EXPECT_DOUBLE_EQ(a.coarsen_threshold, 0.001);
+  EXPECT_DOUBLE_EQ(a.steady_rate, 0.1);
+  EXPECT_DOUBLE_EQ(a.min_lifetime, 0.5);
+  EXPECT_EQ(a.min_level, 1);
+  EXPECT_EQ(a.max_level, 5);
+  EXPECT_EQ(a.max_vertices, 800);
+  EXPECT_DOUBLE_EQ(a.merge_batch, 0.1);
+  EXPECT_TRUE(a.even_levels);
   EXPECT_FALSE(parse_sketch(sketch_with(R"({"enabled": false})"), "t.json").simulate.adaptive);
 }
 
@@ -80,7 +91,11 @@ TEST(AdaptiveSketch, BadValuesNameTheirPath) {
   EXPECT_EQ(error_of(R"({"even_levels": "yes"})").rfind("/simulate/adaptive/even_levels:", 0), 0u);
   EXPECT_EQ(error_of(R"({"refine": 0.1})").rfind("/simulate/adaptive", 0), 0u);  // unknown key
   EXPECT_EQ(error_of(R"({"max_vertices": 0})"), "");
+  // A value against the simulator's default is left to run (AdaptiveSettings::validate): the
+  // file is read as written.
+  EXPECT_EQ(error_of(R"({"coarsen_threshold": 0.003})"), "");
+  EXPECT_EQ(error_of(R"({"min_level": 8})"), "");
 }
 
 }  // namespace
-}  // namespace sd::garment
+}  // namespace sd::scene

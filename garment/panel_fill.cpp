@@ -1,0 +1,208 @@
+#include "garment/panel_fill.hpp"
+
+#include <fmt/format.h>
+
+#include <cstdint>
+#include <optional>
+#include <tuple>
+#include <unordered_map>
+
+#include "garment/panel_surface.hpp"
+#include "garment/surface_relaxation.hpp"
+#include "garment/surface_untangle.hpp"
+#include "meshing/quad_quality.hpp"
+
+namespace sd::garment {
+namespace {
+
+// Smoothing along the body after the fill (surface_relaxation.hpp): at most this many sweeps
+// (the t-shirt's back needs 20 to unfold its crease with steps of half an edge; 10 do not),
+// stopped early once no vertex moves more than 1e-2 edge lengths (0.25 mm) in a sweep.
+constexpr int kSurfaceSweeps = 20;
+constexpr double kSurfaceTolerance = 1e-2;  // edge lengths
+constexpr double kSurfaceMaxStep = 0.5;     // edge lengths
+// m: an "auto" panel whose spanned surface stands farther than this off the body's offset
+// surface spans a hollow and is made "free"; otherwise it lies on the body.
+constexpr double kSpanGap = 0.03;
+// cos of the angle beyond which a closest body point faces away from its panel (100°): the
+// sides of a half-tube are perpendicular to its facing, so only the far side is refused.
+constexpr double kAgainstFacing = -0.17;
+// ... and the surface seen from the panel's side replaces it only when it is at most this many
+// times as far (a point in the middle of a limb is about as far from both sides; a panel that
+// wraps over the shoulder to its front has points much nearer the front than the back).
+constexpr double kSeenReach = 2.0;
+// A quad this many times longer than wide is a sliver (the quality gate warns from 10).
+constexpr double kSliverAspect = 10;
+
+// The unit vector area of a panel's boundary loop (the sides, corner to corner), or zero.
+Eigen::Vector3d loop_facing(const std::vector<Eigen::MatrixX3d>& side_points) {
+  std::vector<Eigen::Vector3d> loop;
+  for (const auto& side : side_points)
+    for (Eigen::Index r = 0; r + 1 < side.rows(); ++r) loop.emplace_back(side.row(r).transpose());
+  Eigen::Vector3d area = Eigen::Vector3d::Zero();
+  for (size_t k = 0; k < loop.size(); ++k)
+    area += (loop[k] - loop.front()).cross(loop[(k + 1) % loop.size()] - loop.front());
+  return area.norm() > 0 ? Eigen::Vector3d(area.normalized()) : Eigen::Vector3d::Zero();
+}
+
+}  // namespace
+
+meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& spec,
+                                const PanelLoop& loop, const CurveNetwork& net,
+                                const std::vector<Eigen::MatrixX3d>& side_points,
+                                const BodySurface& body, GarmentPanel& panel) {
+  // Project interior points onto the offset surface where the panel lies on the body:
+  // inside it, or less than one edge length outside it; points spanning a hollow (between
+  // the legs, under the bust) are left where the relaxation puts them.
+  // Any on-body curve makes the panel a body panel; free-hanging parts (a flared hem) are
+  // more than `reach` off the body and are not pulled in.
+  double offset = 0;
+  int on_body = 0;
+  for (const LoopEdge& e : loop.edges) {
+    const CurveSpec& cs = sketch.curves[static_cast<size_t>(
+        net.curves[static_cast<size_t>(net.edges[static_cast<size_t>(e.edge)].curve)].spec)];
+    if (!cs.on_body) continue;
+    offset += cs.offset;
+    ++on_body;
+  }
+  if (on_body > 0) offset /= on_body;
+  const double reach = spec.edge_length.value_or(sketch.edge_length);
+  meshing::FillGeometryOptions options;
+  options.relax_iterations = sketch.relax_iterations;
+  // Each query starts from the last answer found in the same cell of half an edge length: a
+  // vertex moves less than that per relaxation sweep, so the hint is usually its own last
+  // projection (a hash collision only gives a poorer hint, never another answer).
+  std::unordered_map<std::int64_t, SurfacePoint> hints;
+  const double cell = 0.5 * reach;
+  // The panel faces `facing` (its boundary's vector area: the loop runs counter-clockwise
+  // seen from outside). A point whose closest body point faces the other way has crossed
+  // the limb or torso it lies on: the interior of a half-sleeve starts on the chord plane
+  // through the arm, where the far side of the arm can be nearest (a hole in the back of a
+  // long sleeve at the elbow). Such a point goes to the body's first surface seen from the
+  // panel's side instead: a ray from outside the body's box along −facing.
+  const Eigen::Vector3d facing = loop_facing(side_points);
+  const double outside = (body.box().max - body.box().min).norm();
+  const auto closest = [&body, &hints, cell, facing, outside](const Eigen::Vector3d& p) {
+    const Eigen::Vector3d q = (p / cell).array().floor();
+    const std::int64_t key = (static_cast<std::int64_t>(q.x()) * 73856093) ^
+                             (static_cast<std::int64_t>(q.y()) * 19349663) ^
+                             (static_cast<std::int64_t>(q.z()) * 83492791);
+    SurfacePoint& hint = hints[key];
+    hint = body.closest_point(p, hint);
+    if (hint.normal.dot(facing) < kAgainstFacing) {
+      if (const auto seen = body.first_hit(p + outside * facing, -facing);
+          seen && seen->normal.dot(facing) > 0 &&
+          (seen->position - p).norm() < kSeenReach * hint.distance)
+        return *seen;
+    }
+    return hint;
+  };
+  const SurfaceLift lift = [&closest, offset, reach](const Eigen::Vector3d& p) -> LiftedPoint {
+    const SurfacePoint s = closest(p);
+    const double signed_distance = (p - s.position).dot(s.normal);
+    if (signed_distance < offset + reach) return {s.position + offset * s.normal, s.normal};
+    return {p, Eigen::Vector3d::Zero()};
+  };
+  // The body as an obstacle only: a point inside the offset surface goes to its closest
+  // point on it, any other point stays.
+  const PushOut push_out = [&closest,
+                            offset](const Eigen::Vector3d& p) -> std::optional<Eigen::Vector3d> {
+    const SurfacePoint s = closest(p);
+    if ((p - s.position).dot(s.normal) >= offset) return std::nullopt;
+    return s.position + offset * s.normal;
+  };
+  const auto fill = [&](const meshing::FillGeometryOptions& o) {
+    try {
+      return meshing::fill_region(side_points, o);
+    } catch (const meshing::FillError& e) {
+      sketch.fail(loop.json_path,
+                  fmt::format("panel '{}' cannot be filled with quads: {}", loop.id, e.what()));
+    }
+  };
+  // The surface spanned by the boundary decides an "auto" panel: where it stays near or
+  // inside the body the panel lies on it (a t-shirt's front over the chest); where it
+  // stands off by more than kSpanGap it spans a hollow (a skirt across the legs).
+  PanelFit fit = spec.fit;
+  if (on_body == 0) fit = PanelFit::kFree;
+  meshing::FillGeometryOptions free_options = options;
+  free_options.project = nullptr;
+  std::optional<meshing::FilledPatch> spanned;
+  if (fit != PanelFit::kBody) {
+    spanned = fill(free_options);
+    std::vector<char> boundary(static_cast<size_t>(spanned->mesh.vertex_count()), 0);
+    for (const auto& side : spanned->topology.side_vertices)
+      for (int v : side) boundary[static_cast<size_t>(v)] = 1;
+    meshing::QuadMesh membrane = spanned->mesh;
+    span_harmonic(membrane, boundary);
+    for (Eigen::Index v = 0; v < membrane.vertex_count(); ++v) {
+      if (boundary[static_cast<size_t>(v)]) continue;
+      const Eigen::Vector3d p = membrane.vertices.row(v).transpose();
+      const SurfacePoint s = body.closest_point(p);
+      panel.span_gap = std::max(panel.span_gap, (p - s.position).dot(s.normal) - offset);
+    }
+    if (fit == PanelFit::kAuto) fit = panel.span_gap > kSpanGap ? PanelFit::kFree : PanelFit::kBody;
+  }
+  panel.fit = fit == PanelFit::kFree ? "free" : "body";
+  if (fit == PanelFit::kBody)
+    options.project = [&lift](const Eigen::Vector3d& p) { return lift(p).position; };
+  else
+    options.project = [&push_out](const Eigen::Vector3d& p) { return push_out(p).value_or(p); };
+  const auto normal = [&body](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+    return body.closest_point(p).normal;
+  };
+  meshing::FilledPatch patch = fit == PanelFit::kBody ? fill(options) : std::move(*spanned);
+  std::vector<char> fixed(static_cast<size_t>(patch.mesh.vertex_count()), 0);
+  for (const auto& side : patch.topology.side_vertices)
+    for (int v : side) fixed[static_cast<size_t>(v)] = 1;
+  if (fit == PanelFit::kFree) {
+    // A panel the body does not touch keeps the filler's own interpolation of its boundary
+    // (transfinite, then relaxed), which reproduces a ruled surface such as a tube skirt's
+    // cylinder exactly; the uniform harmonic membrane would flatten it between its curves.
+    // Where the body is in the way, the membrane spans over it.
+    bool touches = false;
+    for (Eigen::Index v = 0; v < patch.mesh.vertex_count() && !touches; ++v)
+      touches = !fixed[static_cast<size_t>(v)] &&
+                push_out(patch.mesh.vertices.row(v).transpose()).has_value();
+    if (touches) span_over_obstacle(patch.mesh, fixed, push_out);
+    patch.quality = meshing::measure_quality(patch.mesh, patch.topology.corner_vertices());
+  }
+  // Candidates: the fill, its smoothing along the surface (body panels; see
+  // surface_relaxation.hpp), and each of those unfolded against the body's normals when it
+  // folds (surface_untangle.hpp). The best by the quality gate's measures wins: fewest folded
+  // quads, then no sliver (aspect ratio 10 or more: the t-shirt dress's back at 3 cm had a
+  // clean fill with two vertices on one spot at the armpit, and a smoothed mesh with one
+  // fold that unfolding removes), then the best worst corner.
+  const auto rank = [](const meshing::QuadQuality& q) {
+    return std::tuple(q.inverted_quads, q.max_aspect_ratio >= kSliverAspect,
+                      -q.scaled_jacobian_min);
+  };
+  const auto consider = [&](meshing::QuadMesh&& mesh, meshing::FilledPatch& best) {
+    const meshing::QuadQuality quality =
+        meshing::measure_quality(mesh, patch.topology.corner_vertices());
+    if (rank(quality) < rank(best.quality)) {
+      best.mesh = std::move(mesh);
+      best.quality = quality;
+    }
+  };
+  const auto unfold = [&](const meshing::QuadMesh& mesh) {
+    meshing::QuadMesh unfolded = mesh;
+    untangle_on_surface(unfolded, fixed, options.project, normal);
+    return unfolded;
+  };
+  meshing::FilledPatch best = patch;
+  if (patch.quality.inverted_quads > 0) consider(unfold(patch.mesh), best);
+  if (fit == PanelFit::kBody) {
+    meshing::QuadMesh relaxed = patch.mesh;
+    relax_on_surface(relaxed, fixed, lift,
+                     {kSurfaceSweeps, kSurfaceTolerance * reach, kSurfaceMaxStep * reach});
+    const meshing::QuadQuality quality =
+        meshing::measure_quality(relaxed, patch.topology.corner_vertices());
+    if (quality.inverted_quads > 0) consider(unfold(relaxed), best);
+    consider(std::move(relaxed), best);
+  }
+  patch.mesh = std::move(best.mesh);
+  patch.quality = best.quality;
+  return patch;
+}
+
+}  // namespace sd::garment

@@ -1,0 +1,28 @@
+#pragma once
+// One panel of a garment filled with quads (the third stage of build_garment, garment_mesh.hpp):
+// its sides' points go to the quad filler, and the interior is laid on the body's offset surface
+// or spans a hollow between its curves (docs/garment.md, "Panel surfaces"); the fill, its
+// smoothing along the body and their unfolded versions compete on the quality gate's measures.
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "garment/body_surface.hpp"
+#include "garment/curve_network.hpp"
+#include "garment/garment_mesh.hpp"
+#include "garment/garment_request.hpp"
+#include "garment/panel_loop.hpp"
+#include "meshing/patch_fill.hpp"
+
+namespace sd::garment {
+
+// An original panel's (not a mirror copy's) quads: the fill of its sides (`side_points`, corner to
+// corner), laid on the body's offset surface or spanning a hollow (sets panel.fit and
+// panel.span_gap), then the best of the fill, its smoothing along the body and their unfolded
+// versions. Throws SketchError at the panel's path when the filler cannot fill it.
+meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& spec,
+                                const PanelLoop& loop, const CurveNetwork& net,
+                                const std::vector<Eigen::MatrixX3d>& side_points,
+                                const BodySurface& body, GarmentPanel& panel);
+
+}  // namespace sd::garment

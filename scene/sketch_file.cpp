@@ -1,0 +1,142 @@
+#include "scene/sketch_file.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <fstream>
+#include <functional>
+#include <sstream>
+
+#include "garment/input_checks.hpp"
+#include "scene/sketch_sections.hpp"
+
+namespace sd::scene {
+
+using namespace detail;  // the reader and the sections' parsers
+
+Sketch parse_sketch(std::string_view text, const std::string& file,
+                    const std::filesystem::path& base_dir) {
+  Sketch sketch;
+  sketch.file = file;
+  sketch.base_dir = base_dir;
+  const Reader r(sketch);
+
+  // UTF-16 (what some Windows editors save): a byte-order mark, or ASCII text whose every
+  // other byte is zero.
+  const auto utf16 = [&] {
+    if (text.starts_with("\xff\xfe") || text.starts_with("\xfe\xff")) return true;
+    if (text.size() < 4) return false;
+    const size_t zero = text[0] == '\0' ? 0 : 1;  // big- or little-endian
+    for (size_t i = 0; i + 1 < std::min<size_t>(text.size(), 64); i += 2)
+      if (text[i + zero] != '\0' || text[i + 1 - zero] == '\0') return false;
+    return true;
+  };
+  if (utf16())
+    r.fail("",
+           "the file is UTF-16 text; this program reads sketch files in UTF-8 (save it as "
+           "UTF-8 in the editor)");
+  // A NUL byte would end the text for the JSON reader, silently dropping the rest.
+  if (const size_t nul = text.find('\0'); nul != std::string_view::npos)
+    r.fail("", fmt::format("{}: the file holds a NUL byte (a zero byte); a sketch file is text: "
+                           "the file is damaged or not a sketch file",
+                           position_of(text, nul + 1)));
+  json root;
+  try {
+    DuplicateKeyCheck duplicates(sketch);
+    root =
+        json::parse(mark_overflowing_numbers(text), std::ref(duplicates), /*allow_exceptions=*/true,
+                    /*ignore_comments=*/true);
+  } catch (const json::parse_error& e) {
+    std::string detail = e.what();
+    const size_t colon = detail.find("error while parsing");
+    if (colon != std::string::npos) detail = detail.substr(colon);
+    r.fail("",
+           fmt::format("{}: the file is not valid JSON ({})", position_of(text, e.byte), detail));
+  }
+  r.require_object(root, "", "a sketch file");
+  r.check_keys(root, "",
+               {"format", "body", "edge_length", "offset", "junction_tolerance", "corner_angle",
+                "relax_iterations", "fabric", "garment_mesh", "curves", "panels", "join",
+                "simulate", "output", "sheet"});
+  if (root.contains("format")) {
+    const std::string format = r.text(root["format"], "/format");
+    if (format != kSketchFormat)
+      r.fail("/format",
+             fmt::format("this program reads format \"{}\", not \"{}\"", kSketchFormat, format));
+  }
+  if (root.contains("body")) parse_body(r, root["body"], sketch.body);
+  if (root.contains("edge_length")) {
+    sketch.edge_length = r.positive(root["edge_length"], "/edge_length");
+    if (sketch.edge_length < 0.002 || sketch.edge_length > 0.5)
+      r.fail("/edge_length",
+             fmt::format("an edge length of {} m is outside 2 mm .. 50 cm", sketch.edge_length));
+  }
+  if (root.contains("offset")) sketch.offset = r.number(root["offset"], "/offset");
+  if (root.contains("junction_tolerance"))
+    sketch.junction_tolerance = r.positive(root["junction_tolerance"], "/junction_tolerance");
+  if (sketch.junction_tolerance > kMaxJunctionTolerance)
+    r.fail("/junction_tolerance",
+           out_of_range_sentence(sketch.junction_tolerance, 0, kMaxJunctionTolerance,
+                                 "a junction tolerance of"));
+  if (root.contains("corner_angle")) {
+    sketch.corner_angle_degrees = r.positive(root["corner_angle"], "/corner_angle");
+    if (sketch.corner_angle_degrees >= 180)
+      r.fail("/corner_angle", "a corner angle is a turn in degrees below 180");
+  }
+  if (root.contains("relax_iterations"))
+    sketch.relax_iterations = r.integer(root["relax_iterations"], "/relax_iterations", 0);
+  if (sketch.relax_iterations > kMaxRelaxIterations)
+    r.fail("/relax_iterations", fmt::format("{} sweeps is more than the {} allowed",
+                                            sketch.relax_iterations, kMaxRelaxIterations));
+  if (root.contains("fabric")) {
+    // A preset name, a path to a fabric file, or the fabric's constants inline (the presets'
+    // schema, checked when the scene is built).
+    if (root["fabric"].is_object()) {
+      sketch.fabric_inline = root["fabric"].dump();
+      sketch.fabric = root["fabric"].contains("name") && root["fabric"]["name"].is_string()
+                          ? root["fabric"]["name"].get<std::string>()
+                          : "custom";
+    } else {
+      sketch.fabric = r.text(root["fabric"], "/fabric");
+    }
+  }
+  if (root.contains("simulate")) parse_simulate(r, root["simulate"], sketch.simulate);
+  if (root.contains("output")) parse_output(r, root["output"], sketch.output);
+
+  if (root.contains("sheet")) {
+    sketch.sheet = parse_sheet(r, root["sheet"]);
+    for (const char* key : {"curves", "panels", "garment_mesh", "join"})
+      if (root.contains(key))
+        r.fail("/sheet", fmt::format("a sheet scene has no \"{}\": remove one or the other", key));
+    if (!root.contains("body"))
+      sketch.body.mesh = "none";  // a sheet falls freely unless given a body
+    return sketch;
+  }
+
+  if (root.contains("garment_mesh")) {
+    sketch.garment_mesh = r.text(root["garment_mesh"], "/garment_mesh");
+    if (root.contains("curves") || root.contains("panels"))
+      r.fail("/garment_mesh",
+             "a file with \"garment_mesh\" skips sketching: remove \"curves\" "
+             "and \"panels\" (or remove \"garment_mesh\")");
+    return sketch;
+  }
+  parse_garment(r, root, sketch);
+  return sketch;
+}
+
+Sketch load_sketch(const std::filesystem::path& path) {
+  if (const auto problem = input_file_problem(path, kMaxSketchFileBytes))
+    throw SketchError(path.string(), "", "the sketch file " + *problem);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    const bool exists = std::filesystem::exists(path);
+    throw SketchError(path.string(), "",
+                      exists ? "the sketch file cannot be read" : "the sketch file does not exist");
+  }
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  return parse_sketch(buffer.str(), path.string(), path.parent_path());
+}
+
+}  // namespace sd::scene

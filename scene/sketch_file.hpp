@@ -1,0 +1,127 @@
+#pragma once
+// The scene layer's sketch file (format "sketchdrape/1", docs/sketch-format.md): it reads and
+// validates the file once and hands each module its own plain inputs: the garment request
+// (garment::GarmentRequest, the base of Sketch), the simulator's settings (SimulateSpec, whose
+// adaptive settings are sim's own type) and the render specs (OutputSpec's images). Units are
+// metres, +Y up, the mannequin faces +Z. Parsing checks each field on its own; whether curves
+// meet, panels close and strokes land on the body is checked later (curve network, projection),
+// with the same SketchError and JSON paths.
+//
+// Where a new field goes: a garment field (curve, panel, join, meshing setting) in
+// garment/garment_request.hpp and its parser in scene/sketch_garment.cpp; a "simulate" field in
+// SimulateSpec below (an adaptive one in sim::AdaptiveSettings) and its parser in
+// scene/sketch_settings.cpp; an "output" or "sheet" field below, parsed in
+// scene/sketch_settings.cpp.
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "garment/garment_request.hpp"
+#include "garment/sketch_error.hpp"
+#include "sim/adaptive_settings.hpp"
+
+namespace sd::scene {
+
+inline constexpr const char* kSketchFormat = "sketchdrape/1";
+
+// How the drape is simulated (`sketchdrape run`): plain values with defaults.
+struct SimulateSpec {
+  double duration = 3.0;        // seconds of simulated time at most
+  bool adaptive = true;         // 4-8 refinement/coarsening
+  bool adaptive_given = false;  // the file says "adaptive" (a sheet adapts only then)
+  // "adaptive": {...} (with "enabled" for the bool): the simulator's own settings, its defaults
+  // where the file says nothing (docs/adaptive.md); checked together by run (validate()).
+  sim::AdaptiveSettings adaptive_settings;
+  double time_step = 1.0 / 60.0;              // seconds, the largest step
+  std::string integrator = "implicit-euler";  // "implicit-euler" | "bdf2"
+  std::string solver = "auto";                // "auto" (the default) | "pcg" | "cholmod"
+  // "time_step": "auto" (the default): the step, like an "auto" solver, is chosen from the scene
+  // (sim/automatic_settings.hpp); time_step is then what estimates assume before it is built.
+  bool time_step_auto = true;
+  // "hinges" | "quadratic": the discrete bending energy (docs/simulator.md, "Bending on any
+  // mesh"). Hinges by default until the quadratic model is as fast and every design rests with
+  // it (docs/fabrics.md).
+  std::string bending = "hinges";
+  bool stop_at_rest = true;
+  Eigen::Vector3d gravity{0.0, -9.81, 0.0};
+  std::optional<double> pin_above;  // metres: garment vertices designed at y >= this are pinned
+  // Also keep the body's vertices from poking through cloth triangles (sharp features: a dress
+  // form's edges, shoulder tips, the front of a shoulder under 3 cm triangles). On by default:
+  // without it a preview shows the body through the cloth; off saves up to half a drape's
+  // time (docs/collision.md).
+  bool check_body_vertices = true;
+  // The cloth's rest shape: "shaped" (each triangle as drawn on the body) or "flat" (the
+  // triangle in the panel's flattened pattern piece, docs/pattern.md). Panels may override it.
+  std::string rest = "shaped";
+  // Cloth-cloth contact (sim/self_contact.hpp): folds and layers do not pass through each
+  // other. Unset: on for garments, off for sheets.
+  std::optional<bool> self_collision;
+};
+
+// A rectangular sheet of cloth instead of a garment: scenes for tests and benchmarks.
+struct SheetSpec {
+  Eigen::Vector2d size{1.0, 1.0};         // metres: width (x) and height (y, or z when horizontal)
+  int columns = 16;                       // quads along the width
+  int rows = 16;                          // quads along the height
+  bool horizontal = false;                // in the XZ plane instead of the XY plane
+  Eigen::Vector3d centre{0.0, 1.0, 0.0};  // metres
+  std::vector<std::string> pins;          // "top-left", ..., or whole edges "top", "left", ...
+  // Copies of the sheet stacked one over the other (two sheets falling onto each other): layer
+  // k is the first moved by k·layer_offset and turned k·layer_turn degrees about the vertical
+  // through the centre. Pins hold the first layer only.
+  int layers = 1;
+  Eigen::Vector3d layer_offset{0.0, 0.05, 0.0};  // metres
+  double layer_turn = 0.0;                       // degrees
+};
+
+struct ImageSpec {
+  // "front", "back", "left", "right", "three-quarter", or "camera" (then `camera` is used).
+  std::string view = "front";
+  garment::CameraSpec camera;
+  int width = 800;
+  int height = 1200;
+  std::optional<bool> wireframe;  // default: output.wireframe
+};
+
+// "output": {"pattern": true | {...}}: the flat sewing pattern (pattern.svg, .dxf, .json).
+struct PatternSpec {
+  double fabric_width = 1.5;     // metres across the bolt
+  double seam_allowance = 0.01;  // metres, every piece without its own
+  double max_stretch = 0.05;     // flattening stretch (95th percentile) that flags a panel
+};
+
+struct OutputSpec {
+  std::vector<ImageSpec> images;
+  bool images_listed = false;        // "images" was given (an empty list means none)
+  std::string mesh = "garment.obj";  // file name of the stitched garment (.obj or .glb)
+  bool report = true;
+  bool wireframe = false;
+  std::optional<PatternSpec> pattern;  // absent: no pattern files
+};
+
+// The whole file. The garment request is its base rather than a member: garment/ takes it as
+// `const garment::GarmentRequest&`, and the app and the tests keep reading `sketch.curves`,
+// `sketch.body`, ... where they always did (fields other branches add keep their place).
+struct Sketch : garment::GarmentRequest {
+  std::string fabric =
+      "jersey";  // a preset of data/fabrics or a fabric .json path (sketchdrape run checks it)
+  std::string
+      fabric_inline;  // "fabric" given as an object: its JSON text (then `fabric` is its name)
+  std::optional<SheetSpec> sheet;  // a sheet scene: no curves, panels or (unless given) body
+  SimulateSpec simulate;
+  OutputSpec output;
+};
+
+// Parses and validates the text of a sketch file; `file` names it in errors, `base_dir` is where
+// relative paths point. Throws SketchError.
+Sketch parse_sketch(std::string_view text, const std::string& file,
+                    const std::filesystem::path& base_dir = {});
+
+// Reads and parses a sketch file. Throws SketchError (also when the file cannot be read).
+Sketch load_sketch(const std::filesystem::path& path);
+
+}  // namespace sd::scene

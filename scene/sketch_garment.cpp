@@ -1,0 +1,413 @@
+// The garment request's sections of a sketch file: the body, "curves", "panels" and "join".
+
+#include <fmt/format.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <set>
+
+#include "garment/body_landmarks.hpp"
+#include "garment/sketch_inputs.hpp"
+#include "scene/sketch_sections.hpp"
+
+namespace sd::scene::detail {
+namespace {
+
+// "poses": [{"time": 0.5, "mesh": "raised.obj"}, ...] of a "poses" motion.
+void parse_body_poses(const Reader& r, const json& m, const std::string& mpath,
+                      const BodySpec& body, BodyMotionSpec& motion) {
+  if (!m.contains("poses"))
+    r.fail(mpath,
+           "a \"poses\" motion needs \"poses\": [{\"time\": 1.0, \"mesh\": "
+           "\"pose.obj\"}, ...], the body's mesh in other poses");
+  const json& list = m["poses"];
+  const std::string lpath = mpath + "/poses";
+  if (!list.is_array() || list.empty())
+    r.fail(lpath, "expected a list of at least one pose {\"time\": seconds, \"mesh\": file}");
+  if (body.mesh == "builtin")
+    r.fail(lpath,
+           "the poses must be meshes of the same body: give the body's own file as "
+           "\"mesh\" (the pose at time 0) instead of \"builtin\"");
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    const std::string ppath = lpath + "/" + std::to_string(k);
+    const json& p = list[k];
+    r.require_object(p, ppath, "a pose");
+    r.check_keys(p, ppath, {"time", "mesh"});
+    if (!p.contains("time") || !p.contains("mesh"))
+      r.fail(ppath,
+             "a pose needs a \"time\" (seconds) and a \"mesh\" (the body file in that pose)");
+    BodyPoseSpec pose;
+    pose.json_path = ppath;
+    pose.time = r.positive(p["time"], ppath + "/time");
+    pose.mesh = r.text(p["mesh"], ppath + "/mesh");
+    if (pose.mesh.empty()) r.fail(ppath + "/mesh", "the pose's mesh path is empty");
+    if (!motion.poses.empty() && !(pose.time > motion.poses.back().time))
+      r.fail(ppath + "/time",
+             fmt::format("the poses must come in time order: {} s is not after {} s", pose.time,
+                         motion.poses.back().time));
+    motion.poses.push_back(pose);
+  }
+}
+
+}  // namespace
+
+void parse_body(const Reader& r, const json& j, BodySpec& body) {
+  const std::string path = "/body";
+  if (j.is_string()) {  // shorthand: "body": "builtin"
+    body.mesh = r.text(j, path);
+    return;
+  }
+  r.require_object(j, path, "body");
+  r.check_keys(j, path, {"mesh", "height", "up", "scale", "motion"});
+  if (j.contains("mesh")) body.mesh = r.text(j["mesh"], path + "/mesh");
+  if (body.mesh.empty()) r.fail(path + "/mesh", "the body mesh path is empty");
+  if (j.contains("height")) {
+    body.height = r.positive(j["height"], path + "/height");
+    if (*body.height < kMinBodyHeight || *body.height > kMaxBodyHeight)
+      r.fail(path + "/height", out_of_range_sentence(*body.height, kMinBodyHeight, kMaxBodyHeight,
+                                                     "a body height of"));
+  }
+  if (j.contains("scale")) body.scale = r.positive(j["scale"], path + "/scale");
+  if (j.contains("up")) {
+    const std::string up = r.text(j["up"], path + "/up");
+    static const std::set<std::string> kAxes = {"x", "y", "z", "+x", "+y", "+z", "-x", "-y", "-z",
+                                                "X", "Y", "Z", "+X", "+Y", "+Z", "-X", "-Y", "-Z"};
+    if (!kAxes.contains(up))
+      r.fail(path + "/up", fmt::format("'{}' is not an axis; use +x, -x, +y, -y, +z or -z", up));
+    body.up = up;
+  }
+  if (j.contains("motion")) {
+    const std::string mpath = path + "/motion";
+    const json& m = j["motion"];
+    r.require_object(m, mpath, "the body's motion");
+    if (body.mesh == "none") r.fail(mpath, "a body motion needs a body: \"mesh\" is \"none\"");
+    BodyMotionSpec motion;
+    if (m.contains("type")) motion.type = r.text(m["type"], mpath + "/type");
+    if (motion.type == "poses") {
+      r.check_keys(m, mpath, {"type", "poses"});
+      parse_body_poses(r, m, mpath, body, motion);
+      body.motion = motion;
+      return;
+    }
+    if (motion.type != "arms-lowering")
+      r.fail(mpath + "/type",
+             fmt::format("'{}' is not a body motion; use arms-lowering or poses", motion.type));
+    r.check_keys(m, mpath, {"type", "degrees", "start", "duration"});
+    if (m.contains("degrees")) motion.degrees = r.number(m["degrees"], mpath + "/degrees");
+    // The built-in mannequin's arms hang 17° out from the body: lowering them by more than 15°
+    // would press them into the torso.
+    if (motion.degrees < -30.0 || motion.degrees > 15.0)
+      r.fail(mpath + "/degrees",
+             fmt::format("{}° is too far: the arms can be lowered by up to 15° (into the torso "
+                         "beyond) and raised by up to 30° (negative degrees)",
+                         motion.degrees));
+    if (m.contains("start")) motion.start = r.non_negative(m["start"], mpath + "/start");
+    if (m.contains("duration")) motion.duration = r.positive(m["duration"], mpath + "/duration");
+    body.motion = motion;
+  }
+}
+
+namespace {
+
+// The landmarks of the sketch's body (docs/bodies.md), found once per body and kept: a sketch
+// that places points relative to them loads its body while it is read.
+const BodyLandmarks& sketch_landmarks(const Reader& r, const Sketch& sk, const std::string& path) {
+  static std::mutex mutex;
+  static std::map<std::string, BodyLandmarks> cache;
+  const std::string key =
+      fmt::format("{}|{}|{}|{}", sk.resolve(sk.body.mesh).string(), sk.body.height.value_or(0),
+                  sk.body.scale.value_or(0), sk.body.up.value_or(""));
+  const std::lock_guard lock(mutex);
+  if (const auto it = cache.find(key); it != cache.end()) return it->second;
+  const Body body = load_sketch_body(sk);
+  try {
+    return cache.emplace(key, find_landmarks(body.mesh)).first->second;
+  } catch (const std::runtime_error& e) {
+    r.fail(path, fmt::format("a point is given relative to a landmark, but the body has none: {}",
+                             e.what()));
+  }
+}
+
+// {"at": "left_armpit", "offset": [dx, dy, dz]}: a landmark's position plus an offset (m).
+Eigen::Vector3d landmark_point(const Reader& r, const json& j, const std::string& path,
+                               const Sketch& sk) {
+  r.check_keys(j, path, {"at", "offset"});
+  if (!j.contains("at"))
+    r.fail(path,
+           "a point given by a landmark needs \"at\": its name, e.g. {\"at\": "
+           "\"left_armpit\", \"offset\": [0.01, -0.03, 0]}");
+  const std::string name = r.text(j["at"], path + "/at");
+  const Eigen::Vector3d offset =
+      j.contains("offset") ? r.vector<3>(j["offset"], path + "/offset") : Eigen::Vector3d::Zero();
+  const BodyLandmarks& landmarks = sketch_landmarks(r, sk, path);
+  if (const Landmark* l = landmarks.find(name)) return l->position + offset;
+  std::string names;
+  for (const std::string& n : landmark_names()) names += (names.empty() ? "" : ", ") + n;
+  r.fail(path + "/at", fmt::format("there is no landmark '{}'; the landmarks are {}", name, names));
+}
+
+CurveSpec parse_curve(const Reader& r, const json& j, const std::string& path, const Sketch& sk) {
+  r.require_object(j, path, "a curve");
+  r.check_keys(j, path,
+               {"id", "view", "points", "points3d", "offset", "on_body", "smooth", "closed",
+                "edge_length", "edges"});
+  CurveSpec curve;
+  curve.json_path = path;
+  if (!j.contains("id")) r.fail(path, "every curve needs an \"id\"");
+  curve.id = r.identifier(j["id"], path + "/id");
+  const bool has_2d = j.contains("points"), has_3d = j.contains("points3d");
+  if (has_2d == has_3d)
+    r.fail(path, fmt::format("curve '{}' needs exactly one of \"points\" (2D, drawn in a view) or "
+                             "\"points3d\"",
+                             curve.id));
+  const std::string key = has_2d ? "points" : "points3d";
+  const json& pts = j[key];
+  const std::string ppath = path + "/" + key;
+  if (!pts.is_array())
+    r.fail(ppath, fmt::format("expected a list of points, got {}", type_name(pts)));
+  if (pts.size() < 2) r.fail(ppath, fmt::format("curve '{}' needs at least 2 points", curve.id));
+  r.check_count(pts, ppath, kMaxPointsPerCurve, "points");
+  for (size_t i = 0; i < pts.size(); ++i) {
+    const std::string ip = fmt::format("{}/{}", ppath, i);
+    if (has_2d)
+      curve.points.push_back(r.position<2>(pts[i], ip));
+    else
+      curve.points3d.push_back(pts[i].is_object() ? landmark_point(r, pts[i], ip, sk)
+                                                  : r.position<3>(pts[i], ip));
+  }
+  if (j.contains("view")) {
+    if (has_3d)
+      r.fail(path + "/view",
+             "a \"view\" only applies to 2D \"points\"; \"points3d\" are world "
+             "coordinates");
+    curve.view = r.view(j["view"], path + "/view");
+  }
+  curve.offset = j.contains("offset") ? r.number(j["offset"], path + "/offset") : sk.offset;
+  if (std::abs(curve.offset) > 0.5)
+    r.fail(path + "/offset", fmt::format("an offset of {} m is more than half a metre from the "
+                                         "body; offsets are in metres (1 cm = 0.01)",
+                                         curve.offset));
+  if (j.contains("on_body")) curve.on_body = r.boolean(j["on_body"], path + "/on_body");
+  if (j.contains("smooth")) curve.smooth = r.boolean(j["smooth"], path + "/smooth");
+  if (j.contains("closed")) curve.closed = r.boolean(j["closed"], path + "/closed");
+  if (curve.closed && pts.size() < 3)
+    r.fail(ppath, fmt::format("closed curve '{}' needs at least 3 points", curve.id));
+  if (j.contains("edge_length"))
+    curve.edge_length = r.edge_length(j["edge_length"], path + "/edge_length");
+  if (j.contains("edges")) {
+    curve.edges = r.integer(j["edges"], path + "/edges", 1);
+    if (*curve.edges > kMaxCurveEdges)
+      r.fail(path + "/edges", fmt::format("{} edges on one curve is more than the {} allowed",
+                                          *curve.edges, kMaxCurveEdges));
+  }
+  // Repeated consecutive points make a stroke without direction there.
+  const size_t n = has_2d ? curve.points.size() : curve.points3d.size();
+  for (size_t i = 1; i < n; ++i) {
+    const double d = has_2d ? (curve.points[i] - curve.points[i - 1]).norm()
+                            : (curve.points3d[i] - curve.points3d[i - 1]).norm();
+    if (d < 1e-6)
+      r.fail(fmt::format("{}/{}", ppath, i),
+             fmt::format("point {} of curve '{}' repeats the point before it", i, curve.id));
+  }
+  return curve;
+}
+
+PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, const Sketch& sk) {
+  r.require_object(j, path, "a panel");
+  r.check_keys(j, path,
+               {"id", "boundary", "corners", "fabric", "mirror", "edge_length", "ease", "seed",
+                "rest", "seam_allowance", "fit"});
+  PanelSpec panel;
+  panel.json_path = path;
+  if (!j.contains("id")) r.fail(path, "every panel needs an \"id\"");
+  panel.id = r.identifier(j["id"], path + "/id");
+  if (!j.contains("boundary"))
+    r.fail(path, fmt::format("panel '{}' needs a \"boundary\": its curve ids in order, or "
+                             "\"auto\"",
+                             panel.id));
+  const json& b = j["boundary"];
+  if (b.is_string()) {
+    if (b.get<std::string>() != "auto")
+      r.fail(path + "/boundary", fmt::format("\"boundary\" is a list of curve ids or \"auto\", "
+                                             "not \"{}\"",
+                                             b.get<std::string>()));
+    panel.auto_boundary = true;
+    if (!j.contains("seed"))
+      r.fail(path + "/boundary",
+             fmt::format("panel '{}' has \"boundary\": \"auto\" but no \"seed\": say which "
+                         "region of the curves it is with a point inside it, e.g. \"seed\": "
+                         "{{\"view\": \"front\", \"point\": [0.1, 1.0]}}",
+                         panel.id));
+  } else {
+    if (!b.is_array())
+      r.fail(path + "/boundary", fmt::format("expected a list of curve ids, got {}", type_name(b)));
+    if (b.empty())
+      r.fail(path + "/boundary", fmt::format("panel '{}' has no boundary curves", panel.id));
+    for (size_t i = 0; i < b.size(); ++i) {
+      const std::string ip = fmt::format("{}/boundary/{}", path, i);
+      std::string id = r.text(b[i], ip);
+      const std::string base = id.ends_with(".mirror") ? id.substr(0, id.size() - 7) : id;
+      if (sk.find_curve(base) == nullptr) {
+        std::string sentence = fmt::format("curve '{}' is not defined", id);
+        size_t best = 3;
+        std::string hint;
+        for (const CurveSpec& c : sk.curves) {
+          const size_t d = edit_distance(base, c.id);
+          if (d < best) best = d, hint = c.id;
+        }
+        if (!hint.empty()) sentence += fmt::format(" (did you mean '{}'?)", hint);
+        r.fail(ip, sentence);
+      }
+      panel.boundary.push_back(std::move(id));
+    }
+  }
+  if (j.contains("seed")) {
+    const std::string sp = path + "/seed";
+    if (!panel.auto_boundary)
+      r.fail(sp,
+             "a \"seed\" only picks the region of a \"boundary\": \"auto\" panel; this "
+             "panel lists its curves");
+    const json& sj = j["seed"];
+    r.require_object(sj, sp, "a seed");
+    r.check_keys(sj, sp, {"view", "point", "point3d"});
+    SeedSpec seed;
+    seed.json_path = sp;
+    if (sj.contains("point") == sj.contains("point3d"))
+      r.fail(sp,
+             "a seed needs exactly one of \"point\" ([x, y] in its \"view\") or "
+             "\"point3d\" ([x, y, z])");
+    if (sj.contains("point")) seed.point = r.position<2>(sj["point"], sp + "/point");
+    if (sj.contains("point3d")) seed.point3d = r.position<3>(sj["point3d"], sp + "/point3d");
+    if (sj.contains("view")) {
+      if (seed.point3d)
+        r.fail(sp + "/view",
+               "a \"view\" only applies to a 2D \"point\"; \"point3d\" is in "
+               "world coordinates");
+      seed.view = r.view(sj["view"], sp + "/view");
+    }
+    panel.seed = seed;
+  }
+  if (j.contains("corners")) {
+    if (panel.auto_boundary)
+      r.fail(path + "/corners", "explicit corners need an explicit boundary list");
+    const json& c = j["corners"];
+    if (!c.is_array()) r.fail(path + "/corners", "expected a list of curve ids");
+    for (size_t i = 0; i < c.size(); ++i) {
+      const std::string ip = fmt::format("{}/corners/{}", path, i);
+      std::string id = r.text(c[i], ip);
+      if (std::find(panel.boundary.begin(), panel.boundary.end(), id) == panel.boundary.end())
+        r.fail(ip, fmt::format("corner '{}' is not one of panel '{}''s boundary curves (a corner "
+                               "is named by the curve that starts there)",
+                               id, panel.id));
+      panel.corners.push_back(std::move(id));
+    }
+  }
+  panel.fabric = j.contains("fabric") ? r.text(j["fabric"], path + "/fabric") : sk.fabric;
+  if (j.contains("mirror")) panel.mirror = r.boolean(j["mirror"], path + "/mirror");
+  if (j.contains("edge_length"))
+    panel.edge_length = r.edge_length(j["edge_length"], path + "/edge_length");
+  if (j.contains("ease")) {
+    panel.ease = r.positive(j["ease"], path + "/ease");
+    if (panel.ease < 0.5 || panel.ease > 2.0)
+      r.fail(path + "/ease", fmt::format("ease {} is outside 0.5 .. 2 (1 = rest shape as "
+                                         "designed, 1.05 = 5% looser)",
+                                         panel.ease));
+  }
+  if (j.contains("rest")) {
+    panel.rest = r.text(j["rest"], path + "/rest");
+    if (*panel.rest != "flat" && *panel.rest != "shaped")
+      r.fail(path + "/rest", fmt::format("unknown rest shape '{}'; use \"flat\" (the flattened "
+                                         "pattern piece) or \"shaped\" (as drawn on the body)",
+                                         *panel.rest));
+  }
+  if (j.contains("seam_allowance")) {
+    panel.seam_allowance = r.number(j["seam_allowance"], path + "/seam_allowance");
+    if (*panel.seam_allowance < 0 || *panel.seam_allowance > 0.1)
+      r.fail(path + "/seam_allowance",
+             fmt::format("seam allowance {} m is outside 0 .. 0.1 m", *panel.seam_allowance));
+  }
+  if (j.contains("fit")) {
+    const std::string fit = r.text(j["fit"], path + "/fit");
+    if (fit == "auto")
+      panel.fit = PanelFit::kAuto;
+    else if (fit == "body")
+      panel.fit = PanelFit::kBody;
+    else if (fit == "free")
+      panel.fit = PanelFit::kFree;
+    else
+      r.fail(path + "/fit", fmt::format("\"fit\" is \"auto\", \"body\" (the panel lies on the "
+                                        "body) or \"free\" (spanned by its curves, pushed out of "
+                                        "the body only where it would be inside), not \"{}\"",
+                                        fit));
+  }
+  return panel;
+}
+
+}  // namespace
+
+void parse_garment(const Reader& r, const json& root, Sketch& sketch) {
+  if (!root.contains("curves")) r.fail("", "the file has no \"curves\"");
+  const json& curves = root["curves"];
+  if (!curves.is_array()) r.fail("/curves", "expected a list of curves");
+  if (curves.empty()) r.fail("/curves", "the list of curves is empty");
+  r.check_count(curves, "/curves", kMaxCurves, "curves");
+  for (size_t i = 0; i < curves.size(); ++i) {
+    CurveSpec curve = parse_curve(r, curves[i], fmt::format("/curves/{}", i), sketch);
+    if (const CurveSpec* other = sketch.find_curve(curve.id))
+      r.fail(curve.json_path + "/id", fmt::format("two curves have the id '{}' ({} and {})",
+                                                  curve.id, other->json_path, curve.json_path));
+    sketch.curves.push_back(std::move(curve));
+  }
+
+  if (!root.contains("panels")) r.fail("", "the file has no \"panels\"");
+  const json& panels = root["panels"];
+  if (!panels.is_array()) r.fail("/panels", "expected a list of panels");
+  if (panels.empty())
+    r.fail("/panels", "the list of panels is empty: a garment needs at least one panel");
+  r.check_count(panels, "/panels", kMaxPanels, "panels");
+  for (size_t i = 0; i < panels.size(); ++i) {
+    PanelSpec panel = parse_panel(r, panels[i], fmt::format("/panels/{}", i), sketch);
+    if (const PanelSpec* other = sketch.find_panel(panel.id))
+      r.fail(panel.json_path + "/id", fmt::format("two panels have the id '{}' ({} and {})",
+                                                  panel.id, other->json_path, panel.json_path));
+    sketch.panels.push_back(std::move(panel));
+  }
+  if (root.contains("join")) {
+    const json& joins = root["join"];
+    if (!joins.is_array()) r.fail("/join", "expected a list of {\"id\": ..., \"panels\": [...]}");
+    std::set<std::string> joined;
+    for (size_t i = 0; i < joins.size(); ++i) {
+      const std::string ip = fmt::format("/join/{}", i);
+      const json& jj = joins[i];
+      r.require_object(jj, ip, "a join");
+      r.check_keys(jj, ip, {"id", "panels"});
+      JoinSpec join;
+      join.json_path = ip;
+      if (!jj.contains("id")) r.fail(ip, "a join needs an \"id\" for the merged panel");
+      join.id = r.identifier(jj["id"], ip + "/id");
+      if (!jj.contains("panels") || !jj["panels"].is_array() || jj["panels"].size() < 2)
+        r.fail(ip + "/panels", "a join lists at least two panel ids");
+      for (size_t k = 0; k < jj["panels"].size(); ++k) {
+        const std::string kp = fmt::format("{}/panels/{}", ip, k);
+        const std::string id = r.text(jj["panels"][k], kp);
+        const bool is_copy = id.ends_with(".mirror");
+        const PanelSpec* p = sketch.find_panel(is_copy ? id.substr(0, id.size() - 7) : id);
+        if (p == nullptr) r.fail(kp, fmt::format("panel '{}' is not defined", id));
+        if (is_copy && !p->mirror)
+          r.fail(kp, fmt::format("panel '{}' has no mirror copy (set \"mirror\": true on '{}')", id,
+                                 p->id));
+        if (!joined.insert(id).second)
+          r.fail(kp, fmt::format("panel '{}' is already part of a join", id));
+        join.panels.push_back(id);
+      }
+      for (const JoinSpec& other : sketch.joins)
+        if (other.id == join.id)
+          r.fail(ip + "/id", fmt::format("two joins have the id '{}'", join.id));
+      sketch.joins.push_back(std::move(join));
+    }
+  }
+}
+
+}  // namespace sd::scene::detail

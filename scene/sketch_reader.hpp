@@ -1,0 +1,299 @@
+#pragma once
+// Inside the scene layer: reading a sketch file's JSON with what a message needs. Reader checks
+// each value's type and range and fails with the file, the JSON path and a sentence
+// (SketchError); DuplicateKeyCheck follows nlohmann's parser to refuse a key given twice; numbers
+// that overflow a double are marked before parsing so that they are refused at their path too.
+// The parsers of the file's sections (sketch_sections.hpp) use them; nothing outside scene/ does.
+
+#include <fmt/format.h>
+
+#include <Eigen/Core>
+#include <initializer_list>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "garment/garment_request.hpp"
+#include "garment/sketch_ranges.hpp"
+#include "scene/sketch_file.hpp"
+
+namespace sd::scene::detail {
+
+// The garment request's types, SketchError and the input limits (garment/sketch_ranges.hpp) by
+// name, in the parsers' own namespace only.
+using namespace garment;
+using nlohmann::json;
+
+// Levenshtein distance, for "did you mean" hints on misspelt keys and names.
+size_t edit_distance(std::string_view a, std::string_view b);
+
+// "the text \"x\"", "a list", ...: what a value is, for messages.
+std::string type_name(const json& value);
+
+// JSON has no NaN or infinity literal, but a number like 1e999 overflows a double; the JSON
+// library rejects it without saying where. Such literals are replaced by a marked string before
+// parsing, so the reader reports them with their JSON path.
+inline constexpr const char* kOverflowMarker = "\x01sketchdrape-overflow:";
+std::string mark_overflowing_numbers(std::string_view text);
+
+// "line 3, column 7" from a byte offset.
+std::string position_of(std::string_view text, size_t byte);
+
+// Reads one JSON document with the context needed for messages.
+class Reader {
+ public:
+  explicit Reader(const Sketch& sketch) : sketch_(sketch) {}
+
+  [[noreturn]] void fail(const std::string& path, const std::string& sentence) const {
+    sketch_.fail(path, sentence);
+  }
+
+  // Rejects keys not in `known`, suggesting the nearest known one.
+  void check_keys(const json& object, const std::string& path,
+                  std::initializer_list<std::string_view> known) const {
+    for (const auto& [key, value] : object.items()) {
+      if (std::find(known.begin(), known.end(), key) != known.end()) continue;
+      std::string_view best;
+      size_t best_distance = 3;  // suggest only close spellings
+      for (std::string_view k : known) {
+        const size_t d = edit_distance(key, k);
+        if (d < best_distance) best = k, best_distance = d;
+      }
+      std::string sentence = fmt::format("unknown key '{}'", key);
+      if (!best.empty())
+        sentence += fmt::format(" (did you mean '{}'?)", best);
+      else
+        sentence += fmt::format(" (known keys here: {})", fmt::join(known, ", "));
+      fail(path + "/" + key, sentence);
+    }
+  }
+
+  void require_object(const json& value, const std::string& path, std::string_view what) const {
+    if (!value.is_object())
+      fail(path, fmt::format("{} must be an object {{...}}, not {}", what, type_name(value)));
+  }
+
+  double number(const json& value, const std::string& path) const {
+    if (value.is_string() && value.get<std::string>().starts_with(kOverflowMarker)) {
+      fail(path,
+           fmt::format("the number {} is not finite (too large for a double); coordinates "
+                       "and sizes must be finite numbers",
+                       value.get<std::string>().substr(std::string_view(kOverflowMarker).size())));
+    }
+    if (value.is_string()) {
+      fail(path, fmt::format("expected a number, got {}; JSON numbers are written without quotes "
+                             "and must be finite (no NaN or infinity)",
+                             type_name(value)));
+    }
+    if (!value.is_number()) fail(path, fmt::format("expected a number, got {}", type_name(value)));
+    const double x = value.get<double>();
+    if (!std::isfinite(x))
+      fail(path, fmt::format("the number {} is not finite; coordinates and sizes must be finite "
+                             "numbers",
+                             value.dump()));
+    return x;
+  }
+
+  double positive(const json& value, const std::string& path) const {
+    const double x = number(value, path);
+    if (!(x > 0)) fail(path, fmt::format("must be greater than zero, not {}", x));
+    return x;
+  }
+
+  double non_negative(const json& value, const std::string& path) const {
+    const double x = number(value, path);
+    if (x < 0) fail(path, fmt::format("must not be negative, not {}", x));
+    return x;
+  }
+
+  int integer(const json& value, const std::string& path, int min_value) const {
+    const double x = number(value, path);
+    if (x != std::floor(x) || x < min_value || x > 1e7)
+      fail(path,
+           fmt::format("expected a whole number of at least {}, got {}", min_value, value.dump()));
+    return static_cast<int>(x);
+  }
+
+  bool boolean(const json& value, const std::string& path) const {
+    if (!value.is_boolean())
+      fail(path, fmt::format("expected true or false, got {}", type_name(value)));
+    return value.get<bool>();
+  }
+
+  std::string text(const json& value, const std::string& path) const {
+    if (!value.is_string())
+      fail(path, fmt::format("expected text in quotes, got {}", type_name(value)));
+    return value.get<std::string>();
+  }
+
+  std::string identifier(const json& value, const std::string& path) const {
+    std::string id = text(value, path);
+    if (id.empty()) fail(path, "an id must not be empty");
+    const bool ok = std::all_of(id.begin(), id.end(), [](char c) {
+      return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
+    });
+    if (!ok) fail(path, fmt::format("id '{}' may only use letters, digits, '_' and '-'", id));
+    return id;
+  }
+
+  template <int N>
+  Eigen::Matrix<double, N, 1> vector(const json& value, const std::string& path) const {
+    if (!value.is_array() || value.size() != N)
+      fail(path,
+           fmt::format(
+               "expected a point of {} numbers [{}], got {}", N, N == 2 ? "x, y" : "x, y, z",
+               value.is_array() ? fmt::format("{} numbers", value.size()) : type_name(value)));
+    Eigen::Matrix<double, N, 1> v;
+    for (int k = 0; k < N; ++k) v[k] = number(value[k], fmt::format("{}/{}", path, k));
+    return v;
+  }
+
+  // A point in the world or in a view plane: within ±kMaxCoordinate metres on every axis.
+  template <int N>
+  Eigen::Matrix<double, N, 1> position(const json& value, const std::string& path) const {
+    const Eigen::Matrix<double, N, 1> v = vector<N>(value, path);
+    for (int k = 0; k < N; ++k)
+      if (std::abs(v[k]) > kMaxCoordinate)
+        fail(fmt::format("{}/{}", path, k),
+             out_of_range_sentence(v[k], -kMaxCoordinate, kMaxCoordinate, "the coordinate"));
+    return v;
+  }
+
+  // An edge length in metres: 2 mm .. 50 cm.
+  double edge_length(const json& value, const std::string& path) const {
+    const double x = positive(value, path);
+    if (x < 0.002 || x > 0.5) fail(path, out_of_range_sentence(x, 0.002, 0.5, "an edge length of"));
+    return x;
+  }
+
+  // A list of at most `most` entries at `path`.
+  void check_count(const json& list, const std::string& path, size_t most,
+                   std::string_view what) const {
+    if (list.is_array() && list.size() > most)
+      fail(path, fmt::format("{} {} is more than the {} allowed", list.size(), what, most));
+  }
+
+  ViewSpec view(const json& value, const std::string& path) const {
+    ViewSpec view;
+    if (value.is_string()) {
+      const std::string name = value.get<std::string>();
+      static const std::pair<const char*, ViewKind> kNames[] = {{"front", ViewKind::kFront},
+                                                                {"back", ViewKind::kBack},
+                                                                {"left", ViewKind::kLeft},
+                                                                {"right", ViewKind::kRight}};
+      for (const auto& [n, kind] : kNames)
+        if (name == n) {
+          view.kind = kind;
+          return view;
+        }
+      fail(path, fmt::format("there is no view called '{}'; use front, back, left, right or "
+                             "{{\"camera\": {{\"eye\": [...], \"target\": [...]}}}}",
+                             name));
+    }
+    if (!value.is_object())
+      fail(path, fmt::format("a view is a name (front, back, left, right) or a camera object, "
+                             "not {}",
+                             type_name(value)));
+    check_keys(value, path, {"camera"});
+    if (!value.contains("camera")) fail(path, "a view object needs a \"camera\"");
+    const json& cam = value["camera"];
+    const std::string cpath = path + "/camera";
+    require_object(cam, cpath, "a camera");
+    check_keys(cam, cpath, {"eye", "target", "up", "fov"});
+    view.kind = ViewKind::kCamera;
+    if (!cam.contains("eye")) fail(cpath, "a camera needs an \"eye\" point [x, y, z]");
+    view.camera.eye = position<3>(cam["eye"], cpath + "/eye");
+    if (cam.contains("target")) view.camera.target = position<3>(cam["target"], cpath + "/target");
+    if (cam.contains("up")) view.camera.up = vector<3>(cam["up"], cpath + "/up");
+    if (cam.contains("fov")) {
+      view.camera.fov_degrees = positive(cam["fov"], cpath + "/fov");
+      if (view.camera.fov_degrees >= 170)
+        fail(cpath + "/fov", "the field of view must be below 170 degrees");
+    }
+    const Eigen::Vector3d dir = view.camera.target - view.camera.eye;
+    if (dir.norm() < 1e-6) fail(cpath, "the camera's eye and target are the same point");
+    if (dir.normalized().cross(view.camera.up).norm() < 1e-3)
+      fail(cpath + "/up", "the camera's up direction is parallel to its viewing direction");
+    return view;
+  }
+
+ private:
+  const Sketch& sketch_;
+};
+
+constexpr int kMaxNesting = 64;
+
+// Tracks the JSON path while nlohmann's parser reports events, to reject a key given twice in
+// one object (JSON allows it and keeps the last value, silently dropping the first).
+class DuplicateKeyCheck {
+ public:
+  explicit DuplicateKeyCheck(const Sketch& sketch) : sketch_(sketch) {}
+
+  bool operator()(int depth, json::parse_event_t event, json& parsed) {
+    // A sketch file nests a few levels (a point in a list in a curve in the list of curves);
+    // thousands of levels are a damaged or hostile file, and cost time and memory to build.
+    if (depth > kMaxNesting)
+      sketch_.fail(path(), fmt::format("lists and objects are nested more than {} levels deep "
+                                       "here; a sketch file needs fewer than 10",
+                                       kMaxNesting));
+    switch (event) {
+      case json::parse_event_t::object_start:
+      case json::parse_event_t::array_start:
+        enter_element();
+        frames_.push_back({event == json::parse_event_t::array_start, -1, {}, {}});
+        break;
+      case json::parse_event_t::key: {
+        Frame& f = frames_.back();
+        f.key = parsed.get<std::string>();
+        if (!f.keys.insert(f.key).second)
+          sketch_.fail(path(),
+                       fmt::format("the key '{}' is given twice in this object; JSON would keep "
+                                   "only the last one: remove one of them",
+                                   f.key));
+        break;
+      }
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end:
+        frames_.pop_back();
+        break;
+      case json::parse_event_t::value:
+        enter_element();
+        break;
+    }
+    return true;
+  }
+
+ private:
+  struct Frame {
+    bool array = false;
+    long index = -1;
+    std::set<std::string> keys;
+    std::string key;
+  };
+
+  // A value or container begins: in an array it is the next element.
+  void enter_element() {
+    if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
+  }
+
+  // "/a/0/b": keys with JSON Pointer escapes (~0 for ~, ~1 for /).
+  std::string path() const {
+    std::string out;
+    for (const Frame& f : frames_) {
+      if (f.array) {
+        out += "/" + std::to_string(f.index);
+        continue;
+      }
+      out += "/";
+      for (char c : f.key) out += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
+    }
+    return out;
+  }
+
+  const Sketch& sketch_;
+  std::vector<Frame> frames_;
+};
+
+}  // namespace sd::scene::detail

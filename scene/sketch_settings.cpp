@@ -1,0 +1,292 @@
+// The simulator's, the sheet's and the outputs' sections of a sketch file: "simulate" (the
+// simulator's own settings), "sheet" and "output" (the render specs and the sewing pattern).
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "scene/sketch_sections.hpp"
+
+namespace sd::scene::detail {
+namespace {
+
+// "adaptive": true | false | {"enabled": ..., "refine_threshold": ..., ...}.
+void parse_adaptive(const Reader& r, const json& a, SimulateSpec& sim) {
+  const std::string path = "/simulate/adaptive";
+  sim.adaptive_given = true;
+  if (a.is_boolean()) {
+    sim.adaptive = a.get<bool>();
+    return;
+  }
+  if (!a.is_object())
+    r.fail(path,
+           "expected true, false or an object of adaptive settings {\"refine_threshold\": "
+           "0.002, ...}");
+  r.check_keys(a, path,
+               {"enabled", "refine_threshold", "coarsen_threshold", "steady_rate", "min_lifetime",
+                "min_level", "max_level", "max_vertices", "merge_batch", "even_levels"});
+  sim::AdaptiveSettings& s = sim.adaptive_settings;  // the simulator's defaults where unset
+  if (a.contains("enabled")) sim.adaptive = r.boolean(a["enabled"], path + "/enabled");
+  if (a.contains("refine_threshold"))
+    s.refine_threshold = r.positive(a["refine_threshold"], path + "/refine_threshold");
+  if (a.contains("coarsen_threshold"))
+    s.coarsen_threshold = r.positive(a["coarsen_threshold"], path + "/coarsen_threshold");
+  // Two values the file gives are checked against each other here; a value against a default
+  // is checked by run (sim::AdaptiveSettings::validate, at /simulate/adaptive).
+  if (a.contains("refine_threshold") && a.contains("coarsen_threshold") &&
+      !(s.coarsen_threshold < s.refine_threshold))
+    r.fail(path + "/coarsen_threshold",
+           fmt::format("the coarsen threshold ({} m) must be below the refine threshold ({} m): "
+                       "the gap keeps a merged block from being split again at once",
+                       s.coarsen_threshold, s.refine_threshold));
+  if (a.contains("steady_rate"))
+    s.steady_rate = r.non_negative(a["steady_rate"], path + "/steady_rate");
+  if (a.contains("min_lifetime"))
+    s.min_lifetime = r.non_negative(a["min_lifetime"], path + "/min_lifetime");
+  for (const auto& [key, level] :
+       {std::pair{"min_level", &s.min_level}, std::pair{"max_level", &s.max_level}}) {
+    if (!a.contains(key)) continue;
+    *level = r.integer(a[key], path + "/" + key, 0);
+    if (*level > 30) r.fail(path + "/" + key, "levels go from 0 (the input's blocks) to 30");
+  }
+  if (a.contains("min_level") && a.contains("max_level") && s.max_level < s.min_level)
+    r.fail(path + "/max_level", fmt::format("max_level ({}) must not be below min_level ({})",
+                                            s.max_level, s.min_level));
+  if (a.contains("max_vertices"))
+    s.max_vertices = r.integer(a["max_vertices"], path + "/max_vertices", 0);
+  if (a.contains("merge_batch")) {
+    s.merge_batch = r.non_negative(a["merge_batch"], path + "/merge_batch");
+    if (!(s.merge_batch < 1.0))
+      r.fail(path + "/merge_batch",
+             "the merge batch is a fraction of the particles (0.05: merges wait until 5 % of "
+             "them can go at once); it must be below 1");
+  }
+  if (a.contains("even_levels")) s.even_levels = r.boolean(a["even_levels"], path + "/even_levels");
+}
+
+// "pattern": true, false, or an object of settings.
+void parse_pattern(const Reader& r, const json& j, OutputSpec& out) {
+  const std::string path = "/output/pattern";
+  if (j.is_boolean()) {
+    if (j.get<bool>()) out.pattern = PatternSpec{};
+    return;
+  }
+  r.require_object(j, path, "true, false or an object of pattern settings");
+  r.check_keys(j, path, {"fabric_width", "seam_allowance", "max_stretch"});
+  PatternSpec spec;
+  if (j.contains("fabric_width"))
+    spec.fabric_width = r.positive(j["fabric_width"], path + "/fabric_width");
+  if (j.contains("seam_allowance")) {
+    spec.seam_allowance = r.number(j["seam_allowance"], path + "/seam_allowance");
+    if (spec.seam_allowance < 0 || spec.seam_allowance > 0.1)
+      r.fail(path + "/seam_allowance",
+             fmt::format("seam allowance {} m is outside 0 .. 0.1 m", spec.seam_allowance));
+  }
+  if (j.contains("max_stretch"))
+    spec.max_stretch = r.positive(j["max_stretch"], path + "/max_stretch");
+  out.pattern = spec;
+}
+
+}  // namespace
+
+void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
+  const std::string path = "/simulate";
+  r.require_object(j, path, "simulate");
+  r.check_keys(
+      j, path,
+      {"duration", "adaptive", "time_step", "integrator", "solver", "bending", "stop_at_rest",
+       "gravity", "pin_above", "check_body_vertices", "rest", "self_collision"});
+  if (j.contains("pin_above")) sim.pin_above = r.number(j["pin_above"], path + "/pin_above");
+  if (j.contains("duration")) {
+    sim.duration = r.positive(j["duration"], path + "/duration");
+    if (sim.duration > kMaxDuration)
+      r.fail(path + "/duration",
+             fmt::format("a drape of {:.6g} s is longer than the {:g} s (one hour of simulated "
+                         "time) allowed; a garment settles within seconds",
+                         sim.duration, kMaxDuration));
+  }
+  if (j.contains("adaptive")) parse_adaptive(r, j["adaptive"], sim);
+  if (j.contains("time_step") && j["time_step"].is_string()) {
+    if (r.text(j["time_step"], path + "/time_step") != "auto")
+      r.fail(path + "/time_step",
+             "a time step is a number of seconds (1/60 s is 0.0167) or \"auto\" (the default: "
+             "chosen from the scene)");
+    sim.time_step_auto = true;
+  } else if (j.contains("time_step")) {
+    sim.time_step_auto = false;
+    sim.time_step = r.positive(j["time_step"], path + "/time_step");
+    if (sim.time_step < kMinTimeStep || sim.time_step > kMaxTimeStep)
+      r.fail(path + "/time_step",
+             fmt::format("a time step of {:.6g} s is outside {:g} .. {:g} s (the step control "
+                         "shortens steps itself when it needs to; 1/60 s is the default)",
+                         sim.time_step, kMinTimeStep, kMaxTimeStep));
+  }
+  if (j.contains("integrator")) {
+    sim.integrator = r.text(j["integrator"], path + "/integrator");
+    if (sim.integrator != "implicit-euler" && sim.integrator != "bdf2")
+      r.fail(path + "/integrator", fmt::format("unknown integrator '{}'; use \"implicit-euler\" "
+                                               "or \"bdf2\"",
+                                               sim.integrator));
+  }
+  if (j.contains("solver")) {
+    sim.solver = r.text(j["solver"], path + "/solver");
+    if (sim.solver != "pcg" && sim.solver != "cholmod" && sim.solver != "auto")
+      r.fail(path + "/solver", fmt::format("unknown solver '{}'; use \"auto\" (the default), "
+                                           "\"pcg\" or \"cholmod\"",
+                                           sim.solver));
+  }
+  if (j.contains("bending")) {
+    sim.bending = r.text(j["bending"], path + "/bending");
+    if (sim.bending != "hinges" && sim.bending != "quadratic")
+      r.fail(
+          path + "/bending",
+          fmt::format("unknown bending model '{}'; use \"hinges\" or \"quadratic\"", sim.bending));
+  }
+  if (j.contains("stop_at_rest"))
+    sim.stop_at_rest = r.boolean(j["stop_at_rest"], path + "/stop_at_rest");
+  if (j.contains("gravity")) {
+    sim.gravity = r.vector<3>(j["gravity"], path + "/gravity");
+    for (int k = 0; k < 3; ++k)
+      if (std::abs(sim.gravity[k]) > kMaxGravity)
+        r.fail(fmt::format("{}/gravity/{}", path, k),
+               fmt::format("{:.6g} m/s² is outside ±{:g} m/s² (Earth's gravity is 9.81 m/s²)",
+                           sim.gravity[k], kMaxGravity));
+  }
+  if (j.contains("check_body_vertices"))
+    sim.check_body_vertices = r.boolean(j["check_body_vertices"], path + "/check_body_vertices");
+  if (j.contains("rest")) {
+    sim.rest = r.text(j["rest"], path + "/rest");
+    if (sim.rest != "flat" && sim.rest != "shaped")
+      r.fail(path + "/rest", fmt::format("unknown rest shape '{}'; use \"flat\" (the flattened "
+                                         "pattern pieces) or \"shaped\" (as drawn on the body)",
+                                         sim.rest));
+  }
+  if (j.contains("self_collision"))
+    sim.self_collision = r.boolean(j["self_collision"], path + "/self_collision");
+}
+
+SheetSpec parse_sheet(const Reader& r, const json& j) {
+  const std::string path = "/sheet";
+  r.require_object(j, path, "sheet");
+  r.check_keys(j, path,
+               {"size", "resolution", "orientation", "centre", "pins", "layers", "layer_offset",
+                "layer_turn"});
+  SheetSpec sheet;
+  if (j.contains("layers")) sheet.layers = r.integer(j["layers"], path + "/layers", 1);
+  if (j.contains("layer_offset"))
+    sheet.layer_offset = r.vector<3>(j["layer_offset"], path + "/layer_offset");
+  if (j.contains("layer_turn")) sheet.layer_turn = r.number(j["layer_turn"], path + "/layer_turn");
+  if (j.contains("size")) {
+    sheet.size = r.vector<2>(j["size"], path + "/size");
+    for (int k = 0; k < 2; ++k)
+      if (!(sheet.size[k] > 0))
+        r.fail(fmt::format("{}/size/{}", path, k), "a sheet's width and height must be positive");
+    for (int k = 0; k < 2; ++k)
+      if (sheet.size[k] > kMaxSheetSide)
+        r.fail(fmt::format("{}/size/{}", path, k),
+               out_of_range_sentence(sheet.size[k], 0, kMaxSheetSide, "a sheet side of"));
+  }
+  if (j.contains("resolution")) {
+    const json& res = j["resolution"];
+    if (!res.is_array() || res.size() != 2)
+      r.fail(path + "/resolution", "expected [columns, rows] of quads");
+    sheet.columns = r.integer(res[0], path + "/resolution/0", 1);
+    sheet.rows = r.integer(res[1], path + "/resolution/1", 1);
+    if (sheet.columns > 1024 || sheet.rows > 1024)
+      r.fail(path + "/resolution", "a sheet has at most 1024 quads along a side");
+  }
+  if (j.contains("orientation")) {
+    const std::string o = r.text(j["orientation"], path + "/orientation");
+    if (o != "vertical" && o != "horizontal")
+      r.fail(path + "/orientation",
+             fmt::format("unknown orientation '{}'; use \"vertical\" or \"horizontal\"", o));
+    sheet.horizontal = o == "horizontal";
+  }
+  if (j.contains("centre")) sheet.centre = r.position<3>(j["centre"], path + "/centre");
+  if (j.contains("pins")) {
+    const json& pins = j["pins"];
+    if (!pins.is_array()) r.fail(path + "/pins", "expected a list of corner or edge names");
+    static constexpr std::string_view kNames[] = {
+        "top-left", "top-right", "bottom-left", "bottom-right", "top", "bottom", "left", "right"};
+    for (size_t i = 0; i < pins.size(); ++i) {
+      const std::string pp = fmt::format("{}/pins/{}", path, i);
+      const std::string name = r.text(pins[i], pp);
+      // A clamp "top:N" holds N lines of vertices from that edge (a cantilever's clamp).
+      const std::size_t colon = name.find(':');
+      const std::string edge = name.substr(0, colon);
+      const bool clamp = colon != std::string::npos &&
+                         (edge == "top" || edge == "bottom" || edge == "left" || edge == "right");
+      if (clamp) {
+        const std::string digits = name.substr(colon + 1);
+        const int lines = (edge == "top" || edge == "bottom" ? sheet.rows : sheet.columns) + 1;
+        const bool number = !digits.empty() && digits.size() < 7 &&
+                            std::all_of(digits.begin(), digits.end(),
+                                        [](char ch) { return ch >= '0' && ch <= '9'; });
+        if (!number || std::stoi(digits) < 1 || std::stoi(digits) > lines)
+          r.fail(pp, fmt::format("the clamp '{}' must hold 1 to {} lines of vertices ({}:N)", name,
+                                 lines, edge));
+      } else if (std::find(std::begin(kNames), std::end(kNames), name) == std::end(kNames)) {
+        r.fail(pp, fmt::format("unknown pin '{}'; use a corner (top-left, top-right, bottom-left, "
+                               "bottom-right), an edge (top, bottom, left, right) or a clamp of "
+                               "several lines of vertices (top:3)",
+                               name));
+      }
+      sheet.pins.push_back(name);
+    }
+  }
+  return sheet;
+}
+
+void parse_output(const Reader& r, const json& j, OutputSpec& out) {
+  const std::string path = "/output";
+  r.require_object(j, path, "output");
+  r.check_keys(j, path, {"images", "mesh", "report", "wireframe", "pattern"});
+  if (j.contains("mesh")) {
+    out.mesh = r.text(j["mesh"], path + "/mesh");
+    if (!out.mesh.ends_with(".obj") && !out.mesh.ends_with(".glb"))
+      r.fail(path + "/mesh", fmt::format("'{}' must end in .obj or .glb", out.mesh));
+    if (out.mesh.find('/') != std::string::npos)
+      r.fail(path + "/mesh", "give a file name only; the directory comes from -o");
+  }
+  if (j.contains("report")) out.report = r.boolean(j["report"], path + "/report");
+  if (j.contains("wireframe")) out.wireframe = r.boolean(j["wireframe"], path + "/wireframe");
+  if (j.contains("pattern")) parse_pattern(r, j["pattern"], out);
+  if (j.contains("images")) {
+    out.images_listed = true;
+    const json& images = j["images"];
+    if (!images.is_array()) r.fail(path + "/images", "expected a list of images");
+    r.check_count(images, path + "/images", kMaxImages, "images");
+    for (size_t i = 0; i < images.size(); ++i) {
+      const std::string ip = fmt::format("{}/images/{}", path, i);
+      const json& im = images[i];
+      r.require_object(im, ip, "an image");
+      r.check_keys(im, ip, {"view", "size", "wireframe"});
+      ImageSpec image;
+      if (im.contains("view")) {
+        const json& v = im["view"];
+        if (v.is_string() && v.get<std::string>() == "three-quarter") {
+          image.view = "three-quarter";
+        } else {
+          const ViewSpec view = r.view(v, ip + "/view");
+          image.view = view.name();
+          image.camera = view.camera;
+        }
+      }
+      if (im.contains("size")) {
+        const json& s = im["size"];
+        if (!s.is_array() || s.size() != 2)
+          r.fail(ip + "/size", "expected [width, height] in pixels");
+        image.width = r.integer(s[0], ip + "/size/0", 16);
+        image.height = r.integer(s[1], ip + "/size/1", 16);
+        if (image.width > kMaxImageSide || image.height > kMaxImageSide)
+          r.fail(ip + "/size", fmt::format("images are at most {} pixels on a side (a {}x{} "
+                                           "picture takes half a gigabyte to draw)",
+                                           kMaxImageSide, kMaxImageSide, kMaxImageSide));
+      }
+      if (im.contains("wireframe")) image.wireframe = r.boolean(im["wireframe"], ip + "/wireframe");
+      out.images.push_back(image);
+    }
+  }
+}
+
+}  // namespace sd::scene::detail
