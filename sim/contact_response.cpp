@@ -396,8 +396,9 @@ void ContactResponse::spring_start_piercings(const Eigen::VectorXd& start,
     if (found != candidates.end() && found->body_vertex == body_vertex &&
         found->cloth_triangle == triangle)
       continue;
-    if (const std::optional<BodyPiercing> p = collider_.piercing_of_pair(
-            start, cloth_.triangles[static_cast<std::size_t>(triangle)], triangle, body_vertex))
+    if (const std::optional<BodyPiercing> p =
+            collider_.piercing_of_pair(start, cloth_.triangles[static_cast<std::size_t>(triangle)],
+                                       triangle, body_vertex, &cloth_))
       candidates.insert(found, *p);
   }
   std::vector<BodyPiercing> springs;
