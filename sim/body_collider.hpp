@@ -206,7 +206,9 @@ class BodyCollider {
   // triangle, as find_piercings measures it, with none of its filters (the band, the open edges,
   // the inside check): for a pair the caller already follows. Nothing for a degenerate triangle or
   // one edge-on to the body there. With `cloth`, a closest point on a corner or an edge measures
-  // the height along the cloth's pseudo-normal there, as find_piercings does.
+  // the height along the cloth's pseudo-normal there, as find_piercings does with
+  // `pseudo_normal_sides` (else: over the triangle's plane; the simulator's springs use the
+  // plane, its count of body vertices through the cloth the pseudo-normal).
   std::optional<BodyPiercing> piercing_of_pair(const Eigen::VectorXd& x,
                                                const std::array<int, 3>& triangle,
                                                int triangle_index, int body_vertex,
@@ -216,7 +218,8 @@ class BodyCollider {
                                            double min_height, double max_height,
                                            double unchecked_height = 0.0,
                                            PiercingQueryStats* stats = nullptr,
-                                           bool every_triangle = false) const;
+                                           bool every_triangle = false,
+                                           bool pseudo_normal_sides = false) const;
 
   // Closest point of the current pose within `max_distance` of p (unbounded by default), with
   // the signed distance and outward normal; nothing when the surface is farther than that.

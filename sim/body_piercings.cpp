@@ -127,7 +127,8 @@ std::optional<BodyPiercing> BodyCollider::piercing_of_pair(const Eigen::VectorXd
 
 std::vector<BodyPiercing> BodyCollider::find_piercings(
     const Eigen::VectorXd& x, const ClothTriangles& cloth, double min_height, double max_height,
-    double unchecked_height, PiercingQueryStats* stats_out, bool every_triangle) const {
+    double unchecked_height, PiercingQueryStats* stats_out, bool every_triangle,
+    bool pseudo_normal_sides) const {
   const std::vector<std::array<int, 3>>& triangles = cloth.triangles;
   PiercingQueryStats stats;
   std::vector<BodyPiercing> result;
@@ -232,7 +233,9 @@ std::vector<BodyPiercing> BodyCollider::find_piercings(
             closest_point_on_triangle(b, p0, row(x, triangles[t][1]), row(x, triangles[t][2]));
         if (closest.squared_distance >= max_height * max_height) continue;
         // At a corner or an edge the cloth's side is its pseudo-normal's, not t's plane.
-        const double height = feature_height(b, closest, triangles[t], normal, cloth, x);
+        const double height = pseudo_normal_sides
+                                  ? feature_height(b, closest, triangles[t], normal, cloth, x)
+                                  : plane_height;
         if (height <= min_height || (!every_triangle && best && height <= best->height)) continue;
         // Not through (within the asked band below the cloth): only where the cloth covers the
         // vertex, its projection inside the triangle.

@@ -615,10 +615,12 @@ TEST(BodyCollider, BodyVertexBesideAClothCornerIsSidedByThePseudoNormal) {
   ASSERT_TRUE(sided.has_value());
   EXPECT_LT(sided->height, -0.002);
   // The search (heights to 1 cm unchecked, as the simulator's reach) finds nothing through.
-  EXPECT_TRUE(collider.find_piercings(x, cloth, 0.0, 0.05, 0.01).empty());
+  EXPECT_TRUE(collider.find_piercings(x, cloth, 0.0, 0.05, 0.01, nullptr, false, true).empty());
+  // Over the planes alone (the springs' conservative measure) A reports it.
+  EXPECT_EQ(collider.find_piercings(x, cloth, 0.0, 0.05, 0.01).size(), 1u);
   // Lowered 2 cm the apex pokes through the fan (5 mm over B at x = 0): found.
   const std::vector<BodyPiercing> through =
-      collider.find_piercings(fan(-0.02), cloth, 0.0, 0.05, 0.03);
+      collider.find_piercings(fan(-0.02), cloth, 0.0, 0.05, 0.03, nullptr, false, true);
   ASSERT_EQ(through.size(), 1u);
   EXPECT_EQ(through.front().body_vertex, 0);
   EXPECT_GT(through.front().height, 0.005);
