@@ -85,6 +85,11 @@ struct ClothTriangles {
 
   std::vector<std::array<int, 3>> triangles;
   std::vector<std::uint8_t> open_edges;  // per triangle, bit k: edge k (corners k, k+1) is open
+  // The triangles around each vertex (compressed rows: vertex v's are
+  // vertex_triangles[vertex_offsets[v] .. vertex_offsets[v + 1]]), for the side of the cloth at
+  // a corner or an edge (BodyCollider::find_piercings).
+  std::vector<int> vertex_offsets;
+  std::vector<int> vertex_triangles;
 };
 
 struct PiercingQueryStats {
@@ -200,16 +205,21 @@ class BodyCollider {
   // under a cloth edge is under both its triangles). The height of one body vertex over one cloth
   // triangle, as find_piercings measures it, with none of its filters (the band, the open edges,
   // the inside check): for a pair the caller already follows. Nothing for a degenerate triangle or
-  // one edge-on to the body there.
+  // one edge-on to the body there. With `cloth`, a closest point on a corner or an edge measures
+  // the height along the cloth's pseudo-normal there, as find_piercings does with
+  // `pseudo_normal_sides` (else: over the triangle's plane; the simulator's springs use the
+  // plane, its count of body vertices through the cloth the pseudo-normal).
   std::optional<BodyPiercing> piercing_of_pair(const Eigen::VectorXd& x,
                                                const std::array<int, 3>& triangle,
-                                               int triangle_index, int body_vertex) const;
+                                               int triangle_index, int body_vertex,
+                                               const ClothTriangles* cloth = nullptr) const;
 
   std::vector<BodyPiercing> find_piercings(const Eigen::VectorXd& x, const ClothTriangles& cloth,
                                            double min_height, double max_height,
                                            double unchecked_height = 0.0,
                                            PiercingQueryStats* stats = nullptr,
-                                           bool every_triangle = false) const;
+                                           bool every_triangle = false,
+                                           bool pseudo_normal_sides = false) const;
 
   // Closest point of the current pose within `max_distance` of p (unbounded by default), with
   // the signed distance and outward normal; nothing when the surface is farther than that.

@@ -191,7 +191,8 @@ class ContactResponse {
   int count_penetrating(const Eigen::VectorXd& x, double* deepest = nullptr) const;
   // Body vertices more than the tolerance through the cloth triangles (set_cloth_triangles) at
   // x, whether or not check_body_vertices keeps them out: what a preview shows as the body
-  // poking through. `highest`: the largest height through, m (0 when none).
+  // poking through. `highest`: the largest height through, m (0 when none). Where a body vertex's
+  // closest cloth point is a corner or an edge, it is sided by the cloth's pseudo-normal there.
   int count_piercing(const Eigen::VectorXd& x, double* highest = nullptr) const;
   // The cloth's own friction coefficient (FabricParameters::friction), used for whichever of
   // the two coefficients the settings leave unset.

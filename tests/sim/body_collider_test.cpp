@@ -584,6 +584,48 @@ TEST(BodyCollider, BodyVertexBesideTheClothsOpenEdgeIsNotAPiercing) {
   EXPECT_GT(ridge.front().height, 0.0);
 }
 
+// A body vertex beside a cloth vertex, in the crease the cloth bridges (an arm vertex in the
+// armpit of the arms-lowering t-shirt): above the plane of one triangle around the cloth vertex,
+// whose closest point to it is that vertex, but in front of the cloth by the pseudo-normal of the
+// triangles around it. The cloth covers it: not a piercing. Lowered by 2 cm, the same fan has the
+// apex through it, and that is one.
+TEST(BodyCollider, BodyVertexBesideAClothCornerIsSidedByThePseudoNormal) {
+  const meshing::TriMesh cone = testing::make_cone(0.1, 0.2, 24);  // apex (0, 0.2, 0)
+  const BodyCollider collider(cone);
+  // The fan around c = (0.02, 0.2, 0): A rises to +x (away from the apex), B spans over the apex
+  // at y = 0.215, C and D close the fan at z = ±0.03.
+  const auto fan = [](double dy) {
+    Eigen::VectorXd x(15);
+    x << 0.02, 0.2 + dy, 0.0,                           // c
+        0.05, 0.21 + dy, -0.03, 0.05, 0.21 + dy, 0.03,  // A's far corners
+        0.0, 0.215 + dy, -0.03, 0.0, 0.215 + dy, 0.03;  // B's far corners
+    return x;
+  };
+  const Triangles triangles = {{0, 1, 2}, {0, 4, 3}, {0, 2, 4}, {0, 3, 1}};
+  const Eigen::VectorXd x = fan(0.0);
+  // The premise: the apex is above A's plane, with A's closest point at c.
+  const std::optional<BodyPiercing> over_a = collider.piercing_of_pair(x, triangles[0], 0, 0);
+  ASSERT_TRUE(over_a.has_value());
+  EXPECT_GT(over_a->height, 0.005);
+  EXPECT_NEAR(over_a->barycentric[0], 1.0, 1e-12);
+  // With the cloth's triangles the pair is sided by the pseudo-normal at c: in front (negative).
+  const ClothTriangles cloth(triangles);
+  const std::optional<BodyPiercing> sided =
+      collider.piercing_of_pair(x, triangles[0], 0, 0, &cloth);
+  ASSERT_TRUE(sided.has_value());
+  EXPECT_LT(sided->height, -0.002);
+  // The search (heights to 1 cm unchecked, as the simulator's reach) finds nothing through.
+  EXPECT_TRUE(collider.find_piercings(x, cloth, 0.0, 0.05, 0.01, nullptr, false, true).empty());
+  // Over the planes alone (the springs' conservative measure) A reports it.
+  EXPECT_EQ(collider.find_piercings(x, cloth, 0.0, 0.05, 0.01).size(), 1u);
+  // Lowered 2 cm the apex pokes through the fan (5 mm over B at x = 0): found.
+  const std::vector<BodyPiercing> through =
+      collider.find_piercings(fan(-0.02), cloth, 0.0, 0.05, 0.03, nullptr, false, true);
+  ASSERT_EQ(through.size(), 1u);
+  EXPECT_EQ(through.front().body_vertex, 0);
+  EXPECT_GT(through.front().height, 0.005);
+}
+
 TEST(BodyCollider, ClothBeyondAThinBodyPartIsNotAPiercing) {
   // A 1 cm slab; cloth 3 mm under it (a sleeve under the arm): the slab's top corners are
   // 13 mm "in front of" the cloth along their normals, but the cloth does not enter the body.

@@ -55,6 +55,71 @@ TEST(SelfContactResponse, FailSafeLeavesNoCollisionAndKeepsMomentum) {
   EXPECT_LT((sheet.x + 0.01 * v1 - x1).lpNorm<Eigen::Infinity>(), 1e-12);
 }
 
+// Friction between layers: a vertex of the upper layer of a fold sliding at 0.1 m/s over the lower
+// layer, pressed by one repulsion spring of force F. Coulomb: the pair's relative tangential
+// velocity drops by μ β F Σ w²/m (the impulse bound), or to zero when that is more; the normal
+// velocity and the total momentum do not change.
+TEST(SelfContactResponse, FrictionBetweenLayersIsCoulombsBound) {
+  const testing::FoldedSheet sheet = testing::folded_sheet(6, 0.3, 0.01);
+  const ClothModel model = folded_model(testing::folded_sheet(6, 0.3, -1.0));
+  const double beta = 0.01;
+  for (const double mu : {0.3, 1e6}) {
+    SelfContactSettings settings;
+    settings.enabled = true;
+    settings.friction = mu;
+    SelfContactResponse response(settings);
+    response.set_cloth(model, sheet.x);
+    SelfPair pair;
+    bool found = false;
+    for (const SelfPair& p : response.collider().find_proximities(sheet.x, 0.015))
+      if (p.kind == SelfPairKind::vertex_face && sheet.upper[p.vertices[0]]) {
+        pair = p;
+        found = true;
+        break;
+      }
+    ASSERT_TRUE(found);
+    const int vertex = pair.vertices[0];
+    // Sliding along a direction in the layer's plane.
+    Eigen::Vector3d along = pair.normal.cross(Eigen::Vector3d::UnitZ());
+    if (along.norm() < 0.5) along = pair.normal.cross(Eigen::Vector3d::UnitX());
+    along.normalize();
+    Eigen::VectorXd v1 = Eigen::VectorXd::Zero(sheet.x.size());
+    v1.segment<3>(3 * vertex) = 0.1 * along;
+    Eigen::VectorXd x1 = sheet.x + beta * v1;
+    StepForces extra;
+    PairSpring spring;
+    spring.vertices = pair.vertices;
+    spring.weights = pair.weights;
+    spring.normal = pair.normal;
+    spring.target = pair.distance + 0.001;
+    spring.stiffness = 1.0;  // N/m: a 1 mm push, F ≈ 1 mN
+    extra.pair_springs.push_back(spring);
+    const double force = spring.stiffness * (spring.target - along_pair_normal(spring, x1));
+    ASSERT_GT(force, 0.0);
+    double inverse = 0.0;
+    for (int k = 0; k < 4; ++k)
+      inverse += pair.weights[k] * pair.weights[k] / model.mass[pair.vertices[k]];
+    const double bound = mu * beta * force * inverse;
+    const Eigen::VectorXd v_before = v1;
+    response.resolve(sheet.x, x1, v1, beta, model.mass, {}, extra);
+    EXPECT_EQ(response.step_stats().collisions, 0);
+    Eigen::Vector3d relative = Eigen::Vector3d::Zero(), momentum = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 4; ++k) relative += pair.weights[k] * v1.segment<3>(3 * pair.vertices[k]);
+    for (int i = 0; i < model.vertex_count; ++i)
+      momentum += model.mass[i] * (v1 - v_before).segment<3>(3 * i);
+    const double expected = std::max(0.0, 0.1 - bound);
+    EXPECT_NEAR(relative.dot(along), expected, 1e-12);
+    EXPECT_NEAR(relative.dot(pair.normal), 0.0, 1e-12);
+    EXPECT_LT(momentum.norm(), 1e-15);
+    if (mu < 1.0) {
+      EXPECT_GT(bound, 1e-3);  // the premise: friction slows the slide, without stopping it
+      EXPECT_LT(bound, 0.1);
+    }
+    // x1 follows v1.
+    EXPECT_LT((sheet.x + beta * v1 - x1).lpNorm<Eigen::Infinity>(), 1e-15);
+  }
+}
+
 TEST(SelfContactResponse, UntangleSeparatesAStartThatPassesThroughItself) {
   // The far part of the upper layer of a fold pushed 2 cm through the lower layer.
   const testing::FoldedSheet sheet = testing::folded_sheet(6, 0.3, 0.01);
@@ -166,19 +231,4 @@ TEST(SelfContactSimulation, SheetOnASphereWithBodyAndSelfContact) {
 }
 
 }  // namespace
-}  // namespace sd::sim
-namespace sd::sim {
-TEST(SelfDebug, Print) {
-  const testing::FoldedSheet sheet = testing::folded_sheet(6, 0.3, 0.01);
-  SelfCollider c(sheet.triangles, sheet.x);
-  for (auto p : c.find_intersections(sheet.x)) {
-    for (int t : p) {
-      for (int v : sheet.triangles[t])
-        std::printf("%d(%.2f %.3f %.2f) ", v, sheet.x[3 * v], sheet.x[3 * v + 1],
-                    sheet.x[3 * v + 2]);
-      std::printf(" | ");
-    }
-    std::printf("\n");
-  }
-}
 }  // namespace sd::sim
