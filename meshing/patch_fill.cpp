@@ -870,7 +870,9 @@ FilledPatch fill_with_plan(const Plan& plan, std::span<const int> counts,
   std::vector<char> fixed(positions.size(), 0);
   for (const auto& side : patch.topology.side_vertices)
     for (const int v : side) fixed[static_cast<size_t>(v)] = 1;
-  if (options.project)
+  if (options.place)
+    options.place(positions, built.builder.faces(), fixed);
+  else if (options.project)
     for (size_t v = 0; v < positions.size(); ++v)
       if (!fixed[v]) positions[v] = options.project(positions[v]);
   detail::relax_interior(positions, built.builder.faces(), fixed, options.relax_iterations,

@@ -5,6 +5,7 @@
 // optional projection).
 
 #include <Eigen/Core>
+#include <array>
 #include <functional>
 #include <span>
 #include <stdexcept>
@@ -48,6 +49,15 @@ struct FillGeometryOptions {
   // Optional: moves an interior point onto the target surface (e.g. the body's offset surface);
   // applied after every relaxation sweep and at the end.
   std::function<Eigen::Vector3d(const Eigen::Vector3d&)> project;
+  // Optional: places the interior on the target surface before the relaxation, instead of
+  // `project` vertex by vertex. Given the fill's #V positions (boundary exact, interior where
+  // the layout's interpolation put it), its #Q counter-clockwise quads and #V fixed flags
+  // (nonzero: boundary), it moves the free positions in place. A panel wrapping a limb needs it:
+  // its interpolated interior runs through the limb, where the nearest surface point can be on
+  // either side (garment_mesh.cpp).
+  std::function<void(std::vector<Eigen::Vector3d>&, std::span<const std::array<int, 4>>,
+                     std::span<const char>)>
+      place;
 };
 
 struct FilledPatch {

@@ -155,6 +155,16 @@ using Projection = std::function<Eigen::Vector3d(const Eigen::Vector3d&)>;
 // feasible region; this search looks at the quads' orientation itself. Stops when no quad is
 // below the target or after kUntanglePasses passes.
 constexpr double kUntangleTarget = 0.02;
+// The pattern search's eight directions (cosine, sine of k·45°), computed once: the sine and
+// cosine calls were 4 % of a folding garment fill's time.
+const std::array<std::pair<double, double>, 8> kCompass = [] {
+  std::array<std::pair<double, double>, 8> directions;
+  for (int k = 0; k < 8; ++k) {
+    const double angle = k * std::numbers::pi / 4;
+    directions[static_cast<size_t>(k)] = {std::cos(angle), std::sin(angle)};
+  }
+  return directions;
+}();
 constexpr int kUntanglePasses = 100;
 // A pass that raises no vertex's minimum by more than this is the last one (the search creeps by
 // ever smaller steps when a fold cannot be undone).
@@ -224,8 +234,8 @@ void untangle(std::vector<Eigen::Vector3d>& x, std::span<const Quad> quads,
         Eigen::Vector3d best_position = start;
         double best = current;
         for (int k = 0; k < 8; ++k) {
-          const double angle = k * std::numbers::pi / 4;
-          x[v] = start + step * (std::cos(angle) * t1 + std::sin(angle) * t2);
+          const auto& [c, s] = kCompass[static_cast<size_t>(k)];
+          x[v] = start + step * (c * t1 + s * t2);
           const double value = around(v);
           if (value > best + 1e-12) {
             best = value;

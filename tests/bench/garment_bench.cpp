@@ -86,6 +86,11 @@ BENCHMARK_CAPTURE(mesh_design, one_shoulder_top, "one-shoulder-top.json")
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(mesh_design, wrap_skirt, "wrap-skirt.json")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(mesh_design, vest_collar, "vest-collar.json")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(mesh_design, long_sleeve_tee, "long-sleeve-tee.json")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(mesh_design, circle_skirt, "circle-skirt.json")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(mesh_design, raglan_top, "raglan-top.json")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(mesh_design, cape_hood, "cape-hood.json")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(mesh_human_design, trousers_human, "trousers-human.json")
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(mesh_human_design, jumpsuit_human, "jumpsuit-human.json")

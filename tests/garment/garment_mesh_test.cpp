@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <filesystem>
 #include <map>
 #include <set>
 
@@ -229,6 +230,38 @@ TEST(Garment, ExamplesHaveNoFoldedQuadsBeyondTheRecordedFew) {
       if (!boundary.contains(v)) {
         EXPECT_GE(n, 3) << file << ": inner vertex " << v;
       }
+  }
+}
+
+TEST(Garment, RaglanBackSleeveLiesOnTheBackOfTheArm) {
+  // data/designs/repro/raglan-top.json: the back sleeve is half a tube from the top of the arm
+  // to its underside, its interpolated interior on the plane through the arm's axis. From the
+  // nearest body points its interior landed on the front of the arm (quads facing into the
+  // arm, 5 folded, the back of the arm bare); filled again from the start along its own
+  // normals, every quad faces away from the body and none folds or is a sliver.
+  const Garment g = build_garment(
+      load_sketch(std::filesystem::path(SD_SOURCE_DIR) / "data/designs/repro/raglan-top.json"),
+      builtin_surface());
+  for (const std::string id : {"sleeve_back", "sleeve_back.mirror"}) {
+    int index = -1;
+    for (size_t p = 0; p < g.panels.size(); ++p)
+      if (g.panels[p].id == id) index = static_cast<int>(p);
+    ASSERT_GE(index, 0) << id;
+    EXPECT_EQ(g.panels[static_cast<size_t>(index)].quality.inverted_quads, 0) << id;
+    EXPECT_LT(g.panels[static_cast<size_t>(index)].quality.max_aspect_ratio, 10.0) << id;
+    int faces = 0, inward = 0;
+    for (Eigen::Index f = 0; f < g.mesh.face_count(); ++f) {
+      if (g.face_panel(f) != index) continue;
+      const Eigen::Vector3d a = g.mesh.vertices.row(g.mesh.faces(f, 0)),
+                            b = g.mesh.vertices.row(g.mesh.faces(f, 1)),
+                            c = g.mesh.vertices.row(g.mesh.faces(f, 2)),
+                            d = g.mesh.vertices.row(g.mesh.faces(f, 3));
+      const Eigen::Vector3d centre = (a + b + c + d) / 4, n = (c - a).cross(d - b);
+      inward += n.dot(builtin_surface().closest_point(centre).normal) < 0 ? 1 : 0;
+      ++faces;
+    }
+    EXPECT_GT(faces, 100) << id;
+    EXPECT_EQ(inward, 0) << id;
   }
 }
 

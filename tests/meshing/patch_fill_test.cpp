@@ -228,6 +228,45 @@ TEST(PatchFillGeometry, ProjectionPutsInteriorOnTheSurface) {
   EXPECT_TRUE(validate(patch.mesh).ok());
 }
 
+TEST(PatchFillGeometry, PlaceReplacesTheVertexByVertexStart) {
+  // The same cap: a `place` that lifts the free vertices (and only those) onto the sphere along
+  // +z is the start instead of `project`, called once per filled plan with the boundary fixed;
+  // with no relaxation sweep the interior stays exactly where it put it.
+  const double radius = 2;
+  auto cap = [&](double t) {
+    const double a = 2 * std::numbers::pi * t;
+    return Eigen::Vector3d(std::cos(a), std::sin(a), std::sqrt(radius * radius - 1));
+  };
+  int calls = 0, projected = 0;
+  FillGeometryOptions options;
+  options.relax_iterations = 0;
+  options.project = [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+    ++projected;
+    return p;
+  };
+  options.place = [&](std::vector<Eigen::Vector3d>& positions,
+                      std::span<const std::array<int, 4>> quads, std::span<const char> fixed) {
+    ++calls;
+    ASSERT_EQ(fixed.size(), positions.size());
+    ASSERT_FALSE(quads.empty());
+    for (size_t v = 0; v < positions.size(); ++v) {
+      if (fixed[v]) {
+        EXPECT_NEAR(positions[v].norm(), radius, 1e-12);  // the boundary is on the sphere
+        continue;
+      }
+      const Eigen::Vector2d xy = positions[v].head<2>();
+      positions[v].z() = std::sqrt(radius * radius - xy.squaredNorm());
+    }
+  };
+  const std::vector<int> counts{6, 6, 6, 4, 4};
+  const FilledPatch patch = fill_region(sides_on(cap, counts), options);
+  EXPECT_GE(calls, 1);
+  EXPECT_EQ(projected, 0);
+  for (Eigen::Index v = 0; v < patch.mesh.vertices.rows(); ++v)
+    EXPECT_NEAR(patch.mesh.vertices.row(v).norm(), radius, 1e-12);
+  EXPECT_EQ(patch.quality.inverted_quads, 0);
+}
+
 TEST(PatchFillGeometry, ScaleInvariant) {
   // The same region at 1e-4 and 1e4 gives the same mesh up to scale.
   const std::vector<int> counts{7, 5, 6, 4};
