@@ -47,6 +47,8 @@ struct CurveSpec {
   bool closed = false;                    // the last point joins the first
   std::optional<double> edge_length;      // metres; overrides panel and global
   std::optional<int> edges;               // fixed edge count (parity may not change it)
+  std::optional<double> seam_allowance;   // metres, along this curve in the pattern (a seam's
+                                          // two sides, or an edge's); default: the panel's
 
   bool is_3d() const { return !points3d.empty(); }
 };
@@ -132,6 +134,7 @@ struct AdaptiveSpec {
 // How the drape is simulated (`sketchdrape run`): plain values with defaults.
 struct SimulateSpec {
   double duration = 3.0;                      // seconds of simulated time at most
+  bool duration_given = false;                // the file says "duration"
   bool adaptive = true;                       // 4-8 refinement/coarsening
   bool adaptive_given = false;                // the file says "adaptive" (a sheet adapts only then)
   AdaptiveSpec adaptive_settings;             // "adaptive": {...} (with "enabled" for the bool)
