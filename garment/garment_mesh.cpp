@@ -250,6 +250,13 @@ void assemble_mesh(std::vector<std::array<int, 4>>& faces, std::vector<int>& fac
     for (auto& q : faces)
       for (int& v : q) v = remap[static_cast<size_t>(v)];
     pool.positions = std::move(kept);
+    std::map<std::pair<int, int>, std::string> edge_curve;
+    for (const auto& [edge, curve] : garment.edge_curve) {
+      const int a = remap[static_cast<size_t>(edge.first)],
+                b = remap[static_cast<size_t>(edge.second)];
+      if (a >= 0 && b >= 0) edge_curve[std::minmax(a, b)] = curve;
+    }
+    garment.edge_curve = std::move(edge_curve);
   }
   garment.mesh.vertices.resize(static_cast<Eigen::Index>(pool.positions.size()), 3);
   for (size_t v = 0; v < pool.positions.size(); ++v)
@@ -413,9 +420,13 @@ Garment build_garment(const GarmentRequest& sketch, const BodySurface& body) {
     panel.fabric = spec.fabric;
     panel.mirror_copy = loop.mirror_copy;
     panel.ease = spec.ease;
-    for (const LoopEdge& e : loop.edges)
+    for (const LoopEdge& e : loop.edges) {
       panel.curves.push_back(
           net.curves[static_cast<size_t>(net.edges[static_cast<size_t>(e.edge)].curve)].id);
+      const std::vector<int>& ids = boundary.ids(e.edge);
+      for (size_t j = 0; j + 1 < ids.size(); ++j)
+        garment.edge_curve[std::minmax(ids[j], ids[j + 1])] = panel.curves.back();
+    }
 
     // Sides: points and global ids from corner i to corner i+1.
     std::vector<Eigen::MatrixX3d> side_points;

@@ -11,7 +11,9 @@
 // 6. label_panels: join groups, body parts, areas.
 
 #include <Eigen/Core>
+#include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "garment/body_surface.hpp"
@@ -61,6 +63,10 @@ struct Garment {
   // side vertex of one quad on a seam a panel shares with its own mirror copy (the shorts' centre
   // front has one).
   int merged_doublets = 0;
+  // The network curve (its id: "hem", "side.mirror") that each mesh edge on a panel's outline
+  // lies on, by the edge's (lower, higher) vertex: which seam or edge of the sketch a piece's
+  // outline follows (a curve's own seam allowance). Edges made by merging a doublet are absent.
+  std::map<std::pair<int, int>, std::string> edge_curve;
 };
 
 // The whole meshing pipeline for a sketch with curves and panels. Throws SketchError for

@@ -49,6 +49,8 @@ struct CurveSpec {
   bool closed = false;                    // the last point joins the first
   std::optional<double> edge_length;      // metres; overrides panel and global
   std::optional<int> edges;               // fixed edge count (parity may not change it)
+  std::optional<double> seam_allowance;   // metres, along this curve in the pattern (a seam's
+                                          // two sides, or an edge's); default: the panel's
 
   bool is_3d() const { return !points3d.empty(); }
 };

@@ -9,9 +9,13 @@
 #include <CGAL/create_offset_polygons_2.h>
 #include <fmt/format.h>
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
 namespace sd::garment {
 namespace {
@@ -66,6 +70,109 @@ Eigen::MatrixX2d simplify_closed(const Eigen::MatrixX2d& p, double tolerance) {
   Eigen::MatrixX2d out(static_cast<Eigen::Index>(rows.size()), 2);
   for (size_t k = 0; k < rows.size(); ++k) out.row(static_cast<Eigen::Index>(k)) = p.row(rows[k]);
   return out;
+}
+
+// Douglas-Peucker on the open polyline p[first .. last] (indices modulo p.rows()): marks in
+// `keep` the points the simplified run keeps (its two ends always).
+void simplify_run(const Eigen::MatrixX2d& p, Eigen::Index first, Eigen::Index last,
+                  double tolerance, std::vector<bool>& keep) {
+  const Eigen::Index n = p.rows();
+  keep[static_cast<size_t>(first % n)] = keep[static_cast<size_t>(last % n)] = true;
+  std::vector<std::pair<Eigen::Index, Eigen::Index>> stack = {{first, last}};
+  while (!stack.empty()) {
+    const auto [a, b] = stack.back();
+    stack.pop_back();
+    const Eigen::Vector2d pa = p.row(a % n), pb = p.row(b % n);
+    const Eigen::Vector2d d = pb - pa;
+    double worst = -1;
+    Eigen::Index at = -1;
+    for (Eigen::Index i = a + 1; i < b; ++i) {
+      const Eigen::Vector2d q = Eigen::Vector2d(p.row(i % n)) - pa;
+      const double dist =
+          d.norm() > 0 ? std::abs(d.x() * q.y() - d.y() * q.x()) / d.norm() : q.norm();
+      if (dist > worst) {
+        worst = dist;
+        at = i;
+      }
+    }
+    if (at >= 0 && worst > tolerance) {
+      keep[static_cast<size_t>(at % n)] = true;
+      stack.emplace_back(a, at);
+      stack.emplace_back(at, b);
+    }
+  }
+}
+
+// The sewing line offset outwards by a different allowance per edge (allowance[i]: edge i from
+// point i to i + 1, at least two values). CGAL 5.5's straight skeleton has no weights, so: each
+// run of one allowance is simplified (Douglas-Peucker, 0.1 mm; the points where the allowance
+// changes are kept), every simplified edge's line is moved out by its allowance, and the lines
+// of consecutive edges meet at their intersection (the mitre a pattern maker draws where two
+// allowances meet at a corner). Where two different allowances meet with their edges nearly in
+// line, or their lines would meet farther than 4 allowances out, the cutting line steps across
+// at the point instead. Throws PatternError if the result crosses itself.
+Eigen::MatrixX2d offset_by_edge(const std::string& name, const Eigen::MatrixX2d& sewing,
+                                const std::vector<double>& allowance) {
+  const Eigen::Index n = sewing.rows();
+  std::vector<Eigen::Index> changes;  // points where the allowance changes
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (allowance[static_cast<size_t>(i)] != allowance[static_cast<size_t>((i + n - 1) % n)])
+      changes.push_back(i);
+  std::vector<bool> keep(static_cast<size_t>(n), false);
+  for (size_t k = 0; k < changes.size(); ++k) {
+    const Eigen::Index a = changes[k];
+    Eigen::Index b = changes[(k + 1) % changes.size()];
+    if (b <= a) b += n;
+    simplify_run(sewing, a, b, 1e-4, keep);
+  }
+  std::vector<Eigen::Index> kept;
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (keep[static_cast<size_t>(i)]) kept.push_back(i);
+  const size_t m = kept.size();
+  // Simplified edge j: kept[j] → kept[j + 1], inside one run: the allowance of its first edge.
+  std::vector<Eigen::Vector2d> tangent(m), normal(m);
+  std::vector<double> d(m);
+  for (size_t j = 0; j < m; ++j) {
+    const Eigen::Vector2d a = sewing.row(kept[j]), b = sewing.row(kept[(j + 1) % m]);
+    tangent[j] = (b - a).normalized();
+    normal[j] = Eigen::Vector2d(tangent[j].y(), -tangent[j].x());  // outwards on a CCW outline
+    d[j] = allowance[static_cast<size_t>(kept[j])];
+  }
+  std::vector<Eigen::Vector2d> out;
+  for (size_t j = 0; j < m; ++j) {
+    const size_t i = (j + m - 1) % m;  // the edge before point kept[j]
+    const Eigen::Vector2d p = sewing.row(kept[j]);
+    const Eigen::Vector2d on_a = p + d[i] * normal[i], on_b = p + d[j] * normal[j];
+    Eigen::Matrix2d lines;
+    lines << tangent[i], -tangent[j];
+    const double sine = tangent[i].x() * tangent[j].y() - tangent[i].y() * tangent[j].x();
+    const bool same = d[i] == d[j];
+    if (std::abs(sine) < (same ? 1e-12 : 1e-3)) {
+      out.push_back(on_a);
+      if (!same) out.push_back(on_b);
+      continue;
+    }
+    const Eigen::Vector2d st = lines.partialPivLu().solve(on_b - on_a);
+    const Eigen::Vector2d corner = on_a + st.x() * tangent[i];
+    if (!same && (corner - p).norm() > 4 * std::max(d[i], d[j])) {
+      out.push_back(on_a);
+      out.push_back(on_b);
+    } else {
+      out.push_back(corner);
+    }
+  }
+  Polygon polygon;
+  Eigen::MatrixX2d cutting(static_cast<Eigen::Index>(out.size()), 2);
+  for (size_t k = 0; k < out.size(); ++k) {
+    cutting.row(static_cast<Eigen::Index>(k)) = out[k].transpose();
+    polygon.push_back(Kernel::Point_2(out[k].x(), out[k].y()));
+  }
+  if (!polygon.is_simple() || polygon.orientation() != CGAL::COUNTERCLOCKWISE)
+    throw PatternError(name, fmt::format("the seam allowances of panel '{}' cross each other: "
+                                         "a concave curve of its outline is tighter than the "
+                                         "allowance along it; give that seam a smaller one",
+                                         name));
+  return cutting;
 }
 
 // The sewing line offset outwards by `allowance` (straight skeleton: corners stay sharp).
@@ -150,10 +257,32 @@ PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOpt
     piece.allowance = p < options.panel_allowance.size() && options.panel_allowance[p] >= 0
                           ? options.panel_allowance[p]
                           : options.seam_allowance;
-    piece.sewing.resize(static_cast<Eigen::Index>(flat.boundary.size()), 2);
-    for (size_t k = 0; k < flat.boundary.size(); ++k)
+    const size_t edges = flat.boundary.size();
+    std::vector<double> allowance(edges, piece.allowance);
+    if (p < options.edge_allowance.size() && !options.edge_allowance[p].empty()) {
+      if (options.edge_allowance[p].size() != edges)
+        throw std::invalid_argument(
+            fmt::format("edge allowances of piece '{}': {} given for {} outline edges", flat.id,
+                        options.edge_allowance[p].size(), edges));
+      for (size_t k = 0; k < edges; ++k)
+        if (options.edge_allowance[p][k] >= 0) allowance[k] = options.edge_allowance[p][k];
+    }
+    for (size_t k = 0; k < edges; ++k)
+      if (k == 0 || allowance[k] != allowance[k - 1])
+        piece.allowances.push_back({static_cast<int>(k), static_cast<int>(k), allowance[k]});
+      else
+        piece.allowances.back().last = static_cast<int>(k);
+    if (piece.allowances.size() > 1 &&
+        piece.allowances.back().allowance == piece.allowances.front().allowance) {
+      piece.allowances.front().first = piece.allowances.back().first;  // the run across point 0
+      piece.allowances.pop_back();
+    }
+    piece.sewing.resize(static_cast<Eigen::Index>(edges), 2);
+    for (size_t k = 0; k < edges; ++k)
       piece.sewing.row(static_cast<Eigen::Index>(k)) = piece.ease * flat.uv.row(flat.boundary[k]);
-    piece.cutting = offset_outwards(flat.id, piece.sewing, piece.allowance);
+    piece.cutting = piece.allowances.size() > 1
+                        ? offset_by_edge(flat.id, piece.sewing, allowance)
+                        : offset_outwards(flat.id, piece.sewing, piece.allowances[0].allowance);
     piece.origin = -piece.cutting.colwise().minCoeff().transpose();
     piece.sewing.rowwise() += piece.origin.transpose();
     piece.cutting.rowwise() += piece.origin.transpose();
@@ -163,7 +292,10 @@ PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOpt
     for (const int v : flat.notches) {
       const auto at = std::find(flat.boundary.begin(), flat.boundary.end(), v);
       const Eigen::Index i = at - flat.boundary.begin();
-      piece.notches.push_back({piece.sewing.row(i).transpose(), outward_normal(piece.sewing, i)});
+      const double narrower = std::min(allowance[static_cast<size_t>(i)],
+                                       allowance[(static_cast<size_t>(i) + edges - 1) % edges]);
+      piece.notches.push_back(
+          {piece.sewing.row(i).transpose(), outward_normal(piece.sewing, i), narrower});
     }
     grain_line(piece);
     if (piece.size.x() > options.fabric_width - 2 * options.gap)

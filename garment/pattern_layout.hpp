@@ -16,6 +16,10 @@ struct PatternLayoutOptions {
   double seam_allowance = 0.01;  // m, for pieces without their own
   // Per FlatPattern panel (empty: none); a negative entry takes seam_allowance.
   std::vector<double> panel_allowance;
+  // Per FlatPattern panel, per outline edge k (boundary[k] → boundary[k + 1]): that edge's own
+  // allowance (a seam's or a hem's, m), or negative for the piece's; an empty list (or none for
+  // the panel) gives the piece's everywhere.
+  std::vector<std::vector<double>> edge_allowance;
   std::vector<double> panel_ease;  // per panel rest-shape scale (empty: 1)
   double gap = 0.01;               // m between pieces, and from the selvedges and the cut end
 };
@@ -24,16 +28,29 @@ struct PatternLayoutOptions {
 struct PatternNotch {
   Eigen::Vector2d point = Eigen::Vector2d::Zero();
   Eigen::Vector2d normal = Eigen::Vector2d::UnitY();
+  double allowance = 0;  // m: the narrower of the allowances of the two outline edges there
+};
+
+// A run of the sewing line with one seam allowance: edges first .. last (edge i joins sewing
+// point i to i + 1, cyclically), `allowance` m.
+struct AllowanceRun {
+  int first = 0, last = 0;
+  double allowance = 0;
 };
 
 // One piece in its own frame: piece = ease · FlatPanel::uv + origin (m), warp along +y, the
 // cutting line's bounding box starting at (0, 0). On the fabric it sits at `placement`.
 struct PatternPiece {
-  int panel = -1;  // index into FlatPattern::panels
-  double ease = 1, allowance = 0;
+  int panel = -1;                        // index into FlatPattern::panels
+  double ease = 1, allowance = 0;        // allowance: the piece's (m), where no seam has its own
+  std::vector<AllowanceRun> allowances;  // along the sewing line, covering every edge once
   Eigen::Vector2d origin = Eigen::Vector2d::Zero();
-  Eigen::MatrixX2d sewing;   // the sewing line, closed (first point not repeated), CCW
-  Eigen::MatrixX2d cutting;  // the sewing line offset out by `allowance`, CCW
+  Eigen::MatrixX2d sewing;  // the sewing line, closed (first point not repeated), CCW
+  // The sewing line offset out by its allowances, CCW: by the straight skeleton when they are
+  // all equal; else each simplified edge's line moved out by its own and neighbouring lines
+  // met at their intersection (a mitred corner; where two different allowances meet nearly in
+  // line, a step across).
+  Eigen::MatrixX2d cutting;
   std::vector<PatternNotch> notches;
   Eigen::Vector2d grain_start = Eigen::Vector2d::Zero(), grain_end = Eigen::Vector2d::Zero();
   Eigen::Vector2d size = Eigen::Vector2d::Zero();       // of the cutting line's bounding box
@@ -48,8 +65,9 @@ struct PatternLayout {
   double efficiency = 0;             // Σ cut area / (length_used · fabric_width)
 };
 
-// Lays out every piece. Throws PatternError for a piece whose outline crosses itself in 2D or
-// that is wider than the fabric.
+// Lays out every piece. Throws PatternError for a piece whose outline crosses itself in 2D, whose
+// cutting line with different seam allowances crosses itself (a concave curve tighter than its
+// allowance) or that is wider than the fabric.
 PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOptions& options = {});
 
 }  // namespace sd::garment

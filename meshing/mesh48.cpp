@@ -393,6 +393,9 @@ int Mesh48::level(TriangleId t) const {
 int Mesh48::source_face(TriangleId t) const {
   return root_source_[triangle_at(t).root];
 }
+int Mesh48::root(TriangleId t) const {
+  return triangle_at(t).root;
+}
 
 double Mesh48::rest_area(TriangleId t) const {
   const Triangle& tri = triangle_at(t);

@@ -53,6 +53,9 @@ struct BlockChange {
   // children share; -1 for a missing second side. Recorded when the change is made: the
   // triangle slots may be reused by the next change of a chain of forced splits.
   int source_a1 = -1, source_a2 = -1;
+  // Level-0 triangles (Mesh48::root) the two parents lie in, recorded likewise; -1 for a
+  // missing second side.
+  int root_a1 = -1, root_a2 = -1;
 };
 
 // Flat arrays for the solver. Rows are compact: vertex row r is vertex_ids[r]; when the mesh
@@ -128,6 +131,11 @@ class Mesh48 {
   // an input edge, one of the edge's two faces (each triangle of a block gets one of them).
   // Lets per-face data (panel, fabric) reach every level.
   int source_face(TriangleId t) const;
+  // The level-0 triangle the triangle lies in (its index in the input's triangle order: for
+  // from_quads quad q gives 2q and 2q + 1). Every descendant lies in its root's plane, its
+  // vertices' rest positions being midpoints of rest positions, so data given affinely on the
+  // level-0 triangles (a flattened pattern's coordinates) reaches every level.
+  int root(TriangleId t) const;
   double rest_area(TriangleId t) const;
   Eigen::Vector3d rest_normal(TriangleId t) const;  // unit
 

@@ -80,6 +80,8 @@ BlockChange Mesh48::split_complete(BlockId k, bool forced) {
   ch.area_a2 = has_d ? rest_area(t1) : 0.0;
   ch.source_a1 = source_face(t0);
   ch.source_a2 = has_d ? source_face(t1) : -1;
+  ch.root_a1 = root(t0);
+  ch.root_a2 = has_d ? root(t1) : -1;
 
   const VertexId e = new_vertex();
   {
@@ -289,6 +291,8 @@ BlockChange Mesh48::merge(BlockId k) {
   ch.area_a2 = has_d ? rest_area(t1) : 0.0;
   ch.source_a1 = source_face(t0);
   ch.source_a2 = has_d ? source_face(t1) : -1;
+  ch.root_a1 = root(t0);
+  ch.root_a2 = has_d ? root(t1) : -1;
   debug_validate(*this, "Mesh48::merge");
   return ch;
 }

@@ -31,6 +31,7 @@ inline constexpr const char* kSketchFormat = "sketchdrape/1";
 // How the drape is simulated (`sketchdrape run`): plain values with defaults.
 struct SimulateSpec {
   double duration = 3.0;        // seconds of simulated time at most
+  bool duration_given = false;  // the file says "duration"
   bool adaptive = true;         // 4-8 refinement/coarsening
   bool adaptive_given = false;  // the file says "adaptive" (a sheet adapts only then)
   // "adaptive": {...} (with "enabled" for the bool): the simulator's own settings, its defaults

@@ -152,7 +152,7 @@ CurveSpec parse_curve(const Reader& r, const json& j, const std::string& path, c
   r.require_object(j, path, "a curve");
   r.check_keys(j, path,
                {"id", "view", "points", "points3d", "offset", "on_body", "smooth", "closed",
-                "edge_length", "edges"});
+                "edge_length", "edges", "seam_allowance"});
   CurveSpec curve;
   curve.json_path = path;
   if (!j.contains("id")) r.fail(path, "every curve needs an \"id\"");
@@ -201,6 +201,12 @@ CurveSpec parse_curve(const Reader& r, const json& j, const std::string& path, c
     if (*curve.edges > kMaxCurveEdges)
       r.fail(path + "/edges", fmt::format("{} edges on one curve is more than the {} allowed",
                                           *curve.edges, kMaxCurveEdges));
+  }
+  if (j.contains("seam_allowance")) {
+    curve.seam_allowance = r.number(j["seam_allowance"], path + "/seam_allowance");
+    if (*curve.seam_allowance < 0 || *curve.seam_allowance > 0.1)
+      r.fail(path + "/seam_allowance",
+             fmt::format("seam allowance {} m is outside 0 .. 0.1 m", *curve.seam_allowance));
   }
   // Repeated consecutive points make a stroke without direction there.
   const size_t n = has_2d ? curve.points.size() : curve.points3d.size();

@@ -99,6 +99,7 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
   if (j.contains("pin_above")) sim.pin_above = r.number(j["pin_above"], path + "/pin_above");
   if (j.contains("duration")) {
     sim.duration = r.positive(j["duration"], path + "/duration");
+    sim.duration_given = true;
     if (sim.duration > kMaxDuration)
       r.fail(path + "/duration",
              fmt::format("a drape of {:.6g} s is longer than the {:g} s (one hour of simulated "

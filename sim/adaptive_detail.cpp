@@ -64,12 +64,39 @@ AdaptiveCloth::AdaptiveCloth(meshing::Mesh48 mesh, AdaptiveMaterial material,
     : mesh_(std::move(mesh)), material_(std::move(material)), settings_(adaptive) {
   settings_.validate();
   simulation.validate();
-  if (material_.rest_uv.rows() > 0 && settings_.enabled)
-    throw InvalidAdaptiveSettingsError(
-        "pattern rest shapes (rest_uv) need a fixed mesh: turn adaptive detail off");
   if (!mesh_.is_compact())
     throw std::invalid_argument("the adaptive cloth needs a compact 4-8 mesh (call compact())");
   arrays_ = mesh_.arrays();
+  if (material_.rest_uv.rows() > 0) {
+    const Eigen::Index faces = arrays_.faces.rows();
+    if (material_.rest_uv.rows() != faces || material_.rest_uv.cols() != 6 ||
+        !material_.rest_uv.allFinite())
+      throw InvalidClothError("the rest coordinates must be finite, one row of 6 per triangle (" +
+                              std::to_string(faces) + ")");
+    if (faces > 0 && arrays_.face_level.maxCoeff() > 0)
+      throw std::invalid_argument(
+          "pattern rest shapes (rest_uv) are given on a 4-8 mesh's level-0 triangles");
+    root_uv_.setZero(faces, 6);
+    root_rest_.setZero(faces, 9);
+    root_area_scale_.setZero(faces);
+    for (Eigen::Index f = 0; f < faces; ++f) {
+      const int r = mesh_.root(arrays_.triangle_ids[static_cast<std::size_t>(f)]);
+      if (r < 0 || r >= faces)
+        throw std::invalid_argument("a level-0 triangle's root is not a triangle of the mesh");
+      root_uv_.row(r) = material_.rest_uv.row(f);
+      for (int k = 0; k < 3; ++k)
+        root_rest_.block<1, 3>(r, 3 * k) = arrays_.rest_positions.row(arrays_.faces(f, k));
+      const Eigen::Vector3d p0 = arrays_.rest_positions.row(arrays_.faces(f, 0));
+      const Eigen::Vector3d p1 = arrays_.rest_positions.row(arrays_.faces(f, 1));
+      const Eigen::Vector3d p2 = arrays_.rest_positions.row(arrays_.faces(f, 2));
+      const auto uv = material_.rest_uv.row(f);
+      const double area_uv =
+          0.5 * ((uv(2) - uv(0)) * (uv(5) - uv(1)) - (uv(4) - uv(0)) * (uv(3) - uv(1)));
+      const double area_3d = 0.5 * (p1 - p0).cross(p2 - p0).norm();
+      // build_cloth_model refuses degenerate and inverted rest triangles with their names.
+      root_area_scale_(r) = area_3d > 0.0 ? area_uv / area_3d : 1.0;
+    }
+  }
   const int n = mesh_.vertex_count();
   if (positions.rows() == 0) positions = arrays_.rest_positions;
   if (positions.rows() != n || !positions.allFinite())
@@ -149,8 +176,6 @@ const ContactResponse* AdaptiveCloth::active_contact() const {
 }
 
 AdaptiveTransfer AdaptiveCloth::begin_transfer() const {
-  if (material_.rest_uv.rows() > 0)
-    throw std::logic_error("a cloth with pattern rest shapes (rest_uv) cannot be split or merged");
   return sim::begin_transfer(mesh_, positions(), velocities(), masses_, birth_, pins_,
                              simulation_->time());
 }
@@ -160,7 +185,8 @@ void AdaptiveCloth::apply(const BlockChange& change, AdaptiveTransfer& state) {
     state.before = conserved_quantities();  // the simulation still holds the old state
     state.measured = true;
   }
-  transfer_change(change, mesh_, material_.fabric.area_density, material_.source_ease, state);
+  transfer_change(change, mesh_, material_.fabric.area_density, material_.source_ease, state,
+                  root_area_scale_);
   if (change.kind == BlockChange::Kind::kSplit)
     if (const ContactResponse* contact = active_contact())
       if (keep_off_body(change.e.value(), state.x, *contact)) ++state.moved_off_body;
@@ -186,6 +212,36 @@ void AdaptiveCloth::clear_body() {
   body_sag_cache_.clear();
 }
 
+Eigen::MatrixXd AdaptiveCloth::pattern_rest_uv() const {
+  const Eigen::Index faces = arrays_.faces.rows();
+  Eigen::MatrixXd uv(faces, 6);
+  for (Eigen::Index f = 0; f < faces; ++f) {
+    const TriangleId t = arrays_.triangle_ids[static_cast<std::size_t>(f)];
+    const int r = mesh_.root(t);
+    if (arrays_.face_level(f) == 0) {  // the root itself, as given (bit for bit)
+      uv.row(f) = root_uv_.row(r);
+      continue;
+    }
+    // Barycentric coordinates in the root's plane (the normal equations of the 3×2 edge matrix:
+    // exact for points in the plane, the closest in-plane point otherwise).
+    const Eigen::Vector3d p0 = root_rest_.block<1, 3>(r, 0).transpose();
+    Eigen::Matrix<double, 3, 2> edges;
+    edges.col(0) = root_rest_.block<1, 3>(r, 3).transpose() - p0;
+    edges.col(1) = root_rest_.block<1, 3>(r, 6).transpose() - p0;
+    const Eigen::Matrix2d gram = edges.transpose() * edges;
+    const Eigen::Vector2d u0 = root_uv_.block<1, 2>(r, 0).transpose();
+    Eigen::Matrix2d uv_edges;
+    uv_edges.col(0) = root_uv_.block<1, 2>(r, 2).transpose() - u0;
+    uv_edges.col(1) = root_uv_.block<1, 2>(r, 4).transpose() - u0;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d p = arrays_.rest_positions.row(arrays_.faces(f, k)).transpose();
+      const Eigen::Vector2d lambda = gram.ldlt().solve(edges.transpose() * (p - p0));
+      uv.block<1, 2>(f, 2 * k) = (u0 + uv_edges * lambda).transpose();
+    }
+  }
+  return uv;
+}
+
 double AdaptiveCloth::rebuild(AdaptiveTransfer& state, const SimulationSettings* first_settings) {
   const auto start = Clock::now();
   const bool first = simulation_ == nullptr;
@@ -201,7 +257,7 @@ double AdaptiveCloth::rebuild(AdaptiveTransfer& state, const SimulationSettings*
   input.rest_positions = arrays_.rest_positions;
   input.triangles = arrays_.faces;
   input.up = material_.up;
-  input.rest_uv = material_.rest_uv;  // empty, or the unchanged first mesh's (see begin_transfer)
+  if (root_uv_.rows() > 0) input.rest_uv = pattern_rest_uv();
   if (material_.source_warp.rows() > 0) {
     input.warp.resize(arrays_.faces.rows(), 3);
     for (Eigen::Index f = 0; f < arrays_.faces.rows(); ++f) {

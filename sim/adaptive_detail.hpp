@@ -48,8 +48,11 @@ struct AdaptiveMaterial {
   // moves between triangles at the eased density ρ·e².
   Eigen::VectorXd source_ease;
   // Rest coordinates of each triangle of the mesh as given (ClothInput::rest_uv: a flattened
-  // pattern's), or empty. Only for a mesh that never changes: with them the driver refuses
-  // adaptivity and every split or merge (children have no pattern coordinates of their own yet).
+  // pattern's), or empty. The mesh must then be all level 0. A finer triangle gets its
+  // coordinates from the level-0 triangle it lies in (Mesh48::root): the pattern map is affine
+  // on it, and its vertices' rest positions are midpoints, so each vertex's coordinates are its
+  // barycentric combination of the root's corners' (a split vertex is the midpoint in the
+  // pattern too; a seam vertex keeps one position per piece, each triangle using its own).
   Eigen::MatrixXd rest_uv;
 };
 
@@ -216,6 +219,13 @@ class AdaptiveCloth {
   Eigen::VectorXd masses_;     // #V, by vertex id
   std::vector<double> birth_;  // #F, simulated time each triangle was made
   std::vector<PinRecord> pins_;
+  // The pattern rest shape (AdaptiveMaterial::rest_uv) per level-0 triangle: its rest
+  // coordinates (#roots by 6), its corners' 3D rest positions (#roots by 9) and its rest area
+  // over its 3D area (#roots); all empty without rest_uv.
+  Eigen::MatrixXd root_uv_, root_rest_;
+  Eigen::VectorXd root_area_scale_;
+  // The rest coordinates of every triangle of the current mesh (rows of arrays_.faces).
+  Eigen::MatrixXd pattern_rest_uv() const;
   EdgeRestGeometry edge_rest_;   // per interior edge (rows of arrays_.interior_edges)
   BodySagCache body_sag_cache_;  // carried through topology changes by rebuild
   AdaptiveReport report_;

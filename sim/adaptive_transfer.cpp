@@ -75,7 +75,8 @@ double face_ease(const Eigen::VectorXd& source_ease, int source) {
 }
 
 void transfer_change(const BlockChange& change, const meshing::Mesh48& mesh, double area_density,
-                     const Eigen::VectorXd& source_ease, AdaptiveTransfer& state) {
+                     const Eigen::VectorXd& source_ease, AdaptiveTransfer& state,
+                     const Eigen::VectorXd& root_area_scale) {
   state.changed = true;
   // Mass moves at each triangle's eased density ρ·e². The ease comes from the input faces the
   // change recorded: by the time a forced split of a chain is applied, its child slots may
@@ -83,7 +84,17 @@ void transfer_change(const BlockChange& change, const meshing::Mesh48& mesh, dou
   const double rho = area_density;
   const double e1 = face_ease(source_ease, change.source_a1);
   const double e2 = change.source_a2 >= 0 ? face_ease(source_ease, change.source_a2) : 1.0;
-  meshing::transfer_mass_and_velocity(change, {rho * e1 * e1, rho * e2 * e2}, state.m, state.v);
+  const auto area_scale = [&root_area_scale](int root) {
+    if (root_area_scale.size() == 0 || root < 0) return 1.0;
+    if (root >= root_area_scale.size())
+      throw InvalidClothError("the rest-area scale must be given for every level-0 triangle (" +
+                              std::to_string(root_area_scale.size()) + " given, triangle " +
+                              std::to_string(root) + " needed)");
+    return root_area_scale(root);
+  };
+  const double s1 = area_scale(change.root_a1), s2 = area_scale(change.root_a2);
+  meshing::transfer_mass_and_velocity(change, {rho * e1 * e1 * s1, rho * e2 * e2 * s2}, state.m,
+                                      state.v);
   const auto grow = [](auto& vector, int size, auto fill) {
     if (static_cast<int>(vector.size()) < size) vector.resize(static_cast<std::size_t>(size), fill);
   };

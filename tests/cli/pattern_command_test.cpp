@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <filesystem>
@@ -12,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <sstream>
+#include <utility>
 #include <vector>
 
 #include "src/render/image.hpp"
@@ -135,6 +137,79 @@ TEST(PatternCommand, EveryExampleGivesPiecesThatSewAndDoNotOverlap) {
     EXPECT_EQ(count(svg, "<g class=\"piece\""), pieces.size()) << name;
     EXPECT_NE(svg.find("width=\"1500.0mm\""), std::string::npos);
   }
+}
+
+// A seam allowance per seam, as a designer writes it on the curves: a 3 cm hem, a 6 mm neckline,
+// 1 cm elsewhere. On every piece the sewing line lies the seam's own allowance inside the cutting
+// line (points inside a run, to 0.5 mm: the cutting line follows the sewing line simplified to
+// 0.1 mm), pattern.json lists the runs, and the DXF labels give the range.
+TEST(PatternCommand, SeamAllowancePerSeamFromTheCurves) {
+  const fs::path dir = fresh_dir("per-seam");
+  fs::create_directories(dir);
+  std::string text = read(example("tshirt"));
+  for (const auto& [id, allowance] : std::vector<std::pair<std::string, std::string>>{
+           {"hem_f", "0.03"}, {"hem_b", "0.03"}, {"neck_f", "0.006"}, {"neck_b", "0.006"}}) {
+    const std::string key = "{ \"id\": \"" + id + "\", ";
+    const size_t at = text.find(key);
+    ASSERT_NE(at, std::string::npos) << id;
+    text.insert(at + key.size(), "\"seam_allowance\": " + allowance + ", ");
+  }
+  std::ofstream(dir / "tshirt.json") << text;
+  const CommandResult r = run_sketchdrape("pattern " + (dir / "tshirt.json").string() + " -o " +
+                                          (dir / "out").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto json = nlohmann::json::parse(read(dir / "out/pattern.json"));
+  int hems = 0, necks = 0;
+  for (const auto& piece : json["pieces"]) {
+    const auto& sewing = piece["sewing_line"];
+    const auto cutting = piece["cutting_line"];
+    const size_t n = sewing.size();
+    const auto distance_to_cut = [&cutting](double x, double y) {
+      double best = 1e300;
+      for (size_t k = 0; k < cutting.size(); ++k) {
+        const double ax = cutting[k][0], ay = cutting[k][1];
+        const double bx = cutting[(k + 1) % cutting.size()][0];
+        const double by = cutting[(k + 1) % cutting.size()][1];
+        const double dx = bx - ax, dy = by - ay;
+        const double t =
+            std::clamp(((x - ax) * dx + (y - ay) * dy) / (dx * dx + dy * dy), 0.0, 1.0);
+        best = std::min(best, std::hypot(x - ax - t * dx, y - ay - t * dy));
+      }
+      return best;
+    };
+    double covered = 0;
+    for (const auto& run : piece["allowances"]) {
+      const int first = run["first_edge"], last = run["last_edge"];
+      const double mm = run["mm"];
+      const int edges =
+          static_cast<int>((last - first + static_cast<int>(n)) % static_cast<int>(n)) + 1;
+      covered += edges;
+      hems += mm == 30.0;
+      necks += mm == 6.0;
+      // Points strictly inside the run (both their edges have this allowance) where the outline
+      // turns by less than 20°: at a sharper concave corner the mitred cutting line lies
+      // d / cos(θ/2) away, as the straight skeleton's does.
+      for (int k = 1; k < edges; ++k) {
+        const int i = (first + k) % static_cast<int>(n);
+        const auto& p = sewing[static_cast<size_t>(i)];
+        const auto& a =
+            sewing[static_cast<size_t>((i + static_cast<int>(n) - 1) % static_cast<int>(n))];
+        const auto& b = sewing[static_cast<size_t>((i + 1) % static_cast<int>(n))];
+        const double turn =
+            std::abs(std::remainder(std::atan2(b[1].get<double>() - p[1].get<double>(),
+                                               b[0].get<double>() - p[0].get<double>()) -
+                                        std::atan2(p[1].get<double>() - a[1].get<double>(),
+                                                   p[0].get<double>() - a[0].get<double>()),
+                                    2 * M_PI));
+        if (turn > 20 * M_PI / 180) continue;
+        EXPECT_NEAR(distance_to_cut(p[0], p[1]), mm, 0.5) << piece["id"] << " point " << k;
+      }
+    }
+    EXPECT_EQ(covered, static_cast<double>(n)) << piece["id"] << ": the runs cover the outline";
+  }
+  EXPECT_EQ(hems, 4);  // front and back, each mirrored
+  EXPECT_EQ(necks, 4);
+  EXPECT_NE(read(dir / "out/pattern.dxf").find("Seam allowance: 6-30 mm"), std::string::npos);
 }
 
 // The sheet in a real browser: the SVG parses (one <g class="piece"> per piece in the DOM) and

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/SVD>
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <vector>
@@ -21,6 +23,19 @@ AdaptiveSheetSpec short_sheet() {
   AdaptiveSheetSpec spec;
   spec.duration = 0.5;
   return spec;
+}
+
+// Each triangle's rest coordinates: its (x, −z) in the horizontal sheet, x stretched by
+// `stretch`, so that the rest shape is not the drawn one.
+Eigen::MatrixXd stretched_rest_uv(const meshing::Mesh48Arrays& arrays, double stretch) {
+  Eigen::MatrixXd uv(arrays.faces.rows(), 6);
+  for (Eigen::Index t = 0; t < arrays.faces.rows(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::RowVector3d p = arrays.rest_positions.row(arrays.faces(t, k));
+      uv(t, 2 * k) = stretch * p.x();
+      uv(t, 2 * k + 1) = -p.z();
+    }
+  return uv;
 }
 
 AdaptiveSettings off() {
@@ -92,28 +107,15 @@ TEST(ClothDriver, ObserverSeesEveryStepCapsItAndStopsTheRun) {
   EXPECT_EQ(static_cast<int>(driver.adaptive_report()->steps.size()), report.steps);
 }
 
-// Pattern rest coordinates (a flat rest) belong to the mesh as given: the driver drapes them on
-// the fixed 4-8 mesh exactly as the simulator on the same input, and refuses adaptivity and
-// every split (children would have no pattern coordinates).
-TEST(ClothDriver, PatternRestShapesNeedTheFixedMesh) {
+// Rest coordinates (a flat rest) on the fixed 4-8 mesh drape exactly as the simulator on the
+// same input: the driver adds nothing.
+TEST(ClothDriver, PatternRestShapesOnTheFixedMeshDrapeAsTheSimulator) {
   const AdaptiveSheetSpec spec = short_sheet();
   AdaptiveSheet sheet = build_adaptive_sheet(spec);
   const meshing::Mesh48Arrays arrays = sheet.mesh.arrays();
-  // Each triangle's rest coordinates: its (x, −z) in the horizontal sheet, stretched 10 % along
-  // x, so that the rest shape is not the drawn one.
-  sheet.material.rest_uv.resize(arrays.faces.rows(), 6);
-  for (Eigen::Index t = 0; t < arrays.faces.rows(); ++t)
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::RowVector3d p = arrays.rest_positions.row(arrays.faces(t, k));
-      sheet.material.rest_uv(t, 2 * k) = 1.1 * p.x();
-      sheet.material.rest_uv(t, 2 * k + 1) = -p.z();
-    }
+  sheet.material.rest_uv = stretched_rest_uv(arrays, 1.1);
   const SimulationSettings settings = adaptive_sheet_settings(spec);
-  EXPECT_THROW(
-      ClothDriver(sheet.mesh, sheet.material, {}, sheet.pins, settings, AdaptiveSettings{}),
-      InvalidAdaptiveSettingsError);
   ClothDriver driver(sheet.mesh, sheet.material, {}, sheet.pins, settings, off());
-  EXPECT_THROW(driver.adaptive()->refine_uniformly(1), std::logic_error);
 
   ClothInput input;
   input.rest_positions = arrays.rest_positions;
@@ -131,6 +133,55 @@ TEST(ClothDriver, PatternRestShapesNeedTheFixedMesh) {
   driver.run();
   EXPECT_EQ((driver.positions() - unflatten_positions(plain.positions())).cwiseAbs().maxCoeff(),
             0.0);
+}
+
+// Adaptive detail carries the pattern rest shape to every level: a split vertex is the midpoint
+// in the pattern too, so every triangle of a finer mesh rests in the 10 %-stretched sheet. Its
+// deformation gradient against the rest triangle is the identity on the pattern's positions
+// (x stretched by 1.1) and diag(1/1.1, 1) on the drawn ones, at every level; the masses carried
+// through the splits are the model's, lumped from the pattern areas (1.1 times the drawn area).
+TEST(ClothDriver, PatternRestShapesReachEveryLevelOfAdaptiveDetail) {
+  const AdaptiveSheetSpec spec = short_sheet();
+  AdaptiveSheet sheet = build_adaptive_sheet(spec);
+  const meshing::Mesh48Arrays arrays = sheet.mesh.arrays();
+  sheet.material.rest_uv = stretched_rest_uv(arrays, 1.1);
+  ClothDriver driver(sheet.mesh, sheet.material, {}, sheet.pins, adaptive_sheet_settings(spec),
+                     AdaptiveSettings{});
+  const double drawn_area = spec.size * spec.size;
+  const double density = sheet.material.fabric.area_density;
+  driver.adaptive()->refine_uniformly(3);
+  // A forced chain of splits and a merge back on top of the uniform level.
+  const std::vector<meshing::BlockId> leaves = driver.adaptive()->mesh().leaf_blocks();
+  driver.adaptive()->split_blocks({leaves.front(), leaves[leaves.size() / 2]});
+  driver.adaptive()->merge_blocks({driver.adaptive()->mesh().mergeable_blocks().front()});
+  const ClothModel& model = driver.simulation().model();
+  ASSERT_GE(driver.face_levels().maxCoeff(), 4);
+  EXPECT_NEAR(model.mass.sum(), 1.1 * density * drawn_area, 1e-12 * density);
+  EXPECT_LT((driver.adaptive()->masses() - model.mass).cwiseAbs().maxCoeff(), 1e-15);
+  const Eigen::MatrixX3d& rest = driver.adaptive()->rest_positions();
+  Eigen::MatrixX3d pattern = rest;
+  pattern.col(0) *= 1.1;
+  double pattern_error = 0, drawn_error = 0;
+  for (const TriangleElement& t : model.triangles) {
+    const auto gradient = [&t](const Eigen::MatrixX3d& x) {
+      Eigen::Matrix<double, 3, 2> f = Eigen::Matrix<double, 3, 2>::Zero();
+      for (int k = 0; k < 3; ++k) {
+        f.col(0) += t.du[k] * x.row(t.vertices[k]).transpose();
+        f.col(1) += t.dv[k] * x.row(t.vertices[k]).transpose();
+      }
+      return Eigen::JacobiSVD<Eigen::Matrix<double, 3, 2>>(f).singularValues();
+    };
+    pattern_error = std::max(pattern_error, (gradient(pattern) - Eigen::Vector2d(1, 1)).norm());
+    drawn_error = std::max(drawn_error, (gradient(rest) - Eigen::Vector2d(1.0, 1.0 / 1.1)).norm());
+  }
+  EXPECT_LT(pattern_error, 1e-12);
+  EXPECT_LT(drawn_error, 1e-12);
+
+  // And it drapes, adapting, with the total mass kept.
+  const SimulationReport report = driver.run();
+  EXPECT_FALSE(report.failed);
+  EXPECT_GT(driver.adaptive_report()->splits + driver.adaptive_report()->merges, 0);
+  EXPECT_NEAR(driver.adaptive()->masses().sum(), 1.1 * density * drawn_area, 1e-12 * density);
 }
 
 TEST(ClothDriver, ModelGivenAsIsKeepsItsTriangles) {

@@ -183,14 +183,10 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   Eigen::VectorXi triangle_group;
   Eigen::VectorXd face_levels;
   const bool flat_rest = scene.input.rest_uv.rows() > 0;
-  if (flat_rest && sketch.simulate.adaptive)
-    spdlog::warn(
-        "\"rest\": \"flat\" drapes on the fixed mesh: adaptive detail does not yet carry "
-        "pattern rest shapes through its splits (docs/pattern.md)");
   try {
     // A garment adapts unless the file says "adaptive": false; a sheet only when it asks.
     const bool adaptive =
-        sketch.simulate.adaptive && (!sketch.sheet || sketch.simulate.adaptive_given) && !flat_rest;
+        sketch.simulate.adaptive && (!sketch.sheet || sketch.simulate.adaptive_given);
     sim::ClothDriver driver = scene_driver(
         scene, settings, adaptive ? std::optional(adaptive_settings(sketch)) : std::nullopt);
     // Contacts and friction (through every split and merge), with the body still or moving.

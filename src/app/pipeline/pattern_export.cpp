@@ -34,12 +34,46 @@ Eigen::Vector2d on_fabric(const garment::PatternPiece& piece, const Eigen::Vecto
 
 // A notch: a snip 5 mm deep into the seam allowance from the cutting line, on the sewing line's
 // normal (the whole allowance when it is narrower).
-std::pair<Eigen::Vector2d, Eigen::Vector2d> notch_segment(const garment::PatternPiece& piece,
-                                                          const garment::PatternNotch& n) {
-  const double a = piece.allowance;
+std::pair<Eigen::Vector2d, Eigen::Vector2d> notch_segment(const garment::PatternNotch& n) {
+  const double a = n.allowance;
   const double depth = std::min(a, 0.005);
   if (a <= 0) return {n.point - 0.004 * n.normal, n.point};  // no allowance: a snip inwards
   return {n.point + a * n.normal, n.point + (a - depth) * n.normal};
+}
+
+// The piece's seam allowance in mm for a label: "10", or "10-30" when its seams differ.
+std::string allowance_mm(const garment::PatternPiece& piece) {
+  double lo = piece.allowance, hi = piece.allowance;
+  if (!piece.allowances.empty()) lo = hi = piece.allowances.front().allowance;
+  for (const garment::AllowanceRun& run : piece.allowances) {
+    lo = std::min(lo, run.allowance);
+    hi = std::max(hi, run.allowance);
+  }
+  return hi - lo < 5e-4 ? fmt::format("{:.0f}", kMm * lo)
+                        : fmt::format("{:.0f}-{:.0f}", kMm * lo, kMm * hi);
+}
+
+// The curve's own seam allowance of every outline edge of a piece (m; −1: the piece's), from the
+// curve each edge lies on (Garment::edge_curve; a mirror copy's curve takes its original's).
+std::vector<double> edge_allowances(const scene::Sketch& sketch, const garment::Garment& garment,
+                                    const garment::FlatPanel& flat) {
+  std::vector<double> out(flat.boundary.size(), -1.0);
+  bool any = false;
+  for (size_t k = 0; k < flat.boundary.size(); ++k) {
+    const int a = flat.vertices[static_cast<size_t>(flat.boundary[k])];
+    const int b = flat.vertices[static_cast<size_t>(flat.boundary[(k + 1) % flat.boundary.size()])];
+    const auto found = garment.edge_curve.find(std::minmax(a, b));
+    if (found == garment.edge_curve.end()) continue;
+    std::string id = found->second;
+    if (id.ends_with(".mirror")) id.resize(id.size() - 7);
+    for (const garment::CurveSpec& curve : sketch.curves)
+      if (curve.id == id && curve.seam_allowance) {
+        out[k] = *curve.seam_allowance;
+        any = true;
+      }
+  }
+  if (!any) out.clear();
+  return out;
 }
 
 std::string piece_name(const PatternSheet& sheet, const garment::PatternPiece& piece) {
@@ -78,6 +112,7 @@ PatternSheet build_pattern_sheet(const scene::Sketch& sketch, const garment::Gar
       const garment::GarmentPanel& panel = garment.panels[static_cast<size_t>(flat.panel)];
       const garment::PanelSpec* ps = panel_spec(sketch, panel.id);
       layout.panel_allowance.push_back(ps && ps->seam_allowance ? *ps->seam_allowance : -1.0);
+      layout.edge_allowance.push_back(edge_allowances(sketch, garment, flat));
       layout.panel_ease.push_back(panel.ease);
       sheet.fabrics.push_back(panel.fabric);
     }
@@ -127,7 +162,7 @@ std::string pattern_svg(const PatternSheet& sheet) {
         g0.x(), length - g0.y(), length - g1.y(), g0.x() - 0.5 * head, length - g0.y() - head,
         g0.x() + 0.5 * head, length - g1.y() + head);
     for (const garment::PatternNotch& n : piece.notches) {
-      const auto [a, b] = notch_segment(piece, n);
+      const auto [a, b] = notch_segment(n);
       const Eigen::Vector2d pa = on_fabric(piece, a), pb = on_fabric(piece, b);
       svg += fmt::format(
           "<line class=\"notch\" x1=\"{:.2f}\" y1=\"{:.2f}\" x2=\"{:.2f}\" y2=\"{:.2f}\"/>\n",
@@ -144,7 +179,8 @@ std::string pattern_svg(const PatternSheet& sheet) {
         "<text class=\"label\" x=\"{0:.1f}\" y=\"{9:.1f}\" font-size=\"{5:.1f}\">cut 1 · ease "
         "{10:g} · stretch {11:.1f} % (95th pct)</text>\n",
         at.x(), length - at.y(), size, markup_escape(name), length - at.y() + size, 0.75 * size,
-        kMm * (piece.size.x() - 2 * piece.allowance), kMm * (piece.size.y() - 2 * piece.allowance),
+        kMm * (piece.sewing.col(0).maxCoeff() - piece.sewing.col(0).minCoeff()),
+        kMm * (piece.sewing.col(1).maxCoeff() - piece.sewing.col(1).minCoeff()),
         markup_escape(fabric), length - at.y() + 1.9 * size, piece.ease,
         100 * flat.distortion.length_p95);
     svg += "</g>\n";
@@ -251,7 +287,7 @@ std::string pattern_dxf(const PatternSheet& sheet) {
     polyline("14", piece.sewing);  // sewing line
     line("7", piece.grain_start, piece.grain_end);
     for (const garment::PatternNotch& n : piece.notches) {
-      const auto [a, b] = notch_segment(piece, n);
+      const auto [a, b] = notch_segment(n);
       line("4", a, b);
     }
     const Eigen::Vector2d at =
@@ -262,7 +298,7 @@ std::string pattern_dxf(const PatternSheet& sheet) {
          "Material: " + sheet.fabrics[static_cast<size_t>(piece.panel)]);
     text("15", at - Eigen::Vector2d(0, 0.016), h, "Quantity: 1");
     text("15", at - Eigen::Vector2d(0, 0.024), h,
-         fmt::format("Seam allowance: {:.0f} mm", kMm * piece.allowance));
+         fmt::format("Seam allowance: {} mm", allowance_mm(piece)));
     pair(0, "ENDBLK");
     pair(8, "0");
   }
@@ -331,10 +367,15 @@ nlohmann::json pattern_json(const PatternSheet& sheet) {
     nlohmann::json notches = nlohmann::json::array();
     for (const garment::PatternNotch& n : piece.notches)
       notches.push_back({{"at", point_mm(n.point)}, {"outward", {n.normal.x(), n.normal.y()}}});
+    nlohmann::json allowances = nlohmann::json::array();
+    for (const garment::AllowanceRun& run : piece.allowances)
+      allowances.push_back(
+          {{"first_edge", run.first}, {"last_edge", run.last}, {"mm", kMm * run.allowance}});
     pieces.push_back({{"id", flat.id},
                       {"fabric", sheet.fabrics[static_cast<size_t>(piece.panel)]},
                       {"ease", piece.ease},
                       {"seam_allowance_mm", kMm * piece.allowance},
+                      {"allowances", allowances},
                       {"size_mm", point_mm(piece.size)},
                       {"placement_mm", point_mm(piece.placement)},
                       {"sewn_area_mm2", kMm * kMm * piece.sewn_area},

@@ -1,0 +1,147 @@
+// Tests of garment/pattern_layout: the cutting line with a seam allowance per outline edge (a
+// seam's or a hem's own), against exact figures on a square piece, and its refusal when the
+// allowances of a tight concave outline would cross.
+#include "garment/pattern_layout.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+namespace sd::garment {
+namespace {
+
+// One piece: a closed outline of `points` (m, counter-clockwise), each side sampled with `per`
+// edges so that runs of edges share an allowance as on a real piece.
+FlatPattern one_piece(const std::vector<Eigen::Vector2d>& corners, int per) {
+  FlatPanel panel;
+  panel.id = "piece";
+  panel.panel = 0;
+  std::vector<Eigen::Vector2d> points;
+  for (size_t c = 0; c < corners.size(); ++c)
+    for (int k = 0; k < per; ++k)
+      points.push_back(corners[c] + (corners[(c + 1) % corners.size()] - corners[c]) * k / per);
+  panel.uv.resize(static_cast<Eigen::Index>(points.size()), 2);
+  for (size_t i = 0; i < points.size(); ++i) {
+    panel.uv.row(static_cast<Eigen::Index>(i)) = points[i].transpose();
+    panel.boundary.push_back(static_cast<int>(i));
+    panel.vertices.push_back(static_cast<int>(i));
+  }
+  FlatPattern pattern;
+  pattern.panels.push_back(panel);
+  return pattern;
+}
+
+double signed_area(const Eigen::MatrixX2d& p) {
+  double a = 0;
+  for (Eigen::Index i = 0; i < p.rows(); ++i) {
+    const Eigen::Index j = (i + 1) % p.rows();
+    a += p(i, 0) * p(j, 1) - p(j, 0) * p(i, 1);
+  }
+  return 0.5 * a;
+}
+
+// A 0.2 m square, 1 cm allowance on three sides and a 3 cm hem along the bottom: the cutting
+// line is the 0.22 × 0.24 m rectangle (the hem's line meets the sides' at square corners),
+// exactly; notches at the hem's ends are snipped as deep as the narrower allowance allows.
+TEST(PatternLayout, AllowancePerSeamCutsTheExactRectangle) {
+  const int per = 8;  // edges per side
+  FlatPattern pattern = one_piece({{0, 0}, {0.2, 0}, {0.2, 0.2}, {0, 0.2}}, per);
+  pattern.panels[0].notches = {0, per};  // the hem's two ends
+  PatternLayoutOptions options;
+  options.seam_allowance = 0.01;
+  options.edge_allowance = {std::vector<double>(4 * per, -1.0)};
+  for (int k = 0; k < per; ++k) options.edge_allowance[0][static_cast<size_t>(k)] = 0.03;
+  const PatternLayout layout = lay_out_pattern(pattern, options);
+  const PatternPiece& piece = layout.pieces[0];
+  EXPECT_NEAR(piece.size.x(), 0.22, 1e-12);
+  EXPECT_NEAR(piece.size.y(), 0.24, 1e-12);
+  EXPECT_NEAR(piece.cut_area, 0.22 * 0.24, 1e-12);
+  EXPECT_NEAR(piece.sewn_area, 0.04, 1e-12);
+  EXPECT_EQ(piece.cutting.rows(), 4);
+  // The sewing line sits 1 cm from the left and 3 cm from the bottom of the cutting line.
+  EXPECT_NEAR(piece.sewing.col(0).minCoeff(), 0.01, 1e-12);
+  EXPECT_NEAR(piece.sewing.col(1).minCoeff(), 0.03, 1e-12);
+  ASSERT_EQ(piece.allowances.size(), 2u);
+  EXPECT_EQ(piece.allowances[0].first, 0);
+  EXPECT_EQ(piece.allowances[0].last, per - 1);
+  EXPECT_DOUBLE_EQ(piece.allowances[0].allowance, 0.03);
+  EXPECT_EQ(piece.allowances[1].first, per);
+  EXPECT_EQ(piece.allowances[1].last, 4 * per - 1);
+  EXPECT_DOUBLE_EQ(piece.allowances[1].allowance, 0.01);
+  ASSERT_EQ(piece.notches.size(), 2u);
+  for (const PatternNotch& notch : piece.notches) EXPECT_DOUBLE_EQ(notch.allowance, 0.01);
+}
+
+// Without edge allowances the piece keeps the straight skeleton's offset at its own allowance,
+// and one edge allowance equal to it everywhere changes nothing.
+TEST(PatternLayout, UniformEdgeAllowanceIsTheStraightSkeletonOffset) {
+  const FlatPattern pattern = one_piece({{0, 0}, {0.3, 0}, {0.15, 0.2}}, 5);
+  PatternLayoutOptions options;
+  options.seam_allowance = 0.015;
+  const PatternLayout plain = lay_out_pattern(pattern, options);
+  options.edge_allowance = {std::vector<double>(15, 0.015)};
+  const PatternLayout same = lay_out_pattern(pattern, options);
+  EXPECT_EQ(plain.pieces[0].cutting, same.pieces[0].cutting);
+  ASSERT_EQ(same.pieces[0].allowances.size(), 1u);
+  EXPECT_EQ(same.pieces[0].allowances[0].first, 0);
+  EXPECT_EQ(same.pieces[0].allowances[0].last, 14);
+}
+
+// A triangle with one side's allowance raised: every cutting-line corner lies on the lines of
+// its two sides moved out by their own allowances (distance to each side's line = allowance).
+TEST(PatternLayout, MitredCornersLieOnBothOffsetLines) {
+  const std::vector<Eigen::Vector2d> corners = {{0, 0}, {0.3, 0}, {0.1, 0.25}};
+  const int per = 6;
+  const FlatPattern pattern = one_piece(corners, per);
+  PatternLayoutOptions options;
+  options.seam_allowance = 0.01;
+  options.edge_allowance = {std::vector<double>(3 * per, -1.0)};
+  for (int k = per; k < 2 * per; ++k) options.edge_allowance[0][static_cast<size_t>(k)] = 0.025;
+  const PatternPiece piece = lay_out_pattern(pattern, options).pieces[0];
+  ASSERT_EQ(piece.cutting.rows(), 3);
+  const double allowance[3] = {0.01, 0.025, 0.01};
+  // Sides in the piece's frame: the sewing line's corners are rows 0, per and 2·per.
+  for (Eigen::Index c = 0; c < 3; ++c) {
+    const Eigen::Vector2d p = piece.cutting.row(c);
+    int on_lines = 0;
+    for (int s = 0; s < 3; ++s) {
+      const Eigen::Vector2d a = piece.sewing.row(s * per);
+      const Eigen::Vector2d b = piece.sewing.row(((s + 1) % 3) * per);
+      const Eigen::Vector2d t = (b - a).normalized();
+      const double outside = (p - a).x() * t.y() - (p - a).y() * t.x();  // right of a→b: out
+      if (std::abs(outside - allowance[s]) < 1e-12) ++on_lines;
+    }
+    EXPECT_EQ(on_lines, 2) << "corner " << c;
+  }
+  EXPECT_GT(signed_area(piece.cutting), signed_area(piece.sewing));
+}
+
+// A piece with a slot 1 cm wide cut into it, a 3 cm allowance along the slot's end and 1 cm
+// elsewhere: the mitred lines of the slot's two walls, 1 cm out each, cross inside it. Refused
+// with the panel named (a uniform allowance goes through the straight skeleton, which merges
+// them instead).
+TEST(PatternLayout, CrossingAllowancesAreRefused) {
+  const FlatPattern pattern = one_piece({{0, 0},
+                                         {0.2, 0},
+                                         {0.2, 0.2},
+                                         {0.105, 0.2},
+                                         {0.105, 0.05},
+                                         {0.095, 0.05},
+                                         {0.095, 0.2},
+                                         {0, 0.2}},
+                                        2);
+  PatternLayoutOptions options;
+  options.edge_allowance = {std::vector<double>(16, -1.0)};
+  options.edge_allowance[0][8] = options.edge_allowance[0][9] = 0.03;  // the notch's right side
+  try {
+    lay_out_pattern(pattern, options);
+    FAIL() << "crossing allowances were accepted";
+  } catch (const PatternError& e) {
+    EXPECT_EQ(e.panel(), "piece");
+    EXPECT_NE(std::string(e.what()).find("cross"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace sd::garment
