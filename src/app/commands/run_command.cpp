@@ -7,10 +7,12 @@
 #include <spdlog/spdlog.h>
 
 #include <Eigen/SVD>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <stdexcept>
 
 #include "garment/body_landmarks.hpp"
@@ -18,6 +20,7 @@
 #include "meshing/slice_dent.hpp"
 #include "sim/adaptive_detail.hpp"
 #include "sim/cloth_driver.hpp"
+#include "sim/drape_coefficient.hpp"
 #include "sim/simulation.hpp"
 #include "src/app/commands/cli.hpp"
 #include "src/app/pipeline/cloth_scene.hpp"
@@ -161,6 +164,30 @@ nlohmann::json meshing_json(const ClothScene& scene) {
           {"quads", scene.garment->mesh.face_count()},
           {"meshing_ms", scene.meshing_ms},
           {"panels", panels}};
+}
+
+// The Cusick drape test's measures of a horizontal disc sheet held by a clamp "centre:R"
+// (docs/fabrics.md, "Cusick drape"): DC and nodes of its shadow along the vertical.
+std::optional<nlohmann::json> cusick_json(const garment::Sketch& sketch,
+                                          const meshing::TriMesh& draped) {
+  if (!sketch.sheet || !sketch.sheet->disc || !sketch.sheet->horizontal ||
+      sketch.sheet->layers != 1)
+    return std::nullopt;
+  double support = 0.0;
+  for (const std::string& pin : sketch.sheet->pins)
+    if (pin.starts_with("centre:")) support = std::max(support, std::stod(pin.substr(7)));
+  if (support <= 0.0) return std::nullopt;
+  sim::DrapeShadowOptions options;
+  options.specimen_radius = 0.5 * sketch.sheet->size[0];
+  options.support_radius = support;
+  options.pixel = options.specimen_radius / 150;  // 1 mm on the standard's 30 cm disc
+  const sim::DrapeShadow shadow = sim::measure_drape_shadow(
+      draped.vertices, draped.faces, sketch.sheet->centre, Eigen::Vector3d::UnitY(), options);
+  return nlohmann::json{{"specimen_radius", options.specimen_radius},
+                        {"support_radius", support},
+                        {"shadow_area", shadow.shadow_area},
+                        {"drape_coefficient", shadow.drape_coefficient},
+                        {"nodes", shadow.nodes}};
 }
 
 // How far the drape is from the cloth's rest shape (the pattern with "rest": "flat"), per group:
@@ -491,6 +518,9 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   out["pinned_vertices"] = scene.pinned.size();
   out["meshing"] = meshing_json(scene);
   out["bending"] = std::string(sim::bend_model_name(scene.bend_model));
+  out["compression"] = std::string(sim::compression_name(scene.compression));
+  if (const std::optional<nlohmann::json> cusick = cusick_json(sketch, draped))
+    out["cusick"] = *cusick;
   out["rest_shape"] = flat_rest ? (scene.bend_rest_flat ? "flat" : "flat and shaped") : "shaped";
   out["strain"] = strain;  // per group, against the rest shape (the pattern when flat)
   if (scene.garment && sketch.output.pattern) {
