@@ -75,6 +75,40 @@ TEST(RunCommand, FramesWriteAPictureSequenceOfTheDrape) {
   EXPECT_FALSE(fs::exists(dir / "bad"));
 }
 
+// The Cusick drape test as a plain scene file: a 30 cm disc clamped at its centre by 18 cm discs
+// drapes, and report.json gives its drape coefficient and nodes (a coarse disc: 16 cells across,
+// 1 s, with the buckling compression); a disc pinned by an edge exits 2 and writes nothing.
+TEST(RunCommand, DiscSceneReportsItsCusickDrape) {
+  const fs::path dir = fresh_dir("cusick");
+  nlohmann::json sketch = {
+      {"format", "sketchdrape/1"},
+      {"sheet",
+       {{"shape", "disc"},
+        {"size", {0.3, 0.3}},
+        {"resolution", {16, 16}},
+        {"orientation", "horizontal"},
+        {"pins", {"centre:0.09"}}}},
+      {"fabric", "denim"},
+      {"simulate", {{"duration", 1.0}, {"bending", "quadratic"}, {"compression", "buckling"}}},
+      {"output", {{"images", nlohmann::json::array()}}}};
+  const CommandResult r = run_sketchdrape("-q run " + write_sketch(dir, sketch).string() + " -o " +
+                                          (dir / "out").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json report = read_json(dir / "out" / "report.json");
+  EXPECT_EQ(report["compression"], "buckling");
+  const nlohmann::json& cusick = report.at("cusick");
+  EXPECT_EQ(cusick["support_radius"].get<double>(), 0.09);
+  // Draped below flat (1) and well above hanging straight down (0).
+  EXPECT_GT(cusick["drape_coefficient"].get<double>(), 0.5);
+  EXPECT_LT(cusick["drape_coefficient"].get<double>(), 0.99);
+  sketch["sheet"]["pins"] = {"top"};
+  const CommandResult bad = run_sketchdrape("-q run " + write_sketch(dir, sketch).string() +
+                                            " -o " + (dir / "bad").string());
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("/sheet/pins/0"), std::string::npos) << bad.output;
+  EXPECT_FALSE(fs::exists(dir / "bad"));
+}
+
 TEST(RunCommand, SheetSceneWritesReportMeshAndTrace) {
   const fs::path dir = fresh_dir("sheet");
   const fs::path out = dir / "out";
