@@ -165,7 +165,7 @@ std::string cusick_csv(const std::vector<CusickPoint>& drapes) {
 }
 
 std::string textile_gnuplot() {
-  return R"(# gnuplot textile.gp: the textile bench's plots from its CSVs.
+  return R"(# gnuplot textile.gp: the textile bench's plots from its CSVs (converged solves only).
 set datafile separator ","
 set terminal pngcairo size 900,600
 set key outside right
@@ -175,14 +175,15 @@ set xlabel "cells along the overhang 2c"
 set ylabel "simulated c / predicted c"
 set logscale x 2
 plot for [f in "cotton denim jersey polyester silk wool"] "textile-cantilever.csv" \
-  using ($2):(strcol(1) eq f ? $4/$3 : 1/0) with linespoints title f, 1 title "exact" dt 2
+  using ($2):(strcol(1) eq f && $6 == 1 ? $4/$3 : 1/0) with linespoints title f, \
+  1 title "exact" dt 2
 set output "textile-cusick.png"
 set title "Cusick drape coefficient"
 set xlabel "cells across the 30 cm disc"
 set ylabel "DC"
 unset logscale x
 plot for [f in "cotton denim jersey polyester silk wool"] "textile-cusick.csv" \
-  using ($2):(strcol(1) eq f ? $4 : 1/0) with linespoints title f
+  using ($2):(strcol(1) eq f && $6 == 1 ? $4 : 1/0) with linespoints title f
 )";
 }
 

@@ -53,7 +53,8 @@ std::string textile_table(const std::vector<CantileverPoint>& cantilevers,
                           const std::vector<CusickPoint>& drapes);
 std::string cantilever_csv(const std::vector<CantileverPoint>& cantilevers);
 std::string cusick_csv(const std::vector<CusickPoint>& drapes);
-// gnuplot script drawing textile-cantilever.png and textile-cusick.png from the two CSVs.
+// gnuplot script drawing textile-cantilever.png and textile-cusick.png from the two CSVs (the
+// converged static solves only).
 std::string textile_gnuplot();
 
 }  // namespace sd::app
