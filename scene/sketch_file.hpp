@@ -47,6 +47,9 @@ struct SimulateSpec {
   // mesh"). Hinges by default until the quadratic model is as fast and every design rests with
   // it (docs/fabrics.md).
   std::string bending = "hinges";
+  // "linear" | "buckling": the membrane's answer to compression (docs/simulator.md,
+  // "Compression and buckling"); buckling caps it at each triangle's Euler load.
+  std::string compression = "linear";
   bool stop_at_rest = true;
   Eigen::Vector3d gravity{0.0, -9.81, 0.0};
   std::optional<double> pin_above;  // metres: garment vertices designed at y >= this are pinned
@@ -71,6 +74,10 @@ struct SheetSpec {
   bool horizontal = false;                // in the XZ plane instead of the XY plane
   Eigen::Vector3d centre{0.0, 1.0, 0.0};  // metres
   std::vector<std::string> pins;          // "top-left", ..., or whole edges "top", "left", ...
+  // "shape": "disc": a disc of diameter size[0] (the Cusick drape test's specimen), cells about
+  // size[0] / resolution[0] wide; pins "centre:R" hold every vertex within R metres of the
+  // centre (a clamp between two discs, with a ring of vertices at R).
+  bool disc = false;
   // Copies of the sheet stacked one over the other (two sheets falling onto each other): layer
   // k is the first moved by k·layer_offset and turned k·layer_turn degrees about the vertical
   // through the centre. Pins hold the first layer only.

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <exception>
 
 #include "scene/sketch_sections.hpp"
 
@@ -94,8 +95,8 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
   r.require_object(j, path, "simulate");
   r.check_keys(
       j, path,
-      {"duration", "adaptive", "time_step", "integrator", "solver", "bending", "stop_at_rest",
-       "gravity", "pin_above", "check_body_vertices", "rest", "self_collision"});
+      {"duration", "adaptive", "time_step", "integrator", "solver", "bending", "compression",
+       "stop_at_rest", "gravity", "pin_above", "check_body_vertices", "rest", "self_collision"});
   if (j.contains("pin_above")) sim.pin_above = r.number(j["pin_above"], path + "/pin_above");
   if (j.contains("duration")) {
     sim.duration = r.positive(j["duration"], path + "/duration");
@@ -143,6 +144,13 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
           path + "/bending",
           fmt::format("unknown bending model '{}'; use \"hinges\" or \"quadratic\"", sim.bending));
   }
+  if (j.contains("compression")) {
+    sim.compression = r.text(j["compression"], path + "/compression");
+    if (sim.compression != "linear" && sim.compression != "buckling")
+      r.fail(path + "/compression",
+             fmt::format("unknown compression model '{}'; use \"linear\" or \"buckling\"",
+                         sim.compression));
+  }
   if (j.contains("stop_at_rest"))
     sim.stop_at_rest = r.boolean(j["stop_at_rest"], path + "/stop_at_rest");
   if (j.contains("gravity")) {
@@ -171,7 +179,7 @@ SheetSpec parse_sheet(const Reader& r, const json& j) {
   r.require_object(j, path, "sheet");
   r.check_keys(j, path,
                {"size", "resolution", "orientation", "centre", "pins", "layers", "layer_offset",
-                "layer_turn"});
+                "layer_turn", "shape"});
   SheetSpec sheet;
   if (j.contains("layers")) sheet.layers = r.integer(j["layers"], path + "/layers", 1);
   if (j.contains("layer_offset"))
@@ -204,6 +212,21 @@ SheetSpec parse_sheet(const Reader& r, const json& j) {
     sheet.horizontal = o == "horizontal";
   }
   if (j.contains("centre")) sheet.centre = r.position<3>(j["centre"], path + "/centre");
+  if (j.contains("shape")) {
+    const std::string shape = r.text(j["shape"], path + "/shape");
+    if (shape != "rectangle" && shape != "disc")
+      r.fail(path + "/shape",
+             fmt::format("unknown shape '{}'; use \"rectangle\" or \"disc\"", shape));
+    sheet.disc = shape == "disc";
+    if (sheet.disc && sheet.size[1] != sheet.size[0])
+      r.fail(path + "/size", "a disc's size is [diameter, diameter]: give the same length twice");
+    if (sheet.disc && sheet.rows != sheet.columns)
+      r.fail(path + "/resolution",
+             "a disc's resolution is [cells, cells] across its diameter: give the same count "
+             "twice");
+    if (sheet.disc && sheet.columns < 4)
+      r.fail(path + "/resolution", "a disc needs at least 4 cells across its diameter");
+  }
   if (j.contains("pins")) {
     const json& pins = j["pins"];
     if (!pins.is_array()) r.fail(path + "/pins", "expected a list of corner or edge names");
@@ -217,7 +240,27 @@ SheetSpec parse_sheet(const Reader& r, const json& j) {
       const std::string edge = name.substr(0, colon);
       const bool clamp = colon != std::string::npos &&
                          (edge == "top" || edge == "bottom" || edge == "left" || edge == "right");
-      if (clamp) {
+      if (edge == "centre" && colon != std::string::npos) {
+        // A clamp at the centre: "centre:0.09" holds the vertices within 9 cm (Cusick's support).
+        const std::string number = name.substr(colon + 1);
+        double radius = 0.0;
+        try {
+          std::size_t used = 0;
+          radius = std::stod(number, &used);
+          if (used != number.size()) radius = 0.0;
+        } catch (const std::exception&) {
+          radius = 0.0;
+        }
+        const double largest = 0.5 * std::min(sheet.size[0], sheet.size[1]);
+        if (!(radius > 0.0 && radius < largest))
+          r.fail(pp, fmt::format("the clamp '{}' must give a radius in metres between 0 and {} "
+                                 "(half the sheet), e.g. centre:0.09",
+                                 name, largest));
+      } else if (sheet.disc) {
+        r.fail(pp, fmt::format("a disc is held only by a clamp at its centre (centre:R, R in "
+                               "metres), not by '{}'",
+                               name));
+      } else if (clamp) {
         const std::string digits = name.substr(colon + 1);
         const int lines = (edge == "top" || edge == "bottom" ? sheet.rows : sheet.columns) + 1;
         const bool number = !digits.empty() && digits.size() < 7 &&

@@ -25,6 +25,16 @@ std::string_view bend_model_name(BendModel model) {
   return model == BendModel::hinges ? "hinges" : "quadratic";
 }
 
+std::string_view compression_name(Compression compression) {
+  return compression == Compression::buckling ? "buckling" : "linear";
+}
+
+std::optional<Compression> parse_compression(std::string_view name) {
+  if (name == "linear") return Compression::linear;
+  if (name == "buckling") return Compression::buckling;
+  return std::nullopt;
+}
+
 std::optional<BendModel> parse_bend_model(std::string_view name) {
   if (name == "quadratic") return BendModel::quadratic;
   if (name == "hinges") return BendModel::hinges;
@@ -125,6 +135,8 @@ TriangleElement make_triangle(const ClothInput& input, Eigen::Index f, double ex
     const Vector3d weft = normal.cross(warp);
     d << (p1 - p0).dot(warp), (p2 - p0).dot(warp), (p1 - p0).dot(weft), (p2 - p0).dot(weft);
   }
+  t.width_u = std::max({0.0, d(0, 0), d(0, 1)}) - std::min({0.0, d(0, 0), d(0, 1)});
+  t.width_v = std::max({0.0, d(1, 0), d(1, 1)}) - std::min({0.0, d(1, 0), d(1, 1)});
   const Eigen::Matrix2d inverse = d.inverse();
   t.du = Vector3d(-inverse(0, 0) - inverse(1, 0), inverse(0, 0), inverse(1, 0));
   t.dv = Vector3d(-inverse(0, 1) - inverse(1, 1), inverse(0, 1), inverse(1, 1));
@@ -766,6 +778,7 @@ ClothModel build_cloth_model(const ClothInput& input, const FabricParameters& fa
   if (options.bend_stencil_stiffness > 0.0)
     model.stencils = make_bend_stencils(rest, input.triangles);
   model.bend_model = options.bend_model;
+  model.compression = options.compression;
   if (options.bend_model == BendModel::quadratic)
     model.vertex_bends = make_vertex_bends(rest, input.triangles, options.bend_rest);
 
@@ -960,6 +973,7 @@ ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse&
   // Vertex bends likewise: rebuilt (linear time); a row is rebuilt when a vertex bend over it is
   // not one of the previous ones (the same vertices).
   model.bend_model = options.bend_model;
+  model.compression = options.compression;
   if (options.bend_model == BendModel::quadratic)
     model.vertex_bends = make_vertex_bends(rest, input.triangles, options.bend_rest);
   mark_changed_rows(previous.vertex_bends, model.vertex_bends);

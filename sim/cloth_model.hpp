@@ -64,6 +64,24 @@ enum class BendModel {
   hinges,
 };
 
+// How the membrane answers compression along warp or weft (docs/simulator.md, "Compression and
+// buckling"). Tension is the same in both.
+enum class Compression {
+  // ½·K·A·ε² in compression as in tension: the fabric resists compression with its tensile
+  // stiffness, which real fabric never does (it buckles out of its plane at almost no load).
+  linear,
+  // Choi & Ko's (2002) post-buckling response: along a direction the compressive force per
+  // width stops growing at the Euler load N* = π²·B / l² of the triangle's own width l along
+  // that direction, the largest load an element of that length carries before it would buckle
+  // out of its plane. Beyond the buckling strain ε* = N*/K the energy grows linearly, A·N*
+  // per unit strain: the triangle shortens as a strip that has buckled below the mesh's
+  // resolution. As l → 0 the cap N* grows as 1/l², so the response converges to linear.
+  buckling,
+};
+
+std::string_view compression_name(Compression compression);
+std::optional<Compression> parse_compression(std::string_view name);
+
 // The bend model's name in sketch files ("quadratic", "hinges") and the model from it.
 std::string_view bend_model_name(BendModel model);
 std::optional<BendModel> parse_bend_model(std::string_view name);
@@ -71,6 +89,7 @@ std::optional<BendModel> parse_bend_model(std::string_view name);
 struct ClothModelOptions {
   BendRestShape bend_rest = BendRestShape::designed;
   BendModel bend_model = BendModel::quadratic;
+  Compression compression = Compression::linear;
   BendWeights bend_weights = BendWeights::edge;
   // Stiffness of the bend stencils relative to the fabric's B (0: none); see BendStencil.
   // Off by default: they hold the 4-8 mesh's sublattice mode only away from the boundary
@@ -90,6 +109,8 @@ struct TriangleElement {
   Eigen::Vector3d du = Eigen::Vector3d::Zero();
   Eigen::Vector3d dv = Eigen::Vector3d::Zero();
   std::array<int, 9> blocks{};  // offset of block (a,b) in the matrix row, see BlockPattern
+  double width_u = 0.0;         // m, the rest triangle's extent along the warp (Compression)
+  double width_v = 0.0;         // m, along the weft
 };
 
 // One interior edge (x0,x1) with opposite vertices x2 (first triangle) and x3 (second).
@@ -149,6 +170,7 @@ struct ClothModel {
   std::vector<TriangleElement> triangles;
   std::vector<HingeElement> hinges;  // built for both bend models, used by BendModel::hinges
   BendModel bend_model = BendModel::quadratic;
+  Compression compression = Compression::linear;
   std::vector<VertexBendElement> vertex_bends;  // with BendModel::quadratic
   std::vector<BendStencil> stencils;  // with ClothModelOptions::bend_stencil_stiffness > 0
   double bend_stencil_stiffness = 0.0;

@@ -5,7 +5,10 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <string>
+#include <string_view>
 #include <utility>
+#include <vector>
 
 namespace sd::sim {
 namespace detail {
@@ -33,6 +36,46 @@ struct ConstantSpec {
   const char* unit;
   double FabricParameters::*field;
 };
+
+// A unit a constant may also be given in, with its conversion to the SI unit: value × scale,
+// or for a strain at a standard load (KES-F EMT, FAST E100, in %) load / (value / 100), the
+// secant stiffness up to that load.
+struct UnitSpec {
+  const char* key;
+  const char* unit;
+  double scale;      // SI per unit; 0 for a strain at a load
+  double load;       // N/m, the standard load of a strain unit
+  const char* what;  // where the unit comes from, for the error message
+};
+
+constexpr UnitSpec kOtherUnits[] = {
+    {"area_density", "g/m^2", 1e-3, 0.0, "FAST W"},
+    {"area_density", "mg/cm^2", 1e-2, 0.0, "KES-F W"},
+    // 500 gf/cm = 490.3 N/m, the KES-F tensile test's maximum load.
+    {"stretch_warp", "% EMT", 0.0, 490.3, "KES-F EMT, strain at 500 gf/cm"},
+    {"stretch_weft", "% EMT", 0.0, 490.3, "KES-F EMT, strain at 500 gf/cm"},
+    // 100 gf/cm = 98.07 N/m, FAST-3's extensibility load.
+    {"stretch_warp", "% E100", 0.0, 98.07, "FAST E100, strain at 100 gf/cm"},
+    {"stretch_weft", "% E100", 0.0, 98.07, "FAST E100, strain at 100 gf/cm"},
+    // 1 gf/cm per degree = 0.9807 N/m × 57.30 per radian.
+    {"shear", "gf/cm/deg", 0.9807 * 57.2958, 0.0, "KES-F G"},
+    // 1 gf·cm²/cm = 9.807e-3 N × 0.01 m.
+    {"bend", "gf*cm^2/cm", 9.807e-5, 0.0, "KES-F B"},
+    {"bend", "uN*m", 1e-6, 0.0, "FAST B"},
+    {"thickness", "mm", 1e-3, 0.0, "KES-F or FAST T"},
+};
+
+// "N*m, gf*cm^2/cm (KES-F B) or uN*m (FAST B)": the units `key` accepts.
+std::string accepted_units(const ConstantSpec& spec) {
+  std::vector<std::string> units = {spec.unit};
+  for (const UnitSpec& other : kOtherUnits)
+    if (std::string_view(other.key) == spec.key)
+      units.push_back(std::string(other.unit) + " (" + other.what + ")");
+  std::string text = units.front();
+  for (size_t i = 1; i < units.size(); ++i)
+    text += (i + 1 == units.size() ? " or " : ", ") + units[i];
+  return text;
+}
 
 constexpr ConstantSpec kConstants[] = {
     {"area_density", "kg/m^2", &FabricParameters::area_density},
@@ -86,9 +129,27 @@ FabricParameters parse_fabric_json(std::string_view text, const std::string& ori
     if (!entry.is_object() || !entry.contains("value") || !entry["value"].is_number())
       throw InvalidFabricError(origin + ": " + pointer + " must be an object with a numeric value",
                                pointer);
-    if (!entry.contains("unit") || entry["unit"] != spec.unit)
-      throw InvalidFabricError(origin + ": " + pointer + " must be given in " + spec.unit, pointer);
-    fabric.*spec.field = entry["value"].get<double>();
+    const double value = entry["value"].get<double>();
+    const std::string unit =
+        entry.contains("unit") && entry["unit"].is_string() ? entry["unit"].get<std::string>() : "";
+    const UnitSpec* other = nullptr;
+    for (const UnitSpec& candidate : kOtherUnits)
+      if (std::string_view(candidate.key) == spec.key && unit == candidate.unit) other = &candidate;
+    if (unit != spec.unit && other == nullptr)
+      throw InvalidFabricError(
+          origin + ": " + pointer + " must be given in " + accepted_units(spec), pointer);
+    if (other == nullptr) {
+      fabric.*spec.field = value;
+    } else if (other->scale > 0.0) {
+      fabric.*spec.field = value * other->scale;
+    } else {
+      if (!(value > 0.0 && std::isfinite(value)))
+        throw InvalidFabricError(origin + ": " + pointer + " is a strain of " +
+                                     std::to_string(value) + " % (" + other->what +
+                                     ") but must be greater than zero and finite",
+                                 pointer + "/value");
+      fabric.*spec.field = other->load / (value / 100.0);
+    }
   }
   try {
     fabric.validate();

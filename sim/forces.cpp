@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numbers>
 #include <utility>
 #include <vector>
 
@@ -15,31 +16,39 @@ namespace {
 
 using Eigen::Vector3d;
 
-// Adds the contribution of one condition C with stiffness k and damping k_d to the force, the
+// An energy φ(C) of a condition: its value, slope φ' and curvature φ''.
+struct ConditionEnergy {
+  double value = 0.0;
+  double slope = 0.0;
+  double curvature = 0.0;
+};
+
+// Adds the contribution of one condition C with energy φ(C) and damping k_d to the force, the
 // energy and the Jacobian target. `vertices`/`blocks` locate the element in the global arrays.
+// The curvature term −φ'·∇²C is kept in the solve's Jacobian only where φ' > 0 (stretched): in
+// compression it is indefinite.
 template <int N>
-void add_condition(const Condition<N>& c, double rest_value, double stiffness, double damping,
-                   bool keep_curvature_in_solve, const int* vertices, const int* blocks,
-                   const Eigen::VectorXd& v, Eigen::VectorXd& force, double& energy,
-                   const JacobianTarget* jacobian) {
+void add_condition_energy(const Condition<N>& c, const ConditionEnergy& phi, double damping,
+                          bool keep_curvature_in_solve, const int* vertices, const int* blocks,
+                          const Eigen::VectorXd& v, Eigen::VectorXd& force, double& energy,
+                          const JacobianTarget* jacobian) {
   constexpr int kVertices = N / 3;
   using VectorN = Eigen::Matrix<double, N, 1>;
   using MatrixN = Eigen::Matrix<double, N, N>;
-  const double c_value = c.value - rest_value;
   VectorN local_v;
   for (int k = 0; k < kVertices; ++k)
     local_v.template segment<3>(3 * k) = v.segment<3>(3 * vertices[k]);
   const double c_dot = damping > 0.0 ? c.gradient.dot(local_v) : 0.0;
-  energy += 0.5 * stiffness * c_value * c_value;
-  const VectorN local_force = -(stiffness * c_value + damping * c_dot) * c.gradient;
+  energy += phi.value;
+  const VectorN local_force = -(phi.slope + damping * c_dot) * c.gradient;
   for (int k = 0; k < kVertices; ++k)
     force.segment<3>(3 * vertices[k]) += local_force.template segment<3>(3 * k);
   if (jacobian == nullptr) return;
 
   const bool exact = jacobian->kind == JacobianKind::exact;
   const MatrixN outer = c.gradient * c.gradient.transpose();
-  MatrixN dfdx = -stiffness * outer;
-  if (exact || (keep_curvature_in_solve && c_value > 0.0)) dfdx -= stiffness * c_value * c.hessian;
+  MatrixN dfdx = -phi.curvature * outer;
+  if (exact || (keep_curvature_in_solve && phi.slope > 0.0)) dfdx -= phi.slope * c.hessian;
   if (exact && damping > 0.0) {
     dfdx -=
         damping * (c_dot * c.hessian + c.gradient * (c.hessian.transpose() * local_v).transpose());
@@ -63,6 +72,28 @@ void add_condition(const Condition<N>& c, double rest_value, double stiffness, d
         for (int b = 0; b < 3; ++b) row[b] += local(3 * k + a, 3 * l + b);
       }
     }
+}
+
+// The quadratic energy ½·k·(C − C0)² (Baraff & Witkin).
+template <int N>
+void add_condition(const Condition<N>& c, double rest_value, double stiffness, double damping,
+                   bool keep_curvature_in_solve, const int* vertices, const int* blocks,
+                   const Eigen::VectorXd& v, Eigen::VectorXd& force, double& energy,
+                   const JacobianTarget* jacobian) {
+  const double c_value = c.value - rest_value;
+  add_condition_energy(
+      c, ConditionEnergy{0.5 * stiffness * c_value * c_value, stiffness * c_value, stiffness},
+      damping, keep_curvature_in_solve, vertices, blocks, v, force, energy, jacobian);
+}
+
+// Stretch along one direction with Choi & Ko's post-buckling cap (Compression::buckling): the
+// strain C with stiffness k = K·A, quadratic down to −ε* and then linear with slope −k·ε*
+// (force per width N* = K·ε*), so force and energy are continuous at −ε*.
+ConditionEnergy buckling_stretch(double strain, double stiffness, double buckling_strain) {
+  if (strain >= -buckling_strain)
+    return {0.5 * stiffness * strain * strain, stiffness * strain, stiffness};
+  return {stiffness * buckling_strain * (-strain - 0.5 * buckling_strain),
+          -stiffness * buckling_strain, 0.0};
 }
 
 // [a]_×: the matrix of a × ·.
@@ -283,10 +314,23 @@ void evaluate_forces(const ClothModel& model, const ForceSettings& settings,
       if (terms.stretch) {
         const double k_u = fabric.stretch_warp * t.rest_area;
         const double k_v = fabric.stretch_weft * t.rest_area;
-        add_condition(c.warp, 0.0, k_u, damping_scale * fabric.damping * k_u, true, vs.data(),
-                      t.blocks.data(), v, force, local_energy.stretch, jacobian);
-        add_condition(c.weft, 0.0, k_v, damping_scale * fabric.damping * k_v, true, vs.data(),
-                      t.blocks.data(), v, force, local_energy.stretch, jacobian);
+        if (model.compression == Compression::buckling) {
+          // ε* = N*/K with N* = π²·B / l² for the triangle's width l along each direction.
+          const double pi2b = std::numbers::pi * std::numbers::pi * fabric.bend;
+          const double eps_u = pi2b / (t.width_u * t.width_u * fabric.stretch_warp);
+          const double eps_v = pi2b / (t.width_v * t.width_v * fabric.stretch_weft);
+          add_condition_energy(c.warp, buckling_stretch(c.warp.value, k_u, eps_u),
+                               damping_scale * fabric.damping * k_u, true, vs.data(),
+                               t.blocks.data(), v, force, local_energy.stretch, jacobian);
+          add_condition_energy(c.weft, buckling_stretch(c.weft.value, k_v, eps_v),
+                               damping_scale * fabric.damping * k_v, true, vs.data(),
+                               t.blocks.data(), v, force, local_energy.stretch, jacobian);
+        } else {
+          add_condition(c.warp, 0.0, k_u, damping_scale * fabric.damping * k_u, true, vs.data(),
+                        t.blocks.data(), v, force, local_energy.stretch, jacobian);
+          add_condition(c.weft, 0.0, k_v, damping_scale * fabric.damping * k_v, true, vs.data(),
+                        t.blocks.data(), v, force, local_energy.stretch, jacobian);
+        }
       }
       if (terms.shear) {
         const double k_s = fabric.shear * t.rest_area;

@@ -3,9 +3,107 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <map>
+#include <numbers>
+#include <optional>
 #include <string>
+#include <utility>
 
 namespace sd::sim {
+
+namespace {
+
+// R of a pin "centre:R" (metres), nullopt for other names; throws for a malformed radius.
+std::optional<double> centre_clamp_radius(const std::string& name) {
+  if (!name.starts_with("centre:")) return std::nullopt;
+  const std::string number = name.substr(7);
+  double radius = 0.0;
+  try {
+    std::size_t used = 0;
+    radius = std::stod(number, &used);
+    if (used != number.size()) radius = 0.0;
+  } catch (const std::exception&) {
+    radius = 0.0;
+  }
+  if (!(radius > 0.0 && std::isfinite(radius)))
+    throw InvalidSheetError("pin '" + name +
+                            "' must give a positive radius in metres (centre:0.09)");
+  return radius;
+}
+
+// The disc's quads in its own plane (s, t), counter-clockwise, with shared vertices merged.
+struct DiscBuilder {
+  std::vector<Eigen::Vector2d> points;
+  std::map<std::pair<long long, long long>, int> index;  // key: position in 1e-9 m units
+  std::vector<Eigen::Vector4i> quads;
+  std::vector<int> parity;  // (i + j) mod 2 of each quad: alternating diagonals, checkerboard
+
+  int vertex(const Eigen::Vector2d& p) {
+    const std::pair<long long, long long> key{std::llround(p.x() * 1e9), std::llround(p.y() * 1e9)};
+    const auto [it, inserted] = index.emplace(key, static_cast<int>(points.size()));
+    if (inserted) points.push_back(p);
+    return it->second;
+  }
+  // A structured patch of along × across quads from point(i, j): (i, j), (i+1, j), (i+1, j+1),
+  // (i, j+1) is counter-clockwise, or clockwise (`flip`: i runs counter-clockwise round the
+  // centre and j outwards) and then reversed.
+  template <class Point>
+  void patch(int along, int across, bool flip, Point point) {
+    std::vector<int> ids((along + 1) * (across + 1));
+    for (int j = 0; j <= across; ++j)
+      for (int i = 0; i <= along; ++i) ids[j * (along + 1) + i] = vertex(point(i, j));
+    for (int j = 0; j < across; ++j)
+      for (int i = 0; i < along; ++i) {
+        const int q0 = ids[j * (along + 1) + i], q1 = ids[j * (along + 1) + i + 1];
+        const int q2 = ids[(j + 1) * (along + 1) + i + 1], q3 = ids[(j + 1) * (along + 1) + i];
+        if (flip)
+          quads.emplace_back(q0, q3, q2, q1);
+        else
+          quads.emplace_back(q0, q1, q2, q3);
+        parity.push_back((i + j) % 2);
+      }
+  }
+};
+
+// Disc of radius R with cells about h wide: the annulus from the clamp radius r0 (half the
+// radius without a clamp) to the rim in L rings of S sectors, S = 4M so that the core's square
+// of M × M cells and its four curved blocks meet the annulus's inner ring vertex for vertex.
+DiscBuilder build_disc(const SheetSpec& spec, double clamp) {
+  const double radius = 0.5 * spec.size.x();
+  const double h = spec.size.x() / spec.columns;
+  const double r0 = clamp > 0.0 && clamp < radius ? clamp : 0.5 * radius;
+  const double pi = std::numbers::pi;
+  // Sectors sized to h at the annulus's mid radius: cells are 0.6-1.6 h wide across it.
+  const int m = std::max(2, static_cast<int>(std::lround(2 * pi * 0.5 * (r0 + radius) / h / 4)));
+  const int sectors = 4 * m;
+  const int rings = std::max(1, static_cast<int>(std::lround((radius - r0) / h)));
+  DiscBuilder b;
+  const auto polar = [](double r, double angle) {
+    return Eigen::Vector2d(r * std::cos(angle), r * std::sin(angle));
+  };
+  // Annulus: i along the sectors (counter-clockwise), j outwards.
+  b.patch(sectors, rings, true, [&](int i, int j) {
+    return polar(r0 + (radius - r0) * j / rings, pi / 4 + 2 * pi * (i % sectors) / sectors);
+  });
+  // Core square of half-side a, and a block between each of its sides and the circle r0.
+  const double a = 0.5 * r0;
+  b.patch(m, m, false,
+          [&](int i, int j) { return Eigen::Vector2d(-a + 2 * a * i / m, -a + 2 * a * j / m); });
+  const int layers = std::max(1, static_cast<int>(std::lround((r0 - a) / h)));
+  for (int side = 0; side < 4; ++side) {
+    const double start = pi / 4 + side * pi / 2;  // the side's first corner, counter-clockwise
+    const Eigen::Vector2d c0 = polar(a * std::numbers::sqrt2, start);
+    const Eigen::Vector2d c1 = polar(a * std::numbers::sqrt2, start + pi / 2);
+    b.patch(m, layers, true, [&](int i, int j) {
+      const Eigen::Vector2d inner = c0 + (c1 - c0) * i / m;
+      const Eigen::Vector2d outer = polar(r0, start + pi / 2 * i / m);
+      return Eigen::Vector2d(inner + (outer - inner) * j / layers);
+    });
+  }
+  return b;
+}
+
+}  // namespace
 
 SheetScene build_sheet(const SheetSpec& spec) {
   if (!(spec.size.allFinite() && spec.size.x() > 0.0 && spec.size.y() > 0.0))
@@ -13,47 +111,95 @@ SheetScene build_sheet(const SheetSpec& spec) {
   if (spec.columns < 1 || spec.rows < 1)
     throw InvalidSheetError("the sheet resolution must be at least 1 by 1 quads");
   if (!spec.centre.allFinite()) throw InvalidSheetError("the sheet centre must be finite");
-  SheetScene scene;
-  scene.columns = spec.columns;
-  scene.rows = spec.rows;
-  const int nv = (spec.rows + 1) * (spec.columns + 1);
   const bool vertical = spec.orientation == SheetOrientation::vertical;
   // In-sheet axes: "right" (+X) and "up" (towards the top edge).
   const Eigen::Vector3d right = Eigen::Vector3d::UnitX();
   const Eigen::Vector3d up =
       vertical ? Eigen::Vector3d::UnitY() : Eigen::Vector3d(-Eigen::Vector3d::UnitZ());
-  scene.input.rest_positions.resize(nv, 3);
-  for (int r = 0; r <= spec.rows; ++r)
-    for (int c = 0; c <= spec.columns; ++c) {
-      const double s = spec.size.x() * (static_cast<double>(c) / spec.columns - 0.5);
-      const double t = spec.size.y() * (0.5 - static_cast<double>(r) / spec.rows);
-      scene.input.rest_positions.row(scene.vertex(r, c)) = spec.centre + s * right + t * up;
-    }
-  const int nf = 2 * spec.rows * spec.columns;
-  scene.input.triangles.resize(nf, 3);
-  scene.input.warp.resize(nf, 3);
-  scene.quads.resize(spec.rows * spec.columns, 4);
-  int f = 0;
-  for (int r = 0; r < spec.rows; ++r)
-    for (int c = 0; c < spec.columns; ++c) {
-      const int tl = scene.vertex(r, c), tr = scene.vertex(r, c + 1);
-      const int bl = scene.vertex(r + 1, c), br = scene.vertex(r + 1, c + 1);
-      scene.quads.row(r * spec.columns + c) << bl, br, tr, tl;
-      // Counter-clockwise seen from +Z (vertical) or +Y (horizontal).
-      if ((r + c) % 2 == 0) {
-        scene.input.triangles.row(f++) << bl, br, tr;
-        scene.input.triangles.row(f++) << bl, tr, tl;
+  const bool disc = spec.shape == SheetShape::disc;
+  double clamp = 0.0;  // the largest "centre:R" radius
+  for (const std::string& name : spec.pins)
+    if (const std::optional<double> r = centre_clamp_radius(name)) clamp = std::max(clamp, *r);
+  SheetScene scene;
+  if (disc) {
+    if (spec.size.y() != spec.size.x() || spec.rows != spec.columns)
+      throw InvalidSheetError(
+          "a disc's size is [diameter, diameter] and its resolution [cells, cells] across it");
+    if (spec.columns < 4) throw InvalidSheetError("a disc needs at least 4 cells across it");
+    const DiscBuilder built = build_disc(spec, clamp);
+    const std::vector<Eigen::Vector2d>& points = built.points;
+    const std::vector<Eigen::Vector4i>& quads = built.quads;
+    scene.input.rest_positions.resize(static_cast<Eigen::Index>(points.size()), 3);
+    for (size_t i = 0; i < points.size(); ++i)
+      scene.input.rest_positions.row(static_cast<Eigen::Index>(i)) =
+          spec.centre + points[i].x() * right + points[i].y() * up;
+    const Eigen::Index nq = static_cast<Eigen::Index>(quads.size());
+    scene.quads.resize(nq, 4);
+    scene.input.triangles.resize(2 * nq, 3);
+    for (Eigen::Index q = 0; q < nq; ++q) {
+      const Eigen::Vector4i& v = quads[static_cast<size_t>(q)];
+      scene.quads.row(q) = v.transpose();
+      // Alternating diagonals, as on the rectangle (quad q: triangles 2q and 2q + 1).
+      if (built.parity[static_cast<size_t>(q)] == 0) {
+        scene.input.triangles.row(2 * q) << v(0), v(1), v(2);
+        scene.input.triangles.row(2 * q + 1) << v(0), v(2), v(3);
       } else {
-        scene.input.triangles.row(f++) << bl, br, tl;
-        scene.input.triangles.row(f++) << br, tr, tl;
+        scene.input.triangles.row(2 * q) << v(0), v(1), v(3);
+        scene.input.triangles.row(2 * q + 1) << v(1), v(2), v(3);
       }
     }
-  for (int k = 0; k < nf; ++k) scene.input.warp.row(k) = up;
-  scene.input.up = vertical ? up : Eigen::Vector3d::UnitY();
+    scene.input.warp.resize(2 * nq, 3);
+    for (Eigen::Index k = 0; k < 2 * nq; ++k) scene.input.warp.row(k) = up;
+    scene.input.up = vertical ? up : Eigen::Vector3d::UnitY();
+  } else {
+    scene.columns = spec.columns;
+    scene.rows = spec.rows;
+    const int nv = (spec.rows + 1) * (spec.columns + 1);
+    scene.input.rest_positions.resize(nv, 3);
+    for (int r = 0; r <= spec.rows; ++r)
+      for (int c = 0; c <= spec.columns; ++c) {
+        const double s = spec.size.x() * (static_cast<double>(c) / spec.columns - 0.5);
+        const double t = spec.size.y() * (0.5 - static_cast<double>(r) / spec.rows);
+        scene.input.rest_positions.row(scene.vertex(r, c)) = spec.centre + s * right + t * up;
+      }
+    const int nf = 2 * spec.rows * spec.columns;
+    scene.input.triangles.resize(nf, 3);
+    scene.input.warp.resize(nf, 3);
+    scene.quads.resize(spec.rows * spec.columns, 4);
+    int f = 0;
+    for (int r = 0; r < spec.rows; ++r)
+      for (int c = 0; c < spec.columns; ++c) {
+        const int tl = scene.vertex(r, c), tr = scene.vertex(r, c + 1);
+        const int bl = scene.vertex(r + 1, c), br = scene.vertex(r + 1, c + 1);
+        scene.quads.row(r * spec.columns + c) << bl, br, tr, tl;
+        // Counter-clockwise seen from +Z (vertical) or +Y (horizontal).
+        if ((r + c) % 2 == 0) {
+          scene.input.triangles.row(f++) << bl, br, tr;
+          scene.input.triangles.row(f++) << bl, tr, tl;
+        } else {
+          scene.input.triangles.row(f++) << bl, br, tl;
+          scene.input.triangles.row(f++) << br, tr, tl;
+        }
+      }
+    for (int k = 0; k < nf; ++k) scene.input.warp.row(k) = up;
+    scene.input.up = vertical ? up : Eigen::Vector3d::UnitY();
+  }
 
   for (const std::string& name : spec.pins) {
     std::vector<int> add;
-    if (name == "top-left")
+    if (const std::optional<double> held = centre_clamp_radius(name)) {
+      // Every vertex within r of the centre, measured in the sheet's plane (a ring of the disc
+      // lies at r exactly; 1 um tolerance for its rounding).
+      for (Eigen::Index v = 0; v < scene.input.rest_positions.rows(); ++v)
+        if ((scene.input.rest_positions.row(v).transpose() - spec.centre).norm() <= *held + 1e-6)
+          add.push_back(static_cast<int>(v));
+      if (add.empty())
+        throw InvalidSheetError("pin '" + name + "' holds no vertex: the radius is too small");
+    } else if (disc) {
+      throw InvalidSheetError("unknown pin '" + name +
+                              "' for a disc: a disc is held by a clamp at its centre (centre:R, "
+                              "R in metres)");
+    } else if (name == "top-left")
       add = {scene.vertex(0, 0)};
     else if (name == "top-right")
       add = {scene.vertex(0, spec.columns)};

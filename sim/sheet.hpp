@@ -16,6 +16,9 @@ class InvalidSheetError : public std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
+// A rectangle of rows × columns square-ish quads, or a disc (the Cusick drape test's specimen).
+enum class SheetShape { rectangle, disc };
+
 enum class SheetOrientation {
   vertical,    // in the XY plane (facing +Z), top edge at centre.y + height/2
   horizontal,  // in the XZ plane at centre.y; "top" is the edge at −Z (far from the viewer)
@@ -27,8 +30,14 @@ struct SheetSpec {
   int rows = 16;                   // quads along the height
   SheetOrientation orientation = SheetOrientation::vertical;
   Eigen::Vector3d centre{0.0, 1.0, 0.0};
+  // A disc of diameter size.x() (size.y() must equal it) with cells about size.x() / columns
+  // wide (docs/fabrics.md, "Cusick drape"); `rows` must equal `columns`.
+  SheetShape shape = SheetShape::rectangle;
   // Corners "top-left", "top-right", "bottom-left", "bottom-right", whole edges "top",
-  // "bottom", "left", "right", or clamps "top:N" (N lines of vertices from that edge, N ≥ 1).
+  // "bottom", "left", "right", or clamps "top:N" (N lines of vertices from that edge, N ≥ 1);
+  // "centre:R" holds every vertex within R metres of the centre (a disc clamped between two
+  // discs of radius R; on a disc sheet a ring of vertices lies exactly at R). A disc takes only
+  // "centre:R".
   std::vector<std::string> pins;
 };
 
@@ -39,15 +48,19 @@ struct SheetScene {
   // clockwise seen from the sheet's normal side), row by row from the top; the input of the
   // sheet's 4-8 mesh (Mesh48::from_quads, which picks each quad's diagonal itself).
   Eigen::MatrixX4i quads;
-  int columns = 0;
+  int columns = 0;  // 0 for a disc (its quads are not a grid)
   int rows = 0;
   // Vertex index of grid point (row r from the top, column c from the left).
   int vertex(int r, int c) const { return r * (columns + 1) + c; }
 };
 
-// Builds the (rows+1)·(columns+1) vertices and 2·rows·columns triangles (each quad split along
-// alternating diagonals so the mesh has no preferred shear direction). Throws InvalidSheetError
-// for a non-positive size or resolution or an unknown pin name.
+// Builds a rectangle or a disc. A rectangle: the (rows+1)·(columns+1) vertices and 2·rows·columns
+// triangles (each quad split along alternating diagonals so the mesh has no preferred shear
+// direction). Throws InvalidSheetError for a non-positive size or resolution or an unknown pin
+// name. A disc: an annulus of quads in rings and sectors from the clamp radius (or half the radius)
+// to the rim, whose polar layout has no preferred direction for folds, around a core of five blocks
+// (a square and four quads curved to the core's circle); each quad is split along alternating
+// diagonals.
 SheetScene build_sheet(const SheetSpec& spec);
 
 // The sheet as a 4-8 mesh: its quads through Mesh48::from_quads (vertex ids = grid ids; each

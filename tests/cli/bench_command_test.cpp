@@ -11,12 +11,14 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "src/app/bench/bench_scaling.hpp"
 #include "src/app/bench/bench_study.hpp"
+#include "src/app/bench/bench_textile.hpp"
 #include "tests/cli/run_command.hpp"
 
 namespace {
@@ -338,6 +340,49 @@ TEST(BenchScaling, BadSizesAndSolversAreRefusedBeforeAnyRun) {
     EXPECT_EQ(result.exit_code, 2) << args << "\n" << result.output;
     EXPECT_FALSE(fs::exists(dir / "out")) << args;
   }
+}
+
+// `bench --textile` on denim, coarse (seconds): every point is written; the cantilever's
+// bending length from Peirce's formula is near the predicted one (16 cells: chord within 1.5° of
+// 41.5°, c within 3 %), the drape lies between hanging and flat. A name that is not a preset is
+// refused before any run.
+TEST(BenchTextile, DenimCantileverAndDrapeAreWrittenWithTheirMeasures) {
+  const fs::path dir = fresh_dir("textile");
+  const auto result = run_sketchdrape(
+      "bench --textile --fabric denim --cantilever-cells 8 16 --cusick-cells 12 --json -o " +
+      (dir / "out").string());
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  for (const char* name :
+       {"textile.md", "textile.json", "textile-cantilever.csv", "textile-cusick.csv", "textile.gp"})
+    EXPECT_TRUE(fs::exists(dir / "out" / name)) << name;
+  const nlohmann::json json = read_json(dir / "out" / "textile.json");
+  ASSERT_EQ(json.at("cantilever").size(), 2u);
+  const auto& fine = json.at("cantilever").at(1);
+  EXPECT_EQ(fine.at("cells").get<int>(), 16);
+  EXPECT_NEAR(fine.at("predicted_c_m").get<double>(), 0.0292, 2e-4);
+  EXPECT_NEAR(fine.at("chord_deg").get<double>(), 41.5, 1.5);
+  EXPECT_NEAR(fine.at("simulated_c_m").get<double>() / fine.at("predicted_c_m").get<double>(), 1.0,
+              0.03);
+  ASSERT_EQ(json.at("cusick").size(), 1u);
+  const double dc = json.at("cusick").at(0).at("drape_coefficient").get<double>();
+  EXPECT_GT(dc, 0.0);
+  EXPECT_LT(dc, 1.0);
+  const auto bad = run_sketchdrape("bench --textile --fabric tweed -o " + (dir / "bad").string());
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_FALSE(fs::exists(dir / "bad"));
+}
+
+// 41.5° at overhang l reads c = l/2 (the standard); a stiffer strip (smaller angle) reads a
+// longer bending length, as Peirce's formula: c ∝ (cos(θ/2)/tan θ)^(1/3).
+TEST(BenchTextile, PeirceBendingLengthAtTheStandardAngleIsHalfTheOverhang) {
+  EXPECT_NEAR(sd::app::peirce_bending_length(0.04, 41.5), 0.02, 1e-15);
+  const double ratio =
+      sd::app::peirce_bending_length(0.04, 30.0) / sd::app::peirce_bending_length(0.04, 41.5);
+  const double r = std::numbers::pi / 180;
+  EXPECT_NEAR(
+      ratio,
+      std::cbrt(std::cos(15 * r) / std::tan(30 * r) / (std::cos(20.75 * r) / std::tan(41.5 * r))),
+      1e-12);
 }
 
 // The fit is ordinary least squares in log-log: exact on a power law.

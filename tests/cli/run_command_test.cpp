@@ -75,6 +75,77 @@ TEST(RunCommand, FramesWriteAPictureSequenceOfTheDrape) {
   EXPECT_FALSE(fs::exists(dir / "bad"));
 }
 
+// The Cusick drape test as a plain scene file: a 30 cm disc clamped at its centre by 18 cm discs
+// drapes, and report.json gives its drape coefficient and nodes (a coarse disc: 16 cells across,
+// 1 s, with the buckling compression); a disc pinned by an edge exits 2 and writes nothing.
+TEST(RunCommand, DiscSceneReportsItsCusickDrape) {
+  const fs::path dir = fresh_dir("cusick");
+  nlohmann::json sketch = {
+      {"format", "sketchdrape/1"},
+      {"sheet",
+       {{"shape", "disc"},
+        {"size", {0.3, 0.3}},
+        {"resolution", {16, 16}},
+        {"orientation", "horizontal"},
+        {"pins", {"centre:0.09"}}}},
+      {"fabric", "denim"},
+      {"simulate", {{"duration", 1.0}, {"bending", "quadratic"}, {"compression", "buckling"}}},
+      {"output", {{"images", nlohmann::json::array()}}}};
+  const CommandResult r = run_sketchdrape("-q run " + write_sketch(dir, sketch).string() + " -o " +
+                                          (dir / "out").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json report = read_json(dir / "out" / "report.json");
+  EXPECT_EQ(report["compression"], "buckling");
+  const nlohmann::json& cusick = report.at("cusick");
+  EXPECT_EQ(cusick["support_radius"].get<double>(), 0.09);
+  // Draped below flat (1) and well above hanging straight down (0).
+  EXPECT_GT(cusick["drape_coefficient"].get<double>(), 0.5);
+  EXPECT_LT(cusick["drape_coefficient"].get<double>(), 0.99);
+  sketch["sheet"]["pins"] = {"top"};
+  const CommandResult bad = run_sketchdrape("-q run " + write_sketch(dir, sketch).string() +
+                                            " -o " + (dir / "bad").string());
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("/sheet/pins/0"), std::string::npos) << bad.output;
+  EXPECT_FALSE(fs::exists(dir / "bad"));
+}
+
+// The Cusick drape with the buckling compression, dropped and draped to rest as `run` does
+// (1.5 cm cells): cotton, denim and polyester lie in their published ranges with 4-10 nodes.
+// Measured: 0.608 (8 nodes), 0.864 (6), 0.546 (8); 0.631, 0.877, 0.527 at 1 cm cells
+// (docs/fabrics.md, "Cusick drape"). About 4 s each.
+TEST(RunCommand, CusickDrapeWithBucklingLiesInThePublishedRanges) {
+  struct Case {
+    std::string fabric;
+    double low, high;
+  };
+  for (const Case& c :
+       {Case{"cotton", 0.5, 0.7}, Case{"denim", 0.7, 0.9}, Case{"polyester", 0.4, 0.7}}) {
+    const fs::path dir = fresh_dir("cusick-" + c.fabric);
+    const nlohmann::json sketch = {
+        {"format", "sketchdrape/1"},
+        {"sheet",
+         {{"shape", "disc"},
+          {"size", {0.3, 0.3}},
+          {"resolution", {20, 20}},
+          {"orientation", "horizontal"},
+          {"pins", {"centre:0.09"}}}},
+        {"fabric", c.fabric},
+        {"simulate", {{"duration", 6.0}, {"bending", "quadratic"}, {"compression", "buckling"}}},
+        {"output", {{"images", nlohmann::json::array()}}}};
+    const CommandResult r = run_sketchdrape("-q run " + write_sketch(dir, sketch).string() +
+                                            " -o " + (dir / "out").string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const nlohmann::json report = read_json(dir / "out" / "report.json");
+    EXPECT_TRUE(report["at_rest"].get<bool>()) << c.fabric;
+    const double dc = report["cusick"]["drape_coefficient"].get<double>();
+    const int nodes = report["cusick"]["nodes"].get<int>();
+    EXPECT_GE(dc, c.low) << c.fabric;
+    EXPECT_LE(dc, c.high) << c.fabric;
+    EXPECT_GE(nodes, 4) << c.fabric;
+    EXPECT_LE(nodes, 10) << c.fabric;
+  }
+}
+
 TEST(RunCommand, SheetSceneWritesReportMeshAndTrace) {
   const fs::path dir = fresh_dir("sheet");
   const fs::path out = dir / "out";

@@ -317,4 +317,39 @@ TEST(SketchFile, SheetClampPins) {
 }
 
 }  // namespace
+namespace {
+
+// A disc sheet (the Cusick test's specimen) held by a clamp at its centre; a disc's size and
+// resolution are given twice alike, and only "centre:R" pins it.
+TEST(SketchFile, DiscSheetWithACentreClamp) {
+  const auto sheet = [](const std::string& body) { return R"({"sheet": {)" + body + "}}"; };
+  const Sketch sketch = parse_sketch(sheet(R"("shape": "disc", "size": [0.3, 0.3],
+      "resolution": [20, 20], "pins": ["centre:0.09"])"),
+                                     "t.json");
+  ASSERT_TRUE(sketch.sheet);
+  EXPECT_TRUE(sketch.sheet->disc);
+  EXPECT_EQ(sketch.sheet->pins.front(), "centre:0.09");
+  EXPECT_FALSE(parse_sketch(sheet(R"("pins": ["centre:0.2"])"), "t.json").sheet->disc);
+  struct Bad {
+    std::string body, path;
+  };
+  for (const Bad& bad :
+       {Bad{R"("shape": "circle")", "/sheet/shape"},
+        Bad{R"("shape": "disc", "size": [0.3, 0.2])", "/sheet/size"},
+        Bad{R"("shape": "disc", "resolution": [20, 10])", "/sheet/resolution"},
+        Bad{R"("shape": "disc", "resolution": [2, 2])", "/sheet/resolution"},
+        Bad{R"("shape": "disc", "pins": ["top"])", "/sheet/pins/0"},
+        Bad{R"("shape": "disc", "size": [0.3, 0.3], "pins": ["centre:0.2"])", "/sheet/pins/0"},
+        Bad{R"("pins": ["centre:x"])", "/sheet/pins/0"},
+        Bad{R"("pins": ["centre:-0.1"])", "/sheet/pins/0"}}) {
+    try {
+      parse_sketch(sheet(bad.body), "t.json");
+      ADD_FAILURE() << bad.body << " was accepted";
+    } catch (const SketchError& e) {
+      EXPECT_EQ(e.json_path(), bad.path) << bad.body;
+    }
+  }
+}
+
+}  // namespace
 }  // namespace sd::scene

@@ -8,6 +8,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <cmath>
+#include <numbers>
 #include <random>
 #include <string>
 
@@ -280,6 +282,98 @@ TEST(Forces, BendingEnergyIsResolutionInvariantOnACylinder) {
         EXPECT_NEAR(energy.bend / continuum, 1.0, 0.25 * (0.5 / n) * (0.5 / n) / (radius * radius))
             << n << " columns";
     }
+  }
+}
+
+// Compression::buckling (Choi & Ko's post-buckling cap) against finite differences: the force is
+// −∂E/∂x and the exact Jacobian ∂f/∂x, on random configurations squeezed by up to 5 % or
+// stretched by up to 2 %, so that triangles lie on every branch (ε* = π²B/(l²K) = 2.5e-3 along
+// the warp and 3.9e-3 along the weft here).
+TEST(Forces, BucklingCompressionMatchesFiniteDifferences) {
+  Fixture f = make_fixture();
+  ClothModelOptions options;
+  options.compression = Compression::buckling;
+  f.model = build_cloth_model(f.scene.input, f.model.fabric, options);
+  ForceSettings settings;
+  settings.terms = ForceTerms{true, false, false, false, false, false};  // stretch only
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> squeeze(0.95, 1.02), noise(-2e-3, 2e-3);
+  int buckled = 0, stretched = 0;
+  for (int trial = 0; trial < 10; ++trial) {
+    Eigen::VectorXd x = flatten_positions(f.scene.input.rest_positions);
+    const double sx = squeeze(rng), sy = squeeze(rng);
+    for (Eigen::Index i = 0; i < x.size(); i += 3) {
+      x(i) *= sx;
+      x(i + 1) = 1.0 + (x(i + 1) - 1.0) * sy;
+      for (int k = 0; k < 3; ++k) x(i + k) += noise(rng);
+    }
+    for (const TriangleElement& t : f.model.triangles) {
+      Eigen::Vector3d wu = Eigen::Vector3d::Zero();
+      for (int k = 0; k < 3; ++k) wu += t.du(k) * x.segment<3>(3 * t.vertices[k]);
+      const double eps = std::numbers::pi * std::numbers::pi * f.model.fabric.bend /
+                         (t.width_u * t.width_u * f.model.fabric.stretch_warp);
+      buckled += wu.norm() - 1.0 < -eps;
+      stretched += wu.norm() > 1.0;
+    }
+    const Eigen::VectorXd v = Eigen::VectorXd::Zero(x.size());
+    const testing::ForceDifferences d = testing::force_differences(f.model, settings, x, v);
+    Eigen::VectorXd force, scratch, gradient(x.size());
+    evaluate_forces(f.model, settings, x, v, force);
+    const double h = 1e-7;
+    for (Eigen::Index j = 0; j < x.size(); ++j) {
+      Eigen::VectorXd plus = x, minus = x;
+      plus[j] += h;
+      minus[j] -= h;
+      EnergyBreakdown ep, em;
+      evaluate_forces(f.model, settings, plus, v, scratch, &ep);
+      evaluate_forces(f.model, settings, minus, v, scratch, &em);
+      gradient[j] = (ep.stretch - em.stretch) / (2 * h);
+    }
+    EXPECT_LE((gradient + force).norm(), 1e-5 * force.norm()) << "trial " << trial;
+    const Eigen::MatrixXd dfdx = dense_jacobian(f.model, settings, x, v, 1, 0, JacobianKind::exact);
+    EXPECT_LE((d.dfdx - dfdx).norm(), 1e-5 * dfdx.norm()) << "trial " << trial;
+  }
+  EXPECT_GT(buckled, 10);  // both branches were exercised
+  EXPECT_GT(stretched, 10);
+}
+
+// Tension is exactly the linear model's; a uniform compression s along the warp costs the
+// post-buckling energy A·K·ε*·(s − ε*/2) per triangle (force per width N* = K·ε* = π²B/l²),
+// against ½·A·K·s² for the linear model.
+TEST(Forces, BucklingKeepsTensionExactAndCapsCompressionAtTheEulerLoad) {
+  Fixture f = make_fixture();
+  const ClothModel linear = f.model;
+  ClothModelOptions options;
+  options.compression = Compression::buckling;
+  const ClothModel buckling = build_cloth_model(f.scene.input, f.model.fabric, options);
+  ForceSettings settings;
+  settings.terms = ForceTerms{true, false, false, false, false, false};
+  const FabricParameters& fabric = linear.fabric;
+  for (const double s : {0.01, 0.05, -0.01, -0.05}) {  // strain along the warp (the sheet's y)
+    Eigen::VectorXd x = flatten_positions(f.scene.input.rest_positions);
+    for (Eigen::Index i = 1; i < x.size(); i += 3) x(i) = 1.0 + (x(i) - 1.0) * (1.0 + s);
+    const Eigen::VectorXd v = Eigen::VectorXd::Zero(x.size());
+    Eigen::VectorXd f_linear, f_buckling;
+    EnergyBreakdown e_linear, e_buckling;
+    evaluate_forces(linear, settings, x, v, f_linear, &e_linear);
+    evaluate_forces(buckling, settings, x, v, f_buckling, &e_buckling);
+    if (s > 0) {
+      EXPECT_EQ(f_linear, f_buckling) << s;
+      EXPECT_EQ(e_linear.stretch, e_buckling.stretch) << s;
+      continue;
+    }
+    double expected = 0.0, quadratic = 0.0;
+    for (const TriangleElement& t : buckling.triangles) {
+      const double n_star =
+          std::numbers::pi * std::numbers::pi * fabric.bend / (t.width_u * t.width_u);
+      const double eps = n_star / fabric.stretch_warp;
+      ASSERT_LT(eps, -s);  // every triangle is past its buckling strain
+      expected += t.rest_area * fabric.stretch_warp * eps * (-s - 0.5 * eps);
+      quadratic += 0.5 * t.rest_area * fabric.stretch_warp * s * s;
+    }
+    EXPECT_NEAR(e_buckling.stretch, expected, 1e-12 * expected) << s;
+    EXPECT_NEAR(e_linear.stretch, quadratic, 1e-9 * quadratic) << s;
+    EXPECT_LT(e_buckling.stretch, e_linear.stretch) << s;
   }
 }
 

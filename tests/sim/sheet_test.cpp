@@ -4,7 +4,11 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cmath>
+#include <map>
+#include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace sd::sim {
@@ -82,6 +86,77 @@ TEST(Sheet, ClampPinsHoldSeveralLines) {
     spec.pins = {bad};
     EXPECT_THROW(build_sheet(spec), InvalidSheetError) << bad;
   }
+}
+
+}  // namespace
+}  // namespace sd::sim
+
+namespace sd::sim {
+namespace {
+
+// The Cusick test's disc: a closed disc (Euler characteristic 1, every edge in one or two
+// triangles), all triangles facing up, its rim on the circle, its area that of the inscribed
+// polygon, and the clamp "centre:R" holding exactly the vertices within R, a ring of them at R.
+TEST(Sheet, DiscIsAClosedDiscWithItsClampRingAtTheRadius) {
+  SheetSpec spec;
+  spec.shape = SheetShape::disc;
+  spec.size = {0.3, 0.3};
+  spec.orientation = SheetOrientation::horizontal;
+  spec.centre = {0.1, 1.0, -0.2};
+  spec.pins = {"centre:0.09"};
+  for (const int cells : {8, 20, 30}) {
+    spec.columns = spec.rows = cells;
+    const SheetScene scene = build_sheet(spec);
+    const Eigen::MatrixX3d& x = scene.input.rest_positions;
+    const Eigen::MatrixX3i& t = scene.input.triangles;
+    ASSERT_EQ(t.rows(), 2 * scene.quads.rows());
+    double area = 0.0, smallest = 1.0;
+    std::map<std::pair<int, int>, int> edges;
+    for (Eigen::Index f = 0; f < t.rows(); ++f) {
+      const Eigen::Vector3d a = x.row(t(f, 0)), b = x.row(t(f, 1)), c = x.row(t(f, 2));
+      const Eigen::Vector3d n = (b - a).cross(c - a);
+      EXPECT_GT(n.y(), 0.0) << f;
+      area += 0.5 * n.norm();
+      smallest = std::min(smallest, 0.5 * n.norm());
+      for (int k = 0; k < 3; ++k) {
+        const int u = t(f, k), v = t(f, (k + 1) % 3);
+        ++edges[{std::min(u, v), std::max(u, v)}];
+      }
+    }
+    int rim = 0;
+    double rim_radius = 0.0;
+    for (const auto& [edge, count] : edges) {
+      EXPECT_LE(count, 2);
+      if (count == 1) {
+        ++rim;
+        for (const int v : {edge.first, edge.second})
+          rim_radius = std::max(rim_radius, (x.row(v).transpose() - spec.centre).norm());
+      }
+    }
+    EXPECT_EQ(x.rows() - static_cast<Eigen::Index>(edges.size()) + t.rows(), 1) << cells;
+    EXPECT_NEAR(rim_radius, 0.15, 1e-12);
+    // The rim is a regular polygon of `rim` sides inscribed in the circle.
+    const double polygon = 0.5 * rim * 0.15 * 0.15 * std::sin(2 * std::numbers::pi / rim);
+    EXPECT_NEAR(area, polygon, 1e-12) << cells;
+    const double h = 0.3 / cells;
+    EXPECT_GT(smallest, 0.05 * h * h) << cells;  // no sliver
+    int at_clamp = 0;
+    for (Eigen::Index v = 0; v < x.rows(); ++v) {
+      const double r = (x.row(v).transpose() - spec.centre).norm();
+      const bool held =
+          std::binary_search(scene.pinned_vertices.begin(), scene.pinned_vertices.end(), v);
+      EXPECT_EQ(held, r <= 0.09 + 1e-9) << v;
+      at_clamp += std::abs(r - 0.09) < 1e-12;
+    }
+    EXPECT_GE(at_clamp, 8) << cells;
+  }
+  spec.pins = {"top"};
+  EXPECT_THROW(build_sheet(spec), InvalidSheetError);
+  spec.pins = {"centre:-1"};
+  EXPECT_THROW(build_sheet(spec), InvalidSheetError);
+  spec.pins = {};
+  spec.size = {0.3, 0.2};
+  EXPECT_THROW(build_sheet(spec), InvalidSheetError);
 }
 
 }  // namespace

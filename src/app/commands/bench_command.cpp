@@ -21,8 +21,10 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "sim/fabric.hpp"
 #include "src/app/bench/bench_scaling.hpp"
 #include "src/app/bench/bench_study.hpp"
+#include "src/app/bench/bench_textile.hpp"
 #include "src/app/commands/cli.hpp"
 #include "src/app/pipeline/atomic_file.hpp"
 #include "src/app/pipeline/child_process.hpp"
@@ -51,6 +53,9 @@ struct BenchOptions {
   // The scaling study (--scaling) instead of the work-precision grid.
   bool scaling = false;
   ScalingOptions scaling_options;
+  // The textile study (--textile): cantilever and Cusick drape of every preset.
+  bool textile = false;
+  TextileOptions textile_options;
 };
 
 std::string read_file(const fs::path& path) {
@@ -518,9 +523,62 @@ void run_scaling_study(const BenchOptions& options, const GlobalOptions& global)
                       p.quads_per_side, p.solver, p.message));
 }
 
+// `bench --textile`: Peirce's cantilever and the Cusick drape of every preset at three
+// resolutions (docs/fabrics.md, "The textile bench"), in this process (static solves).
+void run_textile_study(const BenchOptions& options, const GlobalOptions& global) {
+  const TextileOptions& o = options.textile_options;
+  const std::vector<std::string> known = sim::fabric_preset_names();
+  for (const std::string& fabric : o.fabrics)
+    if (std::find(known.begin(), known.end(), fabric) == known.end())
+      throw std::invalid_argument(fmt::format("--fabric: '{}' is not a preset", fabric));
+  const long count = static_cast<long>((o.fabrics.empty() ? known.size() : o.fabrics.size()) *
+                                       (o.cantilever_cells.size() + o.cusick_cells.size()));
+  Progress progress("bench --textile", count, global.quiet);
+  long done = 0;
+  std::vector<CantileverPoint> cantilevers;
+  std::vector<CusickPoint> drapes;
+  run_textile(o, cantilevers, drapes,
+              [&](const std::string& line) { progress.update(++done, line); });
+  progress.finish();
+  nlohmann::json json = {{"format", "sketchdrape/1 bench textile"},
+                         {"version", kVersion},
+                         {"cantilever", nlohmann::json::array()},
+                         {"cusick", nlohmann::json::array()}};
+  for (const CantileverPoint& p : cantilevers)
+    json["cantilever"].push_back({{"fabric", p.fabric},
+                                  {"cells", p.cells},
+                                  {"predicted_c_m", p.predicted_c},
+                                  {"simulated_c_m", p.simulated_c},
+                                  {"chord_deg", p.chord_deg},
+                                  {"converged", p.converged},
+                                  {"seconds", p.seconds}});
+  for (const CusickPoint& p : drapes)
+    json["cusick"].push_back({{"fabric", p.fabric},
+                              {"cells", p.cells},
+                              {"vertices", p.vertices},
+                              {"drape_coefficient", p.drape_coefficient},
+                              {"nodes", p.nodes},
+                              {"converged", p.converged},
+                              {"seconds", p.seconds}});
+  const fs::path dir = options.out;
+  const std::string table = textile_table(cantilevers, drapes);
+  StagedOutputs outputs;
+  outputs.stage(dir / "textile-cantilever.csv", cantilever_csv(cantilevers));
+  outputs.stage(dir / "textile-cusick.csv", cusick_csv(drapes));
+  outputs.stage(dir / "textile.gp", textile_gnuplot());
+  outputs.stage(dir / "textile.md", table);
+  outputs.stage(dir / "textile.json", json.dump(2) + "\n");
+  outputs.commit();
+  if (options.json)
+    fmt::print("{}\n", json.dump(2));
+  else
+    fmt::print("{}", table);
+}
+
 void run_bench(const BenchOptions& options, const GlobalOptions& global) {
   if (!options.worker_config.empty()) return run_worker_side(options);
   if (options.scaling) return run_scaling_study(options, global);
+  if (options.textile) return run_textile_study(options, global);
   const BenchGrid grid = parse_grid(options);
   if (options.timeout < 0)
     throw std::invalid_argument("--timeout must be positive (seconds per run)");
@@ -693,6 +751,17 @@ void add_bench_command(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--steps", options->scaling_options.steps,
                   "With --scaling: steps of 1/60 s per run (default 10)")
       ->check(CLI::Range(2, 10000));
+  cmd->add_flag("--textile", options->textile,
+                "The textile study instead: Peirce's cantilever and the Cusick drape of every "
+                "preset at three resolutions each (table, CSVs and a gnuplot script)");
+  cmd->add_option("--fabric", options->textile_options.fabrics,
+                  "With --textile: the presets to measure (default all six)");
+  cmd->add_option("--cantilever-cells", options->textile_options.cantilever_cells,
+                  "With --textile: cells along the overhang (default 4 8 16)")
+      ->check(CLI::Range(2, 256));
+  cmd->add_option("--cusick-cells", options->textile_options.cusick_cells,
+                  "With --textile: cells across the disc (default 16 20 30)")
+      ->check(CLI::Range(4, 200));
   cmd->add_option("--worker", options->worker_config)->group("");  // internal: one run
   cmd->add_option("--worker-scene", options->worker_scene)->group("");
   cmd->add_option("--worker-out", options->worker_out)->group("");

@@ -6,10 +6,12 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <stdexcept>
 
 #include "garment/body_landmarks.hpp"
@@ -17,6 +19,7 @@
 #include "scene/sketch_file.hpp"
 #include "sim/adaptive_detail.hpp"
 #include "sim/cloth_driver.hpp"
+#include "sim/drape_coefficient.hpp"
 #include "sim/simulation.hpp"
 #include "src/app/commands/cli.hpp"
 #include "src/app/pipeline/cloth_scene.hpp"
@@ -86,6 +89,30 @@ sim::AdaptiveSettings adaptive_settings(const scene::Sketch& sketch) {
 std::string memory_text(double bytes) {
   return bytes >= 1e9 ? fmt::format("{:.1f} GB", bytes / 1e9)
                       : fmt::format("{:.0f} MB", bytes / 1e6);
+}
+
+// The Cusick drape test's measures of a horizontal disc sheet held by a clamp "centre:R"
+// (docs/fabrics.md, "Cusick drape"): DC and nodes of its shadow along the vertical.
+std::optional<nlohmann::json> cusick_json(const scene::Sketch& sketch,
+                                          const meshing::TriMesh& draped) {
+  if (!sketch.sheet || !sketch.sheet->disc || !sketch.sheet->horizontal ||
+      sketch.sheet->layers != 1)
+    return std::nullopt;
+  double support = 0.0;
+  for (const std::string& pin : sketch.sheet->pins)
+    if (pin.starts_with("centre:")) support = std::max(support, std::stod(pin.substr(7)));
+  if (support <= 0.0) return std::nullopt;
+  sim::DrapeShadowOptions options;
+  options.specimen_radius = 0.5 * sketch.sheet->size[0];
+  options.support_radius = support;
+  options.pixel = options.specimen_radius / 150;  // 1 mm on the standard's 30 cm disc
+  const sim::DrapeShadow shadow = sim::measure_drape_shadow(
+      draped.vertices, draped.faces, sketch.sheet->centre, Eigen::Vector3d::UnitY(), options);
+  return nlohmann::json{{"specimen_radius", options.specimen_radius},
+                        {"support_radius", support},
+                        {"shadow_area", shadow.shadow_area},
+                        {"drape_coefficient", shadow.drape_coefficient},
+                        {"nodes", shadow.nodes}};
 }
 
 void run_drape(const RunOptions& options, const GlobalOptions& global) {
@@ -324,6 +351,8 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   out.pinned_vertices = scene.pinned.size();
   out.meshing = meshing_summary(scene);
   out.bending = sim::bend_model_name(scene.bend_model);
+  out.compression = sim::compression_name(scene.compression);
+  out.cusick = cusick_json(sketch, draped);
   out.rest_shape = flat_rest ? (scene.bend_rest_flat ? "flat" : "flat and shaped") : "shaped";
   if (scene.garment && sketch.output.pattern) {
     const PatternSheet sheet = build_pattern_sheet(sketch, *scene.garment, *sketch.output.pattern);

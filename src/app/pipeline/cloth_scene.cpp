@@ -70,6 +70,7 @@ void build_sheet_scene(const scene::Sketch& sketch, ClothScene& scene) {
       spec.horizontal ? sim::SheetOrientation::horizontal : sim::SheetOrientation::vertical;
   sheet.centre = spec.centre;
   sheet.pins = spec.pins;
+  if (spec.disc) sheet.shape = sim::SheetShape::disc;
   sim::SheetScene built = sim::build_sheet(sheet);
   scene.sheet = true;
   Eigen::MatrixX4i quads = built.quads;
@@ -133,6 +134,8 @@ void build_sheet_scene(const scene::Sketch& sketch, ClothScene& scene) {
   scene.fabric = fabric_at(sketch, sketch.fabric, "/fabric");
   scene.bend_model =
       sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::hinges);
+  scene.compression =
+      sim::parse_compression(sketch.simulate.compression).value_or(sim::Compression::linear);
 }
 
 // "rest": "flat" (the file's or a panel's): the flattened pattern pieces become the rest shape.
@@ -208,6 +211,8 @@ void build_garment_scene(const scene::Sketch& sketch, ClothScene& scene) {
   scene.fabric_name = first.fabric;
   scene.bend_model =
       sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::hinges);
+  scene.compression =
+      sim::parse_compression(sketch.simulate.compression).value_or(sim::Compression::linear);
   const garment::PanelSpec* first_spec = sketch.find_panel(first.id);
   scene.fabric =
       fabric_at(sketch, first.fabric, first_spec ? first_spec->json_path + "/fabric" : "/fabric");
@@ -272,6 +277,8 @@ void build_imported_scene(const scene::Sketch& sketch, ClothScene& scene) {
   scene.fabric = fabric_at(sketch, sketch.fabric, "/fabric");
   scene.bend_model =
       sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::hinges);
+  scene.compression =
+      sim::parse_compression(sketch.simulate.compression).value_or(sim::Compression::linear);
   pin_above(sketch, scene);
   scene.mesh48 = std::move(m48);
 }
@@ -326,6 +333,7 @@ sim::AutomaticChoice apply_automatic_settings(const scene::Sketch& sketch, const
 sim::ClothModel build_scene_model(const ClothScene& scene) {
   sim::ClothModelOptions options;
   options.bend_model = scene.bend_model;
+  options.compression = scene.compression;
   if (scene.bend_rest_flat) options.bend_rest = sim::BendRestShape::flat;
   sim::ClothModel model = sim::build_cloth_model(scene.input, scene.fabric, options);
   if (scene.face_ease.size() > 0) {
@@ -341,6 +349,7 @@ sim::AdaptiveMaterial scene_material(const ClothScene& scene) {
   sim::AdaptiveMaterial material;
   material.fabric = scene.fabric;
   material.model_options.bend_model = scene.bend_model;
+  material.model_options.compression = scene.compression;
   if (scene.bend_rest_flat) material.model_options.bend_rest = sim::BendRestShape::flat;
   material.source_warp = scene.face_warp;
   material.up = scene.input.up;

@@ -55,6 +55,8 @@ struct ClothScene {
   std::optional<garment::FlatPattern> flat_pattern;
   bool bend_rest_flat = false;
   sim::BendModel bend_model = sim::BendModel::hinges;  // simulate.bending
+  // simulate.compression
+  sim::Compression compression = sim::Compression::linear;
   double flattening_ms = 0;
 };
 

@@ -192,6 +192,8 @@ nlohmann::json run_report_json(const RunReport& r) {
   out["pinned_vertices"] = r.pinned_vertices;
   out["meshing"] = r.meshing ? meshing_json(*r.meshing) : nlohmann::json(nullptr);
   out["bending"] = r.bending;
+  out["compression"] = r.compression;
+  if (r.cusick) out["cusick"] = *r.cusick;
   out["rest_shape"] = r.rest_shape;
   nlohmann::json strain = nlohmann::json::array();
   for (const GroupStrain& s : r.strain)

@@ -67,7 +67,10 @@ struct RunReport {
   std::optional<std::string> body;  // the body's source; none for a sheet without a body
   std::size_t pinned_vertices = 0;
   std::optional<MeshingSummary> meshing;
-  std::string bending;     // the bend model that ran
+  std::string bending;      // the bend model that ran
+  std::string compression;  // the membrane's compression model that ran
+  // A horizontal disc held at its centre: the Cusick drape test's measures (DC, nodes).
+  std::optional<nlohmann::json> cusick;
   std::string rest_shape;  // "shaped", "flat" or "flat and shaped"
   sim::SimulationSettings settings;
   // The automatic rule's reason, when the file left the solver or the step to it ("auto").

@@ -1,0 +1,190 @@
+#include "src/app/bench/bench_textile.hpp"
+
+#include <fmt/format.h>
+
+#include <Eigen/Core>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "sim/drape_coefficient.hpp"
+#include "sim/fabric.hpp"
+#include "sim/sheet.hpp"
+#include "sim/static_equilibrium.hpp"
+
+namespace sd::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+}  // namespace
+
+double peirce_bending_length(double overhang, double chord_deg) {
+  const auto peirce = [](double degrees) {
+    const double theta = degrees * std::numbers::pi / 180.0;
+    return std::cbrt(std::cos(0.5 * theta) / (8.0 * std::tan(theta)));
+  };
+  // Peirce's formula gives 1.019·l/2 at 41.5°, where the standard (and the elastica) say l/2:
+  // scaled so that the standard's angle gives its bending length exactly.
+  return 0.5 * overhang * peirce(chord_deg) / peirce(41.5);
+}
+
+CantileverPoint run_cantilever(const std::string& name, int cells) {
+  const auto start = Clock::now();
+  const sim::FabricParameters fabric = sim::fabric_preset(name);
+  CantileverPoint point;
+  point.fabric = name;
+  point.cells = cells;
+  point.predicted_c = std::cbrt(fabric.bend / (fabric.area_density * 9.81));
+  // A strip 4 cells wide, the overhang 2c in `cells` square cells beyond a clamp of three lines
+  // of vertices (two cells), as data/scenes/cantilever-cotton.json.
+  const double overhang = 2.0 * point.predicted_c;
+  const double cell = overhang / cells;
+  sim::SheetSpec spec;
+  spec.orientation = sim::SheetOrientation::horizontal;
+  spec.columns = 4;
+  spec.rows = cells + 2;
+  spec.size = {4 * cell, overhang + 2 * cell};
+  spec.centre = {0.0, 1.0, 0.0};
+  spec.pins = {"top:3"};
+  const sim::SheetScene scene = sim::build_sheet(spec);
+  const sim::ClothModel model = sim::build_cloth_model(scene.input, fabric);
+  Eigen::VectorXd x = sim::flatten_positions(scene.input.rest_positions);
+  sim::StaticOptions options;
+  options.load_steps = 8;
+  point.converged = sim::solve_static(model, x, scene.pinned_vertices, options).converged;
+  Eigen::Vector3d clamp = Eigen::Vector3d::Zero(), tip = Eigen::Vector3d::Zero();
+  for (int c = 0; c <= spec.columns; ++c) {
+    clamp += x.segment<3>(3 * scene.vertex(2, c)) / (spec.columns + 1);
+    tip += x.segment<3>(3 * scene.vertex(spec.rows, c)) / (spec.columns + 1);
+  }
+  point.chord_deg = std::atan2(clamp.y() - tip.y(), tip.z() - clamp.z()) * 180.0 / std::numbers::pi;
+  point.simulated_c = peirce_bending_length(overhang, point.chord_deg);
+  point.seconds = seconds_since(start);
+  return point;
+}
+
+CusickPoint run_cusick(const std::string& name, int cells) {
+  const auto start = Clock::now();
+  const sim::FabricParameters fabric = sim::fabric_preset(name);
+  sim::SheetSpec spec;
+  spec.shape = sim::SheetShape::disc;
+  spec.size = {0.3, 0.3};
+  spec.columns = spec.rows = cells;
+  spec.orientation = sim::SheetOrientation::horizontal;
+  spec.centre = {0.0, 1.0, 0.0};
+  spec.pins = {"centre:0.09"};
+  const sim::SheetScene scene = sim::build_sheet(spec);
+  const sim::ClothModel model = sim::build_cloth_model(scene.input, fabric);
+  Eigen::VectorXd x = sim::flatten_positions(scene.input.rest_positions);
+  // A random lift of up to 0.1 mm of the free vertices leaves the symmetric state (as the test).
+  std::vector<char> pinned(static_cast<size_t>(model.vertex_count), 0);
+  for (int v : scene.pinned_vertices) pinned[static_cast<size_t>(v)] = 1;
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> lift(0.0, 1e-4);
+  for (int v = 0; v < model.vertex_count; ++v)
+    if (!pinned[static_cast<size_t>(v)]) x(3 * v + 1) += lift(rng);
+  sim::StaticOptions options;
+  options.load_steps = 16;
+  CusickPoint point;
+  point.fabric = name;
+  point.cells = cells;
+  point.vertices = model.vertex_count;
+  point.converged = sim::solve_static(model, x, scene.pinned_vertices, options).converged;
+  Eigen::MatrixX3d positions(model.vertex_count, 3);
+  for (int v = 0; v < model.vertex_count; ++v) positions.row(v) = x.segment<3>(3 * v).transpose();
+  const sim::DrapeShadow shadow = sim::measure_drape_shadow(positions, scene.input.triangles,
+                                                            spec.centre, Eigen::Vector3d::UnitY());
+  point.drape_coefficient = shadow.drape_coefficient;
+  point.nodes = shadow.nodes;
+  point.seconds = seconds_since(start);
+  return point;
+}
+
+void run_textile(const TextileOptions& options, std::vector<CantileverPoint>& cantilevers,
+                 std::vector<CusickPoint>& drapes,
+                 const std::function<void(const std::string&)>& note) {
+  const std::vector<std::string> fabrics =
+      options.fabrics.empty() ? sim::fabric_preset_names() : options.fabrics;
+  for (const std::string& fabric : fabrics) {
+    for (const int cells : options.cantilever_cells) {
+      cantilevers.push_back(run_cantilever(fabric, cells));
+      const CantileverPoint& p = cantilevers.back();
+      note(fmt::format(
+          "cantilever {} {} cells: chord {:.2f} deg, c {:.2f} cm (predicted {:.2f}), "
+          "{:.1f} s",
+          fabric, cells, p.chord_deg, 100 * p.simulated_c, 100 * p.predicted_c, p.seconds));
+    }
+    for (const int cells : options.cusick_cells) {
+      drapes.push_back(run_cusick(fabric, cells));
+      const CusickPoint& p = drapes.back();
+      note(fmt::format("Cusick {} {} cells: DC {:.3f}, {} nodes{}, {:.1f} s", fabric, cells,
+                       p.drape_coefficient, p.nodes, p.converged ? "" : " (not converged)",
+                       p.seconds));
+    }
+  }
+}
+
+std::string textile_table(const std::vector<CantileverPoint>& cantilevers,
+                          const std::vector<CusickPoint>& drapes) {
+  std::string out =
+      "| fabric | cells along 2c | predicted c (cm) | simulated c (cm) | chord (41.5°) | static "
+      "solve |\n|---|---|---|---|---|---|\n";
+  for (const CantileverPoint& p : cantilevers)
+    out += fmt::format("| {} | {} | {:.3f} | {:.3f} | {:.2f}° | {} |\n", p.fabric, p.cells,
+                       100 * p.predicted_c, 100 * p.simulated_c, p.chord_deg,
+                       p.converged ? "converged" : "not converged");
+  out +=
+      "\n| fabric | cells across the disc | vertices | DC | nodes | static solve |\n"
+      "|---|---|---|---|---|---|\n";
+  for (const CusickPoint& p : drapes)
+    out += fmt::format("| {} | {} | {} | {:.3f} | {} | {} |\n", p.fabric, p.cells, p.vertices,
+                       p.drape_coefficient, p.nodes, p.converged ? "converged" : "not converged");
+  return out;
+}
+
+std::string cantilever_csv(const std::vector<CantileverPoint>& cantilevers) {
+  std::string out = "fabric,cells,predicted_c_m,simulated_c_m,chord_deg,converged,seconds\n";
+  for (const CantileverPoint& p : cantilevers)
+    out += fmt::format("{},{},{:.6g},{:.6g},{:.4f},{},{:.2f}\n", p.fabric, p.cells, p.predicted_c,
+                       p.simulated_c, p.chord_deg, p.converged ? 1 : 0, p.seconds);
+  return out;
+}
+
+std::string cusick_csv(const std::vector<CusickPoint>& drapes) {
+  std::string out = "fabric,cells,vertices,drape_coefficient,nodes,converged,seconds\n";
+  for (const CusickPoint& p : drapes)
+    out += fmt::format("{},{},{},{:.4f},{},{},{:.2f}\n", p.fabric, p.cells, p.vertices,
+                       p.drape_coefficient, p.nodes, p.converged ? 1 : 0, p.seconds);
+  return out;
+}
+
+std::string textile_gnuplot() {
+  return R"(# gnuplot textile.gp: the textile bench's plots from its CSVs (converged solves only).
+set datafile separator ","
+set terminal pngcairo size 900,600
+set key outside right
+set output "textile-cantilever.png"
+set title "Peirce cantilever: simulated / predicted bending length"
+set xlabel "cells along the overhang 2c"
+set ylabel "simulated c / predicted c"
+set logscale x 2
+plot for [f in "cotton denim jersey polyester silk wool"] "textile-cantilever.csv" \
+  using ($2):(strcol(1) eq f && $6 == 1 ? $4/$3 : 1/0) with linespoints title f, \
+  1 title "exact" dt 2
+set output "textile-cusick.png"
+set title "Cusick drape coefficient"
+set xlabel "cells across the 30 cm disc"
+set ylabel "DC"
+unset logscale x
+plot for [f in "cotton denim jersey polyester silk wool"] "textile-cusick.csv" \
+  using ($2):(strcol(1) eq f && $6 == 1 ? $4 : 1/0) with linespoints title f
+)";
+}
+
+}  // namespace sd::app

@@ -1,0 +1,60 @@
+#pragma once
+// The textile study of `sketchdrape bench --textile` (docs/fabrics.md, "The textile bench"):
+// for every preset, Peirce's cantilever (ASTM D1388) and the Cusick drape (ISO 9073-9) at three
+// resolutions each, settled by the static solver with the quadratic bending. The cantilever's
+// predicted bending length is c = (B/ρg)^(1/3) and its chord at overhang 2c is 41.5°; the
+// simulated bending length is Peirce's c ∝ l·(cos(θ/2) / (8·tan θ))^(1/3) from the chord θ,
+// scaled to give l/2 at 41.5° (ASTM D1388's fixed-angle reading).
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace sd::app {
+
+struct TextileOptions {
+  std::vector<std::string> fabrics;                // empty: every preset
+  std::vector<int> cantilever_cells = {4, 8, 16};  // cells along the overhang 2c
+  std::vector<int> cusick_cells = {16, 20, 30};    // cells across the 30 cm disc
+};
+
+struct CantileverPoint {
+  std::string fabric;
+  int cells = 0;
+  double predicted_c = 0.0;  // m
+  double simulated_c = 0.0;  // m, Peirce's formula from the chord
+  double chord_deg = 0.0;    // the continuum's is 41.5
+  bool converged = false;
+  double seconds = 0.0;
+};
+
+struct CusickPoint {
+  std::string fabric;
+  int cells = 0;
+  int vertices = 0;
+  double drape_coefficient = 0.0;
+  int nodes = 0;
+  bool converged = false;
+  double seconds = 0.0;
+};
+
+CantileverPoint run_cantilever(const std::string& fabric, int cells);
+CusickPoint run_cusick(const std::string& fabric, int cells);
+
+// Peirce's bending length from the chord angle θ (degrees) of an overhang l (m); l/2 at 41.5°.
+double peirce_bending_length(double overhang, double chord_deg);
+
+// Every fabric × resolution; `note` is called with a line after each point.
+void run_textile(const TextileOptions& options, std::vector<CantileverPoint>& cantilevers,
+                 std::vector<CusickPoint>& drapes,
+                 const std::function<void(const std::string&)>& note);
+
+std::string textile_table(const std::vector<CantileverPoint>& cantilevers,
+                          const std::vector<CusickPoint>& drapes);
+std::string cantilever_csv(const std::vector<CantileverPoint>& cantilevers);
+std::string cusick_csv(const std::vector<CusickPoint>& drapes);
+// gnuplot script drawing textile-cantilever.png and textile-cusick.png from the two CSVs (the
+// converged static solves only).
+std::string textile_gnuplot();
+
+}  // namespace sd::app
