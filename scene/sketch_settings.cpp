@@ -7,6 +7,7 @@
 #include <exception>
 
 #include "scene/sketch_sections.hpp"
+#include "sim/sheet.hpp"
 
 namespace sd::scene::detail {
 namespace {
@@ -242,14 +243,11 @@ SheetSpec parse_sheet(const Reader& r, const json& j) {
                          (edge == "top" || edge == "bottom" || edge == "left" || edge == "right");
       if (edge == "centre" && colon != std::string::npos) {
         // A clamp at the centre: "centre:0.09" holds the vertices within 9 cm (Cusick's support).
-        const std::string number = name.substr(colon + 1);
         double radius = 0.0;
         try {
-          std::size_t used = 0;
-          radius = std::stod(number, &used);
-          if (used != number.size()) radius = 0.0;
-        } catch (const std::exception&) {
-          radius = 0.0;
+          radius = sim::centre_clamp_radius(name).value_or(0.0);
+        } catch (const sim::InvalidSheetError&) {
+          radius = 0.0;  // refused below, with the sheet's bound
         }
         const double largest = 0.5 * std::min(sheet.size[0], sheet.size[1]);
         if (!(radius > 0.0 && radius < largest))

@@ -2,6 +2,7 @@
 // A rectangular sheet as plain simulator input, for tests, benchmarks and sheet scenes.
 
 #include <Eigen/Core>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -68,5 +69,9 @@ SheetScene build_sheet(const SheetSpec& spec);
 meshing::Mesh48 sheet_mesh48(const SheetScene& scene);
 // #Q by 3: the warp of each quad (its triangles'), for AdaptiveMaterial::source_warp.
 Eigen::MatrixX3d sheet_quad_warp(const SheetScene& scene);
+
+// R of a pin "centre:R" (metres: a clamp holding every vertex within R of the centre), nullopt
+// for other pin names; throws InvalidSheetError for a radius that is not a positive number.
+std::optional<double> centre_clamp_radius(const std::string& name);
 
 }  // namespace sd::sim

@@ -20,6 +20,7 @@
 #include "sim/adaptive_detail.hpp"
 #include "sim/cloth_driver.hpp"
 #include "sim/drape_coefficient.hpp"
+#include "sim/sheet.hpp"
 #include "sim/simulation.hpp"
 #include "src/app/commands/cli.hpp"
 #include "src/app/pipeline/cloth_scene.hpp"
@@ -100,7 +101,7 @@ std::optional<nlohmann::json> cusick_json(const scene::Sketch& sketch,
     return std::nullopt;
   double support = 0.0;
   for (const std::string& pin : sketch.sheet->pins)
-    if (pin.starts_with("centre:")) support = std::max(support, std::stod(pin.substr(7)));
+    support = std::max(support, sim::centre_clamp_radius(pin).value_or(0.0));
   if (support <= 0.0) return std::nullopt;
   sim::DrapeShadowOptions options;
   options.specimen_radius = 0.5 * sketch.sheet->size[0];
