@@ -87,23 +87,6 @@ DiscBuilder build_disc(const SheetSpec& spec, double clamp) {
 
 }  // namespace
 
-std::optional<double> centre_clamp_radius(const std::string& name) {
-  if (!name.starts_with("centre:")) return std::nullopt;
-  const std::string number = name.substr(7);
-  double radius = 0.0;
-  try {
-    std::size_t used = 0;
-    radius = std::stod(number, &used);
-    if (used != number.size()) radius = 0.0;
-  } catch (const std::exception&) {
-    radius = 0.0;
-  }
-  if (!(radius > 0.0 && std::isfinite(radius)))
-    throw InvalidSheetError("pin '" + name +
-                            "' must give a positive radius in metres (centre:0.09)");
-  return radius;
-}
-
 SheetScene build_sheet(const SheetSpec& spec) {
   if (!(spec.size.allFinite() && spec.size.x() > 0.0 && spec.size.y() > 0.0))
     throw InvalidSheetError("the sheet size must be two positive lengths in metres");

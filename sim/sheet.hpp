@@ -2,6 +2,8 @@
 // A rectangular sheet as plain simulator input, for tests, benchmarks and sheet scenes.
 
 #include <Eigen/Core>
+#include <cmath>
+#include <exception>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -72,6 +74,22 @@ Eigen::MatrixX3d sheet_quad_warp(const SheetScene& scene);
 
 // R of a pin "centre:R" (metres: a clamp holding every vertex within R of the centre), nullopt
 // for other pin names; throws InvalidSheetError for a radius that is not a positive number.
-std::optional<double> centre_clamp_radius(const std::string& name);
+// (Inline: the sketch reader, built on its own for the fuzzer, calls it too.)
+inline std::optional<double> centre_clamp_radius(const std::string& name) {
+  if (!name.starts_with("centre:")) return std::nullopt;
+  const std::string number = name.substr(7);
+  double radius = 0.0;
+  try {
+    std::size_t used = 0;
+    radius = std::stod(number, &used);
+    if (used != number.size()) radius = 0.0;
+  } catch (const std::exception&) {
+    radius = 0.0;
+  }
+  if (!(radius > 0.0 && std::isfinite(radius)))
+    throw InvalidSheetError("pin '" + name +
+                            "' must give a positive radius in metres (centre:0.09)");
+  return radius;
+}
 
 }  // namespace sd::sim
