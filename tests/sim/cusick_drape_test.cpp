@@ -17,6 +17,7 @@
 #include "sim/fabric.hpp"
 #include "sim/sheet.hpp"
 #include "sim/static_equilibrium.hpp"
+#include "tests/sim/test_scenes.hpp"
 
 namespace sd::sim {
 namespace {
@@ -28,23 +29,12 @@ struct CusickRun {
   int vertices = 0;
 };
 
-SheetScene cusick_disc(int cells) {
-  SheetSpec spec;
-  spec.shape = SheetShape::disc;
-  spec.size = {0.3, 0.3};
-  spec.columns = spec.rows = cells;
-  spec.orientation = SheetOrientation::horizontal;
-  spec.centre = {0.0, 1.0, 0.0};
-  spec.pins = {"centre:0.09"};
-  return build_sheet(spec);
-}
-
 // The quadratic bending, linear compression, static: the equilibrium reached as gravity grows
 // from the flat disc, lifted by a random 0.1 mm so that the symmetric state is left (16 load
 // steps). docs/fabrics.md compares it with dynamic drapes.
 CusickRun drape(const FabricParameters& fabric, int cells, unsigned seed = 1) {
   const auto start = std::chrono::steady_clock::now();
-  const SheetScene scene = cusick_disc(cells);
+  const SheetScene scene = testing::cusick_disc(cells);
   const ClothModel model = build_cloth_model(scene.input, fabric);
   Eigen::VectorXd x = flatten_positions(scene.input.rest_positions);
   std::vector<char> pinned(static_cast<size_t>(model.vertex_count), 0);

@@ -10,23 +10,13 @@
 #include <vector>
 
 #include "sim/sheet.hpp"
+#include "tests/sim/test_scenes.hpp"
 
 namespace sd::sim {
 namespace {
 
-SheetScene disc(int cells) {
-  SheetSpec spec;
-  spec.shape = SheetShape::disc;
-  spec.size = {0.3, 0.3};
-  spec.columns = spec.rows = cells;
-  spec.orientation = SheetOrientation::horizontal;
-  spec.centre = {0.0, 1.0, 0.0};
-  spec.pins = {"centre:0.09"};
-  return build_sheet(spec);
-}
-
 TEST(DrapeCoefficient, FlatDiscCoversItsSpecimen) {
-  const SheetScene scene = disc(30);
+  const SheetScene scene = testing::cusick_disc(30);
   const DrapeShadow shadow = measure_drape_shadow(scene.input.rest_positions, scene.input.triangles,
                                                   {0.0, 1.0, 0.0}, Eigen::Vector3d::UnitY());
   // The rim is a polygon of 76 sides: 0.11 % less area than the circle, DC 0.998.
@@ -36,7 +26,7 @@ TEST(DrapeCoefficient, FlatDiscCoversItsSpecimen) {
 }
 
 TEST(DrapeCoefficient, PetalOutlineGivesItsAreaAndNodes) {
-  const SheetScene scene = disc(40);
+  const SheetScene scene = testing::cusick_disc(40);
   const double r0 = 0.09, big = 0.15, pi = std::numbers::pi;
   for (const int n : {4, 6, 9}) {
     const double a = 0.12, b = 0.015;  // outline a + b cos(nθ) between 10.5 and 13.5 cm

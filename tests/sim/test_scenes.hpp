@@ -35,6 +35,19 @@ inline SheetSetup horizontal_sheet(int n, double size, const Eigen::Vector3d& ce
   return s;
 }
 
+// The Cusick drape test's specimen (ISO 9073-9): a horizontal 30 cm disc with `cells` quads
+// across its diameter, clamped at its centre by the 18 cm support (pin "centre:0.09").
+inline SheetScene cusick_disc(int cells) {
+  SheetSpec spec;
+  spec.shape = SheetShape::disc;
+  spec.size = {0.3, 0.3};
+  spec.columns = spec.rows = cells;
+  spec.orientation = SheetOrientation::horizontal;
+  spec.centre = {0.0, 1.0, 0.0};
+  spec.pins = {"centre:0.09"};
+  return build_sheet(spec);
+}
+
 inline std::vector<Pin> fixed_pins(const SheetScene& scene) {
   std::vector<Pin> pins;
   for (int v : scene.pinned_vertices) pins.push_back({v, {}});
