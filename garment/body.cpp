@@ -106,6 +106,18 @@ void check_declared_counts(const std::string& file) {
                         "a header line (it holds {} before end_header)",
                         file, number, numeric ? "numbers" : "binary bytes"));
     }
+    // The keyword must open a line: inside another word ("floend_headerat32", a later fuzz
+    // finding) it does not end the header, and assimp reads on for ever.
+    const auto ends_header = [](const std::string& text) {
+      std::istringstream rows(text);
+      std::string row, keyword;
+      while (std::getline(rows, row))
+        if (std::istringstream(row) >> keyword && keyword == "end_header") return true;
+      return false;
+    };
+    if (!ends_header(header))
+      throw BodyError(
+          fmt::format("body file '{}' is corrupt: its PLY header has no end_header line", file));
     while (words >> word && word != "end_header") {
       if (word != "element") continue;
       std::string kind;

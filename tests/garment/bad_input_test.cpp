@@ -85,6 +85,13 @@ TEST(BadInput, FuzzFindingsEndWithAClearError) {
   } catch (const BodyError& e) {
     EXPECT_NE(std::string(e.what()).find("has no end_header"), std::string::npos) << e.what();
   }
+  // "end_header" only inside another word ("floend_headerat32"): the same loop.
+  try {
+    load_body((dir / "body-ply-end-header-inside-a-word.ply").string());
+    ADD_FAILURE() << "accepted";
+  } catch (const BodyError& e) {
+    EXPECT_NE(std::string(e.what()).find("has no end_header"), std::string::npos) << e.what();
+  }
   // A PLY header with lines that are not header lines: the same loop (body_loader_fuzz).
   try {
     load_body((dir / "body-ply-unknown-header-line.ply").string());
