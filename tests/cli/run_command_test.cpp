@@ -181,11 +181,28 @@ TEST(RunCommand, SheetSceneWritesReportMeshAndTrace) {
   std::ifstream trace(out / "trace.jsonl");
   std::string line;
   int lines = 0;
+  nlohmann::json last;
   while (std::getline(trace, line)) {
     const auto j = nlohmann::json::parse(line);
     EXPECT_EQ(j["step"], ++lines);
+    // Where the cloth moves: the fastest vertex, in the sheet's one group, and how many move.
+    EXPECT_GE(j["fastest"]["vertex"].get<int>(), 0);
+    EXPECT_LT(j["fastest"]["vertex"].get<int>(), 49);
+    EXPECT_EQ(j["fastest"]["at"].size(), 3u);
+    EXPECT_FALSE(j["fastest"]["panel"].get<std::string>().empty());
+    EXPECT_EQ(j["fastest"]["contact"], "free");  // no body
+    EXPECT_FALSE(j.contains("contacts"));
+    // After one step of 1/20 s every free vertex falls at about g·h = 0.49 m/s, far above the
+    // at-rest 5 mm/s: all 47 unpinned vertices move.
+    if (lines == 1) {
+      EXPECT_EQ(j["moving"], 47);
+    }
+    last = j;
   }
   EXPECT_EQ(lines, steps);
+  // The last line's fastest vertex is the report's at-rest residual of the last step.
+  EXPECT_EQ(last["fastest"]["speed"].get<double>(),
+            report["rest"]["speed_final_m_s"].get<double>());
   EXPECT_TRUE(fs::exists(out / "drape.glb"));
   std::ifstream obj(out / "drape.obj");
   std::stringstream text;
@@ -279,11 +296,24 @@ TEST(RunCommand, PinnedGarmentDrapesWithImages) {
   sketch["output"] = {{"images", {{{"view", "front"}, {"size", {120, 180}}}}}};
   // The example's body path ("builtin") does not depend on where the sketch lives.
   const fs::path out = dir / "out";
-  const CommandResult r =
-      run_sketchdrape("-q run " + write_sketch(dir, sketch).string() + " -o " + out.string());
+  const CommandResult r = run_sketchdrape("-q run " + write_sketch(dir, sketch).string() + " -o " +
+                                          out.string() + " --trace");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json report = read_json(out / "report.json");
   EXPECT_EQ(report["scene"], "garment");
+  // The trace says where on the body and in which panel the fastest vertex is, and counts the
+  // body contacts of each step.
+  std::ifstream trace(out / "trace.jsonl");
+  int lines = 0;
+  for (std::string line; std::getline(trace, line); ++lines) {
+    const auto j = nlohmann::json::parse(line);
+    const std::string panel = j["fastest"]["panel"];
+    EXPECT_TRUE(panel.starts_with("yoke") || panel.starts_with("skirt")) << panel;
+    EXPECT_TRUE(j["fastest"].contains("near"));
+    EXPECT_GE(j["contacts"]["held"].get<int>(), j["contacts"]["stuck"].get<int>());
+    EXPECT_GE(j["contacts"]["body_vertex_springs"].get<int>(), 0);
+  }
+  EXPECT_EQ(lines, report["steps"].get<int>());
   EXPECT_GT(report["pinned_vertices"].get<int>(), 0);
   EXPECT_GT(report["meshing"]["quads"].get<int>(), 0);
   EXPECT_EQ(report["triangles"].get<int>(), 2 * report["meshing"]["quads"].get<int>());

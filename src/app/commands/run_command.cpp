@@ -157,7 +157,17 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   // Called after every accepted step, by either driver.
   // Adaptive detail can grow the cloth past the estimate: the budget is also checked as it runs.
   const double memory_budget = memory_budget_bytes(limits);
-  const auto on_step = [&](const sim::Simulation& s) {
+  // For the trace: the body's landmarks, to say where on the body the cloth still moves.
+  std::optional<garment::BodyLandmarks> landmarks;
+  if (options.trace && scene.body) {
+    try {
+      landmarks = garment::find_landmarks(scene.body->mesh);
+    } catch (const std::runtime_error&) {
+      // Not a standing figure: the trace gives positions only.
+    }
+  }
+  const auto on_step = [&](const sim::ClothDriver& d) {
+    const sim::Simulation& s = d.simulation();
     if (const double resident = resident_memory_bytes();
         memory_budget > 0 && resident > memory_budget)
       throw RunLimitExceeded(fmt::format(
@@ -186,6 +196,48 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
                         {"kinetic", e.kinetic},
                         {"potential", e.potential}};
     }
+    // Why a drape is not at rest: the fastest vertex (where, in which panel, near which
+    // landmark, and whether a body contact holds it), how many move faster than the at-rest
+    // speed, and the contact switches of the step (contacts released, body-vertex springs).
+    const Eigen::VectorXd& velocity = s.velocities();
+    int fastest = 0, moving = 0;
+    double top = 0.0;
+    for (int i = 0; i < s.model().vertex_count; ++i) {
+      const double speed = velocity.segment<3>(3 * i).norm();
+      if (speed > settings.rest_speed) ++moving;
+      if (speed > top) {
+        top = speed;
+        fastest = i;
+      }
+    }
+    const Eigen::Vector3d at = s.positions().segment<3>(3 * fastest);
+    std::string panel;
+    const Eigen::MatrixX3i& faces = d.faces();
+    const Eigen::VectorXi sources = d.source_faces();
+    for (Eigen::Index t = 0; t < faces.rows() && panel.empty(); ++t)
+      if ((faces.row(t).array() == fastest).any() && sources(t) < scene.face_group.size() &&
+          scene.face_group(sources(t)) < static_cast<int>(scene.group_names.size()))
+        panel = scene.group_names[static_cast<size_t>(scene.face_group(sources(t)))];
+    std::string held = "free";
+    if (s.contact())
+      for (const sim::ActiveContact& c : s.contact()->contacts())
+        if (c.contact.vertex == fastest) held = c.released ? "released" : "held";
+    line["fastest"] = {{"vertex", fastest},
+                       {"speed", top},
+                       {"at", {at.x(), at.y(), at.z()}},
+                       {"panel", panel},
+                       {"contact", held}};
+    if (landmarks) line["fastest"]["near"] = landmarks->nearest(at).name;
+    line["moving"] = moving;
+    if (s.contact()) {
+      const sim::ContactStepStats& c = s.contact()->step_stats();
+      line["contacts"] = {{"held", c.contacts},
+                          {"released", c.released},
+                          {"stuck", c.stuck},
+                          {"body_vertex_springs", c.piercings_held},
+                          {"body_vertex_springs_added", c.piercings_resolved}};
+    }
+    line["self_contacts"] = r.self_contacts_final;
     trace += line.dump() + "\n";
   };
 
@@ -229,7 +281,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
     sim::ClothObserver observer;
     observer.after_step = [&](const sim::ClothDriver& d, const sim::StepOutcome& outcome) {
       if (!outcome.accepted) return false;
-      on_step(d.simulation());
+      on_step(d);
       while (frame_due(d.time()))
         frames.push_back({d.time(), {d.positions(), d.faces()}, groups_of(d)});
       return true;
