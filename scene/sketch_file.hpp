@@ -61,6 +61,9 @@ struct SimulateSpec {
   // The cloth's rest shape: "shaped" (each triangle as drawn on the body) or "flat" (the
   // triangle in the panel's flattened pattern piece, docs/pattern.md). Panels may override it.
   std::string rest = "shaped";
+  // s: with flat rest, the cloth's rest shape moves from the drawn triangles to the pattern's
+  // over this time (sewing the cut pieces up gently; 0: released at once; docs/pattern.md).
+  double rest_ramp = 1.0;
   // Cloth-cloth contact (sim/self_contact.hpp): folds and layers do not pass through each
   // other. Unset: on for garments, off for sheets.
   std::optional<bool> self_collision;

@@ -94,10 +94,10 @@ void parse_pattern(const Reader& r, const json& j, OutputSpec& out) {
 void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
   const std::string path = "/simulate";
   r.require_object(j, path, "simulate");
-  r.check_keys(
-      j, path,
-      {"duration", "adaptive", "time_step", "integrator", "solver", "bending", "compression",
-       "stop_at_rest", "gravity", "pin_above", "check_body_vertices", "rest", "self_collision"});
+  r.check_keys(j, path,
+               {"duration", "adaptive", "time_step", "integrator", "solver", "bending",
+                "compression", "stop_at_rest", "gravity", "pin_above", "check_body_vertices",
+                "rest", "self_collision", "rest_ramp"});
   if (j.contains("pin_above")) sim.pin_above = r.number(j["pin_above"], path + "/pin_above");
   if (j.contains("duration")) {
     sim.duration = r.positive(j["duration"], path + "/duration");
@@ -173,6 +173,15 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
   }
   if (j.contains("self_collision"))
     sim.self_collision = r.boolean(j["self_collision"], path + "/self_collision");
+  if (j.contains("rest_ramp")) {
+    sim.rest_ramp = r.number(j["rest_ramp"], path + "/rest_ramp");
+    if (!(sim.rest_ramp >= 0.0 && sim.rest_ramp <= 10.0))
+      r.fail(path + "/rest_ramp",
+             fmt::format("a rest ramp of {:.6g} s is outside 0-10 s: the time over which cloth "
+                         "draped from its flat pattern goes from its drawn shape to the "
+                         "pattern's (0: at once)",
+                         sim.rest_ramp));
+  }
 }
 
 SheetSpec parse_sheet(const Reader& r, const json& j) {

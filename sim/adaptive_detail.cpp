@@ -96,6 +96,24 @@ AdaptiveCloth::AdaptiveCloth(meshing::Mesh48 mesh, AdaptiveMaterial material,
       // build_cloth_model refuses degenerate and inverted rest triangles with their names.
       root_area_scale_(r) = area_3d > 0.0 ? area_uv / area_3d : 1.0;
     }
+    if (material_.rest_ramp > 0.0) {
+      if (material_.start_rest_uv.rows() != faces || material_.start_rest_uv.cols() != 6 ||
+          !material_.start_rest_uv.allFinite())
+        throw InvalidClothError(
+            "the rest ramp's start coordinates must be finite, one row of 6 per triangle (" +
+            std::to_string(faces) + ")");
+      root_start_uv_.setZero(faces, 6);
+      for (Eigen::Index f = 0; f < faces; ++f)
+        root_start_uv_.row(mesh_.root(arrays_.triangle_ids[static_cast<std::size_t>(f)])) =
+            material_.start_rest_uv.row(f);
+    }
+  }
+  if (!std::isfinite(material_.rest_ramp) || material_.rest_ramp < 0.0)
+    throw std::invalid_argument("the rest ramp must be zero (none) or a positive time in seconds");
+  if (root_start_uv_.rows() > 0) {
+    ramp_finished_ = false;
+    // Still while its rest shape still moves is not at rest.
+    simulation.rest_not_before = std::max(simulation.rest_not_before, material_.rest_ramp);
   }
   const int n = mesh_.vertex_count();
   if (positions.rows() == 0) positions = arrays_.rest_positions;
@@ -212,14 +230,14 @@ void AdaptiveCloth::clear_body() {
   body_sag_cache_.clear();
 }
 
-Eigen::MatrixXd AdaptiveCloth::pattern_rest_uv() const {
+Eigen::MatrixXd AdaptiveCloth::pattern_rest_uv(const Eigen::MatrixXd& roots) const {
   const Eigen::Index faces = arrays_.faces.rows();
   Eigen::MatrixXd uv(faces, 6);
   for (Eigen::Index f = 0; f < faces; ++f) {
     const TriangleId t = arrays_.triangle_ids[static_cast<std::size_t>(f)];
     const int r = mesh_.root(t);
     if (arrays_.face_level(f) == 0) {  // the root itself, as given (bit for bit)
-      uv.row(f) = root_uv_.row(r);
+      uv.row(f) = roots.row(r);
       continue;
     }
     // Barycentric coordinates in the root's plane (the normal equations of the 3×2 edge matrix:
@@ -229,10 +247,10 @@ Eigen::MatrixXd AdaptiveCloth::pattern_rest_uv() const {
     edges.col(0) = root_rest_.block<1, 3>(r, 3).transpose() - p0;
     edges.col(1) = root_rest_.block<1, 3>(r, 6).transpose() - p0;
     const Eigen::Matrix2d gram = edges.transpose() * edges;
-    const Eigen::Vector2d u0 = root_uv_.block<1, 2>(r, 0).transpose();
+    const Eigen::Vector2d u0 = roots.block<1, 2>(r, 0).transpose();
     Eigen::Matrix2d uv_edges;
-    uv_edges.col(0) = root_uv_.block<1, 2>(r, 2).transpose() - u0;
-    uv_edges.col(1) = root_uv_.block<1, 2>(r, 4).transpose() - u0;
+    uv_edges.col(0) = roots.block<1, 2>(r, 2).transpose() - u0;
+    uv_edges.col(1) = roots.block<1, 2>(r, 4).transpose() - u0;
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector3d p = arrays_.rest_positions.row(arrays_.faces(f, k)).transpose();
       const Eigen::Vector2d lambda = gram.ldlt().solve(edges.transpose() * (p - p0));
@@ -240,6 +258,34 @@ Eigen::MatrixXd AdaptiveCloth::pattern_rest_uv() const {
     }
   }
   return uv;
+}
+
+Eigen::VectorXd AdaptiveCloth::ease_scale() const {
+  Eigen::VectorXd scale;  // per face, empty without ease
+  if (material_.source_ease.size() > 0) {
+    scale.resize(arrays_.faces.rows());
+    for (Eigen::Index f = 0; f < scale.size(); ++f)
+      scale(f) = face_ease(material_.source_ease,
+                           mesh_.source_face(arrays_.triangle_ids[static_cast<std::size_t>(f)]));
+  }
+  return scale;
+}
+
+std::vector<TriangleElement> AdaptiveCloth::ramped_triangles() const {
+  const double t = simulation_ ? simulation_->time() : 0.0;
+  const double a = std::min(t / material_.rest_ramp, 1.0);
+  ClothInput input;
+  input.rest_positions = arrays_.rest_positions;
+  input.triangles = arrays_.faces;
+  input.up = material_.up;
+  input.rest_uv = pattern_rest_uv(a >= 1.0 ? root_uv_
+                                           : ((1.0 - a * a * (3.0 - 2.0 * a)) * root_start_uv_ +
+                                              (a * a * (3.0 - 2.0 * a)) * root_uv_)
+                                                 .eval());
+  ClothModel model = build_cloth_model(input, material_.fabric, material_.model_options);
+  const Eigen::VectorXd scale = ease_scale();
+  if (scale.size() > 0) scale_rest_shapes(model, scale);
+  return std::move(model.triangles);
 }
 
 double AdaptiveCloth::rebuild(AdaptiveTransfer& state, const SimulationSettings* first_settings) {
@@ -269,14 +315,7 @@ double AdaptiveCloth::rebuild(AdaptiveTransfer& state, const SimulationSettings*
       input.warp.row(f) = material_.source_warp.row(source);
     }
   }
-  Eigen::VectorXd ease_scale;  // per face, empty without ease
-  if (material_.source_ease.size() > 0) {
-    ease_scale.resize(arrays_.faces.rows());
-    for (Eigen::Index f = 0; f < ease_scale.size(); ++f)
-      ease_scale(f) =
-          face_ease(material_.source_ease,
-                    mesh_.source_face(arrays_.triangle_ids[static_cast<std::size_t>(f)]));
-  }
+  const Eigen::VectorXd ease_scale = this->ease_scale();  // per face, empty without ease
   ClothModel model;
   if (first) {
     model = build_cloth_model(input, material_.fabric, material_.model_options);
@@ -304,6 +343,18 @@ double AdaptiveCloth::rebuild(AdaptiveTransfer& state, const SimulationSettings*
   masses_ = state.m;
   birth_ = std::move(state.birth);
   pins_ = std::move(state.pins);
+  // On the rest ramp the membrane rests in the blend of the current time (masses, bending and
+  // the rest of the model are rest_uv's); the reused triangles held an earlier blend.
+  if (!ramp_finished_) {
+    std::vector<TriangleElement> ramped = ramped_triangles();
+    for (std::size_t t = 0; t < ramped.size(); ++t) {
+      model.triangles[t].du = ramped[t].du;
+      model.triangles[t].dv = ramped[t].dv;
+      model.triangles[t].rest_area = ramped[t].rest_area;
+      model.triangles[t].width_u = ramped[t].width_u;
+      model.triangles[t].width_v = ramped[t].width_v;
+    }
+  }
   if (first) {
     simulation_ = std::make_unique<Simulation>(std::move(model), flatten_positions(state.x),
                                                std::move(pins), *first_settings);
@@ -529,6 +580,12 @@ void AdaptiveCloth::record(const StepOutcome& outcome, const AdaptStats& stats) 
 }
 
 StepOutcome AdaptiveCloth::step(double max_step) {
+  if (!ramp_finished_) {
+    // The step starts in the rest shapes of its start time; from the first step at or after the
+    // ramp's end, in rest_uv's exactly.
+    simulation_->set_triangle_rest_shapes(ramped_triangles());
+    ramp_finished_ = time() >= material_.rest_ramp;
+  }
   const StepOutcome outcome = simulation_->step(max_step);
   if (!outcome.accepted) return outcome;
   record(outcome, adapt());

@@ -54,6 +54,13 @@ struct AdaptiveMaterial {
   // barycentric combination of the root's corners' (a split vertex is the midpoint in the
   // pattern too; a seam vertex keeps one position per piece, each triangle using its own).
   Eigen::MatrixXd rest_uv;
+  // The rest ramp: with rest_uv and rest_ramp > 0 (s), the triangles' rest shapes start as
+  // start_rest_uv (the same rows and frames: the drawn triangles' own coordinates, in which the
+  // cloth starts unstrained) and move to rest_uv by the smoothstep 3a² − 2a³ of a = t/rest_ramp,
+  // reaching it exactly at t = rest_ramp: a cloth cut from flat pieces is sewn up slowly instead
+  // of being released 5-10 % stretched at once. Masses and bending are rest_uv's throughout.
+  Eigen::MatrixXd start_rest_uv;
+  double rest_ramp = 0.0;
 };
 
 // What one call of adapt() (or of the explicit operations) did.
@@ -224,8 +231,18 @@ class AdaptiveCloth {
   // over its 3D area (#roots); all empty without rest_uv.
   Eigen::MatrixXd root_uv_, root_rest_;
   Eigen::VectorXd root_area_scale_;
-  // The rest coordinates of every triangle of the current mesh (rows of arrays_.faces).
-  Eigen::MatrixXd pattern_rest_uv() const;
+  // The rest ramp's start coordinates per level-0 triangle (#roots by 6), empty without a ramp.
+  Eigen::MatrixXd root_start_uv_;
+  // The rest coordinates of every triangle of the current mesh (rows of arrays_.faces), from
+  // the roots' coordinates `roots` (root_uv_ or a blend on the ramp).
+  Eigen::MatrixXd pattern_rest_uv() const { return pattern_rest_uv(root_uv_); }
+  Eigen::MatrixXd pattern_rest_uv(const Eigen::MatrixXd& roots) const;
+  // The ease of every triangle of the current mesh (its input face's), or empty without ease.
+  Eigen::VectorXd ease_scale() const;
+  // The rest ramp's triangles at the current time (a = min(time() / rest_ramp, 1)), with ease:
+  // build_cloth_model's triangles for the blended coordinates; rest_uv's exactly at a = 1.
+  std::vector<TriangleElement> ramped_triangles() const;
+  bool ramp_finished_ = true;    // no ramp, or the rest shapes have reached rest_uv
   EdgeRestGeometry edge_rest_;   // per interior edge (rows of arrays_.interior_edges)
   BodySagCache body_sag_cache_;  // carried through topology changes by rebuild
   AdaptiveReport report_;

@@ -57,6 +57,8 @@ void SimulationSettings::validate() const {
   require(positive(rest_speed) && positive(rest_kinetic_energy) && std::isfinite(rest_window) &&
               rest_window >= 0.0,
           "the at-rest thresholds must be positive and the window zero or more");
+  require(std::isfinite(rest_not_before) && rest_not_before >= 0.0,
+          "the earliest at-rest time must be zero or more seconds");
   require(forces.gravity.allFinite() && forces.wind.allFinite() && std::isfinite(forces.air_drag) &&
               forces.air_drag >= 0.0,
           "gravity, wind and air drag must be finite (air drag zero or more)");
@@ -79,6 +81,21 @@ Simulation::Simulation(ClothModel model, Eigen::VectorXd x0, std::vector<Pin> pi
   dt_ = settings_.dt;
   replace_model(std::move(model), std::move(x0), Eigen::VectorXd(), std::move(pins));
   report_.dt_min_used = 0.0;
+}
+
+void Simulation::set_triangle_rest_shapes(const std::vector<TriangleElement>& rest) {
+  if (rest.size() != model_.triangles.size())
+    throw std::invalid_argument("new rest shapes need one triangle per triangle of the model");
+  for (std::size_t t = 0; t < rest.size(); ++t) {
+    TriangleElement& e = model_.triangles[t];
+    if (rest[t].vertices != e.vertices)
+      throw std::invalid_argument("new rest shapes must be given for the model's own triangles");
+    e.du = rest[t].du;
+    e.dv = rest[t].dv;
+    e.rest_area = rest[t].rest_area;
+    e.width_u = rest[t].width_u;
+    e.width_v = rest[t].width_v;
+  }
 }
 
 void Simulation::replace_model(ClothModel model, Eigen::VectorXd x, Eigen::VectorXd v,
@@ -419,7 +436,7 @@ void Simulation::accept(Attempt& attempt, double h) {
     report_.rest_kinetic_per_kg_window = std::max(report_.rest_kinetic_per_kg_window, k);
   }
   if (speed < settings_.rest_speed && kinetic / mass < settings_.rest_kinetic_energy &&
-      !body_moving)
+      !body_moving && time_ >= settings_.rest_not_before)
     rest_time_ += h;
   else
     rest_time_ = 0.0;

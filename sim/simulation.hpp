@@ -58,7 +58,9 @@ struct SimulationSettings {
   double rest_speed = 5.0e-3;           // m/s, maximum vertex speed at rest
   double rest_kinetic_energy = 1.0e-6;  // J/kg, kinetic energy per unit mass at rest
   double rest_window = 0.25;            // s the two must stay below their thresholds
-  bool record_energy = true;            // energy time series in the report (one sample a step)
+  // s: the window starts no earlier (a rest shape still changing, AdaptiveMaterial::rest_ramp)
+  double rest_not_before = 0.0;
+  bool record_energy = true;  // energy time series in the report (one sample a step)
   ForceSettings forces;
   ContactSettings contact;           // used once a body is set (set_body, set_body_motion)
   SelfContactSettings self_contact;  // cloth-cloth contact (off unless enabled)
@@ -198,6 +200,11 @@ class Simulation {
   void replace_model(ClothModel model, Eigen::VectorXd x, Eigen::VectorXd v, std::vector<Pin> pins,
                      const std::vector<VertexOrigin>& origin);
   void set_velocities(const Eigen::VectorXd& v);
+  // Gives the model's triangles the rest shapes (du, dv, rest_area, width_u, width_v) of `rest`,
+  // the same triangles (same vertices, same order) with other rest shapes; masses, bending and
+  // the state stay. For a rest shape that changes with time (AdaptiveMaterial::rest_ramp).
+  // Throws std::invalid_argument for other triangles.
+  void set_triangle_rest_shapes(const std::vector<TriangleElement>& rest);
 
   // The body the cloth rests on and cannot enter: a still mesh (metres, closed, counter-
   // clockwise seen from outside), or a pose sequence the body follows in simulation time

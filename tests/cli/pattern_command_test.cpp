@@ -338,6 +338,17 @@ TEST(PatternCommand, BadInputExitsTwoWithoutFiles) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("/simulate/rest"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(bad / "out"));
+
+  // A rest ramp outside 0-10 s is refused at its path, saying what it is.
+  text = read(example("tshirt"));
+  text.insert(at + std::string("\"simulate\": {").size(), " \"rest_ramp\": -0.5,");
+  std::ofstream(bad / "ramp.json") << text;
+  const CommandResult ramp =
+      run_sketchdrape("run " + (bad / "ramp.json").string() + " -o " + (bad / "ramp-out").string());
+  EXPECT_EQ(ramp.exit_code, 2) << ramp.output;
+  EXPECT_NE(ramp.output.find("/simulate/rest_ramp"), std::string::npos) << ramp.output;
+  EXPECT_NE(ramp.output.find("drawn shape to the pattern"), std::string::npos) << ramp.output;
+  EXPECT_FALSE(fs::exists(bad / "ramp-out"));
 }
 
 TEST(PatternCommand, MeshWritesThePatternWhenTheFileAsksForIt) {

@@ -184,6 +184,72 @@ TEST(ClothDriver, PatternRestShapesReachEveryLevelOfAdaptiveDetail) {
   EXPECT_NEAR(driver.adaptive()->masses().sum(), 1.1 * density * drawn_area, 1e-12 * density);
 }
 
+// The rest ramp (AdaptiveMaterial::rest_ramp): the sheet's rest shape starts as drawn and is
+// stretched to the pattern (x by 1.1) by the smoothstep of t / 0.2 s. A step starts in the blend
+// of its start time, so after a step ending at t the drawn sheet's deformation gradient has the
+// singular values 1 and 1/s, s = 1 + 0.1·smoothstep((t − h) / 0.2), at every level of a
+// refined mesh; the masses are the pattern's throughout, the run is not at rest before the ramp
+// ends, and after it the triangles are the unramped model's bit for bit.
+TEST(ClothDriver, RestRampMovesTheRestShapeFromTheDrawnOneToThePattern) {
+  AdaptiveSheetSpec spec = short_sheet();
+  spec.duration = 0.3;
+  AdaptiveSheet sheet = build_adaptive_sheet(spec);
+  const meshing::Mesh48Arrays arrays = sheet.mesh.arrays();
+  sheet.material.rest_uv = stretched_rest_uv(arrays, 1.1);
+  AdaptiveMaterial ramped = sheet.material;
+  ramped.start_rest_uv = stretched_rest_uv(arrays, 1.0);
+  ramped.rest_ramp = 0.2;
+  ClothDriver plain(sheet.mesh, sheet.material, {}, sheet.pins, adaptive_sheet_settings(spec),
+                    off());
+  ClothDriver driver(sheet.mesh, ramped, {}, sheet.pins, adaptive_sheet_settings(spec), off());
+  plain.adaptive()->refine_uniformly(2);
+  driver.adaptive()->refine_uniformly(2);
+  EXPECT_EQ(driver.simulation().settings().rest_not_before, 0.2);
+  const Eigen::MatrixX3d& drawn = driver.adaptive()->rest_positions();
+  // The largest deviation of the gradient's singular values on the drawn sheet from (1, 1/s).
+  const auto deviation = [&](const ClothModel& model, double s) {
+    double worst = 0;
+    for (const TriangleElement& t : model.triangles) {
+      Eigen::Matrix<double, 3, 2> f = Eigen::Matrix<double, 3, 2>::Zero();
+      for (int k = 0; k < 3; ++k) {
+        f.col(0) += t.du[k] * drawn.row(t.vertices[k]).transpose();
+        f.col(1) += t.dv[k] * drawn.row(t.vertices[k]).transpose();
+      }
+      const Eigen::Vector2d sigma =
+          Eigen::JacobiSVD<Eigen::Matrix<double, 3, 2>>(f).singularValues();
+      worst = std::max(worst, (sigma - Eigen::Vector2d(1.0, 1.0 / s)).norm());
+    }
+    return worst;
+  };
+  EXPECT_LT(deviation(driver.simulation().model(), 1.0), 1e-12);  // as drawn at t = 0
+  EXPECT_EQ(driver.simulation().model().mass, plain.simulation().model().mass);
+  double previous = 0.0, worst = 0.0;
+  int steps_on_ramp = 0;
+  ClothObserver observer;
+  observer.after_step = [&](const ClothDriver& d, const StepOutcome& outcome) {
+    const double a = std::min(previous / 0.2, 1.0);
+    worst = std::max(worst, deviation(d.simulation().model(), 1.0 + 0.1 * a * a * (3 - 2 * a)));
+    if (previous < 0.2) ++steps_on_ramp;
+    EXPECT_FALSE(d.simulation().at_rest() && d.time() < 0.2 + 0.25);
+    previous = d.time();
+    return outcome.accepted;
+  };
+  const SimulationReport report = driver.run(observer);
+  EXPECT_FALSE(report.failed);
+  EXPECT_NEAR(report.sim_time, 0.3, 1e-12);
+  EXPECT_GE(steps_on_ramp, 10);
+  EXPECT_LT(worst, 1e-12);
+  const ClothModel& a = driver.simulation().model();
+  const ClothModel& b = plain.simulation().model();
+  ASSERT_EQ(a.triangles.size(), b.triangles.size());
+  for (std::size_t t = 0; t < a.triangles.size(); ++t) {
+    EXPECT_EQ(a.triangles[t].du, b.triangles[t].du);
+    EXPECT_EQ(a.triangles[t].dv, b.triangles[t].dv);
+    EXPECT_EQ(a.triangles[t].rest_area, b.triangles[t].rest_area);
+  }
+  EXPECT_EQ(a.mass, b.mass);
+}
+
 TEST(ClothDriver, ModelGivenAsIsKeepsItsTriangles) {
   SheetSpec spec;
   spec.columns = spec.rows = 3;

@@ -78,6 +78,27 @@ TEST(Simulation, HangingSheetReachesStaticEquilibrium) {
   }
 }
 
+// A cloth at rest from the start (no gravity, in its rest shape) stops once the at-rest window
+// has passed, and with rest_not_before (a rest shape still changing) only that long after it.
+TEST(Simulation, AtRestIsNotDeclaredBeforeRestNotBefore) {
+  for (double not_before : {0.0, 0.5}) {
+    const HangingSheet h = hanging_sheet(4);
+    SimulationSettings settings;
+    settings.dt = 1.0 / 20;
+    settings.duration = 5.0;
+    settings.forces.gravity.setZero();
+    settings.rest_not_before = not_before;
+    Simulation sim = make_simulation(h, settings);
+    const SimulationReport report = sim.run();
+    EXPECT_TRUE(report.at_rest);
+    // The window counts the steps that end at or after rest_not_before: 0.25 s of them.
+    EXPECT_NEAR(report.sim_time, not_before + settings.rest_window, 1e-9) << not_before;
+  }
+  SimulationSettings bad;
+  bad.rest_not_before = -1.0;
+  EXPECT_THROW(bad.validate(), InvalidSimulationSettingsError);
+}
+
 struct SettledShape {
   double lowest = 0.0;
   Eigen::Vector3d extent;

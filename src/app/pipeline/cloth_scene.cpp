@@ -190,6 +190,9 @@ void flat_rest_shapes(const scene::Sketch& sketch, const garment::Garment& g,
   const Eigen::VectorXi& triangle_quad = scene.triangle_face;
   scene.input.rest_uv = garment::triangle_rest_coordinates(
       drawn, triangle_quad, frames, Eigen::VectorXd::Ones(g.mesh.face_count()));
+  // The rest ramp starts in the drawn triangles (u along the same warp, v along n × warp).
+  scene.start_rest_uv = scene.input.rest_uv;
+  scene.rest_ramp = sketch.simulate.rest_ramp;
   for (Eigen::Index t = 0; t < arrays.faces.rows(); ++t) {
     const size_t panel = static_cast<size_t>(g.face_panel(triangle_quad(t)));
     if (!flat[panel]) continue;
@@ -297,11 +300,12 @@ sim::SimulationSettings simulation_settings(const scene::Sketch& sketch) {
   // Cloth draped from its flat pattern starts out of its rest shape (each drawn panel is
   // stretched by up to its flattening's distortion, 5-10 % over shoulders, hips and seat) and
   // first releases that strain, sliding over the body: without a duration of its own it gets
-  // twice the default. The run still stops as soon as it is at rest (measured: the shorts at
-  // 3.85 s, the t-shirt at 2.13 s; docs/pattern.md).
+  // twice the default, plus the rest ramp (simulate.rest_ramp: the rest shape moves from the
+  // drawn one to the pattern's over that time, and the drape is not at rest before it ends).
+  // The run still stops as soon as it is at rest (docs/pattern.md).
   bool flat = spec.rest == "flat";
   for (const garment::PanelSpec& panel : sketch.panels) flat = flat || panel.rest == "flat";
-  if (flat && !spec.duration_given) settings.duration = 2 * spec.duration;
+  if (flat && !spec.duration_given) settings.duration = 2 * spec.duration + spec.rest_ramp;
   settings.stop_at_rest = spec.stop_at_rest;
   settings.forces.gravity = spec.gravity;
   settings.contact.check_body_vertices = spec.check_body_vertices;
@@ -355,6 +359,10 @@ sim::AdaptiveMaterial scene_material(const ClothScene& scene) {
   material.up = scene.input.up;
   material.source_ease = scene.face_ease;
   material.rest_uv = scene.input.rest_uv;
+  if (scene.rest_ramp > 0.0 && scene.input.rest_uv.rows() > 0) {
+    material.start_rest_uv = scene.start_rest_uv;
+    material.rest_ramp = scene.rest_ramp;
+  }
   return material;
 }
 

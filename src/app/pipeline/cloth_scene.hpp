@@ -54,6 +54,10 @@ struct ClothScene {
   // panels, the drawn triangle for shaped ones) and the hinges rest flat when all panels are flat.
   std::optional<garment::FlatPattern> flat_pattern;
   bool bend_rest_flat = false;
+  // With flat rest: every triangle's drawn coordinates (rows and frames of input.rest_uv), where
+  // the rest ramp starts, and the ramp's time (simulate.rest_ramp, s; 0: none).
+  Eigen::MatrixXd start_rest_uv;
+  double rest_ramp = 0.0;
   sim::BendModel bend_model = sim::BendModel::hinges;  // simulate.bending
   // simulate.compression
   sim::Compression compression = sim::Compression::linear;
