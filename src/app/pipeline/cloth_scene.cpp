@@ -198,6 +198,26 @@ void flat_rest_shapes(const scene::Sketch& sketch, const garment::Garment& g,
     if (!flat[panel]) continue;
     for (int k = 0; k < 3; ++k)
       scene.input.rest_uv.block<1, 2>(t, 2 * k) = panel_uv[panel].row(arrays.faces(t, k));
+    // The ramp blends the drawn triangle into the pattern's coordinate by coordinate: turned
+    // first by the rotation closest to the map between them (the quad's warp and the piece's
+    // grain differ by a few degrees), so that the blend changes the triangle's shape only; an
+    // unturned blend of two triangles θ apart is cos(θ/2) smaller halfway. Unstrained either way.
+    const auto drawn_uv = scene.start_rest_uv.row(t);
+    const auto pattern_uv = scene.input.rest_uv.row(t);
+    Eigen::Matrix2d from, to;
+    for (int k = 0; k < 2; ++k) {
+      from.col(k) = (drawn_uv.segment<2>(2 * k + 2) - drawn_uv.segment<2>(0)).transpose();
+      to.col(k) = (pattern_uv.segment<2>(2 * k + 2) - pattern_uv.segment<2>(0)).transpose();
+    }
+    const Eigen::Matrix2d map = to * from.inverse();
+    const double angle = std::atan2(map(1, 0) - map(0, 1), map(0, 0) + map(1, 1));
+    const Eigen::Matrix2d turn = Eigen::Rotation2Dd(angle).toRotationMatrix();
+    Eigen::Matrix<double, 1, 6> turned;
+    for (int k = 0; k < 3; ++k)
+      turned.segment<2>(2 * k) =
+          pattern_uv.segment<2>(0) +
+          (turn * (drawn_uv.segment<2>(2 * k) - drawn_uv.segment<2>(0)).transpose()).transpose();
+    scene.start_rest_uv.row(t) = turned;
   }
   if (!scene.input.rest_uv.allFinite())
     throw std::runtime_error("flat rest: a triangle's vertex is missing from its pattern piece");
