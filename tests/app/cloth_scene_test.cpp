@@ -83,6 +83,56 @@ TEST(ClothScene, PanelEaseScalesRestShapeAndMass) {
     EXPECT_EQ(a.hinges[h].rest_angle, b.hinges[h].rest_angle);
 }
 
+// Flat rest with its rest ramp: each triangle's start coordinates are its drawn triangle
+// (congruent: the same edge lengths), turned and moved onto its pattern triangle (same first
+// corner, and the map between them has no rotation left), so the ramp changes shapes only; the
+// ramp's time is the file's, and 0 turns it off.
+TEST(ClothScene, RestRampStartsFromTheDrawnTrianglesTurnedOntoThePattern) {
+  std::string text = two_patches(1.0);
+  text.insert(text.rfind('}'), R"(, "simulate": { "rest": "flat", "rest_ramp": 0.5 })");
+  const ClothScene scene = build_cloth_scene(scene::parse_sketch(text, "ramp.json"));
+  EXPECT_EQ(scene.rest_ramp, 0.5);
+  ASSERT_EQ(scene.start_rest_uv.rows(), scene.input.rest_uv.rows());
+  double worst_length = 0, worst_angle = 0, worst_corner = 0;
+  for (Eigen::Index t = 0; t < scene.input.triangles.rows(); ++t) {
+    const auto start = scene.start_rest_uv.row(t);
+    const auto pattern = scene.input.rest_uv.row(t);
+    Eigen::Matrix2d from, to;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d a = scene.input.rest_positions.row(scene.input.triangles(t, k));
+      const Eigen::Vector3d b =
+          scene.input.rest_positions.row(scene.input.triangles(t, (k + 1) % 3));
+      const Eigen::Vector2d u = start.segment<2>(2 * ((k + 1) % 3)) - start.segment<2>(2 * k);
+      worst_length = std::max(worst_length, std::abs(u.norm() - (b - a).norm()));
+    }
+    for (int k = 0; k < 2; ++k) {
+      from.col(k) = start.segment<2>(2 * k + 2) - start.segment<2>(0);
+      to.col(k) = pattern.segment<2>(2 * k + 2) - pattern.segment<2>(0);
+    }
+    worst_corner = std::max(worst_corner, (start.segment<2>(0) - pattern.segment<2>(0)).norm());
+    const Eigen::Matrix2d map = to * from.inverse();
+    worst_angle =
+        std::max(worst_angle, std::abs(std::atan2(map(1, 0) - map(0, 1), map(0, 0) + map(1, 1))));
+  }
+  EXPECT_LT(worst_length, 1e-12);  // m: congruent to the drawn triangle
+  EXPECT_LT(worst_corner, 1e-15);
+  EXPECT_LT(worst_angle, 1e-9);  // rad: no rotation left between start and pattern
+  const sim::AdaptiveMaterial material = scene_material(scene);
+  EXPECT_EQ(material.rest_ramp, 0.5);
+  EXPECT_EQ(material.start_rest_uv, scene.start_rest_uv);
+
+  std::string off = two_patches(1.0);
+  off.insert(off.rfind('}'), R"(, "simulate": { "rest": "flat", "rest_ramp": 0 })");
+  EXPECT_EQ(scene_material(build_cloth_scene(scene::parse_sketch(off, "off.json"))).rest_ramp, 0.0);
+  // Shaped rest has no ramp whatever the file says.
+  std::string shaped = two_patches(1.0);
+  shaped.insert(shaped.rfind('}'), R"(, "simulate": { "rest_ramp": 0.5 })");
+  const sim::AdaptiveMaterial plain =
+      scene_material(build_cloth_scene(scene::parse_sketch(shaped, "shaped.json")));
+  EXPECT_EQ(plain.rest_ramp, 0.0);
+  EXPECT_EQ(plain.start_rest_uv.rows(), 0);
+}
+
 // A sheet with "layers": copies stacked by layer_offset and turned by layer_turn about the
 // vertical through the centre, one group each; self-collision is off for sheets unless asked and
 // on for garments.
