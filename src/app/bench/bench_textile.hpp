@@ -16,6 +16,7 @@ struct TextileOptions {
   std::vector<std::string> fabrics;                // empty: every preset
   std::vector<int> cantilever_cells = {4, 8, 16};  // cells along the overhang 2c
   std::vector<int> cusick_cells = {16, 20, 30};    // cells across the 30 cm disc
+  int cusick_specimens = 3;  // drapes per point, each from its own random lift (their mean)
 };
 
 struct CantileverPoint {
@@ -32,14 +33,18 @@ struct CusickPoint {
   std::string fabric;
   int cells = 0;
   int vertices = 0;
-  double drape_coefficient = 0.0;
-  int nodes = 0;
-  bool converged = false;
+  double drape_coefficient = 0.0;  // the mean over the specimens
+  double dc_min = 0.0;
+  double dc_max = 0.0;
+  int specimens = 0;
+  int nodes = 0;           // the mean over the specimens, rounded
+  bool converged = false;  // every specimen's drape came to rest
   double seconds = 0.0;
 };
 
 CantileverPoint run_cantilever(const std::string& fabric, int cells);
-CusickPoint run_cusick(const std::string& fabric, int cells);
+// The Cusick drape of `specimens` discs, dynamic with the buckling compression, to rest.
+CusickPoint run_cusick(const std::string& fabric, int cells, int specimens);
 
 // Peirce's bending length from the chord angle θ (degrees) of an overhang l (m); l/2 at 41.5°.
 double peirce_bending_length(double overhang, double chord_deg);
