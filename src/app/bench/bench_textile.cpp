@@ -201,7 +201,7 @@ std::string cusick_csv(const std::vector<CusickPoint>& drapes) {
 }
 
 std::string textile_gnuplot() {
-  return R"(# gnuplot textile.gp: the textile bench's plots from its CSVs (converged solves only).
+  return R"(# gnuplot textile.gp: the textile bench's plots from its CSVs (converged solves and drapes at rest only).
 set datafile separator ","
 set terminal pngcairo size 900,600
 set key outside right
@@ -216,10 +216,10 @@ plot for [f in "cotton denim jersey polyester silk wool"] "textile-cantilever.cs
 set output "textile-cusick.png"
 set title "Cusick drape coefficient"
 set xlabel "cells across the 30 cm disc"
-set ylabel "DC"
+set ylabel "DC: mean of the specimens, bars their range"
 unset logscale x
 plot for [f in "cotton denim jersey polyester silk wool"] "textile-cusick.csv" \
-  using ($2):(strcol(1) eq f && $6 == 1 ? $4 : 1/0) with linespoints title f
+  using ($2):(strcol(1) eq f && $6 == 1 ? $4 : 1/0):8:9 with yerrorlines title f
 )";
 }
 

@@ -1,7 +1,8 @@
 #pragma once
 // The textile study of `sketchdrape bench --textile` (docs/fabrics.md, "The textile bench"):
 // for every preset, Peirce's cantilever (ASTM D1388) and the Cusick drape (ISO 9073-9) at three
-// resolutions each, settled by the static solver with the quadratic bending. The cantilever's
+// resolutions each, with the quadratic bending: the cantilever settled by the static solver, the
+// drape dynamic with the buckling compression (several specimens). The cantilever's
 // predicted bending length is c = (B/ρg)^(1/3) and its chord at overhang 2c is 41.5°; the
 // simulated bending length is Peirce's c ∝ l·(cos(θ/2) / (8·tan θ))^(1/3) from the chord θ,
 // scaled to give l/2 at 41.5° (ASTM D1388's fixed-angle reading).
@@ -59,7 +60,7 @@ std::string textile_table(const std::vector<CantileverPoint>& cantilevers,
 std::string cantilever_csv(const std::vector<CantileverPoint>& cantilevers);
 std::string cusick_csv(const std::vector<CusickPoint>& drapes);
 // gnuplot script drawing textile-cantilever.png and textile-cusick.png from the two CSVs (the
-// converged static solves only).
+// converged static solves and the drapes at rest only; the Cusick means with their range).
 std::string textile_gnuplot();
 
 }  // namespace sd::app
