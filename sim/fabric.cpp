@@ -193,6 +193,22 @@ void FabricParameters::validate() const {
   check_constant(name, "bend_damping", "bend damping", bend_damping, Bound::non_negative, "s");
   check_constant(name, "friction", "friction", friction, Bound::non_negative, "");
   check_constant(name, "thickness", "thickness", thickness, Bound::positive, "m");
+  // A curve built in code (the parser checks its own with the point's path): the shape
+  // TensileCurve::at relies on.
+  for (const auto& [key, curve] :
+       {std::pair{"tensile_warp", &tensile_warp}, std::pair{"tensile_weft", &tensile_weft}}) {
+    if (curve->empty() && curve->stress.empty()) continue;
+    bool ok = curve->strain.size() >= 2 && curve->strain.size() == curve->stress.size() &&
+              curve->strain[0] == 0.0 && curve->stress[0] == 0.0;
+    for (size_t i = 1; ok && i < curve->strain.size(); ++i)
+      ok = std::isfinite(curve->strain[i]) && std::isfinite(curve->stress[i]) &&
+           curve->strain[i] > curve->strain[i - 1] && curve->stress[i] > curve->stress[i - 1];
+    if (!ok)
+      throw InvalidFabricError("fabric '" + name + "': the " + key +
+                                   " curve must start at (0, 0) and rise in both strain and "
+                                   "stress over at least two points",
+                               std::string("/") + key);
+  }
 }
 
 FabricParameters parse_fabric_json(std::string_view text, const std::string& origin) {

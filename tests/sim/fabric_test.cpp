@@ -188,6 +188,27 @@ TEST(Fabric, TensileCurveIsConvertedAndInterpolated) {
   }
 }
 
+// A curve built in code is checked by validate() too (TensileCurve::at needs its shape).
+TEST(Fabric, ValidateChecksTensileCurvesBuiltInCode) {
+  FabricParameters f;
+  f.tensile_weft.strain = {0.0, 0.01};
+  f.tensile_weft.stress = {0.0, 5.0};
+  EXPECT_NO_THROW(f.validate());
+  f.tensile_weft.stress = {0.0};  // sizes differ
+  EXPECT_THROW(f.validate(), InvalidFabricError);
+  f.tensile_weft.stress = {0.0, -1.0};  // falls
+  EXPECT_THROW(f.validate(), InvalidFabricError);
+  f.tensile_weft = {};
+  f.tensile_warp.strain = {0.01};
+  f.tensile_warp.stress = {1.0};
+  try {
+    f.validate();
+    FAIL() << "a one-point curve was accepted";
+  } catch (const InvalidFabricError& e) {
+    EXPECT_EQ(e.pointer(), "/tensile_warp");
+  }
+}
+
 // A bad curve is refused at its JSON path with a sentence: not an object, a unit that is not
 // one of the listed, too few points, not starting at [0, 0], a negative value, a strain that
 // does not increase, a stress that falls (non-monotone).
