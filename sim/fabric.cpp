@@ -89,7 +89,97 @@ constexpr ConstantSpec kConstants[] = {
     {"thickness", "m", &FabricParameters::thickness},
 };
 
+// The units a tensile curve's points may be written in: strain as a fraction ("1") or in percent
+// (KES-F, FAST), stress in N/m or gf/cm (KES-F's tensile load per centimetre of width).
+struct CurveUnit {
+  const char* name;
+  double scale;  // to the SI quantity
+};
+constexpr CurveUnit kStrainUnits[] = {{"1", 1.0}, {"%", 0.01}};
+constexpr CurveUnit kStressUnits[] = {{"N/m", 1.0}, {"gf/cm", 0.9807}};
+
+template <size_t N>
+double curve_unit_scale(const nlohmann::json& curve, const char* key, const CurveUnit (&units)[N],
+                        const std::string& where, const std::string& pointer) {
+  std::string names;
+  for (size_t i = 0; i < N; ++i)
+    names += std::string(i == 0 ? "" : (i + 1 == N ? " or " : ", ")) + "\"" + units[i].name + "\"";
+  const std::string at = pointer + "/" + key;
+  if (!curve.contains(key) || !curve[key].is_string())
+    throw InvalidFabricError(where + ": " + at + " must be given: " + names, at);
+  const std::string unit = curve[key].get<std::string>();
+  for (const CurveUnit& u : units)
+    if (unit == u.name) return u.scale;
+  throw InvalidFabricError(where + ": " + at + " is \"" + unit + "\" but must be " + names, at);
+}
+
+// {"strain_unit": "%", "stress_unit": "gf/cm", "points": [[0, 0], [1.2, 50], ...]}: a tensile
+// curve from (0, 0) with strain and stress both strictly increasing (a curve that falls or
+// stays flat would let the cloth stretch without limit under a constant load).
+TensileCurve parse_tensile_curve(const nlohmann::json& curve, const std::string& where,
+                                 const std::string& pointer) {
+  if (!curve.is_object())
+    throw InvalidFabricError(where + ": " + pointer +
+                                 " must be an object {\"strain_unit\", \"stress_unit\", "
+                                 "\"points\": [[strain, stress], ...]}",
+                             pointer);
+  const double strain_scale = curve_unit_scale(curve, "strain_unit", kStrainUnits, where, pointer);
+  const double stress_scale = curve_unit_scale(curve, "stress_unit", kStressUnits, where, pointer);
+  const std::string points_at = pointer + "/points";
+  if (!curve.contains("points") || !curve["points"].is_array() || curve["points"].size() < 2)
+    throw InvalidFabricError(
+        where + ": " + points_at +
+            " must list at least two [strain, stress] points, the first [0, 0]",
+        points_at);
+  TensileCurve result;
+  const nlohmann::json& points = curve["points"];
+  for (size_t i = 0; i < points.size(); ++i) {
+    const std::string at = points_at + "/" + std::to_string(i);
+    const nlohmann::json& p = points[i];
+    if (!p.is_array() || p.size() != 2 || !p[0].is_number() || !p[1].is_number())
+      throw InvalidFabricError(where + ": " + at + " must be a pair [strain, stress] of numbers",
+                               at);
+    const double strain = p[0].get<double>() * strain_scale;
+    const double stress = p[1].get<double>() * stress_scale;
+    if (!std::isfinite(strain) || !std::isfinite(stress) || strain < 0.0 || stress < 0.0)
+      throw InvalidFabricError(where + ": " + at +
+                                   " has a negative or non-finite value: a tensile curve's strains "
+                                   "and stresses are zero or more",
+                               at);
+    if (i == 0 && (strain != 0.0 || stress != 0.0))
+      throw InvalidFabricError(where + ": " + at + " must be [0, 0]: the curve starts unloaded",
+                               at);
+    if (i > 0 && !(strain > result.strain.back()))
+      throw InvalidFabricError(where + ": " + at +
+                                   ": the strain does not increase (each point's "
+                                   "strain must be greater than the one before)",
+                               at);
+    if (i > 0 && !(stress > result.stress.back()))
+      throw InvalidFabricError(where + ": " + at +
+                                   ": the stress does not increase with the "
+                                   "strain (the curve must rise: a falling or flat segment lets "
+                                   "the fabric stretch without limit)",
+                               at);
+    result.strain.push_back(strain);
+    result.stress.push_back(stress);
+  }
+  return result;
+}
+
 }  // namespace
+
+TensileCurve::Point TensileCurve::at(double e) const {
+  // The segment ε lies on (the last one beyond the curve's end), and the energy up to its start.
+  Point p;
+  size_t i = 0;
+  for (; i + 2 < strain.size() && e > strain[i + 1]; ++i)
+    p.energy += 0.5 * (stress[i] + stress[i + 1]) * (strain[i + 1] - strain[i]);
+  p.tangent = (stress[i + 1] - stress[i]) / (strain[i + 1] - strain[i]);
+  const double d = e - strain[i];
+  p.stress = stress[i] + p.tangent * d;
+  p.energy += stress[i] * d + 0.5 * p.tangent * d * d;
+  return p;
+}
 
 void FabricParameters::validate() const {
   check_constant(name, "area_density", "area density", area_density, Bound::positive, "kg/m^2");
@@ -103,6 +193,22 @@ void FabricParameters::validate() const {
   check_constant(name, "bend_damping", "bend damping", bend_damping, Bound::non_negative, "s");
   check_constant(name, "friction", "friction", friction, Bound::non_negative, "");
   check_constant(name, "thickness", "thickness", thickness, Bound::positive, "m");
+  // A curve built in code (the parser checks its own with the point's path): the shape
+  // TensileCurve::at relies on.
+  for (const auto& [key, curve] :
+       {std::pair{"tensile_warp", &tensile_warp}, std::pair{"tensile_weft", &tensile_weft}}) {
+    if (curve->empty() && curve->stress.empty()) continue;
+    bool ok = curve->strain.size() >= 2 && curve->strain.size() == curve->stress.size() &&
+              curve->strain[0] == 0.0 && curve->stress[0] == 0.0;
+    for (size_t i = 1; ok && i < curve->strain.size(); ++i)
+      ok = std::isfinite(curve->strain[i]) && std::isfinite(curve->stress[i]) &&
+           curve->strain[i] > curve->strain[i - 1] && curve->stress[i] > curve->stress[i - 1];
+    if (!ok)
+      throw InvalidFabricError("fabric '" + name + "': the " + key +
+                                   " curve must start at (0, 0) and rise in both strain and "
+                                   "stress over at least two points",
+                               std::string("/") + key);
+  }
 }
 
 FabricParameters parse_fabric_json(std::string_view text, const std::string& origin) {
@@ -151,6 +257,10 @@ FabricParameters parse_fabric_json(std::string_view text, const std::string& ori
       fabric.*spec.field = other->load / (value / 100.0);
     }
   }
+  for (const auto& [key, curve] : {std::pair{"tensile_warp", &fabric.tensile_warp},
+                                   std::pair{"tensile_weft", &fabric.tensile_weft}})
+    if (document.contains(key))
+      *curve = parse_tensile_curve(document[key], origin, std::string("/") + key);
   try {
     fabric.validate();
   } catch (const InvalidFabricError& e) {

@@ -28,6 +28,25 @@ class UnknownFabricError : public std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
+// A measured tensile curve along warp or weft (KES-F tensile test, a strip test): the stress
+// (force per unit width, N/m) at increasing strains, starting at (0, 0); both strictly increase.
+// Between points the stress is linear in the strain; beyond the last point the last segment's
+// slope continues. Empty: the fabric is linear in tension (its stretch constant).
+struct TensileCurve {
+  std::vector<double> strain;  // 1 (not %), strain[0] = 0
+  std::vector<double> stress;  // N/m, stress[0] = 0
+
+  bool empty() const { return strain.empty(); }
+  // At a strain ε ≥ 0: the energy per unit area W(ε) = ∫₀^ε σ (J/m²), the stress σ(ε) (N/m) and
+  // the tangent stiffness dσ/dε (N/m, the slope of the segment ε lies on).
+  struct Point {
+    double energy = 0.0;
+    double stress = 0.0;
+    double tangent = 0.0;
+  };
+  Point at(double strain) const;
+};
+
 // Constants of the Baraff-Witkin model as densities, so that one set behaves the same at any
 // mesh resolution (see docs/simulator.md, "Resolution invariance"):
 //   stretch/shear energy of a triangle = ½ · stiffness · rest area · condition²,
@@ -43,6 +62,11 @@ struct FabricParameters {
   double bend_damping = 2.0e-2;  // s, stiffness-proportional damping of bending
   double friction = 0.3;         // Coulomb coefficient against the body (contacts, later)
   double thickness = 5.0e-4;     // m, collision thickness
+  // Optional measured curves in tension (docs/fabrics.md, "Tensile curves"): when given, the
+  // tension along that direction follows the curve and stretch_warp/stretch_weft only answer
+  // compression (and set the buckling strain).
+  TensileCurve tensile_warp;
+  TensileCurve tensile_weft;
 
   // Throws InvalidFabricError naming the first bad constant.
   void validate() const;

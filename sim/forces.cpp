@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <utility>
 #include <vector>
@@ -94,6 +95,21 @@ ConditionEnergy buckling_stretch(double strain, double stiffness, double bucklin
     return {0.5 * stiffness * strain * strain, stiffness * strain, stiffness};
   return {stiffness * buckling_strain * (-strain - 0.5 * buckling_strain),
           -stiffness * buckling_strain, 0.0};
+}
+
+// No buckling strain: compression stays quadratic however far it goes.
+constexpr double kLinearCompression = std::numeric_limits<double>::infinity();
+
+// Stretch along one direction at strain C: in tension the fabric's measured curve when it has
+// one (energy A·W(ε), force A·σ(ε), stiffness A·dσ/dε), otherwise ½·k·C² with k = K·A; in
+// compression ½·k·C² capped beyond the buckling strain (buckling_stretch).
+ConditionEnergy stretch_energy(double strain, double stiffness, double buckling_strain,
+                               const TensileCurve& curve, double rest_area) {
+  if (strain > 0.0 && !curve.empty()) {
+    const TensileCurve::Point p = curve.at(strain);
+    return {rest_area * p.energy, rest_area * p.stress, rest_area * p.tangent};
+  }
+  return buckling_stretch(strain, stiffness, buckling_strain);
 }
 
 // [a]_×: the matrix of a × ·.
@@ -314,23 +330,22 @@ void evaluate_forces(const ClothModel& model, const ForceSettings& settings,
       if (terms.stretch) {
         const double k_u = fabric.stretch_warp * t.rest_area;
         const double k_v = fabric.stretch_weft * t.rest_area;
-        if (model.compression == Compression::buckling) {
-          // ε* = N*/K with N* = π²·B / l² for the triangle's width l along each direction.
-          const double pi2b = std::numbers::pi * std::numbers::pi * fabric.bend;
-          const double eps_u = pi2b / (t.width_u * t.width_u * fabric.stretch_warp);
-          const double eps_v = pi2b / (t.width_v * t.width_v * fabric.stretch_weft);
-          add_condition_energy(c.warp, buckling_stretch(c.warp.value, k_u, eps_u),
-                               damping_scale * fabric.damping * k_u, true, vs.data(),
-                               t.blocks.data(), v, force, local_energy.stretch, jacobian);
-          add_condition_energy(c.weft, buckling_stretch(c.weft.value, k_v, eps_v),
-                               damping_scale * fabric.damping * k_v, true, vs.data(),
-                               t.blocks.data(), v, force, local_energy.stretch, jacobian);
-        } else {
-          add_condition(c.warp, 0.0, k_u, damping_scale * fabric.damping * k_u, true, vs.data(),
-                        t.blocks.data(), v, force, local_energy.stretch, jacobian);
-          add_condition(c.weft, 0.0, k_v, damping_scale * fabric.damping * k_v, true, vs.data(),
-                        t.blocks.data(), v, force, local_energy.stretch, jacobian);
-        }
+        // ε* = N*/K with N* = π²·B / l² for the triangle's width l along each direction (only
+        // with the buckling compression; infinity leaves compression quadratic).
+        const bool buckling = model.compression == Compression::buckling;
+        const double pi2b = std::numbers::pi * std::numbers::pi * fabric.bend;
+        const double eps_u =
+            buckling ? pi2b / (t.width_u * t.width_u * fabric.stretch_warp) : kLinearCompression;
+        const double eps_v =
+            buckling ? pi2b / (t.width_v * t.width_v * fabric.stretch_weft) : kLinearCompression;
+        add_condition_energy(
+            c.warp, stretch_energy(c.warp.value, k_u, eps_u, fabric.tensile_warp, t.rest_area),
+            damping_scale * fabric.damping * k_u, true, vs.data(), t.blocks.data(), v, force,
+            local_energy.stretch, jacobian);
+        add_condition_energy(
+            c.weft, stretch_energy(c.weft.value, k_v, eps_v, fabric.tensile_weft, t.rest_area),
+            damping_scale * fabric.damping * k_v, true, vs.data(), t.blocks.data(), v, force,
+            local_energy.stretch, jacobian);
       }
       if (terms.shear) {
         const double k_s = fabric.shear * t.rest_area;

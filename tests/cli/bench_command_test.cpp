@@ -344,12 +344,13 @@ TEST(BenchScaling, BadSizesAndSolversAreRefusedBeforeAnyRun) {
 
 // `bench --textile` on denim, coarse (seconds): every point is written; the cantilever's
 // bending length from Peirce's formula is near the predicted one (16 cells: chord within 1.5° of
-// 41.5°, c within 3 %), the drape lies between hanging and flat. A name that is not a preset is
-// refused before any run.
+// 41.5°, c within 3 %), the drape (two dynamic specimens) lies between hanging and flat. A name
+// that is not a preset is refused before any run.
 TEST(BenchTextile, DenimCantileverAndDrapeAreWrittenWithTheirMeasures) {
   const fs::path dir = fresh_dir("textile");
   const auto result = run_sketchdrape(
-      "bench --textile --fabric denim --cantilever-cells 8 16 --cusick-cells 12 --json -o " +
+      "bench --textile --fabric denim --cantilever-cells 8 16 --cusick-cells 12 "
+      "--cusick-specimens 2 --json -o " +
       (dir / "out").string());
   ASSERT_EQ(result.exit_code, 0) << result.output;
   for (const char* name :
@@ -364,9 +365,16 @@ TEST(BenchTextile, DenimCantileverAndDrapeAreWrittenWithTheirMeasures) {
   EXPECT_NEAR(fine.at("simulated_c_m").get<double>() / fine.at("predicted_c_m").get<double>(), 1.0,
               0.03);
   ASSERT_EQ(json.at("cusick").size(), 1u);
-  const double dc = json.at("cusick").at(0).at("drape_coefficient").get<double>();
+  const auto& drape = json.at("cusick").at(0);
+  const double dc = drape.at("drape_coefficient").get<double>();
   EXPECT_GT(dc, 0.0);
   EXPECT_LT(dc, 1.0);
+  // The mean of two dynamic drapes (each from its own random lift), both at rest, within their
+  // range.
+  EXPECT_EQ(drape.at("specimens").get<int>(), 2);
+  EXPECT_TRUE(drape.at("converged").get<bool>());
+  EXPECT_LE(drape.at("drape_coefficient_min").get<double>(), dc);
+  EXPECT_GE(drape.at("drape_coefficient_max").get<double>(), dc);
   const auto bad = run_sketchdrape("bench --textile --fabric tweed -o " + (dir / "bad").string());
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
   EXPECT_FALSE(fs::exists(dir / "bad"));

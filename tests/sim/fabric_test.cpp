@@ -141,5 +141,110 @@ TEST(Fabric, KesAndFastUnitsAreConverted) {
   }
 }
 
+// A cotton preset with a tensile curve added under `key` (the JSON text of the curve).
+std::string cotton_with(const std::string& key, const std::string& curve) {
+  return R"({"name": "c", "area_density": {"value": 0.13, "unit": "kg/m^2"},
+             "stretch_warp": {"value": 9810, "unit": "N/m"},
+             "stretch_weft": {"value": 6130, "unit": "N/m"},
+             "shear": {"value": 45, "unit": "N/m"}, "bend": {"value": 9.81e-6, "unit": "N*m"},
+             "damping": {"value": 0.001, "unit": "s"}, "bend_damping": {"value": 0.05, "unit": "s"},
+             "friction": {"value": 0.3, "unit": "1"}, "thickness": {"value": 3e-4, "unit": "m"},
+             ")" +
+         key + R"(": )" + curve + "}";
+}
+
+// A tensile curve in KES-F units (% strain, gf/cm) is converted to SI, and its energy, stress
+// and tangent are the integral, the piecewise-linear interpolation and the segment's slope
+// (beyond the last point the last slope continues).
+TEST(Fabric, TensileCurveIsConvertedAndInterpolated) {
+  const FabricParameters f =
+      parse_fabric_json(cotton_with("tensile_warp",
+                                    R"({"strain_unit": "%", "stress_unit": "gf/cm",
+                      "points": [[0, 0], [1, 10], [3, 110]], "source": "a made-up curve"})"),
+                        "curve.json");
+  EXPECT_TRUE(f.tensile_weft.empty());
+  ASSERT_EQ(f.tensile_warp.strain.size(), 3u);
+  EXPECT_NEAR(f.tensile_warp.strain[2], 0.03, 1e-15);
+  EXPECT_NEAR(f.tensile_warp.stress[1], 9.807, 1e-12);
+  const double s1 = 9.807, s2 = 110 * 0.9807;  // N/m at 1 % and 3 %
+  const double k1 = s1 / 0.01, k2 = (s2 - s1) / 0.02;
+  TensileCurve::Point p = f.tensile_warp.at(0.005);
+  EXPECT_NEAR(p.stress, 0.5 * s1, 1e-12);
+  EXPECT_NEAR(p.tangent, k1, 1e-9);
+  EXPECT_NEAR(p.energy, 0.5 * k1 * 0.005 * 0.005, 1e-15);
+  p = f.tensile_warp.at(0.02);
+  EXPECT_NEAR(p.stress, s1 + k2 * 0.01, 1e-12);
+  EXPECT_NEAR(p.tangent, k2, 1e-9);
+  EXPECT_NEAR(p.energy, 0.5 * s1 * 0.01 + s1 * 0.01 + 0.5 * k2 * 0.01 * 0.01, 1e-14);
+  p = f.tensile_warp.at(0.04);  // past the end: the last slope
+  EXPECT_NEAR(p.stress, s2 + k2 * 0.01, 1e-12);
+  EXPECT_NEAR(p.tangent, k2, 1e-9);
+  // The energy is the integral of the stress: a central difference of W gives σ.
+  for (double e : {0.002, 0.0101, 0.025, 0.05}) {
+    const double h = 1e-7;
+    EXPECT_NEAR((f.tensile_warp.at(e + h).energy - f.tensile_warp.at(e - h).energy) / (2 * h),
+                f.tensile_warp.at(e).stress, 1e-6)
+        << e;
+  }
+}
+
+// A curve built in code is checked by validate() too (TensileCurve::at needs its shape).
+TEST(Fabric, ValidateChecksTensileCurvesBuiltInCode) {
+  FabricParameters f;
+  f.tensile_weft.strain = {0.0, 0.01};
+  f.tensile_weft.stress = {0.0, 5.0};
+  EXPECT_NO_THROW(f.validate());
+  f.tensile_weft.stress = {0.0};  // sizes differ
+  EXPECT_THROW(f.validate(), InvalidFabricError);
+  f.tensile_weft.stress = {0.0, -1.0};  // falls
+  EXPECT_THROW(f.validate(), InvalidFabricError);
+  f.tensile_weft = {};
+  f.tensile_warp.strain = {0.01};
+  f.tensile_warp.stress = {1.0};
+  try {
+    f.validate();
+    FAIL() << "a one-point curve was accepted";
+  } catch (const InvalidFabricError& e) {
+    EXPECT_EQ(e.pointer(), "/tensile_warp");
+  }
+}
+
+// A bad curve is refused at its JSON path with a sentence: not an object, a unit that is not
+// one of the listed, too few points, not starting at [0, 0], a negative value, a strain that
+// does not increase, a stress that falls (non-monotone).
+TEST(Fabric, BadTensileCurvesAreRefusedAtTheirPath) {
+  struct Case {
+    std::string curve, pointer, words;
+  };
+  const std::string units = R"("strain_unit": "1", "stress_unit": "N/m", )";
+  for (const Case& c : {
+           Case{"[1, 2]", "/tensile_weft", "must be an object"},
+           Case{R"({"strain_unit": "mm", "stress_unit": "N/m", "points": [[0, 0], [1, 1]]})",
+                "/tensile_weft/strain_unit", "\"1\" or \"%\""},
+           Case{R"({"strain_unit": "%", "stress_unit": "N", "points": [[0, 0], [1, 1]]})",
+                "/tensile_weft/stress_unit", "\"N/m\" or \"gf/cm\""},
+           Case{"{" + units + R"("points": [[0, 0]]})", "/tensile_weft/points", "at least two"},
+           Case{"{" + units + R"("points": [[0.01, 0], [0.02, 5]]})", "/tensile_weft/points/0",
+                "must be [0, 0]"},
+           Case{"{" + units + R"("points": [[0, 0], [0.01, -5]]})", "/tensile_weft/points/1",
+                "negative"},
+           Case{"{" + units + R"("points": [[0, 0], [0.02, 5], [0.01, 8]]})",
+                "/tensile_weft/points/2", "strain does not increase"},
+           Case{"{" + units + R"("points": [[0, 0], [0.01, 5], [0.02, 4]]})",
+                "/tensile_weft/points/2", "stress does not increase"},
+           Case{"{" + units + R"("points": [[0, 0], [0.01]]})", "/tensile_weft/points/1",
+                "pair [strain, stress]"},
+       }) {
+    try {
+      parse_fabric_json(cotton_with("tensile_weft", c.curve), "bad.json");
+      FAIL() << "accepted: " << c.curve;
+    } catch (const InvalidFabricError& error) {
+      EXPECT_EQ(error.pointer(), c.pointer) << c.curve << ": " << error.what();
+      EXPECT_NE(std::string(error.what()).find(c.words), std::string::npos) << error.what();
+      EXPECT_NE(std::string(error.what()).find("bad.json"), std::string::npos) << error.what();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace sd::sim

@@ -337,6 +337,58 @@ TEST(Forces, BucklingCompressionMatchesFiniteDifferences) {
   EXPECT_GT(stretched, 10);
 }
 
+// With measured tensile curves on warp and weft (three segments, strains spread across all of
+// them and into compression), the force is −∇E and the exact Jacobian matches central
+// differences, as for the linear and buckling models.
+TEST(Forces, TensileCurveMatchesFiniteDifferences) {
+  Fixture f = make_fixture();
+  FabricParameters fabric = f.model.fabric;
+  fabric.tensile_warp.strain = {0.0, 0.005, 0.015};
+  fabric.tensile_warp.stress = {0.0, 2.0, 60.0};  // N/m: 400, then 5800 N/m
+  fabric.tensile_weft.strain = {0.0, 0.01, 0.02};
+  fabric.tensile_weft.stress = {0.0, 5.0, 30.0};
+  f.model = build_cloth_model(f.scene.input, fabric);
+  ForceSettings settings;
+  settings.terms = ForceTerms{true, false, false, false, false, false};  // stretch only
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> stretch(0.99, 1.03), noise(-2e-3, 2e-3);
+  int on_segment[3] = {0, 0, 0};
+  for (int trial = 0; trial < 10; ++trial) {
+    Eigen::VectorXd x = flatten_positions(f.scene.input.rest_positions);
+    const double sx = stretch(rng), sy = stretch(rng);
+    for (Eigen::Index i = 0; i < x.size(); i += 3) {
+      x(i) *= sx;
+      x(i + 1) = 1.0 + (x(i + 1) - 1.0) * sy;
+      for (int k = 0; k < 3; ++k) x(i + k) += noise(rng);
+    }
+    for (const TriangleElement& t : f.model.triangles) {
+      Eigen::Vector3d wu = Eigen::Vector3d::Zero();
+      for (int k = 0; k < 3; ++k) wu += t.du(k) * x.segment<3>(3 * t.vertices[k]);
+      const double e = wu.norm() - 1.0;
+      ++on_segment[e <= 0.0 ? 0 : (e < 0.005 ? 1 : 2)];
+    }
+    const Eigen::VectorXd v = Eigen::VectorXd::Zero(x.size());
+    const testing::ForceDifferences d = testing::force_differences(f.model, settings, x, v);
+    Eigen::VectorXd force, scratch, gradient(x.size());
+    evaluate_forces(f.model, settings, x, v, force);
+    const double h = 1e-7;
+    for (Eigen::Index j = 0; j < x.size(); ++j) {
+      Eigen::VectorXd plus = x, minus = x;
+      plus[j] += h;
+      minus[j] -= h;
+      EnergyBreakdown ep, em;
+      evaluate_forces(f.model, settings, plus, v, scratch, &ep);
+      evaluate_forces(f.model, settings, minus, v, scratch, &em);
+      gradient[j] = (ep.stretch - em.stretch) / (2 * h);
+    }
+    EXPECT_LE((gradient + force).norm(), 1e-5 * force.norm()) << "trial " << trial;
+    const Eigen::MatrixXd dfdx = dense_jacobian(f.model, settings, x, v, 1, 0, JacobianKind::exact);
+    EXPECT_LE((d.dfdx - dfdx).norm(), 1e-5 * dfdx.norm()) << "trial " << trial;
+  }
+  for (int segment = 0; segment < 3; ++segment)
+    EXPECT_GT(on_segment[segment], 10) << "compression, first or later segment: " << segment;
+}
+
 // Tension is exactly the linear model's; a uniform compression s along the warp costs the
 // post-buckling energy A·K·ε*·(s − ε*/2) per triangle (force per width N* = K·ε* = π²B/l²),
 // against ½·A·K·s² for the linear model.

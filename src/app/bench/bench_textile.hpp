@@ -1,7 +1,8 @@
 #pragma once
 // The textile study of `sketchdrape bench --textile` (docs/fabrics.md, "The textile bench"):
 // for every preset, Peirce's cantilever (ASTM D1388) and the Cusick drape (ISO 9073-9) at three
-// resolutions each, settled by the static solver with the quadratic bending. The cantilever's
+// resolutions each, with the quadratic bending: the cantilever settled by the static solver, the
+// drape dynamic with the buckling compression (several specimens). The cantilever's
 // predicted bending length is c = (B/ρg)^(1/3) and its chord at overhang 2c is 41.5°; the
 // simulated bending length is Peirce's c ∝ l·(cos(θ/2) / (8·tan θ))^(1/3) from the chord θ,
 // scaled to give l/2 at 41.5° (ASTM D1388's fixed-angle reading).
@@ -16,6 +17,7 @@ struct TextileOptions {
   std::vector<std::string> fabrics;                // empty: every preset
   std::vector<int> cantilever_cells = {4, 8, 16};  // cells along the overhang 2c
   std::vector<int> cusick_cells = {16, 20, 30};    // cells across the 30 cm disc
+  int cusick_specimens = 3;  // drapes per point, each from its own random lift (their mean)
 };
 
 struct CantileverPoint {
@@ -32,14 +34,18 @@ struct CusickPoint {
   std::string fabric;
   int cells = 0;
   int vertices = 0;
-  double drape_coefficient = 0.0;
-  int nodes = 0;
-  bool converged = false;
+  double drape_coefficient = 0.0;  // the mean over the specimens
+  double dc_min = 0.0;
+  double dc_max = 0.0;
+  int specimens = 0;
+  int nodes = 0;           // the mean over the specimens, rounded
+  bool converged = false;  // every specimen's drape came to rest
   double seconds = 0.0;
 };
 
 CantileverPoint run_cantilever(const std::string& fabric, int cells);
-CusickPoint run_cusick(const std::string& fabric, int cells);
+// The Cusick drape of `specimens` discs, dynamic with the buckling compression, to rest.
+CusickPoint run_cusick(const std::string& fabric, int cells, int specimens);
 
 // Peirce's bending length from the chord angle θ (degrees) of an overhang l (m); l/2 at 41.5°.
 double peirce_bending_length(double overhang, double chord_deg);
@@ -54,7 +60,7 @@ std::string textile_table(const std::vector<CantileverPoint>& cantilevers,
 std::string cantilever_csv(const std::vector<CantileverPoint>& cantilevers);
 std::string cusick_csv(const std::vector<CusickPoint>& drapes);
 // gnuplot script drawing textile-cantilever.png and textile-cusick.png from the two CSVs (the
-// converged static solves only).
+// converged static solves and the drapes at rest only; the Cusick means with their range).
 std::string textile_gnuplot();
 
 }  // namespace sd::app

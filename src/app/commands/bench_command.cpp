@@ -217,7 +217,8 @@ void run_scaling_study(const BenchOptions& options, const GlobalOptions& global)
 }
 
 // `bench --textile`: Peirce's cantilever and the Cusick drape of every preset at three
-// resolutions (docs/fabrics.md, "The textile bench"), in this process (static solves).
+// resolutions (docs/fabrics.md, "The textile bench"), in this process (cantilever static, Cusick
+// dynamic).
 void run_textile_study(const BenchOptions& options, const GlobalOptions& global) {
   const TextileOptions& o = options.textile_options;
   const std::vector<std::string> known = sim::fabric_preset_names();
@@ -250,6 +251,9 @@ void run_textile_study(const BenchOptions& options, const GlobalOptions& global)
                               {"cells", p.cells},
                               {"vertices", p.vertices},
                               {"drape_coefficient", p.drape_coefficient},
+                              {"drape_coefficient_min", p.dc_min},
+                              {"drape_coefficient_max", p.dc_max},
+                              {"specimens", p.specimens},
                               {"nodes", p.nodes},
                               {"converged", p.converged},
                               {"seconds", p.seconds}});
@@ -455,6 +459,10 @@ void add_bench_command(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--cusick-cells", options->textile_options.cusick_cells,
                   "With --textile: cells across the disc (default 16 20 30)")
       ->check(CLI::Range(4, 200));
+  cmd->add_option("--cusick-specimens", options->textile_options.cusick_specimens,
+                  "With --textile: Cusick drapes per point, each from its own random lift; the "
+                  "table gives their mean and range (default 3)")
+      ->check(CLI::Range(1, 20));
   cmd->add_option("--worker", options->worker_config)->group("");  // internal: one run
   cmd->add_option("--worker-scene", options->worker_scene)->group("");
   cmd->add_option("--worker-out", options->worker_out)->group("");

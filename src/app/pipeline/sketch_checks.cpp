@@ -56,10 +56,30 @@ std::string gigabytes(double bytes) {
 }  // namespace
 
 void check_sketch(const scene::Sketch& sketch) {
+  // Each fabric as build_cloth_scene reads it (cloth_scene.cpp, fabric_at): the inline object
+  // (by its name), a preset, or a fabric file; checking the name against the presets alone
+  // refused every inline fabric not named after a preset and every fabric file.
   auto check_fabric = [&](const std::string& name, const std::string& path) {
+    if (!sketch.fabric_inline.empty() && name == sketch.fabric) {
+      try {
+        (void)sim::parse_fabric_json(sketch.fabric_inline, "the fabric given inline");
+      } catch (const sim::InvalidFabricError& e) {
+        sketch.fail("/fabric" + e.pointer(), e.what());
+      }
+      return;
+    }
     try {
       (void)sim::fabric_preset(name);
+      return;
     } catch (const sim::UnknownFabricError& e) {
+      if (!name.ends_with(".json"))
+        sketch.fail(path, std::string(e.what()) +
+                              "; or give a fabric file (.json) or the fabric's constants as an "
+                              "object");
+    }
+    try {
+      (void)sim::load_fabric_file(sketch.resolve(name).string());
+    } catch (const sim::InvalidFabricError& e) {
       sketch.fail(path, e.what());
     }
   };
