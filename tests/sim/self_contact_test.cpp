@@ -57,6 +57,35 @@ TEST(SelfContactResponse, FailSafeLeavesNoCollisionAndKeepsMomentum) {
   EXPECT_LT((sheet.x + 0.01 * v1 - x1).lpNorm<Eigen::Infinity>(), 1e-12);
 }
 
+// The fail-safe's landing: a layer that starts the step 0.1 mm above another (closer than the
+// landing separation, a tenth of the 2 mm thickness) and is driven 1 mm through it lands where it
+// started (inelastic, no lift to 0.2 mm): lifted, a resting layer fell back within a step and was
+// lifted again, a cycle that kept the t-shirt's underarm moving.
+TEST(SelfContactResponse, FailSafeLandsAPairThatStartedCloseWhereItStarted) {
+  const double gap = 1.0e-4;
+  const testing::FoldedSheet sheet = testing::folded_sheet(6, 0.3, gap);
+  const ClothModel model = folded_model(testing::folded_sheet(6, 0.3, -1.0));
+  std::vector<unsigned char> pinned(static_cast<std::size_t>(model.vertex_count), 0);
+  for (int i = 0; i < model.vertex_count; ++i) pinned[i] = sheet.upper[i] ? 0 : 1;
+  Eigen::VectorXd x1 = sheet.x;
+  for (int i = 0; i < model.vertex_count; ++i)
+    if (sheet.upper[i]) x1[3 * i + 1] -= 0.001;
+  SelfContactSettings settings;
+  settings.enabled = true;
+  SelfContactResponse response(settings);
+  response.set_cloth(model, sheet.x);
+  Eigen::VectorXd v1 = (x1 - sheet.x) / 0.01;
+  response.resolve(sheet.x, x1, v1, 0.01, model.mass, pinned, StepForces{});
+  EXPECT_GT(response.step_stats().collisions, 0);
+  EXPECT_FALSE(response.step_stats().unresolved);
+  EXPECT_EQ(testing::count_intersecting_pairs(sheet.triangles, x1), 0);
+  for (int i = 0; i < model.vertex_count; ++i) {
+    if (!sheet.upper[i] || sheet.x[3 * i] > -0.1) continue;
+    EXPECT_NEAR(x1[3 * i + 1], gap, 1e-9) << "vertex " << i;  // where it started, not 0.2 mm
+    EXPECT_NEAR(v1[3 * i + 1], 0.0, 1e-7) << "vertex " << i;  // and at rest along the normal
+  }
+}
+
 TEST(SelfContactResponse, UntangleSeparatesAStartThatPassesThroughItself) {
   // The far part of the upper layer of a fold pushed 2 cm through the lower layer.
   const testing::FoldedSheet sheet = testing::folded_sheet(6, 0.3, 0.01);
