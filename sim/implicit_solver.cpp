@@ -37,10 +37,8 @@ void ImplicitSolver::add_extra_force(const ClothModel& model, const StepForces* 
     for (int k = 0; k < 3; ++k) force_.segment<3>(3 * corners[k]) += (s.weights[k] * f) * s.normal;
   }
   for (const PairSpring& s : extra->pair_springs) {
-    const double f =
-        s.stiffness * (s.target - along_pair_normal(s, x)) - s.damping * along_pair_normal(s, v);
-    for (int k = 0; k < 4; ++k)
-      force_.segment<3>(3 * s.vertices[k]) += (s.weights[k] * f) * s.normal;
+    const Eigen::Vector3d f = pair_spring_force(s, x, v);
+    for (int k = 0; k < 4; ++k) force_.segment<3>(3 * s.vertices[k]) += s.weights[k] * f;
   }
 }
 
@@ -105,18 +103,16 @@ void ImplicitSolver::assemble(const ClothModel& model, const ForceSettings& forc
     // pair where the two happen to be neighbours) go into matrix_; add_cross_blocks adds the
     // others on a widened pattern. The product term is exact.
     for (const PairSpring& s : extra->pair_springs) {
-      const Eigen::Matrix3d outer = s.normal * s.normal.transpose();
-      const double scale = beta * beta * s.stiffness + beta * s.damping;
       for (int k = 0; k < 4; ++k)
         for (int l = 0; l < 4; ++l) {
           const int i = s.vertices[k];
           const int offset =
               k == l ? model.pattern.diagonal_offsets[i] : block_offset(matrix_, i, s.vertices[l]);
           if (offset < 0) continue;
-          const double w = scale * s.weights[k] * s.weights[l];
+          const Eigen::Matrix3d block = pair_block(s, beta, k, l);
           for (int a = 0; a < 3; ++a)
             for (int b = 0; b < 3; ++b)
-              values[block_value_index(matrix_, i, offset, a, b)] += w * outer(a, b);
+              values[block_value_index(matrix_, i, offset, a, b)] += block(a, b);
         }
       if (u != nullptr) {
         const double along = along_pair_normal(s, *u);
@@ -140,16 +136,13 @@ void ImplicitSolver::add_cross_blocks(const ClothModel& model, double beta,
     Eigen::Matrix3d value;
   };
   std::vector<Block> blocks;
-  for (const PairSpring& s : extra->pair_springs) {
-    const Eigen::Matrix3d outer = s.normal * s.normal.transpose();
-    const double scale = beta * beta * s.stiffness + beta * s.damping;
+  for (const PairSpring& s : extra->pair_springs)
     for (int k = 0; k < 4; ++k)
       for (int l = 0; l < 4; ++l) {
         const int i = s.vertices[k], j = s.vertices[l];
         if (k == l || i == j || block_offset(matrix_, i, j) >= 0) continue;
-        blocks.push_back({i, j, (scale * s.weights[k] * s.weights[l]) * outer});
+        blocks.push_back({i, j, pair_block(s, beta, k, l)});
       }
-  }
   if (blocks.empty()) return;
   std::sort(blocks.begin(), blocks.end(), [](const Block& a, const Block& b) {
     return a.row != b.row ? a.row < b.row : a.column < b.column;

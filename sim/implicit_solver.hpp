@@ -94,6 +94,12 @@ inline double along_spring_normal(const PointSpring& spring, const std::array<in
 // such springs (CHOLMOD then analyses the widened pattern again). With only the blocks within
 // each side, the coupling across a pair was explicit and a compressed stack of layers gained
 // energy (docs/collision.md).
+//
+// Friction between the two layers enters the same way: a tangential dashpot on the pair's
+// relative velocity, f_k = −w_k c_t (I − n nᵀ) Σ_l w_l v_l (`friction` = c_t, kg/s), whose
+// blocks β c_t w_k w_l (I − n nᵀ) join the spring's (rank two, positive semi-definite). The
+// caller sizes c_t from Coulomb's law (sim/self_contact.cpp); a pair may carry friction alone
+// (stiffness and damping 0).
 struct PairSpring {
   std::array<int, 4> vertices{};
   Eigen::Vector4d weights = Eigen::Vector4d::Zero();
@@ -101,7 +107,37 @@ struct PairSpring {
   double target = 0.0;     // m
   double stiffness = 0.0;  // N/m
   double damping = 0.0;    // kg/s
+  double friction = 0.0;   // kg/s: the tangential dashpot c_t
 };
+
+// The pair's relative velocity Σ_k w_k v_k (3) for a 3n velocity vector v.
+inline Eigen::Vector3d pair_relative(const PairSpring& spring, const Eigen::VectorXd& v) {
+  Eigen::Vector3d relative = Eigen::Vector3d::Zero();
+  for (int k = 0; k < 4; ++k) relative += spring.weights[k] * v.segment<3>(3 * spring.vertices[k]);
+  return relative;
+}
+
+// The force of a pair spring (3, N) on a vertex of weight w is w times this: the spring along n
+// and the friction dashpot across it, at positions x and velocities v (3n each).
+inline Eigen::Vector3d pair_spring_force(const PairSpring& spring, const Eigen::VectorXd& x,
+                                         const Eigen::VectorXd& v) {
+  double along = 0.0;
+  for (int k = 0; k < 4; ++k)
+    along += spring.weights[k] * spring.normal.dot(x.segment<3>(3 * spring.vertices[k]));
+  const Eigen::Vector3d relative = pair_relative(spring, v);
+  const double speed = spring.normal.dot(relative);
+  return (spring.stiffness * (spring.target - along) - spring.damping * speed) * spring.normal -
+         spring.friction * (relative - speed * spring.normal);
+}
+
+// The 3×3 block of A for corners (k, l) of a pair spring: (β² k + β c) w_k w_l n nᵀ +
+// β c_t w_k w_l (I − n nᵀ).
+inline Eigen::Matrix3d pair_block(const PairSpring& spring, double beta, int k, int l) {
+  const Eigen::Matrix3d outer = spring.normal * spring.normal.transpose();
+  const double w = spring.weights[k] * spring.weights[l];
+  return (w * (beta * beta * spring.stiffness + beta * spring.damping)) * outer +
+         (w * beta * spring.friction) * (Eigen::Matrix3d::Identity() - outer);
+}
 
 inline double along_pair_normal(const PairSpring& spring, const Eigen::VectorXd& y) {
   double along = 0.0;

@@ -7,21 +7,30 @@
 //     a tenth of the way to `thickness` (a bounded repulsion, as Bridson et al. 2002 §7.2),
 //     critically damped, its stiffness m ω² sized from the pair's effective mass m = 1/Σ w_k²/m_k
 //     (as the body's piercing springs are), so its strength follows the cloth's resolution.
-//  2. Friction between the layers after the solve (Bridson et al. 2002 §7.2): each spring's normal
-//     impulse J = β F at the end of the step bounds the change of the pair's relative tangential
-//     velocity to μ J / m (Coulomb), μ the fabric's friction.
+//  2. Friction between the layers inside the same solve: every pair closer than `thickness` that
+//     carried a normal force in the last accepted steps (lagged, mean of two steps), or that gets
+//     a spring now, gets a tangential dashpot on its relative velocity, c_t = μ F / max(|v_t|,
+//     ε) with |v_t| the pair's tangential speed at the step's start (Coulomb's force μF for a
+//     sliding pair; a pair slower than ε = 1 mm/s is held as hard as μF allows, creeping at most
+//     ε·(tangential load / μF)), at most kMaxStick effective masses per β. The solve sees it, so
+//     a sticking pair holds its neighbours too (a post-solve impulse held only the pair's four
+//     vertices, and the t-shirt's underarm never came to rest).
 //  3. Fail-safe: a continuous test of the straight paths x0 → x1. Every colliding pair gets an
-//     inelastic impulse that lands it `kSeparation`·thickness apart on the side it came from
-//     (Gauss-Seidel over the pairs, `impulse_passes` times); pairs that still collide are merged
-//     into impact zones (Provot 1997; Bridson et al. 2002 §7.4) that move rigidly over the step
-//     (the mass-weighted translation and rotation of their vertices), growing until no path
-//     collides. A cloth that starts the step free of intersections ends it free of them.
+//     inelastic impulse that lands it `kSeparation`·thickness apart on the side it came from, or
+//     where it started when it started closer than that (Gauss-Seidel over the pairs,
+//     `impulse_passes` times); pairs that still collide are merged into impact zones (Provot 1997;
+//     Bridson et al. 2002 §7.4) that move rigidly over the step (the mass-weighted translation and
+//     rotation of their vertices), growing until no path collides. A cloth that starts the step
+//     free of intersections ends it free of them.
 //
 // Pinned vertices are immovable (infinite mass) in the impulses; a zone holding a pinned vertex
 // moves with the pins' mean displacement. Vertices the body's contact holds are heavy, so that
 // cloth pinched between cloth and body gives way on its free side rather than into the body.
 
 #include <Eigen/Core>
+#include <array>
+#include <cstddef>
+#include <unordered_map>
 #include <vector>
 
 #include "sim/cloth_model.hpp"
@@ -79,35 +88,58 @@ class SelfContactResponse {
                const std::vector<unsigned char>& pinned, int* found = nullptr,
                int* remaining = nullptr);
 
-  // Step 1: springs of the pairs closer than the thickness at `start` (3n) into extra, each
-  // pushing its pair a tenth of the way to the thickness; with `velocity` (3n, the step's start)
-  // none for pairs already separating faster than a fifth of that push over the step (beta, s).
-  // pinned: per vertex, 1 when the step's filter pins it.
+  // Steps 1 and 2: springs of the pairs closer than the thickness at `start` (3n) into extra,
+  // each pushing its pair a tenth of the way to the thickness; with `velocity` (3n, the step's
+  // start) none for pairs already separating faster than a fifth of that push over the step
+  // (beta, s). Every spring, and every separating pair that carried a normal force in the last
+  // accepted steps, gets the friction dashpot. pinned: per vertex, 1 when the step's filter
+  // pins it.
   void add_springs(const Eigen::VectorXd& start, const Eigen::VectorXd& mass,
                    const std::vector<unsigned char>& pinned, StepForces& extra,
                    const Eigen::VectorXd* velocity = nullptr, double beta = 0.0);
-  // Steps 2 and 3 on the solve's result: x1 (3n) and v1 change together (v1 += Δx1 / beta).
+  // Step 3 on the solve's result: x1 (3n) and v1 change together (v1 += Δx1 / beta). Records
+  // each pair's normal force (its spring's at the solve's end plus its impulses) for accept_step.
   // pinned: per vertex, 0 free, kHeldByBody for a vertex the body's contact constrains (it
   // weighs a thousand times its mass in the impulses and moves with its zone), else pinned.
   void resolve(const Eigen::VectorXd& x0, Eigen::VectorXd& x1, Eigen::VectorXd& v1, double beta,
                const Eigen::VectorXd& mass, const std::vector<unsigned char>& pinned,
                const StepForces& extra);
 
+  // The step was accepted: the normal forces resolve() measured become the lagged forces the
+  // next step's friction is sized from (a rejected attempt leaves them as they were).
+  void accept_step();
+
   const SelfContactStepStats& step_stats() const { return stats_; }
   SelfCollider& collider() { return collider_; }
 
+  // A pair of elements across steps: its kind and its four vertices (the same pair keeps them
+  // while the mesh does not change).
+  using PairKey = std::array<int, 5>;
+  struct PairKeyHash {
+    std::size_t operator()(const PairKey& key) const;
+  };
+
  private:
-  void apply_friction(Eigen::VectorXd& x1, Eigen::VectorXd& v1, double beta,
-                      const Eigen::VectorXd& mass, const std::vector<unsigned char>& pinned,
-                      const StepForces& extra) const;
-  // One Gauss-Seidel round of inelastic impulses over `hits`.
-  void apply_impulses(const std::vector<SelfPair>& hits, Eigen::VectorXd& x1,
-                      const Eigen::VectorXd& mass, const std::vector<unsigned char>& pinned) const;
+  // One Gauss-Seidel round of inelastic impulses over `hits`; each impulse's force (impulse/β²
+  // in these position units) is added to the pair's normal force of the step.
+  void apply_impulses(const std::vector<SelfPair>& hits, const Eigen::VectorXd& x0,
+                      Eigen::VectorXd& x1, double beta, const Eigen::VectorXd& mass,
+                      const std::vector<unsigned char>& pinned);
+  // N: the normal force the pair carried over the last two accepted steps (their mean; 0 for a
+  // pair that carried none).
+  double lagged_force(const PairKey& key) const;
 
   SelfContactSettings settings_;
   SelfCollider collider_;
   double fabric_friction_ = 0.3;
   SelfContactStepStats stats_;
+  // Friction between layers is sized from the normal force each pair carried in the accepted
+  // steps before (lagged, as Li et al. 2020 lag it in IPC): per pair, the force of the last
+  // step and of the one before it.
+  std::unordered_map<PairKey, std::array<double, 2>, PairKeyHash> lagged_;
+  std::unordered_map<PairKey, double, PairKeyHash> step_force_;  // this attempt's, N
+  std::vector<PairKey> spring_keys_;  // the key of each pair spring added this attempt
+  std::size_t first_spring_ = 0;      // index of this response's first spring in the extra forces
 };
 
 }  // namespace sd::sim

@@ -404,6 +404,7 @@ void Simulation::accept(Attempt& attempt, double h) {
     contact_->accept_step(attempt.solve.constraint_impulse);
   }
   if (self_contact_) {
+    self_contact_->accept_step();
     const SelfContactStepStats& stats = self_contact_->step_stats();
     report_.self_contacts_max = std::max(report_.self_contacts_max, stats.springs);
     report_.self_contacts_final = stats.springs;

@@ -142,6 +142,76 @@ TEST(ImplicitSolver, PairSpringsAcrossTheMeshAreImplicitExactly) {
   }
 }
 
+// The friction between layers is a tangential dashpot on the pair's relative velocity. Its
+// blocks, and the spring's, must be the force's derivatives: −β ∂f/∂v − β² ∂f/∂x by central
+// differences of pair_spring_force (the force the solver adds) equals pair_block for every
+// corner pair; and the solver's matrix with the spring minus the one without is exactly those
+// blocks, across the pair (outside the mesh's pattern) too.
+TEST(ImplicitSolver, PairFrictionBlocksAreTheForceDerivatives) {
+  PairSpring spring;
+  spring.vertices = {3, 0, 1, 2};
+  spring.weights << 1.0, -0.2, -0.5, -0.3;
+  spring.normal = Vector3d(0.2, 1.0, -0.3).normalized();
+  spring.target = 0.004;
+  spring.stiffness = 30.0;
+  spring.damping = 0.4;
+  spring.friction = 2.5;
+  const double beta = 1.0 / 60.0;
+  Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(18, -0.1, 0.2);
+  Eigen::VectorXd v = Eigen::VectorXd::LinSpaced(18, 0.3, -0.2);
+  const double step = 1e-6;
+  for (int k = 0; k < 4; ++k)
+    for (int l = 0; l < 4; ++l) {
+      Eigen::Matrix3d numeric;
+      for (int b = 0; b < 3; ++b) {
+        const int column = 3 * spring.vertices[l] + b;
+        Eigen::VectorXd xp = x, xm = x, vp = v, vm = v;
+        xp[column] += step;
+        xm[column] -= step;
+        vp[column] += step;
+        vm[column] -= step;
+        const Vector3d dfdx =
+            spring.weights[k] *
+            (pair_spring_force(spring, xp, v) - pair_spring_force(spring, xm, v)) / (2.0 * step);
+        const Vector3d dfdv =
+            spring.weights[k] *
+            (pair_spring_force(spring, x, vp) - pair_spring_force(spring, x, vm)) / (2.0 * step);
+        numeric.col(b) = -beta * dfdv - beta * beta * dfdx;
+      }
+      EXPECT_LT((numeric - pair_block(spring, beta, k, l)).norm(),
+                1e-8 * pair_block(spring, beta, k, l).norm() + 1e-12)
+          << "block " << k << ", " << l;
+    }
+
+  // In the assembled matrix: the two triangles of PairSpringsAcrossTheMeshAreImplicitExactly.
+  ClothInput input;
+  input.rest_positions.resize(6, 3);
+  input.rest_positions << 0.0, 0.0, 0.0, 0.0, 0.0, 0.1, 0.1, 0.0, 0.0, 0.0, 0.003, 0.0, 0.0, 0.003,
+      0.1, 0.1, 0.003, 0.0;
+  input.triangles.resize(2, 3);
+  input.triangles << 0, 1, 2, 3, 4, 5;
+  const ClothModel model = build_cloth_model(input, fabric_preset("cotton"));
+  ForceSettings forces;
+  const Eigen::VectorXd x0 = flatten_positions(input.rest_positions);
+  const Eigen::VectorXd v0 = Eigen::VectorXd::Zero(18);
+  const ConstraintFilter filter(6);
+  NewtonSettings settings;
+  settings.solver = LinearSolverKind::cholmod;
+  StepForces extra;
+  extra.pair_springs.push_back(spring);
+  ImplicitSolver with, without;
+  with.solve(model, forces, filter, x0, v0, beta, x0, v0, settings, &extra);
+  without.solve(model, forces, filter, x0, v0, beta, x0, v0, settings);
+  const Eigen::MatrixXd difference =
+      Eigen::MatrixXd(with.matrix()) - Eigen::MatrixXd(without.matrix());
+  Eigen::MatrixXd expected = Eigen::MatrixXd::Zero(18, 18);
+  for (int k = 0; k < 4; ++k)
+    for (int l = 0; l < 4; ++l)
+      expected.block<3, 3>(3 * spring.vertices[k], 3 * spring.vertices[l]) +=
+          pair_block(spring, beta, k, l);
+  EXPECT_LT((difference - expected).cwiseAbs().maxCoeff(), 1e-12 * expected.cwiseAbs().maxCoeff());
+}
+
 // A system CHOLMOD cannot factorise (not positive definite: a spring of negative stiffness
 // strong enough to make m + β²k < 0 along the normal) must never yield a zero step taken for a
 // solution (it did: the factorisation failed, the step was zero and, at the minimum step size,
