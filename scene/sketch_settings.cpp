@@ -133,9 +133,10 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
   }
   if (j.contains("solver")) {
     sim.solver = r.text(j["solver"], path + "/solver");
-    if (sim.solver != "pcg" && sim.solver != "cholmod" && sim.solver != "auto")
+    if (sim.solver != "pcg" && sim.solver != "cholmod" && sim.solver != "auto" &&
+        sim.solver != "pcg-two-level")
       r.fail(path + "/solver", fmt::format("unknown solver '{}'; use \"auto\" (the default), "
-                                           "\"pcg\" or \"cholmod\"",
+                                           "\"pcg\", \"pcg-two-level\" or \"cholmod\"",
                                            sim.solver));
   }
   if (j.contains("bending")) {

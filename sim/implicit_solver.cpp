@@ -11,7 +11,7 @@ std::string_view solver_name(LinearSolverKind solver) {
 }
 
 std::optional<LinearSolverKind> parse_solver(std::string_view name) {
-  if (name == "pcg") return LinearSolverKind::pcg;
+  if (name == "pcg" || name == "pcg-two-level") return LinearSolverKind::pcg;
   if (name == "cholmod") return LinearSolverKind::cholmod;
   return std::nullopt;
 }

@@ -307,7 +307,7 @@ TEST(BenchScaling, SmallSheetsGiveEveryPointAndAFit) {
   for (const char* name : {"scaling.csv", "scaling.md", "scaling.json"})
     EXPECT_TRUE(fs::exists(dir / "out" / name)) << name;
   const nlohmann::json json = read_json(dir / "out" / "scaling.json");
-  ASSERT_EQ(json.at("points").size(), 4u);  // 2 sizes × 2 solvers
+  ASSERT_EQ(json.at("points").size(), 6u);  // 2 sizes × 3 solvers
   for (const auto& p : json.at("points")) {
     const int n = p.at("quads_per_side").get<int>();
     EXPECT_EQ(p.at("vertices").get<int>(), (n + 1) * (n + 1));
@@ -320,7 +320,7 @@ TEST(BenchScaling, SmallSheetsGiveEveryPointAndAFit) {
     EXPECT_LT(std::abs(p.at("cpu_step_s").get<double>()), 1.0);
     EXPECT_GT(p.at("peak_rss_mb").get<double>(), 1.0);
   }
-  ASSERT_EQ(json.at("fits").size(), 2u);
+  ASSERT_EQ(json.at("fits").size(), 3u);
   for (const auto& f : json.at("fits")) {
     int positive = 0;
     for (const auto& p : json.at("points"))

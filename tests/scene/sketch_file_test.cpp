@@ -234,7 +234,7 @@ TEST(SketchFile, ErrorsCarryFilePathAndSentence) {
       {R"({"sheet": {"size": [1, 1], "resolution": [4, 4]}, "simulate": {"time_step": "fast"}})",
        "/simulate/time_step", "or \"auto\""},
       {R"({"sheet": {"size": [1, 1], "resolution": [4, 4]}, "simulate": {"solver": "lu"}})",
-       "/simulate/solver", "use \"auto\" (the default), \"pcg\" or \"cholmod\""},
+       "/simulate/solver", "use \"auto\" (the default), \"pcg\", \"pcg-two-level\" or \"cholmod\""},
   };
   for (const Case& c : cases) {
     const SketchError e = error_of(c.text);

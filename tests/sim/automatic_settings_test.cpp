@@ -5,19 +5,22 @@
 namespace sd::sim {
 namespace {
 
-TEST(AutomaticSettings, PcgUpToTheThresholdThenCholmod) {
+TEST(AutomaticSettings, IncompleteCholeskyUpToTheThresholdThenTwoLevel) {
   SceneTraits scene;
-  scene.vertices = kAutomaticCholmodVertices;
+  scene.vertices = kAutomaticTwoLevelVertices;
   AutomaticChoice choice = choose_settings(scene);
   EXPECT_EQ(choice.integrator, Integrator::implicit_euler);
   EXPECT_EQ(choice.solver, LinearSolverKind::pcg);
   EXPECT_EQ(choice.preconditioner, PcgPreconditioner::block_incomplete_cholesky);
-  scene.vertices = kAutomaticCholmodVertices + 1;
-  EXPECT_EQ(choose_settings(scene).solver, LinearSolverKind::cholmod);
+  scene.vertices = kAutomaticTwoLevelVertices + 1;
+  choice = choose_settings(scene);
+  EXPECT_EQ(choice.solver, LinearSolverKind::pcg);
+  EXPECT_EQ(choice.preconditioner, PcgPreconditioner::two_level);
+  EXPECT_NE(choice.reason.find("two-level"), std::string::npos) << choice.reason;
   // An adaptive cloth is judged by the most it may grow to.
   scene.vertices = 1000;
   scene.max_vertices = 20000;
-  EXPECT_EQ(choose_settings(scene).solver, LinearSolverKind::cholmod);
+  EXPECT_EQ(choose_settings(scene).preconditioner, PcgPreconditioner::two_level);
 }
 
 TEST(AutomaticSettings, SelfContactTakesCholmodAndShorterSteps) {

@@ -151,7 +151,7 @@ void run_scaling_study(const BenchOptions& options, const GlobalOptions& global)
   for (const std::string& solver : o.solvers)
     if (!sim::parse_solver(solver))
       throw std::invalid_argument(
-          fmt::format("--solver: '{}' is not a solver (cholmod or pcg)", solver));
+          fmt::format("--solver: '{}' is not a solver (cholmod, pcg or pcg-two-level)", solver));
   const fs::path exe = fs::read_symlink("/proc/self/exe");
   const fs::path dir = options.out;
   WorkDir work{fs::temp_directory_path() / fmt::format("sketchdrape-scaling-{}", getpid())};
@@ -444,7 +444,7 @@ void add_bench_command(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--sizes", options->scaling_options.sizes,
                   "With --scaling: quads a side (default 32 64 128 256)");
   cmd->add_option("--solver", options->scaling_options.solvers,
-                  "With --scaling: cholmod, pcg or both (default both)");
+                  "With --scaling: cholmod, pcg, pcg-two-level (default all three)");
   cmd->add_option("--steps", options->scaling_options.steps,
                   "With --scaling: steps of 1/60 s per run (default 10)")
       ->check(CLI::Range(2, 10000));

@@ -314,6 +314,8 @@ sim::SimulationSettings simulation_settings(const scene::Sketch& sketch) {
   settings.integrator =
       sim::parse_integrator(spec.integrator).value_or(sim::Integrator::implicit_euler);
   settings.solver = sim::parse_solver(spec.solver).value_or(sim::LinearSolverKind::cholmod);
+  if (spec.solver == "pcg-two-level")
+    settings.pcg_preconditioner = sim::PcgPreconditioner::two_level;
   settings.dt = spec.time_step;
   settings.min_dt = std::min(settings.min_dt, spec.time_step / 64);
   settings.duration = spec.duration;

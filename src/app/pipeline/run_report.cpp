@@ -179,6 +179,7 @@ nlohmann::json run_report_json(const RunReport& r) {
   out["settings"]["preconditioner"] =
       r.settings.solver == sim::LinearSolverKind::pcg
           ? (r.settings.pcg_preconditioner == sim::PcgPreconditioner::block_jacobi ? "block-jacobi"
+             : r.settings.pcg_preconditioner == sim::PcgPreconditioner::two_level  ? "two-level"
                                                                                    : "block-ic0")
           : "none";
   out["settings"]["automatic"] =
