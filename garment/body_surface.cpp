@@ -67,7 +67,7 @@ Eigen::Vector3d nearest_on_triangle(const Eigen::Vector3d& p, const Eigen::Vecto
 // point is not unique (a tie, below) CGAL's tree still answers: garments mesh as before.
 class ClosestPointTree {
  public:
-  static constexpr int kLeafSize = 4;
+  static constexpr int kLeafSize = 2;
 
   explicit ClosestPointTree(const meshing::TriMesh& mesh) : mesh_(mesh) {
     const auto nf = static_cast<int>(mesh.face_count());
@@ -78,6 +78,21 @@ class ClosestPointTree {
       centroids_[static_cast<size_t>(f)] = (corner(f, 0) + corner(f, 1) + corner(f, 2)) / 3;
     nodes_.reserve(static_cast<size_t>(2 * nf / kLeafSize + 2));
     build(0, nf);
+    // The triangles in tree order, so that a leaf reads one contiguous block (the mesh's
+    // vertex matrix is column-major and indexed through the faces: three scattered reads per
+    // corner), with each one's plane.
+    packed_.resize(static_cast<size_t>(nf));
+    for (int k = 0; k < nf; ++k) {
+      const int f = order_[static_cast<size_t>(k)];
+      Packed& t = packed_[static_cast<size_t>(k)];
+      t.a = corner(f, 0);
+      t.b = corner(f, 1);
+      t.c = corner(f, 2);
+      t.normal = (t.b - t.a).cross(t.c - t.a);
+      const double length = t.normal.norm();
+      t.normal = length > 0 ? Eigen::Vector3d(t.normal / length) : Eigen::Vector3d::Zero();
+      t.plane = t.normal.dot(t.a);
+    }
   }
 
   // The nearest point's face and position; `hint` (a face, or -1) bounds the search first.
@@ -100,8 +115,9 @@ class ClosestPointTree {
     std::array<std::pair<double, Eigen::Vector3d>, 8> near;
     size_t near_count = 0;
     bool overflow = false;
-    const auto consider = [&](int f) {
-      const Eigen::Vector3d q = nearest_on_triangle(p, corner(f, 0), corner(f, 1), corner(f, 2));
+    const auto consider = [&](int f, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                              const Eigen::Vector3d& c) {
+      const Eigen::Vector3d q = nearest_on_triangle(p, a, b, c);
       const double d = (q - p).squaredNorm();
       if (!(d <= bound)) return;
       if (near_count < near.size())
@@ -115,7 +131,8 @@ class ClosestPointTree {
         bound = std::pow(std::sqrt(best) + kTie, 2);
       }
     };
-    if (hint >= 0 && hint < static_cast<int>(order_.size())) consider(hint);
+    if (hint >= 0 && hint < static_cast<int>(order_.size()))
+      consider(hint, corner(hint, 0), corner(hint, 1), corner(hint, 2));
     std::array<int, 64> stack;
     int top = 0;
     stack[static_cast<size_t>(top++)] = 0;
@@ -123,8 +140,14 @@ class ClosestPointTree {
       const Node& node = nodes_[static_cast<size_t>(stack[static_cast<size_t>(--top)])];
       if (box_distance(node, p) > bound) continue;
       if (node.count > 0) {
-        for (int k = node.first; k < node.first + node.count; ++k)
-          consider(order_[static_cast<size_t>(k)]);
+        for (int k = node.first; k < node.first + node.count; ++k) {
+          const Packed& t = packed_[static_cast<size_t>(k)];
+          // The distance from the triangle's plane is a lower bound of the distance from
+          // the triangle: most of a leaf's triangles are passed over on it.
+          const double plane = t.normal.dot(p) - t.plane;
+          if (plane * plane > bound) continue;
+          consider(order_[static_cast<size_t>(k)], t.a, t.b, t.c);
+        }
         continue;
       }
       const int left = node.first, right = node.second;
@@ -200,7 +223,14 @@ class ClosestPointTree {
     return index;
   }
 
+  struct Packed {
+    Eigen::Vector3d a, b, c;
+    Eigen::Vector3d normal;  // unit (zero for a degenerate triangle)
+    double plane = 0;        // normal · a
+  };
+
   const meshing::TriMesh& mesh_;
+  std::vector<Packed> packed_;  // the triangles in tree order: packed_[k] is face order_[k]
   std::vector<int> order_;
   std::vector<Eigen::Vector3d> centroids_;
   std::vector<Node> nodes_;

@@ -177,11 +177,15 @@ void untangle(std::vector<Eigen::Vector3d>& x, std::span<const Quad> quads,
               std::span<const char> fixed, const Projection& project,
               const std::vector<size_t>* suspects = nullptr) {
   const size_t nf = quads.size(), nv = x.size();
-  auto around = [&](size_t v) {  // smallest scaled Jacobian of the quads at v
+  // Smallest scaled Jacobian of the quads at v; once it is at most `floor` the rest are not
+  // looked at (a candidate that cannot win: most of the pattern search's, which was 17 % of
+  // a folding garment's meshing time), so only values above `floor` are exact.
+  auto around = [&](size_t v, double floor = -std::numeric_limits<double>::infinity()) {
     double worst = std::numeric_limits<double>::infinity();
     for (int c = adj.corner_start[v]; c < adj.corner_start[v + 1]; ++c) {
       const auto f = static_cast<size_t>(adj.corners[static_cast<size_t>(c)] / 4);
       worst = std::min(worst, quad_min_jacobian(quads[f], normals[f], x));
+      if (worst <= floor) break;
     }
     return worst;
   };
@@ -236,7 +240,7 @@ void untangle(std::vector<Eigen::Vector3d>& x, std::span<const Quad> quads,
         for (int k = 0; k < 8; ++k) {
           const auto& [c, s] = kCompass[static_cast<size_t>(k)];
           x[v] = start + step * (c * t1 + s * t2);
-          const double value = around(v);
+          const double value = around(v, best + 1e-12);
           if (value > best + 1e-12) {
             best = value;
             best_position = x[v];
