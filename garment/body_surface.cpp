@@ -321,6 +321,7 @@ SurfacePoint BodySurface::Impl::answer(const Eigen::Vector3d& p, int hint,
   s.face = face;
   s.normal = normal_at(s.face, s.position);
   s.distance = (s.position - p).norm();
+  s.tied = tied;
   return s;
 }
 

@@ -15,6 +15,9 @@ struct SurfacePoint {
   Eigen::Vector3d normal;    // unit, outward: vertex normals interpolated barycentrically
   int face = -1;             // body triangle
   double distance = 0;       // from the query point (closest point) or the ray origin (hit)
+  // closest_point only: another, different surface point is as near (within 1e-10 m; a point
+  // on a symmetric body's mirror plane), and this one is the tree's choice among them.
+  bool tied = false;
 };
 
 class BodySurface {

@@ -109,14 +109,18 @@ std::array<Eigen::Vector3d, 4> quad_edges(const Quad& q, const std::vector<Eigen
 }
 
 // Smallest scaled Jacobian over the four corners of quad q at positions x.
+// Once a corner is at most `floor` the others are not looked at: only values above `floor`
+// are exact (the untangling's candidates that cannot win).
 double quad_min_jacobian(const Quad& q, const Eigen::Vector3d& normal,
-                         const std::vector<Eigen::Vector3d>& x) {
+                         const std::vector<Eigen::Vector3d>& x,
+                         double floor = -std::numeric_limits<double>::infinity()) {
   const auto e = quad_edges(q, x);
   double worst = std::numeric_limits<double>::infinity();
   for (size_t k = 0; k < 4; ++k) {
     const Eigen::Vector3d& before = e[(k + 3) % 4];
     const double denom = std::sqrt(before.squaredNorm() * e[k].squaredNorm());
     worst = std::min(worst, denom > 0 ? before.cross(e[k]).dot(normal) / denom : -1.0);
+    if (worst <= floor) break;
   }
   return worst;
 }
@@ -184,7 +188,7 @@ void untangle(std::vector<Eigen::Vector3d>& x, std::span<const Quad> quads,
     double worst = std::numeric_limits<double>::infinity();
     for (int c = adj.corner_start[v]; c < adj.corner_start[v + 1]; ++c) {
       const auto f = static_cast<size_t>(adj.corners[static_cast<size_t>(c)] / 4);
-      worst = std::min(worst, quad_min_jacobian(quads[f], normals[f], x));
+      worst = std::min(worst, quad_min_jacobian(quads[f], normals[f], x, floor));
       if (worst <= floor) break;
     }
     return worst;
