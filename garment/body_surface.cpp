@@ -96,15 +96,21 @@ class ClosestPointTree {
   }
 
   // The nearest point's face and position; `hint` (a face, or -1) bounds the search first.
-  // `tied` is set when another triangle holds a different point within kTie of the same
-  // distance: a point on a symmetric body's mirror plane (a centre seam between the legs of
-  // the Collada human) is equally near to both sides, and which side wins is then only a
-  // matter of traversal order and rounding. The caller lets CGAL's tree decide those, so
-  // that the answer is always CGAL's (docs/benchmarks.md).
+  // `tied` is set when another triangle comes within kTie of the same distance: the nearest
+  // point lies on an edge or a corner the triangles share, or is not unique at all (a point on
+  // a symmetric body's mirror plane, a centre seam between the legs of the Collada human, is
+  // as near to both sides). Which triangle wins is then a matter of traversal order and
+  // rounding, and the caller lets CGAL's tree decide, so that every answer is CGAL's to the
+  // bit (docs/benchmarks.md: a drape with self-collision amplifies a difference of 1e-16 m).
   struct Found {
     int face = -1;
     Eigen::Vector3d point = Eigen::Vector3d::Zero();
     bool tied = false;
+    // Every triangle within kTie of the nearest distance (the nearest first), when they all
+    // fit; `overflow` otherwise.
+    std::array<int, 8> near_faces{};
+    size_t near_count = 0;
+    bool overflow = false;
   };
   Found closest(const Eigen::Vector3d& p, int hint) const {
     Found found;
@@ -112,7 +118,7 @@ class ClosestPointTree {
     double bound = best;  // (√best + kTie)²: boxes farther than this cannot hold a rival
     // Candidates within `bound` when they were seen, sorted out at the end; more than the
     // array holds counts as a tie (CGAL decides).
-    std::array<std::pair<double, Eigen::Vector3d>, 8> near;
+    std::array<std::pair<double, int>, 8> near;  // squared distance, face
     size_t near_count = 0;
     bool overflow = false;
     const auto consider = [&](int f, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
@@ -121,7 +127,7 @@ class ClosestPointTree {
       const double d = (q - p).squaredNorm();
       if (!(d <= bound)) return;
       if (near_count < near.size())
-        near[near_count++] = {d, q};
+        near[near_count++] = {d, f};
       else
         overflow = true;
       if (d < best) {
@@ -163,17 +169,22 @@ class ClosestPointTree {
       }
     }
     found.tied = overflow;
-    for (size_t k = 0; k < near_count && !found.tied; ++k)
-      found.tied = near[k].first <= bound && (near[k].second - found.point).norm() > kSamePoint;
+    found.overflow = overflow;
+    if (found.face >= 0) found.near_faces[found.near_count++] = found.face;
+    for (size_t k = 0; k < near_count; ++k) {
+      const int f = near[k].second;
+      if (!(near[k].first <= bound) || f == found.face) continue;
+      found.tied = true;
+      if (std::find(found.near_faces.begin(), found.near_faces.begin() + found.near_count, f) ==
+          found.near_faces.begin() + found.near_count)
+        found.near_faces[found.near_count++] = f;  // fits: near_count ≤ near.size()
+    }
     return found;
   }
 
-  // Distances within kTie (m) are ties; points within kSamePoint (m) are one point (a shared
-  // edge or corner of the welded body, where every face gives the same smooth normal). Both
-  // are far above the rounding of either computation (~1e-15 m on a body of 2 m) and far
-  // below anything a garment can see.
+  // Distances within kTie (m) are ties: far above the rounding of either computation (~1e-15 m
+  // on a body of 2 m), so that a triangle this tree finds alone is the one CGAL's finds.
   static constexpr double kTie = 1e-10;
-  static constexpr double kSamePoint = 1e-9;
 
  private:
   struct Node {
@@ -304,24 +315,61 @@ SurfacePoint BodySurface::closest_point(const Eigen::Vector3d& p, const SurfaceP
 
 SurfacePoint BodySurface::Impl::answer(const Eigen::Vector3d& p, int hint,
                                        const Eigen::Vector3d& hint_point) const {
-  auto [face, point, tied] = nearest->closest(p, hint);
-  // A tie, or no distance compared (a coordinate that is not a number): CGAL decides, with
-  // the same hint, as it did before this tree.
-  if (face < 0 || tied) {
-    const auto [found, id] =
+  const ClosestPointTree::Found found = nearest->closest(p, hint);
+  int face = found.face;
+  Eigen::Vector3d point = found.point;
+  // The answer of CGAL's tree, to the bit (the garments mesh as they did with it; a drape with
+  // self-collision amplifies a difference of 1e-16 m): its point on a triangle is CGAL's
+  // projection (Ericson's formula differs from it by rounding), and among the triangles as
+  // near as the nearest (within kTie: the nearest point on an edge or a corner they share, or
+  // equally near points on a symmetric body's mirror plane) the tree keeps the last one it
+  // visits that is not farther than the one it holds, starting from the hint. So where one
+  // projection is strictly nearest by CGAL's own comparison, the tree ends on it, or on the
+  // hint, when that is nearer still (a hint a rounding error away on the same triangle);
+  // otherwise the order of its traversal decides and the tree itself is asked.
+  bool decided = false;
+  const Point query = to_cgal(p);
+  if (face >= 0 && !found.overflow && (hint >= 0 || found.near_count == 1)) {
+    // Without a hint CGAL starts from a point of its own search tree, which can be as near as
+    // the nearest only when several triangles are (a corner): those go to the tree.
+    std::array<Point, 8> projected;
+    projected.fill(query);
+    size_t nearest_k = 0;
+    for (size_t k = 0; k < found.near_count; ++k) {
+      projected[k] = Kernel::Construct_projected_point_3()(
+          triangles[static_cast<size_t>(found.near_faces[k])], query);
+      if (Kernel::Compare_distance_3()(query, projected[k], projected[nearest_k]) == CGAL::SMALLER)
+        nearest_k = k;
+    }
+    decided = true;
+    for (size_t k = 0; k < found.near_count && decided; ++k)
+      decided = k == nearest_k || Kernel::Compare_distance_3()(
+                                      query, projected[k], projected[nearest_k]) == CGAL::LARGER;
+    if (decided) {
+      face = found.near_faces[nearest_k];
+      point = to_eigen(projected[nearest_k]);
+      if (hint >= 0 && Kernel::Compare_distance_3()(query, projected[nearest_k],
+                                                    to_cgal(hint_point)) == CGAL::LARGER) {
+        face = hint;
+        point = hint_point;
+      }
+    }
+  }
+  if (!decided) {
+    const auto [cgal_point, id] =
         hint >= 0 ? tree.closest_point_and_primitive(
-                        to_cgal(p), Tree::Point_and_primitive_id(to_cgal(hint_point),
-                                                                 triangles.cbegin() + hint))
-                  : tree.closest_point_and_primitive(to_cgal(p));
+                        query, Tree::Point_and_primitive_id(to_cgal(hint_point),
+                                                            triangles.cbegin() + hint))
+                  : tree.closest_point_and_primitive(query);
     face = static_cast<int>(id - triangles.cbegin());
-    point = to_eigen(found);
+    point = to_eigen(cgal_point);
   }
   SurfacePoint s;
   s.position = point;
   s.face = face;
   s.normal = normal_at(s.face, s.position);
   s.distance = (s.position - p).norm();
-  s.tied = tied;
+  s.tied = found.tied;
   return s;
 }
 

@@ -112,8 +112,8 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
   const double outside = (body.box().max - body.box().min).norm();
   // The answers by query point, bit for bit: a fill asks again for points it asked before
   // (a vertex whose neighbours did not move, the untangling's candidates): 28 % of the
-  // raglan's and the shorts' queries. A point with equally near body points is not kept (which
-  // of them the tree answers may depend on the hint).
+  // raglan's and the shorts' queries. A point with equally near body triangles is not kept
+  // (which of them the tree answers may depend on the hint).
   struct Answer {
     SurfacePoint nearest;  // the body's closest point (the hint it leaves)
     SurfacePoint chosen;   // what `closest` returns
