@@ -126,11 +126,31 @@ std::vector<LoopEdge> resolve_explicit(const GarmentRequest& sketch, const Curve
     if (meet) continue;
     const NodeGap gap = node_gap(net, a, b);
     const std::string& next = panel.boundary[(i + 1) % k];
-    const std::string where = fmt::format(
-        "(their junctions are {:.1f} cm apart, '{}' at {} m and '{}' at {} m; curves "
-        "meet when their ends are within {:.1f} cm{})",
-        gap.distance * 100, panel.boundary[i], at(gap.on_a), next, at(gap.on_b),
-        sketch.junction_tolerance * 100, gap_advice(sketch, panel.boundary[i], next));
+    // A curve of the sketch that runs from one to the other and is not in the list: the seam
+    // the designer left out (a side seam forgotten between the armhole and the hem).
+    std::string missing;
+    for (size_t c = 0; c < net.curves.size() && missing.empty(); ++c) {
+      const int ci = static_cast<int>(c);
+      if (std::find(curve_ids.begin(), curve_ids.end(), ci) != curve_ids.end()) continue;
+      bool meets_a = false, meets_b = false;
+      for (const int node : net.curves[c].nodes) {
+        meets_a = meets_a || curve_has_node(net, a, node);
+        meets_b = meets_b || curve_has_node(net, b, node);
+      }
+      if (meets_a && meets_b) missing = net.curves[c].id;
+    }
+    const std::string where =
+        !missing.empty()
+            ? fmt::format(
+                  "(curve '{}' runs from one to the other: is it missing from the list "
+                  "between them? their junctions are {:.1f} cm apart, '{}' at {} m and "
+                  "'{}' at {} m)",
+                  missing, gap.distance * 100, panel.boundary[i], at(gap.on_a), next, at(gap.on_b))
+            : fmt::format(
+                  "(their junctions are {:.1f} cm apart, '{}' at {} m and '{}' at {} m; "
+                  "curves meet when their ends are within {:.1f} cm{})",
+                  gap.distance * 100, panel.boundary[i], at(gap.on_a), next, at(gap.on_b),
+                  sketch.junction_tolerance * 100, gap_advice(sketch, panel.boundary[i], next));
     if (i + 1 == k)
       sketch.fail(fmt::format("{}/boundary", panel.json_path),
                   fmt::format("panel '{}' does not close: its last curve '{}' does not meet its "
