@@ -12,8 +12,11 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <numeric>
+#include <set>
 #include <sstream>
+#include <string>
 
 #include "garment/input_checks.hpp"
 #include "garment/sketch_ranges.hpp"
@@ -410,7 +413,13 @@ Body load_body(const std::string& path, const BodyOptions& options) {
   raw.shift = Eigen::Vector3d(-box.centre().x(), -box.min.y(), -box.centre().z());
   mesh.vertices.rowwise() += raw.shift.transpose();
   body.mesh = std::move(mesh);
-  for (const auto& warning : body.warnings) spdlog::warn("{}", warning);
+  // Said once per process: a sketch whose points name landmarks loads its body while it is
+  // read and again to mesh it, and the designer saw each repair twice.
+  static std::mutex mutex;
+  static std::set<std::string> said;
+  const std::lock_guard lock(mutex);
+  for (const auto& warning : body.warnings)
+    if (said.insert(fmt::format("{}: {}", file, warning)).second) spdlog::warn("{}", warning);
   return body;
 }
 

@@ -15,6 +15,10 @@ struct SurfacePoint {
   Eigen::Vector3d normal;    // unit, outward: vertex normals interpolated barycentrically
   int face = -1;             // body triangle
   double distance = 0;       // from the query point (closest point) or the ray origin (hit)
+  // closest_point only: another triangle is as near (within 1e-10 m): the point lies on an
+  // edge or corner they share, or another surface point is as near (a point on a symmetric
+  // body's mirror plane); the face (and the point, in the second case) is the tree's choice.
+  bool tied = false;
 };
 
 class BodySurface {

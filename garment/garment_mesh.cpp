@@ -420,6 +420,25 @@ Garment build_garment(const GarmentRequest& sketch, const BodySurface& body) {
     panel.fabric = spec.fabric;
     panel.mirror_copy = loop.mirror_copy;
     panel.ease = spec.ease;
+    if (spec.corners.empty() && !spec.auto_boundary) {
+      // Each corner's name as "corners" gives it: the curve listed later of the two that meet
+      // there (docs/sketch-format.md), in the order of the file's list.
+      const int count = static_cast<int>(spec.boundary.size());
+      const size_t m = loop.edges.size();
+      std::vector<std::pair<int, double>> named;
+      for (const int k : loop.side_begin) {
+        const int a = loop.edges[(static_cast<size_t>(k) + m - 1) % m].boundary;
+        const int b = loop.edges[static_cast<size_t>(k)].boundary;
+        if (a == b) {  // a corner inside one curve cannot be named
+          named.clear();
+          break;
+        }
+        named.emplace_back((a + 1) % count == b ? b : a, loop.turning_deg[static_cast<size_t>(k)]);
+      }
+      std::sort(named.begin(), named.end());
+      for (const auto& [index, turning] : named)
+        panel.turning_corners.emplace_back(spec.boundary[static_cast<size_t>(index)], turning);
+    }
     for (const LoopEdge& e : loop.edges) {
       panel.curves.push_back(
           net.curves[static_cast<size_t>(net.edges[static_cast<size_t>(e.edge)].curve)].id);

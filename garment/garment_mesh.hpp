@@ -50,6 +50,11 @@ struct GarmentPanel {
   double max_body_gap = 0;   // m: largest |distance to body − offset| of on-body vertices
   std::string fit = "body";  // how the interior was shaped: "body" or "free"
   double span_gap = 0;       // m: farthest the spanned surface stands off the offset surface
+  // The corners found by turning angle (empty when the panel lists "corners" or a corner lies
+  // inside one curve): the curve that begins at each, as "corners" names it, in the order of
+  // the panel's boundary list, with the turning angle in degrees. The quality gate suggests
+  // the list without the gentlest one.
+  std::vector<std::pair<std::string, double>> turning_corners;
 };
 
 struct Garment {

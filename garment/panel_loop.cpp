@@ -9,6 +9,7 @@
 #include <map>
 #include <numbers>
 #include <optional>
+#include <string>
 
 #include "garment/network_faces.hpp"
 
@@ -62,13 +63,45 @@ bool curve_has_node(const CurveNetwork& net, int c, int node) {
   return std::find(nodes.begin(), nodes.end(), node) != nodes.end();
 }
 
-double node_gap(const CurveNetwork& net, int a, int b) {
-  double best = std::numeric_limits<double>::infinity();
+// The nearest junctions of curves a and b: the gap a designer has to close, where it is.
+struct NodeGap {
+  double distance = std::numeric_limits<double>::infinity();
+  Eigen::Vector3d on_a = Eigen::Vector3d::Zero(), on_b = Eigen::Vector3d::Zero();
+};
+
+NodeGap node_gap(const CurveNetwork& net, int a, int b) {
+  NodeGap best;
   for (int x : net.curves[static_cast<size_t>(a)].nodes)
-    for (int y : net.curves[static_cast<size_t>(b)].nodes)
-      best = std::min(
-          best, (net.nodes[static_cast<size_t>(x)] - net.nodes[static_cast<size_t>(y)]).norm());
+    for (int y : net.curves[static_cast<size_t>(b)].nodes) {
+      const Eigen::Vector3d& p = net.nodes[static_cast<size_t>(x)];
+      const Eigen::Vector3d& q = net.nodes[static_cast<size_t>(y)];
+      if ((p - q).norm() < best.distance) best = {(p - q).norm(), p, q};
+    }
   return best;
+}
+
+// "(0.092, 0.860, -0.132)": a junction where a designer can find it (metres).
+std::string at(const Eigen::Vector3d& p) {
+  return fmt::format("({:.3f}, {:.3f}, {:.3f})", p.x(), p.y(), p.z());
+}
+
+// What to do about a gap between two curve ends, for the sentence that reports it. Curves
+// on the body are moved onto it (by `offset`), so an end written where an on-body curve ends
+// can miss it by about the offset and the body's curvature; a curve with "on_body": false is
+// used as written.
+std::string gap_advice(const GarmentRequest& sketch, const std::string& a, const std::string& b) {
+  const std::string rest =
+      "or give both curves one point for it (a landmark-relative point, or the same [x, y, z]), "
+      "or raise junction_tolerance";
+  for (const std::string& id : {a, b})
+    for (const CurveSpec& c : sketch.curves)
+      if (c.id == id && !c.on_body)
+        return fmt::format(
+            "; curve '{}' has \"on_body\": false and is used exactly as written, while curves "
+            "on the body are moved onto it (plus their offset): write its end at the junction "
+            "given here, {}",
+            id, rest);
+  return "; move one end onto the other, " + rest;
 }
 
 // Explicit boundary list → loop edges (unoriented), or a SketchError.
@@ -91,20 +124,41 @@ std::vector<LoopEdge> resolve_explicit(const GarmentRequest& sketch, const Curve
     for (int node : net.curves[static_cast<size_t>(a)].nodes)
       meet = meet || curve_has_node(net, b, node);
     if (meet) continue;
-    const double gap = node_gap(net, a, b);
+    const NodeGap gap = node_gap(net, a, b);
+    const std::string& next = panel.boundary[(i + 1) % k];
+    // A curve of the sketch that runs from one to the other and is not in the list: the seam
+    // the designer left out (a side seam forgotten between the armhole and the hem).
+    std::string missing;
+    for (size_t c = 0; c < net.curves.size() && missing.empty(); ++c) {
+      const int ci = static_cast<int>(c);
+      if (std::find(curve_ids.begin(), curve_ids.end(), ci) != curve_ids.end()) continue;
+      bool meets_a = false, meets_b = false;
+      for (const int node : net.curves[c].nodes) {
+        meets_a = meets_a || curve_has_node(net, a, node);
+        meets_b = meets_b || curve_has_node(net, b, node);
+      }
+      if (meets_a && meets_b) missing = net.curves[c].id;
+    }
+    const std::string where =
+        !missing.empty()
+            ? fmt::format(
+                  "(curve '{}' runs from one to the other: is it missing from the list "
+                  "between them? their junctions are {:.1f} cm apart, '{}' at {} m and "
+                  "'{}' at {} m)",
+                  missing, gap.distance * 100, panel.boundary[i], at(gap.on_a), next, at(gap.on_b))
+            : fmt::format(
+                  "(their junctions are {:.1f} cm apart, '{}' at {} m and '{}' at {} m; "
+                  "curves meet when their ends are within {:.1f} cm{})",
+                  gap.distance * 100, panel.boundary[i], at(gap.on_a), next, at(gap.on_b),
+                  sketch.junction_tolerance * 100, gap_advice(sketch, panel.boundary[i], next));
     if (i + 1 == k)
       sketch.fail(fmt::format("{}/boundary", panel.json_path),
                   fmt::format("panel '{}' does not close: its last curve '{}' does not meet its "
-                              "first curve '{}' (their junctions are {:.1f} cm apart; curves "
-                              "meet when their ends are within {:.1f} cm)",
-                              panel.id, panel.boundary[i], panel.boundary[0], gap * 100,
-                              sketch.junction_tolerance * 100));
+                              "first curve '{}' {}",
+                              panel.id, panel.boundary[i], panel.boundary[0], where));
     sketch.fail(fmt::format("{}/boundary/{}", panel.json_path, i + 1),
-                fmt::format("curve '{}' does not meet curve '{}' before it in panel '{}' (their "
-                            "junctions are {:.1f} cm apart; curves meet when their ends are "
-                            "within {:.1f} cm)",
-                            panel.boundary[i + 1], panel.boundary[i], panel.id, gap * 100,
-                            sketch.junction_tolerance * 100));
+                fmt::format("curve '{}' does not meet curve '{}' before it in panel '{}' {}",
+                            panel.boundary[i + 1], panel.boundary[i], panel.id, where));
   }
   std::vector<LoopEdge> loop;
   std::vector<int> used(net.edges.size(), 0);

@@ -7,7 +7,9 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <string>
 #include <unordered_map>
+#include <vector>
 
 namespace sd::garment {
 namespace {
@@ -133,11 +135,28 @@ std::vector<QualityWarning> check_quality(const Garment& garment, const GarmentR
       q.message = fmt::format("panel '{}': {} {}", panel.id, sentence, place(w.where, q.landmark));
       warnings.push_back(std::move(q));
     };
+    // Which corner to move: a panel whose corners came from the turning angles may have one
+    // too many where one seam runs on into another (a tank top's underarm, where the armhole
+    // meets the side seam, made its back fold in every plan; without it as a corner the back
+    // is clean). Name the gentlest and give the list without it, ready to paste.
+    std::string fewer_corners;
+    if (panel.turning_corners.size() >= 4) {
+      const auto gentlest =
+          std::min_element(panel.turning_corners.begin(), panel.turning_corners.end(),
+                           [](const auto& a, const auto& b) { return a.second < b.second; });
+      std::vector<std::string> rest;
+      for (auto it = panel.turning_corners.begin(); it != panel.turning_corners.end(); ++it)
+        if (it != gentlest) rest.push_back(fmt::format("\"{}\"", it->first));
+      fewer_corners = fmt::format(
+          " (its gentlest corner is where '{}' begins, turning {:.0f}°: with one side fewer the "
+          "filler may fit a plain grid, \"corners\": [{}])",
+          gentlest->first, gentlest->second, fmt::join(rest, ", "));
+    }
     emit(inverted, "inverted_quads",
          fmt::format("{} quad(s) fold over (the worst corner's scaled Jacobian {:.2f}); make the "
                      "curves around the panel smoother there, or move a corner so that the sides "
-                     "facing each other have similar edge counts;",
-                     inverted.count, inverted.value));
+                     "facing each other have similar edge counts{};",
+                     inverted.count, inverted.value, fewer_corners));
     emit(angle, "min_angle",
          fmt::format("{} quad(s) have a corner below {:.0f}° (the smallest {:.1f}°); a boundary "
                      "corner there is too sharp or not listed in \"corners\": give it as a corner "
@@ -146,8 +165,8 @@ std::vector<QualityWarning> check_quality(const Garment& garment, const GarmentR
     emit(aspect, "aspect_ratio",
          fmt::format("{} quad(s) are long and thin (the worst {:.1f} times longer than wide); "
                      "sides facing each other have very different edge counts there: give them "
-                     "similar \"edge_length\" or move a corner;",
-                     aspect.count, aspect.value));
+                     "similar \"edge_length\" or move a corner{};",
+                     aspect.count, aspect.value, fewer_corners));
     emit(near, "near_vertices",
          fmt::format("{} pair(s) of vertices lie closer than {:.1f} mm (the closest {:.2f} mm); "
                      "curves meet at a very narrow angle or a curve doubles back: open the angle "

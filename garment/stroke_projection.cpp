@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 namespace sd::garment {
 namespace {
@@ -294,9 +295,29 @@ ProjectedCurve project_curve(const GarmentRequest& sketch, const CurveSpec& curv
   const auto [i, j] = find_self_intersection(out.points, curve.closed, 1e-3);
   if (i >= 0) {
     const Eigen::RowVector3d where = out.points.row(i);
-    sketch.fail(points_path, fmt::format("curve '{}' crosses itself near ({:.3f}, {:.3f}, {:.3f}); "
-                                         "a curve must not cross itself",
-                                         curve.id, where.x(), where.y(), where.z()));
+    // Written points snapped onto the body can fold a curve that does not cross itself as
+    // written (points around a limb's axis guessed a few centimetres off, each landing on the
+    // nearest side): say which written point moved farthest, so that the designer looks there.
+    std::string snapped;
+    if (curve.is_3d() && curve.on_body && body != nullptr) {
+      size_t farthest = 0;
+      double moved = -1;
+      for (size_t k = 0; k < curve.points3d.size(); ++k) {
+        const double m =
+            (body->snap_to_offset(curve.points3d[k], curve.offset) - curve.points3d[k]).norm();
+        if (m > moved) moved = m, farthest = k;
+      }
+      const Eigen::Vector3d& written = curve.points3d[farthest];
+      snapped = fmt::format(
+          " once its points are moved onto the body: point {} ({:.3f}, {:.3f}, {:.3f}) moved "
+          "farthest, {:.1f} cm; write the points near the body's surface (`info BODY --slice Y` "
+          "prints its outlines at height Y)",
+          farthest, written.x(), written.y(), written.z(), moved * 100);
+    }
+    sketch.fail(points_path,
+                fmt::format("curve '{}' crosses itself near ({:.3f}, {:.3f}, {:.3f}){}; a curve "
+                            "must not cross itself",
+                            curve.id, where.x(), where.y(), where.z(), snapped));
   }
   return out;
 }

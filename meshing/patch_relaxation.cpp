@@ -109,14 +109,18 @@ std::array<Eigen::Vector3d, 4> quad_edges(const Quad& q, const std::vector<Eigen
 }
 
 // Smallest scaled Jacobian over the four corners of quad q at positions x.
+// Once a corner is at most `floor` the others are not looked at: only values above `floor`
+// are exact (the untangling's candidates that cannot win).
 double quad_min_jacobian(const Quad& q, const Eigen::Vector3d& normal,
-                         const std::vector<Eigen::Vector3d>& x) {
+                         const std::vector<Eigen::Vector3d>& x,
+                         double floor = -std::numeric_limits<double>::infinity()) {
   const auto e = quad_edges(q, x);
   double worst = std::numeric_limits<double>::infinity();
   for (size_t k = 0; k < 4; ++k) {
     const Eigen::Vector3d& before = e[(k + 3) % 4];
     const double denom = std::sqrt(before.squaredNorm() * e[k].squaredNorm());
     worst = std::min(worst, denom > 0 ? before.cross(e[k]).dot(normal) / denom : -1.0);
+    if (worst <= floor) break;
   }
   return worst;
 }
@@ -177,11 +181,15 @@ void untangle(std::vector<Eigen::Vector3d>& x, std::span<const Quad> quads,
               std::span<const char> fixed, const Projection& project,
               const std::vector<size_t>* suspects = nullptr) {
   const size_t nf = quads.size(), nv = x.size();
-  auto around = [&](size_t v) {  // smallest scaled Jacobian of the quads at v
+  // Smallest scaled Jacobian of the quads at v; once it is at most `floor` the rest are not
+  // looked at (a candidate that cannot win: most of the pattern search's, which was 17 % of
+  // a folding garment's meshing time), so only values above `floor` are exact.
+  auto around = [&](size_t v, double floor = -std::numeric_limits<double>::infinity()) {
     double worst = std::numeric_limits<double>::infinity();
     for (int c = adj.corner_start[v]; c < adj.corner_start[v + 1]; ++c) {
       const auto f = static_cast<size_t>(adj.corners[static_cast<size_t>(c)] / 4);
-      worst = std::min(worst, quad_min_jacobian(quads[f], normals[f], x));
+      worst = std::min(worst, quad_min_jacobian(quads[f], normals[f], x, floor));
+      if (worst <= floor) break;
     }
     return worst;
   };
@@ -236,7 +244,7 @@ void untangle(std::vector<Eigen::Vector3d>& x, std::span<const Quad> quads,
         for (int k = 0; k < 8; ++k) {
           const auto& [c, s] = kCompass[static_cast<size_t>(k)];
           x[v] = start + step * (c * t1 + s * t2);
-          const double value = around(v);
+          const double value = around(v, best + 1e-12);
           if (value > best + 1e-12) {
             best = value;
             best_position = x[v];

@@ -143,9 +143,16 @@ Eigen::Vector3d landmark_point(const Reader& r, const json& j, const std::string
       j.contains("offset") ? r.vector<3>(j["offset"], path + "/offset") : Eigen::Vector3d::Zero();
   const BodyLandmarks& landmarks = sketch_landmarks(r, sk, path);
   if (const Landmark* l = landmarks.find(name)) return l->position + offset;
-  std::string names;
-  for (const std::string& n : landmark_names()) names += (names.empty() ? "" : ", ") + n;
-  r.fail(path + "/at", fmt::format("there is no landmark '{}'; the landmarks are {}", name, names));
+  std::string names, hint;
+  size_t best = 4;  // suggest only close spellings ("left_sholder", "rightarmpit", "Waist")
+  for (const std::string& n : landmark_names()) {
+    names += (names.empty() ? "" : ", ") + n;
+    const size_t d = edit_distance(name, n);
+    if (d < best) best = d, hint = n;
+  }
+  r.fail(path + "/at",
+         fmt::format("there is no landmark '{}'{}; the landmarks are {}", name,
+                     hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint), names));
 }
 
 CurveSpec parse_curve(const Reader& r, const json& j, const std::string& path, const Sketch& sk) {
@@ -303,10 +310,17 @@ PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, c
     for (size_t i = 0; i < c.size(); ++i) {
       const std::string ip = fmt::format("{}/corners/{}", path, i);
       std::string id = r.text(c[i], ip);
-      if (std::find(panel.boundary.begin(), panel.boundary.end(), id) == panel.boundary.end())
-        r.fail(ip, fmt::format("corner '{}' is not one of panel '{}''s boundary curves (a corner "
-                               "is named by the curve that starts there)",
-                               id, panel.id));
+      if (std::find(panel.boundary.begin(), panel.boundary.end(), id) == panel.boundary.end()) {
+        size_t best = 3;
+        std::string hint;
+        for (const std::string& curve : panel.boundary)
+          if (const size_t d = edit_distance(id, curve); d < best) best = d, hint = curve;
+        r.fail(ip, fmt::format("corner '{}' is not one of panel '{}''s boundary curves{} (a corner "
+                               "is named by the curve that starts there; the boundary is {})",
+                               id, panel.id,
+                               hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint),
+                               fmt::join(panel.boundary, ", ")));
+      }
       panel.corners.push_back(std::move(id));
     }
   }

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <regex>
 #include <string>
 
 #include "garment/body_surface.hpp"
@@ -129,6 +130,38 @@ TEST(PanelLoop, CurvesThatDoNotMeetNameThePanel) {
     EXPECT_EQ(e.file(), "loops.json");
     EXPECT_EQ(e.json_path().rfind("/panels/0", 0), 0u) << e.json_path();
     EXPECT_FALSE(e.sentence().empty());
+  }
+}
+
+// A gap names where both ends are, so that a designer can close it; a curve written off the body
+// ("on_body": false, used as written) is told to end where the on-body curve's junction is.
+TEST(PanelLoop, AGapSaysWhereTheEndsAreAndWhatToMove) {
+  const std::string json = R"({
+    "curves": [
+      { "id": "a", "points": [[-0.1, 1.1], [0.1, 1.1]] },
+      { "id": "b", "points": [[0.1, 1.1], [0.1, 0.9]] },
+      { "id": "hang", "on_body": false, "points3d": [[0.1, 0.9, 0.45], [-0.1, 1.1, 0.45]] }
+    ],
+    "panels": [ { "id": "open", "boundary": ["a", "b", "hang"] } ] })";
+  try {
+    resolve(json);
+    FAIL() << "an open loop was accepted";
+  } catch (const SketchError& e) {
+    EXPECT_EQ(e.json_path(), "/panels/0/boundary/2");
+    // The on-body stroke b ends on the sphere (radius 0.3 about (0, 1, 0)) plus the 1 cm
+    // offset, near (0.1, 0.9); "hang" starts at z = 0.45 as written.
+    std::smatch at;
+    const std::string& sentence = e.sentence();
+    ASSERT_TRUE(std::regex_search(sentence, at,
+                                  std::regex(R"('b' at \(([-0-9.]+), ([-0-9.]+), ([-0-9.]+)\) m)")))
+        << sentence;
+    const Eigen::Vector3d b_end(std::stod(at[1]), std::stod(at[2]), std::stod(at[3]));
+    EXPECT_NEAR((b_end - Eigen::Vector3d(0, 1, 0)).norm(), 0.31, 0.003) << sentence;
+    EXPECT_LT((b_end - Eigen::Vector3d(0.1, 0.9, 0.276)).norm(), 0.01) << sentence;
+    EXPECT_NE(e.sentence().find("'hang' at (0.100, 0.900, 0.450) m"), std::string::npos)
+        << e.sentence();
+    EXPECT_NE(e.sentence().find("curve 'hang' has \"on_body\": false"), std::string::npos)
+        << e.sentence();
   }
 }
 

@@ -106,6 +106,34 @@ TEST(StrokeProjection, Points3dSnapToOffsetSurface) {
     EXPECT_NEAR((p.points.row(k).transpose() - kCentre).norm(), kRadius + 0.01, 2e-3);
 }
 
+// Points written inside the body around its centre (a cuff drawn round a guessed arm axis):
+// they do not cross, but snapped radially onto the sphere the curve runs 0° → 90°, back to
+// 45°, then on to 135° and doubles over itself. The error says so and names the written point
+// that moved farthest (the one 2 cm from the centre: 0.29 m).
+TEST(StrokeProjection, Points3dFoldedBySnappingNameTheFarthestMove) {
+  const BodySurface body(meshing::icosphere(kRadius, 5, kCentre));
+  CurveSpec c;
+  c.id = "cuff";
+  c.json_path = "/curves/0";
+  c.smooth = false;
+  const auto at = [](double degrees, double r) {
+    const double a = degrees * M_PI / 180;
+    return Eigen::Vector3d(r * std::cos(a), 1.0, r * std::sin(a));
+  };
+  c.points3d = {at(0, 0.05), at(90, 0.05), at(45, 0.02), at(135, 0.05)};
+  c.offset = 0.0;
+  try {
+    project_curve(sketch_with(c), c, &body);
+    FAIL() << "the folded curve was accepted";
+  } catch (const SketchError& e) {
+    EXPECT_EQ(e.json_path(), "/curves/0/points3d");
+    EXPECT_NE(e.sentence().find("once its points are moved onto the body: point 2 (0.014, 1.000, "
+                                "0.014) moved farthest, 28."),
+              std::string::npos)
+        << e.sentence();
+  }
+}
+
 TEST(StrokeProjection, SelfIntersectionFound) {
   const std::vector<Eigen::Vector2d> figure8 = {{0, 0}, {1, 1}, {1, 0}, {0, 1}};
   EXPECT_GE(find_self_intersection(figure8, false).first, 0);
