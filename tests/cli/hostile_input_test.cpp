@@ -308,11 +308,14 @@ TEST(HostileInput, OutputPathsInTheWayLeaveNothing) {
 }
 
 // Out of memory is reported as such (it ended as "a vertex reached 50.9 m/s"): under a 700 MB
-// address-space limit, the 201 x 201-vertex sheet's CHOLMOD factorisation cannot be allocated.
+// address-space limit, the 201 x 201-vertex sheet's CHOLMOD factorisation cannot be allocated
+// (the solver is named: the automatic choice for a sheet this size is the two-level PCG, which
+// fits).
 TEST(HostileInput, OutOfMemoryIsReportedAsSuch) {
   const fs::path dir = fresh_dir("oom");
   write(dir / "sheet.json", R"({"sheet": {"size": [1, 1], "resolution": [200, 200],
-    "pins": ["top"]}, "simulate": {"duration": 0.02}, "output": {"images": []}})");
+    "pins": ["top"]}, "simulate": {"duration": 0.02, "solver": "cholmod"},
+    "output": {"images": []}})");
   const std::string command = "ulimit -v 700000; " + std::string(SD_BINARY) + " run " +
                               (dir / "sheet.json").string() + " -o " + (dir / "out").string() +
                               " 2>&1";
