@@ -143,7 +143,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
       "s), {:.0f} frames",
       estimate.vertices, estimate.memory_bytes / 1e9, estimate.factor_bytes / 1e9, estimate.steps,
       estimate.seconds, estimate.frames);
-  {
+  if (spdlog::should_log(spdlog::level::debug)) {  // the probe opens an OpenMP region: -v only
     const char* omp_limit = std::getenv("OMP_THREAD_LIMIT");
     const char* blas_limit = std::getenv("OPENBLAS_NUM_THREADS");
     const sim::SolverLibraryThreads library = sim::solver_library_threads();
