@@ -30,7 +30,14 @@ void limit_solver_library_threads() {
   static std::once_flag blas_once;
   std::call_once(blas_once, [] {
     if (std::getenv("OPENBLAS_NUM_THREADS") != nullptr) return;
-    if (auto* set = find_function<void(int)>("openblas_set_num_threads")) set(1);
+    auto* const set = find_function<void(int)>("openblas_set_num_threads");
+    if (set == nullptr) return;
+    set(1);
+    // OpenBLAS started its pool (one thread per further core, each with its stack and buffers:
+    // +140 MB of address space on two cores) when it was loaded. One thread never uses it, so
+    // it is stopped the way OpenBLAS stops it before a fork; a later request for more threads
+    // would start it again.
+    if (auto* shutdown = find_function<int()>("blas_thread_shutdown_")) shutdown();
   });
   thread_local bool openmp_limited = false;
   if (openmp_limited) return;

@@ -7,7 +7,8 @@
 // OMP_NUM_THREADS does not reach (the t-shirt drape's solve: 3.5 s with them, 0.72 s on one
 // thread; docs/simulator.md, "Threads"). Both can be limited at run time, without the
 // environment variables they read when they are loaded:
-//  * OpenBLAS: openblas_set_num_threads(1), process-wide;
+//  * OpenBLAS: openblas_set_num_threads(1), process-wide, and its pool (started at load, one
+//    thread per further core) stopped again;
 //  * OpenMP: omp_set_max_active_levels(0) makes every parallel region the calling thread opens
 //    inactive (one thread), whatever its num_threads clause asks for. libgomp keeps that setting
 //    per thread, so it is made on each thread that factorises (CholmodSolver::factorize).
