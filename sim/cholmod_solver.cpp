@@ -7,6 +7,8 @@
 #include <cmath>
 #include <vector>
 
+#include "sim/solver_library_threads.hpp"
+
 namespace sd::sim {
 
 using ColMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
@@ -151,6 +153,7 @@ bool CholmodSolver::factorize(const SparseMatrixR& a, const ConstraintFilter& fi
       }
     }
   }
+  limit_solver_library_threads();  // before CHOLMOD's OpenMP loops and OpenBLAS kernels
   if (!same_pattern) {
     // AMD on the vertex graph (a ninth of the scalar pattern's entries), each vertex's three
     // rows kept together: the analysis of a new pattern (after every adaptive topology change)

@@ -1,8 +1,8 @@
 #include <cstdio>
 
+#include "sim/solver_library_threads.hpp"
 #include "src/app/batch/batch_runner.hpp"
 #include "src/app/commands/cli.hpp"
-#include "src/solver_threads.hpp"
 
 int main(int argc, char** argv) {
   // A batch's child dies with its batch (a SIGKILLed batch must not leave jobs that write into
@@ -11,6 +11,8 @@ int main(int argc, char** argv) {
     std::fputs("error: the batch that started this job has ended; not starting\n", stderr);
     return sd::app::kExitFailure;
   }
-  sd::restart_with_single_threaded_solvers(argv);
+  // CHOLMOD's OpenMP loops and OpenBLAS on one thread unless the user chose (the program starts
+  // once: the limits are set at run time, sim/solver_library_threads.hpp).
+  sd::sim::limit_solver_library_threads();
   return sd::app::run_cli(argc, argv);
 }

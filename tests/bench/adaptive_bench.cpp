@@ -40,7 +40,7 @@
 #include <vector>
 
 #include "sim/adaptive_detail.hpp"
-#include "src/solver_threads.hpp"
+#include "sim/solver_library_threads.hpp"
 #include "tests/sim/adaptive_scenes.hpp"
 #include "tests/sim/test_bodies.hpp"
 
@@ -421,7 +421,7 @@ int run_study(const StudyOptions& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  sd::restart_with_single_threaded_solvers(argv);  // the solvers as sketchdrape runs them
+  sd::sim::limit_solver_library_threads();  // the solvers as sketchdrape runs them
   StudyOptions options;
   std::vector<char*> rest;
   for (int i = 0; i < argc; ++i) {

@@ -1,11 +1,11 @@
 // main() of the simulator's benchmarks: the solvers on one thread, as the program runs them
-// (src/solver_threads.hpp), then Google Benchmark.
+// (sim/solver_library_threads.hpp), then Google Benchmark.
 #include <benchmark/benchmark.h>
 
-#include "src/solver_threads.hpp"
+#include "sim/solver_library_threads.hpp"
 
 int main(int argc, char** argv) {
-  sd::restart_with_single_threaded_solvers(argv);
+  sd::sim::limit_solver_library_threads();
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -22,6 +23,7 @@
 #include "sim/drape_coefficient.hpp"
 #include "sim/sheet.hpp"
 #include "sim/simulation.hpp"
+#include "sim/solver_library_threads.hpp"
 #include "src/app/commands/cli.hpp"
 #include "src/app/pipeline/cloth_scene.hpp"
 #include "src/app/pipeline/mesh_export.hpp"
@@ -141,6 +143,16 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
       "s), {:.0f} frames",
       estimate.vertices, estimate.memory_bytes / 1e9, estimate.factor_bytes / 1e9, estimate.steps,
       estimate.seconds, estimate.frames);
+  if (spdlog::should_log(spdlog::level::debug)) {  // the probe opens an OpenMP region: -v only
+    const char* omp_limit = std::getenv("OMP_THREAD_LIMIT");
+    const char* blas_limit = std::getenv("OPENBLAS_NUM_THREADS");
+    const sim::SolverLibraryThreads library = sim::solver_library_threads();
+    spdlog::debug(
+        "solver libraries: OMP_THREAD_LIMIT {}, OPENBLAS_NUM_THREADS {}; an OpenMP region asking "
+        "for 4 threads gets {}, OpenBLAS runs {}",
+        omp_limit ? omp_limit : "unset", blas_limit ? blas_limit : "unset", library.openmp_region,
+        library.openblas);
+  }
   if (!limits.max_time_s && estimate.seconds > 3600)
     spdlog::warn(
         "this drape may take up to about {:.1f} h ({:.0f} steps on {:.0f} vertices, by "

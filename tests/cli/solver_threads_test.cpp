@@ -1,0 +1,60 @@
+// sketchdrape run from a clean environment (no OMP_THREAD_LIMIT, no OPENBLAS_NUM_THREADS): the
+// program starts once and still runs CHOLMOD's OpenMP loops and OpenBLAS on one thread.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "tests/cli/run_command.hpp"
+
+namespace sd::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string write_sheet(const std::string& name, const std::string& solver) {
+  const fs::path dir = fs::temp_directory_path() / "sd_solver_threads_test" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "sheet.json") << R"({"format": "sketchdrape/1",
+ "sheet": {"size": [1.0, 1.0], "resolution": [24, 24], "orientation": "horizontal",
+           "centre": [0.0, 1.2, 0.0], "pins": ["top-left", "top-right"]},
+ "fabric": "cotton",
+ "simulate": {"duration": 0.2, "time_step": 0.05, "stop_at_rest": false, "solver": ")"
+                                    << solver << R"("},
+ "output": {"images": [], "mesh": "drape.obj"}})";
+  return dir.string();
+}
+
+// The -v line that names what the solver libraries see: had the program set the variables and
+// started itself again, it would read them as 1, not unset.
+std::string library_line(const std::string& dir) {
+  const CommandResult run =
+      run_sketchdrape_with_env("env -u OMP_THREAD_LIMIT -u OPENBLAS_NUM_THREADS -u OMP_NUM_THREADS",
+                               "run " + dir + "/sheet.json -o " + dir + "/out -v");
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  const size_t at = run.output.find("solver libraries:");
+  if (at == std::string::npos) return run.output;
+  return run.output.substr(at, run.output.find('\n', at) - at);
+}
+
+TEST(SolverThreads, CholmodRunStartsOnceWithOneOpenMpAndOneBlasThread) {
+  const std::string line = library_line(write_sheet("cholmod", "cholmod"));
+  EXPECT_NE(line.find("OMP_THREAD_LIMIT unset, OPENBLAS_NUM_THREADS unset"), std::string::npos)
+      << line;
+  EXPECT_NE(line.find("asking for 4 threads gets 1,"), std::string::npos) << line;
+  // 1 with Debian's OpenBLAS; 0 if the BLAS alternative is another library.
+  EXPECT_TRUE(line.find("OpenBLAS runs 1") != std::string::npos ||
+              line.find("OpenBLAS runs 0") != std::string::npos)
+      << line;
+}
+
+TEST(SolverThreads, PcgRunStartsOnce) {
+  const std::string line = library_line(write_sheet("pcg", "pcg"));
+  EXPECT_NE(line.find("OMP_THREAD_LIMIT unset, OPENBLAS_NUM_THREADS unset"), std::string::npos)
+      << line;
+}
+
+}  // namespace
+}  // namespace sd::test
