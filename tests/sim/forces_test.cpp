@@ -89,6 +89,29 @@ Eigen::MatrixXd dense_jacobian(const ClothModel& model, const ForceSettings& set
   return Eigen::MatrixXd(matrix);
 }
 
+// At rest velocity, the stretch force is −∇E_stretch (central differences of the energy, h = 1e-7
+// m) and the exact Jacobian matches central differences of the force, both to 1e-5 relative.
+void expect_stretch_derivatives(const ClothModel& model, const ForceSettings& settings,
+                                const Eigen::VectorXd& x, int trial) {
+  const Eigen::VectorXd v = Eigen::VectorXd::Zero(x.size());
+  const testing::ForceDifferences d = testing::force_differences(model, settings, x, v);
+  Eigen::VectorXd force, scratch, gradient(x.size());
+  evaluate_forces(model, settings, x, v, force);
+  const double h = 1e-7;
+  for (Eigen::Index j = 0; j < x.size(); ++j) {
+    Eigen::VectorXd plus = x, minus = x;
+    plus[j] += h;
+    minus[j] -= h;
+    EnergyBreakdown ep, em;
+    evaluate_forces(model, settings, plus, v, scratch, &ep);
+    evaluate_forces(model, settings, minus, v, scratch, &em);
+    gradient[j] = (ep.stretch - em.stretch) / (2 * h);
+  }
+  EXPECT_LE((gradient + force).norm(), 1e-5 * force.norm()) << "trial " << trial;
+  const Eigen::MatrixXd dfdx = dense_jacobian(model, settings, x, v, 1, 0, JacobianKind::exact);
+  EXPECT_LE((d.dfdx - dfdx).norm(), 1e-5 * dfdx.norm()) << "trial " << trial;
+}
+
 TEST(Forces, ForceIsMinusTheEnergyGradient) {
   const Fixture f = make_fixture();
   std::mt19937 rng(3);
@@ -315,23 +338,7 @@ TEST(Forces, BucklingCompressionMatchesFiniteDifferences) {
       buckled += wu.norm() - 1.0 < -eps;
       stretched += wu.norm() > 1.0;
     }
-    const Eigen::VectorXd v = Eigen::VectorXd::Zero(x.size());
-    const testing::ForceDifferences d = testing::force_differences(f.model, settings, x, v);
-    Eigen::VectorXd force, scratch, gradient(x.size());
-    evaluate_forces(f.model, settings, x, v, force);
-    const double h = 1e-7;
-    for (Eigen::Index j = 0; j < x.size(); ++j) {
-      Eigen::VectorXd plus = x, minus = x;
-      plus[j] += h;
-      minus[j] -= h;
-      EnergyBreakdown ep, em;
-      evaluate_forces(f.model, settings, plus, v, scratch, &ep);
-      evaluate_forces(f.model, settings, minus, v, scratch, &em);
-      gradient[j] = (ep.stretch - em.stretch) / (2 * h);
-    }
-    EXPECT_LE((gradient + force).norm(), 1e-5 * force.norm()) << "trial " << trial;
-    const Eigen::MatrixXd dfdx = dense_jacobian(f.model, settings, x, v, 1, 0, JacobianKind::exact);
-    EXPECT_LE((d.dfdx - dfdx).norm(), 1e-5 * dfdx.norm()) << "trial " << trial;
+    expect_stretch_derivatives(f.model, settings, x, trial);
   }
   EXPECT_GT(buckled, 10);  // both branches were exercised
   EXPECT_GT(stretched, 10);
@@ -367,23 +374,7 @@ TEST(Forces, TensileCurveMatchesFiniteDifferences) {
       const double e = wu.norm() - 1.0;
       ++on_segment[e <= 0.0 ? 0 : (e < 0.005 ? 1 : 2)];
     }
-    const Eigen::VectorXd v = Eigen::VectorXd::Zero(x.size());
-    const testing::ForceDifferences d = testing::force_differences(f.model, settings, x, v);
-    Eigen::VectorXd force, scratch, gradient(x.size());
-    evaluate_forces(f.model, settings, x, v, force);
-    const double h = 1e-7;
-    for (Eigen::Index j = 0; j < x.size(); ++j) {
-      Eigen::VectorXd plus = x, minus = x;
-      plus[j] += h;
-      minus[j] -= h;
-      EnergyBreakdown ep, em;
-      evaluate_forces(f.model, settings, plus, v, scratch, &ep);
-      evaluate_forces(f.model, settings, minus, v, scratch, &em);
-      gradient[j] = (ep.stretch - em.stretch) / (2 * h);
-    }
-    EXPECT_LE((gradient + force).norm(), 1e-5 * force.norm()) << "trial " << trial;
-    const Eigen::MatrixXd dfdx = dense_jacobian(f.model, settings, x, v, 1, 0, JacobianKind::exact);
-    EXPECT_LE((d.dfdx - dfdx).norm(), 1e-5 * dfdx.norm()) << "trial " << trial;
+    expect_stretch_derivatives(f.model, settings, x, trial);
   }
   for (int segment = 0; segment < 3; ++segment)
     EXPECT_GT(on_segment[segment], 10) << "compression, first or later segment: " << segment;
