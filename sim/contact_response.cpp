@@ -368,8 +368,9 @@ PointSpring ContactResponse::piercing_spring(const BodyPiercing& p, const Eigen:
   // starts the step pushing (its preload) or not at all, never pulling the cloth back onto the
   // vertex (which, released at the band's edge, fell back through and was caught again).
   const double push = p.height + kPiercingClearance * settings_.thickness;
-  spring.target =
-      along_spring_normal(spring, t, x) + (settings_.spring_band ? std::max(push, 0.0) : push);
+  spring.target = settings_.spring_band ? along_spring_normal(spring, t, x) + std::max(push, 0.0)
+                                        : along_spring_normal(spring, t, x) + p.height +
+                                              kPiercingClearance * settings_.thickness;
   spring.reference_velocity = p.body_velocity;
   if (!(inverse_mass > 0.0)) return spring;  // all corners pinned: nothing can move
   const double mass = 1.0 / inverse_mass;
