@@ -49,6 +49,13 @@ constexpr double kPiercingUncheckedFraction = 0.5;
 // hysteresis as kHoldMargin for contacts: without it a triangle resting on a tip at the
 // clearance drops out as soon as it ends a hair farther, falls back and is pushed again).
 constexpr double kPiercingHoldMargin = 0.25;
+// With ContactSettings::spring_band a held spring is kept while its point is within this many
+// thicknesses past the clearance in front of the body vertex (a real separation; otherwise
+// kPiercingHoldMargin, a 0.75 mm band narrower than the cycles it met: on the flat capelet's
+// neckline a spring pushed its point out past it, was dropped, the cloth fell back through and
+// was caught again every 9 steps, 39 <-> 40 springs, a 5 mm cycle), and until its force turns
+// adhesive. Off by default: measured, it fails two smooth-body tests (docs/collision.md).
+constexpr double kPiercingReleaseBand = 1.0;
 // A spring's stiffness and damping are those of its point's effective
 // mass m (1/Σ w_k²/m_k over the free corners) oscillating at this angular frequency, critically
 // damped: k = m ω², c = 2 m ω. Resolution independent, and at any step size a physical
@@ -336,6 +343,13 @@ void ContactResponse::constrain_start(const Eigen::VectorXd& x_hat, const Eigen:
   spring_start_piercings(x_hat + y, v0, beta, filter, extra);
 }
 
+double ContactResponse::point_mass(const BodyPiercing& p) const {
+  const std::array<int, 3>& t = cloth_.triangles[p.cloth_triangle];
+  double mass = 0.0;
+  for (int k = 0; k < 3; ++k) mass += p.barycentric[k] * mass_[t[k]];
+  return mass;
+}
+
 PointSpring ContactResponse::piercing_spring(const BodyPiercing& p, const Eigen::VectorXd& x,
                                              const std::vector<unsigned char>& pinned,
                                              double preload) const {
@@ -350,8 +364,13 @@ PointSpring ContactResponse::piercing_spring(const BodyPiercing& p, const Eigen:
       inverse_mass += p.barycentric[k] * p.barycentric[k] / mass_[t[k]];
   // The body vertex is the height above the point; the point must end the clearance in front of
   // it.
-  spring.target =
-      along_spring_normal(spring, t, x) + p.height + kPiercingClearance * settings_.thickness;
+  // With the band a point already farther than that keeps its distance: the spring
+  // starts the step pushing (its preload) or not at all, never pulling the cloth back onto the
+  // vertex (which, released at the band's edge, fell back through and was caught again).
+  const double push = p.height + kPiercingClearance * settings_.thickness;
+  spring.target = settings_.spring_band ? along_spring_normal(spring, t, x) + std::max(push, 0.0)
+                                        : along_spring_normal(spring, t, x) + p.height +
+                                              kPiercingClearance * settings_.thickness;
   spring.reference_velocity = p.body_velocity;
   if (!(inverse_mass > 0.0)) return spring;  // all corners pinned: nothing can move
   const double mass = 1.0 / inverse_mass;
@@ -372,7 +391,9 @@ void ContactResponse::spring_start_piercings(const Eigen::VectorXd& start,
   if (!settings_.check_body_vertices || cloth_.triangles.empty() || repairing()) return;
   const int n = static_cast<int>(start.size() / 3);
   const double clearance = kPiercingClearance * settings_.thickness;
-  const double hold = clearance + kPiercingHoldMargin * settings_.thickness;
+  const double hold =
+      clearance +
+      (settings_.spring_band ? kPiercingReleaseBand : kPiercingHoldMargin) * settings_.thickness;
   pinned_.assign(static_cast<std::size_t>(n), 0);
   for (int i = 0; i < n; ++i) pinned_[i] = filter.is_pinned(i);
   // Every triangle near a body vertex, not only the highest: a vertex under a cloth edge is
@@ -403,7 +424,13 @@ void ContactResponse::spring_start_piercings(const Eigen::VectorXd& start,
   std::vector<BodyPiercing> springs;
   for (const BodyPiercing& p : candidates) {
     const auto [with_body, coasting] = end_heights(p, cloth_.triangles[p.cloth_triangle], v0, beta);
-    const bool held = !std::isnan(last_piercing_force_[p.body_vertex]);
+    const double carried = last_piercing_force_[p.body_vertex];
+    bool held = !std::isnan(carried);
+    // With the band, released by the sign of its force, as a contact is: it ended pulling the
+    // point onto the vertex by more than kReleaseFraction of the point's weight. It is caught
+    // again only within the clearance.
+    if (held && settings_.spring_band && carried < -kReleaseFraction * gravity_ * point_mass(p))
+      held = false;
     // A spring only where it would push: the point ends within the clearance of the body vertex
     // (or through), or the vertex had a spring last step and the cloth has not left its reach
     // (the same hysteresis as contacts: dropping a spring as soon as it ended a hair beyond the

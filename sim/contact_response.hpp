@@ -73,6 +73,14 @@ struct ContactSettings {
   // elbows, corners). See docs/collision.md, "Body vertices poking through the cloth", for
   // what it does and costs.
   bool check_body_vertices = false;
+  // Body-vertex springs with a band between catching and releasing (docs/collision.md,
+  // "Catching and releasing body-vertex springs"): a spring never starts a step pulling its
+  // point back onto the body vertex (a point farther than the clearance keeps its distance), a
+  // held spring is released when its force turned adhesive (more than a tenth of its point's
+  // weight, as contacts are) or its point is a thickness past the clearance, and caught again
+  // only within the clearance. Off by default (measured: the flat capelet rests with it, but a
+  // sheet hung on a cone tip is let 1.09 mm through and a sheet on a sphere rests later).
+  bool spring_band = false;
   // Collider query parameters (see sim/body_collider.hpp, ContactQuery).
   double search_margin = 0.02;
   double max_substep_motion = 0.005;
@@ -226,6 +234,8 @@ class ContactResponse {
   // The largest preload a spring carries (N): kMaxSpringLoadClothWeights times the cloth's
   // weight.
   double max_spring_preload() const;
+  // kg: the cloth mass at a piercing's point (its triangle's corner masses by its weights).
+  double point_mass(const BodyPiercing& p) const;
   // Start of step: body vertices through the cloth at `start` (x̂ + y), about to be, or held
   // last step, become springs in `extra`.
   void spring_start_piercings(const Eigen::VectorXd& start, const Eigen::VectorXd& v0, double beta,
