@@ -158,12 +158,35 @@ std::vector<BendStencil> make_bend_stencils(const Eigen::MatrixX3d& rest,
 // added to both ends' rows (n̄ the outward conormal in the rest triangle's plane).
 std::vector<VertexBendElement> make_vertex_bends(const Eigen::MatrixX3d& rest,
                                                  const Eigen::MatrixX3i& faces,
-                                                 BendRestShape bend_rest) {
+                                                 BendRestShape bend_rest,
+                                                 const std::vector<char>& wanted) {
   const int n = static_cast<int>(rest.rows());
+  // An element reads the faces around its vertex (its row, area, fan and boundary flux) and the
+  // faces around its one-ring (the two-ring's points). Only those faces are visited, in the same
+  // order as for the whole mesh, so a wanted element is the same bits either way.
+  const bool all = wanted.empty();
+  const auto want = [&](int v) { return all || wanted[static_cast<std::size_t>(v)] != 0; };
+  std::vector<char> near(all ? 0 : static_cast<std::size_t>(n), 0);  // wanted or in a one-ring
+  std::vector<char> face_near(all ? 0 : static_cast<std::size_t>(faces.rows()), 0);
+  if (!all) {
+    for (Eigen::Index f = 0; f < faces.rows(); ++f)
+      if (want(faces(f, 0)) || want(faces(f, 1)) || want(faces(f, 2)))
+        for (int k = 0; k < 3; ++k) near[static_cast<std::size_t>(faces(f, k))] = 1;
+    for (Eigen::Index f = 0; f < faces.rows(); ++f)
+      face_near[static_cast<std::size_t>(f)] = near[static_cast<std::size_t>(faces(f, 0))] ||
+                                               near[static_cast<std::size_t>(faces(f, 1))] ||
+                                               near[static_cast<std::size_t>(faces(f, 2))];
+  }
+  const auto visit = [&](Eigen::Index f) {
+    return all || face_near[static_cast<std::size_t>(f)] != 0;
+  };
+  const auto wanted_face = [&](Eigen::Index f) {
+    return all || want(faces(f, 0)) || want(faces(f, 1)) || want(faces(f, 2));
+  };
   std::vector<std::vector<std::pair<int, double>>> row(static_cast<std::size_t>(n));
   std::vector<double> area(static_cast<std::size_t>(n), 0.0);
   const auto add = [&](int i, int j, double w) {
-    row[static_cast<std::size_t>(i)].emplace_back(j, w);
+    if (want(i)) row[static_cast<std::size_t>(i)].emplace_back(j, w);
   };
   // Edges (low, high) with the face and corner of the apex opposite, to find boundary edges.
   struct FaceEdge {
@@ -172,6 +195,7 @@ std::vector<VertexBendElement> make_vertex_bends(const Eigen::MatrixX3d& rest,
   std::vector<FaceEdge> edges;
   edges.reserve(static_cast<std::size_t>(3 * faces.rows()));
   for (Eigen::Index f = 0; f < faces.rows(); ++f) {
+    if (!wanted_face(f)) continue;
     const std::array<int, 3> v{faces(f, 0), faces(f, 1), faces(f, 2)};
     std::array<Vector3d, 3> p;
     for (int k = 0; k < 3; ++k) p[k] = rest.row(v[k]);
@@ -244,13 +268,17 @@ std::vector<VertexBendElement> make_vertex_bends(const Eigen::MatrixX3d& rest,
   std::vector<Vector3d> normal(static_cast<std::size_t>(n), Vector3d::Zero());
   std::vector<std::vector<std::array<int, 2>>> fans(static_cast<std::size_t>(n));
   for (Eigen::Index f = 0; f < faces.rows(); ++f) {
+    if (!visit(f)) continue;
     const Vector3d p0 = rest.row(faces(f, 0));
     const Vector3d a =
         (Vector3d(rest.row(faces(f, 1))) - p0).cross(Vector3d(rest.row(faces(f, 2))) - p0);
     for (int k = 0; k < 3; ++k) {
       const auto v = static_cast<std::size_t>(faces(f, k));
-      normal[v] += a;
-      fans[v].push_back({faces(f, (k + 1) % 3), faces(f, (k + 2) % 3)});
+      if (!all && !near[v]) continue;
+      if (want(faces(f, k))) {
+        normal[v] += a;
+        fans[v].push_back({faces(f, (k + 1) % 3), faces(f, (k + 2) % 3)});
+      }
       for (int l = 0; l < 3; ++l)
         if (k != l) ring[v].push_back(faces(f, l));
     }
@@ -262,6 +290,7 @@ std::vector<VertexBendElement> make_vertex_bends(const Eigen::MatrixX3d& rest,
   std::vector<VertexBendElement> elements;
   elements.reserve(static_cast<std::size_t>(n));
   for (int v = 0; v < n; ++v) {
+    if (!want(v)) continue;
     auto& entries = row[static_cast<std::size_t>(v)];
     if (entries.empty() || !(area[static_cast<std::size_t>(v)] > 0.0)) continue;
     const double vertex_area = area[static_cast<std::size_t>(v)];

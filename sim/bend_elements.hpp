@@ -27,9 +27,12 @@ void calibrate_hinge_weights(const Eigen::MatrixX3d& rest, std::vector<HingeElem
 std::vector<BendStencil> make_bend_stencils(const Eigen::MatrixX3d& rest,
                                             const Eigen::MatrixX3i& faces);
 
-// The quadratic bending elements of every vertex that has a triangle (VertexBendElement).
+// The quadratic bending elements of every vertex that has a triangle (VertexBendElement), in
+// vertex order; with `wanted` (#V, empty: all) only those of the vertices with wanted[v], each
+// the same bits as in the whole set (update_cloth_model makes the changed ones this way).
 std::vector<VertexBendElement> make_vertex_bends(const Eigen::MatrixX3d& rest,
                                                  const Eigen::MatrixX3i& faces,
-                                                 BendRestShape bend_rest);
+                                                 BendRestShape bend_rest,
+                                                 const std::vector<char>& wanted = {});
 
 }  // namespace sd::sim::detail

@@ -241,10 +241,26 @@ SparseMatrixR zero_pattern_matrix(const Neighbours& neighbours) {
                                          inner.data(), zeros.data());
 }
 
+// offset(vertices[k], vertices[l]) for every l into out[count·k + l], for sorted `vertices`: one
+// walk along row vertices[k] (sorted too) instead of a binary search per entry.
+void set_row_offsets(const Neighbours& neighbours, const std::vector<int>& vertices, int k,
+                     std::vector<int>& out) {
+  const int count = static_cast<int>(vertices.size());
+  const int i = vertices[static_cast<std::size_t>(k)];
+  const int* run = neighbours.list.data() + neighbours.start[static_cast<std::size_t>(i)];
+  const int size = neighbours.size[static_cast<std::size_t>(i)];
+  int m = 0;
+  for (int l = 0; l < count; ++l) {
+    const int j = vertices[static_cast<std::size_t>(l)];
+    while (m < size && run[m] < j) ++m;
+    out[static_cast<std::size_t>(count * k + l)] = 3 * m;
+  }
+}
+
 // The elements' block offsets and the diagonal offsets of the rows with wanted[i] (every row
-// when empty).
+// when empty); vertex bends with fresh_bends[b] (every one when empty) get all their rows.
 void set_block_offsets(ClothModel& model, const Neighbours& neighbours,
-                       const std::vector<char>& wanted) {
+                       const std::vector<char>& wanted, const std::vector<char>& fresh_bends = {}) {
   const auto want = [&](int v) { return wanted.empty() || wanted[static_cast<std::size_t>(v)]; };
   model.pattern.diagonal_offsets.resize(static_cast<std::size_t>(model.vertex_count));
   for (int i = 0; i < model.vertex_count; ++i)
@@ -260,13 +276,15 @@ void set_block_offsets(ClothModel& model, const Neighbours& neighbours,
       if (want(h.vertices[k]))
         for (int l = 0; l < 4; ++l)
           h.blocks[4 * k + l] = neighbours.offset(h.vertices[k], h.vertices[l]);
-  // Stencils and vertex bends are rebuilt with every model, so all their offsets are set.
-  for (VertexBendElement& b : model.vertex_bends) {
+  // Stencils are rebuilt with every model, so all their offsets are set; vertex bends kept
+  // from the previous model hold theirs in the rows that did not change.
+  for (std::size_t e = 0; e < model.vertex_bends.size(); ++e) {
+    VertexBendElement& b = model.vertex_bends[e];
+    const bool fresh = fresh_bends.empty() || fresh_bends[e];
     const int count = static_cast<int>(b.vertices.size());
     for (int k = 0; k < count; ++k)
-      for (int l = 0; l < count; ++l)
-        b.blocks[static_cast<std::size_t>(count * k + l)] = neighbours.offset(
-            b.vertices[static_cast<std::size_t>(k)], b.vertices[static_cast<std::size_t>(l)]);
+      if (fresh || want(b.vertices[static_cast<std::size_t>(k)]))
+        set_row_offsets(neighbours, b.vertices, k, b.blocks);
   }
   for (BendStencil& b : model.stencils) {
     const int count = static_cast<int>(b.vertices.size());
@@ -309,7 +327,11 @@ void clamp_bending(ClothModel& model, const std::vector<int>& pinned) {
   }
   for (VertexBendElement& b : model.vertex_bends) {
     const auto v = static_cast<std::size_t>(b.vertices[static_cast<std::size_t>(b.centre)]);
-    if (is_pinned[v] && in_pinned_triangle[v] && in_free_triangle[v]) b.inverse_area *= 2.0;
+    // Doubled once: a model updated after an adaptive change keeps the elements it can, with
+    // their clamp (halving and doubling are exact).
+    const bool clamp = is_pinned[v] && in_pinned_triangle[v] && in_free_triangle[v];
+    if (clamp != b.clamped) b.inverse_area *= clamp ? 2.0 : 0.5;
+    b.clamped = clamp;
   }
 }
 
@@ -392,6 +414,7 @@ ClothModel build_cloth_model(const ClothInput& input, const FabricParameters& fa
   if (options.bend_stencil_stiffness > 0.0)
     model.stencils = make_bend_stencils(rest, input.triangles);
   model.bend_model = options.bend_model;
+  model.bend_rest = options.bend_rest;
   model.compression = options.compression;
   if (options.bend_model == BendModel::quadratic)
     model.vertex_bends = make_vertex_bends(rest, input.triangles, options.bend_rest);
@@ -584,13 +607,92 @@ ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse&
             changed_row[static_cast<std::size_t>(i)] = 1;
   };
   mark_changed_rows(previous.stencils, model.stencils);
-  // Vertex bends likewise: rebuilt (linear time); a row is rebuilt when a vertex bend over it is
-  // not one of the previous ones (the same vertices).
   model.bend_model = options.bend_model;
+  model.bend_rest = options.bend_rest;
   model.compression = options.compression;
-  if (options.bend_model == BendModel::quadratic)
-    model.vertex_bends = make_vertex_bends(rest, input.triangles, options.bend_rest);
-  mark_changed_rows(previous.vertex_bends, model.vertex_bends);
+  // Vertex bends: an element reads the faces around its vertex and around its one-ring (and
+  // the rest positions there), so where none of those faces changed it is the previous one
+  // with its vertices renumbered (renumbering keeps the order, so its sorted vertices stay
+  // sorted). The others are made anew (`fresh`: all their block offsets are set below).
+  std::vector<char> fresh_bends;
+  if (options.bend_model == BendModel::quadratic) {
+    const bool reusable =
+        previous.bend_model == BendModel::quadratic && options.bend_rest == previous.bend_rest;
+    // Vertices on a triangle the change removed or made (new rows).
+    std::vector<char> touched(static_cast<std::size_t>(n), 0);
+    for (std::size_t p = 0; p < next_vertex.size(); ++p)
+      if (around_removed[p] && next_vertex[p] >= 0)
+        touched[static_cast<std::size_t>(next_vertex[p])] = 1;
+    for (int f = 0; f < face_count; ++f)
+      if (reuse.previous_triangle[static_cast<std::size_t>(f)] < 0)
+        for (int k = 0; k < 3; ++k) touched[static_cast<std::size_t>(input.triangles(f, k))] = 1;
+    for (int i = 0; i < n; ++i)
+      if (reuse.previous_vertex[static_cast<std::size_t>(i)] < 0) touched[i] = 1;
+    // Made anew: a touched vertex and every vertex with a touched neighbour.
+    std::vector<char> remake(static_cast<std::size_t>(n), reusable ? 0 : 1);
+    if (reusable)
+      for (int f = 0; f < face_count; ++f) {
+        const int a = input.triangles(f, 0), b = input.triangles(f, 1), c = input.triangles(f, 2);
+        if (touched[a] || touched[b] || touched[c]) remake[a] = remake[b] = remake[c] = 1;
+      }
+    std::vector<int> previous_element(static_cast<std::size_t>(previous.vertex_count), -1);
+    for (std::size_t e = 0; e < previous.vertex_bends.size(); ++e) {
+      const VertexBendElement& b = previous.vertex_bends[e];
+      previous_element[static_cast<std::size_t>(b.vertices[static_cast<std::size_t>(b.centre)])] =
+          static_cast<int>(e);
+    }
+    std::vector<VertexBendElement> made =
+        make_vertex_bends(rest, input.triangles, options.bend_rest, remake);
+    std::vector<char> matched(previous.vertex_bends.size(), 0);
+    model.vertex_bends.reserve(made.size() + previous.vertex_bends.size());
+    std::size_t next_made = 0;
+    for (int i = 0; i < n; ++i) {
+      const int p = reuse.previous_vertex[static_cast<std::size_t>(i)];
+      const int e = p >= 0 ? previous_element[static_cast<std::size_t>(p)] : -1;
+      if (!remake[i]) {
+        if (e < 0) continue;  // no triangle around it before, none now
+        VertexBendElement b = previous.vertex_bends[static_cast<std::size_t>(e)];
+        for (int& vertex : b.vertices) vertex = renumber(vertex);
+        matched[static_cast<std::size_t>(e)] = 1;
+        model.vertex_bends.push_back(std::move(b));
+        fresh_bends.push_back(0);
+        continue;
+      }
+      if (next_made == made.size() ||
+          made[next_made].vertices[static_cast<std::size_t>(made[next_made].centre)] != i)
+        continue;  // no element for i (no triangle, or no area)
+      VertexBendElement& b = made[next_made++];
+      // Its rows keep their pattern only if the previous element of the same vertex had the
+      // same vertices.
+      bool same = e >= 0;
+      if (same) {
+        const VertexBendElement& old = previous.vertex_bends[static_cast<std::size_t>(e)];
+        same = old.vertices.size() == b.vertices.size();
+        for (std::size_t j = 0; same && j < b.vertices.size(); ++j)
+          same = reuse.previous_vertex[static_cast<std::size_t>(b.vertices[j])] == old.vertices[j];
+        matched[static_cast<std::size_t>(e)] = 1;
+        if (!same)
+          for (int q : old.vertices)
+            if (const int k = next_vertex[static_cast<std::size_t>(q)]; k >= 0)
+              changed_row[static_cast<std::size_t>(k)] = 1;
+      }
+      if (!same)
+        for (int v : b.vertices) changed_row[static_cast<std::size_t>(v)] = 1;
+      model.vertex_bends.push_back(std::move(b));
+      fresh_bends.push_back(1);
+    }
+    // A previous element that has none of the same vertex now: its rows lose its entries.
+    for (std::size_t e = 0; e < previous.vertex_bends.size(); ++e)
+      if (!matched[e])
+        for (int q : previous.vertex_bends[e].vertices)
+          if (const int k = next_vertex[static_cast<std::size_t>(q)]; k >= 0)
+            changed_row[static_cast<std::size_t>(k)] = 1;
+  } else {
+    for (const VertexBendElement& b : previous.vertex_bends)
+      for (int q : b.vertices)
+        if (const int k = next_vertex[static_cast<std::size_t>(q)]; k >= 0)
+          changed_row[static_cast<std::size_t>(k)] = 1;
+  }
 
   // Pattern: unchanged rows are the previous rows renumbered (kept vertices keep their order,
   // so each run stays sorted), the changed ones are collected from the elements and sorted.
@@ -629,7 +731,7 @@ ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse&
       model.pattern.diagonal_offsets[static_cast<std::size_t>(i)] =
           previous.pattern.diagonal_offsets[static_cast<std::size_t>(
               reuse.previous_vertex[static_cast<std::size_t>(i)])];
-  set_block_offsets(model, neighbours, changed_row);
+  set_block_offsets(model, neighbours, changed_row, fresh_bends);
   return model;
 }
 

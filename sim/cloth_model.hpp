@@ -154,6 +154,7 @@ struct VertexBendElement {
   std::vector<std::array<int, 2>> fan;  // (b, c) indices into `vertices` of each triangle
                                         // (v, b, c); only when rest_normal != 0
   std::vector<int> blocks;              // #vertices², offset of block (j,l), see BlockPattern
+  bool clamped = false;                 // inverse_area doubled by clamp_bending
 };
 
 // Structurally symmetric block sparsity: rows 3i..3i+2 all hold the columns of the vertices
@@ -170,6 +171,7 @@ struct ClothModel {
   std::vector<TriangleElement> triangles;
   std::vector<HingeElement> hinges;  // built for both bend models, used by BendModel::hinges
   BendModel bend_model = BendModel::quadratic;
+  BendRestShape bend_rest = BendRestShape::designed;  // what the vertex bends were made for
   Compression compression = Compression::linear;
   std::vector<VertexBendElement> vertex_bends;  // with BendModel::quadratic
   std::vector<BendStencil> stencils;  // with ClothModelOptions::bend_stencil_stiffness > 0
@@ -199,7 +201,9 @@ struct ClothModelReuse {
 // from `previous` (that model of the mesh before the change) where the change did not reach:
 // kept triangles and the hinges between two of them are copied with their vertices renumbered,
 // and the pattern rows of vertices whose elements are all kept are copied, with their elements'
-// offsets. Only the changed neighbourhood is computed and sorted. Vertex and triangle
+// offsets; so are the vertex bends (BendModel::quadratic) of the vertices whose faces and
+// one-ring's faces the change did not reach. Only the changed neighbourhood is computed and
+// sorted. Vertex and triangle
 // renumbering must keep the order of what is kept (as Mesh48::compact does); hinges then come in
 // the reference's order. Throws InvalidClothError as build_cloth_model, and when `reuse` does
 // not describe the input.

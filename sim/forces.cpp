@@ -24,15 +24,23 @@ struct ConditionEnergy {
   double curvature = 0.0;
 };
 
-// Adds the contribution of one condition C with energy φ(C) and damping k_d to the force, the
-// energy and the Jacobian target. `vertices`/`blocks` locate the element in the global arrays.
+// What one condition C with energy φ(C) and damping k_d adds: its energy, its force on the
+// element's vertices, and (with a Jacobian target) its block of the matrix and of the product.
 // The curvature term −φ'·∇²C is kept in the solve's Jacobian only where φ' > 0 (stretched): in
 // compression it is indefinite.
 template <int N>
-void add_condition_energy(const Condition<N>& c, const ConditionEnergy& phi, double damping,
-                          bool keep_curvature_in_solve, const int* vertices, const int* blocks,
-                          const Eigen::VectorXd& v, Eigen::VectorXd& force, double& energy,
-                          const JacobianTarget* jacobian) {
+struct ConditionContribution {
+  double energy = 0.0;
+  Eigen::Matrix<double, N, 1> force;
+  Eigen::Matrix<double, N, 1> product;  // ∂f/∂x·u on the element, with a product target
+  Eigen::Matrix<double, N, N> matrix;  // dfdx_scale·∂f/∂x + dfdv_scale·∂f/∂v, with a matrix
+};
+
+template <int N>
+void condition_contribution(const Condition<N>& c, const ConditionEnergy& phi, double damping,
+                            bool keep_curvature_in_solve, const int* vertices,
+                            const Eigen::VectorXd& v, const JacobianTarget* jacobian,
+                            ConditionContribution<N>& out) {
   constexpr int kVertices = N / 3;
   using VectorN = Eigen::Matrix<double, N, 1>;
   using MatrixN = Eigen::Matrix<double, N, N>;
@@ -40,10 +48,8 @@ void add_condition_energy(const Condition<N>& c, const ConditionEnergy& phi, dou
   for (int k = 0; k < kVertices; ++k)
     local_v.template segment<3>(3 * k) = v.segment<3>(3 * vertices[k]);
   const double c_dot = damping > 0.0 ? c.gradient.dot(local_v) : 0.0;
-  energy += phi.value;
-  const VectorN local_force = -(phi.slope + damping * c_dot) * c.gradient;
-  for (int k = 0; k < kVertices; ++k)
-    force.segment<3>(3 * vertices[k]) += local_force.template segment<3>(3 * k);
+  out.energy = phi.value;
+  out.force = -(phi.slope + damping * c_dot) * c.gradient;
   if (jacobian == nullptr) return;
 
   const bool exact = jacobian->kind == JacobianKind::exact;
@@ -58,33 +64,47 @@ void add_condition_energy(const Condition<N>& c, const ConditionEnergy& phi, dou
     VectorN local_u;
     for (int k = 0; k < kVertices; ++k)
       local_u.template segment<3>(3 * k) = jacobian->product_input->segment<3>(3 * vertices[k]);
-    const VectorN product = dfdx * local_u;
-    for (int k = 0; k < kVertices; ++k)
-      jacobian->product_output->segment<3>(3 * vertices[k]) += product.template segment<3>(3 * k);
+    out.product = dfdx * local_u;
   }
   if (jacobian->matrix == nullptr) return;
-  const MatrixN local = jacobian->dfdx_scale * dfdx - (jacobian->dfdv_scale * damping) * outer;
-  double* values = jacobian->matrix->valuePtr();
+  out.matrix = jacobian->dfdx_scale * dfdx - (jacobian->dfdv_scale * damping) * outer;
+}
+
+// Adds a condition's contribution to the rows of the element's vertices k with
+// own(vertices[k]) (the force, the product and the matrix; not the energy). Every entry then
+// receives its sums in the order the conditions are added, whichever rows a thread owns.
+template <int N, class Own>
+void scatter_contribution(const ConditionContribution<N>& c, const int* vertices, const int* blocks,
+                          Eigen::VectorXd& force, const JacobianTarget* jacobian, const Own& own) {
+  constexpr int kVertices = N / 3;
   for (int k = 0; k < kVertices; ++k)
+    if (own(vertices[k])) force.segment<3>(3 * vertices[k]) += c.force.template segment<3>(3 * k);
+  if (jacobian == nullptr) return;
+  if (jacobian->product_input != nullptr)
+    for (int k = 0; k < kVertices; ++k)
+      if (own(vertices[k]))
+        jacobian->product_output->segment<3>(3 * vertices[k]) +=
+            c.product.template segment<3>(3 * k);
+  if (jacobian->matrix == nullptr) return;
+  double* values = jacobian->matrix->valuePtr();
+  for (int k = 0; k < kVertices; ++k) {
+    if (!own(vertices[k])) continue;
     for (int l = 0; l < kVertices; ++l) {
       const int offset = blocks[kVertices * k + l];
       for (int a = 0; a < 3; ++a) {
         double* row = values + block_value_index(*jacobian->matrix, vertices[k], offset, a, 0);
-        for (int b = 0; b < 3; ++b) row[b] += local(3 * k + a, 3 * l + b);
+        for (int b = 0; b < 3; ++b) row[b] += c.matrix(3 * k + a, 3 * l + b);
       }
     }
+  }
 }
 
-// The quadratic energy ½·k·(C − C0)² (Baraff & Witkin).
-template <int N>
-void add_condition(const Condition<N>& c, double rest_value, double stiffness, double damping,
-                   bool keep_curvature_in_solve, const int* vertices, const int* blocks,
-                   const Eigen::VectorXd& v, Eigen::VectorXd& force, double& energy,
-                   const JacobianTarget* jacobian) {
-  const double c_value = c.value - rest_value;
-  add_condition_energy(
-      c, ConditionEnergy{0.5 * stiffness * c_value * c_value, stiffness * c_value, stiffness},
-      damping, keep_curvature_in_solve, vertices, blocks, v, force, energy, jacobian);
+constexpr auto kEveryRow = [](int) { return true; };
+
+// The quadratic energy ½·k·(C − C0)² (Baraff & Witkin) at the condition's value C.
+ConditionEnergy quadratic_energy(double value, double rest_value, double stiffness) {
+  const double c_value = value - rest_value;
+  return {0.5 * stiffness * c_value * c_value, stiffness * c_value, stiffness};
 }
 
 // Stretch along one direction with Choi & Ko's post-buckling cap (Compression::buckling): the
@@ -279,27 +299,82 @@ void add_vertex_bend(const VertexBendElement& b, double bend, double beta, const
     }
 }
 
-// Calls add(k, conditions of element k) for k = 0 … count − 1 in order, computing the
-// conditions with compute(k) (their derivatives are most of the work of a force evaluation). On
-// more than one thread a block of elements is computed in parallel first, then added in order:
-// every sum into the force and the matrix happens in the same order as on one thread, so the
-// result is the same bits on any thread count. Blocks of kBlock elements keep the buffer
-// (2.2 kB per triangle with its Hessians) in the cache.
-template <class Conditions, class Compute, class Add>
-void for_each_element(int count, const Compute& compute, const Add& add) {
+// The contributions of one element: up to K conditions of N coordinates, each with the energy
+// it adds to (a member of EnergyBreakdown).
+template <int N, int K>
+struct ElementContribution {
+  std::array<ConditionContribution<N>, K> conditions;
+  std::array<double EnergyBreakdown::*, K> energy{};
+  int count = 0;  // conditions filled, in the order they are added
+
+  ConditionContribution<N>& next(double EnergyBreakdown::*into) {
+    energy[static_cast<std::size_t>(count)] = into;
+    return conditions[static_cast<std::size_t>(count++)];
+  }
+};
+
+// Adds the contributions of elements 0 … count − 1: contribute(k, out) fills element k's (the
+// conditions and their derivatives: most of the work of a force evaluation), element(k) gives
+// its vertices and block offsets. On one thread each element is added as it is computed. On
+// more, a block of elements is computed in parallel, then added in parallel by rows: each
+// thread owns a range of vertices and adds, element by element in order, what lands in its
+// rows. Every entry of the force, the product and the matrix so receives its sums in the same
+// order as on one thread, and the energies are summed in that order too: the result is the same
+// bits on any thread count. Blocks of kBlock elements keep the buffer (2.4 kB per triangle
+// with its matrices) in the cache.
+template <int N, int K, class Element, class Contribute>
+void add_elements(int count, int vertex_count, const Element& element, const Contribute& contribute,
+                  Eigen::VectorXd& force, EnergyBreakdown& energy, const JacobianTarget* jacobian) {
+  using Contribution = ElementContribution<N, K>;
   constexpr int kBlock = 512;
   constexpr int kGrain = 128;
-  if (thread_count() <= 1 || count < 2 * kGrain) {
-    for (int k = 0; k < count; ++k) add(k, compute(k));
+  const auto add_energy = [&](const Contribution& c) {
+    for (int j = 0; j < c.count; ++j)
+      energy.*c.energy[static_cast<std::size_t>(j)] +=
+          c.conditions[static_cast<std::size_t>(j)].energy;
+  };
+  const int threads = thread_count();
+  if (threads <= 1 || count < 2 * kGrain) {
+    Contribution c;
+    for (int k = 0; k < count; ++k) {
+      c.count = 0;
+      contribute(k, c);
+      const auto [vertices, blocks] = element(k);
+      add_energy(c);
+      for (int j = 0; j < c.count; ++j)
+        scatter_contribution(c.conditions[static_cast<std::size_t>(j)], vertices, blocks, force,
+                             jacobian, kEveryRow);
+    }
     return;
   }
-  std::vector<Conditions> buffer(static_cast<std::size_t>(std::min(count, kBlock)));
+  // Kept between calls (one per thread that evaluates forces): no allocation per evaluation.
+  // Named through a reference: inside the lambdas the thread_local itself would be the worker
+  // thread's own.
+  thread_local std::vector<Contribution> kept;
+  std::vector<Contribution>& buffer = kept;
+  buffer.resize(static_cast<std::size_t>(std::min(count, kBlock)));
+  // One range of rows per thread: which thread adds into a row does not change the order.
+  const int row_grain = std::max(1, (vertex_count + threads - 1) / threads);
   for (int first = 0; first < count; first += kBlock) {
     const int size = std::min(kBlock, count - first);
     parallel_chunks(size, kGrain, [&](int, int begin, int end) {
-      for (int k = begin; k < end; ++k) buffer[static_cast<std::size_t>(k)] = compute(first + k);
+      for (int k = begin; k < end; ++k) {
+        Contribution& c = buffer[static_cast<std::size_t>(k)];
+        c.count = 0;
+        contribute(first + k, c);
+      }
     });
-    for (int k = 0; k < size; ++k) add(first + k, buffer[static_cast<std::size_t>(k)]);
+    parallel_chunks(vertex_count, row_grain, [&](int, int low, int high) {
+      const auto own = [low, high](int vertex) { return vertex >= low && vertex < high; };
+      for (int k = 0; k < size; ++k) {
+        const Contribution& c = buffer[static_cast<std::size_t>(k)];
+        const auto [vertices, blocks] = element(first + k);
+        for (int j = 0; j < c.count; ++j)
+          scatter_contribution(c.conditions[static_cast<std::size_t>(j)], vertices, blocks, force,
+                               jacobian, own);
+      }
+    });
+    for (int k = 0; k < size; ++k) add_energy(buffer[static_cast<std::size_t>(k)]);
   }
 }
 
@@ -318,15 +393,16 @@ void evaluate_forces(const ClothModel& model, const ForceSettings& settings,
   const double damping_scale = terms.damping ? 1.0 : 0.0;
 
   if (terms.stretch || terms.shear) {
-    const auto conditions = [&](int k) {
+    const auto element = [&](int k) {
       const TriangleElement& t = model.triangles[static_cast<std::size_t>(k)];
-      const auto& vs = t.vertices;
-      return triangle_conditions(t, x.segment<3>(3 * vs[0]), x.segment<3>(3 * vs[1]),
-                                 x.segment<3>(3 * vs[2]), want_hessian);
+      return std::make_pair(t.vertices.data(), t.blocks.data());
     };
-    const auto add = [&](int k, const TriangleConditions& c) {
+    const auto contribute = [&](int k, ElementContribution<9, 3>& out) {
       const TriangleElement& t = model.triangles[static_cast<std::size_t>(k)];
       const auto& vs = t.vertices;
+      const TriangleConditions c =
+          triangle_conditions(t, x.segment<3>(3 * vs[0]), x.segment<3>(3 * vs[1]),
+                              x.segment<3>(3 * vs[2]), want_hessian);
       if (terms.stretch) {
         const double k_u = fabric.stretch_warp * t.rest_area;
         const double k_v = fabric.stretch_weft * t.rest_area;
@@ -338,22 +414,24 @@ void evaluate_forces(const ClothModel& model, const ForceSettings& settings,
             buckling ? pi2b / (t.width_u * t.width_u * fabric.stretch_warp) : kLinearCompression;
         const double eps_v =
             buckling ? pi2b / (t.width_v * t.width_v * fabric.stretch_weft) : kLinearCompression;
-        add_condition_energy(
+        condition_contribution(
             c.warp, stretch_energy(c.warp.value, k_u, eps_u, fabric.tensile_warp, t.rest_area),
-            damping_scale * fabric.damping * k_u, true, vs.data(), t.blocks.data(), v, force,
-            local_energy.stretch, jacobian);
-        add_condition_energy(
+            damping_scale * fabric.damping * k_u, true, vs.data(), v, jacobian,
+            out.next(&EnergyBreakdown::stretch));
+        condition_contribution(
             c.weft, stretch_energy(c.weft.value, k_v, eps_v, fabric.tensile_weft, t.rest_area),
-            damping_scale * fabric.damping * k_v, true, vs.data(), t.blocks.data(), v, force,
-            local_energy.stretch, jacobian);
+            damping_scale * fabric.damping * k_v, true, vs.data(), v, jacobian,
+            out.next(&EnergyBreakdown::stretch));
       }
       if (terms.shear) {
         const double k_s = fabric.shear * t.rest_area;
-        add_condition(c.shear, 0.0, k_s, damping_scale * fabric.damping * k_s, false, vs.data(),
-                      t.blocks.data(), v, force, local_energy.shear, jacobian);
+        condition_contribution(c.shear, quadratic_energy(c.shear.value, 0.0, k_s),
+                               damping_scale * fabric.damping * k_s, false, vs.data(), v, jacobian,
+                               out.next(&EnergyBreakdown::shear));
       }
     };
-    for_each_element<TriangleConditions>(static_cast<int>(model.triangles.size()), conditions, add);
+    add_elements<9, 3>(static_cast<int>(model.triangles.size()), n, element, contribute, force,
+                       local_energy, jacobian);
   }
   if (terms.bend && fabric.bend > 0.0 && model.bend_model == BendModel::quadratic) {
     const double beta = damping_scale * fabric.bend_damping;
@@ -361,19 +439,24 @@ void evaluate_forces(const ClothModel& model, const ForceSettings& settings,
       add_vertex_bend(b, fabric.bend, beta, x, v, force, local_energy.bend, jacobian);
   }
   if (terms.bend && fabric.bend > 0.0 && model.bend_model == BendModel::hinges) {
-    // The bend Hessian is only needed for the exact Jacobian: the solve uses −k·∇θ∇θᵀ.
-    const auto conditions = [&](int k) {
-      const auto& vs = model.hinges[static_cast<std::size_t>(k)].vertices;
-      return dihedral_angle_condition(x.segment<3>(3 * vs[0]), x.segment<3>(3 * vs[1]),
-                                      x.segment<3>(3 * vs[2]), x.segment<3>(3 * vs[3]), exact);
-    };
-    const auto add = [&](int k, const Condition<12>& c) {
+    const auto element = [&](int k) {
       const HingeElement& h = model.hinges[static_cast<std::size_t>(k)];
-      const double k_b = fabric.bend * h.weight;
-      add_condition(c, h.rest_angle, k_b, damping_scale * fabric.bend_damping * k_b, false,
-                    h.vertices.data(), h.blocks.data(), v, force, local_energy.bend, jacobian);
+      return std::make_pair(h.vertices.data(), h.blocks.data());
     };
-    for_each_element<Condition<12>>(static_cast<int>(model.hinges.size()), conditions, add);
+    const auto contribute = [&](int k, ElementContribution<12, 1>& out) {
+      const HingeElement& h = model.hinges[static_cast<std::size_t>(k)];
+      const auto& vs = h.vertices;
+      // The bend Hessian is only needed for the exact Jacobian: the solve uses −k·∇θ∇θᵀ.
+      const Condition<12> c =
+          dihedral_angle_condition(x.segment<3>(3 * vs[0]), x.segment<3>(3 * vs[1]),
+                                   x.segment<3>(3 * vs[2]), x.segment<3>(3 * vs[3]), exact);
+      const double k_b = fabric.bend * h.weight;
+      condition_contribution(c, quadratic_energy(c.value, h.rest_angle, k_b),
+                             damping_scale * fabric.bend_damping * k_b, false, vs.data(), v,
+                             jacobian, out.next(&EnergyBreakdown::bend));
+    };
+    add_elements<12, 1>(static_cast<int>(model.hinges.size()), n, element, contribute, force,
+                        local_energy, jacobian);
   }
   if (terms.bend && fabric.bend > 0.0 && model.bend_model == BendModel::hinges &&
       model.bend_stencil_stiffness > 0.0) {

@@ -101,6 +101,9 @@ void expect_reference_model(const AdaptiveCloth& cloth, const AdaptiveMaterial& 
     ASSERT_EQ(got.vertices, want.vertices) << "change " << change << ", vertex bend " << b;
     ASSERT_EQ(got.rows, want.rows) << "change " << change << ", vertex bend " << b;
     ASSERT_EQ(got.rest_normal, want.rest_normal) << "change " << change << ", vertex bend " << b;
+    ASSERT_EQ(got.centre, want.centre) << "change " << change << ", vertex bend " << b;
+    ASSERT_EQ(got.inverse_area, want.inverse_area) << "change " << change << ", vertex bend " << b;
+    ASSERT_EQ(got.fan, want.fan) << "change " << change << ", vertex bend " << b;
     ASSERT_EQ(got.blocks, want.blocks) << "change " << change << ", vertex bend " << b;
   }
   const SparseMatrixR &got = model.pattern.zero_matrix, &want = reference.pattern.zero_matrix;

@@ -98,8 +98,9 @@ TEST_F(ThreadCount, ContactQueriesAreTheSameOnOneAndManyThreads) {
   }
 }
 
-// The force evaluation computes its elements' conditions on many threads (sim/forces.cpp): the
-// force, the energies and the solve matrix must be the same bits as on one thread. A 40×40 sheet
+// The force evaluation computes its elements' conditions on many threads and adds them into the
+// rows each thread owns (sim/forces.cpp): the force, the energies, the matrix and the product
+// ∂f/∂x·u must be the same bits as on one thread. A 40×40 sheet
 // (3,200 triangles, 4,720 hinges: several blocks of elements) in a random crumpled state.
 TEST_F(ThreadCount, ForcesAndJacobianAreTheSameOnOneAndManyThreads) {
   SheetSpec spec;
@@ -125,17 +126,26 @@ TEST_F(ThreadCount, ForcesAndJacobianAreTheSameOnOneAndManyThreads) {
       target.matrix = &matrix;
       target.dfdx_scale = -1e-4;
       target.dfdv_scale = -1e-2;
+      // The product ∂f/∂x·u as the implicit solver's first iteration asks for it.
+      const Eigen::VectorXd u = 1e-3 * v;
+      Eigen::VectorXd product = Eigen::VectorXd::Zero(x.size());
+      target.product_input = &u;
+      target.product_output = &product;
       Eigen::VectorXd force;
       EnergyBreakdown energy;
       evaluate_forces(model, ForceSettings{}, x, v, force, &energy, &target);
-      return std::make_tuple(force, energy, matrix);
+      return std::make_tuple(force, energy, matrix, product);
     };
     for (const JacobianKind kind : {JacobianKind::solve, JacobianKind::exact}) {
-      const auto [force1, energy1, matrix1] = run(1, kind);
-      const auto [force2, energy2, matrix2] = run(2, kind);
-      const auto [force4, energy4, matrix4] = run(4, kind);
+      const auto [force1, energy1, matrix1, product1] = run(1, kind);
+      const auto [force2, energy2, matrix2, product2] = run(2, kind);
+      const auto [force4, energy4, matrix4, product4] = run(4, kind);
       ASSERT_GT(force1.norm(), 0.0);
+      ASSERT_GT(product1.norm(), 0.0);
       EXPECT_TRUE(force1 == force2 && force1 == force4);  // bit for bit
+      EXPECT_TRUE(product1 == product2 && product1 == product4);
+      EXPECT_EQ(energy1.stretch, energy2.stretch);
+      EXPECT_EQ(energy1.shear, energy2.shear);
       EXPECT_EQ(energy1.stretch, energy4.stretch);
       EXPECT_EQ(energy1.shear, energy4.shear);
       EXPECT_EQ(energy1.bend, energy2.bend);
