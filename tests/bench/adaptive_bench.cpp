@@ -22,7 +22,10 @@
 //                                             --adaptive-start: the adaptive runs' first level
 //                                             (default 0); --even-levels: adaptive runs keep
 //                                             even levels; --fine-ladder: thresholds in steps
-//                                             of √2 instead of 2.
+//                                             of √2 instead of 2; --threads=N: the
+//                                             simulator's own parallel loops on N threads
+//                                             (default: every core; 1 keeps the CPU time free
+//                                             of idle worker threads' spinning).
 #include <benchmark/benchmark.h>
 
 #include <chrono>
@@ -40,6 +43,7 @@
 #include <vector>
 
 #include "sim/adaptive_detail.hpp"
+#include "sim/parallel.hpp"
 #include "sim/solver_library_threads.hpp"
 #include "tests/sim/adaptive_scenes.hpp"
 #include "tests/sim/test_bodies.hpp"
@@ -443,6 +447,8 @@ int main(int argc, char** argv) {
       options.fine_ladder = true;
     else if (std::strcmp(argv[i], "--quick") == 0)
       options.quick = true;
+    else if (std::strncmp(argv[i], "--threads=", 10) == 0)
+      sd::sim::set_thread_count(std::atoi(argv[i] + 10));
     else
       rest.push_back(argv[i]);
   }

@@ -35,6 +35,39 @@ TEST(ClothModel, MassesAddUpToDensityTimesArea) {
   EXPECT_EQ(model.hinges.size(), 62u);
 }
 
+// clamp_bending doubles the energy of the vertex bends on a clamp's edge once, however often it
+// is applied (an adaptive update keeps the elements of the previous, clamped model), and a vertex
+// that leaves the clamp gets its own energy back exactly.
+TEST(ClothModel, ClampBendingDoublesOnceAndUndoesExactly) {
+  SheetSpec spec;
+  spec.size = {0.6, 0.4};
+  spec.columns = 6;
+  spec.rows = 4;
+  spec.pins = {"top:2"};  // two lines of vertices: the triangles between them are all pinned
+  const SheetScene scene = build_sheet(spec);
+  const ClothModel plain = build_cloth_model(scene.input, fabric_preset("cotton"));
+  ClothModel model = plain;
+  clamp_bending(model, scene.pinned_vertices);
+  int doubled = 0;
+  for (std::size_t b = 0; b < model.vertex_bends.size(); ++b)
+    if (model.vertex_bends[b].clamped) {
+      ++doubled;
+      EXPECT_EQ(model.vertex_bends[b].inverse_area, 2.0 * plain.vertex_bends[b].inverse_area);
+    } else {
+      EXPECT_EQ(model.vertex_bends[b].inverse_area, plain.vertex_bends[b].inverse_area);
+    }
+  EXPECT_EQ(doubled, spec.columns + 1);  // the second line of pinned vertices
+  const ClothModel once = model;
+  clamp_bending(model, scene.pinned_vertices);
+  for (std::size_t b = 0; b < model.vertex_bends.size(); ++b)
+    EXPECT_EQ(model.vertex_bends[b].inverse_area, once.vertex_bends[b].inverse_area);
+  clamp_bending(model, {});
+  for (std::size_t b = 0; b < model.vertex_bends.size(); ++b) {
+    EXPECT_FALSE(model.vertex_bends[b].clamped);
+    EXPECT_EQ(model.vertex_bends[b].inverse_area, plain.vertex_bends[b].inverse_area);
+  }
+}
+
 TEST(ClothModel, RestShapeHasNoStrainNoElasticForceAndUnitWarp) {
   for (auto orientation : {SheetOrientation::vertical, SheetOrientation::horizontal}) {
     const SheetScene scene = small_sheet(orientation);
