@@ -166,12 +166,6 @@ struct Neighbours {
     return 3 * static_cast<int>(
                    std::lower_bound(first, first + size[static_cast<std::size_t>(i)], j) - first);
   }
-  void sort_run(int i) {
-    const auto first = list.begin() + start[static_cast<std::size_t>(i)];
-    const auto last = list.begin() + start[static_cast<std::size_t>(i) + 1];
-    std::sort(first, last);
-    size[static_cast<std::size_t>(i)] = static_cast<int>(std::unique(first, last) - first);
-  }
 };
 
 // Room in vertex runs for every element's entries: 1 for itself, 2 per triangle, 3 per hinge.
@@ -194,7 +188,9 @@ std::vector<int> run_starts(int n, const std::vector<TriangleElement>& triangles
 }
 
 // Fills the runs of the vertices with wanted[i] (every vertex when empty) from the elements and
-// sorts them.
+// sorts them. The vertex bends, which overlap most (a vertex lies in the bends of its whole
+// two-ring, each over a two-ring), are added row by row through their incidence with a mark per
+// neighbour, so a run is sorted without their duplicates.
 void collect_neighbours(Neighbours& neighbours, const std::vector<TriangleElement>& triangles,
                         const std::vector<HingeElement>& hinges,
                         const std::vector<BendStencil>& stencils,
@@ -216,45 +212,65 @@ void collect_neighbours(Neighbours& neighbours, const std::vector<TriangleElemen
   for (const HingeElement& h : hinges) connect(h.vertices.data(), 4);
   for (const BendStencil& b : stencils)
     connect(b.vertices.data(), static_cast<int>(b.vertices.size()));
+  // The vertex bends over each wanted vertex (CSR by vertex).
+  std::vector<int> bend_start(static_cast<std::size_t>(n) + 1, 0);
   for (const VertexBendElement& b : vertex_bends)
-    connect(b.vertices.data(), static_cast<int>(b.vertices.size()));
-  for (int i = 0; i < n; ++i)
-    if (want(i)) neighbours.sort_run(i);
+    for (int v : b.vertices)
+      if (want(v)) ++bend_start[static_cast<std::size_t>(v) + 1];
+  for (int i = 0; i < n; ++i) bend_start[i + 1] += bend_start[i];
+  std::vector<int> bends(static_cast<std::size_t>(bend_start[n]));
+  {
+    std::vector<int> next(bend_start.begin(), bend_start.end() - 1);
+    for (std::size_t e = 0; e < vertex_bends.size(); ++e)
+      for (int v : vertex_bends[e].vertices)
+        if (want(v)) bends[static_cast<std::size_t>(next[v]++)] = static_cast<int>(e);
+  }
+  std::vector<int> mark(static_cast<std::size_t>(n), -1);  // the row that last took a vertex
+  for (int i = 0; i < n; ++i) {
+    if (!want(i)) continue;
+    const auto first = neighbours.list.begin() + neighbours.start[static_cast<std::size_t>(i)];
+    // The run so far (itself, triangles, hinges, stencils) without its repeats.
+    auto end = first;
+    for (auto it = first; it != neighbours.list.begin() + fill[i]; ++it)
+      if (mark[static_cast<std::size_t>(*it)] != i) {
+        mark[static_cast<std::size_t>(*it)] = i;
+        *end++ = *it;
+      }
+    for (int m = bend_start[i]; m < bend_start[i + 1]; ++m)
+      for (int j :
+           vertex_bends[static_cast<std::size_t>(bends[static_cast<std::size_t>(m)])].vertices)
+        if (mark[static_cast<std::size_t>(j)] != i) {
+          mark[static_cast<std::size_t>(j)] = i;
+          *end++ = j;
+        }
+    std::sort(first, end);
+    neighbours.size[static_cast<std::size_t>(i)] = static_cast<int>(end - first);
+  }
 }
 
-// The pattern's matrix: rows 3i..3i+2 hold the 3×3 blocks of vertex i's neighbours.
+// The pattern's matrix: rows 3i..3i+2 hold the 3×3 blocks of vertex i's neighbours. Made in
+// place (no index arrays copied into it).
 SparseMatrixR zero_pattern_matrix(const Neighbours& neighbours) {
   const int n = static_cast<int>(neighbours.size.size());
-  std::vector<int> outer(3 * n + 1, 0);
-  std::vector<int> inner;
-  inner.reserve(static_cast<std::size_t>(9 * neighbours.start[static_cast<std::size_t>(n)]));
+  SparseMatrixR matrix(3 * n, 3 * n);
+  std::size_t entries = 0;
+  for (int i = 0; i < n; ++i)
+    entries += 9 * static_cast<std::size_t>(neighbours.size[static_cast<std::size_t>(i)]);
+  matrix.resizeNonZeros(static_cast<Eigen::Index>(entries));
+  int* outer = matrix.outerIndexPtr();
+  int* inner = matrix.innerIndexPtr();
+  outer[0] = 0;
+  int position = 0;
   for (int i = 0; i < n; ++i) {
     const int* run = neighbours.list.data() + neighbours.start[static_cast<std::size_t>(i)];
     for (int a = 0; a < 3; ++a) {
       for (int m = 0; m < neighbours.size[static_cast<std::size_t>(i)]; ++m)
-        for (int b = 0; b < 3; ++b) inner.push_back(3 * run[m] + b);
-      outer[3 * i + a + 1] = static_cast<int>(inner.size());
+        for (int b = 0; b < 3; ++b) inner[position++] = 3 * run[m] + b;
+      outer[3 * i + a + 1] = position;
     }
   }
-  const std::vector<double> zeros(inner.size(), 0.0);
-  return Eigen::Map<const SparseMatrixR>(3 * n, 3 * n, static_cast<int>(inner.size()), outer.data(),
-                                         inner.data(), zeros.data());
-}
-
-// offset(vertices[k], vertices[l]) for every l into out[count·k + l], for sorted `vertices`: one
-// walk along row vertices[k] (sorted too) instead of a binary search per entry.
-void set_row_offsets(const Neighbours& neighbours, const std::vector<int>& vertices, int k,
-                     std::vector<int>& out) {
-  const int count = static_cast<int>(vertices.size());
-  const int i = vertices[static_cast<std::size_t>(k)];
-  const int* run = neighbours.list.data() + neighbours.start[static_cast<std::size_t>(i)];
-  const int size = neighbours.size[static_cast<std::size_t>(i)];
-  int m = 0;
-  for (int l = 0; l < count; ++l) {
-    const int j = vertices[static_cast<std::size_t>(l)];
-    while (m < size && run[m] < j) ++m;
-    out[static_cast<std::size_t>(count * k + l)] = 3 * m;
-  }
+  std::fill(matrix.valuePtr(), matrix.valuePtr() + entries, 0.0);
+  return matrix;
 }
 
 // The elements' block offsets and the diagonal offsets of the rows with wanted[i] (every row
@@ -278,13 +294,43 @@ void set_block_offsets(ClothModel& model, const Neighbours& neighbours,
           h.blocks[4 * k + l] = neighbours.offset(h.vertices[k], h.vertices[l]);
   // Stencils are rebuilt with every model, so all their offsets are set; vertex bends kept
   // from the previous model hold theirs in the rows that did not change.
-  for (std::size_t e = 0; e < model.vertex_bends.size(); ++e) {
-    VertexBendElement& b = model.vertex_bends[e];
-    const bool fresh = fresh_bends.empty() || fresh_bends[e];
-    const int count = static_cast<int>(b.vertices.size());
-    for (int k = 0; k < count; ++k)
-      if (fresh || want(b.vertices[static_cast<std::size_t>(k)]))
-        set_row_offsets(neighbours, b.vertices, k, b.blocks);
+  // Row by row: the (element, local row) pairs to set in each vertex's row, then the row's
+  // offsets by column through a position map (every column an element reads is in the row).
+  const int n = model.vertex_count;
+  const auto rows_to_set = [&](std::size_t e, int k) {
+    return fresh_bends.empty() || fresh_bends[e] ||
+           want(model.vertex_bends[e].vertices[static_cast<std::size_t>(k)]);
+  };
+  std::vector<int> row_start(static_cast<std::size_t>(n) + 1, 0);
+  for (std::size_t e = 0; e < model.vertex_bends.size(); ++e)
+    for (std::size_t k = 0; k < model.vertex_bends[e].vertices.size(); ++k)
+      if (rows_to_set(e, static_cast<int>(k)))
+        ++row_start[static_cast<std::size_t>(model.vertex_bends[e].vertices[k]) + 1];
+  for (int i = 0; i < n; ++i) row_start[i + 1] += row_start[i];
+  std::vector<std::pair<int, int>> pairs(static_cast<std::size_t>(row_start[n]));
+  {
+    std::vector<int> next(row_start.begin(), row_start.end() - 1);
+    for (std::size_t e = 0; e < model.vertex_bends.size(); ++e)
+      for (std::size_t k = 0; k < model.vertex_bends[e].vertices.size(); ++k)
+        if (rows_to_set(e, static_cast<int>(k)))
+          pairs[static_cast<std::size_t>(
+              next[static_cast<std::size_t>(model.vertex_bends[e].vertices[k])]++)] = {
+              static_cast<int>(e), static_cast<int>(k)};
+  }
+  std::vector<int> position(static_cast<std::size_t>(n), 0);
+  for (int i = 0; i < n; ++i) {
+    if (row_start[i] == row_start[i + 1]) continue;
+    const int* run = neighbours.list.data() + neighbours.start[static_cast<std::size_t>(i)];
+    for (int m = 0; m < neighbours.size[static_cast<std::size_t>(i)]; ++m)
+      position[static_cast<std::size_t>(run[m])] = 3 * m;
+    for (int p = row_start[i]; p < row_start[i + 1]; ++p) {
+      const auto [e, k] = pairs[static_cast<std::size_t>(p)];
+      VertexBendElement& b = model.vertex_bends[static_cast<std::size_t>(e)];
+      const int count = static_cast<int>(b.vertices.size());
+      for (int l = 0; l < count; ++l)
+        b.blocks[static_cast<std::size_t>(count * k + l)] =
+            position[static_cast<std::size_t>(b.vertices[static_cast<std::size_t>(l)])];
+    }
   }
   for (BendStencil& b : model.stencils) {
     const int count = static_cast<int>(b.vertices.size());
