@@ -174,12 +174,26 @@ Eigen::MatrixXd area_vector_hessian(const VertexBendElement& b, const Vector3d& 
   return h;
 }
 
+// What the quadratic bending of one vertex adds (VertexBendElement): its energy row by row, its
+// force and, with a Jacobian target, its product and matrix block. A flat rest's rows are linear,
+// so its matrix is coupling ⊗ I times `scale` (m × m, m the element's vertices); a curved rest's
+// is dense (3m × 3m). The buffers keep their size between evaluations.
+struct VertexBendContribution {
+  std::array<double, 3> energy{};
+  bool flat = true;
+  Eigen::MatrixX3d flat_force, flat_product;  // m × 3
+  Eigen::MatrixXd coupling;                   // m × m
+  double scale = 0.0;
+  Eigen::VectorXd force, product;  // 3m
+  Eigen::MatrixXd local;           // 3m × 3m
+};
+
 // The quadratic bending of one vertex (VertexBendElement): energy ½·k·Σ_k s_k|r_k|², force
 // −k·Σ_k s_k·J_kᵀ(r_k + β·ṙ_k) with J_k = ∂r_k/∂x = rows_k ⊗ I − c_k·G(x), ṙ_k = J_k·v,
 // k = B/A_v and s = (½, ½, 2).
-void add_vertex_bend(const VertexBendElement& b, double bend, double beta, const Eigen::VectorXd& x,
-                     const Eigen::VectorXd& v, Eigen::VectorXd& force, double& energy,
-                     const JacobianTarget* jacobian) {
+void vertex_bend_contribution(const VertexBendElement& b, double bend, double beta,
+                              const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                              const JacobianTarget* jacobian, VertexBendContribution& out) {
   static constexpr std::array<double, 3> kRowScale{0.5, 0.5, 2.0};
   const auto m = static_cast<Eigen::Index>(b.vertices.size());
   const double k = bend * b.inverse_area;
@@ -190,41 +204,27 @@ void add_vertex_bend(const VertexBendElement& b, double bend, double beta, const
   }
   const Eigen::Matrix3d r_lin = b.rows * xs;  // row k: Σ_j rows(k, j)·x_j
   const Eigen::Matrix3d r_dot_lin = b.rows * vs;
-  if (b.fan.empty()) {
+  out.flat = b.fan.empty();
+  if (out.flat) {
     // r_k linear: every 3×3 block of Σ s_k J_kᵀJ_k is (Σ_k s_k·rows(k,j)·rows(k,l))·I.
     Eigen::Matrix3d pull;  // row k: k·s_k·(r_k + β ṙ_k)
     for (int row = 0; row < 3; ++row) {
-      energy += 0.5 * k * kRowScale[row] * r_lin.row(row).squaredNorm();
+      out.energy[static_cast<std::size_t>(row)] =
+          0.5 * k * kRowScale[row] * r_lin.row(row).squaredNorm();
       pull.row(row) = k * kRowScale[row] * (r_lin.row(row) + beta * r_dot_lin.row(row));
     }
-    const Eigen::MatrixX3d local_force = -b.rows.transpose() * pull;  // m × 3
-    for (Eigen::Index j = 0; j < m; ++j)
-      force.segment<3>(3 * b.vertices[static_cast<std::size_t>(j)]) +=
-          local_force.row(j).transpose();
+    out.flat_force.noalias() = -b.rows.transpose() * pull;  // m × 3
     if (jacobian == nullptr) return;
     const Eigen::Vector3d scales(kRowScale[0], kRowScale[1], kRowScale[2]);
-    const Eigen::MatrixXd coupling = b.rows.transpose() * scales.asDiagonal() * b.rows;  // m × m
+    out.coupling.noalias() = b.rows.transpose() * scales.asDiagonal() * b.rows;  // m × m
     if (jacobian->product_input != nullptr) {
       Eigen::MatrixX3d us(m, 3);
       for (Eigen::Index j = 0; j < m; ++j)
         us.row(j) = jacobian->product_input->segment<3>(3 * b.vertices[static_cast<std::size_t>(j)])
                         .transpose();
-      const Eigen::MatrixX3d product = -k * coupling * us;
-      for (Eigen::Index j = 0; j < m; ++j)
-        jacobian->product_output->segment<3>(3 * b.vertices[static_cast<std::size_t>(j)]) +=
-            product.row(j).transpose();
+      out.flat_product.noalias() = -k * out.coupling * us;
     }
-    if (jacobian->matrix == nullptr) return;
-    double* values = jacobian->matrix->valuePtr();
-    const double scale = -k * (jacobian->dfdx_scale + jacobian->dfdv_scale * beta);
-    for (Eigen::Index j = 0; j < m; ++j)
-      for (Eigen::Index l = 0; l < m; ++l) {
-        const double entry = scale * coupling(j, l);
-        const int offset = b.blocks[static_cast<std::size_t>(m * j + l)];
-        for (int a = 0; a < 3; ++a)
-          values[block_value_index(*jacobian->matrix, b.vertices[static_cast<std::size_t>(j)],
-                                   offset, a, a)] += entry;
-      }
+    out.scale = -k * (jacobian->dfdx_scale + jacobian->dfdv_scale * beta);
     return;
   }
   Vector3d area_vector = Vector3d::Zero();
@@ -236,7 +236,7 @@ void add_vertex_bend(const VertexBendElement& b, double bend, double beta, const
   const bool want = jacobian != nullptr;
   const bool exact = want && jacobian->kind == JacobianKind::exact;
   const Eigen::MatrixXd g_v = exact && beta > 0.0 ? area_vector_jacobian(b, vs) : Eigen::MatrixXd();
-  Eigen::VectorXd local_force = Eigen::VectorXd::Zero(3 * m);
+  out.force = Eigen::VectorXd::Zero(3 * m);
   // The three rows' Jacobians stacked, each scaled by √(k·s_k): Σ_k k·s_k·J_kᵀJ_k = SᵀS.
   Eigen::MatrixXd stacked(9, 3 * m);
   Eigen::MatrixXd dfdx;
@@ -252,8 +252,8 @@ void add_vertex_bend(const VertexBendElement& b, double bend, double beta, const
     for (Eigen::Index j = 0; j < m; ++j)
       jac.block<3, 3>(0, 3 * j).diagonal().array() += b.rows(row, j);
     const Vector3d r_dot = jac * local_v;
-    energy += 0.5 * weight * r.squaredNorm();
-    local_force.noalias() -= weight * (jac.transpose() * (r + beta * r_dot));
+    out.energy[static_cast<std::size_t>(row)] = 0.5 * weight * r.squaredNorm();
+    out.force.noalias() -= weight * (jac.transpose() * (r + beta * r_dot));
     if (exact) {
       // ∇²E_k = w(JᵀJ − c·∇²(r·N)); damping: ∂(JᵀJv)/∂x = −c·∇²(ṙ·N) − c·Jᵀ·G(v).
       dfdx += weight * c * area_vector_hessian(b, r);
@@ -262,41 +262,103 @@ void add_vertex_bend(const VertexBendElement& b, double bend, double beta, const
     }
     jac *= std::sqrt(weight);
   }
-  Eigen::MatrixXd gauss_newton;
-  if (want) {
-    gauss_newton.noalias() = stacked.transpose() * stacked;
-    if (exact)
-      dfdx -= gauss_newton;
-    else
-      dfdx = -gauss_newton;
-  }
-  for (Eigen::Index j = 0; j < m; ++j)
-    force.segment<3>(3 * b.vertices[static_cast<std::size_t>(j)]) += local_force.segment<3>(3 * j);
   if (!want) return;
+  Eigen::MatrixXd gauss_newton;
+  gauss_newton.noalias() = stacked.transpose() * stacked;
+  if (exact)
+    dfdx -= gauss_newton;
+  else
+    dfdx = -gauss_newton;
   if (jacobian->product_input != nullptr) {
     Eigen::VectorXd local_u(3 * m);
     for (Eigen::Index j = 0; j < m; ++j)
       local_u.segment<3>(3 * j) =
           jacobian->product_input->segment<3>(3 * b.vertices[static_cast<std::size_t>(j)]);
-    const Eigen::VectorXd product = dfdx * local_u;
-    for (Eigen::Index j = 0; j < m; ++j)
-      jacobian->product_output->segment<3>(3 * b.vertices[static_cast<std::size_t>(j)]) +=
-          product.segment<3>(3 * j);
+    out.product.noalias() = dfdx * local_u;
   }
   if (jacobian->matrix == nullptr) return;
-  const Eigen::MatrixXd local =
-      jacobian->dfdx_scale * dfdx - (jacobian->dfdv_scale * beta) * gauss_newton;
-  double* values = jacobian->matrix->valuePtr();
+  out.local = jacobian->dfdx_scale * dfdx - (jacobian->dfdv_scale * beta) * gauss_newton;
+}
+
+// Adds a vertex bend's contribution to the rows of its vertices with own(vertex) (not the
+// energy), as scatter_contribution does for the conditions.
+template <class Own>
+void scatter_vertex_bend(const VertexBendElement& b, const VertexBendContribution& c,
+                         Eigen::VectorXd& force, const JacobianTarget* jacobian, const Own& own) {
+  const auto m = static_cast<Eigen::Index>(b.vertices.size());
+  const auto vertex = [&](Eigen::Index j) { return b.vertices[static_cast<std::size_t>(j)]; };
   for (Eigen::Index j = 0; j < m; ++j)
+    if (own(vertex(j)))
+      force.segment<3>(3 * vertex(j)) +=
+          c.flat ? Vector3d(c.flat_force.row(j).transpose()) : Vector3d(c.force.segment<3>(3 * j));
+  if (jacobian == nullptr) return;
+  if (jacobian->product_input != nullptr)
+    for (Eigen::Index j = 0; j < m; ++j)
+      if (own(vertex(j)))
+        jacobian->product_output->segment<3>(3 * vertex(j)) +=
+            c.flat ? Vector3d(c.flat_product.row(j).transpose())
+                   : Vector3d(c.product.segment<3>(3 * j));
+  if (jacobian->matrix == nullptr) return;
+  double* values = jacobian->matrix->valuePtr();
+  for (Eigen::Index j = 0; j < m; ++j) {
+    if (!own(vertex(j))) continue;
     for (Eigen::Index l = 0; l < m; ++l) {
       const int offset = b.blocks[static_cast<std::size_t>(m * j + l)];
+      if (c.flat) {
+        const double entry = c.scale * c.coupling(j, l);
+        for (int a = 0; a < 3; ++a)
+          values[block_value_index(*jacobian->matrix, vertex(j), offset, a, a)] += entry;
+        continue;
+      }
       for (int a = 0; a < 3; ++a) {
-        double* row =
-            values + block_value_index(*jacobian->matrix, b.vertices[static_cast<std::size_t>(j)],
-                                       offset, a, 0);
-        for (int e = 0; e < 3; ++e) row[e] += local(3 * j + a, 3 * l + e);
+        double* row = values + block_value_index(*jacobian->matrix, vertex(j), offset, a, 0);
+        for (int e = 0; e < 3; ++e) row[e] += c.local(3 * j + a, 3 * l + e);
       }
     }
+  }
+}
+
+// The quadratic bending of every vertex, as add_elements does for the conditions: on more than
+// one thread a block of elements is computed in parallel, then added in parallel by rows, the
+// energies in element order; the same bits on any thread count.
+void add_vertex_bends(const ClothModel& model, double bend, double beta, const Eigen::VectorXd& x,
+                      const Eigen::VectorXd& v, Eigen::VectorXd& force, double& energy,
+                      const JacobianTarget* jacobian) {
+  constexpr int kBlock = 256;
+  constexpr int kGrain = 64;
+  const int count = static_cast<int>(model.vertex_bends.size());
+  const int threads = thread_count();
+  const auto add_energy = [&](const VertexBendContribution& c) {
+    for (double e : c.energy) energy += e;
+  };
+  if (threads <= 1 || count < 2 * kGrain) {
+    VertexBendContribution c;
+    for (const VertexBendElement& b : model.vertex_bends) {
+      vertex_bend_contribution(b, bend, beta, x, v, jacobian, c);
+      add_energy(c);
+      scatter_vertex_bend(b, c, force, jacobian, kEveryRow);
+    }
+    return;
+  }
+  thread_local std::vector<VertexBendContribution> kept;  // see add_elements
+  std::vector<VertexBendContribution>& buffer = kept;
+  buffer.resize(static_cast<std::size_t>(std::min(count, kBlock)));
+  const int row_grain = std::max(1, (model.vertex_count + threads - 1) / threads);
+  for (int first = 0; first < count; first += kBlock) {
+    const int size = std::min(kBlock, count - first);
+    parallel_chunks(size, kGrain, [&](int, int begin, int end) {
+      for (int k = begin; k < end; ++k)
+        vertex_bend_contribution(model.vertex_bends[static_cast<std::size_t>(first + k)], bend,
+                                 beta, x, v, jacobian, buffer[static_cast<std::size_t>(k)]);
+    });
+    parallel_chunks(model.vertex_count, row_grain, [&](int, int low, int high) {
+      const auto own = [low, high](int vertex) { return vertex >= low && vertex < high; };
+      for (int k = 0; k < size; ++k)
+        scatter_vertex_bend(model.vertex_bends[static_cast<std::size_t>(first + k)],
+                            buffer[static_cast<std::size_t>(k)], force, jacobian, own);
+    });
+    for (int k = 0; k < size; ++k) add_energy(buffer[static_cast<std::size_t>(k)]);
+  }
 }
 
 // The contributions of one element: up to K conditions of N coordinates, each with the energy
@@ -435,8 +497,7 @@ void evaluate_forces(const ClothModel& model, const ForceSettings& settings,
   }
   if (terms.bend && fabric.bend > 0.0 && model.bend_model == BendModel::quadratic) {
     const double beta = damping_scale * fabric.bend_damping;
-    for (const VertexBendElement& b : model.vertex_bends)
-      add_vertex_bend(b, fabric.bend, beta, x, v, force, local_energy.bend, jacobian);
+    add_vertex_bends(model, fabric.bend, beta, x, v, force, local_energy.bend, jacobian);
   }
   if (terms.bend && fabric.bend > 0.0 && model.bend_model == BendModel::hinges) {
     const auto element = [&](int k) {
