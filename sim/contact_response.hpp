@@ -81,6 +81,15 @@ struct ContactSettings {
   // only within the clearance. Off by default (measured: the flat capelet rests with it, but a
   // sheet hung on a cone tip is let 1.09 mm through and a sheet on a sphere rests later).
   bool spring_band = false;
+  // Where a second body part faces the contact's surface closer than 2.5 thicknesses along
+  // its normal (the armpit as the arm comes down, between the thighs, the seat's cleft), each
+  // side's contact keeps a third of the gap (at least the body-vertex springs' clearance)
+  // instead of the full thickness, leaving the middle third free (docs/collision.md, "A
+  // thickness budget for a pinch"). Without it a vertex in a gap narrower than two
+  // thicknesses is pushed out of one side's band into the other's and pushed back: a contact
+  // cycle that never rests. Off by default: measured, it keeps the shaped tee dress on the
+  // Collada human from resting in its 3 s (its back over the seat's cleft).
+  bool pinch_budget = false;
   // Collider query parameters (see sim/body_collider.hpp, ContactQuery).
   double search_margin = 0.02;
   double max_substep_motion = 0.005;
@@ -213,8 +222,11 @@ class ContactResponse {
   // Constrains one contact's normal velocity so that it ends at `thickness` (moving x̂ + y out
   // first when it is already too close); `allow_release`: leave it free if it was adhesive.
   // Returns the index of its ActiveContact.
-  int add_contact(const BodyContact& contact, const Eigen::VectorXd& x_hat, double beta,
-                  ConstraintFilter& filter, Eigen::VectorXd& y, bool allow_release);
+  int add_contact(const BodyContact& contact, double thickness, const Eigen::VectorXd& x_hat,
+                  double beta, ConstraintFilter& filter, Eigen::VectorXd& y, bool allow_release);
+  // m: the distance a contact keeps its vertex from the body: the thickness, or with
+  // pinch_budget a third of the gap to a body part facing it across a pinch.
+  double contact_thickness(const BodyContact& contact) const;
   // m: body vertices farther than this through the cloth are not looked for.
   double piercing_reach() const;
   // Piercings of x1 whose body vertex is more than `min_height` through the cloth; none when

@@ -165,5 +165,65 @@ TEST(ContactHysteresis, SpringBandKeepsTheSphereSheetOutsideAndComesToRest) {
   EXPECT_TRUE(r.at_rest);
 }
 
+// A sheet squeezed between a table and a lid 1.5 thicknesses above it (ContactSettings::
+// pinch_budget): each side's contact keeps a third of the gap, 1.5 mm, so the sheet settles on
+// the table's band and stays clear of the lid's, at rest with no contact switching. Without the
+// budget a vertex pushed to the table's thickness (3 mm) is inside the lid's band (1.5 mm from
+// it), is caught by the lid and pushed back, step after step.
+TEST(ContactHysteresis, SheetPinchedBetweenTwoBodyPartsKeepsAThirdOfTheGapEach) {
+  const double gap = 1.5 * kThickness;
+  meshing::TriMesh body = table();
+  const meshing::TriMesh lid = testing::make_box({-0.5, gap, -0.5}, {0.5, gap + 0.2, 0.5});
+  const Eigen::Index table_vertices = body.vertices.rows();
+  body.vertices.conservativeResize(table_vertices + lid.vertices.rows(), 3);
+  body.vertices.bottomRows(lid.vertices.rows()) = lid.vertices;
+  const Eigen::Index table_faces = body.faces.rows();
+  body.faces.conservativeResize(table_faces + lid.faces.rows(), 3);
+  body.faces.bottomRows(lid.faces.rows()) = lid.faces.array() + static_cast<int>(table_vertices);
+  for (const bool budget : {false, true}) {
+    const SheetSetup s = horizontal_sheet(8, 0.3, {0.0, 0.5 * gap, 0.0});
+    const int n = s.model.vertex_count;
+    SimulationSettings settings = box_settings(2.0);
+    settings.stop_at_rest = true;
+    settings.contact.pinch_budget = budget;
+    Simulation sim(s.model, flatten_positions(s.scene.input.rest_positions), {}, settings);
+    sim.set_body(body);
+    int switches = 0;
+    double lowest = gap, highest = 0.0;
+    std::vector<unsigned char> last;
+    const SimulationReport report = sim.run([&](const Simulation& step) {
+      const std::vector<unsigned char> held = held_vertices(*step.contact(), n);
+      // After the fall onto the table's band (0.75 mm, 12 ms).
+      if (!last.empty() && step.time() > 0.1)
+        for (int i = 0; i < n; ++i) switches += held[i] != last[i];
+      last = held;
+      if (step.time() <= 0.1) return;
+      for (int i = 0; i < n; ++i) {
+        lowest = std::min(lowest, step.positions()[3 * i + 1]);
+        highest = std::max(highest, step.positions()[3 * i + 1]);
+      }
+    });
+    std::printf(
+        "pinched sheet, budget %s: at rest %d at %.2f s, %d switches after 0.1 s, heights "
+        "%.3f-%.3f mm (gap %.1f mm)\n",
+        budget ? "on" : "off", report.at_rest, report.sim_time, switches, 1e3 * lowest,
+        1e3 * highest, 1e3 * gap);
+    EXPECT_FALSE(report.failed);
+    if (!budget) {
+      // The cycle the budget ends (measured: 6,156 switches of 81 vertices from 0.1 s to 2 s,
+      // heights 0.3-3.0 mm).
+      EXPECT_GT(switches, 100);
+      EXPECT_FALSE(report.at_rest);
+      continue;
+    }
+    EXPECT_TRUE(report.at_rest);
+    EXPECT_GT(report.sim_time, 0.1);
+    EXPECT_EQ(switches, 0);
+    // On the table's band (a third of the gap), never inside the lid's.
+    EXPECT_GT(lowest, gap / 3.0 - 1e-4);
+    EXPECT_LT(highest, 2.0 * gap / 3.0);
+  }
+}
+
 }  // namespace
 }  // namespace sd::sim
