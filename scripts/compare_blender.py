@@ -15,8 +15,10 @@ mass of the pinned 16 x 16 sheet fell 8 mm in 1 s (70 mm without air) where sket
 comparable motions.
 
 Measured for each: the simulation's wall time (Blender: the frame evaluations; sketchdrape: the
-report's wall_time_s, the simulator's run without loading and output) and CPU time (Blender:
-the frame evaluations, all threads; sketchdrape: the whole process, loading included),
+report's wall_time_s, the simulator's run without loading and output) and CPU time, like with
+like (Blender: the frame evaluations, all threads; sketchdrape: the report's cpu_time_s, the
+stepping on all threads, without loading and output; the whole process's CPU time, loading and
+writing included, is given as well),
 and the final stretch: the largest relative elongation of the sheet's grid edges (warp and
 weft; diagonals are shear, not stretch), computed the same way from both programs' final
 positions. Writes results.json and results.md (a Markdown table) to --out.
@@ -311,6 +313,7 @@ def main():
                 "sketchdrape_s": report["wall_time_s"],
                 "sketchdrape_process_wall_s": sd_wall,
                 "sketchdrape_process_cpu_s": sd_cpu,
+                "sketchdrape_cpu_s": report["cpu_time_s"],
                 "sketchdrape_stretch_max": stretch_max(vertices, sd_final, edges),
                 "sketchdrape_settings": report["settings"],
                 "sketchdrape_steps": report["steps"],
@@ -330,7 +333,9 @@ def main():
                 row["sketchdrape_intersections_cgal"] = report["self_intersections_final"]
                 row["sketchdrape_self_collision_share"] = report["self_collision_share"]
             row["speedup"] = row["blender_s"] / row["sketchdrape_s"]
-            row["cpu_speedup"] = row["blender_cpu_s"] / row["sketchdrape_process_cpu_s"]
+            # Like with like: both programs' simulation alone, every thread.
+            row["cpu_speedup"] = row["blender_cpu_s"] / row["sketchdrape_cpu_s"]
+            row["process_cpu_speedup"] = row["blender_cpu_s"] / row["sketchdrape_process_cpu_s"]
             rows.append(row)
             print(f"{row['scene']}: Blender {row['blender_s']:.2f} s, stretch "
                   f"{100 * row['blender_stretch_max']:.2f} %; sketchdrape "
@@ -353,14 +358,16 @@ def main():
         f"{args.fps} fps, {args.fabric}; load average {load_before:.1f} before, "
         f"{load_after:.1f} after, {os.cpu_count()} cores.",
         "",
-        "| scene | Blender | sketchdrape | ratio | CPU: Blender / sketchdrape (ratio) "
+        "| scene | wall: Blender / sketchdrape (ratio) | CPU: Blender / sketchdrape (ratio) "
+        "| sketchdrape's whole process, CPU (ratio) "
         "| stretch max: Blender / sketchdrape | centre of mass fell: Blender / sketchdrape |",
-        "|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|",
     ]
     for r in rows:
-        lines.append(f"| {r['scene']} | {r['blender_s']:.2f} s | {r['sketchdrape_s']:.2f} s | "
-                     f"{r['speedup']:.2f}x | {r['blender_cpu_s']:.2f} s / "
-                     f"{r['sketchdrape_process_cpu_s']:.2f} s ({r['cpu_speedup']:.2f}x) | "
+        lines.append(f"| {r['scene']} | {r['blender_s']:.2f} s / {r['sketchdrape_s']:.2f} s "
+                     f"({r['speedup']:.2f}x) | {r['blender_cpu_s']:.2f} s / "
+                     f"{r['sketchdrape_cpu_s']:.2f} s ({r['cpu_speedup']:.2f}x) | "
+                     f"{r['sketchdrape_process_cpu_s']:.2f} s ({r['process_cpu_speedup']:.2f}x) | "
                      f"{100 * r['blender_stretch_max']:.1f} % / "
                      f"{100 * r['sketchdrape_stretch_max']:.2f} % | {r['blender_drop_m']:.3f} / "
                      f"{r['sketchdrape_drop_m']:.3f} m |")

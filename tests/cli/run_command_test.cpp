@@ -154,8 +154,8 @@ TEST(RunCommand, SheetSceneWritesReportMeshAndTrace) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json report = read_json(out / "report.json");
   for (const char* key :
-       {"steps", "sim_time", "wall_time_s", "at_rest", "retries", "nan_free", "vertices",
-        "triangles", "cg_iterations_mean", "cg_iterations_max", "timing_s", "energy"})
+       {"steps", "sim_time", "wall_time_s", "cpu_time_s", "at_rest", "retries", "nan_free",
+        "vertices", "triangles", "cg_iterations_mean", "cg_iterations_max", "timing_s", "energy"})
     EXPECT_TRUE(report.contains(key)) << key;
   EXPECT_EQ(report["vertices"], 49);
   EXPECT_EQ(report["triangles"], 72);

@@ -60,6 +60,9 @@ struct BenchConfig {
   sim::Integrator integrator = sim::Integrator::implicit_euler;
   sim::LinearSolverKind solver = sim::LinearSolverKind::cholmod;
   int steps_per_second = 60;  // dt = 1 / steps_per_second
+  // BDF2 only: one Newton iteration, linearised at the start of the step (the linearly implicit
+  // BDF2 step, docs/simulator.md "Integration") instead of simplified Newton with fallbacks.
+  bool linearized = false;
 
   double dt() const { return 1.0 / steps_per_second; }
   std::string id() const;     // "fixed-L4-ie-cholmod-60", unique in a grid
