@@ -337,13 +337,16 @@ BenchPlan bench_plan(const BenchScene& scene, BenchGrid grid) {
   // What "solver": "auto" and "time_step": "auto" (the sketch defaults) choose at each level
   // (sim/automatic_settings.hpp), so that the summary shows where the default sits on the front.
   // A level roughly doubles the vertices (each doubles the triangles).
-  {
-    BenchFamily family{"automatic (the sketch default): levels", {}};
+  // Twice: for a drape (the end state) and with `run --frames` (the motion asked for).
+  for (const bool motion : {false, true}) {
+    BenchFamily family{motion ? kAutomaticMotionFamily : kAutomaticFamily, {}};
     for (int level : levels) {
       sim::SceneTraits traits;
       traits.vertices = scene.mesh->vertex_count() << level;
       traits.self_contact = scene.settings.self_contact.enabled;
       traits.garment = !scene.sheet;
+      traits.body = scene.body.has_value() && scene.settings.contact.enabled;
+      traits.motion = motion;
       const sim::AutomaticChoice choice = sim::choose_settings(traits);
       family.members.push_back(config(BenchMeshKind::fixed, level, choice.integrator, choice.solver,
                                       static_cast<int>(std::lround(1.0 / choice.dt))));
@@ -354,7 +357,7 @@ BenchPlan bench_plan(const BenchScene& scene, BenchGrid grid) {
   // PCG at the long steps, implicit Euler against the linearly implicit BDF2 step, on the finest
   // fixed mesh, so the summary shows what the rule chose from. Every step divides the 0.1 s
   // between samples.
-  if (sheet)
+  if (sheet && grid != BenchGrid::tiny)
     for (const bool bdf2 : {false, true}) {
       BenchFamily family{
           fmt::format("fixed L{}, {}, PCG: long steps", finest, bdf2 ? "BDF2 (linearised)" : "IE"),

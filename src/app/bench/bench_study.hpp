@@ -81,6 +81,12 @@ struct BenchPlan {
   std::vector<BenchConfig> runs;  // the union of the families' members, each once
 };
 
+// The families of what the sketch defaults ("solver" and "time_step" "auto") run at each level:
+// for a drape, and with `run --frames` (sim/automatic_settings.hpp).
+inline const std::string kAutomaticFamily = "automatic (the sketch default): levels";
+inline const std::string kAutomaticMotionFamily =
+    "automatic with --frames (the motion asked for): levels";
+
 // Names of the built-in scenes.
 std::vector<std::string> builtin_bench_scenes();
 // A built-in scene by name, or a sketch file (a sheet or a garment; imported garments are not
