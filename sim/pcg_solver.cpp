@@ -120,9 +120,12 @@ bool BlockIncompleteCholesky::factorize_shifted(double alpha) {
   pivot_inverse_.resize(n);
   for (int i = 0; i < n; ++i) {
     pivot[i] = 0.5 * (pivot[i] + pivot[i].transpose());
-    const Eigen::LLT<Eigen::Matrix3d> llt(pivot[i]);
-    if (llt.info() != Eigen::Success) return false;
-    pivot_inverse_[i] = llt.solve(Eigen::Matrix3d::Identity());
+    // Positive definite by Sylvester's criterion (the leading minors), then the inverse from the
+    // cofactors: what a 3x3 LLT and its solve decide and give, without their general loops.
+    const Eigen::Matrix3d& p = pivot[i];
+    const double minor2 = p(0, 0) * p(1, 1) - p(0, 1) * p(1, 0);
+    if (!(p(0, 0) > 0.0) || !(minor2 > 0.0) || !(p.determinant() > 0.0)) return false;
+    pivot_inverse_[i] = p.inverse();
     if (!pivot_inverse_[i].allFinite()) return false;
     // Schur complement restricted to the pattern: for k < j both above-diagonal neighbours of
     // i, U_kj −= U_ikᵀ P_i⁻¹ U_ij (no fill: dropped if (k, j) is not in the pattern).
