@@ -19,6 +19,11 @@ struct SceneTraits {
   bool self_contact = false;
   // Sewn panels worn on a body (not a sheet scene), with or without self-contact.
   bool garment = false;
+  // A body the cloth can touch (a sheet dropped on a sphere): contact changes the step's limit.
+  bool body = false;
+  // The motion is asked for, not only the drape (`run --frames N`): the step must follow the
+  // trajectory, not only reach the end state.
+  bool motion = false;
 };
 
 struct AutomaticChoice {
@@ -35,6 +40,11 @@ struct AutomaticChoice {
 // IC(0) and CHOLMOD (docs/benchmarks.md, "Scaling"); below, IC(0) is (its cycle costs less).
 // Garments and cloth with self-contact always use CHOLMOD.
 inline constexpr int kAutomaticTwoLevelVertices = 8000;
+
+// The sheets' steps (s): for a drape, and when the motion is asked for. The measurements behind
+// each are in docs/simulator.md, "Automatic settings".
+inline constexpr double kAutomaticSheetStep = 1.0 / 20.0;
+inline constexpr double kAutomaticMotionStep = 1.0 / 60.0;
 
 AutomaticChoice choose_settings(const SceneTraits& scene);
 

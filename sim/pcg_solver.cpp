@@ -7,6 +7,63 @@
 
 namespace sd::sim {
 
+namespace {
+
+// Whether `a` is made of 3x3 blocks as the cloth's matrices are: the three rows of a vertex hold
+// the same columns, in runs of three starting at a multiple of three (one pass over the indices).
+bool has_vertex_blocks(const SparseMatrixR& a) {
+  if (a.rows() % 3 != 0 || a.cols() != a.rows() || !a.isCompressed()) return false;
+  const int* outer = a.outerIndexPtr();
+  const int* inner = a.innerIndexPtr();
+  for (Eigen::Index i = 0; i < a.rows() / 3; ++i) {
+    const int begin = outer[3 * i];
+    const int width = outer[3 * i + 1] - begin;
+    if (width % 3 != 0 || outer[3 * i + 2] - outer[3 * i + 1] != width ||
+        outer[3 * i + 3] - outer[3 * i + 2] != width)
+      return false;
+    for (int k = 0; k < width; k += 3) {
+      const int column = inner[begin + k];
+      if (column % 3 != 0) return false;
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c)
+          if (inner[begin + r * width + k + c] != column + c) return false;
+    }
+  }
+  return true;
+}
+
+// y = A x for a matrix of vertex blocks (has_vertex_blocks): one column index and one load of
+// x's three entries per block for the three rows, where the scalar product reads them three
+// times. The PCG's products are about a third of a sheet's solve (docs/benchmarks.md).
+void multiply_vertex_blocks(const SparseMatrixR& a, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+  const int* outer = a.outerIndexPtr();
+  const int* inner = a.innerIndexPtr();
+  const double* values = a.valuePtr();
+  const double* in = x.data();
+  y.resize(a.rows());
+  double* out = y.data();
+  for (Eigen::Index i = 0; i < a.rows() / 3; ++i) {
+    const int begin = outer[3 * i];
+    const int width = outer[3 * i + 1] - begin;
+    const double* row0 = values + begin;
+    const double* row1 = row0 + width;
+    const double* row2 = row1 + width;
+    double sum0 = 0.0, sum1 = 0.0, sum2 = 0.0;
+    for (int k = 0; k < width; k += 3) {
+      const double* xj = in + inner[begin + k];
+      const double x0 = xj[0], x1 = xj[1], x2 = xj[2];
+      sum0 += row0[k] * x0 + row0[k + 1] * x1 + row0[k + 2] * x2;
+      sum1 += row1[k] * x0 + row1[k + 1] * x1 + row1[k + 2] * x2;
+      sum2 += row2[k] * x0 + row2[k + 1] * x1 + row2[k + 2] * x2;
+    }
+    out[3 * i] = sum0;
+    out[3 * i + 1] = sum1;
+    out[3 * i + 2] = sum2;
+  }
+}
+
+}  // namespace
+
 bool BlockIncompleteCholesky::factorize(const SparseMatrixR& a,
                                         const std::vector<int>& diagonal_offsets,
                                         const ConstraintFilter& filter) {
@@ -63,9 +120,12 @@ bool BlockIncompleteCholesky::factorize_shifted(double alpha) {
   pivot_inverse_.resize(n);
   for (int i = 0; i < n; ++i) {
     pivot[i] = 0.5 * (pivot[i] + pivot[i].transpose());
-    const Eigen::LLT<Eigen::Matrix3d> llt(pivot[i]);
-    if (llt.info() != Eigen::Success) return false;
-    pivot_inverse_[i] = llt.solve(Eigen::Matrix3d::Identity());
+    // Positive definite by Sylvester's criterion (the leading minors), then the inverse from the
+    // cofactors: what a 3x3 LLT and its solve decide and give, without their general loops.
+    const Eigen::Matrix3d& p = pivot[i];
+    const double minor2 = p(0, 0) * p(1, 1) - p(0, 1) * p(1, 0);
+    if (!(p(0, 0) > 0.0) || !(minor2 > 0.0) || !(p.determinant() > 0.0)) return false;
+    pivot_inverse_[i] = p.inverse();
     if (!pivot_inverse_[i].allFinite()) return false;
     // Schur complement restricted to the pattern: for k < j both above-diagonal neighbours of
     // i, U_kj −= U_ikᵀ P_i⁻¹ U_ij (no fill: dropped if (k, j) is not in the pattern).
@@ -164,6 +224,13 @@ LinearSolveStats PcgSolver::solve(const SparseMatrixR& a, const std::vector<int>
   }
   const bool incomplete = incomplete_ready_;
   const bool coarse = coarse_ready_;
+  const bool blocks = has_vertex_blocks(a);
+  const auto multiply = [&](const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+    if (blocks)
+      multiply_vertex_blocks(a, x, y);
+    else
+      y.noalias() = a * x;
+  };
   const auto precondition = [&](const Eigen::VectorXd& in, Eigen::VectorXd& out) {
     if (coarse) {
       // Balancing two-grid cycle on B, with Q = P Ac⁻¹ Pᵀ (exact on the coarse space, so
@@ -173,7 +240,7 @@ LinearSolveStats PcgSolver::solve(const SparseMatrixR& a, const std::vector<int>
       // (measured: that one lost definiteness on a swinging sheet, and the cheaper A-DEF2 form
       // took more iterations than IC(0) alone). B x = S A x for filtered x.
       const auto multiply_b = [&](const Eigen::VectorXd& x, Eigen::VectorXd& y) {
-        y.noalias() = a * x;
+        multiply(x, y);
         filter.apply(y);
       };
       cycle_coarse_.setZero(in.size());
@@ -215,7 +282,7 @@ LinearSolveStats PcgSolver::solve(const SparseMatrixR& a, const std::vector<int>
     return stats;
   }
   while (stats.iterations < max_iterations) {
-    q_.noalias() = a * c_;
+    multiply(c_, q_);
     filter.apply(q_);
     const double curvature = c_.dot(q_);
     if (!(curvature > 0.0)) break;  // A is not positive definite on the filtered subspace

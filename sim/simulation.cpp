@@ -1,6 +1,7 @@
 #include "sim/simulation.hpp"
 
 #include <spdlog/spdlog.h>
+#include <time.h>
 
 #include <algorithm>
 #include <chrono>
@@ -10,6 +11,18 @@
 #include <utility>
 
 namespace sd::sim {
+
+namespace {
+
+// The CPU time of the whole process, every thread (s): what the run costs, comparable with
+// another program's CPU time for the same simulation (scripts/compare_blender.py).
+double process_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+}  // namespace
 
 std::string_view integrator_name(Integrator integrator) {
   return integrator == Integrator::bdf2 ? "bdf2" : "implicit-euler";
@@ -535,6 +548,7 @@ SimulationReport Simulation::run(const std::function<void(const Simulation&)>& o
 
 SimulationReport Simulation::run(const RunHooks& hooks) {
   const auto start = std::chrono::steady_clock::now();
+  const double cpu_start = process_cpu_seconds();
   const double forces_before = report_.forces_s;
   const double solve_before = report_.solve_s;
   const double collision_before = report_.collision_s;
@@ -574,6 +588,7 @@ SimulationReport Simulation::run(const RunHooks& hooks) {
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   report_.wall_time_s += wall;
+  report_.cpu_time_s += process_cpu_seconds() - cpu_start;
   report_.other_s += wall - (report_.forces_s - forces_before) - (report_.solve_s - solve_before) -
                      (report_.collision_s - collision_before) -
                      (report_.self_collision_s - self_before);

@@ -95,6 +95,9 @@ struct SimulationReport {
   int steps = 0;          // accepted steps
   double sim_time = 0.0;  // s simulated
   double wall_time_s = 0.0;
+  // CPU time of the process (all threads) while `run` stepped, s: the stepping alone, without
+  // loading the scene or writing output.
+  double cpu_time_s = 0.0;
   bool at_rest = false;          // the run stopped early because the cloth was at rest
   int retries = 0;               // rejected attempts (each one halved the step or, for BDF2, was
                                  // retried at the same step linearised: a fallback)

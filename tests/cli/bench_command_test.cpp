@@ -175,12 +175,20 @@ TEST(BenchCommand, TinyGridMeasuresErrorsAndReusesTheCachedReference) {
   const std::string key = report["scenes"][0]["reference"]["key"];
   EXPECT_TRUE(fs::exists(dir / "cache" / (key + ".bin")));
   EXPECT_NE(first.output.find("defaults:"), std::string::npos) << first.output;
-  // The sketch default is run (the automatic rule: a sheet without self-contact gets the IC(0)
-  // PCG at 1/20 s) and placed against the front.
+  // The sketch defaults are run (the automatic rule: a sheet without a body or self-contact gets
+  // the IC(0) PCG at 1/20 s, at 1/60 s with --frames) and placed against the front and the error
+  // band (1.5x the same mesh's error at 1/60 s with CHOLMOD).
   EXPECT_EQ(runs["hanging-sheet/fixed-L3-ie-pcg-20"].at("status"), "ok");
+  EXPECT_EQ(runs["hanging-sheet/fixed-L3-ie-pcg-60"].at("status"), "ok");
   EXPECT_NE(first.output.find("the sketch default (automatic: fixed L3, IE, PCG, 1/20 s"),
             std::string::npos)
       << first.output;
+  EXPECT_NE(first.output.find("the default with --frames (automatic: fixed L3, IE, PCG, 1/60 s"),
+            std::string::npos)
+      << first.output;
+  // At 1/60 s the PCG solves to 1e-3 what CHOLMOD solves exactly (the same error within 20 %,
+  // below), so the default with --frames is within the band.
+  EXPECT_NE(first.output.find("within the error band"), std::string::npos) << first.output;
 
   if (has_gnuplot()) {
     const std::string png = read_text(dir / "out/bench_hanging-sheet.png");

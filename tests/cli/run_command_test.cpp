@@ -56,7 +56,12 @@ TEST(RunCommand, FramesWriteAPictureSequenceOfTheDrape) {
   const CommandResult r = run_sketchdrape("-q run " + write_sketch(dir, small_sheet()).string() +
                                           " -o " + out.string() + " --frames 8");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_EQ(read_json(out / "report.json")["frames"], 5);
+  const nlohmann::json report = read_json(out / "report.json");
+  EXPECT_EQ(report["frames"], 5);
+  // The motion is asked for: the automatic step is 1/60 s, not the drape's 1/20 s.
+  EXPECT_DOUBLE_EQ(report["settings"]["dt"].get<double>(), 1.0 / 60.0);
+  EXPECT_NE(report["settings"]["automatic"].get<std::string>().find("the motion asked for"),
+            std::string::npos);
   std::vector<std::string> pictures;
   for (int i = 0; i < 5; ++i) {
     const fs::path frame = out / "frames" / ("frame-000" + std::to_string(i) + "-front.png");
@@ -154,8 +159,8 @@ TEST(RunCommand, SheetSceneWritesReportMeshAndTrace) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json report = read_json(out / "report.json");
   for (const char* key :
-       {"steps", "sim_time", "wall_time_s", "at_rest", "retries", "nan_free", "vertices",
-        "triangles", "cg_iterations_mean", "cg_iterations_max", "timing_s", "energy"})
+       {"steps", "sim_time", "wall_time_s", "cpu_time_s", "at_rest", "retries", "nan_free",
+        "vertices", "triangles", "cg_iterations_mean", "cg_iterations_max", "timing_s", "energy"})
     EXPECT_TRUE(report.contains(key)) << key;
   EXPECT_EQ(report["vertices"], 49);
   EXPECT_EQ(report["triangles"], 72);

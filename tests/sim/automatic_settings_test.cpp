@@ -62,5 +62,37 @@ TEST(AutomaticSettings, SettingsTheFileGivesAreKept) {
   EXPECT_NO_THROW(settings.validate());
 }
 
+// A sheet's step: 1/20 s with or without a body, 1/60 s when the motion is asked for (implicit
+// Euler's trajectory error grows with the step); garments keep 1/60 s.
+TEST(AutomaticSettings, SheetStepsFollowTheMotion) {
+  SceneTraits scene;
+  scene.vertices = 1089;
+  AutomaticChoice choice = choose_settings(scene);
+  EXPECT_DOUBLE_EQ(choice.dt, kAutomaticSheetStep);
+  EXPECT_NE(choice.reason.find("1/20 s"), std::string::npos) << choice.reason;
+  EXPECT_NE(choice.reason.find("without a body"), std::string::npos) << choice.reason;
+  scene.body = true;
+  choice = choose_settings(scene);
+  EXPECT_DOUBLE_EQ(choice.dt, kAutomaticSheetStep);
+  EXPECT_NE(choice.reason.find("on a body"), std::string::npos) << choice.reason;
+  EXPECT_EQ(choice.solver, LinearSolverKind::pcg);
+  scene.motion = true;
+  choice = choose_settings(scene);
+  EXPECT_DOUBLE_EQ(choice.dt, kAutomaticMotionStep);
+  EXPECT_EQ(choice.solver, LinearSolverKind::pcg);
+  EXPECT_NE(choice.reason.find("the motion asked for"), std::string::npos) << choice.reason;
+  scene.body = false;
+  EXPECT_DOUBLE_EQ(choose_settings(scene).dt, kAutomaticMotionStep);
+  scene.garment = true;
+  choice = choose_settings(scene);
+  EXPECT_EQ(choice.solver, LinearSolverKind::cholmod);
+  EXPECT_DOUBLE_EQ(choice.dt, 1.0 / 60.0);
+  EXPECT_EQ(choice.reason.find("the motion asked for"), std::string::npos) << choice.reason;
+  // Every step the rule gives is longer than the step control's floor it sets.
+  SimulationSettings settings;
+  apply_choice(choose_settings(SceneTraits{}), true, true, settings);
+  EXPECT_NO_THROW(settings.validate());
+}
+
 }  // namespace
 }  // namespace sd::sim

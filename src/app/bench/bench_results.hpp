@@ -59,6 +59,9 @@ std::string last_line(const std::filesystem::path& log);
 bool usable(const RunRow& row);
 // Marks the runs not beaten in both CPU time and RMS error by another run of the scene.
 void mark_pareto(std::vector<RunRow>& rows);
+// The accuracy bar's error band for the defaults: this many times the RMS error of the same mesh
+// at 1/60 s, implicit Euler, CHOLMOD (see defaults_note).
+inline constexpr double kDefaultErrorBand = 1.5;
 // Where the sketch defaults sit on the scene's front, as a sentence.
 std::string defaults_note(const SceneResult& s);
 // One bench.csv row (`error` null when the run was not measured).

@@ -197,6 +197,7 @@ sim::SimulationSettings run_settings(const BenchScene& scene, const BenchConfig&
   sim::SimulationSettings settings = scene.settings;
   settings.integrator = config.integrator;
   settings.solver = config.solver;
+  if (config.linearized) settings.newton_iterations = 1;
   settings.dt = config.dt();
   settings.min_dt = std::min(settings.min_dt, settings.dt / 64);
   settings.duration = scene.duration;
@@ -211,7 +212,8 @@ sim::SimulationSettings run_settings(const BenchScene& scene, const BenchConfig&
 // --------------------------------------------------------------------------------
 
 std::string BenchConfig::id() const {
-  const std::string integ(sim::integrator_short_name(integrator));
+  const std::string integ =
+      std::string(sim::integrator_short_name(integrator)) + (linearized ? "lin" : "");
   const std::string solv(sim::solver_name(solver));
   if (mesh == BenchMeshKind::adaptive)
     return fmt::format("adaptive-{:g}mm-L{}-{}-{}-{}", threshold * 1e3, level, integ, solv,
@@ -220,7 +222,8 @@ std::string BenchConfig::id() const {
 }
 
 std::string BenchConfig::label() const {
-  const std::string integ = integrator == sim::Integrator::bdf2 ? "BDF2" : "IE";
+  const std::string integ =
+      integrator == sim::Integrator::bdf2 ? (linearized ? "BDF2 (linearised)" : "BDF2") : "IE";
   const std::string solv = solver == sim::LinearSolverKind::pcg ? "PCG" : "CHOLMOD";
   if (mesh == BenchMeshKind::adaptive)
     return fmt::format("adaptive {:g} mm (<= L{}), {}, {}, 1/{} s", threshold * 1e3, level, integ,
@@ -334,19 +337,40 @@ BenchPlan bench_plan(const BenchScene& scene, BenchGrid grid) {
   // What "solver": "auto" and "time_step": "auto" (the sketch defaults) choose at each level
   // (sim/automatic_settings.hpp), so that the summary shows where the default sits on the front.
   // A level roughly doubles the vertices (each doubles the triangles).
-  {
-    BenchFamily family{"automatic (the sketch default): levels", {}};
+  // Twice: for a drape (the end state) and with `run --frames` (the motion asked for).
+  for (const bool motion : {false, true}) {
+    BenchFamily family{motion ? kAutomaticMotionFamily : kAutomaticFamily, {}};
     for (int level : levels) {
       sim::SceneTraits traits;
       traits.vertices = scene.mesh->vertex_count() << level;
       traits.self_contact = scene.settings.self_contact.enabled;
       traits.garment = !scene.sheet;
+      traits.body = scene.body.has_value() && scene.settings.contact.enabled;
+      traits.motion = motion;
       const sim::AutomaticChoice choice = sim::choose_settings(traits);
       family.members.push_back(config(BenchMeshKind::fixed, level, choice.integrator, choice.solver,
                                       static_cast<int>(std::lround(1.0 / choice.dt))));
     }
     plan.families.push_back(family);
   }
+  // The automatic rule's candidates for a sheet (docs/simulator.md, "Automatic settings"): the
+  // PCG at the long steps, implicit Euler against the linearly implicit BDF2 step, on the finest
+  // fixed mesh, so the summary shows what the rule chose from. Every step divides the 0.1 s
+  // between samples.
+  if (sheet && grid != BenchGrid::tiny)
+    for (const bool bdf2 : {false, true}) {
+      BenchFamily family{
+          fmt::format("fixed L{}, {}, PCG: long steps", finest, bdf2 ? "BDF2 (linearised)" : "IE"),
+          {}};
+      for (int rate : {10, 20, 30}) {
+        BenchConfig c = config(BenchMeshKind::fixed, finest,
+                               bdf2 ? Integrator::bdf2 : Integrator::implicit_euler,
+                               LinearSolverKind::pcg, rate);
+        c.linearized = bdf2;
+        family.members.push_back(c);
+      }
+      plan.families.push_back(family);
+    }
   // At 1/60 s the step's error hides the mesh's (every level within a few per cent on the
   // sheets): the full grid repeats the levels and the adaptive family at its smallest step,
   // where refinement shows and adaptive detail can pay.
@@ -648,7 +672,8 @@ std::string config_to_json(const BenchConfig& c) {
                         {"threshold", c.threshold},
                         {"integrator", sim::integrator_short_name(c.integrator)},
                         {"solver", sim::solver_name(c.solver)},
-                        {"steps_per_second", c.steps_per_second}}
+                        {"steps_per_second", c.steps_per_second},
+                        {"linearized", c.linearized}}
       .dump();
 }
 
@@ -663,6 +688,7 @@ BenchConfig config_from_json(const std::string& text) {
   c.solver =
       sim::parse_solver(j.at("solver").get<std::string>()).value_or(sim::LinearSolverKind::cholmod);
   c.steps_per_second = j.at("steps_per_second");
+  c.linearized = j.value("linearized", false);
   return c;
 }
 

@@ -60,6 +60,9 @@ struct BenchConfig {
   sim::Integrator integrator = sim::Integrator::implicit_euler;
   sim::LinearSolverKind solver = sim::LinearSolverKind::cholmod;
   int steps_per_second = 60;  // dt = 1 / steps_per_second
+  // BDF2 only: one Newton iteration, linearised at the start of the step (the linearly implicit
+  // BDF2 step, docs/simulator.md "Integration") instead of simplified Newton with fallbacks.
+  bool linearized = false;
 
   double dt() const { return 1.0 / steps_per_second; }
   std::string id() const;     // "fixed-L4-ie-cholmod-60", unique in a grid
@@ -77,6 +80,12 @@ struct BenchPlan {
   std::vector<BenchFamily> families;
   std::vector<BenchConfig> runs;  // the union of the families' members, each once
 };
+
+// The families of what the sketch defaults ("solver" and "time_step" "auto") run at each level:
+// for a drape, and with `run --frames` (sim/automatic_settings.hpp).
+inline const std::string kAutomaticFamily = "automatic (the sketch default): levels";
+inline const std::string kAutomaticMotionFamily =
+    "automatic with --frames (the motion asked for): levels";
 
 // Names of the built-in scenes.
 std::vector<std::string> builtin_bench_scenes();

@@ -132,7 +132,8 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
     check_run_fits(sketch, *before, limits, options.frames_per_second);
   const ClothScene scene = build_cloth_scene(sketch);
   // "solver"/"time_step": "auto" (the defaults): chosen now that the scene's size is known.
-  const sim::AutomaticChoice automatic = apply_automatic_settings(sketch, scene, settings);
+  const sim::AutomaticChoice automatic =
+      apply_automatic_settings(sketch, scene, settings, options.frames_per_second > 0.0);
   spdlog::debug("settings: {}", automatic.reason);
   const RunEstimate estimate =
       estimate_run(sketch, scene.input.triangles, static_cast<int>(scene.start.rows()),

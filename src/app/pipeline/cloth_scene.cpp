@@ -342,7 +342,7 @@ sim::SimulationSettings simulation_settings(const scene::Sketch& sketch) {
 }
 
 sim::AutomaticChoice apply_automatic_settings(const scene::Sketch& sketch, const ClothScene& scene,
-                                              sim::SimulationSettings& settings) {
+                                              sim::SimulationSettings& settings, bool motion) {
   const scene::SimulateSpec& spec = sketch.simulate;
   sim::SceneTraits traits;
   traits.vertices = static_cast<int>(scene.start.rows());
@@ -351,6 +351,8 @@ sim::AutomaticChoice apply_automatic_settings(const scene::Sketch& sketch, const
   if (adaptive) traits.max_vertices = spec.adaptive_settings.max_vertices;
   traits.self_contact = settings.self_contact.enabled;
   traits.garment = !scene.sheet;
+  traits.body = scene.body.has_value() && settings.contact.enabled;
+  traits.motion = motion;
   const sim::AutomaticChoice choice = sim::choose_settings(traits);
   sim::apply_choice(choice, spec.solver == "auto", spec.time_step_auto, settings);
   return choice;

@@ -26,6 +26,7 @@ nlohmann::json simulation_json(const sim::SimulationReport& r, const sim::Simula
   return {{"steps", r.steps},
           {"sim_time", r.sim_time},
           {"wall_time_s", r.wall_time_s},
+          {"cpu_time_s", r.cpu_time_s},
           {"at_rest", r.at_rest},
           {"retries", r.retries},
           {"forced_steps", r.forced_steps},
