@@ -8,6 +8,7 @@
 // Run: ./build/tests/bench/garment_bench
 
 #include <benchmark/benchmark.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -81,6 +82,7 @@ std::vector<fs::path> sketches_in(const char* folder) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  spdlog::set_level(spdlog::level::err);  // the shorts' merged doublet would warn every iteration
   for (const char* folder : {"data/examples", "data/designs"})
     for (const fs::path& file : sketches_in(folder))
       benchmark::RegisterBenchmark(
