@@ -91,7 +91,7 @@ INSTANTIATE_TEST_SUITE_P(Corpus, Design, ::testing::ValuesIn(design_names()), te
 // aline-dress-human 12 s, tee-human 3 s, cowl-top 1.4 s of CPU, boat-top 4 s, tank-human 4 s,
 // culottes 9 s, tank-top 2 s, gored-skirt 10 s, pencil-skirt-human 11-16 s (26 November; 2 s of
 // CPU), collar-top-human 6 s (1.2 s of CPU),
-// hooded-top 7 s (3.3 s of CPU): about 220 s in all.
+// hooded-top 7 s (3.3 s of CPU): about 220 s in all; and the long garments below.
 class DesignDrape : public ::testing::TestWithParam<std::string> {};
 
 nlohmann::json drape(const std::string& name) {
@@ -110,8 +110,11 @@ void expect_at_rest_outside_the_body(const nlohmann::json& report) {
   ASSERT_FALSE(report.is_null());
   EXPECT_TRUE(report["at_rest"].get<bool>());
   EXPECT_EQ(report["penetrating_vertices_final"].get<int>(), 0);
-  EXPECT_LT(report["rest"]["speed_window_m_s"].get<double>(),
-            report["rest"]["speed_limit_m_s"].get<double>());
+  // At rest bounds how far the cloth moved over the window (a vertex chattering in place between
+  // contacts may still have a speed): the drift, at most rest_speed·rest_window.
+  EXPECT_LE(report["rest"]["drift_m"].get<double>(), report["rest"]["drift_limit_m"].get<double>());
+  EXPECT_LT(report["rest"]["kinetic_per_kg_window_J_kg"].get<double>(),
+            report["rest"]["kinetic_per_kg_limit_J_kg"].get<double>());
 }
 
 TEST_P(DesignDrape, RestsOutsideTheBodyWithoutADentBetweenTheLegs) {
@@ -125,7 +128,8 @@ TEST_P(DesignDrape, RestsOutsideTheBodyWithoutADentBetweenTheLegs) {
 }
 
 const std::vector<std::string> straight_skirts = {"pencil-skirt", "straight-skirt-human",
-                                                  "wrap-skirt", "pencil-skirt-human"};
+                                                  "wrap-skirt", "pencil-skirt-human",
+                                                  "pencil-skirt-plain"};
 
 INSTANTIATE_TEST_SUITE_P(Skirts, DesignDrape, ::testing::ValuesIn(straight_skirts), test_name);
 
@@ -150,11 +154,21 @@ const std::vector<std::string> other_designs = {
 
 INSTANTIATE_TEST_SUITE_P(Corpus, DesignDrapeTop, ::testing::ValuesIn(other_designs), test_name);
 
+// Long free skirts, which swung past 6 s before garments had air drag and a duration that follows
+// their length (issue 18's fifth round, docs/simulator.md): rest and penetration. Wall time at
+// load 10-11 on the 2 cores: maxi-dress 64 s, gored-midi-skirt 92 s, long-aline-skirt-human
+// 62 s (and pencil-skirt-plain 9 s in the straight skirts).
+const std::vector<std::string> long_garments = {"maxi-dress", "gored-midi-skirt",
+                                                "long-aline-skirt-human"};
+
+INSTANTIATE_TEST_SUITE_P(Long, DesignDrapeTop, ::testing::ValuesIn(long_garments), test_name);
+
 // Every design in data/designs is draped by one of the two lists above: a design added to the
 // corpus without a drape would only be meshed.
 TEST(DesignCorpus, EveryDesignIsDraped) {
   std::vector<std::string> draped = straight_skirts;
   draped.insert(draped.end(), other_designs.begin(), other_designs.end());
+  draped.insert(draped.end(), long_garments.begin(), long_garments.end());
   std::sort(draped.begin(), draped.end());
   std::vector<std::string> designs = design_names();
   std::sort(designs.begin(), designs.end());

@@ -14,6 +14,7 @@
 #include "sim/sheet.hpp"
 #include "sim/simulation.hpp"
 #include "src/app/pipeline/garment_stage.hpp"
+#include "src/app/pipeline/settle_time.hpp"
 
 namespace sd::app {
 namespace {
@@ -330,6 +331,8 @@ sim::SimulationSettings simulation_settings(const scene::Sketch& sketch) {
   if (flat && !spec.duration_given) settings.duration = 2 * spec.duration + spec.rest_ramp;
   settings.stop_at_rest = spec.stop_at_rest;
   settings.forces.gravity = spec.gravity;
+  // A garment swings in still air; a sheet (a test specimen) keeps the simulator's none.
+  if (!sketch.sheet) settings.forces.air_drag = kGarmentAirDrag;
   settings.contact.check_body_vertices = spec.check_body_vertices;
   // Garments fold onto themselves (a skirt's front and back, a sleeve); a sheet scene asks.
   settings.self_contact.enabled = spec.self_collision.value_or(!sketch.sheet.has_value());
@@ -353,6 +356,21 @@ sim::AutomaticChoice apply_automatic_settings(const scene::Sketch& sketch, const
   traits.garment = !scene.sheet;
   const sim::AutomaticChoice choice = sim::choose_settings(traits);
   sim::apply_choice(choice, spec.solver == "auto", spec.time_step_auto, settings);
+  // A garment without a duration of its own gets the time its hanging cloth needs to settle
+  // (a long skirt's hem swings as a pendulum; settle_time.hpp), at least the default. The run
+  // still stops as soon as it is at rest, so a garment that rests early costs nothing more.
+  const double g = settings.forces.gravity.norm();
+  if (!scene.sheet && !spec.duration_given && g > 0.0 && scene.start.rows() > 0) {
+    const Eigen::VectorXd along = scene.start * (settings.forces.gravity / g);
+    SettleInput settle;
+    settle.length = std::max(along.maxCoeff() - along.minCoeff(), 0.1);
+    settle.area_density = scene.fabric.area_density;
+    settle.air_drag = settings.forces.air_drag;
+    settle.time_step = settings.dt;
+    settle.gravity = g;
+    settle.rest_speed = settings.rest_speed;
+    settings.duration = std::max(settings.duration, settle_time(settle));
+  }
   return choice;
 }
 
