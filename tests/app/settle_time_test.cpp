@@ -31,8 +31,8 @@ double simulated_decay_time(const SettleInput& in) {
 TEST(SettleTime, MatchesTheDampedPendulumItModels) {
   // A 1 m cotton skirt, a 1.35 m jersey maxi dress, a 0.6 m top; the numerical damping alone.
   for (const auto& [length, density, drag] :
-       {std::tuple{1.0, 0.13, kGarmentAirDrag}, std::tuple{1.35, 0.18, kGarmentAirDrag},
-        std::tuple{0.6, 0.13, kGarmentAirDrag}, std::tuple{1.0, 0.13, 0.0}}) {
+       {std::tuple{1.0, 0.13, kStillAirDrag}, std::tuple{1.35, 0.18, kStillAirDrag},
+        std::tuple{0.6, 0.13, kStillAirDrag}, std::tuple{1.0, 0.13, 0.0}}) {
     SettleInput in;
     in.length = length;
     in.area_density = density;
@@ -48,6 +48,7 @@ TEST(SettleTime, MatchesTheDampedPendulumItModels) {
 
 TEST(SettleTime, LongerForLongerLighterAndUndampedCloth) {
   SettleInput in;
+  in.air_drag = kStillAirDrag;
   const double base = settle_time(in);
   SettleInput longer = in;
   longer.length = 2 * in.length;  // less numerical damping (ω² ∝ 1/L)
@@ -62,6 +63,7 @@ TEST(SettleTime, LongerForLongerLighterAndUndampedCloth) {
   // 1 m of cotton at 1/60 s: γ = 0.1/0.26 + 14.7·(1/60)/2 = 0.507 /s, ln 20 / γ + 1 = 6.9 s.
   SettleInput cotton;
   cotton.area_density = 0.13;
+  cotton.air_drag = kStillAirDrag;
   EXPECT_NEAR(settle_time(cotton), 1.0 + std::log(20.0) / (0.1 / 0.26 + 0.75 * 9.81 / 60), 1e-12);
   EXPECT_NEAR(settle_time(cotton), 6.9, 0.05);
 }

@@ -154,12 +154,12 @@ const std::vector<std::string> other_designs = {
 
 INSTANTIATE_TEST_SUITE_P(Corpus, DesignDrapeTop, ::testing::ValuesIn(other_designs), test_name);
 
-// Long free skirts, which swung past 6 s before garments had air drag and a duration that follows
-// their length (issue 18's fifth round, docs/simulator.md): rest and penetration. Wall time at
-// load 10-11 on the 2 cores: maxi-dress 64 s, gored-midi-skirt 92 s, long-aline-skirt-human
-// 62 s (and pencil-skirt-plain 9 s in the straight skirts).
+// Long free skirts, which swung past 6 s before garments had a duration that follows their length
+// and the drift-based rest test (issue 18's fifth round, docs/simulator.md): rest and
+// penetration. Wall time at load 10-11 on the 2 cores: maxi-dress 62 s, gored-midi-skirt 63 s,
+// long-aline-skirt-human 57 s, slit-maxi-skirt 68 s (and pencil-skirt-plain 9 s above).
 const std::vector<std::string> long_garments = {"maxi-dress", "gored-midi-skirt",
-                                                "long-aline-skirt-human"};
+                                                "long-aline-skirt-human", "slit-maxi-skirt"};
 
 INSTANTIATE_TEST_SUITE_P(Long, DesignDrapeTop, ::testing::ValuesIn(long_garments), test_name);
 

@@ -331,8 +331,6 @@ sim::SimulationSettings simulation_settings(const scene::Sketch& sketch) {
   if (flat && !spec.duration_given) settings.duration = 2 * spec.duration + spec.rest_ramp;
   settings.stop_at_rest = spec.stop_at_rest;
   settings.forces.gravity = spec.gravity;
-  // A garment swings in still air; a sheet (a test specimen) keeps the simulator's none.
-  if (!sketch.sheet) settings.forces.air_drag = kGarmentAirDrag;
   settings.contact.check_body_vertices = spec.check_body_vertices;
   // Garments fold onto themselves (a skirt's front and back, a sleeve); a sheet scene asks.
   settings.self_contact.enabled = spec.self_collision.value_or(!sketch.sheet.has_value());
@@ -369,7 +367,8 @@ sim::AutomaticChoice apply_automatic_settings(const scene::Sketch& sketch, const
     settle.time_step = settings.dt;
     settle.gravity = g;
     settle.rest_speed = settings.rest_speed;
-    settings.duration = std::max(settings.duration, settle_time(settle));
+    settings.duration =
+        std::max(settings.duration, std::min(settle_time(settle), kMaxSettleDuration));
   }
   return choice;
 }
