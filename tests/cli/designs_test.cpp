@@ -157,7 +157,8 @@ INSTANTIATE_TEST_SUITE_P(Corpus, DesignDrapeTop, ::testing::ValuesIn(other_desig
 // Long free skirts, which swung past 6 s before garments had a duration that follows their length
 // and the drift-based rest test (issue 18's fifth round, docs/simulator.md): rest and
 // penetration. Wall time at load 10-11 on the 2 cores: maxi-dress 62 s, gored-midi-skirt 63 s,
-// long-aline-skirt-human 57 s, slit-maxi-skirt 68 s (and pencil-skirt-plain 9 s above).
+// long-aline-skirt-human 57 s, slit-maxi-skirt 68 s (and pencil-skirt-plain 9 s above); the whole
+// of designs_tests took 105 s wall at -j2 and load 4-8.
 const std::vector<std::string> long_garments = {"maxi-dress", "gored-midi-skirt",
                                                 "long-aline-skirt-human", "slit-maxi-skirt"};
 
