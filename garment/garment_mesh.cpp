@@ -19,6 +19,7 @@
 #include "garment/panel_fill.hpp"
 #include "garment/panel_loop.hpp"
 #include "garment/panel_surface.hpp"
+#include "garment/panel_tasks.hpp"
 #include "garment/sketch_ranges.hpp"
 #include "garment/stroke_projection.hpp"
 #include "garment/surface_relaxation.hpp"
@@ -224,6 +225,35 @@ class BoundaryVertices {
   std::vector<std::vector<int>> edge_ids_;
 };
 
+// A panel's sides, corner i to corner i+1: the points of its curve pieces joined (each junction
+// once) and, when `ids` is given, their pool ids (which adds the pieces' vertices to the pool).
+std::vector<Eigen::MatrixX3d> panel_sides(const PanelLoop& loop, BoundaryVertices& boundary,
+                                          std::vector<std::vector<int>>* ids) {
+  std::vector<Eigen::MatrixX3d> sides;
+  if (ids) ids->clear();
+  for (int s = 0; s < loop.side_count(); ++s) {
+    std::vector<Eigen::Vector3d> pts;
+    std::vector<int> side_ids;
+    for (int k = loop.side_begin[static_cast<size_t>(s)]; k < loop.side_end(s); ++k) {
+      const LoopEdge& e = loop.edges[static_cast<size_t>(k)];
+      const Eigen::MatrixX3d& p = boundary.points(e.edge);
+      const Eigen::Index n = p.rows();
+      for (Eigen::Index j = 0; j < n; ++j) {
+        const Eigen::Index src = e.forward ? j : n - 1 - j;
+        if (!pts.empty() && j == 0) continue;  // the junction is already there
+        pts.push_back(p.row(src).transpose());
+        if (ids) side_ids.push_back(boundary.ids(e.edge)[static_cast<size_t>(src)]);
+      }
+    }
+    Eigen::MatrixX3d m(static_cast<Eigen::Index>(pts.size()), 3);
+    for (size_t j = 0; j < pts.size(); ++j)
+      m.row(static_cast<Eigen::Index>(j)) = pts[j].transpose();
+    sides.push_back(std::move(m));
+    if (ids) ids->push_back(std::move(side_ids));
+  }
+  return sides;
+}
+
 // Stage 4, one mesh: doublets merged, vertices no face uses dropped (in order), the arrays
 // filled. `faces` (pool ids), `face_panel` and `pool` are renumbered in place.
 void assemble_mesh(std::vector<std::array<int, 4>>& faces, std::vector<int>& face_panel,
@@ -411,6 +441,27 @@ Garment build_garment(const GarmentRequest& sketch, const BodySurface& body) {
   std::map<int, std::vector<int>> patch_globals;
   std::map<int, meshing::FilledPatch> patches;
 
+  // Stage 3, every original panel's quads, on the body or spanning a hollow (panel_fill.hpp), the
+  // panels side by side (panel_tasks.hpp): a fill depends on its own sides only, so the garment
+  // has the same bits on any number of threads. The sides' points are placed first (they add
+  // nothing to the pool, whose numbering below stays that of a fill in the loop's order).
+  std::vector<meshing::FilledPatch> filled(loops.size());
+  std::vector<GarmentPanel> fits(loops.size());  // each fill's fit and span_gap
+  {
+    std::vector<int> originals;
+    std::vector<std::vector<Eigen::MatrixX3d>> sides(loops.size());
+    for (size_t l = 0; l < loops.size(); ++l)
+      if (!loops[l].mirror_copy) {
+        originals.push_back(static_cast<int>(l));
+        sides[l] = panel_sides(loops[l], boundary, nullptr);
+      }
+    run_panel_tasks(static_cast<int>(originals.size()), [&](int k) {
+      const auto l = static_cast<size_t>(originals[static_cast<size_t>(k)]);
+      const PanelSpec& spec = sketch.panels[static_cast<size_t>(loops[l].spec)];
+      filled[l] = fill_panel(sketch, spec, loops[l], net, sides[l], body, fits[l]);
+    });
+  }
+
   for (size_t l = 0; l < loops.size(); ++l) {
     const PanelLoop& loop = loops[l];
     const PanelSpec& spec = sketch.panels[static_cast<size_t>(loop.spec)];
@@ -447,43 +498,19 @@ Garment build_garment(const GarmentRequest& sketch, const BodySurface& body) {
         garment.edge_curve[std::minmax(ids[j], ids[j + 1])] = panel.curves.back();
     }
 
-    // Sides: points and global ids from corner i to corner i+1.
-    std::vector<Eigen::MatrixX3d> side_points;
+    // Sides: global ids from corner i to corner i+1 (their points were filled above).
     std::vector<std::vector<int>> side_ids;
-    auto build_sides = [&] {
-      side_points.clear();
-      side_ids.clear();
-      panel.side_counts.clear();
-      for (int s = 0; s < loop.side_count(); ++s) {
-        std::vector<Eigen::Vector3d> pts;
-        std::vector<int> ids;
-        for (int k = loop.side_begin[static_cast<size_t>(s)]; k < loop.side_end(s); ++k) {
-          const LoopEdge& e = loop.edges[static_cast<size_t>(k)];
-          const Eigen::MatrixX3d& p = boundary.points(e.edge);
-          const std::vector<int>& g = boundary.ids(e.edge);
-          const Eigen::Index n = p.rows();
-          for (Eigen::Index j = 0; j < n; ++j) {
-            const Eigen::Index src = e.forward ? j : n - 1 - j;
-            if (!ids.empty() && j == 0) continue;  // the junction is already there
-            pts.push_back(p.row(src).transpose());
-            ids.push_back(g[static_cast<size_t>(src)]);
-          }
-        }
-        Eigen::MatrixX3d m(static_cast<Eigen::Index>(pts.size()), 3);
-        for (size_t j = 0; j < pts.size(); ++j)
-          m.row(static_cast<Eigen::Index>(j)) = pts[j].transpose();
-        side_points.push_back(std::move(m));
-        side_ids.push_back(std::move(ids));
-        panel.side_counts.push_back(static_cast<int>(side_ids.back().size()) - 1);
-      }
-    };
-    build_sides();
+    panel_sides(loop, boundary, &side_ids);
+    for (const std::vector<int>& ids : side_ids)
+      panel.side_counts.push_back(static_cast<int>(ids.size()) - 1);
 
     const int panel_index = static_cast<int>(garment.panels.size());
     std::vector<int> globals;
     if (!loop.mirror_copy) {
       // Stage 3: the panel's quads, on the body or spanning a hollow (panel_fill.hpp).
-      meshing::FilledPatch patch = fill_panel(sketch, spec, loop, net, side_points, body, panel);
+      meshing::FilledPatch patch = std::move(filled[static_cast<size_t>(l)]);
+      panel.fit = fits[static_cast<size_t>(l)].fit;
+      panel.span_gap = fits[static_cast<size_t>(l)].span_gap;
       globals.assign(static_cast<size_t>(patch.mesh.vertex_count()), -1);
       for (size_t s = 0; s < patch.topology.side_vertices.size(); ++s)
         for (size_t j = 0; j < patch.topology.side_vertices[s].size(); ++j)

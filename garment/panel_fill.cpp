@@ -155,6 +155,20 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
     if ((p - s.position).dot(s.normal) >= offset) return std::nullopt;
     return s.position + offset * s.normal;
   };
+  // push_out along the spanned surface's normal `n` (a unit vector, or zero): a point inside
+  // the offset surface goes where the ray along n leaves the body, when that surface faces along
+  // n within kAlongReach times the nearest distance plus an edge; otherwise to its nearest point.
+  const PushAlong push_along = [&closest, &body, offset, reach](
+                                   const Eigen::Vector3d& p,
+                                   const Eigen::Vector3d& n) -> std::optional<Eigen::Vector3d> {
+    const SurfacePoint s = closest(p);
+    if ((p - s.position).dot(s.normal) >= offset) return std::nullopt;
+    if (n.norm() > 0.5)
+      if (const auto hit = body.first_hit(p, n);
+          hit && hit->normal.dot(n) > 0 && hit->distance <= kAlongReach * s.distance + reach)
+        return Eigen::Vector3d(hit->position + offset * hit->normal);
+    return Eigen::Vector3d(s.position + offset * s.normal);
+  };
   const auto fill = [&](const meshing::FillGeometryOptions& o) {
     try {
       return meshing::fill_region(side_points, o);
@@ -267,8 +281,29 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
       for (Eigen::Index v = 0; v < patch.mesh.vertex_count() && !touches; ++v)
         touches = !fixed[static_cast<size_t>(v)] &&
                   push_out(patch.mesh.vertices.row(v).transpose()).has_value();
-      if (touches) span_over_obstacle(patch.mesh, fixed, push_out);
-      patch.quality = meshing::measure_quality(patch.mesh, patch.topology.corner_vertices());
+      if (touches) {
+        const meshing::QuadMesh start = patch.mesh;
+        span_over_obstacle(patch.mesh, fixed, push_out);
+        patch.quality = meshing::measure_quality(patch.mesh, patch.topology.corner_vertices());
+        // Folded or a sliver: where the membrane crosses a crease of the body (a one-piece
+        // skirt's front over the crotch, its back over the seat), the nearest points gather
+        // neighbouring vertices on the crease's floor, down to quads of no area that the
+        // simulator refuses. Spanned again, pushed along the membrane's own normals instead
+        // (parallel rays keep neighbours apart); the better by the same measures is kept. Only
+        // then, so that every panel that came out clean the first way keeps its bits.
+        if (patch.quality.inverted_quads > 0 || patch.quality.max_aspect_ratio >= kSliverAspect) {
+          meshing::QuadMesh along = start;
+          span_over_obstacle(along, fixed, push_along, true);
+          const meshing::QuadQuality quality =
+              meshing::measure_quality(along, patch.topology.corner_vertices());
+          if (rank(quality) < rank(patch.quality)) {
+            patch.mesh = std::move(along);
+            patch.quality = quality;
+          }
+        }
+      } else {
+        patch.quality = meshing::measure_quality(patch.mesh, patch.topology.corner_vertices());
+      }
     }
     const auto consider = [&](meshing::QuadMesh&& mesh, meshing::FilledPatch& best) {
       const meshing::QuadQuality quality =

@@ -1,5 +1,6 @@
 #include "garment/panel_surface.hpp"
 
+#include <Eigen/Geometry>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #include <algorithm>
@@ -70,24 +71,69 @@ void span_harmonic(meshing::QuadMesh& mesh, std::span<const char> fixed) {
 
 SpannedSurface span_over_obstacle(meshing::QuadMesh& mesh, std::span<const char> fixed,
                                   const PushOut& push_out, int max_rounds) {
+  return span_over_obstacle(
+      mesh, fixed,
+      [&push_out](const Eigen::Vector3d& p, const Eigen::Vector3d&) { return push_out(p); }, false,
+      max_rounds);
+}
+
+SpannedSurface span_over_obstacle(meshing::QuadMesh& mesh, std::span<const char> fixed,
+                                  const PushAlong& push_along, bool release, int max_rounds) {
   if (static_cast<Eigen::Index>(fixed.size()) != mesh.vertex_count())
     throw std::invalid_argument("span_over_obstacle: one fixed flag per vertex is needed");
   const std::vector<std::pair<int, int>> edges = quad_edges(mesh);
   std::vector<char> held(fixed.begin(), fixed.end());
   solve_harmonic(mesh, edges, held);
   SpannedSurface result;
+  std::vector<Eigen::Vector3d> normals;
+  std::vector<std::vector<int>> neighbours(static_cast<size_t>(release ? mesh.vertex_count() : 0));
+  if (release)
+    for (const auto& [a, b] : edges) {
+      neighbours[static_cast<size_t>(a)].push_back(b);
+      neighbours[static_cast<size_t>(b)].push_back(a);
+    }
   for (;;) {
+    normals.assign(static_cast<size_t>(mesh.vertex_count()), Eigen::Vector3d::Zero());
+    for (Eigen::Index f = 0; f < mesh.face_count(); ++f) {
+      const Eigen::Vector3d n =
+          (mesh.vertices.row(mesh.faces(f, 2)) - mesh.vertices.row(mesh.faces(f, 0)))
+              .transpose()
+              .cross((mesh.vertices.row(mesh.faces(f, 3)) - mesh.vertices.row(mesh.faces(f, 1)))
+                         .transpose());
+      for (int k = 0; k < 4; ++k) normals[static_cast<size_t>(mesh.faces(f, k))] += n;
+    }
+    for (Eigen::Vector3d& n : normals)
+      if (n.norm() > 0) n.normalize();
     int pushed = 0;
     for (Eigen::Index v = 0; v < mesh.vertex_count(); ++v) {
       if (held[static_cast<size_t>(v)]) continue;
-      if (const auto out = push_out(mesh.vertices.row(v).transpose())) {
+      if (const auto out =
+              push_along(mesh.vertices.row(v).transpose(), normals[static_cast<size_t>(v)])) {
         mesh.vertices.row(v) = out->transpose();
         held[static_cast<size_t>(v)] = 1;
         ++pushed;
       }
     }
+    // With `release`: a held vertex whose neighbours' mean lies outside the obstacle is let go
+    // (the membrane there would lift off the body; held, it pulls its free neighbours in after
+    // it: a skirt's front held on the inner curve of both thighs sags into the gap between them).
+    int released = 0;
+    if (release && pushed == 0) {
+      for (Eigen::Index v = 0; v < mesh.vertex_count(); ++v) {
+        if (!held[static_cast<size_t>(v)] || fixed[static_cast<size_t>(v)]) continue;
+        const std::vector<int>& around = neighbours[static_cast<size_t>(v)];
+        if (around.empty()) continue;
+        Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+        for (const int u : around) mean += mesh.vertices.row(u).transpose();
+        mean /= static_cast<double>(around.size());
+        if (!push_along(mean, normals[static_cast<size_t>(v)])) {
+          held[static_cast<size_t>(v)] = 0;
+          ++released;
+        }
+      }
+    }
     result.contacts += pushed;
-    if (pushed == 0) break;
+    if (pushed == 0 && released == 0) break;
     if (result.rounds == max_rounds) {
       result.settled = false;
       break;

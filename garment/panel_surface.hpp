@@ -20,6 +20,11 @@ namespace sd::garment {
 // Where a point inside the obstacle goes: its closest point on the offset surface; empty when
 // the point is outside (or on) it.
 using PushOut = std::function<std::optional<Eigen::Vector3d>(const Eigen::Vector3d&)>;
+// The same with the spanned surface's unit normal at the point (its quads' diagonal cross
+// products summed at the vertex): a push along it keeps neighbours apart where the nearest
+// point of a crease would gather them.
+using PushAlong =
+    std::function<std::optional<Eigen::Vector3d>(const Eigen::Vector3d&, const Eigen::Vector3d&)>;
 
 struct SpannedSurface {
   int rounds = 0;       // harmonic solves after the first (each after a batch of new contacts)
@@ -36,5 +41,13 @@ void span_harmonic(meshing::QuadMesh& mesh, std::span<const char> fixed);
 // that `push_out` moves and solving the others again with those held.
 SpannedSurface span_over_obstacle(meshing::QuadMesh& mesh, std::span<const char> fixed,
                                   const PushOut& push_out, int max_rounds = 30);
+// The same, each round's pushes given the spanned surface's normals at the vertices (taken after
+// that round's harmonic solve, before any push). With `release`, once a round pushes nothing,
+// every held vertex whose neighbours' mean `push_along` leaves where it is (outside the obstacle)
+// is let go and the rest solved again, until a round neither pushes nor lets go: the membrane
+// touches the body only where the body holds it up (an obstacle problem's contact set), not
+// wherever it was once pushed.
+SpannedSurface span_over_obstacle(meshing::QuadMesh& mesh, std::span<const char> fixed,
+                                  const PushAlong& push_along, bool release, int max_rounds = 30);
 
 }  // namespace sd::garment

@@ -134,6 +134,7 @@ void Simulation::replace_model(ClothModel model, Eigen::VectorXd x, Eigen::Vecto
   }
   x_ = std::move(x);
   v_ = std::move(v);
+  rest_anchor_ = x_;  // the first still stretch is measured from the start
   pins_ = std::move(pins);
   pin_rest_.clear();
   for (const Pin& pin : pins_) pin_rest_.emplace_back(x_.segment<3>(3 * pin.vertex));
@@ -449,11 +450,26 @@ void Simulation::accept(Attempt& attempt, double h) {
     report_.rest_speed_window = std::max(report_.rest_speed_window, s);
     report_.rest_kinetic_per_kg_window = std::max(report_.rest_kinetic_per_kg_window, k);
   }
-  if (speed < settings_.rest_speed && kinetic / mass < settings_.rest_kinetic_energy &&
-      !body_moving && time_ >= settings_.rest_not_before)
+  // The still stretch is measured from an anchor: the positions when it began. A vertex
+  // chattering in place (sub-millimetre steps between contacts, its speed flipping every step)
+  // stays near the anchor; a hem still swinging or creeping faster than rest_speed leaves it.
+  const double drift_limit = settings_.rest_speed * settings_.rest_window;
+  double drift = 0.0;
+  const bool anchored = rest_anchor_.size() == x_.size();
+  if (anchored)
+    for (Eigen::Index i = 0; i < x_.size() / 3; ++i)
+      drift = std::max(drift, (x_.segment<3>(3 * i) - rest_anchor_.segment<3>(3 * i)).norm());
+  const bool still = anchored && drift <= drift_limit &&
+                     kinetic / mass < settings_.rest_kinetic_energy && !body_moving &&
+                     time_ >= settings_.rest_not_before;
+  if (still) {
     rest_time_ += h;
-  else
+    report_.rest_drift = drift;
+  } else {
+    rest_anchor_ = x_;
     rest_time_ = 0.0;
+    report_.rest_drift = 0.0;
+  }
 }
 
 StepOutcome Simulation::step(double max_step) {

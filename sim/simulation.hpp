@@ -58,6 +58,9 @@ struct SimulationSettings {
   double rest_speed = 5.0e-3;           // m/s, maximum vertex speed at rest
   double rest_kinetic_energy = 1.0e-6;  // J/kg, kinetic energy per unit mass at rest
   double rest_window = 0.25;            // s the two must stay below their thresholds
+  // At rest: over rest_window no vertex moves farther than rest_speed·rest_window from where it
+  // was when the window began (the window's mean speed, not the instantaneous one), with the
+  // kinetic energy per kg below rest_kinetic_energy at every step.
   // s: the window starts no earlier (a rest shape still changing, AdaptiveMaterial::rest_ramp)
   double rest_not_before = 0.0;
   bool record_energy = true;  // energy time series in the report (one sample a step)
@@ -142,6 +145,9 @@ struct SimulationReport {
   double rest_kinetic_per_kg_window = 0.0;
   double rest_speed_final = 0.0;
   double rest_kinetic_per_kg_final = 0.0;
+  // m: the largest displacement of a vertex since the current still stretch began (the whole
+  // run's still steps when at rest), the figure the at-rest test bounds by rest_speed·rest_window.
+  double rest_drift = 0.0;
   // Self-contact (zero when off; sim/self_contact.hpp).
   int self_intersections_start = 0;  // intersecting triangle pairs of the start
   int self_untangled_vertices = 0;   // vertices the start's untangling moved
@@ -267,6 +273,10 @@ class Simulation {
   double rest_time_ = 0.0;
   // (time, largest speed, kinetic energy per kg) of the steps in the last rest window.
   std::vector<std::array<double, 3>> rest_history_;
+  // Positions when the current still stretch began (empty: none yet). At rest asks how far the
+  // cloth has moved since, not how fast it moves now: a vertex chattering in place between
+  // contacts has a speed but goes nowhere (docs/simulator.md, "Step control and at rest").
+  Eigen::VectorXd rest_anchor_;
   ConstraintFilter filter_;
   StepForces contact_forces_;  // friction drags and piercing springs of the current attempt
   ImplicitSolver solver_;

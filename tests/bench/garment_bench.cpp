@@ -1,62 +1,61 @@
 // Meshing a sketch, body loading excluded: sketch parse + stroke projection + curve network +
-// panels + edge counts + quad fill + stitching (build_garment), for each example garment.
-// The body and its AABB tree are built once, outside the timed loop (as `mesh` reports them
-// apart). Run: ./build/tests/bench/garment_bench
+// panels + edge counts + quad fill + stitching (build_garment), for every example garment
+// (data/examples/) and every design of the corpus (data/designs/, the Collada human's skipped
+// when it is not installed). Each body and its trees are built once, outside the timed loop (as
+// `mesh` reports them apart). Each garment on 1 and 2 threads (the argument: build_garment fills
+// the panels side by side, garment/panel_tasks.hpp); "Time" is wall time, "CPU" the whole
+// process's over every thread.
+// Run: ./build/tests/bench/garment_bench
 
 #include <benchmark/benchmark.h>
+#include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
 
 #include "garment/body.hpp"
 #include "garment/body_surface.hpp"
 #include "garment/garment_mesh.hpp"
+#include "garment/panel_tasks.hpp"
 #include "garment/sketch_inputs.hpp"
 #include "scene/sketch_file.hpp"
 
 namespace {
 
-const sd::garment::BodySurface& surface() {
-  static const sd::garment::Body body = sd::garment::load_body("builtin");
-  static const sd::garment::BodySurface s(body.mesh);
-  return s;
-}
+namespace fs = std::filesystem;
 
-void mesh_file(benchmark::State& state, const std::filesystem::path& file) {
-  const sd::garment::BodySurface& body = surface();
-  long quads = 0;
-  for (auto _ : state) {
-    const sd::scene::Sketch sketch = sd::scene::load_sketch(file);
-    const sd::garment::Garment g = sd::garment::build_garment(sketch, body);
-    quads = static_cast<long>(g.mesh.face_count());
-    benchmark::DoNotOptimize(g.mesh.vertices.data());
+// A design's body with its closest-point and ray trees, loaded once per sketch file.
+const sd::garment::BodySurface& body_of(const fs::path& file) {
+  struct Loaded {
+    sd::garment::Body body;
+    std::unique_ptr<sd::garment::BodySurface> surface;
+  };
+  static std::map<fs::path, Loaded> loaded;
+  auto it = loaded.find(file);
+  if (it == loaded.end()) {
+    Loaded l{sd::garment::load_sketch_body(sd::scene::load_sketch(file)), nullptr};
+    l.surface = std::make_unique<sd::garment::BodySurface>(l.body.mesh);
+    it = loaded.emplace(file, std::move(l)).first;
   }
-  state.counters["quads"] = static_cast<double>(quads);
+  return *it->second.surface;
 }
 
-void mesh_example(benchmark::State& state, const char* name) {
-  mesh_file(state, std::filesystem::path(SD_SOURCE_DIR) / "data/examples" / name);
-}
-
-// The design corpus on the built-in body (data/designs/): the garments' panels spanned by their
-// curves ("fit": "free") cost a harmonic solve per obstacle round.
-void mesh_design(benchmark::State& state, const char* name) {
-  mesh_file(state, std::filesystem::path(SD_SOURCE_DIR) / "data/designs" / name);
-}
-
-// The designs on the second body, Debian's Collada human (skipped when it is not installed).
-void mesh_human_design(benchmark::State& state, const char* name) {
-  const std::filesystem::path file = std::filesystem::path(SD_SOURCE_DIR) / "data/designs" / name;
+void mesh_file(benchmark::State& state, const fs::path& file) {
   const sd::scene::Sketch sketch = sd::scene::load_sketch(file);
-  if (!std::filesystem::exists(sketch.resolve(sketch.body.mesh))) {
-    state.SkipWithError("the Collada human (assimp-testmodels) is not installed");
+  if (!fs::exists(sketch.resolve(sketch.body.mesh)) && sketch.body.mesh != "builtin") {
+    state.SkipWithError("the design's body is not installed");
     return;
   }
-  static const sd::garment::Body body = sd::garment::load_sketch_body(sketch);
-  static const sd::garment::BodySurface human(body.mesh);
+  const sd::garment::BodySurface& body = body_of(file);
+  sd::garment::set_panel_threads(static_cast<int>(state.range(0)));
   long quads = 0;
   for (auto _ : state) {
     const sd::scene::Sketch parsed = sd::scene::load_sketch(file);
-    const sd::garment::Garment g = sd::garment::build_garment(parsed, human);
+    const sd::garment::Garment g = sd::garment::build_garment(parsed, body);
     quads = static_cast<long>(g.mesh.face_count());
     benchmark::DoNotOptimize(g.mesh.vertices.data());
   }
@@ -71,32 +70,33 @@ void body_surface_build(benchmark::State& state) {
   }
 }
 
+// The sketch files of a folder, by name.
+std::vector<fs::path> sketches_in(const char* folder) {
+  std::vector<fs::path> files;
+  for (const auto& entry : fs::directory_iterator(fs::path(SD_SOURCE_DIR) / folder))
+    if (entry.path().extension() == ".json") files.push_back(entry.path());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
 }  // namespace
 
-BENCHMARK_CAPTURE(mesh_example, tshirt, "tshirt.json")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(mesh_example, a_line_skirt, "a-line-skirt.json")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(mesh_example, sleeveless_dress, "sleeveless-dress.json")
-    ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(mesh_example, shorts, "shorts.json")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(mesh_example, godet_skirt, "godet-skirt.json")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(mesh_design, pencil_skirt, "pencil-skirt.json")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(mesh_design, vest, "vest.json")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(mesh_design, capelet, "capelet.json")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(mesh_design, one_shoulder_top, "one-shoulder-top.json")
-    ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(mesh_design, wrap_skirt, "wrap-skirt.json")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(mesh_design, vest_collar, "vest-collar.json")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(mesh_design, long_sleeve_tee, "long-sleeve-tee.json")
-    ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(mesh_design, circle_skirt, "circle-skirt.json")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(mesh_design, raglan_top, "raglan-top.json")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(mesh_design, cape_hood, "cape-hood.json")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(mesh_human_design, trousers_human, "trousers-human.json")
-    ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(mesh_human_design, jumpsuit_human, "jumpsuit-human.json")
-    ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(mesh_human_design, tee_dress_human, "tee-dress-human.json")
-    ->Unit(benchmark::kMillisecond);
-BENCHMARK(body_surface_build)->Unit(benchmark::kMillisecond);
-
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  spdlog::set_level(spdlog::level::err);  // the shorts' merged doublet would warn every iteration
+  for (const char* folder : {"data/examples", "data/designs"})
+    for (const fs::path& file : sketches_in(folder))
+      benchmark::RegisterBenchmark(
+          (fs::path(folder).filename().string() + "/" + file.stem().string()).c_str(),
+          [file](benchmark::State& state) { mesh_file(state, file); })
+          ->Arg(1)
+          ->Arg(2)
+          ->MeasureProcessCPUTime()
+          ->Unit(benchmark::kMillisecond);
+  benchmark::RegisterBenchmark("body_surface_build", body_surface_build)
+      ->Unit(benchmark::kMillisecond);
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -89,7 +89,9 @@ INSTANTIATE_TEST_SUITE_P(Corpus, Design, ::testing::ValuesIn(design_names()), te
 // long-sleeve-tee 10 s, jumpsuit-human 8 s, vest-collar 8 s, tee-dress-human 14 s, capelet 8 s,
 // circle-skirt 23 s, vest 6 s, vest-human 2 s, raglan-top 7 s, cape-hood 11 s,
 // aline-dress-human 12 s, tee-human 3 s, cowl-top 1.4 s of CPU, boat-top 4 s, tank-human 4 s,
-// culottes 9 s, tank-top 2 s, gored-skirt 10 s: about 190 s in all.
+// culottes 9 s, tank-top 2 s, gored-skirt 10 s, pencil-skirt-human 11-16 s (26 November; 2 s of
+// CPU), collar-top-human 6 s (1.2 s of CPU),
+// hooded-top 7 s (3.3 s of CPU): about 220 s in all; and the long garments below.
 class DesignDrape : public ::testing::TestWithParam<std::string> {};
 
 nlohmann::json drape(const std::string& name) {
@@ -108,8 +110,11 @@ void expect_at_rest_outside_the_body(const nlohmann::json& report) {
   ASSERT_FALSE(report.is_null());
   EXPECT_TRUE(report["at_rest"].get<bool>());
   EXPECT_EQ(report["penetrating_vertices_final"].get<int>(), 0);
-  EXPECT_LT(report["rest"]["speed_window_m_s"].get<double>(),
-            report["rest"]["speed_limit_m_s"].get<double>());
+  // At rest bounds how far the cloth moved over the window (a vertex chattering in place between
+  // contacts may still have a speed): the drift, at most rest_speed·rest_window.
+  EXPECT_LE(report["rest"]["drift_m"].get<double>(), report["rest"]["drift_limit_m"].get<double>());
+  EXPECT_LT(report["rest"]["kinetic_per_kg_window_J_kg"].get<double>(),
+            report["rest"]["kinetic_per_kg_limit_J_kg"].get<double>());
 }
 
 TEST_P(DesignDrape, RestsOutsideTheBodyWithoutADentBetweenTheLegs) {
@@ -123,7 +128,8 @@ TEST_P(DesignDrape, RestsOutsideTheBodyWithoutADentBetweenTheLegs) {
 }
 
 const std::vector<std::string> straight_skirts = {"pencil-skirt", "straight-skirt-human",
-                                                  "wrap-skirt"};
+                                                  "wrap-skirt", "pencil-skirt-human",
+                                                  "pencil-skirt-plain"};
 
 INSTANTIATE_TEST_SUITE_P(Skirts, DesignDrape, ::testing::ValuesIn(straight_skirts), test_name);
 
@@ -143,15 +149,27 @@ const std::vector<std::string> other_designs = {
     "one-shoulder-top", "long-sleeve-tee", "trousers-human",    "jumpsuit-human", "vest-collar",
     "tee-dress-human",  "capelet",         "circle-skirt",      "vest",           "vest-human",
     "raglan-top",       "cape-hood",       "aline-dress-human", "tee-human",      "cowl-top",
-    "boat-top",         "tank-human",      "culottes",          "tank-top",       "gored-skirt"};
+    "boat-top",         "tank-human",      "culottes",          "tank-top",       "gored-skirt",
+    "collar-top-human", "hooded-top"};
 
 INSTANTIATE_TEST_SUITE_P(Corpus, DesignDrapeTop, ::testing::ValuesIn(other_designs), test_name);
+
+// Long free skirts, which swung past 6 s before garments had a duration that follows their length
+// and the drift-based rest test (issue 18's fifth round, docs/simulator.md): rest and
+// penetration. Wall time at load 10-11 on the 2 cores: maxi-dress 62 s, gored-midi-skirt 63 s,
+// long-aline-skirt-human 57 s, slit-maxi-skirt 68 s (and pencil-skirt-plain 9 s above); the whole
+// of designs_tests took 105 s wall at -j2 and load 4-8.
+const std::vector<std::string> long_garments = {"maxi-dress", "gored-midi-skirt",
+                                                "long-aline-skirt-human", "slit-maxi-skirt"};
+
+INSTANTIATE_TEST_SUITE_P(Long, DesignDrapeTop, ::testing::ValuesIn(long_garments), test_name);
 
 // Every design in data/designs is draped by one of the two lists above: a design added to the
 // corpus without a drape would only be meshed.
 TEST(DesignCorpus, EveryDesignIsDraped) {
   std::vector<std::string> draped = straight_skirts;
   draped.insert(draped.end(), other_designs.begin(), other_designs.end());
+  draped.insert(draped.end(), long_garments.begin(), long_garments.end());
   std::sort(draped.begin(), draped.end());
   std::vector<std::string> designs = design_names();
   std::sort(designs.begin(), designs.end());

@@ -80,6 +80,62 @@ TEST(PanelSurface, MembraneSpansAGapWithoutSinkingIntoIt) {
   EXPECT_GT(mesh.vertices(8 * (n + 1) + 8, 2), 0.0);
 }
 
+// The obstacle problem with contacts let go: a flat membrane (16 x 16 units, z = 0) over a ball
+// of radius 3 whose top pokes 1.5 through it. Pushed along the membrane's normals (+z here), and
+// with `release`, the membrane ends touching the ball only where the ball holds it up: no vertex
+// inside the ball, every held one with its neighbours' mean inside (it would lift off otherwise),
+// the top held exactly, and fewer contacts than the pushes without release leave (which keep
+// every vertex once pushed, down the ball's flanks where the membrane leaves it).
+TEST(PanelSurface, ReleasedContactsAreOnlyWhereTheObstacleHoldsTheMembrane) {
+  const int n = 16;
+  const double r = 3.0;
+  const Eigen::Vector3d centre(8.0, 8.0, -1.5);
+  const auto inside = [&](const Eigen::Vector3d& p) { return (p - centre).norm() < r; };
+  const PushAlong push_along =
+      [&](const Eigen::Vector3d& p,
+          const Eigen::Vector3d& normal) -> std::optional<Eigen::Vector3d> {
+    if (!inside(p)) return std::nullopt;
+    // Where the ray p + t normal leaves the ball (t > 0): |p + t n - c| = r.
+    const Eigen::Vector3d d = p - centre;
+    const double b = d.dot(normal);
+    return Eigen::Vector3d(p + (-b + std::sqrt(b * b - d.squaredNorm() + r * r)) * normal);
+  };
+  const std::vector<char> fixed = test::grid_boundary(n);
+  meshing::QuadMesh kept = test::plane_grid(n);
+  meshing::QuadMesh released = kept;
+  const SpannedSurface without = span_over_obstacle(kept, fixed, push_along, false);
+  const SpannedSurface with = span_over_obstacle(released, fixed, push_along, true);
+  EXPECT_TRUE(with.settled);
+
+  const meshing::QuadMesh grid = test::plane_grid(n);  // the vertices' grid places
+  const auto on_ball = [&](const meshing::QuadMesh& m, Eigen::Index v) {
+    return std::abs((m.vertices.row(v).transpose() - centre).norm() - r) < 1e-9;
+  };
+  int held_with = 0, held_without = 0;
+  for (Eigen::Index v = 0; v < released.vertex_count(); ++v) {
+    const Eigen::Vector3d p = released.vertices.row(v).transpose();
+    EXPECT_GE((p - centre).norm(), r - 1e-9) << "vertex " << v << " inside the ball";
+    held_without += on_ball(kept, v) ? 1 : 0;
+    if (!on_ball(released, v)) continue;
+    ++held_with;
+    // Its neighbours pull it into the ball: the membrane rests on the ball there. (On a regular
+    // grid a vertex's two edge neighbours per direction: the mean of the four.)
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    int count = 0;
+    for (Eigen::Index u = 0; u < released.vertex_count(); ++u)
+      if ((grid.vertices.row(u) - grid.vertices.row(v)).cwiseAbs().sum() == 1.0) {
+        mean += released.vertices.row(u).transpose();
+        ++count;
+      }
+    ASSERT_EQ(count, 4);
+    EXPECT_TRUE(inside(mean / count)) << "vertex " << v << " is held but would lift off";
+  }
+  EXPECT_NEAR(released.vertices(8 * (n + 1) + 8, 2), 1.5, 1e-9);  // the top
+  EXPECT_GT(held_with, 0);
+  EXPECT_LT(held_with, held_without);
+  EXPECT_GE(without.contacts, held_without);
+}
+
 const BodySurface& builtin_surface() {
   static const Body body = load_body("builtin");
   static const BodySurface surface(body.mesh);

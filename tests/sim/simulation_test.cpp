@@ -162,6 +162,43 @@ TEST(Simulation, ReportsTheAtRestResidual) {
             0.5 * report.rest_speed_final * report.rest_speed_final + 1e-15);
 }
 
+// At rest bounds how far the cloth moved over the window, not its speed at each step: the
+// reported drift is the largest distance of a vertex from where it was when the still stretch
+// began (a recorded step at least a window before the end), and below rest_speed·rest_window.
+TEST(Simulation, AtRestBoundsTheDriftOverTheWindow) {
+  const HangingSheet h = hanging_sheet(6);
+  SimulationSettings settings;
+  settings.dt = 1.0 / 30;
+  settings.duration = 30.0;
+  settings.forces.air_drag = 0.2;
+  Simulation sim = make_simulation(h, settings);
+  std::vector<std::pair<double, Eigen::VectorXd>> states;  // (time, positions) per step
+  const SimulationReport report =
+      sim.run([&](const Simulation& s) { states.emplace_back(s.time(), s.positions()); });
+  ASSERT_TRUE(report.at_rest);
+  ASSERT_GT(states.size(), 2u);
+  const Eigen::VectorXd& last = states.back().second;
+  const auto drift_from = [&](const Eigen::VectorXd& anchor) {
+    double drift = 0.0;
+    for (Eigen::Index i = 0; i < last.size() / 3; ++i)
+      drift = std::max(drift, (last.segment<3>(3 * i) - anchor.segment<3>(3 * i)).norm());
+    return drift;
+  };
+  EXPECT_GT(report.rest_drift, 0.0);
+  EXPECT_LE(report.rest_drift, settings.rest_speed * settings.rest_window);
+  // The anchor is the last step that was not still: the newest recorded state at least a
+  // window before the end (the still steps after it add up to the window).
+  const double anchor_time = report.sim_time - settings.rest_window;
+  const auto anchor = std::find_if(states.rbegin(), states.rend(), [&](const auto& state) {
+    return state.first <= anchor_time + 1e-9;
+  });
+  ASSERT_NE(anchor, states.rend());
+  EXPECT_DOUBLE_EQ(report.rest_drift, drift_from(anchor->second));
+  // No vertex can have drifted farther than the largest speed over the window allows.
+  EXPECT_LE(report.rest_drift, report.rest_speed_window * settings.rest_window * (1 + 1e-9) +
+                                   settings.dt * report.rest_speed_window);
+}
+
 TEST(Simulation, ResolutionInvariance) {
   const SettledShape coarse = settle(8);
   const SettledShape medium = settle(16);

@@ -9,6 +9,7 @@
 #include <new>
 #include <stdexcept>
 
+#include "garment/panel_tasks.hpp"
 #include "sim/parallel.hpp"
 #include "src/app/version.hpp"
 
@@ -54,12 +55,14 @@ int run_cli(int argc, char** argv) {
   app.add_flag("-q,--quiet", global.quiet, "Only print errors; no progress bars");
   app.add_flag("-v,--verbose", global.verbose, "Print debug logs (GL version, timings, ...)");
   app.add_option("--threads", global.threads,
-                 "Threads for the simulator's parallel loops (contact queries); default: every "
-                 "core. Results are the same bits for any count")
+                 "Threads for the simulator's parallel loops (contact queries) and for meshing "
+                 "panels side by side; default: every core. Results are the same bits for any "
+                 "count")
       ->check(CLI::Range(1, 256));
   app.parse_complete_callback([&] {
     configure_logging(global);
     sim::set_thread_count(global.threads);
+    garment::set_panel_threads(global.threads);
   });
 
   add_info_command(app, global);

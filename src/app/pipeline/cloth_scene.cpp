@@ -14,6 +14,7 @@
 #include "sim/sheet.hpp"
 #include "sim/simulation.hpp"
 #include "src/app/pipeline/garment_stage.hpp"
+#include "src/app/pipeline/settle_time.hpp"
 
 namespace sd::app {
 namespace {
@@ -355,6 +356,22 @@ sim::AutomaticChoice apply_automatic_settings(const scene::Sketch& sketch, const
   traits.motion = motion;
   const sim::AutomaticChoice choice = sim::choose_settings(traits);
   sim::apply_choice(choice, spec.solver == "auto", spec.time_step_auto, settings);
+  // A garment without a duration of its own gets the time its hanging cloth needs to settle
+  // (a long skirt's hem swings as a pendulum; settle_time.hpp), at least the default. The run
+  // still stops as soon as it is at rest, so a garment that rests early costs nothing more.
+  const double g = settings.forces.gravity.norm();
+  if (!scene.sheet && !spec.duration_given && g > 0.0 && scene.start.rows() > 0) {
+    const Eigen::VectorXd along = scene.start * (settings.forces.gravity / g);
+    SettleInput settle;
+    settle.length = std::max(along.maxCoeff() - along.minCoeff(), 0.1);
+    settle.area_density = scene.fabric.area_density;
+    settle.air_drag = settings.forces.air_drag;
+    settle.time_step = settings.dt;
+    settle.gravity = g;
+    settle.rest_speed = settings.rest_speed;
+    settings.duration =
+        std::max(settings.duration, std::min(settle_time(settle), kMaxSettleDuration));
+  }
   return choice;
 }
 

@@ -4,10 +4,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
 #include <stdexcept>
 
+#include "garment/body_landmarks.hpp"
 #include "garment/body_surface.hpp"
 #include "garment/sketch_inputs.hpp"
+#include "src/app/pipeline/quality_warnings.hpp"
 
 namespace sd::app {
 namespace {
@@ -22,7 +25,71 @@ void check_mesh48(const meshing::Mesh48& m48) {
   if (!problems.empty()) throw std::runtime_error("4-8 mesh check failed: " + problems.front());
 }
 
+// The garment's quads cannot become the simulator's 4-8 mesh (a quad with three corners in a
+// line or two on one spot: its triangles have no area). The filler's vertex numbers mean nothing
+// to a designer, so the error names the panel at its JSON path, the place and the nearest
+// landmark, after the quality gate's warnings (logged), which say what to change there.
+[[noreturn]] void fail_on_collapsed_quad(const scene::Sketch& sketch, const garment::Body& body,
+                                         const garment::Garment& g,
+                                         const meshing::Mesh48InputError& error) {
+  // The quad whose flattest corner triangle (area over its longest side squared) is flattest.
+  Eigen::Index worst = -1;
+  double flattest = std::numeric_limits<double>::infinity();
+  for (Eigen::Index f = 0; f < g.mesh.face_count(); ++f)
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector3d a = g.mesh.vertices.row(g.mesh.faces(f, k)).transpose();
+      const Eigen::Vector3d b = g.mesh.vertices.row(g.mesh.faces(f, (k + 1) % 4)).transpose();
+      const Eigen::Vector3d c = g.mesh.vertices.row(g.mesh.faces(f, (k + 2) % 4)).transpose();
+      const double longest =
+          std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()});
+      const double flatness = longest > 0 ? 0.5 * (b - a).cross(c - a).norm() / longest : 0.0;
+      if (flatness < flattest) {
+        flattest = flatness;
+        worst = f;
+      }
+    }
+  if (worst < 0) throw std::runtime_error("4-8 mesh: " + std::string(error.what()));
+  const std::vector<garment::QualityWarning> warnings = quality_warnings(g, sketch, body);
+  const garment::GarmentPanel& panel = g.panels[static_cast<size_t>(g.face_panel(worst))];
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (int k = 0; k < 4; ++k)
+    centre += 0.25 * g.mesh.vertices.row(g.mesh.faces(worst, k)).transpose();
+  std::string near;
+  try {
+    near = fmt::format(", near the body's {}",
+                       garment::find_landmarks(body.mesh).nearest(centre).name);
+  } catch (const std::runtime_error&) {
+    // Not a standing figure: the place alone.
+  }
+  const std::string original =
+      panel.mirror_copy ? panel.id.substr(0, panel.id.rfind('.')) : panel.id;
+  std::string path = "/panels";
+  for (const garment::PanelSpec& spec : sketch.panels)
+    if (spec.id == original) path = spec.json_path;
+  sketch.fail(
+      path,
+      fmt::format("panel '{}' has a collapsed quad at ({:.3f}, {:.3f}, {:.3f}) m{} (corners in "
+                  "a line or on one spot), which the simulator cannot use; {}",
+                  panel.id, centre.x(), centre.y(), centre.z(), near,
+                  warnings.empty() ? "move the panel's curves there apart, or give the panel "
+                                     "a different \"edge_length\""
+                                   : "the mesh warnings above say what to change there"));
+}
+
 }  // namespace
+
+meshing::Mesh48 garment_mesh48(const scene::Sketch& sketch, const garment::Body& body,
+                               const garment::Garment& g) {
+  meshing::Mesh48 m48 = [&] {
+    try {
+      return meshing::Mesh48::from_quads(g.mesh);
+    } catch (const meshing::Mesh48InputError& e) {
+      fail_on_collapsed_quad(sketch, body, g, e);
+    }
+  }();
+  check_mesh48(m48);
+  return m48;
+}
 
 MeshedGarment mesh_garment(const scene::Sketch& sketch) {
   const auto body_start = std::chrono::steady_clock::now();
@@ -40,8 +107,7 @@ MeshedGarment mesh_garment(const scene::Sketch& sketch) {
     if (it == groups.end()) it = groups.insert(groups.end(), g.panels[p].group);
     panel_group[p] = static_cast<int>(it - groups.begin());
   }
-  meshing::Mesh48 m48 = meshing::Mesh48::from_quads(g.mesh);
-  check_mesh48(m48);
+  meshing::Mesh48 m48 = garment_mesh48(sketch, body, g);
   return {std::move(body), std::move(g), std::move(groups), std::move(panel_group),
           std::move(m48),  body_ms,      meshing_ms};
 }

@@ -26,6 +26,12 @@ struct MeshedGarment {
   double meshing_ms = 0;         // build_garment
 };
 
+// The garment's quads as a checked 4-8 mesh. A quad of no area (corners in a line or on one
+// spot: the simulator cannot use it) fails as garment::SketchError at its panel's path, naming
+// the place and the nearest body landmark, after logging the quality gate's warnings.
+meshing::Mesh48 garment_mesh48(const scene::Sketch& sketch, const garment::Body& body,
+                               const garment::Garment& g);
+
 // Loads the body and builds the garment. Throws garment::SketchError for what the designer can
 // fix, std::runtime_error when the 4-8 mesh fails its check (an internal error).
 MeshedGarment mesh_garment(const scene::Sketch& sketch);
