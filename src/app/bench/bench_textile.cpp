@@ -26,6 +26,13 @@ double seconds_since(Clock::time_point start) {
 
 }  // namespace
 
+sim::FabricParameters textile_fabric(const std::string& fabric) {
+  // A name with a path separator or a .json ending is a fabric file (docs/fabrics.md).
+  const bool is_file = fabric.find('/') != std::string::npos ||
+                       (fabric.size() > 5 && fabric.compare(fabric.size() - 5, 5, ".json") == 0);
+  return is_file ? sim::load_fabric_file(fabric) : sim::fabric_preset(fabric);
+}
+
 double peirce_bending_length(double overhang, double chord_deg) {
   const auto peirce = [](double degrees) {
     const double theta = degrees * std::numbers::pi / 180.0;
@@ -38,7 +45,7 @@ double peirce_bending_length(double overhang, double chord_deg) {
 
 CantileverPoint run_cantilever(const std::string& name, int cells) {
   const auto start = Clock::now();
-  const sim::FabricParameters fabric = sim::fabric_preset(name);
+  const sim::FabricParameters fabric = textile_fabric(name);
   CantileverPoint point;
   point.fabric = name;
   point.cells = cells;
@@ -73,7 +80,7 @@ CantileverPoint run_cantilever(const std::string& name, int cells) {
 
 CusickPoint run_cusick(const std::string& name, int cells, int specimens) {
   const auto start = Clock::now();
-  const sim::FabricParameters fabric = sim::fabric_preset(name);
+  const sim::FabricParameters fabric = textile_fabric(name);
   sim::SheetSpec spec;
   spec.shape = sim::SheetShape::disc;
   spec.size = {0.3, 0.3};

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "sim/fabric.hpp"
+
 namespace sd::app {
 
 struct TextileOptions {
@@ -42,6 +44,10 @@ struct CusickPoint {
   bool converged = false;  // every specimen's drape came to rest
   double seconds = 0.0;
 };
+
+// A preset by name, or a fabric file (a path: with a '/' or ending in .json). Throws
+// sim::UnknownFabricError or sim::InvalidFabricError.
+sim::FabricParameters textile_fabric(const std::string& fabric);
 
 CantileverPoint run_cantilever(const std::string& fabric, int cells);
 // The Cusick drape of `specimens` discs, dynamic with the buckling compression, to rest.

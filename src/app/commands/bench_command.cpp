@@ -222,9 +222,14 @@ void run_scaling_study(const BenchOptions& options, const GlobalOptions& global)
 void run_textile_study(const BenchOptions& options, const GlobalOptions& global) {
   const TextileOptions& o = options.textile_options;
   const std::vector<std::string> known = sim::fabric_preset_names();
-  for (const std::string& fabric : o.fabrics)
-    if (std::find(known.begin(), known.end(), fabric) == known.end())
-      throw std::invalid_argument(fmt::format("--fabric: '{}' is not a preset", fabric));
+  for (const std::string& fabric : o.fabrics) {
+    try {
+      textile_fabric(fabric);  // a preset or a readable, valid fabric file, before any drape
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(fmt::format(
+          "--fabric: '{}' is neither a preset nor a fabric file ({})", fabric, e.what()));
+    }
+  }
   const long count = static_cast<long>((o.fabrics.empty() ? known.size() : o.fabrics.size()) *
                                        (o.cantilever_cells.size() + o.cusick_cells.size()));
   Progress progress("bench --textile", count, global.quiet);
@@ -451,8 +456,10 @@ void add_bench_command(CLI::App& app, const GlobalOptions& global) {
   cmd->add_flag("--textile", options->textile,
                 "The textile study instead: Peirce's cantilever and the Cusick drape of every "
                 "preset at three resolutions each (table, CSVs and a gnuplot script)");
-  cmd->add_option("--fabric", options->textile_options.fabrics,
-                  "With --textile: the presets to measure (default all six)");
+  cmd->add_option(
+      "--fabric", options->textile_options.fabrics,
+      "With --textile: the presets to measure, or fabric files (a path with a '/' or ending "
+      "in .json; default all six presets)");
   cmd->add_option("--cantilever-cells", options->textile_options.cantilever_cells,
                   "With --textile: cells along the overhang (default 4 8 16)")
       ->check(CLI::Range(2, 256));
