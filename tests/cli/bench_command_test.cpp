@@ -412,6 +412,32 @@ TEST(BenchTextile, FabricFilesAreMeasuredLikePresets) {
   EXPECT_FALSE(fs::exists(dir / "bad"));
 }
 
+// `--cusick-cells-per-c` picks each fabric's Cusick resolutions from its bending length
+// c = (B/ρg)^(1/3): the fewest cells across the 30 cm disc that give at least that many cells
+// per c (silk, c = 1.493 cm: 41 and 51 for 2 and 2.5; denim, 2.924 cm: 21 and 26). It cannot be
+// given with --cusick-cells (exit 2, nothing written).
+TEST(BenchTextile, CusickCellsFollowTheBendingLength) {
+  for (const std::string& name : sd::sim::fabric_preset_names()) {
+    const sd::sim::FabricParameters fabric = sd::app::textile_fabric(name);
+    const double c = std::cbrt(fabric.bend / (fabric.area_density * 9.81));
+    for (const double per_c : {2.0, 2.5}) {
+      const int cells = sd::app::cusick_cells_for(fabric, per_c);
+      EXPECT_GE(cells * c / 0.30, per_c) << name;
+      EXPECT_LT((cells - 1) * c / 0.30, per_c) << name;
+    }
+  }
+  EXPECT_EQ(sd::app::cusick_cells_for(sd::app::textile_fabric("silk"), 2.0), 41);
+  EXPECT_EQ(sd::app::cusick_cells_for(sd::app::textile_fabric("silk"), 2.5), 51);
+  EXPECT_EQ(sd::app::cusick_cells_for(sd::app::textile_fabric("denim"), 2.0), 21);
+  EXPECT_EQ(sd::app::cusick_cells_for(sd::app::textile_fabric("denim"), 2.5), 26);
+  const fs::path dir = fresh_dir("textile-per-c");
+  const auto both = run_sketchdrape(
+      "bench --textile --fabric denim --cusick-cells 12 --cusick-cells-per-c 2 -o " +
+      (dir / "out").string());
+  EXPECT_EQ(both.exit_code, 2) << both.output;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
 // 41.5° at overhang l reads c = l/2 (the standard); a stiffer strip (smaller angle) reads a
 // longer bending length, as Peirce's formula: c ∝ (cos(θ/2)/tan θ)^(1/3).
 TEST(BenchTextile, PeirceBendingLengthAtTheStandardAngleIsHalfTheOverhang) {

@@ -143,6 +143,12 @@ CusickPoint run_cusick(const std::string& name, int cells, int specimens) {
   return point;
 }
 
+int cusick_cells_for(const sim::FabricParameters& fabric, double per_c) {
+  const double c = std::cbrt(fabric.bend / (fabric.area_density * 9.81));  // m
+  // The small slack keeps an exact multiple (0.30·per_c/c an integer) from rounding up.
+  return std::max(4, static_cast<int>(std::ceil(0.30 * per_c / c - 1e-9)));
+}
+
 void run_textile(const TextileOptions& options, std::vector<CantileverPoint>& cantilevers,
                  std::vector<CusickPoint>& drapes,
                  const std::function<void(const std::string&)>& note) {
@@ -157,7 +163,14 @@ void run_textile(const TextileOptions& options, std::vector<CantileverPoint>& ca
           "{:.1f} s",
           fabric, cells, p.chord_deg, 100 * p.simulated_c, 100 * p.predicted_c, p.seconds));
     }
-    for (const int cells : options.cusick_cells) {
+    std::vector<int> cusick_cells = options.cusick_cells;
+    if (!options.cusick_cells_per_c.empty()) {
+      const sim::FabricParameters parameters = textile_fabric(fabric);
+      cusick_cells.clear();
+      for (const double per_c : options.cusick_cells_per_c)
+        cusick_cells.push_back(cusick_cells_for(parameters, per_c));
+    }
+    for (const int cells : cusick_cells) {
       drapes.push_back(run_cusick(fabric, cells, options.cusick_specimens));
       const CusickPoint& p = drapes.back();
       note(fmt::format(

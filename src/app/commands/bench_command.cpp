@@ -230,8 +230,10 @@ void run_textile_study(const BenchOptions& options, const GlobalOptions& global)
           "--fabric: '{}' is neither a preset nor a fabric file ({})", fabric, e.what()));
     }
   }
-  const long count = static_cast<long>((o.fabrics.empty() ? known.size() : o.fabrics.size()) *
-                                       (o.cantilever_cells.size() + o.cusick_cells.size()));
+  const long count = static_cast<long>(
+      (o.fabrics.empty() ? known.size() : o.fabrics.size()) *
+      (o.cantilever_cells.size() +
+       (o.cusick_cells_per_c.empty() ? o.cusick_cells.size() : o.cusick_cells_per_c.size())));
   Progress progress("bench --textile", count, global.quiet);
   long done = 0;
   std::vector<CantileverPoint> cantilevers;
@@ -463,9 +465,15 @@ void add_bench_command(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--cantilever-cells", options->textile_options.cantilever_cells,
                   "With --textile: cells along the overhang (default 4 8 16)")
       ->check(CLI::Range(2, 256));
-  cmd->add_option("--cusick-cells", options->textile_options.cusick_cells,
-                  "With --textile: cells across the disc (default 16 20 30)")
-      ->check(CLI::Range(4, 200));
+  CLI::Option* cusick_cells =
+      cmd->add_option("--cusick-cells", options->textile_options.cusick_cells,
+                      "With --textile: cells across the disc (default 16 20 30)")
+          ->check(CLI::Range(4, 200));
+  cmd->add_option("--cusick-cells-per-c", options->textile_options.cusick_cells_per_c,
+                  "With --textile: the Cusick resolutions per fabric as cells per bending length "
+                  "c = (B/rho g)^(1/3) instead of --cusick-cells (2 2.5 converge to 0.03)")
+      ->check(CLI::Range(0.5, 10.0))
+      ->excludes(cusick_cells);
   cmd->add_option("--cusick-specimens", options->textile_options.cusick_specimens,
                   "With --textile: Cusick drapes per point, each from its own random lift; the "
                   "table gives their mean and range (default 3)")
