@@ -20,7 +20,7 @@ struct TextileOptions {
   std::vector<int> cantilever_cells = {4, 8, 16};  // cells along the overhang 2c
   std::vector<int> cusick_cells = {16, 20, 30};    // cells across the 30 cm disc
   // When not empty, the Cusick resolutions per fabric instead: cells per bending length c/l
-  // (docs/fabrics.md, "The resolution follows the bending length"; 2 and 2.5 converge).
+  // (docs/fabrics.md, "Convergence follows the cells per bending length"; 2.5 and 3).
   std::vector<double> cusick_cells_per_c;
   int cusick_specimens = 3;  // drapes per point, each from its own random lift (their mean)
 };

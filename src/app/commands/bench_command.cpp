@@ -471,7 +471,7 @@ void add_bench_command(CLI::App& app, const GlobalOptions& global) {
           ->check(CLI::Range(4, 200));
   cmd->add_option("--cusick-cells-per-c", options->textile_options.cusick_cells_per_c,
                   "With --textile: the Cusick resolutions per fabric as cells per bending length "
-                  "c = (B/rho g)^(1/3) instead of --cusick-cells (2 2.5 converge to 0.03)")
+                  "c = (B/rho g)^(1/3) instead of --cusick-cells (2.5 3: where the DC converges)")
       ->check(CLI::Range(0.5, 10.0))
       ->excludes(cusick_cells);
   cmd->add_option("--cusick-specimens", options->textile_options.cusick_specimens,
