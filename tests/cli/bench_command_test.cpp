@@ -388,6 +388,64 @@ TEST(BenchTextile, DenimCantileverAndDrapeAreWrittenWithTheirMeasures) {
   EXPECT_FALSE(fs::exists(dir / "bad"));
 }
 
+// `--fabric` also takes a fabric file (docs/fabrics.md): a copy of the denim preset with half its
+// bending rigidity measures as such (c = (B/ρg)^(1/3) is 2^(-1/3) of denim's), named by its path;
+// a file that is not a valid fabric exits 2 with the file's error and writes nothing.
+TEST(BenchTextile, FabricFilesAreMeasuredLikePresets) {
+  const fs::path dir = fresh_dir("textile-file");
+  fs::create_directories(dir);
+  nlohmann::json denim = read_json(fs::path(SD_SOURCE_DIR) / "data/fabrics/denim.json");
+  denim["bend"]["value"] = 0.5 * denim["bend"]["value"].get<double>();
+  const fs::path soft = dir / "soft-denim.json";
+  std::ofstream(soft) << denim.dump(1);
+  const auto result = run_sketchdrape("bench --textile --fabric " + soft.string() +
+                                      " --cantilever-cells 8 --cusick-cells 8 "
+                                      "--cusick-specimens 1 --json -o " +
+                                      (dir / "out").string());
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const nlohmann::json json = read_json(dir / "out" / "textile.json");
+  ASSERT_EQ(json.at("cantilever").size(), 1u);
+  const auto& strip = json.at("cantilever").at(0);
+  EXPECT_EQ(strip.at("fabric").get<std::string>(), soft.string());
+  EXPECT_NEAR(strip.at("predicted_c_m").get<double>(), 0.02924 * std::cbrt(0.5), 2e-4);
+  EXPECT_NEAR(strip.at("chord_deg").get<double>(), 41.5, 4.0);  // 8 cells: 42.8° for the presets
+  nlohmann::json broken = denim;
+  broken["bend"]["unit"] = "furlong";
+  const fs::path bad = dir / "broken.json";
+  std::ofstream(bad) << broken.dump(1);
+  const auto refused =
+      run_sketchdrape("bench --textile --fabric " + bad.string() + " -o " + (dir / "bad").string());
+  EXPECT_EQ(refused.exit_code, 2) << refused.output;
+  EXPECT_NE(refused.output.find("/bend must be given in N*m"), std::string::npos) << refused.output;
+  EXPECT_FALSE(fs::exists(dir / "bad"));
+}
+
+// `--cusick-cells-per-c` picks each fabric's Cusick resolutions from its bending length
+// c = (B/ρg)^(1/3): the fewest cells across the 30 cm disc that give at least that many cells
+// per c (silk, c = 1.493 cm: 41 and 51 for 2 and 2.5; denim, 2.924 cm: 21 and 26). It cannot be
+// given with --cusick-cells (exit 2, nothing written).
+TEST(BenchTextile, CusickCellsFollowTheBendingLength) {
+  for (const std::string& name : sd::sim::fabric_preset_names()) {
+    const sd::sim::FabricParameters fabric = sd::app::textile_fabric(name);
+    const double c = std::cbrt(fabric.bend / (fabric.area_density * 9.81));
+    for (const double per_c : {2.0, 2.5}) {
+      const int cells = sd::app::cusick_cells_for(fabric, per_c);
+      EXPECT_GE(cells * c / 0.30, per_c) << name;
+      EXPECT_LT((cells - 1) * c / 0.30, per_c) << name;
+    }
+  }
+  EXPECT_EQ(sd::app::cusick_cells_for(sd::app::textile_fabric("silk"), 2.0), 41);
+  EXPECT_EQ(sd::app::cusick_cells_for(sd::app::textile_fabric("silk"), 2.5), 51);
+  EXPECT_EQ(sd::app::cusick_cells_for(sd::app::textile_fabric("denim"), 2.0), 21);
+  EXPECT_EQ(sd::app::cusick_cells_for(sd::app::textile_fabric("denim"), 2.5), 26);
+  const fs::path dir = fresh_dir("textile-per-c");
+  const auto both = run_sketchdrape(
+      "bench --textile --fabric denim --cusick-cells 12 --cusick-cells-per-c 2 -o " +
+      (dir / "out").string());
+  EXPECT_EQ(both.exit_code, 2) << both.output;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
 // 41.5° at overhang l reads c = l/2 (the standard); a stiffer strip (smaller angle) reads a
 // longer bending length, as Peirce's formula: c ∝ (cos(θ/2)/tan θ)^(1/3).
 TEST(BenchTextile, PeirceBendingLengthAtTheStandardAngleIsHalfTheOverhang) {

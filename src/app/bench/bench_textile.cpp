@@ -26,6 +26,13 @@ double seconds_since(Clock::time_point start) {
 
 }  // namespace
 
+sim::FabricParameters textile_fabric(const std::string& fabric) {
+  // A name with a path separator or a .json ending is a fabric file (docs/fabrics.md).
+  const bool is_file = fabric.find('/') != std::string::npos ||
+                       (fabric.size() > 5 && fabric.compare(fabric.size() - 5, 5, ".json") == 0);
+  return is_file ? sim::load_fabric_file(fabric) : sim::fabric_preset(fabric);
+}
+
 double peirce_bending_length(double overhang, double chord_deg) {
   const auto peirce = [](double degrees) {
     const double theta = degrees * std::numbers::pi / 180.0;
@@ -38,7 +45,7 @@ double peirce_bending_length(double overhang, double chord_deg) {
 
 CantileverPoint run_cantilever(const std::string& name, int cells) {
   const auto start = Clock::now();
-  const sim::FabricParameters fabric = sim::fabric_preset(name);
+  const sim::FabricParameters fabric = textile_fabric(name);
   CantileverPoint point;
   point.fabric = name;
   point.cells = cells;
@@ -73,7 +80,7 @@ CantileverPoint run_cantilever(const std::string& name, int cells) {
 
 CusickPoint run_cusick(const std::string& name, int cells, int specimens) {
   const auto start = Clock::now();
-  const sim::FabricParameters fabric = sim::fabric_preset(name);
+  const sim::FabricParameters fabric = textile_fabric(name);
   sim::SheetSpec spec;
   spec.shape = sim::SheetShape::disc;
   spec.size = {0.3, 0.3};
@@ -136,6 +143,12 @@ CusickPoint run_cusick(const std::string& name, int cells, int specimens) {
   return point;
 }
 
+int cusick_cells_for(const sim::FabricParameters& fabric, double per_c) {
+  const double c = std::cbrt(fabric.bend / (fabric.area_density * 9.81));  // m
+  // The small slack keeps an exact multiple (0.30·per_c/c an integer) from rounding up.
+  return std::max(4, static_cast<int>(std::ceil(0.30 * per_c / c - 1e-9)));
+}
+
 void run_textile(const TextileOptions& options, std::vector<CantileverPoint>& cantilevers,
                  std::vector<CusickPoint>& drapes,
                  const std::function<void(const std::string&)>& note) {
@@ -150,7 +163,14 @@ void run_textile(const TextileOptions& options, std::vector<CantileverPoint>& ca
           "{:.1f} s",
           fabric, cells, p.chord_deg, 100 * p.simulated_c, 100 * p.predicted_c, p.seconds));
     }
-    for (const int cells : options.cusick_cells) {
+    std::vector<int> cusick_cells = options.cusick_cells;
+    if (!options.cusick_cells_per_c.empty()) {
+      const sim::FabricParameters parameters = textile_fabric(fabric);
+      cusick_cells.clear();
+      for (const double per_c : options.cusick_cells_per_c)
+        cusick_cells.push_back(cusick_cells_for(parameters, per_c));
+    }
+    for (const int cells : cusick_cells) {
       drapes.push_back(run_cusick(fabric, cells, options.cusick_specimens));
       const CusickPoint& p = drapes.back();
       note(fmt::format(

@@ -11,12 +11,17 @@
 #include <string>
 #include <vector>
 
+#include "sim/fabric.hpp"
+
 namespace sd::app {
 
 struct TextileOptions {
   std::vector<std::string> fabrics;                // empty: every preset
   std::vector<int> cantilever_cells = {4, 8, 16};  // cells along the overhang 2c
   std::vector<int> cusick_cells = {16, 20, 30};    // cells across the 30 cm disc
+  // When not empty, the Cusick resolutions per fabric instead: cells per bending length c/l
+  // (docs/fabrics.md, "Convergence follows the cells per bending length"; 2.5 and 3).
+  std::vector<double> cusick_cells_per_c;
   int cusick_specimens = 3;  // drapes per point, each from its own random lift (their mean)
 };
 
@@ -42,6 +47,14 @@ struct CusickPoint {
   bool converged = false;  // every specimen's drape came to rest
   double seconds = 0.0;
 };
+
+// A preset by name, or a fabric file (a path: with a '/' or ending in .json). Throws
+// sim::UnknownFabricError or sim::InvalidFabricError.
+sim::FabricParameters textile_fabric(const std::string& fabric);
+
+// Cells across the 30 cm Cusick disc for at least `per_c` cells per bending length
+// c = (B/ρg)^(1/3): ⌈0.30 m · per_c / c⌉, at least 4.
+int cusick_cells_for(const sim::FabricParameters& fabric, double per_c);
 
 CantileverPoint run_cantilever(const std::string& fabric, int cells);
 // The Cusick drape of `specimens` discs, dynamic with the buckling compression, to rest.

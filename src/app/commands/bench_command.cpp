@@ -222,11 +222,18 @@ void run_scaling_study(const BenchOptions& options, const GlobalOptions& global)
 void run_textile_study(const BenchOptions& options, const GlobalOptions& global) {
   const TextileOptions& o = options.textile_options;
   const std::vector<std::string> known = sim::fabric_preset_names();
-  for (const std::string& fabric : o.fabrics)
-    if (std::find(known.begin(), known.end(), fabric) == known.end())
-      throw std::invalid_argument(fmt::format("--fabric: '{}' is not a preset", fabric));
-  const long count = static_cast<long>((o.fabrics.empty() ? known.size() : o.fabrics.size()) *
-                                       (o.cantilever_cells.size() + o.cusick_cells.size()));
+  for (const std::string& fabric : o.fabrics) {
+    try {
+      textile_fabric(fabric);  // a preset or a readable, valid fabric file, before any drape
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(fmt::format(
+          "--fabric: '{}' is neither a preset nor a fabric file ({})", fabric, e.what()));
+    }
+  }
+  const long count = static_cast<long>(
+      (o.fabrics.empty() ? known.size() : o.fabrics.size()) *
+      (o.cantilever_cells.size() +
+       (o.cusick_cells_per_c.empty() ? o.cusick_cells.size() : o.cusick_cells_per_c.size())));
   Progress progress("bench --textile", count, global.quiet);
   long done = 0;
   std::vector<CantileverPoint> cantilevers;
@@ -451,14 +458,22 @@ void add_bench_command(CLI::App& app, const GlobalOptions& global) {
   cmd->add_flag("--textile", options->textile,
                 "The textile study instead: Peirce's cantilever and the Cusick drape of every "
                 "preset at three resolutions each (table, CSVs and a gnuplot script)");
-  cmd->add_option("--fabric", options->textile_options.fabrics,
-                  "With --textile: the presets to measure (default all six)");
+  cmd->add_option(
+      "--fabric", options->textile_options.fabrics,
+      "With --textile: the presets to measure, or fabric files (a path with a '/' or ending "
+      "in .json; default all six presets)");
   cmd->add_option("--cantilever-cells", options->textile_options.cantilever_cells,
                   "With --textile: cells along the overhang (default 4 8 16)")
       ->check(CLI::Range(2, 256));
-  cmd->add_option("--cusick-cells", options->textile_options.cusick_cells,
-                  "With --textile: cells across the disc (default 16 20 30)")
-      ->check(CLI::Range(4, 200));
+  CLI::Option* cusick_cells =
+      cmd->add_option("--cusick-cells", options->textile_options.cusick_cells,
+                      "With --textile: cells across the disc (default 16 20 30)")
+          ->check(CLI::Range(4, 200));
+  cmd->add_option("--cusick-cells-per-c", options->textile_options.cusick_cells_per_c,
+                  "With --textile: the Cusick resolutions per fabric as cells per bending length "
+                  "c = (B/rho g)^(1/3) instead of --cusick-cells (2.5 3: where the DC converges)")
+      ->check(CLI::Range(0.5, 10.0))
+      ->excludes(cusick_cells);
   cmd->add_option("--cusick-specimens", options->textile_options.cusick_specimens,
                   "With --textile: Cusick drapes per point, each from its own random lift; the "
                   "table gives their mean and range (default 3)")
