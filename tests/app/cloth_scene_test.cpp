@@ -13,6 +13,7 @@
 
 #include "scene/sketch_file.hpp"
 #include "sim/cloth_model.hpp"
+#include "src/app/pipeline/settle_time.hpp"
 
 namespace sd::app {
 namespace {
@@ -177,6 +178,27 @@ TEST(ClothScene, SheetLayersAndTheSelfCollisionDefault) {
   EXPECT_TRUE(simulation_settings(scene::parse_sketch(asked, "asked.json")).self_contact.enabled);
   EXPECT_TRUE(simulation_settings(scene::parse_sketch(two_patches(1.0), "garment.json"))
                   .self_contact.enabled);
+}
+
+// A garment without a duration of its own runs for the time its hanging cloth needs to settle
+// (longer than the 3 s default, at most kMaxSettleDuration; it still stops at rest). A file's
+// own duration is kept, and so is the default when the drape is told not to stop at rest: it
+// would run every step of the longer time.
+TEST(ClothScene, GarmentDurationFollowsTheSettleTimeOnlyWhenTheDrapeMayStopAtRest) {
+  const auto duration = [](const std::string& simulate) {
+    std::string text = two_patches(1.0);
+    if (!simulate.empty()) text.insert(text.rfind('}'), ", \"simulate\": {" + simulate + "}");
+    const scene::Sketch sketch = scene::parse_sketch(text, "settle.json");
+    const ClothScene scene = build_cloth_scene(sketch);
+    sim::SimulationSettings settings = simulation_settings(sketch);
+    apply_automatic_settings(sketch, scene, settings, false);
+    return settings.duration;
+  };
+  const double settle = duration("");
+  EXPECT_GT(settle, 3.0);
+  EXPECT_LE(settle, kMaxSettleDuration);
+  EXPECT_EQ(duration(R"("duration": 2.5)"), 2.5);
+  EXPECT_EQ(duration(R"("stop_at_rest": false)"), 3.0);
 }
 
 }  // namespace

@@ -137,7 +137,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   spdlog::debug("settings: {}", automatic.reason);
   const RunEstimate estimate =
       estimate_run(sketch, scene.input.triangles, static_cast<int>(scene.start.rows()),
-                   options.frames_per_second);
+                   options.frames_per_second, settings.duration, settings.dt);
   check_run_fits(sketch, estimate, limits, options.frames_per_second);
   spdlog::debug(
       "estimate: {:.0f} vertices, {:.2f} GB ({:.2f} GB the factor), at most {:.0f} steps ({:.0f} "

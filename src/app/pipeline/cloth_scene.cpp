@@ -358,9 +358,11 @@ sim::AutomaticChoice apply_automatic_settings(const scene::Sketch& sketch, const
   sim::apply_choice(choice, spec.solver == "auto", spec.time_step_auto, settings);
   // A garment without a duration of its own gets the time its hanging cloth needs to settle
   // (a long skirt's hem swings as a pendulum; settle_time.hpp), at least the default. The run
-  // still stops as soon as it is at rest, so a garment that rests early costs nothing more.
+  // still stops as soon as it is at rest, so a garment that rests early costs nothing more; a
+  // drape told not to stop at rest keeps the default duration (it would run every step of it).
   const double g = settings.forces.gravity.norm();
-  if (!scene.sheet && !spec.duration_given && g > 0.0 && scene.start.rows() > 0) {
+  if (!scene.sheet && !spec.duration_given && settings.stop_at_rest && g > 0.0 &&
+      scene.start.rows() > 0) {
     const Eigen::VectorXd along = scene.start * (settings.forces.gravity / g);
     SettleInput settle;
     settle.length = std::max(along.maxCoeff() - along.minCoeff(), 0.1);

@@ -125,7 +125,16 @@ std::optional<RunEstimate> estimate_before_building(const scene::Sketch& sketch,
 
 RunEstimate estimate_run(const scene::Sketch& sketch, const Eigen::MatrixX3i& triangles,
                          int vertices, double frames_per_second) {
+  return estimate_run(sketch, triangles, vertices, frames_per_second, sketch.simulate.duration,
+                      sketch.simulate.time_step);
+}
+
+RunEstimate estimate_run(const scene::Sketch& sketch, const Eigen::MatrixX3i& triangles,
+                         int vertices, double frames_per_second, double duration,
+                         double time_step) {
   RunEstimate e;
+  e.duration = duration;
+  e.time_step = time_step;
   e.vertices = vertices;
   e.factor_bytes =
       sim::predict_factor_size(
@@ -133,9 +142,8 @@ RunEstimate estimate_run(const scene::Sketch& sketch, const Eigen::MatrixX3i& tr
           sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::hinges))
           .bytes;
   e.memory_bytes = kBaseBytes + e.vertices * kBytesPerVertex + e.factor_bytes;
-  e.steps = std::ceil(sketch.simulate.duration / sketch.simulate.time_step);
-  e.frames =
-      frames_per_second > 0 ? std::floor(sketch.simulate.duration * frames_per_second) + 1 : 0;
+  e.steps = std::ceil(duration / time_step);
+  e.frames = frames_per_second > 0 ? std::floor(duration * frames_per_second) + 1 : 0;
   // The PNG sequence keeps each picture's cloth until the drape ends: positions, triangles and
   // groups, about 64 bytes per vertex.
   e.memory_bytes += e.frames * 64.0 * e.vertices;
@@ -179,17 +187,17 @@ void check_run_fits(const scene::Sketch& sketch, const RunEstimate& estimate,
     throw std::invalid_argument(fmt::format(
         "--frames {:g} over a drape of {:g} s makes {:.0f} pictures, more than the {:.0f} "
         "allowed; at most {:.4g} per second fit this duration",
-        frames_per_second, sketch.simulate.duration, estimate.frames, kMaxFrames,
-        (kMaxFrames - 1) / sketch.simulate.duration));
+        frames_per_second, estimate.duration, estimate.frames, kMaxFrames,
+        (kMaxFrames - 1) / estimate.duration));
   // Without stop_at_rest the run takes every step up to the duration: its time is known.
   if (limits.max_time_s && !sketch.simulate.stop_at_rest && estimate.seconds > *limits.max_time_s) {
-    const double fits = *limits.max_time_s / estimate.seconds * sketch.simulate.duration;
+    const double fits = *limits.max_time_s / estimate.seconds * estimate.duration;
     sketch.fail("/simulate/duration",
                 fmt::format("{:.0f} steps of {:.3g} s on {:.0f} vertices take about {:.0f} s, more "
                             "than --max-time {:g} s; a duration of about {:.3g} s would fit (or "
                             "\"stop_at_rest\": true)",
-                            estimate.steps, sketch.simulate.time_step, estimate.vertices,
-                            estimate.seconds, *limits.max_time_s, fits));
+                            estimate.steps, estimate.time_step, estimate.vertices, estimate.seconds,
+                            *limits.max_time_s, fits));
   }
 }
 

@@ -42,10 +42,17 @@ struct RunEstimate {
   double steps = 0;         // duration / time_step: the most steps the run can take
   double frames = 0;        // PNG sequence pictures (--frames)
   double seconds = 0;       // wall time if it runs the whole duration
+  double duration = 0;      // s, the drape's duration the estimate assumes
+  double time_step = 0;     // s, its largest step
 };
-// `triangles`: the cloth's #F×3 triangles into `vertices` vertices.
+// `triangles`: the cloth's #F×3 triangles into `vertices` vertices; the duration and the step
+// are the file's.
 RunEstimate estimate_run(const scene::Sketch& sketch, const Eigen::MatrixX3i& triangles,
                          int vertices, double frames_per_second);
+// The same for the duration and step the run will take (the automatic settings may change both:
+// a garment without a duration of its own gets its settle time, settle_time.hpp).
+RunEstimate estimate_run(const scene::Sketch& sketch, const Eigen::MatrixX3i& triangles,
+                         int vertices, double frames_per_second, double duration, double time_step);
 
 // The estimate of a cloth whose mesh is known without building the scene (a sheet: its grid of
 // triangles, without the body or the model); nullopt for a garment.
