@@ -42,6 +42,8 @@ TriangleConditions triangle_conditions(const TriangleElement& triangle, const Ve
   const Vector3d wu = du[0] * x0 + du[1] * x1 + du[2] * x2;
   const Vector3d wv = dv[0] * x0 + dv[1] * x1 + dv[2] * x2;
   TriangleConditions out;
+  out.warp_vector = wu;
+  out.weft_vector = wv;
   out.warp = stretch_condition(du, wu, with_hessian);
   out.weft = stretch_condition(dv, wv, with_hessian);
   out.shear.value = wu.dot(wv);
