@@ -42,6 +42,8 @@ TriangleConditions triangle_conditions(const TriangleElement& triangle, const Ve
   const Vector3d wu = du[0] * x0 + du[1] * x1 + du[2] * x2;
   const Vector3d wv = dv[0] * x0 + dv[1] * x1 + dv[2] * x2;
   TriangleConditions out;
+  out.warp_vector = wu;
+  out.weft_vector = wv;
   out.warp = stretch_condition(du, wu, with_hessian);
   out.weft = stretch_condition(dv, wv, with_hessian);
   out.shear.value = wu.dot(wv);
@@ -100,14 +102,13 @@ Condition<12> dihedral_angle_condition(const Vector3d& x0, const Vector3d& x1, c
   const double theta_y = x / r2;
   const Vector9d grad_q = theta_x * grad_x + theta_y * grad_y;
 
-  // q as a function of p: Jacobian jq (rows N1, N2, e; columns e, a, b).
-  Matrix9d jq = Matrix9d::Zero();
-  jq.block<3, 3>(0, 0) = -cross_matrix(a);
-  jq.block<3, 3>(0, 3) = cross_matrix(e);
-  jq.block<3, 3>(3, 0) = cross_matrix(b);
-  jq.block<3, 3>(3, 6) = -cross_matrix(e);
-  jq.block<3, 3>(6, 0) = Matrix3d::Identity();
-  const Vector9d grad_p = jq.transpose() * grad_q;
+  // q as a function of p: N1 = e×a, N2 = b×e. With grad_n1, grad_n2, g_e = ∂θ/∂N1, ∂θ/∂N2,
+  // ∂θ/∂e (the parts of grad_q): ∂θ/∂e = a×grad_n1 − b×grad_n2 + g_e, ∂θ/∂a = grad_n1×e,
+  // ∂θ/∂b = e×grad_n2 (jqᵀ·grad_q, written out: every force evaluation needs the gradient).
+  const Vector3d grad_n1 = grad_q.segment<3>(0), grad_n2 = grad_q.segment<3>(3);
+  Vector9d grad_p;
+  grad_p << a.cross(grad_n1) - b.cross(grad_n2) + grad_q.segment<3>(6), grad_n1.cross(e),
+      e.cross(grad_n2);
 
   // p as a function of x: e, a, b each subtract x0.
   const auto to_x_gradient = [](const Vector9d& gp) {
@@ -146,6 +147,13 @@ Condition<12> dihedral_angle_condition(const Vector3d& x0, const Vector3d& x1, c
                           theta_yy * grad_y * grad_y.transpose() + theta_x * hess_x +
                           theta_y * hess_y;
 
+  // q as a function of p: Jacobian jq (rows N1, N2, e; columns e, a, b).
+  Matrix9d jq = Matrix9d::Zero();
+  jq.block<3, 3>(0, 0) = -cross_matrix(a);
+  jq.block<3, 3>(0, 3) = cross_matrix(e);
+  jq.block<3, 3>(3, 0) = cross_matrix(b);
+  jq.block<3, 3>(3, 6) = -cross_matrix(e);
+  jq.block<3, 3>(6, 0) = Matrix3d::Identity();
   Matrix9d hess_p = jq.transpose() * hess_q * jq;
   // Second derivatives of N1 = e×a and N2 = b×e contracted with ∂θ/∂N1 and ∂θ/∂N2.
   const Matrix3d g1 = cross_matrix(grad_q.segment<3>(0));

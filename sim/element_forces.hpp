@@ -25,6 +25,7 @@ struct TriangleConditions {
   Condition<9> warp;
   Condition<9> weft;
   Condition<9> shear;
+  Eigen::Vector3d warp_vector, weft_vector;  // w_u and w_v (dimensionless)
 };
 
 TriangleConditions triangle_conditions(const TriangleElement& triangle, const Eigen::Vector3d& x0,

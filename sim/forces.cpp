@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -30,6 +31,7 @@ struct ConditionEnergy {
 // compression it is indefinite.
 template <int N>
 struct ConditionContribution {
+  bool energy_only = false;  // its force, product and matrix are in another condition's
   double energy = 0.0;
   Eigen::Matrix<double, N, 1> force;
   Eigen::Matrix<double, N, 1> product;  // ∂f/∂x·u on the element, with a product target
@@ -42,6 +44,7 @@ void condition_contribution(const Condition<N>& c, const ConditionEnergy& phi, d
                             const Eigen::VectorXd& v, const JacobianTarget* jacobian,
                             ConditionContribution<N>& out) {
   constexpr int kVertices = N / 3;
+  out.energy_only = false;
   using VectorN = Eigen::Matrix<double, N, 1>;
   using MatrixN = Eigen::Matrix<double, N, N>;
   VectorN local_v;
@@ -53,6 +56,19 @@ void condition_contribution(const Condition<N>& c, const ConditionEnergy& phi, d
   if (jacobian == nullptr) return;
 
   const bool exact = jacobian->kind == JacobianKind::exact;
+  if (!exact && !(keep_curvature_in_solve && phi.slope > 0.0)) {
+    // The solve without a curvature term (the hinges): rank one, ∂f/∂x = −φ''·∇C∇Cᵀ.
+    if (jacobian->product_input != nullptr) {
+      VectorN local_u;
+      for (int k = 0; k < kVertices; ++k)
+        local_u.template segment<3>(3 * k) = jacobian->product_input->segment<3>(3 * vertices[k]);
+      out.product = (-phi.curvature * c.gradient.dot(local_u)) * c.gradient;
+    }
+    if (jacobian->matrix == nullptr) return;
+    const double alpha = -jacobian->dfdx_scale * phi.curvature - jacobian->dfdv_scale * damping;
+    out.matrix.noalias() = (alpha * c.gradient) * c.gradient.transpose();
+    return;
+  }
   const MatrixN outer = c.gradient * c.gradient.transpose();
   MatrixN dfdx = -phi.curvature * outer;
   if (exact || (keep_curvature_in_solve && phi.slope > 0.0)) dfdx -= phi.slope * c.hessian;
@@ -77,6 +93,7 @@ template <int N, class Own>
 void scatter_contribution(const ConditionContribution<N>& c, const int* vertices, const int* blocks,
                           Eigen::VectorXd& force, const JacobianTarget* jacobian, const Own& own) {
   constexpr int kVertices = N / 3;
+  if (c.energy_only) return;
   for (int k = 0; k < kVertices; ++k)
     if (own(vertices[k])) force.segment<3>(3 * vertices[k]) += c.force.template segment<3>(3 * k);
   if (jacobian == nullptr) return;
@@ -375,6 +392,81 @@ struct ElementContribution {
   }
 };
 
+// One condition of a triangle: its condition, energy φ and damping k_d; for a stretch condition
+// also d (du or dv) and w = Σ_k d[k]·x_k, whose gradient is d ⊗ ŵ and Hessian
+// d dᵀ ⊗ (I − ŵŵᵀ)/|w| (element_forces.cpp).
+struct TriangleTerm {
+  const Condition<9>* condition = nullptr;
+  ConditionEnergy energy;
+  double damping = 0.0;
+  const Vector3d* d = nullptr;  // null for the shear
+  const Vector3d* w = nullptr;
+  double EnergyBreakdown::*into = nullptr;
+};
+
+// The solve's contribution of a triangle (JacobianKind::solve): the same force, product and
+// matrix as condition_contribution gives each condition, summed into the first condition (the
+// others keep only their energies) so that the element is scattered once, and built from the
+// conditions' structure instead of 9×9 products: a stretch term is d dᵀ ⊗ S with one symmetric
+// 3×3 S = α·ŵŵᵀ − dfdx_scale·φ'·(I − ŵŵᵀ)/|w| (the curvature only while stretched), the shear
+// α·∇C∇Cᵀ, with α = −dfdx_scale·φ'' − dfdv_scale·k_d.
+void triangle_solve_contribution(std::span<const TriangleTerm> parts, const int* vertices,
+                                 const Eigen::VectorXd& v, const JacobianTarget& jacobian,
+                                 ElementContribution<9, 3>& out) {
+  using Vector9d = Eigen::Matrix<double, 9, 1>;
+  if (parts.empty()) return;
+  const bool want_product = jacobian.product_input != nullptr;
+  const bool want_matrix = jacobian.matrix != nullptr;
+  Vector9d local_v, local_u = Vector9d::Zero();
+  for (int k = 0; k < 3; ++k) {
+    local_v.segment<3>(3 * k) = v.segment<3>(3 * vertices[k]);
+    if (want_product)
+      local_u.segment<3>(3 * k) = jacobian.product_input->segment<3>(3 * vertices[k]);
+  }
+  Vector9d force = Vector9d::Zero(), product = Vector9d::Zero();
+  Eigen::Matrix<double, 9, 9> matrix = Eigen::Matrix<double, 9, 9>::Zero();
+  for (const TriangleTerm& part : parts) {
+    ConditionContribution<9>& slot = out.next(part.into);
+    slot.energy = part.energy.value;
+    slot.energy_only = true;
+    const Vector9d& gradient = part.condition->gradient;
+    const double c_dot = part.damping > 0.0 ? gradient.dot(local_v) : 0.0;
+    force -= (part.energy.slope + part.damping * c_dot) * gradient;
+    const double alpha =
+        -jacobian.dfdx_scale * part.energy.curvature - jacobian.dfdv_scale * part.damping;
+    if (part.d == nullptr) {  // the shear: rank one
+      if (want_product) product -= (part.energy.curvature * gradient.dot(local_u)) * gradient;
+      if (want_matrix) matrix.noalias() += (alpha * gradient) * gradient.transpose();
+      continue;
+    }
+    const double length = part.w->norm();
+    if (length < 1e-300) continue;  // zero derivatives (element_forces.hpp)
+    const Vector3d unit = *part.w / length;
+    const bool curved = part.energy.slope > 0.0;
+    const Eigen::Matrix3d along = unit * unit.transpose();
+    const Eigen::Matrix3d across = (Eigen::Matrix3d::Identity() - along) / length;
+    const Vector3d& d = *part.d;
+    if (want_product) {
+      const Vector3d w_u = d[0] * local_u.segment<3>(0) + d[1] * local_u.segment<3>(3) +
+                           d[2] * local_u.segment<3>(6);
+      Vector3d p = (-part.energy.curvature * unit.dot(w_u)) * unit;
+      if (curved) p -= part.energy.slope * (across * w_u);
+      for (int k = 0; k < 3; ++k) product.segment<3>(3 * k) += d[k] * p;
+    }
+    if (want_matrix) {
+      Eigen::Matrix3d block = alpha * along;
+      if (curved) block -= (jacobian.dfdx_scale * part.energy.slope) * across;
+      for (int k = 0; k < 3; ++k)
+        for (int l = 0; l < 3; ++l) matrix.block<3, 3>(3 * k, 3 * l) += (d[k] * d[l]) * block;
+    }
+  }
+  ConditionContribution<9>& total = out.conditions[0];
+  total.energy_only = false;
+  total.force = force;
+  if (want_product) total.product = product;
+  if (want_matrix) total.matrix = matrix;
+}
+
 // Adds the contributions of elements 0 … count − 1: contribute(k, out) fills element k's (the
 // conditions and their derivatives: most of the work of a force evaluation), element(k) gives
 // its vertices and block offsets. On one thread each element is added as it is computed. On
@@ -450,7 +542,6 @@ void evaluate_forces(const ClothModel& model, const ForceSettings& settings,
   const int n = model.vertex_count;
   force.setZero(3 * n);
   EnergyBreakdown local_energy;
-  const bool want_hessian = jacobian != nullptr;
   const bool exact = jacobian != nullptr && jacobian->kind == JacobianKind::exact;
   const double damping_scale = terms.damping ? 1.0 : 0.0;
 
@@ -462,9 +553,12 @@ void evaluate_forces(const ClothModel& model, const ForceSettings& settings,
     const auto contribute = [&](int k, ElementContribution<9, 3>& out) {
       const TriangleElement& t = model.triangles[static_cast<std::size_t>(k)];
       const auto& vs = t.vertices;
-      const TriangleConditions c =
-          triangle_conditions(t, x.segment<3>(3 * vs[0]), x.segment<3>(3 * vs[1]),
-                              x.segment<3>(3 * vs[2]), want_hessian);
+      const bool solve = jacobian != nullptr && !exact;
+      // The solve (triangle_solve_contribution) needs no Hessian matrices.
+      TriangleConditions c = triangle_conditions(
+          t, x.segment<3>(3 * vs[0]), x.segment<3>(3 * vs[1]), x.segment<3>(3 * vs[2]), exact);
+      std::array<TriangleTerm, 3> parts;
+      int count = 0;
       if (terms.stretch) {
         const double k_u = fabric.stretch_warp * t.rest_area;
         const double k_v = fabric.stretch_weft * t.rest_area;
@@ -476,20 +570,40 @@ void evaluate_forces(const ClothModel& model, const ForceSettings& settings,
             buckling ? pi2b / (t.width_u * t.width_u * fabric.stretch_warp) : kLinearCompression;
         const double eps_v =
             buckling ? pi2b / (t.width_v * t.width_v * fabric.stretch_weft) : kLinearCompression;
-        condition_contribution(
-            c.warp, stretch_energy(c.warp.value, k_u, eps_u, fabric.tensile_warp, t.rest_area),
-            damping_scale * fabric.damping * k_u, true, vs.data(), v, jacobian,
-            out.next(&EnergyBreakdown::stretch));
-        condition_contribution(
-            c.weft, stretch_energy(c.weft.value, k_v, eps_v, fabric.tensile_weft, t.rest_area),
-            damping_scale * fabric.damping * k_v, true, vs.data(), v, jacobian,
-            out.next(&EnergyBreakdown::stretch));
+        parts[count++] = {
+            &c.warp,
+            stretch_energy(c.warp.value, k_u, eps_u, fabric.tensile_warp, t.rest_area),
+            damping_scale * fabric.damping * k_u,
+            &t.du,
+            &c.warp_vector,
+            &EnergyBreakdown::stretch};
+        parts[count++] = {
+            &c.weft,
+            stretch_energy(c.weft.value, k_v, eps_v, fabric.tensile_weft, t.rest_area),
+            damping_scale * fabric.damping * k_v,
+            &t.dv,
+            &c.weft_vector,
+            &EnergyBreakdown::stretch};
       }
       if (terms.shear) {
         const double k_s = fabric.shear * t.rest_area;
-        condition_contribution(c.shear, quadratic_energy(c.shear.value, 0.0, k_s),
-                               damping_scale * fabric.damping * k_s, false, vs.data(), v, jacobian,
-                               out.next(&EnergyBreakdown::shear));
+        parts[count++] = {&c.shear,
+                          quadratic_energy(c.shear.value, 0.0, k_s),
+                          damping_scale * fabric.damping * k_s,
+                          nullptr,
+                          nullptr,
+                          &EnergyBreakdown::shear};
+      }
+      if (solve) {
+        triangle_solve_contribution(
+            std::span<const TriangleTerm>(parts.data(), static_cast<std::size_t>(count)), vs.data(),
+            v, *jacobian, out);
+        return;
+      }
+      for (int j = 0; j < count; ++j) {
+        const TriangleTerm& part = parts[static_cast<std::size_t>(j)];
+        condition_contribution(*part.condition, part.energy, part.damping, part.d != nullptr,
+                               vs.data(), v, jacobian, out.next(part.into));
       }
     };
     add_elements<9, 3>(static_cast<int>(model.triangles.size()), n, element, contribute, force,

@@ -225,6 +225,29 @@ TEST(Forces, JacobianProductEqualsMatrixProduct) {
   }
 }
 
+// The solve keeps the stretch curvature −φ'·∇²C only while stretched (its Hessians are computed
+// after the energies, where needed). On the flat sheet scaled uniformly by 1.1 every triangle is
+// stretched, the shear is zero (w_u ⟂ w_v) and the bend is at rest, so at zero velocity the solve
+// Jacobian is the exact one; scaled by 0.9 the stretch curvature is dropped and they differ.
+TEST(Forces, SolveJacobianKeepsTheStretchCurvatureOnlyWhileStretched) {
+  const Fixture f = make_fixture();
+  ForceSettings settings;
+  const Eigen::VectorXd rest = flatten_positions(f.scene.input.rest_positions);
+  const Eigen::VectorXd v = Eigen::VectorXd::Zero(rest.size());
+  for (double scale : {1.1, 0.9}) {
+    const Eigen::VectorXd x = scale * rest;
+    const Eigen::MatrixXd exact =
+        dense_jacobian(f.model, settings, x, v, 1, 0, JacobianKind::exact);
+    const Eigen::MatrixXd solve =
+        dense_jacobian(f.model, settings, x, v, 1, 0, JacobianKind::solve);
+    if (scale > 1.0) {
+      EXPECT_LE((solve - exact).norm(), 1e-12 * exact.norm());
+    } else {
+      EXPECT_GT((solve - exact).norm(), 1e-3 * exact.norm());
+    }
+  }
+}
+
 // The calibrated hinge weights and the bend stencils (ClothModelOptions): force against the
 // energy's gradient, exact ∂f/∂x and ∂f/∂v against finite differences, and the solve Jacobian
 // symmetric and negative semi-definite, on a sheet with degree-8 vertices (stencils).
