@@ -27,6 +27,16 @@ Simulation make_simulation(const HangingSheet& h, const SimulationSettings& sett
                     testing::fixed_pins(h.scene), settings);
 }
 
+// A hanging sheet's drape that comes to rest well within its duration: 1/30 s steps and air drag
+// 0.2 kg/(m²·s) damping the swing, up to 30 s.
+SimulationSettings damped_settling_settings() {
+  SimulationSettings settings;
+  settings.dt = 1.0 / 30;
+  settings.duration = 30.0;
+  settings.forces.air_drag = 0.2;
+  return settings;
+}
+
 // The simulator owns the names of its integrators and solvers: one spelling everywhere (sketch
 // files, reports, bench and stress ids), read back to the same enum.
 TEST(Simulation, IntegratorAndSolverNamesRoundTrip) {
@@ -135,10 +145,7 @@ SettledShape settle(int n, Integrator integrator = Integrator::implicit_euler) {
 // at rest has below both thresholds.
 TEST(Simulation, ReportsTheAtRestResidual) {
   const HangingSheet h = hanging_sheet(6);
-  SimulationSettings settings;
-  settings.dt = 1.0 / 30;
-  settings.duration = 30.0;
-  settings.forces.air_drag = 0.2;
+  const SimulationSettings settings = damped_settling_settings();
   Simulation sim = make_simulation(h, settings);
   double window_speed = 0.0;
   std::vector<std::pair<double, double>> speeds;  // (time, largest speed) per step
@@ -167,10 +174,7 @@ TEST(Simulation, ReportsTheAtRestResidual) {
 // began (a recorded step at least a window before the end), and below rest_speed·rest_window.
 TEST(Simulation, AtRestBoundsTheDriftOverTheWindow) {
   const HangingSheet h = hanging_sheet(6);
-  SimulationSettings settings;
-  settings.dt = 1.0 / 30;
-  settings.duration = 30.0;
-  settings.forces.air_drag = 0.2;
+  const SimulationSettings settings = damped_settling_settings();
   Simulation sim = make_simulation(h, settings);
   std::vector<std::pair<double, Eigen::VectorXd>> states;  // (time, positions) per step
   const SimulationReport report =
