@@ -331,6 +331,27 @@ TEST(Forces, BendingEnergyIsResolutionInvariantOnACylinder) {
   }
 }
 
+// The fixture's sheet scaled by sx across and sy down from its top (y = 1 m), each coordinate
+// then moved by a draw of `noise`: a configuration with every triangle near a chosen strain.
+Eigen::VectorXd scaled_noisy_positions(const Fixture& f, double sx, double sy,
+                                       std::uniform_real_distribution<double>& noise,
+                                       std::mt19937& rng) {
+  Eigen::VectorXd x = flatten_positions(f.scene.input.rest_positions);
+  for (Eigen::Index i = 0; i < x.size(); i += 3) {
+    x(i) *= sx;
+    x(i + 1) = 1.0 + (x(i + 1) - 1.0) * sy;
+    for (int k = 0; k < 3; ++k) x(i + k) += noise(rng);
+  }
+  return x;
+}
+
+// w_u = ∂x/∂u of triangle t at positions x: its warp direction, of length 1 + warp strain.
+Eigen::Vector3d warp_vector(const TriangleElement& t, const Eigen::VectorXd& x) {
+  Eigen::Vector3d wu = Eigen::Vector3d::Zero();
+  for (int k = 0; k < 3; ++k) wu += t.du(k) * x.segment<3>(3 * t.vertices[k]);
+  return wu;
+}
+
 // Compression::buckling (Choi & Ko's post-buckling cap) against finite differences: the force is
 // −∂E/∂x and the exact Jacobian ∂f/∂x, on random configurations squeezed by up to 5 % or
 // stretched by up to 2 %, so that triangles lie on every branch (ε* = π²B/(l²K) = 2.5e-3 along
@@ -346,16 +367,10 @@ TEST(Forces, BucklingCompressionMatchesFiniteDifferences) {
   std::uniform_real_distribution<double> squeeze(0.95, 1.02), noise(-2e-3, 2e-3);
   int buckled = 0, stretched = 0;
   for (int trial = 0; trial < 10; ++trial) {
-    Eigen::VectorXd x = flatten_positions(f.scene.input.rest_positions);
-    const double sx = squeeze(rng), sy = squeeze(rng);
-    for (Eigen::Index i = 0; i < x.size(); i += 3) {
-      x(i) *= sx;
-      x(i + 1) = 1.0 + (x(i + 1) - 1.0) * sy;
-      for (int k = 0; k < 3; ++k) x(i + k) += noise(rng);
-    }
+    const double sx = squeeze(rng), sy = squeeze(rng);  // in this order: the draws are the seed's
+    const Eigen::VectorXd x = scaled_noisy_positions(f, sx, sy, noise, rng);
     for (const TriangleElement& t : f.model.triangles) {
-      Eigen::Vector3d wu = Eigen::Vector3d::Zero();
-      for (int k = 0; k < 3; ++k) wu += t.du(k) * x.segment<3>(3 * t.vertices[k]);
+      const Eigen::Vector3d wu = warp_vector(t, x);
       const double eps = std::numbers::pi * std::numbers::pi * f.model.fabric.bend /
                          (t.width_u * t.width_u * f.model.fabric.stretch_warp);
       buckled += wu.norm() - 1.0 < -eps;
@@ -384,16 +399,10 @@ TEST(Forces, TensileCurveMatchesFiniteDifferences) {
   std::uniform_real_distribution<double> stretch(0.99, 1.03), noise(-2e-3, 2e-3);
   int on_segment[3] = {0, 0, 0};
   for (int trial = 0; trial < 10; ++trial) {
-    Eigen::VectorXd x = flatten_positions(f.scene.input.rest_positions);
-    const double sx = stretch(rng), sy = stretch(rng);
-    for (Eigen::Index i = 0; i < x.size(); i += 3) {
-      x(i) *= sx;
-      x(i + 1) = 1.0 + (x(i + 1) - 1.0) * sy;
-      for (int k = 0; k < 3; ++k) x(i + k) += noise(rng);
-    }
+    const double sx = stretch(rng), sy = stretch(rng);  // in this order: the draws are the seed's
+    const Eigen::VectorXd x = scaled_noisy_positions(f, sx, sy, noise, rng);
     for (const TriangleElement& t : f.model.triangles) {
-      Eigen::Vector3d wu = Eigen::Vector3d::Zero();
-      for (int k = 0; k < 3; ++k) wu += t.du(k) * x.segment<3>(3 * t.vertices[k]);
+      const Eigen::Vector3d wu = warp_vector(t, x);
       const double e = wu.norm() - 1.0;
       ++on_segment[e <= 0.0 ? 0 : (e < 0.005 ? 1 : 2)];
     }

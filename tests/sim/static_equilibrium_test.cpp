@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <numbers>
 #include <random>
+#include <vector>
 
 #include "sim/fabric.hpp"
 #include "sim/sheet.hpp"
@@ -19,28 +20,40 @@
 namespace sd::sim {
 namespace {
 
+// A strip 5 cm wide (two columns of cells) and `length` m long hanging from its top edge in
+// `rows` rows, solved for static equilibrium: how far each vertex of its free end has dropped
+// (m), one per column; empty when Newton did not converge.
+std::vector<double> hanging_strip_drops(const FabricParameters& fabric, double length, int rows) {
+  SheetSpec spec;
+  spec.size = {0.05, length};
+  spec.columns = 2;
+  spec.rows = rows;
+  spec.pins = {"top"};
+  const SheetScene scene = build_sheet(spec);
+  const ClothModel model = build_cloth_model(scene.input, fabric);
+  Eigen::VectorXd x = flatten_positions(scene.input.rest_positions);
+  const StaticResult result = solve_static(model, x, scene.pinned_vertices);
+  EXPECT_TRUE(result.converged) << result.failure;
+  if (!result.converged) return {};
+  std::vector<double> drops;
+  for (int c = 0; c <= spec.columns; ++c) {
+    const int v = scene.vertex(spec.rows, c);
+    drops.push_back(scene.input.rest_positions(v, 1) - x(3 * v + 1));
+  }
+  return drops;
+}
+
 // A strip hanging from its top edge stretches by ρgL²/(2K) at its free end (uniform load on a
 // linear bar; linear elements with lumped loads are exact at the nodes).
 TEST(StaticEquilibrium, HangingStripStretchesByRhoGLSquaredOverTwoK) {
   for (const std::string& name : {std::string("silk"), std::string("denim")}) {
     const FabricParameters fabric = fabric_preset(name);
-    SheetSpec spec;
-    spec.size = {0.05, 0.5};
-    spec.columns = 2;
-    spec.rows = 20;
-    spec.pins = {"top"};
-    const SheetScene scene = build_sheet(spec);
-    const ClothModel model = build_cloth_model(scene.input, fabric);
-    Eigen::VectorXd x = flatten_positions(scene.input.rest_positions);
-    const StaticResult result = solve_static(model, x, scene.pinned_vertices);
-    ASSERT_TRUE(result.converged) << result.failure;
+    const std::vector<double> drops = hanging_strip_drops(fabric, 0.5, 20);
+    ASSERT_FALSE(drops.empty());
     const double expected =
         fabric.area_density * 9.81 * 0.5 * 0.5 / (2.0 * fabric.stretch_warp);  // m
-    for (int c = 0; c <= spec.columns; ++c) {
-      const int v = scene.vertex(spec.rows, c);
-      const double stretch = scene.input.rest_positions(v, 1) - x(3 * v + 1);
-      EXPECT_NEAR(stretch / expected, 1.0, 1e-3) << name << ", column " << c;
-    }
+    for (size_t c = 0; c < drops.size(); ++c)
+      EXPECT_NEAR(drops[c] / expected, 1.0, 1e-3) << name << ", column " << c;
   }
 }
 
@@ -57,24 +70,15 @@ TEST(StaticEquilibrium, HangingStripFollowsItsTensileCurve) {
   const double e1 = 0.004, s1 = 0.5, k1 = s1 / e1, k2 = 500.0;  // 125 then 500 N/m
   fabric.tensile_warp.strain = {0.0, e1, 0.01};
   fabric.tensile_warp.stress = {0.0, s1, s1 + k2 * (0.01 - e1)};
-  SheetSpec spec;
-  spec.size = {0.05, length};
-  spec.columns = 2;
-  spec.rows = 40;
-  spec.pins = {"top"};
-  const SheetScene scene = build_sheet(spec);
-  const ClothModel model = build_cloth_model(scene.input, fabric);
-  Eigen::VectorXd x = flatten_positions(scene.input.rest_positions);
-  const StaticResult result = solve_static(model, x, scene.pinned_vertices);
-  ASSERT_TRUE(result.converged) << result.failure;
+  const std::vector<double> drops = hanging_strip_drops(fabric, length, 40);
+  ASSERT_FALSE(drops.empty());
   const double knee = s1 / rho_g;  // m above the free end
   ASSERT_LT(knee, length);
   const double expected =
       rho_g * knee * knee / (2.0 * k1) + e1 * (length - knee) +
       (0.5 * rho_g * (length * length - knee * knee) - s1 * (length - knee)) / k2;
-  for (int c = 0; c <= spec.columns; ++c) {
-    const int v = scene.vertex(spec.rows, c);
-    const double stretch = scene.input.rest_positions(v, 1) - x(3 * v + 1);
+  for (size_t c = 0; c < drops.size(); ++c) {
+    const double stretch = drops[c];
     if (c == 0)
       std::printf("hanging strip on its curve: %.6f of the integral\n", stretch / expected);
     // Each row carries a constant strain: the knee's row averages the two slopes, which the
