@@ -69,13 +69,21 @@ void check_declared_counts(const std::string& file) {
   double vertices = 0, faces = 0;
   if (!(words >> word)) return;
   if (word.size() >= 3 && word.compare(word.size() - 3, 3, "OFF") == 0) {
-    // Skip comment lines between the keyword and the counts.
+    // Skip comment and blank lines between the keyword and the counts. The first line that
+    // opens with a number is the counts line, as assimp reads it, even without a face count
+    // (a fuzz finding: "7777777777777777777777" alone on its line, which assimp wraps to 3.3e9
+    // vertices and reserves 39 GB for, while a later line's "770" had passed this check).
     std::string line;
     while (std::getline(words, line)) {
       const auto hash = line.find('#');
       if (hash != std::string::npos) line.resize(hash);
       std::istringstream counts(line);
-      if (counts >> vertices >> faces) break;
+      if (!(counts >> vertices)) {
+        vertices = 0;
+        continue;
+      }
+      if (!(counts >> faces)) faces = 0;
+      break;
     }
   } else if (word.compare(0, 3, "ply") == 0) {
     // assimp takes any file that starts with "ply" for PLY, whatever follows on the line (the

@@ -101,6 +101,14 @@ TEST(BadInput, FuzzFindingsEndWithAClearError) {
               std::string::npos)
         << e.what();
   }
+  // An OFF counts line with a vertex count too large for 32 bits and no face count: assimp
+  // wrapped it to 3.3e9 vertices and reserved 39 GB (body_loader_fuzz under ASan).
+  try {
+    load_body((dir / "body-off-count-line-without-faces.off").string());
+    ADD_FAILURE() << "accepted";
+  } catch (const BodyError& e) {
+    EXPECT_NE(std::string(e.what()).find("more than its"), std::string::npos) << e.what();
+  }
   // "ply" glued to binary bytes on its line, and no end_header: assimp took it for PLY and
   // read for over 10 s under ASan (body_loader_fuzz, the third finding).
   try {
