@@ -149,6 +149,93 @@ ConditionEnergy stretch_energy(double strain, double stiffness, double buckling_
   return buckling_stretch(strain, stiffness, buckling_strain);
 }
 
+// Bias wrinkling (Compression::buckling, docs/simulator.md "Compression and buckling"): the
+// membrane energy of a triangle per unit rest area as the least energy over wrinkle strains
+// β_u, β_v, β_b ≥ 0 along warp, weft and the compressed bias n = (u − s·v)/√2 (s = sign γ):
+// W(c) = min_β ½·eᵀ·D·e + Σ N*·β with the elastic strain e = c + P·β, c = (ε_u, ε_v, γ),
+// D = diag(K_u, K_v, G) and P's columns (1,0,0), (0,1,0), (½,½,−s) (a wrinkle of β along n
+// shortens warp and weft by β/2 and shears by s·β). Each wrinkle costs the element's Euler
+// load N* per unit strain. The problem is strictly convex; its value is C¹ with gradient the
+// elastic stress σ = D·e (N/m) and, on the active set S, Hessian D − D·P_S·(P_Sᵀ·D·P_S)⁻¹·P_Sᵀ·D.
+// With β_b = 0 it is the warp and weft caps (buckling_stretch); this is called only where that
+// answer would compress the bias beyond its load, so β_b > 0 and S holds b.
+struct BiasWrinkle {
+  Eigen::Vector3d elastic = Eigen::Vector3d::Zero();  // e
+  Eigen::Vector3d wrinkle = Eigen::Vector3d::Zero();  // β_u, β_v, β_b
+  Eigen::Matrix3d hessian = Eigen::Matrix3d::Zero();  // N/m
+};
+
+BiasWrinkle bias_wrinkle(const Eigen::Vector3d& c, const Eigen::Vector3d& stiffness,
+                         const Eigen::Vector3d& load, double s) {
+  Eigen::Matrix3d p = Eigen::Matrix3d::Identity();
+  p.col(2) << 0.5, 0.5, -s;
+  const Eigen::Matrix3d d = stiffness.asDiagonal();
+  // The sets holding b: {b}, {u,b}, {v,b}, {u,v,b}. Exactly one satisfies the optimality
+  // conditions (β_S ≥ 0, p_jᵀ·σ + N*_j ≥ 0 off S); rounding at a boundary may leave none or
+  // two, so the one violating them least is taken.
+  BiasWrinkle best;
+  double best_violation = std::numeric_limits<double>::infinity();
+  for (const int mask : {4, 5, 6, 7}) {
+    std::array<int, 3> set{};
+    int m = 0;
+    for (int j = 0; j < 3; ++j)
+      if (mask & (1 << j)) set[static_cast<std::size_t>(m++)] = j;
+    Eigen::MatrixXd ps(3, m);
+    Eigen::VectorXd loads(m);
+    for (int k = 0; k < m; ++k) {
+      ps.col(k) = p.col(set[static_cast<std::size_t>(k)]);
+      loads(k) = load(set[static_cast<std::size_t>(k)]);
+    }
+    const Eigen::MatrixXd normal = ps.transpose() * d * ps;
+    const Eigen::VectorXd beta = normal.ldlt().solve(-(ps.transpose() * d * c + loads));
+    const Eigen::Vector3d e = c + ps * beta;
+    const Eigen::Vector3d sigma = d * e;
+    double violation = 0.0;
+    for (int k = 0; k < m; ++k) violation = std::max(violation, -beta(k) * stiffness.maxCoeff());
+    for (int j = 0; j < 3; ++j)
+      if (!(mask & (1 << j))) violation = std::max(violation, -(p.col(j).dot(sigma) + load(j)));
+    if (violation >= best_violation) continue;
+    best_violation = violation;
+    best.elastic = e;
+    best.wrinkle.setZero();
+    for (int k = 0; k < m; ++k) best.wrinkle(set[static_cast<std::size_t>(k)]) = beta(k);
+    const Eigen::MatrixXd dp = d * ps;
+    best.hessian = d - dp * normal.ldlt().solve(dp.transpose());
+    if (violation <= 0.0) break;
+  }
+  return best;
+}
+
+// The rest triangle's extent along the bias (u − s·v)/√2, m. Its rest edges (Δu_k, Δv_k),
+// k = 1, 2, are the columns of D = [[du1, dv1], [du2, dv2]]⁻¹ (build_cloth_model makes du, dv
+// from D⁻¹), so the extent follows the rest shape wherever du, dv are replaced.
+double bias_width(const TriangleElement& t, double s) {
+  Eigen::Matrix2d inverse;
+  inverse << t.du[1], t.dv[1], t.du[2], t.dv[2];
+  const Eigen::Matrix2d d = inverse.inverse();
+  const double p1 = (d(0, 0) - s * d(1, 0)) / std::numbers::sqrt2;
+  const double p2 = (d(0, 1) - s * d(1, 1)) / std::numbers::sqrt2;
+  return std::max({0.0, p1, p2}) - std::min({0.0, p1, p2});
+}
+
+// What the coupling O between a triangle's warp, weft and shear conditions (3×3, zero diagonal,
+// N·m: the off-diagonal of the energy's Hessian in the conditions) adds to its Jacobian:
+// ∂f/∂x gains −Σ_{i≠j} O_ij·∇C_i·∇C_jᵀ. Damping stays per condition.
+void add_condition_coupling(const TriangleConditions& c, const Eigen::Matrix3d& coupling,
+                            const int* vertices, const JacobianTarget& jacobian,
+                            ConditionContribution<9>& into) {
+  Eigen::Matrix<double, 9, 3> g;
+  g << c.warp.gradient, c.weft.gradient, c.shear.gradient;
+  const Eigen::Matrix<double, 9, 9> dfdx = -(g * coupling * g.transpose());
+  if (jacobian.product_input != nullptr) {
+    Eigen::Matrix<double, 9, 1> local_u;
+    for (int k = 0; k < 3; ++k)
+      local_u.segment<3>(3 * k) = jacobian.product_input->segment<3>(3 * vertices[k]);
+    into.product += dfdx * local_u;
+  }
+  if (jacobian.matrix != nullptr) into.matrix += jacobian.dfdx_scale * dfdx;
+}
+
 // [a]_×: the matrix of a × ·.
 Eigen::Matrix3d cross_matrix(const Vector3d& a) {
   Eigen::Matrix3d m;
@@ -559,13 +646,13 @@ void evaluate_forces(const ClothModel& model, const ForceSettings& settings,
           t, x.segment<3>(3 * vs[0]), x.segment<3>(3 * vs[1]), x.segment<3>(3 * vs[2]), exact);
       std::array<TriangleTerm, 3> parts;
       int count = 0;
+      // ε* = N*/K with N* = π²·B / l² for the triangle's width l along each direction (only
+      // with the buckling compression; infinity leaves compression quadratic).
+      const bool buckling = model.compression == Compression::buckling;
+      const double pi2b = std::numbers::pi * std::numbers::pi * fabric.bend;
       if (terms.stretch) {
         const double k_u = fabric.stretch_warp * t.rest_area;
         const double k_v = fabric.stretch_weft * t.rest_area;
-        // ε* = N*/K with N* = π²·B / l² for the triangle's width l along each direction (only
-        // with the buckling compression; infinity leaves compression quadratic).
-        const bool buckling = model.compression == Compression::buckling;
-        const double pi2b = std::numbers::pi * std::numbers::pi * fabric.bend;
         const double eps_u =
             buckling ? pi2b / (t.width_u * t.width_u * fabric.stretch_warp) : kLinearCompression;
         const double eps_v =
@@ -594,10 +681,43 @@ void evaluate_forces(const ClothModel& model, const ForceSettings& settings,
                           nullptr,
                           &EnergyBreakdown::shear};
       }
+      // Bias wrinkling (bias_wrinkle), where the capped warp and weft leave the compressed bias
+      // beyond its Euler load N*_b: the larger of the triangle's own along the bias and the mean
+      // of its warp and weft loads, so that it never acts without shear (at γ = 0 the capped
+      // yarns keep ½·(σ_u + σ_v) ≥ −N*_b). The measured tensile curves keep the yarn caps only.
+      Eigen::Matrix3d coupling = Eigen::Matrix3d::Zero();
+      bool coupled = false;
+      if (buckling && terms.stretch && terms.shear && fabric.tensile_warp.empty() &&
+          fabric.tensile_weft.empty()) {
+        const double area = t.rest_area;
+        const double s = c.shear.value < 0.0 ? -1.0 : 1.0;
+        const double width_b = bias_width(t, s);
+        const Eigen::Vector3d load(pi2b / (t.width_u * t.width_u), pi2b / (t.width_v * t.width_v),
+                                   0.0);
+        const Eigen::Vector3d n_star(
+            load(0), load(1), std::max(pi2b / (width_b * width_b), 0.5 * (load(0) + load(1))));
+        const double bias_stress = 0.5 * (parts[0].energy.slope + parts[1].energy.slope) / area -
+                                   fabric.shear * std::abs(c.shear.value);
+        if (bias_stress + n_star(2) < 0.0) {
+          const Eigen::Vector3d stiffness(fabric.stretch_warp, fabric.stretch_weft, fabric.shear);
+          const BiasWrinkle w = bias_wrinkle(
+              Eigen::Vector3d(c.warp.value, c.weft.value, c.shear.value), stiffness, n_star, s);
+          for (int j = 0; j < 3; ++j) {
+            const double e = w.elastic(j);
+            parts[static_cast<std::size_t>(j)].energy = {
+                area * (0.5 * stiffness(j) * e * e + n_star(j) * w.wrinkle(j)),
+                area * stiffness(j) * e, area * w.hessian(j, j)};
+          }
+          coupling = area * w.hessian;
+          coupling.diagonal().setZero();
+          coupled = true;
+        }
+      }
       if (solve) {
         triangle_solve_contribution(
             std::span<const TriangleTerm>(parts.data(), static_cast<std::size_t>(count)), vs.data(),
             v, *jacobian, out);
+        if (coupled) add_condition_coupling(c, coupling, vs.data(), *jacobian, out.conditions[0]);
         return;
       }
       for (int j = 0; j < count; ++j) {
@@ -605,6 +725,8 @@ void evaluate_forces(const ClothModel& model, const ForceSettings& settings,
         condition_contribution(*part.condition, part.energy, part.damping, part.d != nullptr,
                                vs.data(), v, jacobian, out.next(part.into));
       }
+      if (coupled && jacobian != nullptr)
+        add_condition_coupling(c, coupling, vs.data(), *jacobian, out.conditions[0]);
     };
     add_elements<9, 3>(static_cast<int>(model.triangles.size()), n, element, contribute, force,
                        local_energy, jacobian);

@@ -89,10 +89,11 @@ Eigen::MatrixXd dense_jacobian(const ClothModel& model, const ForceSettings& set
   return Eigen::MatrixXd(matrix);
 }
 
-// At rest velocity, the stretch force is −∇E_stretch (central differences of the energy, h = 1e-7
-// m) and the exact Jacobian matches central differences of the force, both to 1e-5 relative.
-void expect_stretch_derivatives(const ClothModel& model, const ForceSettings& settings,
-                                const Eigen::VectorXd& x, int trial) {
+// At rest velocity, the membrane force is −∇(E_stretch + E_shear) (central differences of the
+// energy, h = 1e-7 m) and the exact Jacobian matches central differences of the force, both to
+// 1e-5 relative.
+void expect_membrane_derivatives(const ClothModel& model, const ForceSettings& settings,
+                                 const Eigen::VectorXd& x, int trial) {
   const Eigen::VectorXd v = Eigen::VectorXd::Zero(x.size());
   const testing::ForceDifferences d = testing::force_differences(model, settings, x, v);
   Eigen::VectorXd force, scratch, gradient(x.size());
@@ -105,7 +106,7 @@ void expect_stretch_derivatives(const ClothModel& model, const ForceSettings& se
     EnergyBreakdown ep, em;
     evaluate_forces(model, settings, plus, v, scratch, &ep);
     evaluate_forces(model, settings, minus, v, scratch, &em);
-    gradient[j] = (ep.stretch - em.stretch) / (2 * h);
+    gradient[j] = (ep.stretch + ep.shear - em.stretch - em.shear) / (2 * h);
   }
   EXPECT_LE((gradient + force).norm(), 1e-5 * force.norm()) << "trial " << trial;
   const Eigen::MatrixXd dfdx = dense_jacobian(model, settings, x, v, 1, 0, JacobianKind::exact);
@@ -376,7 +377,7 @@ TEST(Forces, BucklingCompressionMatchesFiniteDifferences) {
       buckled += wu.norm() - 1.0 < -eps;
       stretched += wu.norm() > 1.0;
     }
-    expect_stretch_derivatives(f.model, settings, x, trial);
+    expect_membrane_derivatives(f.model, settings, x, trial);
   }
   EXPECT_GT(buckled, 10);  // both branches were exercised
   EXPECT_GT(stretched, 10);
@@ -406,7 +407,7 @@ TEST(Forces, TensileCurveMatchesFiniteDifferences) {
       const double e = wu.norm() - 1.0;
       ++on_segment[e <= 0.0 ? 0 : (e < 0.005 ? 1 : 2)];
     }
-    expect_stretch_derivatives(f.model, settings, x, trial);
+    expect_membrane_derivatives(f.model, settings, x, trial);
   }
   for (int segment = 0; segment < 3; ++segment)
     EXPECT_GT(on_segment[segment], 10) << "compression, first or later segment: " << segment;
@@ -449,6 +450,180 @@ TEST(Forces, BucklingKeepsTensionExactAndCapsCompressionAtTheEulerLoad) {
     EXPECT_NEAR(e_buckling.stretch, expected, 1e-12 * expected) << s;
     EXPECT_NEAR(e_linear.stretch, quadratic, 1e-9 * quadratic) << s;
     EXPECT_LT(e_buckling.stretch, e_linear.stretch) << s;
+  }
+}
+
+// The fixture's sheet under the homogeneous in-plane map F of its rest (warp, weft) coordinates
+// (F's columns: the deformed warp and weft, so (ε_u, ε_v, γ) = (|F₀| − 1, |F₁| − 1, F₀·F₁) in
+// every triangle), each coordinate then moved by a draw of `noise` (none: exactly homogeneous).
+Eigen::VectorXd mapped_positions(const Fixture& f, const Eigen::Matrix2d& map,
+                                 std::uniform_real_distribution<double>* noise = nullptr,
+                                 std::mt19937* rng = nullptr) {
+  const Eigen::VectorXd rest = flatten_positions(f.scene.input.rest_positions);
+  const TriangleElement& t = f.model.triangles[0];
+  const Eigen::Vector3d warp = warp_vector(t, rest);
+  Eigen::Vector3d weft = Eigen::Vector3d::Zero();
+  for (int k = 0; k < 3; ++k) weft += t.dv(k) * rest.segment<3>(3 * t.vertices[k]);
+  Eigen::VectorXd x = rest;
+  for (Eigen::Index i = 0; i < x.size(); i += 3) {
+    const Eigen::Vector3d p = rest.segment<3>(i);
+    const Eigen::Vector2d uv(p.dot(warp), p.dot(weft));
+    const Eigen::Vector2d mapped = map * uv;
+    x.segment<3>(i) = p + (mapped(0) - uv(0)) * warp + (mapped(1) - uv(1)) * weft;
+    if (noise != nullptr)
+      for (int k = 0; k < 3; ++k) x(i + k) += (*noise)(*rng);
+  }
+  return x;
+}
+
+// F with warp and weft of length a = 1 − s/2, each turned by θ toward the other, a²·sin 2θ = s:
+// exactly (ε_u, ε_v, γ) = (−s/2, −s/2, s), a squeeze s along the bias (u − v)/√2 (to first
+// order the map I − s·nnᵀ) whose conditions move along that bias's direction, dc/ds = (−½, −½, 1).
+Eigen::Matrix2d bias_squeeze(double s) {
+  const double a = 1.0 - 0.5 * s;
+  const double theta = 0.5 * std::asin(s / (a * a));
+  Eigen::Matrix2d map;
+  map.col(0) = a * Eigen::Vector2d(std::cos(theta), std::sin(theta));
+  map.col(1) = a * Eigen::Vector2d(std::sin(theta), std::cos(theta));
+  return map;
+}
+
+// Each triangle's compressed bias Euler load (docs/simulator.md, "Compression and buckling"),
+// computed here from the rest positions: N*_b = max(π²B/l_b², ½(N*_u + N*_v)), l_b the rest
+// triangle's extent along (u − s·v)/√2.
+double bias_euler_load(const ClothModel& model, const TriangleElement& t,
+                       const Eigen::VectorXd& rest, double s) {
+  const Eigen::Vector3d warp = warp_vector(model.triangles[0], rest);
+  Eigen::Vector3d weft = Eigen::Vector3d::Zero();
+  for (int k = 0; k < 3; ++k)
+    weft += model.triangles[0].dv(k) * rest.segment<3>(3 * model.triangles[0].vertices[k]);
+  const Eigen::Vector3d bias = (warp - s * weft) / std::numbers::sqrt2;
+  double low = 1e300, high = -1e300;
+  for (int k = 0; k < 3; ++k) {
+    const double p = rest.segment<3>(3 * t.vertices[k]).dot(bias);
+    low = std::min(low, p);
+    high = std::max(high, p);
+  }
+  const double pi2b = std::numbers::pi * std::numbers::pi * model.fabric.bend;
+  const double mean_yarn =
+      0.5 * pi2b * (1.0 / (t.width_u * t.width_u) + 1.0 / (t.width_v * t.width_v));
+  return std::max(pi2b / ((high - low) * (high - low)), mean_yarn);
+}
+
+ClothModel buckling_model(const Fixture& f) {
+  ClothModelOptions options;
+  options.compression = Compression::buckling;
+  return build_cloth_model(f.scene.input, f.model.fabric, options);
+}
+
+// Bias wrinkling against finite differences: random squeezes along either bias (1-12 %) with
+// yarn strains of ±1 % and position noise, so that triangles lie with and without a bias wrinkle
+// (counted here from the criterion: the capped yarns leave the compressed bias's stress
+// ½(σ_u + σ_v) − G|γ| below −N*_b), the force is −∇E and the exact Jacobian ∂f/∂x; the solve's
+// Jacobian is symmetric, negative semi-definite and its product is the matrix's.
+TEST(Forces, BiasWrinklingMatchesFiniteDifferences) {
+  Fixture f = make_fixture();
+  f.model = buckling_model(f);
+  const FabricParameters& fabric = f.model.fabric;
+  ForceSettings settings;
+  settings.terms = ForceTerms{true, true, false, false, false, false};  // stretch and shear
+  const Eigen::VectorXd rest = flatten_positions(f.scene.input.rest_positions);
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> squeeze(0.01, 0.12), yarn(-0.01, 0.01), noise(-1e-3, 1e-3);
+  const double pi2b = std::numbers::pi * std::numbers::pi * fabric.bend;
+  const auto capped = [](double strain, double stiffness, double load) {
+    return std::max(stiffness * strain, -load);
+  };
+  int wrinkled = 0, plain = 0;
+  for (int trial = 0; trial < 12; ++trial) {
+    const double s = squeeze(rng), su = yarn(rng), sv = yarn(rng);
+    Eigen::Matrix2d map = bias_squeeze(s);
+    map.col(0) *= 1.0 + su;
+    map.col(1) *= 1.0 + sv;
+    // Odd trials squeeze the other bias: F ↦ R·F·R with R = diag(1, −1) flips the sign of γ.
+    const Eigen::Matrix2d flip = Eigen::Vector2d(1.0, trial % 2 == 1 ? -1.0 : 1.0).asDiagonal();
+    const Eigen::VectorXd x = mapped_positions(f, flip * map * flip, &noise, &rng);
+    for (const TriangleElement& t : f.model.triangles) {
+      const Eigen::Vector3d wu = warp_vector(t, x);
+      Eigen::Vector3d wv = Eigen::Vector3d::Zero();
+      for (int k = 0; k < 3; ++k) wv += t.dv(k) * x.segment<3>(3 * t.vertices[k]);
+      const double gamma = wu.dot(wv);
+      const double n_u = pi2b / (t.width_u * t.width_u), n_v = pi2b / (t.width_v * t.width_v);
+      const double bias = 0.5 * (capped(wu.norm() - 1.0, fabric.stretch_warp, n_u) +
+                                 capped(wv.norm() - 1.0, fabric.stretch_weft, n_v)) -
+                          fabric.shear * std::abs(gamma);
+      const bool active = bias < -bias_euler_load(f.model, t, rest, gamma < 0.0 ? -1.0 : 1.0);
+      wrinkled += active;
+      plain += !active;
+    }
+    expect_membrane_derivatives(f.model, settings, x, trial);
+    const Eigen::VectorXd v = Eigen::VectorXd::Zero(x.size());
+    const Eigen::MatrixXd j = dense_jacobian(f.model, settings, x, v, 1, 0, JacobianKind::solve);
+    EXPECT_LE((j - j.transpose()).norm(), 1e-12 * j.norm()) << "trial " << trial;
+    EXPECT_LE(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(j).eigenvalues().maxCoeff(),
+              1e-9 * j.norm())
+        << "trial " << trial;
+    const Eigen::VectorXd u = Eigen::VectorXd::Random(x.size());
+    JacobianTarget target;
+    Eigen::VectorXd product = Eigen::VectorXd::Zero(x.size()), force;
+    target.product_input = &u;
+    target.product_output = &product;
+    evaluate_forces(f.model, settings, x, v, force, nullptr, &target);
+    EXPECT_LE((product - j * u).norm(), 1e-12 * (j * u).norm()) << "trial " << trial;
+  }
+  EXPECT_GT(wrinkled, 20);  // both kinds of triangles were exercised
+  EXPECT_GT(plain, 20);
+}
+
+// Under a squeeze s along the bias, (ε_u, ε_v, γ) = (−s/2, −s/2, s) in every triangle, the
+// membrane energy grows at dE/ds = Σ A·N*_b once every triangle has wrinkled along the bias: the
+// compressive force per width along the bias is its Euler load, as N* is along a buckled yarn
+// (for the linear membrane it is A·((K_u + K_v)/4 + G)·s, here 6-13 times more). Tension and
+// shear under tension are the linear model's to the bit: a stretch along a bias (the other bias
+// is then free of stress) and a 2 % pretension in both yarns with a shear G·γ below it.
+TEST(Forces, BiasWrinklingCapsBiasCompressionAtItsEulerLoadAndKeepsTension) {
+  Fixture f = make_fixture();
+  const ClothModel linear = f.model;
+  const ClothModel buckling = buckling_model(f);
+  ForceSettings settings;
+  settings.terms = ForceTerms{true, true, false, false, false, false};
+  const Eigen::VectorXd rest = flatten_positions(f.scene.input.rest_positions);
+  const auto membrane = [&](const ClothModel& model, const Eigen::VectorXd& x) {
+    Eigen::VectorXd force;
+    EnergyBreakdown e;
+    evaluate_forces(model, settings, x, Eigen::VectorXd::Zero(x.size()), force, &e);
+    return e.stretch + e.shear;
+  };
+  double euler = 0.0;
+  for (const TriangleElement& t : buckling.triangles)
+    euler += t.rest_area * bias_euler_load(buckling, t, rest, 1.0);
+  const double h = 1e-6;
+  for (const double s : {0.05, 0.1}) {
+    const double slope = (membrane(buckling, mapped_positions(f, bias_squeeze(s + h))) -
+                          membrane(buckling, mapped_positions(f, bias_squeeze(s - h)))) /
+                         (2 * h);
+    EXPECT_NEAR(slope, euler, 1e-6 * euler) << s;
+    const double linear_slope = (membrane(linear, mapped_positions(f, bias_squeeze(s + h))) -
+                                 membrane(linear, mapped_positions(f, bias_squeeze(s - h)))) /
+                                (2 * h);
+    EXPECT_GT(linear_slope, 4.0 * slope) << s;
+  }
+  // Pretension 2 % (½(σ_u + σ_v) = 13 N/m) and γ = 1.02²·sin 0.1 = 0.104 (G·γ = 6.2 N/m, which
+  // without the pretension would wrinkle the bias: N*_b ≤ 3.95 N/m here).
+  const double c = std::cos(0.05), sn = std::sin(0.05);
+  Eigen::Matrix2d stretched_bias, pretension_and_shear;
+  stretched_bias << 1.03, 0.03, 0.03, 1.03;  // 4.2 % along u + v
+  pretension_and_shear << 1.02 * c, 1.02 * sn, 1.02 * sn, 1.02 * c;
+  for (const Eigen::Matrix2d& map : {stretched_bias, pretension_and_shear}) {
+    const Eigen::VectorXd x = mapped_positions(f, map);
+    const Eigen::VectorXd v = Eigen::VectorXd::Zero(x.size());
+    Eigen::VectorXd f_linear, f_buckling;
+    EnergyBreakdown e_linear, e_buckling;
+    evaluate_forces(linear, settings, x, v, f_linear, &e_linear);
+    evaluate_forces(buckling, settings, x, v, f_buckling, &e_buckling);
+    EXPECT_EQ(f_linear, f_buckling);
+    EXPECT_EQ(e_linear.stretch + e_linear.shear, e_buckling.stretch + e_buckling.shear);
+    EXPECT_GT(e_linear.shear, 0.0);
   }
 }
 
