@@ -691,14 +691,17 @@ void evaluate_forces(const ClothModel& model, const ForceSettings& settings,
           fabric.tensile_weft.empty()) {
         const double area = t.rest_area;
         const double s = c.shear.value < 0.0 ? -1.0 : 1.0;
-        const double width_b = bias_width(t, s);
-        const Eigen::Vector3d load(pi2b / (t.width_u * t.width_u), pi2b / (t.width_v * t.width_v),
-                                   0.0);
-        const Eigen::Vector3d n_star(
-            load(0), load(1), std::max(pi2b / (width_b * width_b), 0.5 * (load(0) + load(1))));
+        const double n_u = pi2b / (t.width_u * t.width_u), n_v = pi2b / (t.width_v * t.width_v);
         const double bias_stress = 0.5 * (parts[0].energy.slope + parts[1].energy.slope) / area -
                                    fabric.shear * std::abs(c.shear.value);
-        if (bias_stress + n_star(2) < 0.0) {
+        // N*_b is at least the mean: the triangle's bias extent is needed only below it.
+        double n_b = 0.5 * (n_u + n_v);
+        if (bias_stress + n_b < 0.0) {
+          const double width_b = bias_width(t, s);
+          n_b = std::max(n_b, pi2b / (width_b * width_b));
+        }
+        const Eigen::Vector3d n_star(n_u, n_v, n_b);
+        if (bias_stress + n_b < 0.0) {
           const Eigen::Vector3d stiffness(fabric.stretch_warp, fabric.stretch_weft, fabric.shear);
           const BiasWrinkle w = bias_wrinkle(
               Eigen::Vector3d(c.warp.value, c.weft.value, c.shear.value), stiffness, n_star, s);
