@@ -76,6 +76,8 @@ enum class Compression {
   // out of its plane. Beyond the buckling strain ε* = N*/K the energy grows linearly, A·N*
   // per unit strain: the triangle shortens as a strip that has buckled below the mesh's
   // resolution. As l → 0 the cap N* grows as 1/l², so the response converges to linear.
+  // Where shear compresses a bias beyond its Euler load the bias wrinkles the same way
+  // (sim/forces.cpp, bias_wrinkle); tension and shear under tension are unchanged.
   buckling,
 };
 

@@ -98,9 +98,12 @@ TEST_P(CusickPreset, DrapesNearItsPublishedRangeOnTheCoarseDisc) {
               d.at_rest ? "at rest" : "not at rest", d.seconds);
   EXPECT_TRUE(d.at_rest);
   if (range.above_range) {
-    // The bench: 0.444 at 20 cells (0.418-0.470 over three specimens), 0.450-0.459 converged.
+    // Silk stays above its range with the bias wrinkling (docs/fabrics.md, "Silk"): the bench
+    // measured 0.421 at 20 cells (0.401-0.434 over three specimens; this specimen 0.430) and
+    // 0.459 and 0.475 at 51 and 61 cells, so the coarse disc reads 0.04-0.05 low as for the
+    // other presets; the band is the measured reading with a specimen's scatter.
     EXPECT_GE(d.shadow.drape_coefficient, range.high);
-    EXPECT_LE(d.shadow.drape_coefficient, 0.50);
+    EXPECT_LE(d.shadow.drape_coefficient, 0.47);
   } else {
     EXPECT_GE(d.shadow.drape_coefficient, range.low - 0.08);
     EXPECT_LE(d.shadow.drape_coefficient, range.high + 0.03);
