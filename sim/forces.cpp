@@ -180,14 +180,18 @@ BiasWrinkle bias_wrinkle(const Eigen::Vector3d& c, const Eigen::Vector3d& stiffn
     int m = 0;
     for (int j = 0; j < 3; ++j)
       if (mask & (1 << j)) set[static_cast<std::size_t>(m++)] = j;
-    Eigen::MatrixXd ps(3, m);
-    Eigen::VectorXd loads(m);
+    // At most 3 × 3: fixed-capacity storage, no allocation per triangle.
+    using Columns = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, 3>;
+    using Square = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3>;
+    using Vector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1>;
+    Columns ps(3, m);
+    Vector loads(m);
     for (int k = 0; k < m; ++k) {
       ps.col(k) = p.col(set[static_cast<std::size_t>(k)]);
       loads(k) = load(set[static_cast<std::size_t>(k)]);
     }
-    const Eigen::MatrixXd normal = ps.transpose() * d * ps;
-    const Eigen::VectorXd beta = normal.ldlt().solve(-(ps.transpose() * d * c + loads));
+    const Square normal = ps.transpose() * d * ps;
+    const Vector beta = normal.ldlt().solve(-(ps.transpose() * d * c + loads));
     const Eigen::Vector3d e = c + ps * beta;
     const Eigen::Vector3d sigma = d * e;
     double violation = 0.0;
@@ -199,7 +203,7 @@ BiasWrinkle bias_wrinkle(const Eigen::Vector3d& c, const Eigen::Vector3d& stiffn
     best.elastic = e;
     best.wrinkle.setZero();
     for (int k = 0; k < m; ++k) best.wrinkle(set[static_cast<std::size_t>(k)]) = beta(k);
-    const Eigen::MatrixXd dp = d * ps;
+    const Columns dp = d * ps;
     best.hessian = d - dp * normal.ldlt().solve(dp.transpose());
     if (violation <= 0.0) break;
   }

@@ -86,10 +86,11 @@ class CusickPreset : public ::testing::TestWithParam<PresetRange> {};
 
 // On the 1.5 cm disc (20 cells across, 560 vertices) the drape comes to rest with 4-10 nodes and
 // its DC lies in the preset's published range widened by what the coarse disc is known to miss:
-// the bench (three specimens each) measured 1.5 cm cells reading up to 0.08 below the mean of the
-// two finest resolutions (wool 0.45 against 0.51-0.53: coarse cells give up more hoop compression
-// to the buckling cap) and never more than 0.03 above it (within one specimen's scatter, ±0.03),
-// so the band is [low - 0.08, high + 0.03].
+// with the bias wrinkling the bench (three specimens at 20 cells, two at each of the two finest
+// resolutions) measured 1.5 cm cells reading up to 0.10 below the mean of the two finest (jersey
+// 0.237 against 0.334-0.335, wool 0.434 against 0.523-0.524: coarse cells give up more
+// compression to the buckling caps) and never more than 0.03 above it (within one specimen's
+// scatter, ±0.03), so the band is [low - 0.10, high + 0.03].
 TEST_P(CusickPreset, DrapesNearItsPublishedRangeOnTheCoarseDisc) {
   const PresetRange& range = GetParam();
   const Drape d = drape(fabric_preset(range.name), 20);
@@ -105,7 +106,7 @@ TEST_P(CusickPreset, DrapesNearItsPublishedRangeOnTheCoarseDisc) {
     EXPECT_GE(d.shadow.drape_coefficient, range.high);
     EXPECT_LE(d.shadow.drape_coefficient, 0.47);
   } else {
-    EXPECT_GE(d.shadow.drape_coefficient, range.low - 0.08);
+    EXPECT_GE(d.shadow.drape_coefficient, range.low - 0.10);
     EXPECT_LE(d.shadow.drape_coefficient, range.high + 0.03);
   }
   EXPECT_GE(d.shadow.nodes, 4);
