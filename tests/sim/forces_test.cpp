@@ -580,7 +580,8 @@ TEST(Forces, BiasWrinklingMatchesFiniteDifferences) {
 // compressive force per width along the bias is its Euler load, as N* is along a buckled yarn
 // (for the linear membrane it is A·((K_u + K_v)/4 + G)·s, here 6-13 times more). Tension and
 // shear under tension are the linear model's to the bit: a stretch along a bias (the other bias
-// is then free of stress) and a 2 % pretension in both yarns with a shear G·γ below it.
+// is then free of stress) and a 2 % pretension in both yarns with a shear G·γ below it. On
+// cells ten times smaller the same squeeze is the linear membrane's (the caps converge).
 TEST(Forces, BiasWrinklingCapsBiasCompressionAtItsEulerLoadAndKeepsTension) {
   Fixture f = make_fixture();
   const ClothModel linear = f.model;
@@ -607,6 +608,22 @@ TEST(Forces, BiasWrinklingCapsBiasCompressionAtItsEulerLoadAndKeepsTension) {
                                  membrane(linear, mapped_positions(f, bias_squeeze(s - h)))) /
                                 (2 * h);
     EXPECT_GT(linear_slope, 4.0 * slope) << s;
+  }
+  // The caps converge to the linear membrane: on the same sheet in cells ten times smaller
+  // (N* a hundred times larger, 197 N/m along the yarns) the squeeze s = 0.05 is below every
+  // Euler load and the buckling membrane is the linear one to the bit.
+  {
+    SheetSpec spec;
+    spec.size = {0.3, 0.2};
+    spec.columns = 30;
+    spec.rows = 20;
+    Fixture fine{build_sheet(spec), {}};
+    fine.model = build_cloth_model(fine.scene.input, linear.fabric);
+    const ClothModel fine_buckling = buckling_model(fine);
+    const Eigen::VectorXd x = mapped_positions(fine, bias_squeeze(0.05));
+    EXPECT_EQ(membrane(fine.model, x), membrane(fine_buckling, x));
+    EXPECT_LT(membrane(buckling, mapped_positions(f, bias_squeeze(0.05))),
+              0.5 * membrane(linear, mapped_positions(f, bias_squeeze(0.05))));
   }
   // Pretension 2 % (½(σ_u + σ_v) = 13 N/m) and γ = 1.02²·sin 0.1 = 0.104 (G·γ = 6.2 N/m, which
   // without the pretension would wrinkle the bias: N*_b ≤ 3.95 N/m here).
