@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -83,12 +84,10 @@ constexpr double kMaxSpringLoadClothWeights = 2.0;
 // the tee dress and kept it from resting; at 2.5 the armpits are still caught.
 constexpr double kPinchGapThicknesses = 2.5;
 constexpr double kPinchFacingCos = -0.5;
-// The least a pinched contact keeps, as a fraction of the thickness: the body-vertex springs'
-// clearance (kPiercingClearance). A contact nearer than that holds the cloth's triangles within
-// the clearance of the body's vertices around them, and their springs push against it
-// (measured with a quarter thickness: the shaped tee dress's back over the seat's cleft thrown
-// about at up to 3 m/s, 21 retried steps).
-constexpr double kMinPinchThicknessFraction = 0.5;
+// A pinch holds the cloth only where the gap crosses it: the segment between the two facing
+// surfaces within this cosine (60°) of the cloth's normal. Beside it (a cleft the cloth bridges,
+// its rims under the cloth) the cloth is not squeezed and keeps the full thickness.
+constexpr double kPinchAcrossCos = 0.5;
 
 class Stopwatch {
  public:
@@ -147,6 +146,8 @@ void ContactSettings::validate() const {
           "the swept check's sub-step motion must be positive");
   require(std::isfinite(stick_speed) && stick_speed > 0.0,
           "the friction stick speed must be positive");
+  require(std::isfinite(pinch_floor) && pinch_floor > 0.0 && pinch_floor <= 1.0,
+          "the least share of a pinch must be more than zero and at most one thickness");
 }
 
 ContactResponse::ContactResponse(const meshing::TriMesh& body, ContactSettings settings)
@@ -253,20 +254,64 @@ void ContactResponse::move_body_to(double t, double h) {
   body_time_ = t + h;
 }
 
-double ContactResponse::contact_thickness(const BodyContact& contact) const {
+Eigen::Vector3d ContactResponse::cloth_vertex_normal(int v, const Eigen::VectorXd& x) const {
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  if (v < 0 || static_cast<std::size_t>(v) + 1 >= cloth_.vertex_offsets.size()) return normal;
+  for (int k = cloth_.vertex_offsets[v]; k < cloth_.vertex_offsets[v + 1]; ++k) {
+    const std::array<int, 3>& t = cloth_.triangles[cloth_.vertex_triangles[k]];
+    const Eigen::Vector3d a = x.segment<3>(3 * t[0]);
+    normal += (x.segment<3>(3 * t[1]) - a).cross(x.segment<3>(3 * t[2]) - a);
+  }
+  return normal;
+}
+
+std::optional<double> ContactResponse::pinch_gap(const Eigen::Vector3d& point,
+                                                 const Eigen::Vector3d& normal,
+                                                 const Eigen::Vector3d& cloth_normal) const {
+  // The other side of a pinch: the body's closest point to the point kPinchGapThicknesses
+  // thicknesses out along the normal. Its own surface (flat) is exactly that far; a facing
+  // surface nearer (or the point inside the facing part, a negative distance) gives the gap
+  // along the normal, g = reach + distance (exact for parallel surfaces, smaller for tilted
+  // ones).
+  const double reach = kPinchGapThicknesses * settings_.thickness;
+  const std::optional<BodyProximity> other = collider_.closest_point(point + reach * normal, reach);
+  if (!other || other->normal.dot(normal) > kPinchFacingCos) return std::nullopt;
+  // Inside the gap, or bridging its opening? Cloth inside a gap lies between the two surfaces:
+  // the segment from one to the other crosses the cloth, along its normal (the armpit's layer
+  // between arm and torso). Cloth over a cleft's opening has both surfaces on its body side and
+  // the segment runs along the cloth, beside it (the back of a skirt over the seat's cleft,
+  // whose rims hold it). Such cloth is not squeezed: its contacts keep the full thickness, as
+  // everywhere else (measured: budgeting them started a new cycle under the shaped tee dress).
+  const Eigen::Vector3d across = other->point - point;
+  const double scale = across.norm() * cloth_normal.norm();
+  if (!(scale > 0.0) || std::abs(across.dot(cloth_normal)) < kPinchAcrossCos * scale)
+    return std::nullopt;
+  return reach + other->distance;
+}
+
+double ContactResponse::contact_thickness(const BodyContact& contact,
+                                          const Eigen::VectorXd& x) const {
   const double thickness = settings_.thickness;
   if (!settings_.pinch_budget) return thickness;
-  // The other side of a pinch: the body's closest point to the point kPinchGapThicknesses
-  // thicknesses out along the contact's normal. Its own surface (flat) is exactly that far;
-  // a facing surface nearer (or the point inside the facing part, a negative distance) gives
-  // the gap along the normal, g = reach + distance (exact for parallel surfaces, smaller for
-  // tilted ones).
-  const double reach = kPinchGapThicknesses * thickness;
-  const std::optional<BodyProximity> other =
-      collider_.closest_point(contact.point + reach * contact.normal, reach);
-  if (!other || other->normal.dot(contact.normal) > kPinchFacingCos) return thickness;
-  const double gap = reach + other->distance;
-  return std::clamp(gap / 3.0, kMinPinchThicknessFraction * thickness, thickness);
+  const std::optional<double> gap =
+      pinch_gap(contact.point, contact.normal, cloth_vertex_normal(contact.vertex, x));
+  if (!gap) return thickness;
+  return std::clamp(*gap / 3.0, settings_.pinch_floor * thickness, thickness);
+}
+
+double ContactResponse::spring_clearance(const BodyPiercing& p, const Eigen::VectorXd& x) const {
+  const double clearance = kPiercingClearance * settings_.thickness;
+  if (!settings_.pinch_budget) return clearance;
+  // The body vertex, from the triangle's point under it and its height along the normal.
+  const std::array<int, 3>& t = cloth_.triangles[p.cloth_triangle];
+  Eigen::Vector3d vertex = p.height * p.normal;
+  for (int k = 0; k < 3; ++k) vertex += p.barycentric[k] * x.segment<3>(3 * t[k]);
+  // The same budget as the contacts: a third of the gap to a facing body part across the
+  // cloth, so that the springs of the two sides do not ask for the same cloth twice.
+  const std::optional<double> gap = pinch_gap(vertex, p.normal, p.normal);
+  if (!gap) return clearance;
+  return std::clamp(*gap / 3.0, std::min(settings_.pinch_floor * settings_.thickness, clearance),
+                    clearance);
 }
 
 int ContactResponse::add_contact(const BodyContact& contact, double thickness,
@@ -339,7 +384,7 @@ void ContactResponse::constrain_start(const Eigen::VectorXd& x_hat, const Eigen:
     // Farther than thickness: only a contact of the last step is held (and pulled back to the
     // thickness; if that pulls, it is released next step).
     // (A vertex placed at exactly the thickness counts as a contact despite rounding.)
-    const double thickness = contact_thickness(c);
+    const double thickness = contact_thickness(c, x_hat);
     if (c.distance >= thickness * (1.0 + 1e-9) && std::isnan(last_normal_force_[c.vertex]))
       continue;
     // A pinched contact's band is its own (the query's covers the full thickness).
@@ -386,7 +431,7 @@ double ContactResponse::point_mass(const BodyPiercing& p) const {
 
 PointSpring ContactResponse::piercing_spring(const BodyPiercing& p, const Eigen::VectorXd& x,
                                              const std::vector<unsigned char>& pinned,
-                                             double preload) const {
+                                             double preload, double clearance) const {
   const std::array<int, 3>& t = cloth_.triangles[p.cloth_triangle];
   PointSpring spring;
   spring.triangle = p.cloth_triangle;
@@ -401,10 +446,9 @@ PointSpring ContactResponse::piercing_spring(const BodyPiercing& p, const Eigen:
   // With the band a point already farther than that keeps its distance: the spring
   // starts the step pushing (its preload) or not at all, never pulling the cloth back onto the
   // vertex (which, released at the band's edge, fell back through and was caught again).
-  const double push = p.height + kPiercingClearance * settings_.thickness;
+  const double push = p.height + clearance;
   spring.target = settings_.spring_band ? along_spring_normal(spring, t, x) + std::max(push, 0.0)
-                                        : along_spring_normal(spring, t, x) + p.height +
-                                              kPiercingClearance * settings_.thickness;
+                                        : along_spring_normal(spring, t, x) + p.height + clearance;
   spring.reference_velocity = p.body_velocity;
   if (!(inverse_mass > 0.0)) return spring;  // all corners pinned: nothing can move
   const double mass = 1.0 / inverse_mass;
@@ -425,9 +469,9 @@ void ContactResponse::spring_start_piercings(const Eigen::VectorXd& start,
   if (!settings_.check_body_vertices || cloth_.triangles.empty() || repairing()) return;
   const int n = static_cast<int>(start.size() / 3);
   const double clearance = kPiercingClearance * settings_.thickness;
-  const double hold =
-      clearance +
+  const double margin =
       (settings_.spring_band ? kPiercingReleaseBand : kPiercingHoldMargin) * settings_.thickness;
+  const double hold = clearance + margin;
   pinned_.assign(static_cast<std::size_t>(n), 0);
   for (int i = 0; i < n; ++i) pinned_[i] = filter.is_pinned(i);
   // Every triangle near a body vertex, not only the highest: a vertex under a cloth edge is
@@ -456,6 +500,7 @@ void ContactResponse::spring_start_piercings(const Eigen::VectorXd& start,
       candidates.insert(found, *p);
   }
   std::vector<BodyPiercing> springs;
+  std::vector<double> clearances;  // per spring, m
   for (const BodyPiercing& p : candidates) {
     const auto [with_body, coasting] = end_heights(p, cloth_.triangles[p.cloth_triangle], v0, beta);
     const double carried = last_piercing_force_[p.body_vertex];
@@ -471,7 +516,14 @@ void ContactResponse::spring_start_piercings(const Eigen::VectorXd& start,
     // clearance let the cloth fall back through the next step, and a sheet on a sphere
     // re-solved every step).
     if (held ? with_body <= -hold : std::max(with_body, coasting) <= -clearance) continue;
+    // Inside a pinch (pinch_budget) the clearance is the vertex's share of the gap, held like
+    // a pinched contact up to (1 + kHoldMargin) times it: the two sides' bands stay apart.
+    const double own = spring_clearance(p, start);
+    if (own < clearance &&
+        (held ? with_body <= -(1.0 + kHoldMargin) * own : std::max(with_body, coasting) <= -own))
+      continue;
     springs.push_back(p);
+    clearances.push_back(own);
   }
   // The load a body vertex carried last step is shared by its springs (sorted by body vertex),
   // and so are the stiffness and damping: a vertex under a cloth edge pushes no harder than one
@@ -483,7 +535,7 @@ void ContactResponse::spring_start_piercings(const Eigen::VectorXd& start,
     const double share = std::isnan(force) ? 0.0 : std::max(force, 0.0) / (last - first);
     for (std::size_t k = first; k < last; ++k) {
       spring_body_vertex_.push_back(springs[k].body_vertex);
-      PointSpring spring = piercing_spring(springs[k], start, pinned_, share);
+      PointSpring spring = piercing_spring(springs[k], start, pinned_, share, clearances[k]);
       spring.stiffness /= static_cast<double>(last - first);
       spring.damping /= static_cast<double>(last - first);
       extra.springs.push_back(spring);
@@ -519,7 +571,7 @@ int ContactResponse::spring_end_piercings(const Eigen::VectorXd& x1, StepForces&
       // triangle, carrying the load. The old springs stay (their triangles may still rest on
       // the vertex).
       spring_body_vertex_.push_back(p.body_vertex);
-      extra.springs.push_back(piercing_spring(p, x1, pinned_, carried));
+      extra.springs.push_back(piercing_spring(p, x1, pinned_, carried, spring_clearance(p, x1)));
     }
     ++changed;
   }
@@ -598,7 +650,7 @@ int ContactResponse::constrain_deep(const Eigen::VectorXd& x0, const Eigen::Vect
   if ((too_deep_.empty() && piercings_.empty()) || stats_.resolves >= settings_.max_resolves)
     return 0;
   for (const BodyContact& c : too_deep_)
-    add_contact(c, contact_thickness(c), x_hat, beta, filter, y, false);
+    add_contact(c, contact_thickness(c, x1), x_hat, beta, filter, y, false);
   const int springs = spring_end_piercings(x1, extra);
   stats_.piercings_resolved += springs;
   const int added = static_cast<int>(too_deep_.size()) + springs;
@@ -615,7 +667,7 @@ void ContactResponse::finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v, const 
     const int i = c.vertex;
     Eigen::Vector3d point = c.point;
     Eigen::Vector3d normal = c.normal;
-    const double thickness = contact_thickness(c);
+    const double thickness = contact_thickness(c, x);
     for (int round = 0; round < kProjectionRounds; ++round) {
       x.segment<3>(3 * i) = point + thickness * normal;
       const std::optional<BodyProximity> check = collider_.closest_point(x.segment<3>(3 * i));

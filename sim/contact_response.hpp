@@ -82,14 +82,19 @@ struct ContactSettings {
   // sheet hung on a cone tip is let 1.09 mm through and a sheet on a sphere rests later).
   bool spring_band = false;
   // Where a second body part faces the contact's surface closer than 2.5 thicknesses along
-  // its normal (the armpit as the arm comes down, between the thighs, the seat's cleft), each
-  // side's contact keeps a third of the gap (at least the body-vertex springs' clearance)
-  // instead of the full thickness, leaving the middle third free (docs/collision.md, "A
-  // thickness budget for a pinch"). Without it a vertex in a gap narrower than two
-  // thicknesses is pushed out of one side's band into the other's and pushed back: a contact
-  // cycle that never rests. Off by default: measured, it keeps the shaped tee dress on the
-  // Collada human from resting in its 3 s (its back over the seat's cleft).
-  bool pinch_budget = false;
+  // its normal, across the cloth (the armpit as the arm comes down, between the thighs), each
+  // side's contact keeps a third of the gap (at least `pinch_floor` thicknesses) instead of the
+  // full thickness, leaving the middle third free; so do the body-vertex springs, at most their
+  // clearance (docs/collision.md, "A thickness budget for a pinch"). Without it a vertex in a
+  // gap narrower than two thicknesses is pushed out of one side's band into the other's and
+  // pushed back: a contact cycle that never rests. Cloth bridging a gap's opening (the back of
+  // a skirt over the seat's cleft: both surfaces beside it, not across it) is not squeezed and
+  // keeps the full thickness.
+  bool pinch_budget = true;
+  // The least share of a pinch a contact or a body-vertex spring keeps, in thicknesses. At the
+  // default, half a thickness, a spring's share is its clearance; measured, a quarter left the
+  // flat arms-lowering t-shirt moving more (docs/collision.md).
+  double pinch_floor = 0.5;
   // Collider query parameters (see sim/body_collider.hpp, ContactQuery).
   double search_margin = 0.02;
   double max_substep_motion = 0.005;
@@ -225,8 +230,22 @@ class ContactResponse {
   int add_contact(const BodyContact& contact, double thickness, const Eigen::VectorXd& x_hat,
                   double beta, ConstraintFilter& filter, Eigen::VectorXd& y, bool allow_release);
   // m: the distance a contact keeps its vertex from the body: the thickness, or with
-  // pinch_budget a third of the gap to a body part facing it across a pinch.
-  double contact_thickness(const BodyContact& contact) const;
+  // pinch_budget a third of the gap to a body part facing it across a pinch. x: the cloth's
+  // positions (3n), for the cloth's normal at the vertex (inside a gap or bridging its opening).
+  double contact_thickness(const BodyContact& contact, const Eigen::VectorXd& x) const;
+  // m: the clearance a body-vertex spring keeps between its body vertex and the cloth: half
+  // the thickness, or with pinch_budget at most a third of the gap to a body part facing the
+  // vertex across the cloth. x: the cloth's positions the piercing was found at.
+  double spring_clearance(const BodyPiercing& p, const Eigen::VectorXd& x) const;
+  // m: with pinch_budget, the gap from `point` on the body along its outward `normal` to a body
+  // surface facing it within kPinchGapThicknesses thicknesses, when that surface lies across the
+  // cloth (the gap runs along `cloth_normal`, any length and sign); none when nothing faces it
+  // or the cloth bridges the gap's opening (the facing surface beside it, not across it).
+  std::optional<double> pinch_gap(const Eigen::Vector3d& point, const Eigen::Vector3d& normal,
+                                  const Eigen::Vector3d& cloth_normal) const;
+  // The cloth's area-weighted normal at vertex `v` of x (3n), any orientation; zero without
+  // triangles (set_cloth_triangles).
+  Eigen::Vector3d cloth_vertex_normal(int v, const Eigen::VectorXd& x) const;
   // m: body vertices farther than this through the cloth are not looked for.
   double piercing_reach() const;
   // Piercings of x1 whose body vertex is more than `min_height` through the cloth; none when
@@ -242,7 +261,8 @@ class ContactResponse {
   // The spring that pushes piercing p's triangle to the clearance in
   // front of its body vertex, from positions x (the body at its end pose), with `preload`.
   PointSpring piercing_spring(const BodyPiercing& p, const Eigen::VectorXd& x,
-                              const std::vector<unsigned char>& pinned, double preload) const;
+                              const std::vector<unsigned char>& pinned, double preload,
+                              double clearance) const;
   // The largest preload a spring carries (N): kMaxSpringLoadClothWeights times the cloth's
   // weight.
   double max_spring_preload() const;
