@@ -292,9 +292,14 @@ TEST(BodyCollider, CacheSkipsWorkWithoutChangingTheContacts) {
     const std::vector<BodyContact> cached = collider.find_contacts(x, query, &cache, &stats);
     const std::vector<BodyContact> fresh = collider.find_contacts(x, query);
     ASSERT_EQ(cached.size(), fresh.size()) << step;
+    // The cached searches also start from last step's nearest triangle (a hint that bounds the
+    // search): the same triangle and the same bits as a search without it.
     for (std::size_t k = 0; k < fresh.size(); ++k) {
       EXPECT_EQ(cached[k].vertex, fresh[k].vertex);
-      EXPECT_NEAR(cached[k].distance, fresh[k].distance, 1e-12);
+      EXPECT_EQ(cached[k].triangle, fresh[k].triangle);
+      EXPECT_EQ(cached[k].distance, fresh[k].distance);
+      EXPECT_EQ(cached[k].point, fresh[k].point);
+      EXPECT_EQ(cached[k].normal, fresh[k].normal);
     }
     skipped += stats.skipped;
   }
