@@ -39,7 +39,7 @@ AutomaticChoice choose_settings(const SceneTraits& scene) {
     choice.preconditioner = vertices > kAutomaticTwoLevelVertices
                                 ? PcgPreconditioner::two_level
                                 : PcgPreconditioner::block_incomplete_cholesky;
-    // Third round: the drape's step by what holds the sheet (bench, 1 s at L4 against the
+    // Fourth round: the drape's step by what holds the sheet (bench, 1 s at L4 against the
     // 1/60 s run's RMS trajectory error): pins that hold its shape leave only elastic sag, and
     // 1/20 s stayed within the band (hanging sheet on three corners 1.46x); a sheet on two
     // corners swings as a pendulum, which long steps damp (1/20 s 1.93x, 1/30 s 1.57x, 1/40 s

@@ -149,8 +149,10 @@ bool CholmodSolver::factorize(const SparseMatrixR& a, const ConstraintFilter& fi
         }
     upper_.resize(rows, rows);
     upper_.setFromTriplets(entries.begin(), entries.end());
-    if (upper_.nonZeros() != static_cast<Eigen::Index>(upper_source_.size()))
+    if (upper_.nonZeros() != static_cast<Eigen::Index>(upper_source_.size())) {
+      outer_.clear();  // analyse again next time
       throw std::invalid_argument("the system matrix repeats an entry of its pattern");
+    }
   }
   // Values of S A S + (I − S), block by block; blocks between free vertices (S = I) stay A's.
   std::copy(a.valuePtr(), a.valuePtr() + a.nonZeros(), filtered_.valuePtr());
