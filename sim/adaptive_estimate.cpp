@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "sim/element_forces.hpp"
+#include "sim/parallel.hpp"
 
 namespace sd::sim {
 namespace {
@@ -93,6 +94,10 @@ double body_sag(const BodyCollider& body, double reach, const Eigen::Vector3d& x
   return std::max(0.0, (middle->point - 0.5 * (at_i->point + at_j->point)).dot(middle->normal));
 }
 
+// Vertices or edges per chunk at least in BodySagCache::sags: most need no query (a comparison),
+// a stale one up to three closest-point searches of a few microseconds.
+constexpr int kSagGrain = 512;
+
 Eigen::VectorXd BodySagCache::sags(const meshing::Mesh48Arrays& arrays,
                                    const ContactResponse& contact, double reach,
                                    const Eigen::VectorXd& x, double refine_threshold,
@@ -138,20 +143,26 @@ Eigen::VectorXd BodySagCache::sags(const meshing::Mesh48Arrays& arrays,
   }
   // The body point under each of those vertices within reach (bounded queries: most of a
   // garment is not, and FCL prunes by the bound).
+  // Both loops on the simulator's threads: each item writes only its own entry, so the result
+  // is the same on any thread count.
   std::vector<std::optional<BodyProximity>> under(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i)
-    if (needed[static_cast<std::size_t>(i)])
-      under[static_cast<std::size_t>(i)] = contact.collider().closest_point(row3(x, i), reach);
-  for (Eigen::Index r = 0; r < edges.rows(); ++r) {
-    if (!stale[static_cast<std::size_t>(r)]) continue;
-    const int i = edges(r, 0), j = edges(r, 1);
-    const std::optional<BodyProximity>& at_i = under[static_cast<std::size_t>(i)];
-    const std::optional<BodyProximity>& at_j = under[static_cast<std::size_t>(j)];
-    if (at_i || at_j)
-      sags(r) = body_sag(contact.collider(), reach, row3(x, i), row3(x, j), at_i ? &*at_i : nullptr,
-                         at_j ? &*at_j : nullptr);
-    memory_[static_cast<std::size_t>(r)] = {row3(x, i), row3(x, j), body_motion, sags(r), true};
-  }
+  parallel_chunks(n, kSagGrain, [&](int, int first, int last) {
+    for (int i = first; i < last; ++i)
+      if (needed[static_cast<std::size_t>(i)])
+        under[static_cast<std::size_t>(i)] = contact.collider().closest_point(row3(x, i), reach);
+  });
+  parallel_chunks(static_cast<int>(edges.rows()), kSagGrain, [&](int, int first, int last) {
+    for (int r = first; r < last; ++r) {
+      if (!stale[static_cast<std::size_t>(r)]) continue;
+      const int i = edges(r, 0), j = edges(r, 1);
+      const std::optional<BodyProximity>& at_i = under[static_cast<std::size_t>(i)];
+      const std::optional<BodyProximity>& at_j = under[static_cast<std::size_t>(j)];
+      if (at_i || at_j)
+        sags(r) = body_sag(contact.collider(), reach, row3(x, i), row3(x, j),
+                           at_i ? &*at_i : nullptr, at_j ? &*at_j : nullptr);
+      memory_[static_cast<std::size_t>(r)] = {row3(x, i), row3(x, j), body_motion, sags(r), true};
+    }
+  });
   return sags;
 }
 

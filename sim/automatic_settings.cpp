@@ -39,7 +39,17 @@ AutomaticChoice choose_settings(const SceneTraits& scene) {
     choice.preconditioner = vertices > kAutomaticTwoLevelVertices
                                 ? PcgPreconditioner::two_level
                                 : PcgPreconditioner::block_incomplete_cholesky;
-    choice.dt = scene.motion ? kAutomaticMotionStep : kAutomaticSheetStep;
+    // Fourth round: the drape's step by what holds the sheet (bench, 1 s at L4 against the
+    // 1/60 s run's RMS trajectory error): pins that hold its shape leave only elastic sag, and
+    // 1/20 s stayed within the band (hanging sheet on three corners 1.46x); a sheet on two
+    // corners swings as a pendulum, which long steps damp (1/20 s 1.93x, 1/30 s 1.57x, 1/40 s
+    // 1.32x); on a body it slides and folds over it (1/30 s 1.81x, 1/40 s 1.51x, 1/50 s 1.12x).
+    if (scene.motion)
+      choice.dt = kAutomaticMotionStep;
+    else if (scene.body)
+      choice.dt = kAutomaticContactStep;
+    else
+      choice.dt = scene.pins_hold_shape ? kAutomaticSheetStep : kAutomaticSwingStep;
   }
   choice.reason = fmt::format(
       "automatic: implicit Euler, {} ({} vertices), steps of 1/{:.0f} s ({}{})",
@@ -47,12 +57,34 @@ AutomaticChoice choose_settings(const SceneTraits& scene) {
       : choice.preconditioner == PcgPreconditioner::two_level ? "the two-level PCG"
                                                               : "the IC(0) PCG",
       vertices, 1.0 / choice.dt,
-      scene.garment        ? "a garment"
-      : scene.self_contact ? "self-contact"
-      : scene.body         ? "a sheet on a body, without self-contact"
-                           : "a sheet without a body or self-contact",
+      scene.garment           ? "a garment"
+      : scene.self_contact    ? "self-contact"
+      : scene.body            ? "a sheet on a body, without self-contact"
+      : scene.pins_hold_shape ? "a sheet without a body or self-contact, its pins holding its shape"
+                              : "a sheet without a body or self-contact, free to swing on its pins",
       scene.motion && !scene.garment && !scene.self_contact ? "; the motion asked for" : "");
   return choice;
+}
+
+bool pins_hold_shape(const Eigen::MatrixX3d& positions, const std::vector<int>& pinned) {
+  if (pinned.size() < 3) return false;
+  const auto at = [&](int v) -> Eigen::Vector3d { return positions.row(v).transpose(); };
+  // The two farthest apart, approximately: the pin farthest from the first, then the pin
+  // farthest from that one (exact for collinear pins, within a factor 2 otherwise).
+  const auto farthest_from = [&](const Eigen::Vector3d& p) {
+    int best = pinned.front();
+    for (int v : pinned)
+      if ((at(v) - p).squaredNorm() > (at(best) - p).squaredNorm()) best = v;
+    return best;
+  };
+  const Eigen::Vector3d a = at(farthest_from(at(pinned.front())));
+  const Eigen::Vector3d b = at(farthest_from(a));
+  const double length = (b - a).norm();
+  if (!(length > 0.0)) return false;
+  const Eigen::Vector3d axis = (b - a) / length;
+  double off_line = 0.0;
+  for (int v : pinned) off_line = std::max(off_line, (at(v) - a).cross(axis).norm());
+  return off_line >= 0.1 * length;
 }
 
 void apply_choice(const AutomaticChoice& choice, bool solver_automatic, bool step_automatic,

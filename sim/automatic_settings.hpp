@@ -4,7 +4,9 @@
 // a rule read off the work-precision front (docs/simulator.md, "Automatic settings", has the
 // measurements behind every threshold).
 
+#include <Eigen/Core>
 #include <string>
+#include <vector>
 
 #include "sim/implicit_solver.hpp"
 #include "sim/simulation.hpp"
@@ -24,6 +26,10 @@ struct SceneTraits {
   // The motion is asked for, not only the drape (`run --frames N`): the step must follow the
   // trajectory, not only reach the end state.
   bool motion = false;
+  // The pins hold the sheet's shape: at least three pinned vertices not on one line
+  // (pins_hold_shape below), so no rigid motion is left free. Two corners, one edge or no pins
+  // leave a swing (or a slide, or a fall) that long implicit Euler steps damp away.
+  bool pins_hold_shape = false;
 };
 
 struct AutomaticChoice {
@@ -41,10 +47,19 @@ struct AutomaticChoice {
 // Garments and cloth with self-contact always use CHOLMOD.
 inline constexpr int kAutomaticTwoLevelVertices = 8000;
 
-// The sheets' steps (s): for a drape, and when the motion is asked for. The measurements behind
-// each are in docs/simulator.md, "Automatic settings".
+// The sheets' steps (s): for a drape whose pins hold its shape, for one they leave free to swing
+// (or unpinned), for one on a body, and when the motion is asked for. Each is the longest of the
+// measured steps that kept the bench's sheets within the error band (1.5x the trajectory error
+// at 1/60 s); the measurements are in docs/simulator.md, "Automatic settings".
 inline constexpr double kAutomaticSheetStep = 1.0 / 20.0;
+inline constexpr double kAutomaticSwingStep = 1.0 / 40.0;
+inline constexpr double kAutomaticContactStep = 1.0 / 50.0;
 inline constexpr double kAutomaticMotionStep = 1.0 / 60.0;
+
+// True when the pinned vertices (rows of `positions`, m) hold a rigid body still: at least three
+// of them, not all near one line (the farthest from the line through the two farthest apart is at
+// least a tenth of their distance). Two pins leave the swing about their axis.
+bool pins_hold_shape(const Eigen::MatrixX3d& positions, const std::vector<int>& pinned);
 
 AutomaticChoice choose_settings(const SceneTraits& scene);
 

@@ -85,6 +85,13 @@ std::vector<BodyContact> contacts_by_vertex(int n, ContactQueryStats& total, Vis
   return join_chunks(chunk_contacts, chunk_stats, total);
 }
 
+// m: how far past the hint's distance a search still reaches (BodyCollider::nearest). A box's
+// distance is computed with rounding (the RSS frames' transforms) and may exceed the exact
+// distance of a triangle inside it by that much: a search bounded at the hint's distance exactly
+// cut such a box and took another triangle (the 2 cm tee's drape changed). A nanometre
+// is far above the rounding and far below any distance the contacts care about.
+constexpr double kHintSlack = 1e-9;
+
 }  // namespace
 
 // Adjacency for pseudo-normals at arbitrary pose times (CSR lists).
@@ -368,10 +375,21 @@ bool BodyCollider::outside_box(const Eigen::Vector3d& p) const {
   return (p.array() < box_min_.array()).any() || (p.array() > box_max_.array()).any();
 }
 
-std::optional<BodyProximity> BodyCollider::nearest(const Eigen::Vector3d& p, double t,
-                                                   double bound) const {
+std::optional<BodyProximity> BodyCollider::nearest(const Eigen::Vector3d& p, double t, double bound,
+                                                   int hint) const {
   // Depth-first branch and bound over FCL's tree, nearer child first. The boxes bound each
   // triangle at both of the last two poses, hence at every pose in between.
+  // The hint's distance d_h bounds the nearest distance d*, so starting the search at just above
+  // d_h instead of `bound` only prunes subtrees whose box is farther than d_h >= d*: the
+  // traversal still reaches, in the same order, the first triangle at d* it reached before (a
+  // subtree is cut only at box distance >= best, and best falls to d* only once a triangle at d*
+  // was found), and leaves are taken only when strictly nearer. Same triangle, same bits.
+  if (hint >= 0 && hint < faces_.rows()) {
+    const TriangleClosestPoint cp = closest_point_on_triangle(
+        p, corner(faces_(hint, 0), t), corner(faces_(hint, 1), t), corner(faces_(hint, 2), t));
+    const double d = std::sqrt(cp.squared_distance);
+    if (d + kHintSlack < bound) bound = d + kHintSlack;
+  }
   double best = bound;
   int best_triangle = -1;
   TriangleClosestPoint best_point;
@@ -481,18 +499,19 @@ void BodyCollider::classify_current(int vertex, const Eigen::Vector3d& p, bool k
     return;
   }
   const double bound = query.thickness + (use_margin ? query.search_margin : 0.0);
-  std::optional<BodyProximity> found = nearest(p, 1.0, bound);
+  const int hint = entry != nullptr ? entry->triangle : -1;
+  std::optional<BodyProximity> found = nearest(p, 1.0, bound, hint);
   ++stats.bounded_searches;
   if (!found && !known_outside && !outside_box(p)) {
     // Nothing within reach: far outside, or deep inside. Only a full search tells.
-    found = nearest(p, 1.0, std::numeric_limits<double>::infinity());
+    found = nearest(p, 1.0, std::numeric_limits<double>::infinity(), hint);
     ++stats.full_searches;
   }
   if (found) {
     if (found->distance < query.thickness) contacts.push_back(make_contact(vertex, *found));
     if (entry != nullptr)
       *entry = {p, std::abs(found->distance), total_motion_,
-                found->distance >= 0.0 ? State::outside : State::inside};
+                found->distance >= 0.0 ? State::outside : State::inside, found->triangle};
   } else if (entry != nullptr) {
     *entry = {p, bound, total_motion_, State::outside};
   }
@@ -573,7 +592,8 @@ std::vector<BodyContact> BodyCollider::find_contacts_swept(const Eigen::VectorXd
           }
         }
         if (!sign_known && relative_motion > 0.0) {
-          const std::optional<BodyProximity> start = nearest(p0, 0.0, relative_motion);
+          const std::optional<BodyProximity> start =
+              nearest(p0, 0.0, relative_motion, entry != nullptr ? entry->triangle : -1);
           ++local.bounded_searches;
           if (start) {
             sign_known = true;
@@ -607,7 +627,8 @@ std::vector<BodyContact> BodyCollider::find_contacts_swept(const Eigen::VectorXd
               const double bound =
                   std::max(relative_motion / samples, relative_motion * (1.0 - t)) +
                   query.thickness;
-              const std::optional<BodyProximity> sample = nearest(p0 + t * (p1 - p0), t, bound);
+              const std::optional<BodyProximity> sample =
+                  nearest(p0 + t * (p1 - p0), t, bound, entry != nullptr ? entry->triangle : -1);
               ++local.sweep_samples;
               if (!sample) {
                 clear_to_end = true;
@@ -642,7 +663,7 @@ std::vector<BodyContact> BodyCollider::find_contacts_swept(const Eigen::VectorXd
           if (!(normal.squaredNorm() > 0.0)) normal = face_normals_[f];
           normal.normalize();
           const double behind = (p1 - point).dot(normal);
-          const BodyProximity end = *nearest(p1, 1.0, infinity);
+          const BodyProximity end = *nearest(p1, 1.0, infinity, entry_point->triangle);
           ++local.full_searches;
           // Came back out on the entry side, or ended inside with the nearest surface facing the
           // way it came in: the ordinary contact is right. Otherwise it tunnelled.
@@ -664,7 +685,7 @@ std::vector<BodyContact> BodyCollider::find_contacts_swept(const Eigen::VectorXd
             if (end.distance < query.thickness) contacts.push_back(make_contact(i, end));
             if (entry != nullptr)
               *entry = {p1, std::abs(end.distance), total_motion_,
-                        end.distance >= 0.0 ? State::outside : State::inside};
+                        end.distance >= 0.0 ? State::outside : State::inside, end.triangle};
           }
           return;
         }

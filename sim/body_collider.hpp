@@ -141,6 +141,7 @@ class ContactCache {
     double clearance = 0.0;  // lower bound of the unsigned distance to the body there, m
     double stamp = 0.0;      // the collider's cumulative motion at the evaluated pose, m
     State state = State::unknown;
+    int triangle = -1;  // the body triangle nearest to it then (a hint for the next search)
   };
   std::vector<Entry> entries_;
   std::uint64_t collider_id_ = 0;
@@ -254,8 +255,11 @@ class BodyCollider {
   using Model = fcl::BVHModel<fcl::RSS<double>>;
 
   // Closest point at pose time t ∈ [0, 1] (0 = previous pose, 1 = current), searching only
-  // within `bound`; nothing if the surface is farther.
-  std::optional<BodyProximity> nearest(const Eigen::Vector3d& p, double t, double bound) const;
+  // within `bound`; nothing if the surface is farther. `hint`: a body triangle likely near p
+  // (the one found for the same cloth vertex last step, or -1): its distance bounds the search,
+  // which then prunes most of the tree and returns the same result (see the definition).
+  std::optional<BodyProximity> nearest(const Eigen::Vector3d& p, double t, double bound,
+                                       int hint = -1) const;
   // Body vertex at time t ∈ [0, 1] of the current step (0 = previous pose, 1 = current).
   Eigen::Vector3d corner(int vertex, double t) const;
   // FCL refit with prev_vertices = from and vertices = to (#V each).

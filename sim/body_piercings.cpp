@@ -169,26 +169,80 @@ std::vector<BodyPiercing> BodyCollider::find_piercings(
                            static_cast<int>((p.y() - low.y()) / cell),
                            static_cast<int>((p.z() - low.z()) / cell));
   };
-  const auto key_of = [&](const Eigen::Vector3i& c) {
-    return (static_cast<std::int64_t>(c.x()) * kMaxCells + c.y()) * kMaxCells + c.z();
-  };
-  // (cell key, triangle) for every cell a triangle's box, grown by the reach (where the body
-  // vertices it can cover lie), overlaps; sorted by key.
-  std::vector<std::pair<std::int64_t, int>> cells;
-  cells.reserve(8 * triangles.size());
-  for (int t = 0; t < static_cast<int>(triangles.size()); ++t) {
+  // Every cell a triangle's box, grown by the reach (where the body vertices it can cover lie),
+  // overlaps: the triangles of each cell in increasing order. Cells are counted and filled in
+  // triangle order (a counting sort over the grid's cells, row-major i, j, k), the order the
+  // sorted (cell, triangle) pairs of the first version had, so each vertex meets its triangles
+  // in the same order and the result is the same bits. A sparse grid (more cells than 4 per
+  // entry) keeps the sorted pairs: the count array would cost more than the sort.
+  const Eigen::Vector3i dims = cell_of(high) + Eigen::Vector3i::Ones();
+  std::vector<std::array<Eigen::Vector3i, 2>> boxes(triangles.size());
+  std::int64_t entries = 0;
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
     Eigen::Vector3d a = row(x, triangles[t][0]), b = a;
     for (int k = 1; k < 3; ++k) {
       a = a.cwiseMin(row(x, triangles[t][k]));
       b = b.cwiseMax(row(x, triangles[t][k]));
     }
-    const Eigen::Vector3i c0 = cell_of(a.array() - reach), c1 = cell_of(b.array() + reach);
+    boxes[t] = {cell_of(a.array() - reach), cell_of(b.array() + reach)};
+    entries += (boxes[t][1] - boxes[t][0] + Eigen::Vector3i::Ones()).cast<std::int64_t>().prod();
+  }
+  const std::int64_t grid_cells = dims.cast<std::int64_t>().prod();
+  const bool dense = grid_cells <= std::max<std::int64_t>(4 * entries, 1 << 16);
+  const auto key_of = [&](const Eigen::Vector3i& c) {
+    return dense ? (static_cast<std::int64_t>(c.x()) * dims.y() + c.y()) * dims.z() + c.z()
+                 : (static_cast<std::int64_t>(c.x()) * kMaxCells + c.y()) * kMaxCells + c.z();
+  };
+  const auto each_cell = [&](std::size_t t, const auto& visit) {
+    const auto& [c0, c1] = boxes[t];
     for (int i = c0.x(); i <= c1.x(); ++i)
       for (int j = c0.y(); j <= c1.y(); ++j)
-        for (int k = c0.z(); k <= c1.z(); ++k) cells.emplace_back(key_of({i, j, k}), t);
+        for (int k = c0.z(); k <= c1.z(); ++k) visit(key_of({i, j, k}));
+  };
+  std::vector<std::int64_t> cell_start;  // per cell (dense) or listed key (sparse): first entry
+  std::vector<int> cell_triangles;       // the entries, cell by cell
+  std::vector<std::int64_t> keys;        // sparse: the cells holding entries, increasing
+  if (dense) {
+    cell_start.assign(static_cast<std::size_t>(grid_cells) + 1, 0);
+    for (std::size_t t = 0; t < triangles.size(); ++t)
+      each_cell(t, [&](std::int64_t key) { ++cell_start[static_cast<std::size_t>(key) + 1]; });
+    for (std::size_t c = 1; c < cell_start.size(); ++c) cell_start[c] += cell_start[c - 1];
+    cell_triangles.resize(static_cast<std::size_t>(entries));
+    std::vector<std::int64_t> fill(cell_start.begin(), cell_start.end() - 1);
+    for (std::size_t t = 0; t < triangles.size(); ++t)
+      each_cell(t, [&](std::int64_t key) {
+        cell_triangles[static_cast<std::size_t>(fill[static_cast<std::size_t>(key)]++)] =
+            static_cast<int>(t);
+      });
+  } else {
+    std::vector<std::pair<std::int64_t, int>> cells;
+    cells.reserve(static_cast<std::size_t>(entries));
+    for (std::size_t t = 0; t < triangles.size(); ++t)
+      each_cell(t, [&](std::int64_t key) { cells.emplace_back(key, static_cast<int>(t)); });
+    std::sort(cells.begin(), cells.end());
+    cell_triangles.reserve(cells.size());
+    for (std::size_t e = 0; e < cells.size(); ++e) {
+      if (e == 0 || cells[e].first != cells[e - 1].first) {
+        keys.push_back(cells[e].first);
+        cell_start.push_back(static_cast<std::int64_t>(e));
+      }
+      cell_triangles.push_back(cells[e].second);
+    }
+    cell_start.push_back(static_cast<std::int64_t>(cells.size()));
   }
-  std::sort(cells.begin(), cells.end());
-  stats.grid_entries = static_cast<std::int64_t>(cells.size());
+  // The triangles in the cell of point b (inside the grid), in increasing order.
+  const auto triangles_at = [&](const Eigen::Vector3d& b) -> std::pair<const int*, const int*> {
+    std::int64_t key = key_of(cell_of(b));
+    if (!dense) {
+      const auto it = std::lower_bound(keys.begin(), keys.end(), key);
+      if (it == keys.end() || *it != key) return {nullptr, nullptr};
+      key = it - keys.begin();
+    }
+    const int* first = cell_triangles.data();
+    return {first + cell_start[static_cast<std::size_t>(key)],
+            first + cell_start[static_cast<std::size_t>(key) + 1]};
+  };
+  stats.grid_entries = entries;
   // Unit normals once per triangle (zero when degenerate), not once per pair.
   std::vector<Eigen::Vector3d> normals(triangles.size());
   for (std::size_t t = 0; t < triangles.size(); ++t)
@@ -207,12 +261,11 @@ std::vector<BodyPiercing> BodyCollider::find_piercings(
       const Eigen::Vector3d b = corner(v, 1.0);
       if ((b - low).minCoeff() < 0.0 || (high - b).minCoeff() < 0.0) continue;
       ++local.body_vertices;
-      const std::int64_t key = key_of(cell_of(b));
-      auto it = std::lower_bound(cells.begin(), cells.end(), std::make_pair(key, -1));
+      const auto [cell_first, cell_last] = triangles_at(b);
       const Eigen::Vector3d body_normal = vertex_normals_[v].normalized();
       std::optional<BodyPiercing> best;
-      for (; it != cells.end() && it->first == key; ++it) {
-        const int t = it->second;
+      for (const int* it = cell_first; it != cell_last; ++it) {
+        const int t = *it;
         ++local.pairs;
         Eigen::Vector3d normal = normals[static_cast<std::size_t>(t)];
         const double facing = normal.dot(body_normal);

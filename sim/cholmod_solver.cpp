@@ -116,6 +116,12 @@ void CholmodSolver::record_analysed_size() {
 }
 
 bool CholmodSolver::factorize(const SparseMatrixR& a, const ConstraintFilter& filter) {
+  // The arrays below are read as a compressed matrix's (a matrix filled by insert() is not).
+  if (!a.isCompressed()) {
+    SparseMatrixR compressed = a;
+    compressed.makeCompressed();
+    return factorize(compressed, filter);
+  }
   const int rows = static_cast<int>(a.rows());
   const int* outer = a.outerIndexPtr();
   const int* inner = a.innerIndexPtr();
@@ -129,6 +135,24 @@ bool CholmodSolver::factorize(const SparseMatrixR& a, const ConstraintFilter& fi
     // A is structurally symmetric, so its row-major arrays read as column-major are A itself.
     filtered_ = Eigen::Map<const ColMatrix>(rows, rows, static_cast<int>(a.nonZeros()), outer,
                                             inner, a.valuePtr());
+    // CHOLMOD reads only the upper triangle of a symmetric matrix (stype 1), but its numeric
+    // factorisation first makes the permuted transpose, scanning every stored entry: given the
+    // upper triangle alone it scans half as many. The same entries in the same column order,
+    // so the same factor, bit for bit.
+    std::vector<Eigen::Triplet<double>> entries;
+    upper_source_.clear();
+    for (int j = 0; j < rows; ++j)
+      for (int k = filtered_.outerIndexPtr()[j]; k < filtered_.outerIndexPtr()[j + 1]; ++k)
+        if (filtered_.innerIndexPtr()[k] <= j) {
+          entries.emplace_back(filtered_.innerIndexPtr()[k], j, 0.0);
+          upper_source_.push_back(k);
+        }
+    upper_.resize(rows, rows);
+    upper_.setFromTriplets(entries.begin(), entries.end());
+    if (upper_.nonZeros() != static_cast<Eigen::Index>(upper_source_.size())) {
+      outer_.clear();  // analyse again next time
+      throw std::invalid_argument("the system matrix repeats an entry of its pattern");
+    }
   }
   // Values of S A S + (I − S), block by block; blocks between free vertices (S = I) stay A's.
   std::copy(a.valuePtr(), a.valuePtr() + a.nonZeros(), filtered_.valuePtr());
@@ -153,6 +177,10 @@ bool CholmodSolver::factorize(const SparseMatrixR& a, const ConstraintFilter& fi
       }
     }
   }
+  // The upper triangle's values (A's columns are sorted, so upper_'s entries are in the order
+  // they were collected in).
+  for (std::size_t e = 0; e < upper_source_.size(); ++e)
+    upper_.valuePtr()[e] = filtered_.valuePtr()[upper_source_[e]];
   limit_solver_library_threads();  // before CHOLMOD's OpenMP loops and OpenBLAS kernels
   if (!same_pattern) {
     // AMD on the vertex graph (a ninth of the scalar pattern's entries), each vertex's three
@@ -160,14 +188,14 @@ bool CholmodSolver::factorize(const SparseMatrixR& a, const ConstraintFilter& fi
     // costs about a numeric factorisation when CHOLMOD orders the 3n scalar rows itself.
     std::vector<int> order = block_ordering(outer, inner, rows);
     if (order.empty())
-      factor_->llt.analyzePattern(filtered_);
+      factor_->llt.analyzePattern(upper_);
     else
-      factor_->llt.analyze_with_ordering(filtered_, order);
+      factor_->llt.analyze_with_ordering(upper_, order);
     ++analyses_;
     throw_if_out_of_memory(rows, "analysis");
     record_analysed_size();
   }
-  factor_->llt.factorize(filtered_);
+  factor_->llt.factorize(upper_);
   ++factorizations_;
   throw_if_out_of_memory(rows, "factorisation");
   factorized_ = factor_->llt.info() == Eigen::Success;

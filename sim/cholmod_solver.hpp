@@ -62,6 +62,10 @@ class CholmodSolver {
   CholmodMethod method_;
   std::unique_ptr<Factor> factor_;
   Eigen::SparseMatrix<double, Eigen::ColMajor, int> filtered_;
+  // The upper triangle of filtered_, what CHOLMOD is given, and where each of its values sits in
+  // filtered_'s value array.
+  Eigen::SparseMatrix<double, Eigen::ColMajor, int> upper_;
+  std::vector<int> upper_source_;
   std::vector<int> outer_;
   std::vector<int> inner_;
   bool factorized_ = false;

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "sim/collision_geometry.hpp"
+#include "sim/parallel.hpp"
 
 namespace sd::sim {
 namespace {
@@ -359,6 +360,37 @@ void SelfCollider::pair_test(int a, int b, LeafTest& leaf, SelfQueryStats& stats
   }
 }
 
+namespace {
+
+// Triangle pairs per chunk at least: each costs up to 15 element tests (a few microseconds).
+constexpr int kLeafGrain = 256;
+
+// The triangle pairs the traversal reached, tested by `leaf(ta, tb, found, tests)` in chunks on
+// the simulator's threads; the chunks' element pairs are joined in traversal order, so the list
+// (and the order) is the same on any thread count as on one, and as testing each leaf during the
+// traversal gave. The traversal itself (box tests, the curvature culling) stays serial.
+template <class Leaf>
+void test_leaves(const std::vector<std::array<int, 2>>& leaves, const Leaf& leaf,
+                 std::vector<SelfPair>& pairs, long long& element_tests) {
+  const int n = static_cast<int>(leaves.size());
+  const int chunks = chunk_count(n, kLeafGrain);
+  std::vector<std::vector<SelfPair>> found(static_cast<std::size_t>(chunks));
+  std::vector<long long> tests(static_cast<std::size_t>(chunks), 0);
+  parallel_chunks(n, kLeafGrain, [&](int chunk, int first, int last) {
+    const auto c = static_cast<std::size_t>(chunk);
+    for (int i = first; i < last; ++i) {
+      const std::array<int, 2>& l = leaves[static_cast<std::size_t>(i)];
+      leaf(l[0], l[1], found[c], tests[c]);
+    }
+  });
+  for (std::size_t c = 0; c < found.size(); ++c) {
+    pairs.insert(pairs.end(), found[c].begin(), found[c].end());
+    element_tests += tests[c];
+  }
+}
+
+}  // namespace
+
 std::vector<SelfPair> SelfCollider::find_proximities(const Eigen::VectorXd& x, double distance,
                                                      SelfQueryStats* stats) {
   SelfQueryStats local;
@@ -369,10 +401,10 @@ std::vector<SelfPair> SelfCollider::find_proximities(const Eigen::VectorXd& x, d
   if (nodes_.empty()) return pairs;
   refit(x, x, 0.5 * distance);
   const double limit2 = distance * distance;
-  const auto vertex_face = [&](int v, int t) {
+  const auto vertex_face = [&](int v, int t, std::vector<SelfPair>& out, long long& tests) {
     const std::array<int, 3>& f = triangles_[t];
     if (v == f[0] || v == f[1] || v == f[2]) return;
-    ++s.element_tests;
+    ++tests;
     const std::array<Eigen::Vector3d, 4> p = {row(x, v), row(x, f[0]), row(x, f[1]), row(x, f[2])};
     const TriangleClosestPoint cp = closest_point_on_triangle(p[0], p[1], p[2], p[3]);
     if (cp.squared_distance >= limit2) return;
@@ -389,13 +421,13 @@ std::vector<SelfPair> SelfCollider::find_proximities(const Eigen::VectorXd& x, d
     } else {
       return;
     }
-    pairs.push_back(pair);
+    out.push_back(pair);
   };
-  const auto edge_edge = [&](int e, int g) {
+  const auto edge_edge = [&](int e, int g, std::vector<SelfPair>& out, long long& tests) {
     const std::array<int, 2>& a = edges_[e];
     const std::array<int, 2>& b = edges_[g];
     if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) return;
-    ++s.element_tests;
+    ++tests;
     const SegmentClosestPoints cp =
         closest_points_on_segments(row(x, a[0]), row(x, a[1]), row(x, b[0]), row(x, b[1]));
     // Closest points at an end are a vertex's contact, found by the vertex-face test.
@@ -413,24 +445,27 @@ std::vector<SelfPair> SelfCollider::find_proximities(const Eigen::VectorXd& x, d
       if (!(n.norm() > 0.0)) return;
       pair.normal = n.normalized();
     }
-    pairs.push_back(pair);
+    out.push_back(pair);
   };
-  auto leaf = [&](int ta, int tb) {
+  const auto leaf = [&](int ta, int tb, std::vector<SelfPair>& out, long long& tests) {
     for (int k = 0; k < 3; ++k) {
       const int va = triangles_[ta][k], vb = triangles_[tb][k];
-      if (vertex_owner_[va] == ta) vertex_face(va, tb);
-      if (vertex_owner_[vb] == tb) vertex_face(vb, ta);
+      if (vertex_owner_[va] == ta) vertex_face(va, tb, out, tests);
+      if (vertex_owner_[vb] == tb) vertex_face(vb, ta, out, tests);
     }
     for (int i = 0; i < 3; ++i) {
       const int e = triangle_edges_[ta][i];
       if (edge_owner_[e] != ta) continue;
       for (int j = 0; j < 3; ++j) {
         const int g = triangle_edges_[tb][j];
-        if (edge_owner_[g] == tb) edge_edge(e, g);
+        if (edge_owner_[g] == tb) edge_edge(e, g, out, tests);
       }
     }
   };
-  self_test(0, x, x, leaf, s);
+  std::vector<std::array<int, 2>> leaves;
+  auto collect = [&](int ta, int tb) { leaves.push_back({ta, tb}); };
+  self_test(0, x, x, collect, s);
+  test_leaves(leaves, leaf, pairs, s.element_tests);
   s.pairs_found = static_cast<int>(pairs.size());
   return pairs;
 }
@@ -473,43 +508,46 @@ std::vector<SelfPair> SelfCollider::find_collisions(const Eigen::VectorXd& x0,
     box.max().array() += 0.5 * tolerance;
     return box;
   };
-  const auto vertex_face = [&](int v, int t) {
+  const auto vertex_face = [&](int v, int t, std::vector<SelfPair>& out, long long& tests) {
     const std::array<int, 3>& f = triangles_[t];
     if (v == f[0] || v == f[1] || v == f[2]) return;
     if (!swept({v}).intersects(swept({f[0], f[1], f[2]}))) return;
-    ++s.element_tests;
+    ++tests;
     SelfPair hit;
     hit.vertices = {v, f[0], f[1], f[2]};
     if (vertex_face_collision(gather(hit.vertices, x0), gather(hit.vertices, x1), tolerance, hit))
-      pairs.push_back(hit);
+      out.push_back(hit);
   };
-  const auto edge_edge = [&](int e, int g) {
+  const auto edge_edge = [&](int e, int g, std::vector<SelfPair>& out, long long& tests) {
     const std::array<int, 2>& a = edges_[e];
     const std::array<int, 2>& b = edges_[g];
     if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) return;
     if (!swept({a[0], a[1]}).intersects(swept({b[0], b[1]}))) return;
-    ++s.element_tests;
+    ++tests;
     SelfPair hit;
     hit.vertices = {a[0], a[1], b[0], b[1]};
     if (edge_edge_collision(gather(hit.vertices, x0), gather(hit.vertices, x1), tolerance, hit))
-      pairs.push_back(hit);
+      out.push_back(hit);
   };
-  auto leaf = [&](int ta, int tb) {
+  const auto leaf = [&](int ta, int tb, std::vector<SelfPair>& out, long long& tests) {
     for (int k = 0; k < 3; ++k) {
       const int va = triangles_[ta][k], vb = triangles_[tb][k];
-      if (vertex_owner_[va] == ta) vertex_face(va, tb);
-      if (vertex_owner_[vb] == tb) vertex_face(vb, ta);
+      if (vertex_owner_[va] == ta) vertex_face(va, tb, out, tests);
+      if (vertex_owner_[vb] == tb) vertex_face(vb, ta, out, tests);
     }
     for (int i = 0; i < 3; ++i) {
       const int e = triangle_edges_[ta][i];
       if (edge_owner_[e] != ta) continue;
       for (int j = 0; j < 3; ++j) {
         const int g = triangle_edges_[tb][j];
-        if (edge_owner_[g] == tb) edge_edge(e, g);
+        if (edge_owner_[g] == tb) edge_edge(e, g, out, tests);
       }
     }
   };
-  self_test(0, x0, x1, leaf, s);
+  std::vector<std::array<int, 2>> leaves;
+  auto collect = [&](int ta, int tb) { leaves.push_back({ta, tb}); };
+  self_test(0, x0, x1, collect, s);
+  test_leaves(leaves, leaf, pairs, s.element_tests);
   dirty_.clear();
   s.pairs_found = static_cast<int>(pairs.size());
   return pairs;

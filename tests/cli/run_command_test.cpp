@@ -172,11 +172,12 @@ TEST(RunCommand, SheetSceneWritesReportMeshAndTrace) {
   EXPECT_EQ(report["scene"], "sheet");
   EXPECT_EQ(report["pinned_vertices"], 2);
   // The defaults "solver": "auto" and "time_step": "auto": the rule of
-  // sim/automatic_settings.hpp for a small sheet without self-contact, and why.
+  // sim/automatic_settings.hpp for a small sheet without self-contact on two corners (free to
+  // swing about them: 1/40 s), and why.
   EXPECT_EQ(report["settings"]["solver"], "pcg");
   EXPECT_EQ(report["settings"]["preconditioner"], "block-ic0");
-  EXPECT_DOUBLE_EQ(report["settings"]["dt"].get<double>(), 1.0 / 20.0);
-  EXPECT_NE(report["settings"]["automatic"].get<std::string>().find("1/20 s"), std::string::npos);
+  EXPECT_DOUBLE_EQ(report["settings"]["dt"].get<double>(), 1.0 / 40.0);
+  EXPECT_NE(report["settings"]["automatic"].get<std::string>().find("1/40 s"), std::string::npos);
   const int steps = report["steps"];
   EXPECT_GT(steps, 0);
   EXPECT_NEAR(report["sim_time"].get<double>(), 0.5, 1e-9);
@@ -201,7 +202,7 @@ TEST(RunCommand, SheetSceneWritesReportMeshAndTrace) {
     EXPECT_FALSE(j["fastest"]["panel"].get<std::string>().empty());
     EXPECT_EQ(j["fastest"]["contact"], "free");  // no body
     EXPECT_FALSE(j.contains("contacts"));
-    // After one step of 1/20 s every free vertex falls at about g·h = 0.49 m/s, far above the
+    // After one step of 1/40 s every free vertex falls at about g·h = 0.25 m/s, far above the
     // at-rest 5 mm/s: all 47 unpinned vertices move.
     if (lines == 1) {
       EXPECT_EQ(j["moving"], 47);
@@ -238,7 +239,7 @@ TEST(RunCommand, SheetAdaptsOnlyWhenAsked) {
   sketch["simulate"]["adaptive"] = {
       {"max_level", 3}, {"refine_threshold", 0.0005}, {"coarsen_threshold", 0.0001}};
   // Short steps, so that the first recorded step still has the 49 vertices of level 0 (at the
-  // automatic 1/20 s the first step already refines).
+  // automatic 1/20 s, the step before issue 24's third round, the first step already refined).
   sketch["simulate"]["time_step"] = 1.0 / 60.0;
   const CommandResult r = run_sketchdrape("-q run " + write_sketch(dir, sketch).string() + " -o " +
                                           (dir / "adaptive").string());

@@ -292,9 +292,14 @@ TEST(BodyCollider, CacheSkipsWorkWithoutChangingTheContacts) {
     const std::vector<BodyContact> cached = collider.find_contacts(x, query, &cache, &stats);
     const std::vector<BodyContact> fresh = collider.find_contacts(x, query);
     ASSERT_EQ(cached.size(), fresh.size()) << step;
+    // The cached searches also start from last step's nearest triangle (a hint that bounds the
+    // search): the same triangle and the same bits as a search without it.
     for (std::size_t k = 0; k < fresh.size(); ++k) {
       EXPECT_EQ(cached[k].vertex, fresh[k].vertex);
-      EXPECT_NEAR(cached[k].distance, fresh[k].distance, 1e-12);
+      EXPECT_EQ(cached[k].triangle, fresh[k].triangle);
+      EXPECT_EQ(cached[k].distance, fresh[k].distance);
+      EXPECT_EQ(cached[k].point, fresh[k].point);
+      EXPECT_EQ(cached[k].normal, fresh[k].normal);
     }
     skipped += stats.skipped;
   }
@@ -506,6 +511,33 @@ TEST(BodyCollider, FineClothWithALongReachKeepsTheGridSmall) {
   EXPECT_EQ(found.front().body_vertex, 0);
   EXPECT_NEAR(found.front().height, 0.01, 1e-12);
   EXPECT_LE(stats.grid_entries, 64 * static_cast<std::int64_t>(triangles.size()));
+}
+
+// The broad-phase grid counts its cells densely when they are few and keeps a sorted list when
+// the cloth is spread thin (here a second triangle 100 km away: about 170,000 cells of 0.58 m,
+// the longest edge, along x for a handful of entries); both give the piercing under the apex,
+// with the same height and barycentric coordinates bit for bit.
+TEST(BodyCollider, PiercingsAreTheSameOnADenseAndASparseGrid) {
+  const BodyCollider collider(testing::make_cone(0.1, 0.2, 24));
+  const Eigen::VectorXd near = flat_triangle(0.19);  // 1 cm under the apex
+  Eigen::VectorXd spread(18);
+  spread << near, near;
+  for (int k = 3; k < 6; ++k) spread[3 * k] += 1e5;
+  const std::vector<std::array<int, 3>> one = {{0, 1, 2}};
+  const std::vector<std::array<int, 3>> two = {{0, 1, 2}, {3, 4, 5}};
+  PiercingQueryStats dense_stats, sparse_stats;
+  const std::vector<BodyPiercing> dense =
+      collider.find_piercings(near, one, 0.0, 0.05, 0.0, &dense_stats);
+  const std::vector<BodyPiercing> sparse =
+      collider.find_piercings(spread, two, 0.0, 0.05, 0.0, &sparse_stats);
+  ASSERT_EQ(dense.size(), 1u);
+  ASSERT_EQ(sparse.size(), 1u);
+  EXPECT_EQ(sparse.front().cloth_triangle, 0);
+  EXPECT_EQ(sparse.front().body_vertex, dense.front().body_vertex);
+  EXPECT_EQ(sparse.front().height, dense.front().height);
+  EXPECT_EQ(sparse.front().barycentric, dense.front().barycentric);
+  EXPECT_NEAR(dense.front().height, 0.01, 1e-12);
+  EXPECT_EQ(sparse_stats.pairs, dense_stats.pairs);  // the far triangle shares no cell
 }
 
 TEST(BodyCollider, BodyVertexThroughAClothTriangleIsAPiercing) {

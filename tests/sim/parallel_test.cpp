@@ -13,6 +13,7 @@
 #include "sim/cloth_model.hpp"
 #include "sim/fabric.hpp"
 #include "sim/forces.hpp"
+#include "sim/self_collision.hpp"
 #include "sim/sheet.hpp"
 #include "tests/sim/test_bodies.hpp"
 
@@ -95,6 +96,52 @@ TEST_F(ThreadCount, ContactQueriesAreTheSameOnOneAndManyThreads) {
     EXPECT_EQ(one_stats.full_searches, four_stats.full_searches);
     EXPECT_EQ(one_stats.sweep_samples, four_stats.sweep_samples);
     EXPECT_EQ(one_stats.crossings, four_stats.crossings);
+  }
+}
+
+// The self-collision queries test the triangle pairs the tree traversal reaches in chunks on
+// many threads and join them in traversal order: the same element pairs, in the same order,
+// with the same counts on one thread and on four. A 30x30 sheet crumpled at random (jitter
+// about half an edge, so many pairs are near) moving by a random step.
+TEST_F(ThreadCount, SelfCollisionQueriesAreTheSameOnOneAndManyThreads) {
+  SheetSpec spec;
+  spec.columns = spec.rows = 30;
+  const SheetScene scene = build_sheet(spec);
+  std::vector<std::array<int, 3>> triangles;
+  const Eigen::MatrixX3i& faces = scene.input.triangles;
+  for (Eigen::Index f = 0; f < faces.rows(); ++f)
+    triangles.push_back({faces(f, 0), faces(f, 1), faces(f, 2)});
+  std::mt19937 rng(5);
+  std::normal_distribution<double> jitter(0.0, 0.015);  // m; edges are 1/30 m
+  Eigen::VectorXd x0 = flatten_positions(scene.input.rest_positions);
+  Eigen::VectorXd x1 = x0;
+  for (Eigen::Index i = 0; i < x0.size(); ++i) {
+    x0[i] += jitter(rng);
+    x1[i] = x0[i] + 0.5 * jitter(rng);
+  }
+  const auto run = [&](int threads, bool swept) {
+    set_thread_count(threads);
+    SelfCollider collider(triangles, x0);
+    SelfQueryStats stats;
+    std::vector<SelfPair> pairs = swept ? collider.find_collisions(x0, x1, 0.002, &stats)
+                                        : collider.find_proximities(x0, 0.01, &stats);
+    return std::make_pair(pairs, stats);
+  };
+  for (const bool swept : {false, true}) {
+    const auto [one, one_stats] = run(1, swept);
+    const auto [four, four_stats] = run(4, swept);
+    ASSERT_GT(one_stats.triangle_pairs, 1000) << "several chunks of triangle pairs";
+    ASSERT_GT(one.size(), 10u) << swept;
+    ASSERT_EQ(one.size(), four.size());
+    for (std::size_t k = 0; k < one.size(); ++k) {
+      EXPECT_EQ(one[k].kind, four[k].kind);
+      EXPECT_EQ(one[k].vertices, four[k].vertices);
+      EXPECT_EQ(one[k].weights, four[k].weights);  // bit for bit
+      EXPECT_EQ(one[k].normal, four[k].normal);
+    }
+    EXPECT_EQ(one_stats.element_tests, four_stats.element_tests);
+    EXPECT_EQ(one_stats.triangle_pairs, four_stats.triangle_pairs);
+    EXPECT_EQ(one_stats.pairs_found, four_stats.pairs_found);
   }
 }
 

@@ -347,6 +347,7 @@ BenchPlan bench_plan(const BenchScene& scene, BenchGrid grid) {
       traits.garment = !scene.sheet;
       traits.body = scene.body.has_value() && scene.settings.contact.enabled;
       traits.motion = motion;
+      traits.pins_hold_shape = sim::pins_hold_shape(scene.start, scene.pinned);
       const sim::AutomaticChoice choice = sim::choose_settings(traits);
       family.members.push_back(config(BenchMeshKind::fixed, level, choice.integrator, choice.solver,
                                       static_cast<int>(std::lround(1.0 / choice.dt))));
@@ -362,7 +363,7 @@ BenchPlan bench_plan(const BenchScene& scene, BenchGrid grid) {
       BenchFamily family{
           fmt::format("fixed L{}, {}, PCG: long steps", finest, bdf2 ? "BDF2 (linearised)" : "IE"),
           {}};
-      for (int rate : {10, 20, 30}) {
+      for (int rate : {10, 20, 30, 40, 50}) {
         BenchConfig c = config(BenchMeshKind::fixed, finest,
                                bdf2 ? Integrator::bdf2 : Integrator::implicit_euler,
                                LinearSolverKind::pcg, rate);

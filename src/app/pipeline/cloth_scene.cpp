@@ -354,6 +354,7 @@ sim::AutomaticChoice apply_automatic_settings(const scene::Sketch& sketch, const
   traits.garment = !scene.sheet;
   traits.body = scene.body.has_value() && settings.contact.enabled;
   traits.motion = motion;
+  traits.pins_hold_shape = sim::pins_hold_shape(scene.start, scene.pinned);
   const sim::AutomaticChoice choice = sim::choose_settings(traits);
   sim::apply_choice(choice, spec.solver == "auto", spec.time_step_auto, settings);
   // A garment without a duration of its own gets the time its hanging cloth needs to settle
