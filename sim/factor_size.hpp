@@ -27,13 +27,15 @@ struct FactorSize {
 // CHOLMOD runs out of memory.
 //
 // That is the pattern of the hinge bending (BendModel::hinges). The quadratic bending couples
-// every pair of vertices in a vertex's stencil (up to its two-ring), a pattern this graph does
-// not hold and which would cost hundreds of pairs per vertex to list; for it the prediction is
-// scaled by kQuadraticBendingFactorScale, an upper bound measured on sheets and tubes (the
-// solver's analysis was 3.1–3.9× the hinge pattern's; tests/sim/factor_size_test.cpp).
+// every pair of vertices in a vertex's stencil (its one-ring and the nearest points of its
+// two-ring), a pattern this graph does not hold and which would cost dozens of pairs per vertex
+// to list; for it the prediction is scaled by kQuadraticBendingFactorScale, an upper bound
+// measured on sheets and tubes (the solver's analysis was 1.8–2.5× the hinge pattern's bytes,
+// 2.5–5.2× its flops, on sheets of 16×12 to 100×75 quads and tubes of 24×12 to 96×48;
+// tests/sim/factor_size_test.cpp).
 FactorSize predict_factor_size(const Eigen::MatrixX3i& triangles, int vertex_count,
                                BendModel bend_model = BendModel::hinges);
 
-inline constexpr double kQuadraticBendingFactorScale = 5.0;
+inline constexpr double kQuadraticBendingFactorScale = 3.0;
 
 }  // namespace sd::sim

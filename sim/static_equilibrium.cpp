@@ -150,7 +150,9 @@ StaticResult solve_static(const ClothModel& unclamped, Eigen::VectorXd& x,
         }
         length *= 0.5;
       }
-      if (!accepted) {
+      // A step whose energy equals the current one to the last bit passes the Armijo test only
+      // because its decrease is below the energy's round-off: no progress either.
+      if (!accepted || !(trial_energy < energy)) {
         // Near round-off the energy no longer decreases measurably: converged if the force is
         // already small (the tolerance is far below what shapes need), else a failure.
         if (result.residual < kRoundOffTolerance * weight_scale) {

@@ -314,6 +314,54 @@ BENCHMARK(BM_AssembleHingesForcesJacobian)
     ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
 
+// What each bending model costs a 48x48 sheet (2,401 vertices) per assembly of the solve's
+// forces, matrix and product, and how many matrix entries its pattern holds (the PCG's product
+// and its IC(0) factor scale with them); arg: 0 hinges, 1 quadratic on a flat rest, 2 quadratic
+// on a curved rest (the sheet rolled into a cylinder of radius 0.3 m, so every vertex bend has a
+// rest curvature and its N(x) term). One thread; the same crumple as above.
+void BM_BendingAssembly(benchmark::State& state) {
+  const int previous_threads = thread_count();
+  set_thread_count(1);
+  SheetSpec spec;
+  spec.columns = spec.rows = 48;
+  SheetScene scene = build_sheet(spec);
+  if (state.range(0) == 2) {
+    for (Eigen::Index i = 0; i < scene.input.rest_positions.rows(); ++i) {
+      const double angle = scene.input.rest_positions(i, 0) / 0.3;
+      scene.input.rest_positions(i, 0) = 0.3 * std::sin(angle);
+      scene.input.rest_positions(i, 2) = 0.3 * (1.0 - std::cos(angle));
+    }
+  }
+  ClothModelOptions options;
+  options.bend_model = state.range(0) == 0 ? BendModel::hinges : BendModel::quadratic;
+  const ClothModel model = build_cloth_model(scene.input, fabric_preset("cotton"), options);
+  Eigen::VectorXd x = flatten_positions(scene.input.rest_positions);
+  Eigen::VectorXd v(x.size());
+  for (Eigen::Index i = 0; i < x.size(); ++i) {
+    x[i] += 0.004 * std::sin(1.7 * static_cast<double>(i));
+    v[i] = 0.04 * std::cos(0.9 * static_cast<double>(i));
+  }
+  const Eigen::VectorXd u = 1e-3 * v;
+  SparseMatrixR matrix = model.pattern.zero_matrix;
+  Eigen::VectorXd force, product(x.size());
+  JacobianTarget target;
+  target.matrix = &matrix;
+  target.dfdx_scale = -1e-3;
+  target.dfdv_scale = -1e-2;
+  target.product_input = &u;
+  target.product_output = &product;
+  for (auto _ : state) {
+    std::fill(matrix.valuePtr(), matrix.valuePtr() + matrix.nonZeros(), 0.0);
+    product.setZero();
+    evaluate_forces(model, ForceSettings{}, x, v, force, nullptr, &target);
+    benchmark::DoNotOptimize(force.data());
+  }
+  state.counters["nnz_per_vertex"] =
+      static_cast<double>(matrix.nonZeros()) / static_cast<double>(model.vertex_count);
+  set_thread_count(previous_threads);
+}
+BENCHMARK(BM_BendingAssembly)->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
+
 // Cost of one PCG iteration per vertex (SpMV, filter, block-Jacobi, three vector updates), on
 // the 64x64 system; compare with BM_StreamCopy's bandwidth (see docs/benchmarks.md).
 void BM_PcgIterationPerVertex64(benchmark::State& state) {

@@ -211,19 +211,21 @@ TEST(HostileInput, WorkThatDoesNotFitIsRefusedWithWhatWould) {
   EXPECT_EQ(big.exit_code, 2) << big.output;
   EXPECT_NE(big.output.find("/sheet/resolution: "), std::string::npos) << big.output;
   EXPECT_NE(big.output.find("quads would fit"), std::string::npos) << big.output;
-  // The factor's size is CHOLMOD's symbolic analysis of this grid (12.2 GB), not a fit.
-  EXPECT_NE(big.output.find("needs about 18.1 GB to simulate (12.2 GB of it the solver's factor)"),
+  // The factor's size is CHOLMOD's symbolic analysis of this grid (12.2 GB with the hinges), not
+  // a fit, times the quadratic bending's bound of 3 (sim/factor_size.hpp; the sheets' default).
+  EXPECT_NE(big.output.find("needs about 42.6 GB to simulate (36.7 GB of it the solver's factor)"),
             std::string::npos)
       << big.output;
 
-  // A 128 x 128 sheet: 67 MB + 16,641 vertices x 5.8 kB + its analysed factor (103 MB) = 267 MB:
-  // refused under 200M, and drapes under 1G.
+  // A 128 x 128 sheet: 67 MB + 16,641 vertices x 5.8 kB + its analysed factor (103 MB with the
+  // hinges, times 3 for the sheets' quadratic bending) = 473 MB: refused under 200M, and drapes
+  // under 1G.
   write(dir / "mid-sheet.json", R"({"sheet": {"size": [1, 1], "resolution": [128, 128],
     "pins": ["top"]}, "simulate": {"duration": 0.01}, "output": {"images": []}})");
   const CommandResult tight = run_sketchdrape("run " + (dir / "mid-sheet.json").string() +
                                               " --max-memory 200M -o " + (dir / "out").string());
   EXPECT_EQ(tight.exit_code, 2) << tight.output;
-  EXPECT_NE(tight.output.find("needs about 0.3 GB to simulate (0.1 GB of it the solver's factor), "
+  EXPECT_NE(tight.output.find("needs about 0.5 GB to simulate (0.3 GB of it the solver's factor), "
                               "more than the 0.2 GB of --max-memory"),
             std::string::npos)
       << tight.output;

@@ -134,13 +134,15 @@ TEST(ContactHysteresis, ContactIsReleasedExactlyWhenItsForceTurnsAdhesive) {
 
 TEST(ContactHysteresis, SpringBandKeepsTheSphereSheetOutsideAndComesToRest) {
   // The sheet of ContactResponsePiercing.SheetOnASphereStaysOutsideWithTheCheck, with the band:
-  // nothing through the sphere (independent collider) and at rest. Measured: at rest at 4.85 s
-  // (2.13 s without the band, which is why it is off by default), one change of the spring
-  // count in the last 0.5 s, 49 springs at the end.
+  // nothing through the sphere (independent collider) and at rest. Measured: at rest at 6.33 s
+  // (2.13 s without the band, which is why it is off by default), no change of the spring count
+  // in the last 0.5 s, 65 springs at the end. The limit was 6 s until the quadratic bending's
+  // wider rows took the nearest points of the two-ring (issue 21; at rest at 4.72-4.85 s with
+  // the whole two-ring's rows): the same sheet settles later, not through the sphere.
   const meshing::TriMesh sphere = testing::make_sphere(0.2, 3);
   const BodyCollider check_body(sphere);
   const SheetSetup s = horizontal_sheet(16, 0.6, {0.0, 0.25, 0.0});
-  SimulationSettings settings = box_settings(6.0);
+  SimulationSettings settings = box_settings(8.0);
   settings.stop_at_rest = true;
   settings.forces.air_drag = 0.3;
   settings.contact.check_body_vertices = true;

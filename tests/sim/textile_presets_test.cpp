@@ -125,7 +125,7 @@ INSTANTIATE_TEST_SUITE_P(
 // quadratic bending: every preset on the 4-8 mesh along the strip and at 45° (issue 21's two
 // orientations), and on an equilateral mesh with edges across and an irregular jittered grid
 // (triangulations a designer imports). The tolerance is issue 21's ±1.5°; measured 40.23° (silk,
-// 4-8 at 45°: the stiffest membrane against its bending) to 42.20° (jersey, 4-8 at 45°).
+// 4-8 at 45°: the stiffest membrane against its bending) to 42.25° (jersey, 4-8 at 45°).
 TEST(PeirceCantilever, ChordIsWithinOneAndAHalfDegreesForEveryPresetOnEveryMesh) {
   const double peirce = test::cantilever_elastica(8.0).chord_angle_deg();
   for (const std::string& name : fabric_preset_names()) {
@@ -137,7 +137,8 @@ TEST(PeirceCantilever, ChordIsWithinOneAndAHalfDegreesForEveryPresetOnEveryMesh)
       const test::Strip strip = test::make_strip(mesh, length, 0.25 * length, 16, 4);
       const ClothModel model = build_cloth_model(strip.input, fabric);
       Eigen::VectorXd x = flatten_positions(strip.input.rest_positions);
-      const bool converged = solve_static(model, x, strip.clamped).converged;
+      const StaticResult solved = solve_static(model, x, strip.clamped);
+      const bool converged = solved.converged;
       Eigen::Vector3d clamp = Eigen::Vector3d::Zero(), tip = Eigen::Vector3d::Zero();
       for (int v : strip.clamp_line) clamp += x.segment<3>(3 * v) / strip.clamp_line.size();
       for (int v : strip.tip) tip += x.segment<3>(3 * v) / strip.tip.size();
@@ -145,7 +146,8 @@ TEST(PeirceCantilever, ChordIsWithinOneAndAHalfDegreesForEveryPresetOnEveryMesh)
           std::atan2(clamp.y() - tip.y(), tip.z() - clamp.z()) * 180.0 / std::numbers::pi;
       std::printf("Peirce %-9s %-26s 16 cells: chord %.2f deg\n", name.c_str(),
                   test::strip_mesh_name(mesh).c_str(), chord);
-      ASSERT_TRUE(converged) << name << ", " << test::strip_mesh_name(mesh);
+      ASSERT_TRUE(converged) << name << ", " << test::strip_mesh_name(mesh) << ": "
+                             << solved.failure;
       EXPECT_NEAR(chord, peirce, 1.5) << name << ", " << test::strip_mesh_name(mesh);
     }
   }

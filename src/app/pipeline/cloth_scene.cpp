@@ -134,7 +134,7 @@ void build_sheet_scene(const scene::Sketch& sketch, ClothScene& scene) {
   scene.fabric_name = sketch.fabric;
   scene.fabric = fabric_at(sketch, sketch.fabric, "/fabric");
   scene.bend_model =
-      sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::hinges);
+      sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::quadratic);
   scene.compression =
       sim::parse_compression(sketch.simulate.compression).value_or(sim::Compression::linear);
 }
@@ -300,7 +300,7 @@ void build_imported_scene(const scene::Sketch& sketch, ClothScene& scene) {
   scene.fabric_name = sketch.fabric;
   scene.fabric = fabric_at(sketch, sketch.fabric, "/fabric");
   scene.bend_model =
-      sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::hinges);
+      sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::quadratic);
   scene.compression =
       sim::parse_compression(sketch.simulate.compression).value_or(sim::Compression::linear);
   pin_above(sketch, scene);

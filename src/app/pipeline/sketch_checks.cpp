@@ -136,11 +136,12 @@ RunEstimate estimate_run(const scene::Sketch& sketch, const Eigen::MatrixX3i& tr
   e.duration = duration;
   e.time_step = time_step;
   e.vertices = vertices;
-  e.factor_bytes =
-      sim::predict_factor_size(
-          triangles, vertices,
-          sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::hinges))
-          .bytes;
+  e.factor_bytes = sim::predict_factor_size(
+                       triangles, vertices,
+                       sim::parse_bend_model(sketch.simulate.bending)
+                           .value_or(sketch.sheet || sketch.garment_mesh ? sim::BendModel::quadratic
+                                                                         : sim::BendModel::hinges))
+                       .bytes;
   e.memory_bytes = kBaseBytes + e.vertices * kBytesPerVertex + e.factor_bytes;
   e.steps = std::ceil(duration / time_step);
   e.frames = frames_per_second > 0 ? std::floor(duration * frames_per_second) + 1 : 0;
