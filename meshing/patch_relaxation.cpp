@@ -294,7 +294,8 @@ void relax_interior(std::vector<Eigen::Vector3d>& positions,
                     std::span<const std::array<int, 4>> quads, std::span<const char> fixed,
                     int sweeps,
                     const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& project,
-                    ReferenceNormals reference) {
+                    ReferenceNormals reference, RelaxProbe* probe) {
+  if (probe != nullptr) *probe = RelaxProbe{probe->stop_at};
   if (sweeps <= 0 || quads.empty()) return;
   const size_t nv = positions.size(), nf = quads.size();
   const Adjacency adj = build_adjacency(quads, nv);
@@ -360,6 +361,15 @@ void relax_interior(std::vector<Eigen::Vector3d>& positions,
       untangle(x, quads, normals, adj, fixed, project, &suspects);
       positions = x;
       return;
+    }
+    if (probe != nullptr) {
+      for (size_t f = 0; f < nf; ++f)
+        probe->folds += quad_min_jacobian(quads[f], normals[f], x) < 0;
+      if (probe->folds >= probe->stop_at) {
+        probe->stopped = true;
+        positions = x;
+        return;
+      }
     }
   }
   // The guarded sweeps run between two scratch arrays, from the start again; the result is
