@@ -528,11 +528,7 @@ FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
   // smoothing turns into a quad of aspect 24). Only the best plan: retrying all of them also
   // cleans 5 more of the 210° chevrons of the concave test (20 instead of 25 of 648 keep a fold)
   // but cost the t-shirt's and the shorts' backs, which no plan cleans, 20 and 9 ms of meshing.
-  // Only without a projection: the clusters are the Coons blocks of a flat layout overlapping;
-  // on a projected fill (a garment's panel on the body) none of the 15 retries over the
-  // examples, designs and reproducers came out clean, and they were a quarter of the cropped
-  // jacket's and a tenth of the raglan's meshing.
-  if (!options.project && !filled.empty() && best_patch->quality.inverted_quads > 0) {
+  if (!filled.empty() && best_patch->quality.inverted_quads > 0) {
     std::optional<Built> none;
     FilledPatch patch = fill_with_plan(filled.front(), counts, side_points, shape, none, options,
                                        detail::ReferenceNormals::kAfterSweeps);
