@@ -7,6 +7,8 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
+#include <stdexcept>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -123,6 +125,27 @@ std::vector<QualityWarning> check_quality(const Garment& garment, const GarmentR
             }
           }
 
+    // Which corner to move: a panel whose corners came from the turning angles may have one
+    // too many where one seam runs on into another (a tank top's underarm, where the armhole
+    // meets the side seam, made its back fold in every plan; without it as a corner the back
+    // is clean). Name the gentlest and give the list without it, ready to paste.
+    std::string fewer_corners;
+    std::vector<std::string> corner_list;
+    if (panel.turning_corners.size() >= 4) {
+      const auto gentlest =
+          std::min_element(panel.turning_corners.begin(), panel.turning_corners.end(),
+                           [](const auto& a, const auto& b) { return a.second < b.second; });
+      std::vector<std::string> rest;
+      for (auto it = panel.turning_corners.begin(); it != panel.turning_corners.end(); ++it)
+        if (it != gentlest) {
+          rest.push_back(fmt::format("\"{}\"", it->first));
+          corner_list.push_back(it->first);
+        }
+      fewer_corners = fmt::format(
+          " (its gentlest corner is where '{}' begins, turning {:.0f}°: with one side fewer the "
+          "filler may fit a plain grid, \"corners\": [{}])",
+          gentlest->first, gentlest->second, fmt::join(rest, ", "));
+    }
     const auto emit = [&](const Worst& w, const char* kind, const std::string& sentence) {
       if (w.count == 0) return;
       QualityWarning q;
@@ -133,25 +156,12 @@ std::vector<QualityWarning> check_quality(const Garment& garment, const GarmentR
       q.where = w.where;
       if (landmarks != nullptr) q.landmark = landmarks->nearest(w.where).name;
       q.message = fmt::format("panel '{}': {} {}", panel.id, sentence, place(w.where, q.landmark));
+      if (!fewer_corners.empty() && sentence.find(fewer_corners) != std::string::npos) {
+        q.corners = corner_list;
+        q.corners_hint = fewer_corners;
+      }
       warnings.push_back(std::move(q));
     };
-    // Which corner to move: a panel whose corners came from the turning angles may have one
-    // too many where one seam runs on into another (a tank top's underarm, where the armhole
-    // meets the side seam, made its back fold in every plan; without it as a corner the back
-    // is clean). Name the gentlest and give the list without it, ready to paste.
-    std::string fewer_corners;
-    if (panel.turning_corners.size() >= 4) {
-      const auto gentlest =
-          std::min_element(panel.turning_corners.begin(), panel.turning_corners.end(),
-                           [](const auto& a, const auto& b) { return a.second < b.second; });
-      std::vector<std::string> rest;
-      for (auto it = panel.turning_corners.begin(); it != panel.turning_corners.end(); ++it)
-        if (it != gentlest) rest.push_back(fmt::format("\"{}\"", it->first));
-      fewer_corners = fmt::format(
-          " (its gentlest corner is where '{}' begins, turning {:.0f}°: with one side fewer the "
-          "filler may fit a plain grid, \"corners\": [{}])",
-          gentlest->first, gentlest->second, fmt::join(rest, ", "));
-    }
     emit(inverted, "inverted_quads",
          fmt::format("{} quad(s) fold over (the worst corner's scaled Jacobian {:.2f}); make the "
                      "curves around the panel smoother there, or move a corner so that the sides "
@@ -174,9 +184,95 @@ std::vector<QualityWarning> check_quality(const Garment& garment, const GarmentR
                      near.count, 1e3 * threshold, 1e3 * near.value));
     emit(size, "quad_size",
          fmt::format("{} quad(s) have sides outside {:.2g}-{:.2g} times the edge length of {:.1f} "
-                     "cm (the worst {:.2f} times); the filler could not fit a grid to the sides' "
-                     "edge counts: make facing sides' edge counts closer or split the panel;",
-                     size.count, limits.size_low, limits.size_high, 100 * target, size.value));
+                     "cm (the worst {:.2f} times): {};",
+                     size.count, limits.size_low, limits.size_high, 100 * target, size.value,
+                     size.value > 1
+                         ? "larger than asked, where the filler's layout widens between sides "
+                           "of different edge counts"
+                         : "smaller than asked, where the panel narrows towards a short side"));
+  }
+  return warnings;
+}
+
+std::vector<QualityWarning> check_quality_tried(const Garment& garment,
+                                                const GarmentRequest& sketch,
+                                                const meshing::TriMesh& body,
+                                                const BodyLandmarks* landmarks,
+                                                const QualityLimits& limits) {
+  std::vector<QualityWarning> warnings = check_quality(garment, sketch, landmarks, limits);
+  // One trial per panel (its warnings of several kinds offer the same list).
+  std::unordered_map<std::string, bool> helps;
+  std::optional<BodySurface> surface;
+  // How many warnings the sketch gives with `trial` in its place; SIZE_MAX when it does not mesh.
+  const auto warnings_with = [&](const GarmentRequest& trial) {
+    try {
+      if (!surface) surface.emplace(body);
+      return check_quality(build_garment(trial, *surface), trial, landmarks, limits).size();
+    } catch (const std::exception&) {
+      return std::numeric_limits<std::size_t>::max();
+    }
+  };
+  // Quads larger than the band: more edges along the panel's curve nearest the worst place
+  // give the filler's layout more columns there. Lowering the whole panel's edge_length does
+  // not (the shell top's front at 2 cm: 10 quads up to 2.75 times, and a sliver); the curve's
+  // own edge_length at target × high / worst does (its armhole or its side seam: clean). Tried
+  // at that length, then a fifth below the panel's; offered only when the warnings fall.
+  const auto offer_curve_edge_length = [&](QualityWarning& w) {
+    const auto panel = std::find_if(garment.panels.begin(), garment.panels.end(),
+                                    [&](const GarmentPanel& p) { return p.id == w.panel; });
+    if (panel == garment.panels.end()) return;
+    std::string nearest;
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& [edge, curve] : garment.edge_curve) {
+      if (std::find(panel->curves.begin(), panel->curves.end(), curve) == panel->curves.end())
+        continue;
+      const Eigen::Vector3d middle =
+          0.5 * (garment.mesh.vertices.row(edge.first) + garment.mesh.vertices.row(edge.second))
+                    .transpose();
+      if ((middle - w.where).norm() < best) best = (middle - w.where).norm(), nearest = curve;
+    }
+    if (nearest.empty()) return;
+    auto spec = std::find_if(sketch.curves.begin(), sketch.curves.end(),
+                             [&](const CurveSpec& c) { return c.id == nearest; });
+    if (spec == sketch.curves.end()) return;
+    double asked = sketch.edge_length;
+    for (const PanelSpec& p : sketch.panels)
+      if (p.id == w.panel && p.edge_length) asked = *p.edge_length;
+    if (spec->edge_length) asked = std::min(asked, *spec->edge_length);
+    for (const double length : {std::floor(1e3 * asked * limits.size_high / w.worst) / 1e3,
+                                std::floor(1e3 * 0.8 * asked) / 1e3}) {
+      if (!(length > 0.0) || length >= asked) continue;
+      GarmentRequest trial = sketch;
+      for (CurveSpec& c : trial.curves)
+        if (c.id == nearest) c.edge_length = length;
+      if (warnings_with(trial) >= warnings.size()) continue;
+      w.message.insert(w.message.find(';'),
+                       fmt::format("; curve '{}' with its own \"edge_length\": {:g} (more edges "
+                                   "along it) gives the garment fewer warnings",
+                                   nearest, length));
+      w.curve = nearest;
+      w.curve_edge_length = length;
+      return;
+    }
+  };
+  for (QualityWarning& w : warnings) {
+    if (w.kind == "quad_size" && w.worst > limits.size_high) offer_curve_edge_length(w);
+    if (w.corners.empty()) continue;
+    auto known = helps.find(w.panel);
+    if (known == helps.end()) {
+      GarmentRequest trial = sketch;
+      bool found = false;
+      for (PanelSpec& spec : trial.panels)
+        if (spec.id == w.panel) spec.corners = w.corners, found = true;
+      // A list the loop cannot take (no valid panel) is not offered either.
+      const bool better = found && warnings_with(trial) < warnings.size();
+      known = helps.emplace(w.panel, better).first;
+    }
+    if (known->second) continue;
+    const std::size_t at = w.message.find(w.corners_hint);
+    if (at != std::string::npos) w.message.erase(at, w.corners_hint.size());
+    w.corners.clear();
+    w.corners_hint.clear();
   }
   return warnings;
 }

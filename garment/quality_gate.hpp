@@ -32,6 +32,13 @@ struct QualityWarning {
   Eigen::Vector3d where = Eigen::Vector3d::Zero();  // m, the worst place
   std::string landmark;  // the nearest body landmark ("" when the body has none)
   std::string message;   // one sentence for the designer, with what to change
+  // The "corners" list the message offers (a folding panel's turning corners without the
+  // gentlest) and the words that offer it, as they appear in `message`; empty when none.
+  std::vector<std::string> corners;
+  std::string corners_hint;
+  // A curve the message offers its own edge_length for (m; check_quality_tried), else empty.
+  std::string curve;
+  double curve_edge_length = 0.0;
 };
 
 // Checks every panel of `garment` except mirror copies (the same quads reflected: a warning on
@@ -40,5 +47,19 @@ struct QualityWarning {
 std::vector<QualityWarning> check_quality(const Garment& garment, const GarmentRequest& sketch,
                                           const BodyLandmarks* landmarks,
                                           const QualityLimits& limits = {});
+
+// check_quality, with the advice that rewrites the sketch tried before it is given: a panel
+// offered a "corners" list is meshed again with it (the rest of the sketch unchanged), and the
+// offer stays only when the garment then has fewer warnings, else it is taken out of the
+// message; quads larger than the band are offered an edge_length of their own for the panel's
+// curve nearest them, only one that was tried and gave fewer warnings (dropping the underarm corner
+// cleaned the tank top's back on the Collada human, but dropping the shell top's turned its 2
+// warnings into 3). Costs one more garment build per panel with an offer (and the body's search
+// tree, built then).
+std::vector<QualityWarning> check_quality_tried(const Garment& garment,
+                                                const GarmentRequest& sketch,
+                                                const meshing::TriMesh& body,
+                                                const BodyLandmarks* landmarks,
+                                                const QualityLimits& limits = {});
 
 }  // namespace sd::garment

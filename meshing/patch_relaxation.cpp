@@ -174,11 +174,20 @@ constexpr int kUntanglePasses = 100;
 // ever smaller steps when a fold cannot be undone).
 constexpr double kUntangleProgress = 1e-4;
 
+// Untangling moves no vertex farther than this many of the patch's mean edge lengths (at the
+// start of the relaxation) from where it began. Without a bound a search can run away: off the
+// body the projection leaves a point where it is, a longer step lengthens the vertex's edges, and
+// with them its next step (the raglan's back sleeve at 2 cm edges, filled from the start along
+// its normals: one vertex 6e8 m away, which the fill then kept for having fewer folded quads).
+// Some folds need long moves: a bound of 2 edge lengths changed four fills of the corpus and the
+// reproducers (the kimono tee's back: 0 → 2 folded quads); with 10 every garment.obj is the same.
+constexpr double kUntangleReach = 10;
+
 // `suspects`, when given, are the only quads that can be below kUntangleTarget at the start
-// (increasing), so the first pass looks at them alone.
+// (increasing), so the first pass looks at them alone. `reach`: kUntangleReach in metres.
 void untangle(std::vector<Eigen::Vector3d>& x, std::span<const Quad> quads,
               const std::vector<Eigen::Vector3d>& normals, const Adjacency& adj,
-              std::span<const char> fixed, const Projection& project,
+              std::span<const char> fixed, const Projection& project, double reach,
               const std::vector<size_t>* suspects = nullptr) {
   const size_t nf = quads.size(), nv = x.size();
   // Smallest scaled Jacobian of the quads at v; once it is at most `floor` the rest are not
@@ -195,6 +204,7 @@ void untangle(std::vector<Eigen::Vector3d>& x, std::span<const Quad> quads,
   };
   std::vector<char> chosen(nv, 0);
   std::vector<size_t> movable;
+  const std::vector<Eigen::Vector3d> origin = x;
   for (int pass = 0; pass < kUntanglePasses; ++pass) {
     movable.clear();
     std::fill(chosen.begin(), chosen.end(), 0);
@@ -244,6 +254,7 @@ void untangle(std::vector<Eigen::Vector3d>& x, std::span<const Quad> quads,
         for (int k = 0; k < 8; ++k) {
           const auto& [c, s] = kCompass[static_cast<size_t>(k)];
           x[v] = start + step * (c * t1 + s * t2);
+          if ((x[v] - origin[v]).squaredNorm() > reach * reach) continue;
           const double value = around(v, best + 1e-12);
           if (value > best + 1e-12) {
             best = value;
@@ -253,7 +264,7 @@ void untangle(std::vector<Eigen::Vector3d>& x, std::span<const Quad> quads,
         if (project && best > current) {
           best_position = project(best_position);
           x[v] = best_position;
-          best = around(v);
+          best = (x[v] - origin[v]).squaredNorm() > reach * reach ? current : around(v);
         }
         if (best > current) {
           x[v] = best_position;
@@ -294,7 +305,8 @@ void relax_interior(std::vector<Eigen::Vector3d>& positions,
                     std::span<const std::array<int, 4>> quads, std::span<const char> fixed,
                     int sweeps,
                     const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& project,
-                    ReferenceNormals reference) {
+                    ReferenceNormals reference, RelaxProbe* probe) {
+  if (probe != nullptr) *probe = RelaxProbe{probe->stop_at};
   if (sweeps <= 0 || quads.empty()) return;
   const size_t nv = positions.size(), nf = quads.size();
   const Adjacency adj = build_adjacency(quads, nv);
@@ -311,6 +323,7 @@ void relax_interior(std::vector<Eigen::Vector3d>& positions,
   for (const Quad& q : quads)
     edge_sum += (old[static_cast<size_t>(q[0])] - old[static_cast<size_t>(q[1])]).norm();
   const double tolerance = 1e-3 * edge_sum / static_cast<double>(nf);
+  const double reach = kUntangleReach * edge_sum / static_cast<double>(nf);
   // The vertices a sweep moves; every other entry of the position buffers keeps its start.
   std::vector<size_t> movers;
   for (size_t v = 0; v < nv; ++v)
@@ -357,9 +370,18 @@ void relax_interior(std::vector<Eigen::Vector3d>& positions,
                    quad_min_jacobian(quads[f], normals[f], old) - 1e-12;
     }
     if (acceptable) {
-      untangle(x, quads, normals, adj, fixed, project, &suspects);
+      untangle(x, quads, normals, adj, fixed, project, reach, &suspects);
       positions = x;
       return;
+    }
+    if (probe != nullptr) {
+      for (size_t f = 0; f < nf; ++f)
+        probe->folds += quad_min_jacobian(quads[f], normals[f], x) < 0;
+      if (probe->folds >= probe->stop_at) {
+        probe->stopped = true;
+        positions = x;
+        return;
+      }
     }
   }
   // The guarded sweeps run between two scratch arrays, from the start again; the result is
@@ -411,7 +433,7 @@ void relax_interior(std::vector<Eigen::Vector3d>& positions,
     std::swap(current, next);
     if (move < tolerance * tolerance) break;  // converged
   }
-  untangle(current, quads, normals, adj, fixed, project);
+  untangle(current, quads, normals, adj, fixed, project, reach);
   positions = current;
 }
 

@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <functional>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -37,11 +38,24 @@ enum class ReferenceNormals { kStart, kAfterSweeps };
 
 // The same on a mesh being built (QuadMeshBuilder's arrays): #V positions, relaxed in place,
 // and #Q counter-clockwise quads; saves copying them into a QuadMesh and back.
+// `probe`, when given, asks for an early answer on a layout that folds: the quads folded
+// (smallest scaled Jacobian below 0) after the unguarded sweeps are counted when those sweeps
+// left a quad below min(its start, 0.05) (0 otherwise); when there are at least
+// probe->stop_at of them, the positions are left where the unguarded sweeps put them and
+// nothing more is done (the guarded sweeps and the untangling that would follow are most of a
+// folding plan's time); otherwise the relaxation runs to its end as without a probe, to the
+// same bits.
+struct RelaxProbe {
+  int stop_at = std::numeric_limits<int>::max();  // in
+  int folds = 0;                                  // out
+  bool stopped = false;                           // out
+};
 void relax_interior(std::vector<Eigen::Vector3d>& positions,
                     std::span<const std::array<int, 4>> quads, std::span<const char> fixed,
                     int sweeps,
                     const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& project = {},
-                    ReferenceNormals reference = ReferenceNormals::kStart);
+                    ReferenceNormals reference = ReferenceNormals::kStart,
+                    RelaxProbe* probe = nullptr);
 
 // Foldover-free placement in a plane, after Garanzha, Kaporin, Kudryavtseva, Protais, Ray and
 // Sokolov (2021), "Foldover-free maps in 50 lines of code": the free vertices of #Q

@@ -10,6 +10,8 @@
 #include <tuple>
 #include <utility>
 
+#include "sim/collision_geometry.hpp"
+
 namespace sd::sim {
 namespace {
 
@@ -219,7 +221,28 @@ void ContactResponse::reset_cloth(const Eigen::VectorXd& x, const Eigen::VectorX
     last_piercing_force_.assign(static_cast<std::size_t>(collider_.vertex_count()), kNoImpulse);
   spring_body_vertex_.clear();
   spring_ends_.clear();
-  held_springs_.clear();
+  // A renumbered cloth (adaptive detail's splits and merges): the held pairs named the old
+  // triangles. Each follows its point on the cloth to the new triangles that hold it (a split's
+  // children hold it exactly, a merged parent within the merge error), and
+  // spring_start_piercings keeps or drops it by its height as it does any held pair. Without
+  // this a pair in front of a cloth edge, which find_piercings does not report, lost its
+  // spring at every split or merge, and the cloth fell onto the body vertex: a loose strapless
+  // top resting on the hip's vertices lost 11 of its 18 springs at each late split, dropped
+  // 2 mm and moved at up to 27 cm/s (docs/garment.md, "Seventh round").
+  std::vector<SpringEnd> followed;
+  const double follow = kPiercingHoldMargin * settings_.thickness;
+  for (const SpringEnd& held : held_springs_)
+    for (std::size_t t = 0; t < cloth_.triangles.size(); ++t) {
+      const std::array<int, 3>& c = cloth_.triangles[t];
+      const TriangleClosestPoint q = closest_point_on_triangle(
+          held.point, x.segment<3>(3 * c[0]), x.segment<3>(3 * c[1]), x.segment<3>(3 * c[2]));
+      if (q.squared_distance <= follow * follow) {
+        SpringEnd next = held;
+        next.triangle = static_cast<int>(t);
+        followed.push_back(next);
+      }
+    }
+  held_springs_ = std::move(followed);
   // Plan the push-out on the first cloth, or again (over the remaining steps) when the cloth
   // is renumbered in the middle of one.
   if (!repair_planned_ || repairing()) {
@@ -584,8 +607,11 @@ void ContactResponse::record_spring_forces(const Eigen::VectorXd& x, const StepF
     const PointSpring& spring = extra.springs[s];
     const double along = along_spring_normal(spring, cloth_.triangles[spring.triangle], x);
     const double force = spring.preload + spring.stiffness * (spring.target - along);
+    const std::array<int, 3>& c = cloth_.triangles[spring.triangle];
+    Eigen::Vector3d point = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) point += spring.weights[k] * x.segment<3>(3 * c[k]);
     spring_ends_.push_back(
-        {spring_body_vertex_[s], spring.triangle, std::min(force, max_spring_preload())});
+        {spring_body_vertex_[s], spring.triangle, std::min(force, max_spring_preload()), point});
   }
 }
 

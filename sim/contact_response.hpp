@@ -314,6 +314,7 @@ class ContactResponse {
     int body_vertex = -1;
     int triangle = -1;
     double force = 0.0;
+    Eigen::Vector3d point = Eigen::Vector3d::Zero();  // m: the spring's point on the cloth
   };
   // This attempt's springs at its end (record_spring_forces), and those of the last accepted
   // step, whose pairs the next start follows even where find_piercings does not report them (a

@@ -485,5 +485,36 @@ TEST(RunCommand, MistakesExitTwoAndWriteNothing) {
   }
 }
 
+// A strapless top drawn 1 cm off the body with no negative ease (data/designs/repro/peplum-top)
+// has nothing gripping it: it slides down the torso until its waist catches on the hips, comes
+// to rest there (it did not before body-vertex springs followed a renumbered cloth, docs/
+// garment.md "Seventh round"), and run says how far it went. The same top with its bodice 5 %
+// smaller than drawn grips and stays where it was drawn.
+TEST(RunCommand, AGarmentThatSlidSaysHowFar) {
+  nlohmann::json sketch = read_json(fs::path(SD_SOURCE_DIR) / "data/designs/repro/peplum-top.json");
+  sketch["output"] = {{"images", nlohmann::json::array()}};
+  for (const bool grips : {false, true}) {
+    if (grips)
+      for (nlohmann::json& panel : sketch["panels"])
+        if (panel["id"].get<std::string>().rfind("bodice", 0) == 0) panel["ease"] = 0.95;
+    const fs::path dir = fresh_dir(grips ? "slid-ease" : "slid");
+    const CommandResult r = run_sketchdrape("run " + write_sketch(dir, sketch).string() + " -o " +
+                                            (dir / "out").string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const nlohmann::json report = read_json(dir / "out" / "report.json");
+    EXPECT_TRUE(report["at_rest"].get<bool>()) << grips;
+    EXPECT_EQ(report["penetrating_vertices_final"], 0);
+    const double drop = report["settled_drop_m"].get<double>();
+    const bool told = r.output.find("below where it was drawn") != std::string::npos;
+    if (grips) {
+      EXPECT_LT(drop, 0.01);  // measured 3.6 mm
+      EXPECT_FALSE(told) << r.output;
+    } else {
+      EXPECT_GT(drop, 0.03);  // measured 4.7 cm
+      EXPECT_TRUE(told) << r.output;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace sd::test

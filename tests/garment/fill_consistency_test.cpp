@@ -112,5 +112,27 @@ TEST(FillConsistency, QuadCountsFallAndSizesFollowTheEdgeLength) {
       kSmallest, kLargest, total_outside, total_quads, 100 * worst_share, worst.c_str());
 }
 
+// A panel whose fold no plan undoes must still come out near the body: the raglan top at 2 cm
+// edges refills its back sleeve from the start along its normals, and the untangling's pattern
+// search there walked one vertex 6e8 m away (off the body the projection leaves a point where it
+// is, and a vertex's step grows with its edges), which the fill kept for having fewer folded
+// quads. Untangling now moves no vertex more than 10 mean edge lengths.
+TEST(FillConsistency, NoVertexRunsAwayWhereAFoldCannotBeUndone) {
+  Sketch sketch = load_sketch(fs::path(SD_SOURCE_DIR) / "data/designs/raglan-top.json");
+  const Body body = load_sketch_body(sketch);
+  const BodySurface surface(body.mesh);
+  sketch.edge_length = 0.02;
+  const Garment garment = build_garment(sketch, surface);
+  const Eigen::Vector3d low = surface.box().min - Eigen::Vector3d::Constant(0.1);
+  const Eigen::Vector3d high = surface.box().max + Eigen::Vector3d::Constant(0.1);
+  for (Eigen::Index v = 0; v < garment.mesh.vertex_count(); ++v) {
+    const Eigen::Vector3d p = garment.mesh.vertices.row(v).transpose();
+    ASSERT_TRUE((p.array() >= low.array()).all() && (p.array() <= high.array()).all())
+        << "vertex " << v << " at " << p.transpose() << " m";
+  }
+  for (const GarmentPanel& panel : garment.panels)
+    EXPECT_LT(panel.area, 0.5) << "panel '" << panel.id << "': " << panel.area << " m²";
+}
+
 }  // namespace
 }  // namespace sd::garment

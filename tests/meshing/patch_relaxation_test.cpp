@@ -123,5 +123,46 @@ TEST(PlanarUntangling, UnfoldsAnLShapeWithItsReflexCornerInverted) {
   EXPECT_GT(smallest_corner(x, quads), 0);
 }
 
+// The relaxation's probe (detail::RelaxProbe): a grid whose right side is pushed in past the
+// middle as a narrow tongue folds quads in the unguarded sweeps. A probe that stops there
+// leaves those sweeps' positions and counts the folded quads; one that does not stop, and a
+// grid that does not fold, relax to the same bits as without a probe.
+TEST(RelaxationProbe, StopsAFoldingLayoutAfterTheUnguardedSweepsAndChangesNothingElse) {
+  const auto relaxed = [](double push, detail::RelaxProbe* probe) {
+    const QuadMesh grid = test::quad_grid(10, 10);
+    std::vector<Eigen::Vector3d> x(static_cast<size_t>(grid.vertices.rows()));
+    std::vector<char> fixed(x.size(), 0);
+    for (size_t v = 0; v < x.size(); ++v) {
+      x[v] = grid.vertices.row(static_cast<Eigen::Index>(v)).transpose();
+      const int i = static_cast<int>(v) % 11, j = static_cast<int>(v) / 11;
+      fixed[v] = i == 0 || i == 10 || j == 0 || j == 10;
+      if (i == 10 && j > 1 && j < 9) x[v].x() -= push;  // the right side's tongue
+    }
+    detail::relax_interior(x, quads_of(grid), fixed, 10, {}, detail::ReferenceNormals::kStart,
+                           probe);
+    return x;
+  };
+  for (const double push : {9.5, 0.5}) {
+    SCOPED_TRACE(push);
+    const std::vector<Eigen::Vector3d> plain = relaxed(push, nullptr);
+    detail::RelaxProbe watching;  // never stops
+    EXPECT_EQ(relaxed(push, &watching), plain);
+    EXPECT_FALSE(watching.stopped);
+    detail::RelaxProbe stopping{1};
+    const std::vector<Eigen::Vector3d> probed = relaxed(push, &stopping);
+    EXPECT_EQ(stopping.folds, watching.folds);
+    if (push > 1) {  // the tongue reaches past the middle: folds, stopped
+      EXPECT_TRUE(stopping.stopped);
+      EXPECT_GT(stopping.folds, 0);
+      EXPECT_LT(smallest_corner(probed, quads_of(test::quad_grid(10, 10))), 0);
+      EXPECT_NE(probed, plain);  // the guarded sweeps and untangling did not run
+    } else {
+      EXPECT_EQ(stopping.folds, 0);
+      EXPECT_FALSE(stopping.stopped);
+      EXPECT_EQ(probed, plain);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace sd::meshing

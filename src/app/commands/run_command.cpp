@@ -38,6 +38,10 @@
 namespace sd::app {
 namespace {
 
+// m: a garment whose centre of mass ends more than this below where it was drawn is told it
+// slid (the loose strapless peplum top: 4.6 cm; its bodice with ease 0.95, which grips: none).
+constexpr double kSlidWarning = 0.03;
+
 using Clock = std::chrono::steady_clock;
 
 struct RunOptions {
@@ -306,6 +310,21 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
     triangle_group = groups_of(driver);
     out.strain = group_strains(driver.simulation().model(), draped.vertices, triangle_group,
                                scene.group_names);
+    // How far the garment went down from where it was drawn: its centre of mass, from the
+    // potential energy −Σ m g·x of the first and last samples (mass is conserved through
+    // adaptive detail's splits and merges).
+    const double weight = driver.simulation().model().total_mass() * settings.forces.gravity.norm();
+    if (scene.garment && scene.body && report.energy.size() >= 2 && weight > 0.0) {
+      out.settled_drop =
+          (report.energy.front().potential - report.energy.back().potential) / weight;
+      if (*out.settled_drop > kSlidWarning)
+        spdlog::warn(
+            "{}: the garment settled {:.1f} cm below where it was drawn (its centre of mass): "
+            "nothing held it up there, so it slid until the body caught it (a strapless or loose "
+            "top needs an \"ease\" below 1 or a smaller \"offset\" to grip; docs/garment.md, "
+            "\"Seventh round\")",
+            sketch.file, 100 * *out.settled_drop);
+    }
     if (adaptive) out.adaptive = *driver.adaptive_report();
   } catch (const sim::InvalidFabricError& e) {
     sketch.fail("/fabric", e.what());

@@ -17,7 +17,7 @@ std::vector<garment::QualityWarning> quality_warnings(const garment::Garment& ga
     // Not a standing figure (a dress form, a test sphere): places are given without a landmark.
   }
   std::vector<garment::QualityWarning> warnings =
-      garment::check_quality(garment, sketch, landmarks ? &*landmarks : nullptr);
+      garment::check_quality_tried(garment, sketch, body.mesh, landmarks ? &*landmarks : nullptr);
   for (const garment::QualityWarning& w : warnings) spdlog::warn("{}: {}", sketch.file, w.message);
   return warnings;
 }

@@ -213,6 +213,8 @@ nlohmann::json run_report_json(const RunReport& r) {
                          {"from_fraction", 0.1},
                          {"to_fraction", 0.6}};
   }
+  out["settled_drop_m"] =
+      r.settled_drop ? nlohmann::json(*r.settled_drop) : nlohmann::json(nullptr);
   out["images"] = r.images;
   out["frames"] = r.frames;
   out["body_motion"] = nullptr;

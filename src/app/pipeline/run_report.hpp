@@ -80,7 +80,11 @@ struct RunReport {
   std::vector<GroupStrain> strain;               // against the rest shape (the pattern when flat)
   int self_intersections_final = 0;              // counted whether or not self-collision was on
   std::optional<meshing::SliceDent> slice_dent;  // garments: the dent between supports
-  std::optional<nlohmann::json> pattern;         // pattern_summary, when the file asks
+  // Garments on a body: how far (m) the cloth's centre of mass ended below where it was drawn
+  // (negative: above), from the gravitational potential of the first and last steps. A garment
+  // nothing grips (a loose strapless top) slides down until something holds it.
+  std::optional<double> settled_drop;
+  std::optional<nlohmann::json> pattern;  // pattern_summary, when the file asks
   std::vector<std::string> images;
   std::size_t frames = 0;
   std::optional<BodyMotionSummary> body_motion;
