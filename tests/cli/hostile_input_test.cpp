@@ -401,7 +401,7 @@ TEST(HostileInput, InterruptedRunLeavesNothing) {
     const std::string sketch = (dir / "sheet.json").string();
     const std::string out_text = out.string();
     std::vector<const char*> argv = {SD_BINARY,        "-q",       "run",  sketch.c_str(), "-o",
-                                     out_text.c_str(), "--frames", "3000", nullptr};
+                                     out_text.c_str(), "--frames", "1000", nullptr};
     pid_t pid = 0;
     ASSERT_EQ(
         posix_spawn(&pid, SD_BINARY, nullptr, nullptr, const_cast<char**>(argv.data()), environ),
