@@ -59,16 +59,6 @@ constexpr double kPiercingHoldMargin = 0.25;
 // was caught again every 9 steps, 39 <-> 40 springs, a 5 mm cycle), and until its force turns
 // adhesive. Off by default: measured, it fails two smooth-body tests (docs/collision.md).
 constexpr double kPiercingReleaseBand = 1.0;
-// A spring held for at most this many steps that still pushes (its carried load > 0) is kept
-// beyond the hold, out to where its own preload P puts its point (P/k past the hold, at most
-// kPiercingReleaseBand past the clearance). The multiplier climbs while the caught point is
-// still being pushed out and unwinds by only k × overshoot per step, so a freshly caught point
-// overshoots: the flat arms-lowering t-shirt's hem spring (body vertex 767) climbed to 45 mN
-// against a 4.5 mN static load, ended 0.86 mm past the clearance still pushing 15 mN, was
-// dropped at the 0.75 mm hold and fell back through: an 8-step cycle (docs/collision.md). Only
-// young springs: measured, extending every loaded spring kept shoulder springs carrying
-// 0.1-0.25 N past the hold for good, and the armpits below went unstable.
-constexpr int kPiercingYoungSteps = 10;
 // A spring's stiffness and damping are those of its point's effective
 // mass m (1/Σ w_k²/m_k over the free corners) oscillating at this angular frequency, critically
 // damped: k = m ω², c = 2 m ω. Resolution independent, and at any step size a physical
@@ -548,22 +538,7 @@ void ContactResponse::spring_start_piercings(const Eigen::VectorXd& start,
     // (the same hysteresis as contacts: dropping a spring as soon as it ended a hair beyond the
     // clearance let the cloth fall back through the next step, and a sheet on a sphere
     // re-solved every step).
-    // A young spring still pushing is kept out to where its own preload P puts its point, P/k past
-    // the hold (at most kPiercingReleaseBand past the clearance): its load is the augmented-
-    // Lagrangian multiplier still unwinding from the catch, not a sign that the cloth left.
-    double reach = hold;
-    if (held && carried > 0.0 && with_body <= -hold &&
-        static_cast<std::size_t>(p.body_vertex) < spring_held_steps_.size() &&
-        spring_held_steps_[p.body_vertex] <= kPiercingYoungSteps) {
-      const std::array<int, 3>& tt = cloth_.triangles[p.cloth_triangle];
-      double inverse_mass = 0.0;
-      for (int k = 0; k < 3; ++k)
-        if (pinned_[tt[k]] == 0) inverse_mass += p.barycentric[k] * p.barycentric[k] / mass_[tt[k]];
-      if (inverse_mass > 0.0)
-        reach = std::min(hold + carried * inverse_mass / (kSpringFrequency * kSpringFrequency),
-                         clearance + kPiercingReleaseBand * settings_.thickness);
-    }
-    if (held ? with_body <= -reach : std::max(with_body, coasting) <= -clearance) continue;
+    if (held ? with_body <= -hold : std::max(with_body, coasting) <= -clearance) continue;
     // Inside a pinch (pinch_budget) the clearance is the vertex's share of the gap, held like
     // a pinched contact up to (1 + kHoldMargin) times it: the two sides' bands stay apart.
     const double own = spring_clearance(p, start);
@@ -762,10 +737,6 @@ void ContactResponse::finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v, const 
 
 void ContactResponse::record_normal_forces(const Eigen::VectorXd& impulse) {
   std::fill(last_normal_force_.begin(), last_normal_force_.end(), kNoImpulse);
-  // The last accepted step's loads: count how long each body vertex has been held.
-  spring_held_steps_.resize(last_piercing_force_.size(), 0);
-  for (std::size_t b = 0; b < last_piercing_force_.size(); ++b)
-    spring_held_steps_[b] = std::isnan(last_piercing_force_[b]) ? 0 : spring_held_steps_[b] + 1;
   std::fill(last_piercing_force_.begin(), last_piercing_force_.end(), kNoImpulse);
   if (impulse.size() != static_cast<Eigen::Index>(3 * last_normal_force_.size())) return;
   for (const ActiveContact& a : active_) {

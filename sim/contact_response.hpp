@@ -304,8 +304,6 @@ class ContactResponse {
   // Per body vertex: the force (N, along the triangles' normals; < 0: it ended pulling) its
   // springs ended the last accepted step with, NaN when it had none.
   std::vector<double> last_piercing_force_;
-  // Per body vertex: accepted steps its springs have been held without a break (0: not held).
-  std::vector<int> spring_held_steps_;
   std::vector<unsigned char> pinned_;  // per cloth vertex, pinned in the step's filter
   Eigen::VectorXd mass_;               // per cloth vertex, kg
   double gravity_ = 9.81;              // m/s²
