@@ -272,22 +272,14 @@ void BM_AssembleForcesJacobian64(benchmark::State& state) {
 }
 BENCHMARK(BM_AssembleForcesJacobian64)->Unit(benchmark::kMillisecond);
 
-// Force and Jacobian assembly of a garment-sized cloth as garments bend it (hinges), with the
-// implicit solver's product ∂f/∂x·u: a 48×48 sheet (2,401 vertices, 4,608 triangles, 6,816
-// hinges), crumpled, on range(0) threads (sim/parallel.hpp). Wall time: the point of a second
-// thread (the machine's other load shows here too).
-void BM_AssembleHingesForcesJacobian(benchmark::State& state) {
-  const int previous_threads = thread_count();
-  set_thread_count(static_cast<int>(state.range(0)));
-  SheetSpec spec;
-  spec.columns = spec.rows = 48;
-  const SheetScene scene = build_sheet(spec);
-  ClothModelOptions options;
-  options.bend_model = BendModel::hinges;
-  const ClothModel model = build_cloth_model(scene.input, fabric_preset("cotton"), options);
+// Times the solve's assembly (forces, matrix with the implicit step's scales, product ∂f/∂x·u)
+// of `model` on `scene`'s sheet crumpled by a fixed pattern, a fifth of an edge, with fixed
+// velocities; returns the number of matrix entries the pattern holds.
+Eigen::Index time_crumpled_assembly(benchmark::State& state, const ClothModel& model,
+                                    const SheetScene& scene) {
   Eigen::VectorXd x = flatten_positions(scene.input.rest_positions);
   Eigen::VectorXd v(x.size());
-  for (Eigen::Index i = 0; i < x.size(); ++i) {  // a fixed crumple, a fifth of an edge
+  for (Eigen::Index i = 0; i < x.size(); ++i) {
     x[i] += 0.004 * std::sin(1.7 * static_cast<double>(i));
     v[i] = 0.04 * std::cos(0.9 * static_cast<double>(i));
   }
@@ -306,6 +298,23 @@ void BM_AssembleHingesForcesJacobian(benchmark::State& state) {
     evaluate_forces(model, ForceSettings{}, x, v, force, nullptr, &target);
     benchmark::DoNotOptimize(force.data());
   }
+  return matrix.nonZeros();
+}
+
+// Force and Jacobian assembly of a garment-sized cloth as garments bend it (hinges), with the
+// implicit solver's product ∂f/∂x·u: a 48×48 sheet (2,401 vertices, 4,608 triangles, 6,816
+// hinges), crumpled, on range(0) threads (sim/parallel.hpp). Wall time: the point of a second
+// thread (the machine's other load shows here too).
+void BM_AssembleHingesForcesJacobian(benchmark::State& state) {
+  const int previous_threads = thread_count();
+  set_thread_count(static_cast<int>(state.range(0)));
+  SheetSpec spec;
+  spec.columns = spec.rows = 48;
+  const SheetScene scene = build_sheet(spec);
+  ClothModelOptions options;
+  options.bend_model = BendModel::hinges;
+  const ClothModel model = build_cloth_model(scene.input, fabric_preset("cotton"), options);
+  time_crumpled_assembly(state, model, scene);
   set_thread_count(previous_threads);
 }
 BENCHMARK(BM_AssembleHingesForcesJacobian)
@@ -335,29 +344,9 @@ void BM_BendingAssembly(benchmark::State& state) {
   ClothModelOptions options;
   options.bend_model = state.range(0) == 0 ? BendModel::hinges : BendModel::quadratic;
   const ClothModel model = build_cloth_model(scene.input, fabric_preset("cotton"), options);
-  Eigen::VectorXd x = flatten_positions(scene.input.rest_positions);
-  Eigen::VectorXd v(x.size());
-  for (Eigen::Index i = 0; i < x.size(); ++i) {
-    x[i] += 0.004 * std::sin(1.7 * static_cast<double>(i));
-    v[i] = 0.04 * std::cos(0.9 * static_cast<double>(i));
-  }
-  const Eigen::VectorXd u = 1e-3 * v;
-  SparseMatrixR matrix = model.pattern.zero_matrix;
-  Eigen::VectorXd force, product(x.size());
-  JacobianTarget target;
-  target.matrix = &matrix;
-  target.dfdx_scale = -1e-3;
-  target.dfdv_scale = -1e-2;
-  target.product_input = &u;
-  target.product_output = &product;
-  for (auto _ : state) {
-    std::fill(matrix.valuePtr(), matrix.valuePtr() + matrix.nonZeros(), 0.0);
-    product.setZero();
-    evaluate_forces(model, ForceSettings{}, x, v, force, nullptr, &target);
-    benchmark::DoNotOptimize(force.data());
-  }
+  const Eigen::Index entries = time_crumpled_assembly(state, model, scene);
   state.counters["nnz_per_vertex"] =
-      static_cast<double>(matrix.nonZeros()) / static_cast<double>(model.vertex_count);
+      static_cast<double>(entries) / static_cast<double>(model.vertex_count);
   set_thread_count(previous_threads);
 }
 BENCHMARK(BM_BendingAssembly)->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
