@@ -396,6 +396,21 @@ std::vector<VertexBendElement> make_vertex_bends(const Eigen::MatrixX3d& rest,
     std::sort(r.begin(), r.end());
     r.erase(std::unique(r.begin(), r.end()), r.end());
   }
+  // Whether a vertex's one-ring has a symmetric part (symmetric_shells), memoised. The split of
+  // the curvature rows by shells cancels the coupling of smooth bends to the sublattice mode only
+  // between vertices that both read the mode with central differences: on the 4-8 mesh with
+  // w × h cells both kinds of vertices do (the degree-4 ones by their nearer pair), but a vertex
+  // next to a free edge or to the centre of a rectangle split into four (whose four neighbours
+  // are equidistant) does not, and splitting its neighbours' rows alone made the rhombic mesh
+  // softer (docs/simulator.md, "Elongated cells"). Only one-ring points of wanted vertices are
+  // asked, whose rings are complete also when only some elements are made.
+  std::vector<signed char> shells_known(static_cast<std::size_t>(n), -1);
+  const auto has_shells = [&](int j) {
+    signed char& known = shells_known[static_cast<std::size_t>(j)];
+    if (known < 0)
+      known = symmetric_shells(rest, j, ring[static_cast<std::size_t>(j)]).empty() ? 0 : 1;
+    return known == 1;
+  };
   std::vector<VertexBendElement> elements;
   elements.reserve(static_cast<std::size_t>(n));
   for (int v = 0; v < n; ++v) {
@@ -431,7 +446,10 @@ std::vector<VertexBendElement> make_vertex_bends(const Eigen::MatrixX3d& rest,
     const double radius = std::sqrt(radius2);
     // Before the one-ring: its centrally symmetric parts, nearest shells first (see
     // symmetric_shells); `ring_hood` is the one-ring's index among the neighbourhoods.
+    // Only where every neighbour has such a part too, so that neighbours read a grid-scale mode
+    // alike (see has_shells).
     std::vector<std::vector<int>> hood = symmetric_shells(rest, v, one_ring);
+    if (!std::all_of(one_ring.begin(), one_ring.end(), has_shells)) hood.clear();
     const std::size_t ring_hood = hood.size();
     hood.push_back(one_ring);
     hood[ring_hood].push_back(v);
