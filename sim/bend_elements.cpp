@@ -27,7 +27,10 @@ constexpr double kNegligibleWeight = 1e-13;
 // their chord errors: with the nearest points alone a cylinder's energy on the irregular strip
 // erred by 3.6 % (1.9 % on the whole two-ring), and with 9 points Peirce's chord on the 4-8 mesh at
 // 45° came out 0.3° stiffer than with the whole two-ring (silk 39.97° against 41.49°); with 11 the
-// chords are the whole two-ring's within 0.05° (tests/sim/textile_presets_test.cpp).
+// chords are the whole two-ring's within 0.05° (tests/sim/textile_presets_test.cpp). The 9-point
+// fit is the more accurate bending (0.981 B at 16 cells at 45° against 0.962); silk's chord is
+// stiffened by the membrane locking on that layout, which the 11-point fit's softness offsets
+// (docs/simulator.md, "Elongated cells", "Still open").
 constexpr std::size_t kFewestFitPoints = 11;
 
 // The points an element's rows read: its centre and every point with a weight in some row.
@@ -364,7 +367,9 @@ std::vector<VertexBendElement> make_vertex_bends(const Eigen::MatrixX3d& rest,
   // least-squares quadratic. Each row uses the smallest neighbourhood that determines it: the
   // one-ring, else the one-ring with the nearest points of the two-ring (the tangent frame is
   // aligned with an edge, so on the 4-8 mesh a degree-4 vertex's one-ring determines
-  // x_uu − x_vv, and its twist takes the four diagonal points, the usual cross stencil).
+  // x_uu − x_vv, and its twist takes the four diagonal points, the usual cross stencil); a row
+  // the one-ring determines is read part by part from its nearest symmetric shells where it and
+  // its neighbours have them (symmetric_shells, functional_row).
   // Every point an element reads couples its vertex to every other in the system matrix, so
   // the nearest points also keep the matrix narrow: on the 4-8 mesh 25 blocks a row instead of
   // the whole two-ring's 72.
