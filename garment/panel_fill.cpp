@@ -333,7 +333,26 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
     patch.quality = best.quality;
     return patch;
   };
-  meshing::FilledPatch patch = finish(fit == PanelFit::kBody ? fill(options) : std::move(*spanned));
+  // A body panel is filled first without the filler's last resorts
+  // (FillGeometryOptions::last_resorts: a second search and a second relaxation, each a full
+  // relaxation more along the body, on panels where every plan folds), because the smoothing
+  // and unfolding along the body above usually mend what they would: the raglan top's sleeves
+  // and the long-sleeved tee's back sleeve come out clean either way, the last resorts being a
+  // third of their meshing time. Only when the finished panel still folds or has a sliver is it
+  // filled again with them, and the better kept (the thorough fill on a tie, which is what every
+  // panel got before).
+  const auto fill_on_body = [&](meshing::FillGeometryOptions o) {
+    o.last_resorts = false;
+    meshing::FilledPatch quick = finish(fill(o));
+    if (!quick.last_resorts_deferred ||
+        (quick.quality.inverted_quads == 0 && quick.quality.max_aspect_ratio < kSliverAspect))
+      return quick;
+    o.last_resorts = true;
+    meshing::FilledPatch thorough = finish(fill(o));
+    return rank(quick.quality) < rank(thorough.quality) ? quick : thorough;
+  };
+  meshing::FilledPatch patch =
+      fit == PanelFit::kBody ? fill_on_body(options) : finish(std::move(*spanned));
   // Interior vertices of a body panel whose own normal (the quads' diagonal cross products
   // summed) turns against the body's normal at their nearest point: the panel lies there on
   // the far side of a limb, wound the wrong way round it.
@@ -372,7 +391,7 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
       far_side(patch) > 0) {
     meshing::FillGeometryOptions along = options;
     along.place = place;
-    meshing::FilledPatch other = finish(fill(along));
+    meshing::FilledPatch other = fill_on_body(along);
     if (rank(other.quality) < rank(patch.quality)) patch = std::move(other);
   }
   return patch;
