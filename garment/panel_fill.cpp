@@ -333,23 +333,37 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
     patch.quality = best.quality;
     return patch;
   };
-  // A body panel is filled first without the filler's last resorts
-  // (FillGeometryOptions::last_resorts: a second search and a second relaxation, each a full
-  // relaxation more along the body, on panels where every plan folds), because the smoothing
-  // and unfolding along the body above usually mend what they would: the raglan top's sleeves
-  // and the long-sleeved tee's back sleeve come out clean either way, the last resorts being a
-  // third of their meshing time. Only when the finished panel still folds or has a sliver is it
-  // filled again with them, and the better kept (the thorough fill on a tie, which is what every
-  // panel got before).
+  // A body panel whose every plan folds is finished (smoothed and unfolded along the body,
+  // above) before the filler's last resorts (FillGeometryOptions::good_enough: a second search
+  // and a second relaxation, each a full relaxation more along the body), because that usually
+  // mends what they would: the raglan top's sleeves and the long-sleeved tee's back sleeve come
+  // out clean either way, the last resorts being a third of their meshing time. Only when the
+  // finished panel still folds or has a sliver does the filler go on to them, and the better of
+  // the two finished panels is kept (the thorough one on a tie, which is what every panel got
+  // before).
+  const auto clean = [](const meshing::QuadQuality& q) {
+    return q.inverted_quads == 0 && q.max_aspect_ratio < kSliverAspect;
+  };
   const auto fill_on_body = [&](meshing::FillGeometryOptions o) {
-    o.last_resorts = false;
-    meshing::FilledPatch quick = finish(fill(o));
-    if (!quick.last_resorts_deferred ||
-        (quick.quality.inverted_quads == 0 && quick.quality.max_aspect_ratio < kSliverAspect))
-      return quick;
-    o.last_resorts = true;
-    meshing::FilledPatch thorough = finish(fill(o));
-    return rank(quick.quality) < rank(thorough.quality) ? quick : thorough;
+    std::optional<meshing::FilledPatch> quick;  // the search's best, finished
+    Eigen::MatrixX3d offered;                   // ... as the search left it
+    o.good_enough = [&](const meshing::FilledPatch& searched) {
+      offered = searched.mesh.vertices;
+      quick = finish(searched);
+      return clean(quick->quality);
+    };
+    meshing::FilledPatch filled = fill(o);
+    if (!quick) return finish(std::move(filled));
+    // The last resorts changed nothing (the panel was finished already) or did not come out
+    // better once finished.
+    if (clean(quick->quality) ||
+        (filled.mesh.vertices.rows() == offered.rows() &&
+         filled.mesh.faces.rows() == quick->mesh.faces.rows() &&
+         filled.mesh.faces == quick->mesh.faces && filled.mesh.vertices == offered))
+      return std::move(*quick);
+    meshing::FilledPatch thorough = finish(std::move(filled));
+    if (quick && rank(quick->quality) < rank(thorough.quality)) return std::move(*quick);
+    return thorough;
   };
   meshing::FilledPatch patch =
       fit == PanelFit::kBody ? fill_on_body(options) : finish(std::move(*spanned));

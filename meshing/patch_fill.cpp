@@ -519,13 +519,13 @@ FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
     best_patch = std::move(completed[chosen].patch);
     return clean(completed[chosen]);
   };
-  bool deferred = false;  // a last resort below was due but options.last_resorts is off
-  if (!search(false) && first_set_aside) {
-    if (options.last_resorts)
-      search(true);
-    else
-      deferred = true;
-  }
+  const bool searched_clean = search(false);
+  // The last resorts below are due: offered first to the caller's good_enough.
+  if (((!searched_clean && first_set_aside) ||
+       (!filled.empty() && best_patch->quality.inverted_quads > 0)) &&
+      options.good_enough && options.good_enough(*best_patch))
+    return std::move(*best_patch);
+  if (!searched_clean && first_set_aside) search(true);
   // Every plan tried keeps inverted quads: relax the best of them again with reference normals
   // taken after the unguarded sweeps, which untangle the large overlapping clusters the starting
   // normals cannot see. Last, so that no fill that comes out clean the first way changes; and
@@ -540,16 +540,12 @@ FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
   // pass came out clean 10 times, each with at most 1 such fold; 45 runs had 5 or more, and their
   // guarded sweeps and untangling were a tenth of the raglan top's meshing time.
   if (!filled.empty() && best_patch->quality.inverted_quads > 0) {
-    if (options.last_resorts) {
-      std::optional<Built> none;
-      detail::RelaxProbe probe;
-      if (options.project) probe.stop_at = kProbeFolds;
-      FilledPatch patch = fill_with_plan(filled.front(), counts, side_points, shape, none, options,
-                                         detail::ReferenceNormals::kAfterSweeps, &probe);
-      if (!probe.stopped && patch.quality.inverted_quads == 0) best_patch = std::move(patch);
-    } else {
-      deferred = true;
-    }
+    std::optional<Built> none;
+    detail::RelaxProbe probe;
+    if (options.project) probe.stop_at = kProbeFolds;
+    FilledPatch patch = fill_with_plan(filled.front(), counts, side_points, shape, none, options,
+                                       detail::ReferenceNormals::kAfterSweeps, &probe);
+    if (!probe.stopped && patch.quality.inverted_quads == 0) best_patch = std::move(patch);
   }
   // Still folded, on a flat boundary without projection: a foldover-free placement of the same
   // connectivity in the boundary's plane (a barrier on every quad corner's signed area,
@@ -573,7 +569,6 @@ FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
   if (shape.planar && !options.project && best_patch->quality.inverted_quads == 0 &&
       best_patch->mesh.faces.rows() <= kThinQuadMaxQuads)
     widen_thin_quads(*best_patch, shape.normal);
-  best_patch->last_resorts_deferred = deferred;
   return std::move(*best_patch);
 }
 

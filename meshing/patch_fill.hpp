@@ -43,6 +43,8 @@ struct PatchTopology {
 // otherwise throws FillError with a sentence.
 PatchTopology fill_region(std::span<const int> side_counts);
 
+struct FilledPatch;
+
 struct FillGeometryOptions {
   // Sweeps of interior smoothing after Coons interpolation (0 keeps the Coons positions).
   int relax_iterations = 10;
@@ -61,20 +63,18 @@ struct FillGeometryOptions {
   // When no plan comes out clean, fill_region has two last resorts, each a full relaxation more
   // for one plan: the search again with its first plan relaxed to the end, and the best plan
   // relaxed again with the reference normals of its unguarded sweeps. Over the garments they
-  // cleaned 3 of 57 panels and were a third of the raglan top's meshing time. A caller with its
-  // own way of unfolding (garment/panel_fill.cpp smooths and unfolds along the body) may turn
-  // them off, see whether that way comes out clean, and fill again with them only when not;
-  // FilledPatch::last_resorts_deferred says whether they would have run.
-  bool last_resorts = true;
+  // cleaned 3 of 57 panels and were a third of the raglan top's meshing time. Optional: a
+  // caller with its own way of mending a fill (garment/panel_fill.cpp smooths and unfolds along
+  // the body) is offered the search's best patch before them; when it returns true that patch
+  // is the result (without the planar placement that follows on an unprojected fill), otherwise
+  // the fill goes on as without it, to the same result.
+  std::function<bool(const FilledPatch&)> good_enough;
 };
 
 struct FilledPatch {
   PatchTopology topology;
   QuadMesh mesh;  // 3D; same connectivity and vertex indices as topology.mesh
   QuadQuality quality;
-  // FillGeometryOptions::last_resorts was off and a last resort would have run: filling again
-  // with them on may give another mesh.
-  bool last_resorts_deferred = false;
 };
 
 // side_points[i] is (l_i + 1) by 3: the exact boundary vertices of side i, from corner i to
