@@ -362,7 +362,7 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
          filled.mesh.faces == quick->mesh.faces && filled.mesh.vertices == offered))
       return std::move(*quick);
     meshing::FilledPatch thorough = finish(std::move(filled));
-    if (quick && rank(quick->quality) < rank(thorough.quality)) return std::move(*quick);
+    if (rank(quick->quality) < rank(thorough.quality)) return std::move(*quick);
     return thorough;
   };
   meshing::FilledPatch patch =
