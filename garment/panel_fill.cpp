@@ -10,6 +10,7 @@
 #include <tuple>
 #include <unordered_map>
 
+#include "garment/fold_repair.hpp"
 #include "garment/panel_surface.hpp"
 #include "garment/surface_relaxation.hpp"
 #include "garment/surface_untangle.hpp"
@@ -407,6 +408,23 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
     along.place = place;
     meshing::FilledPatch other = fill_on_body(along);
     if (rank(other.quality) < rank(patch.quality)) patch = std::move(other);
+  }
+  // Folds that every start, plan, smoothing and unfolding left: mended by local changes of the
+  // quads at each fold (fold_repair.hpp), kept only when the gate's measures improve. A clean
+  // panel is not touched.
+  if (patch.quality.inverted_quads > 0) {
+    std::vector<char> fixed(static_cast<size_t>(patch.mesh.vertex_count()), 0);
+    for (const auto& side : patch.topology.side_vertices)
+      for (const int v : side) fixed[static_cast<size_t>(v)] = 1;
+    const std::vector<int> corners = patch.topology.corner_vertices();
+    const FoldRepairResult repaired = repair_folds(patch.mesh, fixed, corners, options.project);
+    if (repaired.edge_turns + repaired.smoothings > 0) {
+      patch.quality = meshing::measure_quality(patch.mesh, corners);
+      // The layout's connectivity follows the turned edges; its distortion is the new one.
+      patch.topology.mesh.faces = patch.mesh.faces;
+      patch.topology.distortion = patch.quality.distortion;
+      patch.topology.irregular_vertices = patch.quality.irregular_vertices;
+    }
   }
   return patch;
 }
