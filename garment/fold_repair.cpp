@@ -3,7 +3,9 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <set>
 #include <tuple>
@@ -73,6 +75,22 @@ std::vector<double> worst_corners(const meshing::QuadMesh& mesh) {
   return worst;
 }
 
+// degrees: the smallest corner angle over all quads as the gate measures it (the angle between
+// a corner's edges, whichever way the corner turns; measure_quality counts a folded corner as
+// reflex instead, and so misses a fold traded for a sliver).
+double smallest_angle(const meshing::QuadMesh& mesh) {
+  double largest_cosine = -1;
+  for (Eigen::Index f = 0; f < mesh.face_count(); ++f)
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector3d p = mesh.vertices.row(mesh.faces(f, k)).transpose();
+      const Eigen::Vector3d e1 = mesh.vertices.row(mesh.faces(f, (k + 1) % 4)).transpose() - p;
+      const Eigen::Vector3d e2 = mesh.vertices.row(mesh.faces(f, (k + 3) % 4)).transpose() - p;
+      const double scale = e1.norm() * e2.norm();
+      if (scale > 0) largest_cosine = std::max(largest_cosine, e1.dot(e2) / scale);
+    }
+  return std::acos(std::clamp(largest_cosine, -1.0, 1.0)) * 180 / std::numbers::pi;
+}
+
 // Edge neighbours of every vertex.
 std::vector<std::vector<int>> edge_neighbours(const meshing::QuadMesh& mesh) {
   std::vector<std::vector<int>> around(static_cast<size_t>(mesh.vertex_count()));
@@ -121,6 +139,7 @@ FoldRepairResult repair_folds(meshing::QuadMesh& mesh, std::span<const char> fix
   FoldRepairResult result;
   const meshing::QuadQuality start = meshing::measure_quality(mesh, corner_vertices);
   meshing::QuadQuality quality = start;
+  const double start_angle = smallest_angle(mesh);
   result.folded_before = result.folded_after = quality.inverted_quads;
   for (int round = 0; round < rounds && quality.inverted_quads > 0; ++round) {
     const std::vector<double> worst = worst_corners(mesh);
@@ -153,7 +172,7 @@ FoldRepairResult repair_folds(meshing::QuadMesh& mesh, std::span<const char> fix
       const meshing::QuadQuality q = meshing::measure_quality(candidate, corner_vertices);
       // A fold is not traded for a sharper corner or a longer sliver than the gate already
       // warned about (the tank top's back: 3 folds for a 0.7° corner where it had 3.0°).
-      if (q.min_angle_deg < std::min(kGateAngle, start.min_angle_deg) ||
+      if (smallest_angle(candidate) < std::min(kGateAngle, start_angle) ||
           q.max_aspect_ratio > std::max(kSliverAspect, start.max_aspect_ratio))
         return;
       if (rank(q) < rank(best_quality)) {
@@ -197,6 +216,9 @@ FoldRepairResult repair_folds(meshing::QuadMesh& mesh, std::span<const char> fix
              {std::tuple(x1, y1, Face{x1, x2, t, y1}, Face{y1, y2, s, x1}),
               std::tuple(x2, y2, Face{x2, t, y1, y2}, Face{y2, s, x1, x2})}) {
           if (edges.count({std::min(u, w), std::max(u, w)})) continue;  // the diagonal exists
+          // A chord between two boundary vertices would cut the panel; two on one seam (a
+          // centre seam shared with the mirror copy) would read as a seam edge used twice.
+          if (fixed[static_cast<size_t>(u)] && fixed[static_cast<size_t>(w)]) continue;
           meshing::QuadMesh candidate = mesh;
           for (int c = 0; c < 4; ++c) {
             candidate.faces(f, c) = first[static_cast<size_t>(c)];
