@@ -1,17 +1,20 @@
 #pragma once
 // The last repair of a filled panel that still has folded quads: local changes of the quads at
-// each fold, kept only when the quality gate's own measure (meshing::measure_quality) improves.
-// Two folds survive the filler, the smoothing and the unfolding along the body (docs/garment.md,
-// "Folds at a panel's corners"), both at a boundary vertex whose angle the quads share badly:
-//  * a boundary vertex in one quad whose angle there is about 180° or more: a plan whose corner
-//    was moved along the boundary by one vertex ("shifted-corners": the yoke's hip corner), or a
-//    corner that turns more than 180° on a saddle of the body (a sleeve's armpit). No position
-//    of the interior mends it; turning the edge between the folded quad and a neighbour (the
-//    hexagon of the two quads split along one of its other two diagonals) gives the vertex a
-//    second quad, or moves the quad corner back to the panel's corner;
-//  * a boundary vertex whose two quads split its angle unevenly (36° and 155° at a back neck),
-//    so that the wide one folds against its neighbours: the interior vertices around the fold
-//    moved to the mean of their neighbours, lifted onto the surface.
+// each fold, kept only when the panel's quality measure (meshing::measure_quality, the one the
+// garment ranks fills by) improves. The folds that survive the filler, the smoothing and the
+// unfolding along the body (docs/garment.md, "Folds at a panel's corners") sit at a boundary
+// vertex whose angle the quads share badly:
+//  * a boundary vertex in one quad at about 180° or more: a plan whose corner was moved along the
+//    boundary by one vertex ("shifted-corners": the silk skirt's yoke at the hip, the shorts'
+//    back at the crotch). No position of the interior mends it; turning the edge between the
+//    folded quad and a neighbour (the hexagon of the two quads split along one of its other two
+//    diagonals) moves the quad corner back to the panel's corner or gives the vertex a second
+//    quad;
+//  * a boundary vertex whose two quads split its angle unevenly (36° and 155° at the shell top's
+//    back neck), so that the wide one folds: a turn there too, in the corpus.
+// The other candidate, the interior around the fold smoothed towards the mean of its
+// neighbours and lifted onto the surface, is tried as well. A corner that turns more than 180°
+// in one quad on a saddle of the body (shirt-human's armpit) is not reached (docs/garment.md).
 
 #include <Eigen/Core>
 #include <functional>
