@@ -301,6 +301,11 @@ void relax_interior(QuadMesh& mesh, std::span<const char> fixed, int sweeps,
 
 namespace detail {
 
+RelaxationTally& relaxation_tally() {
+  thread_local RelaxationTally tally;
+  return tally;
+}
+
 void relax_interior(std::vector<Eigen::Vector3d>& positions,
                     std::span<const std::array<int, 4>> quads, std::span<const char> fixed,
                     int sweeps,
@@ -379,6 +384,7 @@ void relax_interior(std::vector<Eigen::Vector3d>& positions,
         probe->folds += quad_min_jacobian(quads[f], normals[f], x) < 0;
       if (probe->folds >= probe->stop_at) {
         probe->stopped = true;
+        ++relaxation_tally().stopped;
         positions = x;
         return;
       }
@@ -386,6 +392,7 @@ void relax_interior(std::vector<Eigen::Vector3d>& positions,
   }
   // The guarded sweeps run between two scratch arrays, from the start again; the result is
   // copied out.
+  ++relaxation_tally().guarded;
   std::vector<Eigen::Vector3d>& current = y;
   std::vector<Eigen::Vector3d>& next = x;
   current = old;

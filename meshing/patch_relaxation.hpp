@@ -57,6 +57,15 @@ void relax_interior(std::vector<Eigen::Vector3d>& positions,
                     ReferenceNormals reference = ReferenceNormals::kStart,
                     RelaxProbe* probe = nullptr);
 
+// This thread's relaxations since the tally was last reset (tests read it to check how much work
+// a fill does, which its result alone does not show): those that went on to the guarded sweeps
+// and the untangling (the expensive part of a folding plan), and those a probe stopped before.
+struct RelaxationTally {
+  int guarded = 0;
+  int stopped = 0;
+};
+RelaxationTally& relaxation_tally();
+
 // Foldover-free placement in a plane, after Garanzha, Kaporin, Kudryavtseva, Protais, Ray and
 // Sokolov (2021), "Foldover-free maps in 50 lines of code": the free vertices of #Q
 // counter-clockwise quads (about `normal`, unit) move in the plane square to `normal` to

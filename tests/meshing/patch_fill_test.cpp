@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <random>
 
 #include "meshing/region_partition.hpp"
@@ -310,6 +311,43 @@ TEST(PatchFillGeometry, SidesThatDoNotMeetAreAFillError) {
   sides = sides_on(ellipse, std::vector<int>{4, 4, 4, 4});
   sides[1](1, 2) = std::nan("");
   EXPECT_THROW(fill_region(sides), FillError);
+}
+
+// FillGeometryOptions::good_enough: offered the search's best patch only when a last resort is
+// due (the notched quadrilaterals with a 210° corner: every plan of some folds before the last
+// resorts and the planar placement clean them). Declined, the fill is the same bits as without
+// it; accepted, the offered patch is the result, as offered.
+TEST(PatchFill, GoodEnoughIsOfferedTheSearchsBestBeforeTheLastResorts) {
+  int offers = 0, fills = 0;
+  test::for_each_count_vector(4, [&](const std::vector<int>& small) {
+    if (offers >= 3) return;
+    std::vector<int> counts = small;
+    for (int& c : counts) c += 4;
+    const std::vector<Eigen::MatrixX3d> sides = test::notched_sides(counts, 210);
+    ++fills;
+    const FilledPatch plain = fill_region(sides);
+    std::optional<FilledPatch> offered;
+    FillGeometryOptions declining;
+    declining.good_enough = [&](const FilledPatch& p) {
+      offered = p;
+      return false;
+    };
+    const FilledPatch declined = fill_region(sides, declining);
+    SCOPED_TRACE(test::describe(counts));
+    EXPECT_TRUE(declined.mesh.vertices == plain.mesh.vertices);
+    EXPECT_TRUE(declined.mesh.faces == plain.mesh.faces);
+    if (!offered) return;
+    ++offers;
+    // Offered because it folds: the last resorts are for fills that keep inverted quads.
+    EXPECT_GT(offered->quality.inverted_quads, 0);
+    FillGeometryOptions accepting;
+    accepting.good_enough = [](const FilledPatch&) { return true; };
+    const FilledPatch accepted = fill_region(sides, accepting);
+    EXPECT_TRUE(accepted.mesh.vertices == offered->mesh.vertices);
+    EXPECT_EQ(accepted.quality.inverted_quads, offered->quality.inverted_quads);
+    EXPECT_EQ(plain.quality.inverted_quads, 0);  // the last resorts clean it
+  });
+  EXPECT_GE(offers, 1) << "of " << fills << " notched fills";
 }
 
 }  // namespace
