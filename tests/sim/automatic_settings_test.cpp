@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
 #include <vector>
 
 namespace sd::sim {
@@ -111,6 +112,38 @@ TEST(AutomaticSettings, SheetStepsFollowThePinsTheBodyAndTheMotion) {
       apply_choice(choose_settings(sheet), true, true, settings);
       EXPECT_NO_THROW(settings.validate());
     }
+}
+
+// The PCG's looser tolerance goes with the swinging sheet's step only (measured there against
+// the bench's error band), and only into settings whose solver and step are both automatic.
+TEST(AutomaticSettings, LooserPcgToleranceOnlyForTheSwingingSheet) {
+  SceneTraits scene;
+  scene.vertices = 1089;
+  AutomaticChoice choice = choose_settings(scene);
+  EXPECT_DOUBLE_EQ(choice.pcg_tolerance, kAutomaticSwingPcgTolerance);
+  EXPECT_NE(choice.reason.find("PCG to 0.01"), std::string::npos) << choice.reason;
+  SimulationSettings settings;
+  apply_choice(choice, true, true, settings);
+  EXPECT_DOUBLE_EQ(settings.pcg_tolerance, kAutomaticSwingPcgTolerance);
+  EXPECT_NO_THROW(settings.validate());
+  for (const auto& [solver_automatic, step_automatic] :
+       {std::pair{true, false}, std::pair{false, true}, std::pair{false, false}}) {
+    SimulationSettings given;
+    apply_choice(choice, solver_automatic, step_automatic, given);
+    EXPECT_DOUBLE_EQ(given.pcg_tolerance, kDefaultPcgTolerance);
+  }
+  EXPECT_DOUBLE_EQ(SimulationSettings{}.pcg_tolerance, kDefaultPcgTolerance);
+  // Pins holding its shape, a body, the motion asked for, a garment: the default tolerance.
+  for (int which = 0; which < 4; ++which) {
+    SceneTraits other = scene;
+    other.pins_hold_shape = which == 0;
+    other.body = which == 1;
+    other.motion = which == 2;
+    other.garment = which == 3;
+    choice = choose_settings(other);
+    EXPECT_DOUBLE_EQ(choice.pcg_tolerance, kDefaultPcgTolerance) << which;
+    EXPECT_EQ(choice.reason.find(" to 0.0"), std::string::npos) << choice.reason;
+  }
 }
 
 // Pins hold a sheet's shape when at least three of them span a triangle: the corners of a
