@@ -48,7 +48,8 @@ struct AutomaticChoice {
   double dt = 1.0 / 60.0;  // s, the largest step
   // The PCG's relative residual reduction (SimulationSettings::pcg_tolerance).
   double pcg_tolerance = kDefaultPcgTolerance;
-  std::string reason;  // one sentence for report.json and logs
+  double step_error = 0.0;  // m, SimulationSettings::step_error; 0: the step does not follow it
+  std::string reason;       // one sentence for report.json and logs
 };
 
 // Above this many vertices a sheet's PCG takes the two-level preconditioner: IC(0)'s iterations
@@ -66,6 +67,13 @@ inline constexpr double kAutomaticSheetStep = 1.0 / 20.0;
 inline constexpr double kAutomaticSwingStep = 1.0 / 40.0;
 inline constexpr double kAutomaticContactStep = 1.0 / 50.0;
 inline constexpr double kAutomaticMotionStep = 1.0 / 60.0;
+// Fifth round: the sheet free to swing starts at kAutomaticSwingStep (the largest step, dt, is
+// kAutomaticSheetStep, the run starts at half of it) and its step then follows implicit Euler's
+// local error estimate held near this (m, RMS; SimulationSettings::step_error): steps of 1/40 s
+// and shorter while it swings, growing to 1/20 s as it settles (bench, 1 s at L4, against the
+// 1/60 s run's RMS trajectory error, band 1.5x: two corners 1.10x, one edge 1.29x, one corner
+// 0.99x; 3 mm gave 1.43x, 1.54x (outside), 1.20x; docs/simulator.md, "Automatic settings").
+inline constexpr double kAutomaticSwingStepError = 2e-3;
 
 // True when the pinned vertices (rows of `positions`, m) hold a rigid body still: at least three
 // of them, not all near one line (the farthest from the line through the two farthest apart is at

@@ -62,7 +62,10 @@ TEST(AutomaticSettings, SettingsTheFileGivesAreKept) {
   EXPECT_EQ(settings.integrator, Integrator::bdf2);  // the file's integrator stays
   EXPECT_DOUBLE_EQ(settings.dt, 0.01);
   apply_choice(choice, false, true, settings);
-  EXPECT_DOUBLE_EQ(settings.dt, kAutomaticSwingStep);  // no pins holding it: free to swing
+  // No pins holding it: free to swing, from 1/40 s by the local error up to 1/20 s.
+  EXPECT_DOUBLE_EQ(settings.dt, kAutomaticSheetStep);
+  EXPECT_DOUBLE_EQ(settings.step_error, kAutomaticSwingStepError);
+  EXPECT_DOUBLE_EQ(0.5 * settings.dt, kAutomaticSwingStep);
   EXPECT_LE(settings.min_dt, settings.dt / 64);
   EXPECT_NO_THROW(settings.validate());
 }
@@ -75,18 +78,23 @@ TEST(AutomaticSettings, SheetStepsFollowThePinsTheBodyAndTheMotion) {
   SceneTraits scene;
   scene.vertices = 1089;
   AutomaticChoice choice = choose_settings(scene);
-  EXPECT_DOUBLE_EQ(choice.dt, kAutomaticSwingStep);
-  EXPECT_NE(choice.reason.find("1/40 s"), std::string::npos) << choice.reason;
+  EXPECT_DOUBLE_EQ(choice.dt, kAutomaticSheetStep);
+  EXPECT_DOUBLE_EQ(choice.step_error, kAutomaticSwingStepError);
+  EXPECT_NE(choice.reason.find("from 1/40 s up to 1/20 s by a local error of 2 mm"),
+            std::string::npos)
+      << choice.reason;
   EXPECT_NE(choice.reason.find("free to swing"), std::string::npos) << choice.reason;
   scene.pins_hold_shape = true;
   choice = choose_settings(scene);
   EXPECT_DOUBLE_EQ(choice.dt, kAutomaticSheetStep);
+  EXPECT_DOUBLE_EQ(choice.step_error, 0.0);  // a fixed step where the pins hold the shape
   EXPECT_NE(choice.reason.find("1/20 s"), std::string::npos) << choice.reason;
   EXPECT_NE(choice.reason.find("holding its shape"), std::string::npos) << choice.reason;
   // Contact with a body takes the shorter step whatever the pins.
   scene.body = true;
   choice = choose_settings(scene);
   EXPECT_DOUBLE_EQ(choice.dt, kAutomaticContactStep);
+  EXPECT_DOUBLE_EQ(choice.step_error, 0.0);
   EXPECT_NE(choice.reason.find("1/50 s"), std::string::npos) << choice.reason;
   EXPECT_NE(choice.reason.find("on a body"), std::string::npos) << choice.reason;
   EXPECT_EQ(choice.solver, LinearSolverKind::pcg);

@@ -199,6 +199,7 @@ sim::SimulationSettings run_settings(const BenchScene& scene, const BenchConfig&
   settings.solver = config.solver;
   if (config.linearized) settings.newton_iterations = 1;
   if (config.pcg_tolerance > 0.0) settings.pcg_tolerance = config.pcg_tolerance;
+  settings.step_error = config.step_error;
   settings.dt = config.dt();
   settings.min_dt = std::min(settings.min_dt, settings.dt / 64);
   settings.duration = scene.duration;
@@ -221,7 +222,10 @@ std::string BenchConfig::id() const {
                        steps_per_second);
   const std::string tolerance =
       pcg_tolerance > 0.0 ? fmt::format("-tol{:g}", pcg_tolerance) : std::string();
-  return fmt::format("fixed-L{}-{}-{}{}-{}", level, integ, solv, tolerance, steps_per_second);
+  const std::string error =
+      step_error > 0.0 ? fmt::format("-err{:g}mm", step_error * 1e3) : std::string();
+  return fmt::format("fixed-L{}-{}-{}{}-{}{}", level, integ, solv, tolerance, steps_per_second,
+                     error);
 }
 
 std::string BenchConfig::label() const {
@@ -233,6 +237,9 @@ std::string BenchConfig::label() const {
                        solv, steps_per_second);
   const std::string tolerance =
       pcg_tolerance > 0.0 ? fmt::format(" to {:g}", pcg_tolerance) : std::string();
+  if (step_error > 0.0)
+    return fmt::format("fixed L{}, {}, {}{}, up to 1/{} s by {:g} mm", level, integ, solv,
+                       tolerance, steps_per_second, step_error * 1e3);
   return fmt::format("fixed L{}, {}, {}{}, 1/{} s", level, integ, solv, tolerance,
                      steps_per_second);
 }
@@ -360,6 +367,7 @@ BenchPlan bench_plan(const BenchScene& scene, BenchGrid grid) {
       if (choice.solver == sim::LinearSolverKind::pcg &&
           choice.pcg_tolerance != sim::kDefaultPcgTolerance)
         c.pcg_tolerance = choice.pcg_tolerance;
+      c.step_error = choice.step_error;
       family.members.push_back(c);
     }
     plan.families.push_back(family);
@@ -685,7 +693,8 @@ std::string config_to_json(const BenchConfig& c) {
                         {"solver", sim::solver_name(c.solver)},
                         {"steps_per_second", c.steps_per_second},
                         {"linearized", c.linearized},
-                        {"pcg_tolerance", c.pcg_tolerance}}
+                        {"pcg_tolerance", c.pcg_tolerance},
+                        {"step_error", c.step_error}}
       .dump();
 }
 
@@ -702,6 +711,7 @@ BenchConfig config_from_json(const std::string& text) {
   c.steps_per_second = j.at("steps_per_second");
   c.linearized = j.value("linearized", false);
   c.pcg_tolerance = j.value("pcg_tolerance", 0.0);
+  c.step_error = j.value("step_error", 0.0);
   return c;
 }
 

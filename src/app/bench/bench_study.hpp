@@ -66,6 +66,8 @@ struct BenchConfig {
   // > 0: the PCG's relative tolerance (the automatic rule's, when it is not the default); 0: the
   // scene's.
   double pcg_tolerance = 0.0;
+  // > 0: the step follows this local error (m, sim::SimulationSettings::step_error) up to dt.
+  double step_error = 0.0;
 
   double dt() const { return 1.0 / steps_per_second; }
   std::string id() const;     // "fixed-L4-ie-cholmod-60", unique in a grid
