@@ -65,6 +65,8 @@ void SimulationSettings::validate() const {
   require(pcg_max_iterations >= 1, "the PCG iteration limit must be at least 1");
   require(positive(max_strain), "the strain limit must be positive");
   require(positive(max_speed), "the speed limit must be positive");
+  require(std::isfinite(step_error) && step_error >= 0.0,
+          "the step's error target must be zero (off) or a positive length in metres");
   require(easy_steps_to_grow >= 1, "easy_steps_to_grow must be at least 1");
   require(std::isfinite(grow_factor) && grow_factor >= 1.0, "the growth factor must be at least 1");
   require(positive(rest_speed) && positive(rest_kinetic_energy) && std::isfinite(rest_window) &&
@@ -91,7 +93,7 @@ Simulation::Simulation(ClothModel model, Eigen::VectorXd x0, std::vector<Pin> pi
                        SimulationSettings settings)
     : settings_(std::move(settings)) {
   settings_.validate();
-  dt_ = settings_.dt;
+  dt_ = error_controlled() ? 0.5 * settings_.dt : settings_.dt;
   replace_model(std::move(model), std::move(x0), Eigen::VectorXd(), std::move(pins));
   report_.dt_min_used = 0.0;
 }
@@ -475,6 +477,7 @@ void Simulation::accept(Attempt& attempt, double h) {
 StepOutcome Simulation::step(double max_step) {
   StepOutcome outcome;
   double h = std::min(dt_, max_step);
+  const double planned = dt_;  // before a cut to land on max_step
   // Land exactly on max_step instead of leaving a sliver for the next step.
   if (max_step - h < 1e-3 * h) h = max_step;
   Attempt candidate;
@@ -548,6 +551,21 @@ StepOutcome Simulation::step(double max_step) {
     dt_ = std::min(settings_.dt, dt_ * factor);
     easy_steps_ = 0;
     spdlog::debug("sim: t = {:.6f} s: step grows to {:.4g} s", time_, dt_);
+  }
+  if (error_controlled() && v_previous_.size() == v_.size()) {
+    // Implicit Euler's local error (SimulationSettings::step_error): x1 = x0 + h v1 against
+    // x0 + h v0 + (h²/2) a, i.e. (h/2)(v1 − v0), as an RMS over the vertices; it scales with h²,
+    // hence the square root and a proposal that does not depend on h (a step cut short to land
+    // on max_step proposes the same; its bounds are those of the step planned). After a
+    // rejected attempt the step does not grow.
+    const double estimate = 0.5 * h * (v_ - v_previous_).norm() / std::sqrt(v_.size() / 3.0);
+    const double base = outcome.retries > 0 ? h : std::max(h, planned);
+    double next =
+        estimate > 0.0 ? 0.9 * h * std::sqrt(settings_.step_error / estimate) : 2.0 * base;
+    next = std::clamp(next, 0.5 * base, 2.0 * base);
+    if (outcome.retries > 0 || outcome.forced) next = std::min(next, h);
+    dt_ = std::clamp(next, settings_.min_dt, settings_.dt);
+    easy_steps_ = 0;
   }
   return outcome;
 }

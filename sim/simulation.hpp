@@ -50,8 +50,15 @@ struct SimulationSettings {
   // Block IC(0) needs 6-12x fewer iterations than block Jacobi on stiff woven cloth and makes
   // the PCG step 4x faster (docs/benchmarks.md, "Simulator"); block Jacobi is kept to compare.
   PcgPreconditioner pcg_preconditioner = PcgPreconditioner::block_incomplete_cholesky;
-  double max_strain = 1.0;     // a step that stretches any triangle by more (100 %) fails
-  double max_speed = 50.0;     // m/s, a step with a faster vertex fails
+  double max_strain = 1.0;  // a step that stretches any triangle by more (100 %) fails
+  double max_speed = 50.0;  // m/s, a step with a faster vertex fails
+  // m; > 0 (implicit Euler only): the step follows a local error estimate instead of growing
+  // back to dt after easy steps. Implicit Euler's position error over one step is about
+  // (h/2)|v1 − v0| (h²/2 times the acceleration); the RMS of it over the vertices is held near
+  // step_error: the next step is h·0.9·√(step_error/estimate), within [h/2, 2h] and [min_dt, dt].
+  // No step is rejected for it. The run starts at dt/2 (nothing is known of the motion yet).
+  // A swinging sheet takes short steps while it swings and long ones as it settles.
+  double step_error = 0.0;
   int easy_steps_to_grow = 4;  // consecutive steps without trouble before the step grows
   double grow_factor = 2.0;    // capped at 2 for BDF2 (zero-stability needs ω < 1 + √2)
   bool stop_at_rest = true;
@@ -232,6 +239,10 @@ class Simulation {
   const Eigen::VectorXd& velocities() const { return v_; }
   double time() const { return time_; }
   double current_dt() const { return dt_; }
+  // The step follows the local error estimate (SimulationSettings::step_error).
+  bool error_controlled() const {
+    return settings_.step_error > 0.0 && settings_.integrator == Integrator::implicit_euler;
+  }
   bool at_rest() const { return rest_time_ >= settings_.rest_window; }
   const SimulationReport& report() const { return report_; }
   EnergyBreakdown energy() const;

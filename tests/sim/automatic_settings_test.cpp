@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
 #include <vector>
 
 namespace sd::sim {
@@ -61,7 +62,10 @@ TEST(AutomaticSettings, SettingsTheFileGivesAreKept) {
   EXPECT_EQ(settings.integrator, Integrator::bdf2);  // the file's integrator stays
   EXPECT_DOUBLE_EQ(settings.dt, 0.01);
   apply_choice(choice, false, true, settings);
-  EXPECT_DOUBLE_EQ(settings.dt, kAutomaticSwingStep);  // no pins holding it: free to swing
+  // No pins holding it: free to swing, from 1/40 s by the local error up to 1/20 s.
+  EXPECT_DOUBLE_EQ(settings.dt, kAutomaticSheetStep);
+  EXPECT_DOUBLE_EQ(settings.step_error, kAutomaticSwingStepError);
+  EXPECT_DOUBLE_EQ(0.5 * settings.dt, kAutomaticSwingStep);
   EXPECT_LE(settings.min_dt, settings.dt / 64);
   EXPECT_NO_THROW(settings.validate());
 }
@@ -74,18 +78,23 @@ TEST(AutomaticSettings, SheetStepsFollowThePinsTheBodyAndTheMotion) {
   SceneTraits scene;
   scene.vertices = 1089;
   AutomaticChoice choice = choose_settings(scene);
-  EXPECT_DOUBLE_EQ(choice.dt, kAutomaticSwingStep);
-  EXPECT_NE(choice.reason.find("1/40 s"), std::string::npos) << choice.reason;
+  EXPECT_DOUBLE_EQ(choice.dt, kAutomaticSheetStep);
+  EXPECT_DOUBLE_EQ(choice.step_error, kAutomaticSwingStepError);
+  EXPECT_NE(choice.reason.find("from 1/40 s up to 1/20 s by a local error of 2 mm"),
+            std::string::npos)
+      << choice.reason;
   EXPECT_NE(choice.reason.find("free to swing"), std::string::npos) << choice.reason;
   scene.pins_hold_shape = true;
   choice = choose_settings(scene);
   EXPECT_DOUBLE_EQ(choice.dt, kAutomaticSheetStep);
+  EXPECT_DOUBLE_EQ(choice.step_error, 0.0);  // a fixed step where the pins hold the shape
   EXPECT_NE(choice.reason.find("1/20 s"), std::string::npos) << choice.reason;
   EXPECT_NE(choice.reason.find("holding its shape"), std::string::npos) << choice.reason;
   // Contact with a body takes the shorter step whatever the pins.
   scene.body = true;
   choice = choose_settings(scene);
   EXPECT_DOUBLE_EQ(choice.dt, kAutomaticContactStep);
+  EXPECT_DOUBLE_EQ(choice.step_error, 0.0);
   EXPECT_NE(choice.reason.find("1/50 s"), std::string::npos) << choice.reason;
   EXPECT_NE(choice.reason.find("on a body"), std::string::npos) << choice.reason;
   EXPECT_EQ(choice.solver, LinearSolverKind::pcg);
@@ -111,6 +120,38 @@ TEST(AutomaticSettings, SheetStepsFollowThePinsTheBodyAndTheMotion) {
       apply_choice(choose_settings(sheet), true, true, settings);
       EXPECT_NO_THROW(settings.validate());
     }
+}
+
+// The PCG's looser tolerance goes with the swinging sheet's step only (measured there against
+// the bench's error band), and only into settings whose solver and step are both automatic.
+TEST(AutomaticSettings, LooserPcgToleranceOnlyForTheSwingingSheet) {
+  SceneTraits scene;
+  scene.vertices = 1089;
+  AutomaticChoice choice = choose_settings(scene);
+  EXPECT_DOUBLE_EQ(choice.pcg_tolerance, kAutomaticSwingPcgTolerance);
+  EXPECT_NE(choice.reason.find("PCG to 0.01"), std::string::npos) << choice.reason;
+  SimulationSettings settings;
+  apply_choice(choice, true, true, settings);
+  EXPECT_DOUBLE_EQ(settings.pcg_tolerance, kAutomaticSwingPcgTolerance);
+  EXPECT_NO_THROW(settings.validate());
+  for (const auto& [solver_automatic, step_automatic] :
+       {std::pair{true, false}, std::pair{false, true}, std::pair{false, false}}) {
+    SimulationSettings given;
+    apply_choice(choice, solver_automatic, step_automatic, given);
+    EXPECT_DOUBLE_EQ(given.pcg_tolerance, kDefaultPcgTolerance);
+  }
+  EXPECT_DOUBLE_EQ(SimulationSettings{}.pcg_tolerance, kDefaultPcgTolerance);
+  // Pins holding its shape, a body, the motion asked for, a garment: the default tolerance.
+  for (int which = 0; which < 4; ++which) {
+    SceneTraits other = scene;
+    other.pins_hold_shape = which == 0;
+    other.body = which == 1;
+    other.motion = which == 2;
+    other.garment = which == 3;
+    choice = choose_settings(other);
+    EXPECT_DOUBLE_EQ(choice.pcg_tolerance, kDefaultPcgTolerance) << which;
+    EXPECT_EQ(choice.reason.find(" to 0.0"), std::string::npos) << choice.reason;
+  }
 }
 
 // Pins hold a sheet's shape when at least three of them span a triangle: the corners of a

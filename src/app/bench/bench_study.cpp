@@ -198,6 +198,8 @@ sim::SimulationSettings run_settings(const BenchScene& scene, const BenchConfig&
   settings.integrator = config.integrator;
   settings.solver = config.solver;
   if (config.linearized) settings.newton_iterations = 1;
+  if (config.pcg_tolerance > 0.0) settings.pcg_tolerance = config.pcg_tolerance;
+  settings.step_error = config.step_error;
   settings.dt = config.dt();
   settings.min_dt = std::min(settings.min_dt, settings.dt / 64);
   settings.duration = scene.duration;
@@ -218,7 +220,12 @@ std::string BenchConfig::id() const {
   if (mesh == BenchMeshKind::adaptive)
     return fmt::format("adaptive-{:g}mm-L{}-{}-{}-{}", threshold * 1e3, level, integ, solv,
                        steps_per_second);
-  return fmt::format("fixed-L{}-{}-{}-{}", level, integ, solv, steps_per_second);
+  const std::string tolerance =
+      pcg_tolerance > 0.0 ? fmt::format("-tol{:g}", pcg_tolerance) : std::string();
+  const std::string error =
+      step_error > 0.0 ? fmt::format("-err{:g}mm", step_error * 1e3) : std::string();
+  return fmt::format("fixed-L{}-{}-{}{}-{}{}", level, integ, solv, tolerance, steps_per_second,
+                     error);
 }
 
 std::string BenchConfig::label() const {
@@ -228,7 +235,13 @@ std::string BenchConfig::label() const {
   if (mesh == BenchMeshKind::adaptive)
     return fmt::format("adaptive {:g} mm (<= L{}), {}, {}, 1/{} s", threshold * 1e3, level, integ,
                        solv, steps_per_second);
-  return fmt::format("fixed L{}, {}, {}, 1/{} s", level, integ, solv, steps_per_second);
+  const std::string tolerance =
+      pcg_tolerance > 0.0 ? fmt::format(" to {:g}", pcg_tolerance) : std::string();
+  if (step_error > 0.0)
+    return fmt::format("fixed L{}, {}, {}{}, up to 1/{} s by {:g} mm", level, integ, solv,
+                       tolerance, steps_per_second, step_error * 1e3);
+  return fmt::format("fixed L{}, {}, {}{}, 1/{} s", level, integ, solv, tolerance,
+                     steps_per_second);
 }
 
 std::vector<std::string> builtin_bench_scenes() {
@@ -349,8 +362,13 @@ BenchPlan bench_plan(const BenchScene& scene, BenchGrid grid) {
       traits.motion = motion;
       traits.pins_hold_shape = sim::pins_hold_shape(scene.start, scene.pinned);
       const sim::AutomaticChoice choice = sim::choose_settings(traits);
-      family.members.push_back(config(BenchMeshKind::fixed, level, choice.integrator, choice.solver,
-                                      static_cast<int>(std::lround(1.0 / choice.dt))));
+      BenchConfig c = config(BenchMeshKind::fixed, level, choice.integrator, choice.solver,
+                             static_cast<int>(std::lround(1.0 / choice.dt)));
+      if (choice.solver == sim::LinearSolverKind::pcg &&
+          choice.pcg_tolerance != sim::kDefaultPcgTolerance)
+        c.pcg_tolerance = choice.pcg_tolerance;
+      c.step_error = choice.step_error;
+      family.members.push_back(c);
     }
     plan.families.push_back(family);
   }
@@ -674,7 +692,9 @@ std::string config_to_json(const BenchConfig& c) {
                         {"integrator", sim::integrator_short_name(c.integrator)},
                         {"solver", sim::solver_name(c.solver)},
                         {"steps_per_second", c.steps_per_second},
-                        {"linearized", c.linearized}}
+                        {"linearized", c.linearized},
+                        {"pcg_tolerance", c.pcg_tolerance},
+                        {"step_error", c.step_error}}
       .dump();
 }
 
@@ -690,6 +710,8 @@ BenchConfig config_from_json(const std::string& text) {
       sim::parse_solver(j.at("solver").get<std::string>()).value_or(sim::LinearSolverKind::cholmod);
   c.steps_per_second = j.at("steps_per_second");
   c.linearized = j.value("linearized", false);
+  c.pcg_tolerance = j.value("pcg_tolerance", 0.0);
+  c.step_error = j.value("step_error", 0.0);
   return c;
 }
 

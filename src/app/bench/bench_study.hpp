@@ -63,6 +63,11 @@ struct BenchConfig {
   // BDF2 only: one Newton iteration, linearised at the start of the step (the linearly implicit
   // BDF2 step, docs/simulator.md "Integration") instead of simplified Newton with fallbacks.
   bool linearized = false;
+  // > 0: the PCG's relative tolerance (the automatic rule's, when it is not the default); 0: the
+  // scene's.
+  double pcg_tolerance = 0.0;
+  // > 0: the step follows this local error (m, sim::SimulationSettings::step_error) up to dt.
+  double step_error = 0.0;
 
   double dt() const { return 1.0 / steps_per_second; }
   std::string id() const;     // "fixed-L4-ie-cholmod-60", unique in a grid
