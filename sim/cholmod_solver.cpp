@@ -156,21 +156,27 @@ void CholmodSolver::make_permuted_lower() {
       const int pi = inverse[upper_.innerIndexPtr()[k]], pj = inverse[j];
       entries.push_back({std::max(pi, pj), std::min(pi, pj), upper_source_[e]});
     }
-  std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
-    return a.column != b.column ? a.column < b.column : a.row < b.row;
-  });
+  // Two stable counting passes, by row and then by column: sorted by (column, row) in O(nnz)
+  // (a comparison sort of the entries cost 5 % of a garment drape's profile, once per analysis).
+  std::vector<Entry> by_row(entries.size());
+  std::vector<int> start(static_cast<std::size_t>(rows) + 1, 0);
+  for (const Entry& entry : entries) ++start[static_cast<std::size_t>(entry.row) + 1];
+  for (int r = 0; r < rows; ++r) start[r + 1] += start[r];
+  for (const Entry& entry : entries) by_row[static_cast<std::size_t>(start[entry.row]++)] = entry;
   lower_.resize(rows, rows);
   lower_.resizeNonZeros(static_cast<Eigen::Index>(entries.size()));
   int* outer = lower_.outerIndexPtr();
   std::fill(outer, outer + rows + 1, 0);
-  lower_source_.resize(entries.size());
-  for (std::size_t k = 0; k < entries.size(); ++k) {
-    ++outer[entries[k].column + 1];
-    lower_.innerIndexPtr()[k] = entries[k].row;
-    lower_.valuePtr()[k] = 0.0;
-    lower_source_[k] = entries[k].source;
-  }
+  for (const Entry& entry : by_row) ++outer[entry.column + 1];
   for (int j = 0; j < rows; ++j) outer[j + 1] += outer[j];
+  std::vector<int> next(outer, outer + rows);
+  lower_source_.resize(entries.size());
+  for (const Entry& entry : by_row) {
+    const int k = next[static_cast<std::size_t>(entry.column)]++;
+    lower_.innerIndexPtr()[k] = entry.row;
+    lower_.valuePtr()[k] = 0.0;
+    lower_source_[static_cast<std::size_t>(k)] = entry.source;
+  }
 }
 
 bool CholmodSolver::factorize(const SparseMatrixR& a, const ConstraintFilter& filter) {
