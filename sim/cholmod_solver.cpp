@@ -255,10 +255,15 @@ bool CholmodSolver::factorize(const SparseMatrixR& a, const ConstraintFilter& fi
     throw_if_out_of_memory(rows, "analysis");
     record_analysed_size();
     permutation_.clear();
-    if (method_ == CholmodMethod::supernodal && factor_->llt.factor() != nullptr) {
-      permutation_ = factor_->llt.take_permutation();
-      make_permuted_lower();
-    }
+    pattern_factorizations_ = 0;
+  }
+  // The permuted lower triangle's index map costs about three of CHOLMOD's permuted transposes
+  // to make, so a pattern is given to CHOLMOD permuted from its third factorisation on (an
+  // adaptive run that changes its mesh at every step never pays for it).
+  if (++pattern_factorizations_ == 3 && permutation_.empty() &&
+      method_ == CholmodMethod::supernodal && factor_->llt.factor() != nullptr) {
+    permutation_ = factor_->llt.take_permutation();
+    make_permuted_lower();
   }
   if (!permutation_.empty()) {
     for (std::size_t e = 0; e < lower_source_.size(); ++e)

@@ -74,6 +74,7 @@ class CholmodSolver {
   std::vector<int> permutation_;
   Eigen::SparseMatrix<double, Eigen::ColMajor, int> lower_;
   std::vector<int> lower_source_;
+  int pattern_factorizations_ = 0;  // numeric factorisations since the last analysis
   std::vector<int> outer_;
   std::vector<int> inner_;
   bool factorized_ = false;
