@@ -57,6 +57,8 @@ class CholmodSolver {
   // Throws CholmodOutOfMemoryError when CHOLMOD's last call ran out of memory.
   void throw_if_out_of_memory(int rows, const char* stage);
   void record_analysed_size();
+  // lower_ and lower_source_ from upper_, upper_source_ and permutation_.
+  void make_permuted_lower();
 
   struct Factor;
   CholmodMethod method_;
@@ -66,6 +68,13 @@ class CholmodSolver {
   // filtered_'s value array.
   Eigen::SparseMatrix<double, Eigen::ColMajor, int> upper_;
   std::vector<int> upper_source_;
+  // Supernodal: the fill-reducing permutation P taken out of the factor (row k of the factored
+  // matrix is row permutation_[k] of A), tril(P A Pᵀ) that is factorised, and where each of its
+  // values sits in filtered_'s value array. Empty permutation_: upper_ is factorised.
+  std::vector<int> permutation_;
+  Eigen::SparseMatrix<double, Eigen::ColMajor, int> lower_;
+  std::vector<int> lower_source_;
+  int pattern_factorizations_ = 0;  // numeric factorisations since the last analysis
   std::vector<int> outer_;
   std::vector<int> inner_;
   bool factorized_ = false;

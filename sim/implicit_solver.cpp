@@ -52,9 +52,10 @@ void ImplicitSolver::assemble(const ClothModel& model, const ForceSettings& forc
       !std::equal(pattern.outerIndexPtr(), pattern.outerIndexPtr() + pattern.rows() + 1,
                   matrix_.outerIndexPtr()) ||
       !std::equal(pattern.innerIndexPtr(), pattern.innerIndexPtr() + pattern.nonZeros(),
-                  matrix_.innerIndexPtr()))
+                  matrix_.innerIndexPtr())) {
     matrix_ = pattern;
-  else
+    ++pattern_changes_;
+  } else
     std::fill(matrix_.valuePtr(), matrix_.valuePtr() + matrix_.nonZeros(), 0.0);
   double* values = matrix_.valuePtr();
   for (int i = 0; i < model.vertex_count; ++i)
@@ -129,33 +130,66 @@ void ImplicitSolver::assemble(const ClothModel& model, const ForceSettings& forc
 void ImplicitSolver::add_cross_blocks(const ClothModel& model, double beta,
                                       const StepForces* extra) {
   widened_ = false;
-  if (extra == nullptr || extra->pair_springs.empty()) return;
+  const bool keep = keep_cross_pattern_ && kept_cross_pattern_ == pattern_changes_;
+  if (!keep_cross_pattern_ || kept_cross_pattern_ != pattern_changes_) kept_cross_.clear();
+  if ((extra == nullptr || extra->pair_springs.empty()) && kept_cross_.empty()) return;
   struct Block {
     int row = 0;  // vertices
     int column = 0;
     Eigen::Matrix3d value;
   };
   std::vector<Block> blocks;
-  for (const PairSpring& s : extra->pair_springs)
-    for (int k = 0; k < 4; ++k)
-      for (int l = 0; l < 4; ++l) {
-        const int i = s.vertices[k], j = s.vertices[l];
-        if (k == l || i == j || block_offset(matrix_, i, j) >= 0) continue;
-        blocks.push_back({i, j, pair_block(s, beta, k, l)});
-      }
-  if (blocks.empty()) return;
-  std::sort(blocks.begin(), blocks.end(), [](const Block& a, const Block& b) {
+  if (extra != nullptr)
+    for (const PairSpring& s : extra->pair_springs)
+      for (int k = 0; k < 4; ++k)
+        for (int l = 0; l < 4; ++l) {
+          const int i = s.vertices[k], j = s.vertices[l];
+          if (k == l || i == j || block_offset(matrix_, i, j) >= 0) continue;
+          blocks.push_back({i, j, pair_block(s, beta, k, l)});
+        }
+  if (blocks.empty() && kept_cross_.empty()) return;
+  const auto before = [](const Block& a, const Block& b) {
     return a.row != b.row ? a.row < b.row : a.column < b.column;
-  });
+  };
+  std::sort(blocks.begin(), blocks.end(), before);
   // One block per (row, column): several springs can join the same two vertices.
-  std::size_t kept = 0;
-  for (std::size_t b = 1; b < blocks.size(); ++b) {
-    if (blocks[b].row == blocks[kept].row && blocks[b].column == blocks[kept].column)
-      blocks[kept].value += blocks[b].value;
-    else
-      blocks[++kept] = blocks[b];
+  if (!blocks.empty()) {
+    std::size_t kept = 0;
+    for (std::size_t b = 1; b < blocks.size(); ++b) {
+      if (blocks[b].row == blocks[kept].row && blocks[b].column == blocks[kept].column)
+        blocks[kept].value += blocks[b].value;
+      else
+        blocks[++kept] = blocks[b];
+    }
+    blocks.resize(kept + 1);
   }
-  blocks.resize(kept + 1);
+  if (keep_cross_pattern_) {
+    // The kept pattern: the blocks in use joined with those kept from earlier steps (as zeros),
+    // started afresh when it has grown to more than twice what is in use plus 16 blocks and 1 %
+    // of the mesh's (the extra fill would cost more than the analyses it saves).
+    std::vector<Block> joined;
+    joined.reserve(blocks.size() + kept_cross_.size());
+    std::size_t b = 0, k = 0;
+    while (b < blocks.size() || k < kept_cross_.size()) {
+      if (k == kept_cross_.size() ||
+          (b < blocks.size() &&
+           std::array<int, 2>{blocks[b].row, blocks[b].column} <= kept_cross_[k])) {
+        if (k < kept_cross_.size() &&
+            std::array<int, 2>{blocks[b].row, blocks[b].column} == kept_cross_[k])
+          ++k;
+        joined.push_back(blocks[b++]);
+      } else {
+        joined.push_back({kept_cross_[k][0], kept_cross_[k][1], Eigen::Matrix3d::Zero()});
+        ++k;
+      }
+    }
+    const std::size_t slack = 16 + static_cast<std::size_t>(matrix_.nonZeros()) / 900;
+    if (keep && joined.size() <= 2 * blocks.size() + slack) blocks = std::move(joined);
+    kept_cross_.clear();
+    for (const Block& block : blocks) kept_cross_.push_back({block.row, block.column});
+    kept_cross_pattern_ = pattern_changes_;
+    if (blocks.empty()) return;
+  }
 
   // Merge each vertex's rows with its cross blocks' columns (both sorted). Every row of a vertex
   // holds the same block columns, so the block structure (and offset(i, j)) stays per vertex.
@@ -261,6 +295,7 @@ ImplicitSolveResult ImplicitSolver::solve(const ClothModel& model, const ForceSe
                                           const Eigen::VectorXd& v_lin,
                                           const NewtonSettings& settings, const StepForces* extra) {
   ImplicitSolveResult result;
+  keep_cross_pattern_ = settings.solver == LinearSolverKind::cholmod;
   const int n = model.vertex_count;
   const auto mass_times = [&](const Eigen::VectorXd& w) {
     Eigen::VectorXd out(3 * n);

@@ -224,6 +224,14 @@ class ImplicitSolver {
   void record_constraint_impulse(const ConstraintFilter& filter, ImplicitSolveResult& result);
 
   SparseMatrixR matrix_;
+  int pattern_changes_ = 0;  // times matrix_ took a new mesh pattern (an adaptive change)
+  // With CHOLMOD: the cross blocks the widened pattern keeps (vertex row, column; sorted), a
+  // superset of this step's, so that a spring pair that comes and goes does not change the
+  // pattern and cost a new symbolic analysis (zero blocks do not change the system). Reset when
+  // the mesh pattern changes or when it holds much more than the blocks in use.
+  std::vector<std::array<int, 2>> kept_cross_;
+  int kept_cross_pattern_ = -1;        // pattern_changes_ when kept_cross_ was started
+  bool keep_cross_pattern_ = false;    // set per solve: CHOLMOD (the PCG's IC(0) reads the pattern)
   SparseMatrixR coupled_;              // matrix_ widened by the cross-pair blocks
   std::vector<int> coupled_diagonal_;  // offset(i, i) in coupled_, #V
   bool widened_ = false;

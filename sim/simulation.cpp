@@ -632,6 +632,10 @@ SimulationReport Simulation::run(const RunHooks& hooks) {
       report_.steps > 0 ? static_cast<double>(newton_total_) / report_.steps : 0.0;
   report_.max_strain = max_stretch_strain(model_, x_);
   report_.nan_free = x_.allFinite() && v_.allFinite();
+  if (settings_.solver == LinearSolverKind::cholmod)
+    spdlog::debug("sim: CHOLMOD: {} symbolic analyses, {} numeric factorisations",
+                  solver_.cholmod().symbolic_analyses(),
+                  solver_.cholmod().numeric_factorizations());
   return report_;
 }
 

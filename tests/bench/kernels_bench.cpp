@@ -17,6 +17,7 @@
 #include "sim/constraint_filter.hpp"
 #include "sim/fabric.hpp"
 #include "sim/forces.hpp"
+#include "sim/implicit_solver.hpp"
 #include "sim/sheet.hpp"
 
 namespace {
@@ -108,6 +109,52 @@ void BM_CholmodAnalyseAndFactor(benchmark::State& state) {
   state.counters["vertices"] = s.model.vertex_count;
 }
 BENCHMARK(BM_CholmodAnalyseAndFactor)->Arg(32)->Arg(64)->Unit(benchmark::kMillisecond);
+
+// One linearised implicit Euler solve with CHOLMOD (assembly, factorisation, solve) of the 64x64
+// sheet, each step with a different subset of 40 self-contact pair springs across the sheet
+// (vertex i against the triangle of vertex i + 600: not neighbours in the mesh), as a garment's
+// springs come and go: the solver keeps the cross blocks of earlier steps so that the pattern,
+// and its symbolic analysis, stay (counter: analyses per solve).
+void BM_CholmodPairSpringsComeAndGo(benchmark::State& state) {
+  const System s = sheet_system(64);
+  const ClothModel& model = s.model;
+  SheetSpec spec;
+  spec.columns = spec.rows = 64;
+  spec.orientation = SheetOrientation::horizontal;
+  spec.pins = {"top-left", "top-right"};
+  const Eigen::VectorXd x = flatten_positions(build_sheet(spec).input.rest_positions);
+  const Eigen::VectorXd v = Eigen::VectorXd::Zero(x.size());
+  std::vector<StepForces> steps(8);
+  for (int k = 0; k < 8; ++k)
+    for (int j = 0; j < 40; ++j) {
+      if ((j + k) % 3 == 0) continue;  // each step leaves out a different third
+      const int i = 100 + 50 * j;
+      PairSpring spring;
+      spring.vertices = {i, model.triangles[i + 600].vertices[0],
+                         model.triangles[i + 600].vertices[1],
+                         model.triangles[i + 600].vertices[2]};
+      spring.weights << 1.0, -1.0 / 3.0, -1.0 / 3.0, -1.0 / 3.0;
+      spring.normal = Eigen::Vector3d::UnitY();
+      spring.target = 0.004;
+      spring.stiffness = 50.0;
+      spring.damping = 0.5;
+      steps[k].pair_springs.push_back(spring);
+    }
+  NewtonSettings settings;
+  settings.solver = LinearSolverKind::cholmod;
+  ImplicitSolver solver;
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const ImplicitSolveResult r = solver.solve(model, ForceSettings{}, s.filter, x, v, 1.0 / 60, x,
+                                               v, settings, &steps[k++ % steps.size()]);
+    benchmark::DoNotOptimize(r.v.data());
+  }
+  state.counters["vertices"] = model.vertex_count;
+  state.counters["analyses_per_solve"] =
+      static_cast<double>(solver.cholmod().symbolic_analyses()) /
+      static_cast<double>(solver.cholmod().numeric_factorizations());
+}
+BENCHMARK(BM_CholmodPairSpringsComeAndGo)->Unit(benchmark::kMillisecond);
 
 // One solve with the factor (forward and back substitution plus the filtering).
 void BM_CholmodSolve(benchmark::State& state) {
