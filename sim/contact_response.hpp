@@ -266,6 +266,9 @@ class ContactResponse {
   // The largest preload a spring carries (N): kMaxSpringLoadClothWeights times the cloth's
   // weight.
   double max_spring_preload() const;
+  // m: how far past the clearance piercing_spring puts a spring's target (with spring_band, a
+  // point already farther keeps its distance; 0 otherwise).
+  double target_past_clearance(const BodyPiercing& p, double clearance) const;
   // kg: the cloth mass at a piercing's point (its triangle's corner masses by its weights).
   double point_mass(const BodyPiercing& p) const;
   // Start of step: body vertices through the cloth at `start` (x̂ + y), about to be, or held
@@ -309,6 +312,9 @@ class ContactResponse {
   double gravity_ = 9.81;              // m/s²
   // Per spring of the attempt's StepForces, its body vertex.
   std::vector<int> spring_body_vertex_;
+  // Per spring of the attempt's StepForces, m its target lies past the clearance in front of its
+  // body vertex (target_past_clearance).
+  std::vector<double> spring_past_clearance_;
   // How a spring ended a step: its pair and the force (N; negative: it ended pulling).
   struct SpringEnd {
     int body_vertex = -1;
