@@ -618,14 +618,15 @@ void ContactResponse::record_spring_forces(const Eigen::VectorXd& x, const StepF
     const PointSpring& spring = extra.springs[s];
     const double along = along_spring_normal(spring, cloth_.triangles[spring.triangle], x);
     double force = spring.preload + spring.stiffness * (spring.target - along);
-    // A push carried past the clearance fades to nothing across the hold margin, so a spring
-    // whose point leaves the hold is released at no load (docs/collision.md, "The hem's cycle,
-    // traced"). Carried in full, the push that built up while the cloth was caught was still
-    // there when it was dropped (15 mN of the hand's 45 at the t-shirt's hem): it pushed the
-    // cloth out, the cloth fell back free, was caught and pushed again, and every such cycle
-    // put energy in.
+    // With fade_carried_push the push carried past the clearance fades to nothing across the
+    // hold margin, so a spring whose point leaves the hold is released at no load
+    // (docs/collision.md, "The hem's cycle, traced"). Carried in full, the push that built up
+    // while the cloth was caught is still there when it is dropped (15 mN of the hand's 45 at
+    // the t-shirt's hem): it pushed the cloth out, the cloth fell back free, was caught and
+    // pushed again, and every such cycle put energy in.
     const double past = along - (spring.target - spring_past_clearance_[s]);
-    if (force > 0.0 && past > 0.0) force *= std::max(0.0, 1.0 - past / margin);
+    if (settings_.fade_carried_push && force > 0.0 && past > 0.0)
+      force *= std::max(0.0, 1.0 - past / margin);
     const std::array<int, 3>& c = cloth_.triangles[spring.triangle];
     Eigen::Vector3d point = Eigen::Vector3d::Zero();
     for (int k = 0; k < 3; ++k) point += spring.weights[k] * x.segment<3>(3 * c[k]);
