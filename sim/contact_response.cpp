@@ -220,6 +220,7 @@ void ContactResponse::reset_cloth(const Eigen::VectorXd& x, const Eigen::VectorX
   if (last_piercing_force_.size() != static_cast<std::size_t>(collider_.vertex_count()))
     last_piercing_force_.assign(static_cast<std::size_t>(collider_.vertex_count()), kNoImpulse);
   spring_body_vertex_.clear();
+  spring_past_clearance_.clear();
   spring_ends_.clear();
   // A renumbered cloth (adaptive detail's splits and merges): the held pairs named the old
   // triangles. Each follows its point on the cloth to the new triangles that hold it (a split's
@@ -481,6 +482,10 @@ PointSpring ContactResponse::piercing_spring(const BodyPiercing& p, const Eigen:
   return spring;
 }
 
+double ContactResponse::target_past_clearance(const BodyPiercing& p, double clearance) const {
+  return settings_.spring_band ? std::max(-(p.height + clearance), 0.0) : 0.0;
+}
+
 double ContactResponse::max_spring_preload() const {
   return kMaxSpringLoadClothWeights * gravity_ * mass_.sum();
 }
@@ -489,6 +494,7 @@ void ContactResponse::spring_start_piercings(const Eigen::VectorXd& start,
                                              const Eigen::VectorXd& v0, double beta,
                                              const ConstraintFilter& filter, StepForces& extra) {
   spring_body_vertex_.clear();
+  spring_past_clearance_.clear();
   if (!settings_.check_body_vertices || cloth_.triangles.empty() || repairing()) return;
   const int n = static_cast<int>(start.size() / 3);
   const double clearance = kPiercingClearance * settings_.thickness;
@@ -558,6 +564,7 @@ void ContactResponse::spring_start_piercings(const Eigen::VectorXd& start,
     const double share = std::isnan(force) ? 0.0 : std::max(force, 0.0) / (last - first);
     for (std::size_t k = first; k < last; ++k) {
       spring_body_vertex_.push_back(springs[k].body_vertex);
+      spring_past_clearance_.push_back(target_past_clearance(springs[k], clearances[k]));
       PointSpring spring = piercing_spring(springs[k], start, pinned_, share, clearances[k]);
       spring.stiffness /= static_cast<double>(last - first);
       spring.damping /= static_cast<double>(last - first);
@@ -593,8 +600,10 @@ int ContactResponse::spring_end_piercings(const Eigen::VectorXd& x1, StepForces&
       // New, or through another triangle (the cloth slid over the vertex): a spring for that
       // triangle, carrying the load. The old springs stay (their triangles may still rest on
       // the vertex).
+      const double own = spring_clearance(p, x1);
       spring_body_vertex_.push_back(p.body_vertex);
-      extra.springs.push_back(piercing_spring(p, x1, pinned_, carried, spring_clearance(p, x1)));
+      spring_past_clearance_.push_back(target_past_clearance(p, own));
+      extra.springs.push_back(piercing_spring(p, x1, pinned_, carried, own));
     }
     ++changed;
   }
@@ -603,10 +612,21 @@ int ContactResponse::spring_end_piercings(const Eigen::VectorXd& x1, StepForces&
 
 void ContactResponse::record_spring_forces(const Eigen::VectorXd& x, const StepForces& extra) {
   spring_ends_.clear();
+  const double margin =
+      (settings_.spring_band ? kPiercingReleaseBand : kPiercingHoldMargin) * settings_.thickness;
   for (std::size_t s = 0; s < spring_body_vertex_.size(); ++s) {
     const PointSpring& spring = extra.springs[s];
     const double along = along_spring_normal(spring, cloth_.triangles[spring.triangle], x);
-    const double force = spring.preload + spring.stiffness * (spring.target - along);
+    double force = spring.preload + spring.stiffness * (spring.target - along);
+    // With fade_carried_push the push carried past the clearance fades to nothing across the
+    // hold margin, so a spring whose point leaves the hold is released at no load
+    // (docs/collision.md, "The hem's cycle, traced"). Carried in full, the push that built up
+    // while the cloth was caught is still there when it is dropped (15 mN of the hand's 45 at
+    // the t-shirt's hem): it pushed the cloth out, the cloth fell back free, was caught and
+    // pushed again, and every such cycle put energy in.
+    const double past = along - (spring.target - spring_past_clearance_[s]);
+    if (settings_.fade_carried_push && force > 0.0 && past > 0.0)
+      force *= std::max(0.0, 1.0 - past / margin);
     const std::array<int, 3>& c = cloth_.triangles[spring.triangle];
     Eigen::Vector3d point = Eigen::Vector3d::Zero();
     for (int k = 0; k < 3; ++k) point += spring.weights[k] * x.segment<3>(3 * c[k]);

@@ -81,6 +81,13 @@ struct ContactSettings {
   // only within the clearance. Off by default (measured: the flat capelet rests with it, but a
   // sheet hung on a cone tip is let 1.09 mm through and a sheet on a sphere rests later).
   bool spring_band = false;
+  // The push a body-vertex spring carries to the next step fades linearly to nothing across the
+  // hold margin past its clearance, so a spring whose point leaves the hold is released at no
+  // load instead of still pushing (docs/collision.md, "The hem's cycle, traced": the pump of
+  // the flat arms-lowering t-shirt's hem). Off by default (measured: the flat t-shirt, the flat
+  // sleeveless dress and the two quadratic-bending skirts rest with it, sooner, but the hooded
+  // top's neckline cycles until 8.6 s, at rest at 3.3 s without it).
+  bool fade_carried_push = false;
   // Where a second body part faces the contact's surface closer than 2.5 thicknesses along
   // its normal, across the cloth (the armpit as the arm comes down, between the thighs), each
   // side's contact keeps a third of the gap (at least `pinch_floor` thicknesses) instead of the
@@ -266,6 +273,9 @@ class ContactResponse {
   // The largest preload a spring carries (N): kMaxSpringLoadClothWeights times the cloth's
   // weight.
   double max_spring_preload() const;
+  // m: how far past the clearance piercing_spring puts a spring's target (with spring_band, a
+  // point already farther keeps its distance; 0 otherwise).
+  double target_past_clearance(const BodyPiercing& p, double clearance) const;
   // kg: the cloth mass at a piercing's point (its triangle's corner masses by its weights).
   double point_mass(const BodyPiercing& p) const;
   // Start of step: body vertices through the cloth at `start` (x̂ + y), about to be, or held
@@ -309,6 +319,9 @@ class ContactResponse {
   double gravity_ = 9.81;              // m/s²
   // Per spring of the attempt's StepForces, its body vertex.
   std::vector<int> spring_body_vertex_;
+  // Per spring of the attempt's StepForces, m its target lies past the clearance in front of its
+  // body vertex (target_past_clearance).
+  std::vector<double> spring_past_clearance_;
   // How a spring ended a step: its pair and the force (N; negative: it ended pulling).
   struct SpringEnd {
     int body_vertex = -1;

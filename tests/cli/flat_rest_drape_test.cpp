@@ -2,8 +2,9 @@
 // `sketchdrape run` as a designer runs it (images off): it comes to rest within its drape time,
 // with no vertex inside the body and no fold through another, hangs from the shoulders or the waist
 // where the shaped drape does, and its cloth is stretched from the pattern by no more than the
-// flattening had to stretch it. The arms-lowering t-shirt is left out: its body moves until 2 s of
-// its 3 s and its shaped drape is not at rest either (the examples drape test covers it shaped).
+// flattening had to stretch it. The arms-lowering t-shirt, whose body moves until 2 s of its 3 s,
+// drapes for 6 s with its body-vertex springs released at no load ("fade_carried_push"; without
+// it its hem cycles, docs/collision.md).
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -48,6 +49,9 @@ struct FlatExample {
   double top_min, top_max;
   bool adaptive = false;
   std::string folder = "data/examples";  // or data/designs
+  double duration = 0.0;                 // s; 0: the file's
+  double strain_max = 0.10;              // the largest strain against the pattern in any piece
+  bool fade_carried_push = false;        // simulate.fade_carried_push
 };
 
 class FlatRestDrape : public ::testing::TestWithParam<FlatExample> {};
@@ -69,6 +73,8 @@ TEST_P(FlatRestDrape, ComesToRestHangingWhereTheShapedDrapeDoes) {
     sketch["simulate"]["adaptive"] = {{"enabled", true}, {"max_level", 1}};
     sketch["simulate"]["duration"] = 3.0;
   }
+  if (example.duration > 0.0) sketch["simulate"]["duration"] = example.duration;
+  if (example.fade_carried_push) sketch["simulate"]["fade_carried_push"] = true;
   const fs::path sketch_path = dir / (example.name + ".json");
   std::ofstream(sketch_path) << sketch.dump(2);
   const CommandResult ran =
@@ -98,7 +104,7 @@ TEST_P(FlatRestDrape, ComesToRestHangingWhereTheShapedDrapeDoes) {
   // body (measured up to 26 % in the sleeves after 3 s; docs/pattern.md): only means there.
   for (const auto& group : report["strain"]) {
     if (!example.adaptive) {
-      EXPECT_LT(group["strain_max"].get<double>(), 0.10) << group["group"];
+      EXPECT_LT(group["strain_max"].get<double>(), example.strain_max) << group["group"];
     }
     EXPECT_LT(group["strain_mean"].get<double>(), 0.035) << group["group"];
   }
@@ -129,7 +135,12 @@ INSTANTIATE_TEST_SUITE_P(
                       // at 1.495 m and 1.024 m (the gored skirt's waist
                       // settles 3.5 cm below where it is drawn).
                       FlatExample{"tank-top", 1.47, 1.52, false, "data/designs"},
-                      FlatExample{"gored-skirt", 1.00, 1.06, false, "data/designs"}),
+                      FlatExample{"gored-skirt", 1.00, 1.06, false, "data/designs"},
+                      // At rest at 4.65 s. The lowered arms press the sleeves' backs and the
+                      // back's sides onto the body: 13.4-14.7 % at most there (13.7-13.8 %
+                      // without the fade; under 8.3 % elsewhere; means 1.1-2.4 %).
+                      FlatExample{"tshirt-arms-lowering", 1.47, 1.53, false, "data/examples", 6.0,
+                                  0.16, true}),
     test_name);
 
 }  // namespace
