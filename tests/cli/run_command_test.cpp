@@ -517,5 +517,29 @@ TEST(RunCommand, AGarmentThatSlidSaysHowFar) {
   }
 }
 
+// A drape from the flat pattern that also writes the pattern flattens the garment once: each
+// panel's stretch warning is told once, and pattern.json carries it (the skirt's free panels span
+// a surface no flat piece covers within 5 %).
+TEST(RunCommand, AFlatRestDrapeWithItsPatternWarnsOncePerPanel) {
+  nlohmann::json sketch =
+      read_json(fs::path(SD_SOURCE_DIR) / "data/designs/repro/silk-flared-midi.json");
+  sketch["output"] = {{"images", nlohmann::json::array()}, {"pattern", true}};
+  sketch["simulate"]["duration"] = 0.02;
+  const fs::path dir = fresh_dir("flat-rest-pattern-warnings");
+  const CommandResult r = run_sketchdrape("run " + write_sketch(dir, sketch).string() + " -o " +
+                                          (dir / "out").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json pattern = read_json(dir / "out" / "pattern.json");
+  ASSERT_FALSE(pattern["warnings"].empty()) << r.output;
+  for (const nlohmann::json& warning : pattern["warnings"]) {
+    const std::string text = warning.get<std::string>();
+    std::size_t told = 0;
+    for (std::size_t at = r.output.find(text); at != std::string::npos;
+         at = r.output.find(text, at + 1))
+      ++told;
+    EXPECT_EQ(told, 1u) << text << "\n" << r.output;
+  }
+}
+
 }  // namespace
 }  // namespace sd::test

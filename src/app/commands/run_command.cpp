@@ -440,7 +440,9 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   out.cusick = cusick_json(sketch, draped);
   out.rest_shape = flat_rest ? (scene.bend_rest_flat ? "flat" : "flat and shaped") : "shaped";
   if (scene.garment && sketch.output.pattern) {
-    const PatternSheet sheet = build_pattern_sheet(sketch, *scene.garment, *sketch.output.pattern);
+    const PatternSheet sheet = build_pattern_sheet(
+        sketch, *scene.garment, *sketch.output.pattern,
+        scene.flat_pattern ? &*scene.flat_pattern : nullptr, scene.flattening_ms);
     stage_pattern(sheet, dir, outputs);
     out.pattern = pattern_summary(sheet);
   }

@@ -160,7 +160,11 @@ void flat_rest_shapes(const scene::Sketch& sketch, const garment::Garment& g,
   if (!any) return;
   const auto start = std::chrono::steady_clock::now();
   try {
-    scene.flat_pattern = garment::flatten_garment(g);
+    // With the pattern's own threshold when the file also asks for the pattern, which then
+    // reuses this flattening (build_pattern_sheet) instead of repeating it and its warnings.
+    garment::FlatteningOptions flattening;
+    if (sketch.output.pattern) flattening.warn_stretch = sketch.output.pattern->max_stretch;
+    scene.flat_pattern = garment::flatten_garment(g, flattening);
   } catch (const garment::PatternError& e) {
     const garment::PanelSpec* spec = sketch.find_panel(e.panel());
     if (!spec && e.panel().ends_with(".mirror"))

@@ -96,15 +96,16 @@ std::string svg_path(const garment::PatternPiece& piece, const Eigen::MatrixX2d&
 }  // namespace
 
 PatternSheet build_pattern_sheet(const scene::Sketch& sketch, const garment::Garment& garment,
-                                 const scene::PatternSpec& spec) {
+                                 const scene::PatternSpec& spec,
+                                 const garment::FlatPattern* flattened, double flattened_ms) {
   PatternSheet sheet;
   sheet.title = std::filesystem::path(sketch.file).filename().string();
   garment::FlatteningOptions flattening;
   flattening.warn_stretch = spec.max_stretch;
   const auto start = Clock::now();
   try {
-    sheet.pattern = garment::flatten_garment(garment, flattening);
-    sheet.flatten_ms = ms_since(start);
+    sheet.pattern = flattened ? *flattened : garment::flatten_garment(garment, flattening);
+    sheet.flatten_ms = flattened ? flattened_ms : ms_since(start);
     garment::PatternLayoutOptions layout;
     layout.fabric_width = spec.fabric_width;
     layout.seam_allowance = spec.seam_allowance;
@@ -123,7 +124,8 @@ PatternSheet build_pattern_sheet(const scene::Sketch& sketch, const garment::Gar
     const garment::PanelSpec* ps = panel_spec(sketch, e.panel());
     sketch.fail(ps ? ps->json_path : "/panels", e.what());
   }
-  for (const std::string& warning : sheet.pattern.warnings) spdlog::warn("{}", warning);
+  if (!flattened)
+    for (const std::string& warning : sheet.pattern.warnings) spdlog::warn("{}", warning);
   return sheet;
 }
 

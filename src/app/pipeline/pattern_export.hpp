@@ -28,9 +28,13 @@ struct PatternSheet {
 
 // Flattens and lays out the garment's panels with the file's pattern settings (`spec`, with each
 // panel's own seam allowance). A panel that cannot be flattened becomes a SketchError at that
-// panel's JSON path; stretch warnings are logged.
+// panel's JSON path; stretch warnings are logged. `flattened`, when given, is the same garment
+// already flattened with `spec`'s warning threshold (a drape from the flat pattern, which has
+// logged its warnings): it is laid out as it is, neither flattened nor reported twice.
 PatternSheet build_pattern_sheet(const scene::Sketch& sketch, const garment::Garment& garment,
-                                 const scene::PatternSpec& spec);
+                                 const scene::PatternSpec& spec,
+                                 const garment::FlatPattern* flattened = nullptr,
+                                 double flattened_ms = 0.0);
 
 std::string pattern_svg(const PatternSheet& sheet);
 std::string pattern_dxf(const PatternSheet& sheet);
