@@ -3,6 +3,7 @@
 // rest mesh for build_cloth_model and update_cloth_model (sim/cloth_model.cpp).
 #include "sim/bend_elements.hpp"
 
+#include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
 #include <algorithm>
@@ -26,7 +27,10 @@ constexpr double kNegligibleWeight = 1e-13;
 // their chord errors: with the nearest points alone a cylinder's energy on the irregular strip
 // erred by 3.6 % (1.9 % on the whole two-ring), and with 9 points Peirce's chord on the 4-8 mesh at
 // 45° came out 0.3° stiffer than with the whole two-ring (silk 39.97° against 41.49°); with 11 the
-// chords are the whole two-ring's within 0.05° (tests/sim/textile_presets_test.cpp).
+// chords are the whole two-ring's within 0.05° (tests/sim/textile_presets_test.cpp). The 9-point
+// fit is the more accurate bending (0.981 B at 16 cells at 45° against 0.962); silk's chord is
+// stiffened by the membrane locking on that layout, which the 11-point fit's softness offsets
+// (docs/simulator.md, "Elongated cells", "Still open").
 constexpr std::size_t kFewestFitPoints = 11;
 
 // The points an element's rows read: its centre and every point with a weight in some row.
@@ -71,6 +75,54 @@ void prune_columns(VertexBendElement& element) {
     b = local[static_cast<std::size_t>(b)];
     c = local[static_cast<std::size_t>(c)];
   }
+}
+
+// Whether every point's mirror through vertex v is also among `points` (to 1e-6 of the reach).
+bool centrally_symmetric(const Eigen::MatrixX3d& rest, int v, const std::vector<int>& points,
+                         double reach2) {
+  const Vector3d centre = rest.row(v);
+  for (int j : points) {
+    const Vector3d mirror = 2.0 * centre - Vector3d(rest.row(j));
+    bool found = false;
+    for (int k : points)
+      found = found || (Vector3d(rest.row(k)) - mirror).squaredNorm() <= 1e-12 * reach2;
+    if (!found) return false;
+  }
+  return true;
+}
+
+// The centrally symmetric parts of a vertex's one-ring, nearest first: the vertex with the
+// one-ring's points up to each distance (equal distances together) wherever every point's mirror
+// through the vertex is also among them, short of the whole one-ring. On regular meshes these
+// are the nearest opposite pairs (on the 4-8 mesh with w × h cells the pair at w, then the pair
+// at h, then the diagonals); irregular one-rings have none.
+std::vector<std::vector<int>> symmetric_shells(const Eigen::MatrixX3d& rest, int v,
+                                               const std::vector<int>& one_ring) {
+  const Vector3d centre = rest.row(v);
+  std::vector<std::pair<double, int>> by_distance;
+  double reach2 = 0.0;
+  for (int j : one_ring) {
+    const double d2 = (Vector3d(rest.row(j)) - centre).squaredNorm();
+    by_distance.emplace_back(d2, j);
+    reach2 = std::max(reach2, d2);
+  }
+  std::sort(by_distance.begin(), by_distance.end());
+  std::vector<std::vector<int>> shells;
+  std::vector<int> points{v};
+  for (std::size_t first = 0; first < by_distance.size();) {
+    std::size_t last = first + 1;
+    while (last < by_distance.size() &&
+           by_distance[last].first - by_distance[first].first <= 1e-9 * reach2)
+      ++last;
+    for (std::size_t j = first; j < last; ++j) points.push_back(by_distance[j].second);
+    first = last;
+    if (last == by_distance.size()) break;
+    if (centrally_symmetric(rest, v, points, reach2)) {
+      shells.push_back(points);
+      std::sort(shells.back().begin(), shells.back().end());
+    }
+  }
+  return shells;
 }
 
 }  // namespace
@@ -315,7 +367,9 @@ std::vector<VertexBendElement> make_vertex_bends(const Eigen::MatrixX3d& rest,
   // least-squares quadratic. Each row uses the smallest neighbourhood that determines it: the
   // one-ring, else the one-ring with the nearest points of the two-ring (the tangent frame is
   // aligned with an edge, so on the 4-8 mesh a degree-4 vertex's one-ring determines
-  // x_uu − x_vv, and its twist takes the four diagonal points, the usual cross stencil).
+  // x_uu − x_vv, and its twist takes the four diagonal points, the usual cross stencil); a row
+  // the one-ring determines is read part by part from its nearest symmetric shells where it and
+  // its neighbours have them (symmetric_shells, functional_row).
   // Every point an element reads couples its vertex to every other in the system matrix, so
   // the nearest points also keep the matrix narrow: on the 4-8 mesh 25 blocks a row instead of
   // the whole two-ring's 72.
@@ -347,6 +401,21 @@ std::vector<VertexBendElement> make_vertex_bends(const Eigen::MatrixX3d& rest,
     std::sort(r.begin(), r.end());
     r.erase(std::unique(r.begin(), r.end()), r.end());
   }
+  // Whether a vertex's one-ring has a symmetric part (symmetric_shells), memoised. The split of
+  // the curvature rows by shells cancels the coupling of smooth bends to the sublattice mode only
+  // between vertices that both read the mode with central differences: on the 4-8 mesh with
+  // w × h cells both kinds of vertices do (the degree-4 ones by their nearer pair), but a vertex
+  // next to a free edge or to the centre of a rectangle split into four (whose four neighbours
+  // are equidistant) does not, and splitting its neighbours' rows alone made the rhombic mesh
+  // softer (docs/simulator.md, "Elongated cells"). Only one-ring points of wanted vertices are
+  // asked, whose rings are complete also when only some elements are made.
+  std::vector<signed char> shells_known(static_cast<std::size_t>(n), -1);
+  const auto has_shells = [&](int j) {
+    signed char& known = shells_known[static_cast<std::size_t>(j)];
+    if (known < 0)
+      known = symmetric_shells(rest, j, ring[static_cast<std::size_t>(j)]).empty() ? 0 : 1;
+    return known == 1;
+  };
   std::vector<VertexBendElement> elements;
   elements.reserve(static_cast<std::size_t>(n));
   for (int v = 0; v < n; ++v) {
@@ -380,15 +449,23 @@ std::vector<VertexBendElement> make_vertex_bends(const Eigen::MatrixX3d& rest,
     double radius2 = 0.0;
     for (int j : points) radius2 = std::max(radius2, distance2(j));
     const double radius = std::sqrt(radius2);
-    std::vector<std::vector<int>> hood(1, one_ring);
-    hood[0].push_back(v);
-    std::sort(hood[0].begin(), hood[0].end());
+    // Before the one-ring: its centrally symmetric parts, nearest shells first (see
+    // symmetric_shells); `ring_hood` is the one-ring's index among the neighbourhoods.
+    // Only where every neighbour has such a part too, so that neighbours read a grid-scale mode
+    // alike (see has_shells).
+    std::vector<std::vector<int>> hood = symmetric_shells(rest, v, one_ring);
+    if (!std::all_of(one_ring.begin(), one_ring.end(), has_shells)) hood.clear();
+    const std::size_t ring_hood = hood.size();
+    hood.push_back(one_ring);
+    hood[ring_hood].push_back(v);
+    std::sort(hood[ring_hood].begin(), hood[ring_hood].end());
     std::vector<std::pair<double, int>> farther;
     for (int j : points)
-      if (!std::binary_search(hood[0].begin(), hood[0].end(), j))
+      if (!std::binary_search(hood[ring_hood].begin(), hood[ring_hood].end(), j))
         farther.emplace_back(distance2(j), j);
     std::sort(farther.begin(), farther.end());
-    std::vector<int> next = hood[0];
+    std::vector<char> nested(hood.size(), 1);  // whether a neighbourhood is split into (below)
+    std::vector<int> next = hood[ring_hood];
     for (std::size_t first = 0; first < farther.size();) {
       std::size_t last = first + 1;
       while (last < farther.size() && farther[last].first - farther[first].first <= 1e-9 * radius2)
@@ -397,6 +474,7 @@ std::vector<VertexBendElement> make_vertex_bends(const Eigen::MatrixX3d& rest,
       if (next.size() >= kFewestFitPoints || last == farther.size()) {
         hood.push_back(next);
         std::sort(hood.back().begin(), hood.back().end());
+        nested.push_back(0);
       }
       first = last;
     }
@@ -427,16 +505,60 @@ std::vector<VertexBendElement> make_vertex_bends(const Eigen::MatrixX3d& rest,
         fit.inverse += svd.matrixV().col(r) * svd.matrixU().col(r).transpose() / sigma(r);
       fit.null = svd.matrixV().rightCols(6 - rank);
     }
-    // Row of a functional c ↦ f·c of the fitted coefficients, from the smallest neighbourhood
-    // that determines it (f orthogonal to the undetermined directions); false if none does.
+    // Row of a functional c ↦ f·c of the fitted coefficients (f zero on 1, u, v): from the
+    // smallest neighbourhood that determines it; false if none does. Where that is the one-ring
+    // or a symmetric part of it, f is split into the parts each nested neighbourhood adds to
+    // what the smaller ones determine (orthogonal in the Frobenius metric of the Hessian, which
+    // no choice of tangent frame changes), and each part is read from the smallest one: a
+    // curvature the nearest symmetric shell determines is its central difference, as on the
+    // vertex's neighbours, whatever the frame (docs/simulator.md, "Elongated cells").
+    // Metric on (c₃, c₄, c₅) = (½x_uu, x_uv, ½x_vv): F:G with F = [[f₃/2, f₄/2], [f₄/2, f₅/2]].
+    const Eigen::Vector3d metric(0.25, 0.5, 0.25);
+    const auto determined = [&](std::size_t h, const Eigen::Matrix<double, 6, 1>& f) {
+      const Fit& fit = fits[h];
+      return fit.null.cols() == 0 || (fit.null.transpose() * f).norm() <= 1e-8 * f.norm();
+    };
+    // The metric-orthogonal projector onto the quadratic functionals neighbourhood h determines.
+    const auto projector = [&](std::size_t h) {
+      const Fit& fit = fits[h];
+      if (fit.null.cols() == 0) return Eigen::Matrix3d::Identity().eval();
+      const Eigen::MatrixXd constraints = fit.null.bottomRows(3).transpose();  // k × 3
+      const Eigen::JacobiSVD<Eigen::MatrixXd> svd(constraints, Eigen::ComputeFullV);
+      int rank = 0;
+      const Eigen::VectorXd& sigma = svd.singularValues();
+      while (rank < sigma.size() && sigma(rank) > 1e-8 * std::max(sigma(0), 1.0)) ++rank;
+      Eigen::MatrixXd basis = svd.matrixV().rightCols(3 - rank);  // 3 × m, spans the determined
+      // Orthonormal in the metric: basis·L⁻ᵀ (3 × m) with L·Lᵀ = basisᵀ·diag(metric)·basis.
+      Eigen::Matrix3d p = Eigen::Matrix3d::Zero();
+      if (basis.cols() == 0) return p;
+      const Eigen::MatrixXd gram = basis.transpose() * metric.asDiagonal() * basis;
+      const Eigen::LLT<Eigen::MatrixXd> llt(gram);
+      const Eigen::MatrixXd orthonormal = llt.matrixL().solve(basis.transpose()).transpose();
+      p = orthonormal * orthonormal.transpose() * metric.asDiagonal();
+      return p;
+    };
     const auto functional_row = [&](const Eigen::Matrix<double, 6, 1>& f, Eigen::RowVectorXd& out) {
       for (std::size_t h = 0; h < hood.size(); ++h) {
-        const Fit& fit = fits[h];
-        if (fit.null.cols() > 0 && (fit.null.transpose() * f).norm() > 1e-8 * f.norm()) continue;
-        const Eigen::RowVectorXd values = f.transpose() * fit.inverse;
+        if (!determined(h, f)) continue;
         out = Eigen::RowVectorXd::Zero(count);
-        for (std::size_t j = 0; j < hood[h].size(); ++j)
-          out(local(hood[h][j])) = values(static_cast<Eigen::Index>(j));
+        const auto add_part = [&](std::size_t k, const Eigen::Matrix<double, 6, 1>& part) {
+          const Eigen::RowVectorXd values = part.transpose() * fits[k].inverse;
+          for (std::size_t j = 0; j < hood[k].size(); ++j)
+            out(local(hood[k][j])) += values(static_cast<Eigen::Index>(j));
+        };
+        if (!nested[h]) {
+          add_part(h, f);
+          return true;
+        }
+        Eigen::Matrix3d previous = Eigen::Matrix3d::Zero();
+        for (std::size_t k = 0; k <= h; ++k) {
+          if (!nested[k]) continue;
+          const Eigen::Matrix3d current = k == h ? Eigen::Matrix3d::Identity() : projector(k);
+          Eigen::Matrix<double, 6, 1> part = Eigen::Matrix<double, 6, 1>::Zero();
+          part.tail<3>() = (current - previous) * f.tail<3>();
+          if (part.norm() > 1e-12 * f.norm()) add_part(k, part);
+          previous = current;
+        }
         return true;
       }
       return false;
@@ -453,7 +575,7 @@ std::vector<VertexBendElement> make_vertex_bends(const Eigen::MatrixX3d& rest,
       // neighbourhood where one exists.
       Eigen::Matrix<double, 6, 1> target;
       target << 0.0, 0.0, 0.0, 2.0 * scale, 0.0, 2.0 * scale;
-      for (std::size_t h = 0; h < hood.size(); ++h) {
+      for (std::size_t h = ring_hood; h < hood.size(); ++h) {
         const Fit& fit = fits[h];
         Eigen::VectorXd current(hood[h].size());
         for (std::size_t j = 0; j < hood[h].size(); ++j)

@@ -230,6 +230,8 @@ set title "Peirce cantilever: simulated / predicted bending length"
 set xlabel "cells along the overhang 2c"
 set ylabel "simulated c / predicted c"
 set logscale x 2
+# A margin above and below the curves, so that the exact ratio 1 is not drawn on the frame.
+set offsets 0, 0, graph 0.05, graph 0.05
 plot for [f in "cotton denim jersey polyester silk wool"] "textile-cantilever.csv" \
   using ($2):(strcol(1) eq f && $6 == 1 ? $4/$3 : 1/0) with linespoints title f, \
   1 title "exact" dt 2
@@ -238,6 +240,7 @@ set title "Cusick drape coefficient"
 set xlabel "cells across the 30 cm disc"
 set ylabel "DC: mean of the specimens, bars their range"
 unset logscale x
+set offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05
 plot for [f in "cotton denim jersey polyester silk wool"] "textile-cusick.csv" \
   using ($2):(strcol(1) eq f && $6 == 1 ? $4 : 1/0):8:9 with yerrorlines title f
 )";
