@@ -495,14 +495,17 @@ std::vector<VertexBendElement> make_vertex_bends(const Eigen::MatrixX3d& rest,
         const double u = d.dot(e1), w = d.dot(e2);
         fit.basis.row(j) << 1.0, u, w, u * u, u * w, w * w;
       }
+      // Thin U (#points × 6): the pseudo-inverse reads only U's first `rank` columns, and the
+      // full #points × #points U (up to 72² on a two-ring) cost most of the element's time.
       const Eigen::JacobiSVD<Eigen::MatrixXd> svd(fit.basis,
-                                                  Eigen::ComputeFullU | Eigen::ComputeFullV);
+                                                  Eigen::ComputeThinU | Eigen::ComputeFullV);
       const Eigen::VectorXd& sigma = svd.singularValues();
       int rank = 0;
       while (rank < sigma.size() && sigma(rank) > 1e-8 * sigma(0)) ++rank;
-      fit.inverse = Eigen::MatrixXd::Zero(6, size);
-      for (int r = 0; r < rank; ++r)
-        fit.inverse += svd.matrixV().col(r) * svd.matrixU().col(r).transpose() / sigma(r);
+      // B⁺ = V_r·Σ_r⁻¹·U_rᵀ (6 × #points).
+      fit.inverse.noalias() = svd.matrixV().leftCols(rank) *
+                              sigma.head(rank).cwiseInverse().asDiagonal() *
+                              svd.matrixU().leftCols(rank).transpose();
       fit.null = svd.matrixV().rightCols(6 - rank);
     }
     // Row of a functional c ↦ f·c of the fitted coefficients (f zero on 1, u, v): from the
