@@ -5,6 +5,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
+#include <Eigen/QR>
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
@@ -495,18 +496,40 @@ std::vector<VertexBendElement> make_vertex_bends(const Eigen::MatrixX3d& rest,
         const double u = d.dot(e1), w = d.dot(e2);
         fit.basis.row(j) << 1.0, u, w, u * u, u * w, w * w;
       }
-      // Thin U (#points × 6): the pseudo-inverse reads only U's first `rank` columns, and the
-      // full #points × #points U (up to 72² on a two-ring) cost most of the element's time.
-      const Eigen::JacobiSVD<Eigen::MatrixXd> svd(fit.basis,
-                                                  Eigen::ComputeThinU | Eigen::ComputeFullV);
-      const Eigen::VectorXd& sigma = svd.singularValues();
+      // B (#points × 6) = Q·R·Pᵀ by a column-pivoted QR, then the 6 × 6 R = U·Σ·Vᵀ by a
+      // fixed-size Jacobi SVD: B = (Q·U)·Σ·(P·V)ᵀ, the thin SVD JacobiSVD would make of B
+      // itself, without its heap-sized work (most of an element's cost, made on every change).
+      Eigen::Matrix<double, 6, 6> v_b;
+      Eigen::Matrix<double, 6, 1> sigma;
       int rank = 0;
-      while (rank < sigma.size() && sigma(rank) > 1e-8 * sigma(0)) ++rank;
-      // B⁺ = V_r·Σ_r⁻¹·U_rᵀ (6 × #points).
-      fit.inverse.noalias() = svd.matrixV().leftCols(rank) *
-                              sigma.head(rank).cwiseInverse().asDiagonal() *
-                              svd.matrixU().leftCols(rank).transpose();
-      fit.null = svd.matrixV().rightCols(6 - rank);
+      if (size >= 6) {
+        const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(fit.basis);
+        const Eigen::Matrix<double, 6, 6> r =
+            qr.matrixQR().topRows<6>().triangularView<Eigen::Upper>();
+        const Eigen::JacobiSVD<Eigen::Matrix<double, 6, 6>> svd(
+            r, Eigen::ComputeFullU | Eigen::ComputeFullV);
+        sigma = svd.singularValues();
+        while (rank < 6 && sigma(rank) > 1e-8 * sigma(0)) ++rank;
+        v_b = qr.colsPermutation() * svd.matrixV();
+        // B⁺ = (P·V)_r·Σ_r⁻¹·(Q·U)_rᵀ, made as its transpose Q·[U_r·Σ_r⁻¹·(P·V)_rᵀ; 0].
+        Eigen::MatrixXd transposed = Eigen::MatrixXd::Zero(size, 6);
+        transposed.topRows<6>().noalias() = svd.matrixU().leftCols(rank) *
+                                            sigma.head(rank).cwiseInverse().asDiagonal() *
+                                            v_b.leftCols(rank).transpose();
+        transposed.applyOnTheLeft(qr.householderQ());
+        fit.inverse = transposed.transpose();
+      } else {
+        const Eigen::JacobiSVD<Eigen::MatrixXd> svd(fit.basis,
+                                                    Eigen::ComputeThinU | Eigen::ComputeFullV);
+        sigma.setZero();
+        sigma.head(svd.singularValues().size()) = svd.singularValues();
+        while (rank < 6 && sigma(rank) > 1e-8 * sigma(0)) ++rank;
+        v_b = svd.matrixV();
+        fit.inverse.noalias() = svd.matrixV().leftCols(rank) *
+                                sigma.head(rank).cwiseInverse().asDiagonal() *
+                                svd.matrixU().leftCols(rank).transpose();
+      }
+      fit.null = v_b.rightCols(6 - rank);
     }
     // Row of a functional c ↦ f·c of the fitted coefficients (f zero on 1, u, v): from the
     // smallest neighbourhood that determines it; false if none does. Where that is the one-ring
