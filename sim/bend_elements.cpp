@@ -506,16 +506,30 @@ std::vector<VertexBendElement> make_vertex_bends(const Eigen::MatrixX3d& rest,
         const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(fit.basis);
         const Eigen::Matrix<double, 6, 6> r =
             qr.matrixQR().topRows<6>().triangularView<Eigen::Upper>();
-        const Eigen::JacobiSVD<Eigen::Matrix<double, 6, 6>> svd(
-            r, Eigen::ComputeFullU | Eigen::ComputeFullV);
-        sigma = svd.singularValues();
-        while (rank < 6 && sigma(rank) > 1e-8 * sigma(0)) ++rank;
-        v_b = qr.colsPermutation() * svd.matrixV();
-        // B⁺ = (P·V)_r·Σ_r⁻¹·(Q·U)_rᵀ, made as its transpose Q·[U_r·Σ_r⁻¹·(P·V)_rᵀ; 0].
+        // With Businger-Golub pivoting σ_min ≥ 3·|r₅₅|/√(4⁶ + 35) > |r₅₅|/22 and
+        // σ_max ≤ √6·|r₀₀|, so |r₅₅| ≥ 1e-4·|r₀₀| means σ_min/σ_max > 1e-6, well above the rank
+        // cut: B has full rank and B⁺ = P·R⁻¹·Qᵀ, no SVD needed (the common case: a
+        // neighbourhood of 6 or more points in general position).
+        Eigen::Matrix<double, 6, 6> upper_left;  // U_r·Σ_r⁻¹·(P·V)_rᵀ, or (P·R⁻¹)ᵀ
+        if (std::abs(r(5, 5)) >= 1e-4 * std::abs(r(0, 0)) && r(0, 0) != 0.0) {
+          rank = 6;
+          const Eigen::Matrix<double, 6, 6> r_inverse =
+              r.triangularView<Eigen::Upper>().solve(Eigen::Matrix<double, 6, 6>::Identity());
+          upper_left = (qr.colsPermutation() * r_inverse).transpose();
+          v_b.setIdentity();  // only its rightCols(0) is read
+        } else {
+          const Eigen::JacobiSVD<Eigen::Matrix<double, 6, 6>> svd(
+              r, Eigen::ComputeFullU | Eigen::ComputeFullV);
+          sigma = svd.singularValues();
+          while (rank < 6 && sigma(rank) > 1e-8 * sigma(0)) ++rank;
+          v_b = qr.colsPermutation() * svd.matrixV();
+          upper_left.noalias() = svd.matrixU().leftCols(rank) *
+                                 sigma.head(rank).cwiseInverse().asDiagonal() *
+                                 v_b.leftCols(rank).transpose();
+        }
+        // B⁺ = P·R⁻¹·Qᵀ = (P·V)_r·Σ_r⁻¹·(Q·U)_rᵀ, made as its transpose Q·[upper_left; 0].
         Eigen::MatrixXd transposed = Eigen::MatrixXd::Zero(size, 6);
-        transposed.topRows<6>().noalias() = svd.matrixU().leftCols(rank) *
-                                            sigma.head(rank).cwiseInverse().asDiagonal() *
-                                            v_b.leftCols(rank).transpose();
+        transposed.topRows<6>() = upper_left;
         transposed.applyOnTheLeft(qr.householderQ());
         fit.inverse = transposed.transpose();
       } else {
