@@ -5,6 +5,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
+#include <Eigen/QR>
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
@@ -495,15 +496,54 @@ std::vector<VertexBendElement> make_vertex_bends(const Eigen::MatrixX3d& rest,
         const double u = d.dot(e1), w = d.dot(e2);
         fit.basis.row(j) << 1.0, u, w, u * u, u * w, w * w;
       }
-      const Eigen::JacobiSVD<Eigen::MatrixXd> svd(fit.basis,
-                                                  Eigen::ComputeFullU | Eigen::ComputeFullV);
-      const Eigen::VectorXd& sigma = svd.singularValues();
+      // B (#points × 6) = Q·R·Pᵀ by a column-pivoted QR, then the 6 × 6 R = U·Σ·Vᵀ by a
+      // fixed-size Jacobi SVD: B = (Q·U)·Σ·(P·V)ᵀ, the thin SVD JacobiSVD would make of B
+      // itself, without its heap-sized work (most of an element's cost, made on every change).
+      Eigen::Matrix<double, 6, 6> v_b;
+      Eigen::Matrix<double, 6, 1> sigma;
       int rank = 0;
-      while (rank < sigma.size() && sigma(rank) > 1e-8 * sigma(0)) ++rank;
-      fit.inverse = Eigen::MatrixXd::Zero(6, size);
-      for (int r = 0; r < rank; ++r)
-        fit.inverse += svd.matrixV().col(r) * svd.matrixU().col(r).transpose() / sigma(r);
-      fit.null = svd.matrixV().rightCols(6 - rank);
+      if (size >= 6) {
+        const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(fit.basis);
+        const Eigen::Matrix<double, 6, 6> r =
+            qr.matrixQR().topRows<6>().triangularView<Eigen::Upper>();
+        // With Businger-Golub pivoting σ_min ≥ 3·|r₅₅|/√(4⁶ + 35) > |r₅₅|/22 and
+        // σ_max ≤ √6·|r₀₀|, so |r₅₅| ≥ 1e-4·|r₀₀| means σ_min/σ_max > 1e-6, well above the rank
+        // cut: B has full rank and B⁺ = P·R⁻¹·Qᵀ, no SVD needed (the common case: a
+        // neighbourhood of 6 or more points in general position).
+        Eigen::Matrix<double, 6, 6> upper_left;  // U_r·Σ_r⁻¹·(P·V)_rᵀ, or (P·R⁻¹)ᵀ
+        if (std::abs(r(5, 5)) >= 1e-4 * std::abs(r(0, 0)) && r(0, 0) != 0.0) {
+          rank = 6;
+          const Eigen::Matrix<double, 6, 6> r_inverse =
+              r.triangularView<Eigen::Upper>().solve(Eigen::Matrix<double, 6, 6>::Identity());
+          upper_left = (qr.colsPermutation() * r_inverse).transpose();
+          v_b.setIdentity();  // only its rightCols(0) is read
+        } else {
+          const Eigen::JacobiSVD<Eigen::Matrix<double, 6, 6>> svd(
+              r, Eigen::ComputeFullU | Eigen::ComputeFullV);
+          sigma = svd.singularValues();
+          while (rank < 6 && sigma(rank) > 1e-8 * sigma(0)) ++rank;
+          v_b = qr.colsPermutation() * svd.matrixV();
+          upper_left.noalias() = svd.matrixU().leftCols(rank) *
+                                 sigma.head(rank).cwiseInverse().asDiagonal() *
+                                 v_b.leftCols(rank).transpose();
+        }
+        // B⁺ = P·R⁻¹·Qᵀ = (P·V)_r·Σ_r⁻¹·(Q·U)_rᵀ, made as its transpose Q·[upper_left; 0].
+        Eigen::MatrixXd transposed = Eigen::MatrixXd::Zero(size, 6);
+        transposed.topRows<6>() = upper_left;
+        transposed.applyOnTheLeft(qr.householderQ());
+        fit.inverse = transposed.transpose();
+      } else {
+        const Eigen::JacobiSVD<Eigen::MatrixXd> svd(fit.basis,
+                                                    Eigen::ComputeThinU | Eigen::ComputeFullV);
+        sigma.setZero();
+        sigma.head(svd.singularValues().size()) = svd.singularValues();
+        while (rank < 6 && sigma(rank) > 1e-8 * sigma(0)) ++rank;
+        v_b = svd.matrixV();
+        fit.inverse.noalias() = svd.matrixV().leftCols(rank) *
+                                sigma.head(rank).cwiseInverse().asDiagonal() *
+                                svd.matrixU().leftCols(rank).transpose();
+      }
+      fit.null = v_b.rightCols(6 - rank);
     }
     // Row of a functional c ↦ f·c of the fitted coefficients (f zero on 1, u, v): from the
     // smallest neighbourhood that determines it; false if none does. Where that is the one-ring
