@@ -16,6 +16,17 @@ namespace {
 
 using Eigen::Vector3d;
 
+// Two separate triangles 3 mm apart, one above the other (a cloth's two layers in self-contact).
+ClothInput two_facing_triangles() {
+  ClothInput input;
+  input.rest_positions.resize(6, 3);
+  input.rest_positions << 0.0, 0.0, 0.0, 0.0, 0.0, 0.1, 0.1, 0.0, 0.0,  // lower
+      0.0, 0.003, 0.0, 0.0, 0.003, 0.1, 0.1, 0.003, 0.0;                // upper
+  input.triangles.resize(2, 3);
+  input.triangles << 0, 1, 2, 3, 4, 5;
+  return input;
+}
+
 // One quad (two equal triangles) at rest, gravity and air drag off, a spring through each
 // triangle's centroid along its normal. Each triangle contributes a third of its mass to each
 // of its corners and the spring a third of its force, so the quad translates rigidly (no
@@ -87,12 +98,7 @@ TEST(ImplicitSolver, PointSpringStepIsBackwardEulerExactly) {
 // exact backward Euler step solves, with the same mass m at every vertex,
 //   ṡ1 (1 + 2β(βk + c)/m) = ṡ0 + 2βk (target − s0)/m.
 TEST(ImplicitSolver, PairSpringsAcrossTheMeshAreImplicitExactly) {
-  ClothInput input;
-  input.rest_positions.resize(6, 3);
-  input.rest_positions << 0.0, 0.0, 0.0, 0.0, 0.0, 0.1, 0.1, 0.0, 0.0,  // lower
-      0.0, 0.003, 0.0, 0.0, 0.003, 0.1, 0.1, 0.003, 0.0;                // upper
-  input.triangles.resize(2, 3);
-  input.triangles << 0, 1, 2, 3, 4, 5;
+  const ClothInput input = two_facing_triangles();
   const ClothModel model = build_cloth_model(input, fabric_preset("cotton"));
   const double m = model.mass[0];
   for (int i = 1; i < 6; ++i) ASSERT_NEAR(model.mass[i], m, 1e-15);
@@ -184,12 +190,7 @@ TEST(ImplicitSolver, PairFrictionBlocksAreTheForceDerivatives) {
     }
 
   // In the assembled matrix: the two triangles of PairSpringsAcrossTheMeshAreImplicitExactly.
-  ClothInput input;
-  input.rest_positions.resize(6, 3);
-  input.rest_positions << 0.0, 0.0, 0.0, 0.0, 0.0, 0.1, 0.1, 0.0, 0.0, 0.0, 0.003, 0.0, 0.0, 0.003,
-      0.1, 0.1, 0.003, 0.0;
-  input.triangles.resize(2, 3);
-  input.triangles << 0, 1, 2, 3, 4, 5;
+  const ClothInput input = two_facing_triangles();
   const ClothModel model = build_cloth_model(input, fabric_preset("cotton"));
   ForceSettings forces;
   const Eigen::VectorXd x0 = flatten_positions(input.rest_positions);
@@ -302,12 +303,7 @@ TEST(ImplicitSolver, PcgNeverReportsTheStartAsASolutionOfAnIndefiniteSystem) {
 // fresh solver (which widens by exactly that step's blocks) gives, to rounding. The PCG's
 // preconditioner reads the pattern, so it gets exactly the step's blocks.
 TEST(ImplicitSolver, CholmodKeepsThePairSpringPatternAcrossSteps) {
-  ClothInput input;
-  input.rest_positions.resize(6, 3);
-  input.rest_positions << 0.0, 0.0, 0.0, 0.0, 0.0, 0.1, 0.1, 0.0, 0.0,  // lower
-      0.0, 0.003, 0.0, 0.0, 0.003, 0.1, 0.1, 0.003, 0.0;                // upper
-  input.triangles.resize(2, 3);
-  input.triangles << 0, 1, 2, 3, 4, 5;
+  const ClothInput input = two_facing_triangles();
   const ClothModel model = build_cloth_model(input, fabric_preset("cotton"));
   ForceSettings forces;
   const Eigen::VectorXd x0 = flatten_positions(input.rest_positions);
