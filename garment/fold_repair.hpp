@@ -14,7 +14,10 @@
 //    back neck), so that the wide one folds: a turn there too, in the corpus.
 // The other candidate, the interior around the fold smoothed towards the mean of its
 // neighbours and lifted onto the surface, is tried as well. A corner that turns more than 180°
-// in one quad on a saddle of the body (shirt-human's armpit) is not reached (docs/garment.md).
+// in one quad on a saddle of the body (shirt-human's armpit) folds by the stitched garment's
+// normals but not by the panel's own: the second pass after stitching (garment_mesh.cpp) runs
+// the same repair with the neighbouring panels' share of each seam vertex's normal
+// (`extra_normals`), so that it judges the panel as the quality gate does.
 
 #include <Eigen/Core>
 #include <functional>
@@ -36,10 +39,14 @@ struct FoldRepairResult {
 // onto the panel's surface (may be empty). The mesh's vertex count and boundary never change;
 // its faces may. Each round takes the best change over all folded quads and stops when none
 // improves (fewer folded quads, then no new sliver, then a better worst corner); at most
-// `rounds` rounds.
+// `rounds` rounds. `extra_normals` (#V × 3, or empty): what the quads outside this mesh add to
+// each vertex's normal (the sum of their corner cross products, m², as the quality gate sums
+// them over the stitched garment); with it a quad folds when a corner turns against the summed
+// normals of the whole garment (the gate's measure, garment/quality_gate.cpp) and the worst
+// corner is taken the same way.
 FoldRepairResult repair_folds(meshing::QuadMesh& mesh, std::span<const char> fixed,
                               std::span<const int> corner_vertices,
                               const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& project,
-                              int rounds = 8);
+                              int rounds = 8, const Eigen::MatrixX3d& extra_normals = {});
 
 }  // namespace sd::garment

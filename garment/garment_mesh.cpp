@@ -12,9 +12,11 @@
 #include <set>
 #include <stdexcept>
 #include <unordered_map>
+#include <utility>
 
 #include "garment/curve_network.hpp"
 #include "garment/edge_counts.hpp"
+#include "garment/fold_repair.hpp"
 #include "garment/network_faces.hpp"
 #include "garment/panel_fill.hpp"
 #include "garment/panel_loop.hpp"
@@ -254,6 +256,143 @@ std::vector<Eigen::MatrixX3d> panel_sides(const PanelLoop& loop, BoundaryVertice
   return sides;
 }
 
+// The gate's scaled Jacobian of quad `q` (garment/quality_gate.cpp): its worst corner against the
+// sum of its vertices' normals, each the sum of the corner cross products around the vertex over
+// the whole garment; below 0 it folds.
+double gate_jacobian(const std::array<int, 4>& q, const std::vector<Eigen::Vector3d>& positions,
+                     const std::vector<Eigen::Vector3d>& normals) {
+  Eigen::Vector3d reference = Eigen::Vector3d::Zero();
+  for (const int v : q) reference += normals[static_cast<size_t>(v)];
+  if (reference.norm() == 0) return 1;
+  reference.normalize();
+  double jacobian = 1;
+  for (size_t k = 0; k < 4; ++k) {
+    const Eigen::Vector3d& p = positions[static_cast<size_t>(q[k])];
+    const Eigen::Vector3d e1 = positions[static_cast<size_t>(q[(k + 1) % 4])] - p;
+    const Eigen::Vector3d e2 = positions[static_cast<size_t>(q[(k + 3) % 4])] - p;
+    const double l1 = e1.norm(), l2 = e2.norm();
+    if (l1 > 0 && l2 > 0) jacobian = std::min(jacobian, e1.cross(e2).dot(reference) / (l1 * l2));
+  }
+  return jacobian;
+}
+
+// The corner cross products of `faces` summed at each vertex (#pool): the gate's vertex normals.
+std::vector<Eigen::Vector3d> corner_normals(const std::vector<std::array<int, 4>>& faces,
+                                            const std::vector<Eigen::Vector3d>& positions) {
+  std::vector<Eigen::Vector3d> normals(positions.size(), Eigen::Vector3d::Zero());
+  for (const auto& q : faces)
+    for (size_t k = 0; k < 4; ++k) {
+      const Eigen::Vector3d& b = positions[static_cast<size_t>(q[k])];
+      normals[static_cast<size_t>(q[k])] +=
+          (positions[static_cast<size_t>(q[(k + 1) % 4])] - b)
+              .cross(positions[static_cast<size_t>(q[(k + 3) % 4])] - b);
+    }
+  return normals;
+}
+
+// Stage 3b, folds only the stitched garment shows. The fold repair of fill_panel judges a panel
+// by its own quads' normals; the quality gate by the garment's, in which a seam vertex's normal
+// also sums the neighbouring panels' quads. At a corner that turns about 200° in one quad on
+// the body's saddle (shirt-human's back sleeve at the armpit) the two disagree: the panel alone
+// had 2 folds there, the garment 3, and the turn that mended the first did not mend the
+// second. Here every original panel that folds by the gate's measure is repaired again with the
+// rest of the garment's share of each vertex's normal (fold_repair.hpp, `extra_normals`); its
+// mirror copies follow. Kept only when the whole garment then has fewer folded quads (a
+// repair moves no seam vertex, but it changes the normals the neighbours are judged by).
+// `face_range[l]` are loop l's quads in `faces`, `loop_globals[l]` its patch vertices' pool ids.
+// Returns how many panels were repaired.
+int repair_stitched_folds(const GarmentRequest& sketch, const CurveNetwork& net,
+                          const BodySurface& body, const std::vector<PanelLoop>& loops,
+                          const std::vector<std::pair<size_t, size_t>>& face_range,
+                          const std::vector<std::vector<int>>& loop_globals,
+                          std::map<int, meshing::FilledPatch>& patches,
+                          std::vector<std::array<int, 4>>& faces, VertexPool& pool,
+                          Garment& garment) {
+  const auto folded = [&](const std::vector<Eigen::Vector3d>& normals, size_t begin, size_t end) {
+    int count = 0;
+    for (size_t f = begin; f < end; ++f)
+      if (gate_jacobian(faces[f], pool.positions, normals) < 0) ++count;
+    return count;
+  };
+  int repaired = 0;
+  for (auto& [l, patch] : patches) {
+    const auto [begin, end] = face_range[static_cast<size_t>(l)];
+    std::vector<Eigen::Vector3d> normals = corner_normals(faces, pool.positions);
+    if (folded(normals, begin, end) == 0) continue;
+    const int before = folded(normals, 0, faces.size());
+    const std::vector<int>& og = loop_globals[static_cast<size_t>(l)];
+    // The panel's quads on the pool's positions, and the rest of the garment's share of each
+    // of its vertices' normals.
+    meshing::QuadMesh mesh = patch.mesh;
+    for (Eigen::Index v = 0; v < mesh.vertex_count(); ++v)
+      mesh.vertices.row(v) =
+          pool.positions[static_cast<size_t>(og[static_cast<size_t>(v)])].transpose();
+    const std::vector<std::array<int, 4>> own(faces.begin() + static_cast<std::ptrdiff_t>(begin),
+                                              faces.begin() + static_cast<std::ptrdiff_t>(end));
+    const std::vector<Eigen::Vector3d> own_normals = corner_normals(own, pool.positions);
+    Eigen::MatrixX3d extra(mesh.vertex_count(), 3);
+    for (Eigen::Index v = 0; v < mesh.vertex_count(); ++v) {
+      const auto g = static_cast<size_t>(og[static_cast<size_t>(v)]);
+      extra.row(v) = (normals[g] - own_normals[g]).transpose();
+    }
+    std::vector<char> fixed(static_cast<size_t>(mesh.vertex_count()), 0);
+    for (const auto& side : patch.topology.side_vertices)
+      for (const int v : side) fixed[static_cast<size_t>(v)] = 1;
+    const std::vector<int> corners = patch.topology.corner_vertices();
+    const PanelLoop& loop = loops[static_cast<size_t>(l)];
+    const auto project =
+        panel_projection(sketch, sketch.panels[static_cast<size_t>(loop.spec)], loop, net, body,
+                         garment.panels[static_cast<size_t>(l)].fit);
+    const FoldRepairResult result = repair_folds(mesh, fixed, corners, project, 8, extra);
+    if (result.edge_turns + result.smoothings == 0) continue;
+    // The repaired quads into the garment, and into each mirror copy reflected (faces reversed
+    // to stay outward, as build_garment makes them).
+    const std::vector<std::array<int, 4>> old_faces = faces;
+    const std::vector<Eigen::Vector3d> old_positions = pool.positions;
+    const auto write = [&](size_t loop_index, bool mirrored) {
+      const std::vector<int>& g = loop_globals[loop_index];
+      size_t f = face_range[loop_index].first;
+      for (Eigen::Index q = 0; q < mesh.face_count(); ++q, ++f) {
+        const auto at = [&](int k) { return g[static_cast<size_t>(mesh.faces(q, k))]; };
+        faces[f] = mirrored ? std::array{at(0), at(3), at(2), at(1)}
+                            : std::array{at(0), at(1), at(2), at(3)};
+      }
+      for (Eigen::Index v = 0; v < mesh.vertex_count(); ++v) {
+        if (fixed[static_cast<size_t>(v)]) continue;
+        const Eigen::Vector3d p = mesh.vertices.row(v).transpose();
+        pool.positions[static_cast<size_t>(g[static_cast<size_t>(v)])] =
+            mirrored ? mirror_point(p) : p;
+      }
+    };
+    write(static_cast<size_t>(l), false);
+    std::vector<size_t> copies;
+    for (size_t c = 0; c < loops.size(); ++c)
+      if (loops[c].mirror_copy && loops[c].original == l) copies.push_back(c);
+    for (const size_t c : copies) write(c, true);
+    if (folded(corner_normals(faces, pool.positions), 0, faces.size()) >= before) {
+      faces = old_faces;
+      pool.positions = old_positions;
+      continue;
+    }
+    ++repaired;
+    patch.mesh = std::move(mesh);
+    patch.quality = meshing::measure_quality(patch.mesh, corners);
+    patch.topology.mesh.faces = patch.mesh.faces;
+    patch.topology.distortion = patch.quality.distortion;
+    patch.topology.irregular_vertices = patch.quality.irregular_vertices;
+    copies.push_back(static_cast<size_t>(l));
+    for (const size_t c : copies) {
+      GarmentPanel& panel = garment.panels[c];
+      panel.quality = patch.quality;
+      panel.distortion = patch.topology.distortion;
+      panel.irregular_vertices = patch.topology.irregular_vertices;
+    }
+    spdlog::debug("panel '{}': {} folded quad(s) of the stitched garment repaired, {} left",
+                  loop.id, result.folded_before - result.folded_after, result.folded_after);
+  }
+  return repaired;
+}
+
 // Stage 4, one mesh: doublets merged, vertices no face uses dropped (in order), the arrays
 // filled. `faces` (pool ids), `face_panel` and `pool` are renumbered in place.
 void assemble_mesh(std::vector<std::array<int, 4>>& faces, std::vector<int>& face_panel,
@@ -440,6 +579,9 @@ Garment build_garment(const GarmentRequest& sketch, const BodySurface& body) {
   // Per original loop: patch vertex → global id, kept for its mirror copy.
   std::map<int, std::vector<int>> patch_globals;
   std::map<int, meshing::FilledPatch> patches;
+  // Per loop: its quads' range in `faces` and its patch vertices' pool ids (for stage 3b).
+  std::vector<std::pair<size_t, size_t>> face_range(loops.size());
+  std::vector<std::vector<int>> loop_globals(loops.size());
 
   // Stage 3, every original panel's quads, on the body or spanning a hollow (panel_fill.hpp), the
   // panels side by side (panel_tasks.hpp): a fill depends on its own sides only, so the garment
@@ -505,6 +647,7 @@ Garment build_garment(const GarmentRequest& sketch, const BodySurface& body) {
       panel.side_counts.push_back(static_cast<int>(ids.size()) - 1);
 
     const int panel_index = static_cast<int>(garment.panels.size());
+    face_range[l].first = faces.size();
     std::vector<int> globals;
     if (!loop.mirror_copy) {
       // Stage 3: the panel's quads, on the body or spanning a hollow (panel_fill.hpp).
@@ -581,9 +724,13 @@ Garment build_garment(const GarmentRequest& sketch, const BodySurface& body) {
       panel.fit = op.fit;
       panel.span_gap = op.span_gap;
     }
+    face_range[l].second = faces.size();
+    loop_globals[l] = globals;
     garment.panels.push_back(std::move(panel));
   }
 
+  repair_stitched_folds(sketch, net, body, loops, face_range, loop_globals, patches, faces, pool,
+                        garment);
   assemble_mesh(faces, face_panel, pool, garment);
   check_fans(sketch, garment, faces, face_panel, pool);
   check_seam_directions(sketch, faces, face_panel, garment);

@@ -9,6 +9,7 @@
 #include <span>
 #include <tuple>
 #include <unordered_map>
+#include <utility>
 
 #include "garment/fold_repair.hpp"
 #include "garment/panel_surface.hpp"
@@ -74,17 +75,10 @@ Eigen::Vector3d loop_facing(const std::vector<Eigen::MatrixX3d>& side_points) {
   return area.norm() > 0 ? Eigen::Vector3d(area.normalized()) : Eigen::Vector3d::Zero();
 }
 
-}  // namespace
-
-meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& spec,
-                                const PanelLoop& loop, const CurveNetwork& net,
-                                const std::vector<Eigen::MatrixX3d>& side_points,
-                                const BodySurface& body, GarmentPanel& panel) {
-  // Project interior points onto the offset surface where the panel lies on the body:
-  // inside it, or less than one edge length outside it; points spanning a hollow (between
-  // the legs, under the bust) are left where the relaxation puts them.
-  // Any on-body curve makes the panel a body panel; free-hanging parts (a flared hem) are
-  // more than `reach` off the body and are not pulled in.
+// The panel's offset from the body (m: the mean of its on-body curves' offsets) and how many of
+// its boundary's pieces lie on the body.
+std::pair<double, int> panel_offset(const GarmentRequest& sketch, const PanelLoop& loop,
+                                    const CurveNetwork& net) {
   double offset = 0;
   int on_body = 0;
   for (const LoopEdge& e : loop.edges) {
@@ -95,6 +89,39 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
     ++on_body;
   }
   if (on_body > 0) offset /= on_body;
+  return {offset, on_body};
+}
+
+}  // namespace
+
+std::function<Eigen::Vector3d(const Eigen::Vector3d&)> panel_projection(
+    const GarmentRequest& sketch, const PanelSpec& spec, const PanelLoop& loop,
+    const CurveNetwork& net, const BodySurface& body, const std::string& fit) {
+  const double offset = panel_offset(sketch, loop, net).first;
+  const double reach = spec.edge_length.value_or(sketch.edge_length);
+  if (fit == "body")
+    return [&body, offset, reach](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+      const SurfacePoint s = body.closest_point(p);
+      if ((p - s.position).dot(s.normal) < offset + reach) return s.position + offset * s.normal;
+      return p;
+    };
+  return [&body, offset](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+    const SurfacePoint s = body.closest_point(p);
+    if ((p - s.position).dot(s.normal) >= offset) return p;
+    return s.position + offset * s.normal;
+  };
+}
+
+meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& spec,
+                                const PanelLoop& loop, const CurveNetwork& net,
+                                const std::vector<Eigen::MatrixX3d>& side_points,
+                                const BodySurface& body, GarmentPanel& panel) {
+  // Project interior points onto the offset surface where the panel lies on the body:
+  // inside it, or less than one edge length outside it; points spanning a hollow (between
+  // the legs, under the bust) are left where the relaxation puts them.
+  // Any on-body curve makes the panel a body panel; free-hanging parts (a flared hem) are
+  // more than `reach` off the body and are not pulled in.
+  const auto [offset, on_body] = panel_offset(sketch, loop, net);
   const double reach = spec.edge_length.value_or(sketch.edge_length);
   meshing::FillGeometryOptions options;
   options.relax_iterations = sketch.relax_iterations;

@@ -5,6 +5,8 @@
 // smoothing along the body and their unfolded versions compete on the quality gate's measures.
 
 #include <Eigen/Core>
+#include <functional>
+#include <string>
 #include <vector>
 
 #include "garment/body_surface.hpp"
@@ -24,5 +26,13 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
                                 const PanelLoop& loop, const CurveNetwork& net,
                                 const std::vector<Eigen::MatrixX3d>& side_points,
                                 const BodySurface& body, GarmentPanel& panel);
+
+// The projection a filled panel's vertices are moved with (fit "body": onto the body's offset
+// surface when less than an edge length outside it; "free": out of the body only), as
+// fill_panel projects them but without its cache and its far-side test: for the repair of folds
+// after stitching (garment_mesh.cpp), which moves a few vertices near a seam. Holds `body`.
+std::function<Eigen::Vector3d(const Eigen::Vector3d&)> panel_projection(
+    const GarmentRequest& sketch, const PanelSpec& spec, const PanelLoop& loop,
+    const CurveNetwork& net, const BodySurface& body, const std::string& fit);
 
 }  // namespace sd::garment
