@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "garment/body.hpp"
@@ -54,8 +55,38 @@ double mean_side(const meshing::QuadMesh& mesh, Eigen::Index f) {
   return sum / 4;
 }
 
+// Each vertex of panel `panel`'s quads: "boundary" (on an edge of one of its quads: the panel's
+// outline, seams included), else by its valence among them, "interior valence 3", "interior
+// valence 5+" or "regular"; vertices of other panels are "".
+std::vector<std::string> vertex_kinds(const Garment& garment, int panel) {
+  const meshing::QuadMesh& mesh = garment.mesh;
+  std::map<std::pair<int, int>, int> uses;
+  for (Eigen::Index f = 0; f < mesh.face_count(); ++f)
+    if (garment.face_panel(f) == panel)
+      for (int k = 0; k < 4; ++k) ++uses[std::minmax(mesh.faces(f, k), mesh.faces(f, (k + 1) % 4))];
+  std::vector<int> valence(static_cast<size_t>(mesh.vertex_count()), 0);
+  std::vector<char> boundary(valence.size(), 0);
+  for (const auto& [edge, count] : uses)
+    for (const int v : {edge.first, edge.second}) {
+      ++valence[static_cast<size_t>(v)];
+      if (count == 1) boundary[static_cast<size_t>(v)] = 1;
+    }
+  std::vector<std::string> kinds(valence.size());
+  for (size_t v = 0; v < kinds.size(); ++v)
+    if (boundary[v])
+      kinds[v] = "boundary";
+    else if (valence[v] == 3)
+      kinds[v] = "interior valence 3";
+    else if (valence[v] >= 5)
+      kinds[v] = "interior valence 5+";
+    else if (valence[v] == 4)
+      kinds[v] = "regular";
+  return kinds;
+}
+
 TEST(FillConsistency, QuadCountsFallAndSizesFollowTheEdgeLength) {
   int garments = 0, total_quads = 0, total_outside = 0;
+  std::map<std::string, int> causes, plans;  // out-of-band quads by where they are, by plan
   double worst_share = 0;
   std::string worst;
   for (const fs::path& file : garment_files()) {
@@ -71,10 +102,23 @@ TEST(FillConsistency, QuadCountsFallAndSizesFollowTheEdgeLength) {
     for (const double edge : kSweep) {
       sketch.edge_length = edge;
       const Garment garment = build_garment(sketch, surface);
+      std::map<int, std::vector<std::string>> kinds;  // by panel, when first needed
       int outside = 0;
       for (Eigen::Index f = 0; f < garment.mesh.face_count(); ++f) {
         const double side = mean_side(garment.mesh, f) / edge;
-        outside += side < kSmallest || side > kLargest ? 1 : 0;
+        if (side >= kSmallest && side <= kLargest) continue;
+        ++outside;
+        // Where it is in its panel: on the panel's boundary, at an interior vertex of valence 3,
+        // of valence 5 or more, or among regular interior vertices only (the first that applies).
+        const int p = garment.face_panel(f);
+        if (!kinds.contains(p)) kinds[p] = vertex_kinds(garment, p);
+        std::string at = "regular interior";
+        for (const char* kind : {"boundary", "interior valence 3", "interior valence 5+"})
+          for (int k = 0; k < 4 && at == "regular interior"; ++k)
+            if (kinds[p][static_cast<size_t>(garment.mesh.faces(f, k))] == kind) at = kind;
+        const GarmentPanel& panel = garment.panels[static_cast<size_t>(p)];
+        ++causes[std::string(side < kSmallest ? "small" : "large") + ", " + at];
+        ++plans[panel.partition];
       }
       total_quads += static_cast<int>(garment.mesh.face_count());
       total_outside += outside;
@@ -110,6 +154,8 @@ TEST(FillConsistency, QuadCountsFallAndSizesFollowTheEdgeLength) {
       "quads outside %.1f-%.1f edge lengths: %d of %d over every garment and edge "
       "length; the largest share %.2f %% (%s)\n",
       kSmallest, kLargest, total_outside, total_quads, 100 * worst_share, worst.c_str());
+  for (const auto& [cause, count] : causes) std::printf("  %s: %d\n", cause.c_str(), count);
+  for (const auto& [plan, count] : plans) std::printf("  in %s plans: %d\n", plan.c_str(), count);
 }
 
 // A panel whose fold no plan undoes must still come out near the body: the raglan top at 2 cm
