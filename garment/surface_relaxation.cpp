@@ -1,6 +1,8 @@
 #include "garment/surface_relaxation.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <stdexcept>
 #include <vector>
 
@@ -33,6 +35,23 @@ SurfaceRelaxationResult relax_on_surface(meshing::QuadMesh& mesh, std::span<cons
     normals[static_cast<std::size_t>(v)] = here.normal;
   }
 
+  // Each vertex's weight in its neighbours' means: 1, but 1 + 2 cos(2π/k) for a free vertex of
+  // valence k ≠ 4 (0 at valence 3, 1.618 at 5, 2 at 6). With uniform weights the ring of quads
+  // around an irregular vertex is no equilibrium at one size: around a vertex c of valence 3
+  // whose three quads are rhombi of side r (120° at c), a neighbour a of c (at distance r) has
+  // the two rhombi's far corners at r/2 along c → a each and its outer neighbour o; the mean
+  // (0 + r/2 + r/2 + |o|) / 4 is r only when o lies 2r beyond a. So the relaxed ring is about
+  // half the size of the next one: 304 of the corpus's 414 quads under half the edge length
+  // touch an interior vertex of valence 3 (docs/garment.md, "Which plans and which
+  // vertices"). With c weighted w_c the balance is 2 r (1 + cos θ) + |o| = r (w_c + 3) at the
+  // angle θ = 2π/k at c, which holds for |o| = 2r (rings of one size) when w_c = 1 + 2 cos θ.
+  std::vector<double> weights(static_cast<std::size_t>(vertex_count), 1.0);
+  for (Eigen::Index v = 0; v < vertex_count; ++v) {
+    const std::size_t k = neighbours[static_cast<std::size_t>(v)].size();
+    if (fixed[static_cast<std::size_t>(v)] || k == 4 || k < 3) continue;
+    weights[static_cast<std::size_t>(v)] =
+        std::max(0.0, 1 + 2 * std::cos(2 * std::numbers::pi / static_cast<double>(k)));
+  }
   SurfaceRelaxationResult result;
   for (; result.sweeps < options.max_sweeps; ++result.sweeps) {
     if (result.sweeps > 0 && result.last_move <= options.tolerance) break;
@@ -42,8 +61,19 @@ SurfaceRelaxationResult relax_on_surface(meshing::QuadMesh& mesh, std::span<cons
       if (fixed[static_cast<std::size_t>(v)] || around.empty()) continue;
       const Eigen::Vector3d here = mesh.vertices.row(v).transpose();
       Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-      for (int w : around) mean += mesh.vertices.row(w).transpose();
-      mean /= static_cast<double>(around.size());
+      double total = 0;
+      for (int w : around) {
+        const double weight = weights[static_cast<std::size_t>(w)];
+        mean += weight * mesh.vertices.row(w).transpose();
+        total += weight;
+      }
+      if (total > 0) {
+        mean /= total;
+      } else {  // every neighbour of valence 3: their plain mean
+        mean.setZero();
+        for (int w : around) mean += mesh.vertices.row(w).transpose();
+        mean /= static_cast<double>(around.size());
+      }
       Eigen::Vector3d& normal = normals[static_cast<std::size_t>(v)];
       Eigen::Vector3d step = mean - here;
       step -= step.dot(normal) * normal;  // a zero normal (off the surface) leaves it whole

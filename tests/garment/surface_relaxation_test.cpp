@@ -3,6 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
 #include <vector>
 
 #include "meshing/quad_quality.hpp"
@@ -36,6 +40,63 @@ TEST(SurfaceRelaxation, SpreadsACollapsedInteriorBackToTheUniformGrid) {
   EXPECT_LT(result.sweeps, 2000);
   EXPECT_EQ(result.refused, 0);
   EXPECT_LT((mesh.vertices - grid.vertices).cwiseAbs().maxCoeff(), 1e-10);
+}
+
+// A regular hexagon of side 2 tiled by three rhombi (120° at the centre c), each cut 2 × 2: 12
+// quads of side 1 around c of valence 3. Its fixed boundary has 12 vertices one apart. With the
+// weights of relax_on_surface this tiling is the fixed point of the sweeps; plain means of the
+// neighbours pull the three spoke midpoints to 0.73 from c and shrink the quads at c (the
+// small quads at valence-3 vertices of the corpus).
+TEST(SurfaceRelaxation, QuadsAroundAValenceThreeVertexKeepTheSizeOfTheirNeighbours) {
+  // Vertices c + s A_i + t A_{i+1} for the spokes A_i (length 2 at 90° + 120° i), s, t in
+  // {0, 1/2, 1}, numbered as they are first met.
+  std::vector<Eigen::Vector3d> points;
+  const auto id = [&](const Eigen::Vector3d& p) {
+    for (size_t k = 0; k < points.size(); ++k)
+      if ((points[k] - p).norm() < 1e-12) return static_cast<int>(k);
+    points.push_back(p);
+    return static_cast<int>(points.size()) - 1;
+  };
+  std::vector<std::array<int, 4>> quads;
+  for (int i = 0; i < 3; ++i) {
+    const auto spoke = [](int j) {
+      const double a = std::numbers::pi / 2 + 2 * std::numbers::pi / 3 * j;
+      return Eigen::Vector3d(2 * std::cos(a), 2 * std::sin(a), 0);
+    };
+    const Eigen::Vector3d a = spoke(i), b = spoke(i + 1);
+    for (int s = 0; s < 2; ++s)
+      for (int t = 0; t < 2; ++t) {
+        const auto at = [&](int u, int w) { return id(0.5 * u * a + 0.5 * w * b); };
+        quads.push_back({at(s, t), at(s + 1, t), at(s + 1, t + 1), at(s, t + 1)});
+      }
+  }
+  meshing::QuadMesh mesh;
+  mesh.vertices.resize(static_cast<Eigen::Index>(points.size()), 3);
+  for (size_t k = 0; k < points.size(); ++k)
+    mesh.vertices.row(static_cast<Eigen::Index>(k)) = points[k].transpose();
+  mesh.faces.resize(static_cast<Eigen::Index>(quads.size()), 4);
+  for (size_t f = 0; f < quads.size(); ++f)
+    for (int k = 0; k < 4; ++k)
+      mesh.faces(static_cast<Eigen::Index>(f), k) = quads[f][static_cast<size_t>(k)];
+  ASSERT_EQ(mesh.vertex_count(), 19);
+  // Interior: c, the three spoke midpoints and the three rhombus centres (|p| ≤ 1; the outline is
+  // at 1.73-2).
+  std::vector<char> fixed(19, 0);
+  for (size_t k = 0; k < points.size(); ++k) fixed[k] = points[k].norm() > 1.5;
+  ASSERT_EQ(std::count(fixed.begin(), fixed.end(), 0), 7);
+  const meshing::QuadMesh tiling = mesh;
+  // Start with the interior pulled towards c.
+  for (Eigen::Index v = 0; v < mesh.vertex_count(); ++v)
+    if (!fixed[static_cast<size_t>(v)]) mesh.vertices.row(v) *= 0.3;
+  const SurfaceLift plane = [](const Eigen::Vector3d& p) {
+    return LiftedPoint{{p.x(), p.y(), 0.0}, Eigen::Vector3d::UnitZ()};
+  };
+  const SurfaceRelaxationResult result = relax_on_surface(
+      mesh, fixed, plane, {.max_sweeps = 2000, .tolerance = 1e-13, .max_step = 1.0});
+  EXPECT_LT(result.sweeps, 2000);
+  // Back on the tiling: every quad's sides 1 long (plain means: the spoke midpoints at 0.73 and the
+  // rhombus centres at 0.93 from c).
+  EXPECT_LT((mesh.vertices - tiling.vertices).cwiseAbs().maxCoeff(), 1e-9);
 }
 
 TEST(SurfaceRelaxation, KeepsTheBoundaryAndStaysOnASphere) {
