@@ -42,10 +42,10 @@ struct SurfaceRelaxationResult {
 
 // Gauss-Seidel sweeps over the vertices not marked in `fixed` (#V flags, nonzero = fixed):
 // each moves by the tangential part of (mean of its edge neighbours − itself), at most
-// `max_step` long, then is lifted. In the mean a free neighbour of valence k ≠ 4 weighs
-// 1 + 2 cos(2π/k) (0 at valence 3): a ring of rhombi of one size around an irregular vertex is
-// then an equilibrium, where uniform weights shrink the quads around a valence-3 vertex to about
-// half the size of the next ring (and grow them around valence 5).
+// `max_step` long, then is lifted. In the mean a free neighbour of valence 3 weighs 0 (the
+// weight 1 + 2 cos(2π/k) that balances rhombi of one size around a vertex of valence k): a ring
+// of rhombi of one size around such a vertex is then an equilibrium, where uniform weights shrink
+// the quads there to about half the size of the next ring.
 SurfaceRelaxationResult relax_on_surface(meshing::QuadMesh& mesh, std::span<const char> fixed,
                                          const SurfaceLift& lift,
                                          const SurfaceRelaxationOptions& options = {});
