@@ -109,8 +109,9 @@ namespace {
 // normals the first repair saw 2 folds and found no turn it could keep; the quality gate, which
 // sums each seam vertex's normal over the stitched garment, counted 3 folds (scaled Jacobian
 // -0.55) and 2 corners of 7.9°. The second repair after stitching judges by the garment's
-// normals: 1 fold of -0.05 is left and no corner below 10°. The mirror copy stays the exact
-// reflection of the repaired sleeve.
+// normals: alone it left 1 fold of -0.05 and no corner below 10°; with the smoothing along the
+// body weighted at valence-3 vertices it takes the 2 folds that fill has to 0, and the shirt
+// meshes without a warning. The mirror copy stays the exact reflection of the repaired sleeve.
 TEST(FoldRepair, TheShirtsArmpitIsRepairedByTheStitchedGarmentsNormals) {
   const std::filesystem::path file =
       std::filesystem::path(SD_SOURCE_DIR) / "data/designs/repro/shirt-human.json";
@@ -119,17 +120,8 @@ TEST(FoldRepair, TheShirtsArmpitIsRepairedByTheStitchedGarmentsNormals) {
     GTEST_SKIP() << "Debian's Collada human (assimp-testmodels) is not installed";
   const Body body = load_sketch_body(sketch);
   const Garment garment = build_garment(sketch, BodySurface(body.mesh));
-  int folded = 0;
-  double worst = 0;
-  for (const QualityWarning& w : check_quality(garment, sketch, nullptr)) {
-    EXPECT_NE(w.kind, "min_angle") << w.message;
-    if (w.kind == "inverted_quads") {
-      folded += w.count;
-      worst = std::min(worst, w.worst);
-    }
-  }
-  EXPECT_LE(folded, 1);
-  EXPECT_GT(worst, -0.1);
+  for (const QualityWarning& w : check_quality(garment, sketch, nullptr))
+    ADD_FAILURE() << w.kind << ": " << w.message;
   // The copy's quads are the original's reflected: the same quad centres, x negated.
   std::vector<std::array<double, 3>> original, copy;
   for (Eigen::Index f = 0; f < garment.mesh.face_count(); ++f) {
