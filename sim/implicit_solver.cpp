@@ -280,11 +280,17 @@ void ImplicitSolver::record_constraint_impulse(const ConstraintFilter& filter,
     return;
   }
   // A s − b is zero in the free directions (up to the solver's tolerance) and, in the
-  // constrained ones, the impulse the constraint had to add: keep only that part.
-  Eigen::VectorXd residual = system() * step_ - rhs_;
-  Eigen::VectorXd free_part = residual;
-  filter.apply(free_part);
-  result.constraint_impulse = residual - free_part;
+  // constrained ones, the impulse the constraint had to add: keep only that part, (I − S)(A s −
+  // b), computed in the constrained vertices' rows only (a pinned sheet has two of a thousand).
+  const SparseMatrixR& a = system();
+  result.constraint_impulse = Eigen::VectorXd::Zero(step_.size());
+  for (int i = 0; i < filter.vertex_count(); ++i) {
+    if (filter.is_free(i)) continue;
+    Eigen::Vector3d residual;
+    for (int r = 0; r < 3; ++r) residual(r) = a.row(3 * i + r).dot(step_) - rhs_(3 * i + r);
+    result.constraint_impulse.segment<3>(3 * i) =
+        (Eigen::Matrix3d::Identity() - filter.filter_matrix(i)) * residual;
+  }
 }
 
 ImplicitSolveResult ImplicitSolver::solve(const ClothModel& model, const ForceSettings& forces,
