@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <utility>
 
 namespace sd::sim {
 
@@ -45,7 +46,7 @@ void ImplicitSolver::add_extra_force(const ClothModel& model, const StepForces* 
 void ImplicitSolver::assemble(const ClothModel& model, const ForceSettings& forces, double beta,
                               const Eigen::VectorXd& x, const Eigen::VectorXd& v,
                               const Eigen::VectorXd* u, const StepForces* extra,
-                              ImplicitSolveResult& result) {
+                              ImplicitSolveResult& result, EnergyBreakdown* energy) {
   const auto start = std::chrono::steady_clock::now();
   const SparseMatrixR& pattern = model.pattern.zero_matrix;
   if (matrix_.rows() != pattern.rows() || matrix_.nonZeros() != pattern.nonZeros() ||
@@ -72,7 +73,7 @@ void ImplicitSolver::assemble(const ClothModel& model, const ForceSettings& forc
     target.product_input = u;
     target.product_output = &product_;
   }
-  evaluate_forces(model, forces, x, v, force_, nullptr, &target);
+  evaluate_forces(model, forces, x, v, force_, energy, &target);
   if (extra != nullptr) {
     // Vertex drags: ∂f/∂v = −C, so A gains β C on the vertex's diagonal block.
     for (const VertexDamping& d : extra->drags)
@@ -313,7 +314,8 @@ ImplicitSolveResult ImplicitSolver::solve(const ClothModel& model, const ForceSe
   //   A s = M (v̂ − v_lin) + β f(x_lin, v_lin) + β (∂f/∂x) u,    v1 = v_lin + s.
   const Eigen::VectorXd u = x_hat + beta * v_lin - x_lin;
   const bool consistent = u.lpNorm<Eigen::Infinity>() == 0.0;
-  assemble(model, forces, beta, x_lin, v_lin, consistent ? nullptr : &u, extra, result);
+  assemble(model, forces, beta, x_lin, v_lin, consistent ? nullptr : &u, extra, result,
+           std::exchange(start_energy_, nullptr));
   rhs_ = mass_times(v_hat - v_lin) + beta * force_;
   if (!consistent) rhs_ += beta * product_;
   filter.constrained_correction(v_lin, z_);
