@@ -328,7 +328,10 @@ Simulation::Attempt Simulation::attempt(double h) {
   EnergyBreakdown start_energy;
   const bool sample_here = energy_pending_ && contact == nullptr && self == nullptr &&
                            (!(bdf2 && has_history_) || newton == 1);
-  if (sample_here) solver_.request_start_energy(&start_energy);
+  if (sample_here)
+    solver_.request_start_energy(&start_energy);
+  else
+    flush_energy_sample();  // evaluated here, before the step moves the state
   for (;;) {
     if (contact != nullptr) {
       result.solve = solver_.solve(model_, settings_.forces, filter_, x_hat + y, v_hat, beta,
@@ -608,7 +611,6 @@ SimulationReport Simulation::run(const RunHooks& hooks) {
   const double self_before = report_.self_collision_s;
   const auto sample = [&] {
     if (!settings_.record_energy) return;
-    flush_energy_sample();  // a sample the step did not take (it failed before its solve)
     energy_pending_ = true;
     if (!settings_.energy_from_next_step) flush_energy_sample();
   };
