@@ -379,6 +379,80 @@ void clamp_bending(ClothModel& model, const std::vector<int>& pinned) {
     if (clamp != b.clamped) b.inverse_area *= clamp ? 2.0 : 0.5;
     b.clamped = clamp;
   }
+  build_flat_bend_operator(model);
+}
+
+void build_flat_bend_operator(ClothModel& model) {
+  FlatBendOperator& k = model.flat_bends;
+  k = FlatBendOperator();
+  if (model.vertex_bends.empty()) return;
+  const SparseMatrixR& pattern = model.pattern.zero_matrix;
+  const int n = model.vertex_count;
+  if (pattern.rows() != 3 * n) return;
+  const int* outer = pattern.outerIndexPtr();
+  const int* inner = pattern.innerIndexPtr();
+  // K's entries on the pattern's blocks, dense by row (block b of row i at block_start[i] + b).
+  std::vector<int> block_start(static_cast<std::size_t>(n) + 1, 0);
+  for (int i = 0; i < n; ++i)
+    block_start[i + 1] = block_start[i] + (outer[3 * i + 1] - outer[3 * i]) / 3;
+  std::vector<double> dense(static_cast<std::size_t>(block_start[n]), 0.0);
+  std::vector<char> touched(dense.size(), 0);
+  const Eigen::Vector3d scales(0.5, 0.5, 2.0);  // vertex_bend_contribution's row weights
+  std::vector<int> vertex_count(static_cast<std::size_t>(n) + 1, 0);
+  k.row_start.assign(1, 0);
+  for (std::size_t e = 0; e < model.vertex_bends.size(); ++e) {
+    const VertexBendElement& b = model.vertex_bends[e];
+    if (!b.fan.empty()) {
+      k.curved.push_back(static_cast<int>(e));
+      continue;
+    }
+    const auto m = static_cast<Eigen::Index>(b.vertices.size());
+    for (int row = 0; row < 3; ++row) {
+      for (Eigen::Index j = 0; j < m; ++j) {
+        k.row_vertex.push_back(b.vertices[static_cast<std::size_t>(j)]);
+        k.row_value.push_back(b.rows(row, j));
+        ++vertex_count[static_cast<std::size_t>(b.vertices[static_cast<std::size_t>(j)]) + 1];
+      }
+      k.row_start.push_back(static_cast<int>(k.row_vertex.size()));
+      k.row_weight.push_back(b.inverse_area * scales(row));
+    }
+    const Eigen::MatrixXd coupling = b.rows.transpose() * scales.asDiagonal() * b.rows;
+    for (Eigen::Index j = 0; j < m; ++j) {
+      const int row = b.vertices[static_cast<std::size_t>(j)];
+      for (Eigen::Index l = 0; l < m; ++l) {
+        const auto slot = static_cast<std::size_t>(
+            block_start[row] + b.blocks[static_cast<std::size_t>(m * j + l)] / 3);
+        dense[slot] += b.inverse_area * coupling(j, l);
+        touched[slot] = 1;
+      }
+    }
+  }
+  // Rᵀ by vertex, rows increasing within each vertex.
+  for (int i = 0; i < n; ++i) vertex_count[i + 1] += vertex_count[i];
+  k.vertex_start = vertex_count;
+  k.vertex_row.resize(k.row_vertex.size());
+  k.vertex_value.resize(k.row_vertex.size());
+  std::vector<int> next(vertex_count.begin(), vertex_count.end() - 1);
+  for (int r = 0; r + 1 < static_cast<int>(k.row_start.size()); ++r)
+    for (int p = k.row_start[static_cast<std::size_t>(r)];
+         p < k.row_start[static_cast<std::size_t>(r) + 1]; ++p) {
+      const auto at = static_cast<std::size_t>(
+          next[static_cast<std::size_t>(k.row_vertex[static_cast<std::size_t>(p)])]++);
+      k.vertex_row[at] = r;
+      k.vertex_value[at] = k.row_value[static_cast<std::size_t>(p)];
+    }
+  k.k_start.assign(1, 0);
+  for (int i = 0; i < n; ++i) {
+    for (int slot = block_start[i]; slot < block_start[i + 1]; ++slot) {
+      if (!touched[static_cast<std::size_t>(slot)]) continue;
+      const int offset = 3 * (slot - block_start[i]);
+      k.k_column.push_back(inner[outer[3 * i] + offset] / 3);
+      k.k_offset.push_back(offset);
+      k.k_value.push_back(dense[static_cast<std::size_t>(slot)]);
+    }
+    k.k_start.push_back(static_cast<int>(k.k_column.size()));
+  }
+  k.elements = model.vertex_bends.size();
 }
 
 Eigen::VectorXd flatten_positions(const Eigen::MatrixX3d& positions) {
@@ -477,6 +551,7 @@ ClothModel build_cloth_model(const ClothInput& input, const FabricParameters& fa
                      {});
   model.pattern.zero_matrix = zero_pattern_matrix(neighbours);
   set_block_offsets(model, neighbours, {});
+  build_flat_bend_operator(model);
   return model;
 }
 
@@ -778,6 +853,7 @@ ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse&
           previous.pattern.diagonal_offsets[static_cast<std::size_t>(
               reuse.previous_vertex[static_cast<std::size_t>(i)])];
   set_block_offsets(model, neighbours, changed_row, fresh_bends);
+  build_flat_bend_operator(model);
   return model;
 }
 

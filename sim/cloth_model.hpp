@@ -167,6 +167,31 @@ struct BlockPattern {
   std::vector<int> diagonal_offsets;  // offset(i,i), #V
 };
 
+// The flat-rest vertex bends (an empty fan: rest_normal = 0) gathered into constant sparse
+// operators. Their rows r = R x (R: each bend's three rows over its vertices, every coordinate
+// alike) give the energy ½·B·Σ w r² and the force −B·Rᵀ W (r + β ṙ) with W the bends' weights
+// inverse_area·(½, ½, 2), as the elements compute them (the energy as squares, so a rigid motion
+// costs nothing to rounding); the Jacobian is constant, K = Rᵀ W R by vertex on the pattern's
+// blocks, for its product −B·K u and matrix blocks. One pass over these arrays replaces every
+// element's dense products (a sheet's bending was a fifth of its drape; docs/benchmarks.md,
+// "Sixth round"). Built by build_cloth_model, update_cloth_model and clamp_bending (the only
+// places that make or change vertex bends); `elements` says how many vertex bends it was built
+// from, so a model whose bends were changed otherwise falls back to the elements.
+struct FlatBendOperator {
+  // R by bend row: entries [row_start[r], row_start[r+1]) of row_vertex / row_value.
+  std::vector<int> row_start, row_vertex;
+  std::vector<double> row_value;   // the rows' weights (dimensionless, m² per m² of curvature)
+  std::vector<double> row_weight;  // inverse_area·s_k, 1/m²
+  // Rᵀ by vertex: entries [vertex_start[i], vertex_start[i+1]) of vertex_row / vertex_value.
+  std::vector<int> vertex_start, vertex_row;
+  std::vector<double> vertex_value;
+  // K by vertex (columns increasing): entries [k_start[i], k_start[i+1]).
+  std::vector<int> k_start, k_column, k_offset;  // k_offset: offset(i, column) of BlockPattern
+  std::vector<double> k_value;                   // K_ij, 1/m²
+  std::vector<int> curved;                       // the vertex bends left out (curved rest)
+  std::size_t elements = 0;                      // vertex_bends.size() when built
+};
+
 struct ClothModel {
   int vertex_count = 0;
   FabricParameters fabric;
@@ -181,6 +206,7 @@ struct ClothModel {
   Eigen::VectorXd mass;         // #V lumped masses, kg
   Eigen::VectorXd vertex_area;  // #V rest area attributed to each vertex (a third of each face)
   BlockPattern pattern;
+  FlatBendOperator flat_bends;  // with BendModel::quadratic, see FlatBendOperator
 
   double total_mass() const { return mass.sum(); }
 };
@@ -228,6 +254,9 @@ void scale_rest_shapes(ClothModel& model, const Eigen::VectorXd& scale);
 // vertex: pinned, in a triangle whose vertices are all pinned and in one with a free vertex.
 // `pinned`: vertex indices. Without it the rigidity near a clamp converges only as O(h).
 void clamp_bending(ClothModel& model, const std::vector<int>& pinned);
+
+// (Re)builds model.flat_bends from model.vertex_bends and the pattern's offsets.
+void build_flat_bend_operator(ClothModel& model);
 
 // Flattens #V by 3 positions into the solver's 3n vector (x0,y0,z0,x1,...) and back.
 Eigen::VectorXd flatten_positions(const Eigen::MatrixX3d& positions);

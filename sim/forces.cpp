@@ -429,19 +429,104 @@ void scatter_vertex_bend(const VertexBendElement& b, const VertexBendContributio
 // The quadratic bending of every vertex, as add_elements does for the conditions: on more than
 // one thread a block of elements is computed in parallel, then added in parallel by rows, the
 // energies in element order; the same bits on any thread count.
+// The flat-rest vertex bends through their operators (FlatBendOperator): for each bend row r
+// (in parallel), r = R x and ṙ = R v, its energy ½·B·w|r|² and pull B·w(r + β ṙ); then for each
+// vertex i (in parallel), the force −Σ R_ri pull_r, the product −B·(Ku)_i and the matrix blocks
+// B·K_ij·(−dfdx_scale − β dfdv_scale)·I. Each row and vertex is computed whole by one thread and
+// the energies are summed in row order: the same bits on any thread count.
+void add_flat_bends(const ClothModel& model, double bend, double beta, const Eigen::VectorXd& x,
+                    const Eigen::VectorXd& v, Eigen::VectorXd& force, double& energy,
+                    const JacobianTarget* jacobian) {
+  const FlatBendOperator& k = model.flat_bends;
+  const int n = model.vertex_count;
+  const int rows = static_cast<int>(k.row_weight.size());
+  const Eigen::VectorXd* u = jacobian != nullptr ? jacobian->product_input : nullptr;
+  double* values =
+      jacobian != nullptr && jacobian->matrix != nullptr ? jacobian->matrix->valuePtr() : nullptr;
+  const double scale =
+      jacobian != nullptr ? -bend * (jacobian->dfdx_scale + jacobian->dfdv_scale * beta) : 0.0;
+  thread_local std::vector<double> kept_energy;  // the caller's, named once (see add_elements)
+  thread_local std::vector<Vector3d> kept_pull;
+  std::vector<double>& row_energy = kept_energy;
+  std::vector<Vector3d>& pull = kept_pull;
+  row_energy.resize(static_cast<std::size_t>(rows));
+  pull.resize(static_cast<std::size_t>(rows));
+  const auto bend_rows = [&](int, int low, int high) {
+    for (int r = low; r < high; ++r) {
+      Vector3d rx = Vector3d::Zero(), rv = Vector3d::Zero();
+      for (int p = k.row_start[static_cast<std::size_t>(r)];
+           p < k.row_start[static_cast<std::size_t>(r) + 1]; ++p) {
+        const double c = k.row_value[static_cast<std::size_t>(p)];
+        const int j = k.row_vertex[static_cast<std::size_t>(p)];
+        rx += c * x.segment<3>(3 * j);
+        rv += c * v.segment<3>(3 * j);
+      }
+      const double w = bend * k.row_weight[static_cast<std::size_t>(r)];
+      row_energy[static_cast<std::size_t>(r)] = 0.5 * w * rx.squaredNorm();
+      pull[static_cast<std::size_t>(r)] = w * (rx + beta * rv);
+    }
+  };
+  const auto vertices = [&](int, int low, int high) {
+    for (int i = low; i < high; ++i) {
+      Vector3d f = Vector3d::Zero();
+      for (int p = k.vertex_start[static_cast<std::size_t>(i)];
+           p < k.vertex_start[static_cast<std::size_t>(i) + 1]; ++p)
+        f += k.vertex_value[static_cast<std::size_t>(p)] *
+             pull[static_cast<std::size_t>(k.vertex_row[static_cast<std::size_t>(p)])];
+      force.segment<3>(3 * i) -= f;
+      if (jacobian == nullptr) continue;
+      Vector3d ku = Vector3d::Zero();
+      for (int p = k.k_start[static_cast<std::size_t>(i)];
+           p < k.k_start[static_cast<std::size_t>(i) + 1]; ++p) {
+        const double c = k.k_value[static_cast<std::size_t>(p)];
+        if (u != nullptr) ku += c * u->segment<3>(3 * k.k_column[static_cast<std::size_t>(p)]);
+        if (values != nullptr) {
+          const double entry = scale * c;
+          const int offset = k.k_offset[static_cast<std::size_t>(p)];
+          for (int a = 0; a < 3; ++a)
+            values[block_value_index(*jacobian->matrix, i, offset, a, a)] += entry;
+        }
+      }
+      if (u != nullptr) jacobian->product_output->segment<3>(3 * i) -= bend * ku;
+    }
+  };
+  const int threads = thread_count();
+  constexpr int kGrain = 512;
+  if (threads <= 1 || n < 2 * kGrain) {
+    bend_rows(0, 0, rows);
+    vertices(0, 0, n);
+  } else {
+    parallel_chunks(rows, std::max(kGrain, (rows + threads - 1) / threads), bend_rows);
+    parallel_chunks(n, std::max(kGrain, (n + threads - 1) / threads), vertices);
+  }
+  for (int r = 0; r < rows; ++r) energy += row_energy[static_cast<std::size_t>(r)];
+}
+
 void add_vertex_bends(const ClothModel& model, double bend, double beta, const Eigen::VectorXd& x,
                       const Eigen::VectorXd& v, Eigen::VectorXd& force, double& energy,
                       const JacobianTarget* jacobian) {
   constexpr int kBlock = 256;
   constexpr int kGrain = 64;
-  const int count = static_cast<int>(model.vertex_bends.size());
+  // The flat-rest bends through their operator when it was built for these bends, then the
+  // curved ones element by element; without it, every element.
+  const bool summed =
+      model.flat_bends.elements == model.vertex_bends.size() &&
+      model.flat_bends.k_start.size() == static_cast<std::size_t>(model.vertex_count) + 1;
+  if (summed) add_flat_bends(model, bend, beta, x, v, force, energy, jacobian);
+  const int count = summed ? static_cast<int>(model.flat_bends.curved.size())
+                           : static_cast<int>(model.vertex_bends.size());
+  const auto element = [&](int k) -> const VertexBendElement& {
+    return model.vertex_bends[static_cast<std::size_t>(
+        summed ? model.flat_bends.curved[static_cast<std::size_t>(k)] : k)];
+  };
   const int threads = thread_count();
   const auto add_energy = [&](const VertexBendContribution& c) {
     for (double e : c.energy) energy += e;
   };
   if (threads <= 1 || count < 2 * kGrain) {
     VertexBendContribution c;
-    for (const VertexBendElement& b : model.vertex_bends) {
+    for (int k = 0; k < count; ++k) {
+      const VertexBendElement& b = element(k);
       vertex_bend_contribution(b, bend, beta, x, v, jacobian, c);
       add_energy(c);
       scatter_vertex_bend(b, c, force, jacobian, kEveryRow);
@@ -456,14 +541,14 @@ void add_vertex_bends(const ClothModel& model, double bend, double beta, const E
     const int size = std::min(kBlock, count - first);
     parallel_chunks(size, kGrain, [&](int, int begin, int end) {
       for (int k = begin; k < end; ++k)
-        vertex_bend_contribution(model.vertex_bends[static_cast<std::size_t>(first + k)], bend,
-                                 beta, x, v, jacobian, buffer[static_cast<std::size_t>(k)]);
+        vertex_bend_contribution(element(first + k), bend, beta, x, v, jacobian,
+                                 buffer[static_cast<std::size_t>(k)]);
     });
     parallel_chunks(model.vertex_count, row_grain, [&](int, int low, int high) {
       const auto own = [low, high](int vertex) { return vertex >= low && vertex < high; };
       for (int k = 0; k < size; ++k)
-        scatter_vertex_bend(model.vertex_bends[static_cast<std::size_t>(first + k)],
-                            buffer[static_cast<std::size_t>(k)], force, jacobian, own);
+        scatter_vertex_bend(element(first + k), buffer[static_cast<std::size_t>(k)], force,
+                            jacobian, own);
     });
     for (int k = 0; k < size; ++k) add_energy(buffer[static_cast<std::size_t>(k)]);
   }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <utility>
 
 namespace sd::sim {
 
@@ -45,7 +46,7 @@ void ImplicitSolver::add_extra_force(const ClothModel& model, const StepForces* 
 void ImplicitSolver::assemble(const ClothModel& model, const ForceSettings& forces, double beta,
                               const Eigen::VectorXd& x, const Eigen::VectorXd& v,
                               const Eigen::VectorXd* u, const StepForces* extra,
-                              ImplicitSolveResult& result) {
+                              ImplicitSolveResult& result, EnergyBreakdown* energy) {
   const auto start = std::chrono::steady_clock::now();
   const SparseMatrixR& pattern = model.pattern.zero_matrix;
   if (matrix_.rows() != pattern.rows() || matrix_.nonZeros() != pattern.nonZeros() ||
@@ -72,7 +73,7 @@ void ImplicitSolver::assemble(const ClothModel& model, const ForceSettings& forc
     target.product_input = u;
     target.product_output = &product_;
   }
-  evaluate_forces(model, forces, x, v, force_, nullptr, &target);
+  evaluate_forces(model, forces, x, v, force_, energy, &target);
   if (extra != nullptr) {
     // Vertex drags: ∂f/∂v = −C, so A gains β C on the vertex's diagonal block.
     for (const VertexDamping& d : extra->drags)
@@ -280,11 +281,17 @@ void ImplicitSolver::record_constraint_impulse(const ConstraintFilter& filter,
     return;
   }
   // A s − b is zero in the free directions (up to the solver's tolerance) and, in the
-  // constrained ones, the impulse the constraint had to add: keep only that part.
-  Eigen::VectorXd residual = system() * step_ - rhs_;
-  Eigen::VectorXd free_part = residual;
-  filter.apply(free_part);
-  result.constraint_impulse = residual - free_part;
+  // constrained ones, the impulse the constraint had to add: keep only that part, (I − S)(A s −
+  // b), computed in the constrained vertices' rows only (a pinned sheet has two of a thousand).
+  const SparseMatrixR& a = system();
+  result.constraint_impulse = Eigen::VectorXd::Zero(step_.size());
+  for (int i = 0; i < filter.vertex_count(); ++i) {
+    if (filter.is_free(i)) continue;
+    Eigen::Vector3d residual;
+    for (int r = 0; r < 3; ++r) residual(r) = a.row(3 * i + r).dot(step_) - rhs_(3 * i + r);
+    result.constraint_impulse.segment<3>(3 * i) =
+        (Eigen::Matrix3d::Identity() - filter.filter_matrix(i)) * residual;
+  }
 }
 
 ImplicitSolveResult ImplicitSolver::solve(const ClothModel& model, const ForceSettings& forces,
@@ -307,7 +314,8 @@ ImplicitSolveResult ImplicitSolver::solve(const ClothModel& model, const ForceSe
   //   A s = M (v̂ − v_lin) + β f(x_lin, v_lin) + β (∂f/∂x) u,    v1 = v_lin + s.
   const Eigen::VectorXd u = x_hat + beta * v_lin - x_lin;
   const bool consistent = u.lpNorm<Eigen::Infinity>() == 0.0;
-  assemble(model, forces, beta, x_lin, v_lin, consistent ? nullptr : &u, extra, result);
+  assemble(model, forces, beta, x_lin, v_lin, consistent ? nullptr : &u, extra, result,
+           std::exchange(start_energy_, nullptr));
   rhs_ = mass_times(v_hat - v_lin) + beta * force_;
   if (!consistent) rhs_ += beta * product_;
   filter.constrained_correction(v_lin, z_);

@@ -199,6 +199,10 @@ class ImplicitSolver {
                             const Eigen::VectorXd& v_lin, const NewtonSettings& settings,
                             const StepForces* extra = nullptr);
 
+  // The next solve's first force evaluation also fills `energy` (the energies at (x_lin,
+  // v_lin)); the request holds for that solve only. Null: none.
+  void request_start_energy(EnergyBreakdown* energy) { start_energy_ = energy; }
+
   // The system matrix of the last assembly (for tests and benchmarks): the mesh's pattern,
   // widened by the pair springs' blocks across their pairs when a step has them.
   const SparseMatrixR& matrix() const { return widened_ ? coupled_ : matrix_; }
@@ -207,7 +211,8 @@ class ImplicitSolver {
  private:
   void assemble(const ClothModel& model, const ForceSettings& forces, double beta,
                 const Eigen::VectorXd& x, const Eigen::VectorXd& v, const Eigen::VectorXd* u,
-                const StepForces* extra, ImplicitSolveResult& result);
+                const StepForces* extra, ImplicitSolveResult& result,
+                EnergyBreakdown* energy = nullptr);
   // force_ += the drags' and springs' forces at (x, v).
   void add_extra_force(const ClothModel& model, const StepForces* extra, const Eigen::VectorXd& x,
                        const Eigen::VectorXd& v);
@@ -230,7 +235,8 @@ class ImplicitSolver {
   // pattern and cost a new symbolic analysis (zero blocks do not change the system). Reset when
   // the mesh pattern changes or when it holds much more than the blocks in use.
   std::vector<std::array<int, 2>> kept_cross_;
-  int kept_cross_pattern_ = -1;        // pattern_changes_ when kept_cross_ was started
+  int kept_cross_pattern_ = -1;              // pattern_changes_ when kept_cross_ was started
+  EnergyBreakdown* start_energy_ = nullptr;  // request_start_energy
   bool keep_cross_pattern_ = false;    // set per solve: CHOLMOD (the PCG's IC(0) reads the pattern)
   SparseMatrixR coupled_;              // matrix_ widened by the cross-pair blocks
   std::vector<int> coupled_diagonal_;  // offset(i, i) in coupled_, #V

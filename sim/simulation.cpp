@@ -99,6 +99,7 @@ Simulation::Simulation(ClothModel model, Eigen::VectorXd x0, std::vector<Pin> pi
 }
 
 void Simulation::set_triangle_rest_shapes(const std::vector<TriangleElement>& rest) {
+  flush_energy_sample();
   if (rest.size() != model_.triangles.size())
     throw std::invalid_argument("new rest shapes need one triangle per triangle of the model");
   for (std::size_t t = 0; t < rest.size(); ++t) {
@@ -115,6 +116,7 @@ void Simulation::set_triangle_rest_shapes(const std::vector<TriangleElement>& re
 
 void Simulation::replace_model(ClothModel model, Eigen::VectorXd x, Eigen::VectorXd v,
                                std::vector<Pin> pins) {
+  flush_energy_sample();
   const int n = model.vertex_count;
   if (x.size() != 3 * n)
     throw std::invalid_argument("the start positions must have 3 coordinates per cloth vertex");
@@ -174,6 +176,7 @@ void Simulation::replace_model(ClothModel model, Eigen::VectorXd x, Eigen::Vecto
 
 void Simulation::replace_model(ClothModel model, Eigen::VectorXd x, Eigen::VectorXd v,
                                std::vector<Pin> pins, const std::vector<VertexOrigin>& origin) {
+  flush_energy_sample();
   if (static_cast<int>(origin.size()) != model.vertex_count)
     throw std::invalid_argument("replace_model needs the origin of every new cloth vertex");
   // Normal force per unit mass (N/kg) of every old vertex, NaN without a pressed contact.
@@ -225,10 +228,18 @@ void Simulation::start_body() {
 }
 
 void Simulation::set_velocities(const Eigen::VectorXd& v) {
+  flush_energy_sample();
   if (v.size() != x_.size() || !v.allFinite())
     throw std::invalid_argument("velocities must be finite, 3 per cloth vertex");
   v_ = v;
   has_history_ = false;
+}
+
+void Simulation::flush_energy_sample(const EnergyBreakdown* energy) {
+  if (!energy_pending_) return;
+  energy_pending_ = false;
+  const EnergyBreakdown e = energy != nullptr ? *energy : this->energy();
+  report_.energy.push_back({time_, e.stretch, e.shear, e.bend, e.kinetic, e.potential});
 }
 
 EnergyBreakdown Simulation::energy() const {
@@ -311,6 +322,16 @@ Simulation::Attempt Simulation::attempt(double h) {
     self->add_springs(y.size() == x_.size() ? Eigen::VectorXd(x_ + y) : x_, model_.mass, pinned,
                       contact_forces_, &v_, beta);
   }
+  // The pending energy sample from this solve's first force evaluation when it is at the
+  // current state: implicit Euler's (and BDF2's linearised step's) x_lin = x_, v_lin = v_, with
+  // no contact correction or self-contact forces.
+  EnergyBreakdown start_energy;
+  const bool sample_here = energy_pending_ && contact == nullptr && self == nullptr &&
+                           (!(bdf2 && has_history_) || newton == 1);
+  if (sample_here)
+    solver_.request_start_energy(&start_energy);
+  else
+    flush_energy_sample();  // evaluated here, before the step moves the state
   for (;;) {
     if (contact != nullptr) {
       result.solve = solver_.solve(model_, settings_.forces, filter_, x_hat + y, v_hat, beta,
@@ -327,6 +348,7 @@ Simulation::Attempt Simulation::attempt(double h) {
     result.linear_solves += result.solve.linear_solves;
     result.cg_iterations += result.solve.cg_iterations;
     result.cg_iterations_max = std::max(result.cg_iterations_max, result.solve.cg_iterations_max);
+    if (sample_here) flush_energy_sample(&start_energy);  // the first pass only: then not pending
     result.x = std::move(result.solve.x);
     result.v = std::move(result.solve.v);
     if (result.solve.cholmod_failures > 0)
@@ -589,8 +611,8 @@ SimulationReport Simulation::run(const RunHooks& hooks) {
   const double self_before = report_.self_collision_s;
   const auto sample = [&] {
     if (!settings_.record_energy) return;
-    const EnergyBreakdown e = energy();
-    report_.energy.push_back({time_, e.stretch, e.shear, e.bend, e.kinetic, e.potential});
+    energy_pending_ = true;
+    if (!settings_.energy_from_next_step) flush_energy_sample();
   };
   if (report_.energy.empty()) sample();
   const double epsilon = 1e-9 * std::max(1.0, settings_.duration);
@@ -611,6 +633,7 @@ SimulationReport Simulation::run(const RunHooks& hooks) {
       break;
     }
   }
+  flush_energy_sample();
   if (contact_ && settings_.contact.enabled) {
     const auto query_start = std::chrono::steady_clock::now();
     report_.penetrating_vertices_final = contact_->count_penetrating(x_);

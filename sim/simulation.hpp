@@ -71,6 +71,12 @@ struct SimulationSettings {
   // s: the window starts no earlier (a rest shape still changing, AdaptiveMaterial::rest_ramp)
   double rest_not_before = 0.0;
   bool record_energy = true;  // energy time series in the report (one sample a step)
+  // The sample of an accepted step taken from the next step's force evaluation where that one
+  // is at the same state (implicit Euler without contact: Baraff-Witkin linearise at the start),
+  // instead of a force evaluation of its own (a tenth of a pinned sheet's drape). The report's
+  // series is the same; only an observer reading report().energy during the run sees it one
+  // step behind (sketchdrape run --trace turns this off).
+  bool energy_from_next_step = true;
   ForceSettings forces;
   ContactSettings contact;           // used once a body is set (set_body, set_body_motion)
   SelfContactSettings self_contact;  // cloth-cloth contact (off unless enabled)
@@ -267,6 +273,9 @@ class Simulation {
   Attempt attempt(double h);
   void accept(Attempt& attempt, double h);
   void start_body();
+  // Appends the pending energy sample (SimulationSettings::energy_from_next_step) from `energy`
+  // when given, else from a force evaluation at the current state.
+  void flush_energy_sample(const EnergyBreakdown* energy = nullptr);
 
   ClothModel model_;
   SimulationSettings settings_;
@@ -294,6 +303,7 @@ class Simulation {
   std::unique_ptr<ContactResponse> contact_;
   std::unique_ptr<SelfContactResponse> self_contact_;  // null when self-contact is off
   SimulationReport report_;
+  bool energy_pending_ = false;  // the sample of the current state is still to be appended
   long long newton_total_ = 0;
   long long cg_total_ = 0;
 };

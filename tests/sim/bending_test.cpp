@@ -93,6 +93,59 @@ Eigen::Matrix3d random_rotation(std::mt19937& rng) {
       .toRotationMatrix();
 }
 
+// The flat-rest bends summed into one operator (FlatBendOperator) against the same bends element
+// by element (the model with its operator removed): force, energy, the Jacobian's product and its
+// matrix, with damping, on a flat sheet (every bend flat), a clamped one (clamp_bending doubles
+// some bends and rebuilds the operator) and a sphere cap (every bend curved: nothing summed).
+TEST(QuadraticBending, FlatBendOperatorMatchesTheElements) {
+  FabricParameters fabric;
+  fabric.bend = 2e-3;
+  fabric.bend_damping = 0.05;
+  std::mt19937 rng(11);
+  ForceSettings settings;
+  settings.terms = {false, false, true, true, false, false};
+  for (int scene = 0; scene < 3; ++scene) {
+    const ClothInput input = scene == 2 ? sphere_cap(6, 0.3, 0.4) : flat_sheet(8, 0.3);
+    ClothModel summed = build_cloth_model(input, fabric);
+    if (scene == 1) clamp_bending(summed, {0, 1, 2, 9, 10, 11});
+    ASSERT_EQ(summed.flat_bends.elements, summed.vertex_bends.size());
+    ASSERT_EQ(summed.flat_bends.k_start.size(), static_cast<std::size_t>(summed.vertex_count) + 1);
+    EXPECT_EQ(summed.flat_bends.curved.size(), scene == 2 ? summed.vertex_bends.size() : 0u);
+    ClothModel elements = summed;
+    elements.flat_bends = FlatBendOperator();
+    for (int trial = 0; trial < 2; ++trial) {
+      const Eigen::VectorXd x = testing::random_configuration(input.rest_positions, rng);
+      const Eigen::VectorXd v = Eigen::VectorXd::Random(x.size());
+      const Eigen::VectorXd u = Eigen::VectorXd::Random(x.size());
+      struct Result {
+        Eigen::VectorXd force, product;
+        EnergyBreakdown energy;
+        Eigen::MatrixXd matrix;
+      };
+      const auto evaluate = [&](const ClothModel& model) {
+        Result r;
+        SparseMatrixR matrix = model.pattern.zero_matrix;
+        JacobianTarget target;
+        target.matrix = &matrix;
+        target.dfdx_scale = -0.01;
+        target.dfdv_scale = -0.1;
+        target.product_input = &u;
+        target.product_output = &r.product;
+        r.product = Eigen::VectorXd::Zero(u.size());
+        evaluate_forces(model, settings, x, v, r.force, &r.energy, &target);
+        r.matrix = Eigen::MatrixXd(matrix);
+        return r;
+      };
+      const Result a = evaluate(summed), b = evaluate(elements);
+      EXPECT_GT(b.energy.bend, 0.0);
+      EXPECT_NEAR(a.energy.bend, b.energy.bend, 1e-10 * b.energy.bend) << scene;
+      EXPECT_LE((a.force - b.force).norm(), 1e-12 * b.force.norm()) << scene;
+      EXPECT_LE((a.product - b.product).norm(), 1e-12 * b.product.norm()) << scene;
+      EXPECT_LE((a.matrix - b.matrix).norm(), 1e-12 * b.matrix.norm()) << scene;
+    }
+  }
+}
+
 // Force against the energy's gradient, the exact ∂f/∂x and ∂f/∂v against central differences,
 // and the solve Jacobian symmetric negative semi-definite, for a flat rest (quadratic energy) and
 // a curved rest (the area-vector target), with damping.

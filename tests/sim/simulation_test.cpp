@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "meshing/tri_mesh.hpp"
+#include "test_bodies.hpp"
 #include "test_scenes.hpp"
 
 namespace sd::sim {
@@ -527,6 +528,50 @@ TEST(Simulation, StepGrowsBackAfterEasySteps) {
 // unstrained, gains g h of speed in every step at every vertex, so the estimate (h/2)|Δv| is
 // g h²/2 and the next step 0.9 √(2 e / g) exactly, whatever the step before; the run starts at
 // dt/2 and never exceeds dt.
+// The energy series taken from the next step's force evaluation (the default) is the series of a
+// force evaluation after every step, sample for sample and bit for bit: for implicit Euler with
+// the error-controlled step (where it is taken from the next step), for BDF2 (its Newton steps
+// linearise elsewhere) and for implicit Euler falling onto a sphere (contact corrects the start),
+// where it is evaluated before the step; the same length, the start and the end included.
+TEST(Simulation, EnergySamplesFromTheNextStepAreEvaluatedOnes) {
+  const HangingSheet h = hanging_sheet(6, 0.5);
+  const meshing::TriMesh sphere = testing::make_sphere(0.1, 2, {0.0, 0.85, 0.0});
+  for (int scene = 0; scene < 3; ++scene) {
+    const Integrator integrator = scene == 1 ? Integrator::bdf2 : Integrator::implicit_euler;
+    const auto run = [&](const SimulationSettings& settings) {
+      Simulation sim = make_simulation(h, settings);
+      if (scene == 2) sim.set_body(sphere);
+      return sim.run();
+    };
+    SimulationSettings settings;
+    settings.dt = 1.0 / 20;
+    settings.step_error = integrator == Integrator::implicit_euler ? 2e-3 : 0.0;
+    settings.integrator = integrator;
+    settings.duration = 0.6;
+    settings.stop_at_rest = false;
+    settings.solver = LinearSolverKind::pcg;
+    settings.energy_from_next_step = false;
+    const SimulationReport evaluated = run(settings);
+    settings.energy_from_next_step = true;
+    const SimulationReport taken = run(settings);
+    ASSERT_GT(evaluated.steps, 10);
+    if (scene == 2) {
+      EXPECT_GT(taken.contacts_max, 0);
+    }
+    ASSERT_EQ(taken.energy.size(), evaluated.energy.size());
+    ASSERT_EQ(taken.energy.size(), static_cast<std::size_t>(evaluated.steps) + 1);
+    for (std::size_t k = 0; k < taken.energy.size(); ++k) {
+      EXPECT_EQ(taken.energy[k].time, evaluated.energy[k].time) << k;
+      EXPECT_EQ(taken.energy[k].stretch, evaluated.energy[k].stretch) << k;
+      EXPECT_EQ(taken.energy[k].shear, evaluated.energy[k].shear) << k;
+      EXPECT_EQ(taken.energy[k].bend, evaluated.energy[k].bend) << k;
+      EXPECT_EQ(taken.energy[k].kinetic, evaluated.energy[k].kinetic) << k;
+      EXPECT_EQ(taken.energy[k].potential, evaluated.energy[k].potential) << k;
+    }
+    EXPECT_GT(taken.energy.back().stretch, 0.0);
+  }
+}
+
 TEST(Simulation, StepFollowsTheLocalErrorInFreeFall) {
   const HangingSheet h = hanging_sheet(4, 0.4);
   SimulationSettings settings;

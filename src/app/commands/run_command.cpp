@@ -139,6 +139,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   const sim::AutomaticChoice automatic =
       apply_automatic_settings(sketch, scene, settings, options.frames_per_second > 0.0);
   spdlog::debug("settings: {}", automatic.reason);
+  settings.energy_from_next_step = !options.trace;  // the trace reads each step's own sample
   const RunEstimate estimate =
       estimate_run(sketch, scene.input.triangles, static_cast<int>(scene.start.rows()),
                    options.frames_per_second, settings.duration, settings.dt);
