@@ -232,8 +232,21 @@ void ContactResponse::reset_cloth(const Eigen::VectorXd& x, const Eigen::VectorX
   // 2 mm and moved at up to 27 cm/s (docs/garment.md, "Seventh round").
   std::vector<SpringEnd> followed;
   const double follow = kPiercingHoldMargin * settings_.thickness;
+  // A triangle whose bounding box lies farther than `follow` from the point cannot hold it (the
+  // closest point is inside the box), so the exact test runs only on the few triangles near
+  // it. The box test errs to the safe side by a relative 1e-6, far above rounding: the same
+  // triangles pass as when every triangle was tested (the held springs × all triangles had
+  // been 3 % of an adaptive garment drape's CPU).
+  std::vector<Eigen::AlignedBox3d> boxes;
+  if (!held_springs_.empty()) {
+    boxes.resize(cloth_.triangles.size());
+    for (std::size_t t = 0; t < cloth_.triangles.size(); ++t)
+      for (int k : cloth_.triangles[t]) boxes[t].extend(x.segment<3>(3 * k));
+  }
+  const double reach = follow * (1.0 + 1e-6);
   for (const SpringEnd& held : held_springs_)
     for (std::size_t t = 0; t < cloth_.triangles.size(); ++t) {
+      if (boxes[t].squaredExteriorDistance(held.point) > reach * reach) continue;
       const std::array<int, 3>& c = cloth_.triangles[t];
       const TriangleClosestPoint q = closest_point_on_triangle(
           held.point, x.segment<3>(3 * c[0]), x.segment<3>(3 * c[1]), x.segment<3>(3 * c[2]));
