@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <numeric>
 #include <stdexcept>
 
@@ -25,6 +26,9 @@ constexpr int kRefitSplitDepth = 4;
 constexpr int kParallelRefitNodes = 1000;
 // Nodes per chunk when each node's boundary is found (a node costs its triangle count).
 constexpr int kNodeGrain = 256;
+// The query's walk is cut into pieces below this depth (self tests of subtrees and node pairs
+// that run on the threads; about 60–200 pieces on a 4,000-triangle garment).
+constexpr int kWalkSplitDepth = 5;
 
 Eigen::Vector3d row(const Eigen::VectorXd& x, int i) {
   return x.segment<3>(3 * i);
@@ -411,6 +415,83 @@ void SelfCollider::pair_test(int a, int b, LeafTest& leaf, SelfQueryStats& stats
   }
 }
 
+void SelfCollider::collect_leaves(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1,
+                                  std::vector<std::array<int, 2>>& leaves, SelfQueryStats& stats) {
+  // A piece: self_test(a), pair_test(a, b), or a pair of triangles the walk met above the
+  // pieces. The walk down to kWalkSplitDepth does what self_test and pair_test do there (dirty
+  // skips, culling, box tests, counts) and lists the calls it would make below, and the
+  // triangle pairs it meets, in the order it would make and meet them.
+  enum class Kind { self, pair, triangles };
+  struct Piece {
+    Kind kind = Kind::self;
+    int a = 0, b = -1;
+  };
+  std::vector<Piece> pieces;
+  const std::function<void(int, int, int)> walk_pair = [&](int a, int b, int depth) {
+    if (depth >= kWalkSplitDepth) {
+      pieces.push_back({Kind::pair, a, b});
+      return;
+    }
+    if (!dirty_.empty() && dirty_[a] == 0 && dirty_[b] == 0) return;
+    ++stats.node_pairs;
+    const Node& na = nodes_[a];
+    const Node& nb = nodes_[b];
+    if (!na.box.intersects(nb.box)) return;
+    const bool a_leaf = na.left < 0, b_leaf = nb.left < 0;
+    if (a_leaf && b_leaf) {
+      ++stats.triangle_pairs;
+      pieces.push_back({Kind::triangles, order_[na.begin], order_[nb.begin]});
+      return;
+    }
+    if (b_leaf || (!a_leaf && na.end - na.begin >= nb.end - nb.begin)) {
+      walk_pair(na.left, b, depth + 1);
+      walk_pair(na.right, b, depth + 1);
+    } else {
+      walk_pair(a, nb.left, depth + 1);
+      walk_pair(a, nb.right, depth + 1);
+    }
+  };
+  const std::function<void(int, int)> walk_self = [&](int index, int depth) {
+    const Node& node = nodes_[index];
+    if (node.left < 0 || (!dirty_.empty() && dirty_[index] == 0)) return;
+    if (depth >= kWalkSplitDepth) {
+      pieces.push_back({Kind::self, index, -1});
+      return;
+    }
+    if (culling_ && region_is_safe(node, x0, x1)) {
+      stats.culled_triangles += node.end - node.begin;
+      return;
+    }
+    walk_self(node.left, depth + 1);
+    walk_self(node.right, depth + 1);
+    walk_pair(node.left, node.right, depth + 1);
+  };
+  if (nodes_.empty()) return;
+  walk_self(0, 0);
+  std::vector<std::vector<std::array<int, 2>>> found(pieces.size());
+  std::vector<SelfQueryStats> counts(pieces.size());
+  parallel_chunks(static_cast<int>(pieces.size()), 1, [&](int, int first, int last) {
+    for (int k = first; k < last; ++k) {
+      const Piece& piece = pieces[static_cast<std::size_t>(k)];
+      std::vector<std::array<int, 2>>& out = found[static_cast<std::size_t>(k)];
+      auto collect = [&out](int ta, int tb) { out.push_back({ta, tb}); };
+      SelfQueryStats& count = counts[static_cast<std::size_t>(k)];
+      if (piece.kind == Kind::self)
+        self_test(piece.a, x0, x1, collect, count);
+      else if (piece.kind == Kind::pair)
+        pair_test(piece.a, piece.b, collect, count);
+      else
+        out.push_back({piece.a, piece.b});
+    }
+  });
+  for (std::size_t k = 0; k < pieces.size(); ++k) {
+    leaves.insert(leaves.end(), found[k].begin(), found[k].end());
+    stats.culled_triangles += counts[k].culled_triangles;
+    stats.node_pairs += counts[k].node_pairs;
+    stats.triangle_pairs += counts[k].triangle_pairs;
+  }
+}
+
 namespace {
 
 // Triangle pairs per chunk at least: each costs up to 15 element tests (a few microseconds).
@@ -514,8 +595,7 @@ std::vector<SelfPair> SelfCollider::find_proximities(const Eigen::VectorXd& x, d
     }
   };
   std::vector<std::array<int, 2>> leaves;
-  auto collect = [&](int ta, int tb) { leaves.push_back({ta, tb}); };
-  self_test(0, x, x, collect, s);
+  collect_leaves(x, x, leaves, s);
   test_leaves(leaves, leaf, pairs, s.element_tests);
   s.pairs_found = static_cast<int>(pairs.size());
   return pairs;
@@ -596,8 +676,7 @@ std::vector<SelfPair> SelfCollider::find_collisions(const Eigen::VectorXd& x0,
     }
   };
   std::vector<std::array<int, 2>> leaves;
-  auto collect = [&](int ta, int tb) { leaves.push_back({ta, tb}); };
-  self_test(0, x0, x1, collect, s);
+  collect_leaves(x0, x1, leaves, s);
   test_leaves(leaves, leaf, pairs, s.element_tests);
   dirty_.clear();
   s.pairs_found = static_cast<int>(pairs.size());
