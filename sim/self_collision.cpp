@@ -29,6 +29,10 @@ constexpr int kNodeGrain = 256;
 // The query's walk is cut into pieces below this depth (self tests of subtrees and node pairs
 // that run on the threads; about 60–200 pieces on a 4,000-triangle garment).
 constexpr int kWalkSplitDepth = 5;
+// The tree is built with its halves on the threads down to this depth, for halves of at least
+// kBuildGrain triangles.
+constexpr int kBuildSplitDepth = 3;
+constexpr int kBuildGrain = 256;
 
 Eigen::Vector3d row(const Eigen::VectorXd& x, int i) {
   return x.segment<3>(3 * i);
@@ -200,9 +204,10 @@ SelfCollider::SelfCollider(std::vector<std::array<int, 3>> triangles, const Eige
   order_.resize(triangles_.size());
   std::iota(order_.begin(), order_.end(), 0);
   position_.assign(triangles_.size(), 0);
-  nodes_.clear();
-  nodes_.reserve(2 * triangles_.size());
-  if (f > 0) build(0, f, x, 0);
+  // A subtree over m triangles has 2m − 1 nodes (one triangle a leaf), so every node's place in
+  // preorder is known before it is built and the top subtrees are built on the threads.
+  nodes_.assign(f > 0 ? 2 * static_cast<std::size_t>(f) - 1 : 0, Node{});
+  if (f > 0) build(0, 0, f, x, 0);
   for (int i = 0; i < f; ++i) position_[order_[i]] = i;
   // Connectivity and boundary of each node: edges with exactly one of their triangles inside.
   // Each node's own, so the nodes are done on all threads.
@@ -244,12 +249,12 @@ SelfCollider::SelfCollider(std::vector<std::array<int, 3>> triangles, const Eige
   });
 }
 
-int SelfCollider::build(int begin, int end, const Eigen::VectorXd& x, int depth) {
-  const int index = static_cast<int>(nodes_.size());
-  nodes_.emplace_back();
-  nodes_[index].begin = begin;
-  nodes_[index].end = end;
-  if (end - begin <= kLeafSize) return index;
+void SelfCollider::build(int index, int begin, int end, const Eigen::VectorXd& x, int depth) {
+  static_assert(kLeafSize == 1, "the preorder places assume single-triangle leaves");
+  Node& node = nodes_[static_cast<std::size_t>(index)];
+  node.begin = begin;
+  node.end = end;
+  if (end - begin <= kLeafSize) return;
   // Median split of the centroids along the longest side of their box.
   Eigen::AlignedBox3d box;
   const auto centroid = [&](int t) {
@@ -262,11 +267,23 @@ int SelfCollider::build(int begin, int end, const Eigen::VectorXd& x, int depth)
   const int middle = begin + (end - begin) / 2;
   std::nth_element(order_.begin() + begin, order_.begin() + middle, order_.begin() + end,
                    [&](int a, int b) { return centroid(a)[axis] < centroid(b)[axis]; });
-  const int left = build(begin, middle, x, depth + 1);
-  const int right = build(middle, end, x, depth + 1);
-  nodes_[index].left = left;
-  nodes_[index].right = right;
-  return index;
+  node.left = index + 1;
+  node.right = index + 2 * (middle - begin);
+  const int left = node.left, right = node.right;
+  // The two halves own disjoint ranges of order_ and of nodes_.
+  if (depth < kBuildSplitDepth && end - begin >= 2 * kBuildGrain) {
+    parallel_chunks(2, 1, [&](int, int first, int last) {
+      for (int half = first; half < last; ++half) {
+        if (half == 0)
+          build(left, begin, middle, x, depth + 1);
+        else
+          build(right, middle, end, x, depth + 1);
+      }
+    });
+  } else {
+    build(left, begin, middle, x, depth + 1);
+    build(right, middle, end, x, depth + 1);
+  }
 }
 
 void SelfCollider::refit(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1, double inflate) {

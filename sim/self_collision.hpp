@@ -97,7 +97,8 @@ class SelfCollider {
     bool connected = false;     // its triangles form one edge-connected region
     std::vector<int> boundary;  // edges with one triangle in the node (when connected)
   };
-  int build(int begin, int end, const Eigen::VectorXd& x, int depth);
+  // Builds the subtree over order_[begin, end) at nodes_[index] (preorder, presized).
+  void build(int index, int begin, int end, const Eigen::VectorXd& x, int depth);
   void refit(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1, double inflate);
   bool region_is_safe(const Node& node, const Eigen::VectorXd& x0, const Eigen::VectorXd& x1);
   template <class LeafTest>
