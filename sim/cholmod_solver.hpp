@@ -63,9 +63,10 @@ class CholmodSolver {
   struct Factor;
   CholmodMethod method_;
   std::unique_ptr<Factor> factor_;
-  Eigen::SparseMatrix<double, Eigen::ColMajor, int> filtered_;
-  // The upper triangle of filtered_, what CHOLMOD is given, and where each of its values sits in
-  // filtered_'s value array.
+  // The values of S A S + (I − S), in A's pattern (outer_, inner_).
+  std::vector<double> filtered_;
+  // The upper triangle of S A S + (I − S), what CHOLMOD is given, and where each of its values
+  // sits in filtered_.
   Eigen::SparseMatrix<double, Eigen::ColMajor, int> upper_;
   std::vector<int> upper_source_;
   // Supernodal: the fill-reducing permutation P taken out of the factor (row k of the factored

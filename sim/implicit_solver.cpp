@@ -5,6 +5,8 @@
 #include <cmath>
 #include <utility>
 
+#include "sim/parallel.hpp"
+
 namespace sd::sim {
 
 std::string_view solver_name(LinearSolverKind solver) {
@@ -17,6 +19,10 @@ std::optional<LinearSolverKind> parse_solver(std::string_view name) {
   return std::nullopt;
 }
 namespace {
+
+// Vertices per chunk when the pair springs' cross blocks widen the matrix (a vertex's rows
+// hold about 27 entries each).
+constexpr int kCrossRowGrain = 512;
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -194,46 +200,52 @@ void ImplicitSolver::add_cross_blocks(const ClothModel& model, double beta,
 
   // Merge each vertex's rows with its cross blocks' columns (both sorted). Every row of a vertex
   // holds the same block columns, so the block structure (and offset(i, j)) stays per vertex.
+  // coupled_ written in place, rows on all threads: vertex i's rows gain 3 entries per block in
+  // its row, so row 3i + a starts 3·(3·B_i + a·c_i) entries later than in matrix_ (B_i blocks
+  // in the rows of vertices before i, c_i in vertex i's). Each row is the same merge as before,
+  // so the same entries in the same places on any thread count.
   const int n = model.vertex_count;
   const int* outer = matrix_.outerIndexPtr();
   const int* inner = matrix_.innerIndexPtr();
   const double* values = matrix_.valuePtr();
-  std::vector<int> new_outer(3 * static_cast<std::size_t>(n) + 1, 0);
-  std::vector<int> new_inner;
-  std::vector<double> new_values;
-  new_inner.reserve(static_cast<std::size_t>(matrix_.nonZeros()) + 9 * blocks.size());
-  new_values.reserve(new_inner.capacity());
+  std::vector<int> first_block(static_cast<std::size_t>(n) + 1, 0);  // B_i
+  for (const Block& block : blocks) ++first_block[static_cast<std::size_t>(block.row) + 1];
+  for (int i = 0; i < n; ++i) first_block[i + 1] += first_block[i];
+  const int nonzeros = static_cast<int>(matrix_.nonZeros()) + 9 * static_cast<int>(blocks.size());
+  coupled_.resize(3 * n, 3 * n);
+  coupled_.resizeNonZeros(nonzeros);
+  int* new_outer = coupled_.outerIndexPtr();
+  int* new_inner = coupled_.innerIndexPtr();
+  double* new_values = coupled_.valuePtr();
   coupled_diagonal_.assign(static_cast<std::size_t>(n), -1);
-  std::size_t first = 0;
-  for (int i = 0; i < n; ++i) {
-    std::size_t last = first;
-    while (last < blocks.size() && blocks[last].row == i) ++last;
-    for (int a = 0; a < 3; ++a) {
-      const int r = 3 * i + a;
-      const int row_begin = static_cast<int>(new_inner.size());
-      int p = outer[r];
-      std::size_t q = first;
-      while (p < outer[r + 1] || q < last) {
-        if (q == last || (p < outer[r + 1] && inner[p] < 3 * blocks[q].column)) {
-          if (a == 0 && inner[p] == 3 * i)
-            coupled_diagonal_[i] = static_cast<int>(new_inner.size()) - row_begin;
-          new_inner.push_back(inner[p]);
-          new_values.push_back(values[p]);
-          ++p;
-        } else {
-          for (int b = 0; b < 3; ++b) {
-            new_inner.push_back(3 * blocks[q].column + b);
-            new_values.push_back(blocks[q].value(a, b));
+  parallel_chunks(n, kCrossRowGrain, [&](int, int low, int high) {
+    for (int i = low; i < high; ++i) {
+      const int first = first_block[i], last = first_block[i + 1];
+      for (int a = 0; a < 3; ++a) {
+        const int r = 3 * i + a;
+        const int row_begin = outer[r] + 3 * (3 * first + a * (last - first));
+        new_outer[r] = row_begin;
+        int out = row_begin;
+        int p = outer[r];
+        int q = first;
+        while (p < outer[r + 1] || q < last) {
+          if (q == last || (p < outer[r + 1] && inner[p] < 3 * blocks[q].column)) {
+            if (a == 0 && inner[p] == 3 * i) coupled_diagonal_[i] = out - row_begin;
+            new_inner[out] = inner[p];
+            new_values[out++] = values[p];
+            ++p;
+          } else {
+            for (int b = 0; b < 3; ++b) {
+              new_inner[out] = 3 * blocks[q].column + b;
+              new_values[out++] = blocks[q].value(a, b);
+            }
+            ++q;
           }
-          ++q;
         }
       }
-      new_outer[r + 1] = static_cast<int>(new_inner.size());
     }
-    first = last;
-  }
-  coupled_ = Eigen::Map<const SparseMatrixR>(3 * n, 3 * n, static_cast<int>(new_inner.size()),
-                                             new_outer.data(), new_inner.data(), new_values.data());
+  });
+  new_outer[3 * n] = nonzeros;
   widened_ = true;
 }
 

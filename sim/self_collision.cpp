@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
+#include <functional>
 #include <numeric>
 #include <stdexcept>
 
@@ -20,6 +20,19 @@ constexpr double kMaxSafeHalfAngle = 0.5 * 3.14159265358979323846 - 0.05;
 // tests it saves); their region is simply not culled.
 constexpr int kMaxBoundaryEdges = 1500;
 constexpr int kLeafSize = 1;
+// The refit runs the subtrees below this depth (16 of them) on all threads, for trees of at
+// least twice this many nodes (a 500-triangle cloth's tree: about 5 µs a subtree).
+constexpr int kRefitSplitDepth = 4;
+constexpr int kParallelRefitNodes = 1000;
+// Nodes per chunk when each node's boundary is found (a node costs its triangle count).
+constexpr int kNodeGrain = 256;
+// The query's walk is cut into pieces below this depth (self tests of subtrees and node pairs
+// that run on the threads; about 60–200 pieces on a 4,000-triangle garment).
+constexpr int kWalkSplitDepth = 5;
+// The tree is built with its halves on the threads down to this depth, for halves of at least
+// kBuildGrain triangles.
+constexpr int kBuildSplitDepth = 3;
+constexpr int kBuildGrain = 256;
 
 Eigen::Vector3d row(const Eigen::VectorXd& x, int i) {
   return x.segment<3>(3 * i);
@@ -159,7 +172,9 @@ SelfCollider::SelfCollider(std::vector<std::array<int, 3>> triangles, const Eige
   const int n = static_cast<int>(x.size() / 3);
   const int f = static_cast<int>(triangles_.size());
   vertex_owner_.assign(static_cast<std::size_t>(n), -1);
-  std::map<std::pair<int, int>, int> edge_index;
+  // Edges numbered in the order they are first met; each vertex lists the edges to its
+  // higher-numbered neighbours (a handful), which finds an edge faster than a tree of pairs.
+  std::vector<std::vector<std::array<int, 2>>> edges_from(static_cast<std::size_t>(n));
   triangle_edges_.resize(triangles_.size());
   for (int t = 0; t < f; ++t) {
     for (int k = 0; k < 3; ++k) {
@@ -167,67 +182,79 @@ SelfCollider::SelfCollider(std::vector<std::array<int, 3>> triangles, const Eige
       if (v < 0 || v >= n) throw std::invalid_argument("self collision: vertex index out of range");
       if (vertex_owner_[v] < 0) vertex_owner_[v] = t;
       const int w = triangles_[t][(k + 1) % 3];
-      const std::pair<int, int> key = std::minmax(v, w);
-      auto [it, inserted] = edge_index.emplace(key, static_cast<int>(edges_.size()));
-      if (inserted) {
-        edges_.push_back({key.first, key.second});
+      if (w < 0 || w >= n) throw std::invalid_argument("self collision: vertex index out of range");
+      const auto [low, high] = std::minmax(v, w);
+      std::vector<std::array<int, 2>>& from = edges_from[static_cast<std::size_t>(low)];
+      auto it = std::find_if(from.begin(), from.end(),
+                             [high](const std::array<int, 2>& e) { return e[0] == high; });
+      int edge = 0;
+      if (it == from.end()) {
+        edge = static_cast<int>(edges_.size());
+        from.push_back({high, edge});
+        edges_.push_back({low, high});
         edge_owner_.push_back(t);
         edge_triangles_.push_back({t, -1});
-      } else if (edge_triangles_[it->second][1] < 0) {
-        edge_triangles_[it->second][1] = t;
+      } else {
+        edge = (*it)[1];
+        if (edge_triangles_[edge][1] < 0) edge_triangles_[edge][1] = t;
       }
-      triangle_edges_[t][k] = it->second;
+      triangle_edges_[t][k] = edge;
     }
   }
   order_.resize(triangles_.size());
   std::iota(order_.begin(), order_.end(), 0);
   position_.assign(triangles_.size(), 0);
-  nodes_.clear();
-  nodes_.reserve(2 * triangles_.size());
-  if (f > 0) build(0, f, x, 0);
+  // A subtree over m triangles has 2m − 1 nodes (one triangle a leaf), so every node's place in
+  // preorder is known before it is built and the top subtrees are built on the threads.
+  nodes_.assign(f > 0 ? 2 * static_cast<std::size_t>(f) - 1 : 0, Node{});
+  if (f > 0) build(0, 0, f, x, 0);
   for (int i = 0; i < f; ++i) position_[order_[i]] = i;
   // Connectivity and boundary of each node: edges with exactly one of their triangles inside.
-  for (Node& node : nodes_) {
-    const auto inside = [&](int t) {
-      return t >= 0 && position_[t] >= node.begin && position_[t] < node.end;
-    };
-    std::vector<int> parent(static_cast<std::size_t>(node.end - node.begin));
-    std::iota(parent.begin(), parent.end(), 0);
-    const auto find = [&](int i) {
-      while (parent[i] != i) i = parent[i] = parent[parent[i]];
-      return i;
-    };
-    int components = node.end - node.begin;
-    node.boundary.clear();
-    for (int i = node.begin; i < node.end; ++i) {
-      const int t = order_[i];
-      for (int k = 0; k < 3; ++k) {
-        const int e = triangle_edges_[t][k];
-        const auto [t0, t1] = edge_triangles_[e];
-        const int other = t0 == t ? t1 : t0;
-        if (!inside(other)) {
-          node.boundary.push_back(e);
-        } else if (other > t) {
-          const int a = find(i - node.begin), b = find(position_[other] - node.begin);
-          if (a != b) {
-            parent[a] = b;
-            --components;
+  // Each node's own, so the nodes are done on all threads.
+  parallel_chunks(static_cast<int>(nodes_.size()), kNodeGrain, [&](int, int first, int last) {
+    for (int index = first; index < last; ++index) {
+      Node& node = nodes_[static_cast<std::size_t>(index)];
+      const auto inside = [&](int t) {
+        return t >= 0 && position_[t] >= node.begin && position_[t] < node.end;
+      };
+      std::vector<int> parent(static_cast<std::size_t>(node.end - node.begin));
+      std::iota(parent.begin(), parent.end(), 0);
+      const auto find = [&](int i) {
+        while (parent[i] != i) i = parent[i] = parent[parent[i]];
+        return i;
+      };
+      int components = node.end - node.begin;
+      node.boundary.clear();
+      for (int i = node.begin; i < node.end; ++i) {
+        const int t = order_[i];
+        for (int k = 0; k < 3; ++k) {
+          const int e = triangle_edges_[t][k];
+          const auto [t0, t1] = edge_triangles_[e];
+          const int other = t0 == t ? t1 : t0;
+          if (!inside(other)) {
+            node.boundary.push_back(e);
+          } else if (other > t) {
+            const int a = find(i - node.begin), b = find(position_[other] - node.begin);
+            if (a != b) {
+              parent[a] = b;
+              --components;
+            }
           }
         }
       }
+      node.connected = components == 1;
+      if (!node.connected || static_cast<int>(node.boundary.size()) > kMaxBoundaryEdges)
+        node.boundary.clear();
     }
-    node.connected = components == 1;
-    if (!node.connected || static_cast<int>(node.boundary.size()) > kMaxBoundaryEdges)
-      node.boundary.clear();
-  }
+  });
 }
 
-int SelfCollider::build(int begin, int end, const Eigen::VectorXd& x, int depth) {
-  const int index = static_cast<int>(nodes_.size());
-  nodes_.emplace_back();
-  nodes_[index].begin = begin;
-  nodes_[index].end = end;
-  if (end - begin <= kLeafSize) return index;
+void SelfCollider::build(int index, int begin, int end, const Eigen::VectorXd& x, int depth) {
+  static_assert(kLeafSize == 1, "the preorder places assume single-triangle leaves");
+  Node& node = nodes_[static_cast<std::size_t>(index)];
+  node.begin = begin;
+  node.end = end;
+  if (end - begin <= kLeafSize) return;
   // Median split of the centroids along the longest side of their box.
   Eigen::AlignedBox3d box;
   const auto centroid = [&](int t) {
@@ -240,16 +267,28 @@ int SelfCollider::build(int begin, int end, const Eigen::VectorXd& x, int depth)
   const int middle = begin + (end - begin) / 2;
   std::nth_element(order_.begin() + begin, order_.begin() + middle, order_.begin() + end,
                    [&](int a, int b) { return centroid(a)[axis] < centroid(b)[axis]; });
-  const int left = build(begin, middle, x, depth + 1);
-  const int right = build(middle, end, x, depth + 1);
-  nodes_[index].left = left;
-  nodes_[index].right = right;
-  return index;
+  node.left = index + 1;
+  node.right = index + 2 * (middle - begin);
+  const int left = node.left, right = node.right;
+  // The two halves own disjoint ranges of order_ and of nodes_.
+  if (depth < kBuildSplitDepth && end - begin >= 2 * kBuildGrain) {
+    parallel_chunks(2, 1, [&](int, int first, int last) {
+      for (int half = first; half < last; ++half) {
+        if (half == 0)
+          build(left, begin, middle, x, depth + 1);
+        else
+          build(right, middle, end, x, depth + 1);
+      }
+    });
+  } else {
+    build(left, begin, middle, x, depth + 1);
+    build(right, middle, end, x, depth + 1);
+  }
 }
 
 void SelfCollider::refit(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1, double inflate) {
   const Eigen::Vector3d grow = Eigen::Vector3d::Constant(inflate);
-  for (int i = static_cast<int>(nodes_.size()) - 1; i >= 0; --i) {
+  const auto refit_node = [&](int i) {
     Node& node = nodes_[i];
     if (node.left < 0) {
       const std::array<int, 3>& t = triangles_[order_[node.begin]];
@@ -270,7 +309,7 @@ void SelfCollider::refit(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1, d
         node.axis = sum.normalized();
         node.half_angle = 0.5 * std::atan2(n0.cross(n1).norm(), n0.dot(n1));
       }
-      continue;
+      return;
     }
     const Node& a = nodes_[node.left];
     const Node& b = nodes_[node.right];
@@ -279,14 +318,47 @@ void SelfCollider::refit(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1, d
     if (a.half_angle > 3.0 || b.half_angle > 3.0 || !(sum.norm() > 1e-9)) {
       node.axis.setZero();
       node.half_angle = 3.2;
-      continue;
+      return;
     }
     node.axis = sum.normalized();
     const auto angle = [&](const Eigen::Vector3d& u) {
       return std::atan2(node.axis.cross(u).norm(), node.axis.dot(u));
     };
     node.half_angle = std::max(angle(a.axis) + a.half_angle, angle(b.axis) + b.half_angle);
+  };
+  // Bottom-up. The nodes are stored in preorder, so a node's subtree is the index range from it
+  // to its last descendant, and the subtrees below the top levels are refitted on all threads
+  // (each node from its own children only: the same bits in any order), then the top nodes,
+  // children before parents (higher index first).
+  const int count = static_cast<int>(nodes_.size());
+  if (count < 2 * kParallelRefitNodes) {
+    for (int i = count - 1; i >= 0; --i) refit_node(i);
+    return;
   }
+  std::vector<int> subtrees;  // roots at depth kRefitSplitDepth, or leaves above it
+  std::vector<int> top;       // inner nodes above that depth, in preorder
+  std::vector<std::array<int, 2>> stack{{0, 0}};
+  while (!stack.empty()) {
+    const auto [i, depth] = stack.back();
+    stack.pop_back();
+    const Node& node = nodes_[i];
+    if (depth == kRefitSplitDepth || node.left < 0) {
+      subtrees.push_back(i);
+      continue;
+    }
+    top.push_back(i);
+    stack.push_back({node.right, depth + 1});
+    stack.push_back({node.left, depth + 1});
+  }
+  const auto subtree_end = [&](int i) {
+    while (nodes_[i].left >= 0) i = nodes_[i].right;
+    return i + 1;
+  };
+  parallel_chunks(static_cast<int>(subtrees.size()), 1, [&](int, int first, int last) {
+    for (int s = first; s < last; ++s)
+      for (int i = subtree_end(subtrees[s]) - 1; i >= subtrees[s]; --i) refit_node(i);
+  });
+  for (auto it = top.rbegin(); it != top.rend(); ++it) refit_node(*it);
 }
 
 bool SelfCollider::region_is_safe(const Node& node, const Eigen::VectorXd& x0,
@@ -357,6 +429,83 @@ void SelfCollider::pair_test(int a, int b, LeafTest& leaf, SelfQueryStats& stats
   } else {
     pair_test(a, nb.left, leaf, stats);
     pair_test(a, nb.right, leaf, stats);
+  }
+}
+
+void SelfCollider::collect_leaves(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1,
+                                  std::vector<std::array<int, 2>>& leaves, SelfQueryStats& stats) {
+  // A piece: self_test(a), pair_test(a, b), or a pair of triangles the walk met above the
+  // pieces. The walk down to kWalkSplitDepth does what self_test and pair_test do there (dirty
+  // skips, culling, box tests, counts) and lists the calls it would make below, and the
+  // triangle pairs it meets, in the order it would make and meet them.
+  enum class Kind { self, pair, triangles };
+  struct Piece {
+    Kind kind = Kind::self;
+    int a = 0, b = -1;
+  };
+  std::vector<Piece> pieces;
+  const std::function<void(int, int, int)> walk_pair = [&](int a, int b, int depth) {
+    if (depth >= kWalkSplitDepth) {
+      pieces.push_back({Kind::pair, a, b});
+      return;
+    }
+    if (!dirty_.empty() && dirty_[a] == 0 && dirty_[b] == 0) return;
+    ++stats.node_pairs;
+    const Node& na = nodes_[a];
+    const Node& nb = nodes_[b];
+    if (!na.box.intersects(nb.box)) return;
+    const bool a_leaf = na.left < 0, b_leaf = nb.left < 0;
+    if (a_leaf && b_leaf) {
+      ++stats.triangle_pairs;
+      pieces.push_back({Kind::triangles, order_[na.begin], order_[nb.begin]});
+      return;
+    }
+    if (b_leaf || (!a_leaf && na.end - na.begin >= nb.end - nb.begin)) {
+      walk_pair(na.left, b, depth + 1);
+      walk_pair(na.right, b, depth + 1);
+    } else {
+      walk_pair(a, nb.left, depth + 1);
+      walk_pair(a, nb.right, depth + 1);
+    }
+  };
+  const std::function<void(int, int)> walk_self = [&](int index, int depth) {
+    const Node& node = nodes_[index];
+    if (node.left < 0 || (!dirty_.empty() && dirty_[index] == 0)) return;
+    if (depth >= kWalkSplitDepth) {
+      pieces.push_back({Kind::self, index, -1});
+      return;
+    }
+    if (culling_ && region_is_safe(node, x0, x1)) {
+      stats.culled_triangles += node.end - node.begin;
+      return;
+    }
+    walk_self(node.left, depth + 1);
+    walk_self(node.right, depth + 1);
+    walk_pair(node.left, node.right, depth + 1);
+  };
+  if (nodes_.empty()) return;
+  walk_self(0, 0);
+  std::vector<std::vector<std::array<int, 2>>> found(pieces.size());
+  std::vector<SelfQueryStats> counts(pieces.size());
+  parallel_chunks(static_cast<int>(pieces.size()), 1, [&](int, int first, int last) {
+    for (int k = first; k < last; ++k) {
+      const Piece& piece = pieces[static_cast<std::size_t>(k)];
+      std::vector<std::array<int, 2>>& out = found[static_cast<std::size_t>(k)];
+      auto collect = [&out](int ta, int tb) { out.push_back({ta, tb}); };
+      SelfQueryStats& count = counts[static_cast<std::size_t>(k)];
+      if (piece.kind == Kind::self)
+        self_test(piece.a, x0, x1, collect, count);
+      else if (piece.kind == Kind::pair)
+        pair_test(piece.a, piece.b, collect, count);
+      else
+        out.push_back({piece.a, piece.b});
+    }
+  });
+  for (std::size_t k = 0; k < pieces.size(); ++k) {
+    leaves.insert(leaves.end(), found[k].begin(), found[k].end());
+    stats.culled_triangles += counts[k].culled_triangles;
+    stats.node_pairs += counts[k].node_pairs;
+    stats.triangle_pairs += counts[k].triangle_pairs;
   }
 }
 
@@ -463,8 +612,7 @@ std::vector<SelfPair> SelfCollider::find_proximities(const Eigen::VectorXd& x, d
     }
   };
   std::vector<std::array<int, 2>> leaves;
-  auto collect = [&](int ta, int tb) { leaves.push_back({ta, tb}); };
-  self_test(0, x, x, collect, s);
+  collect_leaves(x, x, leaves, s);
   test_leaves(leaves, leaf, pairs, s.element_tests);
   s.pairs_found = static_cast<int>(pairs.size());
   return pairs;
@@ -545,8 +693,7 @@ std::vector<SelfPair> SelfCollider::find_collisions(const Eigen::VectorXd& x0,
     }
   };
   std::vector<std::array<int, 2>> leaves;
-  auto collect = [&](int ta, int tb) { leaves.push_back({ta, tb}); };
-  self_test(0, x0, x1, collect, s);
+  collect_leaves(x0, x1, leaves, s);
   test_leaves(leaves, leaf, pairs, s.element_tests);
   dirty_.clear();
   s.pairs_found = static_cast<int>(pairs.size());

@@ -97,7 +97,8 @@ class SelfCollider {
     bool connected = false;     // its triangles form one edge-connected region
     std::vector<int> boundary;  // edges with one triangle in the node (when connected)
   };
-  int build(int begin, int end, const Eigen::VectorXd& x, int depth);
+  // Builds the subtree over order_[begin, end) at nodes_[index] (preorder, presized).
+  void build(int index, int begin, int end, const Eigen::VectorXd& x, int depth);
   void refit(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1, double inflate);
   bool region_is_safe(const Node& node, const Eigen::VectorXd& x0, const Eigen::VectorXd& x1);
   template <class LeafTest>
@@ -105,6 +106,11 @@ class SelfCollider {
                  SelfQueryStats& stats);
   template <class LeafTest>
   void pair_test(int a, int b, LeafTest& leaf, SelfQueryStats& stats);
+  // What self_test(0, ...) reaches, in its order: the triangle pairs (appended to `leaves`)
+  // and the counts. The top levels are walked here; the pieces below them (subtrees and node
+  // pairs) run on the threads and are joined in traversal order.
+  void collect_leaves(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1,
+                      std::vector<std::array<int, 2>>& leaves, SelfQueryStats& stats);
 
   std::vector<std::array<int, 3>> triangles_;
   std::vector<std::array<int, 2>> edges_;

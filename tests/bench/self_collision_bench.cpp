@@ -4,6 +4,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include "sim/parallel.hpp"
 #include "sim/self_collision.hpp"
 #include "tests/sim/self_contact_helpers.hpp"
 
@@ -59,6 +60,34 @@ void BM_SelfBuild(benchmark::State& state) {
   state.counters["triangles"] = static_cast<double>(sheet.triangles.size());
 }
 BENCHMARK(BM_SelfBuild)->Arg(32)->Unit(benchmark::kMicrosecond);
+
+// A step's two queries and a refit on `threads` threads (sketchdrape --threads): a folded strip
+// of 32 (4,096 triangles, a garment's size), culling on. The tree's refit and walk and the pair
+// tests run on the threads (docs/simulator.md, "Threads"); wall time, since the point is
+// what a second core takes off it.
+void BM_SelfStepQueries(benchmark::State& state) {
+  sd::sim::set_thread_count(static_cast<int>(state.range(0)));
+  const auto sheet = sd::sim::testing::folded_sheet(32, 0.5, 0.002);
+  Eigen::VectorXd x1 = sheet.x;
+  for (int i = 0; i < static_cast<int>(sheet.upper.size()); ++i)
+    if (sheet.upper[i]) x1[3 * i + 1] -= 0.001;
+  SelfCollider collider(sheet.triangles, sheet.x);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(collider.find_proximities(sheet.x, 0.004));
+    benchmark::DoNotOptimize(collider.find_collisions(sheet.x, x1, 1e-5));
+  }
+  sd::sim::set_thread_count(0);
+}
+BENCHMARK(BM_SelfStepQueries)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMicrosecond);
+
+// Building the tree after a topology change, on `threads` threads.
+void BM_SelfBuildThreads(benchmark::State& state) {
+  sd::sim::set_thread_count(static_cast<int>(state.range(0)));
+  const auto sheet = sd::sim::testing::folded_sheet(32, 0.5, 0.001);
+  for (auto _ : state) benchmark::DoNotOptimize(SelfCollider(sheet.triangles, sheet.x));
+  sd::sim::set_thread_count(0);
+}
+BENCHMARK(BM_SelfBuildThreads)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 

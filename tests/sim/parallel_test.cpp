@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cmath>
 #include <random>
+#include <set>
 #include <tuple>
 #include <vector>
 
@@ -13,6 +14,7 @@
 #include "sim/cloth_model.hpp"
 #include "sim/fabric.hpp"
 #include "sim/forces.hpp"
+#include "sim/implicit_solver.hpp"
 #include "sim/self_collision.hpp"
 #include "sim/sheet.hpp"
 #include "tests/sim/test_bodies.hpp"
@@ -111,6 +113,10 @@ TEST_F(ThreadCount, SelfCollisionQueriesAreTheSameOnOneAndManyThreads) {
   const Eigen::MatrixX3i& faces = scene.input.triangles;
   for (Eigen::Index f = 0; f < faces.rows(); ++f)
     triangles.push_back({faces(f, 0), faces(f, 1), faces(f, 2)});
+  // Over 1,000 triangles: the tree's refit runs its subtrees on the threads and its nodes'
+  // boundaries are found in chunks (sim/self_collision.cpp), and the culling they feed decides
+  // which pairs are tested.
+  ASSERT_GT(triangles.size(), 1000u);
   std::mt19937 rng(5);
   std::normal_distribution<double> jitter(0.0, 0.015);  // m; edges are 1/30 m
   Eigen::VectorXd x0 = flatten_positions(scene.input.rest_positions);
@@ -204,6 +210,75 @@ TEST_F(ThreadCount, ForcesAndJacobianAreTheSameOnOneAndManyThreads) {
                              matrix4.valuePtr()));
     }
   }
+}
+
+// Pair springs between far parts of a 40×40 sheet widen the solver's matrix by blocks outside
+// the mesh's pattern; the widened matrix is written in place by rows on the threads
+// (ImplicitSolver::add_cross_blocks). It must be the same bits on any thread count, symmetric,
+// hold every cross block, and the CHOLMOD step on it the same bits too.
+TEST_F(ThreadCount, PairSpringCrossBlocksAreTheSameOnOneAndManyThreads) {
+  SheetSpec spec;
+  spec.columns = spec.rows = 40;
+  const SheetScene scene = build_sheet(spec);
+  const ClothModel model = build_cloth_model(scene.input, fabric_preset("cotton"));
+  ASSERT_GT(model.vertex_count, 1024) << "several chunks of rows";
+  const Eigen::VectorXd x = flatten_positions(scene.input.rest_positions);
+  Eigen::VectorXd v = Eigen::VectorXd::Zero(x.size());
+  for (int i = 0; i < model.vertex_count; ++i) v[3 * i + 1] = -0.2 - 1e-4 * i;
+  StepForces extra;
+  // A vertex of the first rows held against a triangle of the last rows, and back.
+  const int triangles = static_cast<int>(model.triangles.size());
+  for (int k = 0; k < 60; ++k) {
+    const int near = 7 * k, far = triangles - 1 - 11 * k;
+    for (const auto& [vertex, triangle] :
+         {std::pair{near, far}, std::pair{model.vertex_count - 1 - 5 * k, 3 * k}}) {
+      PairSpring spring;
+      const std::array<int, 3>& corners = model.triangles[triangle].vertices;
+      spring.vertices = {vertex, corners[0], corners[1], corners[2]};
+      spring.weights << 1.0, -0.2, -0.5, -0.3;
+      spring.normal = Eigen::Vector3d(0.1, 1.0, -0.2).normalized();
+      spring.target = 0.005;
+      spring.stiffness = 30.0;
+      spring.damping = 0.4;
+      spring.friction = 1.5;
+      extra.pair_springs.push_back(spring);
+    }
+  }
+  NewtonSettings settings;
+  settings.solver = LinearSolverKind::cholmod;
+  const ConstraintFilter filter(model.vertex_count);
+  const auto run = [&](int threads) {
+    set_thread_count(threads);
+    ImplicitSolver solver;
+    const ImplicitSolveResult r =
+        solver.solve(model, ForceSettings{}, filter, x, v, 1.0 / 60.0, x, v, settings, &extra);
+    return std::make_pair(SparseMatrixR(solver.matrix()), r.v);
+  };
+  const auto [matrix1, v1] = run(1);
+  const auto [matrix4, v4] = run(4);
+  const SparseMatrixR& mesh = model.pattern.zero_matrix;
+  int cross = 0;  // blocks not in the mesh's pattern, one per ordered pair of vertices
+  std::set<std::pair<int, int>> pairs;
+  for (const PairSpring& s : extra.pair_springs)
+    for (int i : s.vertices)
+      for (int j : s.vertices)
+        if (i != j && block_offset(mesh, i, j) < 0 && pairs.insert({i, j}).second) ++cross;
+  ASSERT_GT(cross, 100);
+  EXPECT_EQ(matrix1.nonZeros(), mesh.nonZeros() + 9 * cross);
+  for (const auto& [i, j] : pairs) EXPECT_GE(block_offset(matrix1, i, j), 0) << i << " " << j;
+  // Symmetric to rounding (the elements' Hessians are): a cross block written into the wrong
+  // row or place would leave an O(1) difference.
+  EXPECT_LT(SparseMatrixR(matrix1 - SparseMatrixR(matrix1.transpose())).norm(),
+            1e-12 * matrix1.norm());
+  ASSERT_EQ(matrix1.nonZeros(), matrix4.nonZeros());
+  EXPECT_TRUE(std::equal(matrix1.outerIndexPtr(), matrix1.outerIndexPtr() + matrix1.rows() + 1,
+                         matrix4.outerIndexPtr()));
+  EXPECT_TRUE(std::equal(matrix1.innerIndexPtr(), matrix1.innerIndexPtr() + matrix1.nonZeros(),
+                         matrix4.innerIndexPtr()));
+  EXPECT_TRUE(
+      std::equal(matrix1.valuePtr(), matrix1.valuePtr() + matrix1.nonZeros(), matrix4.valuePtr()));
+  ASSERT_TRUE(v1.allFinite());
+  EXPECT_TRUE(v1 == v4);  // bit for bit
 }
 
 // Body vertices through a crumpled cloth: the same piercings in the same order on any thread count.
