@@ -298,12 +298,6 @@ PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOpt
           {piece.sewing.row(i).transpose(), outward_normal(piece.sewing, i), narrower});
     }
     grain_line(piece);
-    if (piece.size.x() > options.fabric_width - 2 * options.gap)
-      throw PatternError(flat.id,
-                         fmt::format("the piece of panel '{}' is {:.0f} mm wide with its "
-                                     "seam allowance; the fabric is {:.0f} mm wide: use "
-                                     "a wider fabric or split the panel",
-                                     flat.id, 1000 * piece.size.x(), 1000 * options.fabric_width));
     layout.pieces.push_back(std::move(piece));
   }
 
@@ -316,6 +310,39 @@ PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOpt
   constexpr double kCell = 0.002;  // m
   const int columns = static_cast<int>(std::floor((options.fabric_width - options.gap) / kCell));
   const int pad = static_cast<int>(std::ceil(0.5 * options.gap / kCell));
+  // The fabric must take the widest piece with its seam allowance, a gap at each selvedge and
+  // the grid's rounding (its span of columns, below). Name that piece and the width it needs,
+  // so that one change of the fabric width is enough: the first piece too wide in panel order
+  // is not always the widest, and its width without the gaps can be less than the fabric's.
+  if (!layout.pieces.empty()) {
+    double most = 0;
+    for (const PatternPiece& piece : layout.pieces) most = std::max(most, piece.size.x());
+    // The first within 0.1 mm of the widest: a panel before its mirror copy ("front", not
+    // "front.mirror", which is as wide up to rounding).
+    const PatternPiece& widest =
+        *std::find_if(layout.pieces.begin(), layout.pieces.end(),
+                      [&](const PatternPiece& piece) { return piece.size.x() >= most - 1e-4; });
+    const int span = static_cast<int>(std::ceil(widest.size.x() / kCell)) + 1 + 2 * pad;
+    if (widest.size.x() > options.fabric_width - 2 * options.gap || span > columns) {
+      // Whole millimetres, up to the first width that passes both tests as written (the grid
+      // rounds), so that the width named is enough when given back.
+      const double least = std::max(widest.size.x() + 2 * options.gap, span * kCell + options.gap);
+      int needed_mm = static_cast<int>(std::ceil(1000 * least - 1e-6));
+      const auto fits = [&](double width) {
+        return widest.size.x() <= width - 2 * options.gap &&
+               static_cast<int>(std::floor((width - options.gap) / kCell)) >= span;
+      };
+      while (!fits(needed_mm / 1000.0)) ++needed_mm;
+      const std::string& id = pattern.panels[static_cast<size_t>(widest.panel)].id;
+      throw PatternError(
+          id, fmt::format("the piece of panel '{}' is {:.0f} mm wide with its seam allowance and "
+                          "needs a fabric at least {} mm wide with the {:.0f} mm gap kept "
+                          "free at each selvedge; the fabric is {:.0f} mm wide: use a wider fabric "
+                          "or split the panel",
+                          id, 1000 * widest.size.x(), needed_mm, 1000 * options.gap,
+                          1000 * options.fabric_width));
+    }
+  }
   // Two orders are tried, largest area first and tallest first; the shorter layout is kept.
   const auto nest = [&](const std::vector<size_t>& order) {
     std::vector<double> sky(static_cast<size_t>(columns), 0.0);

@@ -68,6 +68,10 @@ std::string out_of_range_sentence(double value, double low, double high, const s
         "; lengths and coordinates are in metres: if you typed millimetres, "
         "{:.6g} mm is {:.6g} m",
         value, value / 1000);
+  // A tenth in range reads as a decimal point one place off (4.2 for 0.42) as much as a unit:
+  // offer both rather than assert centimetres.
+  if ((as_cm || as_mm) && plausible(value / 10))
+    sentence += fmt::format("; or, if the decimal point slipped, {:.6g} m", value / 10);
   return sentence;
 }
 

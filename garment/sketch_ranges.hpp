@@ -35,6 +35,10 @@ inline constexpr double kMaxDuration = 3600.0;                     // s of simul
 inline constexpr std::uintmax_t kMaxSketchFileBytes = 16'000'000;  // a sketch file
 inline constexpr std::uintmax_t kMaxMeshFileBytes = 512'000'000;   // a body or garment mesh
 
+// output.pattern.fabric_width and `pattern --fabric-width`: a strip of trim to a wide sheeting.
+inline constexpr double kMinFabricWidth = 0.1;   // m
+inline constexpr double kMaxFabricWidth = 10.0;  // m
+
 // Relative to the body (once it is loaded).
 // Points may lie this many body heights outside the body's bounding box (a flared hem, a cape).
 inline constexpr double kBodyMarginHeights = 1.0;

@@ -66,10 +66,8 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
   }
   if (root.contains("body")) parse_body(r, root["body"], sketch.body);
   if (root.contains("edge_length")) {
-    sketch.edge_length = r.positive(root["edge_length"], "/edge_length");
-    if (sketch.edge_length < 0.002 || sketch.edge_length > 0.5)
-      r.fail("/edge_length",
-             fmt::format("an edge length of {} m is outside 2 mm .. 50 cm", sketch.edge_length));
+    // The same range and centimetres hint as a curve's or panel's edge_length.
+    sketch.edge_length = r.edge_length(root["edge_length"], "/edge_length");
   }
   if (root.contains("offset")) sketch.offset = r.number(root["offset"], "/offset");
   if (root.contains("junction_tolerance"))

@@ -192,10 +192,12 @@ CurveSpec parse_curve(const Reader& r, const json& j, const std::string& path, c
     curve.view = r.view(j["view"], path + "/view");
   }
   curve.offset = j.contains("offset") ? r.number(j["offset"], path + "/offset") : sk.offset;
+  // A curve without its own offset carries the file's top-level one: report that at /offset.
   if (std::abs(curve.offset) > 0.5)
-    r.fail(path + "/offset", fmt::format("an offset of {} m is more than half a metre from the "
-                                         "body; offsets are in metres (1 cm = 0.01)",
-                                         curve.offset));
+    r.fail(j.contains("offset") ? path + "/offset" : "/offset",
+           fmt::format("an offset of {} m is more than half a metre from the "
+                       "body; offsets are in metres (1 cm = 0.01)",
+                       curve.offset));
   if (j.contains("on_body")) curve.on_body = r.boolean(j["on_body"], path + "/on_body");
   if (j.contains("smooth")) curve.smooth = r.boolean(j["smooth"], path + "/smooth");
   if (j.contains("closed")) curve.closed = r.boolean(j["closed"], path + "/closed");

@@ -76,8 +76,14 @@ void parse_pattern(const Reader& r, const json& j, OutputSpec& out) {
   r.require_object(j, path, "true, false or an object of pattern settings");
   r.check_keys(j, path, {"fabric_width", "seam_allowance", "max_stretch"});
   PatternSpec spec;
-  if (j.contains("fabric_width"))
+  if (j.contains("fabric_width")) {
     spec.fabric_width = r.positive(j["fabric_width"], path + "/fabric_width");
+    // Bolts are 0.9-3 m wide; 150 is centimetres typed for metres. The range is that of
+    // `pattern --fabric-width`.
+    if (spec.fabric_width < kMinFabricWidth || spec.fabric_width > kMaxFabricWidth)
+      r.fail(path + "/fabric_width", out_of_range_sentence(spec.fabric_width, kMinFabricWidth,
+                                                           kMaxFabricWidth, "a fabric width of"));
+  }
   if (j.contains("seam_allowance")) {
     spec.seam_allowance = r.number(j["seam_allowance"], path + "/seam_allowance");
     if (spec.seam_allowance < 0 || spec.seam_allowance > 0.1)

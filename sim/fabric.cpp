@@ -1,7 +1,10 @@
 #include "sim/fabric.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -98,6 +101,47 @@ struct CurveUnit {
 constexpr CurveUnit kStrainUnits[] = {{"1", 1.0}, {"%", 0.01}};
 constexpr CurveUnit kStressUnits[] = {{"N/m", 1.0}, {"gf/cm", 0.9807}};
 
+// Levenshtein distance between two keys, for the "did you mean" of a misspelt one.
+size_t key_distance(std::string_view a, std::string_view b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+// Refuses a key of `object` (at `pointer`) not in `known`, as the sketch reader does: a
+// misspelt constant would otherwise be dropped silently (a "frictoin" next to the default
+// "friction") or reported only as the correct key missing.
+void check_fabric_keys(const nlohmann::json& object, const std::string& where,
+                       const std::string& pointer, const std::vector<std::string_view>& known) {
+  for (const auto& [key, value] : object.items()) {
+    if (std::find(known.begin(), known.end(), key) != known.end()) continue;
+    std::string_view best;
+    size_t best_distance = 3;  // suggest only close spellings
+    for (std::string_view k : known)
+      if (const size_t d = key_distance(key, k); d < best_distance) best = k, best_distance = d;
+    std::string sentence = "unknown key '" + key + "'";
+    if (!best.empty()) {
+      sentence += " (did you mean '" + std::string(best) + "'?)";
+    } else {
+      sentence += " (known keys here: ";
+      for (size_t i = 0; i < known.size(); ++i)
+        sentence += std::string(i == 0 ? "" : ", ") + std::string(known[i]);
+      sentence += ")";
+    }
+    throw InvalidFabricError(where + ": " + pointer + "/" + key + ": " + sentence,
+                             pointer + "/" + key);
+  }
+}
+
 template <size_t N>
 double curve_unit_scale(const nlohmann::json& curve, const char* key, const CurveUnit (&units)[N],
                         const std::string& where, const std::string& pointer) {
@@ -123,6 +167,7 @@ TensileCurve parse_tensile_curve(const nlohmann::json& curve, const std::string&
                                  " must be an object {\"strain_unit\", \"stress_unit\", "
                                  "\"points\": [[strain, stress], ...]}",
                              pointer);
+  check_fabric_keys(curve, where, pointer, {"strain_unit", "stress_unit", "points", "source"});
   const double strain_scale = curve_unit_scale(curve, "strain_unit", kStrainUnits, where, pointer);
   const double stress_scale = curve_unit_scale(curve, "stress_unit", kStressUnits, where, pointer);
   const std::string points_at = pointer + "/points";
@@ -220,6 +265,12 @@ FabricParameters parse_fabric_json(std::string_view text, const std::string& ori
   }
   if (!document.is_object()) throw InvalidFabricError(origin + ": a fabric must be a JSON object");
   FabricParameters fabric;
+  {
+    std::vector<std::string_view> known = {"name", "description", "note", "tensile_warp",
+                                           "tensile_weft"};
+    for (const ConstantSpec& spec : kConstants) known.emplace_back(spec.key);
+    check_fabric_keys(document, origin, "", known);
+  }
   if (document.contains("name")) {
     if (!document["name"].is_string())
       throw InvalidFabricError(origin + ": /name must be a string", "/name");
@@ -235,6 +286,7 @@ FabricParameters parse_fabric_json(std::string_view text, const std::string& ori
     if (!entry.is_object() || !entry.contains("value") || !entry["value"].is_number())
       throw InvalidFabricError(origin + ": " + pointer + " must be an object with a numeric value",
                                pointer);
+    check_fabric_keys(entry, origin, pointer, {"value", "unit", "source", "note"});
     const double value = entry["value"].get<double>();
     const std::string unit =
         entry.contains("unit") && entry["unit"].is_string() ? entry["unit"].get<std::string>() : "";
@@ -270,8 +322,23 @@ FabricParameters parse_fabric_json(std::string_view text, const std::string& ori
 }
 
 FabricParameters load_fabric_file(const std::string& path) {
+  // The absolute path and the reason: a relative name is resolved against the sketch's folder,
+  // which is not always the folder the designer thinks of.
+  namespace fs = std::filesystem;
+  std::error_code error;
+  fs::path shown = fs::absolute(path, error);
+  if (error) shown = path;
+  shown = shown.lexically_normal();
+  const auto fail = [&](const std::string& reason) {
+    throw InvalidFabricError("cannot read fabric file '" + shown.string() + "': " + reason);
+  };
+  const fs::file_status status = fs::status(path, error);
+  if (status.type() == fs::file_type::not_found) fail("it does not exist");
+  if (error) fail(error.message());
+  if (fs::is_directory(status)) fail("it is a folder, not a file");
+  if (!fs::is_regular_file(status)) fail("it is not a regular file");
   std::ifstream file(path);
-  if (!file) throw InvalidFabricError("cannot read fabric file '" + path + "'");
+  if (!file) fail(std::string(std::strerror(errno)) + " (check the file's permissions)");
   std::ostringstream text;
   text << file.rdbuf();
   return parse_fabric_json(text.str(), path);

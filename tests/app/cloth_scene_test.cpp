@@ -306,5 +306,63 @@ TEST(ClothScene, FabricIsAPresetAnInlineObjectOrAFile) {
   std::filesystem::remove_all(dir);
 }
 
+// Every key of an inline fabric or a fabric file is checked as the rest of the file is: a
+// misspelt one is refused at its path with the nearest key, not dropped ("frictoin" beside the
+// preset's friction) nor reported as the right key missing ("strech_warp"). A fabric file that
+// cannot be read is named by its absolute path with the reason.
+TEST(ClothScene, FabricKeysAreCheckedAndAnUnreadableFileSaysWhy) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "sd-fabric-keys-test";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir / "folder.json");
+  const auto error_path = [&](const std::string& fabric) {
+    try {
+      build_cloth_scene(scene::parse_sketch(sheet_with_fabric(fabric), "k.json", dir));
+    } catch (const garment::SketchError& e) {
+      EXPECT_EQ(e.file(), "k.json");
+      return e.json_path() + " | " + e.sentence();
+    }
+    return std::string("no error");
+  };
+  const auto path_of = [](const std::string& error) { return error.substr(0, error.find(" | ")); };
+
+  const std::string extra = error_path(silk_with("frictoin", R"({"value": 0.5, "unit": "1"})"));
+  EXPECT_EQ(path_of(extra), "/fabric/frictoin") << extra;
+  EXPECT_NE(extra.find("unknown key 'frictoin' (did you mean 'friction'?)"), std::string::npos)
+      << extra;
+
+  nlohmann::json renamed = nlohmann::json::parse(silk_with("", ""));
+  renamed["strech_warp"] = renamed["stretch_warp"];
+  renamed.erase("stretch_warp");
+  const std::string misspelt = error_path(renamed.dump());
+  EXPECT_EQ(path_of(misspelt), "/fabric/strech_warp") << misspelt;
+  EXPECT_NE(misspelt.find("did you mean 'stretch_warp'?"), std::string::npos) << misspelt;
+
+  const std::string in_constant =
+      error_path(silk_with("bend", R"({"value": 3e-6, "unit": "N*m", "sorce": "KES-F B"})"));
+  EXPECT_EQ(path_of(in_constant), "/fabric/bend/sorce") << in_constant;
+  EXPECT_NE(in_constant.find("did you mean 'source'?"), std::string::npos) << in_constant;
+
+  // A fabric file: the error is at "fabric" and names the file and the key inside it.
+  std::ofstream(dir / "typo.json") << silk_with("frictoin", R"({"value": 0.5, "unit": "1"})");
+  const std::string in_file = error_path(R"("typo.json")");
+  EXPECT_EQ(path_of(in_file), "/fabric") << in_file;
+  EXPECT_NE(in_file.find("typo.json: /frictoin: unknown key 'frictoin' (did you mean "
+                         "'friction'?)"),
+            std::string::npos)
+      << in_file;
+
+  const std::string absolute = std::filesystem::absolute(dir).lexically_normal().string();
+  const std::string missing = error_path(R"("fabrics/nowhere.json")");
+  EXPECT_EQ(path_of(missing), "/fabric") << missing;
+  EXPECT_NE(missing.find("'" + absolute + "/fabrics/nowhere.json': it does not exist"),
+            std::string::npos)
+      << missing;
+  const std::string folder = error_path(R"("folder.json")");
+  EXPECT_NE(folder.find("'" + absolute + "/folder.json': it is a folder, not a file"),
+            std::string::npos)
+      << folder;
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace sd::app

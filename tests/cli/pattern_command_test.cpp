@@ -3,6 +3,7 @@
 // read back with ezdxf, bad input, the pattern output of `mesh`, and a flat-rest drape of a tube
 // skirt against its shaped-rest drape.
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <sstream>
@@ -349,6 +351,69 @@ TEST(PatternCommand, BadInputExitsTwoWithoutFiles) {
   EXPECT_NE(ramp.output.find("/simulate/rest_ramp"), std::string::npos) << ramp.output;
   EXPECT_NE(ramp.output.find("drawn shape to the pattern"), std::string::npos) << ramp.output;
   EXPECT_FALSE(fs::exists(bad / "ramp-out"));
+}
+
+// A fabric too narrow for the pattern: the error names the widest piece (not the first too
+// wide in panel order) and the fabric width it needs with the gap at each selvedge, never a
+// piece narrower than the fabric; validate and mesh refuse the file as pattern does.
+TEST(PatternCommand, NarrowFabricNamesTheWidestPieceAndValidateRefusesIt) {
+  const fs::path dir = fresh_dir("narrow-widest");
+  fs::create_directories(dir);
+  ASSERT_EQ(
+      run_sketchdrape("pattern " + example("tshirt").string() + " -o " + (dir / "wide").string())
+          .exit_code,
+      0);
+  const auto wide = nlohmann::json::parse(read(dir / "wide/pattern.json"));
+  std::string widest;
+  double widest_mm = 0, narrowest_mm = 1e9;
+  std::map<std::string, double> width_mm;
+  for (const auto& piece : wide["pieces"]) {
+    double low = 1e9, high = -1e9;
+    for (const auto& p : piece["cutting_line"])
+      low = std::min(low, p[0].get<double>()), high = std::max(high, p[0].get<double>());
+    width_mm[piece["id"]] = high - low;
+    if (high - low > widest_mm) widest_mm = high - low, widest = piece["id"];
+    narrowest_mm = std::min(narrowest_mm, high - low);
+  }
+  ASSERT_GT(widest_mm, narrowest_mm + 20);
+  // A fabric 10 mm wider than the narrowest piece: some pieces fit, the widest does not.
+  const double fabric_m = std::ceil(narrowest_mm + 10) / 1000;
+  std::string text = read(example("tshirt"));
+  const size_t at = text.find("\"output\": {");
+  ASSERT_NE(at, std::string::npos);
+  text.insert(at + std::string("\"output\": {").size(),
+              fmt::format(" \"pattern\": {{ \"fabric_width\": {} }},", fabric_m));
+  std::ofstream(dir / "narrow.json") << text;
+  double named_mm = 0;
+  const auto check = [&](const std::string& command) {
+    const CommandResult r =
+        run_sketchdrape(command + " " + (dir / "narrow.json").string() +
+                        (command == "validate" ? "" : " -o " + (dir / "out").string()));
+    EXPECT_EQ(r.exit_code, 2) << command << ": " << r.output;
+    EXPECT_NE(r.output.find("/panels/"), std::string::npos) << r.output;
+    // The widest piece, or one as wide to 0.1 mm (a panel and its mirror copy).
+    const size_t named = r.output.find("the piece of panel '");
+    ASSERT_NE(named, std::string::npos) << r.output;
+    const std::string id =
+        r.output.substr(named + 20, r.output.find('\'', named + 20) - named - 20);
+    ASSERT_TRUE(width_mm.contains(id)) << id;
+    EXPECT_GE(width_mm[id], widest_mm - 0.1) << r.output << "\n  widest: " << widest;
+    const size_t needs = r.output.find("needs a fabric at least ");
+    ASSERT_NE(needs, std::string::npos) << r.output;
+    const double needed_mm = std::stod(r.output.substr(needs + 24));
+    EXPECT_GE(needed_mm, widest_mm + 20 - 1) << r.output;  // a 10 mm gap each side
+    EXPECT_LE(needed_mm, widest_mm + 30) << r.output;      // and the 2 mm grid's rounding
+    named_mm = needed_mm;
+    EXPECT_FALSE(fs::exists(dir / "out")) << command;
+  };
+  check("pattern");
+  check("validate");
+  check("mesh");
+  // The width it names is enough.
+  const CommandResult named =
+      run_sketchdrape("pattern " + example("tshirt").string() + " -o " + (dir / "named").string() +
+                      " --fabric-width " + std::to_string(named_mm / 1000));
+  EXPECT_EQ(named.exit_code, 0) << named.output;
 }
 
 TEST(PatternCommand, MeshWritesThePatternWhenTheFileAsksForIt) {

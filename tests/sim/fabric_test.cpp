@@ -153,6 +153,40 @@ std::string cotton_with(const std::string& key, const std::string& curve) {
          key + R"(": )" + curve + "}";
 }
 
+// A key the fabric schema does not have is refused at its pointer with the nearest known key,
+// at every level (the fabric, a constant, a tensile curve): a misspelt constant would otherwise
+// be dropped, its preset default used without a word.
+TEST(Fabric, UnknownKeysAreRefusedWithTheNearestKnownOne) {
+  const auto refusal = [](const std::string& text) {
+    try {
+      parse_fabric_json(text, "x.json");
+    } catch (const InvalidFabricError& e) {
+      return e.pointer() + " | " + e.what();
+    }
+    return std::string("no error");
+  };
+  const std::string top = refusal(cotton_with("frictoin", R"({"value": 0.5, "unit": "1"})"));
+  EXPECT_EQ(top.substr(0, top.find(" | ")), "/frictoin") << top;
+  EXPECT_NE(top.find("x.json: /frictoin: unknown key 'frictoin' (did you mean 'friction'?)"),
+            std::string::npos)
+      << top;
+  const std::string entry =
+      refusal(cotton_with("tensile_warp", R"({"strain_unit": "%", "stress_unit": "N/m",
+                                             "pionts": [[0, 0], [1, 10]]})"));
+  EXPECT_EQ(entry.substr(0, entry.find(" | ")), "/tensile_warp/pionts") << entry;
+  EXPECT_NE(entry.find("did you mean 'points'?"), std::string::npos) << entry;
+  std::string constant = cotton_with("note", R"("a note")");
+  constant.replace(constant.find(R"("unit": "N*m")"), 13, R"("unit": "N*m", "vlaue": 1)");
+  const std::string value = refusal(constant);
+  EXPECT_EQ(value.substr(0, value.find(" | ")), "/bend/vlaue") << value;
+  EXPECT_NE(value.find("did you mean 'value'?"), std::string::npos) << value;
+  // Far from every key: the known ones are listed instead.
+  const std::string far = refusal(cotton_with("colour", R"("blue")"));
+  EXPECT_NE(far.find("known keys here: name, description, note"), std::string::npos) << far;
+  // The presets' own keys (description, note, a constant's source) are known.
+  for (const std::string& name : fabric_preset_names()) EXPECT_NO_THROW(fabric_preset(name));
+}
+
 // A tensile curve in KES-F units (% strain, gf/cm) is converted to SI, and its energy, stress
 // and tangent are the integral, the piecewise-linear interpolation and the segment's slope
 // (beyond the last point the last slope continues).

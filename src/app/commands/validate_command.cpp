@@ -10,6 +10,7 @@
 #include "scene/sketch_file.hpp"
 #include "src/app/commands/cli.hpp"
 #include "src/app/pipeline/cloth_scene.hpp"
+#include "src/app/pipeline/pattern_export.hpp"
 #include "src/app/pipeline/quality_warnings.hpp"
 #include "src/app/pipeline/sketch_checks.hpp"
 
@@ -31,6 +32,12 @@ void run_validate(const ValidateOptions& options) {
   check_run_fits(
       sketch, estimate_run(sketch, scene.input.triangles, static_cast<int>(scene.start.rows()), 0),
       RunLimits{}, 0);
+  // The pattern `mesh` and `run` write when the file asks for one (output.pattern), laid out
+  // here too: a fabric too narrow for a piece is refused by validate, not after a drape.
+  if (scene.garment && sketch.output.pattern)
+    (void)build_pattern_sheet(sketch, *scene.garment, *sketch.output.pattern,
+                              scene.flat_pattern ? &*scene.flat_pattern : nullptr,
+                              scene.flattening_ms);
   std::string what;
   if (scene.garment) {
     int distortion = 0;
