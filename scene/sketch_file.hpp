@@ -60,6 +60,9 @@ struct SimulateSpec {
   // without it a preview shows the body through the cloth; off saves up to half a drape's
   // time (docs/collision.md).
   bool check_body_vertices = true;
+  // The body-vertex springs' carried push fades across their hold margin, so a spring is
+  // released at no load (ContactSettings::fade_carried_push; off by default, docs/collision.md).
+  bool fade_carried_push = false;
   // The cloth's rest shape: "shaped" (each triangle as drawn on the body) or "flat" (the
   // triangle in the panel's flattened pattern piece, docs/pattern.md). Panels may override it.
   std::string rest = "shaped";

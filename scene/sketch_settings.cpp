@@ -165,10 +165,8 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
   }
   if (j.contains("check_body_vertices"))
     sim.check_body_vertices = r.boolean(j["check_body_vertices"], path + "/check_body_vertices");
-  // Accepted and checked, but without effect since 27 November: the springs' loads are lowered
-  // within each step instead (docs/collision.md, "The carried load unloaded within the step").
   if (j.contains("fade_carried_push"))
-    (void)r.boolean(j["fade_carried_push"], path + "/fade_carried_push");
+    sim.fade_carried_push = r.boolean(j["fade_carried_push"], path + "/fade_carried_push");
   if (j.contains("rest")) {
     sim.rest = r.text(j["rest"], path + "/rest");
     if (sim.rest != "flat" && sim.rest != "shaped")

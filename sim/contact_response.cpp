@@ -75,18 +75,6 @@ constexpr double kSpringFrequency = 400.0;  // rad/s
 // (resolution dependent: a point of a finer mesh weighs less) left a body vertex 1.03 mm
 // through the t-shirt adapted to level 2.
 constexpr double kMaxSpringLoadClothWeights = 2.0;
-// A body vertex's load is the push its springs carry from step to step, raised while their points
-// end short of their targets (an augmented-Lagrangian multiplier, one update a step: an integral
-// controller). Where the points end past their targets, the load is lowered within the step
-// instead: re-solved until it is consistent with where the points end (changes below the
-// springs' stiffness times this, m), at most kMaxSpringLoadResolves times. Carried in full, the
-// push a spring built while the cloth was caught was still there when the cloth left it: a spring
-// dropped at its hold pushed (15 mN at the flat t-shirt's hem), the cloth fell back free and was
-// caught again, each cycle putting energy in (docs/collision.md, "The carried load unloaded within
-// the step"). Measured: 4 re-solves left the flat arms-lowering t-shirt moving (0.02 m/s at 6 s),
-// 8 let it rest at 4.98 s.
-constexpr double kSpringLoadTolerance = 1e-4;
-constexpr int kMaxSpringLoadResolves = 8;
 // ContactSettings::pinch_budget: a body surface facing a contact's (normals more than
 // kPinchFacingCos apart) closer than this many thicknesses along the contact's normal makes a
 // pinch, and each side's contact keeps a third of the gap g: the bands [0, g/3] of the two
@@ -232,6 +220,7 @@ void ContactResponse::reset_cloth(const Eigen::VectorXd& x, const Eigen::VectorX
   if (last_piercing_force_.size() != static_cast<std::size_t>(collider_.vertex_count()))
     last_piercing_force_.assign(static_cast<std::size_t>(collider_.vertex_count()), kNoImpulse);
   spring_body_vertex_.clear();
+  spring_past_clearance_.clear();
   spring_ends_.clear();
   // A renumbered cloth (adaptive detail's splits and merges): the held pairs named the old
   // triangles. Each follows its point on the cloth to the new triangles that hold it (a split's
@@ -585,8 +574,7 @@ void ContactResponse::spring_start_piercings(const Eigen::VectorXd& start,
   stats_.piercings_held = static_cast<int>(extra.springs.size());
 }
 
-int ContactResponse::spring_end_piercings(const Eigen::VectorXd& x1, StepForces& extra,
-                                          bool raise_held) {
+int ContactResponse::spring_end_piercings(const Eigen::VectorXd& x1, StepForces& extra) {
   int changed = 0;
   const std::size_t springs = extra.springs.size();
   for (const BodyPiercing& p : piercings_) {
@@ -600,7 +588,6 @@ int ContactResponse::spring_end_piercings(const Eigen::VectorXd& x1, StepForces&
       carried += std::max(0.0, spring.preload + spring.stiffness * (spring.target - along));
       if (spring.triangle == p.cloth_triangle) match = s;
     }
-    if (match < springs && !raise_held) continue;
     if (match < springs) {
       // Still through its spring's triangle: carry what the vertex's springs ended pushing with
       // as this one's preload (an augmented-Lagrangian update), so the next solve pushes harder
@@ -631,15 +618,15 @@ void ContactResponse::record_spring_forces(const Eigen::VectorXd& x, const StepF
     const PointSpring& spring = extra.springs[s];
     const double along = along_spring_normal(spring, cloth_.triangles[spring.triangle], x);
     double force = spring.preload + spring.stiffness * (spring.target - along);
-    // The push carried past the clearance fades to nothing across the hold margin, so a spring
-    // whose point leaves the hold is released at no load (docs/collision.md, "The hem's cycle,
-    // traced"). Carried in full, the push that built up while the cloth was caught is still
-    // there when it is dropped (15 mN of the hand's 45 at the t-shirt's hem): it pushed the cloth
-    // out, the cloth fell back free, was caught and pushed again, and every such cycle put energy
-    // in. Alone (before the loads were lowered within the step) the fade made the hooded top's
-    // neckline hunt until 8.6 s.
+    // With fade_carried_push the push carried past the clearance fades to nothing across the
+    // hold margin, so a spring whose point leaves the hold is released at no load
+    // (docs/collision.md, "The hem's cycle, traced"). Carried in full, the push that built up
+    // while the cloth was caught is still there when it is dropped (15 mN of the hand's 45 at
+    // the t-shirt's hem): it pushed the cloth out, the cloth fell back free, was caught and
+    // pushed again, and every such cycle put energy in.
     const double past = along - (spring.target - spring_past_clearance_[s]);
-    if (force > 0.0 && past > 0.0) force *= std::max(0.0, 1.0 - past / margin);
+    if (settings_.fade_carried_push && force > 0.0 && past > 0.0)
+      force *= std::max(0.0, 1.0 - past / margin);
     const std::array<int, 3>& c = cloth_.triangles[spring.triangle];
     Eigen::Vector3d point = Eigen::Vector3d::Zero();
     for (int k = 0; k < 3; ++k) point += spring.weights[k] * x.segment<3>(3 * c[k]);
@@ -706,68 +693,15 @@ int ContactResponse::constrain_deep(const Eigen::VectorXd& x0, const Eigen::Vect
   // re-solve every step and never come to rest.
   piercings_ =
       repair ? std::vector<BodyPiercing>{} : find_piercings(x1, settings_.penetration_tolerance);
-  // The loads of the springs whose points ended past their targets, unloaded to consistency
-  // within the step (re-solved until no body vertex's load changes by more than its springs'
-  // stiffness times kSpringLoadTolerance, at most kMaxSpringLoadResolves times).
-  std::vector<double> loads;
-  const int unloaded =
-      stats_.load_resolves < kMaxSpringLoadResolves ? unload_springs(x1, extra, loads) : 0;
-  if (unloaded > 0) {
-    for (std::size_t s = 0; s < loads.size(); ++s) extra.springs[s].preload = loads[s];
-    ++stats_.load_resolves;
-  }
   if ((too_deep_.empty() && piercings_.empty()) || stats_.resolves >= settings_.max_resolves)
-    return unloaded;
+    return 0;
   for (const BodyContact& c : too_deep_)
     add_contact(c, contact_thickness(c, x1), x_hat, beta, filter, y, false);
-  // A load is lowered or raised in one re-solve, not both: a vertex still through its spring's
-  // triangle has its load raised once no load around it fell (raised together, the flat
-  // arms-lowering t-shirt did not rest in 6 s: 0.03 m/s at the left arm; lowered first, at rest
-  // at 4.98 s).
-  const int springs = spring_end_piercings(x1, extra, unloaded == 0);
+  const int springs = spring_end_piercings(x1, extra);
   stats_.piercings_resolved += springs;
   const int added = static_cast<int>(too_deep_.size()) + springs;
   if (added > 0) ++stats_.resolves;
-  return added + unloaded;
-}
-
-int ContactResponse::unload_springs(const Eigen::VectorXd& x1, const StepForces& extra,
-                                    std::vector<double>& loads) const {
-  // Per body vertex (its springs share its load, stiffness and damping): the load P, the
-  // springs' stiffness k = Σ k_s and the push they end with beyond it, Σ k_s (target_s − n_s·p_s)
-  // = k e, e the stiffness-weighted mean of how far the points ended short of their targets
-  // (< 0: past them).
-  const std::size_t count = spring_body_vertex_.size();
-  loads.resize(count);
-  std::vector<std::size_t> order(count);
-  for (std::size_t s = 0; s < count; ++s) order[s] = s;
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return spring_body_vertex_[a] < spring_body_vertex_[b];
-  });
-  int changed = 0;
-  for (std::size_t first = 0, last = 0; first < count; first = last) {
-    const int vertex = spring_body_vertex_[order[first]];
-    while (last < count && spring_body_vertex_[order[last]] == vertex) ++last;
-    double load = 0.0, stiffness = 0.0, push = 0.0;  // N, N/m, N
-    for (std::size_t k = first; k < last; ++k) {
-      const PointSpring& spring = extra.springs[order[k]];
-      const double along = along_spring_normal(spring, cloth_.triangles[spring.triangle], x1);
-      load += spring.preload;
-      stiffness += spring.stiffness;
-      push += spring.stiffness * (spring.target - along);
-    }
-    // Only down: P ← max(0, P + k e) where the points ended past their targets (e < 0). Raising
-    // the load within the step too (every spring iterated to its target) drove the loads of
-    // springs that cannot reach their targets (held back by the corners' contacts, or two body
-    // parts squeezing the cloth) up to the cap within a step: the flat arms-lowering t-shirt's
-    // armpits then moved at 0.3-0.9 m/s (docs/collision.md).
-    const double next = push < 0.0 ? std::max(load + push, 0.0) : load;
-    if (load - next > stiffness * kSpringLoadTolerance) ++changed;
-    for (std::size_t k = first; k < last; ++k)
-      loads[order[k]] =
-          stiffness > 0.0 ? next * extra.springs[order[k]].stiffness / stiffness : next;
-  }
-  return changed;
+  return added;
 }
 
 void ContactResponse::finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v, const StepForces& extra) {

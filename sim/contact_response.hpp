@@ -81,6 +81,13 @@ struct ContactSettings {
   // only within the clearance. Off by default (measured: the flat capelet rests with it, but a
   // sheet hung on a cone tip is let 1.09 mm through and a sheet on a sphere rests later).
   bool spring_band = false;
+  // The push a body-vertex spring carries to the next step fades linearly to nothing across the
+  // hold margin past its clearance, so a spring whose point leaves the hold is released at no
+  // load instead of still pushing (docs/collision.md, "The hem's cycle, traced": the pump of
+  // the flat arms-lowering t-shirt's hem). Off by default (measured: the flat t-shirt, the flat
+  // sleeveless dress and the two quadratic-bending skirts rest with it, sooner, but the hooded
+  // top's neckline cycles until 8.6 s, at rest at 3.3 s without it).
+  bool fade_carried_push = false;
   // Where a second body part faces the contact's surface closer than 2.5 thicknesses along
   // its normal, across the cloth (the armpit as the arm comes down, between the thighs), each
   // side's contact keeps a third of the gap (at least `pinch_floor` thicknesses) instead of the
@@ -124,7 +131,6 @@ struct ContactStepStats {
   int contacts = 0;              // constrained contacts in the final solve
   int released = 0;              // near the body but released
   int resolves = 0;              // extra solves for vertices that ended too deep
-  int load_resolves = 0;         // extra solves for springs' loads lowered within the step
   int projected = 0;             // vertices projected out after the last solve
   int stuck = 0;                 // contacts in the stick regime (or stopped by friction)
   int repairing = 0;             // vertices still being pushed out of an intersecting start
@@ -276,15 +282,9 @@ class ContactResponse {
   // last step, become springs in `extra`.
   void spring_start_piercings(const Eigen::VectorXd& start, const Eigen::VectorXd& v0, double beta,
                               const ConstraintFilter& filter, StepForces& extra);
-  // End check: a piercing of x1 gets a spring, or (with `raise_held`) its spring's preload rises
-  // by the springs' force at x1. Returns how many changed.
-  int spring_end_piercings(const Eigen::VectorXd& x1, StepForces& extra, bool raise_held);
-  // Within the step: the loads (N, per spring of `extra`, into `loads`) of the body vertices
-  // whose springs ended x1 past their targets, lowered by their springs' stiffness times how far
-  // past (at least to 0; a load is never raised here). Returns how many body vertices' loads
-  // fell by more than their springs' stiffness times kSpringLoadTolerance.
-  int unload_springs(const Eigen::VectorXd& x1, const StepForces& extra,
-                     std::vector<double>& loads) const;
+  // End check: a piercing of x1 gets a spring, or its spring's preload rises by the springs'
+  // force at x1. Returns how many changed.
+  int spring_end_piercings(const Eigen::VectorXd& x1, StepForces& extra);
   // The force (N; negative: it ended pulling) each spring of this attempt ends with at x, to
   // carry to the next step.
   void record_spring_forces(const Eigen::VectorXd& x, const StepForces& extra);

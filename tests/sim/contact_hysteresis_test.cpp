@@ -3,15 +3,13 @@
 // the box has each contact released exactly at the step after its constraint force turned
 // adhesive (pulled the vertex towards the body by more than a tenth of its weight), never
 // before. And the body-vertex springs' band (ContactSettings::spring_band, off by default):
-// a sheet on a sphere with the check stays outside and comes to rest. And the springs' carried
-// push: it fades across the hold margin (a spring leaves its hold carrying no push), a spring
-// whose point ends past its target has its load lowered and the step solved again, and a hammock
+// a sheet on a sphere with the check stays outside and comes to rest. And the springs' fading push
+// (ContactSettings::fade_carried_push): a spring leaves its hold carrying no push, and a hammock
 // caught on a cone tip gains no energy.
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -351,19 +349,19 @@ TEST(ContactHysteresis, BodyVertexSpringsInAPinchKeepAThirdOfTheGap) {
 // off it and is caught again. The cloth's own energy (stretch, shear, bend, gravity and
 // kinetic; the pins stop at 0.3 s, the body is still) can then only fall, except by the work
 // of the contacts and springs. Measured from 0.6 s to 2 s: with the springs' carried push
-// fading across the hold margin and their loads lowered within the step (the default since
-// 27 November) it rises by 5.3e-4 J in all (a spring giving back in a step what it stored in the
-// ones before), falls by 6.1e-5 J net, and no spring is caught or dropped (3 held throughout);
-// carried in full (the push a spring built up while the cloth was caught still there when it
-// was dropped, with or without the lowering within the step) it rose by 0.026 J, by 6.2e-4 J
-// net, with 42 catches and releases: the t-shirt's hem cycle (docs/collision.md, "The hem's
-// cycle, traced").
+// fading across the hold margin (ContactSettings::fade_carried_push) it rises by 5.3e-4 J in all (a
+// spring giving back in a step what it stored in the ones before), falls by 6.1e-5 J net, and no
+// spring is caught or dropped (3 held throughout); carried in full (the push a spring built up
+// while the cloth was caught still there when it was dropped) it rose by 0.026 J, by 6.2e-4 J net,
+// with 42 catches and releases: the t-shirt's hem cycle (docs/collision.md, "The hem's cycle,
+// traced").
 TEST(ContactHysteresis, BodyVertexSpringsPutNoEnergyIntoACatchAndReleaseCycle) {
   const meshing::TriMesh cone = testing::make_cone(0.1, 0.2, 24, Vector3d(0.013, 0.0, 0.007));
   const SheetSetup s =
       horizontal_sheet(9, 0.3, {0.0, 0.201, 0.0}, fabric_preset("jersey"), {"left", "right"});
   SimulationSettings settings = box_settings(2.0);
   settings.contact.check_body_vertices = true;
+  settings.contact.fade_carried_push = true;
   constexpr double kLower = 0.04, kLowerTime = 0.3, kFrom = 0.6;  // m, s, s
   std::vector<Pin> pins;
   for (const int v : s.scene.pinned_vertices) {
@@ -428,6 +426,7 @@ TEST(ContactHysteresis, BodyVertexSpringLeavesItsHoldCarryingNoPush) {
   const double clearance = 0.5 * kThickness, margin = 0.25 * kThickness;  // 1.5 and 0.75 mm
   ContactSettings settings = box_settings(1.0).contact;
   settings.check_body_vertices = true;
+  settings.fade_carried_push = true;
   for (const double past : {0.0, 0.5 * margin, 0.98 * margin}) {
     ContactResponse response(lid, settings);
     response.set_cloth_triangles(s.model);
@@ -478,85 +477,6 @@ TEST(ContactHysteresis, BodyVertexSpringLeavesItsHoldCarryingNoPush) {
     }
     if (past > 0.9 * margin) {
       EXPECT_LT(carried, 0.05 * second);
-    }
-  }
-}
-
-// A body vertex's load is lowered within the step where its springs' points end past their
-// targets: the step is solved again with the load each body vertex's springs ended with
-// (P + Σ k_s (target_s − n·p_s), at least 0), until it no longer falls. A lid's corners 1 mm
-// through a sheet (the body vertices), the sheet moved rigidly as if solved: a first step ending 1
-// mm short of the clearance builds a push; in the next, a solve that ends d past the targets asks
-// for a re-solve with each vertex's load lowered by its springs' stiffness times d (to 0 when
-// that is more than the load), and one that ends at the targets asks for none. Carried in time
-// only (before 27 November), a point past its target left its load as it was for the rest of the
-// step, and the end check asked for no re-solve (docs/collision.md, "The carried load unloaded
-// within the step").
-TEST(ContactHysteresis, BodyVertexSpringLoadIsLoweredWithinTheStep) {
-  const meshing::TriMesh lid = testing::make_box({0.005, -0.001, 0.005}, {0.025, 0.02, 0.025});
-  const SheetSetup s = horizontal_sheet(8, 0.3, {0.0, 0.0, 0.0});
-  const Eigen::VectorXd x = flatten_positions(s.scene.input.rest_positions);
-  const Eigen::VectorXd still = Eigen::VectorXd::Zero(x.size());
-  const auto lowered = [&](double dy) {  // the sheet moved down by dy (m)
-    Eigen::VectorXd moved = x;
-    for (Eigen::Index i = 0; i < moved.size() / 3; ++i) moved[3 * i + 1] -= dy;
-    return moved;
-  };
-  const double clearance = 0.5 * kThickness;  // 1.5 mm
-  const double target = 0.001 + clearance;    // the targets lie 2.5 mm below the sheet's start
-  ContactSettings settings = box_settings(1.0).contact;
-  settings.check_body_vertices = true;
-  constexpr double kBeta = 1.0 / 60.0;
-  for (const double past : {0.0, 0.0002, 0.0005, 0.003}) {
-    ContactResponse response(lid, settings);
-    response.set_cloth_triangles(s.model);
-    response.reset_cloth(x, s.model.mass, 9.81);
-    // The first step, from x ending 1 mm short of the targets: a push of k × 1 mm to carry.
-    ConstraintFilter filter(s.model.vertex_count);
-    Eigen::VectorXd y;
-    StepForces extra;
-    response.constrain_start(x, still, kBeta, filter, y, extra);
-    ASSERT_GE(extra.springs.size(), 4u);  // the lid's four bottom corners
-    Eigen::VectorXd end = lowered(target - 0.001), v = still;
-    response.finish_step(end, v, extra);
-    response.accept_step(Eigen::VectorXd());
-    // The second step: its springs carry that push; its solve ends `past` beyond the targets.
-    ConstraintFilter second(s.model.vertex_count);
-    StepForces held;
-    response.constrain_start(end, still, kBeta, second, y, held);
-    ASSERT_GE(held.springs.size(), 4u);
-    std::vector<double> expected;  // per spring: its load less its own stiffness times `past`
-    double stiffness = 0.0, before = 0.0;
-    for (const PointSpring& spring : held.springs) {
-      ASSERT_NEAR(spring.normal.y(), -1.0, 1e-12);  // pushing the cloth down, off the lid
-      const std::array<int, 3>& t = s.model.triangles[spring.triangle].vertices;
-      ASSERT_NEAR(spring.target - along_spring_normal(spring, t, lowered(target)), 0.0, 1e-12);
-      expected.push_back(std::max(spring.preload - spring.stiffness * past, 0.0));
-      stiffness += spring.stiffness;
-      before += spring.preload;
-    }
-    ASSERT_GT(before, 0.0);
-    const Eigen::VectorXd x_hat = end;
-    const int resolves =
-        response.constrain_deep(end, lowered(target + past), x_hat, kBeta, second, y, held);
-    std::printf("ended %.1f mm past the targets carrying %.1f mN: %d load(s) lowered\n", 1e3 * past,
-                1e3 * before, resolves);
-    if (past == 0.0) {
-      EXPECT_EQ(resolves, 0);  // consistent: nothing to solve again
-      continue;
-    }
-    EXPECT_GT(resolves, 0);
-    EXPECT_EQ(response.step_stats().load_resolves, 1);
-    double after = 0.0;
-    for (std::size_t k = 0; k < held.springs.size(); ++k) {
-      EXPECT_LE(held.springs[k].preload, expected[k] + stiffness * past);  // never raised
-      after += held.springs[k].preload;
-    }
-    // Each corner's load falls by its springs' stiffness times `past`, to 0 at most; the push
-    // (about 59 mN a corner) is far more than 16 N/m × 0.5 mm, so only the 3 mm step empties it.
-    EXPECT_NEAR(after, past < 0.003 ? before - stiffness * past : 0.0, 1e-9 * before);
-    if (past >= 0.003) {
-      EXPECT_EQ(after, 0.0);  // more than the whole push: unloaded
     }
   }
 }

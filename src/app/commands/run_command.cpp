@@ -252,9 +252,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
                           {"released", c.released},
                           {"stuck", c.stuck},
                           {"body_vertex_springs", c.piercings_held},
-                          {"body_vertex_springs_added", c.piercings_resolved},
-                          {"resolves", c.resolves},
-                          {"load_resolves", c.load_resolves}};
+                          {"body_vertex_springs_added", c.piercings_resolved}};
     }
     line["self_contacts"] = r.self_contacts_final;
     trace += line.dump() + "\n";

@@ -336,6 +336,7 @@ sim::SimulationSettings simulation_settings(const scene::Sketch& sketch) {
   settings.stop_at_rest = spec.stop_at_rest;
   settings.forces.gravity = spec.gravity;
   settings.contact.check_body_vertices = spec.check_body_vertices;
+  settings.contact.fade_carried_push = spec.fade_carried_push;
   // Garments fold onto themselves (a skirt's front and back, a sleeve); a sheet scene asks.
   settings.self_contact.enabled = spec.self_collision.value_or(!sketch.sheet.has_value());
   try {
