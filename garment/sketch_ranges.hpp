@@ -38,6 +38,8 @@ inline constexpr std::uintmax_t kMaxMeshFileBytes = 512'000'000;   // a body or 
 // output.pattern.fabric_width and `pattern --fabric-width`: a strip of trim to a wide sheeting.
 inline constexpr double kMinFabricWidth = 0.1;   // m
 inline constexpr double kMaxFabricWidth = 10.0;  // m
+// A seam allowance (a curve's, a panel's or the pattern's), metres: 10 cm is a deep hem.
+inline constexpr double kMaxSeamAllowance = 0.1;
 
 // Relative to the body (once it is loaded).
 // Points may lie this many body heights outside the body's bounding box (a flared hem, a cape).

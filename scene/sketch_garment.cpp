@@ -213,9 +213,10 @@ CurveSpec parse_curve(const Reader& r, const json& j, const std::string& path, c
   }
   if (j.contains("seam_allowance")) {
     curve.seam_allowance = r.number(j["seam_allowance"], path + "/seam_allowance");
-    if (*curve.seam_allowance < 0 || *curve.seam_allowance > 0.1)
+    if (*curve.seam_allowance < 0 || *curve.seam_allowance > kMaxSeamAllowance)
       r.fail(path + "/seam_allowance",
-             fmt::format("seam allowance {} m is outside 0 .. 0.1 m", *curve.seam_allowance));
+             out_of_range_sentence(*curve.seam_allowance, 0, kMaxSeamAllowance,
+                                   "a seam allowance of"));
   }
   // Repeated consecutive points make a stroke without direction there.
   const size_t n = has_2d ? curve.points.size() : curve.points3d.size();
@@ -346,9 +347,10 @@ PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, c
   }
   if (j.contains("seam_allowance")) {
     panel.seam_allowance = r.number(j["seam_allowance"], path + "/seam_allowance");
-    if (*panel.seam_allowance < 0 || *panel.seam_allowance > 0.1)
+    if (*panel.seam_allowance < 0 || *panel.seam_allowance > kMaxSeamAllowance)
       r.fail(path + "/seam_allowance",
-             fmt::format("seam allowance {} m is outside 0 .. 0.1 m", *panel.seam_allowance));
+             out_of_range_sentence(*panel.seam_allowance, 0, kMaxSeamAllowance,
+                                   "a seam allowance of"));
   }
   if (j.contains("fit")) {
     const std::string fit = r.text(j["fit"], path + "/fit");

@@ -86,9 +86,10 @@ void parse_pattern(const Reader& r, const json& j, OutputSpec& out) {
   }
   if (j.contains("seam_allowance")) {
     spec.seam_allowance = r.number(j["seam_allowance"], path + "/seam_allowance");
-    if (spec.seam_allowance < 0 || spec.seam_allowance > 0.1)
-      r.fail(path + "/seam_allowance",
-             fmt::format("seam allowance {} m is outside 0 .. 0.1 m", spec.seam_allowance));
+    if (spec.seam_allowance < 0 || spec.seam_allowance > kMaxSeamAllowance)
+      r.fail(
+          path + "/seam_allowance",
+          out_of_range_sentence(spec.seam_allowance, 0, kMaxSeamAllowance, "a seam allowance of"));
   }
   if (j.contains("max_stretch"))
     spec.max_stretch = r.positive(j["max_stretch"], path + "/max_stretch");
