@@ -135,6 +135,13 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   if (const auto before = estimate_before_building(sketch, options.frames_per_second))
     check_run_fits(sketch, *before, limits, options.frames_per_second);
   const ClothScene scene = build_cloth_scene(sketch);
+  // The pattern does not depend on the drape: laid out first, so that a piece wider than the
+  // fabric is refused before the drape's time is spent, not after it.
+  std::optional<PatternSheet> pattern_sheet;
+  if (scene.garment && sketch.output.pattern)
+    pattern_sheet = build_pattern_sheet(sketch, *scene.garment, *sketch.output.pattern,
+                                        scene.flat_pattern ? &*scene.flat_pattern : nullptr,
+                                        scene.flattening_ms);
   // "solver"/"time_step": "auto" (the defaults): chosen now that the scene's size is known.
   const sim::AutomaticChoice automatic =
       apply_automatic_settings(sketch, scene, settings, options.frames_per_second > 0.0);
@@ -440,12 +447,9 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   out.compression = sim::compression_name(scene.compression);
   out.cusick = cusick_json(sketch, draped);
   out.rest_shape = flat_rest ? (scene.bend_rest_flat ? "flat" : "flat and shaped") : "shaped";
-  if (scene.garment && sketch.output.pattern) {
-    const PatternSheet sheet = build_pattern_sheet(
-        sketch, *scene.garment, *sketch.output.pattern,
-        scene.flat_pattern ? &*scene.flat_pattern : nullptr, scene.flattening_ms);
-    stage_pattern(sheet, dir, outputs);
-    out.pattern = pattern_summary(sheet);
+  if (pattern_sheet) {
+    stage_pattern(*pattern_sheet, dir, outputs);
+    out.pattern = pattern_summary(*pattern_sheet);
   }
   // How deep the draped cloth dents between supports (a skirt pulled between the legs).
   if (scene.garment) out.slice_dent = meshing::slice_dent(draped);
