@@ -86,20 +86,34 @@ void run_info(const InfoOptions& options) {
     out["landmarks"] = nullptr;
     out["landmarks_problem"] = landmark_problem;
   }
+  // Which part of the figure an outline of the slice at height y is: the one spanning x = 0 is
+  // the torso (the head above the neck's base); beside it, arms above the crotch and legs below.
+  // Without landmarks only the side is known.
+  const auto part_of = [&](const garment::SliceOutline& o, double y) -> std::string {
+    const garment::Landmark* crotch = landmarks ? landmarks->find("crotch") : nullptr;
+    const garment::Landmark* neck = landmarks ? landmarks->find("neck_base") : nullptr;
+    if (o.min.x() <= 0 && o.max.x() >= 0) return neck && y > neck->position.y() ? "head" : "torso";
+    const std::string side = o.centroid.x() > 0 ? "left" : "right";
+    if (!crotch) return side + " side";
+    return side + (y < crotch->position.y() ? " leg" : " arm");
+  };
   nlohmann::json slices = nlohmann::json::array();
   std::string slice_text;
   for (const double y : options.slices) {
     nlohmann::json outlines = nlohmann::json::array();
     slice_text += fmt::format("slice y = {:.3f} m:\n", y);
     for (const garment::SliceOutline& o : garment::slice_body(body.mesh, y)) {
-      outlines.push_back({{"centroid", {o.centroid.x(), o.centroid.y(), o.centroid.z()}},
+      const std::string part = part_of(o, y);
+      outlines.push_back({{"part", part},
+                          {"centroid", {o.centroid.x(), o.centroid.y(), o.centroid.z()}},
                           {"x", {o.min.x(), o.max.x()}},
                           {"z", {o.min.z(), o.max.z()}},
                           {"girth", o.girth}});
       slice_text += fmt::format(
-          "  outline x {:.3f} .. {:.3f}, z {:.3f} .. {:.3f} m, centre ({:.3f}, "
+          "  {:<10} x {:.3f} .. {:.3f}, z {:.3f} .. {:.3f} m, centre ({:.3f}, "
           "{:.3f}), girth {:.3f} m\n",
-          o.min.x(), o.max.x(), o.min.z(), o.max.z(), o.centroid.x(), o.centroid.z(), o.girth);
+          part, o.min.x(), o.max.x(), o.min.z(), o.max.z(), o.centroid.x(), o.centroid.z(),
+          o.girth);
     }
     slices.push_back({{"y", y}, {"outlines", outlines}});
   }
