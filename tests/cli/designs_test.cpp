@@ -11,9 +11,11 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include "src/render/image.hpp"
 #include "tests/cli/run_command.hpp"
 
 namespace sd::test {
@@ -214,7 +216,22 @@ TEST(DesignDrapeFailure, SaysWhereAndWritesTheLastState) {
   EXPECT_NE(ran.output.find(", near the "), std::string::npos) << ran.output;
   EXPECT_NE(ran.output.find("m/s (limit 50)"), std::string::npos) << ran.output;
   EXPECT_TRUE(fs::exists(dir / "run" / "drape-failed.obj"));
-  EXPECT_TRUE(fs::exists(dir / "run" / "drape-failed-back.png"));
+  // The place is marked in red (a hue no panel colour, skin or shadow has) in the views that see
+  // it.
+  int red_pixels = 0;
+  for (const char* view : {"front", "back", "left", "right"}) {
+    const fs::path png = dir / "run" / (std::string("drape-failed-") + view + ".png");
+    ASSERT_TRUE(fs::exists(png)) << png;
+    std::ifstream in(png, std::ios::binary);
+    std::stringstream bytes;
+    bytes << in.rdbuf();
+    const render::Image image = render::decode_png(bytes.str());
+    for (size_t i = 0; i + 3 < image.rgba.size(); i += 4) {
+      const int r = image.rgba[i], g = image.rgba[i + 1], b = image.rgba[i + 2];
+      if (r > 80 && r > 5 * g / 2 && r > 5 * b / 2) ++red_pixels;
+    }
+  }
+  EXPECT_GT(red_pixels, 100);
   EXPECT_FALSE(fs::exists(dir / "run" / "report.json"));  // no drape, so no run report
   fs::remove_all(dir);
 }

@@ -194,7 +194,7 @@ void run_mesh(const MeshOptions& options) {
     Eigen::VectorXi tri_panel(2 * g.face_panel.size());
     for (Eigen::Index f = 0; f < g.face_panel.size(); ++f)
       tri_panel(2 * f) = tri_panel(2 * f + 1) = g.face_panel(f);
-    const PreviewCloth preview{cloth, tri_panel, render::quad_edges(g.mesh.faces), {}};
+    const PreviewCloth preview{cloth, tri_panel, render::quad_edges(g.mesh.faces), {}, {}};
     stage_preview_images(sketch.output.images, sketch.output.wireframe, &body.mesh, preview,
                          "garment", dir, outputs);
   }

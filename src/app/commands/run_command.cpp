@@ -340,7 +340,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   progress.finish();
   if (report.failed) {
     // Where and why, and the last accepted state to look at: drape-failed.obj and images with
-    // a marker (an octahedron 5 cm across, in a colour of its own) where it broke, seen from the
+    // a marker (a red octahedron 10 cm across) where it broke, seen from the
     // four sides (the place may face any way).
     const int v = report.failure_vertex;
     const bool located = v >= 0 && v < draped.vertices.rows();
@@ -360,22 +360,15 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
         // Not a standing figure: the place is given without a landmark.
       }
     }
-    meshing::TriMesh marked = draped;
-    Eigen::VectorXi marked_group(draped.faces.rows() + 8);
-    marked_group << triangle_group,
-        Eigen::VectorXi::Constant(8, static_cast<int>(scene.group_names.size()));
-    const Eigen::Index base = marked.vertices.rows();
-    marked.vertices.conservativeResize(base + 6, 3);
-    marked.faces.conservativeResize(marked.faces.rows() + 8, 3);
-    const double r = 0.025;
+    // Red and 10 cm across, so that it shows through a sleeve or a skirt round the place.
+    meshing::TriMesh marker;
+    marker.vertices.resize(6, 3);
+    marker.faces.resize(8, 3);
+    const double r = 0.05;
     const Eigen::Vector3d axes[6] = {{r, 0, 0},  {-r, 0, 0}, {0, 0, r},
                                      {0, 0, -r}, {0, r, 0},  {0, -r, 0}};
-    for (int k = 0; k < 6; ++k) marked.vertices.row(base + k) = (where + axes[k]).transpose();
-    const int corners[8][3] = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
-                               {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
-    for (int f = 0; f < 8; ++f)
-      marked.faces.row(draped.faces.rows() + f) << static_cast<int>(base) + corners[f][0],
-          static_cast<int>(base) + corners[f][1], static_cast<int>(base) + corners[f][2];
+    for (int k = 0; k < 6; ++k) marker.vertices.row(k) = (where + axes[k]).transpose();
+    marker.faces << 0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5;
     StagedOutputs failed_outputs;
     failed_outputs.stage(dir / "drape-failed.obj",
                          to_obj({draped.vertices, draped.faces,
@@ -394,7 +387,8 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
       sides.push_back(image);
     }
     stage_preview_images(sides, false, body_now ? &*body_now : nullptr,
-                         {marked, marked_group, {}, {}}, "drape-failed", dir, failed_outputs);
+                         {draped, triangle_group, {}, {}, marker}, "drape-failed", dir,
+                         failed_outputs);
     failed_outputs.commit();
     throw std::runtime_error(fmt::format(
         "the simulation failed at t = {:.3f} s in panel '{}' at ({:.3f}, {:.3f}, {:.3f}) m{}: {}; "
@@ -416,7 +410,8 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   // The body as it stands at the end (its last pose when it moves).
   const std::optional<meshing::TriMesh> body_end =
       scene.body ? std::optional(body_at(scene, report.sim_time)) : std::nullopt;
-  const PreviewCloth preview{draped, triangle_group, render::triangle_edges(draped), face_levels};
+  const PreviewCloth preview{
+      draped, triangle_group, render::triangle_edges(draped), face_levels, {}};
   const std::vector<scene::ImageSpec> image_specs = run_images(sketch);
   const std::vector<std::string> images =
       stage_preview_images(image_specs, sketch.output.wireframe, body_end ? &*body_end : nullptr,
@@ -429,7 +424,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
     const std::optional<meshing::TriMesh> body =
         scene.body ? std::optional(body_at(scene, frames[i].time)) : std::nullopt;
     stage_preview_images(frame_image, false, body ? &*body : nullptr,
-                         {frames[i].cloth, frames[i].triangle_group, {}, {}},
+                         {frames[i].cloth, frames[i].triangle_group, {}, {}, {}},
                          fmt::format("frame-{:04d}", i), dir / "frames", outputs);
   }
   const double image_s = std::chrono::duration<double>(Clock::now() - image_start).count();

@@ -31,6 +31,12 @@ render::Scene preview_scene(const meshing::TriMesh* body, const PreviewCloth& cl
     }
     scene.meshes.back().wireframe = wire;
   }
+  if (cloth.marker.face_count() > 0) {
+    render::SceneMesh& marker = scene.meshes.emplace_back();
+    marker.mesh = cloth.marker;
+    marker.role = render::MeshRole::kCloth;
+    marker.colour = marker.back_colour = {0.85f, 0.1f, 0.1f};
+  }
   return scene;
 }
 

@@ -17,6 +17,7 @@ struct PreviewCloth {
   Eigen::VectorXi face_panel;   // #F panel (colour) index, or empty for one colour
   Eigen::MatrixX2i wire_edges;  // #E by 2 edges drawn when a wireframe is asked for
   Eigen::VectorXd face_levels;  // optional #F values (4-8 levels) colouring the wireframe
+  meshing::TriMesh marker;      // optional, drawn in red over the cloth (where a drape failed)
 };
 
 // Renders each image of `images` (one GL context for all) and stages it as
