@@ -1,9 +1,9 @@
 #pragma once
 // Where a meshed garment passes through itself: pairs of its triangles (each quad split along
 // one diagonal) that intersect, grouped by the pair of panels they belong to. The simulator
-// separates such a start by smoothing and stops before that stretches the cloth past half its
-// strain limit (docs/collision.md, "An untangled start"), so crossings a designer left in the
-// sketch stay through each other for the whole drape: the quality gate names them.
+// separates such a start by smoothing and stops before that stretches the cloth past twice its
+// strain limit (docs/collision.md, "An untangled start"), and crossings it cannot separate stay
+// through each other for the whole drape: the quality gate names them.
 
 #include <Eigen/Core>
 #include <vector>

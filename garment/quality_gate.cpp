@@ -210,10 +210,10 @@ std::vector<QualityWarning> check_quality(const Garment& garment, const GarmentR
     q.where = c.where;
     if (landmarks != nullptr) q.landmark = landmarks->nearest(c.where).name;
     q.message = fmt::format(
-        "panel '{}': {} ({} pair(s) of triangles cross); the drape pulls them apart only as "
-        "far as it can without stretching the cloth by half its strain limit, and the rest "
-        "stays through each other: smooth the curves "
-        "there, open a narrow angle between them or list it in \"corners\", so that the quads "
+        "panel '{}': {} ({} pair(s) of triangles cross); the drape smooths them apart only "
+        "while that stretches the cloth less than twice its strain limit, else they stay "
+        "through each other: smooth the curves there, open a narrow angle between them or list it "
+        "in \"corners\", so that the quads "
         "are not slivers folded over their neighbours; {}",
         named.id,
         c.panel_a == c.panel_b ? std::string("passes through itself")
