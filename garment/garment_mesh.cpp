@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <functional>
 #include <map>
 #include <numeric>
 #include <optional>
@@ -14,6 +15,7 @@
 #include <unordered_map>
 #include <utility>
 
+#include "garment/body_landmarks.hpp"
 #include "garment/curve_network.hpp"
 #include "garment/edge_counts.hpp"
 #include "garment/fold_repair.hpp"
@@ -200,6 +202,9 @@ class BoundaryVertices {
     p.row(p.rows() - 1) = net_.nodes[static_cast<size_t>(edge.to)].transpose();
     return p;
   }
+
+  // The pool ids of points(e) if they were placed, else an empty list (adds nothing).
+  const std::vector<int>& placed_ids(int e) const { return edge_ids_[static_cast<size_t>(e)]; }
 
   // The pool ids of points(e), the end nodes shared with the pieces that meet there.
   const std::vector<int>& ids(int e) {
@@ -500,26 +505,60 @@ void check_fans(const GarmentRequest& sketch, const Garment& garment,
 }
 
 // ... and the two panels of a seam run it in opposite directions; counts the seam edges.
-void check_seam_directions(const GarmentRequest& sketch,
-                           const std::vector<std::array<int, 4>>& faces,
-                           const std::vector<int>& face_panel, Garment& garment) {
-  // Seams must be traversed in opposite directions by their two panels.
+// `curve_of` names the sketch curve a boundary edge (a, b) of the pool lies on, "" if none.
+void check_seam_directions(const GarmentRequest& sketch, const BodySurface& body,
+                           const VertexPool& pool, const std::vector<std::array<int, 4>>& faces,
+                           const std::vector<int>& face_panel,
+                           const std::function<std::string(int, int)>& curve_of, Garment& garment) {
+  // Seams must be traversed in opposite directions by their two panels. A pair of panels that
+  // run one the same way has one surface turned over: every such edge is collected, so that the
+  // message names the curves and the place (the mean of their midpoints) for the designer.
   std::map<std::pair<int, int>, std::pair<int, int>> directed;  // (a, b) → (face, count)
+  std::optional<std::pair<int, int>> clash;                     // the first panel pair
+  std::set<std::string> curves;
+  Eigen::Vector3d where = Eigen::Vector3d::Zero();
+  int clashing = 0;
   for (size_t f = 0; f < faces.size(); ++f)
     for (int k = 0; k < 4; ++k) {
       const int a = faces[f][static_cast<size_t>(k)],
                 b = faces[f][static_cast<size_t>((k + 1) % 4)];
       auto [it, inserted] = directed.try_emplace({a, b}, static_cast<int>(f), 0);
-      if (!inserted) {
-        const GarmentPanel& p1 =
-            garment.panels[static_cast<size_t>(face_panel[static_cast<size_t>(it->second.first)])];
-        const GarmentPanel& p2 = garment.panels[static_cast<size_t>(face_panel[f])];
-        sketch.fail("/panels",
-                    fmt::format("panels '{}' and '{}' face opposite ways along their shared seam; "
-                                "check that both lie on the same side of the body",
-                                p1.id, p2.id));
-      }
+      if (inserted) continue;
+      const std::pair<int, int> panels{face_panel[static_cast<size_t>(it->second.first)],
+                                       face_panel[f]};
+      if (!clash) clash = panels;
+      if (panels != *clash) continue;
+      const std::string curve = curve_of(a, b);
+      if (!curve.empty()) curves.insert(curve);
+      where +=
+          0.5 * (pool.positions[static_cast<size_t>(a)] + pool.positions[static_cast<size_t>(b)]);
+      ++clashing;
     }
+  if (clash) {
+    const GarmentPanel& p1 = garment.panels[static_cast<size_t>(clash->first)];
+    const GarmentPanel& p2 = garment.panels[static_cast<size_t>(clash->second)];
+    where /= std::max(clashing, 1);
+    std::string along = "their shared seam";
+    if (!curves.empty()) {
+      along = curves.size() == 1 ? "their shared curve " : "their shared curves ";
+      bool first = true;
+      for (const std::string& c : curves) along += (first ? "'" : ", '") + c + "'", first = false;
+    }
+    std::string near;
+    try {  // a body that is not a standing figure has no landmarks: the point alone then
+      near = fmt::format(", near the {}", find_landmarks(body.mesh()).nearest(where).name);
+    } catch (const std::exception&) {
+    }
+    sketch.fail(
+        "/panels",
+        fmt::format("panels '{}' and '{}' face opposite ways along {} ({} seam edge(s), around "
+                    "({:.3f}, {:.3f}, {:.3f}) m{}): one of them covers the other side of the body "
+                    "from the one meant (a sleeve half between curves on opposite sides of the "
+                    "arm can span its front or its back). Add a curve along the middle of the "
+                    "side that panel should cover and split it there (each piece then covers "
+                    "less than half the limb), or move its curves",
+                    p1.id, p2.id, along, clashing, where.x(), where.y(), where.z(), near));
+  }
   for (const auto& [edge, face] : directed)
     if (edge.first < edge.second && directed.contains({edge.second, edge.first}) &&
         face_panel[static_cast<size_t>(face.first)] !=
@@ -733,7 +772,16 @@ Garment build_garment(const GarmentRequest& sketch, const BodySurface& body) {
                         garment);
   assemble_mesh(faces, face_panel, pool, garment);
   check_fans(sketch, garment, faces, face_panel, pool);
-  check_seam_directions(sketch, faces, face_panel, garment);
+  const auto curve_of = [&](int a, int b) -> std::string {
+    for (size_t e = 0; e < net.edges.size(); ++e) {
+      const std::vector<int>& ids = boundary.placed_ids(static_cast<int>(e));
+      for (size_t k = 0; k + 1 < ids.size(); ++k)
+        if ((ids[k] == a && ids[k + 1] == b) || (ids[k] == b && ids[k + 1] == a))
+          return net.curves[static_cast<size_t>(net.edges[e].curve)].id;
+    }
+    return "";
+  };
+  check_seam_directions(sketch, body, pool, faces, face_panel, curve_of, garment);
   label_panels(sketch, body, faces, face_panel, pool, garment);
   garment.parity_changes = static_cast<int>(counts.changed.size());
   for (const auto& u : users) garment.curve_pieces += u.empty() ? 0 : 1;

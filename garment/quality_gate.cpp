@@ -13,6 +13,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include "garment/garment_crossings.hpp"
+
 namespace sd::garment {
 namespace {
 
@@ -190,6 +192,34 @@ std::vector<QualityWarning> check_quality(const Garment& garment, const GarmentR
                          ? "larger than asked, where the filler's layout widens between sides "
                            "of different edge counts"
                          : "smaller than asked, where the panel narrows towards a short side"));
+  }
+  // Panels that pass through themselves or each other: the drape cannot separate them without
+  // stretching the cloth (docs/collision.md, "An untangled start"), so they stay crossed. The
+  // Collada long-sleeve top's sleeve_b crossed itself in 110 triangle pairs near the elbow.
+  for (const PanelCrossing& c : find_panel_crossings(garment)) {
+    const GarmentPanel& a = garment.panels[static_cast<size_t>(c.panel_a)];
+    const GarmentPanel& b = garment.panels[static_cast<size_t>(c.panel_b)];
+    if (a.mirror_copy && b.mirror_copy) continue;  // the original's warning holds for the copy
+    const GarmentPanel& named = a.mirror_copy ? b : a;
+    const GarmentPanel& other = a.mirror_copy ? a : b;
+    QualityWarning q;
+    q.panel = named.id;
+    q.kind = "self_intersection";
+    q.count = c.pairs;
+    q.worst = static_cast<double>(c.pairs);
+    q.where = c.where;
+    if (landmarks != nullptr) q.landmark = landmarks->nearest(c.where).name;
+    q.message = fmt::format(
+        "panel '{}': {} ({} pair(s) of triangles cross); the drape smooths them apart only "
+        "while that stretches the cloth less than twice its strain limit, else they stay "
+        "through each other: smooth the curves there, open a narrow angle between them or list it "
+        "in \"corners\", so that the quads "
+        "are not slivers folded over their neighbours; {}",
+        named.id,
+        c.panel_a == c.panel_b ? std::string("passes through itself")
+                               : fmt::format("passes through panel '{}'", other.id),
+        c.pairs, place(c.where, q.landmark));
+    warnings.push_back(std::move(q));
   }
   return warnings;
 }

@@ -26,7 +26,7 @@ struct QualityLimits {
 struct QualityWarning {
   std::string panel;
   std::string kind;    // "inverted_quads", "min_angle", "aspect_ratio", "near_vertices",
-                       // "quad_size"
+                       // "quad_size", "self_intersection" (count: crossing triangle pairs)
   int count = 0;       // quads (or vertex pairs) of that kind in the panel
   double worst = 0.0;  // the worst value (degrees, ratio, metres, or size / edge_length)
   Eigen::Vector3d where = Eigen::Vector3d::Zero();  // m, the worst place

@@ -9,6 +9,8 @@
 #include <unordered_map>
 #include <utility>
 
+#include "sim/forces.hpp"
+
 namespace sd::sim {
 namespace {
 
@@ -172,7 +174,7 @@ void SelfContactResponse::set_cloth(const ClothModel& model, const Eigen::Vector
 
 int SelfContactResponse::untangle(const ClothModel& model, Eigen::VectorXd& x,
                                   const std::vector<unsigned char>& pinned, int* found,
-                                  int* remaining) {
+                                  int* remaining, double max_strain, Eigen::Vector3d* where) {
   const int n = model.vertex_count;
   std::vector<std::vector<int>> neighbours(static_cast<std::size_t>(n));
   for (const TriangleElement& t : model.triangles)
@@ -184,6 +186,9 @@ int SelfContactResponse::untangle(const ClothModel& model, Eigen::VectorXd& x,
   std::vector<std::array<int, 2>> pairs = collider_.find_intersections(x);
   if (found != nullptr) *found = static_cast<int>(pairs.size());
   constexpr int kRounds = 120;
+  // A start already stretched (a sheet's designed pre-strain) keeps its own strain as the bound.
+  if (!pairs.empty() && std::isfinite(max_strain))
+    max_strain = std::max(max_strain, max_stretch_strain(model, x));
   for (int round = 0; round < kRounds && !pairs.empty(); ++round) {
     // The region: the intersecting triangles' vertices, grown by a ring every 12 rounds. One
     // sweep per round and a check after it: the start moves as little as it can (5 sweeps a
@@ -207,17 +212,34 @@ int SelfContactResponse::untangle(const ClothModel& model, Eigen::VectorXd& x,
             region.push_back(w);
           }
     }
+    const Eigen::VectorXd before = x;
+    std::vector<int> round_moved;
     for (int v : region) {
       if ((!pinned.empty() && pinned[v] != 0) || neighbours[v].empty()) continue;
       Eigen::Vector3d mean = Eigen::Vector3d::Zero();
       for (int w : neighbours[v]) mean += row(x, w);
       mean /= static_cast<double>(neighbours[v].size());
       x.segment<3>(3 * v) = 0.5 * (row(x, v) + mean);
-      moved[v] = 1;
+      round_moved.push_back(v);
     }
+    // The start's strain bound: a designed start is its rest shape (strain 0), and the first
+    // step is rejected above the simulator's limit whatever its length, so a round that passes
+    // the bound is undone and the pairs left stay as designed.
+    if (std::isfinite(max_strain) && max_stretch_strain(model, x) > max_strain) {
+      x = before;
+      break;
+    }
+    for (int v : round_moved) moved[v] = 1;
     pairs = collider_.find_intersections(x);
   }
   if (remaining != nullptr) *remaining = static_cast<int>(pairs.size());
+  if (where != nullptr) {  // the first pair's centre (a mean over both sleeves of a mirrored
+                           // garment would lie between them)
+    *where = Eigen::Vector3d::Zero();
+    if (!pairs.empty())
+      for (int t : pairs.front())
+        for (int v : model.triangles[t].vertices) *where += row(x, v) / 6.0;
+  }
   return static_cast<int>(std::count(moved.begin(), moved.end(), 1));
 }
 

@@ -30,6 +30,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstddef>
+#include <limits>
 #include <unordered_map>
 #include <vector>
 
@@ -84,9 +85,17 @@ class SelfContactResponse {
   // the intersecting triangles and their neighbours are smoothed (each moved halfway to the mean
   // of its neighbours, pinned ones kept) in growing rings until no pair intersects, at most 120
   // rounds. Returns the vertices moved; `found`: pairs at the start, `remaining`: after.
+  // A round that would stretch a triangle beyond `max_strain` (the simulator's stretch measure,
+  // max_stretch_strain) is undone and the untangling stops there, leaving the pairs it could not
+  // separate: smoothing a crumpled region with sliver quads (a corner of 0.1°) stretched the
+  // Collada top's sleeve by 761 %, every first step was rejected for its strain down to the
+  // minimum step, and the drape failed with a push-out speed of 90 m/s (docs/collision.md,
+  // "An untangled start"). `where` (optional): the centre of one pair left, m.
   int untangle(const ClothModel& model, Eigen::VectorXd& x,
                const std::vector<unsigned char>& pinned, int* found = nullptr,
-               int* remaining = nullptr);
+               int* remaining = nullptr,
+               double max_strain = std::numeric_limits<double>::infinity(),
+               Eigen::Vector3d* where = nullptr);
 
   // Steps 1 and 2: springs of the pairs closer than the thickness at `start` (3n) into extra,
   // each pushing its pair a tenth of the way to the thickness; with `velocity` (3n, the step's

@@ -70,6 +70,60 @@ TEST(QualityGate, SliversLongQuadsAndNearVerticesAreNamed) {
   EXPECT_EQ(find_kind(warnings, "inverted_quads"), nullptr);
 }
 
+// Panels that pass through each other or themselves at the start stay so in the drape (the
+// simulator's untangling is bounded by the strain it may add; docs/collision.md): the gate names
+// the panel, the other panel and the place.
+TEST(QualityGate, PanelsCrossingEachOtherAreNamedWhereTheyCross) {
+  // Panel 'a': a 6 × 6 grid of 3 cm quads at z = 0; panel 'b': the same grid standing in the
+  // plane x = 7.5 cm, its middle row at z = 0, so it cuts through 'a' along x = 7.5 cm.
+  Garment g = grid_garment(6, 0.03);
+  meshing::QuadMesh b = test::plane_grid(6);
+  const Eigen::Index offset = g.mesh.vertex_count();
+  b.vertices *= 0.03;
+  for (Eigen::Index v = 0; v < b.vertex_count(); ++v)
+    b.vertices.row(v) = Eigen::RowVector3d(0.075, b.vertices(v, 1), b.vertices(v, 0) - 0.09);
+  g.mesh.vertices.conservativeResize(offset + b.vertex_count(), 3);
+  g.mesh.vertices.bottomRows(b.vertex_count()) = b.vertices;
+  const Eigen::Index quads = g.mesh.face_count();
+  g.mesh.faces.conservativeResize(quads + b.face_count(), 4);
+  g.mesh.faces.bottomRows(b.face_count()) = b.faces.array() + static_cast<int>(offset);
+  g.face_panel.conservativeResize(quads + b.face_count());
+  g.face_panel.tail(b.face_count()).setOnes();
+  GarmentPanel second;
+  second.id = "b";
+  g.panels.push_back(second);
+  g.panels[0].id = "a";
+  const std::vector<QualityWarning> warnings = check_quality(g, sketch_with_edge(0.03), nullptr);
+  const QualityWarning* crossing = find_kind(warnings, "self_intersection");
+  ASSERT_NE(crossing, nullptr);
+  EXPECT_EQ(crossing->panel, "a");
+  EXPECT_GT(crossing->count, 0);
+  EXPECT_NEAR(crossing->where.x(), 0.075, 0.03);  // a pair's centre, within a quad of the cut
+  EXPECT_NE(crossing->message.find("passes through panel 'b'"), std::string::npos);
+  // Each panel alone is clean.
+  EXPECT_EQ(find_kind(check_quality(grid_garment(6, 0.03), sketch_with_edge(0.03), nullptr),
+                      "self_intersection"),
+            nullptr);
+}
+
+TEST(QualityGate, APanelFoldedThroughItselfIsNamed) {
+  // The two last columns of vertices (x = 15 and 18 cm) folded back over the grid to x = 6 cm
+  // (1 cm above) and x = 3 cm (1 cm below): the folded strip passes down through the sheet.
+  Garment g = grid_garment(6, 0.03);
+  for (Eigen::Index v = 0; v < g.mesh.vertex_count(); ++v) {
+    if (g.mesh.vertices(v, 0) > 0.179)
+      g.mesh.vertices.row(v) << 0.03, g.mesh.vertices(v, 1), -0.01;
+    else if (g.mesh.vertices(v, 0) > 0.149)
+      g.mesh.vertices.row(v) << 0.06, g.mesh.vertices(v, 1), 0.01;
+  }
+  const std::vector<QualityWarning> warnings = check_quality(g, sketch_with_edge(0.03), nullptr);
+  const QualityWarning* crossing = find_kind(warnings, "self_intersection");
+  ASSERT_NE(crossing, nullptr);
+  EXPECT_EQ(crossing->panel, "patch");
+  EXPECT_NE(crossing->message.find("passes through itself"), std::string::npos);
+  EXPECT_LT(crossing->where.x(), 0.1);  // on the folded-back part
+}
+
 TEST(QualityGate, QuadsMuchLargerThanAskedAreFound) {
   // 3 cm quads where 1 cm is asked: three times the edge length.
   const std::vector<QualityWarning> warnings =

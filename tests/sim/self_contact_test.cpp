@@ -7,6 +7,7 @@
 
 #include <cmath>
 
+#include "sim/forces.hpp"
 #include "sim/simulation.hpp"
 #include "tests/sim/self_contact_helpers.hpp"
 #include "tests/sim/test_bodies.hpp"
@@ -115,6 +116,48 @@ TEST(SelfContactResponse, UntangleSeparatesAStartThatPassesThroughItself) {
   EXPECT_EQ(response.untangle(model, clean, {}, &found, &remaining), 0);
   EXPECT_EQ(found, 0);
   EXPECT_EQ(clean, sheet.x);
+}
+
+// The untangling's strain bound: a round of smoothing that would stretch a triangle past the
+// bound is undone and the untangling stops, leaving pairs. Unbounded, smoothing the sliver quads
+// of a crumpled sleeve stretched it by 761 % and every first step of the drape was rejected down
+// to the minimum step (docs/collision.md, "An untangled start").
+TEST(SelfContactResponse, UntangleStopsBeforeStretchingPastItsBound) {
+  const testing::FoldedSheet sheet = testing::folded_sheet(6, 0.3, 0.01);
+  const ClothModel model = folded_model(testing::folded_sheet(6, 0.3, -1.0));
+  Eigen::VectorXd start = sheet.x;
+  for (int i = 0; i < model.vertex_count; ++i)
+    if (sheet.upper[i] && sheet.x[3 * i] < -0.1) start[3 * i + 1] -= 0.03;
+  SelfContactSettings settings;
+  settings.enabled = true;
+  const double designed = max_stretch_strain(model, start);
+  // Unbounded: separated, with more stretch than the start had.
+  Eigen::VectorXd free = start;
+  SelfContactResponse unbounded(settings);
+  unbounded.set_cloth(model, free);
+  int found = 0, remaining = -1;
+  ASSERT_GT(unbounded.untangle(model, free, {}, &found, &remaining), 0);
+  ASSERT_EQ(remaining, 0);
+  const double stretched = max_stretch_strain(model, free);
+  ASSERT_GT(stretched, designed + 1e-3);
+  // Bounded halfway between: never past the bound, and pairs are left where it stopped.
+  const double bound = 0.5 * (designed + stretched);
+  Eigen::VectorXd x = start;
+  SelfContactResponse bounded(settings);
+  bounded.set_cloth(model, x);
+  Eigen::Vector3d where = Eigen::Vector3d::Constant(-1.0);
+  bounded.untangle(model, x, {}, &found, &remaining, bound, &where);
+  EXPECT_LE(max_stretch_strain(model, x), bound);
+  EXPECT_GT(remaining, 0);
+  EXPECT_EQ(remaining, static_cast<int>(bounded.collider().find_intersections(x).size()));
+  // The place of a pair left lies on the pushed part of the upper layer (x < -0.1 m, 3 cm down).
+  EXPECT_LT(where.x(), -0.05);
+  // A bound below the start's own strain keeps the start's as the bound: it still untangles.
+  Eigen::VectorXd y = start;
+  SelfContactResponse below(settings);
+  below.set_cloth(model, y);
+  below.untangle(model, y, {}, &found, &remaining, 0.0);
+  EXPECT_LE(max_stretch_strain(model, y), std::max(designed, 0.0) + 1e-12);
 }
 
 struct FoldRun {
