@@ -18,6 +18,7 @@
 #include "garment/garment_request.hpp"
 #include "garment/sketch_ranges.hpp"
 #include "scene/sketch_file.hpp"
+#include "sim/edit_distance.hpp"
 
 namespace sd::scene::detail {
 
@@ -27,7 +28,7 @@ using namespace garment;
 using nlohmann::json;
 
 // Levenshtein distance, for "did you mean" hints on misspelt keys and names.
-size_t edit_distance(std::string_view a, std::string_view b);
+using sim::edit_distance;
 
 // "the text \"x\"", "a list", ...: what a value is, for messages.
 std::string type_name(const json& value);

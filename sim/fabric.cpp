@@ -13,6 +13,8 @@
 #include <utility>
 #include <vector>
 
+#include "sim/edit_distance.hpp"
+
 namespace sd::sim {
 namespace detail {
 const std::vector<std::pair<std::string_view, std::string_view>>& embedded_fabric_presets();
@@ -101,22 +103,6 @@ struct CurveUnit {
 constexpr CurveUnit kStrainUnits[] = {{"1", 1.0}, {"%", 0.01}};
 constexpr CurveUnit kStressUnits[] = {{"N/m", 1.0}, {"gf/cm", 0.9807}};
 
-// Levenshtein distance between two keys, for the "did you mean" of a misspelt one.
-size_t key_distance(std::string_view a, std::string_view b) {
-  std::vector<size_t> row(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    size_t diagonal = row[0];
-    row[0] = i;
-    for (size_t j = 1; j <= b.size(); ++j) {
-      const size_t above = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = above;
-    }
-  }
-  return row[b.size()];
-}
-
 // Refuses a key of `object` (at `pointer`) not in `known`, as the sketch reader does: a
 // misspelt constant would otherwise be dropped silently (a "frictoin" next to the default
 // "friction") or reported only as the correct key missing.
@@ -127,7 +113,7 @@ void check_fabric_keys(const nlohmann::json& object, const std::string& where,
     std::string_view best;
     size_t best_distance = 3;  // suggest only close spellings
     for (std::string_view k : known)
-      if (const size_t d = key_distance(key, k); d < best_distance) best = k, best_distance = d;
+      if (const size_t d = edit_distance(key, k); d < best_distance) best = k, best_distance = d;
     std::string sentence = "unknown key '" + key + "'";
     if (!best.empty()) {
       sentence += " (did you mean '" + std::string(best) + "'?)";
