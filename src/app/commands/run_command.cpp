@@ -193,7 +193,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   }
   const auto on_step = [&](const sim::ClothDriver& d) {
     const sim::Simulation& s = d.simulation();
-    if (const double resident = resident_memory_bytes();
+    if (const double resident = peak_resident_memory_bytes();
         memory_budget > 0 && resident > memory_budget)
       throw RunLimitExceeded(fmt::format(
           "stopped at t = {:.3f} s of the drape: it uses {} with {} vertices, more than "

@@ -1,10 +1,10 @@
 #include "src/app/pipeline/sketch_checks.hpp"
 
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -99,11 +99,18 @@ double available_memory_bytes() {
   return 0;
 }
 
-double resident_memory_bytes() {
-  std::ifstream in("/proc/self/statm");
-  double pages = 0, resident = 0;
-  if (!(in >> pages >> resident)) return 0;
-  return resident * static_cast<double>(::sysconf(_SC_PAGESIZE));
+double peak_resident_memory_bytes() {
+  // The peak (VmHWM), not the resident set now (statm): the kernel's proactive reclaim (DAMON
+  // runs on this machine) pages a process's cold memory out, so the resident set now can fall
+  // below what the drape took, and a budget is about what it took.
+  std::ifstream in("/proc/self/status");
+  for (std::string line; std::getline(in, line);)
+    if (line.starts_with("VmHWM:")) {
+      std::istringstream fields(line.substr(6));
+      double kb = 0;
+      if (fields >> kb) return kb * 1024.0;
+    }
+  return 0;
 }
 
 double memory_budget_bytes(const RunLimits& limits) {

@@ -26,8 +26,9 @@ struct RunLimits {
 // The memory the system can give a process now (MemAvailable), bytes; 0 when unknown.
 double available_memory_bytes();
 
-// This process's resident memory now (/proc/self/statm), bytes; 0 when unknown.
-double resident_memory_bytes();
+// The most resident memory this process has held so far (VmHWM of /proc/self/status), bytes;
+// 0 when unknown.
+double peak_resident_memory_bytes();
 
 // The memory a run may use: --max-memory, else 80 % of the memory available now; 0: unknown.
 double memory_budget_bytes(const RunLimits& limits);
