@@ -101,7 +101,7 @@ double available_memory_bytes() {
 
 double peak_resident_memory_bytes() {
   // The peak (VmHWM), not the resident set now (statm): the kernel's proactive reclaim (DAMON
-  // runs on this machine) pages a process's cold memory out, so the resident set now can fall
+  // runs on this machine) can page a process's cold memory out, so the resident set now can fall
   // below what the drape took, and a budget is about what it took.
   std::ifstream in("/proc/self/status");
   for (std::string line; std::getline(in, line);)
