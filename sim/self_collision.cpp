@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <numeric>
 #include <stdexcept>
 
@@ -398,20 +397,30 @@ bool SelfCollider::region_is_safe(const Node& node, const Eigen::VectorXd& x0,
 
 template <class LeafTest>
 void SelfCollider::self_test(int index, const Eigen::VectorXd& x0, const Eigen::VectorXd& x1,
-                             LeafTest& leaf, SelfQueryStats& stats) {
+                             LeafTest& leaf, SelfQueryStats& stats, int depth,
+                             std::vector<WalkPiece>* pieces) {
   const Node& node = nodes_[index];
   if (node.left < 0 || (!dirty_.empty() && dirty_[index] == 0)) return;
+  if (pieces != nullptr && depth >= kWalkSplitDepth) {
+    pieces->push_back({WalkPiece::Kind::self, index, -1});
+    return;
+  }
   if (culling_ && region_is_safe(node, x0, x1)) {
     stats.culled_triangles += node.end - node.begin;
     return;
   }
-  self_test(node.left, x0, x1, leaf, stats);
-  self_test(node.right, x0, x1, leaf, stats);
-  pair_test(node.left, node.right, leaf, stats);
+  self_test(node.left, x0, x1, leaf, stats, depth + 1, pieces);
+  self_test(node.right, x0, x1, leaf, stats, depth + 1, pieces);
+  pair_test(node.left, node.right, leaf, stats, depth + 1, pieces);
 }
 
 template <class LeafTest>
-void SelfCollider::pair_test(int a, int b, LeafTest& leaf, SelfQueryStats& stats) {
+void SelfCollider::pair_test(int a, int b, LeafTest& leaf, SelfQueryStats& stats, int depth,
+                             std::vector<WalkPiece>* pieces) {
+  if (pieces != nullptr && depth >= kWalkSplitDepth) {
+    pieces->push_back({WalkPiece::Kind::pair, a, b});
+    return;
+  }
   if (!dirty_.empty() && dirty_[a] == 0 && dirty_[b] == 0) return;
   ++stats.node_pairs;
   const Node& na = nodes_[a];
@@ -424,78 +433,33 @@ void SelfCollider::pair_test(int a, int b, LeafTest& leaf, SelfQueryStats& stats
     return;
   }
   if (b_leaf || (!a_leaf && na.end - na.begin >= nb.end - nb.begin)) {
-    pair_test(na.left, b, leaf, stats);
-    pair_test(na.right, b, leaf, stats);
+    pair_test(na.left, b, leaf, stats, depth + 1, pieces);
+    pair_test(na.right, b, leaf, stats, depth + 1, pieces);
   } else {
-    pair_test(a, nb.left, leaf, stats);
-    pair_test(a, nb.right, leaf, stats);
+    pair_test(a, nb.left, leaf, stats, depth + 1, pieces);
+    pair_test(a, nb.right, leaf, stats, depth + 1, pieces);
   }
 }
 
 void SelfCollider::collect_leaves(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1,
                                   std::vector<std::array<int, 2>>& leaves, SelfQueryStats& stats) {
-  // A piece: self_test(a), pair_test(a, b), or a pair of triangles the walk met above the
-  // pieces. The walk down to kWalkSplitDepth does what self_test and pair_test do there (dirty
-  // skips, culling, box tests, counts) and lists the calls it would make below, and the
-  // triangle pairs it meets, in the order it would make and meet them.
-  enum class Kind { self, pair, triangles };
-  struct Piece {
-    Kind kind = Kind::self;
-    int a = 0, b = -1;
-  };
-  std::vector<Piece> pieces;
-  const std::function<void(int, int, int)> walk_pair = [&](int a, int b, int depth) {
-    if (depth >= kWalkSplitDepth) {
-      pieces.push_back({Kind::pair, a, b});
-      return;
-    }
-    if (!dirty_.empty() && dirty_[a] == 0 && dirty_[b] == 0) return;
-    ++stats.node_pairs;
-    const Node& na = nodes_[a];
-    const Node& nb = nodes_[b];
-    if (!na.box.intersects(nb.box)) return;
-    const bool a_leaf = na.left < 0, b_leaf = nb.left < 0;
-    if (a_leaf && b_leaf) {
-      ++stats.triangle_pairs;
-      pieces.push_back({Kind::triangles, order_[na.begin], order_[nb.begin]});
-      return;
-    }
-    if (b_leaf || (!a_leaf && na.end - na.begin >= nb.end - nb.begin)) {
-      walk_pair(na.left, b, depth + 1);
-      walk_pair(na.right, b, depth + 1);
-    } else {
-      walk_pair(a, nb.left, depth + 1);
-      walk_pair(a, nb.right, depth + 1);
-    }
-  };
-  const std::function<void(int, int)> walk_self = [&](int index, int depth) {
-    const Node& node = nodes_[index];
-    if (node.left < 0 || (!dirty_.empty() && dirty_[index] == 0)) return;
-    if (depth >= kWalkSplitDepth) {
-      pieces.push_back({Kind::self, index, -1});
-      return;
-    }
-    if (culling_ && region_is_safe(node, x0, x1)) {
-      stats.culled_triangles += node.end - node.begin;
-      return;
-    }
-    walk_self(node.left, depth + 1);
-    walk_self(node.right, depth + 1);
-    walk_pair(node.left, node.right, depth + 1);
-  };
+  // The traversal's top levels, serially: it stops at kWalkSplitDepth and lists the calls below
+  // (and the triangle pairs it met above) in its order, which then run on the threads.
   if (nodes_.empty()) return;
-  walk_self(0, 0);
+  std::vector<WalkPiece> pieces;
+  auto met = [&pieces](int ta, int tb) { pieces.push_back({WalkPiece::Kind::triangles, ta, tb}); };
+  self_test(0, x0, x1, met, stats, 0, &pieces);
   std::vector<std::vector<std::array<int, 2>>> found(pieces.size());
   std::vector<SelfQueryStats> counts(pieces.size());
   parallel_chunks(static_cast<int>(pieces.size()), 1, [&](int, int first, int last) {
     for (int k = first; k < last; ++k) {
-      const Piece& piece = pieces[static_cast<std::size_t>(k)];
+      const WalkPiece& piece = pieces[static_cast<std::size_t>(k)];
       std::vector<std::array<int, 2>>& out = found[static_cast<std::size_t>(k)];
       auto collect = [&out](int ta, int tb) { out.push_back({ta, tb}); };
       SelfQueryStats& count = counts[static_cast<std::size_t>(k)];
-      if (piece.kind == Kind::self)
+      if (piece.kind == WalkPiece::Kind::self)
         self_test(piece.a, x0, x1, collect, count);
-      else if (piece.kind == Kind::pair)
+      else if (piece.kind == WalkPiece::Kind::pair)
         pair_test(piece.a, piece.b, collect, count);
       else
         out.push_back({piece.a, piece.b});

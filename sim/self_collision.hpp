@@ -101,11 +101,20 @@ class SelfCollider {
   void build(int index, int begin, int end, const Eigen::VectorXd& x, int depth);
   void refit(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1, double inflate);
   bool region_is_safe(const Node& node, const Eigen::VectorXd& x0, const Eigen::VectorXd& x1);
+  // Where a split traversal stopped: self_test(a) or pair_test(a, b) to run below it, or a
+  // pair of triangles (a, b) met above the split.
+  struct WalkPiece {
+    enum class Kind { self, pair, triangles } kind = Kind::self;
+    int a = 0, b = -1;
+  };
+  // The traversal. With `pieces`, it stops at kWalkSplitDepth and lists there, in its order, the
+  // calls it would make below (the leaves it meets above the split go to `leaf` as before).
   template <class LeafTest>
   void self_test(int node, const Eigen::VectorXd& x0, const Eigen::VectorXd& x1, LeafTest& leaf,
-                 SelfQueryStats& stats);
+                 SelfQueryStats& stats, int depth = 0, std::vector<WalkPiece>* pieces = nullptr);
   template <class LeafTest>
-  void pair_test(int a, int b, LeafTest& leaf, SelfQueryStats& stats);
+  void pair_test(int a, int b, LeafTest& leaf, SelfQueryStats& stats, int depth = 0,
+                 std::vector<WalkPiece>* pieces = nullptr);
   // What self_test(0, ...) reaches, in its order: the triangle pairs (appended to `leaves`)
   // and the counts. The top levels are walked here; the pieces below them (subtrees and node
   // pairs) run on the threads and are joined in traversal order.
