@@ -125,6 +125,17 @@ TEST(PatternCommand, EveryExampleGivesPiecesThatSewAndDoNotOverlap) {
       for (size_t j = i + 1; j < pieces.size(); ++j)
         EXPECT_FALSE(overlap(outline(a), outline(pieces[j])))
             << name << ": " << a["id"] << " overlaps " << pieces[j]["id"];
+      // A mirrored panel and its copy name each other; any other piece names none.
+      const std::string id = a["id"], pair = a["mirror_pair"];
+      const bool copy = id.ends_with(".mirror");
+      if (!pair.empty()) {
+        EXPECT_EQ(pair, copy ? id.substr(0, id.size() - 7) : id + ".mirror") << name;
+        EXPECT_NE(read(out / "pattern.svg").find((copy ? "mirror of " : "pair with ") + pair),
+                  std::string::npos)
+            << name << " " << id;
+      } else {
+        EXPECT_FALSE(copy) << name << " " << id;
+      }
     }
     EXPECT_NEAR(json["efficiency"].get<double>(), cut / (width * length), 1e-9);
     ASSERT_FALSE(json["seams"].empty());

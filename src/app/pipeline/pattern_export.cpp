@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "src/app/pipeline/markup_escape.hpp"
+#include "src/app/pipeline/pattern_label.hpp"
 
 namespace sd::app {
 namespace {
@@ -78,6 +79,26 @@ std::vector<double> edge_allowances(const scene::Sketch& sketch, const garment::
 
 std::string piece_name(const PatternSheet& sheet, const garment::PatternPiece& piece) {
   return sheet.pattern.panels[static_cast<size_t>(piece.panel)].id;
+}
+
+// How often a piece is cut, naming its mirror image when the garment has one: "cut 1",
+// "cut 1 · pair with front.mirror", "cut 1 · mirror of front". Each of a pair is laid out and
+// cut on its own (the fabric's face side up for both), so the cutter needs to know they belong
+// together.
+// The piece's mirror image in the pattern ("front" ↔ "front.mirror"), empty when it has none.
+std::string mirror_partner(const PatternSheet& sheet, const std::string& id) {
+  const std::string suffix = ".mirror";
+  const std::string other =
+      id.ends_with(suffix) ? id.substr(0, id.size() - suffix.size()) : id + suffix;
+  for (const garment::FlatPanel& panel : sheet.pattern.panels)
+    if (panel.id == other) return other;
+  return {};
+}
+
+std::string cut_note(const PatternSheet& sheet, const std::string& id) {
+  const std::string partner = mirror_partner(sheet, id);
+  if (partner.empty()) return "cut 1";
+  return (id.ends_with(".mirror") ? "cut 1 · mirror of " : "cut 1 · pair with ") + partner;
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -170,21 +191,34 @@ std::string pattern_svg(const PatternSheet& sheet) {
           "<line class=\"notch\" x1=\"{:.2f}\" y1=\"{:.2f}\" x2=\"{:.2f}\" y2=\"{:.2f}\"/>\n",
           pa.x(), length - pa.y(), pb.x(), length - pb.y());
     }
-    // Label beside the grain line's middle, sized to the piece.
-    const double size = std::clamp(kMm * std::min(piece.size.x(), piece.size.y()) / 14, 3.0, 9.0);
-    const Eigen::Vector2d at = 0.5 * (g0 + g1) + Eigen::Vector2d(0.6 * size, 0);
-    svg += fmt::format(
-        "<text class=\"label\" x=\"{0:.1f}\" y=\"{1:.1f}\" font-size=\"{2:.1f}\" "
-        "font-weight=\"bold\">{3}</text>\n"
-        "<text class=\"label\" x=\"{0:.1f}\" y=\"{4:.1f}\" font-size=\"{5:.1f}\">{6:.0f} × {7:.0f} "
-        "mm · {8}</text>\n"
-        "<text class=\"label\" x=\"{0:.1f}\" y=\"{9:.1f}\" font-size=\"{5:.1f}\">cut 1 · ease "
-        "{10:g} · stretch {11:.1f} % (95th pct)</text>\n",
-        at.x(), length - at.y(), size, markup_escape(name), length - at.y() + size, 0.75 * size,
-        kMm * (piece.sewing.col(0).maxCoeff() - piece.sewing.col(0).minCoeff()),
-        kMm * (piece.sewing.col(1).maxCoeff() - piece.sewing.col(1).minCoeff()),
-        markup_escape(fabric), length - at.y() + 1.9 * size, piece.ease,
-        100 * flat.distortion.length_p95);
+    // The label where it fits inside the piece (pattern_label.hpp).
+    LabelText text;
+    text.title = name;
+    text.lines = {
+        fmt::format("{:.0f} × {:.0f} mm · {}",
+                    kMm * (piece.sewing.col(0).maxCoeff() - piece.sewing.col(0).minCoeff()),
+                    kMm * (piece.sewing.col(1).maxCoeff() - piece.sewing.col(1).minCoeff()),
+                    fabric),
+        fmt::format("{} · ease {:g} · stretch {:.1f} % (95th pct)", cut_note(sheet, flat.id),
+                    piece.ease, 100 * flat.distortion.length_p95)};
+    Eigen::MatrixX2d outline(piece.sewing.rows(), 2);
+    for (Eigen::Index i = 0; i < piece.sewing.rows(); ++i) {
+      const Eigen::Vector2d p = on_fabric(piece, piece.sewing.row(i).transpose());
+      outline.row(i) << p.x(), length - p.y();
+    }
+    const LabelPlacement at =
+        place_label(outline, {g0.x(), length - g0.y()}, {g1.x(), length - g1.y()}, text);
+    svg += fmt::format("<g class=\"label\" transform=\"translate({:.1f} {:.1f}){}\"{}>\n",
+                       at.anchor.x(), at.anchor.y(), at.along ? " rotate(-90)" : "",
+                       at.centred ? " text-anchor=\"middle\"" : "");
+    svg +=
+        fmt::format("<text x=\"0\" y=\"0\" font-size=\"{:.1f}\" font-weight=\"bold\">{}</text>\n",
+                    at.size, markup_escape(text.title));
+    for (size_t k = 0; k < text.lines.size(); ++k)
+      svg += fmt::format("<text x=\"0\" y=\"{:.1f}\" font-size=\"{:.1f}\">{}</text>\n",
+                         at.size * (1 + 0.9 * double(k)), 0.75 * at.size,
+                         markup_escape(text.lines[k]));
+    svg += "</g>\n";
     svg += "</g>\n";
   }
   // Scale bar: 100 mm in 10 mm steps, and the sheet's figures.
@@ -301,6 +335,8 @@ std::string pattern_dxf(const PatternSheet& sheet) {
     text("15", at - Eigen::Vector2d(0, 0.016), h, "Quantity: 1");
     text("15", at - Eigen::Vector2d(0, 0.024), h,
          fmt::format("Seam allowance: {} mm", allowance_mm(piece)));
+    if (const std::string partner = mirror_partner(sheet, name); !partner.empty())
+      text("15", at - Eigen::Vector2d(0, 0.032), h, "Mirror pair: " + partner);
     pair(0, "ENDBLK");
     pair(8, "0");
   }
@@ -389,7 +425,8 @@ nlohmann::json pattern_json(const PatternSheet& sheet) {
                       {"notches", notches},
                       {"distortion", distortion_json(flat.distortion)},
                       {"iterations", flat.iterations},
-                      {"warning", flat.warning}});
+                      {"warning", flat.warning},
+                      {"mirror_pair", mirror_partner(sheet, flat.id)}});
   }
   nlohmann::json seams = nlohmann::json::array();
   for (const garment::PatternSeam& seam : sheet.pattern.seams) {
