@@ -597,19 +597,27 @@ void check_seam_directions(const GarmentRequest& sketch, const BodySurface& body
       std::string hint;
       for (size_t i = 0; i < unused.size(); ++i)
         hint += (i == 0 ? "" : (i + 1 == unused.size() ? " or " : ", ")) + unused[i];
-      sketch.fail(
-          "/panels",
-          fmt::format("curve '{}' bounds both panels '{}' and '{}', but the two lie on the same "
-                      "side of it, folded onto each other there ({} seam edge(s)): a curve can "
-                      "be the seam of two panels only when they lie on either side of it, so one "
-                      "of them was given the wrong curve. Check the boundary lists of '{}' and "
-                      "'{}'{}",
-                      curve, a.id, b.id, sharpest->second.edges, a.id, b.id,
-                      hint.empty()
-                          ? ""
-                          : fmt::format(" (drawn but in no panel: {}; is {} meant "
-                                        "there instead of '{}'?)",
-                                        hint, unused.size() == 1 ? "it" : "one of them", curve)));
+      // Either cause fits a fold: a wrong curve (likelier when a drawn curve is in no panel) or
+      // a panel spanning the other side of a limb (a sleeve half); the likelier comes first.
+      const std::string wrong_curve = fmt::format(
+          "one of them was given the wrong curve (check the boundary lists of '{}' and '{}'{})",
+          a.id, b.id,
+          hint.empty() ? ""
+                       : fmt::format("; drawn but in no panel: {}: is {} meant there instead of "
+                                     "'{}'?",
+                                     hint, unused.size() == 1 ? "it" : "one of them", curve));
+      const std::string other_side =
+          "one of them spans the other side of the body from the one meant (a sleeve half "
+          "between curves on opposite sides of the arm can span its front or its back: add a "
+          "curve along the middle of the side it should cover and split it there)";
+      sketch.fail("/panels",
+                  fmt::format("curve '{}' bounds both panels '{}' and '{}', but the two lie on the "
+                              "same side of it, folded onto each other there ({} seam edge(s)): "
+                              "a curve can be the seam of two panels only when they lie on either "
+                              "side of it. Either {}, or {}",
+                              curve, a.id, b.id, sharpest->second.edges,
+                              hint.empty() ? other_side : wrong_curve,
+                              hint.empty() ? wrong_curve : other_side));
     }
     const GarmentPanel& p1 = garment.panels[static_cast<size_t>(clash->first)];
     const GarmentPanel& p2 = garment.panels[static_cast<size_t>(clash->second)];
