@@ -252,7 +252,8 @@ TEST(HostileInput, FabricConstantsOutsideTheirPhysicalRangeAreRefused) {
 }
 
 // Trial 33: `run d3-wide-shorts.json -o /proc/sketch` draped for 21 s before it found that
-// /proc takes no folders. Every command that writes checks its output folder first: exit code
+// /proc takes no folders. Every command that writes (run, mesh, pattern, batch, bench, stress,
+// render, fill) checks its output folder first: exit code
 // 2, the folder and the reason, nothing written, no work done (no "draping" progress).
 TEST(HostileInput, AnOutputFolderThatCannotBeWrittenIsRefusedFirst) {
   const fs::path dir = fresh_dir("unwritable");
@@ -269,6 +270,7 @@ TEST(HostileInput, AnOutputFolderThatCannotBeWrittenIsRefusedFirst) {
       "bench -o " + proc,
       "stress --quick -o " + proc,
       "render " + (dir / "cloth.obj").string() + " -o " + proc + "/b.png",
+      "fill --sides 4,4 --obj " + proc + "/patch.obj",
       "run " + sketch + " -o " + (dir / "a-file" / "out").string(),
   };
   for (const std::string& command : commands) {
