@@ -142,7 +142,8 @@ TEST(PatternCommand, EveryExampleGivesPiecesThatSewAndDoNotOverlap) {
 }
 
 // Trial 33: the pieces of a garment cut from a fabric file were labelled with the file's path
-// ("../fabrics/linen.json"); they carry the fabric's own name, in pattern.json and the SVG.
+// ("../fabrics/linen.json"); they carry the fabric's own name, in pattern.json, the SVG and
+// validate's summary.
 TEST(PatternCommand, PiecesNameAFabricFileByItsName) {
   const fs::path dir = fresh_dir("fabric-name");
   fs::create_directories(dir / "designs");
@@ -166,6 +167,9 @@ TEST(PatternCommand, PiecesNameAFabricFileByItsName) {
   const std::string svg = read(dir / "out/pattern.svg");
   EXPECT_NE(svg.find("medium linen"), std::string::npos);
   EXPECT_EQ(svg.find("linen.json"), std::string::npos);
+  // validate's summary names it so too.
+  const CommandResult v = run_sketchdrape("validate " + (dir / "designs" / "tshirt.json").string());
+  EXPECT_NE(v.output.find(", fabric medium linen)"), std::string::npos) << v.output;
   fs::remove_all(dir);
 }
 
