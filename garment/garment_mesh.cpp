@@ -535,6 +535,90 @@ void check_seam_directions(const GarmentRequest& sketch, const BodySurface& body
       ++clashing;
     }
   if (clash) {
+    // The usual cause: one curve given to two panels that lie on the same side of it (a front
+    // hem listed again as the back's hem: the back then spans from the back hip round to the
+    // front hem and turns over). Each seam edge's two quads point from it into their panels; on
+    // a seam they point apart, at such a curve the same way (folded flat onto each other).
+    // Named when its mean fold is sharp (the inward directions within 60°); the turned-over
+    // panel elsewhere (the clash below) is only its consequence.
+    std::map<std::pair<int, int>, std::vector<int>> edge_faces;
+    for (size_t f = 0; f < faces.size(); ++f)
+      for (int k = 0; k < 4; ++k) {
+        const int a = faces[f][static_cast<size_t>(k)],
+                  b = faces[f][static_cast<size_t>((k + 1) % 4)];
+        edge_faces[{std::min(a, b), std::max(a, b)}].push_back(static_cast<int>(f));
+      }
+    struct Fold {
+      double dot = 0.0;
+      int edges = 0;
+      int panel_a = -1, panel_b = -1;
+    };
+    std::map<std::string, Fold> folds;  // by curve
+    const auto inward = [&](int f, const Eigen::Vector3d& p, const Eigen::Vector3d& q) {
+      Eigen::Vector3d c = Eigen::Vector3d::Zero();
+      for (int v : faces[static_cast<size_t>(f)]) c += pool.positions[static_cast<size_t>(v)];
+      const Eigen::Vector3d along = (q - p).normalized();
+      Eigen::Vector3d d = 0.25 * c - 0.5 * (p + q);
+      d -= d.dot(along) * along;
+      return Eigen::Vector3d(d.normalized());
+    };
+    for (const auto& [edge, fs] : edge_faces) {
+      if (fs.size() != 2) continue;
+      const int pa = face_panel[static_cast<size_t>(fs[0])],
+                pb = face_panel[static_cast<size_t>(fs[1])];
+      if (pa == pb) continue;
+      const std::string curve = curve_of(edge.first, edge.second);
+      if (curve.empty()) continue;
+      const Eigen::Vector3d& p = pool.positions[static_cast<size_t>(edge.first)];
+      const Eigen::Vector3d& q = pool.positions[static_cast<size_t>(edge.second)];
+      Fold& fold = folds[curve];
+      fold.dot += inward(fs[0], p, q).dot(inward(fs[1], p, q));
+      ++fold.edges;
+      fold.panel_a = std::min(pa, pb), fold.panel_b = std::max(pa, pb);
+    }
+    const std::pair<const std::string, Fold>* sharpest = nullptr;
+    for (const auto& entry : folds)
+      if (entry.second.edges >= 2 && entry.second.dot / entry.second.edges > 0.5 &&
+          (!sharpest ||
+           entry.second.dot / entry.second.edges > sharpest->second.dot / sharpest->second.edges))
+        sharpest = &entry;
+    if (sharpest) {
+      const std::string& curve = sharpest->first;
+      const GarmentPanel& a = garment.panels[static_cast<size_t>(sharpest->second.panel_a)];
+      const GarmentPanel& b = garment.panels[static_cast<size_t>(sharpest->second.panel_b)];
+      // Curves the sketch draws but no panel uses: often the one meant for the second panel.
+      std::vector<std::string> unused;
+      for (const CurveSpec& c : sketch.curves) {
+        bool used = false;
+        for (const PanelSpec& p : sketch.panels)
+          used = used || std::find(p.boundary.begin(), p.boundary.end(), c.id) != p.boundary.end();
+        if (!used) unused.push_back("'" + c.id + "'");
+      }
+      std::string hint;
+      for (size_t i = 0; i < unused.size(); ++i)
+        hint += (i == 0 ? "" : (i + 1 == unused.size() ? " or " : ", ")) + unused[i];
+      // Either cause fits a fold: a wrong curve (likelier when a drawn curve is in no panel) or
+      // a panel spanning the other side of a limb (a sleeve half); the likelier comes first.
+      const std::string wrong_curve = fmt::format(
+          "one of them was given the wrong curve (check the boundary lists of '{}' and '{}'{})",
+          a.id, b.id,
+          hint.empty() ? ""
+                       : fmt::format("; drawn but in no panel: {}: is {} meant there instead of "
+                                     "'{}'?",
+                                     hint, unused.size() == 1 ? "it" : "one of them", curve));
+      const std::string other_side =
+          "one of them spans the other side of the body from the one meant (a sleeve half "
+          "between curves on opposite sides of the arm can span its front or its back: add a "
+          "curve along the middle of the side it should cover and split it there)";
+      sketch.fail("/panels",
+                  fmt::format("curve '{}' bounds both panels '{}' and '{}', but the two lie on the "
+                              "same side of it, folded onto each other there ({} seam edge(s)): "
+                              "a curve can be the seam of two panels only when they lie on either "
+                              "side of it. Either {}, or {}",
+                              curve, a.id, b.id, sharpest->second.edges,
+                              hint.empty() ? other_side : wrong_curve,
+                              hint.empty() ? wrong_curve : other_side));
+    }
     const GarmentPanel& p1 = garment.panels[static_cast<size_t>(clash->first)];
     const GarmentPanel& p2 = garment.panels[static_cast<size_t>(clash->second)];
     where /= std::max(clashing, 1);

@@ -1,11 +1,13 @@
 #include "garment/panel_loop.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <optional>
@@ -126,26 +128,61 @@ std::vector<LoopEdge> resolve_explicit(const GarmentRequest& sketch, const Curve
     if (meet) continue;
     const NodeGap gap = node_gap(net, a, b);
     const std::string& next = panel.boundary[(i + 1) % k];
-    // A curve of the sketch that runs from one to the other and is not in the list: the seam
-    // the designer left out (a side seam forgotten between the armhole and the hem).
+    // The gap's ends: the end of `a` that does not already meet the curve before it and the end
+    // of `b` that does not meet the curve after it (their other ends are taken). The nearest
+    // junctions of a and b are often the taken ones (the two sides of a skirt meet the hip
+    // curve, 38 cm apart, while the hem that is missing joins their lower ends).
+    const auto free_ends = [&](int c, int neighbour) {
+      const NetworkCurve& curve = net.curves[static_cast<size_t>(c)];
+      std::vector<int> ends;
+      if (curve.closed || curve.nodes.empty()) return ends;
+      for (const int node : {curve.nodes.front(), curve.nodes.back()})
+        if (k < 3 || !curve_has_node(net, neighbour, node)) ends.push_back(node);
+      if (ends.empty()) ends = {curve.nodes.front(), curve.nodes.back()};
+      return ends;
+    };
+    const std::vector<int> a_ends = free_ends(a, curve_ids[(i + k - 1) % k]);
+    const std::vector<int> b_ends = free_ends(b, curve_ids[(i + 2) % k]);
+    int end_a = -1, end_b = -1;
+    double gap_length = std::numeric_limits<double>::infinity();
+    for (const int x : a_ends)
+      for (const int y : b_ends)
+        if (const double d =
+                (net.nodes[static_cast<size_t>(x)] - net.nodes[static_cast<size_t>(y)]).norm();
+            d < gap_length)
+          gap_length = d, end_a = x, end_b = y;
+    // Curves of the sketch that run from one end to the other (the seam or hem the designer
+    // left out), with the panels that already use each: a curve in no panel is the likely one.
+    std::vector<std::string> spans;
     std::string missing;
-    for (size_t c = 0; c < net.curves.size() && missing.empty(); ++c) {
+    for (size_t c = 0; end_a >= 0 && c < net.curves.size(); ++c) {
       const int ci = static_cast<int>(c);
       if (std::find(curve_ids.begin(), curve_ids.end(), ci) != curve_ids.end()) continue;
-      bool meets_a = false, meets_b = false;
-      for (const int node : net.curves[c].nodes) {
-        meets_a = meets_a || curve_has_node(net, a, node);
-        meets_b = meets_b || curve_has_node(net, b, node);
-      }
-      if (meets_a && meets_b) missing = net.curves[c].id;
+      if (!curve_has_node(net, ci, end_a) || !curve_has_node(net, ci, end_b)) continue;
+      std::vector<std::string> users;
+      for (const PanelSpec& other : sketch.panels)
+        if (std::find(other.boundary.begin(), other.boundary.end(), net.curves[c].id) !=
+            other.boundary.end())
+          users.push_back("'" + other.id + "'");
+      if (users.empty() && missing.empty()) missing = net.curves[c].id;
+      spans.push_back(fmt::format("'{}' ({})", net.curves[c].id,
+                                  users.empty()
+                                      ? std::string("in no panel")
+                                      : fmt::format("in panel{} {}", users.size() == 1 ? "" : "s",
+                                                    fmt::join(users, " and "))));
     }
     const std::string where =
-        !missing.empty()
+        !spans.empty()
             ? fmt::format(
-                  "(curve '{}' runs from one to the other: is it missing from the list "
-                  "between them? their junctions are {:.1f} cm apart, '{}' at {} m and "
-                  "'{}' at {} m)",
-                  missing, gap.distance * 100, panel.boundary[i], at(gap.on_a), next, at(gap.on_b))
+                  "(the gap runs from the end of '{}' at {} m to the end of '{}' at {} m, "
+                  "{:.1f} cm apart; {} {} {} from one to the other{})",
+                  panel.boundary[i], at(net.nodes[static_cast<size_t>(end_a)]), next,
+                  at(net.nodes[static_cast<size_t>(end_b)]), gap_length * 100,
+                  spans.size() == 1 ? "curve" : "curves", fmt::join(spans, " and "),
+                  spans.size() == 1 ? "runs" : "run",
+                  missing.empty()
+                      ? std::string()
+                      : fmt::format(": is '{}' missing from the list between them?", missing))
             : fmt::format(
                   "(their junctions are {:.1f} cm apart, '{}' at {} m and '{}' at {} m; "
                   "curves meet when their ends are within {:.1f} cm{})",

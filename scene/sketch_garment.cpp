@@ -327,6 +327,13 @@ PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, c
       panel.corners.push_back(std::move(id));
     }
   }
+  // A garment drapes in one fabric (the file's); a panel names a preset or a fabric file, so
+  // that its constants are written once, not inline in every panel (docs/fabrics.md).
+  if (j.contains("fabric") && j["fabric"].is_object())
+    r.fail(path + "/fabric",
+           "a panel's fabric must be a preset name (cotton, denim, jersey, polyester, silk, wool) "
+           "or the path of a fabric file (.json); give the constants inline only in the file's "
+           "top-level \"fabric\", or save them as a fabric file and name it here");
   panel.fabric = j.contains("fabric") ? r.text(j["fabric"], path + "/fabric") : sk.fabric;
   if (j.contains("mirror")) panel.mirror = r.boolean(j["mirror"], path + "/mirror");
   if (j.contains("edge_length"))

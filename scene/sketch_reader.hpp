@@ -176,6 +176,22 @@ class Reader {
       fail(path, fmt::format("{} {} is more than the {} allowed", list.size(), what, most));
   }
 
+  // "there is no view called 'x' (did you mean 'y'?); the views are a, b, ... or a camera".
+  static std::string unknown_view_sentence(const std::string& name,
+                                           const std::vector<std::string_view>& names) {
+    std::string_view best;
+    size_t best_distance = 4;  // close spellings only ("thre-quater", "frnt")
+    for (std::string_view n : names)
+      if (const size_t d = edit_distance(name, n); d < best_distance) best = n, best_distance = d;
+    std::string list;
+    for (size_t i = 0; i < names.size(); ++i)
+      list += std::string(i == 0 ? "" : ", ") + std::string(names[i]);
+    return fmt::format(
+        "there is no view called '{}'{}; the views are {} or a camera {{\"camera\": {{\"eye\": "
+        "[...], \"target\": [...]}}}}",
+        name, best.empty() ? "" : fmt::format(" (did you mean '{}'?)", best), list);
+  }
+
   ViewSpec view(const json& value, const std::string& path) const {
     ViewSpec view;
     if (value.is_string()) {
@@ -189,9 +205,7 @@ class Reader {
           view.kind = kind;
           return view;
         }
-      fail(path, fmt::format("there is no view called '{}'; use front, back, left, right or "
-                             "{{\"camera\": {{\"eye\": [...], \"target\": [...]}}}}",
-                             name));
+      fail(path, unknown_view_sentence(name, {"front", "back", "left", "right"}));
     }
     if (!value.is_object())
       fail(path, fmt::format("a view is a name (front, back, left, right) or a camera object, "

@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 
@@ -325,8 +326,17 @@ void parse_output(const Reader& r, const json& j, OutputSpec& out) {
       ImageSpec image;
       if (im.contains("view")) {
         const json& v = im["view"];
-        if (v.is_string() && v.get<std::string>() == "three-quarter") {
-          image.view = "three-quarter";
+        // A picture may also be taken from three-quarter or above (the renderer's views; it
+        // takes "three_quarter" too); a curve is drawn in front, back, left or right only.
+        std::string name = v.is_string() ? v.get<std::string>() : "";
+        std::replace(name.begin(), name.end(), '_', '-');
+        if (name == "three-quarter" || name == "top") {
+          image.view = name;
+        } else if (v.is_string() && name != "front" && name != "back" && name != "left" &&
+                   name != "right") {
+          r.fail(ip + "/view", Reader::unknown_view_sentence(
+                                   v.get<std::string>(),
+                                   {"front", "back", "left", "right", "three-quarter", "top"}));
         } else {
           const ViewSpec view = r.view(v, ip + "/view");
           image.view = view.name();

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "sim/edit_distance.hpp"
+#include "sim/fabric_ranges.hpp"
 
 namespace sd::sim {
 namespace detail {
@@ -29,9 +30,9 @@ void check_constant(const std::string& fabric, const char* key, const char* what
   const bool ok = std::isfinite(value) && (bound == Bound::positive ? value > 0.0 : value >= 0.0);
   if (!ok) {
     std::ostringstream message;
-    message << "fabric '" << fabric << "': " << what << " is " << value << " " << unit
-            << " but must be " << (bound == Bound::positive ? "greater than zero" : "zero or more")
-            << " and finite";
+    message << "fabric '" << fabric << "': " << what << " is " << value
+            << (*unit != '\0' ? " " : "") << unit << " but must be "
+            << (bound == Bound::positive ? "greater than zero" : "zero or more") << " and finite";
     throw InvalidFabricError(message.str(), std::string("/") + key);
   }
 }
@@ -301,8 +302,11 @@ FabricParameters parse_fabric_json(std::string_view text, const std::string& ori
       *curve = parse_tensile_curve(document[key], origin, std::string("/") + key);
   try {
     fabric.validate();
+    check_physical_range(fabric);
   } catch (const InvalidFabricError& e) {
-    throw InvalidFabricError(origin + ": " + e.what(), e.pointer());
+    // The constant's key in the file (the sketch's error names the sketch's own path).
+    throw InvalidFabricError(
+        origin + ": " + (e.pointer().empty() ? "" : e.pointer() + ": ") + e.what(), e.pointer());
   }
   return fabric;
 }
@@ -327,7 +331,8 @@ FabricParameters load_fabric_file(const std::string& path) {
   if (!file) fail(std::string(std::strerror(errno)) + " (check the file's permissions)");
   std::ostringstream text;
   text << file.rdbuf();
-  return parse_fabric_json(text.str(), path);
+  // Named as given, without "a/../" (a sketch in mistakes/ naming "../fabrics/x.json").
+  return parse_fabric_json(text.str(), fs::path(path).lexically_normal().string());
 }
 
 FabricParameters fabric_preset(std::string_view name) {

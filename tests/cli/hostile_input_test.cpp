@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include "tests/cli/run_command.hpp"
@@ -177,6 +178,169 @@ TEST(HostileInput, EveryCommandAppliesTheSameChecks) {
     EXPECT_NE(r->output.find("all its vertices at one point"), std::string::npos) << r->output;
   }
   EXPECT_FALSE(fs::exists(dir / "render.png"));
+  fs::remove_all(dir);
+}
+
+// The silk preset's constants as a fabric object, with `key`'s {"value", "unit"} replaced.
+std::string silk_with(const std::string& key, const std::string& entry) {
+  nlohmann::json j = nlohmann::json::parse(R"({"name": "my silk",
+    "area_density": {"value": 0.06, "unit": "kg/m^2"},
+    "stretch_warp": {"value": 12300.0, "unit": "N/m"},
+    "stretch_weft": {"value": 8170.0, "unit": "N/m"},
+    "shear": {"value": 22.5, "unit": "N/m"}, "bend": {"value": 1.96e-06, "unit": "N*m"},
+    "damping": {"value": 0.001, "unit": "s"}, "bend_damping": {"value": 0.05, "unit": "s"},
+    "friction": {"value": 0.25, "unit": "1"}, "thickness": {"value": 0.0001, "unit": "m"}})");
+  j[key] = nlohmann::json::parse(entry);
+  return j.dump();
+}
+
+// Trial 33: friction 30 (the drape failed at 1.66 s), friction 3.5 and a warp stiffness of
+// 0.5 N/m (a top sagged 5.5 cm) were accepted. Out of its physical range a constant is refused
+// by validate, mesh and run alike, inline at its own path and in a fabric file at /fabric with
+// the file (normalised: no "a/../") and the key; run writes nothing. An unusual but possible
+// value is a warning, and run lists it in report.json.
+TEST(HostileInput, FabricConstantsOutsideTheirPhysicalRangeAreRefused) {
+  const fs::path dir = fresh_dir("fabric-range");
+  write(dir / "friction.json",
+        square("", ",\n  \"fabric\": " + silk_with("friction", R"({"value": 30, "unit": "1"})")));
+  write(dir / "stretch.json",
+        square("", ",\n  \"fabric\": " +
+                       silk_with("stretch_warp", R"({"value": 0.5, "unit": "N/m"})")));
+  fs::create_directories(dir / "fabrics");
+  fs::create_directories(dir / "designs");
+  write(dir / "fabrics" / "bad.json", silk_with("friction", R"({"value": 3.5, "unit": "1"})"));
+  write(dir / "designs" / "file.json", square("", ",\n  \"fabric\": \"../fabrics/bad.json\""));
+  const std::vector<std::tuple<fs::path, std::string, std::string>> cases = {
+      {dir / "friction.json", "/fabric/friction: ",
+       "fabric 'my silk': friction is 30, which no real fabric has: it must lie between 0 and 2"},
+      {dir / "stretch.json", "/fabric/stretch_warp: ",
+       "warp stretch stiffness is 0.5 N/m, which no real fabric has: it must lie between 20 N/m"},
+      {dir / "designs" / "file.json", "/fabric: ",
+       "designs/../fabrics/bad.json"},  // replaced below: the normalised path must show
+  };
+  for (const auto& [file, path, fragment] : cases) {
+    for (const char* command : {"validate", "mesh", "run"}) {
+      const std::string out =
+          std::string(command) == "validate" ? "" : " -o " + (dir / "out").string();
+      const CommandResult r = run_sketchdrape(std::string(command) + " " + file.string() + out);
+      EXPECT_EQ(r.exit_code, 2) << command << " " << file << "\n" << r.output;
+      EXPECT_NE(r.output.find(file.string() + ": " + path), std::string::npos) << r.output;
+      if (file.filename() == "file.json") {
+        EXPECT_EQ(r.output.find("/../"), std::string::npos) << r.output;
+        EXPECT_NE(r.output.find((dir / "fabrics" / "bad.json").string() +
+                                ": /friction: fabric 'my silk': friction is 3.5, which no real "
+                                "fabric has"),
+                  std::string::npos)
+            << r.output;
+      } else {
+        EXPECT_NE(r.output.find(fragment), std::string::npos) << r.output;
+      }
+      EXPECT_FALSE(fs::exists(dir / "out")) << command;
+    }
+  }
+
+  // Possible but unusual: friction 1.8 validates with a warning at its path.
+  write(dir / "grippy.json",
+        square("", ",\n  \"fabric\": " + silk_with("friction", R"({"value": 1.8, "unit": "1"})")));
+  const CommandResult grippy = run_sketchdrape("validate " + (dir / "grippy.json").string());
+  EXPECT_EQ(grippy.exit_code, 0) << grippy.output;
+  EXPECT_NE(grippy.output.find((dir / "grippy.json").string() +
+                               ": /fabric/friction: fabric 'my silk': friction 1.8 is unusual"),
+            std::string::npos)
+      << grippy.output;
+  fs::remove_all(dir);
+}
+
+// Trial 33: `run d3-wide-shorts.json -o /proc/sketch` draped for 21 s before it found that
+// /proc takes no folders. Every command that writes (run, mesh, pattern, batch, bench, stress,
+// render, fill) checks its output folder first: exit code
+// 2, the folder and the reason, nothing written, no work done (no "draping" progress).
+TEST(HostileInput, AnOutputFolderThatCannotBeWrittenIsRefusedFirst) {
+  const fs::path dir = fresh_dir("unwritable");
+  write(dir / "sketch.json", square());
+  write(dir / "a-file", "");
+  write(dir / "cloth.obj", "v 0 1 0\nv 0.1 1 0\nv 0 1.1 0\nf 1 2 3\n");
+  const std::string sketch = (dir / "sketch.json").string();
+  const std::string proc = "/proc/sd-hostile-test-out";
+  const std::vector<std::string> commands = {
+      "run " + sketch + " -o " + proc,
+      "mesh " + sketch + " -o " + proc + "/deeper",
+      "pattern " + sketch + " -o " + proc,
+      "batch " + sketch + " -o " + proc,
+      "bench -o " + proc,
+      "stress --quick -o " + proc,
+      "render " + (dir / "cloth.obj").string() + " -o " + proc + "/b.png",
+      "fill --sides 4,4 --obj " + proc + "/patch.obj",
+      "run " + sketch + " -o " + (dir / "a-file" / "out").string(),
+  };
+  for (const std::string& command : commands) {
+    const CommandResult r = run_guarded(command);
+    EXPECT_EQ(r.exit_code, 2) << command << "\n" << r.output;
+    EXPECT_NE(r.output.find("cannot write to the output folder '"), std::string::npos)
+        << command << "\n"
+        << r.output;
+    EXPECT_NE(r.output.find("choose another output folder (-o)"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("draping"), std::string::npos) << r.output;
+  }
+  const CommandResult file =
+      run_guarded("mesh " + sketch + " -o " + (dir / "a-file" / "out").string());
+  EXPECT_NE(file.output.find("a-file' is a file, not a folder"), std::string::npos) << file.output;
+  // A folder that can be made is made only by the real outputs: validate-like checks leave none.
+  const CommandResult made =
+      run_guarded("mesh " + sketch + " -o " + (dir / "new" / "deeper").string());
+  EXPECT_EQ(made.exit_code, 0) << made.output;
+  EXPECT_TRUE(fs::exists(dir / "new" / "deeper" / "garment.obj"));
+  for (const auto& entry : fs::recursive_directory_iterator(dir))
+    EXPECT_EQ(entry.path().filename().string().find(".sketchdrape-probe"), std::string::npos)
+        << entry.path();
+  fs::remove_all(dir);
+}
+
+// Trial 33: pin_above -3 held all 993 vertices and reported "at rest" after 0.27 s. A height
+// that holds every vertex is refused with the cloth's and the body's height ranges.
+TEST(HostileInput, PinAboveThatHoldsEveryVertexIsRefused) {
+  const fs::path dir = fresh_dir("pin-all");
+  write(dir / "sketch.json", square("", ",\n  \"simulate\": {\"pin_above\": -3}"));
+  for (const char* command : {"validate", "run"}) {
+    const std::string out =
+        std::string(command) == "validate" ? "" : " -o " + (dir / "out").string();
+    const CommandResult r =
+        run_sketchdrape(std::string(command) + " " + (dir / "sketch.json").string() + out);
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find("/simulate/pin_above: pin_above -3 m holds every vertex of the "
+                            "cloth, so nothing would drape: the cloth lies between 1."),
+              std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("; the body stands from 0.000 to 1.750 m"), std::string::npos)
+        << r.output;
+    EXPECT_FALSE(fs::exists(dir / "out"));
+  }
+  fs::remove_all(dir);
+}
+
+// A drape that ends without reaching at rest says so, where it still moves and what to try, on
+// the terminal and in report.json's warnings; its drift is unknown (null), not 0.
+TEST(HostileInput, ADrapeThatDoesNotComeToRestIsWarned) {
+  const fs::path dir = fresh_dir("not-at-rest");
+  write(dir / "sheet.json", R"({"sheet": {"size": [1, 1], "resolution": [6, 6],
+    "pins": ["top-left", "top-right"]}, "simulate": {"duration": 0.2},
+    "output": {"images": []}})");
+  const CommandResult r =
+      run_sketchdrape("run " + (dir / "sheet.json").string() + " -o " + (dir / "out").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string fragment =
+      "sheet.json: the drape did not come to rest in 0.2 s: the cloth "
+      "still moves at ";
+  EXPECT_NE(r.output.find(fragment), std::string::npos) << r.output;
+  const auto report = nlohmann::json::parse(read(dir / "out" / "report.json"));
+  EXPECT_FALSE(report["at_rest"].get<bool>());
+  ASSERT_EQ(report["warnings"].size(), 1u) << report["warnings"].dump();
+  const std::string warning = report["warnings"][0].get<std::string>();
+  EXPECT_NE(warning.find(fragment), std::string::npos) << warning;
+  EXPECT_NE(warning.find("\"simulate\": {\"duration\": 0.4}"), std::string::npos) << warning;
+  EXPECT_TRUE(report["rest"]["drift_m"].is_null()) << report["rest"].dump();
+  EXPECT_GT(report["rest"]["speed_final_m_s"].get<double>(),
+            report["rest"]["speed_limit_m_s"].get<double>());
   fs::remove_all(dir);
 }
 

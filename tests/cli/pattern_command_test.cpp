@@ -152,6 +152,38 @@ TEST(PatternCommand, EveryExampleGivesPiecesThatSewAndDoNotOverlap) {
   }
 }
 
+// Trial 33: the pieces of a garment cut from a fabric file were labelled with the file's path
+// ("../fabrics/linen.json"); they carry the fabric's own name, in pattern.json, the SVG and
+// validate's summary.
+TEST(PatternCommand, PiecesNameAFabricFileByItsName) {
+  const fs::path dir = fresh_dir("fabric-name");
+  fs::create_directories(dir / "designs");
+  fs::create_directories(dir / "fabrics");
+  nlohmann::json fabric =
+      nlohmann::json::parse(read(fs::path(SD_SOURCE_DIR) / "data/fabrics/cotton.json"));
+  fabric["name"] = "medium linen";
+  std::ofstream(dir / "fabrics" / "linen.json") << fabric.dump(2);
+  std::string text = read(example("tshirt"));
+  const std::string preset = "\"fabric\": \"jersey\"";
+  ASSERT_NE(text.find(preset), std::string::npos);
+  text.replace(text.find(preset), preset.size(), "\"fabric\": \"../fabrics/linen.json\"");
+  std::ofstream(dir / "designs" / "tshirt.json") << text;
+  const CommandResult r = run_sketchdrape("pattern " + (dir / "designs" / "tshirt.json").string() +
+                                          " -o " + (dir / "out").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto json = nlohmann::json::parse(read(dir / "out/pattern.json"));
+  ASSERT_FALSE(json["pieces"].empty());
+  for (const auto& piece : json["pieces"])
+    EXPECT_EQ(piece["fabric"], "medium linen") << piece["id"];
+  const std::string svg = read(dir / "out/pattern.svg");
+  EXPECT_NE(svg.find("medium linen"), std::string::npos);
+  EXPECT_EQ(svg.find("linen.json"), std::string::npos);
+  // validate's summary names it so too.
+  const CommandResult v = run_sketchdrape("validate " + (dir / "designs" / "tshirt.json").string());
+  EXPECT_NE(v.output.find(", fabric medium linen)"), std::string::npos) << v.output;
+  fs::remove_all(dir);
+}
+
 // A seam allowance per seam, as a designer writes it on the curves: a 3 cm hem, a 6 mm neckline,
 // 1 cm elsewhere. On every piece the sewing line lies the seam's own allowance inside the cutting
 // line (points inside a run, to 0.5 mm: the cutting line follows the sewing line simplified to

@@ -45,6 +45,43 @@ TEST(BadInput, EveryFileFailsWithPathAndSentence) {
   }
 }
 
+// Trial 33's misleading hints, in full: a skirt front without its hem was asked whether 'hip_b'
+// (a back curve meeting the sides at the hip) was missing; the front hem given to the back too
+// was explained with 'hip_b', "near the crotch" and a sleeve. The gap's ends and the curve in no
+// panel are named, and the curve the two panels fold onto with the one drawn for the back.
+TEST(BadInput, HintsNameTheCurveAtFault) {
+  const std::filesystem::path dir = std::filesystem::path(SD_SOURCE_DIR) / "tests/garment/bad";
+  const auto error_of = [&](const char* name) -> std::string {
+    try {
+      const Sketch sketch = load_sketch(dir / name);
+      const Body body = load_sketch_body(sketch);
+      const BodySurface surface(body.mesh);
+      build_garment(sketch, surface);
+    } catch (const SketchError& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  const std::string left_out = error_of("hem-left-out.json");
+  EXPECT_NE(left_out.find("curves 'hem_f' (in no panel) and 'hem_b' (in panel 'skirt_back') run "
+                          "from one to the other: is 'hem_f' missing from the list between "
+                          "them?"),
+            std::string::npos)
+      << left_out;
+  EXPECT_EQ(left_out.find("hip_b"), std::string::npos) << left_out;
+  const std::string twice = error_of("hem-in-two-panels.json");
+  EXPECT_NE(twice.find("curve 'hem_f' bounds both panels 'skirt_front' and 'skirt_back'"),
+            std::string::npos)
+      << twice;
+  EXPECT_NE(twice.find("Either one of them was given the wrong curve (check the boundary lists of "
+                       "'skirt_front' and 'skirt_back'; drawn but in no panel: 'hem_b': is it "
+                       "meant there instead of 'hem_f'?), or one of them spans"),
+            std::string::npos)
+      << twice;
+  EXPECT_EQ(twice.find("hip_b"), std::string::npos) << twice;
+  EXPECT_EQ(twice.find("crotch"), std::string::npos) << twice;
+}
+
 // Hostile text that no file in bad/ holds: 100,000 nested lists (the JSON reader would build
 // them all: seconds and hundreds of MB) and a key given twice deep inside.
 TEST(BadInput, DeepNestingAndNestedDuplicatesAreRefusedAtTheirPath) {

@@ -205,6 +205,50 @@ TEST(Simulation, AtRestBoundsTheDriftOverTheWindow) {
                                    settings.dt * report.rest_speed_window);
 }
 
+// Adaptive detail replaces the mesh mid-drape: the still stretch's drift is carried through
+// (a vertex keeps its displacement since the stretch began), so a replaced mesh does not read
+// as freshly still; a step that is not still has no drift (NaN, null in report.json), not 0.
+TEST(Simulation, AtRestDriftIsCarriedThroughAMeshChange) {
+  const HangingSheet h = hanging_sheet(6);
+  const SimulationSettings settings = damped_settling_settings();
+  Simulation sim = make_simulation(h, settings);
+  sim.step();
+  EXPECT_TRUE(std::isnan(sim.report().rest_drift)) << "the first step swings";
+  Eigen::VectorXd anchor;  // the positions when the current still stretch began
+  Eigen::VectorXd previous = sim.positions();
+  int still_steps = 0;
+  while (still_steps < 3 && sim.time() < settings.duration) {
+    sim.step();
+    if (std::isnan(sim.report().rest_drift)) {
+      still_steps = 0;
+    } else if (still_steps++ == 0) {
+      anchor = previous;
+    }
+    previous = sim.positions();
+  }
+  ASSERT_EQ(still_steps, 3);
+  const auto drift_from = [&](const Eigen::VectorXd& x) {
+    double drift = 0.0;
+    for (Eigen::Index i = 0; i < x.size() / 3; ++i)
+      drift = std::max(drift, (x.segment<3>(3 * i) - anchor.segment<3>(3 * i)).norm());
+    return drift;
+  };
+  ASSERT_NEAR(sim.report().rest_drift, drift_from(sim.positions()), 1e-12);
+  ASSERT_GT(sim.report().rest_drift, 0.0);
+  // The same mesh, renumbered as an adaptive step would hand it over (every vertex its own
+  // origin): the drift after the next still step still counts from the stretch's start.
+  std::vector<VertexOrigin> origin(static_cast<std::size_t>(h.model.vertex_count));
+  for (int i = 0; i < h.model.vertex_count; ++i) origin[static_cast<std::size_t>(i)] = {i, i};
+  sim.replace_model(sim.model(), sim.positions(), sim.velocities(), testing::fixed_pins(h.scene),
+                    origin);
+  const double before = sim.report().rest_drift;
+  sim.step();
+  ASSERT_FALSE(std::isnan(sim.report().rest_drift));
+  EXPECT_NEAR(sim.report().rest_drift, drift_from(sim.positions()), 1e-12);
+  // One step's displacement alone (what a fresh anchor would give) is much less than this.
+  EXPECT_GT(sim.report().rest_drift, 0.5 * before);
+}
+
 TEST(Simulation, ResolutionInvariance) {
   const SettledShape coarse = settle(8);
   const SettledShape medium = settle(16);

@@ -12,6 +12,7 @@
 
 #include "src/app/batch/batch_runner.hpp"
 #include "src/app/commands/cli.hpp"
+#include "src/app/pipeline/atomic_file.hpp"
 
 namespace sd::app {
 namespace {
@@ -73,6 +74,7 @@ void run_batch_command(BatchCommandOptions& o, const CLI::App& root, const Globa
     return;
   }
   if (o.batch.out.empty()) throw std::invalid_argument("give the batch folder with -o DIR");
+  check_output_folder(o.batch.out);
   try {
     root.get_subcommand(o.batch.stage);
   } catch (const CLI::OptionNotFound&) {

@@ -281,6 +281,7 @@ void run_textile_study(const BenchOptions& options, const GlobalOptions& global)
 
 void run_bench(const BenchOptions& options, const GlobalOptions& global) {
   if (!options.worker_config.empty()) return run_worker_side(options);
+  check_output_folder(options.out);  // every study writes its tables there
   if (options.scaling) return run_scaling_study(options, global);
   if (options.textile) return run_textile_study(options, global);
   const BenchGrid grid = parse_grid(options);

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -129,6 +130,9 @@ void run_fill(const FillOptions& options) {
     if (c < 1)
       throw FillUsageError("every side needs at least 1 edge; got " + std::to_string(c) +
                            " in --sides " + options.sides);
+  // The folders of --obj and --png can take files, before the fill (as every writing command).
+  for (const std::string& file : {options.obj, options.png})
+    if (!file.empty()) check_output_folder(std::filesystem::path(file).parent_path());
   const meshing::FilledPatch patch = meshing::fill_region(region_sides(counts), counts, geometry);
   const meshing::MeshCheck check = meshing::validate(patch.mesh);
   const auto& q = patch.quality;

@@ -68,6 +68,7 @@ void run_mesh(const MeshOptions& options) {
   const auto start = Clock::now();
   const scene::Sketch sketch = scene::load_sketch(options.sketch);
   check_sketch(sketch);  // the fabrics and settings `run` would refuse, refused here too
+  check_output_folder(options.out);
   const std::filesystem::path dir(options.out);
   StagedOutputs outputs;
   nlohmann::json report = {{"format", "sketchdrape/1 mesh report"}, {"sketch", sketch.file}};

@@ -35,6 +35,7 @@ void run_pattern(const PatternOptions& options) {
   scene::PatternSpec spec = sketch.output.pattern.value_or(scene::PatternSpec{});
   if (options.fabric_width) spec.fabric_width = *options.fabric_width;
   if (options.seam_allowance) spec.seam_allowance = *options.seam_allowance;
+  check_output_folder(options.out);
   const garment::Body body = garment::load_sketch_body(sketch);
   const garment::BodySurface surface(body.mesh);
   const garment::Garment g = garment::build_garment(sketch, surface);

@@ -190,6 +190,8 @@ void run_render(const RenderOptions& options, const GlobalOptions& global) {
     throw std::invalid_argument(fmt::format(
         "-o {} names one image but {} views were asked: give a directory to get one PNG per view",
         options.output, jobs.size()));
+  check_output_folder(single_file ? std::filesystem::path(options.output).parent_path()
+                                  : std::filesystem::path(options.output));
 
   render::Scene scene;
   scene.ground = !options.no_ground;

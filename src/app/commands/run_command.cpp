@@ -25,7 +25,9 @@
 #include "sim/simulation.hpp"
 #include "sim/solver_library_threads.hpp"
 #include "src/app/commands/cli.hpp"
+#include "src/app/pipeline/atomic_file.hpp"
 #include "src/app/pipeline/cloth_scene.hpp"
+#include "src/app/pipeline/drape_warnings.hpp"
 #include "src/app/pipeline/mesh_export.hpp"
 #include "src/app/pipeline/pattern_export.hpp"
 #include "src/app/pipeline/preview_images.hpp"
@@ -126,6 +128,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   const auto start = Clock::now();
   const scene::Sketch sketch = scene::load_sketch(options.sketch);
   check_sketch(sketch);
+  check_output_folder(options.out);  // before the drape's time is spent, not after it
   sim::SimulationSettings settings = simulation_settings(sketch);
   RunLimits limits;
   if (!options.max_memory.empty()) limits.max_memory_bytes = parse_memory_size(options.max_memory);
@@ -281,7 +284,8 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
 
   // One driver: the cloth's 4-8 mesh, adapting or not (a sheet that does not adapt drapes on its
   // own triangles).
-  RunReport out;  // report.json, filled as the drape goes
+  RunReport out;                           // report.json, filled as the drape goes
+  out.warnings = fabric_warnings(sketch);  // logged by check_sketch
   sim::SimulationReport& report = out.simulation;
   out.settings = settings;
   meshing::TriMesh draped;
@@ -325,13 +329,52 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
     if (scene.garment && scene.body && report.energy.size() >= 2 && weight > 0.0) {
       out.settled_drop =
           (report.energy.front().potential - report.energy.back().potential) / weight;
-      if (*out.settled_drop > kSlidWarning)
-        spdlog::warn(
-            "{}: the garment settled {:.1f} cm below where it was drawn (its centre of mass): "
-            "nothing held it up there, so it slid until the body caught it (a strapless or loose "
-            "top needs an \"ease\" below 1 or a smaller \"offset\" to grip; docs/garment.md, "
-            "\"Seventh round\")",
-            sketch.file, 100 * *out.settled_drop);
+      if (*out.settled_drop > kSlidWarning) {
+        // Worded for the garment: the curve at its top (a skirt's waist, a top's upper edge)
+        // and the panels it bounds, which are what should hold it up.
+        const std::optional<TopOpening> opening = top_opening(*scene.garment);
+        std::string landmark;
+        if (opening) {
+          try {
+            landmark = garment::find_landmarks(scene.body->mesh).nearest(opening->centre).name;
+          } catch (const std::runtime_error&) {
+            // Not a standing figure: the height alone.
+          }
+        }
+        out.warnings.push_back(settled_warning(sketch.file, *out.settled_drop, opening, landmark));
+        spdlog::warn("{}", out.warnings.back());
+      }
+    }
+    // Ended without reaching at rest (the duration ran out): where it still moves and what to
+    // try, so that a moving drape is not taken for a settled one.
+    // (With "stop_at_rest": false the run goes on to the end; it is judged by its last window.)
+    if (!report.failed && !report.at_rest &&
+        (settings.stop_at_rest || !driver.simulation().at_rest())) {
+      const sim::Simulation& s = driver.simulation();
+      StillMoving where;
+      where.vertices = s.model().vertex_count;
+      int fastest = 0;
+      for (int i = 0; i < where.vertices; ++i) {
+        const double speed = s.velocities().segment<3>(3 * i).norm();
+        if (speed > settings.rest_speed) ++where.moving;
+        if (speed > where.speed) where.speed = speed, fastest = i;
+      }
+      where.at = draped.vertices.row(fastest).transpose();
+      for (Eigen::Index t = 0; t < draped.faces.rows() && where.panel.empty(); ++t)
+        if ((draped.faces.row(t).array() == fastest).any() && t < triangle_group.size() &&
+            triangle_group(t) >= 0 &&
+            triangle_group(t) < static_cast<int>(scene.group_names.size()))
+          where.panel = scene.group_names[static_cast<size_t>(triangle_group(t))];
+      if (scene.body) {
+        try {
+          where.landmark = garment::find_landmarks(scene.body->mesh).nearest(where.at).name;
+        } catch (const std::runtime_error&) {
+          // Not a standing figure: the place without a landmark.
+        }
+      }
+      out.warnings.push_back(not_at_rest_warning(sketch.file, report.sim_time, settings.rest_speed,
+                                                 settings.rest_window, where));
+      spdlog::warn("{}", out.warnings.back());
     }
     if (adaptive) out.adaptive = *driver.adaptive_report();
   } catch (const sim::InvalidFabricError& e) {

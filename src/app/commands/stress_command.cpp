@@ -92,6 +92,7 @@ void run_stress(const StressCommandOptions& options, const GlobalOptions& global
     throw std::invalid_argument(
         "give either -o DIR (writes DIR/stress.json) or --json (stdout), not both");
   const std::vector<StressCase> cases = selected_cases(options);
+  if (!options.list && !options.out.empty()) check_output_folder(options.out);
   if (options.list) {
     for (const StressCase& c : cases)
       std::printf("%s%s  %s\n", c.id.c_str(), c.quick && !options.quick ? " (quick)" : "",

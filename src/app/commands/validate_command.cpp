@@ -51,8 +51,13 @@ void run_validate(const ValidateOptions& options) {
   }
   std::vector<garment::QualityWarning> warnings;
   if (scene.garment && scene.body) warnings = quality_warnings(*scene.garment, sketch, *scene.body);
+  // A fabric file by its own name ("medium linen"), not its path.
+  const std::string fabric =
+      scene.fabric_name.ends_with(".json") && scene.fabric.name != sim::FabricParameters{}.name
+          ? scene.fabric.name
+          : scene.fabric_name;
   std::cout << fmt::format(
-      "{}: ok ({}, fabric {}){}\n", sketch.file, what, scene.fabric_name,
+      "{}: ok ({}, fabric {}){}\n", sketch.file, what, fabric,
       warnings.empty() ? "" : fmt::format("; {} mesh quality warning(s)", warnings.size()));
   if (options.strict && !warnings.empty())
     throw std::runtime_error(

@@ -1,7 +1,9 @@
 #include "src/app/pipeline/atomic_file.hpp"
 
+#include <fcntl.h>
 #include <pthread.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <array>
@@ -14,7 +16,9 @@
 #include <mutex>
 #include <set>
 #include <stdexcept>
+#include <string>
 #include <system_error>
+#include <vector>
 
 namespace sd::app {
 namespace {
@@ -155,6 +159,56 @@ void write_file_atomically(const std::filesystem::path& path, std::string_view b
     std::filesystem::remove(temp);
     throw std::runtime_error("cannot write '" + path.string() + "': " + ec.message());
   }
+}
+
+void check_output_folder(const std::filesystem::path& dir_in) {
+  namespace fs = std::filesystem;
+  const fs::path dir = dir_in.empty() ? fs::path(".") : dir_in;
+  const auto refuse = [&](const std::string& reason) {
+    throw std::invalid_argument("cannot write to the output folder '" + dir.string() +
+                                "': " + reason + "; choose another output folder (-o)");
+  };
+  // The nearest level that exists: a file there ends it; the missing levels below are made
+  // (and removed again) to see that they can be.
+  std::error_code ec;
+  std::vector<fs::path> missing;
+  fs::path base = dir;
+  for (; !base.empty(); base = base.parent_path()) {
+    const fs::file_status status = fs::status(base, ec);
+    if (fs::exists(status)) {
+      if (!fs::is_directory(status)) refuse("'" + base.string() + "' is a file, not a folder");
+      break;
+    }
+    missing.push_back(base);
+    if (base == base.parent_path()) break;
+  }
+  if (base.empty()) base = ".";
+  std::vector<fs::path> made;  // shallowest first
+  const auto remove_made = [&] {
+    std::error_code ignored;
+    for (auto d = made.rbegin(); d != made.rend(); ++d) fs::remove(*d, ignored);  // if empty
+  };
+  for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
+    if (::mkdir(it->c_str(), 0777) != 0) {
+      const int error = errno;
+      remove_made();
+      refuse("cannot create folder '" + it->string() + "' (" + std::strerror(error) +
+             (error == ENOENT ? ": its parent takes no new folders" : "") + ")");
+    }
+    made.push_back(*it);
+  }
+  // A file can be made there (as root, permission bits say nothing about /proc or a read-only
+  // mount: only trying tells).
+  const fs::path probe = dir / (".sketchdrape-probe-" + std::to_string(::getpid()));
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
+  if (fd < 0) {
+    const int error = errno;
+    remove_made();
+    refuse(std::string("no file can be created in it (") + std::strerror(error) + ")");
+  }
+  ::close(fd);
+  ::unlink(probe.c_str());
+  remove_made();
 }
 
 StagedOutputs::~StagedOutputs() {

@@ -14,6 +14,13 @@ namespace sd::app {
 // reader sees either the old file or the complete new one. Throws std::runtime_error.
 void write_file_atomically(const std::filesystem::path& path, std::string_view bytes);
 
+// Checks, before any work, that files can be written in the output folder `dir`: it is a
+// folder (or can be made one) and a file can be created in it. Leaves nothing behind (folders
+// made for the test are removed again). Throws std::invalid_argument (exit code 2) with the
+// folder, the reason and what to do: a read-only or system folder (/proc) was found only after
+// a 21 s drape.
+void check_output_folder(const std::filesystem::path& dir);
+
 // A set of output files that appear together or not at all. Files are staged under temporary
 // names; commit() renames them all into place; destruction without commit() removes them, and so
 // does SIGINT, SIGTERM or SIGHUP (the process then dies by the signal). Staging in a folder first

@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 
+#include "sim/fabric.hpp"
 #include "src/app/pipeline/markup_escape.hpp"
 #include "src/app/pipeline/pattern_label.hpp"
 
@@ -114,6 +116,20 @@ std::string svg_path(const garment::PatternPiece& piece, const Eigen::MatrixX2d&
   return d + "Z";
 }
 
+// The fabric as a pattern piece names it: a fabric file by its "name" ("medium linen", not
+// "../fabrics/linen.json"), else by the file's stem; a preset or an inline fabric by its name.
+std::string fabric_label(const scene::Sketch& sketch, const std::string& fabric) {
+  if (!fabric.ends_with(".json") || (fabric == sketch.fabric && !sketch.fabric_inline.empty()))
+    return fabric;
+  try {
+    const sim::FabricParameters parameters = sim::load_fabric_file(sketch.resolve(fabric).string());
+    if (parameters.name != sim::FabricParameters{}.name) return parameters.name;
+  } catch (const sim::InvalidFabricError&) {
+    // `run` and `validate` report a bad fabric file; the pattern is labelled by its stem.
+  }
+  return std::filesystem::path(fabric).stem().string();
+}
+
 }  // namespace
 
 PatternSheet build_pattern_sheet(const scene::Sketch& sketch, const garment::Garment& garment,
@@ -136,7 +152,7 @@ PatternSheet build_pattern_sheet(const scene::Sketch& sketch, const garment::Gar
       layout.panel_allowance.push_back(ps && ps->seam_allowance ? *ps->seam_allowance : -1.0);
       layout.edge_allowance.push_back(edge_allowances(sketch, garment, flat));
       layout.panel_ease.push_back(panel.ease);
-      sheet.fabrics.push_back(panel.fabric);
+      sheet.fabrics.push_back(fabric_label(sketch, panel.fabric));
     }
     const auto layout_start = Clock::now();
     sheet.layout = garment::lay_out_pattern(sheet.pattern, layout);

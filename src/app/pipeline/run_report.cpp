@@ -2,6 +2,7 @@
 
 #include <Eigen/SVD>
 #include <algorithm>
+#include <cmath>
 
 namespace sd::app {
 namespace {
@@ -48,7 +49,8 @@ nlohmann::json simulation_json(const sim::SimulationReport& r, const sim::Simula
             {"speed_limit_m_s", s.rest_speed},
             {"kinetic_per_kg_limit_J_kg", s.rest_kinetic_energy},
             {"window_s", s.rest_window},
-            {"drift_m", r.rest_drift},
+            {"drift_m",
+             std::isnan(r.rest_drift) ? nlohmann::json(nullptr) : nlohmann::json(r.rest_drift)},
             {"drift_limit_m", s.rest_speed * s.rest_window}}},
           {"contacts_max", r.contacts_max},
           {"max_penetration_m", r.max_penetration_m},
@@ -215,6 +217,8 @@ nlohmann::json run_report_json(const RunReport& r) {
   }
   out["settled_drop_m"] =
       r.settled_drop ? nlohmann::json(*r.settled_drop) : nlohmann::json(nullptr);
+  // What the run warned about (the same sentences as on the terminal), empty when nothing.
+  out["warnings"] = r.warnings;
   out["images"] = r.images;
   out["frames"] = r.frames;
   out["body_motion"] = nullptr;

@@ -85,6 +85,9 @@ struct RunReport {
   // nothing grips (a loose strapless top) slides down until something holds it.
   std::optional<double> settled_drop;
   std::optional<nlohmann::json> pattern;  // pattern_summary, when the file asks
+  // The run's warnings about the drape (not at rest at the end, settled below where drawn),
+  // each the sentence the terminal shows.
+  std::vector<std::string> warnings;
   std::vector<std::string> images;
   std::size_t frames = 0;
   std::optional<BodyMotionSummary> body_motion;

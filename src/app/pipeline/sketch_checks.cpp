@@ -1,7 +1,9 @@
 #include "src/app/pipeline/sketch_checks.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -10,6 +12,7 @@
 
 #include "garment/sketch_ranges.hpp"
 #include "sim/fabric.hpp"
+#include "sim/fabric_ranges.hpp"
 #include "sim/factor_size.hpp"
 #include "sim/sheet.hpp"
 #include "src/app/pipeline/cloth_scene.hpp"
@@ -87,6 +90,39 @@ void check_sketch(const scene::Sketch& sketch) {
   for (const garment::PanelSpec& panel : sketch.panels)
     if (panel.fabric != sketch.fabric) check_fabric(panel.fabric, panel.json_path + "/fabric");
   (void)simulation_settings(sketch);
+  for (const std::string& warning : fabric_warnings(sketch)) spdlog::warn("{}", warning);
+}
+
+std::vector<std::string> fabric_warnings(const scene::Sketch& sketch) {
+  std::vector<std::string> warnings;
+  std::vector<std::string> seen;  // each fabric once, however many panels name it
+  // The same three sources as check_fabric; an inline constant at its own path
+  // (/fabric/friction), a file's at the sketch's "fabric" with the file and its key named.
+  auto add = [&](const std::string& name, const std::string& path) {
+    if (std::find(seen.begin(), seen.end(), name) != seen.end()) return;
+    seen.push_back(name);
+    if (!sketch.fabric_inline.empty() && name == sketch.fabric) {
+      for (const sim::FabricNote& note : sim::unusual_constants(
+               sim::parse_fabric_json(sketch.fabric_inline, "the fabric given inline")))
+        warnings.push_back(
+            fmt::format("{}: {}{}: {}", sketch.file, "/fabric", note.pointer, note.sentence));
+      return;
+    }
+    try {
+      (void)sim::fabric_preset(name);
+      return;  // the presets lie in the usual ranges (Fabric.PresetsLieInTheUsualRanges)
+    } catch (const sim::UnknownFabricError&) {
+    }
+    const std::string file = sketch.resolve(name).lexically_normal().string();
+    for (const sim::FabricNote& note :
+         sim::unusual_constants(sim::load_fabric_file(sketch.resolve(name).string())))
+      warnings.push_back(fmt::format("{}: {}: fabric file '{}': {}: {}", sketch.file, path, file,
+                                     note.pointer, note.sentence));
+  };
+  add(sketch.fabric, "/fabric");
+  for (const garment::PanelSpec& panel : sketch.panels)
+    if (panel.fabric != sketch.fabric) add(panel.fabric, panel.json_path + "/fabric");
+  return warnings;
 }
 
 double available_memory_bytes() {

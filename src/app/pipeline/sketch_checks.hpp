@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "scene/sketch_file.hpp"
 #include "sim/simulation.hpp"
@@ -14,7 +15,13 @@ namespace sd::app {
 
 // Every panel's fabric (and the file's) is a known preset, the simulation settings work
 // together, every image can be drawn. Throws garment::SketchError at the value's path.
+// Logs fabric_warnings as warnings.
 void check_sketch(const scene::Sketch& sketch);
+
+// The fabrics' constants that are physically possible but unusual for apparel (friction 1.8,
+// a 1 kg/m^2 cloth): one "<file>: <JSON path>: <sentence>" line each, for the terminal and
+// report.json. Call after check_sketch (a bad fabric is not reported here).
+std::vector<std::string> fabric_warnings(const scene::Sketch& sketch);
 
 // What a run may use: --max-memory (default: 80 % of the memory the system has available now)
 // and --max-time (default: none).

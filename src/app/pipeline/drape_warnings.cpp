@@ -1,0 +1,125 @@
+#include "src/app/pipeline/drape_warnings.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <map>
+#include <string_view>
+#include <utility>
+
+namespace sd::app {
+namespace {
+
+// m: curves of the outline whose mean heights lie this close to the highest one's are one
+// opening (a waist drawn as a front and a back curve, a few centimetres apart at the sides).
+constexpr double kSameOpening = 0.03;
+
+// "'a'", "'a' and 'b'", "'a', 'b' and 'c'".
+std::string quoted_list(const std::vector<std::string>& names) {
+  std::string text;
+  for (size_t i = 0; i < names.size(); ++i)
+    text += (i == 0 ? "" : (i + 1 == names.size() ? " and " : ", ")) + ("'" + names[i] + "'");
+  return text;
+}
+
+// "front.mirror" → "front"; "side.mirror" → "side": the designer wrote one.
+std::string unmirrored(std::string name) {
+  constexpr std::string_view suffix = ".mirror";
+  if (name.ends_with(suffix)) name.resize(name.size() - suffix.size());
+  return name;
+}
+
+// "left_knee" → "left knee": a landmark's name in a sentence.
+std::string spoken(std::string name) {
+  std::replace(name.begin(), name.end(), '_', ' ');
+  return name;
+}
+
+void add_once(std::vector<std::string>& list, const std::string& name) {
+  if (std::find(list.begin(), list.end(), name) == list.end()) list.push_back(name);
+}
+
+}  // namespace
+
+std::optional<TopOpening> top_opening(const garment::Garment& garment) {
+  const meshing::QuadMesh& mesh = garment.mesh;
+  // Each edge's quads: an edge on one quad is on the garment's outline (an opening).
+  std::map<std::pair<int, int>, std::vector<int>> edge_faces;
+  for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f)
+    for (int k = 0; k < 4; ++k) {
+      const int a = mesh.faces(f, k), b = mesh.faces(f, (k + 1) % 4);
+      edge_faces[{std::min(a, b), std::max(a, b)}].push_back(static_cast<int>(f));
+    }
+  struct CurveSum {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    int edges = 0;
+    std::vector<std::string> panels;
+  };
+  std::map<std::string, CurveSum> curves;  // by the designer's curve id
+  for (const auto& [edge, faces] : edge_faces) {
+    if (faces.size() != 1) continue;
+    const auto curve = garment.edge_curve.find(edge);
+    if (curve == garment.edge_curve.end()) continue;
+    CurveSum& c = curves[unmirrored(curve->second)];
+    c.sum += 0.5 * (mesh.vertices.row(edge.first) + mesh.vertices.row(edge.second)).transpose();
+    ++c.edges;
+    const int panel = garment.face_panel(faces.front());
+    if (panel >= 0 && panel < static_cast<int>(garment.panels.size()))
+      add_once(c.panels, unmirrored(garment.panels[static_cast<size_t>(panel)].id));
+  }
+  if (curves.empty()) return std::nullopt;
+  double top = -1e300;
+  for (const auto& [id, c] : curves) top = std::max(top, c.sum.y() / c.edges);
+  TopOpening opening;
+  int edges = 0;
+  for (const auto& [id, c] : curves) {
+    if (c.sum.y() / c.edges < top - kSameOpening) continue;
+    opening.curves.push_back(id);
+    for (const std::string& p : c.panels) add_once(opening.panels, p);
+    opening.centre += c.sum;
+    edges += c.edges;
+  }
+  opening.centre /= edges;
+  return opening;
+}
+
+std::string settled_warning(const std::string& file, double drop_m,
+                            const std::optional<TopOpening>& opening, const std::string& landmark) {
+  std::string text = fmt::format(
+      "{}: the garment settled {:.1f} cm below where it was drawn (its centre of mass): nothing "
+      "held it up there, so it slid until the body caught it",
+      file, 100 * drop_m);
+  if (!opening) {
+    return text +
+           "; make the panels that should hold it grip (\"ease\" below 1 or a smaller "
+           "\"offset\"; docs/garment.md, \"Seventh round\")";
+  }
+  const bool one_curve = opening->curves.size() == 1;
+  const bool one_panel = opening->panels.size() == 1;
+  return text + fmt::format(
+                    ". What holds it up is its top edge, curve{} {} at {:.2f} m{} ({} {}): "
+                    "that edge must grip the body. Draw it on the body where the garment should "
+                    "sit and give {} \"ease\" below 1 (e.g. 0.95) or a smaller \"offset\" so it "
+                    "fits snugly there; docs/garment.md, \"Seventh round\"",
+                    one_curve ? "" : "s", quoted_list(opening->curves), opening->centre.y(),
+                    landmark.empty() ? "" : ", near the " + spoken(landmark),
+                    one_panel ? "panel" : "panels", quoted_list(opening->panels),
+                    one_panel ? "that panel" : "those panels");
+}
+
+std::string not_at_rest_warning(const std::string& file, double duration_s, double rest_speed,
+                                double rest_window_s, const StillMoving& where) {
+  std::string place = where.panel.empty() ? "" : fmt::format("in panel '{}' ", where.panel);
+  place += fmt::format("at ({:.3f}, {:.3f}, {:.3f}) m", where.at.x(), where.at.y(), where.at.z());
+  if (!where.landmark.empty()) place += ", near the " + spoken(where.landmark);
+  return fmt::format(
+      "{}: the drape did not come to rest in {:g} s: the cloth still moves at {:.1f} cm/s {} "
+      "({} of {} vertices faster than the at-rest {:.1f} cm/s held for {:g} s), so the result "
+      "may not be its final shape; try a longer \"simulate\": {{\"duration\": {:g}}}, and if it "
+      "is still sliding there, a snugger fit where it should hold (\"ease\" below 1 on the "
+      "panel that holds it); report.json's \"rest\" gives the residual",
+      file, duration_s, 100 * where.speed, place, where.moving, where.vertices, 100 * rest_speed,
+      rest_window_s, 2 * duration_s);
+}
+
+}  // namespace sd::app

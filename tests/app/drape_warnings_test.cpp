@@ -1,0 +1,96 @@
+// The warnings of a drape that finished: worded for the garment at hand (trial 33: a skirt and
+// shorts were told about "a strapless or loose top"; a moving drape said nothing).
+
+#include "src/app/pipeline/drape_warnings.hpp"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+namespace sd::app {
+namespace {
+
+// Two quads, one above the other: a yoke (y 0.9 .. 1.0 m) over a skirt (0.8 .. 0.9 m), sewn
+// along 'hip'; the yoke's top edge is 'waist_f', the skirt's bottom 'hem', the sides 'side_*'.
+garment::Garment yoke_over_skirt() {
+  garment::Garment g;
+  g.mesh.vertices.resize(6, 3);
+  g.mesh.vertices << 0.0, 1.0, 0.1, 0.1, 1.0, 0.1,  //
+      0.0, 0.9, 0.1, 0.1, 0.9, 0.1,                 //
+      0.0, 0.8, 0.1, 0.1, 0.8, 0.1;
+  g.mesh.faces.resize(2, 4);
+  g.mesh.faces << 2, 3, 1, 0, 4, 5, 3, 2;
+  g.face_panel.resize(2);
+  g.face_panel << 0, 1;
+  g.panels.resize(2);
+  g.panels[0].id = "yoke";
+  g.panels[1].id = "skirt.mirror";  // a mirror copy is named as the panel the designer wrote
+  g.edge_curve = {{{0, 1}, "waist_f"}, {{2, 3}, "hip"},    {{4, 5}, "hem.mirror"},
+                  {{0, 2}, "side_a"},  {{1, 3}, "side_a"}, {{2, 4}, "side_b"},
+                  {{3, 5}, "side_b"}};
+  return g;
+}
+
+TEST(DrapeWarnings, TopOpeningIsTheHighestOutlineCurve) {
+  const std::optional<TopOpening> top = top_opening(yoke_over_skirt());
+  ASSERT_TRUE(top);
+  // 'side_a' (mean 0.95 m) is 5 cm below the waist: not part of the opening; 'hip' is a seam.
+  EXPECT_EQ(top->curves, std::vector<std::string>{"waist_f"});
+  EXPECT_EQ(top->panels, std::vector<std::string>{"yoke"});
+  EXPECT_NEAR(top->centre.y(), 1.0, 1e-12);
+  EXPECT_NEAR(top->centre.x(), 0.05, 1e-12);
+
+  // Turned upside down, the skirt's hem is the top: named without its ".mirror".
+  garment::Garment flipped = yoke_over_skirt();
+  flipped.mesh.vertices.col(1) = (1.8 - flipped.mesh.vertices.col(1).array()).matrix();
+  const std::optional<TopOpening> hem = top_opening(flipped);
+  ASSERT_TRUE(hem);
+  EXPECT_EQ(hem->curves, std::vector<std::string>{"hem"});
+  EXPECT_EQ(hem->panels, std::vector<std::string>{"skirt"});
+
+  garment::Garment unnamed = yoke_over_skirt();
+  unnamed.edge_curve.clear();
+  EXPECT_FALSE(top_opening(unnamed));
+}
+
+TEST(DrapeWarnings, SettledWarningNamesWhatHoldsTheGarment) {
+  const std::string text =
+      settled_warning("shorts.json", 0.057, top_opening(yoke_over_skirt()), "waist");
+  EXPECT_EQ(text.rfind("shorts.json: the garment settled 5.7 cm below where it was drawn", 0), 0u)
+      << text;
+  EXPECT_NE(text.find("its top edge, curve 'waist_f' at 1.00 m, near the waist (panel 'yoke')"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("give that panel \"ease\" below 1"), std::string::npos) << text;
+  EXPECT_EQ(text.find("strapless"), std::string::npos) << text;
+  // Without an opening (a closed bag): the general advice, still not about tops.
+  const std::string bare = settled_warning("bag.json", 0.04, std::nullopt, "");
+  EXPECT_NE(bare.find("settled 4.0 cm below"), std::string::npos) << bare;
+  EXPECT_EQ(bare.find("top"), std::string::npos) << bare;
+}
+
+TEST(DrapeWarnings, NotAtRestSaysWhereItMovesAndWhatToTry) {
+  StillMoving where;
+  where.speed = 0.0896;
+  where.at = {0.18, 0.46, -0.092};
+  where.panel = "leg_back";
+  where.landmark = "left_knee";
+  where.moving = 177;
+  where.vertices = 1301;
+  const std::string text = not_at_rest_warning("d3.json", 10.0, 0.005, 0.25, where);
+  EXPECT_NE(text.find("d3.json: the drape did not come to rest in 10 s: the cloth still moves at "
+                      "9.0 cm/s in panel 'leg_back' at (0.180, 0.460, -0.092) m, near the left "
+                      "knee (177 of 1301 vertices faster than the at-rest 0.5 cm/s held for "
+                      "0.25 s)"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("\"simulate\": {\"duration\": 20}"), std::string::npos) << text;
+  // A sheet without a body: no landmark, no panel name when unknown.
+  where.panel.clear();
+  where.landmark.clear();
+  const std::string sheet = not_at_rest_warning("s.json", 0.5, 0.005, 0.25, where);
+  EXPECT_NE(sheet.find("9.0 cm/s at (0.180, 0.460, -0.092) m ("), std::string::npos) << sheet;
+}
+
+}  // namespace
+}  // namespace sd::app
