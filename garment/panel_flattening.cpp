@@ -14,6 +14,7 @@
 #include <numbers>
 #include <optional>
 #include <set>
+#include <tuple>
 #include <unordered_map>
 
 #include "garment/material_frames.hpp"
@@ -297,6 +298,26 @@ FlatDistortion measure(const Eigen::MatrixX2d& uv, const Eigen::MatrixX3i& t,
   return d;
 }
 
+// The interior vertices' angle defects 2π − Σθ (rad), positive ones and negative ones summed
+// (FlatDistortion::dome, saddle). The boundary's vertices are left out: their defect is the
+// outline's turning, not the surface's curvature.
+std::pair<double, double> angle_defects(const Eigen::MatrixX3d& v, const Eigen::MatrixX3i& t,
+                                        const std::vector<int>& boundary) {
+  std::vector<double> angle(static_cast<size_t>(v.rows()), 0.0);
+  for (Eigen::Index f = 0; f < t.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d p = v.row(t(f, k));
+      const Eigen::Vector3d u = Eigen::Vector3d(v.row(t(f, (k + 1) % 3))) - p;
+      const Eigen::Vector3d w = Eigen::Vector3d(v.row(t(f, (k + 2) % 3))) - p;
+      angle[static_cast<size_t>(t(f, k))] += std::atan2(u.cross(w).norm(), u.dot(w));
+    }
+  for (const int b : boundary) angle[static_cast<size_t>(b)] = 2 * std::numbers::pi;
+  double dome = 0, saddle = 0;
+  for (const double a : angle)
+    (a < 2 * std::numbers::pi ? dome : saddle) += 2 * std::numbers::pi - a;
+  return {dome, saddle};
+}
+
 // Where on the piece a 2D point lies, in words ("at the upper left", "in the middle").
 std::string where_on_piece(const Eigen::MatrixX2d& uv, const Eigen::Vector2d& p) {
   const Eigen::Vector2d lo = uv.colwise().minCoeff(), hi = uv.colwise().maxCoeff();
@@ -324,14 +345,29 @@ void judge_stretch(FlatPanel& out, const FlatteningOptions& options) {
                     "cap: split it with seams or darts",
                     name, 100 * d.length_p95, where_on_piece(uv, d.worst_point_2d),
                     d.worst_point.x(), d.worst_point.y(), d.worst_point.z()));
-  if (d.length_p95 > options.warn_stretch)
-    out.warning = fmt::format(
-        "panel '{}': the flat piece is {:.1f} % or more longer or shorter than the surface over a "
-        "twentieth of its area, {} of the piece (near ({:.3f}, {:.3f}, {:.3f}) m; mean {:.2f} %); "
-        "the surface is not developable there: a dart or a seam there would let the cloth lie as "
-        "drawn",
-        name, 100 * d.length_p95, where_on_piece(uv, d.worst_point_2d), d.worst_point.x(),
-        d.worst_point.y(), d.worst_point.z(), 100 * d.length_mean);
+  if (d.length_p95 <= options.warn_stretch) return;
+  // What to do depends on how the surface curves: the larger of its domed and saddle parts.
+  const std::string advice =
+      -d.saddle > d.dome
+          ? fmt::format(
+                "the surface is saddle-shaped ({:.2f} rad more angle round its points than flat "
+                "cloth has, {:.2f} rad less), as where a hem is drawn wider than a cone from the "
+                "seam above would make it: cut flat, the piece keeps its seams and hem at their "
+                "drawn lengths and gathers the difference into a point or a kink of its outline; "
+                "a seam there or a godet (a wedge of cloth let in) would let the cloth lie as "
+                "drawn",
+                -d.saddle, d.dome)
+          : fmt::format(
+                "the surface is domed ({:.2f} rad less angle round its points than flat cloth "
+                "has, {:.2f} rad more), like the seat or the shoulder blades: a dart or a seam "
+                "there would let the cloth lie as drawn",
+                d.dome, -d.saddle);
+  out.warning = fmt::format(
+      "panel '{}': the flat piece is {:.1f} % or more longer or shorter than the surface over a "
+      "twentieth of its area, {} of the piece (near ({:.3f}, {:.3f}, {:.3f}) m; mean {:.2f} %); "
+      "{}",
+      name, 100 * d.length_p95, where_on_piece(uv, d.worst_point_2d), d.worst_point.x(),
+      d.worst_point.y(), d.worst_point.z(), 100 * d.length_mean, advice);
 }
 
 FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
@@ -379,6 +415,7 @@ FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
   out.uv = uv;
   for (Eigen::Index f = 0; f < t.rows(); ++f) out.area_2d += signed_area_2d(uv, t, f);
   out.distortion = measure(uv, t, rest);
+  std::tie(out.distortion.dome, out.distortion.saddle) = angle_defects(v, t, out.boundary);
   judge_stretch(out, options);
   return out;
 }

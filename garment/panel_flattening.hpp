@@ -62,6 +62,14 @@ struct FlatDistortion {
   // Area-weighted centroid (3D, and in the piece's 2D frame) of that worst twentieth.
   Eigen::Vector3d worst_point = Eigen::Vector3d::Zero();
   Eigen::Vector2d worst_point_2d = Eigen::Vector2d::Zero();
+  // What the surface on the body demands: the angle defect 2π − Σθ (rad) of the triangles round
+  // each interior vertex (its Gaussian curvature integrated over its share), summed separately
+  // where it is positive (domed: less angle than flat, as over the seat; cut flat, the cloth
+  // is short there: a dart) and negative (saddle-shaped: more angle than flat, as a membrane
+  // spanned between a hip line and a hem drawn wider than a cone; cut flat, the cloth is short
+  // across it: a seam or a godet). Both zero for a developable surface (a cylinder, a cone).
+  double dome = 0;    // rad, ≥ 0
+  double saddle = 0;  // rad, ≤ 0
 };
 
 struct FlatPanel {

@@ -375,7 +375,9 @@ nlohmann::json distortion_json(const garment::FlatDistortion& d) {
           {"length_p95", d.length_p95},
           {"area_max", d.area_max},
           {"area_mean", d.area_mean},
-          {"worst_near_m", {d.worst_point.x(), d.worst_point.y(), d.worst_point.z()}}};
+          {"worst_near_m", {d.worst_point.x(), d.worst_point.y(), d.worst_point.z()}},
+          {"dome_rad", d.dome},
+          {"saddle_rad", d.saddle}};
 }
 
 // A seam side's polyline in its piece's frame (m, ease applied).
