@@ -10,7 +10,11 @@
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numbers>
+#include <optional>
+#include <set>
+#include <tuple>
 #include <unordered_map>
 
 #include "garment/material_frames.hpp"
@@ -294,6 +298,26 @@ FlatDistortion measure(const Eigen::MatrixX2d& uv, const Eigen::MatrixX3i& t,
   return d;
 }
 
+// The interior vertices' angle defects 2π − Σθ (rad), positive ones and negative ones summed
+// (FlatDistortion::dome, saddle). The boundary's vertices are left out: their defect is the
+// outline's turning, not the surface's curvature.
+std::pair<double, double> angle_defects(const Eigen::MatrixX3d& v, const Eigen::MatrixX3i& t,
+                                        const std::vector<int>& boundary) {
+  std::vector<double> angle(static_cast<size_t>(v.rows()), 0.0);
+  for (Eigen::Index f = 0; f < t.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d p = v.row(t(f, k));
+      const Eigen::Vector3d u = Eigen::Vector3d(v.row(t(f, (k + 1) % 3))) - p;
+      const Eigen::Vector3d w = Eigen::Vector3d(v.row(t(f, (k + 2) % 3))) - p;
+      angle[static_cast<size_t>(t(f, k))] += std::atan2(u.cross(w).norm(), u.dot(w));
+    }
+  for (const int b : boundary) angle[static_cast<size_t>(b)] = 2 * std::numbers::pi;
+  double dome = 0, saddle = 0;
+  for (const double a : angle)
+    (a < 2 * std::numbers::pi ? dome : saddle) += 2 * std::numbers::pi - a;
+  return {dome, saddle};
+}
+
 // Where on the piece a 2D point lies, in words ("at the upper left", "in the middle").
 std::string where_on_piece(const Eigen::MatrixX2d& uv, const Eigen::Vector2d& p) {
   const Eigen::Vector2d lo = uv.colwise().minCoeff(), hi = uv.colwise().maxCoeff();
@@ -304,6 +328,46 @@ std::string where_on_piece(const Eigen::MatrixX2d& uv, const Eigen::Vector2d& p)
   if (*vertical == 0) return fmt::format("at the {} side", horizontal);
   if (*horizontal == 0) return fmt::format("in the {} part", vertical);
   return fmt::format("at the {} {}", vertical, horizontal);
+}
+
+// Refuses a piece beyond refuse_stretch, warns above warn_stretch (sets out.warning), naming
+// where the stretch concentrates.
+void judge_stretch(FlatPanel& out, const FlatteningOptions& options) {
+  const std::string& name = out.id;
+  const Eigen::MatrixX2d& uv = out.uv;
+  const FlatDistortion& d = out.distortion;
+  if (d.length_p95 > options.refuse_stretch)
+    throw PatternError(
+        name,
+        fmt::format("panel '{}' cannot be cut from flat cloth: flattened, it must stretch or "
+                    "shrink by {:.0f} % or more over a twentieth of its area, {} of the piece "
+                    "(near ({:.3f}, {:.3f}, {:.3f}) m); it curves too much, like a nearly closed "
+                    "cap: split it with seams or darts",
+                    name, 100 * d.length_p95, where_on_piece(uv, d.worst_point_2d),
+                    d.worst_point.x(), d.worst_point.y(), d.worst_point.z()));
+  if (d.length_p95 <= options.warn_stretch) return;
+  // What to do depends on how the surface curves: the larger of its domed and saddle parts.
+  const std::string advice =
+      -d.saddle > d.dome
+          ? fmt::format(
+                "the surface is saddle-shaped ({:.2f} rad more angle round its points than flat "
+                "cloth has, {:.2f} rad less), as where a hem is drawn wider than a cone from the "
+                "seam above would make it: cut flat, the piece keeps its seams and hem at their "
+                "drawn lengths and gathers the difference into a point or a kink of its outline; "
+                "a seam there or a godet (a wedge of cloth let in) would let the cloth lie as "
+                "drawn",
+                -d.saddle, d.dome)
+          : fmt::format(
+                "the surface is domed ({:.2f} rad less angle round its points than flat cloth "
+                "has, {:.2f} rad more), like the seat or the shoulder blades: a dart or a seam "
+                "there would let the cloth lie as drawn",
+                d.dome, -d.saddle);
+  out.warning = fmt::format(
+      "panel '{}': the flat piece is {:.1f} % or more longer or shorter than the surface over a "
+      "twentieth of its area, {} of the piece (near ({:.3f}, {:.3f}, {:.3f}) m; mean {:.2f} %); "
+      "{}",
+      name, 100 * d.length_p95, where_on_piece(uv, d.worst_point_2d), d.worst_point.x(),
+      d.worst_point.y(), d.worst_point.z(), 100 * d.length_mean, advice);
 }
 
 FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
@@ -351,25 +415,8 @@ FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
   out.uv = uv;
   for (Eigen::Index f = 0; f < t.rows(); ++f) out.area_2d += signed_area_2d(uv, t, f);
   out.distortion = measure(uv, t, rest);
-
-  const FlatDistortion& d = out.distortion;
-  if (d.length_p95 > options.refuse_stretch)
-    throw PatternError(
-        name,
-        fmt::format("panel '{}' cannot be cut from flat cloth: flattened, it must stretch or "
-                    "shrink by {:.0f} % or more over a twentieth of its area, {} of the piece "
-                    "(near ({:.3f}, {:.3f}, {:.3f}) m); it curves too much, like a nearly closed "
-                    "cap: split it with seams or darts",
-                    name, 100 * d.length_p95, where_on_piece(uv, d.worst_point_2d),
-                    d.worst_point.x(), d.worst_point.y(), d.worst_point.z()));
-  if (d.length_p95 > options.warn_stretch)
-    out.warning = fmt::format(
-        "panel '{}': the flat piece is {:.1f} % or more longer or shorter than the surface over a "
-        "twentieth of its area, {} of the piece (near ({:.3f}, {:.3f}, {:.3f}) m; mean {:.2f} %); "
-        "the surface is not developable there: a dart or a seam there would let the cloth lie as "
-        "drawn",
-        name, 100 * d.length_p95, where_on_piece(uv, d.worst_point_2d), d.worst_point.x(),
-        d.worst_point.y(), d.worst_point.z(), 100 * d.length_mean);
+  std::tie(out.distortion.dome, out.distortion.saddle) = angle_defects(v, t, out.boundary);
+  judge_stretch(out, options);
   return out;
 }
 
@@ -398,6 +445,99 @@ double polyline_length(const Eigen::MatrixX2d& uv, const std::vector<int>& verti
   for (size_t k = 1; k < vertices.size(); ++k)
     length += (uv.row(vertices[k]) - uv.row(vertices[k - 1])).norm();
   return length;
+}
+
+// Balance notches on one side of a seam (`run`: local vertices along the seam, consecutive on
+// the piece's outline in either direction), at `fractions` of the side's 2D length.
+void add_balance_notches(FlatPanel& flat, const std::vector<int>& run,
+                         const std::vector<double>& fractions) {
+  if (fractions.empty() || run.size() < 2) return;
+  const size_t n = flat.boundary.size();
+  std::unordered_map<int, size_t> position;  // local vertex → its place on the outline
+  for (size_t k = 0; k < n; ++k) position[flat.boundary[k]] = k;
+  std::vector<double> at(run.size(), 0.0);  // arc length at each run vertex
+  for (size_t k = 1; k < run.size(); ++k)
+    at[k] = at[k - 1] + (flat.uv.row(run[k]) - flat.uv.row(run[k - 1])).norm();
+  for (const double f : fractions) {
+    const double s = f * at.back();
+    size_t k = 0;  // the segment run[k] → run[k + 1] holding arc length s
+    while (k + 2 < run.size() && at[k + 1] < s) ++k;
+    const double piece = at[k + 1] - at[k];
+    const double t = piece > 0 ? std::clamp((s - at[k]) / piece, 0.0, 1.0) : 0.0;
+    const size_t i = position.at(run[k]), j = position.at(run[k + 1]);
+    if (j == (i + 1) % n)  // the run follows the outline's direction
+      flat.balance_notches.push_back({static_cast<int>(i), t});
+    else  // it runs against it: the outline edge is run[k + 1] → run[k]
+      flat.balance_notches.push_back({static_cast<int>(j), 1 - t});
+  }
+}
+
+// A mirror copy's piece as its original's reflected, when the copy's triangles are exactly the
+// original's reflected across x = 0 (build_garment reflects the original's fill, every
+// position's x negated bit for bit, and split_quad then picks the same diagonals): the
+// flattening of a mirror image is the mirror image of the flattening. Flattened on its own, a
+// copy lands elsewhere: LSCM's pinned vertices, ARAP's held vertex 0 and the order of its
+// sums follow the vertex numbering, and ARAP stops (200 sweeps) before it has converged, so two
+// numberings of one surface ended 2 mm and 0.8 % of stretch apart (the wide shorts' legs).
+// Empty when the copy differs in 3D (a fold repaired on one side only), which is flattened on
+// its own.
+std::optional<FlatPanel> reflected_piece(const FlatPanel& original, const Eigen::MatrixX3d& all,
+                                         const std::string& name, const Eigen::MatrixX3d& v,
+                                         const Eigen::MatrixX3i& t,
+                                         const FlatteningOptions& options) {
+  if (original.vertices.size() != static_cast<size_t>(v.rows()) ||
+      original.triangles.rows() != t.rows())
+    return std::nullopt;
+  std::map<std::array<double, 3>, int> at;
+  for (size_t i = 0; i < original.vertices.size(); ++i) {
+    const auto p = all.row(original.vertices[i]);
+    at.emplace(std::array{p.x(), p.y(), p.z()}, static_cast<int>(i));
+  }
+  std::vector<int> image(static_cast<size_t>(v.rows()), -1);
+  std::vector<char> hit(original.vertices.size(), 0);
+  for (Eigen::Index i = 0; i < v.rows(); ++i) {
+    const auto it = at.find({-v(i, 0), v(i, 1), v(i, 2)});
+    if (it == at.end() || hit[static_cast<size_t>(it->second)]) return std::nullopt;
+    image[static_cast<size_t>(i)] = it->second;
+    hit[static_cast<size_t>(it->second)] = 1;
+  }
+  // Each copy triangle must be an original one with its corners in the opposite turn (a
+  // reflection reverses orientation; the copy's quads are the original's reversed).
+  const auto canonical = [](int a, int b, int c) {
+    if (b < a && b < c) return std::array{b, c, a};
+    if (c < a && c < b) return std::array{c, a, b};
+    return std::array{a, b, c};
+  };
+  std::set<std::array<int, 3>> reversed;
+  for (Eigen::Index f = 0; f < original.triangles.rows(); ++f)
+    reversed.insert(
+        canonical(original.triangles(f, 0), original.triangles(f, 2), original.triangles(f, 1)));
+  for (Eigen::Index f = 0; f < t.rows(); ++f)
+    if (reversed.count(canonical(image[static_cast<size_t>(t(f, 0))],
+                                 image[static_cast<size_t>(t(f, 1))],
+                                 image[static_cast<size_t>(t(f, 2))])) == 0)
+      return std::nullopt;
+
+  FlatPanel out;
+  out.id = name;
+  out.triangles = t;
+  out.boundary = disk_boundary(name, v.rows(), t);
+  // x → width − x keeps the bounding box at (0, 0) and the grain on +y; with the reversed
+  // corners the triangles stay counter-clockwise.
+  const double width = original.uv.col(0).maxCoeff();
+  out.uv.resize(v.rows(), 2);
+  for (Eigen::Index i = 0; i < v.rows(); ++i) {
+    const auto q = original.uv.row(image[static_cast<size_t>(i)]);
+    out.uv.row(i) << width - q.x(), q.y();
+  }
+  out.area_3d = original.area_3d;
+  out.area_2d = original.area_2d;
+  out.iterations = original.iterations;
+  out.distortion = original.distortion;
+  out.distortion.worst_point.x() = -original.distortion.worst_point.x();
+  out.distortion.worst_point_2d.x() = width - original.distortion.worst_point_2d.x();
+  judge_stretch(out, options);
+  return out;
 }
 
 }  // namespace
@@ -466,7 +606,17 @@ FlatPattern flatten_garment(const Garment& garment, const FlatteningOptions& opt
       quad_of(f) = tri_quad[static_cast<size_t>(f)];
       warp.row(f) = frames.warp.row(quad_of(f));
     }
-    FlatPanel flat = flatten_with_warp(name, v, t, warp, options);
+    std::optional<FlatPanel> reflected;
+    if (garment.panels[p].mirror_copy) {
+      const std::string base = name.substr(0, name.rfind('.'));
+      for (size_t o = 0; o < pattern.panels.size() && !reflected; ++o)
+        if (pattern.panels[o].id == base) {
+          reflected = reflected_piece(pattern.panels[o], mesh.vertices, name, v, t, options);
+          if (reflected) reflected->reflection_of = static_cast<int>(o);
+        }
+    }
+    FlatPanel flat =
+        reflected ? std::move(*reflected) : flatten_with_warp(name, v, t, warp, options);
     flat.panel = static_cast<int>(p);
     flat.vertices = std::move(global);
     flat.triangle_quad = std::move(quad_of);
@@ -550,6 +700,16 @@ FlatPattern flatten_garment(const Garment& garment, const FlatteningOptions& opt
                               .norm();
       seam.length_a = polyline_length(fa.uv, seam.vertices_a);
       seam.length_b = polyline_length(fb.uv, seam.vertices_b);
+      if (seam.length_3d > options.balance_from) {
+        const int count =
+            std::max(1, static_cast<int>(std::ceil(seam.length_3d / options.balance_spacing)) - 1);
+        for (int k = 1; k <= count; ++k)
+          seam.balance.push_back(static_cast<double>(k) / (count + 1));
+      }
+      add_balance_notches(pattern.panels[static_cast<size_t>(a.panel)], seam.vertices_a,
+                          seam.balance);
+      add_balance_notches(pattern.panels[static_cast<size_t>(b.panel)], seam.vertices_b,
+                          seam.balance);
       pattern.seams.push_back(std::move(seam));
       break;
     }

@@ -36,6 +36,18 @@ struct FlatteningOptions {
   // Weight of the boundary-length terms against the triangles' rigidity (per edge, relative to
   // a triangle of area l²/2 next to an edge of length l).
   double boundary_weight = 200.0;
+  // Balance notches: a seam longer than balance_from (3D, m) gets notches at equal fractions of
+  // each side's length, at most balance_spacing apart (one in the middle of a 30 cm seam, two at
+  // its thirds for 53 cm), so the two sides are matched along the way as well as at the ends.
+  double balance_from = 0.25;
+  double balance_spacing = 0.20;
+};
+
+// A point on a piece's outline: on edge `edge` (FlatPanel::boundary[edge] → boundary[edge + 1],
+// cyclically), at fraction `t` of the edge from its first point.
+struct OutlinePoint {
+  int edge = 0;
+  double t = 0;
 };
 
 // Distortion of a flattening: σ₁ ≥ σ₂ are the singular values of each triangle's 3D → 2D map.
@@ -50,6 +62,14 @@ struct FlatDistortion {
   // Area-weighted centroid (3D, and in the piece's 2D frame) of that worst twentieth.
   Eigen::Vector3d worst_point = Eigen::Vector3d::Zero();
   Eigen::Vector2d worst_point_2d = Eigen::Vector2d::Zero();
+  // What the surface on the body demands: the angle defect 2π − Σθ (rad) of the triangles round
+  // each interior vertex (its Gaussian curvature integrated over its share), summed separately
+  // where it is positive (domed: less angle than flat, as over the seat; cut flat, the cloth
+  // is short there: a dart) and negative (saddle-shaped: more angle than flat, as a membrane
+  // spanned between a hip line and a hem drawn wider than a cone; cut flat, the cloth is short
+  // across it: a seam or a godet). Both zero for a developable surface (a cylinder, a cone).
+  double dome = 0;    // rad, ≥ 0
+  double saddle = 0;  // rad, ≤ 0
 };
 
 struct FlatPanel {
@@ -63,10 +83,15 @@ struct FlatPanel {
   Eigen::VectorXi triangle_quad;  // #T garment quad of each triangle (two per quad)
   std::vector<int> boundary;      // local vertex loop, counter-clockwise in 2D
   std::vector<int> notches;       // local boundary vertices where seams meet (loop order)
+  std::vector<OutlinePoint> balance_notches;  // along long seams (PatternSeam::balance)
   FlatDistortion distortion;
-  double area_3d = 0;   // m²
-  double area_2d = 0;   // m², before ease
-  int iterations = 0;   // ARAP sweeps made
+  double area_3d = 0;  // m²
+  double area_2d = 0;  // m², before ease
+  int iterations = 0;  // ARAP sweeps made
+  // A mirror copy whose 3D triangles are exactly its original's reflected: the index (into
+  // FlatPattern::panels) of that original, whose piece this one is, reflected (x → width − x).
+  // −1 for a piece flattened on its own.
+  int reflection_of = -1;
   std::string warning;  // empty unless the piece stretches more than warn_stretch
 };
 
@@ -77,6 +102,9 @@ struct PatternSeam {
   std::vector<int> vertices_a, vertices_b;
   double length_3d = 0;               // m along the garment
   double length_a = 0, length_b = 0;  // m in the two pieces (before ease)
+  // Fractions (0..1, increasing from vertices_a[0]) of each side's own length where both sides
+  // have a balance notch: eased or not, the two sides are sewn matching these points.
+  std::vector<double> balance;
   // |length_a − length_b| / max(length_a, length_b): how well the flattening lets it sew.
   double mismatch() const;
 };

@@ -297,6 +297,15 @@ PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOpt
       piece.notches.push_back(
           {piece.sewing.row(i).transpose(), outward_normal(piece.sewing, i), narrower});
     }
+    for (const OutlinePoint& b : flat.balance_notches) {
+      const auto i = static_cast<Eigen::Index>(b.edge);
+      const Eigen::Vector2d from = piece.sewing.row(i).transpose();
+      const Eigen::Vector2d to =
+          piece.sewing.row((i + 1) % static_cast<Eigen::Index>(edges)).transpose();
+      const Eigen::Vector2d along = (to - from).normalized();  // counter-clockwise: out is right
+      piece.notches.push_back({from + b.t * (to - from), Eigen::Vector2d(along.y(), -along.x()),
+                               allowance[static_cast<size_t>(b.edge)], true});
+    }
     grain_line(piece);
     layout.pieces.push_back(std::move(piece));
   }

@@ -29,6 +29,8 @@ struct PatternNotch {
   Eigen::Vector2d point = Eigen::Vector2d::Zero();
   Eigen::Vector2d normal = Eigen::Vector2d::UnitY();
   double allowance = 0;  // m: the narrower of the allowances of the two outline edges there
+  // A balance notch along a seam (FlatPanel::balance_notches), not a seam junction.
+  bool balance = false;
 };
 
 // A run of the sewing line with one seam allowance: edges first .. last (edge i joins sewing

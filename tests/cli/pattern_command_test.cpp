@@ -98,6 +98,32 @@ size_t count(const std::string& text, const std::string& what) {
   return n;
 }
 
+// Where a piece's notches lie along one side of a seam (`polyline`, mm, in the piece's frame):
+// the fractions of the side's length of those within 0.01 mm of it, its ends excluded.
+std::vector<double> notch_fractions(const nlohmann::json& piece, const nlohmann::json& polyline) {
+  std::vector<std::array<double, 2>> p;
+  for (const auto& q : polyline) p.push_back({q[0].get<double>(), q[1].get<double>()});
+  std::vector<double> at(p.size(), 0.0);
+  for (size_t k = 1; k < p.size(); ++k)
+    at[k] = at[k - 1] + std::hypot(p[k][0] - p[k - 1][0], p[k][1] - p[k - 1][1]);
+  std::vector<double> fractions;
+  for (const auto& notch : piece["notches"]) {
+    const double x = notch["at"][0], y = notch["at"][1];
+    for (size_t k = 0; k + 1 < p.size(); ++k) {
+      const double dx = p[k + 1][0] - p[k][0], dy = p[k + 1][1] - p[k][1];
+      const double l2 = dx * dx + dy * dy;
+      if (l2 == 0) continue;
+      const double t = std::clamp(((x - p[k][0]) * dx + (y - p[k][1]) * dy) / l2, 0.0, 1.0);
+      if (std::hypot(p[k][0] + t * dx - x, p[k][1] + t * dy - y) > 0.01) continue;
+      const double f = (at[k] + t * std::sqrt(l2)) / at.back();
+      if (f > 1e-3 && f < 1 - 1e-3) fractions.push_back(f);
+      break;
+    }
+  }
+  std::sort(fractions.begin(), fractions.end());
+  return fractions;
+}
+
 TEST(PatternCommand, EveryExampleGivesPiecesThatSewAndDoNotOverlap) {
   for (const char* name : {"tshirt", "a-line-skirt", "sleeveless-dress", "shorts", "godet-skirt"}) {
     const fs::path out = fresh_dir(name);
@@ -139,14 +165,45 @@ TEST(PatternCommand, EveryExampleGivesPiecesThatSewAndDoNotOverlap) {
     }
     EXPECT_NEAR(json["efficiency"].get<double>(), cut / (width * length), 1e-9);
     ASSERT_FALSE(json["seams"].empty());
+    size_t balance_notches = 0;
     for (const auto& seam : json["seams"]) {
       EXPECT_LE(seam["flattening_mismatch"].get<double>(), 0.005)
           << name << ": " << seam["a"] << " / " << seam["b"];
       // Without ease both sides are cut equally long; with ease they differ by the eases.
       EXPECT_GE(seam["polyline_a"].size(), 2u);
       EXPECT_EQ(seam["polyline_a"].size(), seam["polyline_b"].size());
+      // Balance notches: on both pieces at the same fractions of the seam's side (the listed
+      // ones), one at least on a seam over 25 cm, at most 20 cm of the seam apart.
+      const auto piece_of = [&](const std::string& id) {
+        for (const auto& piece : pieces)
+          if (piece["id"] == id) return piece;
+        return nlohmann::json();
+      };
+      const std::vector<double> fa = notch_fractions(piece_of(seam["a"]), seam["polyline_a"]);
+      const std::vector<double> fb = notch_fractions(piece_of(seam["b"]), seam["polyline_b"]);
+      const auto listed = seam["balance_notches"].get<std::vector<double>>();
+      const double seam_mm = seam["length_3d_mm"];
+      EXPECT_EQ(listed.empty(), seam_mm <= 250) << name << ": " << seam["a"] << " / " << seam["b"];
+      ASSERT_EQ(fa.size(), listed.size()) << name << ": " << seam["a"] << " / " << seam["b"];
+      ASSERT_EQ(fb.size(), listed.size()) << name << ": " << seam["a"] << " / " << seam["b"];
+      for (size_t k = 0; k < listed.size(); ++k) {
+        EXPECT_NEAR(fa[k], listed[k], 1e-4) << name << ": " << seam["a"] << " / " << seam["b"];
+        EXPECT_NEAR(fb[k], listed[k], 1e-4) << name << ": " << seam["a"] << " / " << seam["b"];
+        const double gap = (k == 0 ? listed[0] : listed[k] - listed[k - 1]) * seam_mm;
+        EXPECT_LE(gap, 200 + 1e-6) << name << ": " << seam["a"] << " / " << seam["b"];
+      }
+      if (!listed.empty()) {
+        EXPECT_LE((1 - listed.back()) * seam_mm, 200 + 1e-6);
+      }
+      balance_notches += 2 * listed.size();
     }
+    size_t balance_kind = 0;
+    for (const auto& piece : pieces)
+      for (const auto& notch : piece["notches"]) balance_kind += notch["kind"] == "balance";
+    EXPECT_EQ(balance_kind, balance_notches) << name;
+    EXPECT_GT(balance_notches, 0u) << name;  // every example has seams over 25 cm
     const std::string svg = read(out / "pattern.svg");
+    EXPECT_EQ(count(svg, "class=\"notch balance\""), balance_notches) << name;
     EXPECT_EQ(count(svg, "<g class=\"piece\""), pieces.size()) << name;
     EXPECT_NE(svg.find("width=\"1500.0mm\""), std::string::npos);
   }

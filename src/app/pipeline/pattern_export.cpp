@@ -204,8 +204,8 @@ std::string pattern_svg(const PatternSheet& sheet) {
       const auto [a, b] = notch_segment(n);
       const Eigen::Vector2d pa = on_fabric(piece, a), pb = on_fabric(piece, b);
       svg += fmt::format(
-          "<line class=\"notch\" x1=\"{:.2f}\" y1=\"{:.2f}\" x2=\"{:.2f}\" y2=\"{:.2f}\"/>\n",
-          pa.x(), length - pa.y(), pb.x(), length - pb.y());
+          "<line class=\"notch{}\" x1=\"{:.2f}\" y1=\"{:.2f}\" x2=\"{:.2f}\" y2=\"{:.2f}\"/>\n",
+          n.balance ? " balance" : "", pa.x(), length - pa.y(), pb.x(), length - pb.y());
     }
     // The label where it fits inside the piece (pattern_label.hpp).
     LabelText text;
@@ -391,7 +391,9 @@ nlohmann::json distortion_json(const garment::FlatDistortion& d) {
           {"length_p95", d.length_p95},
           {"area_max", d.area_max},
           {"area_mean", d.area_mean},
-          {"worst_near_m", {d.worst_point.x(), d.worst_point.y(), d.worst_point.z()}}};
+          {"worst_near_m", {d.worst_point.x(), d.worst_point.y(), d.worst_point.z()}},
+          {"dome_rad", d.dome},
+          {"saddle_rad", d.saddle}};
 }
 
 // A seam side's polyline in its piece's frame (m, ease applied).
@@ -420,7 +422,9 @@ nlohmann::json pattern_json(const PatternSheet& sheet) {
     const garment::FlatPanel& flat = sheet.pattern.panels[static_cast<size_t>(piece.panel)];
     nlohmann::json notches = nlohmann::json::array();
     for (const garment::PatternNotch& n : piece.notches)
-      notches.push_back({{"at", point_mm(n.point)}, {"outward", {n.normal.x(), n.normal.y()}}});
+      notches.push_back({{"at", point_mm(n.point)},
+                         {"outward", {n.normal.x(), n.normal.y()}},
+                         {"kind", n.balance ? "balance" : "junction"}});
     nlohmann::json allowances = nlohmann::json::array();
     for (const garment::AllowanceRun& run : piece.allowances)
       allowances.push_back(
@@ -456,6 +460,7 @@ nlohmann::json pattern_json(const PatternSheet& sheet) {
                      {"length_b_mm", kMm * lb},
                      {"flattening_mismatch", seam.mismatch()},
                      {"ease_difference", std::abs(la - lb) / std::max(la, lb)},
+                     {"balance_notches", seam.balance},
                      {"polyline_a", points_mm(a)},
                      {"polyline_b", points_mm(b)}});
   }
