@@ -26,6 +26,7 @@ positions. Writes results.json and results.md (a Markdown table) to --out.
     scripts/compare_blender.py --sizes 32 64 --scenes pinned sphere -o out/blender
     scripts/compare_blender.py --blender-threads 0   # Blender on every core (its default)
     scripts/compare_blender.py --scenes ball --sizes 32 --self-collision   # a folding scene
+    scripts/compare_blender.py --cases pinned:128 --pin-radius 0.02   # 2 cm corner clamps in both
 
 Needs Debian's blender (apt-get install blender) and a built sketchdrape. Timings mean
 something only on a quiet machine: the table states the load average before and after.
