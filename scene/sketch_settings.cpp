@@ -278,6 +278,24 @@ SheetSpec parse_sheet(const Reader& r, const json& j) {
         r.fail(pp, fmt::format("a disc is held only by a clamp at its centre (centre:R, R in "
                                "metres), not by '{}'",
                                name));
+      } else if (colon != std::string::npos && std::find(std::begin(kNames), std::begin(kNames) + 4,
+                                                         edge) != std::begin(kNames) + 4) {
+        // A corner clamp: "top-left:0.02" holds the vertices within 2 cm of that corner.
+        double radius = 0.0;
+        try {
+          radius = sim::corner_clamp(name).value_or(sim::CornerClamp{}).radius;
+        } catch (const sim::InvalidSheetError&) {
+          radius = 0.0;  // refused below, with the sheet's bound
+        }
+        const double largest = 0.5 * std::min(sheet.size[0], sheet.size[1]);
+        if (!(radius > 0.0 && radius <= largest))
+          r.fail(pp, fmt::format("the corner clamp '{}' must give a radius in metres above 0 and "
+                                 "at most {} (half the sheet's shorter side), e.g. {}:0.02{}",
+                                 name, largest, edge,
+                                 radius > largest && radius / 100 <= largest
+                                     ? fmt::format("; if you typed centimetres, {:g} cm is {:g} m",
+                                                   radius, radius / 100)
+                                     : ""));
       } else if (clamp) {
         const std::string digits = name.substr(colon + 1);
         const int lines = (edge == "top" || edge == "bottom" ? sheet.rows : sheet.columns) + 1;
@@ -289,8 +307,9 @@ SheetSpec parse_sheet(const Reader& r, const json& j) {
                                  lines, edge));
       } else if (std::find(std::begin(kNames), std::end(kNames), name) == std::end(kNames)) {
         r.fail(pp, fmt::format("unknown pin '{}'; use a corner (top-left, top-right, bottom-left, "
-                               "bottom-right), an edge (top, bottom, left, right) or a clamp of "
-                               "several lines of vertices (top:3)",
+                               "bottom-right), an edge (top, bottom, left, right), a clamp of "
+                               "several lines of vertices (top:3) or a corner clamp of a radius "
+                               "in metres (top-left:0.02)",
                                name));
       }
       sheet.pins.push_back(name);

@@ -26,6 +26,7 @@ positions. Writes results.json and results.md (a Markdown table) to --out.
     scripts/compare_blender.py --sizes 32 64 --scenes pinned sphere -o out/blender
     scripts/compare_blender.py --blender-threads 0   # Blender on every core (its default)
     scripts/compare_blender.py --scenes ball --sizes 32 --self-collision   # a folding scene
+    scripts/compare_blender.py --cases pinned:128 --pin-radius 0.02   # 2 cm corner clamps in both
 
 Needs Debian's blender (apt-get install blender) and a built sketchdrape. Timings mean
 something only on a quiet machine: the table states the load average before and after.
@@ -256,6 +257,10 @@ def main():
     parser.add_argument("--self-collision", action="store_true",
                         help="self-collision on in both programs; the table adds intersecting "
                              "triangle pairs of each final sheet")
+    parser.add_argument("--pin-radius", type=float, default=0.0, metavar="R",
+                        help="metres: each pinned corner holds every vertex within R of it, in "
+                        "both programs (sketchdrape's \"top-left:R\", the same vertices in "
+                        "Blender's pin group); default 0, one vertex a corner")
     parser.add_argument("--frames", type=int, default=48)
     parser.add_argument("--fps", type=int, default=24)
     parser.add_argument("--fabric", default="cotton")
@@ -285,6 +290,15 @@ def main():
         height = PINNED_HEIGHT if scene_name == "pinned" else 2 * radius + DROP
         vertices, quads = grid(n, height)
         pinned = [0, n] if scene_name == "pinned" else []
+        if pinned and args.pin_radius > 0:
+            # A corner clamp: the grid points within R of each corner (1 um tolerance, as
+            # sketchdrape's build_sheet), checked below against the count sketchdrape held.
+            corners = [vertices[c] for c in pinned]
+            pinned = [i for i, p in enumerate(vertices)
+                      if any(math.dist(p, c) <= args.pin_radius + 1e-6 for c in corners)]
+        pin_names = ["top-left", "top-right"]
+        if args.pin_radius > 0:
+            pin_names = [f"{name}:{args.pin_radius:g}" for name in pin_names]
         duration = args.frames / args.fps
         simulate = {"duration": duration, "stop_at_rest": False,
                     "self_collision": args.self_collision}
@@ -293,7 +307,7 @@ def main():
             "format": "sketchdrape/1",
             "sheet": {"size": [1.0, 1.0], "resolution": [n, n], "orientation": "horizontal",
                       "centre": [0.0, height, 0.0],
-                      "pins": ["top-left", "top-right"] if pinned else []},
+                      "pins": pin_names if pinned else []},
             "fabric": args.fabric,
             "simulate": simulate,
             "output": {"images": [], "mesh": "drape.obj"},
@@ -322,6 +336,9 @@ def main():
             report, sd_wall, sd_cpu, final_obj = run_sketchdrape(args.binary, scene, workdir,
                                                                  [])
             sd_final = [final_obj[i] for i in mapping]
+            if report["pinned_vertices"] != len(pinned):
+                sys.exit(f"sketchdrape held {report['pinned_vertices']} vertices, this script "
+                         f"pins {len(pinned)} in Blender: the comparison would not be fair")
             sd_triangles = read_obj_triangles(workdir / "sketchdrape" / "drape.obj")
             blender, b_wall = run_blender(args.blender, args.blender_threads, spec, workdir)
         edges = grid_edges(quads)
@@ -339,6 +356,7 @@ def main():
             "sketchdrape_stretch_max": stretch_max(vertices, sd_final, edges),
             "sketchdrape_settings": report["settings"],
             "sketchdrape_steps": report["steps"],
+            "pinned_vertices": len(pinned),
         }
         if pinned:
             away = edges_away_from_pins(vertices, edges, pinned, PIN_CLEARANCE)
@@ -375,13 +393,16 @@ def main():
     meta = {"blender": blender_version, "blender_threads": args.blender_threads,
             "frames": args.frames, "fps": args.fps, "fabric": args.fabric,
             "blender_set": args.blender_set, "self_collision": args.self_collision, "blender_mass": args.blender_mass, "sketchdrape_set": args.sketchdrape_set,
+            "pin_radius_m": args.pin_radius,
             "load_average_before": load_before, "load_average_after": load_after,
             "cores": os.cpu_count()}
     (out / "results.json").write_text(json.dumps({"meta": meta, "rows": rows}, indent=1))
     lines = [
         f"{blender_version} (threads: {args.blender_threads or 'all'}) against sketchdrape "
         f"({', '.join(args.sketchdrape_set) or 'default settings'}); {args.frames} frames at "
-        f"{args.fps} fps, {args.fabric}; load average {load_before:.1f} before, "
+        f"{args.fps} fps, {args.fabric}; "
+        + (f"corner clamps of {args.pin_radius:g} m; " if args.pin_radius > 0 else "")
+        + f"load average {load_before:.1f} before, "
         f"{load_after:.1f} after, {os.cpu_count()} cores.",
         "",
         "| scene | wall: Blender / sketchdrape (ratio) | CPU: Blender / sketchdrape (ratio) "

@@ -181,6 +181,15 @@ SheetScene build_sheet(const SheetSpec& spec) {
       throw InvalidSheetError("unknown pin '" + name +
                               "' for a disc: a disc is held by a clamp at its centre (centre:R, "
                               "R in metres)");
+    } else if (const std::optional<CornerClamp> bite = corner_clamp(name)) {
+      // Every vertex within R of the corner (the corner itself always; 1 um tolerance, as the
+      // centre clamp's, for a grid point lying at R).
+      const int r = bite->corner.starts_with("top") ? 0 : spec.rows;
+      const int c = bite->corner.ends_with("left") ? 0 : spec.columns;
+      const Eigen::Vector3d corner = scene.input.rest_positions.row(scene.vertex(r, c));
+      for (Eigen::Index v = 0; v < scene.input.rest_positions.rows(); ++v)
+        if ((scene.input.rest_positions.row(v).transpose() - corner).norm() <= bite->radius + 1e-6)
+          add.push_back(static_cast<int>(v));
     } else if (name == "top-left")
       add = {scene.vertex(0, 0)};
     else if (name == "top-right")
@@ -225,7 +234,8 @@ SheetScene build_sheet(const SheetSpec& spec) {
     } else {
       throw InvalidSheetError("unknown pin '" + name +
                               "' (use top-left, top-right, bottom-left, bottom-right, top, "
-                              "bottom, left, right, or a clamp such as top:3)");
+                              "bottom, left, right, a clamp such as top:3, or a corner clamp "
+                              "such as top-left:0.02)");
     }
     scene.pinned_vertices.insert(scene.pinned_vertices.end(), add.begin(), add.end());
   }

@@ -40,7 +40,8 @@ struct SheetSpec {
   // "bottom", "left", "right", or clamps "top:N" (N lines of vertices from that edge, N ≥ 1);
   // "centre:R" holds every vertex within R metres of the centre (a disc clamped between two
   // discs of radius R; on a disc sheet a ring of vertices lies exactly at R). A disc takes only
-  // "centre:R".
+  // "centre:R". A corner with a radius, "top-left:R", holds every vertex within R metres of
+  // that corner (a clip's bite; corner_clamp).
   std::vector<std::string> pins;
 };
 
@@ -90,6 +91,40 @@ inline std::optional<double> centre_clamp_radius(const std::string& name) {
     throw InvalidSheetError("pin '" + name +
                             "' must give a positive radius in metres (centre:0.09)");
   return radius;
+}
+
+// A corner clamp "top-left:R" ("top-right:R", "bottom-left:R", "bottom-right:R"): every vertex
+// within R metres of that corner is held, like the jaws of a clip biting a quarter disc of
+// cloth; a pin of a single corner vertex is a point load, whose strain grows as 1/r towards it
+// (docs/benchmarks.md, "Sixth round"), a clamp spreads the load over its edge.
+struct CornerClamp {
+  std::string corner;   // "top-left", "top-right", "bottom-left" or "bottom-right"
+  double radius = 0.0;  // m
+};
+
+// The corner clamp a pin names, nullopt for other pin names (a bare corner is a point pin);
+// throws InvalidSheetError for a radius that is not a positive number. (Inline, as
+// centre_clamp_radius.)
+inline std::optional<CornerClamp> corner_clamp(const std::string& name) {
+  const std::size_t colon = name.find(':');
+  if (colon == std::string::npos) return std::nullopt;
+  const std::string corner = name.substr(0, colon);
+  if (corner != "top-left" && corner != "top-right" && corner != "bottom-left" &&
+      corner != "bottom-right")
+    return std::nullopt;
+  const std::string number = name.substr(colon + 1);
+  double radius = 0.0;
+  try {
+    std::size_t used = 0;
+    radius = std::stod(number, &used);
+    if (used != number.size()) radius = 0.0;
+  } catch (const std::exception&) {
+    radius = 0.0;
+  }
+  if (!(radius > 0.0 && std::isfinite(radius)))
+    throw InvalidSheetError("pin '" + name + "' must give a positive radius in metres (" + corner +
+                            ":0.02)");
+  return CornerClamp{corner, radius};
 }
 
 }  // namespace sd::sim

@@ -355,3 +355,32 @@ TEST(SketchFile, DiscSheetWithACentreClamp) {
 
 }  // namespace
 }  // namespace sd::scene
+
+namespace sd::scene {
+namespace {
+
+// A corner clamp "top-left:R" (metres) is kept as written; a radius that is not a number, not
+// positive, or more than half the sheet's shorter side is refused at the pin's path.
+TEST(SketchFile, SheetCornerClampPins) {
+  const auto sheet = [](const std::string& pin) {
+    return R"({"sheet": {"size": [1.0, 0.6], "resolution": [8, 8], "pins": [")" + pin + R"("]}})";
+  };
+  EXPECT_EQ(parse_sketch(sheet("top-left:0.02"), "t.json").sheet->pins.front(), "top-left:0.02");
+  EXPECT_EQ(parse_sketch(sheet("bottom-right:0.3"), "t.json").sheet->pins.front(),
+            "bottom-right:0.3");
+  for (const std::string bad : {"top-left:0", "top-right:-0.02", "bottom-left:x",
+                                "top-left:", "top-left:0.31", "top-left:2cm", "top-centre:0.02"}) {
+    try {
+      parse_sketch(sheet(bad), "t.json");
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const SketchError& e) {
+      EXPECT_EQ(e.json_path(), "/sheet/pins/0") << bad;
+      if (bad != "top-centre:0.02") {
+        EXPECT_NE(std::string(e.what()).find("corner clamp"), std::string::npos) << e.what();
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace sd::scene

@@ -161,3 +161,54 @@ TEST(Sheet, DiscIsAClosedDiscWithItsClampRingAtTheRadius) {
 
 }  // namespace
 }  // namespace sd::sim
+
+namespace sd::sim {
+namespace {
+
+// A corner clamp "top-left:R" holds exactly the grid points within R of that corner: on a
+// 1 m sheet of 10 cm cells, "top-left:0.15" holds the corner, its two neighbours along the
+// edges (10 cm) and the diagonal one (14.1 cm), not those 20 cm away; a radius landing on a grid
+// point (0.1) holds it; the other corners are mirrored; a bad radius is refused.
+TEST(Sheet, CornerClampHoldsTheVerticesWithinItsRadius) {
+  SheetSpec spec;
+  spec.size = {1.0, 1.0};
+  spec.columns = spec.rows = 10;
+  spec.orientation = SheetOrientation::horizontal;
+  spec.centre = {0.3, 1.2, -0.1};
+  spec.pins = {"top-left:0.15"};
+  SheetScene scene = build_sheet(spec);
+  EXPECT_EQ(scene.pinned_vertices, (std::vector<int>{scene.vertex(0, 0), scene.vertex(0, 1),
+                                                     scene.vertex(1, 0), scene.vertex(1, 1)}));
+  spec.pins = {"bottom-right:0.1", "top-right:0.05"};
+  scene = build_sheet(spec);
+  EXPECT_EQ(scene.pinned_vertices, (std::vector<int>{scene.vertex(0, 10), scene.vertex(9, 10),
+                                                     scene.vertex(10, 9), scene.vertex(10, 10)}));
+  // Every held vertex is within R of its corner, and every vertex within R is held (a finer
+  // grid, with points at every distance).
+  spec.columns = spec.rows = 64;
+  spec.pins = {"bottom-left:0.05"};
+  scene = build_sheet(spec);
+  const Eigen::Vector3d corner = scene.input.rest_positions.row(scene.vertex(64, 0));
+  int held = 0;
+  for (Eigen::Index v = 0; v < scene.input.rest_positions.rows(); ++v) {
+    const double r = (scene.input.rest_positions.row(v).transpose() - corner).norm();
+    const bool pinned =
+        std::binary_search(scene.pinned_vertices.begin(), scene.pinned_vertices.end(), v);
+    EXPECT_EQ(pinned, r <= 0.05 + 1e-9) << v;
+    held += pinned;
+  }
+  // The grid points (i, j) with i² + j² ≤ 3.2² cells²: rows of 4, 4, 3 and 2.
+  EXPECT_EQ(held, 13);
+  for (const std::string bad : {"top-left:0", "top-left:-0.1", "top-left:x",
+                                "top-left:", "top-left:0.1m", "top-middle:0.1"}) {
+    spec.pins = {bad};
+    EXPECT_THROW(build_sheet(spec), InvalidSheetError) << bad;
+  }
+  spec.shape = SheetShape::disc;
+  spec.columns = spec.rows = 10;
+  spec.pins = {"top-left:0.1"};
+  EXPECT_THROW(build_sheet(spec), InvalidSheetError);
+}
+
+}  // namespace
+}  // namespace sd::sim
