@@ -793,13 +793,7 @@ Garment build_garment(const GarmentRequest& sketch, const BodySurface& body) {
               panel.body_part.find("leg") != std::string::npos;
     for (const PanelSpec& spec : sketch.panels)
       limbs = limbs || spec.grain.rule == GrainRule::kLimb;
-    std::optional<BodyLandmarks> landmarks;
-    if (limbs) try {
-        landmarks = find_landmarks(body.mesh());
-      } catch (const std::runtime_error&) {
-        // Not a standing figure (a test sphere, a dress form).
-      }
-    choose_grain(sketch, body.mesh(), landmarks ? &*landmarks : nullptr, garment);
+    choose_grain(sketch, body.mesh(), limbs ? body.landmarks() : nullptr, garment);
   }
   garment.parity_changes = static_cast<int>(counts.changed.size());
   for (const auto& u : users) garment.curve_pieces += u.empty() ? 0 : 1;
