@@ -11,7 +11,9 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -256,6 +258,8 @@ struct BodySurface::Impl {
   std::vector<Triangle> triangles;            // #F, same order as mesh.faces
   Tree tree;                                  // ray casts
   std::unique_ptr<ClosestPointTree> nearest;  // closest-point queries (over `mesh`)
+  std::once_flag landmarks_once;              // landmarks(): found on the first call
+  std::optional<BodyLandmarks> landmarks;
 
   // Smooth outward normal at `p` inside face f (barycentric blend of vertex normals).
   Eigen::Vector3d normal_at(int f, const Eigen::Vector3d& p) const {
@@ -396,6 +400,17 @@ double BodySurface::signed_distance(const Eigen::Vector3d& p) const {
 Eigen::Vector3d BodySurface::snap_to_offset(const Eigen::Vector3d& p, double offset) const {
   const SurfacePoint s = closest_point(p);
   return s.position + offset * s.normal;
+}
+
+const BodyLandmarks* BodySurface::landmarks() const {
+  std::call_once(impl_->landmarks_once, [this] {
+    try {
+      impl_->landmarks = find_landmarks(impl_->mesh);
+    } catch (const std::runtime_error&) {
+      // Not a standing figure (a test sphere, a dress form): no landmarks.
+    }
+  });
+  return impl_->landmarks ? &*impl_->landmarks : nullptr;
 }
 
 const meshing::TriMesh& BodySurface::mesh() const {

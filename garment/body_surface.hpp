@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 
+#include "garment/body_landmarks.hpp"
 #include "meshing/tri_mesh.hpp"
 
 namespace sd::garment {
@@ -49,6 +50,10 @@ class BodySurface {
 
   const meshing::TriMesh& mesh() const;
   const meshing::BoundingBox& box() const;
+  // The body's landmarks (body_landmarks.hpp), found on the first call (about 20 ms for the
+  // built-in body) and kept: every garment built on this surface (the quality gate's trials
+  // rebuild it) asks again. nullptr when the body is not a standing figure.
+  const BodyLandmarks* landmarks() const;
 
  private:
   struct Impl;

@@ -21,6 +21,7 @@
 #include "garment/fold_repair.hpp"
 #include "garment/network_faces.hpp"
 #include "garment/panel_fill.hpp"
+#include "garment/panel_grain.hpp"
 #include "garment/panel_loop.hpp"
 #include "garment/panel_surface.hpp"
 #include "garment/panel_tasks.hpp"
@@ -867,6 +868,17 @@ Garment build_garment(const GarmentRequest& sketch, const BodySurface& body) {
   };
   check_seam_directions(sketch, body, pool, faces, face_panel, curve_of, garment);
   label_panels(sketch, body, faces, face_panel, pool, garment);
+  // The grain: a panel on a limb may run along it (panel_grain.hpp); the landmarks are found only
+  // then (a body that is not a standing figure has none: every panel is vertical).
+  {
+    bool limbs = false;
+    for (const GarmentPanel& panel : garment.panels)
+      limbs = limbs || panel.body_part.find("arm") != std::string::npos ||
+              panel.body_part.find("leg") != std::string::npos;
+    for (const PanelSpec& spec : sketch.panels)
+      limbs = limbs || spec.grain.rule == GrainRule::kLimb;
+    choose_grain(sketch, body.mesh(), limbs ? body.landmarks() : nullptr, garment);
+  }
   garment.parity_changes = static_cast<int>(counts.changed.size());
   for (const auto& u : users) garment.curve_pieces += u.empty() ? 0 : 1;
   return garment;

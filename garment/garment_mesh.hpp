@@ -55,6 +55,13 @@ struct GarmentPanel {
   // the panel's boundary list, with the turning angle in degrees. The quality gate suggests
   // the list without the gentlest one.
   std::vector<std::pair<std::string, double>> turning_corners;
+  // The grain (GrainSpec, garment_request.hpp): "vertical" or "limb" as chosen, the unit
+  // direction whose projection into each quad is the warp there (+Y, or the limb's axis pointing
+  // towards the body), and the turn about the outward normal (degrees; a mirror copy's is the
+  // original's negated, so that the copy is the reflection).
+  std::string grain = "vertical";
+  Eigen::Vector3d grain_axis = Eigen::Vector3d::UnitY();
+  double grain_turn_deg = 0.0;
 };
 
 struct Garment {

@@ -70,6 +70,16 @@ struct SeedSpec {
 // body ("auto").
 enum class PanelFit { kAuto, kBody, kFree };
 
+// Which way the warp (the grain line of the cut piece) runs on a panel (docs/garment.md,
+// "Grain"): along the limb the panel wraps (a sleeve, a trouser leg), along the body's vertical,
+// or chosen from the panel ("auto": along the limb for a panel on an arm or round one leg, else
+// vertical). `turn_deg` then turns it about the panel's outward normal (45: on the bias).
+enum class GrainRule { kAuto, kVertical, kLimb };
+struct GrainSpec {
+  GrainRule rule = GrainRule::kAuto;
+  double turn_deg = 0.0;  // degrees, -90 .. 90, counter-clockwise seen from outside
+};
+
 struct PanelSpec {
   std::string id;
   std::string json_path;                 // "/panels/1"
@@ -84,6 +94,7 @@ struct PanelSpec {
   std::optional<std::string> rest;       // "flat" | "shaped"; default: simulate.rest
   std::optional<double> seam_allowance;  // metres; default: output.pattern.seam_allowance
   PanelFit fit = PanelFit::kAuto;        // "fit"
+  GrainSpec grain;                       // "grain"
 };
 
 struct JoinSpec {

@@ -1,7 +1,10 @@
 #include "garment/material_frames.hpp"
 
 #include <Eigen/Geometry>
+#include <numbers>
 #include <stdexcept>
+
+#include "garment/garment_mesh.hpp"
 
 namespace sd::garment {
 
@@ -21,6 +24,24 @@ MaterialFrames material_frames(const meshing::QuadMesh& mesh) {
     if (warp.norm() < 1e-6) warp = Eigen::Vector3d::UnitZ() - n.z() * n;
     warp.normalize();
     frames.normal.row(f) = n.transpose();
+    frames.warp.row(f) = warp.transpose();
+    frames.weft.row(f) = n.cross(warp).transpose();
+  }
+  return frames;
+}
+
+MaterialFrames material_frames(const Garment& garment) {
+  MaterialFrames frames = material_frames(garment.mesh);
+  for (Eigen::Index f = 0; f < frames.warp.rows(); ++f) {
+    const GarmentPanel& panel = garment.panels[static_cast<size_t>(garment.face_panel(f))];
+    const Eigen::Vector3d n = frames.normal.row(f).transpose();
+    Eigen::Vector3d warp = panel.grain_axis - panel.grain_axis.dot(n) * n;
+    if (warp.norm() < 1e-6) warp = frames.warp.row(f).transpose();
+    warp.normalize();
+    if (panel.grain_turn_deg != 0.0) {
+      const double turn = panel.grain_turn_deg * std::numbers::pi / 180.0;
+      warp = std::cos(turn) * warp + std::sin(turn) * n.cross(warp);
+    }
     frames.warp.row(f) = warp.transpose();
     frames.weft.row(f) = n.cross(warp).transpose();
   }

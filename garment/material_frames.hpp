@@ -21,6 +21,12 @@ struct MaterialFrames {
 // it) takes the projection of +Z instead (the mannequin's forward direction).
 MaterialFrames material_frames(const meshing::QuadMesh& mesh);
 
+// One frame per quad, with the warp of each quad from its panel's grain (GarmentPanel::grain_axis
+// projected into the quad, then turned by grain_turn_deg about the normal). A quad whose plane
+// holds no direction of the axis (normal within 1e-6 of it) falls back to the rule above.
+struct Garment;
+MaterialFrames material_frames(const Garment& garment);
+
 // Rest (material) coordinates of each triangle: #T by 6 rows (u0 v0 u1 v1 u2 v2) in metres,
 // u along warp and v along weft of the quad the triangle came from (`triangle_quad`, #T), with
 // the first corner at the origin, scaled by `quad_ease` (#Q, 1 = as designed). Lengths and

@@ -309,6 +309,10 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
       for (Eigen::Index v = 0; v < patch.mesh.vertex_count() && !touches; ++v)
         touches = !fixed[static_cast<size_t>(v)] &&
                   push_out(patch.mesh.vertices.row(v).transpose()).has_value();
+      // ... or the cloth between them (quad_samples, panel_surface.hpp).
+      for (Eigen::Index f = 0; f < patch.mesh.face_count() && !touches; ++f)
+        for (const Eigen::Vector3d& x : quad_samples(patch.mesh, f))
+          touches = touches || push_out(x).has_value();
       if (touches) {
         const meshing::QuadMesh start = patch.mesh;
         span_over_obstacle(patch.mesh, fixed, push_out);

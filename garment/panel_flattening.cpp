@@ -565,7 +565,7 @@ FlatPanel flatten_disk(const std::string& name, const Eigen::MatrixX3d& vertices
 
 FlatPattern flatten_garment(const Garment& garment, const FlatteningOptions& options) {
   const meshing::QuadMesh& mesh = garment.mesh;
-  const MaterialFrames frames = material_frames(mesh);
+  const MaterialFrames frames = material_frames(garment);
   FlatPattern pattern;
   const Eigen::Index nv = mesh.vertex_count();
 

@@ -69,6 +69,20 @@ void span_harmonic(meshing::QuadMesh& mesh, std::span<const char> fixed) {
   solve_harmonic(mesh, quad_edges(mesh), std::vector<char>(fixed.begin(), fixed.end()));
 }
 
+std::array<Eigen::Vector3d, 9> quad_samples(const meshing::QuadMesh& mesh, Eigen::Index f) {
+  std::array<Eigen::Vector3d, 4> c;
+  for (int k = 0; k < 4; ++k)
+    c[static_cast<size_t>(k)] = mesh.vertices.row(mesh.faces(f, k)).transpose();
+  const Eigen::Vector3d centre = 0.25 * (c[0] + c[1] + c[2] + c[3]);
+  std::array<Eigen::Vector3d, 9> out;
+  out[0] = centre;
+  for (size_t k = 0; k < 4; ++k) {
+    out[1 + k] = 0.5 * (c[k] + c[(k + 1) % 4]);
+    out[5 + k] = (centre + c[k] + c[(k + 1) % 4]) / 3.0;
+  }
+  return out;
+}
+
 SpannedSurface span_over_obstacle(meshing::QuadMesh& mesh, std::span<const char> fixed,
                                   const PushOut& push_out, int max_rounds) {
   return span_over_obstacle(
@@ -83,6 +97,7 @@ SpannedSurface span_over_obstacle(meshing::QuadMesh& mesh, std::span<const char>
     throw std::invalid_argument("span_over_obstacle: one fixed flag per vertex is needed");
   const std::vector<std::pair<int, int>> edges = quad_edges(mesh);
   std::vector<char> held(fixed.begin(), fixed.end());
+  std::vector<char> lifted_hold(fixed.size(), 0);  // held by a quad's sample, never released
   solve_harmonic(mesh, edges, held);
   SpannedSurface result;
   std::vector<Eigen::Vector3d> normals;
@@ -120,7 +135,9 @@ SpannedSurface span_over_obstacle(meshing::QuadMesh& mesh, std::span<const char>
     int released = 0;
     if (release && pushed == 0) {
       for (Eigen::Index v = 0; v < mesh.vertex_count(); ++v) {
-        if (!held[static_cast<size_t>(v)] || fixed[static_cast<size_t>(v)]) continue;
+        if (!held[static_cast<size_t>(v)] || fixed[static_cast<size_t>(v)] ||
+            lifted_hold[static_cast<size_t>(v)])
+          continue;
         const std::vector<int>& around = neighbours[static_cast<size_t>(v)];
         if (around.empty()) continue;
         Eigen::Vector3d mean = Eigen::Vector3d::Zero();
@@ -132,8 +149,38 @@ SpannedSurface span_over_obstacle(meshing::QuadMesh& mesh, std::span<const char>
         }
       }
     }
+    // Then the cloth between the vertices: a quad with a sample inside is moved out whole.
+    // Each corner moves by the largest push among its quads' (not their sum: a corner shared by
+    // four quads inside would go four times as far), once: a quad beside the fixed boundary
+    // moves only in part, and pushing its free corners again each round would raise a spike.
+    int lifted = 0;
+    if (pushed == 0 && released == 0) {
+      std::vector<Eigen::Vector3d> moves(static_cast<size_t>(mesh.vertex_count()),
+                                         Eigen::Vector3d::Zero());
+      for (Eigen::Index f = 0; f < mesh.face_count(); ++f) {
+        Eigen::Vector3d move = Eigen::Vector3d::Zero();
+        for (const Eigen::Vector3d& x : quad_samples(mesh, f))
+          if (const auto out = push_along(x, Eigen::Vector3d::Zero());
+              out && (*out - x).norm() > move.norm())
+            move = *out - x;
+        if (move.norm() == 0) continue;
+        for (int k = 0; k < 4; ++k) {
+          Eigen::Vector3d& m = moves[static_cast<size_t>(mesh.faces(f, k))];
+          if (move.norm() > m.norm()) m = move;
+        }
+      }
+      for (Eigen::Index v = 0; v < mesh.vertex_count(); ++v) {
+        const Eigen::Vector3d& m = moves[static_cast<size_t>(v)];
+        if (fixed[static_cast<size_t>(v)] || lifted_hold[static_cast<size_t>(v)] || m.norm() == 0)
+          continue;
+        mesh.vertices.row(v) += m.transpose();
+        held[static_cast<size_t>(v)] = 1;
+        lifted_hold[static_cast<size_t>(v)] = 1;
+        ++lifted;
+      }
+    }
     result.contacts += pushed;
-    if (pushed == 0 && released == 0) break;
+    if (pushed == 0 && released == 0 && lifted == 0) break;
     if (result.rounds == max_rounds) {
       result.settled = false;
       break;

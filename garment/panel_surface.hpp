@@ -9,6 +9,7 @@
 // obstacle problem in which contacts are only added).
 
 #include <Eigen/Core>
+#include <array>
 #include <functional>
 #include <optional>
 #include <span>
@@ -37,8 +38,18 @@ struct SpannedSurface {
 // vertices must touch a fixed one). Throws std::invalid_argument otherwise.
 void span_harmonic(meshing::QuadMesh& mesh, std::span<const char> fixed);
 
+// Points of quad `f` where the cloth between its corners is tested against the obstacle: the
+// centre, the edge midpoints and the centroids of the four triangles the 4-8 mesh splits it into
+// at its centre. A quad whose corners all lie on the offset surface can still cut through a
+// bulge of the body between them (a new user's wide shorts: the inner thigh 6 mm inside the
+// front leg, every vertex outside).
+std::array<Eigen::Vector3d, 9> quad_samples(const meshing::QuadMesh& mesh, Eigen::Index f);
+
 // span_harmonic, then the obstacle: at most `max_rounds` rounds of pushing every free vertex
-// that `push_out` moves and solving the others again with those held.
+// that `push_out` moves and solving the others again with those held. Once no vertex is inside,
+// a quad with a sample (quad_samples) inside has its free corners moved by that sample's push
+// (the deepest one's; a translation of the corners moves the sample by the same) and held, and
+// the rest solved again, until no sample is inside either.
 SpannedSurface span_over_obstacle(meshing::QuadMesh& mesh, std::span<const char> fixed,
                                   const PushOut& push_out, int max_rounds = 30);
 // The same, each round's pushes given the spanned surface's normals at the vertices (taken after

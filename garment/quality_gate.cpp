@@ -13,6 +13,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "garment/body_clearance.hpp"
 #include "garment/garment_crossings.hpp"
 
 namespace sd::garment {
@@ -303,6 +304,30 @@ std::vector<QualityWarning> check_quality_tried(const Garment& garment,
     if (at != std::string::npos) w.message.erase(at, w.corners_hint.size());
     w.corners.clear();
     w.corners_hint.clear();
+  }
+  // The cloth inside the body before the drape (body_clearance.hpp), after the trials above (which
+  // compare counts of check_quality's kinds only).
+  if (!surface) surface.emplace(body);
+  for (const PanelInsideBody& inside :
+       find_panels_inside_body(garment, *surface, limits.inside_tolerance)) {
+    const GarmentPanel& panel = garment.panels[static_cast<size_t>(inside.panel)];
+    if (panel.mirror_copy) continue;  // the original's warning holds for the copy
+    QualityWarning q;
+    q.panel = panel.id;
+    q.kind = "inside_body";
+    q.count = inside.quads;
+    q.worst = inside.deepest;
+    q.where = inside.where;
+    if (landmarks != nullptr) q.landmark = landmarks->nearest(inside.where).name;
+    q.message = fmt::format(
+        "panel '{}': {} quad(s) lie inside the body before the drape ({} of their vertices; the "
+        "deepest {:.1f} mm below the skin), {}; the drape pushes them out at its start, so what "
+        "hangs is not what was drawn: move the panel's curves there out from the body (a curve "
+        "with \"on_body\": false passes through it?), or give the panel a smaller \"edge_length\" "
+        "where the body bulges between its vertices;",
+        panel.id, inside.quads, inside.vertices, 1e3 * inside.deepest,
+        place(inside.where, q.landmark));
+    warnings.push_back(std::move(q));
   }
   return warnings;
 }

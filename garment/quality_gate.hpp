@@ -21,12 +21,18 @@ struct QualityLimits {
   double size_low = 0.25;          // a quad's mean side outside [low, high] × edge_length (low:
                                    // a tapering panel needs small quads near its apex)
   double size_high = 2.0;
+  // m: cloth deeper than this inside the body is reported: twice the simulator's penetration
+  // tolerance (1 mm), so that the sag of a quad's middle below its corners on the offset surface
+  // over a bent arm (an armpit or an elbow, 1-2 mm on the corpus) is not reported, a hem written
+  // through a knee (15 mm) or a thigh bulging through a wide leg (6 mm) is.
+  double inside_tolerance = 0.002;
 };
 
 struct QualityWarning {
   std::string panel;
   std::string kind;    // "inverted_quads", "min_angle", "aspect_ratio", "near_vertices",
-                       // "quad_size", "self_intersection" (count: crossing triangle pairs)
+                       // "quad_size", "self_intersection" (count: crossing triangle pairs),
+                       // "inside_body" (check_quality_tried only; count: quads, worst: m deep)
   int count = 0;       // quads (or vertex pairs) of that kind in the panel
   double worst = 0.0;  // the worst value (degrees, ratio, metres, or size / edge_length)
   Eigen::Vector3d where = Eigen::Vector3d::Zero();  // m, the worst place

@@ -230,11 +230,49 @@ CurveSpec parse_curve(const Reader& r, const json& j, const std::string& path, c
   return curve;
 }
 
+// "grain": "auto", "vertical", "limb", a number of degrees (the auto direction turned by it), or
+// {"along": one of the words, "turn": degrees}.
+GrainSpec parse_grain(const Reader& r, const json& j, const std::string& path) {
+  static constexpr std::string_view kWords =
+      "\"auto\" (along the limb for a sleeve or a trouser leg, else vertical), \"vertical\" (the "
+      "body's vertical), \"limb\" (along the arm or leg the panel is on)";
+  GrainSpec grain;
+  const auto rule = [&](const json& value, const std::string& at) {
+    if (!value.is_string())
+      r.fail(at, fmt::format("\"grain\" is one of {}, or a number of degrees to turn it by "
+                             "(45: on the bias), not {}",
+                             kWords, value.dump()));
+    const std::string word = value.get<std::string>();
+    if (word == "auto") return GrainRule::kAuto;
+    if (word == "vertical") return GrainRule::kVertical;
+    if (word == "limb") return GrainRule::kLimb;
+    r.fail(at, fmt::format("\"grain\" is one of {}, not \"{}\"", kWords, word));
+  };
+  const auto turn = [&](const json& value, const std::string& at) {
+    const double degrees = r.number(value, at);
+    if (!(degrees >= -90.0 && degrees <= 90.0))
+      r.fail(at, fmt::format("a grain turn of {:g}° is outside -90 .. 90 degrees (0: the grain "
+                             "as chosen, 45: on the bias, 90: the weft where the warp was)",
+                             degrees));
+    return degrees;
+  };
+  if (j.is_number()) {
+    grain.turn_deg = turn(j, path);
+  } else if (j.is_object()) {
+    r.check_keys(j, path, {"along", "turn"});
+    if (j.contains("along")) grain.rule = rule(j["along"], path + "/along");
+    if (j.contains("turn")) grain.turn_deg = turn(j["turn"], path + "/turn");
+  } else {
+    grain.rule = rule(j, path);
+  }
+  return grain;
+}
+
 PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, const Sketch& sk) {
   r.require_object(j, path, "a panel");
   r.check_keys(j, path,
                {"id", "boundary", "corners", "fabric", "mirror", "edge_length", "ease", "seed",
-                "rest", "seam_allowance", "fit"});
+                "rest", "seam_allowance", "fit", "grain"});
   PanelSpec panel;
   panel.json_path = path;
   if (!j.contains("id")) r.fail(path, "every panel needs an \"id\"");
@@ -373,6 +411,7 @@ PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, c
                                         "the body only where it would be inside), not \"{}\"",
                                         fit));
   }
+  if (j.contains("grain")) panel.grain = parse_grain(r, j["grain"], path + "/grain");
   return panel;
 }
 

@@ -409,8 +409,11 @@ TEST(Garment, TheGatesAdviceAppliedLeavesFewerWarnings) {
     return check_quality(build_garment(sketch, surface), sketch, nullptr).size();
   };
 
-  const std::vector<QualityWarning> told =
+  std::vector<QualityWarning> told =
       check_quality_tried(build_garment(shell, surface), shell, body.mesh, nullptr);
+  // The advice is weighed by check_quality's kinds; the body's `inside_body` (the back 9 mm
+  // inside the neck) comes on top and is not advice.
+  std::erase_if(told, [](const QualityWarning& w) { return w.kind == "inside_body"; });
   ASSERT_EQ(told.size(), 1u);
   // What following the dropped offer gives (the reason it is dropped).
   GarmentRequest without_side = shell;

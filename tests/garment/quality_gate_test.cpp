@@ -134,6 +134,32 @@ TEST(QualityGate, QuadsMuchLargerThanAskedAreFound) {
   EXPECT_NEAR(size->worst, 3.0, 1e-9);
 }
 
+TEST(QualityGate, ClothInsideTheBodyIsNamedWithItsDepth) {
+  // A 6 × 6 grid of 3 cm quads at z = 0 over a ball of radius 0.1 m whose top pokes 5 mm
+  // through the middle of quad (2, 2): the cloth there lies 5 mm inside the body (less the
+  // icosphere's facets: at 5 subdivisions its faces sit within 0.1 mm of the sphere), so the
+  // gate reports that panel with the depth and the place, the deepest sample right over the
+  // ball's top. A ball 1.5 mm through (below the 2 mm tolerance) is not reported.
+  const Garment g = grid_garment(6, 0.03);
+  BodyLandmarks landmarks;
+  landmarks.points = {{"left_knee", {0.08, 0.07, -0.02}}, {"crotch", {1.0, 1.0, 1.0}}};
+  const meshing::TriMesh deep = meshing::icosphere(0.1, 5, {0.075, 0.075, -0.095});
+  const std::vector<QualityWarning> warnings =
+      check_quality_tried(g, sketch_with_edge(0.03), deep, &landmarks);
+  const QualityWarning* inside = find_kind(warnings, "inside_body");
+  ASSERT_NE(inside, nullptr);
+  EXPECT_EQ(inside->panel, "patch");
+  EXPECT_NEAR(inside->worst, 0.005, 2e-4);
+  EXPECT_NEAR(inside->where.x(), 0.075, 0.005);
+  EXPECT_NEAR(inside->where.y(), 0.075, 0.005);
+  EXPECT_EQ(inside->landmark, "left_knee");
+  EXPECT_NE(inside->message.find("inside the body"), std::string::npos);
+  const meshing::TriMesh shallow = meshing::icosphere(0.1, 5, {0.075, 0.075, -0.0985});
+  EXPECT_EQ(
+      find_kind(check_quality_tried(g, sketch_with_edge(0.03), shallow, &landmarks), "inside_body"),
+      nullptr);
+}
+
 TEST(QualityGate, NamesTheNearestLandmark) {
   Garment g = grid_garment(6, 0.03);
   g.mesh.vertices.row(2 * 7 + 2) += Eigen::RowVector3d(0.045, 0.045, 0.0);

@@ -72,8 +72,8 @@ TEST(SketchSchema, ShapeErrorsAreRejected) {
   const std::string python = python_with_jsonschema();
   ASSERT_FALSE(python.empty()) << "python3-jsonschema is missing: run scripts/setup.sh";
   // Errors of shape (not of geometry) must be caught by the schema as well.
-  for (const char* name :
-       {"unknown-key.json", "nan-string.json", "unknown-view.json", "empty-panels.json"}) {
+  for (const char* name : {"unknown-key.json", "nan-string.json", "unknown-view.json",
+                           "empty-panels.json", "grain-unknown.json", "grain-turn.json"}) {
     const auto file = std::filesystem::path(SD_SOURCE_DIR) / "tests/garment/bad" / name;
     EXPECT_NE(validate_against_schema(file, python), 0) << name;
   }

@@ -163,6 +163,9 @@ void run_mesh(const MeshOptions& options) {
                       {"area_m2", p.area},
                       {"fit", p.fit},
                       {"span_gap_m", p.span_gap},
+                      {"grain", p.grain},
+                      {"grain_axis", {p.grain_axis.x(), p.grain_axis.y(), p.grain_axis.z()}},
+                      {"grain_turn_deg", p.grain_turn_deg},
                       {"quality", quality_json(p.quality)}});
     distortion += p.distortion;
     irregular += p.irregular_vertices;

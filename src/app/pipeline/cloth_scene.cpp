@@ -273,7 +273,7 @@ void build_garment_scene(const scene::Sketch& sketch, ClothScene& scene) {
 
   meshing::Mesh48& m48 = meshed.mesh48;
   const meshing::Mesh48Arrays arrays = m48.arrays();
-  const garment::MaterialFrames frames = garment::material_frames(g.mesh);
+  const garment::MaterialFrames frames = garment::material_frames(g);
   scene.group_names = meshed.group_names;
   const std::vector<int>& panel_group = meshed.panel_group;
 
