@@ -260,6 +260,11 @@ bool ImplicitSolver::solve_on_earlier_factor(const ConstraintFilter& filter,
   const double average =
       (factor_cost_ + iterations_since_factor_) / std::max(1, solves_since_factor_);
   if (last_reuse_iterations_ > average) return false;
+  // After failed tries, skip as many solves as tries failed in a row before trying again.
+  if (skipped_reuses_ < failed_reuses_) {
+    ++skipped_reuses_;
+    return false;
+  }
   // Beyond the factor's own cost in iterations a new one is cheaper anyway.
   const int cap =
       std::clamp(static_cast<int>(std::ceil(factor_cost_)), 1, settings.factor_reuse_iterations);
@@ -267,11 +272,14 @@ bool ImplicitSolver::solve_on_earlier_factor(const ConstraintFilter& filter,
                                                settings.factor_reuse_tolerance, cap);
   iterations_since_factor_ += reuse_stats_.iterations;
   last_reuse_iterations_ = reuse_stats_.iterations;
+  skipped_reuses_ = 0;
   if (!reuse_stats_.converged) {
     // Its iterations are spent; the caller factorises.
     result.cg_iterations += reuse_stats_.iterations;
+    ++failed_reuses_;
     return false;
   }
+  failed_reuses_ = 0;
   factor_current_ = false;
   ++result.factor_reuses;
   return true;

@@ -265,6 +265,8 @@ class ImplicitSolver {
   int solves_since_factor_ = 0;      // CHOLMOD solves since it (the direct one included)
   int iterations_since_factor_ = 0;  // PCG iterations on it since
   int last_reuse_iterations_ = 0;    // of the last solve on it; 0 right after it
+  int failed_reuses_ = 0;            // tries on an earlier factor that failed in a row
+  int skipped_reuses_ = 0;           // solves since the last try that did not try
   LinearSolveStats reuse_stats_;
   Eigen::VectorXd force_, product_, rhs_, z_, step_;
 };
