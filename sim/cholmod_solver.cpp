@@ -337,13 +337,6 @@ LinearSolveStats CholmodSolver::solve_preconditioned(const SparseMatrixR& a,
     ++stats.iterations;
     relative = residual.norm() / scale;
     if (relative <= tolerance) break;
-    // The PCG's residual falls about geometrically: from the third iteration on, stop when at
-    // the rate so far it would need more than max_iterations (the caller factorises instead,
-    // and what it spends here is wasted).
-    if (stats.iterations >= 3 &&
-        stats.iterations * std::log(tolerance) / std::log(std::min(relative, 0.99)) >
-            max_iterations)
-      break;
     Eigen::VectorXd preconditioned = apply_factor(residual);
     filter.apply(preconditioned);
     const double rho_next = residual.dot(preconditioned);

@@ -52,8 +52,7 @@ class CholmodSolver {
   // cloth changes little from step to step it is a near-exact preconditioner, and a few
   // iterations (a triangular solve pair and a product with A each) cost less than factorising
   // again. Stops when the Euclidean residual |S(b − A s)| has dropped by `tolerance` relative to
-  // |S(b − A z)|; not converged after `max_iterations`, or earlier when the residual's rate of
-  // decrease so far would need more (s then holds the last iterate). Needs
+  // |S(b − A z)|; not converged after `max_iterations` (s then holds the last iterate). Needs
   // factor_rows() == a.rows().
   LinearSolveStats solve_preconditioned(const SparseMatrixR& a, const ConstraintFilter& filter,
                                         const Eigen::VectorXd& b, const Eigen::VectorXd& z,
