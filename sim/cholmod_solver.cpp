@@ -290,6 +290,65 @@ bool CholmodSolver::factorize(const SparseMatrixR& a, const ConstraintFilter& fi
   return factorized_;
 }
 
+Eigen::VectorXd CholmodSolver::apply_factor(const Eigen::VectorXd& r) const {
+  if (permutation_.empty()) return factor_->llt.solve(r);
+  // The factor is of P A Pᵀ: solve for P y with P r.
+  const Eigen::Index rows = r.size();
+  Eigen::VectorXd permuted(rows);
+  for (Eigen::Index k = 0; k < rows; ++k) permuted[k] = r[permutation_[k]];
+  const Eigen::VectorXd solved = factor_->llt.solve(permuted);
+  Eigen::VectorXd y(rows);
+  for (Eigen::Index k = 0; k < rows; ++k) y[permutation_[k]] = solved[k];
+  return y;
+}
+
+LinearSolveStats CholmodSolver::solve_preconditioned(const SparseMatrixR& a,
+                                                     const ConstraintFilter& filter,
+                                                     const Eigen::VectorXd& b,
+                                                     const Eigen::VectorXd& z, Eigen::VectorXd& s,
+                                                     double tolerance, int max_iterations) {
+  LinearSolveStats stats;
+  if (factor_rows() != a.rows()) return stats;
+  // With s = z + y, y in the filtered subspace: S A y = S (b − A z) =: r₀. On that subspace
+  // S A S + (I − S) acts as S A, and S M⁻¹ S (M the old factor's matrix, SPD) is a symmetric
+  // positive definite preconditioner, so the conjugate gradients stay in it.
+  Eigen::VectorXd residual = b - a * z;
+  filter.apply(residual);
+  const double scale = residual.norm();
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(residual.size());
+  s = z;
+  if (scale == 0.0 || !std::isfinite(scale)) {
+    stats.converged = scale == 0.0;
+    return stats;
+  }
+  Eigen::VectorXd direction = apply_factor(residual);
+  filter.apply(direction);
+  double rho = residual.dot(direction);
+  Eigen::VectorXd product;
+  double relative = 1.0;
+  while (stats.iterations < max_iterations) {
+    product = a * direction;
+    filter.apply(product);
+    const double curvature = direction.dot(product);
+    if (!(curvature > 0.0) || !(rho > 0.0)) break;  // the old factor no longer preconditions
+    const double alpha = rho / curvature;
+    y += alpha * direction;
+    residual -= alpha * product;
+    ++stats.iterations;
+    relative = residual.norm() / scale;
+    if (relative <= tolerance) break;
+    Eigen::VectorXd preconditioned = apply_factor(residual);
+    filter.apply(preconditioned);
+    const double rho_next = residual.dot(preconditioned);
+    direction = preconditioned + (rho_next / rho) * direction;
+    rho = rho_next;
+  }
+  s = z + y;
+  stats.relative_residual = relative;
+  stats.converged = relative <= tolerance && s.allFinite();
+  return stats;
+}
+
 LinearSolveStats CholmodSolver::solve(const SparseMatrixR& a, const ConstraintFilter& filter,
                                       const Eigen::VectorXd& b, const Eigen::VectorXd& z,
                                       Eigen::VectorXd& s) {
@@ -300,18 +359,7 @@ LinearSolveStats CholmodSolver::solve(const SparseMatrixR& a, const ConstraintFi
   // The start's constrained residual, which constrained_relative_residual would compute again
   // the same way: the scale of the relative residual.
   const double scale = rhs.norm();
-  Eigen::VectorXd y;
-  if (!permutation_.empty()) {
-    // The factor is of P A Pᵀ: solve for P y with P rhs.
-    const Eigen::Index rows = rhs.size();
-    Eigen::VectorXd permuted(rows);
-    for (Eigen::Index k = 0; k < rows; ++k) permuted[k] = rhs[permutation_[k]];
-    const Eigen::VectorXd solved = factor_->llt.solve(permuted);
-    y.resize(rows);
-    for (Eigen::Index k = 0; k < rows; ++k) y[permutation_[k]] = solved[k];
-  } else {
-    y = factor_->llt.solve(rhs);
-  }
+  Eigen::VectorXd y = apply_factor(rhs);
   filter.apply(y);
   s = z + y;
   Eigen::VectorXd residual = b - a * s;

@@ -43,6 +43,21 @@ class CholmodSolver {
   LinearSolveStats solve(const SparseMatrixR& a, const ConstraintFilter& filter,
                          const Eigen::VectorXd& b, const Eigen::VectorXd& z, Eigen::VectorXd& s);
 
+  // The number of rows of the last successful numeric factorisation; 0 before any or after a
+  // failed one.
+  int factor_rows() const { return factorized_ ? static_cast<int>(upper_.rows()) : 0; }
+  // Solves the same constrained system as solve() by the modified PCG (iterates kept in the
+  // filtered subspace), preconditioned by the last factorisation, which may be of an earlier
+  // matrix of the same size (an earlier step's, with other contacts and pair springs): while the
+  // cloth changes little from step to step it is a near-exact preconditioner, and a few
+  // iterations (a triangular solve pair and a product with A each) cost less than factorising
+  // again. Stops when the Euclidean residual |S(b − A s)| has dropped by `tolerance` relative to
+  // |S(b − A z)|; not converged after `max_iterations` (s then holds the last iterate). Needs
+  // factor_rows() == a.rows().
+  LinearSolveStats solve_preconditioned(const SparseMatrixR& a, const ConstraintFilter& filter,
+                                        const Eigen::VectorXd& b, const Eigen::VectorXd& z,
+                                        Eigen::VectorXd& s, double tolerance, int max_iterations);
+
   int symbolic_analyses() const { return analyses_; }
   // The factor of the last symbolic analysis, as predict_factor_size() reports it (for tests
   // and the memory estimate's check).
@@ -59,6 +74,8 @@ class CholmodSolver {
   void record_analysed_size();
   // lower_ and lower_source_ from upper_, upper_source_ and permutation_.
   void make_permuted_lower();
+  // (L Lᵀ)⁻¹ r with the last factorisation, its permutation applied (3n).
+  Eigen::VectorXd apply_factor(const Eigen::VectorXd& r) const;
 
   struct Factor;
   CholmodMethod method_;

@@ -45,6 +45,13 @@ struct NewtonSettings {
   int pcg_max_iterations = 1000;
   // The default of SimulationSettings (see there).
   PcgPreconditioner pcg_preconditioner = PcgPreconditioner::block_incomplete_cholesky;
+  // CHOLMOD only: a solve may first try the PCG preconditioned by the last factorisation (of an
+  // earlier step's matrix of the same size, other contacts and pair springs) and factorises
+  // when that does not reach factor_reuse_tolerance within the factor's own cost in iterations
+  // (at most factor_reuse_iterations), or when the last such solve cost more than the average
+  // solve since the factorisation. 0: a factorisation every solve (the same bits as before).
+  int factor_reuse_iterations = 0;
+  double factor_reuse_tolerance = 1e-9;  // relative Euclidean residual, as CHOLMOD's own solve
 };
 
 // A force on one vertex, affine in its velocity: f = force − C (v − v_ref), C symmetric
@@ -173,6 +180,9 @@ struct ImplicitSolveResult {
   // CHOLMOD factorisations that failed (the system not positive definite); each solve fell
   // back to PCG on the same system.
   int cholmod_failures = 0;
+  // CHOLMOD solves done by the PCG on an earlier factorisation (NewtonSettings::
+  // factor_reuse_iterations) instead of a new one.
+  int factor_reuses = 0;
   // Why the linear solve failed when no step can come of it (the factorisation failed and the
   // PCG fallback did not converge either); empty otherwise.
   std::string linear_failure;
@@ -224,6 +234,10 @@ class ImplicitSolver {
   const std::vector<int>& system_diagonal(const ClothModel& model) const {
     return widened_ ? coupled_diagonal_ : model.pattern.diagonal_offsets;
   }
+  // CHOLMOD: the PCG on the last factorisation (NewtonSettings::factor_reuse_iterations) when
+  // it pays; true when it solved (step_, reuse_stats_), false when the caller is to factorise.
+  bool solve_on_earlier_factor(const ConstraintFilter& filter, const NewtonSettings& settings,
+                               bool refactor, ImplicitSolveResult& result);
   bool linear_solve(const ClothModel& model, const ConstraintFilter& filter,
                     const NewtonSettings& settings, bool refactor, ImplicitSolveResult& result);
   void record_constraint_impulse(const ConstraintFilter& filter, ImplicitSolveResult& result);
@@ -244,6 +258,16 @@ class ImplicitSolver {
   PcgSolver pcg_;
   CholmodSolver cholmod_;
   bool cholmod_failed_ = false;  // the last factorisation failed: solves go to PCG until the next
+  // The CHOLMOD factor is of the current system matrix (false after a solve that reused an
+  // earlier step's factor: a kept-matrix Newton iteration must not solve directly with it).
+  bool factor_current_ = false;
+  double factor_cost_ = 0.0;         // the last factorisation's cost in PCG iterations
+  int solves_since_factor_ = 0;      // CHOLMOD solves since it (the direct one included)
+  int iterations_since_factor_ = 0;  // PCG iterations on it since
+  int last_reuse_iterations_ = 0;    // of the last solve on it; 0 right after it
+  int failed_reuses_ = 0;            // tries on an earlier factor that failed in a row
+  int skipped_reuses_ = 0;           // solves since the last try that did not try
+  LinearSolveStats reuse_stats_;
   Eigen::VectorXd force_, product_, rhs_, z_, step_;
 };
 

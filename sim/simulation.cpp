@@ -309,6 +309,8 @@ Simulation::Attempt Simulation::attempt(double h) {
   newton_settings.pcg_tolerance = settings_.pcg_tolerance;
   newton_settings.pcg_max_iterations = settings_.pcg_max_iterations;
   newton_settings.pcg_preconditioner = settings_.pcg_preconditioner;
+  newton_settings.factor_reuse_iterations = settings_.factor_reuse_iterations;
+  newton_settings.factor_reuse_tolerance = settings_.factor_reuse_tolerance;
 
   // Variable-step BDF2 (ω = h/h_prev): y1 − (1+ω)²/(1+2ω) y0 + ω²/(1+2ω) y−1 = h(1+ω)/(1+2ω) f1.
   Eigen::VectorXd x_hat, v_hat, x_lin, v_lin;
@@ -696,6 +698,8 @@ SimulationReport Simulation::run(const RunHooks& hooks) {
       report_.steps > 0 ? static_cast<double>(newton_total_) / report_.steps : 0.0;
   report_.max_strain = max_stretch_strain(model_, x_);
   report_.nan_free = x_.allFinite() && v_.allFinite();
+  report_.cholmod_factorizations = solver_.cholmod().numeric_factorizations();
+  report_.cholmod_analyses = solver_.cholmod().symbolic_analyses();
   if (settings_.solver == LinearSolverKind::cholmod)
     spdlog::debug("sim: CHOLMOD: {} symbolic analyses, {} numeric factorisations",
                   solver_.cholmod().symbolic_analyses(),

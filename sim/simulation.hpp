@@ -50,6 +50,15 @@ struct SimulationSettings {
   // Block IC(0) needs 6-12x fewer iterations than block Jacobi on stiff woven cloth and makes
   // the PCG step 4x faster (docs/benchmarks.md, "Simulator"); block Jacobi is kept to compare.
   PcgPreconditioner pcg_preconditioner = PcgPreconditioner::block_incomplete_cholesky;
+  // CHOLMOD: a solve first tries the PCG preconditioned by the last factorisation (an earlier
+  // step's, same size), to factor_reuse_tolerance within factor_reuse_iterations iterations, and
+  // factorises only when that fails or the last such solve needed more than half of them
+  // (NewtonSettings). 0: a factorisation every solve.
+  // The PCG converges linearly, so its tolerance is close to CHOLMOD's own residual (1e-12 to
+  // 1e-14): the adaptive 2 cm tee drapes within 0.1 µm of a factorisation every step; at 1e-6
+  // its settling (chaotic under contact) took another path, at rest 0.25 s earlier, 10 mm away.
+  int factor_reuse_iterations = 40;
+  double factor_reuse_tolerance = 1.0e-9;
   double max_strain = 1.0;  // a step that stretches any triangle by more (100 %) fails
   double max_speed = 50.0;  // m/s, a step with a faster vertex fails
   // m; > 0 (implicit Euler only): the step follows a local error estimate instead of growing
@@ -126,8 +135,13 @@ struct SimulationReport {
   int vertices = 0;
   int triangles = 0;
   int linear_solves = 0;
-  double cg_iterations_mean = 0.0;  // per linear solve (0 with CHOLMOD)
+  // per linear solve (with CHOLMOD, those of the PCG on an earlier factor: factor_reuse_*)
+  double cg_iterations_mean = 0.0;
   int cg_iterations_max = 0;
+  // CHOLMOD's numeric factorisations and symbolic analyses (0 with the PCG); fewer
+  // factorisations than linear solves where an earlier factor preconditioned the PCG.
+  int cholmod_factorizations = 0;
+  int cholmod_analyses = 0;
   double newton_iterations_mean = 0.0;  // per accepted step
   double dt_min_used = 0.0;
   double dt_max_used = 0.0;

@@ -317,6 +317,68 @@ TEST(LinearSolvers, CholmodPermutedFactorisationIsTheSameBits) {
   EXPECT_EQ(kept.numeric_factorizations(), 5);
 }
 
+// An earlier factorisation as the PCG's preconditioner: on its own matrix it is exact (one
+// iteration); on the next step's system (other values, another pin, a new contact) the PCG
+// reaches the asked residual, checked independently, and the step a fresh factorisation gives.
+TEST(LinearSolvers, CholmodEarlierFactorPreconditionsTheNextSystem) {
+  System s = make_system(1.0 / 24, 16);
+  Eigen::VectorXd z;
+  s.filter.constrained_correction(Eigen::VectorXd::Zero(s.b.size()), z);
+  CholmodSolver kept;
+  ASSERT_TRUE(kept.factorize(s.a, s.filter));
+  // Two of them, so that the permuted lower triangle (from a pattern's third on) is used too.
+  for (int k = 0; k < 2; ++k) {
+    Eigen::VectorXd direct, iterated;
+    kept.solve(s.a, s.filter, s.b, z, direct);
+    const LinearSolveStats same =
+        kept.solve_preconditioned(s.a, s.filter, s.b, z, iterated, 1e-10, 10);
+    ASSERT_TRUE(same.converged);
+    EXPECT_LE(same.iterations, 2);
+    EXPECT_LE((iterated - direct).norm(), 1e-9 * direct.norm());
+    ASSERT_TRUE(kept.factorize(s.a, s.filter));
+    ASSERT_TRUE(kept.factorize(s.a, s.filter));
+  }
+  ASSERT_EQ(kept.factor_rows(), s.a.rows());
+
+  // The next step: the matrix 2 % larger, a stiff spring on three vertices (as a pair spring's
+  // own blocks), one more pin and a new contact direction: a step's changes are of low rank.
+  SparseMatrixR next = 1.02 * s.a;
+  for (const int i : {s.scene.vertex(3, 3), s.scene.vertex(12, 4), s.scene.vertex(7, 13)})
+    for (int k = 0; k < 3; ++k)
+      next.valuePtr()[block_value_index(next, i, s.model.pattern.diagonal_offsets[i], k, k)] +=
+          50.0;
+  ConstraintFilter filter = s.filter;
+  filter.pin(s.scene.vertex(8, 0), Eigen::Vector3d(0.0, -0.1, 0.0));
+  filter.constrain_direction(s.scene.vertex(9, 9), Eigen::Vector3d(0, 1, 0), 0.03);
+  filter.constrained_correction(Eigen::VectorXd::Zero(s.b.size()), z);
+  Eigen::VectorXd iterated, expected;
+  const double tolerance = 1e-10;
+  const LinearSolveStats stats =
+      kept.solve_preconditioned(next, filter, s.b, z, iterated, tolerance, 200);
+  std::printf("earlier factor on the next system: %d iterations, residual %.3g\n", stats.iterations,
+              stats.relative_residual);
+  ASSERT_TRUE(stats.converged);
+  EXPECT_GT(stats.iterations, 2);  // the factor is not next's
+  CholmodSolver fresh;
+  ASSERT_TRUE(fresh.factorize(next, filter));
+  fresh.solve(next, filter, s.b, z, expected);
+  // The residual, computed here: the filtered equations hold to the tolerance, and the
+  // constrained directions take exactly the prescribed correction.
+  Eigen::VectorXd residual = s.b - next * iterated, start = s.b - next * z;
+  filter.apply(residual);
+  filter.apply(start);
+  EXPECT_LE(residual.norm(), 1.01 * tolerance * start.norm());
+  Eigen::VectorXd off_subspace = iterated - z;
+  Eigen::VectorXd inside = off_subspace;
+  filter.apply(inside);
+  EXPECT_LE((off_subspace - inside).norm(), 1e-14 * z.norm());
+  // The error is the residual through A⁻¹ (condition number about 1e3 here): 1e-10 · 1e3.
+  EXPECT_LE((iterated - expected).norm(), 1e-7 * expected.norm());
+  // Too few iterations: not converged, and said so.
+  Eigen::VectorXd short_run;
+  EXPECT_FALSE(kept.solve_preconditioned(next, filter, s.b, z, short_run, tolerance, 1).converged);
+}
+
 TEST(LinearSolvers, CholmodSimplicialAndSupernodalAgree) {
   const System s = make_system(1.0 / 24);
   Eigen::VectorXd z;

@@ -37,6 +37,8 @@ nlohmann::json simulation_json(const sim::SimulationReport& r, const sim::Simula
           {"linear_solves", r.linear_solves},
           {"cg_iterations_mean", r.cg_iterations_mean},
           {"cg_iterations_max", r.cg_iterations_max},
+          {"cholmod_factorizations", r.cholmod_factorizations},
+          {"cholmod_analyses", r.cholmod_analyses},
           {"newton_iterations_mean", r.newton_iterations_mean},
           {"dt_min_used", r.dt_min_used},
           {"dt_max_used", r.dt_max_used},
