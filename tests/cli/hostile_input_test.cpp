@@ -132,6 +132,33 @@ TEST(HostileInput, BodyPathsThatAreNotFilesFailAtOnce) {
   fs::remove_all(dir);
 }
 
+// `render MESH --body builtin` read the garment mesh with assimp unchecked: the PLY headers the
+// body loader refuses (tests/fuzz/regressions) made it read for ever (killed after 20 s), and
+// an OFF or PLY header declaring billions of vertices ended in "std::bad_alloc". Both are refused
+// at once as the body loader refuses them, naming the garment mesh; no picture is written.
+TEST(HostileInput, RenderRefusesCorruptGarmentMeshHeaders) {
+  const fs::path dir = fresh_dir("render-corrupt");
+  write(dir / "huge.ply",
+        "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\n"
+        "property float y\nproperty float z\nelement face 1\n"
+        "property list uchar int vertex_indices\nend_header\n");
+  std::vector<fs::path> files = {dir / "huge.ply"};
+  for (const auto& entry :
+       fs::directory_iterator(fs::path(SD_SOURCE_DIR) / "tests/fuzz/regressions"))
+    files.push_back(entry.path());
+  ASSERT_GE(files.size(), 5u);
+  for (const fs::path& file : files) {
+    const fs::path png = dir / "out.png";
+    const CommandResult r = run_guarded(
+        "render " + file.string() + " --body builtin --view front --size 32x32 -o " + png.string());
+    EXPECT_EQ(r.exit_code, 2) << file << "\n" << r.output;
+    EXPECT_NE(r.output.find("garment mesh '" + file.string() + "' is corrupt"), std::string::npos)
+        << r.output;
+    EXPECT_FALSE(fs::exists(png)) << file;
+  }
+  fs::remove_all(dir);
+}
+
 // What `validate` and `run` refuse, `mesh` refuses too; what `mesh` cannot draw, `validate`
 // refuses; a sheet meshes; a mesh without area is refused as body and as garment alike.
 TEST(HostileInput, EveryCommandAppliesTheSameChecks) {
