@@ -234,6 +234,8 @@ void run_render(const RenderOptions& options, const GlobalOptions& global) {
   render::Renderer renderer;
   const render::PreparedScene prepared = renderer.prepare(scene);
   StagedOutputs outputs;
+  outputs.keep(options.mesh);
+  if (!options.body.empty()) outputs.keep(options.body);
   Progress progress("rendering", static_cast<long>(jobs.size()), global.quiet);
   for (size_t i = 0; i < jobs.size(); ++i) {
     const ViewJob& job = jobs[i];
