@@ -160,6 +160,12 @@ meshing::TriMesh read_body_mesh(const std::string& file, Body& body) {
   std::vector<Eigen::Vector3i> tris;
   collect_meshes(*scene, *scene->mRootNode, aiMatrix4x4(), points, tris, body.raw.meshes);
   if (tris.empty()) throw BodyError("body file '" + file + "' holds no triangles");
+  if (tris.size() > kMaxBodyTriangles)
+    throw BodyError(fmt::format(
+        "body file '{}' has {} triangles, more than the {} a body may have (collision needs no "
+        "finer body than a few hundred thousand); reduce it first, e.g. with Blender's Decimate "
+        "modifier",
+        file, tris.size(), kMaxBodyTriangles));
   for (const auto& p : points)
     if (!p.allFinite())
       throw BodyError("body file '" + file + "' has NaN or infinite vertex coordinates");

@@ -309,14 +309,11 @@ void parse_output(const Reader& r, const json& j, OutputSpec& out) {
       r.fail(path + "/mesh", fmt::format("'{}' must end in .obj or .glb", out.mesh));
     if (out.mesh.find('/') != std::string::npos)
       r.fail(path + "/mesh", "give a file name only; the directory comes from -o");
-    // The commands write these names themselves: the quad mesh under one of them would be
-    // overwritten by the 4-8 mesh or the drape (mesh wrote only garment48.obj's triangles).
-    for (const char* taken : {"garment48.obj", "drape.obj", "drape.glb", "drape-failed.obj"})
-      if (out.mesh == taken)
-        r.fail(path + "/mesh",
-               fmt::format("'{}' is the name of another output of mesh and run; choose "
-                           "another name (e.g. garment.obj)",
-                           out.mesh));
+    // `mesh` writes the 4-8 mesh under this name: the quads were overwritten by its triangles.
+    if (out.mesh == "garment48.obj")
+      r.fail(path + "/mesh",
+             "'garment48.obj' is the name of the 4-8 mesh that mesh writes too; choose another "
+             "name (e.g. garment.obj)");
     if (out.mesh == ".obj" || out.mesh == ".glb")
       r.fail(path + "/mesh", fmt::format("'{}' has no name before its extension (e.g. garment{})",
                                          out.mesh, out.mesh));
