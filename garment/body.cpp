@@ -403,6 +403,13 @@ Body load_body(const std::string& path, const BodyOptions& options) {
   } else if (raw.height >= 50 && raw.height <= 250) {
     raw.scale = 0.01;
     raw.scale_rule = "height looks like centimetres";
+    // 50-100 units is a short body in centimetres or a tall one in inches (a 67-inch body was
+    // read as 0.67 m and every curve then missed it): say which was chosen and how to choose.
+    if (raw.height < 100)
+      body.warnings.push_back(fmt::format(
+          "body height {:.4g} units was read as centimetres ({:.2f} m tall); if the file is in "
+          "inches the body is {:.2f} m tall: give \"scale\": 0.0254 (or its \"height\")",
+          raw.height, raw.height * 0.01, raw.height * 0.0254));
   } else if (raw.height >= 500 && raw.height <= 2500) {
     raw.scale = 0.001;
     raw.scale_rule = "height looks like millimetres";
