@@ -140,6 +140,9 @@ meshing::TriMesh read_body_mesh(const std::string& file, Body& body) {
   if (const auto problem = input_file_problem(file, kMaxMeshFileBytes))
     throw BodyError("body file '" + file + "' " + *problem);
   check_mesh_file_header(file, "body file");
+  std::error_code size_ec;
+  if (std::filesystem::file_size(file, size_ec) == 0 && !size_ec)
+    throw BodyError("body file '" + file + "' is empty (0 bytes)");
   Assimp::Importer importer;
   // Only structure validation: assimp's Triangulate step aborts the process (ai_assert) on some
   // corrupt files (invalid/OutOfMemory.off), so polygons are fan-triangulated here and
@@ -151,8 +154,16 @@ meshing::TriMesh read_body_mesh(const std::string& file, Body& body) {
   } catch (const std::exception& e) {  // assimp catches most of its own; be sure
     throw BodyError("cannot read body file '" + file + "': " + e.what());
   }
-  if (scene == nullptr)
-    throw BodyError("cannot read body file '" + file + "': " + importer.GetErrorString());
+  if (scene == nullptr) {
+    // assimp's words for a file of no mesh it knows (random bytes named .obj) say nothing to a
+    // designer: "Validation failed: aiScene::mNumMeshes is 0".
+    const std::string reason = importer.GetErrorString();
+    if (reason.find("mNumMeshes is 0") != std::string::npos)
+      throw BodyError("body file '" + file +
+                      "' holds no mesh: no vertices and faces could be read from it (is it "
+                      "really a mesh file of the format its name ends in?)");
+    throw BodyError("cannot read body file '" + file + "': " + reason);
+  }
   if (scene->mRootNode == nullptr || scene->mNumMeshes == 0)
     throw BodyError("body file '" + file + "' holds no mesh");
 

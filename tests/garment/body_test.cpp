@@ -154,7 +154,16 @@ TEST(Body, UnitsAreInferredFromHeight) {
 }
 
 TEST(Body, BadFilesGiveASentence) {
-  EXPECT_NE(body_error(write_temp("empty.obj", "")).find("cannot read"), std::string::npos);
+  // A 0-byte file and random bytes named .obj: said as such, not in assimp's words ("OBJ-file
+  // is too small.", "Validation failed: aiScene::mNumMeshes is 0").
+  EXPECT_NE(body_error(write_temp("empty.obj", "")).find("empty.obj' is empty (0 bytes)"),
+            std::string::npos);
+  std::string noise(4096, '\0');
+  for (size_t i = 0; i < noise.size(); ++i) noise[i] = static_cast<char>((i * 7919 + 13) % 251);
+  EXPECT_NE(body_error(write_temp("noise.obj", noise))
+                .find("noise.obj' holds no mesh: no vertices and faces could be read from it"),
+            std::string::npos)
+      << body_error(write_temp("noise.obj", noise));
   EXPECT_NE(body_error(write_temp("points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n")), "");
   EXPECT_NE(body_error(write_temp("lines.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\nl 2 3\n")), "");
   EXPECT_NE(body_error(write_temp("body.unknownformat", "hello")), "");
