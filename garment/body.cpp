@@ -56,98 +56,6 @@ void collect_meshes(const aiScene& scene, const aiNode& node, const aiMatrix4x4&
     collect_meshes(scene, *node.mChildren[c], transform, vertices, faces, mesh_count);
 }
 
-// OFF and PLY headers declare element counts up front and assimp reserves memory for them before
-// reading (invalid/OutOfMemory.off makes it reserve ~16 GB). Reject a header whose counts could
-// not fit in the file: every vertex takes at least 6 bytes ("0 0 0\n"), every face at least 8.
-void check_declared_counts(const std::string& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::string header(65536, '\0');
-  in.read(header.data(), static_cast<std::streamsize>(header.size()));
-  header.resize(static_cast<size_t>(in.gcount()));
-  std::istringstream words(header);
-  std::string word;
-  double vertices = 0, faces = 0;
-  if (!(words >> word)) return;
-  if (word.size() >= 3 && word.compare(word.size() - 3, 3, "OFF") == 0) {
-    // Skip comment and blank lines between the keyword and the counts. The first line that
-    // opens with a number is the counts line, as assimp reads it, even without a face count
-    // (a fuzz finding: "7777777777777777777777" alone on its line, which assimp wraps to 3.3e9
-    // vertices and reserves 39 GB for, while a later line's "770" had passed this check).
-    std::string line;
-    while (std::getline(words, line)) {
-      const auto hash = line.find('#');
-      if (hash != std::string::npos) line.resize(hash);
-      std::istringstream counts(line);
-      if (!(counts >> vertices)) {
-        vertices = 0;
-        continue;
-      }
-      if (!(counts >> faces)) faces = 0;
-      break;
-    }
-  } else if (word.compare(0, 3, "ply") == 0) {
-    // assimp takes any file that starts with "ply" for PLY, whatever follows on the line (the
-    // third finding: "ply" and binary bytes, no end_header, read for over 10 s).
-    // assimp's PLY reader never returns on a header without end_header (found by
-    // tests/fuzz/body_loader_fuzz): such a file is refused before it is read.
-    if (header.find("end_header") == std::string::npos)
-      throw BodyError(
-          fmt::format("body file '{}' is corrupt: its PLY header has no end_header "
-                      "line{}",
-                      file, header.size() < 65536 ? "" : " in its first 64 KB"));
-    // Nor on some header lines that hold numbers (the second finding: vertex data before
-    // end_header). Free text lines stay allowed (Blender writes one), numbers do not.
-    std::istringstream lines(header);
-    std::string line;
-    std::getline(lines, line);  // "ply"
-    for (int number = 2; std::getline(lines, line); ++number) {
-      std::istringstream first(line);
-      std::string keyword;
-      first >> keyword;
-      if (keyword == "end_header") break;
-      const bool numeric =
-          !keyword.empty() && (std::isdigit(static_cast<unsigned char>(keyword[0])) ||
-                               keyword[0] == '-' || keyword[0] == '+' || keyword[0] == '.');
-      const bool binary = std::any_of(line.begin(), line.end(), [](char c) {
-        return static_cast<unsigned char>(c) < 0x09 || static_cast<unsigned char>(c) == 0x7f;
-      });
-      if (numeric || binary)
-        throw BodyError(
-            fmt::format("body file '{}' is corrupt: line {} of its PLY header is not "
-                        "a header line (it holds {} before end_header)",
-                        file, number, numeric ? "numbers" : "binary bytes"));
-    }
-    // The keyword must open a line: inside another word ("floend_headerat32", a later fuzz
-    // finding) it does not end the header, and assimp reads on for ever.
-    const auto ends_header = [](const std::string& text) {
-      std::istringstream rows(text);
-      std::string row, keyword;
-      while (std::getline(rows, row))
-        if (std::istringstream(row) >> keyword && keyword == "end_header") return true;
-      return false;
-    };
-    if (!ends_header(header))
-      throw BodyError(
-          fmt::format("body file '{}' is corrupt: its PLY header has no end_header line", file));
-    while (words >> word && word != "end_header") {
-      if (word != "element") continue;
-      std::string kind;
-      double count = 0;
-      if (!(words >> kind >> count)) break;
-      if (kind == "vertex") vertices = count;
-      if (kind == "face") faces = count;
-    }
-  } else {
-    return;
-  }
-  const double size = static_cast<double>(std::filesystem::file_size(file));
-  if (vertices < 0 || faces < 0 || 6 * vertices + 8 * faces > size)
-    throw BodyError(fmt::format(
-        "body file '{}' is corrupt: its header declares {:.0f} vertices and {:.0f} faces, more "
-        "than its {:.0f} bytes can hold",
-        file, vertices, faces, size));
-}
-
 // Rotation taking the file's `up` to +Y and its facing direction to +Z (proper rotation).
 Eigen::Matrix3d frame_rotation(const AxisDirection& up, const AxisDirection& facing) {
   Eigen::Vector3d u = Eigen::Vector3d::Zero(), f = Eigen::Vector3d::Zero();
@@ -231,7 +139,10 @@ CleanupCounts weld_and_clean(meshing::TriMesh& mesh, double tolerance, double mi
 meshing::TriMesh read_body_mesh(const std::string& file, Body& body) {
   if (const auto problem = input_file_problem(file, kMaxMeshFileBytes))
     throw BodyError("body file '" + file + "' " + *problem);
-  check_declared_counts(file);
+  check_mesh_file_header(file, "body file");
+  std::error_code size_ec;
+  if (std::filesystem::file_size(file, size_ec) == 0 && !size_ec)
+    throw BodyError("body file '" + file + "' is empty (0 bytes)");
   Assimp::Importer importer;
   // Only structure validation: assimp's Triangulate step aborts the process (ai_assert) on some
   // corrupt files (invalid/OutOfMemory.off), so polygons are fan-triangulated here and
@@ -243,8 +154,16 @@ meshing::TriMesh read_body_mesh(const std::string& file, Body& body) {
   } catch (const std::exception& e) {  // assimp catches most of its own; be sure
     throw BodyError("cannot read body file '" + file + "': " + e.what());
   }
-  if (scene == nullptr)
-    throw BodyError("cannot read body file '" + file + "': " + importer.GetErrorString());
+  if (scene == nullptr) {
+    // assimp's words for a file of no mesh it knows (random bytes named .obj) say nothing to a
+    // designer: "Validation failed: aiScene::mNumMeshes is 0".
+    const std::string reason = importer.GetErrorString();
+    if (reason.find("mNumMeshes is 0") != std::string::npos)
+      throw BodyError("body file '" + file +
+                      "' holds no mesh: no vertices and faces could be read from it (is it "
+                      "really a mesh file of the format its name ends in?)");
+    throw BodyError("cannot read body file '" + file + "': " + reason);
+  }
   if (scene->mRootNode == nullptr || scene->mNumMeshes == 0)
     throw BodyError("body file '" + file + "' holds no mesh");
 
@@ -252,6 +171,12 @@ meshing::TriMesh read_body_mesh(const std::string& file, Body& body) {
   std::vector<Eigen::Vector3i> tris;
   collect_meshes(*scene, *scene->mRootNode, aiMatrix4x4(), points, tris, body.raw.meshes);
   if (tris.empty()) throw BodyError("body file '" + file + "' holds no triangles");
+  if (tris.size() > kMaxBodyTriangles)
+    throw BodyError(fmt::format(
+        "body file '{}' has {} triangles, more than the {} a body may have (collision needs no "
+        "finer body than a few hundred thousand); reduce it first, e.g. with Blender's Decimate "
+        "modifier",
+        file, tris.size(), kMaxBodyTriangles));
   for (const auto& p : points)
     if (!p.allFinite())
       throw BodyError("body file '" + file + "' has NaN or infinite vertex coordinates");
@@ -296,6 +221,98 @@ double signed_volume(const meshing::TriMesh& mesh) {
 }
 
 }  // namespace
+
+// OFF and PLY headers declare element counts up front and assimp reserves memory for them before
+// reading (invalid/OutOfMemory.off makes it reserve ~16 GB). Reject a header whose counts could
+// not fit in the file: every vertex takes at least 6 bytes ("0 0 0\n"), every face at least 8.
+void check_mesh_file_header(const std::string& file, const std::string& what) {
+  std::ifstream in(file, std::ios::binary);
+  std::string header(65536, '\0');
+  in.read(header.data(), static_cast<std::streamsize>(header.size()));
+  header.resize(static_cast<size_t>(in.gcount()));
+  std::istringstream words(header);
+  std::string word;
+  double vertices = 0, faces = 0;
+  if (!(words >> word)) return;
+  if (word.size() >= 3 && word.compare(word.size() - 3, 3, "OFF") == 0) {
+    // Skip comment and blank lines between the keyword and the counts. The first line that
+    // opens with a number is the counts line, as assimp reads it, even without a face count
+    // (a fuzz finding: "7777777777777777777777" alone on its line, which assimp wraps to 3.3e9
+    // vertices and reserves 39 GB for, while a later line's "770" had passed this check).
+    std::string line;
+    while (std::getline(words, line)) {
+      const auto hash = line.find('#');
+      if (hash != std::string::npos) line.resize(hash);
+      std::istringstream counts(line);
+      if (!(counts >> vertices)) {
+        vertices = 0;
+        continue;
+      }
+      if (!(counts >> faces)) faces = 0;
+      break;
+    }
+  } else if (word.compare(0, 3, "ply") == 0) {
+    // assimp takes any file that starts with "ply" for PLY, whatever follows on the line (the
+    // third finding: "ply" and binary bytes, no end_header, read for over 10 s).
+    // assimp's PLY reader never returns on a header without end_header (found by
+    // tests/fuzz/body_loader_fuzz): such a file is refused before it is read.
+    if (header.find("end_header") == std::string::npos)
+      throw BodyError(
+          fmt::format("{} '{}' is corrupt: its PLY header has no end_header "
+                      "line{}",
+                      what, file, header.size() < 65536 ? "" : " in its first 64 KB"));
+    // Nor on some header lines that hold numbers (the second finding: vertex data before
+    // end_header). Free text lines stay allowed (Blender writes one), numbers do not.
+    std::istringstream lines(header);
+    std::string line;
+    std::getline(lines, line);  // "ply"
+    for (int number = 2; std::getline(lines, line); ++number) {
+      std::istringstream first(line);
+      std::string keyword;
+      first >> keyword;
+      if (keyword == "end_header") break;
+      const bool numeric =
+          !keyword.empty() && (std::isdigit(static_cast<unsigned char>(keyword[0])) ||
+                               keyword[0] == '-' || keyword[0] == '+' || keyword[0] == '.');
+      const bool binary = std::any_of(line.begin(), line.end(), [](char c) {
+        return static_cast<unsigned char>(c) < 0x09 || static_cast<unsigned char>(c) == 0x7f;
+      });
+      if (numeric || binary)
+        throw BodyError(
+            fmt::format("{} '{}' is corrupt: line {} of its PLY header is not "
+                        "a header line (it holds {} before end_header)",
+                        what, file, number, numeric ? "numbers" : "binary bytes"));
+    }
+    // The keyword must open a line: inside another word ("floend_headerat32", a later fuzz
+    // finding) it does not end the header, and assimp reads on for ever.
+    const auto ends_header = [](const std::string& text) {
+      std::istringstream rows(text);
+      std::string row, keyword;
+      while (std::getline(rows, row))
+        if (std::istringstream(row) >> keyword && keyword == "end_header") return true;
+      return false;
+    };
+    if (!ends_header(header))
+      throw BodyError(
+          fmt::format("{} '{}' is corrupt: its PLY header has no end_header line", what, file));
+    while (words >> word && word != "end_header") {
+      if (word != "element") continue;
+      std::string kind;
+      double count = 0;
+      if (!(words >> kind >> count)) break;
+      if (kind == "vertex") vertices = count;
+      if (kind == "face") faces = count;
+    }
+  } else {
+    return;
+  }
+  const double size = static_cast<double>(std::filesystem::file_size(file));
+  if (vertices < 0 || faces < 0 || 6 * vertices + 8 * faces > size)
+    throw BodyError(fmt::format(
+        "{} '{}' is corrupt: its header declares {:.0f} vertices and {:.0f} faces, more "
+        "than its {:.0f} bytes can hold",
+        what, file, vertices, faces, size));
+}
 
 std::string AxisDirection::name() const {
   return std::string(sign > 0 ? "+" : "-") + "xyz"[axis];
@@ -397,6 +414,13 @@ Body load_body(const std::string& path, const BodyOptions& options) {
   } else if (raw.height >= 50 && raw.height <= 250) {
     raw.scale = 0.01;
     raw.scale_rule = "height looks like centimetres";
+    // 50-100 units is a short body in centimetres or a tall one in inches (a 67-inch body was
+    // read as 0.67 m and every curve then missed it): say which was chosen and how to choose.
+    if (raw.height < 100)
+      body.warnings.push_back(fmt::format(
+          "body height {:.4g} units was read as centimetres ({:.2f} m tall); if the file is in "
+          "inches the body is {:.2f} m tall: give \"scale\": 0.0254 (or its \"height\")",
+          raw.height, raw.height * 0.01, raw.height * 0.0254));
   } else if (raw.height >= 500 && raw.height <= 2500) {
     raw.scale = 0.001;
     raw.scale_rule = "height looks like millimetres";

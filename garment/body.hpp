@@ -65,6 +65,12 @@ std::string builtin_body_path();
 // unused vertices (with a warning), then normalises. Throws BodyError on unusable input.
 Body load_body(const std::string& path, const BodyOptions& options = {});
 
+// Refuses, before assimp reads it, a mesh file whose OFF or PLY header would make assimp reserve
+// more memory than the file could fill or read for ever (a PLY header without an end_header
+// line, or with numbers or binary bytes in it). `what` opens the message ("body file", "garment
+// mesh"). Throws BodyError; files of other formats pass.
+void check_mesh_file_header(const std::string& file, const std::string& what);
+
 // Loads another pose of `rest` (the same mesh moved: a frame of an animation exported from the
 // same rig) and puts it in the project's frame with exactly the rest body's rotation, scale and
 // shift, so that a pose where the arms are raised is not re-centred. Throws BodyError when the

@@ -2,10 +2,33 @@
 // The one error type for a sketch file a designer got wrong: it names the file, the JSON path of
 // the offending value ("/panels/2/boundary/3") and says what is wrong in a plain sentence.
 
+#include <cstdio>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace sd::garment {
+
+// A piece of the user's file as a message quotes it: control characters (a NUL would end the
+// message where the terminal prints it, an escape sequence would act on the terminal) as \xNN,
+// and at most `max_chars` bytes of a longer text (a 10 MB string where a number goes was echoed
+// whole), with the length it had.
+inline std::string excerpt(std::string_view text, size_t max_chars = 60) {
+  std::string out;
+  const size_t shown = text.size() > max_chars ? max_chars : text.size();
+  for (size_t i = 0; i < shown; ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c < 0x20 || c == 0x7f) {
+      char hex[5];
+      std::snprintf(hex, sizeof hex, "\\x%02x", c);
+      out += hex;
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  if (shown < text.size()) out += "... (" + std::to_string(text.size()) + " characters)";
+  return out;
+}
 
 class SketchError : public std::invalid_argument {
  public:
@@ -23,9 +46,22 @@ class SketchError : public std::invalid_argument {
  private:
   static std::string compose(const std::string& file, const std::string& path,
                              const std::string& sentence) {
+    // No control character reaches the terminal (an id with a NUL byte cut the message short).
     std::string text = file + ": ";
     if (!path.empty()) text += path + ": ";
-    return text + sentence;
+    text += sentence;
+    std::string out;
+    for (const char c : text) {
+      const auto u = static_cast<unsigned char>(c);
+      if ((u < 0x20 && c != '\n' && c != '\t') || u == 0x7f) {
+        char hex[5];
+        std::snprintf(hex, sizeof hex, "\\x%02x", u);
+        out += hex;
+      } else {
+        out += c;
+      }
+    }
+    return out;
   }
 
   std::string file_;

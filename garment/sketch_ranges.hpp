@@ -5,6 +5,7 @@
 // once the body is loaded (check_against_body) and once the edge counts are known
 // (check_panel_sizes). Every failure is a SketchError at the value's JSON path.
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -34,6 +35,10 @@ inline constexpr double kMaxTimeStep = 0.1;   // s
 inline constexpr double kMaxDuration = 3600.0;                     // s of simulated time
 inline constexpr std::uintmax_t kMaxSketchFileBytes = 16'000'000;  // a sketch file
 inline constexpr std::uintmax_t kMaxMeshFileBytes = 512'000'000;   // a body or garment mesh
+// A body's triangles (the built-in body has 8,560; scans come with 50k-500k). A 2M-triangle
+// body took 20 s and 790 MB only to be described by `info` (loaded machine); over this it is
+// refused with the count and how to reduce it instead of loading for minutes.
+inline constexpr std::size_t kMaxBodyTriangles = 1'000'000;
 
 // output.pattern.fabric_width and `pattern --fabric-width`: a strip of trim to a wide sheeting.
 inline constexpr double kMinFabricWidth = 0.1;   // m

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <fstream>
 #include <functional>
 #include <sstream>
@@ -50,8 +51,17 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
     std::string detail = e.what();
     const size_t colon = detail.find("error while parsing");
     if (colon != std::string::npos) detail = detail.substr(colon);
-    r.fail("",
-           fmt::format("{}: the file is not valid JSON ({})", position_of(text, e.byte), detail));
+    // NaN and Infinity as JavaScript and Python write them: say why they are refused.
+    size_t start = std::min<size_t>(e.byte, text.size());
+    while (start > 0 && std::isalpha(static_cast<unsigned char>(text[start - 1]))) --start;
+    std::string word(text.substr(start, 3));
+    for (char& c : word) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const std::string hint =
+        word == "nan" || word == "inf"
+            ? "; NaN and Infinity are not numbers in JSON: every number must be finite"
+            : "";
+    r.fail("", fmt::format("{}: the file is not valid JSON ({}){}", position_of(text, e.byte),
+                           detail, hint));
   }
   r.require_object(root, "", "a sketch file");
   r.check_keys(root, "",

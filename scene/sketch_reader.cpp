@@ -8,7 +8,8 @@
 namespace sd::scene::detail {
 
 std::string type_name(const json& value) {
-  if (value.is_string()) return fmt::format("the text \"{}\"", value.get<std::string>());
+  if (value.is_string())
+    return fmt::format("the text \"{}\"", garment::excerpt(value.get<std::string>()));
   if (value.is_boolean()) return value.get<bool>() ? "true" : "false";
   if (value.is_number()) return fmt::format("the number {}", value.dump());
   if (value.is_null()) return "null";

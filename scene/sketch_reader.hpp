@@ -62,12 +62,12 @@ class Reader {
         const size_t d = edit_distance(key, k);
         if (d < best_distance) best = k, best_distance = d;
       }
-      std::string sentence = fmt::format("unknown key '{}'", key);
+      std::string sentence = fmt::format("unknown key '{}'", garment::excerpt(key));
       if (!best.empty())
         sentence += fmt::format(" (did you mean '{}'?)", best);
       else
         sentence += fmt::format(" (known keys here: {})", fmt::join(known, ", "));
-      fail(path + "/" + key, sentence);
+      fail(path + "/" + garment::excerpt(key), sentence);
     }
   }
 
@@ -81,7 +81,8 @@ class Reader {
       fail(path,
            fmt::format("the number {} is not finite (too large for a double); coordinates "
                        "and sizes must be finite numbers",
-                       value.get<std::string>().substr(std::string_view(kOverflowMarker).size())));
+                       garment::excerpt(std::string_view(value.get<std::string>())
+                                            .substr(std::string_view(kOverflowMarker).size()))));
     }
     if (value.is_string()) {
       fail(path, fmt::format("expected a number, got {}; JSON numbers are written without quotes "
@@ -135,7 +136,9 @@ class Reader {
     const bool ok = std::all_of(id.begin(), id.end(), [](char c) {
       return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
     });
-    if (!ok) fail(path, fmt::format("id '{}' may only use letters, digits, '_' and '-'", id));
+    if (!ok)
+      fail(path,
+           fmt::format("id '{}' may only use letters, digits, '_' and '-'", garment::excerpt(id)));
     return id;
   }
 

@@ -328,6 +328,14 @@ void parse_output(const Reader& r, const json& j, OutputSpec& out) {
       r.fail(path + "/mesh", fmt::format("'{}' must end in .obj or .glb", out.mesh));
     if (out.mesh.find('/') != std::string::npos)
       r.fail(path + "/mesh", "give a file name only; the directory comes from -o");
+    // `mesh` writes the 4-8 mesh under this name: the quads were overwritten by its triangles.
+    if (out.mesh == "garment48.obj")
+      r.fail(path + "/mesh",
+             "'garment48.obj' is the name of the 4-8 mesh that mesh writes too; choose another "
+             "name (e.g. garment.obj)");
+    if (out.mesh == ".obj" || out.mesh == ".glb")
+      r.fail(path + "/mesh", fmt::format("'{}' has no name before its extension (e.g. garment{})",
+                                         out.mesh, out.mesh));
   }
   if (j.contains("report")) out.report = r.boolean(j["report"], path + "/report");
   if (j.contains("wireframe")) out.wireframe = r.boolean(j["wireframe"], path + "/wireframe");

@@ -197,6 +197,32 @@ TEST(CsvManifest, ErrorsNameLineAndColumn) {
   EXPECT_NE(parse("sketch\n").find("no jobs"), std::string::npos);
 }
 
+// A manifest named as a job's sketch (the manifest itself, another JSON manifest, a CSV one) is
+// refused where it is named; it had run as a job that failed with "sketch.json: /jobs: unknown
+// key 'jobs' (did you mean 'join'?)".
+TEST(JsonManifest, AManifestIsNotASketch) {
+  const fs::path dir = manifest_dir("manifest_as_sketch");
+  const std::string self = R"({"format": "sketchdrape-batch/1", "jobs": ["self.json"]})";
+  test::write_text(dir / "self.json", self);
+  test::write_text(dir / "other.json",
+                   R"({"format": "sketchdrape-batch/1", "jobs": ["sketches/dress.json"]})");
+  test::write_text(dir / "rows.csv", "sketch\nsketches/dress.json\n");
+  EXPECT_EQ(error_of([&] { parse_json_manifest(self, "self.json", dir); }),
+            "self.json: /jobs/0: 'self.json' is a batch manifest, not a sketch file; a manifest's "
+            "jobs name sketch files (give another manifest to batch as an input of its own)");
+  EXPECT_NE(error_of([&] {
+              parse_json_manifest(
+                  R"({"format": "sketchdrape-batch/1", "jobs": [{"sketch": ["sketches/dress.json",
+                  "other.json"]}]})",
+                  "m.json", dir);
+            }).find("'other.json' is a batch manifest, not a sketch file"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] {
+              parse_csv_manifest("sketch\nrows.csv\n", "m.csv", dir);
+            }).find("m.csv: line 2, column sketch: 'rows.csv' is a CSV manifest"),
+            std::string::npos);
+}
+
 BatchJob job(const std::string& sketch, const json& overrides) {
   return {"", fs::path("/data") / sketch, overrides, "test", overrides};
 }

@@ -132,6 +132,80 @@ TEST(HostileInput, BodyPathsThatAreNotFilesFailAtOnce) {
   fs::remove_all(dir);
 }
 
+// `render MESH --body builtin` read the garment mesh with assimp unchecked: the PLY headers the
+// body loader refuses (tests/fuzz/regressions) made it read for ever (killed after 20 s), and
+// an OFF or PLY header declaring billions of vertices ended in "std::bad_alloc". Both are refused
+// at once as the body loader refuses them, naming the garment mesh; no picture is written.
+TEST(HostileInput, RenderRefusesCorruptGarmentMeshHeaders) {
+  const fs::path dir = fresh_dir("render-corrupt");
+  write(dir / "huge.ply",
+        "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\n"
+        "property float y\nproperty float z\nelement face 1\n"
+        "property list uchar int vertex_indices\nend_header\n");
+  std::vector<fs::path> files = {dir / "huge.ply"};
+  for (const auto& entry :
+       fs::directory_iterator(fs::path(SD_SOURCE_DIR) / "tests/fuzz/regressions"))
+    files.push_back(entry.path());
+  ASSERT_GE(files.size(), 5u);
+  for (const fs::path& file : files) {
+    const fs::path png = dir / "out.png";
+    const CommandResult r = run_guarded(
+        "render " + file.string() + " --body builtin --view front --size 32x32 -o " + png.string());
+    EXPECT_EQ(r.exit_code, 2) << file << "\n" << r.output;
+    EXPECT_NE(r.output.find("garment mesh '" + file.string() + "' is corrupt"), std::string::npos)
+        << r.output;
+    EXPECT_FALSE(fs::exists(png)) << file;
+  }
+  fs::remove_all(dir);
+}
+
+// An output never replaces a file the command read, nor another output of the same command:
+// `fill --obj f.obj --png f.obj` wrote the picture over the mesh (and printed "wrote f.obj"
+// twice), `render in.png -o in.png` replaced the mesh it drew, `mesh report.json -o .` its own
+// sketch and `mesh` of a garment_mesh "garment.obj" into its folder the imported mesh. Each is
+// exit code 2 naming the file, with the inputs unchanged and nothing written.
+TEST(HostileInput, OutputsNeverReplaceInputsOrEachOther) {
+  const fs::path dir = fresh_dir("outputs-over-inputs");
+  const CommandResult twice = run_guarded("fill --sides 4,4,4,4 --obj " + (dir / "f.obj").string() +
+                                          " --png " + (dir / "f.obj").string());
+  EXPECT_EQ(twice.exit_code, 2) << twice.output;
+  EXPECT_NE(twice.output.find("is named for two outputs"), std::string::npos) << twice.output;
+  EXPECT_FALSE(fs::exists(dir / "f.obj"));
+
+  const std::string tetra =
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  write(dir / "mesh.png", tetra);
+  const CommandResult render =
+      run_guarded("render " + (dir / "mesh.png").string() + " --view front --size 32x32 -o " +
+                  (dir / "mesh.png").string());
+  EXPECT_EQ(render.exit_code, 2) << render.output;
+  EXPECT_NE(render.output.find("it would replace the input file"), std::string::npos)
+      << render.output;
+  EXPECT_EQ(read(dir / "mesh.png"), tetra);
+
+  write(dir / "report.json", square());
+  const CommandResult sketch =
+      run_guarded("mesh " + (dir / "report.json").string() + " -o " + dir.string());
+  EXPECT_EQ(sketch.exit_code, 2) << sketch.output;
+  EXPECT_NE(sketch.output.find("it would replace the input file"), std::string::npos)
+      << sketch.output;
+  EXPECT_EQ(read(dir / "report.json"), square());
+  EXPECT_FALSE(fs::exists(dir / "garment.obj"));
+
+  const fs::path imported = dir / "imported";
+  fs::create_directories(imported);
+  write(imported / "garment.obj", tetra);
+  write(imported / "sketch.json", R"({"garment_mesh": "garment.obj"})");
+  const CommandResult garment =
+      run_guarded("mesh " + (imported / "sketch.json").string() + " -o " + imported.string());
+  EXPECT_EQ(garment.exit_code, 2) << garment.output;
+  EXPECT_NE(garment.output.find("garment.obj': it would replace the input file"), std::string::npos)
+      << garment.output;
+  EXPECT_EQ(read(imported / "garment.obj"), tetra);
+  EXPECT_FALSE(fs::exists(imported / "garment48.obj"));
+  fs::remove_all(dir);
+}
+
 // What `validate` and `run` refuse, `mesh` refuses too; what `mesh` cannot draw, `validate`
 // refuses; a sheet meshes; a mesh without area is refused as body and as garment alike.
 TEST(HostileInput, EveryCommandAppliesTheSameChecks) {

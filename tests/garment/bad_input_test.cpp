@@ -3,13 +3,18 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include "garment/body.hpp"
 #include "garment/body_surface.hpp"
 #include "garment/garment_mesh.hpp"
 #include "garment/sketch_inputs.hpp"
+#include "garment/sketch_ranges.hpp"
 #include "scene/sketch_file.hpp"
 #include "tests/garment/bad_cases.hpp"
 
@@ -159,4 +164,36 @@ TEST(BadInput, FuzzFindingsEndWithAClearError) {
 }
 
 }  // namespace
+// A body of more triangles than kMaxBodyTriangles (a 2M-triangle body took 20 s and 790 MB in
+// `info`) is refused with its count and what to do, before it is welded and analysed. A binary
+// STL of one triangle more: 50 bytes a triangle, read quickly.
+TEST(BadInput, ABodyOverTheTriangleLimitIsRefused) {
+  const auto path = std::filesystem::temp_directory_path() / "sd-bad-input-huge-body.stl";
+  {
+    const auto count = static_cast<std::uint32_t>(kMaxBodyTriangles + 1);
+    std::vector<char> bytes(84 + 50 * static_cast<size_t>(count), 0);
+    std::memcpy(bytes.data() + 80, &count, 4);
+    for (std::uint32_t t = 0; t < count; ++t) {
+      // A small triangle per facet, side by side (the normal is left zero).
+      const float x = static_cast<float>(t % 1000) * 1e-3f,
+                  y = static_cast<float>(t / 1000) * 1e-3f;
+      const float corners[9] = {x, y, 0, x + 1e-3f, y, 0, x, y + 1e-3f, 0};
+      std::memcpy(bytes.data() + 84 + 50 * static_cast<size_t>(t) + 12, corners, sizeof corners);
+    }
+    std::ofstream(path, std::ios::binary)
+        .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  }
+  try {
+    load_body(path.string());
+    ADD_FAILURE() << "accepted";
+  } catch (const BodyError& e) {
+    EXPECT_NE(std::string(e.what()).find("has 1000001 triangles, more than the 1000000 a body "
+                                         "may have"),
+              std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("Decimate"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove(path);
+}
+
 }  // namespace sd::garment

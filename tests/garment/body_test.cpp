@@ -133,10 +133,37 @@ TEST(Body, UnitsAreInferredFromHeight) {
   EXPECT_DOUBLE_EQ(body.raw.scale, 0.01);
   EXPECT_EQ(body.raw.up.name(), "+y");
   EXPECT_NEAR(meshing::bounding_box(body.mesh).extent().y(), 1.70, 1e-12);
+  EXPECT_TRUE(body.warnings.empty());
+  // 67 units tall: centimetres (0.67 m) or inches (1.70 m)? Read as centimetres, with a warning
+  // that gives both heights and the scale for inches; "scale": 0.0254 reads it in inches.
+  const std::string short_obj =
+      "v 0 0 0\nv 12 0 0\nv 0 67 0\nv 0 0 8\n"
+      "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  const Body ambiguous = load_body(write_temp("inches.obj", short_obj));
+  EXPECT_DOUBLE_EQ(ambiguous.raw.scale, 0.01);
+  ASSERT_EQ(ambiguous.warnings.size(), 1u);
+  EXPECT_NE(ambiguous.warnings[0].find("read as centimetres (0.67 m tall); if the file is in "
+                                       "inches the body is 1.70 m tall: give \"scale\": 0.0254"),
+            std::string::npos)
+      << ambiguous.warnings[0];
+  BodyOptions inches;
+  inches.scale = 0.0254;
+  const Body in_inches = load_body(write_temp("inches.obj", short_obj), inches);
+  EXPECT_NEAR(meshing::bounding_box(in_inches.mesh).extent().y(), 67 * 0.0254, 1e-12);
+  EXPECT_TRUE(in_inches.warnings.empty());
 }
 
 TEST(Body, BadFilesGiveASentence) {
-  EXPECT_NE(body_error(write_temp("empty.obj", "")).find("cannot read"), std::string::npos);
+  // A 0-byte file and random bytes named .obj: said as such, not in assimp's words ("OBJ-file
+  // is too small.", "Validation failed: aiScene::mNumMeshes is 0").
+  EXPECT_NE(body_error(write_temp("empty.obj", "")).find("empty.obj' is empty (0 bytes)"),
+            std::string::npos);
+  std::string noise(4096, '\0');
+  for (size_t i = 0; i < noise.size(); ++i) noise[i] = static_cast<char>((i * 7919 + 13) % 251);
+  EXPECT_NE(body_error(write_temp("noise.obj", noise))
+                .find("noise.obj' holds no mesh: no vertices and faces could be read from it"),
+            std::string::npos)
+      << body_error(write_temp("noise.obj", noise));
   EXPECT_NE(body_error(write_temp("points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n")), "");
   EXPECT_NE(body_error(write_temp("lines.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\nl 2 3\n")), "");
   EXPECT_NE(body_error(write_temp("body.unknownformat", "hello")), "");

@@ -28,6 +28,32 @@ std::string read_text(const std::filesystem::path& path, const std::string& show
   return buffer.str();
 }
 
+// What a job's "sketch" is when it is a manifest, not a sketch (the manifest itself, or another
+// one: its job failed with "sketch.json: /jobs: unknown key 'jobs' (did you mean 'join'?)");
+// empty for anything else. Reads at most the 16 MB a sketch may have.
+std::string manifest_kind(const std::filesystem::path& path) {
+  if (path.extension() == ".csv") return "a CSV manifest";
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec) return {};
+  std::ifstream in(path, std::ios::binary);
+  std::string text(static_cast<size_t>(std::min<std::uintmax_t>(size, 16u << 20)), '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<size_t>(in.gcount()));
+  const json root = json::parse(text, nullptr, /*allow_exceptions=*/false,
+                                /*ignore_comments=*/true);
+  if (root.is_object() && root.contains("format") && root["format"] == kManifestFormat)
+    return "a batch manifest";
+  return {};
+}
+
+std::string manifest_as_sketch_sentence(const std::string& given, const std::string& kind) {
+  return fmt::format(
+      "'{}' is {}, not a sketch file; a manifest's jobs name sketch files (give another "
+      "manifest to batch as an input of its own)",
+      given, kind);
+}
+
 std::filesystem::path absolute_path(const std::filesystem::path& base_dir,
                                     const std::string& relative) {
   const std::filesystem::path p(relative);
@@ -188,6 +214,8 @@ class JsonManifestReader {
     if (!std::filesystem::is_regular_file(p))
       fail(path, fmt::format("there is no sketch file '{}' (looked for {})",
                              value.get<std::string>(), p.string()));
+    if (const std::string kind = manifest_kind(p); !kind.empty())
+      fail(path, manifest_as_sketch_sentence(value.get<std::string>(), kind));
     return p;
   }
 
@@ -508,6 +536,8 @@ std::vector<BatchJob> parse_csv_manifest(std::string_view text, const std::strin
       throw ManifestError(
           file, where_sketch,
           fmt::format("there is no sketch file '{}' (looked for {})", sketch, job.sketch.string()));
+    if (const std::string kind = manifest_kind(job.sketch); !kind.empty())
+      throw ManifestError(file, where_sketch, manifest_as_sketch_sentence(sketch, kind));
     if (id_column >= 0) {
       job.id = rec.fields[static_cast<size_t>(id_column)];
       if (!job.id.empty() && !valid_explicit_id(job.id))

@@ -71,6 +71,9 @@ void run_mesh(const MeshOptions& options) {
   check_output_folder(options.out);
   const std::filesystem::path dir(options.out);
   StagedOutputs outputs;
+  outputs.keep(sketch.file);
+  if (sketch.garment_mesh) outputs.keep(sketch.resolve(*sketch.garment_mesh));
+  if (sketch.body.mesh != "builtin") outputs.keep(sketch.resolve(sketch.body.mesh));
   nlohmann::json report = {{"format", "sketchdrape/1 mesh report"}, {"sketch", sketch.file}};
 
   if (sketch.sheet) {

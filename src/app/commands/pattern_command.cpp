@@ -41,6 +41,9 @@ void run_pattern(const PatternOptions& options) {
   const garment::Garment g = garment::build_garment(sketch, surface);
   const PatternSheet sheet = build_pattern_sheet(sketch, g, spec);
   StagedOutputs outputs;
+  outputs.keep(sketch.file);
+  if (sketch.garment_mesh) outputs.keep(sketch.resolve(*sketch.garment_mesh));
+  if (sketch.body.mesh != "builtin") outputs.keep(sketch.resolve(sketch.body.mesh));
   stage_pattern(sheet, options.out, outputs);
   outputs.commit();
   double worst = 0;

@@ -116,6 +116,13 @@ void collect(const aiScene& scene, const aiNode& node, const aiMatrix4x4& parent
 GarmentMesh load_garment_mesh(const std::string& path) {
   if (const auto problem = garment::input_file_problem(path, garment::kMaxMeshFileBytes))
     throw MeshFileError(fmt::format("garment mesh file '{}' {}", path, *problem));
+  try {
+    // The body's loader refuses these headers too: assimp would reserve gigabytes for a PLY or
+    // OFF header's counts, or read a PLY header without end_header for ever.
+    garment::check_mesh_file_header(path, "garment mesh");
+  } catch (const garment::BodyError& e) {
+    throw MeshFileError(e.what());
+  }
   Assimp::Importer importer;
   const aiScene* scene =
       importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
@@ -227,6 +234,8 @@ void run_render(const RenderOptions& options, const GlobalOptions& global) {
   render::Renderer renderer;
   const render::PreparedScene prepared = renderer.prepare(scene);
   StagedOutputs outputs;
+  outputs.keep(options.mesh);
+  if (!options.body.empty()) outputs.keep(options.body);
   Progress progress("rendering", static_cast<long>(jobs.size()), global.quiet);
   for (size_t i = 0; i < jobs.size(); ++i) {
     const ViewJob& job = jobs[i];

@@ -179,6 +179,9 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
 
   const std::filesystem::path dir(options.out);
   StagedOutputs outputs;
+  outputs.keep(sketch.file);
+  if (sketch.garment_mesh) outputs.keep(sketch.resolve(*sketch.garment_mesh));
+  if (sketch.body.mesh != "builtin") outputs.keep(sketch.resolve(sketch.body.mesh));
   std::string trace;
   Progress progress("draping", static_cast<long>(std::ceil(settings.duration * 1000)),
                     global.quiet);

@@ -222,8 +222,40 @@ StagedOutputs::~StagedOutputs() {
   for (const char* held : held_dirs_) release(g_dir_slots, held);
 }
 
+namespace {
+
+// Whether `a` and `b` name the same file: the same inode when both exist, else the same path
+// once "..", "." and links of the existing part are resolved.
+bool same_file(const std::filesystem::path& a, const std::filesystem::path& b) {
+  std::error_code ec;
+  if (std::filesystem::exists(a, ec) && std::filesystem::exists(b, ec))
+    return std::filesystem::equivalent(a, b, ec);
+  const auto ca = std::filesystem::weakly_canonical(a, ec);
+  if (ec) return false;
+  const auto cb = std::filesystem::weakly_canonical(b, ec);
+  return !ec && ca == cb;
+}
+
+}  // namespace
+
+void StagedOutputs::keep(const std::filesystem::path& input) {
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(input, ec)) inputs_.push_back(input);
+}
+
 void StagedOutputs::stage(const std::filesystem::path& path, std::string_view bytes) {
   const std::filesystem::path dir = path.parent_path().empty() ? "." : path.parent_path();
+  // Two outputs at one path (`fill --obj f.obj --png f.obj` wrote the picture over the mesh and
+  // said "wrote f.obj" twice), or an output over a file the command read.
+  for (const auto& staged : finals_)
+    if (same_file(staged, path))
+      throw std::invalid_argument("'" + path.string() + "' is named for two outputs ('" +
+                                  staged.string() + "' too); give each output its own file");
+  for (const auto& input : inputs_)
+    if (same_file(input, path))
+      throw std::invalid_argument("cannot write '" + path.string() +
+                                  "': it would replace the input file '" + input.string() +
+                                  "'; choose another output (-o)");
   // What the user can fix (exit code 2), found before any output is renamed into place: a
   // folder (or a device, a FIFO) where a file goes, a file where the output folder goes.
   std::error_code status_ec;

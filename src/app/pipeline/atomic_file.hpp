@@ -34,7 +34,13 @@ class StagedOutputs {
 
   // Writes `bytes` to a temporary file that becomes `path` on commit(). Creates the parent
   // directory if needed. Throws std::runtime_error when the write fails.
+  // An output at a path already staged, or at a file given to keep(), is refused with
+  // std::invalid_argument (exit code 2) instead of overwriting it.
   void stage(const std::filesystem::path& path, std::string_view bytes);
+
+  // A file the command read (the sketch, a mesh): no output may replace it (`render in.png -o
+  // in.png`, `mesh report.json -o .`). Paths that do not exist are ignored.
+  void keep(const std::filesystem::path& input);
 
   // Renames every staged file into place, in the order staged.
   void commit();
@@ -44,6 +50,7 @@ class StagedOutputs {
  private:
   std::vector<std::filesystem::path> temps_;
   std::vector<std::filesystem::path> finals_;
+  std::vector<std::filesystem::path> inputs_;
   std::vector<std::filesystem::path> created_dirs_;
   // The same paths as held by the signal handler's registry (null when it was full).
   std::vector<const char*> held_;
