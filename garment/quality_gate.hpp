@@ -21,6 +21,11 @@ struct QualityLimits {
   double size_low = 0.25;          // a quad's mean side outside [low, high] × edge_length (low:
                                    // a tapering panel needs small quads near its apex)
   double size_high = 2.0;
+  // Quads above which check_quality_tried does not try its advice: each trial meshes the whole
+  // garment again (the shirt at edge_length 0.004: 52,670 quads, about 15 s per build on one
+  // core, and up to 3 trials per panel), so a fine preview would run for minutes before it said
+  // anything. Above this the advice that needs a trial is left out and an info line says so.
+  int max_trial_quads = 25000;
 };
 
 struct QualityWarning {
@@ -55,7 +60,7 @@ std::vector<QualityWarning> check_quality(const Garment& garment, const GarmentR
 // curve nearest them, only one that was tried and gave fewer warnings (dropping the underarm corner
 // cleaned the tank top's back on the Collada human, but dropping the shell top's turned its 2
 // warnings into 3). Costs one more garment build per panel with an offer (and the body's search
-// tree, built then).
+// tree, built then); none above `limits.max_trial_quads` quads, where those offers are left out.
 std::vector<QualityWarning> check_quality_tried(const Garment& garment,
                                                 const GarmentRequest& sketch,
                                                 const meshing::TriMesh& body,
