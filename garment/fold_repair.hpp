@@ -32,6 +32,11 @@ struct FoldRepairResult {
   int folded_after = 0;
   int edge_turns = 0;  // accepted edge turns
   int smoothings = 0;  // accepted local smoothings
+  // Work done, for the tests that keep it local: candidate changes judged, and quads measured
+  // again to judge them (each candidate re-measures only the quads its change reaches, about
+  // 10-40, however large the mesh; the rounds measure the whole mesh once each).
+  int candidates = 0;
+  long quads_measured = 0;
 };
 
 // `fixed` (#V flags, nonzero = boundary) keeps the boundary vertices where they are;

@@ -1,6 +1,7 @@
 #include "garment/quality_gate.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -235,7 +236,18 @@ std::vector<QualityWarning> check_quality_tried(const Garment& garment,
   std::unordered_map<std::string, bool> helps;
   std::optional<BodySurface> surface;
   // How many warnings the sketch gives with `trial` in its place; SIZE_MAX when it does not mesh.
+  const bool too_large = garment.mesh.face_count() > limits.max_trial_quads;
+  bool said = false;
   const auto warnings_with = [&](const GarmentRequest& trial) {
+    if (too_large) {
+      if (!said)
+        spdlog::info(
+            "{}: {} quads: the quality gate's advice that needs the garment meshed again is not "
+            "tried above {} quads (a coarser edge_length gets it)",
+            sketch.file, garment.mesh.face_count(), limits.max_trial_quads);
+      said = true;
+      return std::numeric_limits<std::size_t>::max();
+    }
     try {
       if (!surface) surface.emplace(body);
       return check_quality(build_garment(trial, *surface), trial, landmarks, limits).size();

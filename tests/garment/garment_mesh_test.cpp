@@ -449,5 +449,35 @@ TEST(Garment, TheGatesAdviceAppliedLeavesFewerWarnings) {
             tank_told.size());
 }
 
+// Above QualityLimits::max_trial_quads the advice that needs the garment meshed again is not
+// tried, and so not offered: the tank top's back, offered a corner list that cleans it (above),
+// gets the plain warning, the same warnings in number and kind (no trial build is run, so a fine
+// preview does not spend minutes re-meshing before it says anything).
+TEST(Garment, TheGatesAdviceIsNotTriedAboveTheQuadLimit) {
+  const Sketch tank =
+      load_sketch(std::filesystem::path(SD_SOURCE_DIR) / "data/designs/repro/tank-human.json");
+  if (!std::filesystem::exists(tank.resolve(tank.body.mesh)))
+    GTEST_SKIP() << "the Collada human (assimp-testmodels) is not installed";
+  const Body body = load_sketch_body(tank);
+  const Garment garment = build_garment(tank, BodySurface(body.mesh));
+  QualityLimits limits;
+  limits.max_trial_quads = static_cast<int>(garment.mesh.face_count()) - 1;
+  const std::vector<QualityWarning> plain = check_quality(garment, tank, nullptr, limits);
+  const std::vector<QualityWarning> told =
+      check_quality_tried(garment, tank, body.mesh, nullptr, limits);
+  ASSERT_EQ(told.size(), plain.size());
+  bool offered_before = false;
+  for (const QualityWarning& w : plain) offered_before |= !w.corners.empty();
+  EXPECT_TRUE(offered_before);  // the untried list, which the trial keeps (test above)
+  for (size_t i = 0; i < told.size(); ++i) {
+    EXPECT_EQ(told[i].kind, plain[i].kind);
+    EXPECT_TRUE(told[i].corners.empty()) << told[i].message;
+    EXPECT_TRUE(told[i].curve.empty()) << told[i].message;
+    if (!plain[i].corners_hint.empty()) {
+      EXPECT_EQ(told[i].message.find(plain[i].corners_hint), std::string::npos) << told[i].message;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace sd::garment
