@@ -463,8 +463,10 @@ TEST(Garment, TheGatesAdviceIsNotTriedAboveTheQuadLimit) {
   QualityLimits limits;
   limits.max_trial_quads = static_cast<int>(garment.mesh.face_count()) - 1;
   const std::vector<QualityWarning> plain = check_quality(garment, tank, nullptr, limits);
-  const std::vector<QualityWarning> told =
-      check_quality_tried(garment, tank, body.mesh, nullptr, limits);
+  std::vector<QualityWarning> told = check_quality_tried(garment, tank, body.mesh, nullptr, limits);
+  // The body's own check (inside_body, the back 9 mm at the neck) is not advice: it has no
+  // counterpart in check_quality, which is not given the body.
+  std::erase_if(told, [](const QualityWarning& w) { return w.kind == "inside_body"; });
   ASSERT_EQ(told.size(), plain.size());
   bool offered_before = false;
   for (const QualityWarning& w : plain) offered_before |= !w.corners.empty();
