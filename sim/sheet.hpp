@@ -76,9 +76,8 @@ Eigen::MatrixX3d sheet_quad_warp(const SheetScene& scene);
 // R of a pin "centre:R" (metres: a clamp holding every vertex within R of the centre), nullopt
 // for other pin names; throws InvalidSheetError for a radius that is not a positive number.
 // (Inline: the sketch reader, built on its own for the fuzzer, calls it too.)
-inline std::optional<double> centre_clamp_radius(const std::string& name) {
-  if (!name.starts_with("centre:")) return std::nullopt;
-  const std::string number = name.substr(7);
+// The radius after a clamp pin's colon (m), 0 when it is not a whole finite number.
+inline double clamp_radius_text(const std::string& number) {
   double radius = 0.0;
   try {
     std::size_t used = 0;
@@ -87,7 +86,13 @@ inline std::optional<double> centre_clamp_radius(const std::string& name) {
   } catch (const std::exception&) {
     radius = 0.0;
   }
-  if (!(radius > 0.0 && std::isfinite(radius)))
+  return std::isfinite(radius) ? radius : 0.0;
+}
+
+inline std::optional<double> centre_clamp_radius(const std::string& name) {
+  if (!name.starts_with("centre:")) return std::nullopt;
+  const double radius = clamp_radius_text(name.substr(7));
+  if (!(radius > 0.0))
     throw InvalidSheetError("pin '" + name +
                             "' must give a positive radius in metres (centre:0.09)");
   return radius;
@@ -112,16 +117,8 @@ inline std::optional<CornerClamp> corner_clamp(const std::string& name) {
   if (corner != "top-left" && corner != "top-right" && corner != "bottom-left" &&
       corner != "bottom-right")
     return std::nullopt;
-  const std::string number = name.substr(colon + 1);
-  double radius = 0.0;
-  try {
-    std::size_t used = 0;
-    radius = std::stod(number, &used);
-    if (used != number.size()) radius = 0.0;
-  } catch (const std::exception&) {
-    radius = 0.0;
-  }
-  if (!(radius > 0.0 && std::isfinite(radius)))
+  const double radius = clamp_radius_text(name.substr(colon + 1));
+  if (!(radius > 0.0))
     throw InvalidSheetError("pin '" + name + "' must give a positive radius in metres (" + corner +
                             ":0.02)");
   return CornerClamp{corner, radius};
