@@ -73,93 +73,12 @@ void multiply_vertex_blocks(const SparseMatrixR& a, const Eigen::VectorXd& x, Ei
 
 }  // namespace
 
-void BlockIncompleteCholesky::choose_order(const SparseMatrixR& a, bool split) {
-  const int n = static_cast<int>(a.rows() / 3);
-  const int* outer = a.outerIndexPtr();
-  const int* inner = a.innerIndexPtr();
-  // The block pattern (each vertex's first row, every third column: the blocks are whole), kept
-  // to see whether the order still fits: a ninth of the indices, read once a factorisation.
-  const auto same_pattern = [&] {
-    if (pattern_outer_.size() != static_cast<std::size_t>(n + 1)) return false;
-    for (int i = 0; i < n; ++i) {
-      if (pattern_outer_[i + 1] - pattern_outer_[i] != (outer[3 * i + 1] - outer[3 * i]) / 3)
-        return false;
-      for (int k = 0, e = pattern_outer_[i]; k < outer[3 * i + 1] - outer[3 * i]; k += 3, ++e)
-        if (pattern_inner_[e] != inner[outer[3 * i] + k]) return false;
-    }
-    return true;
-  };
-  if (split == split_asked_ && static_cast<int>(order_.size()) == n && same_pattern()) return;
-  split_asked_ = split;
-  pattern_outer_.assign(1, 0);
-  pattern_inner_.clear();
-  for (int i = 0; i < n; ++i) {
-    for (int k = outer[3 * i]; k < outer[3 * i + 1]; k += 3) pattern_inner_.push_back(inner[k]);
-    pattern_outer_.push_back(static_cast<int>(pattern_inner_.size()));
-  }
-  // Vertex i's block columns: every third entry of its first row.
-  const auto for_blocks = [&](int i, const auto& visit) {
-    const int width = outer[3 * i + 1] - outer[3 * i];
-    for (int offset = 0; offset < width; offset += 3)
-      visit(inner[outer[3 * i] + offset] / 3, offset);
-  };
-  order_.resize(n);
-  for (int i = 0; i < n; ++i) order_[i] = i;
-  split_ = false;
-  half_ = separator_ = n;
-  // Below 512 vertices the two halves' work is too little to share; a separator above an eighth
-  // of the vertices (a mesh not numbered in bands) would serialise too much.
-  constexpr int kSplitVertices = 512;
-  if (split && n >= kSplitVertices) {
-    const int half = n / 2;
-    std::vector<char> in_separator(n, 0);
-    int separator = 0;
-    for (int i = half; i < n; ++i)
-      for_blocks(i, [&](int j, int) {
-        if (j < half && !in_separator[i]) {
-          in_separator[i] = 1;
-          ++separator;
-        }
-      });
-    if (separator > 0 && 8 * separator <= n) {
-      int p = half;
-      for (int i = n - 1; i >= half; --i)
-        if (!in_separator[i]) order_[p++] = i;
-      for (int i = half; i < n; ++i)
-        if (in_separator[i]) order_[p++] = i;
-      split_ = true;
-      half_ = half;
-      separator_ = n - separator;
-    }
-  }
-  position_.resize(n);
-  for (int p = 0; p < n; ++p) position_[order_[p]] = p;
-  // The upper half in the factor's order: row p holds the blocks (p, q), q > p, q increasing
-  // (in the vertex order, the blocks after the diagonal, as stored).
-  row_start_.assign(1, 0);
-  column_.clear();
-  source_.clear();
-  std::vector<std::pair<int, int>> row;
-  for (int p = 0; p < n; ++p) {
-    row.clear();
-    for_blocks(order_[p], [&](int j, int offset) {
-      if (position_[j] > p) row.emplace_back(position_[j], offset);
-    });
-    std::sort(row.begin(), row.end());
-    for (const auto& [q, offset] : row) {
-      column_.push_back(q);
-      source_.push_back(offset);
-    }
-    row_start_.push_back(static_cast<int>(column_.size()));
-  }
-}
-
 bool BlockIncompleteCholesky::factorize(const SparseMatrixR& a,
                                         const std::vector<int>& diagonal_offsets,
-                                        const ConstraintFilter& filter, bool split) {
+                                        const ConstraintFilter& filter) {
   const int n = filter.vertex_count();
-  choose_order(a, split);
   const int* outer = a.outerIndexPtr();
+  const int* inner = a.innerIndexPtr();
   const double* values = a.valuePtr();
   std::vector<Eigen::Matrix3d> filters;
   if (filter.constrained_count() > 0) {
@@ -172,22 +91,26 @@ bool BlockIncompleteCholesky::factorize(const SparseMatrixR& a,
       for (int c = 0; c < 3; ++c) block(r, c) = values[outer[3 * i + r] + offset + c];
     return block;
   };
-  b_upper_.resize(column_.size());
+  row_start_.assign(1, 0);
+  column_.clear();
+  b_upper_.clear();
   b_diagonal_.resize(n);
-  for (int p = 0; p < n; ++p) {
-    const int i = order_[p];
+  for (int i = 0; i < n; ++i) {
     const bool free_i = filters.empty() || filter.is_free(i);
-    for (int k = row_start_[p]; k < row_start_[p + 1]; ++k) {
-      const int j = order_[column_[k]];
-      Eigen::Matrix3d block = read_block(i, source_[k]);
+    const int width = outer[3 * i + 1] - outer[3 * i];
+    for (int offset = diagonal_offsets[i] + 3; offset < width; offset += 3) {
+      const int j = inner[outer[3 * i] + offset] / 3;
+      Eigen::Matrix3d block = read_block(i, offset);
       if (!free_i || !(filters.empty() || filter.is_free(j)))
         block = filters[i] * block * filters[j];
-      b_upper_[k] = block;
+      column_.push_back(j);
+      b_upper_.push_back(block);
     }
+    row_start_.push_back(static_cast<int>(column_.size()));
     Eigen::Matrix3d diagonal = read_block(i, diagonal_offsets[i]);
     if (!free_i)
       diagonal = filters[i] * diagonal * filters[i] + (Eigen::Matrix3d::Identity() - filters[i]);
-    b_diagonal_[p] = 0.5 * (diagonal + diagonal.transpose());
+    b_diagonal_[i] = 0.5 * (diagonal + diagonal.transpose());
   }
   for (double alpha : {0.0, 1e-4, 1e-3, 1e-2, 1e-1, 1.0})
     if (factorize_shifted(alpha)) {
@@ -200,32 +123,11 @@ bool BlockIncompleteCholesky::factorize(const SparseMatrixR& a,
 bool BlockIncompleteCholesky::factorize_shifted(double alpha) {
   const int n = static_cast<int>(b_diagonal_.size());
   upper_ = b_upper_;
-  pivot_.resize(n);
-  for (int i = 0; i < n; ++i) pivot_[i] = (1.0 + alpha) * b_diagonal_[i];
-  pivot_inverse_.resize(n);
-  if (!split_) return factorize_rows(0, n, nullptr, nullptr);
-  // A and B at once, B's updates of S apart; added to S's blocks in a fixed order; then S.
-  const int s0 = separator_;
-  pivot_s_.assign(static_cast<std::size_t>(n - s0), Eigen::Matrix3d::Zero());
-  upper_s_.assign(column_.size() - static_cast<std::size_t>(row_start_[s0]),
-                  Eigen::Matrix3d::Zero());
-  bool done[2] = {false, false};
-  parallel_chunks(2, 1, [&](int half, int, int) {
-    done[half] = half == 0 ? factorize_rows(0, half_, nullptr, nullptr)
-                           : factorize_rows(half_, s0, &pivot_s_, &upper_s_);
-  });
-  if (!done[0] || !done[1]) return false;
-  for (int k = s0; k < n; ++k) pivot_[k] += pivot_s_[k - s0];
-  for (std::size_t e = 0; e < upper_s_.size(); ++e) upper_[row_start_[s0] + e] += upper_s_[e];
-  return factorize_rows(s0, n, nullptr, nullptr);
-}
-
-bool BlockIncompleteCholesky::factorize_rows(int low, int high,
-                                             std::vector<Eigen::Matrix3d>* pivot_s,
-                                             std::vector<Eigen::Matrix3d>* upper_s) {
   std::vector<Eigen::Matrix3d>& pivot = pivot_;
-  const int s0 = separator_;
-  for (int i = low; i < high; ++i) {
+  pivot.resize(n);
+  for (int i = 0; i < n; ++i) pivot[i] = (1.0 + alpha) * b_diagonal_[i];
+  pivot_inverse_.resize(n);
+  for (int i = 0; i < n; ++i) {
     pivot[i] = 0.5 * (pivot[i] + pivot[i].transpose());
     // Positive definite by Sylvester's criterion (the leading minors), then the inverse from the
     // cofactors: what a 3x3 LLT and its solve decide and give, without their general loops.
@@ -240,18 +142,15 @@ bool BlockIncompleteCholesky::factorize_rows(int low, int high,
     const int end = row_start_[i + 1];
     for (int p_index = begin; p_index < end; ++p_index) {
       const int k = column_[p_index];
-      const bool apart = pivot_s != nullptr && k >= s0;  // B's update of a separator row
       const Eigen::Matrix3d w = upper_[p_index].transpose() * pivot_inverse_[i];
-      (apart ? (*pivot_s)[k - s0] : pivot[k]).noalias() -= w * upper_[p_index];
+      pivot[k].noalias() -= w * upper_[p_index];
       int cursor = row_start_[k];
       const int row_end = row_start_[k + 1];
       for (int q_index = p_index + 1; q_index < end; ++q_index) {
         const int j = column_[q_index];
         while (cursor < row_end && column_[cursor] < j) ++cursor;
         if (cursor == row_end) break;
-        if (column_[cursor] == j)
-          (apart ? (*upper_s)[cursor - row_start_[s0]] : upper_[cursor]).noalias() -=
-              w * upper_[q_index];
+        if (column_[cursor] == j) upper_[cursor].noalias() -= w * upper_[q_index];
       }
     }
   }
@@ -260,76 +159,38 @@ bool BlockIncompleteCholesky::factorize_rows(int low, int high,
 
 void BlockIncompleteCholesky::apply(const Eigen::VectorXd& r, Eigen::VectorXd& out) const {
   const int n = static_cast<int>(pivot_inverse_.size());
-  // Forward: (P Lᵀ)ᵀ y = Uᵀ y = r, column by column; B's updates of S apart (`sums`).
-  const auto forward = [&](Eigen::VectorXd& work, int low, int high,
-                           std::vector<Eigen::Vector3d>* sums) {
-    for (int i = low; i < high; ++i) {
-      const Eigen::Vector3d y = pivot_inverse_[i] * work.segment<3>(3 * i);
-      work.segment<3>(3 * i) = y;
-      for (int k = row_start_[i]; k < row_start_[i + 1]; ++k) {
-        const int j = column_[k];
-        if (sums != nullptr && j >= separator_)
-          (*sums)[j - separator_].noalias() -= upper_[k].transpose() * y;
-        else
-          work.segment<3>(3 * j).noalias() -= upper_[k].transpose() * y;
-      }
-    }
-  };
-  // Backward: Lᵀ x = y, i.e. x_i = y_i − P_i⁻¹ Σ_{j>i} U_ij x_j.
-  const auto backward = [&](Eigen::VectorXd& work, int low, int high) {
-    for (int i = high - 1; i >= low; --i) {
-      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-      for (int k = row_start_[i]; k < row_start_[i + 1]; ++k)
-        sum.noalias() += upper_[k] * work.segment<3>(3 * column_[k]);
-      work.segment<3>(3 * i) -= pivot_inverse_[i] * sum;
-    }
-  };
-  if (!split_) {
-    out = r;
-    forward(out, 0, n, nullptr);
-    backward(out, 0, n);
-    return;
+  // Forward: (P Lᵀ)ᵀ y = Uᵀ y = r, column by column.
+  out = r;
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d y = pivot_inverse_[i] * out.segment<3>(3 * i);
+    out.segment<3>(3 * i) = y;
+    for (int k = row_start_[i]; k < row_start_[i + 1]; ++k)
+      out.segment<3>(3 * column_[k]).noalias() -= upper_[k].transpose() * y;
   }
-  permuted_.resize(3 * n);
-  for (int p = 0; p < n; ++p) permuted_.segment<3>(3 * p) = r.segment<3>(3 * order_[p]);
-  const int s0 = separator_;
-  separator_sum_.assign(static_cast<std::size_t>(n - s0), Eigen::Vector3d::Zero());
-  parallel_chunks(2, 1, [&](int half, int, int) {
-    if (half == 0)
-      forward(permuted_, 0, half_, nullptr);
-    else
-      forward(permuted_, half_, s0, &separator_sum_);
-  });
-  for (int k = s0; k < n; ++k) permuted_.segment<3>(3 * k) += separator_sum_[k - s0];
-  forward(permuted_, s0, n, nullptr);
-  backward(permuted_, s0, n);
-  parallel_chunks(2, 1, [&](int half, int, int) {
-    if (half == 0)
-      backward(permuted_, 0, half_);
-    else
-      backward(permuted_, half_, s0);
-  });
-  out.resize(3 * n);
-  for (int p = 0; p < n; ++p) out.segment<3>(3 * order_[p]) = permuted_.segment<3>(3 * p);
+  // Backward: Lᵀ x = y, i.e. x_i = y_i − P_i⁻¹ Σ_{j>i} U_ij x_j.
+  for (int i = n - 1; i >= 0; --i) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (int k = row_start_[i]; k < row_start_[i + 1]; ++k)
+      sum.noalias() += upper_[k] * out.segment<3>(3 * column_[k]);
+    out.segment<3>(3 * i) -= pivot_inverse_[i] * sum;
+  }
 }
 
 void BlockIncompleteCholesky::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& out) const {
   const int n = static_cast<int>(pivot_.size());
-  // In the factor's order: t = Lᵀ x = P⁻¹ U x, then y = L (P t) with L = Uᵀ P⁻¹:
-  // y_i = P_i t_i + Σ_{k<i} U_kiᵀ t_k; out is y in the vertex order.
-  Eigen::VectorXd t(3 * n), y(3 * n);
+  // t = Lᵀ x = P⁻¹ U x, then out = L (P t) with L = Uᵀ P⁻¹: out_i = P_i t_i + Σ_{k<i} U_kiᵀ t_k.
+  Eigen::VectorXd t(3 * n);
   for (int i = 0; i < n; ++i) {
-    Eigen::Vector3d sum = pivot_[i] * x.segment<3>(3 * order_[i]);
+    Eigen::Vector3d sum = pivot_[i] * x.segment<3>(3 * i);
     for (int k = row_start_[i]; k < row_start_[i + 1]; ++k)
-      sum.noalias() += upper_[k] * x.segment<3>(3 * order_[column_[k]]);
+      sum.noalias() += upper_[k] * x.segment<3>(3 * column_[k]);
     t.segment<3>(3 * i) = pivot_inverse_[i] * sum;
   }
-  for (int i = 0; i < n; ++i) y.segment<3>(3 * i) = pivot_[i] * t.segment<3>(3 * i);
+  out.resize(3 * n);
+  for (int i = 0; i < n; ++i) out.segment<3>(3 * i) = pivot_[i] * t.segment<3>(3 * i);
   for (int i = 0; i < n; ++i)
     for (int k = row_start_[i]; k < row_start_[i + 1]; ++k)
-      y.segment<3>(3 * column_[k]).noalias() += upper_[k].transpose() * t.segment<3>(3 * i);
-  out.resize(3 * n);
-  for (int i = 0; i < n; ++i) out.segment<3>(3 * order_[i]) = y.segment<3>(3 * i);
+      out.segment<3>(3 * column_[k]).noalias() += upper_[k].transpose() * t.segment<3>(3 * i);
 }
 
 void PcgSolver::build_block_jacobi(const SparseMatrixR& a,
@@ -361,12 +222,8 @@ LinearSolveStats PcgSolver::solve(const SparseMatrixR& a, const std::vector<int>
   const int n = filter.vertex_count();
   const bool reuse = !refresh_preconditioner && prepared_vertices_ == n;
   if (!reuse) {
-    // IC(0) alone factorises in two halves on two threads; the two-level cycle reads its blocks
-    // in the vertex order.
-    incomplete_ready_ =
-        preconditioner_ != PcgPreconditioner::block_jacobi &&
-        incomplete_.factorize(a, diagonal_offsets, filter,
-                              preconditioner_ == PcgPreconditioner::block_incomplete_cholesky);
+    incomplete_ready_ = preconditioner_ != PcgPreconditioner::block_jacobi &&
+                        incomplete_.factorize(a, diagonal_offsets, filter);
     coarse_ready_ = incomplete_ready_ && preconditioner_ == PcgPreconditioner::two_level &&
                     coarse_.build(incomplete_.row_start(), incomplete_.column(),
                                   incomplete_.b_upper(), incomplete_.b_diagonal());

@@ -38,30 +38,17 @@ enum class PcgPreconditioner {
 // filter. IC(0) can break down (a pivot block that is not positive definite) on matrices that
 // are SPD but not diagonally dominant; it is then recomputed for B + α·blockdiag(B) with α
 // growing from 1e-4 (Manteuffel's shift), and `shift()` says which α was used.
-//
-// Two halves on two threads (`split`): the vertices are ordered as two halves of the index
-// range, A = [0, n/2) and B = [n/2, n) less S, then S, the vertices of the second half coupled
-// to the first (for a sheet, numbered row by row, a band of rows across its middle). A and B are
-// not coupled, so their rows factorise, and the sweeps of `apply` run, at once, each half's
-// updates of S kept apart and added in a fixed order (the same bits on one thread as on two); S
-// comes last. It is IC(0) in that order, a different incomplete factor from the natural order's
-// (docs/benchmarks.md, "Seventh round"). Taken only where S is small (at most an eighth of the
-// vertices, at least 512 vertices); otherwise, and without `split`, the vertex order. The
-// blocks below (row_start() …) are in the factor's order: the two-level cycle, which reads them
-// in vertex order, factorises without `split`.
 class BlockIncompleteCholesky {
  public:
   // Returns false only if no shift up to α = 1 gave positive definite pivots.
   bool factorize(const SparseMatrixR& a, const std::vector<int>& diagonal_offsets,
-                 const ConstraintFilter& filter, bool split = false);
+                 const ConstraintFilter& filter);
   // out = (L P Lᵀ)⁻¹ r, 3n.
   void apply(const Eigen::VectorXd& r, Eigen::VectorXd& out) const;
   // out = L P Lᵀ x, 3n: the matrix the factor represents (equal to B + α·blockdiag(B) on the
   // pattern, for tests).
   void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& out) const;
   double shift() const { return shift_; }
-  // Vertices in the separator S of the last factorisation (0: the vertex order was used).
-  int separator_size() const { return split_ ? static_cast<int>(order_.size()) - separator_ : 0; }
   // B's blocks (before the factorisation), for the coarse level of the two-level cycle.
   const std::vector<int>& row_start() const { return row_start_; }
   const std::vector<int>& column() const { return column_; }
@@ -70,27 +57,6 @@ class BlockIncompleteCholesky {
 
  private:
   bool factorize_shifted(double alpha);
-  // Rows [low, high) of the factorisation; updates of the separator's pivots and blocks go to
-  // *pivot_s and *upper_s when given (the second half's, kept apart).
-  bool factorize_rows(int low, int high, std::vector<Eigen::Matrix3d>* pivot_s,
-                      std::vector<Eigen::Matrix3d>* upper_s);
-  // The order (order_, position_, separator_, split_) for a's pattern, kept while it holds.
-  void choose_order(const SparseMatrixR& a, bool split);
-
-  // The factor's order: order_[p] is the vertex at position p, position_ its inverse; rows
-  // [0, half_) are A, [half_, separator_) B, [separator_, n) S (split_), else the vertex order.
-  std::vector<int> order_, position_;
-  int half_ = 0, separator_ = 0;
-  bool split_ = false;
-  bool split_asked_ = false;
-  // The block pattern the order was chosen for: per vertex, the first column of each block.
-  std::vector<int> pattern_outer_, pattern_inner_;
-  // For each block of the upper half in the factor's order: where its values start in A
-  // (the first row's entry; the block (order_[p], order_[q]) read from vertex order_[p]'s rows).
-  std::vector<int> source_;
-  mutable Eigen::VectorXd permuted_;                    // apply's work vector
-  mutable std::vector<Eigen::Vector3d> separator_sum_;  // B's updates of S in a sweep
-  std::vector<Eigen::Matrix3d> pivot_s_, upper_s_;      // B's updates of S's blocks
 
   // Upper half of B, block row by block row: blocks (i, column_[k]) for k in
   // [row_start_[i], row_start_[i+1]), columns increasing and > i.

@@ -11,7 +11,6 @@
 
 #include "sim/cholmod_solver.hpp"
 #include "sim/forces.hpp"
-#include "sim/parallel.hpp"
 #include "sim/simulation.hpp"
 #include "test_scenes.hpp"
 
@@ -424,102 +423,6 @@ TEST(LinearSolvers, OneImplicitStepIsTheSameWithEitherSolver) {
     EXPECT_LE((ends[0] - ends[2]).lpNorm<Eigen::Infinity>(), 1e-7 * displacement);
     EXPECT_LE((ends[1] - ends[2]).lpNorm<Eigen::Infinity>(), 1e-7 * displacement);
   }
-}
-
-}  // namespace
-}  // namespace sd::sim
-
-namespace sd::sim {
-namespace {
-
-// IC(0) in two halves (`split`): on a 24×24 sheet (625 vertices, a separator band of two rows)
-// the factor reproduces the filtered matrix on its pattern like the vertex order's, the
-// preconditioner inverts it, the factor is the same bits on one thread as on two, and a PCG
-// solve with it takes about the iterations of the vertex order's IC(0) (the second half is
-// taken from the far edge towards the middle, so both halves sweep towards the separator).
-TEST(LinearSolvers, BlockIncompleteCholeskyInTwoHalves) {
-  const System s = make_system(1.0 / 24, 24);
-  const int n = s.model.vertex_count;
-  const Eigen::MatrixXd b = dense_filtered(s);
-  const double scale = b.cwiseAbs().maxCoeff();
-  std::vector<char> in_pattern(static_cast<std::size_t>(n) * n, 0);
-  for (int r = 0; r < s.a.outerSize(); ++r)
-    for (SparseMatrixR::InnerIterator it(s.a, r); it; ++it)
-      in_pattern[static_cast<std::size_t>(r / 3) * n + it.col() / 3] = 1;
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  Eigen::VectorXd x(3 * n);
-  for (int k = 0; k < 3 * n; ++k) x[k] = uniform(rng);
-  Eigen::VectorXd applied[2];
-  for (const int threads : {1, 2}) {
-    set_thread_count(threads);
-    BlockIncompleteCholesky ic;
-    ASSERT_TRUE(ic.factorize(s.a, s.model.pattern.diagonal_offsets, s.filter, true));
-    // This random state takes Manteuffel's shift (in the vertex order too): L P Lᵀ is then
-    // B + α·blockdiag(B) on the pattern.
-    EXPECT_LE(ic.shift(), 1e-2);
-    Eigen::MatrixXd shifted = b;
-    for (int i = 0; i < n; ++i) shifted.block<3, 3>(3 * i, 3 * i) *= 1.0 + ic.shift();
-    EXPECT_GT(ic.separator_size(), 0);
-    EXPECT_LE(8 * ic.separator_size(), n);
-    Eigen::MatrixXd factor(3 * n, 3 * n);
-    for (int c = 0; c < 3 * n; ++c) {
-      Eigen::VectorXd column;
-      ic.multiply(Eigen::VectorXd::Unit(3 * n, c), column);
-      factor.col(c) = column;
-    }
-    EXPECT_LE((factor - factor.transpose()).cwiseAbs().maxCoeff(), 1e-12 * scale);
-    double on_pattern = 0.0;
-    for (int i = 0; i < n; ++i)
-      for (int j = 0; j < n; ++j)
-        if (in_pattern[static_cast<std::size_t>(i) * n + j])
-          on_pattern = std::max(
-              on_pattern, (factor.block<3, 3>(3 * i, 3 * j) - shifted.block<3, 3>(3 * i, 3 * j))
-                              .cwiseAbs()
-                              .maxCoeff());
-    EXPECT_LE(on_pattern, 1e-10 * scale);
-    Eigen::VectorXd product, back;
-    ic.multiply(x, product);
-    ic.apply(product, back);
-    EXPECT_LE((back - x).norm(), 1e-9 * x.norm());
-    ic.apply(x, applied[threads - 1]);
-  }
-  set_thread_count(0);
-  EXPECT_EQ(std::memcmp(applied[0].data(), applied[1].data(), sizeof(double) * 3 * n), 0);
-  // Conjugate gradients on B with each factor as the preconditioner, to a residual reduction of
-  // 1e-8 in the preconditioned norm: the halves' factor needs at most a quarter more iterations
-  // than the vertex order's (ordering the second half from the middle outwards, like the first,
-  // doubled them on the pinned 32×32 sheet).
-  int iterations[2] = {0, 0};
-  Eigen::VectorXd rhs = x;
-  s.filter.apply(rhs);
-  for (int k = 0; k < 2; ++k) {
-    BlockIncompleteCholesky ic;
-    ASSERT_TRUE(ic.factorize(s.a, s.model.pattern.diagonal_offsets, s.filter, k == 1));
-    EXPECT_EQ(ic.separator_size() > 0, k == 1);
-    Eigen::VectorXd solution = Eigen::VectorXd::Zero(3 * n), r = rhs, c, t;
-    ic.apply(r, c);
-    double delta = r.dot(c);
-    const double delta0 = delta;
-    while (delta > 1e-16 * delta0 && iterations[k] < 1000) {
-      Eigen::VectorXd q = s.a * c;  // B c = S A c for a filtered c
-      s.filter.apply(q);
-      const double alpha = delta / c.dot(q);
-      solution += alpha * c;
-      r -= alpha * q;
-      ic.apply(r, t);
-      const double next = r.dot(t);
-      c = t + (next / delta) * c;
-      delta = next;
-      ++iterations[k];
-    }
-    Eigen::VectorXd residual = s.a * solution - rhs;
-    s.filter.apply(residual);
-    EXPECT_LE(residual.norm(), 1e-6 * rhs.norm());
-  }
-  std::printf("IC(0) on a 24x24 sheet: %d iterations in the vertex order, %d in two halves\n",
-              iterations[0], iterations[1]);
-  EXPECT_LE(iterations[1], iterations[0] * 5 / 4);
 }
 
 }  // namespace

@@ -575,19 +575,23 @@ TEST(Simulation, StepGrowsBackAfterEasySteps) {
 // The energy series taken from the next step's force evaluation (the default) is the series of a
 // force evaluation after every step, sample for sample and bit for bit: for implicit Euler with
 // the error-controlled step (where it is taken from the next step), for BDF2 (its Newton steps
-// linearise elsewhere) and for implicit Euler falling onto a sphere (contact corrects the start),
-// where it is evaluated before the step; the same length, the start and the end included.
+// linearise elsewhere) and for implicit Euler falling onto a sphere, without and with self-contact
+// (taken from the solve on the steps whose start needs no contact correction, evaluated before
+// the others); the same length, the start and the end included.
 TEST(Simulation, EnergySamplesFromTheNextStepAreEvaluatedOnes) {
   const HangingSheet h = hanging_sheet(6, 0.5);
   const meshing::TriMesh sphere = testing::make_sphere(0.1, 2, {0.0, 0.85, 0.0});
-  for (int scene = 0; scene < 3; ++scene) {
+  // Scenes: implicit Euler; BDF2; on a sphere (the sample is taken from the solve on the steps
+  // whose start needs no contact correction); on the sphere with self-contact on.
+  for (int scene = 0; scene < 4; ++scene) {
     const Integrator integrator = scene == 1 ? Integrator::bdf2 : Integrator::implicit_euler;
     const auto run = [&](const SimulationSettings& settings) {
       Simulation sim = make_simulation(h, settings);
-      if (scene == 2) sim.set_body(sphere);
+      if (scene >= 2) sim.set_body(sphere);
       return sim.run();
     };
     SimulationSettings settings;
+    settings.self_contact.enabled = scene == 3;
     settings.dt = 1.0 / 20;
     settings.step_error = integrator == Integrator::implicit_euler ? 2e-3 : 0.0;
     settings.integrator = integrator;
@@ -599,7 +603,7 @@ TEST(Simulation, EnergySamplesFromTheNextStepAreEvaluatedOnes) {
     settings.energy_from_next_step = true;
     const SimulationReport taken = run(settings);
     ASSERT_GT(evaluated.steps, 10);
-    if (scene == 2) {
+    if (scene >= 2) {
       EXPECT_GT(taken.contacts_max, 0);
     }
     ASSERT_EQ(taken.energy.size(), evaluated.energy.size());
