@@ -6,9 +6,11 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <functional>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <numeric>
 #include <optional>
 #include <set>
@@ -121,6 +123,47 @@ struct PanelNetwork {
   EdgeCounts counts;
 };
 
+// Two curve pieces in panels between the same two junctions must not both be one edge: each
+// would be the same straight edge between those junctions, one mesh edge for two seams, and the
+// panels on them would overlap (a coarse edge_length over a shirt's armhole halves made the
+// stitched mesh's seam checks name panels that share no curve). Fails naming both curves, the
+// place and the edge_length that gives the shorter two edges.
+void check_single_edges_apart(const GarmentRequest& sketch, const BodySurface& body,
+                              const CurveNetwork& net, const std::vector<PanelLoop>& loops,
+                              const EdgeCounts& counts) {
+  std::vector<bool> used(net.edges.size(), false);
+  for (const PanelLoop& loop : loops)
+    for (const LoopEdge& e : loop.edges) used[static_cast<size_t>(e.edge)] = true;
+  std::map<std::pair<int, int>, int> single;  // junction pair → the first one-edge piece
+  for (size_t e = 0; e < net.edges.size(); ++e) {
+    const NetworkEdge& edge = net.edges[e];
+    if (!used[e] || counts.counts[e] != 1 || edge.from == edge.to) continue;
+    const auto [it, fresh] =
+        single.try_emplace(std::minmax(edge.from, edge.to), static_cast<int>(e));
+    if (fresh) continue;
+    const NetworkEdge& other = net.edges[static_cast<size_t>(it->second)];
+    const NetworkCurve& a = net.curves[static_cast<size_t>(other.curve)];
+    const NetworkCurve& b = net.curves[static_cast<size_t>(edge.curve)];
+    const Eigen::Vector3d& p = net.nodes[static_cast<size_t>(edge.from)];
+    const Eigen::Vector3d& q = net.nodes[static_cast<size_t>(edge.to)];
+    std::string landmark;
+    if (const BodyLandmarks* landmarks = body.landmarks())
+      landmark = fmt::format(", near the {}", landmarks->nearest(0.5 * (p + q)).name);
+    const double shorter = std::min(edge.length, other.length);
+    const CurveSpec& spec = sketch.curves[static_cast<size_t>(std::max(a.spec, b.spec))];
+    sketch.fail(
+        spec.edge_length ? spec.json_path + "/edge_length" : std::string("/edge_length"),
+        fmt::format("curves '{}' and '{}' both run between the junctions at ({:.3f}, {:.3f}, "
+                    "{:.3f}) and ({:.3f}, {:.3f}, {:.3f}) m{} ({:.1f} and {:.1f} cm long), and at "
+                    "this edge length each is a single edge: both become the same straight edge, "
+                    "and the panels on them would lie over each other. Give a smaller "
+                    "\"edge_length\" (at most {:.3g} m gives each at least two edges), or give "
+                    "these two curves their own \"edge_length\"",
+                    a.id, b.id, p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), landmark,
+                    100 * other.length, 100 * edge.length, std::floor(1e3 * shorter / 1.6) / 1e3));
+  }
+}
+
 PanelNetwork resolve_network(const GarmentRequest& sketch, const BodySurface& body) {
   check_against_body(sketch, body.box());
   const std::vector<ProjectedCurve> projected = project_curves(sketch, body);
@@ -136,6 +179,7 @@ PanelNetwork resolve_network(const GarmentRequest& sketch, const BodySurface& bo
   }
   std::vector<PanelLoop> loops = resolve_panels(sketch, net, body);
   EdgeCounts counts = compute_edge_counts(sketch, net, loops);
+  check_single_edges_apart(sketch, body, net, loops, counts);
   {
     std::vector<double> boundary_edges;
     std::vector<std::string> paths, ids;
@@ -681,13 +725,17 @@ void check_seam_directions(const GarmentRequest& sketch, const BodySurface& body
                           garment.panels[static_cast<size_t>(f.panel_b)].mirror_copy;
       return std::pair(!copies, f.dot / f.edges);
     };
+    // Where the seam directions clash, a fold within 60° names the cause; elsewhere (a panel
+    // turned inside out runs its seams the right way) only one within 30°, since a coarse
+    // straight skirt's front and back (2 × 2 quads each) meet at 58° at their side seams.
+    const double sharp = clash ? 0.5 : std::cos(std::numbers::pi / 6);
     const std::pair<const std::string, Fold>* sharpest = nullptr;
     for (const auto& entry : folds) {
       spdlog::debug("seam '{}' between panels '{}' and '{}': mean fold {:.2f} over {} edge(s)",
                     entry.first, garment.panels[static_cast<size_t>(entry.second.panel_a)].id,
                     garment.panels[static_cast<size_t>(entry.second.panel_b)].id,
                     entry.second.dot / entry.second.edges, entry.second.edges);
-      if (entry.second.edges >= 2 && entry.second.dot / entry.second.edges > 0.5 &&
+      if (entry.second.edges >= 2 && entry.second.dot / entry.second.edges > sharp &&
           (!sharpest || rank(entry.second) > rank(sharpest->second)))
         sharpest = &entry;
     }
