@@ -6,12 +6,16 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <functional>
+#include <limits>
 #include <map>
+#include <numbers>
 #include <numeric>
 #include <optional>
 #include <set>
 #include <stdexcept>
+#include <tuple>
 #include <unordered_map>
 #include <utility>
 
@@ -106,6 +110,10 @@ BodyPart classify_body_point(const Eigen::Vector3d& p, double height) {
 
 namespace {
 
+// m: two boundary curves closer than a quarter edge (3 mm .. 1 cm) for longer than this, away
+// from their junctions, are drawn over one line (check_overlapping_boundaries).
+constexpr double kOverlapRun = 0.03;
+
 // Stage 1, the panels on the curve network: strokes projected on the body, the network (with
 // the mirror copies of every curve a mirrored panel uses), the panel loops and the edge count of
 // every curve piece, and the panels' sizes checked against the body.
@@ -114,6 +122,47 @@ struct PanelNetwork {
   std::vector<PanelLoop> loops;
   EdgeCounts counts;
 };
+
+// Two curve pieces in panels between the same two junctions must not both be one edge: each
+// would be the same straight edge between those junctions, one mesh edge for two seams, and the
+// panels on them would overlap (a coarse edge_length over a shirt's armhole halves made the
+// stitched mesh's seam checks name panels that share no curve). Fails naming both curves, the
+// place and the edge_length that gives the shorter two edges.
+void check_single_edges_apart(const GarmentRequest& sketch, const BodySurface& body,
+                              const CurveNetwork& net, const std::vector<PanelLoop>& loops,
+                              const EdgeCounts& counts) {
+  std::vector<bool> used(net.edges.size(), false);
+  for (const PanelLoop& loop : loops)
+    for (const LoopEdge& e : loop.edges) used[static_cast<size_t>(e.edge)] = true;
+  std::map<std::pair<int, int>, int> single;  // junction pair → the first one-edge piece
+  for (size_t e = 0; e < net.edges.size(); ++e) {
+    const NetworkEdge& edge = net.edges[e];
+    if (!used[e] || counts.counts[e] != 1 || edge.from == edge.to) continue;
+    const auto [it, fresh] =
+        single.try_emplace(std::minmax(edge.from, edge.to), static_cast<int>(e));
+    if (fresh) continue;
+    const NetworkEdge& other = net.edges[static_cast<size_t>(it->second)];
+    const NetworkCurve& a = net.curves[static_cast<size_t>(other.curve)];
+    const NetworkCurve& b = net.curves[static_cast<size_t>(edge.curve)];
+    const Eigen::Vector3d& p = net.nodes[static_cast<size_t>(edge.from)];
+    const Eigen::Vector3d& q = net.nodes[static_cast<size_t>(edge.to)];
+    std::string landmark;
+    if (const BodyLandmarks* landmarks = body.landmarks())
+      landmark = fmt::format(", near the {}", landmarks->nearest(0.5 * (p + q)).name);
+    const double shorter = std::min(edge.length, other.length);
+    const CurveSpec& spec = sketch.curves[static_cast<size_t>(std::max(a.spec, b.spec))];
+    sketch.fail(
+        spec.edge_length ? spec.json_path + "/edge_length" : std::string("/edge_length"),
+        fmt::format("curves '{}' and '{}' both run between the junctions at ({:.3f}, {:.3f}, "
+                    "{:.3f}) and ({:.3f}, {:.3f}, {:.3f}) m{} ({:.1f} and {:.1f} cm long), and at "
+                    "this edge length each is a single edge: both become the same straight edge, "
+                    "and the panels on them would lie over each other. Give a smaller "
+                    "\"edge_length\" (at most {:.3g} m gives each at least two edges), or give "
+                    "these two curves their own \"edge_length\"",
+                    a.id, b.id, p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), landmark,
+                    100 * other.length, 100 * edge.length, std::floor(1e3 * shorter / 1.6) / 1e3));
+  }
+}
 
 PanelNetwork resolve_network(const GarmentRequest& sketch, const BodySurface& body) {
   check_against_body(sketch, body.box());
@@ -130,6 +179,7 @@ PanelNetwork resolve_network(const GarmentRequest& sketch, const BodySurface& bo
   }
   std::vector<PanelLoop> loops = resolve_panels(sketch, net, body);
   EdgeCounts counts = compute_edge_counts(sketch, net, loops);
+  check_single_edges_apart(sketch, body, net, loops, counts);
   {
     std::vector<double> boundary_edges;
     std::vector<std::string> paths, ids;
@@ -505,6 +555,97 @@ void check_fans(const GarmentRequest& sketch, const Garment& garment,
   }
 }
 
+// ... and no two curves run along each other with their panels on one side: a back hem drawn
+// over the front hem puts the back panel over the front one, which the drape cannot separate.
+// Each boundary edge's quad points from it into its panel (the same measure as the folds below,
+// independent of the loops' orientation); edges of two different curves closer than `near`
+// whose quads point the same way (within 60°) overlap. Fails when such edges, away from the
+// network's junctions (where curves meet by design), add up to more than kOverlapRun for one pair
+// of curves, naming both curves, both panels and the place. Two curves side by side with their
+// panels on either side (a slit's two edges below its top) are an opening, not an overlap.
+void check_overlapping_boundaries(const GarmentRequest& sketch, const BodySurface& body,
+                                  const CurveNetwork& net, const VertexPool& pool,
+                                  const std::vector<std::array<int, 4>>& faces,
+                                  const std::vector<int>& face_panel, const Garment& garment) {
+  struct CurveEdge {
+    Eigen::Vector3d middle, inward;
+    double length = 0;
+    const std::string* curve = nullptr;
+    int panel = -1;
+  };
+  const double near = std::clamp(0.25 * sketch.edge_length, 0.003, 0.01);
+  const double around_junction = 0.02;  // m from a junction, where curves meet by design
+  std::vector<CurveEdge> edges;
+  for (size_t f = 0; f < faces.size(); ++f)
+    for (int k = 0; k < 4; ++k) {
+      const int a = faces[f][static_cast<size_t>(k)],
+                b = faces[f][static_cast<size_t>((k + 1) % 4)];
+      const auto it = garment.edge_curve.find(std::minmax(a, b));
+      if (it == garment.edge_curve.end()) continue;
+      const Eigen::Vector3d& p = pool.positions[static_cast<size_t>(a)];
+      const Eigen::Vector3d& q = pool.positions[static_cast<size_t>(b)];
+      CurveEdge e;
+      e.middle = 0.5 * (p + q);
+      bool at_junction = false;
+      for (const Eigen::Vector3d& node : net.nodes)
+        at_junction = at_junction || (node - e.middle).norm() < around_junction;
+      if (at_junction) continue;
+      Eigen::Vector3d c = Eigen::Vector3d::Zero();
+      for (int v : faces[f]) c += pool.positions[static_cast<size_t>(v)] / 4;
+      const Eigen::Vector3d along = (q - p).normalized();
+      e.inward = c - e.middle;
+      e.inward = (e.inward - e.inward.dot(along) * along).normalized();
+      e.length = (q - p).norm();
+      e.curve = &it->second;
+      e.panel = face_panel[f];
+      edges.push_back(e);
+    }
+  // Per (curve, panel, curve, panel): the length of the first curve's edges over the second.
+  std::map<std::tuple<std::string, int, std::string, int>, std::pair<double, Eigen::Vector3d>>
+      overlaps;  // value: the length and the mean place
+  for (const CurveEdge& a : edges)
+    for (const CurveEdge& b : edges) {
+      if (*a.curve == *b.curve || (a.middle - b.middle).norm() >= near ||
+          a.inward.dot(b.inward) <= 0.5)
+        continue;
+      auto& [length, where] = overlaps[{*a.curve, a.panel, *b.curve, b.panel}];
+      where = (length * where + a.length * a.middle) / (length + a.length);  // their mean
+      length += a.length;
+    }
+  const std::pair<const std::tuple<std::string, int, std::string, int>,
+                  std::pair<double, Eigen::Vector3d>>* worst = nullptr;
+  for (const auto& entry : overlaps) {
+    spdlog::debug(
+        "curves '{}' and '{}' run within {:.1f} mm of each other, their panels on one "
+        "side, for {:.1f} cm",
+        std::get<0>(entry.first), std::get<2>(entry.first), 1e3 * near, 1e2 * entry.second.first);
+    if (!worst || entry.second.first > worst->second.first) worst = &entry;
+  }
+  if (!worst || worst->second.first <= kOverlapRun) return;
+  const auto& [curve_a, panel_a, curve_b, panel_b] = worst->first;
+  const auto base = [](const std::string& id) {
+    return id.ends_with(".mirror") ? id.substr(0, id.size() - 7) : id;
+  };
+  const CurveSpec* later = nullptr;
+  for (const CurveSpec& c : sketch.curves)
+    if (c.id == base(curve_a) || c.id == base(curve_b)) later = &c;
+  const Eigen::Vector3d& where = worst->second.second;
+  std::string landmark;
+  if (const BodyLandmarks* landmarks = body.landmarks())
+    landmark = fmt::format(", near the {}", landmarks->nearest(where).name);
+  sketch.fail(
+      later ? later->json_path + (later->is_3d() ? "/points3d" : "/points") : "/panels",
+      fmt::format("curves '{}' (panel '{}') and '{}' (panel '{}') run along each other for {:.1f} "
+                  "cm around ({:.3f}, {:.3f}, {:.3f}) m{}, with both panels on the same side of "
+                  "them: the panels lie over each other there, which the drape cannot separate. "
+                  "If '{}' belongs elsewhere (a back curve drawn on the front?), move its points "
+                  "there; if the two panels meet along this line, they must lie on either side of "
+                  "it: give both the same curve",
+                  curve_a, garment.panels[static_cast<size_t>(panel_a)].id, curve_b,
+                  garment.panels[static_cast<size_t>(panel_b)].id, 1e2 * worst->second.first,
+                  where.x(), where.y(), where.z(), landmark, later ? later->id : base(curve_b)));
+}
+
 // ... and the two panels of a seam run it in opposite directions; counts the seam edges.
 // `curve_of` names the sketch curve a boundary edge (a, b) of the pool lies on, "" if none.
 void check_seam_directions(const GarmentRequest& sketch, const BodySurface& body,
@@ -535,7 +676,7 @@ void check_seam_directions(const GarmentRequest& sketch, const BodySurface& body
           0.5 * (pool.positions[static_cast<size_t>(a)] + pool.positions[static_cast<size_t>(b)]);
       ++clashing;
     }
-  if (clash) {
+  {
     // The usual cause: one curve given to two panels that lie on the same side of it (a front
     // hem listed again as the back's hem: the back then spans from the back hip round to the
     // front hem and turns over). Each seam edge's two quads point from it into their panels; on
@@ -577,12 +718,27 @@ void check_seam_directions(const GarmentRequest& sketch, const BodySurface& body
       ++fold.edges;
       fold.panel_a = std::min(pa, pb), fold.panel_b = std::max(pa, pb);
     }
+    // The sharpest fold, one between two panels of the file before one with a mirror copy (the
+    // copy folds as its original does, and the file names the original).
+    const auto rank = [&](const Fold& f) {
+      const bool copies = garment.panels[static_cast<size_t>(f.panel_a)].mirror_copy ||
+                          garment.panels[static_cast<size_t>(f.panel_b)].mirror_copy;
+      return std::pair(!copies, f.dot / f.edges);
+    };
+    // Where the seam directions clash, a fold within 60° names the cause; elsewhere (a panel
+    // turned inside out runs its seams the right way) only one within 30°, since a coarse
+    // straight skirt's front and back (2 × 2 quads each) meet at 58° at their side seams.
+    const double sharp = clash ? 0.5 : std::cos(std::numbers::pi / 6);
     const std::pair<const std::string, Fold>* sharpest = nullptr;
-    for (const auto& entry : folds)
-      if (entry.second.edges >= 2 && entry.second.dot / entry.second.edges > 0.5 &&
-          (!sharpest ||
-           entry.second.dot / entry.second.edges > sharpest->second.dot / sharpest->second.edges))
+    for (const auto& entry : folds) {
+      spdlog::debug("seam '{}' between panels '{}' and '{}': mean fold {:.2f} over {} edge(s)",
+                    entry.first, garment.panels[static_cast<size_t>(entry.second.panel_a)].id,
+                    garment.panels[static_cast<size_t>(entry.second.panel_b)].id,
+                    entry.second.dot / entry.second.edges, entry.second.edges);
+      if (entry.second.edges >= 2 && entry.second.dot / entry.second.edges > sharp &&
+          (!sharpest || rank(entry.second) > rank(sharpest->second)))
         sharpest = &entry;
+    }
     if (sharpest) {
       const std::string& curve = sharpest->first;
       const GarmentPanel& a = garment.panels[static_cast<size_t>(sharpest->second.panel_a)];
@@ -620,6 +776,8 @@ void check_seam_directions(const GarmentRequest& sketch, const BodySurface& body
                               hint.empty() ? other_side : wrong_curve,
                               hint.empty() ? wrong_curve : other_side));
     }
+  }
+  if (clash) {
     const GarmentPanel& p1 = garment.panels[static_cast<size_t>(clash->first)];
     const GarmentPanel& p2 = garment.panels[static_cast<size_t>(clash->second)];
     where /= std::max(clashing, 1);
@@ -866,6 +1024,7 @@ Garment build_garment(const GarmentRequest& sketch, const BodySurface& body) {
     }
     return "";
   };
+  check_overlapping_boundaries(sketch, body, net, pool, faces, face_panel, garment);
   check_seam_directions(sketch, body, pool, faces, face_panel, curve_of, garment);
   label_panels(sketch, body, faces, face_panel, pool, garment);
   // The grain: a panel on a limb may run along it (panel_grain.hpp); the landmarks are found only

@@ -185,6 +185,96 @@ std::pair<int, int> find_self_intersection(const Eigen::MatrixX3d& polyline, boo
   return {-1, -1};
 }
 
+std::pair<int, int> find_crossing_seen_from_outside(const Eigen::MatrixX3d& polyline, bool closed,
+                                                    const std::vector<Eigen::Vector3d>& outward,
+                                                    double reach) {
+  const int n = static_cast<int>(polyline.rows());
+  const int segments = closed ? n : n - 1;
+  const auto point = [&](int k) -> Eigen::Vector3d { return polyline.row(k % n).transpose(); };
+  for (int i = 0; i < segments; ++i)
+    for (int j = i + 3; j < segments; ++j) {
+      if (closed && (i + segments - j) < 3) continue;
+      const Eigen::Vector3d a = point(i), b = point(i + 1), c = point(j), d = point(j + 1);
+      const Eigen::Vector3d na = outward[static_cast<size_t>(i)] +
+                                 outward[static_cast<size_t>((i + 1) % n)],
+                            nc = outward[static_cast<size_t>(j)] +
+                                 outward[static_cast<size_t>((j + 1) % n)];
+      if (na.norm() == 0 || nc.norm() == 0 || na.normalized().dot(nc.normalized()) < 0.5) continue;
+      if (segment_distance(a, b, c, d) >= reach) continue;
+      // Coordinates in the plane across the mean outward direction.
+      const Eigen::Vector3d normal = (na.normalized() + nc.normalized()).normalized();
+      const Eigen::Vector3d u = normal.unitOrthogonal(), v = normal.cross(u);
+      const auto flat = [&](const Eigen::Vector3d& p) {
+        return Eigen::Vector2d(p.dot(u), p.dot(v));
+      };
+      if (segments_cross(flat(a), flat(b), flat(c), flat(d))) return {i, j};
+    }
+  return {-1, -1};
+}
+
+namespace {
+
+// Strands of a curve farther apart than this (m) are not compared: the outward direction at a
+// point is the body's nearest normal, which says little about a strand 10 cm away.
+constexpr double kCrossingReach = 0.1;
+
+// Fails (at the curve's points) when `out` loops back over itself seen from outside the body,
+// naming the place, its nearest landmark and the written point nearest to it.
+void check_crossing_seen_from_outside(const GarmentRequest& sketch, const CurveSpec& curve,
+                                      const std::string& points_path, const BodySurface& body,
+                                      const ProjectedCurve& out) {
+  const Eigen::Index n = out.points.rows();
+  if (n < 5) return;
+  std::vector<Eigen::Vector3d> outward(static_cast<size_t>(n));
+  SurfacePoint near = body.closest_point(out.points.row(0).transpose());
+  for (Eigen::Index k = 0; k < n; ++k) {
+    near = body.closest_point(out.points.row(k).transpose(), near);
+    outward[static_cast<size_t>(k)] = near.normal;
+  }
+  const auto [i, j] =
+      find_crossing_seen_from_outside(out.points, curve.closed, outward, kCrossingReach);
+  if (i < 0) return;
+  const Eigen::Vector3d a = out.points.row(i).transpose(),
+                        b = out.points.row((i + 1) % n).transpose(),
+                        c = out.points.row(j).transpose(),
+                        d = out.points.row((j + 1) % n).transpose();
+  const Eigen::Vector3d where = 0.25 * (a + b + c + d);
+  const double apart = segment_distance(a, b, c, d);
+  std::string landmark;
+  if (const BodyLandmarks* landmarks = body.landmarks())
+    landmark = fmt::format(", near the {}", landmarks->nearest(where).name);
+  // The written point nearest to the crossing, where the designer looks first.
+  std::string written;
+  if (curve.is_3d()) {
+    size_t best = 0;
+    for (size_t k = 1; k < curve.points3d.size(); ++k)
+      if ((curve.points3d[k] - where).norm() < (curve.points3d[best] - where).norm()) best = k;
+    const Eigen::Vector3d& p = curve.points3d[best];
+    written = fmt::format(" (the nearest written point is {}, ({:.3f}, {:.3f}, {:.3f}))", best,
+                          p.x(), p.y(), p.z());
+  } else if (curve.view.kind != ViewKind::kCamera) {
+    const ViewFrame frame = view_frame(curve.view);
+    const Eigen::Vector2d uv((where - frame.plane_origin).dot(frame.right),
+                             (where - frame.plane_origin).dot(frame.up));
+    size_t best = 0;
+    for (size_t k = 1; k < curve.points.size(); ++k)
+      if ((curve.points[k] - uv).norm() < (curve.points[best] - uv).norm()) best = k;
+    const Eigen::Vector2d& p = curve.points[best];
+    written = fmt::format(" (the nearest written point is {}, ({:.3f}, {:.3f}) in the {} view)",
+                          best, p.x(), p.y(), curve.view.name());
+  }
+  sketch.fail(
+      points_path,
+      fmt::format("curve '{}' crosses itself seen from outside the body at ({:.3f}, {:.3f}, "
+                  "{:.3f}) m{}: it loops back over itself there, one strand {:.1f} cm in front of "
+                  "the other (a figure of eight), and a panel bounded by it would fold over "
+                  "itself. Move or reorder its points there{} so that the curve runs one way "
+                  "along the body without looping back; a curve must not cross itself",
+                  curve.id, where.x(), where.y(), where.z(), landmark, 100 * apart, written));
+}
+
+}  // namespace
+
 ProjectedCurve project_curve(const GarmentRequest& sketch, const CurveSpec& curve,
                              const BodySurface* body) {
   ProjectedCurve out;
@@ -319,6 +409,7 @@ ProjectedCurve project_curve(const GarmentRequest& sketch, const CurveSpec& curv
                             "must not cross itself",
                             curve.id, where.x(), where.y(), where.z(), snapped));
   }
+  if (body != nullptr) check_crossing_seen_from_outside(sketch, curve, points_path, *body, out);
   return out;
 }
 

@@ -69,4 +69,14 @@ std::pair<int, int> find_self_intersection(const std::vector<Eigen::Vector2d>& p
 std::pair<int, int> find_self_intersection(const Eigen::MatrixX3d& polyline, bool closed,
                                            double tolerance);
 
+// Index pair (i, j) of the first two non-adjacent segments of a 3D polyline (#P by 3) that cross
+// seen from outside the body: segments less than `reach` metres apart whose outward directions
+// (`outward`: #P unit vectors, the body's normal nearest each point) agree within 60°, and that
+// cross in the plane across their mean outward direction. A curve that loops back over itself
+// off the body (a figure-of-eight hem with its strands a few centimetres apart in depth) passes
+// the 3D test above, but a panel bounded by it folds over itself. {-1, -1} when none do.
+std::pair<int, int> find_crossing_seen_from_outside(const Eigen::MatrixX3d& polyline, bool closed,
+                                                    const std::vector<Eigen::Vector3d>& outward,
+                                                    double reach);
+
 }  // namespace sd::garment

@@ -143,6 +143,29 @@ TEST(StrokeProjection, SelfIntersectionFound) {
   EXPECT_EQ(find_self_intersection(square, true).first, -1);
 }
 
+// A loop in front of the body (outward +z): the strands of a figure of eight 2 cm apart in
+// depth do not touch in 3D, but seen from outside they cross. The same polyline with its halves
+// on opposite sides of a limb (outward +z and -z) does not fold a panel; a hairpin whose strands
+// do not cross in projection is not a crossing either.
+TEST(StrokeProjection, CrossingSeenFromOutsideFound) {
+  Eigen::MatrixX3d loop(7, 3);  // segment 0 along y = 0 at z = 0.02, segment 3 across it at z ≈ 0
+  loop << 0, 0, 0.02, 0.1, 0, 0.02, 0.11, 0.03, 0.015, 0.08, 0.04, 0.01, 0.06, -0.03, 0.0, 0.08,
+      -0.04, 0.0, 0.2, 0, 0.0;
+  const std::vector<Eigen::Vector3d> front(7, Eigen::Vector3d::UnitZ());
+  EXPECT_EQ(find_self_intersection(loop, false, 1e-3).first, -1);  // 3D: 1 cm apart at least
+  const auto [i, j] = find_crossing_seen_from_outside(loop, false, front, 0.1);
+  EXPECT_EQ(i, 0);
+  EXPECT_EQ(j, 3);
+  std::vector<Eigen::Vector3d> opposite = front;
+  for (size_t k = 4; k < opposite.size(); ++k) opposite[k] = -Eigen::Vector3d::UnitZ();
+  EXPECT_EQ(find_crossing_seen_from_outside(loop, false, opposite, 0.1).first, -1);
+  EXPECT_EQ(find_crossing_seen_from_outside(loop, false, front, 0.005).first, -1);  // too far
+  Eigen::MatrixX3d hairpin(7, 3);
+  hairpin << 0, 0, 0, 0.1, 0, 0, 0.2, 0, 0, 0.21, 0.005, 0.005, 0.2, 0.01, 0.01, 0.1, 0.01, 0.01, 0,
+      0.01, 0.01;
+  EXPECT_EQ(find_crossing_seen_from_outside(hairpin, false, front, 0.1).first, -1);
+}
+
 TEST(StrokeProjection, SamplingKeepsControlPointsAndSpacing) {
   const std::vector<Eigen::Vector2d> pts = {{0, 0}, {0.1, 0.05}, {0.2, 0}};
   const auto dense = sample_stroke<2>(pts, false, true, 0.005);

@@ -175,9 +175,11 @@ void run_mesh(const MeshOptions& options) {
     area += p.area;
   }
   report["warnings"] = warnings_json(warnings);
+  // The body's repairs and defects (an open body, ...): the sentences the terminal showed.
   report["body"] = {{"mesh", sketch.body.mesh},
                     {"source", body.raw.source},
-                    {"triangles", body.mesh.face_count()}};
+                    {"triangles", body.mesh.face_count()},
+                    {"warnings", body.warnings}};
   report["panels"] = panels;
   report["totals"] = {{"panels", g.panels.size()},          {"vertices", g.mesh.vertex_count()},
                       {"quads", g.mesh.face_count()},       {"triangles_48", m48.triangle_count()},

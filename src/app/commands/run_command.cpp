@@ -289,6 +289,10 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   // own triangles).
   RunReport out;                           // report.json, filled as the drape goes
   out.warnings = fabric_warnings(sketch);  // logged by check_sketch
+  // The body's repairs and defects (an open body, inconsistent triangles), logged as it loaded.
+  if (scene.body)
+    out.warnings.insert(out.warnings.end(), scene.body->warnings.begin(),
+                        scene.body->warnings.end());
   sim::SimulationReport& report = out.simulation;
   out.settings = settings;
   meshing::TriMesh draped;

@@ -3,9 +3,13 @@
 // fabric and the simulation settings — and writes nothing.
 
 #include <fmt/format.h>
+#include <spdlog/sinks/base_sink.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <iostream>
+#include <memory>
+#include <mutex>
 
 #include "scene/sketch_file.hpp"
 #include "src/app/commands/cli.hpp"
@@ -17,12 +21,51 @@
 namespace sd::app {
 namespace {
 
+// Counts the warnings logged while it is attached to the default logger: the summary line's
+// count is then the number of warning lines above it, whichever stage logged them (the body's
+// repairs, the fabric's unusual constants, the pattern's stretch, the quality gate).
+class WarningCounter final : public spdlog::sinks::base_sink<std::mutex> {
+ public:
+  int count() {
+    const std::lock_guard lock(mutex_);
+    return count_;
+  }
+
+ protected:
+  void sink_it_(const spdlog::details::log_msg& message) override {
+    if (message.level == spdlog::level::warn) ++count_;
+  }
+  void flush_() override {}
+
+ private:
+  int count_ = 0;
+};
+
+// Attaches a WarningCounter to the default logger for its lifetime.
+class CountedWarnings {
+ public:
+  CountedWarnings() : counter_(std::make_shared<WarningCounter>()) {
+    spdlog::default_logger()->sinks().push_back(counter_);
+  }
+  ~CountedWarnings() {
+    auto& sinks = spdlog::default_logger()->sinks();
+    sinks.erase(std::remove(sinks.begin(), sinks.end(), counter_), sinks.end());
+  }
+  CountedWarnings(const CountedWarnings&) = delete;
+  CountedWarnings& operator=(const CountedWarnings&) = delete;
+  int count() const { return counter_->count(); }
+
+ private:
+  std::shared_ptr<WarningCounter> counter_;
+};
+
 struct ValidateOptions {
   std::string sketch;
   bool strict = false;
 };
 
 void run_validate(const ValidateOptions& options) {
+  const CountedWarnings logged;
   const scene::Sketch sketch = scene::load_sketch(options.sketch);
   check_sketch(sketch);
   // What `run` would refuse for its size, refused here too (a sheet before it is built).
@@ -56,9 +99,17 @@ void run_validate(const ValidateOptions& options) {
       scene.fabric_name.ends_with(".json") && scene.fabric.name != sim::FabricParameters{}.name
           ? scene.fabric.name
           : scene.fabric_name;
-  std::cout << fmt::format(
-      "{}: ok ({}, fabric {}){}\n", sketch.file, what, fabric,
-      warnings.empty() ? "" : fmt::format("; {} mesh quality warning(s)", warnings.size()));
+  // Every warning printed above is counted (--quiet prints none: the gate's are counted then);
+  // the quality gate's share is named, since --strict acts on it.
+  const int total = std::max(logged.count(), static_cast<int>(warnings.size()));
+  std::string counted;
+  if (total > 0)
+    counted = warnings.empty() ? fmt::format("; {} warning(s)", total)
+              : static_cast<size_t>(total) == warnings.size()
+                  ? fmt::format("; {} mesh quality warning(s)", total)
+                  : fmt::format("; {} warning(s), {} of them mesh quality warning(s)", total,
+                                warnings.size());
+  std::cout << fmt::format("{}: ok ({}, fabric {}){}\n", sketch.file, what, fabric, counted);
   if (options.strict && !warnings.empty())
     throw std::runtime_error(
         fmt::format("{}: {} mesh quality warning(s) and --strict", sketch.file, warnings.size()));
