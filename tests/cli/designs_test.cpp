@@ -73,23 +73,12 @@ bool crosses_at_start(const std::string& name) {
   return name == "cropped-jacket";
 }
 
-// Designs whose hem or seam, written off the body ("on_body": false, used as written), passes
-// through it, which the quality gate's `inside_body` names (the pencil skirt's back hem 15 mm
-// into the left knee, the wrap skirt's 11 mm, the plain pencil skirt's 4.5 mm, the gored skirt's
-// side seams 4 mm through the hand hanging at the hip); the drape pushes that cloth out at its
-// start. Only that warning is allowed; their curves are to be moved out (left for now).
-bool written_through_body(const std::string& name) {
-  return name == "pencil-skirt" || name == "wrap-skirt" || name == "pencil-skirt-plain" ||
-         name == "gored-skirt";
-}
-
 TEST_P(Design, MeshesWithoutQualityWarnings) {
   const std::string& name = GetParam();
   if (!body_available(name)) GTEST_SKIP() << "the design's body is not installed";
   const fs::path dir = fs::temp_directory_path() / "sd_designs" / name;
   const fs::path sketch = staged_design(name, dir);
-  const std::string strict =
-      crosses_at_start(name) || written_through_body(name) ? "" : "--strict ";
+  const std::string strict = crosses_at_start(name) ? "" : "--strict ";
   const CommandResult meshed =
       run_sketchdrape("-q mesh " + strict + sketch.string() + " -o " + (dir / "mesh").string());
   ASSERT_EQ(meshed.exit_code, 0) << meshed.output;
@@ -98,9 +87,7 @@ TEST_P(Design, MeshesWithoutQualityWarnings) {
   // `inside_body`): the same start the drape untangles.
   for (const nlohmann::json& warning : report["warnings"]) {
     const std::string kind = warning["kind"].get<std::string>();
-    EXPECT_TRUE(
-        (crosses_at_start(name) && (kind == "self_intersection" || kind == "inside_body")) ||
-        (written_through_body(name) && kind == "inside_body"))
+    EXPECT_TRUE(crosses_at_start(name) && (kind == "self_intersection" || kind == "inside_body"))
         << warning.dump(2);
   }
   for (const nlohmann::json& panel : report["panels"]) {
