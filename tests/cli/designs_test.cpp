@@ -109,7 +109,8 @@ INSTANTIATE_TEST_SUITE_P(Corpus, Design, ::testing::ValuesIn(design_names()), te
 // culottes 9 s, tank-top 2 s, gored-skirt 10 s, pencil-skirt-human 11-16 s (26 November; 2 s of
 // CPU), collar-top-human 6 s (1.2 s of CPU),
 // hooded-top 7 s (3.3 s of CPU), cropped-jacket 27 s at load 10 (7.6 s of CPU, one thread),
-// cotton-shift-dress 3 s on a quiet machine (3.5 s of CPU, 25 s wall at load 10):
+// cotton-shift-dress 3 s on a quiet machine (3.5 s of CPU, 25 s wall at load 10),
+// wide-leg-trousers 18 s at load 7 (3.3 s of CPU), hip-cape 24 s (6.2 s of CPU):
 // about 250 s in all; and the long garments below.
 class DesignDrape : public ::testing::TestWithParam<std::string> {};
 
@@ -172,7 +173,8 @@ const std::vector<std::string> other_designs = {
     "aline-dress-human", "tee-human",       "cowl-top",
     "boat-top",          "tank-human",      "culottes",
     "tank-top",          "gored-skirt",     "collar-top-human",
-    "hooded-top",        "cropped-jacket",  "cotton-shift-dress"};
+    "hooded-top",        "cropped-jacket",  "cotton-shift-dress",
+    "wide-leg-trousers", "hip-cape"};
 
 INSTANTIATE_TEST_SUITE_P(Corpus, DesignDrapeTop, ::testing::ValuesIn(other_designs), test_name);
 
