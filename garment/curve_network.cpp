@@ -226,9 +226,17 @@ CurveNetwork build_network(const GarmentRequest& sketch, const std::vector<Proje
   }
   for (size_t c = 0; c < work.size(); ++c)
     if (!work[c].closed && work[c].start_node == work[c].end_node)
-      sketch.fail(curves[c].json_path,
-                  fmt::format("curve '{}' ends where it starts; set \"closed\": true for a loop",
-                              curves[c].id));
+      sketch.fail(
+          curves[c].json_path,
+          polyline_length(curves[c].points) < 2 * tol
+              ? fmt::format("curve '{}' is {:.1f} mm long, too short to have two ends: "
+                            "ends closer than the junction tolerance ({:.1f} mm) are one "
+                            "junction. Draw it longer (coordinates are in metres), or "
+                            "lower \"junction_tolerance\"",
+                            curves[c].id, 1e3 * polyline_length(curves[c].points), 1e3 * tol)
+              : fmt::format("curve '{}' ends where it starts; set \"closed\": true for a "
+                            "loop",
+                            curves[c].id));
 
   // 2. A node on the interior of another curve splits it (T-junction); the node moves onto it.
   for (size_t node = 0; node < net.nodes.size(); ++node) {

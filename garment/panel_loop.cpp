@@ -118,6 +118,27 @@ std::vector<LoopEdge> resolve_explicit(const GarmentRequest& sketch, const Curve
     curve_ids.push_back(c);
   }
   const size_t k = curve_ids.size();
+  // A curve listed twice would be sewn to itself.
+  for (size_t i = 0; i < k; ++i)
+    for (size_t j = i + 1; j < k; ++j)
+      if (panel.boundary[i] == panel.boundary[j])
+        sketch.fail(fmt::format("{}/boundary/{}", panel.json_path, j),
+                    fmt::format("curve '{}' is listed twice in panel '{}' (at {} and {}); each "
+                                "curve of a panel's boundary is listed once, in order around it",
+                                panel.boundary[i], panel.id, i, j));
+  // One open curve alone cannot bound a panel: say how far its ends are apart.
+  if (k == 1) {
+    const NetworkCurve& only = net.curves[static_cast<size_t>(curve_ids[0])];
+    if (!only.closed && !only.nodes.empty() && only.nodes.front() != only.nodes.back()) {
+      const Eigen::Vector3d& a = net.nodes[static_cast<size_t>(only.nodes.front())];
+      const Eigen::Vector3d& b = net.nodes[static_cast<size_t>(only.nodes.back())];
+      sketch.fail(fmt::format("{}/boundary", panel.json_path),
+                  fmt::format("panel '{}' has one boundary curve, '{}', and it does not close: "
+                              "its ends at {} and {} m are {:.1f} cm apart. List the curves that "
+                              "close the loop after it, or make '{}' a loop with \"closed\": true",
+                              panel.id, only.id, at(a), at(b), 100 * (a - b).norm(), only.id));
+    }
+  }
   // Neighbours in the list must share a junction; say which pair does not.
   for (size_t i = 0; i < k; ++i) {
     const int a = curve_ids[i], b = curve_ids[(i + 1) % k];
