@@ -14,7 +14,6 @@
 #include <numbers>
 #include <optional>
 #include <set>
-#include <tuple>
 #include <unordered_map>
 
 #include "garment/material_frames.hpp"
@@ -298,11 +297,17 @@ FlatDistortion measure(const Eigen::MatrixX2d& uv, const Eigen::MatrixX3i& t,
   return d;
 }
 
-// The interior vertices' angle defects 2π − Σθ (rad), positive ones and negative ones summed
-// (FlatDistortion::dome, saddle). The boundary's vertices are left out: their defect is the
-// outline's turning, not the surface's curvature.
-std::pair<double, double> angle_defects(const Eigen::MatrixX3d& v, const Eigen::MatrixX3i& t,
-                                        const std::vector<int>& boundary) {
+// How a surface curves: its interior vertices' angle defects 2π − Σθ (rad), the positive ones
+// and the negative ones summed (FlatDistortion::dome, saddle), and the defect-weighted centre of
+// the domed ones (m). The boundary's vertices are left out: their defect is the outline's
+// turning, not the surface's curvature.
+struct SurfaceCurvature {
+  double dome = 0, saddle = 0;
+  Eigen::Vector3d dome_centre = Eigen::Vector3d::Zero();
+};
+
+SurfaceCurvature angle_defects(const Eigen::MatrixX3d& v, const Eigen::MatrixX3i& t,
+                               const std::vector<int>& boundary) {
   std::vector<double> angle(static_cast<size_t>(v.rows()), 0.0);
   for (Eigen::Index f = 0; f < t.rows(); ++f)
     for (int k = 0; k < 3; ++k) {
@@ -312,10 +317,42 @@ std::pair<double, double> angle_defects(const Eigen::MatrixX3d& v, const Eigen::
       angle[static_cast<size_t>(t(f, k))] += std::atan2(u.cross(w).norm(), u.dot(w));
     }
   for (const int b : boundary) angle[static_cast<size_t>(b)] = 2 * std::numbers::pi;
-  double dome = 0, saddle = 0;
-  for (const double a : angle)
-    (a < 2 * std::numbers::pi ? dome : saddle) += 2 * std::numbers::pi - a;
-  return {dome, saddle};
+  SurfaceCurvature c;
+  for (size_t i = 0; i < angle.size(); ++i) {
+    const double defect = 2 * std::numbers::pi - angle[i];
+    if (defect > 0) {
+      c.dome += defect;
+      c.dome_centre += defect * v.row(static_cast<Eigen::Index>(i)).transpose();
+    } else {
+      c.saddle += defect;
+    }
+  }
+  if (c.dome > 0) c.dome_centre /= c.dome;
+  return c;
+}
+
+// A surface that curves round past its widest girth (a cap beyond a hemisphere, a hood closing
+// round the head) is refused whatever the mesh: its net curvature (dome + saddle, which the
+// facets' noise does not build up) is above the 2π of a hemisphere. Its rim is then shorter than
+// a girth inside it, which a flat piece can only follow by folding or by stretching a third or
+// more. The stretch's 95th percentile alone missed such caps at fine meshes: a 110° spherical
+// cap was refused at 32-128 quads across and only warned at 192 (ARAP makes fewer sweeps there
+// before its moves fall under the stop), while its curvature is the same at every size.
+void refuse_closing_surface(const std::string& name, const SurfaceCurvature& c) {
+  const double net = c.dome + c.saddle;
+  if (!(net > 2 * std::numbers::pi)) return;
+  // The spherical cap with the same total curvature 2π(1 − cos α).
+  const double cap_degrees =
+      std::acos(std::max(-1.0, 1 - net / (2 * std::numbers::pi))) * 180 / std::numbers::pi;
+  throw PatternError(
+      name,
+      fmt::format("panel '{}' cannot be cut from flat cloth: it curves round like a nearly "
+                  "closed cap ({:.1f} rad of curvature, as much as a cap reaching {:.0f}° "
+                  "from its top; a hemisphere has 6.28), centred near ({:.3f}, {:.3f}, "
+                  "{:.3f}) m, so its edge is shorter than the girth inside it and a flat "
+                  "piece would fold or stretch by a third or more; split it with seams or "
+                  "darts (a hood or a close cap is cut from two or more pieces)",
+                  name, net, cap_degrees, c.dome_centre.x(), c.dome_centre.y(), c.dome_centre.z()));
 }
 
 // Where on the piece a 2D point lies, in words ("at the upper left", "in the middle").
@@ -379,6 +416,8 @@ FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
   out.boundary = disk_boundary(name, v.rows(), t);
   const std::vector<RestTriangle> rest = rest_triangles(v, t, name);
   for (const RestTriangle& r : rest) out.area_3d += r.area;
+  const SurfaceCurvature curvature = angle_defects(v, t, out.boundary);
+  refuse_closing_surface(name, curvature);
 
   const Eigen::MatrixX2d start = lscm_start(name, v, t, out.area_3d);
   Eigen::MatrixX2d uv = start;
@@ -415,7 +454,8 @@ FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
   out.uv = uv;
   for (Eigen::Index f = 0; f < t.rows(); ++f) out.area_2d += signed_area_2d(uv, t, f);
   out.distortion = measure(uv, t, rest);
-  std::tie(out.distortion.dome, out.distortion.saddle) = angle_defects(v, t, out.boundary);
+  out.distortion.dome = curvature.dome;
+  out.distortion.saddle = curvature.saddle;
   judge_stretch(out, options);
   return out;
 }

@@ -3,8 +3,10 @@
 // with no vertex inside the body and no fold through another, hangs from the shoulders or the waist
 // where the shaped drape does, and its cloth is stretched from the pattern by no more than the
 // flattening had to stretch it. The arms-lowering t-shirt, whose body moves until 2 s of its 3 s,
-// drapes for 6 s with its body-vertex springs released at no load ("fade_carried_push"; without
-// it its hem cycles, docs/collision.md).
+// drapes for 6 s. From flat cloth the body-vertex springs are released at no load
+// (fade_carried_push, the flat rest's default; docs/pattern.md, "Drapes that do not rest"):
+// without it the arms-lowering t-shirt's hem, the Collada top's collar and the Collada pencil
+// skirt's hem by the knee cycle and never rest.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -51,7 +53,6 @@ struct FlatExample {
   std::string folder = "data/examples";  // or data/designs
   double duration = 0.0;                 // s; 0: the file's
   double strain_max = 0.10;              // the largest strain against the pattern in any piece
-  bool fade_carried_push = false;        // simulate.fade_carried_push
 };
 
 class FlatRestDrape : public ::testing::TestWithParam<FlatExample> {};
@@ -64,6 +65,12 @@ TEST_P(FlatRestDrape, ComesToRestHangingWhereTheShapedDrapeDoes) {
   fs::create_directories(dir);
   nlohmann::json sketch =
       read_json(fs::path(SD_SOURCE_DIR) / example.folder / (example.name + ".json"));
+  // The Collada human comes with Debian's assimp-testmodels; without it the design cannot run.
+  const nlohmann::json& body = sketch.contains("body") ? sketch["body"] : nlohmann::json();
+  const nlohmann::json mesh = body.is_object() ? body.value("mesh", nlohmann::json()) : body;
+  if (mesh.is_string() && mesh.get<std::string>().starts_with("/") &&
+      !fs::exists(mesh.get<std::string>()))
+    GTEST_SKIP() << "the design's body is not installed: " << mesh.get<std::string>();
   sketch["output"] = {{"images", nlohmann::json::array()}};
   sketch["simulate"]["rest"] = "flat";
   // With adaptive detail the mesh keeps refining where folds move, and the shaped t-shirt is not
@@ -74,7 +81,6 @@ TEST_P(FlatRestDrape, ComesToRestHangingWhereTheShapedDrapeDoes) {
     sketch["simulate"]["duration"] = 3.0;
   }
   if (example.duration > 0.0) sketch["simulate"]["duration"] = example.duration;
-  if (example.fade_carried_push) sketch["simulate"]["fade_carried_push"] = true;
   const fs::path sketch_path = dir / (example.name + ".json");
   std::ofstream(sketch_path) << sketch.dump(2);
   const CommandResult ran =
@@ -140,7 +146,20 @@ INSTANTIATE_TEST_SUITE_P(
                       // back's sides onto the body: 13.4-14.7 % at most there (13.7-13.8 %
                       // without the fade; under 8.3 % elsewhere; means 1.1-2.4 %).
                       FlatExample{"tshirt-arms-lowering", 1.47, 1.53, false, "data/examples", 6.0,
-                                  0.16, true}),
+                                  0.16}),
+    test_name);
+
+// Two designs on the Collada human that rest from flat cloth only with the fade, the flat rest's
+// default (27 November, round 8: not at rest in 10 s without it, a body-vertex spring caught
+// and dropped every 16 steps under the collar's back and at the hem by the left knee; with it
+// at rest at 3.58 s and 2.82 s). Their shaped drapes end with the top at 1.437 m and 1.031 m;
+// the flat ones within 2 cm of that (1.438 m, 1.051 m: the skirt's pattern, short over the
+// seat, holds it higher), so ±3 cm. The top's backs are stretched 9.2 % at most over the
+// shoulder blades, where its pattern's stretch is largest (means 1.0-2.7 %).
+INSTANTIATE_TEST_SUITE_P(
+    Designs, FlatRestDrape,
+    ::testing::Values(FlatExample{"collar-top-human", 1.41, 1.47, false, "data/designs", 0.0, 0.12},
+                      FlatExample{"pencil-skirt-human", 1.00, 1.06, false, "data/designs"}),
     test_name);
 
 }  // namespace

@@ -360,6 +360,41 @@ TEST(PatternCommand, SvgOpensInHeadlessChromium) {
   // Lines, labels and grain lines are neither colour: the white share sits a little below.
   EXPECT_NEAR(covered, json["efficiency"].get<double>(), 0.05);
   EXPECT_GT(covered, 0.3);
+  // The drawn pieces counted in the screenshot: connected white regions (4-neighbours) of the
+  // fabric. Pieces lie 1 cm (8 px) apart on the fabric's colour; inside one, the sewing line is
+  // dashed and the grain line, notches and label do not cut it across, so each piece is one
+  // region. The white inside a letter is a region too, but of a few pixels: only regions over
+  // 2,000 px (about 31 cm² at 0.8 px/mm; the t-shirt's smallest piece is a sleeve of several
+  // hundred) count.
+  std::vector<char> seen(static_cast<size_t>(image.width) * static_cast<size_t>(fabric_rows), 0);
+  const auto is_white = [&](int x, int y) {
+    const std::uint8_t* p = image.pixel(x, y);
+    return p[0] == 255 && p[1] == 255 && p[2] == 255;
+  };
+  size_t drawn = 0;
+  for (int y0 = 2; y0 < fabric_rows; ++y0)
+    for (int x0 = 2; x0 < image.width - 2; ++x0) {
+      const size_t k0 = static_cast<size_t>(y0) * static_cast<size_t>(image.width) + x0;
+      if (seen[k0] || !is_white(x0, y0)) continue;
+      long size = 0;
+      std::vector<std::pair<int, int>> stack{{x0, y0}};
+      seen[k0] = 1;
+      while (!stack.empty()) {
+        const auto [x, y] = stack.back();
+        stack.pop_back();
+        ++size;
+        for (const auto& [dx, dy] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
+          const int nx = x + dx, ny = y + dy;
+          if (nx < 2 || nx >= image.width - 2 || ny < 2 || ny >= fabric_rows) continue;
+          const size_t k = static_cast<size_t>(ny) * static_cast<size_t>(image.width) + nx;
+          if (seen[k] || !is_white(nx, ny)) continue;
+          seen[k] = 1;
+          stack.emplace_back(nx, ny);
+        }
+      }
+      if (size > 2000) ++drawn;
+    }
+  EXPECT_EQ(drawn, json["pieces"].size());
 }
 
 // The DXF read by a real DXF library: one block per piece, each with a closed boundary (layer
