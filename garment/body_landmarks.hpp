@@ -28,7 +28,9 @@ struct BodyLandmarks {
 
   // nullptr when there is no landmark of that name.
   const Landmark* find(std::string_view name) const;
-  // The landmark closest to p (the body has at least one).
+  // The landmark that names p's place: the closest, but an elbow or a wrist only for a place near
+  // the arm and the torso's levels (neck base, chest, waist, hips, crotch) mostly by height
+  // (docs/bodies.md, "Landmarks"). The body has at least one.
   const Landmark& nearest(const Eigen::Vector3d& p) const;
 };
 
