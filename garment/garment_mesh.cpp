@@ -181,16 +181,28 @@ PanelNetwork resolve_network(const GarmentRequest& sketch, const BodySurface& bo
   EdgeCounts counts = compute_edge_counts(sketch, net, loops);
   check_single_edges_apart(sketch, body, net, loops, counts);
   {
-    std::vector<double> boundary_edges;
-    std::vector<std::string> paths, ids;
+    // Each panel's size from its edge counts and its curves' polylines, before any fill.
+    std::vector<PanelSize> sizes;
     for (const PanelLoop& loop : loops) {
-      double edges = 0;
-      for (const LoopEdge& e : loop.edges) edges += counts.counts[static_cast<size_t>(e.edge)];
-      boundary_edges.push_back(edges);
-      paths.push_back(loop.json_path);
-      ids.push_back(loop.id);
+      PanelSize& size = sizes.emplace_back();
+      size.id = loop.id;
+      size.path = loop.json_path;
+      size.mirror_copy = loop.mirror_copy;
+      std::vector<Eigen::Vector3d> outline;
+      for (const LoopEdge& e : loop.edges) {
+        const NetworkEdge& edge = net.edges[static_cast<size_t>(e.edge)];
+        size.boundary_edges += counts.counts[static_cast<size_t>(e.edge)];
+        size.boundary_length += edge.length;
+        const Eigen::Index n = edge.points.rows();
+        for (Eigen::Index j = 0; j + 1 < n; ++j)
+          outline.emplace_back(edge.points.row(e.forward ? j : n - 1 - j).transpose());
+      }
+      size.area = fan_area(outline);
     }
-    check_panel_sizes(sketch, boundary_edges, paths, ids);
+    check_panel_sizes(sketch, sizes);
+    double total = 0;
+    for (const PanelSize& size : sizes) total += estimated_quads(size);
+    spdlog::debug("{}: about {:.0f} quads expected", sketch.file, total);
   }
 
   return {std::move(net), std::move(loops), std::move(counts)};

@@ -3,12 +3,13 @@
 #include <fmt/format.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <bit>
 #include <cstdint>
 #include <cstring>
 #include <optional>
 #include <span>
 #include <tuple>
-#include <unordered_map>
 #include <utility>
 
 #include "garment/fold_repair.hpp"
@@ -49,20 +50,113 @@ constexpr int kAlongRings = 2;
 // A quad this many times longer than wide is a sliver (the quality gate warns from 10).
 constexpr double kSliverAspect = 10;
 
-// Hash of a point's coordinates bit for bit (a cache of exact repeats; -0 and 0 are two keys,
-// which only costs a miss).
-struct ExactPointHash {
-  size_t operator()(const Eigen::Vector3d& p) const {
-    size_t h = 0;
-    for (int k = 0; k < 3; ++k) {
-      std::uint64_t bits = 0;
-      std::memcpy(&bits, &p[k], sizeof bits);
-      h = (h ^ bits) * 0x100000001b3ULL;
-      h ^= h >> 29;
-    }
-    return h;
+// Hash of a point's coordinates bit for bit (-0 and 0 are two keys, which only costs a miss).
+size_t exact_point_hash(const Eigen::Vector3d& p) {
+  size_t h = 0;
+  for (int k = 0; k < 3; ++k) {
+    std::uint64_t bits = 0;
+    std::memcpy(&bits, &p[k], sizeof bits);
+    h = (h ^ bits) * 0x100000001b3ULL;
+    h ^= h >> 29;
   }
+  return h;
+}
+
+// The finaliser of splitmix64: every bit of `x` reaches the low bits a table index takes.
+std::uint64_t mix_bits(std::uint64_t x) {
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+// The last closest body point found in each cell of a grid, by the cell's 64-bit key (two cells
+// with one key share an entry, as in the std::unordered_map this replaces: same hints, same
+// answers). Open addressing in flat arrays: the map's node per cell and its pointer chase were
+// 14 % of a 0.4 cm shirt's validate, and its lookups missed the cache.
+class CellHints {
+ public:
+  CellHints() {
+    empty_.position.setZero();
+    empty_.normal.setZero();
+  }
+
+  // The hint of the cell `key`, a point without a face (no hint) when the cell is new.
+  SurfacePoint& operator[](std::int64_t key) {
+    if (2 * (size_ + 1) > keys_.size()) grow();
+    const size_t mask = keys_.size() - 1;
+    for (size_t slot = mix_bits(static_cast<std::uint64_t>(key)) & mask;;
+         slot = (slot + 1) & mask) {
+      if (!used_[slot]) {
+        used_[slot] = 1;
+        keys_[slot] = key;
+        hints_[slot] = empty_;
+        ++size_;
+        return hints_[slot];
+      }
+      if (keys_[slot] == key) return hints_[slot];
+    }
+  }
+
+ private:
+  void grow() {
+    std::vector<std::int64_t> keys = std::move(keys_);
+    std::vector<char> used = std::move(used_);
+    std::vector<SurfacePoint> hints = std::move(hints_);
+    const size_t slots = std::max<size_t>(1024, 2 * keys.size());
+    keys_.assign(slots, 0);
+    used_.assign(slots, 0);
+    hints_.assign(slots, empty_);
+    size_ = 0;
+    for (size_t k = 0; k < keys.size(); ++k)
+      if (used[k]) (*this)[keys[k]] = hints[k];
+  }
+
+  std::vector<std::int64_t> keys_;
+  std::vector<char> used_;
+  std::vector<SurfacePoint> hints_;
+  size_t size_ = 0;
+  SurfacePoint empty_;  // no face: no hint
 };
+
+// The answers of recent queries by query point, bit for bit, in a table of fixed size where a
+// new answer replaces the one in its slot (a cache, not a record of every query). A fill asks
+// again for points it asked shortly before (a vertex whose neighbours did not move, the
+// untangling's candidates). A std::unordered_map of every answer held 1.3 million of them
+// (about 250 MB) for the back of the long-sleeved tee at 0.4 cm edges and missed the processor's
+// cache on most lookups; a lost answer is only asked again, to the same bits (the answers kept
+// are those that do not depend on the hint).
+template <typename Answer>
+class RecentAnswers {
+ public:
+  // `slots`: a power of two.
+  explicit RecentAnswers(size_t slots) : slots_(slots) {}
+
+  const Answer* find(const Eigen::Vector3d& p) const {
+    const Slot& slot = slots_[index(p)];
+    return slot.used && slot.point == p ? &slot.answer : nullptr;
+  }
+  void store(const Eigen::Vector3d& p, const Answer& answer) {
+    Slot& slot = slots_[index(p)];
+    slot.used = true;
+    slot.point = p;
+    slot.answer = answer;
+  }
+
+ private:
+  struct Slot {
+    Eigen::Vector3d point = Eigen::Vector3d::Zero();
+    Answer answer{};
+    bool used = false;
+  };
+  size_t index(const Eigen::Vector3d& p) const {
+    return mix_bits(exact_point_hash(p)) & (slots_.size() - 1);
+  }
+  std::vector<Slot> slots_;
+};
+
+// Slots of a panel's RecentAnswers: about 4 per vertex the panel is expected to have (its
+// boundary vertices squared over 16, a square's), a power of two between these bounds.
+constexpr size_t kLeastAnswerSlots = size_t{1} << 10, kMostAnswerSlots = size_t{1} << 16;
 
 // The unit vector area of a panel's boundary loop (the sides, corner to corner), or zero.
 Eigen::Vector3d loop_facing(const std::vector<Eigen::MatrixX3d>& side_points) {
@@ -128,7 +222,7 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
   // Each query starts from the last answer found in the same cell of half an edge length: a
   // vertex moves less than that per relaxation sweep, so the hint is usually its own last
   // projection (a hash collision only gives a poorer hint, never another answer).
-  std::unordered_map<std::int64_t, SurfacePoint> hints;
+  CellHints hints;
   const double cell = 0.5 * reach;
   // The panel faces `facing` (its boundary's vector area: the loop runs counter-clockwise
   // seen from outside). A point whose closest body point faces the other way has crossed
@@ -138,15 +232,17 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
   // panel's side instead: a ray from outside the body's box along −facing.
   const Eigen::Vector3d facing = loop_facing(side_points);
   const double outside = (body.box().max - body.box().min).norm();
-  // The answers by query point, bit for bit: a fill asks again for points it asked before
-  // (a vertex whose neighbours did not move, the untangling's candidates): 28 % of the
-  // raglan's and the shorts' queries. A point with equally near body triangles is not kept
-  // (which of them the tree answers may depend on the hint).
+  // Recent answers by query point, bit for bit: 28 % of the raglan's and the shorts' queries
+  // repeat one (RecentAnswers). A point with equally near body triangles is not kept (which of
+  // them the tree answers may depend on the hint).
   struct Answer {
     SurfacePoint nearest;  // the body's closest point (the hint it leaves)
     SurfacePoint chosen;   // what `closest` returns
   };
-  std::unordered_map<Eigen::Vector3d, Answer, ExactPointHash> answers;
+  size_t boundary_vertices = 0;
+  for (const auto& side : side_points) boundary_vertices += static_cast<size_t>(side.rows());
+  RecentAnswers<Answer> answers(std::clamp(std::bit_ceil(boundary_vertices * boundary_vertices / 4),
+                                           kLeastAnswerSlots, kMostAnswerSlots));
   const auto closest = [&body, &hints, &answers, cell, facing,
                         outside](const Eigen::Vector3d& p) -> SurfacePoint {
     const Eigen::Vector3d q = (p / cell).array().floor();
@@ -154,9 +250,9 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
                              (static_cast<std::int64_t>(q.y()) * 19349663) ^
                              (static_cast<std::int64_t>(q.z()) * 83492791);
     SurfacePoint& hint = hints[key];
-    if (const auto known = answers.find(p); known != answers.end()) {
-      hint = known->second.nearest;
-      return known->second.chosen;
+    if (const Answer* known = answers.find(p)) {
+      hint = known->nearest;
+      return known->chosen;
     }
     hint = body.closest_point(p, hint);
     SurfacePoint chosen = hint;
@@ -166,7 +262,7 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
           (seen->position - p).norm() < kSeenReach * hint.distance)
         chosen = *seen;
     }
-    if (!hint.tied) answers.emplace(p, Answer{hint, chosen});
+    if (!hint.tied) answers.store(p, Answer{hint, chosen});
     return chosen;
   };
   const SurfaceLift lift = [&closest, offset, reach](const Eigen::Vector3d& p) -> LiftedPoint {

@@ -5,6 +5,7 @@
 // once the body is loaded (check_against_body) and once the edge counts are known
 // (check_panel_sizes). Every failure is a SketchError at the value's JSON path.
 
+#include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -53,8 +54,19 @@ inline constexpr double kBodyMarginHeights = 1.0;
 inline constexpr double kMaxCurveLengthHeights = 5.0;
 // All curves' control polygons together, in body heights (bounds the samples projected).
 inline constexpr double kMaxTotalCurveLengthHeights = 200.0;
-// The garment's quads, estimated from the panels' boundary edge counts before filling.
-inline constexpr double kMaxGarmentQuads = 400000;
+// The garment's quads, estimated before filling (estimated_quads below): above this the file is
+// refused before any panel is filled, with what it would cost and the edge length that fits.
+// The long-sleeved tee at 0.4 cm (51,000 quads) takes 35 s of CPU and 155 MB to validate; at
+// 150,000 quads meshing alone would take about two and a half minutes and 450 MB (docs/garment.md,
+// "Meshing time and memory at fine edge lengths").
+inline constexpr double kMaxGarmentQuads = 150000;
+// `fill --sides`: one flat region, no body to lift onto.
+inline constexpr double kMaxFillQuads = 400000;
+// What meshing a garment costs per quad (CPU seconds, peak resident bytes), for the message:
+// 0.70 ms and 3.0 kB per quad measured on the long-sleeved tee at 0.4 cm; the time per quad grows
+// with the fineness (folds, docs/garment.md), hence 1 ms.
+inline constexpr double kMeshingSecondsPerQuad = 1e-3;
+inline constexpr double kMeshingBytesPerQuad = 3000;
 
 // "130 m is outside ...": the sentence for a coordinate or length `value` (metres) that is out of
 // range, with a hint when it reads as centimetres or millimetres typed for metres (its hundredth
@@ -66,15 +78,34 @@ std::string out_of_range_sentence(double value, double low, double high, const s
 // at most kMaxCurveLengthHeights body heights long. Throws SketchError.
 void check_against_body(const GarmentRequest& sketch, const meshing::BoundingBox& body_box);
 
-// The quads a panel whose boundary has `boundary_edges` edges can hold at most (a square region
+// The quads a region whose boundary has `boundary_edges` edges can hold at most (a square region
 // of that perimeter): (B/4)².
 double estimated_quads(double boundary_edges);
 
+// A panel's size as the edge counts and its curves give it, before it is filled.
+struct PanelSize {
+  std::string id;    // "front", "front.mirror"
+  std::string path;  // the panel's JSON path
+  bool mirror_copy = false;
+  double boundary_edges = 0;
+  double boundary_length = 0;  // m
+  double area = 0;  // m²: the fan of triangles from its outline's centroid to its outline
+};
+
+// A panel's quads, estimated: its area over its mean boundary edge squared (the filler keeps
+// quads of about that edge, docs/garment.md "Fill consistency"), the area being 1.1 times the fan
+// of its outline (over the corpus the meshes had 0.93-1.38 times the fan's count), at most (B/4)².
+double estimated_quads(const PanelSize& panel);
+
+// The area of the fan of triangles from the centroid of a closed outline (#P points, the last
+// not repeating the first) to each of its segments: the area of a flat star-shaped outline, and
+// a little less than that of a curved panel spanning it (a half-tube's: 0.8 of it).
+double fan_area(const std::vector<Eigen::Vector3d>& outline);
+
 // Before filling: the garment's estimated quads (sum over panels) must stay below
-// kMaxGarmentQuads. `boundary_edges[p]` and `panel_paths[p]` per panel. Throws SketchError at the
-// largest panel's path, with the edge length that would fit.
-void check_panel_sizes(const GarmentRequest& sketch, const std::vector<double>& boundary_edges,
-                       const std::vector<std::string>& panel_paths,
-                       const std::vector<std::string>& panel_ids);
+// kMaxGarmentQuads. Throws SketchError at the largest panel's path, saying how many quads the
+// garment would have, what meshing them would cost (kMeshingSecondsPerQuad, kMeshingBytesPerQuad)
+// and the edge length that would fit.
+void check_panel_sizes(const GarmentRequest& sketch, const std::vector<PanelSize>& panels);
 
 }  // namespace sd::garment

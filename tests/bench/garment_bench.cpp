@@ -5,7 +5,8 @@
 // `mesh` reports them apart). Each garment on 1 and 2 threads (the argument: build_garment fills
 // the panels side by side, garment/panel_tasks.hpp); "Time" is wall time, "CPU" the whole
 // process's over every thread.
-// Run: ./build/tests/bench/garment_bench
+// "fine/<design>/edge_0.1mm:N": one design at edge length N/10 mm, one iteration each.
+// Run: ./build/tests/bench/garment_bench (--benchmark_filter=fine for the scaling alone)
 
 #include <benchmark/benchmark.h>
 #include <spdlog/spdlog.h>
@@ -62,6 +63,32 @@ void mesh_file(benchmark::State& state, const fs::path& file) {
   state.counters["quads"] = static_cast<double>(quads);
 }
 
+// One design at a finer edge length than its own (state.range(0), in tenths of a millimetre; the
+// panels' and curves' own edge lengths dropped): how meshing grows with the quads
+// (docs/garment.md, "Meshing time and memory"). One iteration: the 0.4 cm tee takes ~30 s.
+void mesh_fine(benchmark::State& state, const fs::path& file) {
+  sd::scene::Sketch sketch = sd::scene::load_sketch(file);
+  if (!fs::exists(sketch.resolve(sketch.body.mesh)) && sketch.body.mesh != "builtin") {
+    state.SkipWithError("the design's body is not installed");
+    return;
+  }
+  sketch.edge_length = static_cast<double>(state.range(0)) * 1e-4;
+  for (sd::garment::PanelSpec& panel : sketch.panels) panel.edge_length.reset();
+  for (sd::garment::CurveSpec& curve : sketch.curves) curve.edge_length.reset();
+  const sd::garment::BodySurface& body = body_of(file);
+  sd::garment::set_panel_threads(1);
+  long quads = 0;
+  for (auto _ : state) {
+    const sd::garment::Garment g = sd::garment::build_garment(sketch, body);
+    quads = static_cast<long>(g.mesh.face_count());
+    benchmark::DoNotOptimize(g.mesh.vertices.data());
+  }
+  state.counters["quads"] = static_cast<double>(quads);
+  state.counters["time_per_quad"] =
+      benchmark::Counter(static_cast<double>(quads), benchmark::Counter::kIsIterationInvariantRate |
+                                                         benchmark::Counter::kInvert);
+}
+
 void body_surface_build(benchmark::State& state) {
   static const sd::garment::Body body = sd::garment::load_body("builtin");
   for (auto _ : state) {
@@ -92,6 +119,19 @@ int main(int argc, char** argv) {
           ->Arg(2)
           ->MeasureProcessCPUTime()
           ->Unit(benchmark::kMillisecond);
+  for (const char* design : {"long-sleeve-tee", "tee-dress-human"}) {
+    const fs::path file =
+        fs::path(SD_SOURCE_DIR) / "data/designs" / (std::string(design) + ".json");
+    benchmark::RegisterBenchmark((std::string("fine/") + design).c_str(),
+                                 [file](benchmark::State& state) { mesh_fine(state, file); })
+        ->ArgName("edge_0.1mm")
+        ->Arg(200)
+        ->Arg(100)
+        ->Arg(40)
+        ->Iterations(1)
+        ->MeasureProcessCPUTime()
+        ->Unit(benchmark::kMillisecond);
+  }
   benchmark::RegisterBenchmark("body_surface_build", body_surface_build)
       ->Unit(benchmark::kMillisecond);
   benchmark::Initialize(&argc, argv);

@@ -38,6 +38,13 @@ constexpr std::array<double, 4> kSweep = {0.02, 0.025, 0.03, 0.035};
 // may have at most kOutsideShare of its quads there (tapering panels, a godet's apex, need
 // small quads; see the test's comment on what is left).
 constexpr double kSmallest = 0.5, kLargest = 2.0, kOutsideShare = 0.04;
+// Over every example and design at the four edge lengths together: the quads outside the band as
+// measured on 27 November 2026 (docs/garment.md, "Which plans and which vertices": 578 of about
+// 170,000), and of them the large quads at an interior vertex of valence 5 or more (73), whose
+// cause, the plain mean of the smoothing around such a vertex, is not mended yet. Bounds that
+// only hold what is reached: a change of the filler or of the smoothing that adds out-of-band
+// quads fails here, one that removes some lowers them.
+constexpr int kMostOutside = 578, kMostLargeAtValence5 = 73;
 
 std::vector<fs::path> garment_files() {
   std::vector<fs::path> files = test::example_files();
@@ -146,6 +153,8 @@ TEST(FillConsistency, QuadCountsFallAndSizesFollowTheEdgeLength) {
     ++garments;
   }
   EXPECT_GE(garments, 6);
+  EXPECT_LE(total_outside, kMostOutside);
+  EXPECT_LE(causes["large, interior valence 5+"], kMostLargeAtValence5);
   // The figures docs/garment.md reports ("Fill consistency").
   RecordProperty("outside_share_all",
                  std::to_string(total_outside) + " of " + std::to_string(total_quads));

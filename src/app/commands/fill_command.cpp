@@ -59,16 +59,15 @@ std::vector<int> parse_sides(const std::string& text) {
     counts.push_back(value);
   }
   if (counts.empty()) throw FillUsageError("--sides needs at least two edge counts, like 4,4");
-  // The same bound as a sketch's panels (garment/sketch_ranges.hpp): a region of B boundary
-  // edges holds up to (B/4)² quads.
+  // A region of B boundary edges holds up to (B/4)² quads (garment/sketch_ranges.hpp).
   double total = 0;
   for (int c : counts) total += std::max(c, 0);
-  if (garment::estimated_quads(total) > garment::kMaxGarmentQuads)
+  if (garment::estimated_quads(total) > garment::kMaxFillQuads)
     throw FillUsageError(fmt::format(
         "--sides: {:.0f} boundary edges make up to {:.3g} quads, more than the {:.0f} this "
         "program fills; at most {:.0f} edges in all",
-        total, garment::estimated_quads(total), garment::kMaxGarmentQuads,
-        4 * std::sqrt(garment::kMaxGarmentQuads)));
+        total, garment::estimated_quads(total), garment::kMaxFillQuads,
+        4 * std::sqrt(garment::kMaxFillQuads)));
   return counts;
 }
 
