@@ -518,7 +518,7 @@ void check_fans(const GarmentRequest& sketch, const CurveNetwork& net, const Gar
                 list, p.x(), p.y(), p.z(), ends, snap.ends.size() == 1 ? "was" : "were",
                 100 * from_plane, 100 * tol, snap.ends.size() == 1 ? "it was" : "they were",
                 snap.ends.size() == 1 ? "its" : "their", 200 * from_plane, 100 * tol,
-                100 * from_plane));
+                std::floor(1000 * snap.from_plane) / 10));  // below |x|: no longer moved
       }
       sketch.fail(
           "/panels",
