@@ -250,9 +250,6 @@ TEST(Body, AxisParsing) {
   EXPECT_THROW(AxisDirection::parse("w"), BodyError);
 }
 
-}  // namespace
-}  // namespace sd::garment
-
 // A wrong "up" (trial 34: a Y-up Collada human given "+z") lays the figure on its side: 0.43
 // units along the given up but 1.7 along y. Refused as a BodyUpError naming the inferred axis,
 // where it was a "height not plausible" warning and then a missing-landmark error. A flat body
@@ -281,3 +278,6 @@ TEST(Body, UpAlongWhichTheFigureLiesIsRefused) {
   options.scale = 1.0;  // given: the file is what it is (a ground plane, a rod)
   EXPECT_NO_THROW(load_body(file, options));
 }
+
+}  // namespace
+}  // namespace sd::garment
