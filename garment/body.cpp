@@ -18,6 +18,7 @@
 #include <sstream>
 #include <string>
 
+#include "garment/body_up_error.hpp"
 #include "garment/input_checks.hpp"
 #include "garment/sketch_ranges.hpp"
 
@@ -372,20 +373,45 @@ Body load_body(const std::string& path, const BodyOptions& options) {
   raw.source = builtin ? "builtin (" + file + ")" : file;
   raw.box = meshing::bounding_box(mesh);
   const Eigen::Vector3d extent = raw.box.extent();
+  // The axis a standing figure's height runs along by the rule below, for an inferred up and to
+  // check a given one.
+  const auto tallest_axis = [&] {
+    for (int axis : {1, 2, 0})
+      if (extent[axis] >= 0.99 * extent.maxCoeff()) return axis;
+    return 0;
+  };
   if (options.up) {
     raw.up = *options.up;
     raw.up_inferred = false;
+    // A figure less than half as tall along the given up as along another axis lies on its side
+    // (a Y-up file given "+z"): its height would be scaled from its depth, and the landmarks
+    // then fail for want of a standing figure. Arms held out make a figure at most about as
+    // wide as it is tall, so half leaves room for any pose. Only for a figure: the built-in
+    // body, or a file without "height" or "scale" whose height along the given up is no
+    // body's in m, cm or mm while along the tallest axis it is one (a ground plane or a rod
+    // under a sheet, given "scale", is wide and flat on purpose).
+    const auto plausible = [](double h) {
+      return (h >= 0.5 && h <= 2.5) || (h >= 50 && h <= 250) || (h >= 500 && h <= 2500);
+    };
+    const int tallest = tallest_axis();
+    const bool figure =
+        !options.height && !options.scale &&
+        (builtin || (!plausible(extent[raw.up.axis]) && plausible(extent[tallest])));
+    if (figure && tallest != raw.up.axis && extent[raw.up.axis] < 0.5 * extent[tallest]) {
+      const char* names = "xyz";
+      throw BodyUpError(fmt::format(
+          "with \"up\": \"{}{}\" the body lies on its side: it is {:.4g} units along {} but "
+          "{:.4g} along {}, and a standing figure is tallest along its up axis; is \"up\" "
+          "right? The inferred up axis is +{}: give \"up\": \"+{}\" (\"-{}\" if the body "
+          "then stands on its head), or leave \"up\" out",
+          raw.up.sign > 0 ? '+' : '-', names[raw.up.axis], extent[raw.up.axis], names[raw.up.axis],
+          extent[tallest], names[tallest], names[tallest], names[tallest], names[tallest]));
+    }
   } else {
     // Rule: a standing figure is tallest along its up axis; the sign is taken as positive.
     // Extents within 1% of the largest are ties, settled in favour of y, then z (the two
     // conventions in use), then x.
-    const double tallest = extent.maxCoeff();
-    raw.up.axis = 0;
-    for (int axis : {1, 2, 0})
-      if (extent[axis] >= 0.99 * tallest) {
-        raw.up.axis = axis;
-        break;
-      }
+    raw.up.axis = tallest_axis();
     raw.up.sign = 1;
   }
   // Facing follows the common convention of the up axis: Z-up files (Blender) face -Y,

@@ -257,8 +257,21 @@ CurveNetwork build_network(const GarmentRequest& sketch, const std::vector<Proje
   }
 
   // 3. Nodes of mirrored curves near the plane go onto it, so the copies meet the originals.
-  for (size_t node = 0; node < net.nodes.size(); ++node)
-    if (node_mirrored[node] && std::abs(net.nodes[node].x()) < tol) net.nodes[node].x() = 0;
+  for (size_t node = 0; node < net.nodes.size(); ++node) {
+    if (!node_mirrored[node] || std::abs(net.nodes[node].x()) >= tol) continue;
+    if (2 * std::abs(net.nodes[node].x()) >= tol) {
+      PlaneSnap snap;
+      snap.from_plane = std::abs(net.nodes[node].x());
+      for (const int a : node_members[node]) {
+        const auto [c, which] = ends[static_cast<size_t>(a)];
+        snap.ends.push_back(fmt::format("the {} of '{}'", which == 0 ? "start" : "end",
+                                        curves[static_cast<size_t>(c)].id));
+      }
+      snap.at = Eigen::Vector3d(0, net.nodes[node].y(), net.nodes[node].z());
+      net.plane_snaps.push_back(std::move(snap));
+    }
+    net.nodes[node].x() = 0;
+  }
 
   // Closed curves without junctions get one node at their first point.
   for (WorkCurve& w : work)

@@ -31,10 +31,20 @@ struct NetworkCurve {
   std::vector<int> nodes;  // edges.size() + 1 nodes along the curve (closed: first == last)
 };
 
+// A junction of mirrored curves moved onto the mirror plane x = 0 from farther than half the
+// junction tolerance: there it joins its mirror copy, although the two were farther apart than
+// the tolerance. Kept to explain a seam that then meets only at that point.
+struct PlaneSnap {
+  Eigen::Vector3d at = Eigen::Vector3d::Zero();  // m, on x = 0
+  double from_plane = 0;                         // m, |x| before the move
+  std::vector<std::string> ends;                 // "the end of 'hem_f'", ...
+};
+
 struct CurveNetwork {
   std::vector<Eigen::Vector3d> nodes;
   std::vector<NetworkEdge> edges;
   std::vector<NetworkCurve> curves;
+  std::vector<PlaneSnap> plane_snaps;
 
   // Curve by id ("x.mirror" for a copy; the copy of an on-plane curve is the curve itself);
   // -1 when unknown.

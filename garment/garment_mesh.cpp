@@ -1,6 +1,7 @@
 #include "garment/garment_mesh.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include <Eigen/Geometry>
@@ -507,7 +508,7 @@ void assemble_mesh(std::vector<std::array<int, 4>>& faces, std::vector<int>& fac
 }
 
 // Stage 5, the seams checked: every vertex's quads form one fan.
-void check_fans(const GarmentRequest& sketch, const Garment& garment,
+void check_fans(const GarmentRequest& sketch, const CurveNetwork& net, const Garment& garment,
                 const std::vector<std::array<int, 4>>& faces, const std::vector<int>& face_panel,
                 const VertexPool& pool) {
   // Every vertex's quads must form one fan (joined through edges at the vertex): panels that
@@ -556,6 +557,31 @@ void check_fans(const GarmentRequest& sketch, const Garment& garment,
       std::string list;
       for (const std::string& name : names) list += (list.empty() ? "'" : ", '") + name + "'";
       const Eigen::Vector3d& p = pool.positions[v];
+      // Curve ends moved onto the mirror plane there, each near enough to it, but farther from
+      // their own mirror copies than the tolerance (culottes' inner hems ending 1.2 cm either
+      // side of x = 0): the point is of the program's making, and the message says so.
+      for (const PlaneSnap& snap : net.plane_snaps) {
+        const double tol = sketch.junction_tolerance;
+        if ((snap.at - p).norm() > 0.25 * tol) continue;  // the node's vertex, however moved
+        // To the millimetre, so that the distance to the copy reads as twice it (1.2, 2.4 cm).
+        const double from_plane = std::round(1000 * snap.from_plane) / 1000;
+        std::string ends;  // "the end of 'a', the end of 'b' and the start of 'c'"
+        for (size_t k = 0; k < snap.ends.size(); ++k)
+          ends += (k == 0 ? "" : (k + 1 == snap.ends.size() ? " and " : ", ")) + snap.ends[k];
+        sketch.fail(
+            "/panels",
+            fmt::format(
+                "panels {} meet only at the point ({:.3f}, {:.3f}, {:.3f}) m, not along a seam: "
+                "{} {} {:.1f} cm from the mirror plane x = 0, closer than junction_tolerance "
+                "({:.1f} cm), so {} moved onto it and joined to {} mirror copy, {:.1f} cm away. "
+                "To keep the two sides apart, end the curves at least {:.1f} cm from x = 0 or "
+                "lower junction_tolerance to {:.1f} cm or less; for a seam on the plane (a centre "
+                "front), draw the curve at x = 0",
+                list, p.x(), p.y(), p.z(), ends, snap.ends.size() == 1 ? "was" : "were",
+                100 * from_plane, 100 * tol, snap.ends.size() == 1 ? "it was" : "they were",
+                snap.ends.size() == 1 ? "its" : "their", 200 * from_plane, 100 * tol,
+                std::floor(1000 * snap.from_plane) / 10));  // below |x|: no longer moved
+      }
       sketch.fail(
           "/panels",
           fmt::format("panels {} meet only at the point ({:.3f}, {:.3f}, {:.3f}) m, not along "
@@ -1026,7 +1052,7 @@ Garment build_garment(const GarmentRequest& sketch, const BodySurface& body) {
   repair_stitched_folds(sketch, net, body, loops, face_range, loop_globals, patches, faces, pool,
                         garment);
   assemble_mesh(faces, face_panel, pool, garment);
-  check_fans(sketch, garment, faces, face_panel, pool);
+  check_fans(sketch, net, garment, faces, face_panel, pool);
   const auto curve_of = [&](int a, int b) -> std::string {
     for (size_t e = 0; e < net.edges.size(); ++e) {
       const std::vector<int>& ids = boundary.placed_ids(static_cast<int>(e));

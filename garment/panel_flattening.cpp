@@ -383,17 +383,29 @@ void judge_stretch(FlatPanel& out, const FlatteningOptions& options) {
                     name, 100 * d.length_p95, where_on_piece(uv, d.worst_point_2d),
                     d.worst_point.x(), d.worst_point.y(), d.worst_point.z()));
   if (d.length_p95 <= options.warn_stretch) return;
-  // What to do depends on how the surface curves: the larger of its domed and saddle parts.
+  // What to do depends on how the surface curves: the larger of its domed and saddle parts,
+  // and for a saddle, where it is. The piece is turned with its grain up, so a saddle in the
+  // lowest third lies towards the hem, where a flare drawn wider than a cone makes one and a
+  // godet is the tailor's answer; higher up (a bodice back between the shoulder blades and the
+  // waist) the answer is a dart or a seam.
+  const double lo = uv.col(1).minCoeff(), hi = uv.col(1).maxCoeff();
+  const bool towards_hem = d.worst_point_2d.y() - lo < (hi - lo) / 3;
+  const std::string saddle_cure =
+      towards_hem
+          ? "as where a hem is drawn wider than a cone from the seam above would make it: cut "
+            "flat, the piece keeps its seams and hem at their drawn lengths and gathers the "
+            "difference into a point or a kink of its outline; a seam there or a godet (a wedge "
+            "of cloth let in at the hem) would let the cloth lie as drawn"
+          : "as where cloth is drawn into the hollow of the back or the waist: cut flat, the "
+            "piece keeps its seams at their drawn lengths and gathers the difference into a "
+            "point or a kink of its outline; a dart or a seam through that place (on a bodice, "
+            "a waist or shoulder dart) would let the cloth lie as drawn";
   const std::string advice =
       -d.saddle > d.dome
           ? fmt::format(
-                "the surface is saddle-shaped ({:.2f} rad more angle round its points than flat "
-                "cloth has, {:.2f} rad less), as where a hem is drawn wider than a cone from the "
-                "seam above would make it: cut flat, the piece keeps its seams and hem at their "
-                "drawn lengths and gathers the difference into a point or a kink of its outline; "
-                "a seam there or a godet (a wedge of cloth let in) would let the cloth lie as "
-                "drawn",
-                -d.saddle, d.dome)
+                "the surface is saddle-shaped ({:.2f} rad more angle round its points "
+                "than flat cloth has, {:.2f} rad less), {}",
+                -d.saddle, d.dome, saddle_cure)
           : fmt::format(
                 "the surface is domed ({:.2f} rad less angle round its points than flat cloth "
                 "has, {:.2f} rad more), like the seat or the shoulder blades: a dart or a seam "

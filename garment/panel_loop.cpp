@@ -192,6 +192,24 @@ std::vector<LoopEdge> resolve_explicit(const GarmentRequest& sketch, const Curve
                                       : fmt::format("in panel{} {}", users.size() == 1 ? "" : "s",
                                                     fmt::join(users, " and "))));
     }
+    // A curve of this same list that joins the two (the boundary listed out of order:
+    // ["hip", "hem", "side", "centre"]): the one listed later first, as moving it is the
+    // smaller edit.
+    std::string bridge;
+    for (size_t n = 0; bridge.empty() && n + 2 < k; ++n) {
+      const size_t j = (i + 2 + n) % k;
+      const int c = curve_ids[j];
+      if (c == a || c == b) continue;
+      bool meets_a = false, meets_b = false;
+      for (int node : net.curves[static_cast<size_t>(c)].nodes) {
+        meets_a = meets_a || curve_has_node(net, a, node);
+        meets_b = meets_b || curve_has_node(net, b, node);
+      }
+      if (meets_a && meets_b)
+        bridge = fmt::format("; '{}' ({} in this list) joins them: put it after '{}'?",
+                             panel.boundary[j], j > i ? "listed later" : "listed earlier",
+                             panel.boundary[i]);
+    }
     const std::string where =
         !spans.empty()
             ? fmt::format(
@@ -208,7 +226,8 @@ std::vector<LoopEdge> resolve_explicit(const GarmentRequest& sketch, const Curve
                   "(their junctions are {:.1f} cm apart, '{}' at {} m and '{}' at {} m; "
                   "curves meet when their ends are within {:.1f} cm{})",
                   gap.distance * 100, panel.boundary[i], at(gap.on_a), next, at(gap.on_b),
-                  sketch.junction_tolerance * 100, gap_advice(sketch, panel.boundary[i], next));
+                  sketch.junction_tolerance * 100,
+                  bridge.empty() ? gap_advice(sketch, panel.boundary[i], next) : bridge);
     if (i + 1 == k)
       sketch.fail(fmt::format("{}/boundary", panel.json_path),
                   fmt::format("panel '{}' does not close: its last curve '{}' does not meet its "

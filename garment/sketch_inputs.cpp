@@ -7,6 +7,7 @@
 #include <sstream>
 #include <vector>
 
+#include "garment/body_up_error.hpp"
 #include "garment/input_checks.hpp"
 #include "garment/sketch_ranges.hpp"
 
@@ -25,6 +26,8 @@ Body load_sketch_body(const GarmentRequest& sketch) {
   try {
     if (sketch.body.up) options.up = AxisDirection::parse(*sketch.body.up);
     return load_body(path, options);
+  } catch (const BodyUpError& e) {
+    sketch.fail("/body/up", e.what());
   } catch (const BodyError& e) {
     sketch.fail("/body/mesh",
                 fmt::format("the body '{}' cannot be used: {}", sketch.body.mesh, e.what()));

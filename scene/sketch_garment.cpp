@@ -311,7 +311,24 @@ PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, c
           const size_t d = edit_distance(base, c.id);
           if (d < best) best = d, hint = c.id;
         }
-        if (!hint.empty()) sentence += fmt::format(" (did you mean '{}'?)", hint);
+        if (!hint.empty()) {
+          sentence += fmt::format(" (did you mean '{}'?)", hint);
+        } else {
+          // No close spelling ("hemline_front" for "hem_f"): the ids that exist, the ones
+          // sharing most letters with it first when there are many.
+          std::vector<std::string> ids;
+          for (const CurveSpec& c : sk.curves) ids.push_back(c.id);
+          constexpr size_t kListed = 20;
+          if (ids.size() > kListed) {
+            std::stable_sort(ids.begin(), ids.end(),
+                             [&](const std::string& x, const std::string& y) {
+                               return edit_distance(base, x) < edit_distance(base, y);
+                             });
+            ids.resize(kListed);
+          }
+          sentence += fmt::format("; the curves are {}{}", fmt::join(ids, ", "),
+                                  sk.curves.size() > kListed ? ", ... (the closest shown)" : "");
+        }
         r.fail(ip, sentence);
       }
       panel.boundary.push_back(std::move(id));

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include <Eigen/Core>
+#include <array>
 #include <initializer_list>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -182,10 +183,29 @@ class Reader {
   // "there is no view called 'x' (did you mean 'y'?); the views are a, b, ... or a camera".
   static std::string unknown_view_sentence(const std::string& name,
                                            const std::vector<std::string_view>& names) {
-    std::string_view best;
+    std::string best;
+    // Words a designer uses for a view, where the nearest spelling is another view ("rear" is
+    // two letters from "left"); a synonym is offered only when its view is one of `names`.
+    static constexpr std::array<std::pair<std::string_view, std::string_view>, 10> kSynonyms{{
+        {"rear", "back"},
+        {"behind", "back"},
+        {"frontal", "front"},
+        {"face", "front"},
+        {"side", "left' or 'right"},
+        {"profile", "left' or 'right"},
+        {"3/4", "three-quarter"},
+        {"quarter", "three-quarter"},
+        {"oblique", "three-quarter"},
+        {"above", "top"},
+    }};
+    for (const auto& [word, view] : kSynonyms) {
+      const std::string_view first = view.substr(0, view.find('\''));
+      if (word == name && std::find(names.begin(), names.end(), first) != names.end()) best = view;
+    }
     size_t best_distance = 4;  // close spellings only ("thre-quater", "frnt")
     for (std::string_view n : names)
-      if (const size_t d = edit_distance(name, n); d < best_distance) best = n, best_distance = d;
+      if (const size_t d = edit_distance(name, n); best.empty() && d < best_distance)
+        best = n, best_distance = d;
     std::string list;
     for (size_t i = 0; i < names.size(); ++i)
       list += std::string(i == 0 ? "" : ", ") + std::string(names[i]);

@@ -2,6 +2,7 @@
 // numbers that are not numbers, work that does not fit. Each must end with exit code 2 and a
 // sentence naming the file and the JSON path (or run within the stated limits), and write nothing.
 
+#include <fcntl.h>
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -13,6 +14,7 @@
 #include <array>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
@@ -683,10 +685,17 @@ TEST(HostileInput, InterruptedRunLeavesNothing) {
     const std::string out_text = out.string();
     std::vector<const char*> argv = {SD_BINARY,        "-q",       "run", sketch.c_str(), "-o",
                                      out_text.c_str(), "--frames", "200", nullptr};
+    // Its stderr, for the line that says what was left.
+    const std::string log = (dir / ("log-" + std::to_string(sig))).string();
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, log.c_str(),
+                                     O_WRONLY | O_CREAT | O_TRUNC, 0644);
     pid_t pid = 0;
     ASSERT_EQ(
-        posix_spawn(&pid, SD_BINARY, nullptr, nullptr, const_cast<char**>(argv.data()), environ),
+        posix_spawn(&pid, SD_BINARY, &actions, nullptr, const_cast<char**>(argv.data()), environ),
         0);
+    posix_spawn_file_actions_destroy(&actions);
     // Wait until some pictures are staged (at most a minute), then interrupt.
     bool staged = false;
     for (int i = 0; i < 600 && !staged; ++i) {
@@ -700,6 +709,9 @@ TEST(HostileInput, InterruptedRunLeavesNothing) {
     EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == sig) << status;
     EXPECT_EQ(temporaries_under(out), 0);
     EXPECT_FALSE(fs::exists(out)) << "the folders the run made are removed";
+    std::ifstream in(log);
+    const std::string said((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(said.find("interrupted: nothing written\n"), std::string::npos) << said;
   }
   fs::remove_all(dir);
 }

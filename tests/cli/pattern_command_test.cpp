@@ -488,6 +488,31 @@ TEST(PatternCommand, BadInputExitsTwoWithoutFiles) {
   EXPECT_FALSE(fs::exists(bad / "ramp-out"));
 }
 
+// Lengths on the command line are metres, checked as the file's are: centimetres typed for
+// metres get the same hint (trial 34: "Value 60 not in range 0.100000 to 10.000000").
+TEST(PatternCommand, OptionOutOfRangeNamesItsUnit) {
+  const fs::path out = fresh_dir("option-units");
+  const CommandResult width = run_sketchdrape("pattern " + example("tshirt").string() + " -o " +
+                                              out.string() + " --fabric-width 60");
+  EXPECT_EQ(width.exit_code, 2) << width.output;
+  EXPECT_NE(width.output.find("--fabric-width: a fabric width of 60 m is outside 0.1 .. 10 m"),
+            std::string::npos)
+      << width.output;
+  EXPECT_NE(width.output.find("if you typed centimetres, 60 cm is 0.6 m"), std::string::npos)
+      << width.output;
+  const CommandResult allowance = run_sketchdrape("pattern " + example("tshirt").string() + " -o " +
+                                                  out.string() + " --seam-allowance 1");
+  EXPECT_EQ(allowance.exit_code, 2) << allowance.output;
+  EXPECT_NE(allowance.output.find("a seam allowance of 1 m is outside 0 .. 0.1 m"),
+            std::string::npos)
+      << allowance.output;
+  const CommandResult text = run_sketchdrape("pattern " + example("tshirt").string() + " -o " +
+                                             out.string() + " --fabric-width 1.5m");
+  EXPECT_EQ(text.exit_code, 2) << text.output;
+  EXPECT_NE(text.output.find("'1.5m' is not a number of metres"), std::string::npos) << text.output;
+  EXPECT_FALSE(fs::exists(out / "pattern.svg"));
+}
+
 // A fabric too narrow for the pattern: the error names the widest piece (not the first too
 // wide in panel order) and the fabric width it needs with the gap at each selvedge, never a
 // piece narrower than the fabric; validate and mesh refuse the file as pattern does.

@@ -6,6 +6,8 @@
 #include <fstream>
 #include <string>
 
+#include "garment/body_up_error.hpp"
+
 namespace sd::garment {
 namespace {
 
@@ -246,6 +248,35 @@ TEST(Body, AxisParsing) {
   EXPECT_EQ(AxisDirection::parse("-Z").name(), "-z");
   EXPECT_EQ(AxisDirection::parse("y").name(), "+y");
   EXPECT_THROW(AxisDirection::parse("w"), BodyError);
+}
+
+// A wrong "up" (trial 34: a Y-up Collada human given "+z") lays the figure on its side: 0.43
+// units along the given up but 1.7 along y. Refused as a BodyUpError naming the inferred axis,
+// where it was a "height not plausible" warning and then a missing-landmark error. A flat body
+// given its "scale" (a ground plane under a sheet, wide on purpose) is not a figure and loads.
+TEST(Body, UpAlongWhichTheFigureLiesIsRefused) {
+  // A box 0.4 wide, 1.7 tall (y) and 0.43 deep (z), in metres.
+  std::string box;
+  for (int k = 0; k < 8; ++k)
+    box += "v " + std::to_string(k & 1 ? 0.2 : -0.2) + " " + std::to_string(k & 2 ? 1.7 : 0.0) +
+           " " + std::to_string(k & 4 ? 0.215 : -0.215) + "\n";
+  box += "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";  // closed, outward
+  const std::string file = write_temp("standing-box.obj", box);
+  BodyOptions options;
+  options.up = AxisDirection::parse("+z");
+  try {
+    load_body(file, options);
+    ADD_FAILURE() << "a figure on its side was accepted";
+  } catch (const BodyUpError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("the body lies on its side"), std::string::npos) << what;
+    EXPECT_NE(what.find("give \"up\": \"+y\""), std::string::npos) << what;
+  }
+  options.up = AxisDirection::parse("+y");
+  EXPECT_NO_THROW(load_body(file, options));
+  options.up = AxisDirection::parse("+z");
+  options.scale = 1.0;  // given: the file is what it is (a ground plane, a rod)
+  EXPECT_NO_THROW(load_body(file, options));
 }
 
 }  // namespace

@@ -189,9 +189,29 @@ TEST(PanelFlattening, SaddleIsReportedAsSaddleShaped) {
   EXPECT_LT(flat.distortion.dome, 0.01 * std::abs(total));
   ASSERT_EQ(pattern.warnings.size(), 1u) << flat.distortion.length_p95;
   EXPECT_NE(pattern.warnings[0].find("saddle-shaped"), std::string::npos) << pattern.warnings[0];
-  EXPECT_NE(pattern.warnings[0].find("godet"), std::string::npos) << pattern.warnings[0];
   std::printf("saddle: %.3f rad (the integral: %.3f), stretch %.2f %% (95th percentile)\n",
               flat.distortion.saddle, total, 100 * flat.distortion.length_p95);
+}
+
+// The saddle's advice follows where it is on the piece (turned grain up): at the lower edge,
+// where a hem flared wider than a cone makes one, a godet; higher up (a bodice back between
+// the shoulder blades and the waist), a dart or a seam, never a godet.
+TEST(PanelFlattening, SaddleAdviceFollowsWhereTheSaddleIs) {
+  const double k = 5;  // 1/m: the saddle z = k(x² − y'²) centred on one edge of a 0.4 m square
+  const auto advice = [k](double centre_t) {
+    const FlatPattern pattern = flatten_garment(grid_garment(20, 20, [=](double s, double t) {
+      const double x = 0.4 * (s - 0.5), y = 0.4 * (t - centre_t);
+      return Eigen::Vector3d(x, 1 + 0.4 * t, 0.2 + k * (x * x - y * y));
+    }));
+    EXPECT_EQ(pattern.warnings.size(), 1u) << pattern.panels[0].distortion.length_p95;
+    return pattern.warnings.empty() ? std::string() : pattern.warnings[0];
+  };
+  const std::string at_hem = advice(0.0), at_top = advice(1.0);
+  EXPECT_NE(at_hem.find("saddle-shaped"), std::string::npos) << at_hem;
+  EXPECT_NE(at_hem.find("godet"), std::string::npos) << at_hem;
+  EXPECT_NE(at_top.find("saddle-shaped"), std::string::npos) << at_top;
+  EXPECT_EQ(at_top.find("godet"), std::string::npos) << at_top;
+  EXPECT_NE(at_top.find("a dart or a seam"), std::string::npos) << at_top;
 }
 
 // A cap past a hemisphere is refused at every mesh size, by its curvature, before it is flattened.

@@ -189,7 +189,8 @@ void run_mesh(const MeshOptions& options) {
 
   // The flat sewing pattern, when the file asks for it.
   if (sketch.output.pattern) {
-    const PatternSheet sheet = build_pattern_sheet(sketch, g, *sketch.output.pattern);
+    const PatternSheet sheet =
+        build_pattern_sheet(sketch, g, *sketch.output.pattern, nullptr, 0.0, &body);
     stage_pattern(sheet, dir, outputs);
     report["pattern"] = pattern_summary(sheet);
   }

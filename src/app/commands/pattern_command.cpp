@@ -7,10 +7,13 @@
 
 #include <filesystem>
 #include <iostream>
+#include <stdexcept>
+#include <string>
 
 #include "garment/body_surface.hpp"
 #include "garment/garment_mesh.hpp"
 #include "garment/sketch_inputs.hpp"
+#include "garment/sketch_ranges.hpp"
 #include "scene/sketch_file.hpp"
 #include "src/app/commands/cli.hpp"
 #include "src/app/pipeline/atomic_file.hpp"
@@ -39,7 +42,7 @@ void run_pattern(const PatternOptions& options) {
   const garment::Body body = garment::load_sketch_body(sketch);
   const garment::BodySurface surface(body.mesh);
   const garment::Garment g = garment::build_garment(sketch, surface);
-  const PatternSheet sheet = build_pattern_sheet(sketch, g, spec);
+  const PatternSheet sheet = build_pattern_sheet(sketch, g, spec, nullptr, 0.0, &body);
   StagedOutputs outputs;
   outputs.keep(sketch.file);
   if (sketch.garment_mesh) outputs.keep(sketch.resolve(*sketch.garment_mesh));
@@ -59,6 +62,26 @@ void run_pattern(const PatternOptions& options) {
 
 }  // namespace
 
+// A length option in metres checked as the file's lengths are, with the unit and the likely
+// slip ("a fabric width of 60 m is outside 0.1 .. 10 m; ... if you typed centimetres, 60 cm
+// is 0.6 m") instead of CLI11's "Value 60 not in range 0.100000 to 10.000000".
+CLI::Validator length_in_range(double low, double high, std::string what) {
+  return CLI::Validator(
+      [=](std::string& text) -> std::string {
+        double value = 0;
+        try {
+          size_t used = 0;
+          value = std::stod(text, &used);
+          if (used != text.size()) return fmt::format("'{}' is not a number of metres", text);
+        } catch (const std::exception&) {
+          return fmt::format("'{}' is not a number of metres", text);
+        }
+        if (value >= low && value <= high) return "";
+        return garment::out_of_range_sentence(value, low, high, what);
+      },
+      fmt::format("metres, {} .. {}", low, high));
+}
+
 void add_pattern_command(CLI::App& app, const GlobalOptions& /*global*/) {
   auto options = std::make_shared<PatternOptions>();
   CLI::App* cmd = app.add_subcommand(
@@ -69,11 +92,11 @@ void add_pattern_command(CLI::App& app, const GlobalOptions& /*global*/) {
   cmd->add_option("-o,--out", options->out, "Output directory (created if needed)");
   cmd->add_option("--fabric-width", options->fabric_width,
                   "Fabric width in metres (default: output.pattern.fabric_width, else 1.5)")
-      ->check(CLI::Range(0.1, 10.0));
+      ->check(length_in_range(0.1, 10.0, "a fabric width of"));
   cmd->add_option("--seam-allowance", options->seam_allowance,
                   "Seam allowance in metres for pieces without their own (default: "
                   "output.pattern.seam_allowance, else 0.01)")
-      ->check(CLI::Range(0.0, 0.1));
+      ->check(length_in_range(0.0, 0.1, "a seam allowance of"));
   cmd->callback([options] { run_pattern(*options); });
 }
 

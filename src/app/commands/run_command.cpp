@@ -144,7 +144,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   if (scene.garment && sketch.output.pattern)
     pattern_sheet = build_pattern_sheet(sketch, *scene.garment, *sketch.output.pattern,
                                         scene.flat_pattern ? &*scene.flat_pattern : nullptr,
-                                        scene.flattening_ms);
+                                        scene.flattening_ms, scene.body ? &*scene.body : nullptr);
   // "solver"/"time_step": "auto" (the defaults): chosen now that the scene's size is known.
   const sim::AutomaticChoice automatic =
       apply_automatic_settings(sketch, scene, settings, options.frames_per_second > 0.0);

@@ -40,6 +40,10 @@ std::once_flag g_handlers_installed;
 // the loop below passed its slot. The signal is passed on to the staging thread instead.
 pthread_t g_staging_thread;
 
+// Set once a file of this process has been renamed into place: an interrupted command then
+// says it kept those files instead of "nothing written".
+std::atomic<bool> g_any_committed{false};
+
 extern "C" void remove_temporaries_and_reraise(int sig) {
   if (!pthread_equal(pthread_self(), g_staging_thread)) {
     pthread_kill(g_staging_thread, sig);
@@ -49,6 +53,13 @@ extern "C" void remove_temporaries_and_reraise(int sig) {
     if (char* path = slot.load()) ::unlink(path);
   for (size_t i = kDirSlots; i-- > 0;)  // deepest folders were registered last
     if (char* path = g_dir_slots[i].load()) ::rmdir(path);
+  // One line, so that a log that stops here says why (write(2) is async-signal-safe; the
+  // result is ignored: there is nowhere else to report to).
+  static constexpr std::string_view kNothing = "interrupted: nothing written\n";
+  static constexpr std::string_view kKept =
+      "interrupted: the files already written were kept, the unfinished ones removed\n";
+  const std::string_view line = g_any_committed.load() ? kKept : kNothing;
+  [[maybe_unused]] const ssize_t written = ::write(STDERR_FILENO, line.data(), line.size());
   ::signal(sig, SIG_DFL);
   ::raise(sig);
 }
@@ -72,6 +83,14 @@ void install_handlers() {
 
 // Puts `path` in a free slot; returns the slot's string (to release it later), or null when
 // every slot is taken (the file is then only removed by the destructor or a later sweep).
+}  // namespace
+
+void install_interrupt_cleanup() {
+  install_handlers();
+}
+
+namespace {
+
 template <size_t N>
 char* hold(std::array<std::atomic<char*>, N>& slots, const std::filesystem::path& path) {
   install_handlers();
@@ -153,6 +172,7 @@ void write_file_atomically(const std::filesystem::path& path, std::string_view b
   char* held = hold(g_temp_slots, temp);
   write_all(temp, bytes);
   std::error_code ec;
+  g_any_committed = true;
   std::filesystem::rename(temp, path, ec);
   release(g_temp_slots, held);
   if (ec) {
@@ -296,6 +316,7 @@ void StagedOutputs::stage(const std::filesystem::path& path, std::string_view by
 }
 
 void StagedOutputs::commit() {
+  if (!temps_.empty()) g_any_committed = true;
   for (size_t i = 0; i < temps_.size(); ++i) {
     std::error_code ec;
     std::filesystem::rename(temps_[i], finals_[i], ec);

@@ -14,6 +14,12 @@ namespace sd::app {
 // reader sees either the old file or the complete new one. Throws std::runtime_error.
 void write_file_atomically(const std::filesystem::path& path, std::string_view bytes);
 
+// Installs the SIGINT / SIGTERM / SIGHUP handler that StagedOutputs otherwise installs when it
+// first stages a file, at the start of a command, so that an interrupted command (a drape that
+// has staged nothing yet) still says so in one line ("interrupted: nothing written") before it
+// dies by the signal. Where another handler is already set (a batch), it is left alone.
+void install_interrupt_cleanup();
+
 // Checks, before any work, that files can be written in the output folder `dir`: it is a
 // folder (or can be made one) and a file can be created in it. Leaves nothing behind (folders
 // made for the test are removed again). Throws std::invalid_argument (exit code 2) with the

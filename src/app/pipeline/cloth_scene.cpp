@@ -14,6 +14,7 @@
 #include "sim/sheet.hpp"
 #include "sim/simulation.hpp"
 #include "src/app/pipeline/garment_stage.hpp"
+#include "src/app/pipeline/quality_warnings.hpp"
 #include "src/app/pipeline/settle_time.hpp"
 
 namespace sd::app {
@@ -189,7 +190,9 @@ void flat_rest_shapes(const scene::Sketch& sketch, const garment::Garment& g,
     const garment::PanelSpec* spec = sketch.find_panel(e.panel());
     if (!spec && e.panel().ends_with(".mirror"))
       spec = sketch.find_panel(e.panel().substr(0, e.panel().size() - 7));
-    sketch.fail(spec ? spec->json_path + "/rest" : "/simulate/rest", e.what());
+    sketch.fail(spec ? spec->json_path + "/rest" : "/simulate/rest",
+                scene.body ? flattening_failure(g, sketch, *scene.body, e.panel(), e.what())
+                           : std::string(e.what()));
   }
   scene.flattening_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -11,6 +11,7 @@
 #include "sim/fabric.hpp"
 #include "src/app/pipeline/markup_escape.hpp"
 #include "src/app/pipeline/pattern_label.hpp"
+#include "src/app/pipeline/quality_warnings.hpp"
 
 namespace sd::app {
 namespace {
@@ -134,7 +135,8 @@ std::string fabric_label(const scene::Sketch& sketch, const std::string& fabric)
 
 PatternSheet build_pattern_sheet(const scene::Sketch& sketch, const garment::Garment& garment,
                                  const scene::PatternSpec& spec,
-                                 const garment::FlatPattern* flattened, double flattened_ms) {
+                                 const garment::FlatPattern* flattened, double flattened_ms,
+                                 const garment::Body* body) {
   PatternSheet sheet;
   sheet.title = std::filesystem::path(sketch.file).filename().string();
   garment::FlatteningOptions flattening;
@@ -159,7 +161,8 @@ PatternSheet build_pattern_sheet(const scene::Sketch& sketch, const garment::Gar
     sheet.layout_ms = ms_since(layout_start);
   } catch (const garment::PatternError& e) {
     const garment::PanelSpec* ps = panel_spec(sketch, e.panel());
-    sketch.fail(ps ? ps->json_path : "/panels", e.what());
+    sketch.fail(ps ? ps->json_path : "/panels",
+                body ? flattening_failure(garment, sketch, *body, e.panel(), e.what()) : e.what());
   }
   if (!flattened)
     for (const std::string& warning : sheet.pattern.warnings) spdlog::warn("{}", warning);

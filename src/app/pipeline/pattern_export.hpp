@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "garment/body.hpp"
 #include "garment/garment_mesh.hpp"
 #include "garment/panel_flattening.hpp"
 #include "garment/pattern_layout.hpp"
@@ -30,11 +31,13 @@ struct PatternSheet {
 // panel's own seam allowance). A panel that cannot be flattened becomes a SketchError at that
 // panel's JSON path; stretch warnings are logged. `flattened`, when given, is the same garment
 // already flattened with `spec`'s warning threshold (a drape from the flat pattern, which has
-// logged its warnings): it is laid out as it is, neither flattened nor reported twice.
+// logged its warnings): it is laid out as it is, neither flattened nor reported twice. With
+// `body`, a panel that cannot be flattened is reported after the quality gate's warnings and
+// with the cloth of it inside the body (flattening_failure in quality_warnings.hpp).
 PatternSheet build_pattern_sheet(const scene::Sketch& sketch, const garment::Garment& garment,
                                  const scene::PatternSpec& spec,
                                  const garment::FlatPattern* flattened = nullptr,
-                                 double flattened_ms = 0.0);
+                                 double flattened_ms = 0.0, const garment::Body* body = nullptr);
 
 std::string pattern_svg(const PatternSheet& sheet);
 std::string pattern_dxf(const PatternSheet& sheet);

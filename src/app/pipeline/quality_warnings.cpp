@@ -1,9 +1,13 @@
 #include "src/app/pipeline/quality_warnings.hpp"
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include <optional>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 namespace sd::app {
 
@@ -20,6 +24,35 @@ std::vector<garment::QualityWarning> quality_warnings(const garment::Garment& ga
       garment::check_quality_tried(garment, sketch, body.mesh, landmarks ? &*landmarks : nullptr);
   for (const garment::QualityWarning& w : warnings) spdlog::warn("{}: {}", sketch.file, w.message);
   return warnings;
+}
+
+std::string flattening_failure(const garment::Garment& garment,
+                               const garment::GarmentRequest& sketch, const garment::Body& body,
+                               const std::string& panel, const std::string& error) {
+  const std::string original =
+      panel.ends_with(".mirror") ? panel.substr(0, panel.size() - 7) : panel;
+  // The panel's curves used as written: the ones that can pass through a leg.
+  std::vector<std::string> as_written;
+  for (const garment::PanelSpec& spec : sketch.panels)
+    if (spec.id == original)
+      for (const std::string& id : spec.boundary) {
+        const std::string base = id.ends_with(".mirror") ? id.substr(0, id.size() - 7) : id;
+        for (const garment::CurveSpec& curve : sketch.curves)
+          if (curve.id == base && !curve.on_body) as_written.push_back("'" + id + "'");
+      }
+  for (const garment::QualityWarning& w : quality_warnings(garment, sketch, body)) {
+    if (w.kind != "inside_body" || w.panel != original) continue;
+    return fmt::format(
+        "{}; but {} quad(s) of panel '{}' lie inside the body before the drape (the deepest "
+        "{:.1f} mm below the skin{}): the likely cause is a curve drawn through the body{}, not "
+        "the panel's shape; move that curve out from the body first",
+        error, w.count, original, 1e3 * w.worst,
+        w.landmark.empty() ? std::string() : ", near the " + w.landmark,
+        as_written.empty() ? std::string()
+                           : fmt::format(" (of its curves with \"on_body\": false, {})",
+                                         fmt::join(as_written, ", ")));
+  }
+  return error;
 }
 
 nlohmann::json warnings_json(const std::vector<garment::QualityWarning>& warnings) {
