@@ -57,6 +57,26 @@ double max_speed(const Eigen::VectorXd& v) {
   return speed;
 }
 
+// A corner of the most stretched triangle (its largest stretch along u or v), −1 without
+// triangles: where a drape stuck on the strain limit is held.
+int most_stretched_vertex(const ClothModel& model, const Eigen::VectorXd& x) {
+  double strain = -std::numeric_limits<double>::infinity();
+  int vertex = -1;
+  for (const TriangleElement& t : model.triangles) {
+    Eigen::Vector3d wu = Eigen::Vector3d::Zero(), wv = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) {
+      wu += t.du[k] * x.segment<3>(3 * t.vertices[k]);
+      wv += t.dv[k] * x.segment<3>(3 * t.vertices[k]);
+    }
+    if (const double s = std::max(wu.norm(), wv.norm()) - 1.0; s > strain)
+      strain = s, vertex = t.vertices[0];
+  }
+  return vertex;
+}
+
+// Forced steps printed one by one before they are only counted (summed up at the run's end).
+constexpr int kForcedStepsLogged = 5;
+
 }  // namespace
 
 void SimulationSettings::validate() const {
@@ -79,6 +99,8 @@ void SimulationSettings::validate() const {
   require(positive(rest_speed) && positive(rest_kinetic_energy) && std::isfinite(rest_window) &&
               rest_window >= 0.0,
           "the at-rest thresholds must be positive and the window zero or more");
+  require(stuck_steps >= 0 && std::isfinite(stuck_share) && stuck_share > 0.0 && stuck_share <= 1.0,
+          "the stuck test needs a window of zero (off) or more steps and a share in (0, 1]");
   require(std::isfinite(rest_not_before) && rest_not_before >= 0.0,
           "the earliest at-rest time must be zero or more seconds");
   require(forces.gravity.allFinite() && forces.wind.allFinite() && std::isfinite(forces.air_drag) &&
@@ -545,6 +567,25 @@ void Simulation::accept(Attempt& attempt, double h) {
 
 StepOutcome Simulation::step(double max_step) {
   StepOutcome outcome;
+  // Stuck at the minimum step (SimulationSettings::stuck_steps): no further step, a failure
+  // that says so, with the state of the last accepted step left as it is.
+  if (settings_.stuck_steps > 0 &&
+      static_cast<int>(recent_forced_.size()) >= settings_.stuck_steps &&
+      recent_forced_count_ >= settings_.stuck_share * settings_.stuck_steps) {
+    const bool stretched = last_forced_reason_.starts_with("stretch strain");
+    outcome.stuck = true;
+    outcome.dt = settings_.min_dt;
+    outcome.failure_vertex = stretched ? most_stretched_vertex(model_, x_) : last_forced_vertex_;
+    std::ostringstream why;
+    why << "stuck: " << recent_forced_count_ << " of the last " << recent_forced_.size()
+        << " steps were taken at the minimum step " << last_forced_dt_ << " s despite a failed "
+        << "check (the last: " << last_forced_reason_ << "), "
+        << (stretched ? "the cloth held stretched beyond the limit" : "without progress")
+        << " and the simulated time crawling; it would not finish";
+    outcome.failure_reason = why.str();
+    spdlog::error("sim: t = {:.6f} s: {}", time_, outcome.failure_reason);
+    return outcome;
+  }
   double h = std::min(dt_, max_step);
   const double planned = dt_;  // before a cut to land on max_step
   // Land exactly on max_step instead of leaving a sliver for the next step.
@@ -577,9 +618,22 @@ StepOutcome Simulation::step(double max_step) {
     }
     if (h * 0.5 < settings_.min_dt) {
       if (!candidate.hard_failure) {
-        spdlog::warn("sim: t = {:.6f} s: accepting a step of {:.3g} s at the minimum despite: {}",
-                     time_, h, candidate.failure);
+        // The first few one by one; the rest counted, and summed up at the end of the run.
+        if (report_.forced_steps < kForcedStepsLogged)
+          spdlog::warn(
+              "sim: t = {:.6f} s: accepting a step of {:.3g} s at the minimum despite: {}{}", time_,
+              h, candidate.failure,
+              report_.forced_steps + 1 == kForcedStepsLogged
+                  ? " (further such steps are counted, not printed; the sum comes at the end)"
+                  : "");
+        else
+          spdlog::debug(
+              "sim: t = {:.6f} s: accepting a step of {:.3g} s at the minimum despite: {}", time_,
+              h, candidate.failure);
         ++report_.forced_steps;
+        last_forced_reason_ = candidate.failure;
+        last_forced_vertex_ = candidate.failure_vertex;
+        last_forced_dt_ = h;
         outcome.forced = true;
         break;
       }
@@ -606,6 +660,14 @@ StepOutcome Simulation::step(double max_step) {
   outcome.cg_iterations = candidate.cg_iterations;
   newton_total_ += candidate.solve.newton_iterations;
   accept(candidate, h);
+  if (settings_.stuck_steps > 0) {
+    recent_forced_.push_back(outcome.forced);
+    recent_forced_count_ += outcome.forced ? 1 : 0;
+    if (static_cast<int>(recent_forced_.size()) > settings_.stuck_steps) {
+      recent_forced_count_ -= recent_forced_.front() ? 1 : 0;
+      recent_forced_.pop_front();
+    }
+  }
 
   // Grow back after a run of easy steps: no retry and Newton converging in a few iterations.
   const int newton_budget =
@@ -668,6 +730,7 @@ SimulationReport Simulation::run(const RunHooks& hooks) {
     const StepOutcome outcome = hooks.step ? hooks.step(max_step) : step(max_step);
     if (!outcome.accepted) {
       report_.failed = true;
+      report_.stuck = outcome.stuck;
       report_.failure_reason = outcome.failure_reason;
       report_.failure_vertex = outcome.failure_vertex;
       if (hooks.after_step) hooks.after_step(outcome);
@@ -681,6 +744,11 @@ SimulationReport Simulation::run(const RunHooks& hooks) {
     }
   }
   flush_energy_sample();
+  if (report_.forced_steps > kForcedStepsLogged)
+    spdlog::warn(
+        "sim: {} of {} steps were taken at the minimum step {:.3g} s despite a failed "
+        "check (the first {} printed above)",
+        report_.forced_steps, report_.steps, last_forced_dt_, kForcedStepsLogged);
   if (contact_ && settings_.contact.enabled) {
     const auto query_start = std::chrono::steady_clock::now();
     report_.penetrating_vertices_final = contact_->count_penetrating(x_);

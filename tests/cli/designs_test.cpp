@@ -146,7 +146,8 @@ TEST_P(DesignDrape, RestsOutsideTheBodyWithoutADentBetweenTheLegs) {
   if (!body_available(name)) GTEST_SKIP() << "the design's body is not installed";
   const nlohmann::json report = drape(name);
   expect_at_rest_outside_the_body(report);
-  if (!report.is_null()) {
+  // A top has no slice dent (none of it is below the crotch): null in report.json.
+  if (!report.is_null() && !report["slice_dent"].is_null()) {
     EXPECT_LE(report["slice_dent"]["depth_m"].get<double>(), 0.03);
   }
 }

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 
 #include "garment/body.hpp"
@@ -56,6 +58,16 @@ TEST(BodyLandmarks, BuiltinBody) {
   EXPECT_NEAR(l.find("crotch")->position.y(), 0.78, 0.02);
   EXPECT_NEAR(l.find("left_armpit")->position.y(), 1.23, 0.03);
   EXPECT_EQ(l.nearest({0.3, 1.0, 0.0}).name, "left_wrist");
+  // The wrist where the arm ends, not 13 cm above it (trial 34: a long sleeve to the wrist came
+  // out three-quarter length). The arm has no hand: it ends in a rounded stump at y = 0.87
+  // whose girth falls from 0.25 m at 0.96 to 0.13 m at 0.88; the wrist is where the rounding
+  // starts, 3-10 cm above the end (it was 13.4 cm).
+  double arm_end = 2.0;
+  for (Eigen::Index v = 0; v < body.mesh.vertices.rows(); ++v)
+    if (body.mesh.vertices(v, 0) > 0.25) arm_end = std::min(arm_end, body.mesh.vertices(v, 1));
+  const double above = l.find("left_wrist")->position.y() - arm_end;
+  EXPECT_GT(above, 0.03);
+  EXPECT_LT(above, 0.10);
 }
 
 // A place is named by the part of the body it is on. The built-in body's hands hang beside its
@@ -79,7 +91,22 @@ TEST(BodyLandmarks, ColladaHumanInMetres) {
   if (!std::filesystem::exists(file))
     GTEST_SKIP() << "assimp-testmodels' human.zae is not installed";
   const Body body = load_body(file.string());
-  expect_plausible(find_landmarks(body.mesh), body.mesh.vertices.col(1).maxCoeff());
+  const BodyLandmarks l = find_landmarks(body.mesh);
+  expect_plausible(l, body.mesh.vertices.col(1).maxCoeff());
+  // The wrist is the arm's narrowest section between the forearm and the palm: the arm's
+  // horizontal outline there is narrower than 5 cm higher (the forearm) and 2.5 cm lower (the
+  // palm). The proportion of the arm's length it came from before put it in the palm.
+  const Eigen::Vector3d wrist = l.find("left_wrist")->position;
+  const auto arm_girth = [&](double y) {
+    double girth = 0.0, nearest = 1e9;
+    for (const SliceOutline& o : slice_body(body.mesh, y))
+      if (const double d = std::hypot(o.centroid.x() - wrist.x(), o.centroid.z() - wrist.z());
+          d < nearest)
+        nearest = d, girth = o.girth;
+    return girth;
+  };
+  EXPECT_LT(arm_girth(wrist.y()), arm_girth(wrist.y() + 0.05));
+  EXPECT_LT(arm_girth(wrist.y()), arm_girth(wrist.y() - 0.025));
 }
 
 TEST(BodyLandmarks, ASphereHasNone) {

@@ -540,6 +540,49 @@ TEST(Simulation, FailedStepsAreRolledBackHalvedAndCounted) {
   EXPECT_TRUE(forced.nan_free);
 }
 
+TEST(Simulation, ADrapeStuckAtTheMinimumStepFails) {
+  // A PCG that never converges forces every step at the minimum (as above); with a window of
+  // 20 steps the run fails after the 20th instead of creeping on to the end.
+  SimulationSettings settings;
+  settings.dt = 1.0 / 24;
+  settings.min_dt = 1.0 / 24 / 8;
+  settings.duration = 2.0;
+  settings.pcg_max_iterations = 1;
+  settings.pcg_tolerance = 1e-12;
+  settings.stuck_steps = 20;
+  settings.stuck_share = 0.8;
+  const HangingSheet h = hanging_sheet(12, 0.4);
+  Simulation stuck = make_simulation(h, settings);
+  const SimulationReport report = stuck.run();
+  EXPECT_TRUE(report.failed);
+  EXPECT_TRUE(report.stuck);
+  EXPECT_NE(report.failure_reason.find("stuck: 20 of the last 20 steps"), std::string::npos)
+      << report.failure_reason;
+  EXPECT_NE(report.failure_reason.find("PCG did not converge"), std::string::npos);
+  EXPECT_EQ(report.steps, 20);
+  EXPECT_EQ(report.forced_steps, 20);
+  EXPECT_LT(report.sim_time, 0.5 * settings.duration);  // stopped, not run to the end
+  EXPECT_GE(report.failure_vertex, 0);
+  EXPECT_LT(report.failure_vertex, h.model.vertex_count);
+  EXPECT_TRUE(stuck.positions().allFinite());
+
+  // Off (0 steps): the same sheet runs to the end on forced steps.
+  settings.stuck_steps = 0;
+  settings.duration = 1.0;
+  Simulation free_run = make_simulation(h, settings);
+  const SimulationReport to_end = free_run.run();
+  EXPECT_FALSE(to_end.failed);
+  EXPECT_FALSE(to_end.stuck);
+  EXPECT_GT(to_end.forced_steps, 20);
+  EXPECT_NEAR(to_end.sim_time, settings.duration, 1e-9);
+
+  // The test waits for a full window: with 25 steps it trips after the 25th, not the 20th.
+  settings.stuck_steps = 25;
+  settings.duration = 2.0;
+  Simulation later = make_simulation(h, settings);
+  EXPECT_EQ(later.run().steps, 25);
+}
+
 TEST(Simulation, StepGrowsBackAfterEasySteps) {
   const HangingSheet h = hanging_sheet(4, 0.4);
   SimulationSettings settings;
@@ -733,6 +776,12 @@ TEST(Simulation, BadSettingsAreRejected) {
   EXPECT_THROW(make(settings), InvalidSimulationSettingsError);
   settings = SimulationSettings{};
   settings.newton_iterations = 0;
+  EXPECT_THROW(make(settings), InvalidSimulationSettingsError);
+  settings = SimulationSettings{};
+  settings.stuck_share = 0.0;
+  EXPECT_THROW(make(settings), InvalidSimulationSettingsError);
+  settings = SimulationSettings{};
+  settings.stuck_steps = -1;
   EXPECT_THROW(make(settings), InvalidSimulationSettingsError);
   settings = SimulationSettings{};
   settings.forces.air_drag = -1.0;

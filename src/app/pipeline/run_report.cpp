@@ -215,7 +215,9 @@ nlohmann::json run_report_json(const RunReport& r) {
                          {"height_m", dent.height},
                          {"where", {dent.where.x(), dent.where.y(), dent.where.z()}},
                          {"from_fraction", 0.1},
-                         {"to_fraction", 0.6}};
+                         {"to_fraction", r.slice_dent_to}};
+  } else {
+    out["slice_dent"] = nullptr;  // no garment, or none of it below the crotch (a top)
   }
   out["settled_drop_m"] =
       r.settled_drop ? nlohmann::json(*r.settled_drop) : nlohmann::json(nullptr);
@@ -235,6 +237,12 @@ nlohmann::json run_report_json(const RunReport& r) {
   out["timing_s"]["images"] = r.images_s;
   out["timing_s"]["total"] = r.total_s;
   return out;
+}
+
+std::optional<double> slice_dent_top(double low, double high, std::optional<double> crotch) {
+  if (!crotch) return 0.6;
+  if (*crotch - low < 0.05 || !(high > low)) return std::nullopt;
+  return std::min(0.6, (*crotch - low) / (high - low));
 }
 
 }  // namespace sd::app

@@ -76,10 +76,14 @@ struct RunReport {
   // The automatic rule's reason, when the file left the solver or the step to it ("auto").
   std::optional<std::string> automatic;
   sim::SimulationReport simulation;
-  std::optional<sim::AdaptiveReport> adaptive;   // when the cloth adapted
-  std::vector<GroupStrain> strain;               // against the rest shape (the pattern when flat)
-  int self_intersections_final = 0;              // counted whether or not self-collision was on
-  std::optional<meshing::SliceDent> slice_dent;  // garments: the dent between supports
+  std::optional<sim::AdaptiveReport> adaptive;  // when the cloth adapted
+  std::vector<GroupStrain> strain;              // against the rest shape (the pattern when flat)
+  int self_intersections_final = 0;             // counted whether or not self-collision was on
+  // Garments reaching below the crotch: the dent between supports (a skirt pulled between the
+  // legs), over the slices from 10 % of the garment's height to slice_dent_to (at most 60 %,
+  // never above the crotch: higher up a sleeve beside the torso reads as a dent).
+  std::optional<meshing::SliceDent> slice_dent;
+  double slice_dent_to = 0.6;
   // Garments on a body: how far (m) the cloth's centre of mass ended below where it was drawn
   // (negative: above), from the gravitational potential of the first and last steps. A garment
   // nothing grips (a loose strapless top) slides down until something holds it.
@@ -97,5 +101,11 @@ struct RunReport {
 
 // report.json's contents.
 nlohmann::json run_report_json(const RunReport& report);
+
+// The top of a garment's slice-dent slices (RunReport::slice_dent), as a fraction of the
+// draped garment's height above its lowest point `low` (its highest: `high`): 60 %, lowered to
+// the body's crotch when there is one. Nothing for a garment that ends less than 5 cm below the
+// crotch (a top: only a sleeve and the torso would be there to dent).
+std::optional<double> slice_dent_top(double low, double high, std::optional<double> crotch);
 
 }  // namespace sd::app
