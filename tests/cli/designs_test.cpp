@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -203,77 +204,81 @@ const std::vector<std::string> long_garments = {"maxi-dress", "gored-midi-skirt"
 INSTANTIATE_TEST_SUITE_P(Long, DesignDrapeTop, ::testing::ValuesIn(long_garments), test_name);
 
 // The tiered skirt's lower tier, cut with "ease": {"weft": 1.5} (half as long again round the
-// body as the seam it hangs from) gathers into that seam: its hem flutes round the body. Drawn
-// with the isotropic "ease": 1.15 of the trial that asked for gathers (trial 34, item 5), the tier
-// only grows and bulges. Counted as sign changes of the hem's radial distance from the body's
-// axis about its running mean (a flute is one out and one in): the hem vertices of the tier
-// (its lowest 1 cm) in 48 sectors round the body, each sector's mean radius compared with the
-// mean of its 7 neighbours (an A-line hem's ellipse is smooth at that scale and changes sign
-// 0-4 times; flutes twice per flute). Both drapes come to rest outside the body.
-struct HemFlutes {
-  int sign_changes = 0;
-  int sectors = 0;
-};
-
-HemFlutes hem_flutes(const fs::path& obj, const std::string& group_prefix) {
+// body as the seam it hangs from) gathers into that seam. Drawn with the isotropic "ease": 1.15
+// of the trial that asked for gathers (trial 34, item 5), the tier only grows and bulges. Counted
+// on the row of tier-2 vertices next to the tier seam (those sharing a triangle with a seam
+// vertex), sorted by angle about the body's axis: the turns of their distance from the axis, in
+// and out by more than 5 mm (so the mesh's noise does not count). Measured (27 November, edge
+// 2.5 cm, 56 vertices in the row): gathered 27, isotropic 13, the same with 3 mm and 10 mm.
+int gather_turns(const fs::path& obj) {
   std::ifstream in(obj);
   std::string line, group;
   std::vector<Eigen::Vector3d> vertices;
-  std::vector<char> in_tier;
+  std::vector<std::pair<std::array<int, 3>, std::string>> faces;
   while (std::getline(in, line)) {
     std::istringstream s(line);
     std::string tag;
     s >> tag;
-    if (tag == "g" || tag == "o") {
+    if (tag == "g") {
       s >> group;
     } else if (tag == "v") {
       Eigen::Vector3d p;
       s >> p.x() >> p.y() >> p.z();
       vertices.push_back(p);
-      in_tier.push_back(0);
-    } else if (tag == "f" && group.rfind(group_prefix, 0) == 0) {
-      std::string token;
-      while (s >> token) in_tier[std::stoul(token.substr(0, token.find('/'))) - 1] = 1;
+    } else if (tag == "f") {
+      std::array<int, 3> f{};
+      for (int& index : f) {
+        std::string token;
+        s >> token;
+        index = std::stoi(token.substr(0, token.find('/'))) - 1;
+      }
+      faces.emplace_back(f, group);
     }
   }
-  double lowest = 1e300;
-  for (size_t i = 0; i < vertices.size(); ++i)
-    if (in_tier[i]) lowest = std::min(lowest, vertices[i].y());
-  constexpr int kSectors = 48;
-  constexpr double kTwoPi = 6.283185307179586;
-  const Eigen::Vector2d axis(0.0, 0.01);  // the built-in body's axis (x = 0, z ≈ 0.01 at the knee)
-  std::vector<double> sum(kSectors, 0.0);
-  std::vector<int> count(kSectors, 0);
-  for (size_t i = 0; i < vertices.size(); ++i) {
-    if (!in_tier[i] || vertices[i].y() > lowest + 0.01) continue;
-    const Eigen::Vector2d d = Eigen::Vector2d(vertices[i].x(), vertices[i].z()) - axis;
-    const int k = std::min(kSectors - 1, static_cast<int>((std::atan2(d.y(), d.x()) + kTwoPi / 2) /
-                                                          kTwoPi * kSectors));
-    sum[static_cast<size_t>(k)] += d.norm();
-    ++count[static_cast<size_t>(k)];
-  }
-  std::vector<double> radius;
-  for (int k = 0; k < kSectors; ++k)
-    if (count[static_cast<size_t>(k)] > 0)
-      radius.push_back(sum[static_cast<size_t>(k)] / count[static_cast<size_t>(k)]);
-  HemFlutes flutes;
-  flutes.sectors = static_cast<int>(radius.size());
-  const int n = flutes.sectors;
-  int previous = 0;
-  for (int pass = 0; pass < 2; ++pass)  // the second pass closes the loop
-    for (int k = 0; k < n; ++k) {
-      double mean = 0;
-      for (int j = -3; j <= 3; ++j) mean += radius[static_cast<size_t>((k + j + n) % n)] / 7;
-      const int sign = radius[static_cast<size_t>(k)] > mean ? 1 : -1;
-      if (pass == 1 && sign != previous) ++flutes.sign_changes;
-      previous = sign;
+  const auto in_tier = [](const std::string& g, const char* tier) { return g.rfind(tier, 0) == 0; };
+  std::vector<char> tier1(vertices.size(), 0), tier2(vertices.size(), 0), row(vertices.size(), 0);
+  for (const auto& [f, g] : faces)
+    for (int v : f) {
+      if (in_tier(g, "tier1")) tier1[static_cast<size_t>(v)] = 1;
+      if (in_tier(g, "tier2")) tier2[static_cast<size_t>(v)] = 1;
     }
-  return flutes;
+  const auto on_seam = [&](int v) {
+    return tier1[static_cast<size_t>(v)] && tier2[static_cast<size_t>(v)];
+  };
+  for (const auto& [f, g] : faces)
+    if (in_tier(g, "tier2") && std::any_of(f.begin(), f.end(), on_seam))
+      for (int v : f)
+        if (!on_seam(v)) row[static_cast<size_t>(v)] = 1;
+  std::vector<std::pair<double, double>> around;  // (angle, distance from the axis)
+  for (size_t v = 0; v < vertices.size(); ++v)
+    if (row[v]) {
+      const double x = vertices[v].x(), z = vertices[v].z() - 0.01;  // the axis: x = 0, z = 0.01
+      around.emplace_back(std::atan2(z, x), std::hypot(x, z));
+    }
+  std::sort(around.begin(), around.end());
+  constexpr double kHysteresis = 0.005;  // m
+  int turns = 0, direction = 0;
+  double extreme = around.empty() ? 0.0 : around.front().second;
+  for (int pass = 0; pass < 2; ++pass)  // twice round, so the loop closes; the first primes
+    for (const auto& [angle, r] : around) {
+      if (direction >= 0 && r > extreme) extreme = r;
+      if (direction <= 0 && r < extreme) extreme = r;
+      if (direction >= 0 && extreme - r > kHysteresis) {
+        turns += pass == 1 && direction > 0;
+        direction = -1;
+        extreme = r;
+      } else if (direction <= 0 && r - extreme > kHysteresis) {
+        turns += pass == 1 && direction < 0;
+        direction = 1;
+        extreme = r;
+      }
+    }
+  return turns;
 }
 
-TEST(GatheredTier, FlutesMoreThanAnIsotropicEaseAndRests) {
+TEST(GatheredTier, FoldsUnderItsSeamMoreThanAnIsotropicEaseAndRests) {
   const fs::path dir = fs::temp_directory_path() / "sd_designs_drape" / "gathers";
-  std::map<std::string, HemFlutes> flutes;
+  std::map<std::string, int> turns;
   for (const std::string variant : {"gathered", "isotropic"}) {
     const fs::path sketch = staged_design("tiered-skirt", dir / variant);
     nlohmann::json j = read_json(sketch);
@@ -285,12 +290,11 @@ TEST(GatheredTier, FlutesMoreThanAnIsotropicEaseAndRests) {
         run_sketchdrape("-q run " + sketch.string() + " -o " + (dir / variant / "run").string());
     ASSERT_EQ(ran.exit_code, 0) << variant << ": " << ran.output;
     expect_at_rest_outside_the_body(read_json(dir / variant / "run" / "report.json"));
-    flutes[variant] = hem_flutes(dir / variant / "run" / "drape.obj", "tier2");
-    EXPECT_GE(flutes[variant].sectors, 40) << variant << ": the hem goes round the body";
+    turns[variant] = gather_turns(dir / variant / "run" / "drape.obj");
   }
-  EXPECT_GE(flutes["gathered"].sign_changes, flutes["isotropic"].sign_changes + 4)
-      << "gathered " << flutes["gathered"].sign_changes << ", isotropic "
-      << flutes["isotropic"].sign_changes;
+  // Half the measured difference (27 against 13).
+  EXPECT_GE(turns["gathered"], turns["isotropic"] + 7)
+      << "gathered " << turns["gathered"] << ", isotropic " << turns["isotropic"];
   fs::remove_all(dir);
 }
 
