@@ -568,7 +568,7 @@ ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse&
   const int face_count = static_cast<int>(input.triangles.rows());
   if (static_cast<int>(reuse.previous_vertex.size()) != n ||
       static_cast<int>(reuse.previous_triangle.size()) != face_count ||
-      (scale.size() != 0 && scale.size() != face_count))
+      (scale.size() != 0 && (scale.rows() != face_count || scale.cols() > 2)))
     throw InvalidClothError("the reuse map and the scale must have a row per vertex (" +
                             std::to_string(n) + ") and per triangle (" +
                             std::to_string(face_count) + ")");
