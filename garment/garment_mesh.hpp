@@ -38,7 +38,7 @@ struct GarmentPanel {
   std::string fabric;
   std::string body_part;  // nearest body region (majority over its faces)
   bool mirror_copy = false;
-  double ease = 1.0;
+  PanelEase ease;                   // warp and weft scale of the rest shape and the pattern piece
   std::vector<std::string> curves;  // boundary curves in loop order (pieces repeat their curve)
   std::vector<int> side_counts;     // edges per side, counter-clockwise from outside
   std::string partition;            // the filler's construction

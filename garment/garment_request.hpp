@@ -80,6 +80,17 @@ struct GrainSpec {
   double turn_deg = 0.0;  // degrees, -90 .. 90, counter-clockwise seen from outside
 };
 
+// A panel's ease: the scale of its rest shape, and of its pattern piece, along the warp and
+// along the weft of its material frame (1 = as designed). `"ease": e` is e both ways; a larger
+// factor one way makes the piece longer that way than the seams it is sewn to, so the cloth
+// gathers along them (a skirt tier with weft 1.5 gathers round the body).
+struct PanelEase {
+  double warp = 1.0;
+  double weft = 1.0;
+  bool isotropic() const { return warp == weft; }
+  bool operator==(const PanelEase&) const = default;
+};
+
 struct PanelSpec {
   std::string id;
   std::string json_path;                 // "/panels/1"
@@ -90,7 +101,7 @@ struct PanelSpec {
   std::string fabric;                    // default: the file's fabric
   bool mirror = false;                   // also make the copy across x = 0
   std::optional<double> edge_length;     // metres
-  double ease = 1.0;                     // rest shape scale (1 = as designed)
+  PanelEase ease;                        // rest shape scale (1 = as designed)
   std::optional<std::string> rest;       // "flat" | "shaped"; default: simulate.rest
   std::optional<double> seam_allowance;  // metres; default: output.pattern.seam_allowance
   PanelFit fit = PanelFit::kAuto;        // "fit"

@@ -253,7 +253,7 @@ PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOpt
     const FlatPanel& flat = pattern.panels[p];
     PatternPiece piece;
     piece.panel = static_cast<int>(p);
-    piece.ease = p < options.panel_ease.size() ? options.panel_ease[p] : 1.0;
+    piece.ease = p < options.panel_ease.size() ? options.panel_ease[p] : PanelEase{};
     piece.allowance = p < options.panel_allowance.size() && options.panel_allowance[p] >= 0
                           ? options.panel_allowance[p]
                           : options.seam_allowance;
@@ -279,7 +279,8 @@ PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOpt
     }
     piece.sewing.resize(static_cast<Eigen::Index>(edges), 2);
     for (size_t k = 0; k < edges; ++k)
-      piece.sewing.row(static_cast<Eigen::Index>(k)) = piece.ease * flat.uv.row(flat.boundary[k]);
+      piece.sewing.row(static_cast<Eigen::Index>(k)) =
+          flat.uv.row(flat.boundary[k]).cwiseProduct(piece.scale().transpose());
     piece.cutting = piece.allowances.size() > 1
                         ? offset_by_edge(flat.id, piece.sewing, allowance)
                         : offset_outwards(flat.id, piece.sewing, piece.allowances[0].allowance);

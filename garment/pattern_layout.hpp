@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "garment/garment_request.hpp"
 #include "garment/panel_flattening.hpp"
 
 namespace sd::garment {
@@ -20,8 +21,8 @@ struct PatternLayoutOptions {
   // allowance (a seam's or a hem's, m), or negative for the piece's; an empty list (or none for
   // the panel) gives the piece's everywhere.
   std::vector<std::vector<double>> edge_allowance;
-  std::vector<double> panel_ease;  // per panel rest-shape scale (empty: 1)
-  double gap = 0.01;               // m between pieces, and from the selvedges and the cut end
+  std::vector<PanelEase> panel_ease;  // per panel rest-shape scale (empty: 1)
+  double gap = 0.01;                  // m between pieces, and from the selvedges and the cut end
 };
 
 // A notch on the sewing line, `normal` pointing out of the piece (unit).
@@ -40,11 +41,14 @@ struct AllowanceRun {
   double allowance = 0;
 };
 
-// One piece in its own frame: piece = ease · FlatPanel::uv + origin (m), warp along +y, the
-// cutting line's bounding box starting at (0, 0). On the fabric it sits at `placement`.
+// One piece in its own frame: piece = scale() · FlatPanel::uv + origin (m), warp along +y, the
+// cutting line's bounding box starting at (0, 0): x scaled by the weft ease, y by the warp
+// ease, so a gathered piece (different factors) is cut longer than the seams it is sewn to.
+// On the fabric it sits at `placement`.
 struct PatternPiece {
-  int panel = -1;                        // index into FlatPattern::panels
-  double ease = 1, allowance = 0;        // allowance: the piece's (m), where no seam has its own
+  int panel = -1;  // index into FlatPattern::panels
+  PanelEase ease;
+  double allowance = 0;                  // the piece's (m), where no seam has its own
   std::vector<AllowanceRun> allowances;  // along the sewing line, covering every edge once
   Eigen::Vector2d origin = Eigen::Vector2d::Zero();
   Eigen::MatrixX2d sewing;  // the sewing line, closed (first point not repeated), CCW
@@ -57,7 +61,9 @@ struct PatternPiece {
   Eigen::Vector2d grain_start = Eigen::Vector2d::Zero(), grain_end = Eigen::Vector2d::Zero();
   Eigen::Vector2d size = Eigen::Vector2d::Zero();       // of the cutting line's bounding box
   Eigen::Vector2d placement = Eigen::Vector2d::Zero();  // on the fabric: x across, y along
-  double sewn_area = 0, cut_area = 0;                   // m²
+  // The ease as the piece frame's (x, y) scale: (weft, warp).
+  Eigen::Vector2d scale() const { return {ease.weft, ease.warp}; }
+  double sewn_area = 0, cut_area = 0;  // m²
 };
 
 struct PatternLayout {

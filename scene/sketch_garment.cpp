@@ -230,6 +230,38 @@ CurveSpec parse_curve(const Reader& r, const json& j, const std::string& path, c
   return curve;
 }
 
+// "ease": a number (the rest shape's scale both ways) or {"warp": a, "weft": b} (each 1 when left
+// out), every factor within 0.5 .. 2.
+PanelEase parse_ease(const Reader& r, const json& j, const std::string& path) {
+  const auto factor = [&](const json& value, const std::string& at, std::string_view way) {
+    if (!value.is_number() && !value.is_string())  // a quoted number: r.positive explains
+      r.fail(at, fmt::format("\"ease\" is a number (1.05: the piece 5 % larger both ways) or "
+                             "{{\"warp\": a, \"weft\": b}} (the scale along and across the "
+                             "grain: {{\"weft\": 1.5}} gathers a skirt tier round the body), "
+                             "not {}",
+                             value.dump()));
+    const double e = r.positive(value, at);
+    if (e < 0.5 || e > 2.0)
+      r.fail(at, fmt::format("ease {}{} is outside 0.5 .. 2 (1 = rest shape as designed, 1.05 = "
+                             "5% looser, 1.5 = half as long again to gather)",
+                             e, way));
+    return e;
+  };
+  if (!j.is_object()) {
+    const double e = factor(j, path, "");
+    return {e, e};
+  }
+  r.check_keys(j, path, {"warp", "weft"});
+  if (j.empty())
+    r.fail(path,
+           "an \"ease\" object needs \"warp\", \"weft\" or both (the scale along and "
+           "across the grain, 1 = as designed)");
+  PanelEase ease;
+  if (j.contains("warp")) ease.warp = factor(j["warp"], path + "/warp", " along the warp");
+  if (j.contains("weft")) ease.weft = factor(j["weft"], path + "/weft", " along the weft");
+  return ease;
+}
+
 // "grain": "auto", "vertical", "limb", a number of degrees (the auto direction turned by it), or
 // {"along": one of the words, "turn": degrees}.
 GrainSpec parse_grain(const Reader& r, const json& j, const std::string& path) {
@@ -393,13 +425,7 @@ PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, c
   if (j.contains("mirror")) panel.mirror = r.boolean(j["mirror"], path + "/mirror");
   if (j.contains("edge_length"))
     panel.edge_length = r.edge_length(j["edge_length"], path + "/edge_length");
-  if (j.contains("ease")) {
-    panel.ease = r.positive(j["ease"], path + "/ease");
-    if (panel.ease < 0.5 || panel.ease > 2.0)
-      r.fail(path + "/ease", fmt::format("ease {} is outside 0.5 .. 2 (1 = rest shape as "
-                                         "designed, 1.05 = 5% looser)",
-                                         panel.ease));
-  }
+  if (j.contains("ease")) panel.ease = parse_ease(r, j["ease"], path + "/ease");
   if (j.contains("rest")) {
     panel.rest = r.text(j["rest"], path + "/rest");
     if (*panel.rest != "flat" && *panel.rest != "shaped")

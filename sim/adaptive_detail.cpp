@@ -260,13 +260,14 @@ Eigen::MatrixXd AdaptiveCloth::pattern_rest_uv(const Eigen::MatrixXd& roots) con
   return uv;
 }
 
-Eigen::VectorXd AdaptiveCloth::ease_scale() const {
-  Eigen::VectorXd scale;  // per face, empty without ease
+Eigen::MatrixXd AdaptiveCloth::ease_scale() const {
+  Eigen::MatrixXd scale;  // per face, empty without ease
   if (material_.source_ease.size() > 0) {
-    scale.resize(arrays_.faces.rows());
-    for (Eigen::Index f = 0; f < scale.size(); ++f)
-      scale(f) = face_ease(material_.source_ease,
-                           mesh_.source_face(arrays_.triangle_ids[static_cast<std::size_t>(f)]));
+    scale.resize(arrays_.faces.rows(), 2);
+    for (Eigen::Index f = 0; f < scale.rows(); ++f)
+      scale.row(f) = face_ease(material_.source_ease,
+                               mesh_.source_face(arrays_.triangle_ids[static_cast<std::size_t>(f)]))
+                         .transpose();
   }
   return scale;
 }
@@ -283,7 +284,7 @@ std::vector<TriangleElement> AdaptiveCloth::ramped_triangles() const {
                                               (a * a * (3.0 - 2.0 * a)) * root_uv_)
                                                  .eval());
   ClothModel model = build_cloth_model(input, material_.fabric, material_.model_options);
-  const Eigen::VectorXd scale = ease_scale();
+  const Eigen::MatrixXd scale = ease_scale();
   if (scale.size() > 0) scale_rest_shapes(model, scale);
   return std::move(model.triangles);
 }
@@ -315,7 +316,7 @@ double AdaptiveCloth::rebuild(AdaptiveTransfer& state, const SimulationSettings*
       input.warp.row(f) = material_.source_warp.row(source);
     }
   }
-  const Eigen::VectorXd ease_scale = this->ease_scale();  // per face, empty without ease
+  const Eigen::MatrixXd ease_scale = this->ease_scale();  // per face, empty without ease
   ClothModel model;
   if (first) {
     model = build_cloth_model(input, material_.fabric, material_.model_options);

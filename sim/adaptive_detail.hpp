@@ -43,10 +43,11 @@ struct AdaptiveMaterial {
   // this is the parent's frame too).
   Eigen::MatrixX3d source_warp;
   Eigen::Vector3d up = Eigen::Vector3d::UnitY();
-  // Rest-shape scale per input face (a panel's `ease`, see scale_rest_shapes), or empty: 1.
-  // Children inherit their input face's, so an eased panel keeps its ease at every level; mass
-  // moves between triangles at the eased density ρ·e².
-  Eigen::VectorXd source_ease;
+  // Rest-shape scale per input face (a panel's `ease`, see scale_rest_shapes): #faces by 1
+  // (isotropic) or by 2 (warp, weft), or empty: 1. Children inherit their input face's, so an
+  // eased panel keeps its ease at every level; mass moves between triangles at the eased
+  // density ρ·a·b.
+  Eigen::MatrixXd source_ease;
   // Rest coordinates of each triangle of the mesh as given (ClothInput::rest_uv: a flattened
   // pattern's), or empty. The mesh must then be all level 0. A finer triangle gets its
   // coordinates from the level-0 triangle it lies in (Mesh48::root): the pattern map is affine
@@ -237,8 +238,9 @@ class AdaptiveCloth {
   // the roots' coordinates `roots` (root_uv_ or a blend on the ramp).
   Eigen::MatrixXd pattern_rest_uv() const { return pattern_rest_uv(root_uv_); }
   Eigen::MatrixXd pattern_rest_uv(const Eigen::MatrixXd& roots) const;
-  // The ease of every triangle of the current mesh (its input face's), or empty without ease.
-  Eigen::VectorXd ease_scale() const;
+  // The ease of every triangle of the current mesh (its input face's; #F by 2: warp, weft), or
+  // empty without ease.
+  Eigen::MatrixXd ease_scale() const;
   // The rest ramp's triangles at the current time (a = min(time() / rest_ramp, 1)), with ease:
   // build_cloth_model's triangles for the blended coordinates; rest_uv's exactly at a = 1.
   std::vector<TriangleElement> ramped_triangles() const;

@@ -65,25 +65,27 @@ AdaptiveTransfer begin_transfer(const meshing::Mesh48& mesh, Eigen::MatrixX3d x,
   return state;
 }
 
-double face_ease(const Eigen::VectorXd& source_ease, int source) {
-  if (source_ease.size() == 0) return 1.0;
-  if (source < 0 || source >= source_ease.size())
+Eigen::Vector2d face_ease(const Eigen::MatrixXd& source_ease, int source) {
+  if (source_ease.size() == 0) return Eigen::Vector2d::Ones();
+  if (source < 0 || source >= source_ease.rows())
     throw InvalidClothError("the ease must be given for every input face (" +
-                            std::to_string(source_ease.size()) + " given, face " +
+                            std::to_string(source_ease.rows()) + " given, face " +
                             std::to_string(source) + " needed)");
-  return source_ease(source);
+  const double a = source_ease(source, 0);
+  return {a, source_ease.cols() > 1 ? source_ease(source, 1) : a};
 }
 
 void transfer_change(const BlockChange& change, const meshing::Mesh48& mesh, double area_density,
-                     const Eigen::VectorXd& source_ease, AdaptiveTransfer& state,
+                     const Eigen::MatrixXd& source_ease, AdaptiveTransfer& state,
                      const Eigen::VectorXd& root_area_scale) {
   state.changed = true;
-  // Mass moves at each triangle's eased density ρ·e². The ease comes from the input faces the
+  // Mass moves at each triangle's eased density ρ·a·b. The ease comes from the input faces the
   // change recorded: by the time a forced split of a chain is applied, its child slots may
   // hold the triangles of the next split.
   const double rho = area_density;
-  const double e1 = face_ease(source_ease, change.source_a1);
-  const double e2 = change.source_a2 >= 0 ? face_ease(source_ease, change.source_a2) : 1.0;
+  const Eigen::Vector2d e1 = face_ease(source_ease, change.source_a1);
+  const Eigen::Vector2d e2 =
+      change.source_a2 >= 0 ? face_ease(source_ease, change.source_a2) : Eigen::Vector2d::Ones();
   const auto area_scale = [&root_area_scale](int root) {
     if (root_area_scale.size() == 0 || root < 0) return 1.0;
     if (root >= root_area_scale.size())
@@ -93,8 +95,8 @@ void transfer_change(const BlockChange& change, const meshing::Mesh48& mesh, dou
     return root_area_scale(root);
   };
   const double s1 = area_scale(change.root_a1), s2 = area_scale(change.root_a2);
-  meshing::transfer_mass_and_velocity(change, {rho * e1 * e1 * s1, rho * e2 * e2 * s2}, state.m,
-                                      state.v);
+  meshing::transfer_mass_and_velocity(change, {rho * e1(0) * e1(1) * s1, rho * e2(0) * e2(1) * s2},
+                                      state.m, state.v);
   const auto grow = [](auto& vector, int size, auto fill) {
     if (static_cast<int>(vector.size()) < size) vector.resize(static_cast<std::size_t>(size), fill);
   };

@@ -58,17 +58,18 @@ AdaptiveTransfer begin_transfer(const meshing::Mesh48& mesh, Eigen::MatrixX3d x,
                                 Eigen::VectorXd m, std::vector<double> birth,
                                 std::vector<PinRecord> pins, double now);
 
-// The rest-shape scale of input face `source` (1 when source_ease is empty).
-double face_ease(const Eigen::VectorXd& source_ease, int source);
+// The rest-shape scale (warp, weft) of input face `source` (1 when source_ease is empty; a
+// one-column source_ease is the same both ways).
+Eigen::Vector2d face_ease(const Eigen::MatrixXd& source_ease, int source);
 
 // Moves the state through one change made on `mesh` (already applied to it): mass and velocity
-// at each triangle's eased density ρ·e², the split vertex at the midpoint of its diagonal, ages,
+// at each triangle's eased density ρ·a·b, the split vertex at the midpoint of its diagonal, ages,
 // origins and pins (a split between two pins is pinned at its midpoint, following them).
 // root_area_scale: per level-0 triangle (Mesh48::root), its rest area over its 3D rest area (a
 // pattern rest shape's, constant over the root since its rest coordinates are affine there), or
-// empty: 1. Mass moves at ρ·e²·s then, as the model lumps it from the rest areas.
+// empty: 1. Mass moves at ρ·a·b·s then, as the model lumps it from the rest areas.
 void transfer_change(const meshing::BlockChange& change, const meshing::Mesh48& mesh,
-                     double area_density, const Eigen::VectorXd& source_ease,
+                     double area_density, const Eigen::MatrixXd& source_ease,
                      AdaptiveTransfer& state,
                      const Eigen::VectorXd& root_area_scale = Eigen::VectorXd());
 

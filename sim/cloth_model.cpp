@@ -145,13 +145,17 @@ TriangleElement make_triangle(const ClothInput& input, Eigen::Index f, double ex
   return t;
 }
 
-void scale_triangle(TriangleElement& element, double e, std::size_t t) {
-  if (!(e > 0.0) || !std::isfinite(e))
-    throw InvalidClothError("rest-shape scale " + std::to_string(e) + " of triangle " +
-                            std::to_string(t) + " is not positive");
-  element.du /= e;
-  element.dv /= e;
-  element.rest_area *= e * e;
+// Row t of a #T by 1 (isotropic) or #T by 2 (warp, weft) scale: rest coordinates (u, v) become
+// (a·u, b·v), so [w_u w_v] = [x1−x0, x2−x0]·D⁻¹·diag(1/a, 1/b).
+void scale_triangle(TriangleElement& element, const Eigen::MatrixXd& scale, std::size_t t) {
+  const auto row = static_cast<Eigen::Index>(t);
+  const double a = scale(row, 0), b = scale.cols() > 1 ? scale(row, 1) : a;
+  if (!(a > 0.0) || !(b > 0.0) || !std::isfinite(a) || !std::isfinite(b))
+    throw InvalidClothError("rest-shape scale (" + std::to_string(a) + ", " + std::to_string(b) +
+                            ") of triangle " + std::to_string(t) + " is not positive");
+  element.du /= a;
+  element.dv /= b;
+  element.rest_area *= a * b;
 }
 
 // The vertices adjacent to each vertex (itself included) through triangles and hinges, as one
@@ -343,16 +347,17 @@ void set_block_offsets(ClothModel& model, const Neighbours& neighbours,
 
 }  // namespace
 
-void scale_rest_shapes(ClothModel& model, const Eigen::VectorXd& scale) {
-  if (scale.size() != static_cast<Eigen::Index>(model.triangles.size()))
-    throw InvalidClothError("a rest-shape scale is needed for every triangle (" +
-                            std::to_string(scale.size()) + " given, " +
-                            std::to_string(model.triangles.size()) + " triangles)");
+void scale_rest_shapes(ClothModel& model, const Eigen::MatrixXd& scale) {
+  if (scale.rows() != static_cast<Eigen::Index>(model.triangles.size()) || scale.cols() < 1 ||
+      scale.cols() > 2)
+    throw InvalidClothError("a rest-shape scale (1 or 2 columns) is needed for every triangle (" +
+                            std::to_string(scale.rows()) + " by " + std::to_string(scale.cols()) +
+                            " given, " + std::to_string(model.triangles.size()) + " triangles)");
   model.mass.setZero();
   model.vertex_area.setZero();
   for (std::size_t t = 0; t < model.triangles.size(); ++t) {
     TriangleElement& element = model.triangles[t];
-    scale_triangle(element, scale(static_cast<Eigen::Index>(t)), t);
+    scale_triangle(element, scale, t);
     for (int v : element.vertices) {
       model.vertex_area[v] += element.rest_area / 3.0;
       model.mass[v] += model.fabric.area_density * element.rest_area / 3.0;
@@ -556,14 +561,14 @@ ClothModel build_cloth_model(const ClothInput& input, const FabricParameters& fa
 }
 
 ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse& reuse,
-                              const ClothInput& input, const Eigen::VectorXd& scale,
+                              const ClothInput& input, const Eigen::MatrixXd& scale,
                               const ClothModelOptions& options) {
   check_input(input);
   const int n = static_cast<int>(input.rest_positions.rows());
   const int face_count = static_cast<int>(input.triangles.rows());
   if (static_cast<int>(reuse.previous_vertex.size()) != n ||
       static_cast<int>(reuse.previous_triangle.size()) != face_count ||
-      (scale.size() != 0 && scale.size() != face_count))
+      (scale.size() != 0 && (scale.rows() != face_count || scale.cols() > 2)))
     throw InvalidClothError("the reuse map and the scale must have a row per vertex (" +
                             std::to_string(n) + ") and per triangle (" +
                             std::to_string(face_count) + ")");
@@ -626,7 +631,7 @@ ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse&
       }
     } else {
       t = make_triangle(input, f, extent);
-      if (scale.size() > 0) scale_triangle(t, scale(f), static_cast<std::size_t>(f));
+      if (scale.size() > 0) scale_triangle(t, scale, static_cast<std::size_t>(f));
       new_face[f] = 1;
     }
     for (int k = 0; k < 3; ++k) {

@@ -236,14 +236,16 @@ struct ClothModelReuse {
 // the reference's order. Throws InvalidClothError as build_cloth_model, and when `reuse` does
 // not describe the input.
 ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse& reuse,
-                              const ClothInput& input, const Eigen::VectorXd& scale,
+                              const ClothInput& input, const Eigen::MatrixXd& scale,
                               const ClothModelOptions& options = {});
 
-// Scales each triangle's rest shape by scale(t) (a panel's `ease`: lengths by e, so the gradient
-// operators du, dv by 1/e and the rest area by e²) and recomputes the lumped masses and vertex
-// areas from the scaled areas. Rest angles, and the bending weights |e|²/(A1+A2), do not change
-// under a uniform scale. `scale` is #triangles, every entry positive.
-void scale_rest_shapes(ClothModel& model, const Eigen::VectorXd& scale);
+// Scales each triangle's rest shape along its warp by a and along its weft by b (a panel's
+// `ease`): its rest coordinates (u, v) become (a·u, b·v), so the gradient operators du by 1/a,
+// dv by 1/b and the rest area by a·b, and recomputes the lumped masses and vertex areas from the
+// scaled areas. `scale` is #triangles by 1 (a = b = e, the isotropic ease) or by 2 (a, b), every
+// entry positive. Rest angles, and the bending weights |e|²/(A1+A2), do not change under a
+// uniform scale; under an anisotropic one they, and width_u, width_v, keep the unscaled shape's.
+void scale_rest_shapes(ClothModel& model, const Eigen::MatrixXd& scale);
 
 // Makes the bending of BendModel::quadratic see the edge of a clamp. Where cloth leaves a clamp
 // (a region of pinned vertices held flat) its curvature jumps from 0 to κ0, and the element of a

@@ -170,7 +170,8 @@ TEST(SketchFile, ReadsEverySection) {
   EXPECT_DOUBLE_EQ(s.curves[0].view.camera.fov_degrees, 30);
   EXPECT_FALSE(s.curves[0].smooth);
   EXPECT_DOUBLE_EQ(*s.panels[0].edge_length, 0.015);
-  EXPECT_DOUBLE_EQ(s.panels[0].ease, 1.1);
+  EXPECT_DOUBLE_EQ(s.panels[0].ease.warp, 1.1);  // a number: the same both ways
+  EXPECT_DOUBLE_EQ(s.panels[0].ease.weft, 1.1);
   EXPECT_EQ(s.joins[0].panels.size(), 2u);
   EXPECT_EQ(s.simulate.solver, "cholmod");
   EXPECT_FALSE(s.simulate.time_step_auto);  // the file's 0.01 s
@@ -183,6 +184,28 @@ TEST(SketchFile, ReadsEverySection) {
   EXPECT_EQ(s.output.images[0].width, 640);
   EXPECT_EQ(s.output.images[1].view, "three-quarter");
   EXPECT_EQ(s.output.mesh, "g.glb");
+}
+
+// "ease": {"warp": a, "weft": b} scales the two directions apart (a gathered panel); a factor
+// left out is 1.
+TEST(SketchFile, EaseObjectGivesWarpAndWeft) {
+  const auto ease = [](const std::string& value) {
+    return parse_sketch(R"({"format": "sketchdrape/1",
+      "curves": [{ "id": "c", "view": "front", "points": [[0, 1], [0.1, 1], [0.1, 1.1]] }],
+      "panels": [{ "id": "p", "boundary": ["c"], "ease": )" +
+                            value + R"( }]})",
+                        "test.json")
+        .panels[0]
+        .ease;
+  };
+  EXPECT_EQ(ease(R"({"weft": 1.5})"), (garment::PanelEase{1.0, 1.5}));
+  EXPECT_EQ(ease(R"({"warp": 0.9, "weft": 1.25})"), (garment::PanelEase{0.9, 1.25}));
+  EXPECT_TRUE(ease("1.2").isotropic());
+  EXPECT_FALSE(ease(R"({"warp": 1.2})").isotropic());
+  EXPECT_THROW(ease(R"({})"), garment::SketchError);
+  EXPECT_THROW(ease(R"({"weft": 2.5})"), garment::SketchError);
+  EXPECT_THROW(ease(R"({"weft": "1.5"})"), garment::SketchError);
+  EXPECT_THROW(ease(R"([1, 1.5])"), garment::SketchError);
 }
 
 TEST(SketchFile, SolverAndStepMayBeAutomatic) {

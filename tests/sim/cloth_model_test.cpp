@@ -183,6 +183,71 @@ TEST(ClothModel, RestCoordinatesPerTriangle) {
   EXPECT_THROW(build_cloth_model(folded, FabricParameters{}), InvalidClothError);
 }
 
+// A gathered panel's ease (scale_rest_shapes with a warp and a weft column) is the rest shape
+// whose coordinates along the warp are a times and along the weft b times the designed ones:
+// the same elements as build_cloth_model of those coordinates, unstrained in the sheet
+// stretched by a along its warp (+y) and b along its weft (−x). One column is the isotropic ease,
+// the same as two equal ones bit for bit.
+TEST(ClothModel, EaseScalesTheRestShapeByWarpAndWeftFactors) {
+  const SheetScene scene = small_sheet();
+  const double a = 1.25, b = 1.5;  // binary fractions: the scaled coordinates are exact
+  ClothModel model = build_cloth_model(scene.input, FabricParameters{});
+  const double mass = model.total_mass();
+  const Eigen::Index triangles = static_cast<Eigen::Index>(model.triangles.size());
+  Eigen::MatrixXd scale(triangles, 2);
+  scale.col(0).setConstant(a);
+  scale.col(1).setConstant(b);
+  scale_rest_shapes(model, scale);
+
+  // The same rest shape given as coordinates: the vertical sheet's warp is +y, its weft −x.
+  ClothInput given = scene.input;
+  given.rest_uv.resize(given.triangles.rows(), 6);
+  for (Eigen::Index f = 0; f < given.triangles.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d p = given.rest_positions.row(given.triangles(f, k)) -
+                                given.rest_positions.row(given.triangles(f, 0));
+      given.rest_uv(f, 2 * k) = a * p.y();
+      given.rest_uv(f, 2 * k + 1) = -b * p.x();
+    }
+  const ClothModel reference = build_cloth_model(given, FabricParameters{});
+  for (size_t t = 0; t < model.triangles.size(); ++t) {
+    // Areas: a product of exact factors; du, dv: one division each way (a few ulps of 1/m).
+    EXPECT_NEAR(model.triangles[t].rest_area, reference.triangles[t].rest_area, 1e-15);
+    EXPECT_NEAR((model.triangles[t].du - reference.triangles[t].du).norm(), 0.0, 1e-9);
+    EXPECT_NEAR((model.triangles[t].dv - reference.triangles[t].dv).norm(), 0.0, 1e-9);
+  }
+  EXPECT_NEAR(model.total_mass(), a * b * mass, 1e-15);
+
+  // Lengths: the sheet stretched by a along the warp and b along the weft is at rest (with a
+  // and b swapped it would be strained by b/a − 1 = 0.2); stretched twice that along one
+  // direction, it is strained by 1 along it (max_stretch_strain sees stretch only).
+  const auto strain = [&](double along_warp, double along_weft) {
+    Eigen::MatrixX3d x = scene.input.rest_positions;
+    x.col(1) *= along_warp;
+    x.col(0) *= along_weft;
+    return max_stretch_strain(model, flatten_positions(x));
+  };
+  EXPECT_NEAR(strain(a, b), 0.0, 1e-12);
+  EXPECT_NEAR(strain(2 * a, b), 1.0, 1e-12);
+  EXPECT_NEAR(strain(a, 2 * b), 1.0, 1e-12);
+  EXPECT_NEAR(strain(b, a), b / a - 1.0, 1e-12);
+
+  // The isotropic ease: one column or two equal ones give the same elements bit for bit.
+  ClothModel one = build_cloth_model(scene.input, FabricParameters{});
+  ClothModel two = one;
+  scale_rest_shapes(one, Eigen::VectorXd::Constant(triangles, 1.1));
+  scale_rest_shapes(two, Eigen::MatrixXd::Constant(triangles, 2, 1.1));
+  for (size_t t = 0; t < one.triangles.size(); ++t) {
+    EXPECT_EQ(one.triangles[t].rest_area, two.triangles[t].rest_area);
+    EXPECT_EQ(one.triangles[t].du, two.triangles[t].du);
+    EXPECT_EQ(one.triangles[t].dv, two.triangles[t].dv);
+  }
+  EXPECT_THROW(scale_rest_shapes(one, Eigen::MatrixXd::Constant(triangles, 3, 1.0)),
+               InvalidClothError);
+  EXPECT_THROW(scale_rest_shapes(one, Eigen::MatrixXd::Constant(triangles, 2, -1.0)),
+               InvalidClothError);
+}
+
 TEST(ClothModel, BadMeshesAreRejected) {
   ClothInput input;
   input.rest_positions.resize(3, 3);

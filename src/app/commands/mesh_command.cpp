@@ -155,7 +155,7 @@ void run_mesh(const MeshOptions& options) {
                       {"fabric", p.fabric},
                       {"body_part", p.body_part},
                       {"mirror_copy", p.mirror_copy},
-                      {"ease", p.ease},
+                      {"ease", ease_json(p.ease)},
                       {"sides", p.side_counts.size()},
                       {"side_counts", p.side_counts},
                       {"curves", p.curves},

@@ -283,13 +283,16 @@ void build_garment_scene(const scene::Sketch& sketch, ClothScene& scene) {
   // Per quad: group, ease and warp (the material frames, computed once here).
   const Eigen::Index quads = g.mesh.face_count();
   scene.face_group.resize(quads);
-  scene.face_ease.resize(quads);
+  bool isotropic = true;
+  for (const garment::GarmentPanel& p : g.panels) isotropic = isotropic && p.ease.isotropic();
+  scene.face_ease.resize(quads, isotropic ? 1 : 2);
   for (Eigen::Index q = 0; q < quads; ++q) {
     const auto panel = static_cast<size_t>(g.face_panel(static_cast<int>(q)));
     scene.face_group(q) = panel_group[panel];
-    scene.face_ease(q) = g.panels[panel].ease;
+    scene.face_ease(q, 0) = g.panels[panel].ease.warp;
+    if (!isotropic) scene.face_ease(q, 1) = g.panels[panel].ease.weft;
   }
-  if ((scene.face_ease.array() == 1.0).all()) scene.face_ease.resize(0);
+  if ((scene.face_ease.array() == 1.0).all()) scene.face_ease.resize(0, 0);
   scene.face_warp = frames.warp;
 
   const Eigen::Index triangles = arrays.faces.rows();
@@ -418,9 +421,9 @@ sim::ClothModel build_scene_model(const ClothScene& scene) {
   if (scene.bend_rest_flat) options.bend_rest = sim::BendRestShape::flat;
   sim::ClothModel model = sim::build_cloth_model(scene.input, scene.fabric, options);
   if (scene.face_ease.size() > 0) {
-    Eigen::VectorXd triangle_ease(scene.triangle_face.size());
-    for (Eigen::Index t = 0; t < triangle_ease.size(); ++t)
-      triangle_ease(t) = scene.face_ease(scene.triangle_face(t));
+    Eigen::MatrixXd triangle_ease(scene.triangle_face.size(), scene.face_ease.cols());
+    for (Eigen::Index t = 0; t < triangle_ease.rows(); ++t)
+      triangle_ease.row(t) = scene.face_ease.row(scene.triangle_face(t));
     sim::scale_rest_shapes(model, triangle_ease);
   }
   return model;

@@ -30,7 +30,9 @@ struct ClothScene {
   std::optional<meshing::Mesh48> mesh48;
   // Per input face of mesh48:
   Eigen::VectorXi face_group;  // group (panel or join; a sheet's layer), into group_names
-  Eigen::VectorXd face_ease;   // the panel's `ease` (rest shape scale); empty: all 1
+  // The panel's `ease` (rest shape scale): one column when every panel's is isotropic, else
+  // two (warp, weft); empty: all 1.
+  Eigen::MatrixXd face_ease;
   Eigen::MatrixX3d face_warp;  // warp direction; empty: the in-plane one closest to +Y
   // The fixed mesh as simulator input (rest shape, triangles, per-triangle warp and, with
   // "rest": "flat", rest_uv): mesh48's level-0 triangles, except for a sheet, whose own
@@ -73,10 +75,10 @@ ClothScene build_cloth_scene(const scene::Sketch& sketch);
 meshing::TriMesh body_at(const ClothScene& scene, double t);
 
 // The simulator's model of the scene's cloth on its fixed mesh: build_cloth_model on the input,
-// then each triangle's rest shape scaled by its panel's ease (lengths by e, so rest area and
-// mass by e²; rest angles do not change under a uniform scale). A waistband with ease below 1
-// is cut smaller than the body it was drawn on and holds the garment up. Hinges rest flat when
-// bend_rest_flat.
+// then each triangle's rest shape scaled by its panel's ease (lengths along the warp by a and
+// along the weft by b, so rest area and mass by a·b; see sim::scale_rest_shapes). A waistband with
+// ease below 1 is cut smaller than the body it was drawn on and holds the garment up. Hinges rest
+// flat when bend_rest_flat.
 sim::ClothModel build_scene_model(const ClothScene& scene);
 
 // What the cloth is made of for the 4-8 driver: fabric, bending rest shape, and the warp, ease

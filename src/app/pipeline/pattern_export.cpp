@@ -98,6 +98,12 @@ std::string mirror_partner(const PatternSheet& sheet, const std::string& id) {
   return {};
 }
 
+// The piece label's ease: "ease 1.05", or for a gathered piece the factor each way.
+std::string ease_label(const garment::PanelEase& ease) {
+  if (ease.isotropic()) return fmt::format("ease {:g}", ease.warp);
+  return fmt::format("gathered: ease {:g} along, {:g} across the grain", ease.warp, ease.weft);
+}
+
 std::string cut_note(const PatternSheet& sheet, const std::string& id) {
   const std::string partner = mirror_partner(sheet, id);
   if (partner.empty()) return "cut 1";
@@ -218,8 +224,8 @@ std::string pattern_svg(const PatternSheet& sheet) {
                     kMm * (piece.sewing.col(0).maxCoeff() - piece.sewing.col(0).minCoeff()),
                     kMm * (piece.sewing.col(1).maxCoeff() - piece.sewing.col(1).minCoeff()),
                     fabric),
-        fmt::format("{} · ease {:g} · stretch {:.1f} % (95th pct)", cut_note(sheet, flat.id),
-                    piece.ease, 100 * flat.distortion.length_p95)};
+        fmt::format("{} · {} · stretch {:.1f} % (95th pct)", cut_note(sheet, flat.id),
+                    ease_label(piece.ease), 100 * flat.distortion.length_p95)};
     Eigen::MatrixX2d outline(piece.sewing.rows(), 2);
     for (Eigen::Index i = 0; i < piece.sewing.rows(); ++i) {
       const Eigen::Vector2d p = on_fabric(piece, piece.sewing.row(i).transpose());
@@ -399,6 +405,16 @@ nlohmann::json distortion_json(const garment::FlatDistortion& d) {
           {"saddle_rad", d.saddle}};
 }
 
+// A seam side's polyline as flattened (m, before ease).
+Eigen::MatrixX2d flat_seam_side(const PatternSheet& sheet, int panel,
+                                const std::vector<int>& vertices) {
+  const garment::FlatPanel& flat = sheet.pattern.panels[static_cast<size_t>(panel)];
+  Eigen::MatrixX2d out(static_cast<Eigen::Index>(vertices.size()), 2);
+  for (size_t k = 0; k < vertices.size(); ++k)
+    out.row(static_cast<Eigen::Index>(k)) = flat.uv.row(vertices[k]);
+  return out;
+}
+
 // A seam side's polyline in its piece's frame (m, ease applied).
 Eigen::MatrixX2d seam_side(const PatternSheet& sheet, int panel, const std::vector<int>& vertices) {
   const garment::FlatPanel& flat = sheet.pattern.panels[static_cast<size_t>(panel)];
@@ -406,7 +422,7 @@ Eigen::MatrixX2d seam_side(const PatternSheet& sheet, int panel, const std::vect
   Eigen::MatrixX2d out(static_cast<Eigen::Index>(vertices.size()), 2);
   for (size_t k = 0; k < vertices.size(); ++k)
     out.row(static_cast<Eigen::Index>(k)) =
-        piece.ease * flat.uv.row(vertices[k]) + piece.origin.transpose();
+        flat.uv.row(vertices[k]).cwiseProduct(piece.scale().transpose()) + piece.origin.transpose();
   return out;
 }
 
@@ -417,6 +433,11 @@ double polyline_length(const Eigen::MatrixX2d& p) {
 }
 
 }  // namespace
+
+nlohmann::json ease_json(const garment::PanelEase& ease) {
+  if (ease.isotropic()) return ease.warp;
+  return {{"warp", ease.warp}, {"weft", ease.weft}};
+}
 
 nlohmann::json pattern_json(const PatternSheet& sheet) {
   const garment::PatternLayout& layout = sheet.layout;
@@ -434,7 +455,10 @@ nlohmann::json pattern_json(const PatternSheet& sheet) {
           {{"first_edge", run.first}, {"last_edge", run.last}, {"mm", kMm * run.allowance}});
     pieces.push_back({{"id", flat.id},
                       {"fabric", sheet.fabrics[static_cast<size_t>(piece.panel)]},
-                      {"ease", piece.ease},
+                      {"ease", ease_json(piece.ease)},
+                      {"gathered", !piece.ease.isotropic()},
+                      {"gather_ratio", std::max(piece.ease.warp, piece.ease.weft) /
+                                           std::min(piece.ease.warp, piece.ease.weft)},
                       {"seam_allowance_mm", kMm * piece.allowance},
                       {"allowances", allowances},
                       {"size_mm", point_mm(piece.size)},
@@ -456,6 +480,10 @@ nlohmann::json pattern_json(const PatternSheet& sheet) {
     const Eigen::MatrixX2d a = seam_side(sheet, seam.panel_a, seam.vertices_a);
     const Eigen::MatrixX2d b = seam_side(sheet, seam.panel_b, seam.vertices_b);
     const double la = polyline_length(a), lb = polyline_length(b);
+    // What the ease made of each side's flattened length (1: as flattened; e: eased by e; a
+    // gathered piece's side between its warp and weft factors, by the side's direction).
+    const double ga = la / polyline_length(flat_seam_side(sheet, seam.panel_a, seam.vertices_a));
+    const double gb = lb / polyline_length(flat_seam_side(sheet, seam.panel_b, seam.vertices_b));
     seams.push_back({{"a", sheet.pattern.panels[static_cast<size_t>(seam.panel_a)].id},
                      {"b", sheet.pattern.panels[static_cast<size_t>(seam.panel_b)].id},
                      {"length_3d_mm", kMm * seam.length_3d},
@@ -463,6 +491,9 @@ nlohmann::json pattern_json(const PatternSheet& sheet) {
                      {"length_b_mm", kMm * lb},
                      {"flattening_mismatch", seam.mismatch()},
                      {"ease_difference", std::abs(la - lb) / std::max(la, lb)},
+                     {"ease_a", ga},
+                     {"ease_b", gb},
+                     {"gather", std::max(ga, gb) / std::min(ga, gb)},
                      {"balance_notches", seam.balance},
                      {"polyline_a", points_mm(a)},
                      {"polyline_b", points_mm(b)}});

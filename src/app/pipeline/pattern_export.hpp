@@ -43,6 +43,10 @@ std::string pattern_svg(const PatternSheet& sheet);
 std::string pattern_dxf(const PatternSheet& sheet);
 nlohmann::json pattern_json(const PatternSheet& sheet);
 
+// A panel's ease as its file gives it: a number when it is the same both ways, else
+// {"warp": a, "weft": b} (a gathered panel).
+nlohmann::json ease_json(const garment::PanelEase& ease);
+
 // The figures a run report holds: per piece distortion and size, worst seam mismatch, fabric
 // length and efficiency.
 nlohmann::json pattern_summary(const PatternSheet& sheet);
