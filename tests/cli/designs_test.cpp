@@ -255,16 +255,23 @@ int gather_turns(const fs::path& obj) {
   double extreme = around.empty() ? 0.0 : around.front().second;
   for (int pass = 0; pass < 2; ++pass)  // twice round, so the loop closes; the first primes
     for (const auto& [angle, r] : around) {
-      if (direction >= 0 && r > extreme) extreme = r;
-      if (direction <= 0 && r < extreme) extreme = r;
-      if (direction >= 0 && extreme - r > kHysteresis) {
-        turns += pass == 1 && direction > 0;
-        direction = -1;
-        extreme = r;
-      } else if (direction <= 0 && r - extreme > kHysteresis) {
-        turns += pass == 1 && direction < 0;
-        direction = 1;
-        extreme = r;
+      if (direction >= 0) {  // rising (or not yet known): a fall from the peak by more turns
+        if (r > extreme) {
+          extreme = r;
+        } else if (extreme - r > kHysteresis) {
+          turns += pass == 1 && direction > 0;
+          direction = -1;
+          extreme = r;
+        }
+      }
+      if (direction <= 0) {  // falling (or not yet known): a rise from the trough turns
+        if (r < extreme) {
+          extreme = r;
+        } else if (r - extreme > kHysteresis) {
+          turns += pass == 1 && direction < 0;
+          direction = 1;
+          extreme = r;
+        }
       }
     }
   return turns;
