@@ -81,8 +81,6 @@ void install_handlers() {
   });
 }
 
-// Puts `path` in a free slot; returns the slot's string (to release it later), or null when
-// every slot is taken (the file is then only removed by the destructor or a later sweep).
 }  // namespace
 
 void install_interrupt_cleanup() {
@@ -91,6 +89,8 @@ void install_interrupt_cleanup() {
 
 namespace {
 
+// Puts `path` in a free slot; returns the slot's string (to release it later), or null when
+// every slot is taken (the file is then only removed by the destructor or a later sweep).
 template <size_t N>
 char* hold(std::array<std::atomic<char*>, N>& slots, const std::filesystem::path& path) {
   install_handlers();
