@@ -46,6 +46,14 @@ for t in "${targets[@]}"; do
       -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=10 -print_final_stats=1 \
       >run.log 2>&1); then
     echo "==> $t: FAILED (see $dir/run.log and $dir/crash-*)"
+    # The sanitizer's report and the input, here too: a CI log shows only what was printed.
+    grep -m1 -B2 -A40 -E "ERROR: (AddressSanitizer|UndefinedBehaviorSanitizer|libFuzzer)|runtime error|==ERROR|SUMMARY|Test unit written" \
+      "$dir/run.log" | head -60 || tail -40 "$dir/run.log"
+    for crash in "$dir"/crash-* "$dir"/timeout-* "$dir"/oom-* "$dir"/leak-*; do
+      [ -f "$crash" ] || continue
+      echo "--- $crash (base64):"
+      head -c 6000 "$crash" | base64
+    done
     status=1
   else
     echo "==> $t: clean, $(grep -m1 stat::number_of_executed_units "$dir/run.log" | awk '{print $2}') runs in $(($(date +%s) - start)) s"
