@@ -3,7 +3,11 @@
 #include <dlfcn.h>
 #include <fmt/format.h>
 
+#include <cstdlib>
+#include <iterator>
 #include <mutex>
+#include <string>
+#include <vector>
 
 #include "src/render/renderer.hpp"
 
@@ -14,8 +18,10 @@ Functions functions;
 namespace {
 
 // The shared library's name, found by CMake from the development package (cmake/osmesa.cmake);
-// the unversioned name last, for a system where that is all there is.
+// the unversioned name last, for a system where that is all there is. SKETCHDRAPE_OSMESA, when
+// set, is the one library tried instead (another Mesa build; docs/rendering.md).
 constexpr const char* kLibraryNames[] = {SD_OSMESA_LIBRARY, "libOSMesa.so"};
+constexpr const char* kLibraryVariable = "SKETCHDRAPE_OSMESA";
 
 std::once_flag loaded_once;
 
@@ -30,21 +36,30 @@ void look_up(void* library, const char* library_name, const char* name, Pointer&
 }
 
 void load_once() {
+  std::vector<const char*> names(std::begin(kLibraryNames), std::end(kLibraryNames));
+  const char* chosen = std::getenv(kLibraryVariable);
+  if (chosen != nullptr && *chosen != '\0') names = {chosen};
   void* library = nullptr;
-  const char* library_name = kLibraryNames[0];
+  const char* library_name = names.front();
   std::string errors;
-  for (const char* name : kLibraryNames) {
+  for (const char* name : names) {
     // RTLD_LOCAL: its symbols stay out of the process's namespace (nothing else links GL).
     library = dlopen(name, RTLD_NOW | RTLD_LOCAL);
     if (library != nullptr) {
       library_name = name;
       break;
     }
-    if (const char* error = dlerror()) errors += fmt::format("; {}", error);
+    if (const char* error = dlerror())
+      errors += fmt::format("{}{}", errors.empty() ? "" : "; ", error);
   }
   if (library == nullptr)
-    throw RenderError(
-        fmt::format("cannot render: OSMesa could not be loaded (install libosmesa6){}", errors));
+    throw RenderError(fmt::format(
+        "cannot render: the OSMesa library {} could not be opened ({}){}; it is in Debian's "
+        "package libosmesa6 (apt-get install libosmesa6)",
+        library_name, errors,
+        chosen != nullptr && *chosen != '\0'
+            ? fmt::format(" (the {} environment variable named it)", kLibraryVariable)
+            : ""));
   Functions loaded;
   try {
 #define SD_GL_LOOK_UP(name) look_up(library, library_name, #name, loaded.name##_);

@@ -431,6 +431,10 @@ Renderer::~Renderer() = default;
 Renderer::Renderer(Renderer&&) noexcept = default;
 Renderer& Renderer::operator=(Renderer&&) noexcept = default;
 
+void load_renderer_library() {
+  gl::load_gl();
+}
+
 const std::string& Renderer::gl_version() const {
   return impl_->version;
 }
