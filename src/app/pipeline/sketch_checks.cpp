@@ -76,15 +76,15 @@ double memory_scaled(const RunEstimate& e, double vertices) {
 
 // "1.2 GB", or "74 MB" below a gigabyte (where one decimal of GB says too little: a budget of
 // 60 MB read "0.1 GB").
-std::string gigabytes(double bytes) {
+std::string size_text(double bytes) {
   return bytes >= 1e9 ? fmt::format("{:.1f} GB", bytes / 1e9)
                       : fmt::format("{:.0f} MB", bytes / 1e6);
 }
 
 std::string budget_text(double budget, bool given) {
   return given
-             ? fmt::format("the {} of --max-memory", gigabytes(budget))
-             : fmt::format("the {} a run may take of the memory available now", gigabytes(budget));
+             ? fmt::format("the {} of --max-memory", size_text(budget))
+             : fmt::format("the {} a run may take of the memory available now", size_text(budget));
 }
 
 // What to do about pictures that do not fit.
@@ -247,10 +247,10 @@ std::optional<std::string> rendering_over_budget(double resident, const Renderer
   return fmt::format(
       "the process holds {} and rendering {}x{} pictures takes about {} more ({}the OpenGL "
       "context and its framebuffers), {} in all, more than {}",
-      gigabytes(resident), renderer.width, renderer.height, gigabytes(adds),
+      size_text(resident), renderer.width, renderer.height, size_text(adds),
       library_loaded ? ""
-                     : fmt::format("OSMesa's libraries {}, ", gigabytes(renderer.library_bytes)),
-      gigabytes(resident + adds), budget_text(budget, given));
+                     : fmt::format("OSMesa's libraries {}, ", size_text(renderer.library_bytes)),
+      size_text(resident + adds), budget_text(budget, given));
 }
 
 std::optional<RunEstimate> estimate_before_building(const scene::Sketch& sketch,
@@ -313,9 +313,9 @@ void check_run_fits(const scene::Sketch& sketch, const RunEstimate& estimate,
                   fmt::format("the drape needs about {} and rendering its {}x{} pictures about {} "
                               "more (OSMesa's libraries {}, the OpenGL context and its "
                               "framebuffers {}), {} in all, more than {}; {}",
-                              gigabytes(drape), renderer.width, renderer.height,
-                              gigabytes(renderer.total()), gigabytes(renderer.library_bytes),
-                              gigabytes(renderer.frame_bytes), gigabytes(estimate.memory_bytes),
+                              size_text(drape), renderer.width, renderer.height,
+                              size_text(renderer.total()), size_text(renderer.library_bytes),
+                              size_text(renderer.frame_bytes), size_text(estimate.memory_bytes),
                               limit, kFewerPictures));
     // The largest vertex count that fits, by bisection on the estimate scaled to other sizes.
     double low = 4, high = estimate.vertices;
@@ -325,7 +325,7 @@ void check_run_fits(const scene::Sketch& sketch, const RunEstimate& estimate,
     }
     const std::string pictures =
         renderer.total() > 0
-            ? fmt::format(", {} the renderer of its {}x{} pictures", gigabytes(renderer.total()),
+            ? fmt::format(", {} the renderer of its {}x{} pictures", size_text(renderer.total()),
                           renderer.width, renderer.height)
             : "";
     if (sketch.sheet) {
@@ -335,14 +335,14 @@ void check_run_fits(const scene::Sketch& sketch, const RunEstimate& estimate,
                               "simulate ({} of it the solver's factor{}), more than {}; about "
                               "{:.0f}x{:.0f} quads would fit",
                               sketch.sheet->columns, sketch.sheet->rows, estimate.vertices,
-                              gigabytes(estimate.memory_bytes), gigabytes(estimate.factor_bytes),
+                              size_text(estimate.memory_bytes), size_text(estimate.factor_bytes),
                               pictures, limit, side, side));
     }
     sketch.fail("", fmt::format("the cloth has {:.0f} vertices and needs about {} to simulate "
                                 "({} of it the solver's factor{}), more than {}; about {:.0f} "
                                 "vertices would fit (a longer edge_length)",
-                                estimate.vertices, gigabytes(estimate.memory_bytes),
-                                gigabytes(estimate.factor_bytes), pictures, limit, low));
+                                estimate.vertices, size_text(estimate.memory_bytes),
+                                size_text(estimate.factor_bytes), pictures, limit, low));
   }
   if (estimate.frames > kMaxFrames)
     throw std::invalid_argument(fmt::format(
