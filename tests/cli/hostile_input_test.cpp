@@ -591,7 +591,7 @@ TEST(HostileInput, PicturesAreCountedInTheBudgetOnlyWhenAsked) {
 // OSMesa is opened only when pictures are asked for, and before the drape: a library that
 // cannot be opened (SKETCHDRAPE_OSMESA names another; docs/rendering.md) fails at once with exit
 // code 1, naming the library and Debian's package, with nothing written; a run without pictures
-// does not need it.
+// does not need it, and a failed drape's last state is written without its pictures.
 TEST(HostileInput, AMissingOsmesaFailsOnlyARunWithPictures) {
   const fs::path dir = fresh_dir("no-osmesa");
   const std::string missing = "SKETCHDRAPE_OSMESA=" + (dir / "libOSMesa.so.8").string();
@@ -615,6 +615,21 @@ TEST(HostileInput, AMissingOsmesaFailsOnlyARunWithPictures) {
       missing, "-q run " + (dir / "none.json").string() + " -o " + (dir / "out").string());
   EXPECT_EQ(none.exit_code, 0) << none.output;
   EXPECT_TRUE(fs::exists(dir / "out" / "drape.obj"));
+  fs::remove_all(dir / "out");
+
+  // A failed drape (gravity 1,000 times the Earth's tears the sheet in a few hundredths of a
+  // second) still leaves its last state, and says why its pictures are missing.
+  write(dir / "fails.json", R"({"sheet": {"size": [1, 1], "resolution": [8, 8], "pins": ["top"]},
+    "simulate": {"duration": 1, "gravity": [0, -10000, 0]}, "output": {"images": []}})");
+  const CommandResult fails = run_sketchdrape_with_env(
+      missing, "run " + (dir / "fails.json").string() + " -o " + (dir / "out").string());
+  EXPECT_EQ(fails.exit_code, 1) << fails.output;
+  EXPECT_NE(fails.output.find("the simulation failed at t = "), std::string::npos) << fails.output;
+  EXPECT_NE(fails.output.find("(its pictures were not drawn: cannot render: the OSMesa library"),
+            std::string::npos)
+      << fails.output;
+  EXPECT_TRUE(fs::exists(dir / "out" / "drape-failed.obj"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "drape-failed-front.png"));
   fs::remove_all(dir);
 }
 
