@@ -409,6 +409,7 @@ Renderer::Renderer(const RendererOptions& options) : impl_(std::make_shared<Impl
     throw std::invalid_argument(
         fmt::format("shadow map size {} is outside [64, 8192]", options.shadow_map_size));
   impl_->options = options;
+  gl::load_gl();  // OSMesa is opened by the first renderer, not at start-up (src/render/gl.hpp)
   impl_->create_context();
   impl_->mesh_program =
       std::make_unique<ShaderProgram>(std::vector<std::pair<GLenum, std::string_view>>{
@@ -429,6 +430,10 @@ Renderer::Renderer(const RendererOptions& options) : impl_(std::make_shared<Impl
 Renderer::~Renderer() = default;
 Renderer::Renderer(Renderer&&) noexcept = default;
 Renderer& Renderer::operator=(Renderer&&) noexcept = default;
+
+void load_renderer_library() {
+  gl::load_gl();
+}
 
 const std::string& Renderer::gl_version() const {
   return impl_->version;

@@ -41,6 +41,11 @@ struct RendererOptions {
 
 class Renderer;
 
+// Opens OSMesa now, as the first Renderer would (once per process; later calls return at once):
+// a program that will render after a long computation finds a missing library before it.
+// Throws RenderError naming the library and its Debian package.
+void load_renderer_library();
+
 // A scene uploaded to the renderer's context. Keeps that context alive; use it only with the
 // Renderer that made it. Move-only.
 class PreparedScene {

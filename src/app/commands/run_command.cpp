@@ -35,6 +35,7 @@
 #include "src/app/pipeline/run_report.hpp"
 #include "src/app/pipeline/self_intersections.hpp"
 #include "src/app/pipeline/sketch_checks.hpp"
+#include "src/render/renderer.hpp"
 #include "src/render/scene.hpp"
 
 namespace sd::app {
@@ -67,20 +68,6 @@ struct Frame {
   meshing::TriMesh cloth;
   Eigen::VectorXi triangle_group;
 };
-
-// The images of a run: the file's list, or front, back and left when it lists none.
-std::vector<scene::ImageSpec> run_images(const scene::Sketch& sketch) {
-  if (sketch.output.images_listed) return sketch.output.images;
-  std::vector<scene::ImageSpec> images;
-  for (const char* view : {"front", "back", "left"}) {
-    scene::ImageSpec image;
-    image.view = view;
-    image.width = 600;
-    image.height = 900;
-    images.push_back(image);
-  }
-  return images;
-}
 
 // The sketch's "simulate": {"adaptive": {...}} (the simulator's own settings), checked together
 // here: a value the file gives against a default (a coarsen threshold at or above the default
@@ -137,6 +124,23 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   // the cloth is meshed.
   if (const auto before = estimate_before_building(sketch, options.frames_per_second))
     check_run_fits(sketch, *before, limits, options.frames_per_second);
+  // OSMesa is opened only by a run that renders (src/render/gl.hpp). Opened now, not after the
+  // drape: a missing library is found before the drape's time is spent, and the budget checks
+  // while draping count its memory, which the estimate includes.
+  const RendererMemory renderer = run_renderer_memory(sketch, options.frames_per_second);
+  if (renderer.total() > 0) {
+    const double before = resident_memory_bytes();
+    try {
+      render::load_renderer_library();
+    } catch (const render::RenderError& e) {
+      throw render::RenderError(fmt::format(
+          "{}; a run without pictures (\"output\": {{\"images\": []}}, no --frames) does not "
+          "need it",
+          e.what()));
+    }
+    spdlog::debug("OSMesa opened: resident memory {} -> {}", memory_text(before),
+                  memory_text(resident_memory_bytes()));
+  }
   const ClothScene scene = build_cloth_scene(sketch);
   // The pattern does not depend on the drape: laid out first, so that a piece wider than the
   // fabric is refused before the drape's time is spent, not after it.
@@ -436,9 +440,21 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
       image.height = 900;
       sides.push_back(image);
     }
-    stage_preview_images(sides, false, body_now ? &*body_now : nullptr,
-                         {draped, triangle_group, {}, {}, marker}, "drape-failed", dir,
-                         failed_outputs);
+    // The pictures only when they fit the budget and OSMesa can be opened: drape-failed.obj and
+    // the reason the drape failed come first.
+    std::string pictures = " and drape-failed-<view>.png (the place marked)";
+    if (const auto over = rendering_over_budget(
+            resident_memory_bytes(), renderer_memory(sides.front().width, sides.front().height),
+            renderer.total() > 0, memory_budget, limits.max_memory_bytes > 0))
+      pictures = fmt::format(" (its pictures were not drawn: {})", *over);
+    else
+      try {
+        stage_preview_images(sides, false, body_now ? &*body_now : nullptr,
+                             {draped, triangle_group, {}, {}, marker}, "drape-failed", dir,
+                             failed_outputs);
+      } catch (const render::RenderError& e) {
+        pictures = fmt::format(" (its pictures were not drawn: {})", e.what());
+      }
     failed_outputs.commit();
     // Stuck after a start inside the body: the likely cause, which the start repair could not
     // undo (cloth pushed out on both sides of a leg is caught round it).
@@ -451,10 +467,29 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
           report.start_repair_vertices, 1e3 * report.start_repair_depth_m);
     throw std::runtime_error(fmt::format(
         "the simulation failed at t = {:.3f} s in panel '{}' at ({:.3f}, {:.3f}, {:.3f}) m{}: "
-        "{}{}; the last accepted state is in {} and drape-failed-<view>.png (the place marked)",
+        "{}{}; the last accepted state is in {}{}",
         report.sim_time, panel, where.x(), where.y(), where.z(),
         landmark.empty() ? "" : fmt::format(", near the {}", landmark), report.failure_reason,
-        cause, (dir / "drape-failed.obj").string()));
+        cause, (dir / "drape-failed.obj").string(), pictures));
+  }
+
+  // The drape's memory is known now (adaptive detail may have grown it past the estimate):
+  // the pictures are refused before the context is made, with nothing written, when they would
+  // take the process over its budget.
+  if (renderer.total() > 0) {
+    const double resident = resident_memory_bytes();
+    spdlog::debug(
+        "before the pictures: resident memory {}, {} at most so far; rendering {}x{} "
+        "adds about {}",
+        memory_text(resident), memory_text(peak_resident_memory_bytes()), renderer.width,
+        renderer.height, memory_text(renderer.frame_bytes));
+    if (const auto over = rendering_over_budget(resident, renderer, true, memory_budget,
+                                                limits.max_memory_bytes > 0))
+      throw RunLimitExceeded(fmt::format(
+          "stopped before rendering the pictures: {}; ask for smaller images or none "
+          "(\"output\": {{\"images\": []}}, and no --frames), or give a larger --max-memory; "
+          "nothing was written",
+          *over));
   }
 
   // The draped cloth, one group per panel.
@@ -472,9 +507,14 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   const PreviewCloth preview{
       draped, triangle_group, render::triangle_edges(draped), face_levels, {}};
   const std::vector<scene::ImageSpec> image_specs = run_images(sketch);
+  // One context for the images and the sequence (the renderer's memory counted once).
+  std::optional<render::Renderer> renderer_context;
+  if (!image_specs.empty() || !frames.empty()) renderer_context.emplace();
   const std::vector<std::string> images =
-      stage_preview_images(image_specs, sketch.output.wireframe, body_end ? &*body_end : nullptr,
-                           preview, "drape", dir, outputs);
+      image_specs.empty()
+          ? std::vector<std::string>{}
+          : stage_preview_images(*renderer_context, image_specs, sketch.output.wireframe,
+                                 body_end ? &*body_end : nullptr, preview, "drape", dir, outputs);
   // The sequence: the first image the file asks for (front by default), without edges.
   std::vector<scene::ImageSpec> frame_image = {image_specs.empty() ? scene::ImageSpec{}
                                                                    : image_specs.front()};
@@ -482,7 +522,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   for (std::size_t i = 0; i < frames.size(); ++i) {
     const std::optional<meshing::TriMesh> body =
         scene.body ? std::optional(body_at(scene, frames[i].time)) : std::nullopt;
-    stage_preview_images(frame_image, false, body ? &*body : nullptr,
+    stage_preview_images(*renderer_context, frame_image, false, body ? &*body : nullptr,
                          {frames[i].cloth, frames[i].triangle_group, {}, {}, {}},
                          fmt::format("frame-{:04d}", i), dir / "frames", outputs);
   }

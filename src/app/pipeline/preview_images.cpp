@@ -47,9 +47,19 @@ std::vector<std::string> stage_preview_images(const std::vector<scene::ImageSpec
                                               const PreviewCloth& cloth, const std::string& prefix,
                                               const std::filesystem::path& dir,
                                               StagedOutputs& outputs) {
-  std::vector<std::string> files;
-  if (images.empty()) return files;
+  if (images.empty()) return {};
   render::Renderer renderer;
+  return stage_preview_images(renderer, images, default_wireframe, body, cloth, prefix, dir,
+                              outputs);
+}
+
+std::vector<std::string> stage_preview_images(render::Renderer& renderer,
+                                              const std::vector<scene::ImageSpec>& images,
+                                              bool default_wireframe, const meshing::TriMesh* body,
+                                              const PreviewCloth& cloth, const std::string& prefix,
+                                              const std::filesystem::path& dir,
+                                              StagedOutputs& outputs) {
+  std::vector<std::string> files;
   std::map<std::string, int> used_names;
   for (const scene::ImageSpec& spec : images) {
     const render::Scene scene =

@@ -9,6 +9,7 @@
 #include "meshing/tri_mesh.hpp"
 #include "scene/sketch_file.hpp"
 #include "src/app/pipeline/atomic_file.hpp"
+#include "src/render/renderer.hpp"
 
 namespace sd::app {
 
@@ -24,6 +25,14 @@ struct PreviewCloth {
 // `<prefix>-<view>.png` in `dir` (a repeated view gets `-2`, `-3`, ...). `body` may be null.
 // Returns the file names staged.
 std::vector<std::string> stage_preview_images(const std::vector<scene::ImageSpec>& images,
+                                              bool default_wireframe, const meshing::TriMesh* body,
+                                              const PreviewCloth& cloth, const std::string& prefix,
+                                              const std::filesystem::path& dir,
+                                              StagedOutputs& outputs);
+// The same with a renderer the caller keeps (`run`'s images and its PNG sequence share one
+// context: a context per call cost its shaders' compilation, and memory, each time).
+std::vector<std::string> stage_preview_images(render::Renderer& renderer,
+                                              const std::vector<scene::ImageSpec>& images,
                                               bool default_wireframe, const meshing::TriMesh* body,
                                               const PreviewCloth& cloth, const std::string& prefix,
                                               const std::filesystem::path& dir,

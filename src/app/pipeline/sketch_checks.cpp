@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 #include "garment/sketch_ranges.hpp"
 #include "sim/fabric.hpp"
@@ -32,8 +33,28 @@ static_assert(garment::kMaxImageSide == render::kMaxImageSide,
 // about 1.4 kB each, contacts); the fit is within 3 % of all three. Seconds per vertex and step
 // grow with log2(V) like the fill of the factor (measured on the 2-core machine under a load of
 // 12: 28, 38, 61 µs per vertex and step).
-constexpr double kBaseBytes = 67e6;       // the process before any cloth
-constexpr double kBytesPerVertex = 5800;  // model, forces, system matrices, contacts
+//
+// The process before any cloth is 26 MB since OSMesa is no longer linked (it was 67 MB with the
+// library mapped from the start): `run` of an 8x8 sheet (81 vertices, 0.1 s, "images": []) peaks
+// at 25 MiB (/usr/bin/time's maximum resident set, 27 Nov 2026), and the 64² and 128² sheets
+// above (hinges, CHOLMOD) peak 48 MiB lower than with the library linked (116 -> 68, 273 -> 224
+// MiB, two runs each): the cloth's share per vertex is unchanged.
+//
+// The renderer, counted only when the run renders pictures (images or --frames), measured with
+// `sketchdrape -v run` on that 8x8 sheet, which logs the resident memory (VmRSS) around OSMesa's
+// opening and before the pictures, and /usr/bin/time's peak for one front image of 200², 600x900,
+// 1500², 3000² and 4096² pixels (two runs each, identical to 0.3 MiB):
+// * opening OSMesa (dlopen, its LLVM, z3 and ICU relocated) takes the process from 20-21 to 70 MB;
+// * the peak over the resident memory before the pictures (72 MB) is 55, 78, 156, 458, 805 MB:
+//   least squares gives 54.1 MB + 44.8 bytes per pixel, within 1.4 MB of each. 44 bytes are the
+//   4-sample colour (RGBA8) and depth buffers (16 + 16), the resolved colour, the read-back and
+//   the image (4 each); the 54 MB are the context, llvmpipe's threads and tiles, the shaders and
+//   the 2048² shadow map. Taken as 55 MB + 45 bytes per pixel (over each measurement by 0-2 MB).
+constexpr double kBaseBytes = 26e6;             // the process before any cloth (without OSMesa)
+constexpr double kBytesPerVertex = 5800;        // model, forces, system matrices, contacts
+constexpr double kRendererLibraryBytes = 50e6;  // OSMesa and its libraries, mapped
+constexpr double kRendererContextBytes = 55e6;  // context, shaders, shadow map, llvmpipe
+constexpr double kRendererBytesPerPixel = 45;   // framebuffers, read-back and image
 constexpr double kSecondsPerVertexStepLog = 3e-6;
 constexpr double kSecondsPerFrame = 0.05;  // one picture of the PNG sequence
 // Without --max-memory, a run may use this fraction of the memory available when it starts (the
@@ -49,12 +70,27 @@ double memory_scaled(const RunEstimate& e, double vertices) {
                                    std::log2(std::max(vertices, 2.0)) /
                                    std::log2(std::max(e.vertices, 2.0));
   const double frames_per_vertex = 64.0 * e.frames;
-  return kBaseBytes + vertices * (kBytesPerVertex + factor_per_vertex + frames_per_vertex);
+  return kBaseBytes + e.renderer.total() +
+         vertices * (kBytesPerVertex + factor_per_vertex + frames_per_vertex);
 }
 
-std::string gigabytes(double bytes) {
-  return fmt::format("{:.1f} GB", bytes / 1e9);
+// "1.2 GB", or "74 MB" below a gigabyte (where one decimal of GB says too little: a budget of
+// 60 MB read "0.1 GB").
+std::string size_text(double bytes) {
+  return bytes >= 1e9 ? fmt::format("{:.1f} GB", bytes / 1e9)
+                      : fmt::format("{:.0f} MB", bytes / 1e6);
 }
+
+std::string budget_text(double budget, bool given) {
+  return given
+             ? fmt::format("the {} of --max-memory", size_text(budget))
+             : fmt::format("the {} a run may take of the memory available now", size_text(budget));
+}
+
+// What to do about pictures that do not fit.
+constexpr const char* kFewerPictures =
+    "ask for smaller images or none (\"output\": {\"images\": []}, and no --frames), or give a "
+    "larger --max-memory";
 
 }  // namespace
 
@@ -135,23 +171,86 @@ double available_memory_bytes() {
   return 0;
 }
 
-double peak_resident_memory_bytes() {
-  // The peak (VmHWM), not the resident set now (statm): the kernel's proactive reclaim (DAMON
-  // runs on this machine) can page a process's cold memory out, so the resident set now can fall
-  // below what the drape took, and a budget is about what it took.
+namespace {
+
+// A field of /proc/self/status in kB ("VmRSS:", "VmHWM:"), as bytes; 0 when it is not there.
+double status_bytes(std::string_view key) {
   std::ifstream in("/proc/self/status");
   for (std::string line; std::getline(in, line);)
-    if (line.starts_with("VmHWM:")) {
-      std::istringstream fields(line.substr(6));
+    if (line.starts_with(key)) {
+      std::istringstream fields(line.substr(key.size()));
       double kb = 0;
       if (fields >> kb) return kb * 1024.0;
     }
   return 0;
 }
 
+}  // namespace
+
+double resident_memory_bytes() {
+  return status_bytes("VmRSS:");
+}
+
+double peak_resident_memory_bytes() {
+  // The peak (VmHWM), not the resident set now (statm): the kernel's proactive reclaim (DAMON
+  // runs on this machine) can page a process's cold memory out, so the resident set now can fall
+  // below what the drape took, and a budget is about what it took.
+  return status_bytes("VmHWM:");
+}
+
 double memory_budget_bytes(const RunLimits& limits) {
   return limits.max_memory_bytes > 0 ? limits.max_memory_bytes
                                      : kAvailableFraction * available_memory_bytes();
+}
+
+std::vector<scene::ImageSpec> run_images(const scene::Sketch& sketch) {
+  if (sketch.output.images_listed) return sketch.output.images;
+  std::vector<scene::ImageSpec> images;
+  for (const char* view : {"front", "back", "left"}) {
+    scene::ImageSpec image;
+    image.view = view;
+    image.width = 600;
+    image.height = 900;
+    images.push_back(image);
+  }
+  return images;
+}
+
+RendererMemory renderer_memory(int width, int height) {
+  RendererMemory memory;
+  memory.width = width;
+  memory.height = height;
+  memory.library_bytes = kRendererLibraryBytes;
+  memory.frame_bytes =
+      kRendererContextBytes + kRendererBytesPerPixel * static_cast<double>(width) * height;
+  return memory;
+}
+
+RendererMemory run_renderer_memory(const scene::Sketch& sketch, double frames_per_second) {
+  std::vector<scene::ImageSpec> pictures = run_images(sketch);
+  if (frames_per_second > 0)  // the sequence: the first image's size (run_command.cpp)
+    pictures.push_back(pictures.empty() ? scene::ImageSpec{} : pictures.front());
+  if (pictures.empty()) return {};
+  const auto pixels = [](const scene::ImageSpec& image) {
+    return static_cast<double>(image.width) * image.height;
+  };
+  const scene::ImageSpec& largest = *std::max_element(
+      pictures.begin(), pictures.end(),
+      [&](const scene::ImageSpec& a, const scene::ImageSpec& b) { return pixels(a) < pixels(b); });
+  return renderer_memory(largest.width, largest.height);
+}
+
+std::optional<std::string> rendering_over_budget(double resident, const RendererMemory& renderer,
+                                                 bool library_loaded, double budget, bool given) {
+  const double adds = renderer.frame_bytes + (library_loaded ? 0.0 : renderer.library_bytes);
+  if (budget <= 0 || resident + adds <= budget) return std::nullopt;
+  return fmt::format(
+      "the process holds {} and rendering {}x{} pictures takes about {} more ({}the OpenGL "
+      "context and its framebuffers), {} in all, more than {}",
+      size_text(resident), renderer.width, renderer.height, size_text(adds),
+      library_loaded ? ""
+                     : fmt::format("OSMesa's libraries {}, ", size_text(renderer.library_bytes)),
+      size_text(resident + adds), budget_text(budget, given));
 }
 
 std::optional<RunEstimate> estimate_before_building(const scene::Sketch& sketch,
@@ -191,6 +290,8 @@ RunEstimate estimate_run(const scene::Sketch& sketch, const Eigen::MatrixX3i& tr
   // The PNG sequence keeps each picture's cloth until the drape ends: positions, triangles and
   // groups, about 64 bytes per vertex.
   e.memory_bytes += e.frames * 64.0 * e.vertices;
+  e.renderer = run_renderer_memory(sketch, frames_per_second);
+  e.memory_bytes += e.renderer.total();
   e.seconds =
       e.steps * e.vertices * std::log2(std::max(e.vertices, 2.0)) * kSecondsPerVertexStepLog +
       e.frames * kSecondsPerFrame;
@@ -202,30 +303,46 @@ void check_run_fits(const scene::Sketch& sketch, const RunEstimate& estimate,
   const bool given = limits.max_memory_bytes > 0;
   const double memory = memory_budget_bytes(limits);
   if (memory > 0 && estimate.memory_bytes > memory) {
+    const std::string limit = budget_text(memory, given);
+    // The pictures are what does not fit: said as such, at the images when the file lists them,
+    // not as a cloth too large.
+    const RendererMemory& renderer = estimate.renderer;
+    const double drape = estimate.memory_bytes - renderer.total();
+    if (renderer.total() > 0 && drape <= memory)
+      sketch.fail(sketch.output.images_listed ? "/output/images" : "",
+                  fmt::format("the drape needs about {} and rendering its {}x{} pictures about {} "
+                              "more (OSMesa's libraries {}, the OpenGL context and its "
+                              "framebuffers {}), {} in all, more than {}; {}",
+                              size_text(drape), renderer.width, renderer.height,
+                              size_text(renderer.total()), size_text(renderer.library_bytes),
+                              size_text(renderer.frame_bytes), size_text(estimate.memory_bytes),
+                              limit, kFewerPictures));
     // The largest vertex count that fits, by bisection on the estimate scaled to other sizes.
     double low = 4, high = estimate.vertices;
     for (int i = 0; i < 60; ++i) {
       const double mid = 0.5 * (low + high);
       (memory_scaled(estimate, mid) <= memory ? low : high) = mid;
     }
-    const std::string limit =
-        given ? fmt::format("the {} of --max-memory", gigabytes(memory))
-              : fmt::format("the {} a run may take of the memory available now", gigabytes(memory));
+    const std::string pictures =
+        renderer.total() > 0
+            ? fmt::format(", {} the renderer of its {}x{} pictures", size_text(renderer.total()),
+                          renderer.width, renderer.height)
+            : "";
     if (sketch.sheet) {
       const double side = std::floor(std::sqrt(low)) - 1;
       sketch.fail("/sheet/resolution",
                   fmt::format("a sheet of {}x{} quads ({:.0f} vertices) needs about {} to "
-                              "simulate ({} of it the solver's factor), more than {}; about "
+                              "simulate ({} of it the solver's factor{}), more than {}; about "
                               "{:.0f}x{:.0f} quads would fit",
                               sketch.sheet->columns, sketch.sheet->rows, estimate.vertices,
-                              gigabytes(estimate.memory_bytes), gigabytes(estimate.factor_bytes),
-                              limit, side, side));
+                              size_text(estimate.memory_bytes), size_text(estimate.factor_bytes),
+                              pictures, limit, side, side));
     }
     sketch.fail("", fmt::format("the cloth has {:.0f} vertices and needs about {} to simulate "
-                                "({} of it the solver's factor), more than {}; about {:.0f} "
+                                "({} of it the solver's factor{}), more than {}; about {:.0f} "
                                 "vertices would fit (a longer edge_length)",
-                                estimate.vertices, gigabytes(estimate.memory_bytes),
-                                gigabytes(estimate.factor_bytes), limit, low));
+                                estimate.vertices, size_text(estimate.memory_bytes),
+                                size_text(estimate.factor_bytes), pictures, limit, low));
   }
   if (estimate.frames > kMaxFrames)
     throw std::invalid_argument(fmt::format(

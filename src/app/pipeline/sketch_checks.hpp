@@ -23,7 +23,7 @@ void check_sketch(const scene::Sketch& sketch);
 // report.json. Call after check_sketch (a bad fabric is not reported here).
 std::vector<std::string> fabric_warnings(const scene::Sketch& sketch);
 
-// What a run may use: --max-memory (default: 80 % of the memory the system has available now)
+// What a run may use: --max-memory (default: 60 % of the memory the system has available now)
 // and --max-time (default: none).
 struct RunLimits {
   double max_memory_bytes = 0;       // 0: the available memory (/proc/meminfo)
@@ -33,12 +33,41 @@ struct RunLimits {
 // The memory the system can give a process now (MemAvailable), bytes; 0 when unknown.
 double available_memory_bytes();
 
+// The resident memory of this process now (VmRSS of /proc/self/status), bytes; 0 when unknown.
+double resident_memory_bytes();
+
 // The most resident memory this process has held so far (VmHWM of /proc/self/status), bytes;
 // 0 when unknown.
 double peak_resident_memory_bytes();
 
-// The memory a run may use: --max-memory, else 80 % of the memory available now; 0: unknown.
+// The memory a run may use: --max-memory, else 60 % of the memory available now; 0: unknown.
 double memory_budget_bytes(const RunLimits& limits);
+
+// The pictures `run` renders after the drape: the file's images (front, back and left at
+// 600x900 when it lists none).
+std::vector<scene::ImageSpec> run_images(const scene::Sketch& sketch);
+
+// The renderer's share of a run's memory (measured: sketch_checks.cpp). OSMesa is opened only
+// when pictures are asked for (src/render/gl.hpp), so a run without them has none of it.
+struct RendererMemory {
+  double library_bytes = 0;   // OSMesa and the libraries it loads (LLVM, z3, ICU), mapped
+  double frame_bytes = 0;     // an OpenGL context, shaders, shadow map and the largest framebuffer
+  int width = 0, height = 0;  // the largest picture (most pixels); 0x0: none
+  double total() const { return library_bytes + frame_bytes; }
+};
+// For pictures of at most `width` x `height` pixels.
+RendererMemory renderer_memory(int width, int height);
+// For the pictures a run renders: its images and, with --frames (`frames_per_second` > 0), the
+// sequence, drawn at the first image's size (800x1200 without images). All zero without any.
+RendererMemory run_renderer_memory(const scene::Sketch& sketch, double frames_per_second);
+
+// Just before rendering: the process holds `resident` bytes (with OSMesa mapped when
+// `library_loaded`); rendering `renderer`'s pictures adds its context and framebuffers (and the
+// library when not loaded). Returns why that does not fit `budget` (bytes; 0: no budget) as a
+// sentence naming both parts and the limit (`given`: --max-memory, else the share of the
+// available memory), or nullopt when it fits.
+std::optional<std::string> rendering_over_budget(double resident, const RendererMemory& renderer,
+                                                 bool library_loaded, double budget, bool given);
 
 // A drape's cost, estimated before it starts: the CHOLMOD factor's size from the symbolic
 // analysis of the cloth's mesh (sim::predict_factor_size), plus the measured cost per vertex of
@@ -47,6 +76,7 @@ struct RunEstimate {
   double vertices = 0;
   double memory_bytes = 0;  // peak resident memory
   double factor_bytes = 0;  // of which the CHOLMOD factor and its workspace
+  RendererMemory renderer;  // of which the renderer's, when the run renders pictures
   double steps = 0;         // duration / time_step: the most steps the run can take
   double frames = 0;        // PNG sequence pictures (--frames)
   double seconds = 0;       // wall time if it runs the whole duration
