@@ -95,10 +95,11 @@ int converged_cells(const FabricParameters& fabric) {
 }
 
 // Where the DC has converged (2.5 cells per bending length: the bench's mean there is within 0.03
-// of its mean at 3 per c for every preset, docs/fabrics.md) one specimen comes to rest with 4-10
-// nodes and its DC inside the preset's published range, not widened: the coarse-disc bias (1.5 cm
-// cells read up to 0.10 low) is gone at this resolution. A specimen scatters by about ±0.01 about
-// the bench's two-specimen mean here (wool 0.520-0.529, the closest to its range's edge).
+// of its mean at 3 per c for every preset, docs/fabrics.md; converged as a discretisation, which
+// keeps the membrane locking of docs/simulator.md, "The Cusick drape of silk") one specimen comes
+// to rest with 4-10 nodes and its DC inside the preset's published range, not widened: the
+// coarse-disc bias (1.5 cm cells read up to 0.10 low) is gone at this resolution. Specimens
+// scatter by about ±0.01 here (wool, the closest to its range's edge: 0.520-0.532 over five).
 TEST_P(CusickPreset, DrapesWithinItsPublishedRangeWhereConverged) {
   const PresetRange& range = GetParam();
   const FabricParameters fabric = fabric_preset(range.name);
