@@ -733,7 +733,8 @@ void check_seam_directions(const GarmentRequest& sketch, const BodySurface& body
       int edges = 0;
       int panel_a = -1, panel_b = -1;
     };
-    std::map<std::string, Fold> folds;  // by curve
+    std::map<std::string, Fold> folds;               // by curve
+    std::map<std::pair<int, int>, Fold> pair_folds;  // by panel pair, over all they share
     const auto inward = [&](int f, const Eigen::Vector3d& p, const Eigen::Vector3d& q) {
       Eigen::Vector3d c = Eigen::Vector3d::Zero();
       for (int v : faces[static_cast<size_t>(f)]) c += pool.positions[static_cast<size_t>(v)];
@@ -751,22 +752,33 @@ void check_seam_directions(const GarmentRequest& sketch, const BodySurface& body
       if (curve.empty()) continue;
       const Eigen::Vector3d& p = pool.positions[static_cast<size_t>(edge.first)];
       const Eigen::Vector3d& q = pool.positions[static_cast<size_t>(edge.second)];
-      Fold& fold = folds[curve];
-      fold.dot += inward(fs[0], p, q).dot(inward(fs[1], p, q));
-      ++fold.edges;
-      fold.panel_a = std::min(pa, pb), fold.panel_b = std::max(pa, pb);
+      const double dot = inward(fs[0], p, q).dot(inward(fs[1], p, q));
+      for (Fold* fold : {&folds[curve], &pair_folds[{std::min(pa, pb), std::max(pa, pb)}]}) {
+        fold->dot += dot;
+        ++fold->edges;
+        fold->panel_a = std::min(pa, pb), fold->panel_b = std::max(pa, pb);
+      }
     }
     // The sharpest fold, one between two panels of the file before one with a mirror copy (the
     // copy folds as its original does, and the file names the original).
     const auto rank = [&](const Fold& f) {
       const bool copies = garment.panels[static_cast<size_t>(f.panel_a)].mirror_copy ||
                           garment.panels[static_cast<size_t>(f.panel_b)].mirror_copy;
-      return std::pair(!copies, f.dot / f.edges);
+      // Without a clash the curve folded over the most length: the hem, not a short side seam.
+      return std::pair(!copies, clash ? f.dot / f.edges : f.dot);
     };
-    // Named where the seam directions clash only: without a clash a fold this sharp is the
-    // mesh's, not the sketch's (the long-sleeved tee at edge_length 0.01 folds its sleeves at
-    // the underarm, mean 0.92, which the quality gate reports; at 0.025 it is clean).
+    // Named where the seam directions clash, or where two panels fold onto each other along
+    // everything they share: otherwise a fold this sharp is the mesh's, not the sketch's (the
+    // long-sleeved tee at edge_length 0.01 folds its sleeves at the underarm, mean 0.87-1.00,
+    // which the quality gate reports, while their top seam opens at -0.96 to -1.00; at 0.025 it
+    // is clean). Panels oriented along their seams (panel_loop.hpp) do not clash where one was
+    // given the wrong curve: a back given the front's hem folds onto the front along the hem and
+    // both sides (mean 0.45-0.99 each).
     const double sharp = 0.5;
+    const auto folded_pair = [&](const Fold& f) {
+      const Fold& pair = pair_folds.at({f.panel_a, f.panel_b});
+      return pair.dot / pair.edges > sharp;
+    };
     const std::pair<const std::string, Fold>* sharpest = nullptr;
     for (const auto& entry : folds) {
       spdlog::debug("seam '{}' between panels '{}' and '{}': mean fold {:.2f} over {} edge(s)",
@@ -774,10 +786,11 @@ void check_seam_directions(const GarmentRequest& sketch, const BodySurface& body
                     garment.panels[static_cast<size_t>(entry.second.panel_b)].id,
                     entry.second.dot / entry.second.edges, entry.second.edges);
       if (entry.second.edges >= 2 && entry.second.dot / entry.second.edges > sharp &&
+          (clash || folded_pair(entry.second)) &&
           (!sharpest || rank(entry.second) > rank(sharpest->second)))
         sharpest = &entry;
     }
-    if (clash && sharpest) {
+    if (sharpest) {
       const std::string& curve = sharpest->first;
       const GarmentPanel& a = garment.panels[static_cast<size_t>(sharpest->second.panel_a)];
       const GarmentPanel& b = garment.panels[static_cast<size_t>(sharpest->second.panel_b)];

@@ -28,6 +28,12 @@ struct PanelLoop {
   std::vector<LoopEdge> edges;      // loop order, starting at corner 0
   std::vector<int> side_begin;      // index into edges where side i starts (side_begin[0] = 0)
   std::vector<double> turning_deg;  // turning angle at the start of each edge, degrees
+  // Its own vote on its orientation (which side of its boundary it lies on, along the body's
+  // normals), over its largest possible value: from -1 to 1, positive when it agrees with the
+  // orientation taken. Near 0 for a half-tube round a limb.
+  double vote = 0;
+  // Oriented by the panels sewn to it, against its own vote (resolve_panels).
+  bool turned_by_seams = false;
 
   int side_count() const { return static_cast<int>(side_begin.size()); }
   // Edges of side i: [side_begin[i], side_begin[i+1]) (wrapping to edges.size()).
@@ -39,10 +45,11 @@ int loop_start_node(const CurveNetwork& net, const LoopEdge& e);
 int loop_end_node(const CurveNetwork& net, const LoopEdge& e);
 
 // Resolves every panel (and the mirror copy of each mirrored panel, which follows its original
-// in the result). Corners: the junctions turning more than the file's corner_angle, or the
-// panel's explicit corners; at least 3 (the sharpest junctions are promoted). Throws
-// SketchError with the panel's path when curves do not meet, the loop does not close or a
-// panel has fewer than 3 junctions.
+// in the result), each oriented counter-clockwise seen from outside: a panel sewn to oriented
+// panels the way its seams agree with them, the others by their own vote (panel_loop.cpp). Corners:
+// the junctions turning more than the file's corner_angle, or the panel's explicit corners; at
+// least 3 (the sharpest junctions are promoted). Throws SketchError with the panel's path when
+// curves do not meet, the loop does not close or a panel has fewer than 3 junctions.
 std::vector<PanelLoop> resolve_panels(const GarmentRequest& sketch, const CurveNetwork& net,
                                       const BodySurface& body);
 

@@ -1,8 +1,12 @@
 #include "garment/panel_loop.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <string>
 
 #include "garment/body_surface.hpp"
@@ -130,6 +134,136 @@ TEST(PanelLoop, CurvesThatDoNotMeetNameThePanel) {
     EXPECT_EQ(e.file(), "loops.json");
     EXPECT_EQ(e.json_path().rfind("/panels/0", 0), 0u) << e.json_path();
     EXPECT_FALSE(e.sentence().empty());
+  }
+}
+
+// A closed tube of radius `r` round a bent limb: straight down from (0, top, 0) for `upper`, then
+// bent towards +z by `bend` radians on a circle of radius `turn`, then straight for `lower`
+// (a forearm turned forward). Rings of `around` vertices every 5 mm of the centreline, capped at
+// both ends; outward winding.
+struct BentLimb {
+  double r = 0.04, top = 1.05, upper = 0.3, turn = 0.08, bend = 1.5, lower = 0.3;
+  // Centreline point and unit tangent at arc length s from the top.
+  std::pair<Eigen::Vector3d, Eigen::Vector3d> at(double s) const {
+    const Eigen::Vector3d down(0, -1, 0), forward(0, 0, 1);
+    if (s <= upper) return {Eigen::Vector3d(0, top - s, 0), down};
+    const Eigen::Vector3d corner(0, top - upper, turn);  // centre of the bend
+    const double a = std::min(s - upper, turn * bend) / turn;
+    const Eigen::Vector3d on = corner + turn * (std::cos(a) * -forward + std::sin(a) * down);
+    const Eigen::Vector3d tangent = std::cos(a) * down + std::sin(a) * forward;
+    if (s <= upper + turn * bend) return {on, tangent};
+    return {on + (s - upper - turn * bend) * tangent, tangent};
+  }
+  double length() const { return upper + turn * bend + lower; }
+  // Surface point at arc length s, angle alpha round the tangent from +x (alpha = pi/2: the
+  // side the tube bends towards, +z along the upper part).
+  Eigen::Vector3d surface(double s, double alpha, double offset = 0) const {
+    const auto [c, t] = at(s);
+    const Eigen::Vector3d x = Eigen::Vector3d::UnitX(), w = t.cross(x);
+    return c + (r + offset) * (std::cos(alpha) * x + std::sin(alpha) * w);
+  }
+  meshing::TriMesh mesh(int around = 48) const {
+    const int rings = static_cast<int>(std::ceil(length() / 0.005)) + 1;
+    meshing::TriMesh m;
+    m.vertices.resize(rings * around + 2, 3);
+    for (int i = 0; i < rings; ++i)
+      for (int k = 0; k < around; ++k)
+        m.vertices.row(i * around + k) =
+            surface(length() * i / (rings - 1), 2 * std::numbers::pi * k / around).transpose();
+    m.vertices.row(rings * around) = at(0).first.transpose();
+    m.vertices.row(rings * around + 1) = at(length()).first.transpose();
+    std::vector<Eigen::Vector3i> faces;
+    for (int i = 0; i + 1 < rings; ++i)
+      for (int k = 0; k < around; ++k) {
+        const int a = i * around + k, b = i * around + (k + 1) % around;
+        const int c = a + around, d = b + around;
+        faces.emplace_back(a, b, c);
+        faces.emplace_back(b, d, c);
+      }
+    for (int k = 0; k < around; ++k) {
+      faces.emplace_back(rings * around, (k + 1) % around, k);
+      const int last = (rings - 1) * around;
+      faces.emplace_back(rings * around + 1, last + k, last + (k + 1) % around);
+    }
+    m.faces.resize(static_cast<Eigen::Index>(faces.size()), 3);
+    for (size_t f = 0; f < faces.size(); ++f) m.faces.row(static_cast<Eigen::Index>(f)) = faces[f];
+    return m;
+  }
+};
+
+// "[x, y, z], ..." of n + 1 points on the limb from (s0, a0) to (s1, a1).
+std::string limb_points(const BentLimb& limb, double s0, double s1, double a0, double a1, int n) {
+  std::string out;
+  for (int i = 0; i <= n; ++i) {
+    const double f = static_cast<double>(i) / n;
+    const Eigen::Vector3d p = limb.surface(s0 + f * (s1 - s0), a0 + f * (a1 - a0));
+    out += fmt::format("{}[{:.5f}, {:.5f}, {:.5f}]", i ? ", " : "", p.x(), p.y(), p.z());
+  }
+  return out;
+}
+
+// A tube round the bent limb split into halves: a band at the top (front and back, short, with
+// clear votes) and the sleeve below it down round the bend to a cuff, its seams 'top' (+x) and
+// 'under' (-x). "front" is the side the limb bends towards.
+std::string bent_sleeve(const BentLimb& limb) {
+  const double pi = std::numbers::pi, a = 0.05, b = 0.12, cuff = limb.length() - 0.03;
+  const auto curve = [&](const std::string& id, double s0, double s1, double a0, double a1, int n) {
+    return fmt::format(R"({{ "id": "{}", "points3d": [{}] }})", id,
+                       limb_points(limb, s0, s1, a0, a1, n));
+  };
+  return fmt::format(
+      R"({{ "edge_length": 0.02, "offset": 0.005, "curves": [{}, {}, {}, {}, {}, {}, {}, {}, {}, {}],
+      "panels": [
+        {{ "id": "band_front", "boundary": ["arm_f", "top_upper", "band_f", "under_upper"] }},
+        {{ "id": "band_back", "boundary": ["arm_b", "top_upper", "band_b", "under_upper"] }},
+        {{ "id": "sleeve_front", "boundary": ["band_f", "top", "cuff_f", "under"] }},
+        {{ "id": "sleeve_back", "boundary": ["band_b", "top", "cuff_b", "under"] }} ] }})",
+      curve("arm_f", a, a, 0, pi, 12), curve("arm_b", a, a, pi, 2 * pi, 12),
+      curve("band_f", b, b, 0, pi, 12), curve("band_b", b, b, pi, 2 * pi, 12),
+      curve("cuff_f", cuff, cuff, 0, pi, 12), curve("cuff_b", cuff, cuff, pi, 2 * pi, 12),
+      curve("top_upper", a, b, 0, 0, 8), curve("under_upper", a, b, pi, pi, 8),
+      curve("top", b, cuff, 0, 0, 40), curve("under", b, cuff, pi, pi, 40));
+}
+
+// The back half of a sleeve round an elbow bent 86° (the outside of the bend) has a boundary that
+// says little about its side: its own vote is -0.18 of its largest value, i.e. it would run
+// clockwise. Sewn to the band above it and to the front half, it is oriented by them: every
+// panel runs counter-clockwise seen from outside, which on the seam 'top' (+x, where the body
+// normal is +x) means the back halves run it away from the shoulder and the front halves
+// towards it. Without the seams (each panel by its own vote) the back sleeve runs it the wrong way.
+TEST(PanelLoop, AHalfSleeveRoundABentLimbIsOrientedByItsSeams) {
+  BentLimb limb;
+  limb.bend = 1.5;
+  const BodySurface body(limb.mesh());
+  const Sketch s = parse_sketch(bent_sleeve(limb), "bent-sleeve.json");
+  const CurveNetwork net = build_network(s, project_curves(s, body), curves_to_mirror(s));
+  const std::vector<PanelLoop> loops = resolve_panels(s, net, body);
+  ASSERT_EQ(loops.size(), 4u);
+  const Eigen::Vector3d shoulder = limb.at(0).first;
+  for (const PanelLoop& loop : loops) {
+    const bool back = loop.id.ends_with("back");
+    int on_top = 0;
+    for (const LoopEdge& e : loop.edges) {
+      const std::string& curve =
+          net.curves[static_cast<size_t>(net.edges[static_cast<size_t>(e.edge)].curve)].id;
+      if (curve != "top" && curve != "top_upper") continue;
+      ++on_top;
+      const double from =
+          (net.nodes[static_cast<size_t>(loop_start_node(net, e))] - shoulder).norm();
+      const double to = (net.nodes[static_cast<size_t>(loop_end_node(net, e))] - shoulder).norm();
+      EXPECT_EQ(to > from, back) << loop.id << " runs '" << curve << "' the wrong way";
+    }
+    EXPECT_GT(on_top, 0) << loop.id;
+  }
+  // The case is the one meant: the back sleeve's own vote is against the orientation taken
+  // (turned by its seams), the others' are clear (0.59 for the bands, 0.74 for the front sleeve).
+  const PanelLoop& back = loops[3];
+  ASSERT_EQ(back.id, "sleeve_back");
+  EXPECT_LT(back.vote, -0.05);
+  EXPECT_TRUE(back.turned_by_seams);
+  for (size_t p = 0; p < 3; ++p) {
+    EXPECT_GT(loops[p].vote, 0.5) << loops[p].id;
+    EXPECT_FALSE(loops[p].turned_by_seams) << loops[p].id;
   }
 }
 
