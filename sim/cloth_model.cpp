@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <string>
@@ -345,6 +346,62 @@ void set_block_offsets(ClothModel& model, const Neighbours& neighbours,
   }
 }
 
+// The even extension of the free cloth across a clamp's edge, in a free vertex's rows: a pinned
+// point p behind the edge (pinned, not on the edge) is read as its ghost x_m + 2·x_p − 2·x_c,
+// where m is a free point of the element and c, the midpoint of p and m in `positions`, is a
+// clamp-edge vertex of the element or the midpoint of two. For the clamp's flat layout the ghost
+// is the free side's point m moved back by p − m along the cloth, with the height of m: the
+// extension w(−s) = w(s) of a clamped beam (w = w' = 0 at the edge), whose curvature continues
+// the free side's instead of dropping to the clamp's zero. The rows stay exact for affine maps (c
+// is the midpoint of p and m), so rigid motions and stretches still cost nothing. The nearest such
+// m is taken; a point without one keeps its row. Flat rests only (a curved element's rest terms
+// would change); applied once per element.
+void ghost_clamped_points(VertexBendElement& b, const std::vector<char>& is_pinned,
+                          const std::vector<char>& edge, const Eigen::VectorXd& positions) {
+  if (b.ghosted || !b.fan.empty()) return;
+  const auto at = [&](int v) { return Eigen::Vector3d(positions.segment<3>(3 * v)); };
+  const int count = static_cast<int>(b.vertices.size());
+  const int centre = b.vertices[static_cast<std::size_t>(b.centre)];
+  double reach = 0.0;
+  for (int j : b.vertices) reach = std::max(reach, (at(j) - at(centre)).norm());
+  const double tolerance = 1e-7 * reach;
+  const auto pinned = [&](int k) {
+    return is_pinned[static_cast<std::size_t>(b.vertices[static_cast<std::size_t>(k)])] != 0;
+  };
+  const auto on_edge = [&](int k) {
+    return edge[static_cast<std::size_t>(b.vertices[static_cast<std::size_t>(k)])] != 0;
+  };
+  const auto point = [&](int k) { return at(b.vertices[static_cast<std::size_t>(k)]); };
+  Eigen::Matrix<double, 3, Eigen::Dynamic> rows = b.rows;
+  for (int k = 0; k < count; ++k) {
+    if (!pinned(k) || on_edge(k) || b.rows.col(k).isZero(0.0)) continue;
+    int mirror = -1, first = -1, second = -1;
+    double nearest = std::numeric_limits<double>::infinity();
+    for (int m = 0; m < count; ++m) {
+      const double distance = (point(m) - point(k)).norm();
+      if (pinned(m) || distance >= nearest) continue;
+      const Eigen::Vector3d middle = 0.5 * (point(k) + point(m));
+      for (int c1 = 0; c1 < count; ++c1) {
+        if (!on_edge(c1)) continue;
+        for (int c2 = c1; c2 < count; ++c2)
+          if (on_edge(c2) && (0.5 * (point(c1) + point(c2)) - middle).norm() < tolerance) {
+            mirror = m, first = c1, second = c2, nearest = distance;
+            break;
+          }
+        if (mirror == m) break;
+      }
+    }
+    if (mirror < 0) continue;
+    const Eigen::Vector3d w = b.rows.col(k);
+    rows.col(mirror) += w;
+    rows.col(k) += w;
+    rows.col(first) -= w;
+    rows.col(second) -= w;
+    b.ghosted = true;
+  }
+  b.rows = rows;
+}
+
 }  // namespace
 
 void scale_rest_shapes(ClothModel& model, const Eigen::MatrixXd& scale) {
@@ -365,7 +422,8 @@ void scale_rest_shapes(ClothModel& model, const Eigen::MatrixXd& scale) {
   }
 }
 
-void clamp_bending(ClothModel& model, const std::vector<int>& pinned) {
+void clamp_bending(ClothModel& model, const std::vector<int>& pinned,
+                   const Eigen::VectorXd* positions) {
   const auto n = static_cast<std::size_t>(model.vertex_count);
   std::vector<char> is_pinned(n, 0), in_pinned_triangle(n, 0), in_free_triangle(n, 0);
   for (int v : pinned)
@@ -375,6 +433,15 @@ void clamp_bending(ClothModel& model, const std::vector<int>& pinned) {
     for (int v : t.vertices) all = all && is_pinned[static_cast<std::size_t>(v)];
     for (int v : t.vertices)
       (all ? in_pinned_triangle : in_free_triangle)[static_cast<std::size_t>(v)] = 1;
+  }
+  if (positions != nullptr && model.clamp_ghost_points &&
+      positions->size() == 3 * static_cast<Eigen::Index>(n)) {
+    std::vector<char> edge(n, 0);
+    for (std::size_t v = 0; v < n; ++v)
+      edge[v] = is_pinned[v] && in_pinned_triangle[v] && in_free_triangle[v];
+    for (VertexBendElement& b : model.vertex_bends)
+      if (!is_pinned[static_cast<std::size_t>(b.vertices[static_cast<std::size_t>(b.centre)])])
+        ghost_clamped_points(b, is_pinned, edge, *positions);
   }
   for (VertexBendElement& b : model.vertex_bends) {
     const auto v = static_cast<std::size_t>(b.vertices[static_cast<std::size_t>(b.centre)]);
@@ -536,6 +603,7 @@ ClothModel build_cloth_model(const ClothInput& input, const FabricParameters& fa
     spdlog::warn("cloth mesh: {} non-manifold edges get no bending stiffness", non_manifold);
   if (options.bend_weights == BendWeights::calibrated) calibrate_hinge_weights(rest, model.hinges);
   model.bend_stencil_stiffness = options.bend_stencil_stiffness;
+  model.clamp_ghost_points = options.clamp_ghost_points;
   if (options.bend_stencil_stiffness > 0.0)
     model.stencils = make_bend_stencils(rest, input.triangles);
   model.bend_model = options.bend_model;
@@ -711,6 +779,7 @@ ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse&
   // Stencils are rebuilt too; a row whose stencils are not all the previous ones (the same
   // vertices) is rebuilt.
   model.bend_stencil_stiffness = options.bend_stencil_stiffness;
+  model.clamp_ghost_points = options.clamp_ghost_points;
   if (options.bend_stencil_stiffness > 0.0)
     model.stencils = make_bend_stencils(rest, input.triangles);
   // Marks the rows of the elements over several vertices (stencils, vertex bends) that are not

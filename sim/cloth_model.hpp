@@ -98,6 +98,11 @@ struct ClothModelOptions {
   // (docs/simulator.md, "Bending on any mesh"). Built from the unscaled rest shape (a panel's
   // ease does not rescale them).
   double bend_stencil_stiffness = 0.0;
+  // Whether clamp_bending also reads the pinned points behind a clamp's edge in the free
+  // vertices' rows as ghosts (the even extension of the free side; docs/simulator.md, "Ghost
+  // points at a clamp"). Off by default: alone it stiffens the 4-8 mesh at 45° into its membrane
+  // locking (silk's Peirce chord 39.7°), which the diamonds' virtual centres have to remove first.
+  bool clamp_ghost_points = false;
 };
 
 // Row-major 3n-by-3n matrix, the layout the system matrix and the Jacobians share.
@@ -157,6 +162,7 @@ struct VertexBendElement {
                                         // (v, b, c); only when rest_normal != 0
   std::vector<int> blocks;              // #vertices², offset of block (j,l), see BlockPattern
   bool clamped = false;                 // inverse_area doubled by clamp_bending
+  bool ghosted = false;                 // rows read pinned points as ghosts (clamp_bending)
 };
 
 // Structurally symmetric block sparsity: rows 3i..3i+2 all hold the columns of the vertices
@@ -203,8 +209,9 @@ struct ClothModel {
   std::vector<VertexBendElement> vertex_bends;  // with BendModel::quadratic
   std::vector<BendStencil> stencils;  // with ClothModelOptions::bend_stencil_stiffness > 0
   double bend_stencil_stiffness = 0.0;
-  Eigen::VectorXd mass;         // #V lumped masses, kg
-  Eigen::VectorXd vertex_area;  // #V rest area attributed to each vertex (a third of each face)
+  bool clamp_ghost_points = false;  // ClothModelOptions::clamp_ghost_points
+  Eigen::VectorXd mass;             // #V lumped masses, kg
+  Eigen::VectorXd vertex_area;      // #V rest area attributed to each vertex (a third of each face)
   BlockPattern pattern;
   FlatBendOperator flat_bends;  // with BendModel::quadratic, see FlatBendOperator
 
@@ -255,7 +262,13 @@ void scale_rest_shapes(ClothModel& model, const Eigen::MatrixXd& scale);
 // clamped beam), over half the area, so those elements carry twice their energy. A clamp-edge
 // vertex: pinned, in a triangle whose vertices are all pinned and in one with a free vertex.
 // `pinned`: vertex indices. Without it the rigidity near a clamp converges only as O(h).
-void clamp_bending(ClothModel& model, const std::vector<int>& pinned);
+// With model.clamp_ghost_points and `positions` (3n, the layout the clamp is set up in: pinned
+// points where they are held, the free cloth next to them still in its flat layout) the free
+// vertices' rows also read the pinned points behind the edge as ghosts, the even extension of
+// the free side (ghost_clamped_points in cloth_model.cpp; docs/simulator.md, "Ghost points at a
+// clamp").
+void clamp_bending(ClothModel& model, const std::vector<int>& pinned,
+                   const Eigen::VectorXd* positions = nullptr);
 
 // (Re)builds model.flat_bends from model.vertex_bends and the pattern's offsets.
 void build_flat_bend_operator(ClothModel& model);

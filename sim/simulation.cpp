@@ -163,7 +163,7 @@ void Simulation::replace_model(ClothModel model, Eigen::VectorXd x, Eigen::Vecto
     std::vector<int> fixed;
     for (const Pin& pin : pins)
       if (!pin.path) fixed.push_back(pin.vertex);
-    clamp_bending(model_, fixed);
+    clamp_bending(model_, fixed, &x);
   }
   x_ = std::move(x);
   v_ = std::move(v);

@@ -65,7 +65,7 @@ SparseMatrixC free_stiffness(const ClothModel& model, const ForceSettings& setti
 StaticResult solve_static(const ClothModel& unclamped, Eigen::VectorXd& x,
                           const std::vector<int>& pinned, const StaticOptions& options) {
   ClothModel model = unclamped;
-  clamp_bending(model, pinned);
+  clamp_bending(model, pinned, &x);
   const int n = model.vertex_count;
   std::vector<int> free_index(static_cast<std::size_t>(3 * n), 0);
   for (int v : pinned)
