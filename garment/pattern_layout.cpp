@@ -285,6 +285,22 @@ PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOpt
     for (size_t k = 0; k < edges; ++k)
       piece.sewing.row(static_cast<Eigen::Index>(k)) =
           flat.uv.row(flat.boundary[k]).cwiseProduct(piece.scale().transpose());
+    // A fold is straight: the points of the fold run are moved onto its chord (within 2 mm,
+    // as the app chose it: PatternLayoutOptions::fold_edge).
+    if (p < options.fold_edge.size() && options.fold_edge[p].size() == edges)
+      for (size_t k = 0; k < edges; ++k)
+        if (options.fold_edge[p][k] && !options.fold_edge[p][(k + edges - 1) % edges]) {
+          size_t last = k;
+          while (options.fold_edge[p][(last + 1) % edges]) last = (last + 1) % edges;
+          const auto end = static_cast<Eigen::Index>((last + 1) % edges);
+          const Eigen::Vector2d a = piece.sewing.row(static_cast<Eigen::Index>(k)).transpose();
+          const Eigen::Vector2d along = (piece.sewing.row(end).transpose() - a).normalized();
+          for (size_t i = (k + 1) % edges; i != (last + 1) % edges; i = (i + 1) % edges) {
+            const Eigen::Vector2d q = piece.sewing.row(static_cast<Eigen::Index>(i)).transpose();
+            piece.sewing.row(static_cast<Eigen::Index>(i)) =
+                (a + (q - a).dot(along) * along).transpose();
+          }
+        }
     // The smooth sewing line: corners where the sketch curve changes, at seam junctions, at
     // sharp turns and at the ends of a fold.
     std::vector<bool> corner(edges, false);
