@@ -230,9 +230,12 @@ std::string svg_fold(const garment::PatternPiece& piece, double height) {
     return fmt::format(" M{:.2f},{:.2f} L{:.2f},{:.2f} L{:.2f},{:.2f}", l.x(), l.y(), tip.x(),
                        tip.y(), r.x(), r.y());
   };
-  std::string out = fmt::format(
-      "<line class=\"fold\" x1=\"{:.2f}\" y1=\"{:.2f}\" x2=\"{:.2f}\" y2=\"{:.2f}\"/>\n", a.x(),
-      a.y(), b.x(), b.y());
+  // The fold runs along the cutting line: white under it, so that its dashes show.
+  std::string out;
+  for (const char* kind : {"fold-gap", "fold"})
+    out += fmt::format(
+        "<line class=\"{}\" x1=\"{:.2f}\" y1=\"{:.2f}\" x2=\"{:.2f}\" y2=\"{:.2f}\"/>\n", kind,
+        a.x(), a.y(), b.x(), b.y());
   out += fmt::format(
       "<path class=\"fold-mark\" d=\"M{:.2f},{:.2f} L{:.2f},{:.2f} L{:.2f},{:.2f} "
       "L{:.2f},{:.2f}{}{}\"/>\n",
@@ -328,6 +331,7 @@ std::string pattern_svg(const PatternSheet& sheet) {
       ".grain{{stroke:#1f4e9c;stroke-width:0.5;fill:none}}.notch{{stroke:#000;stroke-width:0.6}}"
       ".label{{fill:#222}}.note{{fill:#444}}"
       ".fold{{stroke:#000;stroke-width:0.5;stroke-dasharray:8 2 1 2}}"
+      ".fold-gap{{stroke:#fff;stroke-width:0.9}}"
       ".fold-mark{{stroke:#000;stroke-width:0.4;fill:none}}.fold-label{{fill:#000}}</style>\n"
       "<rect class=\"fabric\" x=\"0\" y=\"0\" width=\"{0:.1f}\" height=\"{3:.1f}\"/>\n",
       width, length + footer, markup_escape(sheet.title), length);
