@@ -267,6 +267,10 @@ PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOpt
       for (size_t k = 0; k < edges; ++k)
         if (options.edge_allowance[p][k] >= 0) allowance[k] = options.edge_allowance[p][k];
     }
+    // A fold is cut, not sewn: no allowance along it.
+    if (p < options.fold_edge.size() && options.fold_edge[p].size() == edges)
+      for (size_t k = 0; k < edges; ++k)
+        if (options.fold_edge[p][k]) allowance[k] = 0;
     for (size_t k = 0; k < edges; ++k)
       if (k == 0 || allowance[k] != allowance[k - 1])
         piece.allowances.push_back({static_cast<int>(k), static_cast<int>(k), allowance[k]});
@@ -281,33 +285,88 @@ PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOpt
     for (size_t k = 0; k < edges; ++k)
       piece.sewing.row(static_cast<Eigen::Index>(k)) =
           flat.uv.row(flat.boundary[k]).cwiseProduct(piece.scale().transpose());
-    piece.cutting = piece.allowances.size() > 1
-                        ? offset_by_edge(flat.id, piece.sewing, allowance)
-                        : offset_outwards(flat.id, piece.sewing, piece.allowances[0].allowance);
+    // A fold is straight: the points of the fold run are moved onto its chord (within 2 mm,
+    // as the app chose it: PatternLayoutOptions::fold_edge).
+    if (p < options.fold_edge.size() && options.fold_edge[p].size() == edges)
+      for (size_t k = 0; k < edges; ++k)
+        if (options.fold_edge[p][k] && !options.fold_edge[p][(k + edges - 1) % edges]) {
+          size_t last = k;
+          while (options.fold_edge[p][(last + 1) % edges]) last = (last + 1) % edges;
+          const auto end = static_cast<Eigen::Index>((last + 1) % edges);
+          const Eigen::Vector2d a = piece.sewing.row(static_cast<Eigen::Index>(k)).transpose();
+          const Eigen::Vector2d along = (piece.sewing.row(end).transpose() - a).normalized();
+          for (size_t i = (k + 1) % edges; i != (last + 1) % edges; i = (i + 1) % edges) {
+            const Eigen::Vector2d q = piece.sewing.row(static_cast<Eigen::Index>(i)).transpose();
+            piece.sewing.row(static_cast<Eigen::Index>(i)) =
+                (a + (q - a).dot(along) * along).transpose();
+          }
+        }
+    // The smooth sewing line: corners where the sketch curve changes, at seam junctions, at
+    // sharp turns and at the ends of a fold.
+    std::vector<bool> corner(edges, false);
+    if (p < options.corners.size() && options.corners[p].size() == edges)
+      corner = options.corners[p];
+    for (const int v : flat.notches)
+      corner[static_cast<size_t>(std::find(flat.boundary.begin(), flat.boundary.end(), v) -
+                                 flat.boundary.begin())] = true;
+    mark_sharp_turns(piece.sewing, kCornerTurn, corner);
+    const bool folds = p < options.fold_edge.size() && options.fold_edge[p].size() == edges;
+    if (folds)
+      for (size_t k = 0; k < edges; ++k)
+        if (options.fold_edge[p][k] != options.fold_edge[p][(k + edges - 1) % edges])
+          corner[k] = true;
+    piece.curve = smooth_outline(piece.sewing, corner, kCurveTolerance);
+    const Eigen::Index dense = piece.curve.points.rows();
+    std::vector<double> dense_allowance(static_cast<size_t>(dense));
+    for (size_t k = 0; k < edges; ++k) {
+      const Eigen::Index end = k + 1 < edges ? piece.curve.at[k + 1] : dense;
+      for (Eigen::Index i = piece.curve.at[k]; i < end; ++i)
+        dense_allowance[static_cast<size_t>(i)] = allowance[k];
+    }
+    bool uniform = true;
+    for (const double a : dense_allowance) uniform = uniform && a == dense_allowance.front();
+    piece.cutting = !uniform
+                        ? offset_by_edge(flat.id, piece.curve.points, dense_allowance)
+                        : offset_outwards(flat.id, piece.curve.points, dense_allowance.front());
     piece.origin = -piece.cutting.colwise().minCoeff().transpose();
     piece.sewing.rowwise() += piece.origin.transpose();
+    piece.curve.points.rowwise() += piece.origin.transpose();
+    for (BezierSpan& span : piece.curve.spans) {
+      span.b1 += piece.origin;
+      span.b2 += piece.origin;
+    }
     piece.cutting.rowwise() += piece.origin.transpose();
     piece.size = piece.cutting.colwise().maxCoeff().transpose();
-    piece.sewn_area = signed_area(piece.sewing);
+    piece.sewn_area = signed_area(piece.curve.points);
     piece.cut_area = signed_area(piece.cutting);
+    if (folds) {
+      // The fold line: the run of fold edges (one straight run along the centre line).
+      for (size_t k = 0; k < edges; ++k)
+        if (options.fold_edge[p][k] && !options.fold_edge[p][(k + edges - 1) % edges]) {
+          size_t last = k;
+          while (options.fold_edge[p][(last + 1) % edges]) last = (last + 1) % edges;
+          piece.on_fold = true;
+          piece.fold_start = piece.sewing.row(static_cast<Eigen::Index>(k)).transpose();
+          piece.fold_end =
+              piece.sewing.row(static_cast<Eigen::Index>((last + 1) % edges)).transpose();
+        }
+    }
     for (const int v : flat.notches) {
       const auto at = std::find(flat.boundary.begin(), flat.boundary.end(), v);
       const Eigen::Index i = at - flat.boundary.begin();
       const double narrower = std::min(allowance[static_cast<size_t>(i)],
                                        allowance[(static_cast<size_t>(i) + edges - 1) % edges]);
       piece.notches.push_back(
-          {piece.sewing.row(i).transpose(), outward_normal(piece.sewing, i), narrower});
+          {piece.sewing.row(i).transpose(),
+           outward_normal(piece.curve.points, piece.curve.at[static_cast<size_t>(i)]), narrower});
     }
     for (const OutlinePoint& b : flat.balance_notches) {
-      const auto i = static_cast<Eigen::Index>(b.edge);
-      const Eigen::Vector2d from = piece.sewing.row(i).transpose();
-      const Eigen::Vector2d to =
-          piece.sewing.row((i + 1) % static_cast<Eigen::Index>(edges)).transpose();
-      const Eigen::Vector2d along = (to - from).normalized();  // counter-clockwise: out is right
-      piece.notches.push_back({from + b.t * (to - from), Eigen::Vector2d(along.y(), -along.x()),
-                               allowance[static_cast<size_t>(b.edge)], true});
+      // At the same fraction of the span's length on the smooth curve as of its chord.
+      const auto [point, normal] = point_on_span(piece.curve, b.edge, b.t);
+      piece.notches.push_back({point, normal, allowance[static_cast<size_t>(b.edge)], true});
     }
     grain_line(piece);
+    if (p < options.folded_into.size()) piece.folded_into = options.folded_into[p];
     layout.pieces.push_back(std::move(piece));
   }
 
@@ -424,8 +483,9 @@ PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOpt
     }
     return length;
   };
-  std::vector<size_t> by_area(layout.pieces.size());
-  for (size_t i = 0; i < by_area.size(); ++i) by_area[i] = i;
+  std::vector<size_t> by_area;  // a fold piece's other half is not cut on its own
+  for (size_t i = 0; i < layout.pieces.size(); ++i)
+    if (layout.pieces[i].folded_into < 0) by_area.push_back(i);
   std::vector<size_t> by_height = by_area;
   std::stable_sort(by_area.begin(), by_area.end(), [&](size_t a, size_t b) {
     return layout.pieces[a].cut_area > layout.pieces[b].cut_area;
@@ -436,6 +496,7 @@ PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOpt
   if (nest(by_height) < nest(by_area)) nest(by_height);
   double cut = 0;
   for (const PatternPiece& piece : layout.pieces) {
+    if (piece.folded_into >= 0) continue;
     layout.length_used = std::max(layout.length_used, piece.placement.y() + piece.size.y());
     cut += piece.cut_area;
   }

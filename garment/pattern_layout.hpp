@@ -9,6 +9,7 @@
 
 #include "garment/garment_request.hpp"
 #include "garment/panel_flattening.hpp"
+#include "garment/pattern_outline.hpp"
 
 namespace sd::garment {
 
@@ -23,7 +24,24 @@ struct PatternLayoutOptions {
   std::vector<std::vector<double>> edge_allowance;
   std::vector<PanelEase> panel_ease;  // per panel rest-shape scale (empty: 1)
   double gap = 0.01;                  // m between pieces, and from the selvedges and the cut end
+  // Per FlatPattern panel, per outline point k (boundary[k]): where the outline passes from one
+  // sketch curve to the next, a corner the smooth sewing line keeps (empty: none given). Seam
+  // junctions (FlatPanel::notches) and turns sharper than kCornerTurn are corners too.
+  std::vector<std::vector<bool>> corners;
+  // Per FlatPattern panel, per outline edge k: the edge lies on the garment's mirror plane and
+  // the piece is cut on the fold there (no seam allowance; empty: no fold).
+  std::vector<std::vector<bool>> fold_edge;
+  // Per FlatPattern panel: the panel whose fold piece this one is the other half of (a mirror
+  // copy sewn to its original along the centre line only), or −1. Such a piece is not laid out.
+  std::vector<int> folded_into;
 };
+
+// A turn of the outline sharper than this (radians) at a point is a corner the smooth sewing
+// line keeps: 40°, above the mesh's turns along a drawn curve (an armhole of 6 cm radius at
+// 3 cm edges turns 29° a point) and below a seam corner (60-120°).
+constexpr double kCornerTurn = 40.0 * 3.14159265358979323846 / 180.0;
+// m: the densified sewing curve lies within this of its Béziers (a pencil line is 0.5 mm wide).
+constexpr double kCurveTolerance = 1e-4;
 
 // A notch on the sewing line, `normal` pointing out of the piece (unit).
 struct PatternNotch {
@@ -51,11 +69,16 @@ struct PatternPiece {
   double allowance = 0;                  // the piece's (m), where no seam has its own
   std::vector<AllowanceRun> allowances;  // along the sewing line, covering every edge once
   Eigen::Vector2d origin = Eigen::Vector2d::Zero();
-  Eigen::MatrixX2d sewing;  // the sewing line, closed (first point not repeated), CCW
-  // The sewing line offset out by its allowances, CCW: by the straight skeleton when they are
-  // all equal; else each simplified edge's line moved out by its own and neighbouring lines
-  // met at their intersection (a mitred corner; where two different allowances meet nearly in
-  // line, a step across).
+  // The outline's points (the panel's boundary vertices), closed (first point not repeated),
+  // CCW; point k is FlatPanel::boundary[k].
+  Eigen::MatrixX2d sewing;
+  // The sewing line: the smooth curve through `sewing` (pattern_outline.hpp), densified to
+  // kCurveTolerance; curve.at[k] is point k's row.
+  SmoothOutline curve;
+  // The smooth sewing line offset out by its allowances, CCW: by the straight skeleton when they
+  // are all equal; else each simplified edge's line moved out by its own and neighbouring lines met
+  // at their intersection (a mitred corner; where two different allowances meet nearly in line, a
+  // step across).
   Eigen::MatrixX2d cutting;
   std::vector<PatternNotch> notches;
   Eigen::Vector2d grain_start = Eigen::Vector2d::Zero(), grain_end = Eigen::Vector2d::Zero();
@@ -64,6 +87,13 @@ struct PatternPiece {
   // The ease as the piece frame's (x, y) scale: (weft, warp).
   Eigen::Vector2d scale() const { return {ease.weft, ease.warp}; }
   double sewn_area = 0, cut_area = 0;  // m²
+  // Cut on the fold: the fold line (piece frame, from fold_start to fold_end along the outline)
+  // is the piece's straight edge on the garment's mirror plane, cut with no allowance; the piece
+  // stands for itself and its mirror copy. `folded_into` ≥ 0: this piece is that copy, not laid
+  // out (index into PatternLayout::pieces of the fold piece).
+  bool on_fold = false;
+  Eigen::Vector2d fold_start = Eigen::Vector2d::Zero(), fold_end = Eigen::Vector2d::Zero();
+  int folded_into = -1;
 };
 
 struct PatternLayout {

@@ -136,8 +136,12 @@ TEST(PatternCommand, EveryExampleGivesPiecesThatSewAndDoNotOverlap) {
     const double width = json["fabric_width_mm"], length = json["fabric_length_mm"];
     EXPECT_EQ(width, 1500.0);
     double cut = 0;
+    size_t drawn = 0;
     for (size_t i = 0; i < pieces.size(); ++i) {
       const auto& a = pieces[i];
+      // The other half of a piece cut on the fold is not laid out.
+      if (!a["folded_into"].get<std::string>().empty()) continue;
+      ++drawn;
       const double ax = a["placement_mm"][0], ay = a["placement_mm"][1];
       const double aw = a["size_mm"][0], ah = a["size_mm"][1];
       EXPECT_GE(ax, 0);
@@ -148,13 +152,17 @@ TEST(PatternCommand, EveryExampleGivesPiecesThatSewAndDoNotOverlap) {
       EXPECT_GT(a["cut_area_mm2"].get<double>(), a["sewn_area_mm2"].get<double>());
       EXPECT_EQ(a["grain_line"][0][0], a["grain_line"][1][0]);  // grain along +y
       EXPECT_FALSE(a["notches"].empty()) << name << " " << a["id"];
-      for (size_t j = i + 1; j < pieces.size(); ++j)
+      for (size_t j = i + 1; j < pieces.size(); ++j) {
+        if (!pieces[j]["folded_into"].get<std::string>().empty()) continue;
         EXPECT_FALSE(overlap(outline(a), outline(pieces[j])))
             << name << ": " << a["id"] << " overlaps " << pieces[j]["id"];
+      }
       // A mirrored panel and its copy name each other; any other piece names none.
       const std::string id = a["id"], pair = a["mirror_pair"];
       const bool copy = id.ends_with(".mirror");
-      if (!pair.empty()) {
+      if (!pair.empty() && a["on_fold"].get<bool>()) {
+        EXPECT_EQ(pair, id + ".mirror") << name;
+      } else if (!pair.empty()) {
         EXPECT_EQ(pair, copy ? id.substr(0, id.size() - 7) : id + ".mirror") << name;
         EXPECT_NE(read(out / "pattern.svg").find((copy ? "mirror of " : "pair with ") + pair),
                   std::string::npos)
@@ -164,6 +172,8 @@ TEST(PatternCommand, EveryExampleGivesPiecesThatSewAndDoNotOverlap) {
       }
     }
     EXPECT_NEAR(json["efficiency"].get<double>(), cut / (width * length), 1e-9);
+    EXPECT_EQ(count(read(out / "pattern.svg"), "CUT 1 ON FOLD</text>"), pieces.size() - drawn)
+        << name;
     ASSERT_FALSE(json["seams"].empty());
     size_t balance_notches = 0;
     for (const auto& seam : json["seams"]) {
@@ -179,16 +189,21 @@ TEST(PatternCommand, EveryExampleGivesPiecesThatSewAndDoNotOverlap) {
           if (piece["id"] == id) return piece;
         return nlohmann::json();
       };
-      const std::vector<double> fa = notch_fractions(piece_of(seam["a"]), seam["polyline_a"]);
-      const std::vector<double> fb = notch_fractions(piece_of(seam["b"]), seam["polyline_b"]);
+      // The notches sit on the smooth sewing line, at the fraction of each span's length on
+      // the curve that they have of its chord: the fraction of the whole side differs from the
+      // chords' by the spans' different arc/chord ratios (a span of 30 mm on a 60 mm radius is
+      // 0.4 % longer than its chord, a straight one not at all): measured 5.3e-4 at most, 0.3 mm
+      // on a 50 cm seam; bound 1e-3.
+      const std::vector<double> fa = notch_fractions(piece_of(seam["a"]), seam["curve_a"]);
+      const std::vector<double> fb = notch_fractions(piece_of(seam["b"]), seam["curve_b"]);
       const auto listed = seam["balance_notches"].get<std::vector<double>>();
       const double seam_mm = seam["length_3d_mm"];
       EXPECT_EQ(listed.empty(), seam_mm <= 250) << name << ": " << seam["a"] << " / " << seam["b"];
       ASSERT_EQ(fa.size(), listed.size()) << name << ": " << seam["a"] << " / " << seam["b"];
       ASSERT_EQ(fb.size(), listed.size()) << name << ": " << seam["a"] << " / " << seam["b"];
       for (size_t k = 0; k < listed.size(); ++k) {
-        EXPECT_NEAR(fa[k], listed[k], 1e-4) << name << ": " << seam["a"] << " / " << seam["b"];
-        EXPECT_NEAR(fb[k], listed[k], 1e-4) << name << ": " << seam["a"] << " / " << seam["b"];
+        EXPECT_NEAR(fa[k], listed[k], 1e-3) << name << ": " << seam["a"] << " / " << seam["b"];
+        EXPECT_NEAR(fb[k], listed[k], 1e-3) << name << ": " << seam["a"] << " / " << seam["b"];
         const double gap = (k == 0 ? listed[0] : listed[k] - listed[k - 1]) * seam_mm;
         EXPECT_LE(gap, 200 + 1e-6) << name << ": " << seam["a"] << " / " << seam["b"];
       }
@@ -197,14 +212,17 @@ TEST(PatternCommand, EveryExampleGivesPiecesThatSewAndDoNotOverlap) {
       }
       balance_notches += 2 * listed.size();
     }
-    size_t balance_kind = 0;
+    size_t balance_kind = 0, balance_drawn = 0;
     for (const auto& piece : pieces)
-      for (const auto& notch : piece["notches"]) balance_kind += notch["kind"] == "balance";
+      for (const auto& notch : piece["notches"]) {
+        balance_kind += notch["kind"] == "balance";
+        balance_drawn += notch["kind"] == "balance" && piece["folded_into"] == "";
+      }
     EXPECT_EQ(balance_kind, balance_notches) << name;
     EXPECT_GT(balance_notches, 0u) << name;  // every example has seams over 25 cm
     const std::string svg = read(out / "pattern.svg");
-    EXPECT_EQ(count(svg, "class=\"notch balance\""), balance_notches) << name;
-    EXPECT_EQ(count(svg, "<g class=\"piece\""), pieces.size()) << name;
+    EXPECT_EQ(count(svg, "class=\"notch balance\""), balance_drawn) << name;
+    EXPECT_EQ(count(svg, "<g class=\"piece\""), drawn) << name;
     EXPECT_NE(svg.find("width=\"1500.0mm\""), std::string::npos);
   }
 }
@@ -314,6 +332,164 @@ TEST(PatternCommand, SeamAllowancePerSeamFromTheCurves) {
   EXPECT_NE(read(dir / "out/pattern.dxf").find("Seam allowance: 6-30 mm"), std::string::npos);
 }
 
+double turn_deg(const nlohmann::json& a, const nlohmann::json& p, const nlohmann::json& b) {
+  const double ux = p[0].get<double>() - a[0].get<double>(),
+               uy = p[1].get<double>() - a[1].get<double>();
+  const double vx = b[0].get<double>() - p[0].get<double>(),
+               vy = b[1].get<double>() - p[1].get<double>();
+  return std::abs(std::atan2(ux * vy - uy * vx, ux * vx + uy * vy)) * 180 / M_PI;
+}
+
+double polyline_mm(const nlohmann::json& p) {
+  double l = 0;
+  for (size_t k = 1; k < p.size(); ++k)
+    l += std::hypot(p[k][0].get<double>() - p[k - 1][0].get<double>(),
+                    p[k][1].get<double>() - p[k - 1][1].get<double>());
+  return l;
+}
+
+// Trial 35 (#14): at true scale the sewing line was a polyline through the mesh's outline points
+// (one every ~30 mm) and showed an angle at each. It is now a smooth curve through them: it
+// passes through every point; away from the corners it keeps (seam junctions, where the sketch
+// curve changes, turns over 40°) consecutive chords of the densified curve turn by at most 12°
+// (measured 9.8° at most on the examples and two Collada designs; the polylines through the
+// same points turn by more than 15° somewhere that is not a corner, else nothing was tested);
+// at every corner turning over 60° the curve still turns at least half as much (a corner is
+// not rounded off); and the two sides of every seam, measured along the smooth curves, are as
+// long as each other within 0.5 % (gathers divided out), as the issue asks of the polylines.
+TEST(PatternCommand, SewingLinesAreSmoothCurvesThatKeepCornersAndSew) {
+  double most_polyline = 0;  // the polyline's sharpest turn at a point that is not a corner
+  for (const char* name : {"tshirt", "a-line-skirt", "sleeveless-dress", "shorts", "godet-skirt"}) {
+    const fs::path out = fresh_dir(std::string("smooth-") + name);
+    const CommandResult r =
+        run_sketchdrape("pattern " + example(name).string() + " -o " + out.string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const auto json = nlohmann::json::parse(read(out / "pattern.json"));
+    double worst_smooth = 0, worst_polyline = 0;
+    int corners_checked = 0;
+    for (const auto& piece : json["pieces"]) {
+      const auto& points = piece["sewing_line"];
+      const auto& curve = piece["sewing_curve"];
+      const size_t n = points.size(), m = curve.size();
+      ASSERT_GT(m, n) << name << " " << piece["id"];
+      std::vector<bool> corner(n, false);
+      for (const auto& k : piece["sewing_corners"]) corner[k.get<size_t>()] = true;
+      // Row of the curve at each outline point: the curve passes through them in order.
+      std::vector<size_t> row(n, m);
+      size_t from = 0;
+      for (size_t k = 0; k < n; ++k)
+        for (size_t i = from; i < m; ++i)
+          if (std::hypot(curve[i][0].get<double>() - points[k][0].get<double>(),
+                         curve[i][1].get<double>() - points[k][1].get<double>()) < 2e-3) {
+            row[k] = from = i;
+            break;
+          }
+      std::vector<bool> at_corner(m, false);
+      for (size_t k = 0; k < n; ++k) {
+        ASSERT_LT(row[k], m) << name << " " << piece["id"] << ": point " << k
+                             << " not on the curve";
+        at_corner[row[k]] = corner[k];
+      }
+      for (size_t i = 0; i < m; ++i)
+        if (!at_corner[i])
+          worst_smooth = std::max(worst_smooth,
+                                  turn_deg(curve[(i + m - 1) % m], curve[i], curve[(i + 1) % m]));
+      for (size_t k = 0; k < n; ++k) {
+        const double polyline = turn_deg(points[(k + n - 1) % n], points[k], points[(k + 1) % n]);
+        if (!corner[k]) {
+          worst_polyline = std::max(worst_polyline, polyline);
+        } else if (polyline > 60) {
+          ++corners_checked;
+          EXPECT_GT(turn_deg(curve[(row[k] + m - 1) % m], curve[row[k]], curve[(row[k] + 1) % m]),
+                    0.5 * polyline)
+              << name << " " << piece["id"] << ": corner " << k;
+        }
+      }
+    }
+    EXPECT_LE(worst_smooth, 12.0) << name;
+    most_polyline = std::max(most_polyline, worst_polyline);
+    EXPECT_GT(corners_checked, 4) << name;
+    for (const auto& seam : json["seams"]) {
+      const double a = polyline_mm(seam["curve_a"]) / seam["ease_a"].get<double>();
+      const double b = polyline_mm(seam["curve_b"]) / seam["ease_b"].get<double>();
+      // pattern.json rounds points to 1 µm: a sum over ~100 chords to 0.01 mm.
+      EXPECT_NEAR(polyline_mm(seam["curve_a"]), seam["curve_length_a_mm"].get<double>(), 0.01);
+      EXPECT_LE(std::abs(a - b) / std::max(a, b), 0.005)
+          << name << ": " << seam["a"] << " / " << seam["b"];
+      // The curve side runs from the seam's first point to its last.
+      EXPECT_NEAR(seam["curve_a"][0][0].get<double>(), seam["polyline_a"][0][0].get<double>(),
+                  2e-3);
+      EXPECT_NEAR(seam["curve_b"].back()[1].get<double>(),
+                  seam["polyline_b"].back()[1].get<double>(), 2e-3);
+    }
+  }
+  EXPECT_GT(most_polyline, 15.0) << "the polylines were smooth already: nothing tested";
+}
+
+// Trial 35 (#13): a piece whose straight edge lies on the garment's mirror plane, sewn there to
+// its own mirror copy, is cut on the fold: the A-line skirt's two yokes (centre lines within
+// 1.1 mm of straight). Its cutting line runs along the fold (no allowance there: every point of
+// the fold line on the cutting line, to 0.01 mm), elsewhere it keeps its 1 cm; the fold is
+// marked (dash-dot line, bracket, "CUT 1 ON FOLD") and the copy is neither drawn nor laid out;
+// the skirt panels, whose centre lines bow 5-6 mm, keep their centre seams.
+TEST(PatternCommand, CentrePiecesAreCutOnTheFold) {
+  const fs::path out = fresh_dir("fold");
+  const CommandResult r =
+      run_sketchdrape("pattern " + example("a-line-skirt").string() + " -o " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto json = nlohmann::json::parse(read(out / "pattern.json"));
+  const std::string svg = read(out / "pattern.svg");
+  std::vector<std::string> folds;
+  for (const auto& piece : json["pieces"]) {
+    const std::string id = piece["id"];
+    if (!piece["on_fold"].get<bool>()) {
+      EXPECT_TRUE(piece["fold_line"].is_null()) << id;
+      if (id.starts_with("yoke")) {
+        EXPECT_EQ(piece["folded_into"], id.substr(0, id.size() - 7)) << id;
+        EXPECT_EQ(svg.find("id=\"piece-" + id + "\""), std::string::npos) << id;
+      } else {
+        EXPECT_EQ(piece["folded_into"], "") << id;
+      }
+      continue;
+    }
+    folds.push_back(id);
+    const auto& fold = piece["fold_line"];
+    const auto& cutting = piece["cutting_line"];
+    const auto distance_to_cut = [&](double x, double y) {
+      double best = 1e300;
+      for (size_t k = 0; k < cutting.size(); ++k) {
+        const double ax = cutting[k][0], ay = cutting[k][1];
+        const double bx = cutting[(k + 1) % cutting.size()][0];
+        const double by = cutting[(k + 1) % cutting.size()][1];
+        const double dx = bx - ax, dy = by - ay;
+        const double t =
+            std::clamp(((x - ax) * dx + (y - ay) * dy) / (dx * dx + dy * dy), 0.0, 1.0);
+        best = std::min(best, std::hypot(x - ax - t * dx, y - ay - t * dy));
+      }
+      return best;
+    };
+    const double x0 = fold[0][0], y0 = fold[0][1], x1 = fold[1][0], y1 = fold[1][1];
+    EXPECT_GT(std::hypot(x1 - x0, y1 - y0), 150) << id;  // the yoke's centre line, 176 mm
+    for (int k = 0; k <= 20; ++k)
+      EXPECT_LT(distance_to_cut(x0 + k / 20.0 * (x1 - x0), y0 + k / 20.0 * (y1 - y0)), 0.01)
+          << id << " at " << k << "/20 of the fold";
+    bool zero = false, ten = false;
+    for (const auto& run : piece["allowances"]) {
+      zero = zero || run["mm"] == 0.0;
+      ten = ten || run["mm"] == 10.0;
+    }
+    EXPECT_TRUE(zero && ten) << id;
+    const size_t group = svg.find("id=\"piece-" + id + "\"");
+    ASSERT_NE(group, std::string::npos) << id;
+    const std::string drawn = svg.substr(group, svg.find("</g>\n</g>", group) - group);
+    EXPECT_NE(drawn.find("class=\"fold\""), std::string::npos) << id;
+    EXPECT_NE(drawn.find("class=\"fold-mark\""), std::string::npos) << id;
+    EXPECT_NE(drawn.find(">CUT 1 ON FOLD</text>"), std::string::npos) << id;
+    EXPECT_NE(drawn.find("data-fold=\"1\""), std::string::npos) << id;
+  }
+  EXPECT_EQ(folds, (std::vector<std::string>{"yoke_front", "yoke_back"}));
+}
+
 // The sheet in a real browser: the SVG parses (one <g class="piece"> per piece in the DOM) and
 // a screenshot at 0.8 px/mm shows white pieces covering the fabric in the proportion the sheet
 // reports as its efficiency.
@@ -397,6 +573,10 @@ TEST(PatternCommand, SvgOpensInHeadlessChromium) {
   EXPECT_EQ(drawn, json["pieces"].size());
 }
 
+size_t block_lines(const nlohmann::json& block, const std::string& layer) {
+  return block["lines"].contains(layer) ? block["lines"][layer].get<size_t>() : 0;
+}
+
 // The DXF read by a real DXF library: one block per piece, each with a closed boundary (layer
 // 1), a sewing line (14), a grain line (7), notches (4) and its name; millimetres.
 TEST(PatternCommand, DxfReadsBackWithEzdxf) {
@@ -415,11 +595,12 @@ for e in doc.modelspace().query("INSERT"):
     out["inserts"].append([e.dxf.name, e.dxf.insert.x, e.dxf.insert.y])
 for name in set(i[0] for i in out["inserts"]):
     b = doc.blocks.get(name)
-    info = {"closed": {}, "lines": {}, "texts": []}
+    info = {"closed": {}, "lines": {}, "texts": [], "vertices": {}}
     for e in b:
         layer = e.dxf.layer
         if e.dxftype() == "POLYLINE":
             info["closed"][layer] = info["closed"].get(layer, 0) + (1 if e.is_closed else 0)
+            info["vertices"][layer] = len(list(e.vertices))
         elif e.dxftype() == "LINE":
             info["lines"][layer] = info["lines"].get(layer, 0) + 1
         elif e.dxftype() == "TEXT":
@@ -432,10 +613,22 @@ print(json.dumps(out))
                                    (out / "pattern.dxf").string());
   const auto dxf = nlohmann::json::parse(text);
   EXPECT_EQ(dxf["insunits"], 4);  // millimetres
-  ASSERT_EQ(dxf["inserts"].size(), json["pieces"].size());
+  size_t drawn = 0;
+  for (const auto& piece : json["pieces"]) drawn += piece["folded_into"] == "";
+  EXPECT_LT(drawn, json["pieces"].size());  // the yokes are cut on the fold
+  ASSERT_EQ(dxf["inserts"].size(), drawn);
   for (const auto& piece : json["pieces"]) {
     const std::string id = piece["id"];
+    if (piece["folded_into"] != "") {
+      EXPECT_FALSE(dxf["blocks"].contains(id)) << id;
+      continue;
+    }
     ASSERT_TRUE(dxf["blocks"].contains(id)) << id;
+    // The fold (ASTM D6673's layer 6, the mirror line) on a piece cut on the fold only.
+    EXPECT_EQ(block_lines(dxf["blocks"][id], "6"), piece["on_fold"].get<bool>() ? 1 : 0) << id;
+    // The sewing line is the smooth curve densified (ezdxf reads every vertex back).
+    EXPECT_EQ(dxf["blocks"][id]["vertices"]["14"].get<size_t>(), piece["sewing_curve"].size())
+        << id;
     const auto& block = dxf["blocks"][id];
     EXPECT_EQ(block["closed"]["1"], 1) << id;   // boundary
     EXPECT_EQ(block["closed"]["14"], 1) << id;  // sewing line

@@ -80,6 +80,69 @@ std::vector<double> edge_allowances(const scene::Sketch& sketch, const garment::
   return out;
 }
 
+// The outline points of a piece where its outline passes from one sketch curve to the next
+// (a mirror copy's curve counts as its original's): corners its smooth sewing line keeps.
+std::vector<bool> curve_corners(const garment::Garment& garment, const garment::FlatPanel& flat) {
+  const size_t n = flat.boundary.size();
+  std::vector<std::string> curve(n);
+  for (size_t k = 0; k < n; ++k) {
+    const int a = flat.vertices[static_cast<size_t>(flat.boundary[k])];
+    const int b = flat.vertices[static_cast<size_t>(flat.boundary[(k + 1) % n])];
+    const auto found = garment.edge_curve.find(std::minmax(a, b));
+    if (found != garment.edge_curve.end()) curve[k] = found->second;
+  }
+  std::vector<bool> out(n, false);
+  for (size_t k = 0; k < n; ++k) out[k] = curve[k] != curve[(k + n - 1) % n];
+  return out;
+}
+
+// m: how far a centre-line edge may bow from its chord and still be laid on the fold. Cut on
+// the fold, the piece's centre follows the chord instead: the whole piece, both halves, is at
+// most twice this wider or narrower there (4 mm of girth), well inside a garment's ease. The
+// flattening does not hold centre lines straight: measured bows are 0.3-1.6 mm on yokes, gores
+// and collars, 2-37 mm on bodice and skirt fronts and backs, 29-61 mm on crotch curves
+// (docs/pattern.md), so only the first are folded.
+constexpr double kFoldStraightness = 2e-3;
+
+// The outline edges of panel `flat` (not a mirror copy) that lie on the garment's mirror plane
+// x = 0, when its mirror copy is in the pattern and those edges make one straight run (within
+// kFoldStraightness of its chord, in 2D): the piece is cut on the fold there, and stands for
+// its copy too. Empty otherwise.
+std::vector<bool> fold_edges(const garment::Garment& garment, const garment::FlatPattern& pattern,
+                             const garment::FlatPanel& flat, const std::vector<double>& own) {
+  if (flat.id.ends_with(".mirror")) return {};
+  const bool has_copy = std::any_of(pattern.panels.begin(), pattern.panels.end(),
+                                    [&](const auto& p) { return p.id == flat.id + ".mirror"; });
+  if (!has_copy) return {};
+  const size_t n = flat.boundary.size();
+  const auto on_plane = [&](size_t k) {
+    const int v = flat.vertices[static_cast<size_t>(flat.boundary[k % n])];
+    return std::abs(garment.mesh.vertices(v, 0)) <= 1e-6;
+  };
+  std::vector<bool> fold(n, false);
+  size_t runs = 0, first = 0;
+  for (size_t k = 0; k < n; ++k) {
+    fold[k] = on_plane(k) && on_plane(k + 1);
+    const bool starts = fold[k] && !(on_plane(k + n - 1) && on_plane(k));
+    if (starts) first = k;
+    runs += starts;
+  }
+  if (runs != 1) return {};
+  // A centre curve with its own seam allowance is sewn (a centre-back zip), not folded.
+  for (size_t k = 0; k < n && !own.empty(); ++k)
+    if (fold[k] && own[k] >= 0) return {};
+  size_t last = first;
+  while (fold[(last + 1) % n] && (last + 1) % n != first) last = (last + 1) % n;
+  const Eigen::Vector2d a = flat.uv.row(flat.boundary[first]).transpose();
+  const Eigen::Vector2d b = flat.uv.row(flat.boundary[(last + 1) % n]).transpose();
+  const Eigen::Vector2d along = (b - a).normalized();
+  for (size_t k = first; k != (last + 1) % n; k = (k + 1) % n) {
+    const Eigen::Vector2d q = flat.uv.row(flat.boundary[(k + 1) % n]).transpose() - a;
+    if (std::abs(along.x() * q.y() - along.y() * q.x()) > kFoldStraightness) return {};
+  }
+  return fold;
+}
+
 std::string piece_name(const PatternSheet& sheet, const garment::PatternPiece& piece) {
   return sheet.pattern.panels[static_cast<size_t>(piece.panel)].id;
 }
@@ -105,6 +168,11 @@ std::string ease_label(const garment::PanelEase& ease) {
 }
 
 std::string cut_note(const PatternSheet& sheet, const std::string& id) {
+  const auto& piece = sheet.layout.pieces[static_cast<size_t>(
+      std::find_if(sheet.pattern.panels.begin(), sheet.pattern.panels.end(),
+                   [&](const auto& p) { return p.id == id; }) -
+      sheet.pattern.panels.begin())];
+  if (piece.on_fold) return "CUT 1 ON FOLD";
   const std::string partner = mirror_partner(sheet, id);
   if (partner.empty()) return "cut 1";
   return (id.ends_with(".mirror") ? "cut 1 · mirror of " : "cut 1 · pair with ") + partner;
@@ -121,6 +189,68 @@ std::string svg_path(const garment::PatternPiece& piece, const Eigen::MatrixX2d&
     d += fmt::format("{}{:.2f},{:.2f} ", i == 0 ? "M" : "L", p.x(), height - p.y());
   }
   return d + "Z";
+}
+
+// The smooth sewing line as cubic Béziers (mm, SVG frame).
+std::string svg_curve(const garment::PatternPiece& piece, double height) {
+  const auto at = [&](const Eigen::Vector2d& p) {
+    const Eigen::Vector2d q = on_fabric(piece, p);
+    return fmt::format("{:.2f},{:.2f}", q.x(), height - q.y());
+  };
+  const Eigen::Index n = piece.sewing.rows();
+  std::string d = "M" + at(piece.sewing.row(0).transpose());
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const garment::BezierSpan& span = piece.curve.spans[static_cast<size_t>(k)];
+    d += " C" + at(span.b1) + " " + at(span.b2) + " " +
+         at(piece.sewing.row((k + 1) % n).transpose());
+  }
+  return d + " Z";
+}
+
+// "Place on fold": the fold line (dash-dot) and the pattern maker's bracket beside it, a line
+// parallel to the fold 12 mm inside the piece with legs ending in arrows on the fold at a fifth
+// and four fifths of its length, labelled "CUT 1 ON FOLD" (SVG, mm).
+std::string svg_fold(const garment::PatternPiece& piece, double height) {
+  const auto sheet = [&](const Eigen::Vector2d& p) {
+    const Eigen::Vector2d q = on_fabric(piece, p);
+    return Eigen::Vector2d(q.x(), height - q.y());
+  };
+  const Eigen::Vector2d a = sheet(piece.fold_start), b = sheet(piece.fold_end);
+  const Eigen::Vector2d along = (b - a).normalized();
+  // Inside: the piece's outline runs counter-clockwise in the piece frame, clockwise on the
+  // sheet (y flipped), so the inside is right of a → b on the sheet.
+  const Eigen::Vector2d in(-along.y(), along.x());
+  const Eigen::Vector2d inside = -in;
+  const Eigen::Vector2d p = a + 0.2 * (b - a), q = a + 0.8 * (b - a);
+  const double depth = 12, head = 3;
+  const Eigen::Vector2d p1 = p + depth * inside, q1 = q + depth * inside;
+  const auto arrow = [&](const Eigen::Vector2d& tip) {
+    const Eigen::Vector2d l = tip + head * inside + 0.5 * head * along;
+    const Eigen::Vector2d r = tip + head * inside - 0.5 * head * along;
+    return fmt::format(" M{:.2f},{:.2f} L{:.2f},{:.2f} L{:.2f},{:.2f}", l.x(), l.y(), tip.x(),
+                       tip.y(), r.x(), r.y());
+  };
+  // The fold runs along the cutting line: white under it, so that its dashes show.
+  std::string out;
+  for (const char* kind : {"fold-gap", "fold"})
+    out += fmt::format(
+        "<line class=\"{}\" x1=\"{:.2f}\" y1=\"{:.2f}\" x2=\"{:.2f}\" y2=\"{:.2f}\"/>\n", kind,
+        a.x(), a.y(), b.x(), b.y());
+  out += fmt::format(
+      "<path class=\"fold-mark\" d=\"M{:.2f},{:.2f} L{:.2f},{:.2f} L{:.2f},{:.2f} "
+      "L{:.2f},{:.2f}{}{}\"/>\n",
+      p.x(), p.y(), p1.x(), p1.y(), q1.x(), q1.y(), q.x(), q.y(), arrow(p), arrow(q));
+  const Eigen::Vector2d mid = 0.5 * (p1 + q1) + 2.0 * inside;
+  double angle = std::atan2(along.y(), along.x()) * 180 / M_PI;
+  if (angle > 90) angle -= 180;
+  if (angle < -90) angle += 180;
+  // The text 2 mm inside the bracket, turned to read along the fold.
+  out += fmt::format(
+      "<text class=\"fold-label\" x=\"0\" y=\"0\" font-size=\"4\" text-anchor=\"middle\" "
+      "dominant-baseline=\"hanging\" transform=\"translate({:.2f} {:.2f}) rotate({:.1f})\">CUT 1 "
+      "ON FOLD</text>\n",
+      mid.x(), mid.y(), angle);
+  return out;
 }
 
 // The fabric as a pattern piece names it: a fabric file by its "name" ("medium linen", not
@@ -160,8 +290,18 @@ PatternSheet build_pattern_sheet(const scene::Sketch& sketch, const garment::Gar
       layout.panel_allowance.push_back(ps && ps->seam_allowance ? *ps->seam_allowance : -1.0);
       layout.edge_allowance.push_back(edge_allowances(sketch, garment, flat));
       layout.panel_ease.push_back(panel.ease);
+      layout.corners.push_back(curve_corners(garment, flat));
+      layout.fold_edge.push_back(
+          fold_edges(garment, sheet.pattern, flat, layout.edge_allowance.back()));
       sheet.fabrics.push_back(fabric_label(sketch, panel.fabric));
     }
+    // A fold piece's mirror copy is its other half: not cut on its own.
+    layout.folded_into.assign(sheet.pattern.panels.size(), -1);
+    for (size_t p = 0; p < sheet.pattern.panels.size(); ++p)
+      if (!layout.fold_edge[p].empty())
+        for (size_t q = 0; q < sheet.pattern.panels.size(); ++q)
+          if (sheet.pattern.panels[q].id == sheet.pattern.panels[p].id + ".mirror")
+            layout.folded_into[q] = static_cast<int>(p);
     const auto layout_start = Clock::now();
     sheet.layout = garment::lay_out_pattern(sheet.pattern, layout);
     sheet.layout_ms = ms_since(layout_start);
@@ -189,17 +329,22 @@ std::string pattern_svg(const PatternSheet& sheet) {
       ".cut{{fill:#ffffff;stroke:#000;stroke-width:0.5}}"
       ".sew{{fill:none;stroke:#c0392b;stroke-width:0.35;stroke-dasharray:3 1.5}}"
       ".grain{{stroke:#1f4e9c;stroke-width:0.5;fill:none}}.notch{{stroke:#000;stroke-width:0.6}}"
-      ".label{{fill:#222}}.note{{fill:#444}}</style>\n"
+      ".label{{fill:#222}}.note{{fill:#444}}"
+      ".fold{{stroke:#000;stroke-width:0.5;stroke-dasharray:8 2 1 2}}"
+      ".fold-gap{{stroke:#fff;stroke-width:0.9}}"
+      ".fold-mark{{stroke:#000;stroke-width:0.4;fill:none}}.fold-label{{fill:#000}}</style>\n"
       "<rect class=\"fabric\" x=\"0\" y=\"0\" width=\"{0:.1f}\" height=\"{3:.1f}\"/>\n",
       width, length + footer, markup_escape(sheet.title), length);
   for (const garment::PatternPiece& piece : layout.pieces) {
+    if (piece.folded_into >= 0) continue;  // the other half of a piece cut on the fold
     const garment::FlatPanel& flat = sheet.pattern.panels[static_cast<size_t>(piece.panel)];
     const std::string name = piece_name(sheet, piece);
     const std::string fabric = sheet.fabrics[static_cast<size_t>(piece.panel)];
-    svg += fmt::format("<g class=\"piece\" id=\"piece-{0}\" data-panel=\"{0}\">\n",
-                       markup_escape(name));
+    svg += fmt::format("<g class=\"piece\" id=\"piece-{0}\" data-panel=\"{0}\"{1}>\n",
+                       markup_escape(name), piece.on_fold ? " data-fold=\"1\"" : "");
     svg += fmt::format("<path class=\"cut\" d=\"{}\"/>\n", svg_path(piece, piece.cutting, length));
-    svg += fmt::format("<path class=\"sew\" d=\"{}\"/>\n", svg_path(piece, piece.sewing, length));
+    svg += fmt::format("<path class=\"sew\" d=\"{}\"/>\n", svg_curve(piece, length));
+    if (piece.on_fold) svg += svg_fold(piece, length);
     const Eigen::Vector2d g0 = on_fabric(piece, piece.grain_start);
     const Eigen::Vector2d g1 = on_fabric(piece, piece.grain_end);
     const double head = std::min(4.0, 0.2 * (g1 - g0).norm());
@@ -265,8 +410,10 @@ std::string pattern_svg(const PatternSheet& sheet) {
       "mm "
       "wide, {:.0f} mm used · efficiency {:.0f} % · seam allowance included · true scale "
       "(mm)</text>\n",
-      y + 4, markup_escape(sheet.title), layout.pieces.size(), width, length,
-      100 * layout.efficiency);
+      y + 4, markup_escape(sheet.title),
+      std::count_if(layout.pieces.begin(), layout.pieces.end(),
+                    [](const auto& piece) { return piece.folded_into < 0; }),
+      width, length, 100 * layout.efficiency);
   svg += "</svg>\n";
   return svg;
 }
@@ -323,8 +470,8 @@ std::string pattern_dxf(const PatternSheet& sheet) {
   pair(2, "TABLES");
   pair(0, "TABLE");
   pair(2, "LAYER");
-  pair(70, "6");
-  for (const char* layer : {"1", "4", "7", "14", "15"}) {
+  pair(70, "7");
+  for (const char* layer : {"1", "4", "6", "7", "14", "15"}) {
     pair(0, "LAYER");
     pair(2, layer);
     pair(70, "0");
@@ -336,6 +483,7 @@ std::string pattern_dxf(const PatternSheet& sheet) {
   pair(0, "SECTION");
   pair(2, "BLOCKS");
   for (const garment::PatternPiece& piece : sheet.layout.pieces) {
+    if (piece.folded_into >= 0) continue;  // the other half of a piece cut on the fold
     const std::string name = piece_name(sheet, piece);
     pair(0, "BLOCK");
     pair(8, "0");
@@ -344,9 +492,10 @@ std::string pattern_dxf(const PatternSheet& sheet) {
     num(10, 0);
     num(20, 0);
     pair(3, name);
-    polyline("1", piece.cutting);  // boundary: the cutting line
-    polyline("14", piece.sewing);  // sewing line
+    polyline("1", piece.cutting);        // boundary: the cutting line
+    polyline("14", piece.curve.points);  // sewing line, the smooth curve densified
     line("7", piece.grain_start, piece.grain_end);
+    if (piece.on_fold) line("6", piece.fold_start, piece.fold_end);  // mirror (fold) line
     for (const garment::PatternNotch& n : piece.notches) {
       const auto [a, b] = notch_segment(n);
       line("4", a, b);
@@ -357,7 +506,8 @@ std::string pattern_dxf(const PatternSheet& sheet) {
     text("1", at, h, "Piece Name: " + name);
     text("15", at - Eigen::Vector2d(0, 0.008), h,
          "Material: " + sheet.fabrics[static_cast<size_t>(piece.panel)]);
-    text("15", at - Eigen::Vector2d(0, 0.016), h, "Quantity: 1");
+    text("15", at - Eigen::Vector2d(0, 0.016), h,
+         piece.on_fold ? "Quantity: 1 (cut on fold)" : "Quantity: 1");
     text("15", at - Eigen::Vector2d(0, 0.024), h,
          fmt::format("Seam allowance: {} mm", allowance_mm(piece)));
     if (const std::string partner = mirror_partner(sheet, name); !partner.empty())
@@ -369,6 +519,7 @@ std::string pattern_dxf(const PatternSheet& sheet) {
   pair(0, "SECTION");
   pair(2, "ENTITIES");
   for (const garment::PatternPiece& piece : sheet.layout.pieces) {
+    if (piece.folded_into >= 0) continue;
     pair(0, "INSERT");
     pair(8, "0");
     pair(2, piece_name(sheet, piece));
@@ -387,6 +538,14 @@ nlohmann::json points_mm(const Eigen::MatrixX2d& p) {
   for (Eigen::Index i = 0; i < p.rows(); ++i)
     out.push_back(
         {std::round(kMm * p(i, 0) * 1000) / 1000, std::round(kMm * p(i, 1) * 1000) / 1000});
+  return out;
+}
+
+// The outline points the smooth sewing line keeps as corners (indices into sewing_line).
+nlohmann::json corner_points(const garment::SmoothOutline& curve) {
+  nlohmann::json out = nlohmann::json::array();
+  for (size_t k = 0; k < curve.corner.size(); ++k)
+    if (curve.corner[k]) out.push_back(k);
   return out;
 }
 
@@ -426,6 +585,39 @@ Eigen::MatrixX2d seam_side(const PatternSheet& sheet, int panel, const std::vect
   return out;
 }
 
+// A seam side on its piece's smooth sewing line (m, piece frame, ease applied): the densified
+// curve from the side's first outline point to its last, in the side's order.
+Eigen::MatrixX2d curve_side(const PatternSheet& sheet, int panel,
+                            const std::vector<int>& vertices) {
+  const garment::FlatPanel& flat = sheet.pattern.panels[static_cast<size_t>(panel)];
+  const garment::SmoothOutline& curve = sheet.layout.pieces[static_cast<size_t>(panel)].curve;
+  const auto n = static_cast<Eigen::Index>(flat.boundary.size());
+  const auto index = [&](int v) {
+    return static_cast<Eigen::Index>(std::find(flat.boundary.begin(), flat.boundary.end(), v) -
+                                     flat.boundary.begin());
+  };
+  const Eigen::Index first = index(vertices.front());
+  const bool forward = vertices.size() < 2 || index(vertices[1]) == (first + 1) % n;
+  const Eigen::Index m = curve.points.rows();
+  std::vector<Eigen::Index> rows;
+  const Eigen::Index spans = static_cast<Eigen::Index>(vertices.size()) - 1;
+  Eigen::Index row = curve.at[static_cast<size_t>(first)];
+  rows.push_back(row);
+  for (Eigen::Index s = 0; s < spans; ++s) {
+    const Eigen::Index from = forward ? (first + s) % n : (first - s + n) % n;
+    const Eigen::Index to = forward ? (from + 1) % n : (from - 1 + n) % n;
+    const Eigen::Index end = curve.at[static_cast<size_t>(to)];
+    while (row != end) {
+      row = forward ? (row + 1) % m : (row - 1 + m) % m;
+      rows.push_back(row);
+    }
+  }
+  Eigen::MatrixX2d out(static_cast<Eigen::Index>(rows.size()), 2);
+  for (size_t k = 0; k < rows.size(); ++k)
+    out.row(static_cast<Eigen::Index>(k)) = curve.points.row(rows[k]);
+  return out;
+}
+
 double polyline_length(const Eigen::MatrixX2d& p) {
   double l = 0;
   for (Eigen::Index i = 1; i < p.rows(); ++i) l += (p.row(i) - p.row(i - 1)).norm();
@@ -453,33 +645,45 @@ nlohmann::json pattern_json(const PatternSheet& sheet) {
     for (const garment::AllowanceRun& run : piece.allowances)
       allowances.push_back(
           {{"first_edge", run.first}, {"last_edge", run.last}, {"mm", kMm * run.allowance}});
-    pieces.push_back({{"id", flat.id},
-                      {"fabric", sheet.fabrics[static_cast<size_t>(piece.panel)]},
-                      {"ease", ease_json(piece.ease)},
-                      {"gathered", !piece.ease.isotropic()},
-                      {"gather_ratio", std::max(piece.ease.warp, piece.ease.weft) /
-                                           std::min(piece.ease.warp, piece.ease.weft)},
-                      {"seam_allowance_mm", kMm * piece.allowance},
-                      {"allowances", allowances},
-                      {"size_mm", point_mm(piece.size)},
-                      {"placement_mm", point_mm(piece.placement)},
-                      {"sewn_area_mm2", kMm * kMm * piece.sewn_area},
-                      {"cut_area_mm2", kMm * kMm * piece.cut_area},
-                      {"surface_area_mm2", kMm * kMm * flat.area_3d},
-                      {"sewing_line", points_mm(piece.sewing)},
-                      {"cutting_line", points_mm(piece.cutting)},
-                      {"grain_line", {point_mm(piece.grain_start), point_mm(piece.grain_end)}},
-                      {"notches", notches},
-                      {"distortion", distortion_json(flat.distortion)},
-                      {"iterations", flat.iterations},
-                      {"warning", flat.warning},
-                      {"mirror_pair", mirror_partner(sheet, flat.id)}});
+    pieces.push_back(
+        {{"id", flat.id},
+         {"fabric", sheet.fabrics[static_cast<size_t>(piece.panel)]},
+         {"ease", ease_json(piece.ease)},
+         {"gathered", !piece.ease.isotropic()},
+         {"gather_ratio",
+          std::max(piece.ease.warp, piece.ease.weft) / std::min(piece.ease.warp, piece.ease.weft)},
+         {"seam_allowance_mm", kMm * piece.allowance},
+         {"allowances", allowances},
+         {"size_mm", point_mm(piece.size)},
+         {"placement_mm", point_mm(piece.placement)},
+         {"sewn_area_mm2", kMm * kMm * piece.sewn_area},
+         {"cut_area_mm2", kMm * kMm * piece.cut_area},
+         {"surface_area_mm2", kMm * kMm * flat.area_3d},
+         {"sewing_line", points_mm(piece.sewing)},
+         {"sewing_curve", points_mm(piece.curve.points)},
+         {"sewing_corners", corner_points(piece.curve)},
+         {"on_fold", piece.on_fold},
+         {"fold_line", piece.on_fold
+                           ? nlohmann::json{point_mm(piece.fold_start), point_mm(piece.fold_end)}
+                           : nlohmann::json()},
+         {"folded_into", piece.folded_into >= 0
+                             ? sheet.pattern.panels[static_cast<size_t>(piece.folded_into)].id
+                             : std::string()},
+         {"cutting_line", points_mm(piece.cutting)},
+         {"grain_line", {point_mm(piece.grain_start), point_mm(piece.grain_end)}},
+         {"notches", notches},
+         {"distortion", distortion_json(flat.distortion)},
+         {"iterations", flat.iterations},
+         {"warning", flat.warning},
+         {"mirror_pair", mirror_partner(sheet, flat.id)}});
   }
   nlohmann::json seams = nlohmann::json::array();
   for (const garment::PatternSeam& seam : sheet.pattern.seams) {
     const Eigen::MatrixX2d a = seam_side(sheet, seam.panel_a, seam.vertices_a);
     const Eigen::MatrixX2d b = seam_side(sheet, seam.panel_b, seam.vertices_b);
     const double la = polyline_length(a), lb = polyline_length(b);
+    const Eigen::MatrixX2d ca = curve_side(sheet, seam.panel_a, seam.vertices_a);
+    const Eigen::MatrixX2d cb = curve_side(sheet, seam.panel_b, seam.vertices_b);
     // What the ease made of each side's flattened length (1: as flattened; e: eased by e; a
     // gathered piece's side between its warp and weft factors, by the side's direction).
     const double ga = la / polyline_length(flat_seam_side(sheet, seam.panel_a, seam.vertices_a));
@@ -496,7 +700,11 @@ nlohmann::json pattern_json(const PatternSheet& sheet) {
                      {"gather", std::max(ga, gb) / std::min(ga, gb)},
                      {"balance_notches", seam.balance},
                      {"polyline_a", points_mm(a)},
-                     {"polyline_b", points_mm(b)}});
+                     {"polyline_b", points_mm(b)},
+                     {"curve_a", points_mm(ca)},
+                     {"curve_b", points_mm(cb)},
+                     {"curve_length_a_mm", kMm * polyline_length(ca)},
+                     {"curve_length_b_mm", kMm * polyline_length(cb)}});
   }
   return {{"format", "sketchdrape/1 pattern"},
           {"sketch", sheet.title},
