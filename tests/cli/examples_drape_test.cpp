@@ -269,8 +269,6 @@ INSTANTIATE_TEST_SUITE_P(Examples, ExampleDrape, ::testing::ValuesIn(kExamples),
 // body and stretched its children by 340 % (AdaptiveCloth::split_stays_off_body now declines it).
 INSTANTIATE_TEST_SUITE_P(AdaptiveExamples, ExampleDrape, ::testing::ValuesIn(adaptive_examples()),
                          test_name);
-// Two levels deep: the t-shirt failed at 0.055 s (a vertex at 50 m/s after landing on the
-// shoulders) until the body sag refined it before landing and its back panel lost its crease.
 // At 2 cm edges the t-shirt's right underarm chatters in place between its self-contact springs
 // and the fail-safe (0.1-1 mm of drift over 0.25 s, up to 5 cm/s at single steps): until the
 // at-rest test bounded the kinetic energy's mean over the window instead of its value at every
@@ -280,6 +278,8 @@ INSTANTIATE_TEST_SUITE_P(FineExamples, ExampleDrape,
                          ::testing::Values(Example{"tshirt", 1.47, 1.53, 0.04, false, 0.0, 1, 0.02,
                                                    true}),
                          test_name);
+// Two levels deep: the t-shirt failed at 0.055 s (a vertex at 50 m/s after landing on the
+// shoulders) until the body sag refined it before landing and its back panel lost its crease.
 INSTANTIATE_TEST_SUITE_P(DeepAdaptiveExamples, ExampleDrape,
                          ::testing::Values(Example{"tshirt", 1.47, 1.53, 0.04, true, 0.0, 2}),
                          test_name);
