@@ -46,6 +46,7 @@ nlohmann::json simulation_json(const sim::SimulationReport& r, const sim::Simula
           {"rest",
            {{"speed_window_m_s", r.rest_speed_window},
             {"kinetic_per_kg_window_J_kg", r.rest_kinetic_per_kg_window},
+            {"kinetic_per_kg_window_mean_J_kg", r.rest_kinetic_per_kg_window_mean},
             {"speed_final_m_s", r.rest_speed_final},
             {"kinetic_per_kg_final_J_kg", r.rest_kinetic_per_kg_final},
             {"speed_limit_m_s", s.rest_speed},
