@@ -506,6 +506,15 @@ TEST(PatternCommand, OptionOutOfRangeNamesItsUnit) {
   EXPECT_NE(allowance.output.find("a seam allowance of 1 m is outside 0 .. 0.1 m"),
             std::string::npos)
       << allowance.output;
+  // A pattern maker's 10 means 10 mm (trial 35 was told "10 cm is 0.1 m", a deep hem that is
+  // within the range): millimetres first.
+  const CommandResult millimetres = run_sketchdrape("pattern " + example("tshirt").string() +
+                                                    " -o " + out.string() + " --seam-allowance 10");
+  EXPECT_EQ(millimetres.exit_code, 2) << millimetres.output;
+  EXPECT_NE(millimetres.output.find("if you typed millimetres, 10 mm is 0.01 m (if centimetres, "
+                                    "10 cm is 0.1 m)"),
+            std::string::npos)
+      << millimetres.output;
   const CommandResult text = run_sketchdrape("pattern " + example("tshirt").string() + " -o " +
                                              out.string() + " --fabric-width 1.5m");
   EXPECT_EQ(text.exit_code, 2) << text.output;
