@@ -328,7 +328,8 @@ sim::FabricParameters scene_fabric(const scene::Sketch& sketch, const std::strin
   } catch (const sim::UnknownFabricError& e) {
     // A folder (trial 35: "fabrics", "fabrics/") was called an unknown preset.
     std::error_code ec;
-    if (std::filesystem::is_directory(sketch.resolve(name), ec)) {
+    // (A folder named like a file, "x.json", is said to be one by load_fabric_file below.)
+    if (!name.ends_with(".json") && std::filesystem::is_directory(sketch.resolve(name), ec)) {
       std::string folder = name, presets;
       while (folder.size() > 1 && folder.ends_with("/")) folder.pop_back();
       for (const std::string& preset : sim::fabric_preset_names())
