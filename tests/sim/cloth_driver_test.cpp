@@ -4,8 +4,6 @@
 #include "sim/cloth_driver.hpp"
 
 #include <gtest/gtest.h>
-#include <spdlog/sinks/ringbuffer_sink.h>
-#include <spdlog/spdlog.h>
 
 #include <Eigen/SVD>
 #include <algorithm>
@@ -256,8 +254,9 @@ TEST(ClothDriver, RestRampMovesTheRestShapeFromTheDrawnOneToThePattern) {
 // A split on the rest ramp (trial 35: 37 lines of "carried masses differ from the lumped ones
 // by 2.99e-05 kg" on a flat drape with "rest_ramp": 1). The kept triangles hold the ramp's blend
 // (here the drawn sheet, t = 0), the new ones the pattern's (x stretched by 1.1): the vertex areas
-// and the masses stay the pattern's, ρ·A/3 of the pattern triangles, and the total is kept; no
-// warning. Before, the vertex areas round the split mixed drawn and pattern areas (10 % apart).
+// and the masses stay the pattern's, ρ·A/3 of the pattern triangles, and the total is kept.
+// Before, the vertex areas (and the reference the carried masses were checked against) mixed
+// drawn and pattern areas, 10 % apart: 0.00625 m² off at a vertex here.
 TEST(ClothDriver, SplitOnTheRestRampKeepsThePatternsMassesAndAreas) {
   AdaptiveSheetSpec spec = short_sheet();
   AdaptiveSheet sheet = build_adaptive_sheet(spec);
@@ -268,13 +267,8 @@ TEST(ClothDriver, SplitOnTheRestRampKeepsThePatternsMassesAndAreas) {
   ClothDriver driver(sheet.mesh, sheet.material, {}, sheet.pins, adaptive_sheet_settings(spec),
                      off());
   const double total = driver.adaptive()->masses().sum();
-  auto warnings = std::make_shared<spdlog::sinks::ringbuffer_sink_mt>(16);
-  warnings->set_level(spdlog::level::warn);
-  spdlog::default_logger()->sinks().push_back(warnings);
   const AdaptStats stats = driver.adaptive()->split_blocks({meshing::BlockId(0)});
-  spdlog::default_logger()->sinks().pop_back();
   ASSERT_GT(stats.splits, 0);
-  EXPECT_TRUE(warnings->last_formatted().empty());
   // The pattern's lumped areas of the refined mesh: its drawn triangles' areas times 1.1.
   const Eigen::MatrixX3d& rest = driver.adaptive()->rest_positions();
   const Eigen::MatrixX3i& faces = driver.faces();
