@@ -49,10 +49,11 @@ TEST(Cli, UnknownCommandAndOptionSayWhatToWriteInstead) {
                                  "file, \"simulate\": {\"duration\": SECONDS}"),
             std::string::npos)
       << duration.output;
-  // --help lists them in the same order.
+  // --help lists them in the same order (each at the start of its line).
   const CommandResult help = run_sketchdrape("--help");
-  EXPECT_LT(help.output.find("validate"), help.output.find("stress")) << help.output;
-  EXPECT_LT(help.output.find("mesh"), help.output.find("fill")) << help.output;
+  ASSERT_NE(help.output.find("\n  stress "), std::string::npos) << help.output;
+  EXPECT_LT(help.output.find("\n  validate "), help.output.find("\n  stress ")) << help.output;
+  EXPECT_LT(help.output.find("\n  mesh "), help.output.find("\n  fill ")) << help.output;
 }
 
 TEST(Cli, InfoBuiltinReportsYUpAndHeight) {

@@ -8,7 +8,6 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
-#include <memory>
 #include <set>
 #include <vector>
 
