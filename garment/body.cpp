@@ -14,12 +14,15 @@
 #include <fstream>
 #include <mutex>
 #include <numeric>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "garment/body_up_error.hpp"
 #include "garment/input_checks.hpp"
+#include "garment/sketch_error.hpp"
 #include "garment/sketch_ranges.hpp"
 
 namespace sd::garment {
@@ -135,6 +138,63 @@ CleanupCounts weld_and_clean(meshing::TriMesh& mesh, double tolerance, double mi
   return counts;
 }
 
+// An OBJ file's first defect that assimp refuses without a line (trial 35: "OBJ: vertex index out
+// of range", "Validation failed: Mesh  contains no faces"): a vertex without three finite numbers,
+// a face with fewer than three corners or a corner past the vertices, or no face at all (a file
+// cut short). The sentence names the line; nullopt when the scan finds nothing.
+std::optional<std::string> obj_defect(const std::string& file) {
+  // Two passes: the vertices counted first (a face may name a vertex given after it), then each
+  // line in order, so that the first defect in the file is the one named.
+  int vertices = 0;
+  {
+    std::ifstream in(file);
+    std::string line;
+    while (std::getline(in, line))
+      if (line.rfind("v ", 0) == 0 || line.rfind("v\t", 0) == 0) ++vertices;
+  }
+  std::ifstream in(file);
+  std::string line;
+  int number = 0, faces = 0, seen = 0, last_vertex_line = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    std::istringstream words(line);
+    std::string tag;
+    words >> tag;
+    if (tag == "v") {
+      double x = 0, y = 0, z = 0;
+      if (!(words >> x >> y >> z) || !std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z))
+        return fmt::format("line {} ('{}') is not a vertex of three finite numbers x y z{}", number,
+                           excerpt(line),
+                           in.peek() == EOF ? ": the file looks cut short; export it again" : "");
+      ++seen;
+      last_vertex_line = number;
+    } else if (tag == "f") {
+      ++faces;
+      std::vector<long> corners;
+      std::string corner;
+      while (words >> corner) corners.push_back(std::atol(corner.c_str()));
+      if (corners.size() < 3)
+        return fmt::format("line {} ('{}') is a face with fewer than three corners", number,
+                           excerpt(line));
+      for (long c : corners) {
+        if (c < 0) c += seen + 1;  // relative: -1 is the last vertex so far
+        if (c < 1 || c > vertices)
+          return fmt::format(
+              "line {} ('{}') is a face on vertex {}, but the file has {} vertices (numbered "
+              "from 1)",
+              number, excerpt(line), c, vertices);
+      }
+    }
+  }
+  if (faces == 0 && vertices > 0)
+    return fmt::format(
+        "it has {} vertices but no face (the last vertex is line {}): the file looks cut short; "
+        "export the body again",
+        vertices, last_vertex_line);
+  return std::nullopt;
+}
+
 // The triangles of `file` as assimp reads them, merged, welded and cleaned; file units and axes.
 // Repairs are added to body.warnings, the mesh count to body.raw.meshes.
 meshing::TriMesh read_body_mesh(const std::string& file, Body& body) {
@@ -163,7 +223,20 @@ meshing::TriMesh read_body_mesh(const std::string& file, Body& body) {
       throw BodyError("body file '" + file +
                       "' holds no mesh: no vertices and faces could be read from it (is it "
                       "really a mesh file of the format its name ends in?)");
-    throw BodyError("cannot read body file '" + file + "': " + reason);
+    std::string ext = std::filesystem::path(file).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    if (ext == ".obj")
+      if (const std::optional<std::string> defect = obj_defect(file))
+        throw BodyError("body file '" + file + "' cannot be read: " + *defect);
+    // assimp's own words otherwise, without its doubled spaces ("Mesh  contains": an empty name).
+    std::string words;
+    for (const char c : reason)
+      if (!(c == ' ' && !words.empty() && words.back() == ' ')) words += c;
+    throw BodyError("body file '" + file +
+                    "' cannot be read (is it a complete mesh file, exported again if in doubt?); "
+                    "the reader, assimp, says: " +
+                    words);
   }
   if (scene->mRootNode == nullptr || scene->mNumMeshes == 0)
     throw BodyError("body file '" + file + "' holds no mesh");

@@ -368,8 +368,10 @@ std::string where_on_piece(const Eigen::MatrixX2d& uv, const Eigen::Vector2d& p)
 }
 
 // Refuses a piece beyond refuse_stretch, warns above warn_stretch (sets out.warning), naming
-// where the stretch concentrates.
-void judge_stretch(FlatPanel& out, const FlatteningOptions& options) {
+// where the stretch concentrates. The dart advice depends on the panel's place: one lying on the
+// body (`on_body`, fit "body": a bodice) takes a waist or shoulder dart; a free-hanging one (a
+// skirt, trial 35 was told of a bodice dart) a seam through the place or a dart from its top edge.
+void judge_stretch(FlatPanel& out, const FlatteningOptions& options, bool on_body) {
   const std::string& name = out.id;
   const Eigen::MatrixX2d& uv = out.uv;
   const FlatDistortion& d = out.distortion;
@@ -396,10 +398,14 @@ void judge_stretch(FlatPanel& out, const FlatteningOptions& options) {
             "flat, the piece keeps its seams and hem at their drawn lengths and gathers the "
             "difference into a point or a kink of its outline; a seam there or a godet (a wedge "
             "of cloth let in at the hem) would let the cloth lie as drawn"
-          : "as where cloth is drawn into the hollow of the back or the waist: cut flat, the "
-            "piece keeps its seams at their drawn lengths and gathers the difference into a "
-            "point or a kink of its outline; a dart or a seam through that place (on a bodice, "
-            "a waist or shoulder dart) would let the cloth lie as drawn";
+      : on_body ? "as where cloth is drawn into the hollow of the back or the waist: cut flat, the "
+                  "piece keeps its seams at their drawn lengths and gathers the difference into a "
+                  "point or a kink of its outline; a dart or a seam through that place (on a "
+                  "bodice, a waist or shoulder dart) would let the cloth lie as drawn"
+                : "as where a hanging panel is drawn in towards the body: cut flat, the piece "
+                  "keeps its seams at their drawn lengths and gathers the difference into a point "
+                  "or a kink of its outline; a seam through that place, or a dart from the panel's "
+                  "top edge towards it (a skirt's waist dart), would let the cloth lie as drawn";
   const std::string advice =
       -d.saddle > d.dome
           ? fmt::format(
@@ -421,7 +427,7 @@ void judge_stretch(FlatPanel& out, const FlatteningOptions& options) {
 
 FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
                             const Eigen::MatrixX3i& t, const Eigen::MatrixX3d& triangle_warp,
-                            const FlatteningOptions& options) {
+                            const FlatteningOptions& options, bool on_body = true) {
   FlatPanel out;
   out.id = name;
   out.triangles = t;
@@ -468,7 +474,7 @@ FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
   out.distortion = measure(uv, t, rest);
   out.distortion.dome = curvature.dome;
   out.distortion.saddle = curvature.saddle;
-  judge_stretch(out, options);
+  judge_stretch(out, options, on_body);
   return out;
 }
 
@@ -536,7 +542,7 @@ void add_balance_notches(FlatPanel& flat, const std::vector<int>& run,
 std::optional<FlatPanel> reflected_piece(const FlatPanel& original, const Eigen::MatrixX3d& all,
                                          const std::string& name, const Eigen::MatrixX3d& v,
                                          const Eigen::MatrixX3i& t,
-                                         const FlatteningOptions& options) {
+                                         const FlatteningOptions& options, bool on_body) {
   if (original.vertices.size() != static_cast<size_t>(v.rows()) ||
       original.triangles.rows() != t.rows())
     return std::nullopt;
@@ -588,7 +594,7 @@ std::optional<FlatPanel> reflected_piece(const FlatPanel& original, const Eigen:
   out.distortion = original.distortion;
   out.distortion.worst_point.x() = -original.distortion.worst_point.x();
   out.distortion.worst_point_2d.x() = width - original.distortion.worst_point_2d.x();
-  judge_stretch(out, options);
+  judge_stretch(out, options, on_body);
   return out;
 }
 
@@ -658,21 +664,37 @@ FlatPattern flatten_garment(const Garment& garment, const FlatteningOptions& opt
       quad_of(f) = tri_quad[static_cast<size_t>(f)];
       warp.row(f) = frames.warp.row(quad_of(f));
     }
+    const bool on_body = garment.panels[p].fit == "body";
     std::optional<FlatPanel> reflected;
     if (garment.panels[p].mirror_copy) {
       const std::string base = name.substr(0, name.rfind('.'));
       for (size_t o = 0; o < pattern.panels.size() && !reflected; ++o)
         if (pattern.panels[o].id == base) {
-          reflected = reflected_piece(pattern.panels[o], mesh.vertices, name, v, t, options);
+          reflected =
+              reflected_piece(pattern.panels[o], mesh.vertices, name, v, t, options, on_body);
           if (reflected) reflected->reflection_of = static_cast<int>(o);
         }
     }
     FlatPanel flat =
-        reflected ? std::move(*reflected) : flatten_with_warp(name, v, t, warp, options);
+        reflected ? std::move(*reflected) : flatten_with_warp(name, v, t, warp, options, on_body);
     flat.panel = static_cast<int>(p);
     flat.vertices = std::move(global);
     flat.triangle_quad = std::move(quad_of);
-    if (!flat.warning.empty()) pattern.warnings.push_back(flat.warning);
+    // A mirror copy cut as its panel's piece turned over has the panel's warning, mirrored: one
+    // warning names both (trial 35: every warning printed twice, 600 characters each).
+    bool told_with_original = false;
+    if (!flat.warning.empty() && flat.reflection_of >= 0) {
+      const FlatPanel& original = pattern.panels[static_cast<size_t>(flat.reflection_of)];
+      const auto told =
+          std::find(pattern.warnings.begin(), pattern.warnings.end(), original.warning);
+      const std::string prefix = "panel '" + original.id + "':";
+      if (told != pattern.warnings.end() && told->starts_with(prefix)) {
+        *told = fmt::format("panel '{}' and its mirror copy '{}' (the same piece turned over):{}",
+                            original.id, name, told->substr(prefix.size()));
+        told_with_original = true;
+      }
+    }
+    if (!flat.warning.empty() && !told_with_original) pattern.warnings.push_back(flat.warning);
     pattern.panels.push_back(std::move(flat));
   }
 

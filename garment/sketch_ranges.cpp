@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string_view>
+#include <vector>
 
 #include "garment/stroke_projection.hpp"
 
@@ -35,7 +37,9 @@ std::string outside_sentence(const Eigen::Vector3d& p, const Reach& reach,
       "{} is too far from the body ({:.2f} m tall): points must lie within {:.2f} m of it, and {}",
       what, reach.height, kBodyMarginHeights * reach.height,
       out_of_range_sentence(p[axis], reach.low[axis], reach.high[axis],
-                            fmt::format("{} =", kAxis[axis])));
+                            fmt::format("{} =", kAxis[axis]),
+                            {reach.low[axis] + kBodyMarginHeights * reach.height,
+                             reach.high[axis] - kBodyMarginHeights * reach.height}));
 }
 
 // Length of a control polygon, metres (the spline through the points is about as long).
@@ -49,28 +53,43 @@ double polygon_length(const std::vector<Eigen::Matrix<double, D, 1>>& points, bo
 
 }  // namespace
 
-std::string out_of_range_sentence(double value, double low, double high, const std::string& what) {
+std::string out_of_range_sentence(double value, double low, double high, const std::string& what,
+                                  UsualRange usual) {
   std::string sentence =
       fmt::format("{} {:.6g} m is outside {:.6g} .. {:.6g} m", what, value, low, high);
   // A hint only where the reading is a size a garment or body has (within ±2 body heights).
   const auto plausible = [&](double v) {
     return v >= low && v <= high && std::abs(v) <= 2 * kMaxBodyHeight;
   };
-  const bool as_cm = plausible(value / 100);
-  const bool as_mm = plausible(value / 1000);
-  if (as_cm)
+  const auto is_usual = [&](double v) { return v >= usual.low && v <= usual.high; };
+  struct Reading {
+    const char* unit;
+    const char* symbol;
+    double metres;
+  };
+  std::vector<Reading> readings;
+  for (const Reading& r :
+       {Reading{"centimetres", "cm", value / 100}, Reading{"millimetres", "mm", value / 1000}})
+    if (plausible(r.metres)) readings.push_back(r);
+  // Centimetres alone when that is a usual value (130 for a hem at 1.3 m); else the usual
+  // reading first, the other after it (a seam allowance of 10: 10 mm, or 10 cm, a deep hem).
+  if (!readings.empty() && readings[0].symbol == std::string_view("cm") &&
+      is_usual(readings[0].metres))
+    readings.resize(1);
+  std::stable_sort(readings.begin(), readings.end(), [&](const Reading& a, const Reading& b) {
+    return is_usual(a.metres) && !is_usual(b.metres);
+  });
+  if (!readings.empty()) {
     sentence += fmt::format(
-        "; lengths and coordinates are in metres: if you typed centimetres, "
-        "{:.6g} cm is {:.6g} m",
-        value, value / 100);
-  else if (as_mm)
-    sentence += fmt::format(
-        "; lengths and coordinates are in metres: if you typed millimetres, "
-        "{:.6g} mm is {:.6g} m",
-        value, value / 1000);
+        "; lengths and coordinates are in metres: if you typed {}, {:.6g} {} is {:.6g} m",
+        readings[0].unit, value, readings[0].symbol, readings[0].metres);
+    if (readings.size() > 1)
+      sentence += fmt::format(" (if {}, {:.6g} {} is {:.6g} m)", readings[1].unit, value,
+                              readings[1].symbol, readings[1].metres);
+  }
   // A tenth in range reads as a decimal point one place off (4.2 for 0.42) as much as a unit:
   // offer both rather than assert centimetres.
-  if ((as_cm || as_mm) && plausible(value / 10))
+  if (!readings.empty() && plausible(value / 10))
     sentence += fmt::format("; or, if the decimal point slipped, {:.6g} m", value / 10);
   return sentence;
 }

@@ -68,10 +68,31 @@ inline constexpr double kMaxFillQuads = 400000;
 inline constexpr double kMeshingSecondsPerQuad = 1e-3;
 inline constexpr double kMeshingBytesPerQuad = 3000;
 
+// The values a quantity usually takes (metres), inside its allowed range: which reading of a
+// number typed in another unit is the likely one. The whole line by default (no preference).
+struct UsualRange {
+  double low = -1e300;
+  double high = 1e300;
+};
+// Usual values of the sketch's lengths: a point on or round a standing body (its height is at
+// most 2.5 m but for a giant), an edge of a garment's mesh (the examples use 1.5-4 cm), a seam
+// allowance (3 mm on a fine seam to a 5 cm hem; 1 cm and 15 mm are the standard), a bolt's
+// width (0.9-3.2 m), a body's height, a sheet's side (a 10 cm swatch to a 3 m sheet), a junction
+// tolerance (2 mm to 5 cm).
+inline constexpr UsualRange kUsualCoordinate{-2.5, 2.5};
+inline constexpr UsualRange kUsualEdgeLength{0.005, 0.05};
+inline constexpr UsualRange kUsualSeamAllowance{0.003, 0.05};
+inline constexpr UsualRange kUsualFabricWidth{0.9, 3.2};
+inline constexpr UsualRange kUsualBodyHeight{0.5, 2.5};
+inline constexpr UsualRange kUsualSheetSide{0.1, 3.0};
+inline constexpr UsualRange kUsualJunctionTolerance{0.002, 0.05};
+
 // "130 m is outside ...": the sentence for a coordinate or length `value` (metres) that is out of
 // range, with a hint when it reads as centimetres or millimetres typed for metres (its hundredth
-// or thousandth would be within [low, high]).
-std::string out_of_range_sentence(double value, double low, double high, const std::string& what);
+// or thousandth would be within [low, high]); a reading within `usual` is named first (a seam
+// allowance of 10 is 10 mm, not 10 cm; a hem at 520 is 520 mm, not 5.2 m), both when both fit.
+std::string out_of_range_sentence(double value, double low, double high, const std::string& what,
+                                  UsualRange usual = {});
 
 // Every point, seed and camera of the sketch against the body's bounding box (metres, after
 // normalisation): within kBodyMarginHeights body heights of it; every curve's control polygon

@@ -85,7 +85,7 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
   if (sketch.junction_tolerance > kMaxJunctionTolerance)
     r.fail("/junction_tolerance",
            out_of_range_sentence(sketch.junction_tolerance, 0, kMaxJunctionTolerance,
-                                 "a junction tolerance of"));
+                                 "a junction tolerance of", kUsualJunctionTolerance));
   if (root.contains("corner_angle")) {
     sketch.corner_angle_degrees = r.positive(root["corner_angle"], "/corner_angle");
     if (sketch.corner_angle_degrees >= 180)

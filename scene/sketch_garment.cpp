@@ -67,7 +67,7 @@ void parse_body(const Reader& r, const json& j, BodySpec& body) {
     body.height = r.positive(j["height"], path + "/height");
     if (*body.height < kMinBodyHeight || *body.height > kMaxBodyHeight)
       r.fail(path + "/height", out_of_range_sentence(*body.height, kMinBodyHeight, kMaxBodyHeight,
-                                                     "a body height of"));
+                                                     "a body height of", kUsualBodyHeight));
   }
   if (j.contains("scale")) body.scale = r.positive(j["scale"], path + "/scale");
   if (j.contains("up")) {
@@ -198,6 +198,17 @@ CurveSpec parse_curve(const Reader& r, const json& j, const std::string& path, c
            fmt::format("an offset of {} m is more than half a metre from the "
                        "body; offsets are in metres (1 cm = 0.01)",
                        curve.offset));
+  // Below zero the curve would be drawn inside the body (trial 35: -0.03 was accepted and ended
+  // in a message about curves 4 cm apart): cloth must start outside the body.
+  if (curve.offset < 0)
+    r.fail(j.contains("offset") ? path + "/offset" : "/offset",
+           fmt::format("an offset of {} m would draw {} {:.3g} cm inside the body, and cloth "
+                       "cannot hang inside it; the offset is the distance out from the skin: 0 "
+                       "draws on the skin, 0.01 (the default) a centimetre off it",
+                       curve.offset,
+                       j.contains("offset") ? fmt::format("curve '{}'", curve.id)
+                                            : std::string("every curve on the body"),
+                       -100 * curve.offset));
   if (j.contains("on_body")) curve.on_body = r.boolean(j["on_body"], path + "/on_body");
   if (j.contains("smooth")) curve.smooth = r.boolean(j["smooth"], path + "/smooth");
   if (j.contains("closed")) curve.closed = r.boolean(j["closed"], path + "/closed");
@@ -216,7 +227,7 @@ CurveSpec parse_curve(const Reader& r, const json& j, const std::string& path, c
     if (*curve.seam_allowance < 0 || *curve.seam_allowance > kMaxSeamAllowance)
       r.fail(path + "/seam_allowance",
              out_of_range_sentence(*curve.seam_allowance, 0, kMaxSeamAllowance,
-                                   "a seam allowance of"));
+                                   "a seam allowance of", kUsualSeamAllowance));
   }
   // Repeated consecutive points make a stroke without direction there.
   const size_t n = has_2d ? curve.points.size() : curve.points3d.size();
@@ -438,7 +449,7 @@ PanelSpec parse_panel(const Reader& r, const json& j, const std::string& path, c
     if (*panel.seam_allowance < 0 || *panel.seam_allowance > kMaxSeamAllowance)
       r.fail(path + "/seam_allowance",
              out_of_range_sentence(*panel.seam_allowance, 0, kMaxSeamAllowance,
-                                   "a seam allowance of"));
+                                   "a seam allowance of", kUsualSeamAllowance));
   }
   if (j.contains("fit")) {
     const std::string fit = r.text(j["fit"], path + "/fit");

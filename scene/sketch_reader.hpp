@@ -162,14 +162,17 @@ class Reader {
     for (int k = 0; k < N; ++k)
       if (std::abs(v[k]) > kMaxCoordinate)
         fail(fmt::format("{}/{}", path, k),
-             out_of_range_sentence(v[k], -kMaxCoordinate, kMaxCoordinate, "the coordinate"));
+             out_of_range_sentence(v[k], -kMaxCoordinate, kMaxCoordinate, "the coordinate",
+                                   garment::kUsualCoordinate));
     return v;
   }
 
   // An edge length in metres: 2 mm .. 50 cm.
   double edge_length(const json& value, const std::string& path) const {
     const double x = positive(value, path);
-    if (x < 0.002 || x > 0.5) fail(path, out_of_range_sentence(x, 0.002, 0.5, "an edge length of"));
+    if (x < 0.002 || x > 0.5)
+      fail(path,
+           out_of_range_sentence(x, 0.002, 0.5, "an edge length of", garment::kUsualEdgeLength));
     return x;
   }
 
@@ -272,10 +275,17 @@ class DuplicateKeyCheck {
   bool operator()(int depth, json::parse_event_t event, json& parsed) {
     // A sketch file nests a few levels (a point in a list in a curve in the list of curves);
     // thousands of levels are a damaged or hostile file, and cost time and memory to build.
-    if (depth > kMaxNesting)
-      sketch_.fail(path(), fmt::format("lists and objects are nested more than {} levels deep "
-                                       "here; a sketch file needs fewer than 10",
-                                       kMaxNesting));
+    // The path is that of the element that goes too deep (its container entered first, so that
+    // it reads /0 where nothing was counted yet, not /-1), shortened to its first levels: 64
+    // levels of "/0" said nothing more (trial 35).
+    if (depth > kMaxNesting) {
+      if (event == json::parse_event_t::object_start || event == json::parse_event_t::array_start)
+        enter_element();
+      sketch_.fail(path(kShownLevels) + "/…",
+                   fmt::format("lists and objects are nested more than {} levels deep here (the "
+                               "path shows the first {}); a sketch file needs fewer than 10",
+                               kMaxNesting, kShownLevels));
+    }
     switch (event) {
       case json::parse_event_t::object_start:
       case json::parse_event_t::array_start:
@@ -316,10 +326,13 @@ class DuplicateKeyCheck {
     if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
   }
 
-  // "/a/0/b": keys with JSON Pointer escapes (~0 for ~, ~1 for /).
-  std::string path() const {
+  static constexpr std::size_t kShownLevels = 6;
+
+  // "/a/0/b": keys with JSON Pointer escapes (~0 for ~, ~1 for /); the first `levels` only.
+  std::string path(std::size_t levels = std::string::npos) const {
     std::string out;
     for (const Frame& f : frames_) {
+      if (levels-- == 0) break;
       if (f.array) {
         out += "/" + std::to_string(f.index);
         continue;

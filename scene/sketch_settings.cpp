@@ -82,15 +82,16 @@ void parse_pattern(const Reader& r, const json& j, OutputSpec& out) {
     // Bolts are 0.9-3 m wide; 150 is centimetres typed for metres. The range is that of
     // `pattern --fabric-width`.
     if (spec.fabric_width < kMinFabricWidth || spec.fabric_width > kMaxFabricWidth)
-      r.fail(path + "/fabric_width", out_of_range_sentence(spec.fabric_width, kMinFabricWidth,
-                                                           kMaxFabricWidth, "a fabric width of"));
+      r.fail(path + "/fabric_width",
+             out_of_range_sentence(spec.fabric_width, kMinFabricWidth, kMaxFabricWidth,
+                                   "a fabric width of", kUsualFabricWidth));
   }
   if (j.contains("seam_allowance")) {
     spec.seam_allowance = r.number(j["seam_allowance"], path + "/seam_allowance");
     if (spec.seam_allowance < 0 || spec.seam_allowance > kMaxSeamAllowance)
-      r.fail(
-          path + "/seam_allowance",
-          out_of_range_sentence(spec.seam_allowance, 0, kMaxSeamAllowance, "a seam allowance of"));
+      r.fail(path + "/seam_allowance",
+             out_of_range_sentence(spec.seam_allowance, 0, kMaxSeamAllowance, "a seam allowance of",
+                                   kUsualSeamAllowance));
   }
   if (j.contains("max_stretch"))
     spec.max_stretch = r.positive(j["max_stretch"], path + "/max_stretch");
@@ -214,7 +215,8 @@ SheetSpec parse_sheet(const Reader& r, const json& j) {
     for (int k = 0; k < 2; ++k)
       if (sheet.size[k] > kMaxSheetSide)
         r.fail(fmt::format("{}/size/{}", path, k),
-               out_of_range_sentence(sheet.size[k], 0, kMaxSheetSide, "a sheet side of"));
+               out_of_range_sentence(sheet.size[k], 0, kMaxSheetSide, "a sheet side of",
+                                     kUsualSheetSide));
   }
   if (j.contains("resolution")) {
     const json& res = j["resolution"];

@@ -40,6 +40,23 @@ Eigen::Vector3d row3(const Eigen::VectorXd& flat, int i) {
   return flat.segment<3>(3 * i);
 }
 
+// The vertex areas and lumped masses ρ·A/3 of `input`'s pattern triangles (rest_uv, #F×6),
+// each area scaled by its face's ease a·b (`ease`: #F×1 or #F×2, or empty), into `model`.
+void lump_pattern_areas(const ClothInput& input, const Eigen::MatrixXd& ease, ClothModel& model) {
+  model.vertex_area.setZero(input.rest_positions.rows());
+  model.mass.setZero(input.rest_positions.rows());
+  for (Eigen::Index f = 0; f < input.triangles.rows(); ++f) {
+    const auto uv = input.rest_uv.row(f);
+    double area =
+        0.5 * std::abs((uv(2) - uv(0)) * (uv(5) - uv(1)) - (uv(4) - uv(0)) * (uv(3) - uv(1)));
+    if (ease.size() > 0) area *= ease(f, 0) * (ease.cols() > 1 ? ease(f, 1) : ease(f, 0));
+    for (int k = 0; k < 3; ++k) {
+      model.vertex_area(input.triangles(f, k)) += area / 3.0;
+      model.mass(input.triangles(f, k)) += model.fabric.area_density * area / 3.0;
+    }
+  }
+}
+
 }  // namespace
 
 void AdaptiveSettings::validate() const {
@@ -324,6 +341,12 @@ double AdaptiveCloth::rebuild(AdaptiveTransfer& state, const SimulationSettings*
   } else {
     model =
         update_cloth_model(simulation_->model(), reuse, input, ease_scale, material_.model_options);
+    // On the rest ramp the kept triangles hold the blend of rest shapes of the last step (below),
+    // the new ones the pattern's, and the vertex areas and lumped masses summed from them mixed
+    // the two: the carried masses, the pattern's, then read as up to 3e-5 kg (a fifth of a
+    // vertex) "different" on every topology change of a flat drape with "rest_ramp". Both are
+    // the pattern's throughout, as on the first build.
+    if (!ramp_finished_) lump_pattern_areas(input, ease_scale, model);
   }
   if (first) {
     state.m = model.mass;

@@ -23,6 +23,39 @@ TEST(Cli, UnknownSubcommandIsUsageError) {
   EXPECT_EQ(run_sketchdrape("").exit_code, 2);
 }
 
+// Trial 35: `sketchdrape drape FILE` said "A subcommand is required" (one was there, unknown) and
+// `run FILE --duration 5` "The following arguments were not expected: 5 --duration". The unknown
+// word is named with the likely command, the commands are listed in the order of a design's work,
+// and an option that is a sketch file's setting says where it goes.
+TEST(Cli, UnknownCommandAndOptionSayWhatToWriteInstead) {
+  const CommandResult drape = run_sketchdrape("drape sketch.json");
+  EXPECT_EQ(drape.exit_code, 2) << drape.output;
+  EXPECT_NE(drape.output.find("unknown command 'drape' (did you mean 'run'?); the commands are "
+                              "info, validate, mesh, pattern, run, batch,"),
+            std::string::npos)
+      << drape.output;
+  const CommandResult typo = run_sketchdrape("valdiate sketch.json");
+  EXPECT_NE(typo.output.find("(did you mean 'validate'?)"), std::string::npos) << typo.output;
+  const CommandResult none = run_sketchdrape("-q");
+  EXPECT_EQ(none.exit_code, 2) << none.output;
+  EXPECT_NE(none.output.find("a command is required: sketchdrape COMMAND ..., one of info, "
+                             "validate, mesh"),
+            std::string::npos)
+      << none.output;
+  const std::string sketch = std::string(SD_SOURCE_DIR) + "/data/examples/tshirt.json";
+  const CommandResult duration = run_sketchdrape("run " + sketch + " --duration 5");
+  EXPECT_EQ(duration.exit_code, 2) << duration.output;
+  EXPECT_NE(duration.output.find("'run' has no option --duration: that is a setting of the sketch "
+                                 "file, \"simulate\": {\"duration\": SECONDS}"),
+            std::string::npos)
+      << duration.output;
+  // --help lists them in the same order (each at the start of its line).
+  const CommandResult help = run_sketchdrape("--help");
+  ASSERT_NE(help.output.find("\n  stress "), std::string::npos) << help.output;
+  EXPECT_LT(help.output.find("\n  validate "), help.output.find("\n  stress ")) << help.output;
+  EXPECT_LT(help.output.find("\n  mesh "), help.output.find("\n  fill ")) << help.output;
+}
+
 TEST(Cli, InfoBuiltinReportsYUpAndHeight) {
   const CommandResult r = run_sketchdrape("info builtin --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;

@@ -90,6 +90,31 @@ TEST(MeshCommand, ValidateWritesNothing) {
   fs::remove_all(dir);
 }
 
+// `mesh` builds the scene `validate` and `run` build, with their checks (trial 35: "pin_above":
+// 2.5 was meshed, exit 0, and refused by validate, exit 2; docs/cli.md promises they refuse the
+// same files).
+TEST(MeshCommand, RefusesWhatValidateRefuses) {
+  const fs::path dir = fresh_dir("pin-above-high");
+  fs::create_directories(dir);
+  std::ifstream in(std::string(SD_SOURCE_DIR) + "/data/examples/tshirt.json");
+  nlohmann::json sketch = nlohmann::json::parse(in, nullptr, true, /*ignore_comments=*/true);
+  sketch["simulate"]["pin_above"] = 2.5;
+  sketch["output"] = {{"images", nlohmann::json::array()}};
+  std::ofstream(dir / "high.json") << sketch.dump(2);
+  for (const std::string command : {"validate", "mesh"}) {
+    const CommandResult r =
+        run_sketchdrape(command + " " + (dir / "high.json").string() +
+                        (command == "mesh" ? " -o " + (dir / "out").string() : std::string()));
+    EXPECT_EQ(r.exit_code, 2) << command << "\n" << r.output;
+    EXPECT_NE(r.output.find("/simulate/pin_above: no garment vertex lies at or above 2.5 m"),
+              std::string::npos)
+        << command << "\n"
+        << r.output;
+  }
+  EXPECT_FALSE(fs::exists(dir / "out"));
+  fs::remove_all(dir);
+}
+
 TEST(MeshCommand, BadInputExitsTwoWithOneLineAndNoFiles) {
   for (const BadCase& c : bad_cases()) {
     const fs::path out = fresh_dir("bad-" + c.file.stem().string());

@@ -681,6 +681,42 @@ TEST(PatternCommand, BadInputExitsTwoWithoutFiles) {
   EXPECT_FALSE(fs::exists(bad / "ramp-out"));
 }
 
+// Trial 35: every flattening warning of a mirrored panel was printed twice (600 characters each,
+// on every command), and a free-hanging skirt was told of a bodice dart. A mirror copy cut as its
+// panel's piece turned over is named in its panel's warning; the advice follows the panel's place.
+TEST(PatternCommand, MirroredPanelsWarnOnceWithAdviceForTheirPlace) {
+  const fs::path out = fresh_dir("mirror-warnings");
+  const CommandResult dress =
+      run_sketchdrape("pattern " + example("sleeveless-dress").string() + " -o " + out.string());
+  ASSERT_EQ(dress.exit_code, 0) << dress.output;
+  std::size_t warnings = 0;
+  for (std::size_t at = dress.output.find("warning: panel"); at != std::string::npos;
+       at = dress.output.find("warning: panel", at + 1)) {
+    ++warnings;
+    const std::string line = dress.output.substr(at, dress.output.find('\n', at) - at);
+    EXPECT_NE(line.find("and its mirror copy '"), std::string::npos) << line;
+  }
+  EXPECT_EQ(warnings, 2u) << dress.output;  // the back bodice and the back skirt, once each
+  EXPECT_EQ(dress.output.find(".mirror': the flat piece"), std::string::npos) << dress.output;
+  EXPECT_NE(dress.output.find(", 2 warning(s)"), std::string::npos) << dress.output;
+
+  // The strapless dress on the Collada human: its skirt hangs free ("fit" auto gives "free").
+  const fs::path strapless =
+      fs::path(SD_SOURCE_DIR) / "tests/cli/sketches/strapless-dress-human.json";
+  if (!fs::exists("/usr/share/assimp/models/Collada/human.zae"))
+    GTEST_SKIP() << "the Collada human is not installed";
+  const CommandResult skirt =
+      run_sketchdrape("pattern " + strapless.string() + " -o " + (out / "strapless").string());
+  ASSERT_EQ(skirt.exit_code, 0) << skirt.output;
+  const std::size_t at = skirt.output.find("warning: panel 'skirt_front' and its mirror copy");
+  ASSERT_NE(at, std::string::npos) << skirt.output;
+  const std::string line = skirt.output.substr(at, skirt.output.find('\n', at) - at);
+  EXPECT_NE(line.find("a dart from the panel's top edge towards it (a skirt's waist dart)"),
+            std::string::npos)
+      << line;
+  EXPECT_EQ(line.find("on a bodice"), std::string::npos) << line;
+}
+
 // Lengths on the command line are metres, checked as the file's are: centimetres typed for
 // metres get the same hint (trial 34: "Value 60 not in range 0.100000 to 10.000000").
 TEST(PatternCommand, OptionOutOfRangeNamesItsUnit) {
@@ -699,6 +735,15 @@ TEST(PatternCommand, OptionOutOfRangeNamesItsUnit) {
   EXPECT_NE(allowance.output.find("a seam allowance of 1 m is outside 0 .. 0.1 m"),
             std::string::npos)
       << allowance.output;
+  // A pattern maker's 10 means 10 mm (trial 35 was told "10 cm is 0.1 m", a deep hem that is
+  // within the range): millimetres first.
+  const CommandResult millimetres = run_sketchdrape("pattern " + example("tshirt").string() +
+                                                    " -o " + out.string() + " --seam-allowance 10");
+  EXPECT_EQ(millimetres.exit_code, 2) << millimetres.output;
+  EXPECT_NE(millimetres.output.find("if you typed millimetres, 10 mm is 0.01 m (if centimetres, "
+                                    "10 cm is 0.1 m)"),
+            std::string::npos)
+      << millimetres.output;
   const CommandResult text = run_sketchdrape("pattern " + example("tshirt").string() + " -o " +
                                              out.string() + " --fabric-width 1.5m");
   EXPECT_EQ(text.exit_code, 2) << text.output;

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include "tests/cli/run_command.hpp"
@@ -44,6 +45,48 @@ TEST(ValidateCommand, SheetLineNamesTheFabricOnce) {
   EXPECT_NE(v.output.find(": ok (sheet: 25 vertices, 32 triangles, fabric "), std::string::npos)
       << v.output;
   EXPECT_EQ(v.output.find("sheet cotton"), std::string::npos) << v.output;
+  fs::remove_all(dir);
+}
+
+// The trapeze dress of trial 35 with assimp's duck given as its body: the refusal spoke of a
+// curve crossing itself; it says first that the body has no landmarks, so is no standing figure.
+TEST(ValidateCommand, ABodyThatIsNoFigureIsNamedFirst) {
+  const std::string duck = "/usr/share/assimp/models/Collada/duck.dae";
+  if (!fs::exists(duck)) GTEST_SKIP() << "assimp's test models are not installed";
+  const fs::path dir = fs::temp_directory_path() / "sd-validate-duck";
+  fs::create_directories(dir);
+  std::ifstream in(std::string(SD_SOURCE_DIR) + "/data/examples/tshirt.json");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // The t-shirt example on the duck (its "body" key replaced; the file has no other).
+  const size_t at = text.find("\"body\"");
+  ASSERT_NE(at, std::string::npos);
+  const size_t end = text.find_first_of(",\n", text.find(':', at));
+  text.replace(at, end - at, "\"body\": \"" + duck + "\"");
+  std::ofstream(dir / "duck.json") << text;
+  const CommandResult v = run_sketchdrape("validate " + (dir / "duck.json").string());
+  EXPECT_EQ(v.exit_code, 2) << v.output;
+  EXPECT_NE(v.output.find("the body '" + duck + "' has no landmarks (cannot find"),
+            std::string::npos)
+      << v.output;
+  EXPECT_NE(v.output.find("is it the right body file? With it, "), std::string::npos) << v.output;
+  fs::remove_all(dir);
+}
+
+// A folder given as the fabric (trial 35: "fabrics" and "fabrics/" were called unknown presets).
+TEST(ValidateCommand, AFolderAsTheFabricIsSaidToBeOne) {
+  const fs::path dir = fs::temp_directory_path() / "sd-validate-fabric-folder";
+  fs::create_directories(dir / "fabrics");
+  for (const std::string name : {"fabrics", "fabrics/"}) {
+    std::ofstream(dir / "sheet.json")
+        << R"({"sheet": {"size": [0.2, 0.2], "resolution": [4, 4]}, "fabric": ")" + name + R"("})";
+    const CommandResult v = run_sketchdrape("validate " + (dir / "sheet.json").string());
+    EXPECT_EQ(v.exit_code, 2) << v.output;
+    EXPECT_NE(v.output.find("/fabric: '" + name +
+                            "' is a folder, not a fabric: name a fabric file in it "
+                            "(\"fabrics/NAME.json\", relative to the sketch) or a preset (cotton,"),
+              std::string::npos)
+        << v.output;
+  }
   fs::remove_all(dir);
 }
 

@@ -9,6 +9,7 @@
 #include <numbers>
 #include <random>
 
+#include "sim/cantilever.hpp"
 #include "sim/drape_coefficient.hpp"
 #include "sim/fabric.hpp"
 #include "sim/sheet.hpp"
@@ -31,16 +32,6 @@ sim::FabricParameters textile_fabric(const std::string& fabric) {
   const bool is_file = fabric.find('/') != std::string::npos ||
                        (fabric.size() > 5 && fabric.compare(fabric.size() - 5, 5, ".json") == 0);
   return is_file ? sim::load_fabric_file(fabric) : sim::fabric_preset(fabric);
-}
-
-double peirce_bending_length(double overhang, double chord_deg) {
-  const auto peirce = [](double degrees) {
-    const double theta = degrees * std::numbers::pi / 180.0;
-    return std::cbrt(std::cos(0.5 * theta) / (8.0 * std::tan(theta)));
-  };
-  // Peirce's formula gives 1.019·l/2 at 41.5°, where the standard (and the elastica) say l/2:
-  // scaled so that the standard's angle gives its bending length exactly.
-  return 0.5 * overhang * peirce(chord_deg) / peirce(41.5);
 }
 
 CantileverPoint run_cantilever(const std::string& name, int cells) {
@@ -67,13 +58,13 @@ CantileverPoint run_cantilever(const std::string& name, int cells) {
   sim::StaticOptions options;
   options.load_steps = 8;
   point.converged = sim::solve_static(model, x, scene.pinned_vertices, options).converged;
-  Eigen::Vector3d clamp = Eigen::Vector3d::Zero(), tip = Eigen::Vector3d::Zero();
-  for (int c = 0; c <= spec.columns; ++c) {
-    clamp += x.segment<3>(3 * scene.vertex(2, c)) / (spec.columns + 1);
-    tip += x.segment<3>(3 * scene.vertex(spec.rows, c)) / (spec.columns + 1);
-  }
-  point.chord_deg = std::atan2(clamp.y() - tip.y(), tip.z() - clamp.z()) * 180.0 / std::numbers::pi;
-  point.simulated_c = peirce_bending_length(overhang, point.chord_deg);
+  const Eigen::MatrixX3d draped =
+      Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(x.data(),
+                                                                                  x.size() / 3, 3);
+  const sim::CantileverMeasure measure =
+      sim::measure_cantilever(scene, scene.input.rest_positions, draped, 3);
+  point.chord_deg = measure.chord_deg;
+  point.simulated_c = measure.bending_length;
   point.seconds = seconds_since(start);
   return point;
 }

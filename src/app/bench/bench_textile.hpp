@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "sim/cantilever.hpp"
 #include "sim/fabric.hpp"
 
 namespace sd::app {
@@ -61,7 +62,7 @@ CantileverPoint run_cantilever(const std::string& fabric, int cells);
 CusickPoint run_cusick(const std::string& fabric, int cells, int specimens);
 
 // Peirce's bending length from the chord angle θ (degrees) of an overhang l (m); l/2 at 41.5°.
-double peirce_bending_length(double overhang, double chord_deg);
+using sim::peirce_bending_length;
 
 // Every fabric × resolution; `note` is called with a line after each point.
 void run_textile(const TextileOptions& options, std::vector<CantileverPoint>& cantilevers,

@@ -4,12 +4,15 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 #include <new>
 #include <stdexcept>
+#include <utility>
 
 #include "garment/panel_tasks.hpp"
+#include "sim/edit_distance.hpp"
 #include "sim/parallel.hpp"
 #include "src/app/version.hpp"
 
@@ -17,12 +20,96 @@ namespace sd::app {
 namespace {
 
 void configure_logging(const GlobalOptions& global) {
+  if (spdlog::get("sketchdrape")) return;  // a second time: for an error after a failed parse
   auto logger = spdlog::stderr_color_mt("sketchdrape");
   logger->set_pattern("%^%l%$: %v");
   spdlog::set_default_logger(logger);
   spdlog::set_level(global.quiet     ? spdlog::level::err
                     : global.verbose ? spdlog::level::debug
                                      : spdlog::level::info);
+}
+
+// The subcommands in the order --help lists them: "info, validate, mesh, ...".
+std::string command_list(const CLI::App& app) {
+  std::string list;
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+    list += (list.empty() ? "" : ", ") + sub->get_name();
+  return list;
+}
+
+// No command ran: none was given (CLI11's "A subcommand is required"), or the first word is not
+// one (trial 35: `sketchdrape drape ...` was told the same), then with the likely one.
+std::string missing_command_sentence(const CLI::App& app, int argc, char** argv) {
+  std::string word;
+  for (int i = 1; i < argc && word.empty(); ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--threads") {
+      ++i;  // its value
+    } else if (!arg.starts_with("-")) {
+      word = arg;
+    }
+  }
+  if (word.empty())
+    return fmt::format(
+        "a command is required: sketchdrape COMMAND ..., one of {} "
+        "(`sketchdrape --help` says what each does)",
+        command_list(app));
+  // Words a designer may reach for first.
+  static const std::pair<const char*, const char*> kSynonyms[] = {
+      {"drape", "run"},      {"simulate", "run"}, {"sim", "run"},         {"check", "validate"},
+      {"lint", "validate"},  {"meshing", "mesh"}, {"flatten", "pattern"}, {"patterns", "pattern"},
+      {"preview", "render"}, {"show", "render"},  {"body", "info"}};
+  std::string best;
+  for (const auto& [synonym, command] : kSynonyms)
+    if (word == synonym) best = command;
+  std::size_t closest = 3;  // close spellings only ("valdiate", "rnu")
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+    if (const std::size_t d = sim::edit_distance(word, sub->get_name());
+        best.empty() && d < closest)
+      best = sub->get_name(), closest = d;
+  return fmt::format(
+      "unknown command '{}'{}; the commands are {} (`sketchdrape --help` says what "
+      "each does)",
+      word, best.empty() ? "" : fmt::format(" (did you mean '{}'?)", best), command_list(app));
+}
+
+// An option the command does not have (trial 35: `run ... --duration 5` said "The following
+// arguments were not expected: 5 --duration"): named, with where that setting lives when it is
+// the sketch file's, else empty (CLI11's own message then).
+std::string unknown_option_sentence(const CLI::App& app, int argc, char** argv) {
+  const CLI::App* command = nullptr;
+  for (int i = 1; i < argc && command == nullptr; ++i)
+    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+      if (sub->get_name() == argv[i]) command = sub;
+  if (command == nullptr) return "";
+  for (int i = 1; i < argc; ++i) {
+    std::string arg = argv[i];
+    if (!arg.starts_with("-") || arg == "-" || arg == "--") continue;
+    const std::string name = arg.substr(0, arg.find('='));
+    if (command->get_option_no_throw(name) != nullptr || app.get_option_no_throw(name) != nullptr)
+      continue;
+    // Settings of the sketch file that a user may look for on the command line.
+    static const std::pair<const char*, const char*> kFileSettings[] = {
+        {"duration", "\"simulate\": {\"duration\": SECONDS}"},
+        {"time-step", "\"simulate\": {\"time_step\": SECONDS}"},
+        {"dt", "\"simulate\": {\"time_step\": SECONDS}"},
+        {"solver", "\"simulate\": {\"solver\": ...}"},
+        {"adaptive", "\"simulate\": {\"adaptive\": true}"},
+        {"rest", "\"simulate\": {\"rest\": \"flat\"}"},
+        {"fabric", "\"fabric\": NAME"},
+        {"edge-length", "\"edge_length\": METRES"},
+        {"body", "\"body\": FILE"},
+        {"images", "\"output\": {\"images\": [...]}"}};
+    std::string bare = name.substr(name.find_first_not_of('-'));
+    std::replace(bare.begin(), bare.end(), '_', '-');
+    std::string where;
+    for (const auto& [option, setting] : kFileSettings)
+      if (bare == option)
+        where = fmt::format(": that is a setting of the sketch file, {}", setting);
+    return fmt::format("'{}' has no option {}{}; `sketchdrape {} --help` lists its options",
+                       command->get_name(), name, where, command->get_name());
+  }
+  return "";
 }
 
 }  // namespace
@@ -65,17 +152,19 @@ int run_cli(int argc, char** argv) {
     garment::set_panel_threads(global.threads);
   });
 
+  // In the order of a design's work (look at the body, check, mesh, cut, drape, many at once),
+  // then the tools: --help and the "no command" message list them so.
   add_info_command(app, global);
-  add_fill_command(app, global);
-  add_render_command(app, global);
   add_validate_command(app, global);
   add_mesh_command(app, global);
   add_pattern_command(app, global);
   add_run_command(app, global);
   add_batch_command(app, global);
-  add_stress_command(app, global);
-  add_bench_command(app, global);
+  add_render_command(app, global);
+  add_fill_command(app, global);
   add_dent_command(app, global);
+  add_bench_command(app, global);
+  add_stress_command(app, global);
 
   try {
     app.parse(argc, argv);
@@ -85,6 +174,23 @@ int run_cli(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
+  } catch (const CLI::RequiredError& e) {
+    if (!app.get_subcommands().empty()) {
+      app.exit(e);
+      return kExitBadInput;
+    }
+    configure_logging(global);  // the parse stopped before it: "error: ..." as everywhere
+    spdlog::error("{}", missing_command_sentence(app, argc, argv));
+    return kExitBadInput;
+  } catch (const CLI::ExtrasError& e) {
+    const std::string unknown = unknown_option_sentence(app, argc, argv);
+    if (unknown.empty()) {
+      app.exit(e);
+    } else {
+      configure_logging(global);
+      spdlog::error("{}", unknown);
+    }
+    return kExitBadInput;
   } catch (const CLI::ParseError& e) {
     app.exit(e);
     return kExitBadInput;

@@ -75,13 +75,19 @@ void run_mesh(const MeshOptions& options) {
   if (sketch.garment_mesh) outputs.keep(sketch.resolve(*sketch.garment_mesh));
   if (sketch.body.mesh != "builtin") outputs.keep(sketch.resolve(sketch.body.mesh));
   nlohmann::json report = {{"format", "sketchdrape/1 mesh report"}, {"sketch", sketch.file}};
+  // The scene `validate` and `run` build, with every check they make (pin_above, the fabric, a
+  // flat rest's flattening, the body's poses, the drape's size): `mesh` refuses the same files
+  // (trial 35: "pin_above": 2.5 was meshed with exit 0 and refused by validate).
+  if (const auto estimate = estimate_before_building(sketch, 0))
+    check_run_fits(sketch, *estimate, RunLimits{}, 0);
+  const ClothScene scene = build_cloth_scene(sketch);
+  check_run_fits(
+      sketch, estimate_run(sketch, scene.input.triangles, static_cast<int>(scene.start.rows()), 0),
+      RunLimits{}, 0);
 
   if (sketch.sheet) {
     // A sheet scene: its grid of triangles is the fixed mesh `run` simulates (a sheet that asks
     // for adaptive detail drapes on the 4-8 mesh of its quads instead).
-    if (const auto estimate = estimate_before_building(sketch, 0))
-      check_run_fits(sketch, *estimate, RunLimits{}, 0);
-    const ClothScene scene = build_cloth_scene(sketch);
     ExportMesh mesh{scene.input.rest_positions, scene.input.triangles, {}, {"sheet"}};
     outputs.stage(dir / sketch.output.mesh, sketch.output.mesh.ends_with(".glb")
                                                 ? to_glb(mesh, "sheet")
@@ -123,27 +129,25 @@ void run_mesh(const MeshOptions& options) {
   }
 
   // The garment as `run` drapes it: body, stitched quads, panel groups, checked 4-8 mesh.
-  const MeshedGarment meshed = mesh_garment(sketch);
-  const garment::Body& body = meshed.body;
-  const garment::Garment& g = meshed.garment;
-  const double body_ms = meshed.body_ms;
-  const double mesh_ms = meshed.meshing_ms;
+  const garment::Body& body = *scene.body;
+  const garment::Garment& g = *scene.garment;
+  const double body_ms = scene.body_ms;
+  const double mesh_ms = scene.meshing_ms;
   const std::vector<garment::QualityWarning> warnings = quality_warnings(g, sketch, body);
 
-  // Quad mesh with one group per panel (joined panels share their join's group).
-  const std::vector<std::string>& groups = meshed.group_names;
-  const std::vector<int>& panel_group = meshed.panel_group;
+  // Quad mesh with one group per panel (joined panels share their join's group): the scene's
+  // group of each quad.
+  const std::vector<std::string>& groups = scene.group_names;
   ExportMesh quads{g.mesh.vertices, g.mesh.faces, {}, groups};
-  for (Eigen::Index f = 0; f < g.face_panel.size(); ++f)
-    quads.face_groups.push_back(panel_group[static_cast<size_t>(g.face_panel(f))]);
+  for (Eigen::Index f = 0; f < scene.face_group.size(); ++f)
+    quads.face_groups.push_back(scene.face_group(f));
   outputs.stage(dir / sketch.output.mesh, sketch.output.mesh.ends_with(".glb")
                                               ? to_glb(quads, "garment")
                                               : to_obj(quads, "garment"));
 
-  const meshing::Mesh48& m48 = meshed.mesh48;
-  std::vector<int> block_group(static_cast<size_t>(g.mesh.face_count()));
-  for (Eigen::Index f = 0; f < g.mesh.face_count(); ++f)
-    block_group[static_cast<size_t>(f)] = panel_group[static_cast<size_t>(g.face_panel(f))];
+  const meshing::Mesh48& m48 = *scene.mesh48;
+  const std::vector<int> block_group(scene.face_group.data(),
+                                     scene.face_group.data() + scene.face_group.size());
   outputs.stage(dir / "garment48.obj", obj_48(m48, block_group, groups));
 
   nlohmann::json panels = nlohmann::json::array();
@@ -189,8 +193,9 @@ void run_mesh(const MeshOptions& options) {
 
   // The flat sewing pattern, when the file asks for it.
   if (sketch.output.pattern) {
-    const PatternSheet sheet =
-        build_pattern_sheet(sketch, g, *sketch.output.pattern, nullptr, 0.0, &body);
+    const PatternSheet sheet = build_pattern_sheet(
+        sketch, g, *sketch.output.pattern, scene.flat_pattern ? &*scene.flat_pattern : nullptr,
+        scene.flattening_ms, &body);
     stage_pattern(sheet, dir, outputs);
     report["pattern"] = pattern_summary(sheet);
   }
@@ -214,6 +219,10 @@ void run_mesh(const MeshOptions& options) {
                          {"total", ms_since(start)}};
   if (sketch.output.report) outputs.stage(dir / "report.json", report.dump(2) + "\n");
   outputs.commit();
+  if (const std::string notice =
+          stale_outputs_notice(dir, stale_outputs(dir, outputs.paths_and_inputs()));
+      !notice.empty())
+    spdlog::warn("{}", notice);
   spdlog::info("meshed {} → {}: {} panels, {} quads, distortion {} ({:.0f} ms meshing)",
                sketch.file, dir.string(), g.panels.size(), g.mesh.face_count(), distortion,
                mesh_ms);

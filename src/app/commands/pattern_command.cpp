@@ -65,7 +65,8 @@ void run_pattern(const PatternOptions& options) {
 // A length option in metres checked as the file's lengths are, with the unit and the likely
 // slip ("a fabric width of 60 m is outside 0.1 .. 10 m; ... if you typed centimetres, 60 cm
 // is 0.6 m") instead of CLI11's "Value 60 not in range 0.100000 to 10.000000".
-CLI::Validator length_in_range(double low, double high, std::string what) {
+CLI::Validator length_in_range(double low, double high, std::string what,
+                               garment::UsualRange usual) {
   return CLI::Validator(
       [=](std::string& text) -> std::string {
         double value = 0;
@@ -77,7 +78,7 @@ CLI::Validator length_in_range(double low, double high, std::string what) {
           return fmt::format("'{}' is not a number of metres", text);
         }
         if (value >= low && value <= high) return "";
-        return garment::out_of_range_sentence(value, low, high, what);
+        return garment::out_of_range_sentence(value, low, high, what, usual);
       },
       fmt::format("metres, {} .. {}", low, high));
 }
@@ -92,11 +93,11 @@ void add_pattern_command(CLI::App& app, const GlobalOptions& /*global*/) {
   cmd->add_option("-o,--out", options->out, "Output directory (created if needed)");
   cmd->add_option("--fabric-width", options->fabric_width,
                   "Fabric width in metres (default: output.pattern.fabric_width, else 1.5)")
-      ->check(length_in_range(0.1, 10.0, "a fabric width of"));
+      ->check(length_in_range(0.1, 10.0, "a fabric width of", garment::kUsualFabricWidth));
   cmd->add_option("--seam-allowance", options->seam_allowance,
                   "Seam allowance in metres for pieces without their own (default: "
                   "output.pattern.seam_allowance, else 0.01)")
-      ->check(length_in_range(0.0, 0.1, "a seam allowance of"));
+      ->check(length_in_range(0.0, 0.1, "a seam allowance of", garment::kUsualSeamAllowance));
   cmd->callback([options] { run_pattern(*options); });
 }
 

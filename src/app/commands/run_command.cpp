@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <stdexcept>
@@ -19,6 +20,7 @@
 #include "meshing/slice_dent.hpp"
 #include "scene/sketch_file.hpp"
 #include "sim/adaptive_detail.hpp"
+#include "sim/cantilever.hpp"
 #include "sim/cloth_driver.hpp"
 #include "sim/drape_coefficient.hpp"
 #include "sim/sheet.hpp"
@@ -111,6 +113,35 @@ std::optional<nlohmann::json> cusick_json(const scene::Sketch& sketch,
                         {"nodes", shadow.nodes}};
 }
 
+// The cantilever test's measures (docs/fabrics.md, "Cantilever"; the same as `bench --textile`)
+// of a horizontal rectangle held by one clamp "top:N" of its top edge, drawn on its own grid:
+// the chord angle, the overhang and Peirce's bending length from them, beside the fabric's
+// c = (B/ρg)^(1/3) that the chord should give at 41.5° for an overhang of 2c.
+std::optional<nlohmann::json> cantilever_json(const scene::Sketch& sketch, const ClothScene& scene,
+                                              const meshing::TriMesh& draped, double gravity) {
+  if (!sketch.sheet || sketch.sheet->disc || !sketch.sheet->horizontal ||
+      sketch.sheet->layers != 1 || sketch.sheet->pins.size() != 1 ||
+      !sketch.sheet->pins.front().starts_with("top:"))
+    return std::nullopt;
+  const int lines = std::atoi(sketch.sheet->pins.front().c_str() + 4);
+  sim::SheetSpec spec;
+  spec.columns = sketch.sheet->columns;
+  spec.rows = sketch.sheet->rows;
+  spec.size = sketch.sheet->size;
+  spec.orientation = sim::SheetOrientation::horizontal;
+  spec.centre = sketch.sheet->centre;
+  const sim::SheetScene sheet = sim::build_sheet(spec);
+  // The grid's own vertices, numbered as built (adaptive detail would renumber them).
+  if (lines < 1 || lines > spec.rows || draped.vertices.rows() != sheet.input.rest_positions.rows())
+    return std::nullopt;
+  const sim::CantileverMeasure m =
+      sim::measure_cantilever(sheet, sheet.input.rest_positions, draped.vertices, lines);
+  const double c = std::cbrt(scene.fabric.bend / (scene.fabric.area_density * gravity));
+  return nlohmann::json{{"clamp_lines", m.clamp_lines}, {"overhang_m", m.overhang},
+                        {"chord_deg", m.chord_deg},     {"bending_length_m", m.bending_length},
+                        {"fabric_bending_length_m", c}, {"overhang_over_2c", m.overhang / (2 * c)}};
+}
+
 void run_drape(const RunOptions& options, const GlobalOptions& global) {
   const auto start = Clock::now();
   const scene::Sketch sketch = scene::load_sketch(options.sketch);
@@ -122,7 +153,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   if (options.max_time_s > 0) limits.max_time_s = options.max_time_s;
   // Refused before anything is built when the size is known from the file (a sheet), else once
   // the cloth is meshed.
-  if (const auto before = estimate_before_building(sketch, options.frames_per_second))
+  if (const auto before = estimate_before_building(sketch, options.frames_per_second, limits))
     check_run_fits(sketch, *before, limits, options.frames_per_second);
   // OSMesa is opened only by a run that renders (src/render/gl.hpp). Opened now, not after the
   // drape: a missing library is found before the drape's time is spent, and the budget checks
@@ -359,8 +390,9 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
     // Ended without reaching at rest (the duration ran out): where it still moves and what to
     // try, so that a moving drape is not taken for a settled one.
     // (With "stop_at_rest": false the run goes on to the end; it is judged by its last window.)
-    if (!report.failed && !report.at_rest &&
-        (settings.stop_at_rest || !driver.simulation().at_rest())) {
+    const bool still_moving = !report.failed && !report.at_rest &&
+                              (settings.stop_at_rest || !driver.simulation().at_rest());
+    if (still_moving) {
       const sim::Simulation& s = driver.simulation();
       StillMoving where;
       where.vertices = s.model().vertex_count;
@@ -371,6 +403,8 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
         if (speed > where.speed) where.speed = speed, fastest = i;
       }
       where.at = draped.vertices.row(fastest).transpose();
+      where.flat_rest = flat_rest;
+      where.rest_ramp = sketch.simulate.rest_ramp;
       for (Eigen::Index t = 0; t < draped.faces.rows() && where.panel.empty(); ++t)
         if ((draped.faces.row(t).array() == fastest).any() && t < triangle_group.size() &&
             triangle_group(t) >= 0 &&
@@ -386,6 +420,31 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
       out.warnings.push_back(not_at_rest_warning(sketch.file, report.sim_time, settings.rest_speed,
                                                  settings.rest_window, where));
       spdlog::warn("{}", out.warnings.back());
+    }
+    // A panel left stretched far beyond what cloth at rest stretches (drape_warnings.hpp): once
+    // per panel, its mirror copy folded in (the worse of the two).
+    if (scene.garment && !report.failed) {
+      std::map<std::string, const GroupStrain*> worst;
+      for (const GroupStrain& g : out.strain) {
+        const std::string panel =
+            g.group.ends_with(".mirror") ? g.group.substr(0, g.group.size() - 7) : g.group;
+        if (g.stretch_max > kOverstretched &&
+            (!worst.contains(panel) || g.stretch_max > worst[panel]->stretch_max))
+          worst[panel] = &g;
+      }
+      for (const auto& [panel, g] : worst) {
+        std::string landmark;
+        if (scene.body) {
+          try {
+            landmark = garment::find_landmarks(scene.body->mesh).nearest(g->stretch_at).name;
+          } catch (const std::runtime_error&) {
+            // Not a standing figure: the place without a landmark.
+          }
+        }
+        out.warnings.push_back(overstretched_warning(sketch.file, g->group, g->stretch_max,
+                                                     g->stretch_at, landmark, !still_moving));
+        spdlog::warn("{}", out.warnings.back());
+      }
     }
     if (adaptive) out.adaptive = *driver.adaptive_report();
   } catch (const sim::InvalidFabricError& e) {
@@ -455,6 +514,17 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
       } catch (const render::RenderError& e) {
         pictures = fmt::format(" (its pictures were not drawn: {})", e.what());
       }
+    // The trace is what to read when a drape fails (trial 35 found none): its accepted steps and
+    // a last line saying where and why it broke, with the other failure files.
+    if (options.trace) {
+      nlohmann::json failed = {{"failed", report.failure_reason},
+                               {"time", report.sim_time},
+                               {"vertex", located ? v : -1},
+                               {"at", {where.x(), where.y(), where.z()}},
+                               {"panel", panel}};
+      if (!landmark.empty()) failed["near"] = landmark;
+      failed_outputs.stage(dir / "trace.jsonl", trace + failed.dump() + "\n");
+    }
     failed_outputs.commit();
     // Stuck after a start inside the body: the likely cause, which the start repair could not
     // undo (cloth pushed out on both sides of a leg is caught round it).
@@ -467,10 +537,11 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
           report.start_repair_vertices, 1e3 * report.start_repair_depth_m);
     throw std::runtime_error(fmt::format(
         "the simulation failed at t = {:.3f} s in panel '{}' at ({:.3f}, {:.3f}, {:.3f}) m{}: "
-        "{}{}; the last accepted state is in {}{}",
+        "{}{}; the last accepted state is in {}{}{}",
         report.sim_time, panel, where.x(), where.y(), where.z(),
         landmark.empty() ? "" : fmt::format(", near the {}", landmark), report.failure_reason,
-        cause, (dir / "drape-failed.obj").string(), pictures));
+        cause, (dir / "drape-failed.obj").string(), pictures,
+        options.trace ? ", the steps up to it in " + (dir / "trace.jsonl").string() : ""));
   }
 
   // The drape's memory is known now (adaptive detail may have grown it past the estimate):
@@ -540,6 +611,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   out.bending = sim::bend_model_name(scene.bend_model);
   out.compression = sim::compression_name(scene.compression);
   out.cusick = cusick_json(sketch, draped);
+  out.cantilever = cantilever_json(sketch, scene, draped, settings.forces.gravity.norm());
   out.rest_shape = flat_rest ? (scene.bend_rest_flat ? "flat" : "flat and shaped") : "shaped";
   if (pattern_sheet) {
     stage_pattern(*pattern_sheet, dir, outputs);
@@ -582,6 +654,10 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   if (sketch.output.report) outputs.stage(dir / "report.json", run_report_json(out).dump(2) + "\n");
   if (options.trace) outputs.stage(dir / "trace.jsonl", trace);
   outputs.commit();
+  if (const std::string notice =
+          stale_outputs_notice(dir, stale_outputs(dir, outputs.paths_and_inputs()));
+      !notice.empty())
+    spdlog::warn("{}", notice);
   spdlog::info("draped {} → {}: {} steps, {:.2f} s simulated{}, {:.2f} s wall", sketch.file,
                dir.string(), report.steps, report.sim_time, report.at_rest ? " (at rest)" : "",
                report.wall_time_s);

@@ -1,11 +1,13 @@
 #include "src/app/pipeline/atomic_file.hpp"
 
 #include <fcntl.h>
+#include <fmt/format.h>
 #include <pthread.h>
 #include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cerrno>
@@ -17,6 +19,7 @@
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <system_error>
 #include <vector>
 
@@ -327,6 +330,56 @@ void StagedOutputs::commit() {
   for (const char* held : held_dirs_) release(g_dir_slots, held);
   held_.clear();
   held_dirs_.clear();
+}
+
+namespace {
+
+// A name sketchdrape gives its outputs: drape.obj, drape-front.png, drape-failed.obj,
+// garment48.obj, garment-left.png, frame-0007-front.png, pattern.svg, report.json, trace.jsonl.
+bool output_name(const std::string& name) {
+  const auto ends = [&](std::string_view suffix) { return name.ends_with(suffix); };
+  for (std::string_view stem : {"drape", "garment", "frame-"})
+    if (name.starts_with(stem) && (ends(".png") || ends(".obj") || ends(".glb"))) return true;
+  return name == "pattern.svg" || name == "pattern.dxf" || name == "pattern.json" ||
+         name == "report.json" || name == "trace.jsonl";
+}
+
+}  // namespace
+
+std::vector<std::string> stale_outputs(const std::filesystem::path& dir,
+                                       const std::vector<std::filesystem::path>& written) {
+  namespace fs = std::filesystem;
+  const auto ours = [&](const fs::path& file) {
+    std::error_code ec;
+    return std::any_of(written.begin(), written.end(),
+                       [&](const fs::path& w) { return fs::equivalent(file, w, ec); });
+  };
+  std::vector<std::string> stale;
+  for (const fs::path& folder : {dir, dir / "frames"}) {
+    std::error_code ec;
+    for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+      const std::string name = it->path().filename().string();
+      if (it->is_regular_file(ec) && output_name(name) && !ours(it->path()))
+        stale.push_back(it->path().lexically_relative(dir).string());
+    }
+  }
+  std::sort(stale.begin(), stale.end());
+  return stale;
+}
+
+std::string stale_outputs_notice(const std::filesystem::path& dir,
+                                 const std::vector<std::string>& stale) {
+  if (stale.empty()) return "";
+  constexpr std::size_t kNamed = 8;
+  std::string names;
+  for (std::size_t i = 0; i < stale.size() && i < kNamed; ++i)
+    names += (i == 0 ? "" : ", ") + stale[i];
+  if (stale.size() > kNamed) names += fmt::format(" and {} more", stale.size() - kNamed);
+  return fmt::format(
+      "{} also holds {} output file{} of an earlier command that this one did not write: {}; "
+      "they are left as they were, so the folder mixes two results: delete them, or give -o a "
+      "new folder",
+      dir.string(), stale.size(), stale.size() == 1 ? "" : "s", names);
 }
 
 }  // namespace sd::app

@@ -52,6 +52,12 @@ class StagedOutputs {
   void commit();
 
   const std::vector<std::filesystem::path>& paths() const { return finals_; }
+  // The staged files and the inputs given to keep().
+  std::vector<std::filesystem::path> paths_and_inputs() const {
+    std::vector<std::filesystem::path> all = finals_;
+    all.insert(all.end(), inputs_.begin(), inputs_.end());
+    return all;
+  }
 
  private:
   std::vector<std::filesystem::path> temps_;
@@ -63,5 +69,17 @@ class StagedOutputs {
   std::vector<const char*> held_dirs_;
   bool committed_ = false;
 };
+
+// The files in `dir` (and its frames/ folder) named as sketchdrape names its outputs (drape*,
+// garment*, frame-NNNN-*, pattern.svg/.dxf/.json, report.json, trace.jsonl) that are not among
+// `written`: what an earlier command left beside this one's (trial 35: a cantilever's report
+// beside a pair of shorts' images and pattern). Paths relative to `dir`, sorted. Never deletes.
+std::vector<std::string> stale_outputs(const std::filesystem::path& dir,
+                                       const std::vector<std::filesystem::path>& written);
+
+// "<dir> also holds 5 output files that this command did not write: ..." for the terminal, or
+// empty when `stale` is.
+std::string stale_outputs_notice(const std::filesystem::path& dir,
+                                 const std::vector<std::string>& stale);
 
 }  // namespace sd::app

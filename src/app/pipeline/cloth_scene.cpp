@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <limits>
 #include <numbers>
 
@@ -19,34 +20,6 @@
 
 namespace sd::app {
 namespace {
-
-// The fabric at `json_path`: the sketch's inline fabric object (by its name), a preset name,
-// or a path to a fabric .json file (relative to the sketch); else a SketchError at the JSON
-// path of the bad value ("/fabric/bend" for an inline constant) that lists the known presets.
-sim::FabricParameters fabric_at(const scene::Sketch& sketch, const std::string& name,
-                                const std::string& json_path) {
-  // A panel without its own fabric carries the file's name for it, inline ones included.
-  if (!sketch.fabric_inline.empty() && name == sketch.fabric) {
-    try {
-      return sim::parse_fabric_json(sketch.fabric_inline, "the fabric given inline");
-    } catch (const sim::InvalidFabricError& e) {
-      sketch.fail("/fabric" + e.pointer(), e.what());
-    }
-  }
-  try {
-    return sim::fabric_preset(name);
-  } catch (const sim::UnknownFabricError& e) {
-    if (name.size() < 5 || name.substr(name.size() - 5) != ".json")
-      sketch.fail(json_path, std::string(e.what()) +
-                                 "; or give a fabric file (.json) or the "
-                                 "fabric's constants as an object");
-  }
-  try {
-    return sim::load_fabric_file(sketch.resolve(name).string());
-  } catch (const sim::InvalidFabricError& e) {
-    sketch.fail(json_path, e.what());
-  }
-}
 
 // simulate.pin_above: holds every vertex that starts at or above that height.
 void pin_above(const scene::Sketch& sketch, ClothScene& scene) {
@@ -153,7 +126,7 @@ void build_sheet_scene(const scene::Sketch& sketch, ClothScene& scene) {
   std::sort(scene.pinned.begin(), scene.pinned.end());
   scene.pinned.erase(std::unique(scene.pinned.begin(), scene.pinned.end()), scene.pinned.end());
   scene.fabric_name = sketch.fabric;
-  scene.fabric = fabric_at(sketch, sketch.fabric, "/fabric");
+  scene.fabric = scene_fabric(sketch, sketch.fabric, "/fabric");
   scene.bend_model =
       sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::quadratic);
   scene.compression =
@@ -254,6 +227,7 @@ void flat_rest_shapes(const scene::Sketch& sketch, const garment::Garment& g,
 void build_garment_scene(const scene::Sketch& sketch, ClothScene& scene) {
   MeshedGarment meshed = mesh_garment(sketch);  // the stage `mesh` writes out
   scene.body = std::move(meshed.body);
+  scene.body_ms = meshed.body_ms;
   scene.meshing_ms = meshed.meshing_ms;
   garment::Garment& g = meshed.garment;
 
@@ -265,8 +239,8 @@ void build_garment_scene(const scene::Sketch& sketch, ClothScene& scene) {
   scene.compression =
       sim::parse_compression(sketch.simulate.compression).value_or(sim::Compression::linear);
   const garment::PanelSpec* first_spec = sketch.find_panel(first.id);
-  scene.fabric =
-      fabric_at(sketch, first.fabric, first_spec ? first_spec->json_path + "/fabric" : "/fabric");
+  scene.fabric = scene_fabric(sketch, first.fabric,
+                              first_spec ? first_spec->json_path + "/fabric" : "/fabric");
   for (const garment::GarmentPanel& p : g.panels)
     if (p.fabric != first.fabric)
       spdlog::warn(
@@ -328,7 +302,7 @@ void build_imported_scene(const scene::Sketch& sketch, ClothScene& scene) {
   scene.face_group = Eigen::VectorXi::Zero(triangles.face_count());
   scene.group_names = {"garment"};
   scene.fabric_name = sketch.fabric;
-  scene.fabric = fabric_at(sketch, sketch.fabric, "/fabric");
+  scene.fabric = scene_fabric(sketch, sketch.fabric, "/fabric");
   scene.bend_model =
       sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::quadratic);
   scene.compression =
@@ -338,6 +312,44 @@ void build_imported_scene(const scene::Sketch& sketch, ClothScene& scene) {
 }
 
 }  // namespace
+
+sim::FabricParameters scene_fabric(const scene::Sketch& sketch, const std::string& name,
+                                   const std::string& json_path) {
+  // A panel without its own fabric carries the file's name for it, inline ones included.
+  if (!sketch.fabric_inline.empty() && name == sketch.fabric) {
+    try {
+      return sim::parse_fabric_json(sketch.fabric_inline, "the fabric given inline");
+    } catch (const sim::InvalidFabricError& e) {
+      sketch.fail("/fabric" + e.pointer(), e.what());
+    }
+  }
+  try {
+    return sim::fabric_preset(name);
+  } catch (const sim::UnknownFabricError& e) {
+    // A folder (trial 35: "fabrics", "fabrics/") was called an unknown preset.
+    std::error_code ec;
+    // (A folder named like a file, "x.json", is said to be one by load_fabric_file below.)
+    if (!name.ends_with(".json") && std::filesystem::is_directory(sketch.resolve(name), ec)) {
+      std::string folder = name, presets;
+      while (folder.size() > 1 && folder.ends_with("/")) folder.pop_back();
+      for (const std::string& preset : sim::fabric_preset_names())
+        presets += (presets.empty() ? "" : ", ") + preset;
+      sketch.fail(json_path,
+                  fmt::format("'{}' is a folder, not a fabric: name a fabric file in it "
+                              "(\"{}/NAME.json\", relative to the sketch) or a preset ({})",
+                              name, folder, presets));
+    }
+    if (!name.ends_with(".json"))
+      sketch.fail(json_path, std::string(e.what()) +
+                                 "; or give a fabric file (.json) or the "
+                                 "fabric's constants as an object");
+  }
+  try {
+    return sim::load_fabric_file(sketch.resolve(name).string());
+  } catch (const sim::InvalidFabricError& e) {
+    sketch.fail(json_path, e.what());
+  }
+}
 
 sim::SimulationSettings simulation_settings(const scene::Sketch& sketch) {
   const scene::SimulateSpec& spec = sketch.simulate;

@@ -50,6 +50,7 @@ struct ClothScene {
   std::optional<sim::PoseSequence> body_motion;
   std::optional<garment::Garment> garment;
   std::vector<std::string> group_names;
+  double body_ms = 0;     // time spent loading the garment's body
   double meshing_ms = 0;  // time spent building the garment
   // The garment's flattened panels when a panel drapes from flat cloth ("rest": "flat"); then
   // input.rest_uv holds every triangle's rest coordinates (the pattern piece's triangle for flat
@@ -94,6 +95,13 @@ sim::ClothDriver scene_driver(const ClothScene& scene, const sim::SimulationSett
 
 // #F: the group of each triangle, given the input face each descends from.
 Eigen::VectorXi triangle_groups(const ClothScene& scene, const Eigen::VectorXi& source_faces);
+
+// The fabric `name` of the sketch (the file's or a panel's): its inline object (by its name), a
+// preset, or a fabric .json file relative to the sketch. Throws garment::SketchError at
+// `json_path` (at /fabric/KEY for an inline constant) with the known presets, or saying that
+// the name is a folder.
+sim::FabricParameters scene_fabric(const scene::Sketch& sketch, const std::string& name,
+                                   const std::string& json_path);
 
 // The simulator settings of the file's "simulate" section (integrator, solver, step, duration,
 // gravity). Throws garment::SketchError at /simulate when they cannot work together.

@@ -112,14 +112,45 @@ std::string not_at_rest_warning(const std::string& file, double duration_s, doub
   std::string place = where.panel.empty() ? "" : fmt::format("in panel '{}' ", where.panel);
   place += fmt::format("at ({:.3f}, {:.3f}, {:.3f}) m", where.at.x(), where.at.y(), where.at.z());
   if (!where.landmark.empty()) place += ", near the " + spoken(where.landmark);
+  // Cloth released from its flat pattern at once starts stretched out of it over the body's
+  // curves and keeps cycling where it is held (the capelet, the tee dress, trial 35's strapless
+  // dress): the ramp, which sews the pieces up gradually, let each rest (docs/pattern.md).
+  const std::string ramp =
+      where.flat_rest && where.rest_ramp <= 0.0
+          ? "; it was draped from its flat pattern, released at once: try \"simulate\": "
+            "{\"rest_ramp\": 1} first, which sews the cut pieces up over 1 s so that the cloth "
+            "starts unstrained (docs/pattern.md, \"Drape time and the rest ramp\"), then"
+          : "; try";
   return fmt::format(
       "{}: the drape did not come to rest in {:g} s: the cloth still moves at {:.1f} cm/s {} "
       "({} of {} vertices faster than the at-rest {:.1f} cm/s held for {:g} s), so the result "
-      "may not be its final shape; try a longer \"simulate\": {{\"duration\": {:g}}}, and if it "
+      "may not be its final shape{} a longer \"simulate\": {{\"duration\": {:g}}}, and if it "
       "is still sliding there, a snugger fit where it should hold (\"ease\" below 1 on the "
       "panel that holds it); report.json's \"rest\" gives the residual",
       file, duration_s, 100 * where.speed, place, where.moving, where.vertices, 100 * rest_speed,
-      rest_window_s, 2 * duration_s);
+      rest_window_s, ramp, 2 * duration_s);
+}
+
+std::string overstretched_warning(const std::string& file, const std::string& panel, double stretch,
+                                  const Eigen::Vector3d& at, const std::string& landmark,
+                                  bool at_rest) {
+  std::string text = fmt::format(
+      "{}: panel '{}' ends stretched {:.0f} % at ({:.3f}, {:.3f}, {:.3f}) m{}, far beyond the few "
+      "percent cloth stretches resting on a body (a woven tears or pulls its seams apart long "
+      "before): the cloth is pulled there",
+      file, unmirrored(panel), 100 * stretch, at.x(), at.y(), at.z(),
+      landmark.empty() ? "" : ", near the " + spoken(landmark));
+  if (!at_rest)
+    return text +
+           ". The drape did not come to rest (see the warning above): cloth caught on the body "
+           "and still moving is pulled as it moves, so make it rest first (move the seams or "
+           "curves that meet there away from that place, or let the panel hang free of it), "
+           "then look again; report.json's \"strain\" gives each panel's \"stretch_max\"";
+  return text + fmt::format(
+                    ". Give panel '{}' more room there: \"ease\" above 1 (e.g. 1.05), its "
+                    "curves drawn further from the body (\"offset\"), or a seam or dart through "
+                    "that place; report.json's \"strain\" gives each panel's \"stretch_max\"",
+                    unmirrored(panel));
 }
 
 }  // namespace sd::app

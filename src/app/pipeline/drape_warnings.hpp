@@ -1,6 +1,7 @@
 #pragma once
 // The warnings `run` gives about a drape that finished (not a failure): the cloth still moving
-// at the end, and a garment that slid below where it was drawn. Each is worded for the garment
+// at the end, a garment that slid below where it was drawn, and a panel left stretched far
+// beyond what cloth at rest on a body stretches. Each is worded for the garment
 // at hand: the panel and the place that move, the curve that should hold the garment up.
 
 #include <Eigen/Core>
@@ -37,10 +38,31 @@ struct StillMoving {
   std::string landmark;  // the nearest body landmark; empty without a standing body
   int moving = 0;        // vertices faster than the at-rest speed
   int vertices = 0;
+  bool flat_rest = false;  // draped from the flat pattern ("rest": "flat")
+  double rest_ramp = 0.0;  // s, simulate.rest_ramp
 };
 
-// "<file>: the drape did not come to rest in 3.0 s: ..." with the at-rest limits and what to try.
+// "<file>: the drape did not come to rest in 3.0 s: ..." with the at-rest limits and what to try:
+// from the flat pattern without a rest ramp, "rest_ramp": 1 first (docs/pattern.md, "Drape time
+// and the rest ramp"), else a longer duration and a snugger fit.
 std::string not_at_rest_warning(const std::string& file, double duration_s, double rest_speed,
                                 double rest_window_s, const StillMoving& where);
+
+// A panel stretched more than this (σ₁ − 1 of a triangle, against its rest shape) at the end of
+// a drape is pulled, not resting: garments at rest stretch by their own weight ρgL/K ≈ 0.02 % (a
+// linen, 1 m) and by their fit a few percent (the examples 0.2-2 %, the design corpus and
+// shaped drapes up to 5 % at the longest automatic step, flat-rest drapes against their
+// pattern below 10 %: docs/simulator.md, tests/cli/flat_rest_drape_test.cpp), while a woven
+// reaches its KES EMT strain, 0.5-10 %, only under a firm 500 gf/cm pull (docs/fabrics.md).
+// 15 % is 1.5 times the flat-rest bound and beyond any woven's EMT; trial 35's strapless back,
+// caught in the seat's cleft, ended at 45 %.
+inline constexpr double kOverstretched = 0.15;
+
+// "<file>: panel 'bodice_back' ends stretched 45 % ...": the panel (a mirror copy folded into
+// its panel), the place and landmark of its most stretched triangle, and what to change (when
+// the drape did not come to rest, that first: the cloth is pulled as it moves).
+std::string overstretched_warning(const std::string& file, const std::string& panel, double stretch,
+                                  const Eigen::Vector3d& at, const std::string& landmark,
+                                  bool at_rest);
 
 }  // namespace sd::app

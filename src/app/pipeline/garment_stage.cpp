@@ -9,6 +9,7 @@
 
 #include "garment/body_landmarks.hpp"
 #include "garment/body_surface.hpp"
+#include "garment/sketch_error.hpp"
 #include "garment/sketch_inputs.hpp"
 #include "src/app/pipeline/quality_warnings.hpp"
 
@@ -97,7 +98,25 @@ MeshedGarment mesh_garment(const scene::Sketch& sketch) {
   const garment::BodySurface surface(body.mesh);
   const double body_ms = ms_since(body_start);
   const auto mesh_start = std::chrono::steady_clock::now();
-  garment::Garment g = garment::build_garment(sketch, surface);
+  garment::Garment g = [&] {
+    try {
+      return garment::build_garment(sketch, surface);
+    } catch (const garment::SketchError& e) {
+      // On a body that is not a standing figure (trial 35: assimp's duck given as the body) the
+      // curves fail in ways that say nothing of the cause: say it first.
+      std::string why;
+      try {
+        (void)garment::find_landmarks(body.mesh);
+      } catch (const std::runtime_error& landmarks) {
+        why = landmarks.what();
+      }
+      if (why.empty()) throw;
+      sketch.fail(e.json_path(),
+                  fmt::format("the body '{}' has no landmarks ({}), so it is not a standing "
+                              "human figure: is it the right body file? With it, {}",
+                              sketch.body.mesh, why, e.sentence()));
+    }
+  }();
   const double meshing_ms = ms_since(mesh_start);
 
   std::vector<std::string> groups;

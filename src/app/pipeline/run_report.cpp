@@ -159,6 +159,8 @@ std::vector<GroupStrain> group_strains(const sim::ClothModel& model,
                                        const std::vector<std::string>& group_names) {
   std::vector<double> worst(group_names.size(), 0.0), sum(group_names.size(), 0.0),
       area(group_names.size(), 0.0);
+  std::vector<GroupStrain> out;
+  for (const std::string& name : group_names) out.push_back({name});
   for (size_t t = 0; t < model.triangles.size(); ++t) {
     const sim::TriangleElement& e = model.triangles[t];
     Eigen::Matrix<double, 3, 2> f = Eigen::Matrix<double, 3, 2>::Zero();
@@ -174,10 +176,18 @@ std::vector<GroupStrain> group_strains(const sim::ClothModel& model,
     worst[g] = std::max(worst[g], strain);
     sum[g] += e.rest_area * strain;
     area[g] += e.rest_area;
+    if (sigma(0) - 1 > out[g].stretch_max) {
+      out[g].stretch_max = sigma(0) - 1;
+      out[g].stretch_at = (positions.row(e.vertices[0]) + positions.row(e.vertices[1]) +
+                           positions.row(e.vertices[2]))
+                              .transpose() /
+                          3;
+    }
   }
-  std::vector<GroupStrain> out;
-  for (size_t g = 0; g < group_names.size(); ++g)
-    out.push_back({group_names[g], worst[g], area[g] > 0 ? sum[g] / area[g] : 0.0});
+  for (size_t g = 0; g < group_names.size(); ++g) {
+    out[g].max = worst[g];
+    out[g].mean = area[g] > 0 ? sum[g] / area[g] : 0.0;
+  }
   return out;
 }
 
@@ -203,10 +213,14 @@ nlohmann::json run_report_json(const RunReport& r) {
   out["bending"] = r.bending;
   out["compression"] = r.compression;
   if (r.cusick) out["cusick"] = *r.cusick;
+  if (r.cantilever) out["cantilever"] = *r.cantilever;
   out["rest_shape"] = r.rest_shape;
   nlohmann::json strain = nlohmann::json::array();
   for (const GroupStrain& s : r.strain)
-    strain.push_back({{"group", s.group}, {"strain_max", s.max}, {"strain_mean", s.mean}});
+    strain.push_back({{"group", s.group},
+                      {"strain_max", s.max},
+                      {"strain_mean", s.mean},
+                      {"stretch_max", s.stretch_max}});
   out["strain"] = strain;
   if (r.pattern) out["pattern"] = *r.pattern;
   out["adaptive"] = r.adaptive ? adaptive_json(*r.adaptive) : nlohmann::json(nullptr);

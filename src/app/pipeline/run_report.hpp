@@ -38,11 +38,15 @@ struct MeshingSummary {
 std::optional<MeshingSummary> meshing_summary(const ClothScene& scene);
 
 // How far a group of the drape is from its rest shape: per triangle strain =
-// max(σ₁ − 1, 1 − σ₂) of its deformation gradient; max and rest-area-weighted mean.
+// max(σ₁ − 1, 1 − σ₂) of its deformation gradient; max and rest-area-weighted mean. Apart, the
+// largest stretch σ₁ − 1 alone (compression is cloth buckling finer than the mesh, stretch is
+// cloth pulled) and the centre of that triangle, m.
 struct GroupStrain {
   std::string group;
   double max = 0;
   double mean = 0;
+  double stretch_max = 0;
+  Eigen::Vector3d stretch_at = Eigen::Vector3d::Zero();
 };
 
 // Per group (group_names; triangle_group: #F of the model, index into group_names).
@@ -71,6 +75,9 @@ struct RunReport {
   std::string compression;  // the membrane's compression model that ran
   // A horizontal disc held at its centre: the Cusick drape test's measures (DC, nodes).
   std::optional<nlohmann::json> cusick;
+  // A horizontal strip held by a clamp "top:N": the cantilever test's measures (chord angle,
+  // bending length).
+  std::optional<nlohmann::json> cantilever;
   std::string rest_shape;  // "shaped", "flat" or "flat and shaped"
   sim::SimulationSettings settings;
   // The automatic rule's reason, when the file left the solver or the step to it ("auto").

@@ -95,32 +95,10 @@ constexpr const char* kFewerPictures =
 }  // namespace
 
 void check_sketch(const scene::Sketch& sketch) {
-  // Each fabric as build_cloth_scene reads it (cloth_scene.cpp, fabric_at): the inline object
-  // (by its name), a preset, or a fabric file; checking the name against the presets alone
-  // refused every inline fabric not named after a preset and every fabric file.
+  // Each fabric as build_cloth_scene reads it (scene_fabric); checking the name against the
+  // presets alone refused every inline fabric not named after a preset and every fabric file.
   auto check_fabric = [&](const std::string& name, const std::string& path) {
-    if (!sketch.fabric_inline.empty() && name == sketch.fabric) {
-      try {
-        (void)sim::parse_fabric_json(sketch.fabric_inline, "the fabric given inline");
-      } catch (const sim::InvalidFabricError& e) {
-        sketch.fail("/fabric" + e.pointer(), e.what());
-      }
-      return;
-    }
-    try {
-      (void)sim::fabric_preset(name);
-      return;
-    } catch (const sim::UnknownFabricError& e) {
-      if (!name.ends_with(".json"))
-        sketch.fail(path, std::string(e.what()) +
-                              "; or give a fabric file (.json) or the fabric's constants as an "
-                              "object");
-    }
-    try {
-      (void)sim::load_fabric_file(sketch.resolve(name).string());
-    } catch (const sim::InvalidFabricError& e) {
-      sketch.fail(path, e.what());
-    }
+    (void)scene_fabric(sketch, name, path);
   };
   check_fabric(sketch.fabric, "/fabric");
   for (const garment::PanelSpec& panel : sketch.panels)
@@ -254,8 +232,36 @@ std::optional<std::string> rendering_over_budget(double resident, const Renderer
 }
 
 std::optional<RunEstimate> estimate_before_building(const scene::Sketch& sketch,
-                                                    double frames_per_second) {
+                                                    double frames_per_second,
+                                                    const RunLimits& limits) {
   if (!sketch.sheet) return std::nullopt;
+  // A large sheet is first estimated from a proxy grid of the same shape with about 257²
+  // vertices, analysed and scaled to its vertex count (memory_scaled: the factor per vertex grows
+  // like log2 V), and refused at once when that does not fit, without building and analysing a
+  // grid of up to a million vertices (trial 35's 1024² disc took 11 s and 363 MB to be refused).
+  const double vertices = (static_cast<double>(sketch.sheet->columns) + 1) *
+                          (static_cast<double>(sketch.sheet->rows) + 1);
+  constexpr double kProxyVertices = 257.0 * 257.0;
+  if (vertices > 4 * kProxyVertices) {
+    const double shrink = std::sqrt(vertices / kProxyVertices);
+    sim::SheetSpec proxy;
+    proxy.columns = std::max(1, static_cast<int>(std::lround(sketch.sheet->columns / shrink)));
+    proxy.rows = std::max(1, static_cast<int>(std::lround(sketch.sheet->rows / shrink)));
+    const sim::SheetScene small = sim::build_sheet(proxy);
+    const RunEstimate e =
+        estimate_run(sketch, small.input.triangles,
+                     static_cast<int>(small.input.rest_positions.rows()), frames_per_second);
+    RunEstimate scaled = e;
+    scaled.vertices = vertices;
+    scaled.memory_bytes = memory_scaled(e, vertices);
+    scaled.factor_bytes = e.factor_bytes / std::max(e.vertices, 1.0) * vertices *
+                          std::log2(vertices) / std::log2(std::max(e.vertices, 2.0));
+    scaled.seconds = e.steps * vertices * std::log2(vertices) * kSecondsPerVertexStepLog +
+                     e.frames * kSecondsPerFrame;
+    if (const double budget = memory_budget_bytes(limits);
+        budget > 0 && scaled.memory_bytes > budget)
+      return scaled;
+  }
   // The grid's triangles only (its size and place do not change the factor).
   sim::SheetSpec spec;
   spec.columns = sketch.sheet->columns;
@@ -330,13 +336,22 @@ void check_run_fits(const scene::Sketch& sketch, const RunEstimate& estimate,
             : "";
     if (sketch.sheet) {
       const double side = std::floor(std::sqrt(low)) - 1;
+      // Fitting in memory is not being quick: the time of a drape at that size, every step of
+      // the duration (a drape at rest stops earlier).
+      const double seconds =
+          estimate.steps * low * std::log2(std::max(low, 2.0)) * kSecondsPerVertexStepLog;
+      const std::string time = seconds < 120    ? fmt::format("{:.0f} s", seconds)
+                               : seconds < 7200 ? fmt::format("{:.0f} min", seconds / 60)
+                                                : fmt::format("{:.1f} h", seconds / 3600);
       sketch.fail("/sheet/resolution",
                   fmt::format("a sheet of {}x{} quads ({:.0f} vertices) needs about {} to "
                               "simulate ({} of it the solver's factor{}), more than {}; about "
-                              "{:.0f}x{:.0f} quads would fit",
+                              "{:.0f}x{:.0f} quads would fit, and would take up to about {} to "
+                              "drape ({:.0f} steps); the Cusick and cantilever scenes of "
+                              "docs/fabrics.md use 16 to 40 cells a side",
                               sketch.sheet->columns, sketch.sheet->rows, estimate.vertices,
                               size_text(estimate.memory_bytes), size_text(estimate.factor_bytes),
-                              pictures, limit, side, side));
+                              pictures, limit, side, side, time, estimate.steps));
     }
     sketch.fail("", fmt::format("the cloth has {:.0f} vertices and needs about {} to simulate "
                                 "({} of it the solver's factor{}), more than {}; about {:.0f} "

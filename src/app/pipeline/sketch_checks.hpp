@@ -93,9 +93,13 @@ RunEstimate estimate_run(const scene::Sketch& sketch, const Eigen::MatrixX3i& tr
                          int vertices, double frames_per_second, double duration, double time_step);
 
 // The estimate of a cloth whose mesh is known without building the scene (a sheet: its grid of
-// triangles, without the body or the model); nullopt for a garment.
+// triangles, without the body or the model); nullopt for a garment. A sheet whose factor alone,
+// at its smallest (kMinFactorBytesPerVertexLog), would not fit `limits` is estimated from its
+// vertex count without building its grid or analysing it (a 1024² disc took 11 s and 363 MB to
+// be refused; now it answers at once).
 std::optional<RunEstimate> estimate_before_building(const scene::Sketch& sketch,
-                                                    double frames_per_second);
+                                                    double frames_per_second,
+                                                    const RunLimits& limits = {});
 
 // Refuses (garment::SketchError, at /sheet/resolution, /simulate/duration or the file) a run
 // whose estimate does not fit `limits`, or whose PNG sequence has more than kMaxFrames pictures,
