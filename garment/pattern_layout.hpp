@@ -23,7 +23,16 @@ struct PatternLayoutOptions {
   std::vector<std::vector<double>> edge_allowance;
   std::vector<PanelEase> panel_ease;  // per panel rest-shape scale (empty: 1)
   double gap = 0.01;                  // m between pieces, and from the selvedges and the cut end
+  // A panel "X" and its mirror copy "X.mirror" whose pieces are each other's reflection to
+  // kMirrorPairTolerance (cutting and sewing lines, notches) are drawn once on the sheet, as
+  // "cut 2 (mirror pair)" (PatternPiece::quantity); false draws every piece.
+  bool pair_mirrors = true;
 };
+
+// m: two pieces closer than this to each other's reflection, every point of each outline within
+// it of the other's, are one piece to a cutter (a pencil line is about 0.5 mm wide, and shears
+// follow a line to about a millimetre).
+constexpr double kMirrorPairTolerance = 5e-4;
 
 // A notch on the sewing line, `normal` pointing out of the piece (unit).
 struct PatternNotch {
@@ -60,7 +69,13 @@ struct PatternPiece {
   std::vector<PatternNotch> notches;
   Eigen::Vector2d grain_start = Eigen::Vector2d::Zero(), grain_end = Eigen::Vector2d::Zero();
   Eigen::Vector2d size = Eigen::Vector2d::Zero();       // of the cutting line's bounding box
-  Eigen::Vector2d placement = Eigen::Vector2d::Zero();  // on the fabric: x across, y along
+  Eigen::Vector2d placement = Eigen::Vector2d::Zero();  // on the sheet: x across, y along
+  // How many times the drawn piece is cut: 1; 2 for a panel whose mirror copy it stands for
+  // (cut 2, the second with the piece turned over); 0 for that copy, which is not drawn: its
+  // piece is `drawn_as`'s (index into PatternLayout::pieces; −1 for a drawn piece), reflected,
+  // and its placement is that piece's.
+  int quantity = 1;
+  int drawn_as = -1;
   // The ease as the piece frame's (x, y) scale: (weft, warp).
   Eigen::Vector2d scale() const { return {ease.weft, ease.warp}; }
   double sewn_area = 0, cut_area = 0;  // m²
@@ -69,11 +84,20 @@ struct PatternPiece {
 struct PatternLayout {
   std::vector<PatternPiece> pieces;  // in FlatPattern order
   double fabric_width = 0;           // m
-  double length_used = 0;            // m of fabric from the cut end to the last piece (+ gap)
-  double efficiency = 0;             // Σ cut area / (length_used · fabric_width)
+  // The fabric to cut every piece as many times as it is cut, from one layer (a mirror pair's
+  // piece twice, the second turned over): m from the cut end to the last piece (+ gap), and
+  // Σ cut area / (length_used · fabric_width) over all pieces.
+  double length_used = 0;
+  double efficiency = 0;
+  // The sheet: the drawn pieces (quantity ≥ 1) at their placements, the same as the above
+  // when no piece stands for a mirror pair. m, and Σ drawn cut area / (sheet_length · width).
+  double sheet_length = 0;
+  double sheet_efficiency = 0;
+  int pairs = 0;  // pieces drawn once for a mirror pair
 };
 
-// Lays out every piece. Throws PatternError for a piece whose outline crosses itself in 2D, whose
+// Lays out every piece (a mirror pair's once on the sheet: PatternLayoutOptions::pair_mirrors).
+// Throws PatternError for a piece whose outline crosses itself in 2D, whose
 // cutting line with different seam allowances crosses itself (a concave curve tighter than its
 // allowance) or that is wider than the fabric.
 PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOptions& options = {});

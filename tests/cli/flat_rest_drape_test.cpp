@@ -53,6 +53,7 @@ struct FlatExample {
   std::string folder = "data/examples";  // or data/designs
   double duration = 0.0;                 // s; 0: the file's
   double strain_max = 0.10;              // the largest strain against the pattern in any piece
+  double strain_mean = 0.035;            // the largest of the pieces' mean strains
 };
 
 class FlatRestDrape : public ::testing::TestWithParam<FlatExample> {};
@@ -112,7 +113,7 @@ TEST_P(FlatRestDrape, ComesToRestHangingWhereTheShapedDrapeDoes) {
     if (!example.adaptive) {
       EXPECT_LT(group["strain_max"].get<double>(), example.strain_max) << group["group"];
     }
-    EXPECT_LT(group["strain_mean"].get<double>(), 0.035) << group["group"];
+    EXPECT_LT(group["strain_mean"].get<double>(), example.strain_mean) << group["group"];
   }
   const double top = top_of(dir / "run" / "drape.obj");
   EXPECT_GE(top, example.top_min) << "the garment slid down";
@@ -159,7 +160,15 @@ INSTANTIATE_TEST_SUITE_P(
 INSTANTIATE_TEST_SUITE_P(
     Designs, FlatRestDrape,
     ::testing::Values(FlatExample{"collar-top-human", 1.41, 1.47, false, "data/designs", 0.0, 0.12},
-                      FlatExample{"pencil-skirt-human", 1.00, 1.06, false, "data/designs"}),
+                      FlatExample{"pencil-skirt-human", 1.00, 1.06, false, "data/designs"},
+                      // A tier gathered 1.5 : 1 (`"ease": {"weft": 1.5}`): the gathered flat
+                      // drape's ramp and buckling compression (docs/pattern.md, "Gathered
+                      // pieces"); at rest at 13.5 s of its 20 s, its top 1.051 m (the shaped
+                      // drape's waist). The tier is sewn a third shorter round the body than it
+                      // is cut, so its strain against the pattern is that compression: 36.6 % at
+                      // most, piece means up to 12.1 % (the other pieces under 10 % and 3.5 %).
+                      FlatExample{"tiered-skirt", 1.02, 1.07, false, "data/designs", 0.0, 0.40,
+                                  0.15}),
     test_name);
 
 }  // namespace
