@@ -525,7 +525,9 @@ TEST(StartRepair, ARegionInsideALegMovesOutAsOnePieceWithTheClothRoundIt) {
     // (1.5 · push / slope = 14.4 cm from the band's edge at |x| = 5 cm).
     EXPECT_LT(std::hypot(push.x(), push.y()), 1e-12) << v;
     EXPECT_LE(push.z(), out.z() + 1e-12) << v;
-    if (std::abs(grid[v].x()) > 0.05 + 0.145) EXPECT_EQ(push.z(), 0.0) << v;
+    if (std::abs(grid[v].x()) > 0.05 + 0.145) {
+      EXPECT_EQ(push.z(), 0.0) << v;
+    }
   }
   double worst_stretch = 0.0;
   for (const auto& t : triangles)
