@@ -6,7 +6,8 @@
 // drapes for 6 s. From flat cloth the body-vertex springs are released at no load
 // (fade_carried_push, the flat rest's default; docs/pattern.md, "Drapes that do not rest"):
 // without it the arms-lowering t-shirt's hem, the Collada top's collar and the Collada pencil
-// skirt's hem by the knee cycle and never rest.
+// skirt's hem by the knee cycle and never rest. The tiered skirt's gathered tier starts with its
+// ease ramped in and buckling compression (the gathered flat drape's defaults, docs/pattern.md).
 #include <gtest/gtest.h>
 
 #include <filesystem>
