@@ -15,6 +15,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace sd::garment {
@@ -242,6 +243,52 @@ void grain_line(PatternPiece& piece) {
     }
   piece.grain_start = {centroid.x(), lo + 0.2 * (hi - lo)};
   piece.grain_end = {centroid.x(), hi - 0.2 * (hi - lo)};
+}
+
+// m: the farthest any point of closed polygon a lies from closed polygon b's outline.
+double farthest_from(const Eigen::MatrixX2d& a, const Eigen::MatrixX2d& b) {
+  double worst = 0;
+  for (Eigen::Index i = 0; i < a.rows(); ++i) {
+    const Eigen::Vector2d p = a.row(i).transpose();
+    double nearest = std::numeric_limits<double>::infinity();
+    for (Eigen::Index k = 0; k < b.rows(); ++k) {
+      const Eigen::Vector2d s = b.row(k).transpose(), e = b.row((k + 1) % b.rows()).transpose();
+      const Eigen::Vector2d d = e - s;
+      const double t =
+          d.squaredNorm() > 0 ? std::clamp((p - s).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
+      nearest = std::min(nearest, (s + t * d - p).norm());
+    }
+    worst = std::max(worst, nearest);
+  }
+  return worst;
+}
+
+// Whether `copy` is `original` turned over (x → size.x − x of its cutting line's box) to
+// `tolerance`: cutting and sewing lines each within it of the other's both ways, and every
+// notch of each within it of a notch of the same kind of the other.
+bool is_mirror_image(const PatternPiece& original, const PatternPiece& copy, double tolerance) {
+  if (std::abs(original.size.x() - copy.size.x()) > tolerance ||
+      std::abs(original.size.y() - copy.size.y()) > tolerance ||
+      original.notches.size() != copy.notches.size() || !(original.ease == copy.ease))
+    return false;
+  const auto reflect = [&](Eigen::MatrixX2d p) {
+    p.col(0) = original.size.x() - p.col(0).array();
+    return p;
+  };
+  for (const auto& [a, b] :
+       {std::pair{&original.cutting, &copy.cutting}, std::pair{&original.sewing, &copy.sewing}}) {
+    const Eigen::MatrixX2d turned = reflect(*a);
+    if (farthest_from(turned, *b) > tolerance || farthest_from(*b, turned) > tolerance)
+      return false;
+  }
+  for (const PatternNotch& n : original.notches) {
+    const Eigen::Vector2d at(original.size.x() - n.point.x(), n.point.y());
+    const bool matched = std::any_of(copy.notches.begin(), copy.notches.end(), [&](const auto& m) {
+      return m.balance == n.balance && (m.point - at).norm() <= tolerance;
+    });
+    if (!matched) return false;
+  }
+  return true;
 }
 
 }  // namespace
@@ -483,25 +530,59 @@ PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOpt
     }
     return length;
   };
-  std::vector<size_t> by_area;  // a fold piece's other half is not cut on its own
-  for (size_t i = 0; i < layout.pieces.size(); ++i)
-    if (layout.pieces[i].folded_into < 0) by_area.push_back(i);
-  std::vector<size_t> by_height = by_area;
-  std::stable_sort(by_area.begin(), by_area.end(), [&](size_t a, size_t b) {
-    return layout.pieces[a].cut_area > layout.pieces[b].cut_area;
-  });
-  std::stable_sort(by_height.begin(), by_height.end(), [&](size_t a, size_t b) {
-    return layout.pieces[a].size.y() > layout.pieces[b].size.y();
-  });
-  if (nest(by_height) < nest(by_area)) nest(by_height);
-  double cut = 0;
-  for (const PatternPiece& piece : layout.pieces) {
-    if (piece.folded_into >= 0) continue;
-    layout.length_used = std::max(layout.length_used, piece.placement.y() + piece.size.y());
-    cut += piece.cut_area;
-  }
-  layout.length_used += options.gap;
-  layout.efficiency = cut / (layout.length_used * layout.fabric_width);
+  // Nests the pieces drawn (quantity ≥ 1) or all of them; returns the length (m, with the gap
+  // after the last piece) and the cut area (m²) they take.
+  const auto lay_out = [&](bool drawn_only) {
+    std::vector<size_t> by_area;  // a fold piece's other half is not cut on its own
+    for (size_t i = 0; i < layout.pieces.size(); ++i)
+      if (layout.pieces[i].folded_into < 0 && (!drawn_only || layout.pieces[i].quantity > 0))
+        by_area.push_back(i);
+    std::vector<size_t> by_height = by_area;
+    std::stable_sort(by_area.begin(), by_area.end(), [&](size_t a, size_t b) {
+      return layout.pieces[a].cut_area > layout.pieces[b].cut_area;
+    });
+    std::stable_sort(by_height.begin(), by_height.end(), [&](size_t a, size_t b) {
+      return layout.pieces[a].size.y() > layout.pieces[b].size.y();
+    });
+    if (nest(by_height) < nest(by_area)) nest(by_height);
+    double length = 0, cut = 0;
+    for (const size_t i : by_area) {
+      const PatternPiece& piece = layout.pieces[i];
+      length = std::max(length, piece.placement.y() + piece.size.y());
+      cut += piece.cut_area;
+    }
+    return std::pair{length + options.gap, cut};
+  };
+  // Every piece from one layer: the fabric a cutter needs. Then the sheet, where a piece that
+  // stands for a mirror pair is drawn once ("X" for "X" and "X.mirror").
+  // The other half of a piece cut on the fold is cut with it: none of its own.
+  for (PatternPiece& piece : layout.pieces)
+    if (piece.folded_into >= 0) piece.quantity = 0;
+  const auto [length, cut] = lay_out(false);
+  layout.length_used = length;
+  layout.efficiency = cut / (length * layout.fabric_width);
+  if (options.pair_mirrors)
+    for (size_t i = 0; i < layout.pieces.size(); ++i) {
+      const std::string& id = pattern.panels[i].id;
+      if (!id.ends_with(".mirror")) continue;
+      const std::string original = id.substr(0, id.size() - 7);
+      for (size_t j = 0; j < layout.pieces.size(); ++j)
+        if (pattern.panels[j].id == original && layout.pieces[j].quantity == 1 &&
+            layout.pieces[i].folded_into < 0 && layout.pieces[j].folded_into < 0 &&
+            is_mirror_image(layout.pieces[j], layout.pieces[i], kMirrorPairTolerance)) {
+          layout.pieces[j].quantity = 2;
+          layout.pieces[i].quantity = 0;
+          layout.pieces[i].drawn_as = static_cast<int>(j);
+          ++layout.pairs;
+          break;
+        }
+    }
+  const auto [sheet, drawn_cut] = layout.pairs > 0 ? lay_out(true) : std::pair{length, cut};
+  layout.sheet_length = sheet;
+  layout.sheet_efficiency = drawn_cut / (sheet * layout.fabric_width);
+  for (PatternPiece& piece : layout.pieces)
+    if (piece.drawn_as >= 0)
+      piece.placement = layout.pieces[static_cast<size_t>(piece.drawn_as)].placement;
   return layout;
 }
 

@@ -34,6 +34,10 @@ struct PatternLayoutOptions {
   // Per FlatPattern panel: the panel whose fold piece this one is the other half of (a mirror
   // copy sewn to its original along the centre line only), or −1. Such a piece is not laid out.
   std::vector<int> folded_into;
+  // A panel "X" and its mirror copy "X.mirror" whose pieces are each other's reflection to
+  // kMirrorPairTolerance (cutting and sewing lines, notches) are drawn once on the sheet, as
+  // "cut 2 (mirror pair)" (PatternPiece::quantity); false draws every piece.
+  bool pair_mirrors = true;
 };
 
 // A turn of the outline sharper than this (radians) at a point is a corner the smooth sewing
@@ -42,6 +46,11 @@ struct PatternLayoutOptions {
 constexpr double kCornerTurn = 40.0 * 3.14159265358979323846 / 180.0;
 // m: the densified sewing curve lies within this of its Béziers (a pencil line is 0.5 mm wide).
 constexpr double kCurveTolerance = 1e-4;
+
+// m: two pieces closer than this to each other's reflection, every point of each outline within
+// it of the other's, are one piece to a cutter (a pencil line is about 0.5 mm wide, and shears
+// follow a line to about a millimetre).
+constexpr double kMirrorPairTolerance = 5e-4;
 
 // A notch on the sewing line, `normal` pointing out of the piece (unit).
 struct PatternNotch {
@@ -83,7 +92,13 @@ struct PatternPiece {
   std::vector<PatternNotch> notches;
   Eigen::Vector2d grain_start = Eigen::Vector2d::Zero(), grain_end = Eigen::Vector2d::Zero();
   Eigen::Vector2d size = Eigen::Vector2d::Zero();       // of the cutting line's bounding box
-  Eigen::Vector2d placement = Eigen::Vector2d::Zero();  // on the fabric: x across, y along
+  Eigen::Vector2d placement = Eigen::Vector2d::Zero();  // on the sheet: x across, y along
+  // How many times the drawn piece is cut: 1; 2 for a panel whose mirror copy it stands for
+  // (cut 2, the second with the piece turned over); 0 for that copy, which is not drawn: its
+  // piece is `drawn_as`'s (index into PatternLayout::pieces; −1 for a drawn piece), reflected,
+  // and its placement is that piece's.
+  int quantity = 1;
+  int drawn_as = -1;
   // The ease as the piece frame's (x, y) scale: (weft, warp).
   Eigen::Vector2d scale() const { return {ease.weft, ease.warp}; }
   double sewn_area = 0, cut_area = 0;  // m²
@@ -99,11 +114,20 @@ struct PatternPiece {
 struct PatternLayout {
   std::vector<PatternPiece> pieces;  // in FlatPattern order
   double fabric_width = 0;           // m
-  double length_used = 0;            // m of fabric from the cut end to the last piece (+ gap)
-  double efficiency = 0;             // Σ cut area / (length_used · fabric_width)
+  // The fabric to cut every piece as many times as it is cut, from one layer (a mirror pair's
+  // piece twice, the second turned over): m from the cut end to the last piece (+ gap), and
+  // Σ cut area / (length_used · fabric_width) over all pieces.
+  double length_used = 0;
+  double efficiency = 0;
+  // The sheet: the drawn pieces (quantity ≥ 1) at their placements, the same as the above
+  // when no piece stands for a mirror pair. m, and Σ drawn cut area / (sheet_length · width).
+  double sheet_length = 0;
+  double sheet_efficiency = 0;
+  int pairs = 0;  // pieces drawn once for a mirror pair
 };
 
-// Lays out every piece. Throws PatternError for a piece whose outline crosses itself in 2D, whose
+// Lays out every piece (a mirror pair's once on the sheet: PatternLayoutOptions::pair_mirrors).
+// Throws PatternError for a piece whose outline crosses itself in 2D, whose
 // cutting line with different seam allowances crosses itself (a concave curve tighter than its
 // allowance) or that is wider than the fabric.
 PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOptions& options = {});

@@ -52,6 +52,7 @@ struct SimulateSpec {
   // "linear" | "buckling": the membrane's answer to compression (docs/simulator.md,
   // "Compression and buckling"); buckling caps it at each triangle's Euler load.
   std::string compression = "linear";
+  bool compression_given = false;  // the file says "compression" (a gathered flat drape's default)
   bool stop_at_rest = true;
   Eigen::Vector3d gravity{0.0, -9.81, 0.0};
   std::optional<double> pin_above;  // metres: garment vertices designed at y >= this are pinned
@@ -72,6 +73,7 @@ struct SimulateSpec {
   // Measured on the corpus it lets two drapes rest that did not and keeps two from resting
   // that did (docs/pattern.md), so it is an option, not the default.
   double rest_ramp = 0.0;
+  bool rest_ramp_given = false;  // the file says "rest_ramp" (a gathered flat panel's default)
   // Cloth-cloth contact (sim/self_contact.hpp): folds and layers do not pass through each
   // other. Unset: on for garments, off for sheets.
   std::optional<bool> self_collision;

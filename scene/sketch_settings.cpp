@@ -157,6 +157,7 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
   }
   if (j.contains("compression")) {
     sim.compression = r.text(j["compression"], path + "/compression");
+    sim.compression_given = true;
     if (sim.compression != "linear" && sim.compression != "buckling")
       r.fail(path + "/compression",
              fmt::format("unknown compression model '{}'; use \"linear\" or \"buckling\"",
@@ -187,6 +188,7 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
     sim.self_collision = r.boolean(j["self_collision"], path + "/self_collision");
   if (j.contains("rest_ramp")) {
     sim.rest_ramp = r.number(j["rest_ramp"], path + "/rest_ramp");
+    sim.rest_ramp_given = true;
     if (!(sim.rest_ramp >= 0.0 && sim.rest_ramp <= 10.0))
       r.fail(path + "/rest_ramp",
              fmt::format("a rest ramp of {:.6g} s is outside 0-10 s: the time over which cloth "

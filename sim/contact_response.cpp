@@ -278,17 +278,22 @@ void ContactResponse::reset_cloth(const Eigen::VectorXd& x, const Eigen::VectorX
   // is renumbered in the middle of one.
   if (!repair_planned_ || repairing()) {
     const int steps = repair_planned_ ? repair_.steps - repair_step_ : settings_.repair_steps;
-    repair_ = plan_start_repair(collider_, x, {settings_.thickness, std::max(1, steps)});
+    StartRepairOptions options;
+    options.thickness = settings_.thickness;
+    options.steps = std::max(1, steps);
+    repair_ = plan_start_repair(collider_, x, options, &cloth_);
     repair_step_ = 0;
     if (!repair_planned_ && !repair_.empty())
       spdlog::warn(
           "sim: {} cloth vertices start inside the body (deepest {:.1f} mm); pushing them out "
-          "over {} steps",
-          repair_.pushed.size(), 1e3 * repair_.max_depth, repair_.steps);
+          "over {} steps ({} regions moved out as one, {} vertices with the cloth round them, "
+          "{:.1f} mm at most)",
+          repair_.pushed.size(), 1e3 * repair_.max_depth, repair_.steps, repair_.regions,
+          repair_.moved.size(), 1e3 * repair_.max_push);
     repair_planned_ = true;
   }
   in_repair_.assign(n, 0);
-  for (const BodyContact& c : repair_.pushed) in_repair_[c.vertex] = 1;
+  for (const RepairMove& m : repair_.moved) in_repair_[m.vertex] = 1;
 }
 
 void ContactResponse::restore_normal_forces(std::vector<double> forces) {
@@ -414,12 +419,16 @@ void ContactResponse::constrain_start(const Eigen::VectorXd& x_hat, const Eigen:
   too_deep_.clear();
   end_contacts_.clear();
 
-  // Vertices being pushed out of an intersecting start move along their push normal to this
-  // step's goal; ordinary contacts leave them alone until the repair is over.
+  // Vertices being pushed out of an intersecting start (and the cloth round them) move along
+  // their push to this step's goal; ordinary contacts leave them alone until the repair is over.
   const bool repair = repairing();
   if (repair) {
-    for (const BodyContact& c : repair_.pushed) {
-      const int i = c.vertex;
+    for (const RepairMove& m : repair_.moved) {
+      const int i = m.vertex;
+      BodyContact c;  // the push as a constraint along its direction
+      c.vertex = i;
+      c.normal = m.direction;
+      c.point = repair_.target.segment<3>(3 * i);
       if (filter.is_pinned(i)) continue;
       const Eigen::Vector3d goal = repair_.goal(i, repair_step_ + 1);
       // At most kRepairMaxSpeed: the push is planned per step, so a step retried shorter and

@@ -134,6 +134,66 @@ TEST(ClothScene, RestRampStartsFromTheDrawnTrianglesTurnedOntoThePattern) {
   EXPECT_EQ(plain.start_rest_uv.rows(), 0);
 }
 
+// A gathered panel draped from flat cloth (cut 1.5 times wider than drawn: `"ease": {"weft":
+// 1.5}`) starts at its drawn, sewn size: a rest ramp of kGatherRamp that brings the ease in, so
+// each start triangle, scaled by the ease as the model scales it, is congruent to the drawn one;
+// and the buckling compression, in which the gather costs only its Euler load. Released at once
+// in the linear model the tiered skirt's tier went past 50 m/s in its first steps
+// (docs/pattern.md, "Gathered pieces"). The file's own ramp or compression wins; a small ease
+// (1.05), or shaped rest, changes nothing.
+TEST(ClothScene, GatheredFlatPanelStartsAtItsDrawnSizeAndBuckles) {
+  const auto sketch = [](const std::string& ease, const std::string& simulate) {
+    std::string text = two_patches(1.0);
+    const std::string number = std::to_string(1.0);
+    text.replace(text.find(number), number.size(), ease);
+    text.insert(text.rfind('}'), ", \"simulate\": {" + simulate + "}");
+    return scene::parse_sketch(text, "gather.json");
+  };
+  const scene::Sketch gathered = sketch(R"({"weft": 1.5})", R"("rest": "flat")");
+  EXPECT_TRUE(gathered_flat(gathered));
+  const ClothScene scene = build_cloth_scene(gathered);
+  EXPECT_EQ(scene.rest_ramp, kGatherRamp);
+  EXPECT_EQ(scene.compression, sim::Compression::buckling);
+  EXPECT_EQ(scene_material(scene).rest_ramp, kGatherRamp);
+  ASSERT_EQ(scene.face_ease.cols(), 2);
+  double worst = 0;
+  int gathered_triangles = 0;
+  for (Eigen::Index t = 0; t < scene.input.triangles.rows(); ++t) {
+    const auto ease = scene.face_ease.row(scene.triangle_face(t));
+    gathered_triangles += ease(1) == 1.5 ? 1 : 0;
+    Eigen::Matrix<double, 1, 6> start = scene.start_rest_uv.row(t);
+    for (int k = 0; k < 3; ++k) {
+      start(2 * k) *= ease(0);
+      start(2 * k + 1) *= ease(1);
+    }
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d a = scene.input.rest_positions.row(scene.input.triangles(t, k));
+      const Eigen::Vector3d b =
+          scene.input.rest_positions.row(scene.input.triangles(t, (k + 1) % 3));
+      const Eigen::Vector2d u = start.segment<2>(2 * ((k + 1) % 3)) - start.segment<2>(2 * k);
+      worst = std::max(worst, std::abs(u.norm() - (b - a).norm()));
+    }
+  }
+  EXPECT_GT(gathered_triangles, 0);
+  EXPECT_LT(worst, 1e-12);  // m: every start triangle the drawn one, the gathered ones too
+  // The duration without one of the file's: twice the default plus the ramp.
+  EXPECT_EQ(simulation_settings(gathered).duration,
+            2 * scene::SimulateSpec{}.duration + kGatherRamp);
+
+  const ClothScene told = build_cloth_scene(
+      sketch(R"({"weft": 1.5})", R"("rest": "flat", "rest_ramp": 0, "compression": "linear")"));
+  EXPECT_EQ(told.rest_ramp, 0.0);
+  EXPECT_EQ(told.compression, sim::Compression::linear);
+  const ClothScene slight = build_cloth_scene(sketch(R"({"weft": 1.05})", R"("rest": "flat")"));
+  EXPECT_EQ(slight.rest_ramp, 0.0);
+  EXPECT_EQ(slight.compression, sim::Compression::linear);
+  const scene::Sketch shaped = sketch(R"({"weft": 1.5})", R"("rest": "shaped")");
+  EXPECT_FALSE(gathered_flat(shaped));
+  const ClothScene drawn = build_cloth_scene(shaped);
+  EXPECT_EQ(drawn.compression, sim::Compression::linear);
+  EXPECT_EQ(scene_material(drawn).rest_ramp, 0.0);
+}
+
 // Flat cloth's body-vertex springs are released at no load (ContactSettings::fade_carried_push)
 // unless the file says otherwise; shaped cloth's keep their push (docs/pattern.md, "Drapes that
 // do not rest").

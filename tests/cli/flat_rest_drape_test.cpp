@@ -6,7 +6,8 @@
 // drapes for 6 s. From flat cloth the body-vertex springs are released at no load
 // (fade_carried_push, the flat rest's default; docs/pattern.md, "Drapes that do not rest"):
 // without it the arms-lowering t-shirt's hem, the Collada top's collar and the Collada pencil
-// skirt's hem by the knee cycle and never rest.
+// skirt's hem by the knee cycle and never rest. The tiered skirt's gathered tier starts with its
+// ease ramped in and buckling compression (the gathered flat drape's defaults, docs/pattern.md).
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -53,6 +54,7 @@ struct FlatExample {
   std::string folder = "data/examples";  // or data/designs
   double duration = 0.0;                 // s; 0: the file's
   double strain_max = 0.10;              // the largest strain against the pattern in any piece
+  double strain_mean = 0.035;            // the largest of the pieces' mean strains
 };
 
 class FlatRestDrape : public ::testing::TestWithParam<FlatExample> {};
@@ -112,7 +114,7 @@ TEST_P(FlatRestDrape, ComesToRestHangingWhereTheShapedDrapeDoes) {
     if (!example.adaptive) {
       EXPECT_LT(group["strain_max"].get<double>(), example.strain_max) << group["group"];
     }
-    EXPECT_LT(group["strain_mean"].get<double>(), 0.035) << group["group"];
+    EXPECT_LT(group["strain_mean"].get<double>(), example.strain_mean) << group["group"];
   }
   const double top = top_of(dir / "run" / "drape.obj");
   EXPECT_GE(top, example.top_min) << "the garment slid down";
@@ -159,7 +161,15 @@ INSTANTIATE_TEST_SUITE_P(
 INSTANTIATE_TEST_SUITE_P(
     Designs, FlatRestDrape,
     ::testing::Values(FlatExample{"collar-top-human", 1.41, 1.47, false, "data/designs", 0.0, 0.12},
-                      FlatExample{"pencil-skirt-human", 1.00, 1.06, false, "data/designs"}),
+                      FlatExample{"pencil-skirt-human", 1.00, 1.06, false, "data/designs"},
+                      // A tier gathered 1.5 : 1 (`"ease": {"weft": 1.5}`): the gathered flat
+                      // drape's ramp and buckling compression (docs/pattern.md, "Gathered
+                      // pieces"); at rest at 13.5 s of its 20 s, its top 1.051 m (the shaped
+                      // drape's waist). The tier is sewn a third shorter round the body than it
+                      // is cut, so its strain against the pattern is that compression: 36.6 % at
+                      // most, piece means up to 12.1 % (the other pieces under 10 % and 3.5 %).
+                      FlatExample{"tiered-skirt", 1.02, 1.07, false, "data/designs", 0.0, 0.40,
+                                  0.15}),
     test_name);
 
 }  // namespace

@@ -133,30 +133,32 @@ TEST(PatternCommand, EveryExampleGivesPiecesThatSewAndDoNotOverlap) {
     const auto json = nlohmann::json::parse(read(out / "pattern.json"));
     const auto& pieces = json["pieces"];
     ASSERT_GE(pieces.size(), 4u) << name;
-    const double width = json["fabric_width_mm"], length = json["fabric_length_mm"];
+    const double width = json["fabric_width_mm"], length = json["sheet_length_mm"];
     EXPECT_EQ(width, 1500.0);
-    double cut = 0;
-    size_t drawn = 0;
+    // The sheet is never longer than the fabric that cuts every piece from one layer.
+    EXPECT_LE(length, json["fabric_length_mm"].get<double>());
+    double cut = 0, drawn_cut = 0;
+    int pairs = 0;
     for (size_t i = 0; i < pieces.size(); ++i) {
       const auto& a = pieces[i];
-      // The other half of a piece cut on the fold is not laid out.
-      if (!a["folded_into"].get<std::string>().empty()) continue;
-      ++drawn;
+      // The other half of a piece cut on the fold is cut with it, not on its own.
+      if (a["folded_into"].get<std::string>().empty()) cut += a["cut_area_mm2"].get<double>();
+      if (a["quantity"] == 0) continue;  // drawn as its mirror pair's piece (below)
       const double ax = a["placement_mm"][0], ay = a["placement_mm"][1];
       const double aw = a["size_mm"][0], ah = a["size_mm"][1];
       EXPECT_GE(ax, 0);
       EXPECT_LE(ax + aw, width) << name << " " << a["id"];
       EXPECT_LE(ay + ah, length);
-      cut += a["cut_area_mm2"].get<double>();
+      drawn_cut += a["cut_area_mm2"].get<double>();
       // The allowance adds about perimeter × allowance to the sewn area.
       EXPECT_GT(a["cut_area_mm2"].get<double>(), a["sewn_area_mm2"].get<double>());
       EXPECT_EQ(a["grain_line"][0][0], a["grain_line"][1][0]);  // grain along +y
       EXPECT_FALSE(a["notches"].empty()) << name << " " << a["id"];
-      for (size_t j = i + 1; j < pieces.size(); ++j) {
-        if (!pieces[j]["folded_into"].get<std::string>().empty()) continue;
-        EXPECT_FALSE(overlap(outline(a), outline(pieces[j])))
-            << name << ": " << a["id"] << " overlaps " << pieces[j]["id"];
-      }
+      for (size_t j = i + 1; j < pieces.size(); ++j)
+        if (pieces[j]["quantity"] != 0) {
+          EXPECT_FALSE(overlap(outline(a), outline(pieces[j])))
+              << name << ": " << a["id"] << " overlaps " << pieces[j]["id"];
+        }
       // A mirrored panel and its copy name each other; any other piece names none.
       const std::string id = a["id"], pair = a["mirror_pair"];
       const bool copy = id.ends_with(".mirror");
@@ -164,15 +166,55 @@ TEST(PatternCommand, EveryExampleGivesPiecesThatSewAndDoNotOverlap) {
         EXPECT_EQ(pair, id + ".mirror") << name;
       } else if (!pair.empty()) {
         EXPECT_EQ(pair, copy ? id.substr(0, id.size() - 7) : id + ".mirror") << name;
-        EXPECT_NE(read(out / "pattern.svg").find((copy ? "mirror of " : "pair with ") + pair),
+        EXPECT_NE(read(out / "pattern.svg")
+                      .find(a["quantity"] == 2 ? "cut 2 (mirror pair) · " + id + " and " + pair
+                                               : (copy ? "mirror of " : "pair with ") + pair),
                   std::string::npos)
             << name << " " << id;
       } else {
         EXPECT_FALSE(copy) << name << " " << id;
+        EXPECT_EQ(a["quantity"], 1) << name << " " << id;
+      }
+      if (a["quantity"] != 2) continue;
+      // A piece drawn once for its mirror copy: the copy's cutting line is this one turned over
+      // (x → width − x), every point within 0.5 mm (garment::kMirrorPairTolerance) of it.
+      ++pairs;
+      EXPECT_FALSE(copy) << name << " " << id;
+      const auto other = std::find_if(pieces.begin(), pieces.end(),
+                                      [&](const auto& b) { return b["id"] == pair; });
+      ASSERT_NE(other, pieces.end()) << name << " " << id;
+      EXPECT_EQ((*other)["quantity"], 0) << name << " " << pair;
+      EXPECT_EQ((*other)["drawn_as"], id) << name << " " << pair;
+      const double w = a["size_mm"][0];
+      for (const auto& p : (*other)["cutting_line"]) {
+        double nearest = 1e9;
+        const auto& line = a["cutting_line"];
+        for (size_t k = 0; k < line.size(); ++k) {
+          const auto& s0 = line[k];
+          const auto& s1 = line[(k + 1) % line.size()];
+          const double x0 = w - s0[0].get<double>(), y0 = s0[1], x1 = w - s1[0].get<double>(),
+                       y1 = s1[1];
+          const double dx = x1 - x0, dy = y1 - y0, l2 = dx * dx + dy * dy;
+          const double t =
+              l2 > 0 ? std::clamp(
+                           ((p[0].get<double>() - x0) * dx + (p[1].get<double>() - y0) * dy) / l2,
+                           0.0, 1.0)
+                     : 0.0;
+          nearest = std::min(nearest, std::hypot(x0 + t * dx - p[0].get<double>(),
+                                                 y0 + t * dy - p[1].get<double>()));
+        }
+        EXPECT_LE(nearest, 0.5) << name << " " << pair;
       }
     }
-    EXPECT_NEAR(json["efficiency"].get<double>(), cut / (width * length), 1e-9);
-    EXPECT_EQ(count(read(out / "pattern.svg"), "CUT 1 ON FOLD</text>"), pieces.size() - drawn)
+    EXPECT_EQ(json["mirror_pairs"], pairs) << name;
+    EXPECT_NEAR(json["sheet_efficiency"].get<double>(), drawn_cut / (width * length), 1e-9);
+    EXPECT_NEAR(json["efficiency"].get<double>(),
+                cut / (width * json["fabric_length_mm"].get<double>()), 1e-9);
+    const auto folded = std::count_if(pieces.begin(), pieces.end(), [](const auto& a) {
+      return !a["folded_into"].template get<std::string>().empty();
+    });
+    EXPECT_EQ(count(read(out / "pattern.svg"), "CUT 1 ON FOLD</text>"),
+              static_cast<size_t>(folded))
         << name;
     ASSERT_FALSE(json["seams"].empty());
     size_t balance_notches = 0;
@@ -212,16 +254,19 @@ TEST(PatternCommand, EveryExampleGivesPiecesThatSewAndDoNotOverlap) {
       }
       balance_notches += 2 * listed.size();
     }
-    size_t balance_kind = 0, balance_drawn = 0;
-    for (const auto& piece : pieces)
+    size_t balance_kind = 0, drawn_balance = 0, drawn = 0;
+    for (const auto& piece : pieces) {
+      drawn += piece["quantity"] == 0 ? 0 : 1;
       for (const auto& notch : piece["notches"]) {
         balance_kind += notch["kind"] == "balance";
-        balance_drawn += notch["kind"] == "balance" && piece["folded_into"] == "";
+        drawn_balance += notch["kind"] == "balance" && piece["quantity"] != 0;
       }
+    }
     EXPECT_EQ(balance_kind, balance_notches) << name;
     EXPECT_GT(balance_notches, 0u) << name;  // every example has seams over 25 cm
+    // The sheet draws a mirror pair's piece once, with its notches.
     const std::string svg = read(out / "pattern.svg");
-    EXPECT_EQ(count(svg, "class=\"notch balance\""), balance_drawn) << name;
+    EXPECT_EQ(count(svg, "class=\"notch balance\""), drawn_balance) << name;
     EXPECT_EQ(count(svg, "<g class=\"piece\""), drawn) << name;
     EXPECT_NE(svg.find("width=\"1500.0mm\""), std::string::npos);
   }
@@ -509,11 +554,16 @@ TEST(PatternCommand, SvgOpensInHeadlessChromium) {
   const std::string dom = capture(std::string(browser) + flags + " --dump-dom file://" +
                                   (out / "pattern.svg").string() + " 2>/dev/null");
   ASSERT_FALSE(dom.empty()) << "chromium printed no DOM";
-  EXPECT_EQ(count(dom, "class=\"piece\""), json["pieces"].size());
-  EXPECT_EQ(count(dom, "class=\"cut\""), json["pieces"].size());
+  // A mirror pair's piece is drawn once (quantity 2; its copy 0).
+  size_t pieces = 0;
+  for (const auto& piece : json["pieces"]) pieces += piece["quantity"] == 0 ? 0 : 1;
+  EXPECT_LT(pieces, json["pieces"].size());  // the t-shirt's mirrored panels pair up
+  EXPECT_EQ(count(dom, "class=\"piece\""), pieces);
+  EXPECT_EQ(count(dom, "class=\"cut\""), pieces);
+  EXPECT_EQ(count(dom, "data-cut=\"2\""), json["pieces"].size() - pieces);
   EXPECT_EQ(count(dom, "class=\"scale-bar\""), 1u);
 
-  const double length = json["fabric_length_mm"];
+  const double length = json["sheet_length_mm"];
   const int height = static_cast<int>(std::ceil(0.8 * (length + 40)));
   std::ofstream(out / "view.html") << "<html><body style=\"margin:0\"><img src=\"pattern.svg\" "
                                       "style=\"width:1200px;display:block\">"
@@ -534,7 +584,7 @@ TEST(PatternCommand, SvgOpensInHeadlessChromium) {
     }
   const double covered = static_cast<double>(white) / (white + fabric);
   // Lines, labels and grain lines are neither colour: the white share sits a little below.
-  EXPECT_NEAR(covered, json["efficiency"].get<double>(), 0.05);
+  EXPECT_NEAR(covered, json["sheet_efficiency"].get<double>(), 0.05);
   EXPECT_GT(covered, 0.3);
   // The drawn pieces counted in the screenshot: connected white regions (4-neighbours) of the
   // fabric. Pieces lie 1 cm (8 px) apart on the fabric's colour; inside one, the sewing line is
@@ -570,7 +620,7 @@ TEST(PatternCommand, SvgOpensInHeadlessChromium) {
       }
       if (size > 2000) ++drawn;
     }
-  EXPECT_EQ(drawn, json["pieces"].size());
+  EXPECT_EQ(drawn, pieces);
 }
 
 size_t block_lines(const nlohmann::json& block, const std::string& layer) {
@@ -614,12 +664,12 @@ print(json.dumps(out))
   const auto dxf = nlohmann::json::parse(text);
   EXPECT_EQ(dxf["insunits"], 4);  // millimetres
   size_t drawn = 0;
-  for (const auto& piece : json["pieces"]) drawn += piece["folded_into"] == "";
+  for (const auto& piece : json["pieces"]) drawn += piece["quantity"] == 0 ? 0 : 1;
   EXPECT_LT(drawn, json["pieces"].size());  // the yokes are cut on the fold
   ASSERT_EQ(dxf["inserts"].size(), drawn);
   for (const auto& piece : json["pieces"]) {
     const std::string id = piece["id"];
-    if (piece["folded_into"] != "") {
+    if (piece["quantity"] == 0) {  // cut from its mirror pair's block
       EXPECT_FALSE(dxf["blocks"].contains(id)) << id;
       continue;
     }
@@ -635,8 +685,13 @@ print(json.dumps(out))
     EXPECT_EQ(block["lines"]["7"], 1) << id;    // grain line
     EXPECT_EQ(block["lines"]["4"].get<size_t>(), piece["notches"].size()) << id;
     bool named = false;
-    for (const auto& t : block["texts"]) named = named || t == "Piece Name: " + id;
+    bool quantity = false;
+    for (const auto& t : block["texts"]) {
+      named = named || t == "Piece Name: " + id;
+      quantity = quantity || t == "Quantity: " + std::to_string(piece["quantity"].get<int>());
+    }
     EXPECT_TRUE(named) << id;
+    EXPECT_TRUE(quantity) << id;
   }
   for (const auto& insert : dxf["inserts"]) {
     for (const auto& piece : json["pieces"])

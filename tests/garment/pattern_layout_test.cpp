@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -141,6 +142,60 @@ TEST(PatternLayout, CrossingAllowancesAreRefused) {
     EXPECT_EQ(e.panel(), "piece");
     EXPECT_NE(std::string(e.what()).find("cross"), std::string::npos) << e.what();
   }
+}
+
+// A trapezoid "front" and its copy "front.mirror" (x → 0.3 − x, reversed to stay
+// counter-clockwise), each with notches at its hem's ends: one piece to a cutter, drawn once
+// ("cut 2", the copy drawn as it) while the fabric to cut both from one layer is still nested
+// with both; a copy with one corner 2 mm off (4 × the 0.5 mm tolerance) is drawn on its own, one
+// 0.2 mm off (under it) is still the pair; `pair_mirrors` off draws both.
+TEST(PatternLayout, ExactMirrorPairIsDrawnOnceAsCutTwo) {
+  const std::vector<Eigen::Vector2d> front = {{0, 0}, {0.3, 0}, {0.22, 0.4}, {0.05, 0.4}};
+  const auto mirrored = [&](double moved) {
+    std::vector<Eigen::Vector2d> copy;
+    for (auto it = front.rbegin(); it != front.rend(); ++it)
+      copy.push_back({0.3 - it->x(), it->y()});
+    std::rotate(copy.begin(), copy.begin() + 2, copy.end());  // start at the hem's left end
+    copy[2].x() += moved;                                     // a top corner
+    FlatPattern pattern = one_piece(front, 6);
+    FlatPanel panel = one_piece(copy, 6).panels[0];
+    panel.id = "front.mirror";
+    panel.panel = 1;
+    pattern.panels[0].id = "front";
+    pattern.panels[0].notches = {0, 6};
+    panel.notches = {0, 6};
+    pattern.panels.push_back(panel);
+    return pattern;
+  };
+  const PatternLayout pair = lay_out_pattern(mirrored(0.0));
+  ASSERT_EQ(pair.pieces.size(), 2u);
+  EXPECT_EQ(pair.pairs, 1);
+  EXPECT_EQ(pair.pieces[0].quantity, 2);
+  EXPECT_EQ(pair.pieces[0].drawn_as, -1);
+  EXPECT_EQ(pair.pieces[1].quantity, 0);
+  EXPECT_EQ(pair.pieces[1].drawn_as, 0);
+  EXPECT_EQ(pair.pieces[1].placement, pair.pieces[0].placement);
+  // The sheet holds one piece; cutting both from one layer takes the unpaired layout's fabric.
+  const double gap = PatternLayoutOptions{}.gap;
+  EXPECT_NEAR(pair.sheet_length, pair.pieces[0].placement.y() + pair.pieces[0].size.y() + gap,
+              1e-12);
+  EXPECT_NEAR(pair.sheet_efficiency,
+              pair.pieces[0].cut_area / (pair.sheet_length * pair.fabric_width), 1e-12);
+  PatternLayoutOptions apart;
+  apart.pair_mirrors = false;
+  const PatternLayout both = lay_out_pattern(mirrored(0.0), apart);
+  EXPECT_EQ(both.pairs, 0);
+  EXPECT_EQ(both.pieces[0].quantity, 1);
+  EXPECT_EQ(both.pieces[1].quantity, 1);
+  EXPECT_DOUBLE_EQ(pair.length_used, both.length_used);
+  EXPECT_DOUBLE_EQ(pair.efficiency, both.efficiency);
+  EXPECT_DOUBLE_EQ(both.sheet_length, both.length_used);
+
+  EXPECT_EQ(lay_out_pattern(mirrored(0.0002)).pairs, 1);
+  const PatternLayout off = lay_out_pattern(mirrored(0.002));
+  EXPECT_EQ(off.pairs, 0);
+  EXPECT_EQ(off.pieces[0].quantity, 1);
+  EXPECT_EQ(off.pieces[1].quantity, 1);
 }
 
 }  // namespace

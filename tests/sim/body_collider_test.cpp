@@ -474,6 +474,83 @@ TEST(StartRepair, PushesInsideVerticesOutAlongTheNearestSurface) {
   EXPECT_EQ(repair.positions_after(0), x);
 }
 
+// A vertical panel drawn 2 cm into the front of a leg (a 10 cm square box standing along y):
+// the band of it inside the box. Pushed vertex by vertex to the nearest skin, the band's outer
+// thirds go out through the leg's sides, to both sides (the cloth caught round the leg, as a
+// hem drawn 4 cm into the legs was). With the cloth's triangles the band is one region, moved out
+// of the front as one piece (the same push for every vertex: 2 cm and the thickness, +z), and the
+// cloth round it follows over the falloff, no edge's push differing from its other end's by
+// more than the falloff's slope times its length, so no edge is stretched more than about
+// slope²/2 (3.1 %).
+TEST(StartRepair, ARegionInsideALegMovesOutAsOnePieceWithTheClothRoundIt) {
+  const BodyCollider leg(make_box({-0.05, -0.5, -0.05}, {0.05, 0.5, 0.05}));
+  // 1 cm cells over x in [-0.195, 0.195] (no vertex on the leg's sides, x = ±0.05, where
+  // rounding would count one side's column inside and not the other's), y in [-0.08, 0.08].
+  const int nx = 39, ny = 16;
+  std::vector<Vector3d> grid;
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) grid.emplace_back(-0.195 + 0.01 * i, -0.08 + 0.01 * j, 0.03);
+  std::vector<std::array<int, 3>> triangles;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const int a = j * (nx + 1) + i, b = a + 1, c = a + nx + 1, d = c + 1;
+      triangles.push_back({a, b, d});
+      triangles.push_back({a, d, c});
+    }
+  const Eigen::VectorXd x = flatten(grid);
+  StartRepairOptions options;
+  options.thickness = 0.004;
+
+  const StartRepair alone = plan_start_repair(leg, x, options);
+  bool left = false, right = false;
+  for (const RepairMove& m : alone.moved) {
+    left = left || m.direction.x() < -0.9;
+    right = right || m.direction.x() > 0.9;
+  }
+  EXPECT_TRUE(left && right) << "the nearest skin no longer splits the band";
+
+  const ClothTriangles cloth(triangles);
+  const StartRepair repair = plan_start_repair(leg, x, options, &cloth);
+  EXPECT_EQ(repair.regions, 1);
+  EXPECT_EQ(repair.pushed.size(), alone.pushed.size());
+  EXPECT_NEAR(repair.max_depth, 0.02, 1e-9);
+  const Vector3d out(0, 0, 0.02 + options.thickness);
+  std::vector<char> inside(grid.size(), 0);
+  for (const BodyContact& c : repair.pushed) inside[static_cast<size_t>(c.vertex)] = 1;
+  for (size_t v = 0; v < grid.size(); ++v) {
+    const Vector3d push = repair.target.segment<3>(3 * v) - grid[v];
+    if (inside[v]) {
+      EXPECT_LT((push - out).norm(), 1e-9) << v;
+      EXPECT_GE(leg.signed_distance(repair.target.segment<3>(3 * v)), options.thickness - 1e-9);
+    }
+    // Along +z only, never more than the region's push, nothing beyond the falloff's reach
+    // (1.5 · push / slope = 14.4 cm from the band's edge at |x| = 4.5 cm).
+    EXPECT_LT(std::hypot(push.x(), push.y()), 1e-12) << v;
+    EXPECT_LE(push.z(), out.z() + 1e-12) << v;
+    if (std::abs(grid[v].x()) > 0.045 + 0.144) {
+      EXPECT_EQ(push.z(), 0.0) << v;
+    }
+  }
+  double worst_stretch = 0.0;
+  for (const auto& t : triangles)
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      const double length = (grid[a] - grid[b]).norm();
+      const Vector3d pa = repair.target.segment<3>(3 * a), pb = repair.target.segment<3>(3 * b);
+      EXPECT_LE((pa - grid[a] - (pb - grid[b])).norm(), options.falloff_slope * length * (1 + 1e-9))
+          << a << "-" << b;
+      worst_stretch = std::max(worst_stretch, (pa - pb).norm() / length - 1.0);
+    }
+  EXPECT_LT(worst_stretch, 0.5 * options.falloff_slope * options.falloff_slope);
+  EXPECT_GT(worst_stretch, 0.0);
+  // Every moved vertex is listed once, with its push.
+  for (const RepairMove& m : repair.moved)
+    EXPECT_LT((m.distance * m.direction -
+               (repair.target.segment<3>(3 * m.vertex) - x.segment<3>(3 * m.vertex)))
+                  .norm(),
+              1e-12);
+}
+
 using Triangles = std::vector<std::array<int, 3>>;
 
 // One cloth triangle (x, z corners at height y), 3 cloth vertices as 3n positions.

@@ -52,11 +52,15 @@ void run_pattern(const PatternOptions& options) {
   double worst = 0;
   for (const garment::PatternSeam& seam : sheet.pattern.seams)
     worst = std::max(worst, seam.mismatch());
+  const garment::PatternLayout& layout = sheet.layout;
   std::cout << fmt::format(
-      "{} → {}: {} pieces, {:.0f} mm of {:.0f} mm wide fabric, efficiency {:.0f} %, seams within "
-      "{:.2f} %, {} warning(s)\n",
-      sketch.file, options.out, sheet.layout.pieces.size(), 1000 * sheet.layout.length_used,
-      1000 * sheet.layout.fabric_width, 100 * sheet.layout.efficiency, 100 * worst,
+      "{} → {}: {} pieces{}, {:.0f} mm of {:.0f} mm wide fabric, efficiency {:.0f} %, seams "
+      "within {:.2f} %, {} warning(s)\n",
+      sketch.file, options.out, layout.pieces.size(),
+      layout.pairs > 0 ? fmt::format(" ({} mirror pair{} drawn once, cut 2)", layout.pairs,
+                                     layout.pairs == 1 ? "" : "s")
+                       : std::string(),
+      1000 * layout.length_used, 1000 * layout.fabric_width, 100 * layout.efficiency, 100 * worst,
       sheet.pattern.warnings.size());
 }
 

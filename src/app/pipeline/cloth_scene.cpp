@@ -193,7 +193,7 @@ void flat_rest_shapes(const scene::Sketch& sketch, const garment::Garment& g,
       drawn, triangle_quad, frames, Eigen::VectorXd::Ones(g.mesh.face_count()));
   // The rest ramp starts in the drawn triangles (u along the same warp, v along n × warp).
   scene.start_rest_uv = scene.input.rest_uv;
-  scene.rest_ramp = sketch.simulate.rest_ramp;
+  scene.rest_ramp = rest_ramp_of(sketch);
   for (Eigen::Index t = 0; t < arrays.faces.rows(); ++t) {
     const size_t panel = static_cast<size_t>(g.face_panel(triangle_quad(t)));
     if (!flat[panel]) continue;
@@ -220,6 +220,17 @@ void flat_rest_shapes(const scene::Sketch& sketch, const garment::Garment& g,
           (turn * (drawn_uv.segment<2>(2 * k) - drawn_uv.segment<2>(0)).transpose()).transpose();
     scene.start_rest_uv.row(t) = turned;
   }
+  // The ease scales the blend (AdaptiveCloth::ramped_triangles), so the ramp starts from the
+  // drawn triangles divided by it: unstrained, a gathered piece at its drawn (sewn) size.
+  if (scene.face_ease.size() > 0)
+    for (Eigen::Index t = 0; t < arrays.faces.rows(); ++t) {
+      const auto ease = scene.face_ease.row(triangle_quad(t));
+      const double warp = ease(0), weft = ease.size() > 1 ? ease(1) : warp;
+      for (int k = 0; k < 3; ++k) {
+        scene.start_rest_uv(t, 2 * k) /= warp;
+        scene.start_rest_uv(t, 2 * k + 1) /= weft;
+      }
+    }
   if (!scene.input.rest_uv.allFinite())
     throw std::runtime_error("flat rest: a triangle's vertex is missing from its pattern piece");
 }
@@ -237,7 +248,9 @@ void build_garment_scene(const scene::Sketch& sketch, ClothScene& scene) {
   scene.bend_model =
       sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::hinges);
   scene.compression =
-      sim::parse_compression(sketch.simulate.compression).value_or(sim::Compression::linear);
+      !sketch.simulate.compression_given && gathered_flat(sketch)
+          ? sim::Compression::buckling
+          : sim::parse_compression(sketch.simulate.compression).value_or(sim::Compression::linear);
   const garment::PanelSpec* first_spec = sketch.find_panel(first.id);
   scene.fabric = scene_fabric(sketch, first.fabric,
                               first_spec ? first_spec->json_path + "/fabric" : "/fabric");
@@ -351,6 +364,19 @@ sim::FabricParameters scene_fabric(const scene::Sketch& sketch, const std::strin
   }
 }
 
+bool gathered_flat(const scene::Sketch& sketch) {
+  return std::any_of(sketch.panels.begin(), sketch.panels.end(), [&](const auto& panel) {
+    return panel.rest.value_or(sketch.simulate.rest) == "flat" &&
+           std::max(panel.ease.warp, panel.ease.weft) > kGatherEase;
+  });
+}
+
+double rest_ramp_of(const scene::Sketch& sketch) {
+  const scene::SimulateSpec& spec = sketch.simulate;
+  if (spec.rest_ramp_given) return spec.rest_ramp;
+  return gathered_flat(sketch) ? kGatherRamp : spec.rest_ramp;
+}
+
 sim::SimulationSettings simulation_settings(const scene::Sketch& sketch) {
   const scene::SimulateSpec& spec = sketch.simulate;
   sim::SimulationSettings settings;
@@ -370,7 +396,7 @@ sim::SimulationSettings simulation_settings(const scene::Sketch& sketch) {
   // The run still stops as soon as it is at rest (docs/pattern.md).
   bool flat = spec.rest == "flat";
   for (const garment::PanelSpec& panel : sketch.panels) flat = flat || panel.rest == "flat";
-  if (flat && !spec.duration_given) settings.duration = 2 * spec.duration + spec.rest_ramp;
+  if (flat && !spec.duration_given) settings.duration = 2 * spec.duration + rest_ramp_of(sketch);
   settings.stop_at_rest = spec.stop_at_rest;
   settings.forces.gravity = spec.gravity;
   settings.contact.check_body_vertices = spec.check_body_vertices;

@@ -103,6 +103,23 @@ Eigen::VectorXi triangle_groups(const ClothScene& scene, const Eigen::VectorXi& 
 sim::FabricParameters scene_fabric(const scene::Sketch& sketch, const std::string& name,
                                    const std::string& json_path);
 
+// Whether a panel draped from flat cloth is cut more than kGatherEase times its drawn size along
+// its warp or weft (a gather: `"ease": {"weft": 1.5}`). Drawn at its sewn size, such a panel
+// starts compressed by 1 − 1/ease; with the linear compression model (stress K·ε on both sides)
+// it was released at once as a spring: at about that strain times the fabric's wave speed
+// √(K/ρ) (cotton's weft 217 m/s: 72 m/s for a 1.5 gather, past the step's 50 m/s limit), and,
+// ramped in, it still held the tier out at K·ε (2,000 N/m) and crumpled the tier above it. Real
+// cloth gathers by buckling under almost no load, so such a drape gets, unless its file says
+// otherwise, the buckling compression (sim::Compression::buckling, Choi & Ko) and a rest ramp
+// of kGatherRamp that brings the ease in with the pattern, as a gathering thread is drawn up
+// (docs/pattern.md, "Gathered pieces").
+constexpr double kGatherEase = 1.1;  // released at once: 9 % compression, 20 m/s in cotton
+constexpr double kGatherRamp = 1.0;  // s
+bool gathered_flat(const scene::Sketch& sketch);
+// s: the rest ramp of a drape (ClothScene::rest_ramp): the file's `simulate.rest_ramp`, else
+// kGatherRamp for a gathered flat drape (gathered_flat), else 0.
+double rest_ramp_of(const scene::Sketch& sketch);
+
 // The simulator settings of the file's "simulate" section (integrator, solver, step, duration,
 // gravity). Throws garment::SketchError at /simulate when they cannot work together.
 sim::SimulationSettings simulation_settings(const scene::Sketch& sketch);

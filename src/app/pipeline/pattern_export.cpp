@@ -147,10 +147,6 @@ std::string piece_name(const PatternSheet& sheet, const garment::PatternPiece& p
   return sheet.pattern.panels[static_cast<size_t>(piece.panel)].id;
 }
 
-// How often a piece is cut, naming its mirror image when the garment has one: "cut 1",
-// "cut 1 · pair with front.mirror", "cut 1 · mirror of front". Each of a pair is laid out and
-// cut on its own (the fabric's face side up for both), so the cutter needs to know they belong
-// together.
 // The piece's mirror image in the pattern ("front" ↔ "front.mirror"), empty when it has none.
 std::string mirror_partner(const PatternSheet& sheet, const std::string& id) {
   const std::string suffix = ".mirror";
@@ -167,13 +163,15 @@ std::string ease_label(const garment::PanelEase& ease) {
   return fmt::format("gathered: ease {:g} along, {:g} across the grain", ease.warp, ease.weft);
 }
 
-std::string cut_note(const PatternSheet& sheet, const std::string& id) {
-  const auto& piece = sheet.layout.pieces[static_cast<size_t>(
-      std::find_if(sheet.pattern.panels.begin(), sheet.pattern.panels.end(),
-                   [&](const auto& p) { return p.id == id; }) -
-      sheet.pattern.panels.begin())];
+// How often a piece is cut, naming its mirror image when the garment has one: "cut 2 (mirror
+// pair) · front and front.mirror" for a piece drawn once for both (their pieces each other's
+// reflection: cut twice, the second turned over); else "cut 1", "cut 1 · pair with
+// front.mirror", "cut 1 · mirror of front" for a pair that differs and is drawn twice.
+std::string cut_note(const PatternSheet& sheet, const garment::PatternPiece& piece) {
+  const std::string id = piece_name(sheet, piece);
   if (piece.on_fold) return "CUT 1 ON FOLD";
   const std::string partner = mirror_partner(sheet, id);
+  if (piece.quantity == 2) return fmt::format("cut 2 (mirror pair) · {} and {}", id, partner);
   if (partner.empty()) return "cut 1";
   return (id.ends_with(".mirror") ? "cut 1 · mirror of " : "cut 1 · pair with ") + partner;
 }
@@ -318,7 +316,7 @@ PatternSheet build_pattern_sheet(const scene::Sketch& sketch, const garment::Gar
 std::string pattern_svg(const PatternSheet& sheet) {
   const garment::PatternLayout& layout = sheet.layout;
   const double width = kMm * layout.fabric_width;
-  const double length = kMm * layout.length_used;
+  const double length = kMm * layout.sheet_length;
   const double footer = 40;  // mm below the fabric: title and scale bar
   std::string svg = fmt::format(
       "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
@@ -336,12 +334,18 @@ std::string pattern_svg(const PatternSheet& sheet) {
       "<rect class=\"fabric\" x=\"0\" y=\"0\" width=\"{0:.1f}\" height=\"{3:.1f}\"/>\n",
       width, length + footer, markup_escape(sheet.title), length);
   for (const garment::PatternPiece& piece : layout.pieces) {
-    if (piece.folded_into >= 0) continue;  // the other half of a piece cut on the fold
+    // Drawn as its mirror pair's piece, or the other half of a piece cut on the fold.
+    if (piece.quantity == 0) continue;
     const garment::FlatPanel& flat = sheet.pattern.panels[static_cast<size_t>(piece.panel)];
     const std::string name = piece_name(sheet, piece);
     const std::string fabric = sheet.fabrics[static_cast<size_t>(piece.panel)];
-    svg += fmt::format("<g class=\"piece\" id=\"piece-{0}\" data-panel=\"{0}\"{1}>\n",
-                       markup_escape(name), piece.on_fold ? " data-fold=\"1\"" : "");
+    svg += fmt::format(
+        "<g class=\"piece\" id=\"piece-{0}\" data-panel=\"{0}\" data-cut=\"{1}\"{2}{3}>\n",
+        markup_escape(name), piece.quantity,
+        piece.quantity == 2
+            ? fmt::format(" data-mirror=\"{}\"", markup_escape(mirror_partner(sheet, name)))
+            : std::string(),
+        piece.on_fold ? " data-fold=\"1\"" : "");
     svg += fmt::format("<path class=\"cut\" d=\"{}\"/>\n", svg_path(piece, piece.cutting, length));
     svg += fmt::format("<path class=\"sew\" d=\"{}\"/>\n", svg_curve(piece, length));
     if (piece.on_fold) svg += svg_fold(piece, length);
@@ -369,7 +373,7 @@ std::string pattern_svg(const PatternSheet& sheet) {
                     kMm * (piece.sewing.col(0).maxCoeff() - piece.sewing.col(0).minCoeff()),
                     kMm * (piece.sewing.col(1).maxCoeff() - piece.sewing.col(1).minCoeff()),
                     fabric),
-        fmt::format("{} · {} · stretch {:.1f} % (95th pct)", cut_note(sheet, flat.id),
+        fmt::format("{} · {} · stretch {:.1f} % (95th pct)", cut_note(sheet, piece),
                     ease_label(piece.ease), 100 * flat.distortion.length_p95)};
     Eigen::MatrixX2d outline(piece.sewing.rows(), 2);
     for (Eigen::Index i = 0; i < piece.sewing.rows(); ++i) {
@@ -405,15 +409,23 @@ std::string pattern_svg(const PatternSheet& sheet) {
       "<text x=\"10\" y=\"{:.1f}\" font-size=\"4\">0</text><text x=\"100\" y=\"{:.1f}\" "
       "font-size=\"4\">100 mm</text>\n</g>\n",
       y + 8, y + 8);
+  const auto drawn = std::count_if(layout.pieces.begin(), layout.pieces.end(),
+                                   [](const auto& piece) { return piece.quantity > 0; });
+  const auto to_cut = std::count_if(layout.pieces.begin(), layout.pieces.end(),
+                                    [](const auto& piece) { return piece.folded_into < 0; });
   svg += fmt::format(
-      "<text class=\"note\" x=\"130\" y=\"{:.1f}\" font-size=\"5\">{} · {} pieces · fabric {:.0f} "
-      "mm "
-      "wide, {:.0f} mm used · efficiency {:.0f} % · seam allowance included · true scale "
-      "(mm)</text>\n",
-      y + 4, markup_escape(sheet.title),
-      std::count_if(layout.pieces.begin(), layout.pieces.end(),
-                    [](const auto& piece) { return piece.folded_into < 0; }),
-      width, length, 100 * layout.efficiency);
+      "<text class=\"note\" x=\"130\" y=\"{:.1f}\" font-size=\"5\">{} · {} pieces{} · fabric "
+      "{:.0f} mm wide, {:.0f} mm used · efficiency {:.0f} % · seam allowance included · true "
+      "scale (mm)</text>\n",
+      y + 4, markup_escape(sheet.title), drawn,
+      layout.pairs > 0 ? fmt::format(" ({} to cut)", to_cut) : std::string(), width,
+      length, 100 * layout.sheet_efficiency);
+  if (layout.pairs > 0)
+    svg += fmt::format(
+        "<text class=\"note\" x=\"130\" y=\"{:.1f}\" font-size=\"5\">cut 2 pieces: cut twice, "
+        "the second turned over; every piece cut from one layer takes {:.0f} mm of fabric "
+        "(efficiency {:.0f} %)</text>\n",
+        y + 11, kMm * layout.length_used, 100 * layout.efficiency);
   svg += "</svg>\n";
   return svg;
 }
@@ -483,7 +495,8 @@ std::string pattern_dxf(const PatternSheet& sheet) {
   pair(0, "SECTION");
   pair(2, "BLOCKS");
   for (const garment::PatternPiece& piece : sheet.layout.pieces) {
-    if (piece.folded_into >= 0) continue;  // the other half of a piece cut on the fold
+    // Its mirror pair's block (cut twice), or cut with its fold piece.
+    if (piece.quantity == 0) continue;
     const std::string name = piece_name(sheet, piece);
     pair(0, "BLOCK");
     pair(8, "0");
@@ -507,11 +520,13 @@ std::string pattern_dxf(const PatternSheet& sheet) {
     text("15", at - Eigen::Vector2d(0, 0.008), h,
          "Material: " + sheet.fabrics[static_cast<size_t>(piece.panel)]);
     text("15", at - Eigen::Vector2d(0, 0.016), h,
-         piece.on_fold ? "Quantity: 1 (cut on fold)" : "Quantity: 1");
+         piece.on_fold ? "Quantity: 1 (cut on fold)" : fmt::format("Quantity: {}", piece.quantity));
     text("15", at - Eigen::Vector2d(0, 0.024), h,
          fmt::format("Seam allowance: {} mm", allowance_mm(piece)));
     if (const std::string partner = mirror_partner(sheet, name); !partner.empty())
-      text("15", at - Eigen::Vector2d(0, 0.032), h, "Mirror pair: " + partner);
+      text("15", at - Eigen::Vector2d(0, 0.032), h,
+           piece.quantity == 2 ? "Mirror pair: " + partner + " (cut 2, the second turned over)"
+                               : "Mirror pair: " + partner);
     pair(0, "ENDBLK");
     pair(8, "0");
   }
@@ -519,7 +534,7 @@ std::string pattern_dxf(const PatternSheet& sheet) {
   pair(0, "SECTION");
   pair(2, "ENTITIES");
   for (const garment::PatternPiece& piece : sheet.layout.pieces) {
-    if (piece.folded_into >= 0) continue;
+    if (piece.quantity == 0) continue;
     pair(0, "INSERT");
     pair(8, "0");
     pair(2, piece_name(sheet, piece));
@@ -675,7 +690,11 @@ nlohmann::json pattern_json(const PatternSheet& sheet) {
          {"distortion", distortion_json(flat.distortion)},
          {"iterations", flat.iterations},
          {"warning", flat.warning},
-         {"mirror_pair", mirror_partner(sheet, flat.id)}});
+         {"mirror_pair", mirror_partner(sheet, flat.id)},
+         {"quantity", piece.quantity},
+         {"drawn_as", piece.drawn_as >= 0
+                          ? piece_name(sheet, layout.pieces[static_cast<size_t>(piece.drawn_as)])
+                          : flat.id}});
   }
   nlohmann::json seams = nlohmann::json::array();
   for (const garment::PatternSeam& seam : sheet.pattern.seams) {
@@ -715,6 +734,9 @@ nlohmann::json pattern_json(const PatternSheet& sheet) {
           {"fabric_width_mm", kMm * layout.fabric_width},
           {"fabric_length_mm", kMm * layout.length_used},
           {"efficiency", layout.efficiency},
+          {"sheet_length_mm", kMm * layout.sheet_length},
+          {"sheet_efficiency", layout.sheet_efficiency},
+          {"mirror_pairs", layout.pairs},
           {"pieces", pieces},
           {"seams", seams},
           {"warnings", sheet.pattern.warnings}};
@@ -733,6 +755,8 @@ nlohmann::json pattern_summary(const PatternSheet& sheet) {
           {"fabric_width_mm", kMm * sheet.layout.fabric_width},
           {"fabric_length_mm", kMm * sheet.layout.length_used},
           {"efficiency", sheet.layout.efficiency},
+          {"sheet_length_mm", kMm * sheet.layout.sheet_length},
+          {"mirror_pairs", sheet.layout.pairs},
           {"warnings", sheet.pattern.warnings},
           {"timing_ms", {{"flatten", sheet.flatten_ms}, {"layout", sheet.layout_ms}}}};
 }
