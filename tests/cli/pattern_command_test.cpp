@@ -213,8 +213,7 @@ TEST(PatternCommand, EveryExampleGivesPiecesThatSewAndDoNotOverlap) {
     const auto folded = std::count_if(pieces.begin(), pieces.end(), [](const auto& a) {
       return !a["folded_into"].template get<std::string>().empty();
     });
-    EXPECT_EQ(count(read(out / "pattern.svg"), "CUT 1 ON FOLD</text>"),
-              static_cast<size_t>(folded))
+    EXPECT_EQ(count(read(out / "pattern.svg"), "CUT 1 ON FOLD</text>"), static_cast<size_t>(folded))
         << name;
     ASSERT_FALSE(json["seams"].empty());
     size_t balance_notches = 0;

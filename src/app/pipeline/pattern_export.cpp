@@ -418,8 +418,8 @@ std::string pattern_svg(const PatternSheet& sheet) {
       "{:.0f} mm wide, {:.0f} mm used · efficiency {:.0f} % · seam allowance included · true "
       "scale (mm)</text>\n",
       y + 4, markup_escape(sheet.title), drawn,
-      layout.pairs > 0 ? fmt::format(" ({} to cut)", to_cut) : std::string(), width,
-      length, 100 * layout.sheet_efficiency);
+      layout.pairs > 0 ? fmt::format(" ({} to cut)", to_cut) : std::string(), width, length,
+      100 * layout.sheet_efficiency);
   if (layout.pairs > 0)
     svg += fmt::format(
         "<text class=\"note\" x=\"130\" y=\"{:.1f}\" font-size=\"5\">cut 2 pieces: cut twice, "
