@@ -467,11 +467,6 @@ int repair_stitched_folds(const GarmentRequest& sketch, const CurveNetwork& net,
 void assemble_mesh(std::vector<std::array<int, 4>>& faces, std::vector<int>& face_panel,
                    VertexPool& pool, Garment& garment) {
   garment.merged_doublets = remove_doublets(faces, face_panel, pool.positions.size());
-  if (const int doublets = garment.merged_doublets; doublets > 0)
-    spdlog::warn(
-        "{} seam vertex(es) had only two quads folded onto each other; merged them into "
-        "one quad each (the seam steps one vertex aside there)",
-        doublets);
   for (GarmentPanel& p : garment.panels) p.faces = 0;
   for (int p : face_panel) ++garment.panels[static_cast<size_t>(p)].faces;
   // Drop vertices no face uses (the centres of removed doublets), keeping order.
@@ -1077,6 +1072,13 @@ Garment build_garment(const GarmentRequest& sketch, const BodySurface& body) {
   };
   check_overlapping_boundaries(sketch, body, net, pool, faces, face_panel, garment);
   check_seam_directions(sketch, body, pool, faces, face_panel, curve_of, garment);
+  // Said after the checks: two panels folded onto each other along a seam leave doublets there,
+  // and the seam check's error names the cause (a warning before it would only add noise).
+  if (const int doublets = garment.merged_doublets; doublets > 0)
+    spdlog::warn(
+        "{} seam vertex(es) had only two quads folded onto each other; merged them into "
+        "one quad each (the seam steps one vertex aside there)",
+        doublets);
   label_panels(sketch, body, faces, face_panel, pool, garment);
   // The grain: a panel on a limb may run along it (panel_grain.hpp); the landmarks are found only
   // then (a body that is not a standing figure has none: every panel is vertical).

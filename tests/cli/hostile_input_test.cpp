@@ -754,7 +754,8 @@ TEST(HostileInput, AnOpenBodyIsWarnedInTheReportAndCounted) {
   EXPECT_TRUE(listed) << report["warnings"].dump();
 
   // validate: as many warnings counted as printed; the godet skirt has a fabric per panel that
-  // the drape cannot honour (2) besides its quality gate's (3).
+  // the drape cannot honour (2) besides its quality gate's (2 since fill consistency's ninth
+  // round, 3 before): every other warning printed is a mesh quality warning.
   const std::string godet = (fs::path(SD_SOURCE_DIR) / "data/examples/godet-skirt.json").string();
   const CommandResult v = run_sketchdrape("validate " + godet);
   ASSERT_EQ(v.exit_code, 0) << v.output;
@@ -762,10 +763,10 @@ TEST(HostileInput, AnOpenBodyIsWarnedInTheReportAndCounted) {
   for (size_t at = v.output.find("warning: "); at != std::string::npos;
        at = v.output.find("warning: ", at + 1))
     ++printed;
-  EXPECT_GT(printed, 3) << v.output;
-  EXPECT_NE(
-      v.output.find(fmt::format("; {} warning(s), 3 of them mesh quality warning(s)", printed)),
-      std::string::npos)
+  EXPECT_GT(printed, 2) << v.output;
+  EXPECT_NE(v.output.find(fmt::format("; {} warning(s), {} of them mesh quality warning(s)",
+                                      printed, printed - 2)),
+            std::string::npos)
       << v.output;
   fs::remove_all(dir);
 }

@@ -687,7 +687,11 @@ print(json.dumps(out))
     bool quantity = false;
     for (const auto& t : block["texts"]) {
       named = named || t == "Piece Name: " + id;
-      quantity = quantity || t == "Quantity: " + std::to_string(piece["quantity"].get<int>());
+      // A piece cut on the fold says so ("Quantity: 1 (cut on fold)").
+      quantity =
+          quantity || t == (piece["on_fold"].get<bool>()
+                                ? std::string("Quantity: 1 (cut on fold)")
+                                : "Quantity: " + std::to_string(piece["quantity"].get<int>()));
     }
     EXPECT_TRUE(named) << id;
     EXPECT_TRUE(quantity) << id;

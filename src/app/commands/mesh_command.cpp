@@ -78,12 +78,7 @@ void run_mesh(const MeshOptions& options) {
   // The scene `validate` and `run` build, with every check they make (pin_above, the fabric, a
   // flat rest's flattening, the body's poses, the drape's size): `mesh` refuses the same files
   // (trial 35: "pin_above": 2.5 was meshed with exit 0 and refused by validate).
-  if (const auto estimate = estimate_before_building(sketch, 0))
-    check_run_fits(sketch, *estimate, RunLimits{}, 0);
-  const ClothScene scene = build_cloth_scene(sketch);
-  check_run_fits(
-      sketch, estimate_run(sketch, scene.input.triangles, static_cast<int>(scene.start.rows()), 0),
-      RunLimits{}, 0);
+  const ClothScene scene = build_cloth_scene_within_limits(sketch);
 
   if (sketch.sheet) {
     // A sheet scene: its grid of triangles is the fixed mesh `run` simulates (a sheet that asks

@@ -69,12 +69,7 @@ void run_validate(const ValidateOptions& options) {
   const scene::Sketch sketch = scene::load_sketch(options.sketch);
   check_sketch(sketch);
   // What `run` would refuse for its size, refused here too (a sheet before it is built).
-  if (const auto estimate = estimate_before_building(sketch, 0))
-    check_run_fits(sketch, *estimate, RunLimits{}, 0);
-  const ClothScene scene = build_cloth_scene(sketch);
-  check_run_fits(
-      sketch, estimate_run(sketch, scene.input.triangles, static_cast<int>(scene.start.rows()), 0),
-      RunLimits{}, 0);
+  const ClothScene scene = build_cloth_scene_within_limits(sketch);
   // The pattern `mesh` and `run` write when the file asks for one (output.pattern), laid out
   // here too: a fabric too narrow for a piece is refused by validate, not after a drape.
   if (scene.garment && sketch.output.pattern)

@@ -17,6 +17,7 @@
 #include "src/app/pipeline/garment_stage.hpp"
 #include "src/app/pipeline/quality_warnings.hpp"
 #include "src/app/pipeline/settle_time.hpp"
+#include "src/app/pipeline/sketch_checks.hpp"
 
 namespace sd::app {
 namespace {
@@ -548,6 +549,16 @@ ClothScene build_cloth_scene(const scene::Sketch& sketch) {
 
 meshing::TriMesh body_at(const ClothScene& scene, double t) {
   return scene.body_motion ? scene.body_motion->mesh_at(t) : scene.body->mesh;
+}
+
+ClothScene build_cloth_scene_within_limits(const scene::Sketch& sketch) {
+  if (const auto estimate = estimate_before_building(sketch, 0))
+    check_run_fits(sketch, *estimate, RunLimits{}, 0);
+  ClothScene scene = build_cloth_scene(sketch);
+  check_run_fits(
+      sketch, estimate_run(sketch, scene.input.triangles, static_cast<int>(scene.start.rows()), 0),
+      RunLimits{}, 0);
+  return scene;
 }
 
 }  // namespace sd::app

@@ -71,6 +71,12 @@ struct ClothScene {
 // can fix: an unknown fabric, a body that will not load, panels that do not close, ...
 ClothScene build_cloth_scene(const scene::Sketch& sketch);
 
+// build_cloth_scene with the size checks `run` makes under the default limits: a sheet refused
+// before it is built, any cloth once it is (sketch_checks.hpp). What `validate` and `mesh` build,
+// so that they refuse the same files as `run` (trial 35: a file meshed with exit 0 that validate
+// refused).
+ClothScene build_cloth_scene_within_limits(const scene::Sketch& sketch);
+
 // The body as it stands at time t of the drape (its pose when it moves). The scene must have a
 // body.
 meshing::TriMesh body_at(const ClothScene& scene, double t);
