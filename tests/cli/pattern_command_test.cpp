@@ -124,6 +124,20 @@ std::vector<double> notch_fractions(const nlohmann::json& piece, const nlohmann:
   return fractions;
 }
 
+// mm from (x, y) to the closed polyline `outline` ([[x, y], ...] of pattern.json).
+double distance_to_outline(const nlohmann::json& outline, double x, double y) {
+  double best = 1e300;
+  for (size_t k = 0; k < outline.size(); ++k) {
+    const double ax = outline[k][0], ay = outline[k][1];
+    const double bx = outline[(k + 1) % outline.size()][0];
+    const double by = outline[(k + 1) % outline.size()][1];
+    const double dx = bx - ax, dy = by - ay;
+    const double t = std::clamp(((x - ax) * dx + (y - ay) * dy) / (dx * dx + dy * dy), 0.0, 1.0);
+    best = std::min(best, std::hypot(x - ax - t * dx, y - ay - t * dy));
+  }
+  return best;
+}
+
 TEST(PatternCommand, EveryExampleGivesPiecesThatSewAndDoNotOverlap) {
   for (const char* name : {"tshirt", "a-line-skirt", "sleeveless-dress", "shorts", "godet-skirt"}) {
     const fs::path out = fresh_dir(name);
@@ -329,17 +343,7 @@ TEST(PatternCommand, SeamAllowancePerSeamFromTheCurves) {
     const auto cutting = piece["cutting_line"];
     const size_t n = sewing.size();
     const auto distance_to_cut = [&cutting](double x, double y) {
-      double best = 1e300;
-      for (size_t k = 0; k < cutting.size(); ++k) {
-        const double ax = cutting[k][0], ay = cutting[k][1];
-        const double bx = cutting[(k + 1) % cutting.size()][0];
-        const double by = cutting[(k + 1) % cutting.size()][1];
-        const double dx = bx - ax, dy = by - ay;
-        const double t =
-            std::clamp(((x - ax) * dx + (y - ay) * dy) / (dx * dx + dy * dy), 0.0, 1.0);
-        best = std::min(best, std::hypot(x - ax - t * dx, y - ay - t * dy));
-      }
-      return best;
+      return distance_to_outline(cutting, x, y);
     };
     double covered = 0;
     for (const auto& run : piece["allowances"]) {
@@ -499,18 +503,8 @@ TEST(PatternCommand, CentrePiecesAreCutOnTheFold) {
     folds.push_back(id);
     const auto& fold = piece["fold_line"];
     const auto& cutting = piece["cutting_line"];
-    const auto distance_to_cut = [&](double x, double y) {
-      double best = 1e300;
-      for (size_t k = 0; k < cutting.size(); ++k) {
-        const double ax = cutting[k][0], ay = cutting[k][1];
-        const double bx = cutting[(k + 1) % cutting.size()][0];
-        const double by = cutting[(k + 1) % cutting.size()][1];
-        const double dx = bx - ax, dy = by - ay;
-        const double t =
-            std::clamp(((x - ax) * dx + (y - ay) * dy) / (dx * dx + dy * dy), 0.0, 1.0);
-        best = std::min(best, std::hypot(x - ax - t * dx, y - ay - t * dy));
-      }
-      return best;
+    const auto distance_to_cut = [&cutting](double x, double y) {
+      return distance_to_outline(cutting, x, y);
     };
     const double x0 = fold[0][0], y0 = fold[0][1], x1 = fold[1][0], y1 = fold[1][1];
     EXPECT_GT(std::hypot(x1 - x0, y1 - y0), 150) << id;  // the yoke's centre line, 176 mm
