@@ -358,6 +358,18 @@ pid_t start_in_new_group(const std::vector<std::string>& args, const fs::path& l
   return pid;
 }
 
+// Polls a batch's output folder (every 25 ms, for up to 30 s) until one of its jobs has
+// started, i.e. written its log; false if none did.
+bool wait_until_a_job_starts(const fs::path& out) {
+  for (int i = 0; i < 1200; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(25));
+    std::error_code ec;
+    for (const auto& d : fs::directory_iterator(out / "jobs", ec))
+      if (fs::exists(d.path() / "log.txt")) return true;
+  }
+  return false;
+}
+
 TEST(BatchFaults, SigkillMidwayThenResumeRedoesOnlyUnfinishedJobs) {
   const fs::path dir = fresh_batch_dir("sigkill");
   const fs::path manifest = wardrobe(dir, {"jersey", "denim", "silk"});  // 9 jobs
@@ -426,14 +438,7 @@ TEST(BatchFaults, SigtermStopsChildrenWritesTheSummaryAndResumes) {
   const pid_t pid = start_in_new_group(
       {"batch", manifest.string(), "-o", out.string(), "--stage", "mesh", "-j", "2"},
       dir / "first.log");
-  bool started = false;
-  for (int i = 0; i < 1200 && !started; ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(25));
-    std::error_code ec;
-    for (const auto& d : fs::directory_iterator(out / "jobs", ec))
-      started = started || fs::exists(d.path() / "log.txt");
-  }
-  ASSERT_TRUE(started) << read_text(dir / "first.log");
+  ASSERT_TRUE(wait_until_a_job_starts(out)) << read_text(dir / "first.log");
   ASSERT_EQ(kill(pid, SIGTERM), 0);  // the batch only: it must end its children itself
   int status = 0;
   waitpid(pid, &status, 0);
@@ -619,14 +624,7 @@ TEST(BatchFaults, SecondBatchOnTheSameFolderRefuses) {
   const pid_t first = start_in_new_group(
       {"batch", manifest.string(), "-o", out.string(), "--stage", "mesh", "-j", "1"},
       dir / "first.log");
-  bool started = false;
-  for (int i = 0; i < 1200 && !started; ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(25));
-    std::error_code ec;
-    for (const auto& d : fs::directory_iterator(out / "jobs", ec))
-      started = started || fs::exists(d.path() / "log.txt");
-  }
-  ASSERT_TRUE(started) << read_text(dir / "first.log");
+  ASSERT_TRUE(wait_until_a_job_starts(out)) << read_text(dir / "first.log");
   const CommandResult second = run_sketchdrape("batch " + shell_quoted(manifest) + " -o " +
                                                shell_quoted(out) + " --stage mesh -j 1");
   EXPECT_EQ(second.exit_code, 1) << second.output;
@@ -655,14 +653,7 @@ TEST(BatchFaults, ShardsOfAnotherCountOnTheSameFolderRefuse) {
   const pid_t first = start_in_new_group({"batch", manifest.string(), "-o", out.string(), "--stage",
                                           "mesh", "-j", "1", "--shard", "1/2"},
                                          dir / "first.log");
-  bool started = false;
-  for (int i = 0; i < 1200 && !started; ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(25));
-    std::error_code ec;
-    for (const auto& d : fs::directory_iterator(out / "jobs", ec))
-      started = started || fs::exists(d.path() / "log.txt");
-  }
-  ASSERT_TRUE(started) << read_text(dir / "first.log");
+  ASSERT_TRUE(wait_until_a_job_starts(out)) << read_text(dir / "first.log");
   const std::string batch =
       "batch " + shell_quoted(manifest) + " -o " + shell_quoted(out) + " --stage mesh -j 1";
   const CommandResult thirds = run_sketchdrape(batch + " --shard 1/3");
