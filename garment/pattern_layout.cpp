@@ -453,9 +453,10 @@ PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOpt
       throw PatternError(
           id, fmt::format("the piece of panel '{}' is {:.0f} mm wide with its seam allowance and "
                           "needs a fabric at least {} mm wide with the {:.0f} mm gap kept "
-                          "free at each selvedge; the fabric is {:.0f} mm wide: use a wider fabric "
-                          "or split the panel",
-                          id, 1000 * widest.size.x(), needed_mm, 1000 * options.gap,
+                          "free at each selvedge (the piece and both gaps, rounded up to the "
+                          "layout's {:.0f} mm grid); the fabric is {:.0f} mm wide: use a wider "
+                          "fabric or split the panel",
+                          id, 1000 * widest.size.x(), needed_mm, 1000 * options.gap, 1000 * kCell,
                           1000 * options.fabric_width));
     }
   }

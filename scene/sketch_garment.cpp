@@ -254,8 +254,12 @@ PanelEase parse_ease(const Reader& r, const json& j, const std::string& path) {
     const double e = r.positive(value, at);
     if (e < 0.5 || e > 2.0)
       r.fail(at, fmt::format("ease {}{} is outside 0.5 .. 2 (1 = rest shape as designed, 1.05 = "
-                             "5% looser, 1.5 = half as long again to gather)",
-                             e, way));
+                             "5% looser, 1.5 = half as long again to gather){}",
+                             e, way,
+                             // A percentage typed for the factor: 108 (%) is 1.08.
+                             e >= 50.0 && e <= 200.0
+                                 ? fmt::format("; if you meant {:g} %, write {:g}", e, e / 100)
+                                 : std::string()));
     return e;
   };
   if (!j.is_object()) {

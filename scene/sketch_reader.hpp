@@ -139,7 +139,9 @@ class Reader {
     });
     if (!ok)
       fail(path,
-           fmt::format("id '{}' may only use letters, digits, '_' and '-'", garment::excerpt(id)));
+           fmt::format(
+               "id '{}' may only use ASCII letters (a-z, A-Z; no accents), digits, '_' and '-'",
+               garment::excerpt(id)));
     return id;
   }
 

@@ -56,6 +56,31 @@ TEST(Cli, UnknownCommandAndOptionSayWhatToWriteInstead) {
   EXPECT_LT(help.output.find("\n  mesh "), help.output.find("\n  fill ")) << help.output;
 }
 
+// Trial 36: an extra file, a number out of range and a missing file came as CLI11's raw text,
+// the only errors without "error:"; `mesh FILE -o ''` wrote into the working directory.
+TEST(Cli, EveryCommandLineMistakeIsAnErrorSentence) {
+  const std::string sketch = std::string(SD_SOURCE_DIR) + "/data/examples/tshirt.json";
+  const CommandResult extra = run_sketchdrape("validate " + sketch + " extra.json");
+  EXPECT_EQ(extra.exit_code, 2) << extra.output;
+  EXPECT_NE(extra.output.find("error: "), std::string::npos) << extra.output;
+  EXPECT_NE(extra.output.find("extra.json"), std::string::npos) << extra.output;
+  EXPECT_NE(extra.output.find("`sketchdrape validate --help` says what it takes"),
+            std::string::npos)
+      << extra.output;
+  const CommandResult frames = run_sketchdrape("run " + sketch + " --frames 1e308");
+  EXPECT_EQ(frames.exit_code, 2) << frames.output;
+  EXPECT_NE(frames.output.find("error: "), std::string::npos) << frames.output;
+  const CommandResult missing = run_sketchdrape("validate");
+  EXPECT_EQ(missing.exit_code, 2) << missing.output;
+  EXPECT_NE(missing.output.find("error: "), std::string::npos) << missing.output;
+  for (const std::string command : {"mesh", "run", "pattern"}) {
+    const CommandResult empty = run_sketchdrape(command + " " + sketch + " -o ''");
+    EXPECT_EQ(empty.exit_code, 2) << command << ": " << empty.output;
+    EXPECT_NE(empty.output.find("an empty name is no place to write"), std::string::npos)
+        << command << ": " << empty.output;
+  }
+}
+
 TEST(Cli, InfoBuiltinReportsYUpAndHeight) {
   const CommandResult r = run_sketchdrape("info builtin --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;

@@ -252,7 +252,7 @@ TEST(SketchFile, ErrorsCarryFilePathAndSentence) {
           "output": {"images": [{"size": [10, 100]}]}})",
        "/output/images/0/size/0", "at least 16"},
       {R"({"curves": [{"id": "a b", "points": [[0, 1], [1, 1]]}], "panels": []})", "/curves/0/id",
-       "may only use letters"},
+       "may only use ASCII letters"},
       {R"({"curves": [{"id": "a", "points": [[0, 1], [1, 1]]}], "panels": [{"id": "p", "boundary": ["a"]}],
           "join": [{"id": "j", "panels": ["p", "p.mirror"]}]})",
        "/join/0/panels/1", "has no mirror copy"},

@@ -99,7 +99,8 @@ void add_batch_command(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("INPUTS", o->batch.inputs,
                   "Sketch files and manifests (JSON with \"format\": \"sketchdrape-batch/1\", or "
                   "*.csv)");
-  cmd->add_option("-o,--out", o->batch.out, "Batch folder (job folders, batch.json, index.html)");
+  cmd->add_option("-o,--out", o->batch.out, "Batch folder (job folders, batch.json, index.html)")
+      ->check(non_empty_path());
   cmd->add_option("--stage", o->batch.stage, "Command each job runs: run (default) or mesh")
       ->capture_default_str();
   cmd->add_option("-j,--jobs", o->batch.parallel, "Jobs at once (child processes)")

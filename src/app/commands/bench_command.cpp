@@ -438,8 +438,8 @@ void add_bench_command(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--scene", options->scenes,
                   "hanging-sheet, sphere-drop, tshirt or a sketch file (sheet or garment); "
                   "repeat for several (default: all three, or the hanging sheet when quick)");
-  cmd->add_option("-o,--out", options->out,
-                  "Output directory (created if needed; default ./bench)");
+  cmd->add_option("-o,--out", options->out, "Output directory (created if needed; default ./bench)")
+      ->check(non_empty_path());
   cmd->add_flag("--json", options->json,
                 "Print the results as one JSON object instead of the table");
   cmd->add_option("--cache", options->cache,

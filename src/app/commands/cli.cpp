@@ -73,14 +73,32 @@ std::string missing_command_sentence(const CLI::App& app, int argc, char** argv)
       word, best.empty() ? "" : fmt::format(" (did you mean '{}'?)", best), command_list(app));
 }
 
+// The subcommand named on the command line, or null.
+const CLI::App* command_in(const CLI::App& app, int argc, char** argv) {
+  for (int i = 1; i < argc; ++i)
+    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+      if (sub->get_name() == argv[i]) return sub;
+  return nullptr;
+}
+
+// Any other command-line mistake (an extra file, a number out of range): CLI11's sentence in
+// the program's "error: ..." form with where to read what the command takes (trial 36: its
+// raw text came without the prefix, the only error that did).
+std::string parse_error_sentence(const CLI::App& app, int argc, char** argv,
+                                 const CLI::ParseError& e) {
+  const CLI::App* command = command_in(app, argc, argv);
+  std::string text = e.what();
+  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+  return command == nullptr ? fmt::format("{}; `sketchdrape --help` lists the commands", text)
+                            : fmt::format("{}; `sketchdrape {} --help` says what it takes", text,
+                                          command->get_name());
+}
+
 // An option the command does not have (trial 35: `run ... --duration 5` said "The following
 // arguments were not expected: 5 --duration"): named, with where that setting lives when it is
 // the sketch file's, else empty (CLI11's own message then).
 std::string unknown_option_sentence(const CLI::App& app, int argc, char** argv) {
-  const CLI::App* command = nullptr;
-  for (int i = 1; i < argc && command == nullptr; ++i)
-    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
-      if (sub->get_name() == argv[i]) command = sub;
+  const CLI::App* command = command_in(app, argc, argv);
   if (command == nullptr) return "";
   for (int i = 1; i < argc; ++i) {
     std::string arg = argv[i];
@@ -133,6 +151,16 @@ CLI::Validator finite_range(double low, double high) {
       fmt::format("NUMBER in [{:g}, {:g}]", low, high));
 }
 
+CLI::Validator non_empty_path() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        return text.find_first_not_of(" \t") == std::string::npos
+                   ? "an empty name is no place to write: give a folder (e.g. -o out)"
+                   : std::string();
+      },
+      "PATH");
+}
+
 int run_cli(int argc, char** argv) {
   CLI::App app{"sketchdrape: sketch-based garment design — quad meshing, cloth draping, previews"};
   app.set_version_flag("--version", std::string("sketchdrape ") + kVersion);
@@ -175,24 +203,18 @@ int run_cli(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::RequiredError& e) {
-    if (!app.get_subcommands().empty()) {
-      app.exit(e);
-      return kExitBadInput;
-    }
     configure_logging(global);  // the parse stopped before it: "error: ..." as everywhere
-    spdlog::error("{}", missing_command_sentence(app, argc, argv));
+    spdlog::error("{}", app.get_subcommands().empty() ? missing_command_sentence(app, argc, argv)
+                                                      : parse_error_sentence(app, argc, argv, e));
     return kExitBadInput;
   } catch (const CLI::ExtrasError& e) {
     const std::string unknown = unknown_option_sentence(app, argc, argv);
-    if (unknown.empty()) {
-      app.exit(e);
-    } else {
-      configure_logging(global);
-      spdlog::error("{}", unknown);
-    }
+    configure_logging(global);
+    spdlog::error("{}", unknown.empty() ? parse_error_sentence(app, argc, argv, e) : unknown);
     return kExitBadInput;
   } catch (const CLI::ParseError& e) {
-    app.exit(e);
+    configure_logging(global);
+    spdlog::error("{}", parse_error_sentence(app, argc, argv, e));
     return kExitBadInput;
   } catch (const std::invalid_argument& e) {
     spdlog::error("{}", e.what());

@@ -22,6 +22,9 @@ struct GlobalOptions {
 // range checks let "nan" through (every comparison with NaN is false).
 CLI::Validator finite_range(double low, double high);
 
+// An output path that is not empty: `-o ''` wrote into the working directory (trial 36).
+CLI::Validator non_empty_path();
+
 // Parses argv, runs the chosen subcommand and maps exceptions to exit codes:
 // std::invalid_argument (bad input) → 2, any other std::exception → 1.
 int run_cli(int argc, char** argv);

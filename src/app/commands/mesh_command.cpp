@@ -235,7 +235,8 @@ void add_mesh_command(CLI::App& app, const GlobalOptions& /*global*/) {
       "Mesh a sketch file's panels into one stitched garment (quad and 4-8 meshes, report, "
       "images); no simulation");
   cmd->add_option("SKETCH", options->sketch, "Sketch file (format sketchdrape/1)")->required();
-  cmd->add_option("-o,--out", options->out, "Output directory (created if needed)");
+  cmd->add_option("-o,--out", options->out, "Output directory (created if needed)")
+      ->check(non_empty_path());
   cmd->add_flag("--strict", options->strict,
                 "Exit with code 1 when the quality gate warns (the outputs are still written)");
   cmd->callback([options] { run_mesh(*options); });

@@ -94,7 +94,8 @@ void add_pattern_command(CLI::App& app, const GlobalOptions& /*global*/) {
       "Flatten a sketch file's panels into a sewing pattern (pattern.svg, pattern.dxf, "
       "pattern.json); no simulation");
   cmd->add_option("SKETCH", options->sketch, "Sketch file (format sketchdrape/1)")->required();
-  cmd->add_option("-o,--out", options->out, "Output directory (created if needed)");
+  cmd->add_option("-o,--out", options->out, "Output directory (created if needed)")
+      ->check(non_empty_path());
   cmd->add_option("--fabric-width", options->fabric_width,
                   "Fabric width in metres (default: output.pattern.fabric_width, else 1.5)")
       ->check(length_in_range(0.1, 10.0, "a fabric width of", garment::kUsualFabricWidth));

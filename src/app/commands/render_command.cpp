@@ -294,6 +294,7 @@ void add_render_command(CLI::App& app, const GlobalOptions& global) {
                 "Mark the body's landmarks (red; sketchdrape info lists them, docs/bodies.md)");
   cmd->add_option("-o,--output", options->output,
                   "Output directory (one <view>.png each), or a .png file for a single view")
+      ->check(non_empty_path())
       ->required();
   cmd->callback([options, &global] { run_render(*options, global); });
 }

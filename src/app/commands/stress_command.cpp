@@ -182,7 +182,7 @@ void add_stress_command(CLI::App& app, const GlobalOptions& global) {
       "Run the simulator through a matrix of hostile conditions; exit 1 if any case "
       "diverges (docs/stress.md)");
   cmd->add_flag("--quick", options->quick, "The reduced matrix CI runs (under a minute)");
-  cmd->add_option("-o,--out", options->out, "Write DIR/stress.json");
+  cmd->add_option("-o,--out", options->out, "Write DIR/stress.json")->check(non_empty_path());
   cmd->add_flag("--json", options->json, "Print the JSON report on stdout instead of the table");
   cmd->add_option("--case", options->cases,
                   "Only cases whose id contains this text (repeatable; see --list)");

@@ -83,12 +83,27 @@ std::optional<TopOpening> top_opening(const garment::Garment& garment) {
   return opening;
 }
 
+double ease_drop(const TopOpening& opening, const std::vector<garment::PanelSpec>& panels,
+                 double hang_m) {
+  double ease = 1.0;
+  for (const garment::PanelSpec& panel : panels)
+    if (std::find(opening.panels.begin(), opening.panels.end(), unmirrored(panel.id)) !=
+        opening.panels.end())
+      ease = std::max({ease, panel.ease.warp, panel.ease.weft});
+  return (ease - 1.0) * std::max(hang_m, 0.0);
+}
+
 std::string settled_warning(const std::string& file, double drop_m,
-                            const std::optional<TopOpening>& opening, const std::string& landmark) {
+                            const std::optional<TopOpening>& opening, const std::string& landmark,
+                            double eased_m) {
   std::string text = fmt::format(
-      "{}: the garment settled {:.1f} cm below where it was drawn (its centre of mass): nothing "
-      "held it up there, so it slid until the body caught it",
-      file, 100 * drop_m);
+      "{}: the garment settled {:.1f} cm below where it was drawn (its centre of mass){}: "
+      "nothing held it up there, so it slid until the body caught it",
+      file, 100 * drop_m,
+      eased_m > 0.0 ? fmt::format(", {:.1f} cm more than its panels' \"ease\" above 1 "
+                                  "accounts for (about {:.1f} cm)",
+                                  100 * (drop_m - eased_m), 100 * eased_m)
+                    : "");
   if (!opening) {
     return text +
            "; make the panels that should hold it grip (\"ease\" below 1 or a smaller "

@@ -25,10 +25,20 @@ struct TopOpening {
 // nullopt when the garment has no opening (a closed bag) or its outline names no curve.
 std::optional<TopOpening> top_opening(const garment::Garment& garment);
 
+// How much lower a garment hangs because its top opening's panels are eased above 1: cloth
+// ease times larger than drawn, hung from that opening, reaches (ease − 1) times farther down, so
+// its centre of mass (drawn `hang_m` below the opening) drops by about (ease − 1)·hang_m. The
+// larger of warp and weft ease of each panel, the largest over the opening's panels; 0 when none
+// is above 1. (A blouse eased 1.08 settles 4.3 cm lower: docs/sketch-format.md, "ease".)
+double ease_drop(const TopOpening& opening, const std::vector<garment::PanelSpec>& panels,
+                 double hang_m);
+
 // "<file>: the garment settled 4.2 cm below where it was drawn ...": what slid, what should hold
 // it (the top opening's curves and panels, near `landmark` when known) and how to make it grip.
+// `eased_m` (from ease_drop) is the part of the drop the panels' ease accounts for, said as such.
 std::string settled_warning(const std::string& file, double drop_m,
-                            const std::optional<TopOpening>& opening, const std::string& landmark);
+                            const std::optional<TopOpening>& opening, const std::string& landmark,
+                            double eased_m = 0.0);
 
 // Where a drape that ended without reaching at rest still moves: its fastest vertex.
 struct StillMoving {
