@@ -460,33 +460,39 @@ PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOpt
   // the grid's rounding (its span of columns, below). Name that piece and the width it needs,
   // so that one change of the fabric width is enough: the first piece too wide in panel order
   // is not always the widest, and its width without the gaps can be less than the fabric's.
+  // A piece cut on the fold is as wide as its two halves; the other half is not cut apart.
+  const auto cut_width = [&](const PatternPiece& piece) {
+    if (piece.folded_into >= 0) return 0.0;
+    return piece.on_fold ? unfolded_shape(piece).size.x() : piece.size.x();
+  };
   if (!layout.pieces.empty()) {
     double most = 0;
-    for (const PatternPiece& piece : layout.pieces) most = std::max(most, piece.size.x());
+    for (const PatternPiece& piece : layout.pieces) most = std::max(most, cut_width(piece));
     // The first within 0.1 mm of the widest: a panel before its mirror copy ("front", not
     // "front.mirror", which is as wide up to rounding).
     const PatternPiece& widest =
         *std::find_if(layout.pieces.begin(), layout.pieces.end(),
-                      [&](const PatternPiece& piece) { return piece.size.x() >= most - 1e-4; });
-    const int span = static_cast<int>(std::ceil(widest.size.x() / kCell)) + 1 + 2 * pad;
-    if (widest.size.x() > options.fabric_width - 2 * options.gap || span > columns) {
+                      [&](const PatternPiece& piece) { return cut_width(piece) >= most - 1e-4; });
+    const double widest_x = cut_width(widest);
+    const int span = static_cast<int>(std::ceil(widest_x / kCell)) + 1 + 2 * pad;
+    if (widest_x > options.fabric_width - 2 * options.gap || span > columns) {
       // Whole millimetres, up to the first width that passes both tests as written (the grid
       // rounds), so that the width named is enough when given back.
-      const double least = std::max(widest.size.x() + 2 * options.gap, span * kCell + options.gap);
+      const double least = std::max(widest_x + 2 * options.gap, span * kCell + options.gap);
       int needed_mm = static_cast<int>(std::ceil(1000 * least - 1e-6));
       const auto fits = [&](double width) {
-        return widest.size.x() <= width - 2 * options.gap &&
+        return widest_x <= width - 2 * options.gap &&
                static_cast<int>(std::floor((width - options.gap) / kCell)) >= span;
       };
       while (!fits(needed_mm / 1000.0)) ++needed_mm;
       const std::string& id = pattern.panels[static_cast<size_t>(widest.panel)].id;
       throw PatternError(
-          id, fmt::format("the piece of panel '{}' is {:.0f} mm wide with its seam allowance and "
-                          "needs a fabric at least {} mm wide with the {:.0f} mm gap kept "
+          id, fmt::format("the piece of panel '{}' is {:.0f} mm wide{} with its seam allowance "
+                          "and needs a fabric at least {} mm wide with the {:.0f} mm gap kept "
                           "free at each selvedge; the fabric is {:.0f} mm wide: use a wider fabric "
                           "or split the panel",
-                          id, 1000 * widest.size.x(), needed_mm, 1000 * options.gap,
-                          1000 * options.fabric_width));
+                          id, 1000 * widest_x, widest.on_fold ? " opened out from its fold" : "",
+                          needed_mm, 1000 * options.gap, 1000 * options.fabric_width));
     }
   }
   // Two orders are tried, largest area first and tallest first; the shorter layout is kept.

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 
 #include "sim/fabric.hpp"
 #include "src/app/pipeline/markup_escape.hpp"
@@ -45,14 +46,16 @@ std::pair<Eigen::Vector2d, Eigen::Vector2d> notch_segment(const garment::Pattern
   return {n.point + a * n.normal, n.point + (a - depth) * n.normal};
 }
 
-// The piece's seam allowance in mm for a label: "10", or "10-30" when its seams differ.
+// The piece's seam allowance in mm for a label: "10", or "10-30" when its seams differ. A fold
+// has none and is no seam: it is left out.
 std::string allowance_mm(const garment::PatternPiece& piece) {
-  double lo = piece.allowance, hi = piece.allowance;
-  if (!piece.allowances.empty()) lo = hi = piece.allowances.front().allowance;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (const garment::AllowanceRun& run : piece.allowances) {
+    if (piece.on_fold && run.allowance == 0) continue;
     lo = std::min(lo, run.allowance);
     hi = std::max(hi, run.allowance);
   }
+  if (!(lo <= hi)) lo = hi = piece.allowance;
   return hi - lo < 5e-4 ? fmt::format("{:.0f}", kMm * lo)
                         : fmt::format("{:.0f}-{:.0f}", kMm * lo, kMm * hi);
 }
