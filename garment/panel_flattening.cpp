@@ -189,10 +189,13 @@ Eigen::MatrixX2d lscm_start(const std::string& name, const Eigen::MatrixX3d& v,
 //   Σ_t A_t ‖J_t − R_t‖²  +  Σ_boundary w ‖(u_i − u_j) − l_ij·d̂_ij‖²,
 // where l_ij is the edge's 3D length and d̂_ij its current 2D direction: the second term holds
 // the outline at its true length, so both sides of a seam come out as long as the seam is.
+// With `on_line` (local vertices) the energy is minimised with those vertices' x held at 0: they
+// stay on the y axis, free to slide along it (ARAP is blind to rigid motions, so holding them on
+// one fixed line loses nothing; the outline terms still hold their edges at their 3D lengths).
 // Returns the sweeps made.
 int arap(Eigen::MatrixX2d& uv, const Eigen::MatrixX3d& v, const Eigen::MatrixX3i& t,
          const std::vector<RestTriangle>& rest, const std::vector<int>& boundary,
-         const FlatteningOptions& options) {
+         const FlatteningOptions& options, const std::vector<int>& on_line = {}) {
   const Eigen::Index n = v.rows();
   const double w = 0.5 * options.boundary_weight;
   std::vector<Eigen::Triplet<double>> entries;
@@ -227,6 +230,24 @@ int arap(Eigen::MatrixX2d& uv, const Eigen::MatrixX3d& v, const Eigen::MatrixX3i
   matrix.setFromTriplets(entries.begin(), entries.end());
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(matrix);
   if (solver.info() != Eigen::Success) return 0;
+  // x on the line: those rows and columns become the identity (x = 0 there, so nothing moves
+  // to the right-hand side); y keeps the matrix above.
+  std::vector<char> held(static_cast<size_t>(n), 0);
+  for (const int i : on_line) held[static_cast<size_t>(i)] = 1;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver_x;
+  if (!on_line.empty()) {
+    std::vector<Eigen::Triplet<double>> kept;
+    kept.reserve(entries.size() + on_line.size());
+    for (const Eigen::Triplet<double>& e : entries)
+      if (!held[static_cast<size_t>(e.row())] && !held[static_cast<size_t>(e.col())])
+        kept.push_back(e);
+    for (const int i : on_line) kept.emplace_back(i, i, 1.0);
+    Eigen::SparseMatrix<double> matrix_x(n, n);
+    matrix_x.setFromTriplets(kept.begin(), kept.end());
+    solver_x.compute(matrix_x);
+    if (solver_x.info() != Eigen::Success) return 0;
+    for (const int i : on_line) uv(i, 0) = 0;
+  }
 
   const double extent = (v.colwise().maxCoeff() - v.colwise().minCoeff()).norm();
   int sweeps = 0;
@@ -248,7 +269,14 @@ int arap(Eigen::MatrixX2d& uv, const Eigen::MatrixX3d& v, const Eigen::MatrixX3i
       rhs.row(j) -= w * d;
     }
     rhs.row(0) += pin * uv.row(0);
-    const Eigen::MatrixX2d next = solver.solve(rhs);
+    Eigen::MatrixX2d next(n, 2);
+    if (on_line.empty()) {
+      next = solver.solve(rhs);
+    } else {
+      for (const int i : on_line) rhs(i, 0) = 0;
+      next.col(0) = solver_x.solve(rhs.col(0));
+      next.col(1) = solver.solve(rhs.col(1));
+    }
     const double move = (next - uv).rowwise().norm().maxCoeff();
     uv = next;
     if (move < 1e-7 * extent) {  // 0.1 µm on a 1 m piece
@@ -425,9 +453,22 @@ void judge_stretch(FlatPanel& out, const FlatteningOptions& options, bool on_bod
       d.worst_point.y(), d.worst_point.z(), 100 * d.length_mean, advice);
 }
 
+// How far the points of `run` (local vertices) lie from the chord between its ends (m, 2D).
+double bow_from_chord(const Eigen::MatrixX2d& uv, const std::vector<int>& run) {
+  const Eigen::Vector2d a = uv.row(run.front()).transpose();
+  const Eigen::Vector2d along = (Eigen::Vector2d(uv.row(run.back()).transpose()) - a).normalized();
+  double bow = 0;
+  for (const int i : run) {
+    const Eigen::Vector2d q = uv.row(i).transpose() - a;
+    bow = std::max(bow, std::abs(along.x() * q.y() - along.y() * q.x()));
+  }
+  return bow;
+}
+
 FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
                             const Eigen::MatrixX3i& t, const Eigen::MatrixX3d& triangle_warp,
-                            const FlatteningOptions& options, bool on_body = true) {
+                            const FlatteningOptions& options, bool on_body = true,
+                            const std::vector<int>& centre_run = {}) {
   FlatPanel out;
   out.id = name;
   out.triangles = t;
@@ -444,6 +485,32 @@ FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
   if (folded > 0 && folded_triangles(start, t, rest) == 0) {
     uv = start;  // ARAP folded what LSCM kept unfolded: keep the conformal map
     folded = 0;
+  }
+  // A centre line to hold straight (the piece is then cut on the fold): flattened again from the
+  // same start turned with the run's chord on the y axis, the run's x held at 0; kept when it
+  // folds nothing and costs at most `straight_centre_cost` of 95th-percentile stretch.
+  bool straight = false;
+  if (folded == 0 && centre_run.size() >= 3 && options.straight_centre_cost >= 0) {
+    const Eigen::RowVector2d a = start.row(centre_run.front());
+    const Eigen::Vector2d chord = (start.row(centre_run.back()) - a).transpose();
+    const double angle = std::numbers::pi / 2 - std::atan2(chord.y(), chord.x());
+    const Eigen::Matrix2d turn = Eigen::Rotation2Dd(angle).toRotationMatrix();
+    Eigen::MatrixX2d held = ((start.rowwise() - a) * turn.transpose()).eval();
+    const int sweeps = arap(held, v, t, rest, out.boundary, options, centre_run);
+    if (folded_triangles(held, t, rest) == 0) {
+      const FlatDistortion free = measure(uv, t, rest);
+      const FlatDistortion line = measure(held, t, rest);
+      if (line.length_p95 <= free.length_p95 + options.straight_centre_cost) {
+        out.centre_run = centre_run;
+        out.free_centre_bow = bow_from_chord(uv, centre_run);
+        out.free_distortion = free;
+        out.free_distortion.dome = curvature.dome;
+        out.free_distortion.saddle = curvature.saddle;
+        out.iterations = sweeps;
+        uv = held;
+        straight = true;
+      }
+    }
   }
   if (folded > 0) {
     const FlatDistortion d = measure(uv, t, rest);
@@ -465,7 +532,11 @@ FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
     if (image.norm() > 0) grain += r.area * image.normalized();
   }
   if (grain.norm() < 1e-12) grain = Eigen::Vector2d::UnitY();
-  const double turn = std::numbers::pi / 2 - std::atan2(grain.y(), grain.x());
+  // A straight centre line is the fold, and a fold lies along the warp (fabric is folded
+  // lengthwise): the piece is turned with it on +y, the way nearer the warp's mean image. For a
+  // symmetric panel that is the grain of the whole piece the half and its mirror make.
+  double turn = std::numbers::pi / 2 - std::atan2(grain.y(), grain.x());
+  if (straight) turn = grain.y() >= 0 ? 0.0 : std::numbers::pi;
   const Eigen::Matrix2d rotation = Eigen::Rotation2Dd(turn).toRotationMatrix();
   uv = (uv * rotation.transpose()).eval();
   uv.rowwise() -= uv.colwise().minCoeff();
@@ -592,6 +663,9 @@ std::optional<FlatPanel> reflected_piece(const FlatPanel& original, const Eigen:
   out.area_2d = original.area_2d;
   out.iterations = original.iterations;
   out.distortion = original.distortion;
+  out.centre_run = original.centre_run;  // the original's numbering: the caller renumbers it
+  out.free_centre_bow = original.free_centre_bow;
+  out.free_distortion = original.free_distortion;
   out.distortion.worst_point.x() = -original.distortion.worst_point.x();
   out.distortion.worst_point_2d.x() = width - original.distortion.worst_point_2d.x();
   judge_stretch(out, options, on_body);
@@ -626,6 +700,49 @@ FlatPattern flatten_garment(const Garment& garment, const FlatteningOptions& opt
   const MaterialFrames frames = material_frames(garment);
   FlatPattern pattern;
   const Eigen::Index nv = mesh.vertex_count();
+
+  // Which panel lies across each directed garment edge: the one traversing it backwards.
+  std::unordered_map<long long, int> edge_panel;
+  const auto key = [&](int a, int b) { return static_cast<long long>(a) * nv + b; };
+  for (Eigen::Index q = 0; q < mesh.face_count(); ++q)
+    for (int k = 0; k < 4; ++k)
+      edge_panel[key(mesh.faces(q, k), mesh.faces(q, (k + 1) % 4))] = garment.face_panel(q);
+  // The panel's centre line: its one run of outline edges on the mirror plane x = 0 sewn to its
+  // own mirror copy ("front" and "front.mirror"), as local vertices in outline order; empty when
+  // it has none, or several (then there is no one line to fold along).
+  const auto centre_run = [&](size_t p, const std::vector<int>& global,
+                              const std::vector<int>& loop) -> std::vector<int> {
+    const std::string& id = garment.panels[p].id;
+    const std::string partner =
+        garment.panels[p].mirror_copy ? id.substr(0, id.rfind('.')) : id + ".mirror";
+    int other = -1;
+    for (size_t q = 0; q < garment.panels.size(); ++q)
+      if (garment.panels[q].id == partner) other = static_cast<int>(q);
+    if (other < 0) return {};
+    const size_t n = loop.size();
+    const auto on_plane = [&](size_t k) {
+      return std::abs(mesh.vertices(global[static_cast<size_t>(loop[k % n])], 0)) <= 1e-6;
+    };
+    std::vector<char> centre(n, 0);
+    for (size_t k = 0; k < n; ++k) {
+      const int a = global[static_cast<size_t>(loop[k])];
+      const int b = global[static_cast<size_t>(loop[(k + 1) % n])];
+      const auto it = edge_panel.find(key(b, a));
+      centre[k] = on_plane(k) && on_plane(k + 1) && it != edge_panel.end() && it->second == other;
+    }
+    std::vector<int> run;
+    for (size_t k = 0; k < n; ++k) {
+      if (!centre[k] || centre[(k + n - 1) % n]) continue;
+      if (!run.empty()) return {};  // a second run
+      size_t last = k;
+      while (centre[(last + 1) % n] && (last + 1) % n != k) last = (last + 1) % n;
+      for (size_t i = k;; i = (i + 1) % n) {
+        run.push_back(loop[i]);
+        if (i == (last + 1) % n) break;
+      }
+    }
+    return run;
+  };
 
   // Per panel: local vertices, triangles, flattening.
   for (size_t p = 0; p < garment.panels.size(); ++p) {
@@ -675,8 +792,10 @@ FlatPattern flatten_garment(const Garment& garment, const FlatteningOptions& opt
           if (reflected) reflected->reflection_of = static_cast<int>(o);
         }
     }
-    FlatPanel flat =
-        reflected ? std::move(*reflected) : flatten_with_warp(name, v, t, warp, options, on_body);
+    const std::vector<int> run = centre_run(p, global, disk_boundary(name, v.rows(), t));
+    FlatPanel flat = reflected ? std::move(*reflected)
+                               : flatten_with_warp(name, v, t, warp, options, on_body, run);
+    if (reflected && !flat.centre_run.empty()) flat.centre_run = run;
     flat.panel = static_cast<int>(p);
     flat.vertices = std::move(global);
     flat.triangle_quad = std::move(quad_of);
@@ -697,13 +816,6 @@ FlatPattern flatten_garment(const Garment& garment, const FlatteningOptions& opt
     if (!flat.warning.empty() && !told_with_original) pattern.warnings.push_back(flat.warning);
     pattern.panels.push_back(std::move(flat));
   }
-
-  // Which panel lies across each directed garment edge: the one traversing it backwards.
-  std::unordered_map<long long, int> edge_panel;
-  const auto key = [&](int a, int b) { return static_cast<long long>(a) * nv + b; };
-  for (Eigen::Index q = 0; q < mesh.face_count(); ++q)
-    for (int k = 0; k < 4; ++k)
-      edge_panel[key(mesh.faces(q, k), mesh.faces(q, (k + 1) % 4))] = garment.face_panel(q);
 
   // Runs of boundary edges with the same panel across; a run's ends are notches.
   struct Run {

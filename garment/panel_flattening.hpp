@@ -41,6 +41,15 @@ struct FlatteningOptions {
   // its thirds for 53 cm), so the two sides are matched along the way as well as at the ends.
   double balance_from = 0.25;
   double balance_spacing = 0.20;
+  // A panel's outline run on the garment's mirror plane, sewn to its own mirror copy (a centre
+  // front or back), is flattened a second time with that run held on one straight line (ARAP
+  // with the run's points on a line, free to slide along it), so the piece can be cut on the
+  // fold; that flattening is kept when its 95th-percentile length distortion is at most this
+  // much above the free one's (a negative value never holds a centre line straight). 2.5
+  // points: on the examples and designs a bodice or skirt centre held straight costs 0-2.1
+  // points, a back over a deep hollow of the spine 3.2-3.8, a crotch curve 3.2-16, a hood 37-40
+  // (docs/pattern.md, "Cut on the fold").
+  double straight_centre_cost = 0.025;
 };
 
 // A point on a piece's outline: on edge `edge` (FlatPanel::boundary[edge] → boundary[edge + 1],
@@ -88,6 +97,13 @@ struct FlatPanel {
   double area_3d = 0;  // m²
   double area_2d = 0;  // m², before ease
   int iterations = 0;  // ARAP sweeps made
+  // The centre line held straight (local vertices along the outline, on the garment's mirror
+  // plane and sewn to the panel's mirror copy; FlatteningOptions::straight_centre_cost): it lies
+  // on one line along +y. Empty when the piece was flattened freely. Then also what the free
+  // flattening gave: how far the run bowed from its chord (m) and the free distortion.
+  std::vector<int> centre_run;
+  double free_centre_bow = 0;
+  FlatDistortion free_distortion;
   // A mirror copy whose 3D triangles are exactly its original's reflected: the index (into
   // FlatPattern::panels) of that original, whose piece this one is, reflected (x → width − x).
   // −1 for a piece flattened on its own.

@@ -291,6 +291,36 @@ bool is_mirror_image(const PatternPiece& original, const PatternPiece& copy, dou
   return true;
 }
 
+// A piece as the fabric it takes on the bolt: its cutting line(s) in a frame whose bounding box
+// starts at (0, 0), `offset` the piece frame's origin in it.
+struct FabricShape {
+  std::vector<Eigen::MatrixX2d> outlines;
+  Eigen::Vector2d offset = Eigen::Vector2d::Zero();
+  Eigen::Vector2d size = Eigen::Vector2d::Zero();
+};
+
+// A piece cut on the fold, opened out: its cutting line and that line reflected across the fold
+// (the other half, cut through the fold of the fabric under it, or traced a second time with
+// the piece turned over on a single layer). The fold runs along the warp, so both halves keep
+// the grain; the fabric they take is what cutting the piece takes.
+FabricShape unfolded_shape(const PatternPiece& piece) {
+  const Eigen::Vector2d a = piece.fold_start;
+  const Eigen::Vector2d d = (piece.fold_end - piece.fold_start).normalized();
+  const Eigen::Matrix2d mirror = 2 * d * d.transpose() - Eigen::Matrix2d::Identity();
+  Eigen::MatrixX2d other = piece.cutting;
+  for (Eigen::Index i = 0; i < other.rows(); ++i)
+    other.row(i) = (a + mirror * (other.row(i).transpose() - a)).transpose();
+  FabricShape shape;
+  const Eigen::Vector2d lo =
+      piece.cutting.colwise().minCoeff().cwiseMin(other.colwise().minCoeff());
+  const Eigen::Vector2d hi =
+      piece.cutting.colwise().maxCoeff().cwiseMax(other.colwise().maxCoeff());
+  shape.offset = -lo;
+  shape.size = hi - lo;
+  shape.outlines = {piece.cutting.rowwise() - lo.transpose(), other.rowwise() - lo.transpose()};
+  return shape;
+}
+
 }  // namespace
 
 PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOptions& options) {
@@ -430,64 +460,75 @@ PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOpt
   // the grid's rounding (its span of columns, below). Name that piece and the width it needs,
   // so that one change of the fabric width is enough: the first piece too wide in panel order
   // is not always the widest, and its width without the gaps can be less than the fabric's.
+  // A piece cut on the fold is as wide as its two halves; the other half is not cut apart.
+  const auto cut_width = [&](const PatternPiece& piece) {
+    if (piece.folded_into >= 0) return 0.0;
+    return piece.on_fold ? unfolded_shape(piece).size.x() : piece.size.x();
+  };
   if (!layout.pieces.empty()) {
     double most = 0;
-    for (const PatternPiece& piece : layout.pieces) most = std::max(most, piece.size.x());
+    for (const PatternPiece& piece : layout.pieces) most = std::max(most, cut_width(piece));
     // The first within 0.1 mm of the widest: a panel before its mirror copy ("front", not
     // "front.mirror", which is as wide up to rounding).
     const PatternPiece& widest =
         *std::find_if(layout.pieces.begin(), layout.pieces.end(),
-                      [&](const PatternPiece& piece) { return piece.size.x() >= most - 1e-4; });
-    const int span = static_cast<int>(std::ceil(widest.size.x() / kCell)) + 1 + 2 * pad;
-    if (widest.size.x() > options.fabric_width - 2 * options.gap || span > columns) {
+                      [&](const PatternPiece& piece) { return cut_width(piece) >= most - 1e-4; });
+    const double widest_x = cut_width(widest);
+    const int span = static_cast<int>(std::ceil(widest_x / kCell)) + 1 + 2 * pad;
+    if (widest_x > options.fabric_width - 2 * options.gap || span > columns) {
       // Whole millimetres, up to the first width that passes both tests as written (the grid
       // rounds), so that the width named is enough when given back.
-      const double least = std::max(widest.size.x() + 2 * options.gap, span * kCell + options.gap);
+      const double least = std::max(widest_x + 2 * options.gap, span * kCell + options.gap);
       int needed_mm = static_cast<int>(std::ceil(1000 * least - 1e-6));
       const auto fits = [&](double width) {
-        return widest.size.x() <= width - 2 * options.gap &&
+        return widest_x <= width - 2 * options.gap &&
                static_cast<int>(std::floor((width - options.gap) / kCell)) >= span;
       };
       while (!fits(needed_mm / 1000.0)) ++needed_mm;
       const std::string& id = pattern.panels[static_cast<size_t>(widest.panel)].id;
       throw PatternError(
-          id, fmt::format("the piece of panel '{}' is {:.0f} mm wide with its seam allowance and "
-                          "needs a fabric at least {} mm wide with the {:.0f} mm gap kept "
-                          "free at each selvedge (the piece and both gaps, rounded up to the "
-                          "layout's {:.0f} mm grid); the fabric is {:.0f} mm wide: use a wider "
-                          "fabric or split the panel",
-                          id, 1000 * widest.size.x(), needed_mm, 1000 * options.gap, 1000 * kCell,
-                          1000 * options.fabric_width));
+          id,
+          fmt::format("the piece of panel '{}' is {:.0f} mm wide{} with its seam allowance "
+                      "and needs a fabric at least {} mm wide with the {:.0f} mm gap kept "
+                      "free at each selvedge (the piece and both gaps, rounded up to the "
+                      "layout's {:.0f} mm grid); the fabric is {:.0f} mm wide: use a wider "
+                      "fabric or split the panel",
+                      id, 1000 * widest_x, widest.on_fold ? " opened out from its fold" : "",
+                      needed_mm, 1000 * options.gap, 1000 * kCell, 1000 * options.fabric_width));
     }
   }
   // Two orders are tried, largest area first and tallest first; the shorter layout is kept.
-  const auto nest = [&](const std::vector<size_t>& order) {
+  // `unfold`: a piece cut on the fold takes the fabric of both its halves (unfolded_shape).
+  const auto nest = [&](const std::vector<size_t>& order, bool unfold) {
     std::vector<double> sky(static_cast<size_t>(columns), 0.0);
     double length = 0;
     for (const size_t i : order) {
       PatternPiece& piece = layout.pieces[i];
-      const Eigen::MatrixX2d& p = piece.cutting;
-      const int width = static_cast<int>(std::ceil(piece.size.x() / kCell)) + 1;
+      const FabricShape shape = unfold && piece.on_fold
+                                    ? unfolded_shape(piece)
+                                    : FabricShape{{piece.cutting}, {0, 0}, piece.size};
+      const int width = static_cast<int>(std::ceil(shape.size.x() / kCell)) + 1;
       std::vector<double> low(static_cast<size_t>(width), std::numeric_limits<double>::infinity());
       std::vector<double> high(static_cast<size_t>(width),
                                -std::numeric_limits<double>::infinity());
       // Each edge is linear: over a column's slab its y lies between its values at the slab's ends.
-      for (Eigen::Index k = 0; k < p.rows(); ++k) {
-        const Eigen::Vector2d a = p.row(k), b = p.row((k + 1) % p.rows());
-        const double x0 = std::min(a.x(), b.x()), x1 = std::max(a.x(), b.x());
-        const int c0 = std::clamp(static_cast<int>(std::floor(x0 / kCell)), 0, width - 1);
-        const int c1 = std::clamp(static_cast<int>(std::floor(x1 / kCell)), 0, width - 1);
-        for (int c = c0; c <= c1; ++c) {
-          for (double x : {std::clamp(c * kCell, x0, x1), std::clamp((c + 1) * kCell, x0, x1)}) {
-            const double y =
-                b.x() == a.x() ? a.y() : a.y() + (x - a.x()) / (b.x() - a.x()) * (b.y() - a.y());
-            low[static_cast<size_t>(c)] =
-                std::min({low[static_cast<size_t>(c)], y, b.x() == a.x() ? b.y() : y});
-            high[static_cast<size_t>(c)] =
-                std::max({high[static_cast<size_t>(c)], y, b.x() == a.x() ? b.y() : y});
+      for (const Eigen::MatrixX2d& p : shape.outlines)
+        for (Eigen::Index k = 0; k < p.rows(); ++k) {
+          const Eigen::Vector2d a = p.row(k), b = p.row((k + 1) % p.rows());
+          const double x0 = std::min(a.x(), b.x()), x1 = std::max(a.x(), b.x());
+          const int c0 = std::clamp(static_cast<int>(std::floor(x0 / kCell)), 0, width - 1);
+          const int c1 = std::clamp(static_cast<int>(std::floor(x1 / kCell)), 0, width - 1);
+          for (int c = c0; c <= c1; ++c) {
+            for (double x : {std::clamp(c * kCell, x0, x1), std::clamp((c + 1) * kCell, x0, x1)}) {
+              const double y =
+                  b.x() == a.x() ? a.y() : a.y() + (x - a.x()) / (b.x() - a.x()) * (b.y() - a.y());
+              low[static_cast<size_t>(c)] =
+                  std::min({low[static_cast<size_t>(c)], y, b.x() == a.x() ? b.y() : y});
+              high[static_cast<size_t>(c)] =
+                  std::max({high[static_cast<size_t>(c)], y, b.x() == a.x() ? b.y() : y});
+            }
           }
         }
-      }
       // Widened by `pad` columns each side: column j of the profile is piece column j − pad.
       const int span = width + 2 * pad;
       std::vector<double> bottom(static_cast<size_t>(span),
@@ -503,11 +544,13 @@ PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOpt
       if (span > columns)
         throw PatternError(
             pattern.panels[static_cast<size_t>(piece.panel)].id,
-            fmt::format("the piece of panel '{}' is {:.0f} mm wide with its seam allowance and the "
-                        "gaps beside it; the fabric is {:.0f} mm wide: use a wider fabric or split "
-                        "the panel",
+            fmt::format("the piece of panel '{}' is {:.0f} mm wide{} with its seam allowance and "
+                        "the gaps beside it; the fabric is {:.0f} mm wide: use a wider fabric or "
+                        "split the panel",
                         pattern.panels[static_cast<size_t>(piece.panel)].id,
-                        1000 * (piece.size.x() + options.gap), 1000 * options.fabric_width));
+                        1000 * (shape.size.x() + options.gap),
+                        shape.outlines.size() > 1 ? " opened out from its fold" : "",
+                        1000 * options.fabric_width));
       int best_x = 0;
       double best_y = 0, best_top = std::numeric_limits<double>::infinity();
       for (int x = 0; x + span <= columns; ++x) {
@@ -516,8 +559,8 @@ PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOpt
           if (std::isfinite(bottom[static_cast<size_t>(j)]) && sky[static_cast<size_t>(x + j)] > 0)
             y = std::max(
                 y, sky[static_cast<size_t>(x + j)] + options.gap - bottom[static_cast<size_t>(j)]);
-        if (y + piece.size.y() < best_top - 1e-9) {
-          best_top = y + piece.size.y();
+        if (y + shape.size.y() < best_top - 1e-9) {
+          best_top = y + shape.size.y();
           best_y = y;
           best_x = x;
         }
@@ -526,13 +569,15 @@ PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOpt
         if (std::isfinite(top[static_cast<size_t>(j)]))
           sky[static_cast<size_t>(best_x + j)] =
               std::max(sky[static_cast<size_t>(best_x + j)], best_y + top[static_cast<size_t>(j)]);
-      piece.placement = {options.gap + (best_x + pad) * kCell, best_y};
+      piece.placement =
+          Eigen::Vector2d(options.gap + (best_x + pad) * kCell, best_y) + shape.offset;
       length = std::max(length, best_top);
     }
     return length;
   };
-  // Nests the pieces drawn (quantity ≥ 1) or all of them; returns the length (m, with the gap
-  // after the last piece) and the cut area (m²) they take.
+  // Nests the pieces drawn (quantity ≥ 1; a piece cut on the fold as its half) or all of them
+  // as they are cut (a piece cut on the fold as both its halves); returns the length (m, with
+  // the gap after the last piece) and the cut area (m²) they take.
   const auto lay_out = [&](bool drawn_only) {
     std::vector<size_t> by_area;  // a fold piece's other half is not cut on its own
     for (size_t i = 0; i < layout.pieces.size(); ++i)
@@ -545,13 +590,13 @@ PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOpt
     std::stable_sort(by_height.begin(), by_height.end(), [&](size_t a, size_t b) {
       return layout.pieces[a].size.y() > layout.pieces[b].size.y();
     });
-    if (nest(by_height) < nest(by_area)) nest(by_height);
-    double length = 0, cut = 0;
-    for (const size_t i : by_area) {
-      const PatternPiece& piece = layout.pieces[i];
-      length = std::max(length, piece.placement.y() + piece.size.y());
-      cut += piece.cut_area;
-    }
+    const bool unfold = !drawn_only;
+    const double tallest_first = nest(by_height, unfold);
+    double length = nest(by_area, unfold);
+    if (tallest_first < length) length = nest(by_height, unfold);
+    double cut = 0;
+    for (const size_t i : by_area)
+      cut += (unfold && layout.pieces[i].on_fold ? 2 : 1) * layout.pieces[i].cut_area;
     return std::pair{length + options.gap, cut};
   };
   // Every piece from one layer: the fabric a cutter needs. Then the sheet, where a piece that
@@ -578,7 +623,10 @@ PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOpt
           break;
         }
     }
-  const auto [sheet, drawn_cut] = layout.pairs > 0 ? lay_out(true) : std::pair{length, cut};
+  const bool folds = std::any_of(layout.pieces.begin(), layout.pieces.end(),
+                                 [](const PatternPiece& piece) { return piece.on_fold; });
+  const auto [sheet, drawn_cut] =
+      layout.pairs > 0 || folds ? lay_out(true) : std::pair{length, cut};
   layout.sheet_length = sheet;
   layout.sheet_efficiency = drawn_cut / (sheet * layout.fabric_width);
   for (PatternPiece& piece : layout.pieces)

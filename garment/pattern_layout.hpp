@@ -115,12 +115,14 @@ struct PatternLayout {
   std::vector<PatternPiece> pieces;  // in FlatPattern order
   double fabric_width = 0;           // m
   // The fabric to cut every piece as many times as it is cut, from one layer (a mirror pair's
-  // piece twice, the second turned over): m from the cut end to the last piece (+ gap), and
-  // Σ cut area / (length_used · fabric_width) over all pieces.
+  // piece twice, the second turned over; a piece cut on the fold opened out, both its halves,
+  // the fabric it takes however the fold is made): m from the cut end to the last piece
+  // (+ gap), and Σ cut area (a fold piece's twice) / (length_used · fabric_width).
   double length_used = 0;
   double efficiency = 0;
-  // The sheet: the drawn pieces (quantity ≥ 1) at their placements, the same as the above
-  // when no piece stands for a mirror pair. m, and Σ drawn cut area / (sheet_length · width).
+  // The sheet: the drawn pieces (quantity ≥ 1, a fold piece as its half) at their placements,
+  // the same as the above when no piece stands for a mirror pair or is cut on the fold. m, and
+  // Σ drawn cut area / (sheet_length · width).
   double sheet_length = 0;
   double sheet_efficiency = 0;
   int pairs = 0;  // pieces drawn once for a mirror pair

@@ -155,8 +155,10 @@ TEST(PatternCommand, EveryExampleGivesPiecesThatSewAndDoNotOverlap) {
     int pairs = 0;
     for (size_t i = 0; i < pieces.size(); ++i) {
       const auto& a = pieces[i];
-      // The other half of a piece cut on the fold is cut with it, not on its own.
-      if (a["folded_into"].get<std::string>().empty()) cut += a["cut_area_mm2"].get<double>();
+      // The other half of a piece cut on the fold is cut with it, not on its own: the fold
+      // piece counts both halves in the fabric a cutter needs.
+      if (a["folded_into"].get<std::string>().empty())
+        cut += (a["on_fold"].get<bool>() ? 2 : 1) * a["cut_area_mm2"].get<double>();
       if (a["quantity"] == 0) continue;  // drawn as its mirror pair's piece (below)
       const double ax = a["placement_mm"][0], ay = a["placement_mm"][1];
       const double aw = a["size_mm"][0], ah = a["size_mm"][1];
@@ -370,12 +372,17 @@ TEST(PatternCommand, SeamAllowancePerSeamFromTheCurves) {
                                                    p[0].get<double>() - a[0].get<double>()),
                                     2 * M_PI));
         if (turn > 20 * M_PI / 180) continue;
+        // Cut on the fold, the fold line is the cutting line there: a point of the hem nearer
+        // the fold than its allowance is that near the cutting line.
+        if (piece["on_fold"].get<bool>() &&
+            std::abs(p[0].get<double>() - piece["fold_line"][0][0].get<double>()) < mm + 0.5)
+          continue;
         EXPECT_NEAR(distance_to_cut(p[0], p[1]), mm, 0.5) << piece["id"] << " point " << k;
       }
     }
     EXPECT_EQ(covered, static_cast<double>(n)) << piece["id"] << ": the runs cover the outline";
   }
-  EXPECT_EQ(hems, 4);  // front and back, each mirrored
+  EXPECT_EQ(hems, 4);  // front and back, each mirrored (listed, though cut on the fold)
   EXPECT_EQ(necks, 4);
   EXPECT_NE(read(dir / "out/pattern.dxf").find("Seam allowance: 6-30 mm"), std::string::npos);
 }
@@ -474,12 +481,12 @@ TEST(PatternCommand, SewingLinesAreSmoothCurvesThatKeepCornersAndSew) {
   EXPECT_GT(most_polyline, 15.0) << "the polylines were smooth already: nothing tested";
 }
 
-// Trial 35 (#13): a piece whose straight edge lies on the garment's mirror plane, sewn there to
-// its own mirror copy, is cut on the fold: the A-line skirt's two yokes (centre lines within
-// 1.1 mm of straight). Its cutting line runs along the fold (no allowance there: every point of
-// the fold line on the cutting line, to 0.01 mm), elsewhere it keeps its 1 cm; the fold is
-// marked (dash-dot line, bracket, "CUT 1 ON FOLD") and the copy is neither drawn nor laid out;
-// the skirt panels, whose centre lines bow 5-6 mm, keep their centre seams.
+// Trial 35 (#13): a piece whose edge lies on the garment's mirror plane, sewn there to its own
+// mirror copy, is cut on the fold: the A-line skirt's two yokes and, with the centre line held
+// straight by the flattening (it bowed 5-6 mm), its skirt front and back. Its cutting line runs
+// along the fold (no allowance there: every point of the fold line on the cutting line, to
+// 0.01 mm), elsewhere it keeps its 1 cm; the fold lies along the grain; the fold is marked
+// (dash-dot line, bracket, "CUT 1 ON FOLD") and the copy is neither drawn nor laid out.
 TEST(PatternCommand, CentrePiecesAreCutOnTheFold) {
   const fs::path out = fresh_dir("fold");
   const CommandResult r =
@@ -492,7 +499,7 @@ TEST(PatternCommand, CentrePiecesAreCutOnTheFold) {
     const std::string id = piece["id"];
     if (!piece["on_fold"].get<bool>()) {
       EXPECT_TRUE(piece["fold_line"].is_null()) << id;
-      if (id.starts_with("yoke")) {
+      if (id.ends_with(".mirror")) {
         EXPECT_EQ(piece["folded_into"], id.substr(0, id.size() - 7)) << id;
         EXPECT_EQ(svg.find("id=\"piece-" + id + "\""), std::string::npos) << id;
       } else {
@@ -508,6 +515,7 @@ TEST(PatternCommand, CentrePiecesAreCutOnTheFold) {
     };
     const double x0 = fold[0][0], y0 = fold[0][1], x1 = fold[1][0], y1 = fold[1][1];
     EXPECT_GT(std::hypot(x1 - x0, y1 - y0), 150) << id;  // the yoke's centre line, 176 mm
+    EXPECT_NEAR(x0, x1, 0.01) << id << ": the fold lies along the grain";
     for (int k = 0; k <= 20; ++k)
       EXPECT_LT(distance_to_cut(x0 + k / 20.0 * (x1 - x0), y0 + k / 20.0 * (y1 - y0)), 0.01)
           << id << " at " << k << "/20 of the fold";
@@ -525,7 +533,50 @@ TEST(PatternCommand, CentrePiecesAreCutOnTheFold) {
     EXPECT_NE(drawn.find(">CUT 1 ON FOLD</text>"), std::string::npos) << id;
     EXPECT_NE(drawn.find("data-fold=\"1\""), std::string::npos) << id;
   }
-  EXPECT_EQ(folds, (std::vector<std::string>{"yoke_front", "yoke_back"}));
+  EXPECT_EQ(folds,
+            (std::vector<std::string>{"yoke_front", "yoke_back", "skirt_front", "skirt_back"}));
+}
+
+// The t-shirt's front and back, whose centre lines bowed 11 and 15 mm flattened freely, are cut
+// on the fold: every point of the sewing line along the fold within 0.5 mm of the fold line
+// (a pencil line), the fold along the grain, the free bow reported; the fabric the pattern takes
+// counts both halves of each (efficiency = Σ cut area, a fold piece's twice / (width · length)),
+// more than the sheet, which draws the halves.
+TEST(PatternCommand, BodiceCentreFrontIsStraightAndCutOnTheFold) {
+  const fs::path out = fresh_dir("bodice-fold");
+  const CommandResult r =
+      run_sketchdrape("pattern " + example("tshirt").string() + " -o " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto json = nlohmann::json::parse(read(out / "pattern.json"));
+  std::vector<std::string> folds;
+  double cut = 0;
+  for (const auto& piece : json["pieces"]) {
+    const std::string id = piece["id"];
+    if (piece["folded_into"].get<std::string>().empty())
+      cut += (piece["on_fold"].get<bool>() ? 2 : 1) * piece["cut_area_mm2"].get<double>();
+    if (!piece["on_fold"].get<bool>()) continue;
+    folds.push_back(id);
+    const auto& fold = piece["fold_line"];
+    const double x0 = fold[0][0], y0 = fold[0][1], x1 = fold[1][0], y1 = fold[1][1];
+    EXPECT_NEAR(x0, x1, 0.01) << id << ": the fold lies along the grain";
+    EXPECT_GT(std::abs(y1 - y0), 400) << id;  // the centre front, 512 mm
+    const double lo = std::min(y0, y1), hi = std::max(y0, y1);
+    int on_fold = 0;
+    for (const auto& p : piece["sewing_curve"]) {
+      const double y = p[1];
+      // Away from the ends, where the neckline and the hem leave the fold square to it.
+      if (y < lo + 10 || y > hi - 10 || std::abs(p[0].get<double>() - x0) > 5) continue;
+      EXPECT_LT(std::abs(p[0].get<double>() - x0), 0.5) << id << " at y = " << y;
+      ++on_fold;
+    }
+    EXPECT_GT(on_fold, 10) << id;
+    EXPECT_TRUE(piece["centre_line"]["held_straight"].get<bool>()) << id;
+    EXPECT_GT(piece["centre_line"]["free_bow_mm"].get<double>(), 5.0) << id;
+  }
+  EXPECT_EQ(folds, (std::vector<std::string>{"front", "back"}));
+  const double width = json["fabric_width_mm"], length = json["fabric_length_mm"];
+  EXPECT_NEAR(json["efficiency"].get<double>(), cut / (width * length), 1e-9);
+  EXPECT_LT(json["sheet_length_mm"].get<double>(), length);
 }
 
 // The sheet in a real browser: the SVG parses (one <g class="piece"> per piece in the DOM) and
@@ -553,7 +604,9 @@ TEST(PatternCommand, SvgOpensInHeadlessChromium) {
   EXPECT_LT(pieces, json["pieces"].size());  // the t-shirt's mirrored panels pair up
   EXPECT_EQ(count(dom, "class=\"piece\""), pieces);
   EXPECT_EQ(count(dom, "class=\"cut\""), pieces);
-  EXPECT_EQ(count(dom, "data-cut=\"2\""), json["pieces"].size() - pieces);
+  size_t pairs = 0;
+  for (const auto& piece : json["pieces"]) pairs += piece["quantity"] == 2 ? 1 : 0;
+  EXPECT_EQ(count(dom, "data-cut=\"2\""), pairs);
   EXPECT_EQ(count(dom, "class=\"scale-bar\""), 1u);
 
   const double length = json["sheet_length_mm"];
@@ -582,9 +635,10 @@ TEST(PatternCommand, SvgOpensInHeadlessChromium) {
   // The drawn pieces counted in the screenshot: connected white regions (4-neighbours) of the
   // fabric. Pieces lie 1 cm (8 px) apart on the fabric's colour; inside one, the sewing line is
   // dashed and the grain line, notches and label do not cut it across, so each piece is one
-  // region. The white inside a letter is a region too, but of a few pixels: only regions over
-  // 2,000 px (about 31 cm² at 0.8 px/mm; the t-shirt's smallest piece is a sleeve of several
-  // hundred) count.
+  // region. The white inside a letter is a region too, but of a few pixels, and so is the strip
+  // between a fold and its "CUT 1 ON FOLD" bracket (12 mm by 60 % of the fold: about 2,500 px
+  // for the t-shirt's back): only regions over 10,000 px (about 156 cm² at 0.8 px/mm; the
+  // t-shirt's smallest piece is a sleeve of 375 cm², 24,000 px) count.
   std::vector<char> seen(static_cast<size_t>(image.width) * static_cast<size_t>(fabric_rows), 0);
   const auto is_white = [&](int x, int y) {
     const std::uint8_t* p = image.pixel(x, y);
@@ -611,7 +665,7 @@ TEST(PatternCommand, SvgOpensInHeadlessChromium) {
           stack.emplace_back(nx, ny);
         }
       }
-      if (size > 2000) ++drawn;
+      if (size > 10000) ++drawn;
     }
   EXPECT_EQ(drawn, pieces);
 }
@@ -825,6 +879,11 @@ TEST(PatternCommand, NarrowFabricNamesTheWidestPieceAndValidateRefusesIt) {
     if (high - low > widest_mm) widest_mm = high - low, widest = piece["id"];
     narrowest_mm = std::min(narrowest_mm, high - low);
   }
+  // On fabric too narrow to open it out, a piece cut on the fold here keeps its centre seam:
+  // it is then as wide as its mirror copy, which has the seam's allowance.
+  for (const auto& piece : wide["pieces"])
+    if (piece["on_fold"].get<bool>())
+      width_mm[piece["id"]] = width_mm[piece["id"].get<std::string>() + ".mirror"];
   ASSERT_GT(widest_mm, narrowest_mm + 20);
   // A fabric 10 mm wider than the narrowest piece: some pieces fit, the widest does not.
   const double fabric_m = std::ceil(narrowest_mm + 10) / 1000;

@@ -449,6 +449,75 @@ TEST(PanelFlattening, MirrorCopyFlattensToTheReflectedPiece) {
   EXPECT_EQ(inverted_triangles(other.panels[1]), 0);
 }
 
+// The t-shirt's front and back meet their mirror copies along the centre front and back, which
+// bow 11 and 15 mm from straight when flattened freely. Held straight (the piece is cut on the
+// fold there), every point of the centre line lies on one line along the grain (+y) to
+// 0.5 mm (a pencil line; measured: to rounding), at its 3D length to 0.5 %, for at most
+// straight_centre_cost more stretch; the mirror copies are the same pieces turned over. With
+// the option off the same centre line bows, so the test can fail. The shorts' crotch curves,
+// which would cost 16 points of stretch straight, keep their shape.
+TEST(PanelFlattening, SymmetricBodiceCentreLineIsHeldStraight) {
+  static const Body body = load_body("builtin");
+  static const BodySurface surface(body.mesh);
+  const auto example = [](const char* name) {
+    return std::filesystem::path(SD_SOURCE_DIR) / "data/examples" / name;
+  };
+  const Garment g = build_garment(load_sketch(example("tshirt.json")), surface);
+  const FlatPattern pattern = flatten_garment(g);
+  FlatteningOptions free_options;
+  free_options.straight_centre_cost = -1;
+  const FlatPattern free = flatten_garment(g, free_options);
+  const auto bow = [](const FlatPanel& flat) {
+    const std::vector<int>& run = flat.centre_run;
+    const Eigen::Vector2d a = flat.uv.row(run.front()).transpose();
+    const Eigen::Vector2d d =
+        (Eigen::Vector2d(flat.uv.row(run.back()).transpose()) - a).normalized();
+    double most = 0;
+    for (const int i : run) {
+      const Eigen::Vector2d q = flat.uv.row(i).transpose() - a;
+      most = std::max(most, std::abs(d.x() * q.y() - d.y() * q.x()));
+    }
+    return most;
+  };
+  for (const char* id : {"front", "back", "front.mirror", "back.mirror"}) {
+    const auto find = [&](const FlatPattern& p) {
+      return std::find_if(p.panels.begin(), p.panels.end(),
+                          [&](const FlatPanel& f) { return f.id == id; });
+    };
+    const auto held = find(pattern);
+    ASSERT_NE(held, pattern.panels.end()) << id;
+    ASSERT_GE(held->centre_run.size(), 5u) << id;  // the centre front: 15 points
+    EXPECT_LT(bow(*held), 5e-4) << id;
+    const Eigen::Vector2d ends =
+        held->uv.row(held->centre_run.back()) - held->uv.row(held->centre_run.front());
+    EXPECT_LT(std::abs(ends.x()), 1e-9 * ends.norm()) << id << ": the fold runs along the grain";
+    double length_2d = 0, length_3d = 0;
+    for (size_t k = 1; k < held->centre_run.size(); ++k) {
+      const int a = held->centre_run[k - 1], b = held->centre_run[k];
+      length_2d += (held->uv.row(a) - held->uv.row(b)).norm();
+      length_3d += (g.mesh.vertices.row(held->vertices[static_cast<size_t>(a)]) -
+                    g.mesh.vertices.row(held->vertices[static_cast<size_t>(b)]))
+                       .norm();
+    }
+    EXPECT_NEAR(length_2d, length_3d, 0.005 * length_3d) << id;
+    EXPECT_EQ(inverted_triangles(*held), 0) << id;
+    // What the free flattening gave is reported with it, and is what flattening freely gives.
+    const auto loose = find(free);
+    EXPECT_TRUE(loose->centre_run.empty()) << id;
+    EXPECT_NEAR(held->free_distortion.length_p95, loose->distortion.length_p95, 1e-12) << id;
+    EXPECT_NEAR(held->free_distortion.length_mean, loose->distortion.length_mean, 1e-12) << id;
+    EXPECT_GT(held->free_centre_bow, 5e-3) << id;  // measured 11.0 (front) and 14.6 mm (back)
+    EXPECT_LE(held->distortion.length_p95,
+              loose->distortion.length_p95 + FlatteningOptions{}.straight_centre_cost)
+        << id;
+  }
+  for (const PatternSeam& seam : pattern.seams) EXPECT_LE(seam.mismatch(), 0.005);
+
+  const Garment shorts = build_garment(load_sketch(example("shorts.json")), surface);
+  for (const FlatPanel& flat : flatten_garment(shorts).panels)
+    EXPECT_TRUE(flat.centre_run.empty()) << "shorts " << flat.id;
+}
+
 // Every example garment: flat pieces never fold, both sides of every seam are equally long.
 TEST(PanelFlattening, ExampleSeamsSew) {
   static const Body body = load_body("builtin");

@@ -198,5 +198,41 @@ TEST(PatternLayout, ExactMirrorPairIsDrawnOnceAsCutTwo) {
   EXPECT_EQ(off.pieces[1].quantity, 1);
 }
 
+// Two pieces cut on the fold along their left side, each a 0.5 × 0.3 m half (1 cm allowance
+// except along the fold: 0.51 × 0.32 m cut). Cut, each is opened out to 1.02 m, so on 1.5 m of
+// fabric the two go one above the other: 3 gaps + 2 × 0.32 m = 0.67 m of fabric, with both
+// halves of each counted in the efficiency. The sheet draws the halves side by side (0.34 m).
+// Counting the halves only, as before, said 0.34 m for both.
+TEST(PatternLayout, FoldPieceTakesBothHalvesOfTheFabric) {
+  const int per = 5;
+  FlatPattern pattern = one_piece({{0, 0}, {0.5, 0}, {0.5, 0.3}, {0, 0.3}}, per);
+  pattern.panels.push_back(pattern.panels[0]);
+  pattern.panels[1].id = "other";
+  pattern.panels[1].panel = 1;
+  PatternLayoutOptions options;
+  std::vector<bool> fold(4 * per, false);
+  for (int k = 3 * per; k < 4 * per; ++k) fold[static_cast<size_t>(k)] = true;  // x = 0
+  options.fold_edge = {fold, fold};
+  const PatternLayout layout = lay_out_pattern(pattern, options);
+  const double gap = options.gap;
+  for (const PatternPiece& piece : layout.pieces) {
+    EXPECT_TRUE(piece.on_fold);
+    EXPECT_NEAR(piece.size.x(), 0.51, 1e-9);
+    EXPECT_NEAR(piece.size.y(), 0.32, 1e-9);
+    EXPECT_NEAR(piece.fold_start.x(), 0.0, 1e-12);  // the fold is the cutting line's left side
+    EXPECT_NEAR(piece.fold_end.x(), 0.0, 1e-12);
+  }
+  EXPECT_NEAR(layout.length_used, 3 * gap + 2 * 0.32, 1e-9);
+  EXPECT_NEAR(layout.efficiency,
+              2 * 2 * layout.pieces[0].cut_area / (layout.length_used * layout.fabric_width),
+              1e-12);
+  EXPECT_NEAR(layout.sheet_length, 2 * gap + 0.32, 1e-9);
+  EXPECT_NEAR(layout.sheet_efficiency,
+              2 * layout.pieces[0].cut_area / (layout.sheet_length * layout.fabric_width), 1e-12);
+  // The same pieces sewn along x = 0 instead (1 cm allowance there too): 0.52 m, side by side.
+  const PatternLayout seamed = lay_out_pattern(pattern);
+  EXPECT_NEAR(seamed.length_used, 2 * gap + 0.32, 1e-9);
+}
+
 }  // namespace
 }  // namespace sd::garment

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 
 #include "sim/fabric.hpp"
 #include "src/app/pipeline/markup_escape.hpp"
@@ -45,14 +46,16 @@ std::pair<Eigen::Vector2d, Eigen::Vector2d> notch_segment(const garment::Pattern
   return {n.point + a * n.normal, n.point + (a - depth) * n.normal};
 }
 
-// The piece's seam allowance in mm for a label: "10", or "10-30" when its seams differ.
+// The piece's seam allowance in mm for a label: "10", or "10-30" when its seams differ. A fold
+// has none and is no seam: it is left out.
 std::string allowance_mm(const garment::PatternPiece& piece) {
-  double lo = piece.allowance, hi = piece.allowance;
-  if (!piece.allowances.empty()) lo = hi = piece.allowances.front().allowance;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (const garment::AllowanceRun& run : piece.allowances) {
+    if (piece.on_fold && run.allowance == 0) continue;
     lo = std::min(lo, run.allowance);
     hi = std::max(hi, run.allowance);
   }
+  if (!(lo <= hi)) lo = hi = piece.allowance;
   return hi - lo < 5e-4 ? fmt::format("{:.0f}", kMm * lo)
                         : fmt::format("{:.0f}-{:.0f}", kMm * lo, kMm * hi);
 }
@@ -109,8 +112,11 @@ constexpr double kFoldStraightness = 2e-3;
 // kFoldStraightness of its chord, in 2D): the piece is cut on the fold there, and stands for
 // its copy too. Empty otherwise.
 std::vector<bool> fold_edges(const garment::Garment& garment, const garment::FlatPattern& pattern,
-                             const garment::FlatPanel& flat, const std::vector<double>& own) {
+                             const garment::FlatPanel& flat, const std::vector<double>& own,
+                             double opened_width_limit) {
   if (flat.id.ends_with(".mirror")) return {};
+  // Opened out, both halves must fit across the fabric (the layout lays it out so).
+  if (2 * flat.uv.col(0).maxCoeff() > opened_width_limit) return {};
   const bool has_copy = std::any_of(pattern.panels.begin(), pattern.panels.end(),
                                     [&](const auto& p) { return p.id == flat.id + ".mirror"; });
   if (!has_copy) return {};
@@ -289,8 +295,16 @@ PatternSheet build_pattern_sheet(const scene::Sketch& sketch, const garment::Gar
       layout.edge_allowance.push_back(edge_allowances(sketch, garment, flat));
       layout.panel_ease.push_back(panel.ease);
       layout.corners.push_back(curve_corners(garment, flat));
+      // The widest the half of a fold piece may be, flattened (m): both halves with their
+      // widest allowance, the gaps at the selvedges and 2 mm columns' rounding each side.
+      double widest_allowance =
+          layout.panel_allowance.back() >= 0 ? layout.panel_allowance.back() : spec.seam_allowance;
+      for (const double a : layout.edge_allowance.back())
+        widest_allowance = std::max(widest_allowance, a);
+      const double opened_limit =
+          (spec.fabric_width - 2 * layout.gap - 0.008) / panel.ease.weft - 2 * widest_allowance;
       layout.fold_edge.push_back(
-          fold_edges(garment, sheet.pattern, flat, layout.edge_allowance.back()));
+          fold_edges(garment, sheet.pattern, flat, layout.edge_allowance.back(), opened_limit));
       sheet.fabrics.push_back(fabric_label(sketch, panel.fabric));
     }
     // A fold piece's mirror copy is its other half: not cut on its own.
@@ -420,12 +434,15 @@ std::string pattern_svg(const PatternSheet& sheet) {
       y + 4, markup_escape(sheet.title), drawn,
       layout.pairs > 0 ? fmt::format(" ({} to cut)", to_cut) : std::string(), width, length,
       100 * layout.sheet_efficiency);
-  if (layout.pairs > 0)
+  const bool folds = std::any_of(layout.pieces.begin(), layout.pieces.end(),
+                                 [](const auto& piece) { return piece.on_fold; });
+  if (layout.pairs > 0 || folds)
     svg += fmt::format(
-        "<text class=\"note\" x=\"130\" y=\"{:.1f}\" font-size=\"5\">cut 2 pieces: cut twice, "
-        "the second turned over; every piece cut from one layer takes {:.0f} mm of fabric "
-        "(efficiency {:.0f} %)</text>\n",
-        y + 11, kMm * layout.length_used, 100 * layout.efficiency);
+        "<text class=\"note\" x=\"130\" y=\"{:.1f}\" font-size=\"5\">{}{}every piece cut "
+        "from one layer takes {:.0f} mm of fabric (efficiency {:.0f} %)</text>\n",
+        y + 11, layout.pairs > 0 ? "cut 2 pieces: cut twice, the second turned over; " : "",
+        folds ? "CUT 1 ON FOLD pieces: both halves, the fold along the grain; " : "",
+        kMm * layout.length_used, 100 * layout.efficiency);
   svg += "</svg>\n";
   return svg;
 }
@@ -579,6 +596,15 @@ nlohmann::json distortion_json(const garment::FlatDistortion& d) {
           {"saddle_rad", d.saddle}};
 }
 
+// The centre line held straight by the flattening (FlatPanel::centre_run), with what the free
+// flattening gave for comparison; null for a piece flattened freely.
+nlohmann::json centre_line_json(const garment::FlatPanel& flat) {
+  if (flat.centre_run.empty()) return nullptr;
+  return {{"held_straight", true},
+          {"free_bow_mm", kMm * flat.free_centre_bow},
+          {"free_distortion", distortion_json(flat.free_distortion)}};
+}
+
 // A seam side's polyline as flattened (m, before ease).
 Eigen::MatrixX2d flat_seam_side(const PatternSheet& sheet, int panel,
                                 const std::vector<int>& vertices) {
@@ -688,6 +714,7 @@ nlohmann::json pattern_json(const PatternSheet& sheet) {
          {"grain_line", {point_mm(piece.grain_start), point_mm(piece.grain_end)}},
          {"notches", notches},
          {"distortion", distortion_json(flat.distortion)},
+         {"centre_line", centre_line_json(flat)},
          {"iterations", flat.iterations},
          {"warning", flat.warning},
          {"mirror_pair", mirror_partner(sheet, flat.id)},
