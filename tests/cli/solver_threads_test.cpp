@@ -59,6 +59,28 @@ TEST(SolverThreads, PcgRunStartsOnce) {
       << line;
 }
 
+// A user's OMP_THREAD_LIMIT above 1 without OMP_WAIT_POLICY is warned of (CHOLMOD's OpenMP
+// threads would spin while they wait: docs/cli.md, "Threads"); with the policy set, or a limit
+// of 1, it is not.
+TEST(SolverThreads, AnOpenMpLimitAboveOneWithoutAWaitPolicyIsWarnedOf) {
+  const std::string dir = write_sheet("wait_policy", "cholmod");
+  const std::string run = "run " + dir + "/sheet.json -o " + dir + "/out";
+  const CommandResult spinning = run_sketchdrape_with_env(
+      "env -u OMP_WAIT_POLICY -u OPENBLAS_NUM_THREADS OMP_THREAD_LIMIT=2 OMP_NUM_THREADS=2", run);
+  EXPECT_EQ(spinning.exit_code, 0) << spinning.output;
+  EXPECT_NE(spinning.output.find("set OMP_WAIT_POLICY=passive"), std::string::npos)
+      << spinning.output;
+  const CommandResult passive = run_sketchdrape_with_env(
+      "env -u OPENBLAS_NUM_THREADS OMP_THREAD_LIMIT=2 OMP_NUM_THREADS=2 OMP_WAIT_POLICY=passive",
+      run);
+  EXPECT_EQ(passive.exit_code, 0) << passive.output;
+  EXPECT_EQ(passive.output.find("OMP_WAIT_POLICY"), std::string::npos) << passive.output;
+  const CommandResult one =
+      run_sketchdrape_with_env("env -u OMP_WAIT_POLICY OMP_THREAD_LIMIT=1", run);
+  EXPECT_EQ(one.exit_code, 0) << one.output;
+  EXPECT_EQ(one.output.find("OMP_WAIT_POLICY"), std::string::npos) << one.output;
+}
+
 // The first 0.4 s of the adaptive long-sleeve tee at 2 cm (about 2,100 vertices: the splits of
 // its landing, body contact, self-contact springs and the fail-safe's continuous queries) at
 // --threads 1 and 2: every parallel loop joins its chunks in order (docs/simulator.md,

@@ -194,6 +194,17 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
       "s), {:.0f} frames",
       estimate.vertices, estimate.memory_bytes / 1e9, estimate.factor_bytes / 1e9, estimate.steps,
       estimate.seconds, estimate.frames);
+  // A user's own OMP_THREAD_LIMIT above 1 lets CHOLMOD's OpenMP regions run on several threads,
+  // which libgomp keeps spinning while they wait unless told otherwise; the policy is read when
+  // libgomp is loaded, so only the user can set it (docs/benchmarks.md, "Tenth round (issue
+  // 24)": the t-shirt example 33.5 s of CPU at OMP_THREAD_LIMIT=2, 1.76 s with it passive).
+  if (const char* omp_limit = std::getenv("OMP_THREAD_LIMIT");
+      omp_limit != nullptr && std::atoi(omp_limit) > 1 && std::getenv("OMP_WAIT_POLICY") == nullptr)
+    spdlog::warn(
+        "OMP_THREAD_LIMIT={} lets CHOLMOD run on several OpenMP threads, which spin while they "
+        "wait (the t-shirt example took 22 times its CPU time at 2 threads on a busy machine); "
+        "set OMP_WAIT_POLICY=passive as well",
+        omp_limit);
   if (spdlog::should_log(spdlog::level::debug)) {  // the probe opens an OpenMP region: -v only
     const char* omp_limit = std::getenv("OMP_THREAD_LIMIT");
     const char* blas_limit = std::getenv("OPENBLAS_NUM_THREADS");
