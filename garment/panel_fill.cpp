@@ -213,7 +213,7 @@ std::function<Eigen::Vector3d(const Eigen::Vector3d&)> panel_projection(
 meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& spec,
                                 const PanelLoop& loop, const CurveNetwork& net,
                                 const std::vector<Eigen::MatrixX3d>& side_points,
-                                const BodySurface& body, GarmentPanel& panel) {
+                                const BodySurface& body, GarmentPanel& panel, CreaseMoves* crease) {
   // Project interior points onto the offset surface where the panel lies on the body:
   // inside it, or less than one edge length outside it; points spanning a hollow (between
   // the legs, under the bust) are left where the relaxation puts them.
@@ -558,18 +558,18 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
     }
   }
   // Narrow creases (crease_wall.hpp), once the panel is filled: each vertex that lies on the
-  // offset surface (or inside it) goes onto its own wall of a crease, at the offset that fits.
-  // Only those move, so that a panel with no narrow crease keeps its bits. After the fill, not
-  // in its projection: the fill's choice among plans and smoothings at a four-curve junction
-  // changes with any small move of the surface it projects on (the jacket's back sleeve came out
-  // with slivers and quads 2 cm inside the arm). Not kept if it folds a quad or makes a sliver.
-  {
+  // offset surface (or inside it) would go onto its own wall of a crease, at the offset that
+  // fits. After the fill, not in its projection: the fill's choice among plans and smoothings at
+  // a four-curve junction changes with any small move of the surface it projects on (the
+  // jacket's back sleeve came out with slivers and quads 2 cm inside the arm). Not kept if it
+  // folds a quad or makes a sliver; returned, not applied (CreaseMoves).
+  if (crease != nullptr) {
     std::vector<char> fixed(static_cast<size_t>(patch.mesh.vertex_count()), 0);
     for (const auto& side : patch.topology.side_vertices)
       for (const int v : side) fixed[static_cast<size_t>(v)] = 1;
     const std::vector<SeamSide> seams = seam_sides(side_points, body, offset);
-    meshing::QuadMesh moved_mesh = patch.mesh;
-    bool moved = false;
+    meshing::QuadMesh moved = patch.mesh;
+    std::vector<std::pair<int, Eigen::Vector3d>> moves;
     for (Eigen::Index v = 0; v < patch.mesh.vertex_count(); ++v) {
       if (fixed[static_cast<size_t>(v)]) continue;
       const Eigen::Vector3d p = patch.mesh.vertices.row(v).transpose();
@@ -577,18 +577,16 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
       if ((p - s.position).dot(s.normal) > offset + kOnOffsetSurface) continue;
       const CreaseWall w = crease_wall(body, seams, p, s, offset, reach);
       if (!w.moved) continue;
-      moved_mesh.vertices.row(v) = (w.point.position + w.offset * w.point.normal).transpose();
-      moved = true;
+      moves.emplace_back(static_cast<int>(v), w.point.position + w.offset * w.point.normal);
+      moved.vertices.row(v) = moves.back().second.transpose();
     }
-    if (moved) {
+    if (!moves.empty()) {
       const meshing::QuadQuality quality =
-          meshing::measure_quality(moved_mesh, patch.topology.corner_vertices());
+          meshing::measure_quality(moved, patch.topology.corner_vertices());
       if (quality.inverted_quads <= patch.quality.inverted_quads &&
           (quality.max_aspect_ratio < kSliverAspect ||
-           patch.quality.max_aspect_ratio >= kSliverAspect)) {
-        patch.mesh = std::move(moved_mesh);
-        patch.quality = quality;
-      }
+           patch.quality.max_aspect_ratio >= kSliverAspect))
+        *crease = {std::move(moves), quality};
     }
   }
   return patch;
