@@ -24,6 +24,7 @@
 #include "garment/curve_network.hpp"
 #include "garment/edge_counts.hpp"
 #include "garment/fold_repair.hpp"
+#include "garment/garment_crossings.hpp"
 #include "garment/network_faces.hpp"
 #include "garment/panel_fill.hpp"
 #include "garment/panel_grain.hpp"
@@ -502,6 +503,63 @@ void assemble_mesh(std::vector<std::array<int, 4>>& faces, std::vector<int>& fac
       face_panel.data(), static_cast<Eigen::Index>(face_panel.size()));
 }
 
+// Stage 4a (crease_wall.hpp): panels that pass through each other (garment_crossings.hpp) take
+// their narrow-crease moves (CreaseMoves), each mirror copy its original's reflected. Only
+// those: the moves are 1-2 mm where cloth lies in a crease narrower than 2.5 offsets, and
+// where no panel crosses another they only change drapes (the t-shirt at 2 cm edges, whose two
+// underarm vertices a side moved by 1-2.3 mm, no longer rested in its 10 s).
+void settle_crossings_in_creases(const std::vector<PanelLoop>& loops,
+                                 const std::vector<std::vector<int>>& loop_globals,
+                                 const std::vector<CreaseMoves>& creases,
+                                 const std::vector<std::array<int, 4>>& faces,
+                                 const std::vector<int>& face_panel, VertexPool& pool,
+                                 Garment& garment) {
+  if (std::all_of(creases.begin(), creases.end(),
+                  [](const CreaseMoves& c) { return c.moves.empty(); }))
+    return;
+  Garment trial = garment;
+  std::vector<std::array<int, 4>> trial_faces = faces;
+  std::vector<int> trial_panel = face_panel;
+  VertexPool trial_pool = pool;
+  assemble_mesh(trial_faces, trial_panel, trial_pool, trial);
+  const auto original = [&](int p) {
+    const PanelLoop& loop = loops[static_cast<size_t>(p)];
+    return loop.mirror_copy ? loop.original : p;
+  };
+  std::set<int> crossing;
+  for (const PanelCrossing& c : find_panel_crossings(trial)) {
+    crossing.insert(original(c.panel_a));
+    crossing.insert(original(c.panel_b));
+  }
+  if (crossing.empty()) return;
+  const auto move = [&](VertexPool& into, Garment* panels) {
+    for (const int l : crossing) {
+      const CreaseMoves& crease = creases[static_cast<size_t>(l)];
+      if (crease.moves.empty()) continue;
+      for (size_t c = 0; c < loops.size(); ++c) {
+        const bool own = static_cast<int>(c) == l;
+        if (!own && !(loops[c].mirror_copy && loops[c].original == l)) continue;
+        for (const auto& [v, position] : crease.moves)
+          into.positions[static_cast<size_t>(loop_globals[c][static_cast<size_t>(v)])] =
+              own ? position : mirror_point(position);
+        if (panels != nullptr) panels->panels[c].quality = crease.quality;
+      }
+    }
+  };
+  // Kept only when the garment then crosses itself nowhere: moves that leave a crossing are not
+  // what clears it (the t-shirt at 2 cm edges crosses at its sleeves' fronts and backs; with its
+  // underarm moves it no longer rested in 10 s).
+  VertexPool moved = pool;
+  move(moved, nullptr);
+  trial = garment;
+  trial_faces = faces;
+  trial_panel = face_panel;
+  assemble_mesh(trial_faces, trial_panel, moved, trial);
+  if (!find_panel_crossings(trial).empty()) return;
+  spdlog::debug("narrow creases: moved the vertices of {} panel(s) that crossed", crossing.size());
+  move(pool, &garment);
+}
+
 // Stage 5, the seams checked: every vertex's quads form one fan.
 void check_fans(const GarmentRequest& sketch, const CurveNetwork& net, const Garment& garment,
                 const std::vector<std::array<int, 4>>& faces, const std::vector<int>& face_panel,
@@ -916,7 +974,8 @@ Garment build_garment(const GarmentRequest& sketch, const BodySurface& body) {
   // has the same bits on any number of threads. The sides' points are placed first (they add
   // nothing to the pool, whose numbering below stays that of a fill in the loop's order).
   std::vector<meshing::FilledPatch> filled(loops.size());
-  std::vector<GarmentPanel> fits(loops.size());  // each fill's fit and span_gap
+  std::vector<GarmentPanel> fits(loops.size());    // each fill's fit and span_gap
+  std::vector<CreaseMoves> creases(loops.size());  // each fill's narrow-crease moves
   {
     std::vector<int> originals;
     std::vector<std::vector<Eigen::MatrixX3d>> sides(loops.size());
@@ -928,7 +987,7 @@ Garment build_garment(const GarmentRequest& sketch, const BodySurface& body) {
     run_panel_tasks(static_cast<int>(originals.size()), [&](int k) {
       const auto l = static_cast<size_t>(originals[static_cast<size_t>(k)]);
       const PanelSpec& spec = sketch.panels[static_cast<size_t>(loops[l].spec)];
-      filled[l] = fill_panel(sketch, spec, loops[l], net, sides[l], body, fits[l]);
+      filled[l] = fill_panel(sketch, spec, loops[l], net, sides[l], body, fits[l], &creases[l]);
     });
   }
 
@@ -1059,6 +1118,7 @@ Garment build_garment(const GarmentRequest& sketch, const BodySurface& body) {
 
   repair_stitched_folds(sketch, net, body, loops, face_range, loop_globals, patches, faces, pool,
                         garment);
+  settle_crossings_in_creases(loops, loop_globals, creases, faces, face_panel, pool, garment);
   assemble_mesh(faces, face_panel, pool, garment);
   check_fans(sketch, net, garment, faces, face_panel, pool);
   const auto curve_of = [&](int a, int b) -> std::string {

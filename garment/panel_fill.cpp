@@ -12,6 +12,7 @@
 #include <tuple>
 #include <utility>
 
+#include "garment/crease_wall.hpp"
 #include "garment/fold_repair.hpp"
 #include "garment/panel_surface.hpp"
 #include "garment/surface_relaxation.hpp"
@@ -49,6 +50,9 @@ constexpr double kAlongCos = 0.5;
 constexpr int kAlongRings = 2;
 // A quad this many times longer than wide is a sliver (the quality gate warns from 10).
 constexpr double kSliverAspect = 10;
+// m: a vertex this close to the offset surface lies on it (the fill puts a body panel's vertices
+// on it to rounding; a free panel's contacts are on it).
+constexpr double kOnOffsetSurface = 1e-3;
 
 // Hash of a point's coordinates bit for bit (-0 and 0 are two keys, which only costs a miss).
 size_t exact_point_hash(const Eigen::Vector3d& p) {
@@ -209,7 +213,7 @@ std::function<Eigen::Vector3d(const Eigen::Vector3d&)> panel_projection(
 meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& spec,
                                 const PanelLoop& loop, const CurveNetwork& net,
                                 const std::vector<Eigen::MatrixX3d>& side_points,
-                                const BodySurface& body, GarmentPanel& panel) {
+                                const BodySurface& body, GarmentPanel& panel, CreaseMoves* crease) {
   // Project interior points onto the offset surface where the panel lies on the body:
   // inside it, or less than one edge length outside it; points spanning a hollow (between
   // the legs, under the bust) are left where the relaxation puts them.
@@ -551,6 +555,38 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
       patch.topology.mesh.faces = patch.mesh.faces;
       patch.topology.distortion = patch.quality.distortion;
       patch.topology.irregular_vertices = patch.quality.irregular_vertices;
+    }
+  }
+  // Narrow creases (crease_wall.hpp), once the panel is filled: each vertex that lies on the
+  // offset surface (or inside it) would go onto its own wall of a crease, at the offset that
+  // fits. After the fill, not in its projection: the fill's choice among plans and smoothings at
+  // a four-curve junction changes with any small move of the surface it projects on (the
+  // jacket's back sleeve came out with slivers and quads 2 cm inside the arm). Not kept if it
+  // folds a quad or makes a sliver; returned, not applied (CreaseMoves).
+  if (crease != nullptr) {
+    std::vector<char> fixed(static_cast<size_t>(patch.mesh.vertex_count()), 0);
+    for (const auto& side : patch.topology.side_vertices)
+      for (const int v : side) fixed[static_cast<size_t>(v)] = 1;
+    const std::vector<SeamSide> seams = seam_sides(side_points, body, offset);
+    meshing::QuadMesh moved = patch.mesh;
+    std::vector<std::pair<int, Eigen::Vector3d>> moves;
+    for (Eigen::Index v = 0; v < patch.mesh.vertex_count(); ++v) {
+      if (fixed[static_cast<size_t>(v)]) continue;
+      const Eigen::Vector3d p = patch.mesh.vertices.row(v).transpose();
+      const SurfacePoint s = closest(p);
+      if ((p - s.position).dot(s.normal) > offset + kOnOffsetSurface) continue;
+      const CreaseWall w = crease_wall(body, seams, p, s, offset, reach);
+      if (!w.moved) continue;
+      moves.emplace_back(static_cast<int>(v), w.point.position + w.offset * w.point.normal);
+      moved.vertices.row(v) = moves.back().second.transpose();
+    }
+    if (!moves.empty()) {
+      const meshing::QuadQuality quality =
+          meshing::measure_quality(moved, patch.topology.corner_vertices());
+      if (quality.inverted_quads <= patch.quality.inverted_quads &&
+          (quality.max_aspect_ratio < kSliverAspect ||
+           patch.quality.max_aspect_ratio >= kSliverAspect))
+        *crease = {std::move(moves), quality};
     }
   }
   return patch;

@@ -69,33 +69,19 @@ std::string test_name(const ::testing::TestParamInfo<std::string>& param_info) {
 
 class Design : public ::testing::TestWithParam<std::string> {};
 
-// Designs whose panels cross at the start (the quality gate's `self_intersection`), which the
-// drape's untangling separates within its strain bound: the cropped jacket's back crosses its
-// back sleeve in 13 triangle pairs at the back of the left armpit (the drape untangles them and
-// rests with no crossing, docs/collision.md, "An untangled start"). Only that warning is
-// allowed. There the crease between the arm and the torso is 0.6-2.6 cm wide, narrower than the
-// two panels' offsets (2 × 1.2 cm), and the back's first row past its armhole lies on the arm's
-// side of it (docs/garment.md, "inside_body").
-bool crosses_at_start(const std::string& name) {
-  return name == "cropped-jacket";
-}
-
 TEST_P(Design, MeshesWithoutQualityWarnings) {
   const std::string& name = GetParam();
   if (!body_available(name)) GTEST_SKIP() << "the design's body is not installed";
   const fs::path dir = fs::temp_directory_path() / "sd_designs" / name;
   const fs::path sketch = staged_design(name, dir);
-  const std::string strict = crosses_at_start(name) ? "" : "--strict ";
+  // (The cropped jacket was allowed `self_intersection` until 27 November: its back crossed its
+  // back sleeve in 13 triangle pairs in the narrow crease under the left arm, where both lay on
+  // the arm's wall; docs/garment.md, "Narrow creases".)
   const CommandResult meshed =
-      run_sketchdrape("-q mesh " + strict + sketch.string() + " -o " + (dir / "mesh").string());
+      run_sketchdrape("-q mesh --strict " + sketch.string() + " -o " + (dir / "mesh").string());
   ASSERT_EQ(meshed.exit_code, 0) << meshed.output;
   const nlohmann::json report = read_json(dir / "mesh" / "report.json");
-  // (The jacket was also allowed `inside_body`, its back sleeve 12 mm inside that crease: on
-  // 27 November it has no such warning, and it is no longer allowed.)
-  for (const nlohmann::json& warning : report["warnings"]) {
-    const std::string kind = warning["kind"].get<std::string>();
-    EXPECT_TRUE(crosses_at_start(name) && kind == "self_intersection") << warning.dump(2);
-  }
+  for (const nlohmann::json& warning : report["warnings"]) ADD_FAILURE() << warning.dump(2);
   for (const nlohmann::json& panel : report["panels"]) {
     EXPECT_EQ(panel["quality"]["inverted_quads"].get<int>(), 0) << panel["id"];
     EXPECT_LT(panel["quality"]["max_aspect_ratio"].get<double>(), 10.0) << panel["id"];
