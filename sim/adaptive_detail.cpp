@@ -488,9 +488,11 @@ void AdaptiveCloth::split_towards(BlockId k, int level, AdaptiveTransfer& state,
   const int target = std::min(level, settings_.max_level);
   std::vector<BlockId> pending{k};
   while (!pending.empty()) {
-    if (settings_.max_vertices > 0 && mesh_.vertex_count() >= settings_.max_vertices) return;
     const BlockId b = pending.back();
     pending.pop_back();
+    // The budget is checked per edge by the caller, and here for the levels beyond the first.
+    if (b != k && settings_.max_vertices > 0 && mesh_.vertex_count() >= settings_.max_vertices)
+      return;
     if (!mesh_.alive(b) || !mesh_.can_split(b) || mesh_.level(b) + 1 > target) continue;
     // k itself was checked by the caller; the blocks its split made are checked here.
     if (b != k && !split_stays_off_body(b, state.x)) {
@@ -698,7 +700,7 @@ void AdaptiveCloth::record(const StepOutcome& outcome, const AdaptStats& stats) 
 }
 
 StepOutcome AdaptiveCloth::step(double max_step) {
-  if (!looked_ahead_) {
+  if (!looked_ahead_ && settings_.lookahead > 0.0) {
     looked_ahead_ = true;
     for (int round = 0; round < settings_.max_level && refine_ahead().changed(); ++round) {
     }
