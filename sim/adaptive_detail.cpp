@@ -73,6 +73,10 @@ void AdaptiveSettings::validate() const {
   require(max_vertices >= 0, "the particle budget must be zero (none) or a positive count");
   require(std::isfinite(merge_batch) && merge_batch >= 0.0 && merge_batch < 1.0,
           "the merge batch must be a fraction of the particles, at least 0 and below 1");
+  require(std::isfinite(change_interval) && change_interval >= 0.0,
+          "the interval between topology changes must be zero (every step) or positive seconds");
+  require(std::isfinite(lookahead) && lookahead >= 0.0,
+          "the refinement lookahead must be zero (none) or a positive time in seconds");
 }
 
 AdaptiveCloth::AdaptiveCloth(meshing::Mesh48 mesh, AdaptiveMaterial material,
@@ -235,16 +239,19 @@ bool AdaptiveCloth::split_stays_off_body(BlockId k, const Eigen::MatrixX3d& x) c
 void AdaptiveCloth::set_body(const meshing::TriMesh& body) {
   simulation_->set_body(body);
   body_sag_cache_.clear();
+  if (settings_.lookahead > 0.0) still_body_ = body;
 }
 
 void AdaptiveCloth::set_body_motion(PoseSequence motion) {
   simulation_->set_body_motion(std::move(motion));
   body_sag_cache_.clear();
+  still_body_ = {};
 }
 
 void AdaptiveCloth::clear_body() {
   simulation_->clear_body();
   body_sag_cache_.clear();
+  still_body_ = {};
 }
 
 Eigen::MatrixXd AdaptiveCloth::pattern_rest_uv(const Eigen::MatrixXd& roots) const {
@@ -440,6 +447,64 @@ MergeInputs AdaptiveCloth::merge_inputs() const {
   return in;
 }
 
+void AdaptiveCloth::split_edges(const std::vector<std::pair<double, int>>& refinements,
+                                AdaptiveTransfer& state, AdaptStats& stats) {
+  for (const auto& [error, r] : refinements) {
+    if (settings_.max_vertices > 0 && mesh_.vertex_count() >= settings_.max_vertices) break;
+    const VertexId i(arrays_.interior_edges(r, 0)), j(arrays_.interior_edges(r, 1));
+    // The blocks on the two sides of the edge, if the edge still exists (an edge already split
+    // or merged away in this batch waits for the next step: one level per block per step).
+    std::array<BlockId, 2> blocks;
+    for (int side = 0; side < 2; ++side) {
+      const TriangleId t =
+          arrays_.triangle_ids[static_cast<std::size_t>(arrays_.edge_faces(r, side))];
+      if (!mesh_.alive(t)) continue;
+      const auto& corners = mesh_.vertices(t);
+      const bool has_edge = std::find(corners.begin(), corners.end(), i) != corners.end() &&
+                            std::find(corners.begin(), corners.end(), j) != corners.end();
+      if (has_edge) blocks[static_cast<std::size_t>(side)] = mesh_.block(t);
+    }
+    if (blocks[1] == blocks[0]) blocks[1] = BlockId();
+    for (BlockId k : blocks) {
+      if (!k.valid() || !mesh_.can_split(k) || state.touched(k)) continue;
+      if (mesh_.level(k) + 1 > settings_.max_level) continue;
+      if (!split_stays_off_body(k, state.x)) {
+        ++stats.splits_declined_on_body;
+        continue;
+      }
+      split_towards(k, mesh_.level(k) + levels_asked(error), state, stats);
+    }
+  }
+}
+
+int AdaptiveCloth::levels_asked(double error) const {
+  if (!settings_.target_levels || !(error > settings_.refine_threshold)) return 1;
+  // The sag halves per level on a smooth curve (θ and w each fall by √2).
+  return std::max(1, static_cast<int>(std::ceil(std::log2(error / settings_.refine_threshold))));
+}
+
+void AdaptiveCloth::split_towards(BlockId k, int level, AdaptiveTransfer& state,
+                                  AdaptStats& stats) {
+  const int target = std::min(level, settings_.max_level);
+  std::vector<BlockId> pending{k};
+  while (!pending.empty()) {
+    const BlockId b = pending.back();
+    pending.pop_back();
+    // The budget is checked per edge by the caller, and here for the levels beyond the first.
+    if (b != k && settings_.max_vertices > 0 && mesh_.vertex_count() >= settings_.max_vertices)
+      return;
+    if (!mesh_.alive(b) || !mesh_.can_split(b) || mesh_.level(b) + 1 > target) continue;
+    // k itself was checked by the caller; the blocks its split made are checked here.
+    if (b != k && !split_stays_off_body(b, state.x)) {
+      ++stats.splits_declined_on_body;
+      continue;
+    }
+    count_split(mesh_.split(b), state, stats);
+    for (BlockId child : mesh_.children(b))
+      if (child.valid()) pending.push_back(child);
+  }
+}
+
 AdaptStats AdaptiveCloth::adapt() {
   AdaptStats stats;
   if (!settings_.enabled || !(settings_.refine || settings_.coarsen)) {
@@ -450,10 +515,23 @@ AdaptStats AdaptiveCloth::adapt() {
   const auto estimate_start = Clock::now();
   // Merge candidates, flattest first; split candidates, largest estimate first; with even
   // levels, the odd blocks that are split whatever their estimate (adaptive_policy.hpp).
+  // Between regular changes (change_interval) only an edge a whole level behind (sag above
+  // twice the threshold) changes the mesh; the lookahead covers the time to the next change.
+  const bool due = time() >= next_change_ - 1e-9 * settings_.change_interval;
   std::vector<std::pair<double, BlockId>> merges;
-  if (settings_.coarsen) merges = merge_candidates(merge_inputs());
+  if (settings_.coarsen && due) merges = merge_candidates(merge_inputs());
   std::vector<std::pair<double, int>> refinements;
-  if (settings_.refine) refinements = refine_candidates(edge_errors(), arrays_, settings_);
+  if (settings_.refine) {
+    Eigen::VectorXd errors = edge_errors();
+    if (!due) {
+      errors = (errors.array() > 2.0 * settings_.refine_threshold).select(errors, 0.0);
+    } else if (settings_.lookahead > 0.0) {
+      errors = errors.cwiseMax(
+          bend_sags(arrays_, edge_rest_,
+                    simulation_->positions() + settings_.lookahead * simulation_->velocities()));
+    }
+    refinements = refine_candidates(errors, arrays_, settings_);
+  }
   std::vector<BlockId> odd_blocks;
   if (settings_.refine && settings_.even_levels) odd_blocks = odd_level_blocks(mesh_, settings_);
   stats.estimate_s = seconds_since(estimate_start);
@@ -463,6 +541,8 @@ AdaptStats AdaptiveCloth::adapt() {
       static_cast<double>(merge_count(mesh_, settings_, merges)) <
           settings_.merge_batch * mesh_.vertex_count())
     merges.clear();
+  if (due && !(refinements.empty() && odd_blocks.empty() && merges.empty()))
+    next_change_ = time() + settings_.change_interval;
 
   const auto operations_start = Clock::now();
   AdaptiveTransfer state = begin_transfer();
@@ -487,32 +567,7 @@ AdaptStats AdaptiveCloth::adapt() {
     apply(mesh_.merge(k), state);
     ++stats.merges;
   }
-  for (const auto& [error, r] : refinements) {
-    if (settings_.max_vertices > 0 && mesh_.vertex_count() >= settings_.max_vertices) break;
-    const VertexId i(arrays_.interior_edges(r, 0)), j(arrays_.interior_edges(r, 1));
-    // The blocks on the two sides of the edge, if the edge still exists (an edge already split
-    // or merged away in this batch waits for the next step: one level per block per step).
-    std::array<BlockId, 2> blocks;
-    for (int side = 0; side < 2; ++side) {
-      const TriangleId t =
-          arrays_.triangle_ids[static_cast<std::size_t>(arrays_.edge_faces(r, side))];
-      if (!mesh_.alive(t)) continue;
-      const auto& corners = mesh_.vertices(t);
-      const bool has_edge = std::find(corners.begin(), corners.end(), i) != corners.end() &&
-                            std::find(corners.begin(), corners.end(), j) != corners.end();
-      if (has_edge) blocks[static_cast<std::size_t>(side)] = mesh_.block(t);
-    }
-    if (blocks[1] == blocks[0]) blocks[1] = BlockId();
-    for (BlockId k : blocks) {
-      if (!k.valid() || !mesh_.can_split(k) || touched(k)) continue;
-      if (mesh_.level(k) + 1 > settings_.max_level) continue;
-      if (!split_stays_off_body(k, state.x)) {
-        ++stats.splits_declined_on_body;
-        continue;
-      }
-      count_split(mesh_.split(k), state, stats);
-    }
-  }
+  split_edges(refinements, state, stats);
   for (BlockId k : odd_blocks) {
     if (settings_.max_vertices > 0 && mesh_.vertex_count() >= settings_.max_vertices) break;
     // Made or completed by a split above (one level per block per step), or left pending by a
@@ -524,6 +579,47 @@ AdaptStats AdaptiveCloth::adapt() {
     }
     count_split(mesh_.split(k), state, stats);
   }
+  return finish(state, stats, operations_start);
+}
+
+Eigen::VectorXd AdaptiveCloth::preview_sags() const {
+  SimulationSettings trial = simulation_->settings();
+  trial.duration = settings_.lookahead;
+  trial.stop_at_rest = false;
+  std::vector<Pin> pins;
+  for (const PinRecord& pin : pins_) pins.push_back({pin.vertex, pin.path});
+  Simulation preview(simulation_->model(), simulation_->positions(), std::move(pins), trial);
+  if (still_body_.face_count() > 0) preview.set_body(still_body_);
+  Eigen::VectorXd sags = Eigen::VectorXd::Zero(arrays_.interior_edges.rows());
+  // The run's own steps: contacts are found within a step's reach, so one long step would
+  // pass through a body the cloth is about to land on.
+  while (preview.time() < settings_.lookahead * (1.0 - 1e-9)) {
+    if (!preview.step(settings_.lookahead - preview.time()).accepted) break;
+    sags = sags.cwiseMax(bend_sags(arrays_, edge_rest_, preview.positions()));
+  }
+  if (const ContactResponse* contact = preview.contact()) {
+    const double reach = body_reach(trial.contact);
+    const Eigen::VectorXd& x = preview.positions();
+    for (Eigen::Index r = 0; r < sags.size(); ++r) {
+      if (!edge_refinable(arrays_, r, settings_.max_level)) continue;
+      const int i = arrays_.interior_edges(r, 0), j = arrays_.interior_edges(r, 1);
+      sags(r) = std::max(sags(r), body_sag(contact->collider(), reach, row3(x, i), row3(x, j)));
+    }
+  }
+
+  return sags;
+}
+
+AdaptStats AdaptiveCloth::refine_ahead() {
+  AdaptStats stats;
+  const auto estimate_start = Clock::now();
+  std::vector<std::pair<double, int>> refinements;
+  if (settings_.enabled && settings_.refine && settings_.lookahead > 0.0)
+    refinements = refine_candidates(edge_errors().cwiseMax(preview_sags()), arrays_, settings_);
+  stats.estimate_s = seconds_since(estimate_start);
+  const auto operations_start = Clock::now();
+  AdaptiveTransfer state = begin_transfer();
+  split_edges(refinements, state, stats);
   return finish(state, stats, operations_start);
 }
 
@@ -604,6 +700,11 @@ void AdaptiveCloth::record(const StepOutcome& outcome, const AdaptStats& stats) 
 }
 
 StepOutcome AdaptiveCloth::step(double max_step) {
+  if (!looked_ahead_ && settings_.lookahead > 0.0) {
+    looked_ahead_ = true;
+    for (int round = 0; round < settings_.max_level && refine_ahead().changed(); ++round) {
+    }
+  }
   if (!ramp_finished_) {
     // The step starts in the rest shapes of its start time; from the first step at or after the
     // ramp's end, in rest_uv's exactly.

@@ -140,6 +140,13 @@ class AdaptiveCloth {
   // Error estimates, then merges (flattest first) and splits (largest first) as the settings
   // allow; rebuilds the model only if something changed. Called by step().
   AdaptStats adapt();
+  // Refinement ahead of the motion (AdaptiveSettings::lookahead > 0): splits, by the rule of
+  // adapt(), the edges whose sag estimate is above the threshold now or at any step of a trial
+  // run of `lookahead` seconds from the current state (same model, pins, settings and still
+  // body, on a copy: the cloth is not changed). The first step() calls it until it changes
+  // nothing (at most max_level times); a cloth that starts flat is then refined where it is
+  // about to bend instead of after it has bent on the coarse mesh.
+  AdaptStats refine_ahead();
 
   // Explicit operations through the same transfer and rebuild path (pre-refinement, tests).
   // Blocks that are no longer leaves (or, for merges, no longer mergeable) are skipped; max_level
@@ -217,6 +224,19 @@ class AdaptiveCloth {
                     std::chrono::steady_clock::time_point operations_start);
   void count_split(const std::vector<meshing::BlockChange>& changes, AdaptiveTransfer& state,
                    AdaptStats& stats);
+  // Splits the blocks on the edges of `refinements` (error, interior edge row; largest first),
+  // each towards the level its error asks for (levels_asked), within max_level and the budget.
+  void split_edges(const std::vector<std::pair<double, int>>& refinements, AdaptiveTransfer& state,
+                   AdaptStats& stats);
+  // How many levels an edge of sag `error` asks for: 1, or with target_levels
+  // ⌈log2(error / refine_threshold)⌉.
+  int levels_asked(double error) const;
+  // Splits leaf block k, then the blocks its splits make, until their triangles reach `level`.
+  void split_towards(meshing::BlockId k, int level, AdaptiveTransfer& state, AdaptStats& stats);
+  // Per interior edge, the largest sag estimate over a trial run of `lookahead` seconds from the
+  // current state (the simulation's own steps, on a copy; bend sags after each step, the body
+  // sag where the trial ends). Zero where the trial's first step fails.
+  Eigen::VectorXd preview_sags() const;
   void record(const StepOutcome& outcome, const AdaptStats& stats);
 
   meshing::Mesh48 mesh_;
@@ -247,6 +267,9 @@ class AdaptiveCloth {
   bool ramp_finished_ = true;    // no ramp, or the rest shapes have reached rest_uv
   EdgeRestGeometry edge_rest_;   // per interior edge (rows of arrays_.interior_edges)
   BodySagCache body_sag_cache_;  // carried through topology changes by rebuild
+  meshing::TriMesh still_body_;  // the body of set_body, for the trial step; empty otherwise
+  bool looked_ahead_ = false;    // refine_ahead has been called by the first step
+  double next_change_ = 0.0;     // s: the next regular topology change (change_interval)
   AdaptiveReport report_;
 };
 

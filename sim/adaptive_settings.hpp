@@ -44,6 +44,25 @@ struct AdaptiveSettings {
   // level (docs/adaptive.md, "Even levels"). Only the strip around a refined region, where the
   // level rule needs it, stays odd.
   bool even_levels = false;
+  // Refine to the level the estimate asks for at once: the sag of a smooth curve halves with
+  // each level, so an edge whose sag is ε > refine_threshold is refined by
+  // ⌈log2(ε / refine_threshold)⌉ levels in one step (the blocks made by its split are split again
+  // until then) instead of one level per step. A region that starts to bend reaches its level in
+  // one topology change instead of one per level.
+  bool target_levels = false;
+  // s: refine ahead of the motion. The estimate is also taken where the cloth will be after
+  // this time at its current velocity (x + lookahead·v; on regular changes, see
+  // change_interval), and before the first step a trial run of this length from the start state
+  // (a copy of the simulation: pins, gravity, a still body) shows where the cloth is about to
+  // bend: the mesh is refined there, by the same rule, before it moves (AdaptiveCloth::
+  // refine_ahead). 0: refine on the current shape only.
+  double lookahead = 0.0;
+  // s: regular topology changes at most this often. In between, the estimate still runs every
+  // step but only an edge a whole level behind (sag above twice refine_threshold) changes the
+  // mesh; merges wait for the next regular change. Every change costs a model update and a new
+  // CHOLMOD analysis; with lookahead ≥ this interval the regions that will bend before the next
+  // change are refined at this one. 0: every step.
+  double change_interval = 0.0;
   bool refine = true;
   bool coarsen = true;
   // Measure energies, total mass and linear momentum just before and just after each topology

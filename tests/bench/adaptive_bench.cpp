@@ -5,6 +5,8 @@
 //                                             splits and merges, a model rebuild
 //   adaptive_bench --study=DIR [--quick] [--scene=SCENE] [--only=RUN] [--finest=N]
 //                  [--perturbed=K] [--adaptive-start=L] [--even-levels] [--fine-ladder]
+//                  [--target-levels=0|1] [--lookahead=S] [--change-interval=S] [--max-level=L]
+//                  [--sample-errors]
 //                                             the work-precision study: the 3-corner and 2-corner
 //                                             sheets, a tablecloth and a sheet dropped on a sphere
 //                                             run fixed at levels N-4, N-2, N
@@ -22,7 +24,12 @@
 //                                             --adaptive-start: the adaptive runs' first level
 //                                             (default 0); --even-levels: adaptive runs keep
 //                                             even levels; --fine-ladder: thresholds in steps
-//                                             of √2 instead of 2; --threads=N: the
+//                                             of √2 instead of 2; --target-levels,
+//                                             --lookahead, --change-interval: the adaptive
+//                                             runs' AdaptiveSettings of those names;
+//                                             --max-level: their max level instead of N;
+//                                             --sample-errors: print each run's error at
+//                                             every sample time; --threads=N: the
 //                                             simulator's own parallel loops on N threads
 //                                             (default: every core; 1 keeps the CPU time free
 //                                             of idle worker threads' spinning).
@@ -67,6 +74,24 @@ AdaptiveSettings adaptive_settings(double refine_threshold, int max_level,
   settings.coarsen_threshold = 0.25 * refine_threshold;
   settings.max_level = max_level;
   settings.even_levels = even_levels;
+  return settings;
+}
+
+// The study's adaptive runs with the method options of the command line applied.
+struct MethodOptions {
+  int target_levels = -1;  // -1: the default
+  double lookahead = -1;   // s; negative: the default
+  double interval = -1;    // s; negative: the default
+  int max_level = -1;      // the adaptive runs' max level; -1: the study's finest
+};
+MethodOptions g_method;
+
+AdaptiveSettings study_settings(double refine_threshold, int max_level, bool even_levels) {
+  AdaptiveSettings settings = adaptive_settings(refine_threshold, max_level, even_levels);
+  if (g_method.target_levels >= 0) settings.target_levels = g_method.target_levels != 0;
+  if (g_method.lookahead >= 0) settings.lookahead = g_method.lookahead;
+  if (g_method.interval >= 0) settings.change_interval = g_method.interval;
+  if (g_method.max_level >= 0) settings.max_level = g_method.max_level;
   return settings;
 }
 
@@ -180,6 +205,7 @@ struct RunResult {
   int splits = 0, merges = 0, forced = 0, changes = 0, steps = 0, retries = 0;
   std::vector<Eigen::MatrixX3d> samples;  // material-point positions at the sample times
   double error_final = 0, error_trajectory = 0;
+  std::vector<double> errors;  // at each sample time
   ShapeFigures shape;
 };
 
@@ -300,6 +326,7 @@ void errors_against(RunResult& run, const RunResult& reference) {
   double sum = 0;
   for (std::size_t k = 0; k < n; ++k) {
     const double e = rms_distance(run.samples[k], reference.samples[k]);
+    run.errors.push_back(e);
     sum += e * e;
   }
   run.error_trajectory = std::sqrt(sum / static_cast<double>(n));
@@ -316,7 +343,8 @@ struct StudyOptions {
   int perturbed = 0;       // runs of the finest fixed level with the body moved by 1 µm
   int adaptive_start = 0;  // level the adaptive runs start from
   bool even_levels = false;
-  bool fine_ladder = false;  // refine thresholds in steps of √2
+  bool fine_ladder = false;    // refine thresholds in steps of √2
+  bool sample_errors = false;  // print each run's error at every sample time
 };
 
 int run_study(const StudyOptions& options) {
@@ -375,7 +403,7 @@ int run_study(const StudyOptions& options) {
       std::snprintf(name, sizeof name, "adaptive_%gmm", threshold * 1e3);
       if (wanted(name))
         runs.push_back(run_case(dir, scene, name, spec, options.adaptive_start,
-                                adaptive_settings(threshold, finest, options.even_levels), points,
+                                study_settings(threshold, finest, options.even_levels), points,
                                 every));
     }
     if (runs.empty()) continue;
@@ -416,6 +444,11 @@ int run_study(const StudyOptions& options) {
           run.adaptivity_s, run.estimate_s, run.operations_s, run.rebuild_s, run.steps, run.retries,
           run.vertices_final, run.vertices_max, run.splits, run.forced, run.merges,
           1e3 * run.error_final, 1e3 * run.error_trajectory, run.shape.lowest);
+      if (options.sample_errors) {
+        std::printf("%-13s %-16s errors mm:", scene.c_str(), run.name.c_str());
+        for (double e : run.errors) std::printf(" %.2f", 1e3 * e);
+        std::printf("\n");
+      }
       std::fflush(stdout);
     }
   }
@@ -445,6 +478,16 @@ int main(int argc, char** argv) {
       options.even_levels = true;
     else if (std::strcmp(argv[i], "--fine-ladder") == 0)
       options.fine_ladder = true;
+    else if (std::strncmp(argv[i], "--target-levels=", 16) == 0)
+      g_method.target_levels = std::atoi(argv[i] + 16);
+    else if (std::strncmp(argv[i], "--change-interval=", 18) == 0)
+      g_method.interval = std::atof(argv[i] + 18);
+    else if (std::strncmp(argv[i], "--max-level=", 12) == 0)
+      g_method.max_level = std::atoi(argv[i] + 12);
+    else if (std::strncmp(argv[i], "--lookahead=", 12) == 0)
+      g_method.lookahead = std::atof(argv[i] + 12);
+    else if (std::strcmp(argv[i], "--sample-errors") == 0)
+      options.sample_errors = true;
     else if (std::strcmp(argv[i], "--quick") == 0)
       options.quick = true;
     else if (std::strncmp(argv[i], "--threads=", 10) == 0)
