@@ -223,15 +223,15 @@ double polyline_distance(const Eigen::Vector3d& p, const std::vector<Eigen::Vect
 
 const Landmark& BodyLandmarks::nearest(const Eigen::Vector3d& p) const {
   if (points.empty()) throw std::logic_error("BodyLandmarks::nearest: no landmarks");
-  // Two corrections to the straight distance, so that a place is named by the part of the body
+  // Three corrections to the straight distance, so that a place is named by the part of the body
   // it is on: (1) an arm's joints (elbow, wrist: inside the arm, on its axis) name only places
   // within kArmReach of the arm's axis (shoulder, elbow, wrist and on over the hand): the hand
   // hangs beside the hips, and the gate named a seam on the side of the hips "near the
   // left_wrist"; (2) the torso's levels (neck base, chest, waist, hips, crotch: on the front at
   // x = 0) are measured mostly by height, half the horizontal distance counting, so that the
   // side or the back of the hips is named by the hips, not by the crotch 15 cm lower but nearer
-  // through the body. The legs' joints keep the straight distance (a flared hem beside the knee
-  // is named by the knee).
+  // through the body; (3) below. The legs' joints keep the straight distance (a flared hem beside
+  // the knee is named by the knee).
   // m: the arm's radius (4-5 cm) and a hand's width of cloth hanging free: on the built-in body a
   // cape's hem beside the hand is 12-13 cm from the arm's axis, the side of the hips 17 cm.
   constexpr double kArmReach = 0.14;
@@ -252,6 +252,18 @@ const Landmark& BodyLandmarks::nearest(const Eigen::Vector3d& p) const {
     }
     return std::nullopt;
   };
+  // (3) An arm's joints name only places farther from the body's midline than that side's
+  // armpit, where the arm leaves the torso: on the built-in body the elbow is 5 cm below the
+  // armpit and 6 cm out, and the back of the torso under the armpit (a kimono's underarm) was
+  // "near the left_elbow".
+  const auto on_torso_side_of_armpit = [&](const std::string& name, const Eigen::Vector3d& q) {
+    for (const std::string side : {"left_", "right_"}) {
+      if (name != side + "elbow" && name != side + "wrist") continue;
+      const auto armpit = find_position(side + "armpit");
+      return armpit && (armpit->x() > 0 ? q.x() : -q.x()) < std::abs(armpit->x());
+    }
+    return false;
+  };
   const auto level = [](const std::string& name) {
     return name == "neck_base" || name == "chest" || name == "waist" || name == "hips" ||
            name == "crotch";
@@ -261,6 +273,7 @@ const Landmark& BodyLandmarks::nearest(const Eigen::Vector3d& p) const {
   for (const Landmark& l : points) {
     double d = (l.position - p).norm();
     if (const auto chain = arm(l.name); chain && polyline_distance(p, *chain) > kArmReach) continue;
+    if (on_torso_side_of_armpit(l.name, p)) continue;
     if (level(l.name)) {
       const Eigen::Vector3d off = p - l.position;
       d = std::hypot(off.y(), kLevelAcross * std::hypot(off.x(), off.z()));

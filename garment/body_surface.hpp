@@ -48,6 +48,13 @@ class BodySurface {
   // The point on the offset surface (`offset` metres out along the normal) nearest to `p`.
   Eigen::Vector3d snap_to_offset(const Eigen::Vector3d& p, double offset) const;
 
+  // Whether `p` lies in a gap between two parts of the body (between a hanging arm and the
+  // torso, between the legs) rather than near one of them: more than 5 mm outside the offset
+  // surface, with the body across the gap (along the way out from the nearest point) at most
+  // a few times as far as the nearest point, both measured to the offset surface
+  // (body_surface.cpp). A seam written there bridges the gap (stroke_projection.cpp).
+  bool in_gap(const Eigen::Vector3d& p, double offset) const;
+
   const meshing::TriMesh& mesh() const;
   const meshing::BoundingBox& box() const;
   // The body's landmarks (body_landmarks.hpp), found on the first call (about 20 ms for the

@@ -73,6 +73,48 @@ Vec<D> catmull_rom(const Vec<D>& p0, const Vec<D>& p1, const Vec<D>& p2, const V
   return (t2 - t) / (t2 - t1) * b1 + (t - t1) / (t2 - t1) * b2;
 }
 
+// A points3d curve's samples moved onto the offset surface, each to its nearest point, except
+// where a run of them crosses a gap between two parts of the body (a kimono's underarm seam from
+// the underside of the arm across to the side seam on the torso): the nearest point there jumps
+// from one part to the other, so the curve stepped between them at a place that a centimetre's
+// move of a written point shifted, with a zigzag where it stepped (a fold at the cuff). Such a
+// run keeps its written shape: each sample moves by the blend (by arc length) of the moves of
+// the snapped samples before and after the run (the written sample at an end of the curve), and
+// only a sample that would then lie inside the offset surface goes to its nearest point on it.
+void snap_bridging_gaps(std::vector<Eigen::Vector3d>& samples, const BodySurface& body,
+                        double offset) {
+  const size_t n = samples.size();
+  std::vector<char> gap(n, 0);
+  std::vector<Eigen::Vector3d> moved(n);
+  for (size_t k = 0; k < n; ++k) {
+    gap[k] = body.in_gap(samples[k], offset) ? 1 : 0;
+    moved[k] = gap[k] ? samples[k] : body.snap_to_offset(samples[k], offset);
+  }
+  std::vector<double> arc(n, 0.0);
+  for (size_t k = 1; k < n; ++k) arc[k] = arc[k - 1] + (samples[k] - samples[k - 1]).norm();
+  for (size_t k = 0; k < n;) {
+    if (!gap[k]) {
+      ++k;
+      continue;
+    }
+    size_t end = k;
+    while (end < n && gap[end]) ++end;
+    const Eigen::Vector3d before =
+        k > 0 ? Eigen::Vector3d(moved[k - 1] - samples[k - 1]) : Eigen::Vector3d::Zero();
+    const Eigen::Vector3d after =
+        end < n ? Eigen::Vector3d(moved[end] - samples[end]) : Eigen::Vector3d::Zero();
+    const double from = k > 0 ? arc[k - 1] : arc[k];
+    const double to = end < n ? arc[end] : arc[end - 1];
+    for (size_t j = k; j < end; ++j) {
+      const double w = to > from ? (arc[j] - from) / (to - from) : 0.5;
+      const Eigen::Vector3d p = samples[j] + (1 - w) * before + w * after;
+      moved[j] = body.signed_distance(p) < offset ? body.snap_to_offset(p, offset) : p;
+    }
+    k = end;
+  }
+  samples = std::move(moved);
+}
+
 }  // namespace
 
 Eigen::Vector3d ViewFrame::plane_point(const Eigen::Vector2d& uv) const {
@@ -288,12 +330,11 @@ ProjectedCurve project_curve(const GarmentRequest& sketch, const CurveSpec& curv
   if (curve.is_3d()) {
     const auto dense =
         sample_stroke<3>(curve.points3d, curve.closed, curve.smooth, kCurveSampleSpacing);
-    out.points.resize(static_cast<Eigen::Index>(dense.size()), 3);
-    for (size_t i = 0; i < dense.size(); ++i) {
-      Eigen::Vector3d p = dense[i];
-      if (curve.on_body && body != nullptr) p = body->snap_to_offset(p, curve.offset);
-      out.points.row(static_cast<Eigen::Index>(i)) = p.transpose();
-    }
+    std::vector<Eigen::Vector3d> placed(dense.begin(), dense.end());
+    if (curve.on_body && body != nullptr) snap_bridging_gaps(placed, *body, curve.offset);
+    out.points.resize(static_cast<Eigen::Index>(placed.size()), 3);
+    for (size_t i = 0; i < placed.size(); ++i)
+      out.points.row(static_cast<Eigen::Index>(i)) = placed[i].transpose();
   } else {
     const auto dense =
         sample_stroke<2>(curve.points, curve.closed, curve.smooth, kCurveSampleSpacing);

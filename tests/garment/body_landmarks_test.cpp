@@ -86,6 +86,21 @@ TEST(BodyLandmarks, PlacesAreNamedByThePartOfTheBodyTheyAreOn) {
   EXPECT_EQ(l.nearest({0.280, 0.551, -0.055}).name, "left_knee");  // a flared hem by the knee
 }
 
+// The built-in body's elbow is 5 cm below the armpit and 6 cm out from it, nearer than the
+// armpit to the back of the torso under the arm: trial 36's kimono had its back underarm at
+// (0.174, 1.198, -0.100) m "near the left_elbow" (10 cm from the armpit, 8 cm from the elbow). An
+// arm's joints name only places farther out from the midline than the armpit; a place on the
+// arm's underside beside it (the kimono's cuff corner) is still the elbow's, and the right side
+// the right arm's.
+TEST(BodyLandmarks, TheTorsoUnderTheArmIsNamedByTheArmpitNotTheElbow) {
+  const Body body = load_body("builtin");
+  const BodyLandmarks l = find_landmarks(body.mesh);
+  EXPECT_EQ(l.nearest({0.174, 1.198, -0.100}).name, "left_armpit");
+  EXPECT_EQ(l.nearest({-0.174, 1.198, -0.100}).name, "right_armpit");
+  EXPECT_EQ(l.nearest({0.203, 1.132, -0.054}).name, "left_elbow");
+  EXPECT_EQ(l.nearest({-0.203, 1.132, -0.054}).name, "right_elbow");
+}
+
 TEST(BodyLandmarks, ColladaHumanInMetres) {
   const std::filesystem::path file = "/usr/share/assimp/models/Collada/human.zae";
   if (!std::filesystem::exists(file))

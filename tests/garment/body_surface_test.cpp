@@ -154,6 +154,31 @@ TEST(BodySurface, AnswersAreCgalsToTheBit) {
   EXPECT_EQ(differ, 0);
 }
 
+// BodySurface::in_gap on two spheres of 10 cm with a 6 cm gap between them: the middle of the
+// gap is a gap, a point 4 mm off one sphere's offset surface is near that sphere (closer than
+// 5 mm), a point 6 mm off it and 4.4 cm from the other's is near the first (the body across at
+// most 4 times as far), and a point in front of the gap, with nothing across from its nearest
+// point, is in the open.
+TEST(BodySurface, AGapIsBetweenTwoPartsOfTheBody) {
+  const meshing::TriMesh left = meshing::icosphere(0.1, 4, Eigen::Vector3d(-0.13, 1.0, 0.0));
+  meshing::TriMesh both = left;
+  both.vertices.conservativeResize(2 * left.vertex_count(), 3);
+  both.faces.conservativeResize(2 * left.face_count(), 3);
+  const Eigen::Index nv = left.vertex_count();
+  for (Eigen::Index v = 0; v < nv; ++v)
+    both.vertices.row(nv + v) << -left.vertices(v, 0), left.vertices(v, 1), left.vertices(v, 2);
+  for (Eigen::Index f = 0; f < left.face_count(); ++f)  // reversed: the copy faces outward
+    both.faces.row(left.face_count() + f) << left.faces(f, 0) + static_cast<int>(nv),
+        left.faces(f, 2) + static_cast<int>(nv), left.faces(f, 1) + static_cast<int>(nv);
+  const BodySurface body(both);
+  const double offset = 0.005;
+  EXPECT_TRUE(body.in_gap({0.001, 1.0, 0.0}, offset));
+  EXPECT_FALSE(body.in_gap({-0.03 + offset + 0.004, 1.0, 0.0}, offset));
+  EXPECT_FALSE(body.in_gap({-0.03 + offset + 0.006, 1.0, 0.0}, offset));
+  EXPECT_TRUE(body.in_gap({-0.03 + offset + 0.012, 1.0, 0.0}, offset));
+  EXPECT_FALSE(body.in_gap({0.0, 1.0, 0.3}, offset));
+}
+
 // Two mirror-image spheres: a point on the mirror plane is equally near to both (as a centre
 // seam between the Collada human's legs is), so its closest point is not unique and which side
 // wins is a matter of traversal order: CGAL's tree keeps the last of equally near faces it

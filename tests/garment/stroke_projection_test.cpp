@@ -106,6 +106,45 @@ TEST(StrokeProjection, Points3dSnapToOffsetSurface) {
     EXPECT_NEAR((p.points.row(k).transpose() - kCentre).norm(), kRadius + 0.01, 2e-3);
 }
 
+// Two spheres of 10 cm side by side with a 6 cm gap between them (an arm hanging beside the
+// torso). A curve written from the front of one across the gap to the front of the other (a
+// kimono's underarm seam from the underside of the arm to the side seam) used to be snapped
+// sample by sample to the nearer sphere: it ran down into the gap on one side and stepped across
+// to the other where the nearer sphere changed, a step of about 4 cm between two 5 mm samples
+// whose place a 1 cm move of the written middle point shifted. Now the samples in the gap keep
+// their written shape (BodySurface::in_gap), so consecutive samples stay about 5 mm apart, and
+// the samples near either sphere still lie on its offset surface.
+TEST(StrokeProjection, Points3dBridgeAGapBetweenTwoPartsOfTheBody) {
+  const meshing::TriMesh left = meshing::icosphere(0.1, 5, Eigen::Vector3d(-0.13, 1.0, 0.0));
+  const meshing::TriMesh right = meshing::icosphere(0.1, 5, Eigen::Vector3d(0.13, 1.0, 0.0));
+  meshing::TriMesh both = left;
+  both.vertices.conservativeResize(2 * left.vertex_count(), 3);
+  both.faces.conservativeResize(2 * left.face_count(), 3);
+  both.vertices.bottomRows(right.vertex_count()) = right.vertices;
+  both.faces.bottomRows(right.face_count()) =
+      right.faces.array() + static_cast<int>(left.vertex_count());
+  const BodySurface body(both);
+  for (const double middle_z : {0.02, 0.03}) {  // the written middle point moved by 1 cm
+    CurveSpec c;
+    c.id = "underarm";
+    c.offset = 0.01;
+    c.points3d = {{-0.10, 1.0, 0.105}, {0.0, 1.0, middle_z}, {0.10, 1.0, 0.105}};
+    const ProjectedCurve p = project_curve(sketch_with(c), c, &body);
+    double longest = 0;
+    for (Eigen::Index k = 0; k + 1 < p.points.rows(); ++k)
+      longest = std::max(longest, (p.points.row(k + 1) - p.points.row(k)).norm());
+    // 5 mm samples, stretched where a run's ends moved apart onto the offset surfaces: 1 cm
+    // bounds it, where snapping sample by sample stepped 4 cm across the gap.
+    EXPECT_LT(longest, 0.01) << "middle z " << middle_z;
+    // Nothing inside either offset surface (the level-5 sphere's facets: 0.4 mm).
+    for (Eigen::Index k = 0; k < p.points.rows(); ++k)
+      EXPECT_GT(body.signed_distance(p.points.row(k).transpose()), 0.01 - 5e-4);
+    // The ends, near a sphere, are on its offset surface.
+    EXPECT_NEAR(body.signed_distance(p.points.row(0).transpose()), 0.01, 5e-4);
+    EXPECT_NEAR(body.signed_distance(p.points.bottomRows(1).transpose()), 0.01, 5e-4);
+  }
+}
+
 // Points written inside the body around its centre (a cuff drawn round a guessed arm axis):
 // they do not cross, but snapped radially onto the sphere the curve runs 0° → 90°, back to
 // 45°, then on to 135° and doubles over itself. The error says so and names the written point
