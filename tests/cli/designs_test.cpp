@@ -94,7 +94,11 @@ TEST_P(Design, MeshesWithoutQualityWarnings) {
   // 27 November it has no such warning, and it is no longer allowed.)
   for (const nlohmann::json& warning : report["warnings"]) {
     const std::string kind = warning["kind"].get<std::string>();
-    EXPECT_TRUE(crosses_at_start(name) && kind == "self_intersection") << warning.dump(2);
+    // Its underarm junction lies in that crease, narrower than twice the offset: a cleft
+    // (garment/body_clefts.hpp), warned as `junction_in_cleft`.
+    EXPECT_TRUE(crosses_at_start(name) &&
+                (kind == "self_intersection" || kind == "junction_in_cleft"))
+        << warning.dump(2);
   }
   for (const nlohmann::json& panel : report["panels"]) {
     EXPECT_EQ(panel["quality"]["inverted_quads"].get<int>(), 0) << panel["id"];
