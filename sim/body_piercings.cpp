@@ -23,6 +23,13 @@ Eigen::Vector3d row(const Eigen::VectorXd& x, Eigen::Index vertex) {
 
 // Body vertices per chunk at least: most fall outside the cloth's box and cost a comparison.
 constexpr int kBodyVertexGrain = 1024;
+// A body vertex whose normal is more than acos(kMinFacing) from the cloth triangle's normal is
+// beside the cloth, not under it: a wall of a crease the cloth bridges (the seat's cleft), or the
+// cloth edge-on to the body. Its spring would push the cloth sideways, and the walls of the two
+// sides push it against each other: on the Collada strapless dress, whose back lies over the
+// seat's cleft, that pumped the cloth until it blew up at 15 s (docs/collision.md, "Cloth caught
+// in a cleft"). Was 0.2 (78°), for degenerate and edge-on triangles only.
+constexpr double kMinFacing = 0.5;
 
 // The height of body vertex b over the cloth where the closest point of triangle t to it lies on
 // one of t's corners or inner edges: along the cloth's angle-weighted pseudo-normal there
@@ -111,7 +118,7 @@ std::optional<BodyPiercing> BodyCollider::piercing_of_pair(const Eigen::VectorXd
                         p2 = row(x, triangle[2]);
   Eigen::Vector3d normal = triangle_normal(p0, p1, p2);
   const double facing = normal.dot(vertex_normals_[body_vertex].normalized());
-  if (std::abs(facing) < 0.2) return std::nullopt;  // degenerate (zero normal) or edge-on
+  if (std::abs(facing) < kMinFacing) return std::nullopt;  // degenerate, edge-on or beside
   if (facing < 0.0) normal = -normal;
   BodyPiercing piercing;
   piercing.body_vertex = body_vertex;
@@ -269,8 +276,8 @@ std::vector<BodyPiercing> BodyCollider::find_piercings(
         ++local.pairs;
         Eigen::Vector3d normal = normals[static_cast<std::size_t>(t)];
         const double facing = normal.dot(body_normal);
-        // Cloth edge-on to the body surface there (or degenerate): not covering the vertex.
-        if (std::abs(facing) < 0.2) continue;
+        // Cloth edge-on to the body surface there, beside it (or degenerate): not covering it.
+        if (std::abs(facing) < kMinFacing) continue;
         if (facing < 0.0) normal = -normal;
         // The height over the triangle's closest point is the height over its plane (the closest
         // point lies in it): the band test needs no closest point.

@@ -74,6 +74,48 @@ TEST(RunCommand, HemDrawnIntoTheLegsDrapesToRest) {
   fs::remove_all(dir);
 }
 
+// Trial 35's strapless dress on the Collada human in the user's own linen, 20 s: its back bodice
+// and back skirt meet at a four-panel junction in the seat's cleft (validate warns:
+// junction_in_cleft). The cleft's walls, beside the cloth bridging them, held it with body-vertex
+// springs pushing sideways from both cheeks: the 10 s drape ended not at rest with the back 45 %
+// stretched, and the 20 s one blew up at 15.3 s (497 m/s). Springs now come only from body
+// vertices that face the cloth (sim/body_piercings.cpp, kMinFacing): measured, at rest at 17.5 s,
+// 0 retries, 4.9 % strain at most.
+TEST(RunCommand, StraplessDressOverTheSeatsCleftRestsInItsTwentySeconds) {
+  if (!fs::exists("/usr/share/assimp/models/Collada/human.zae"))
+    GTEST_SKIP() << "assimp-testmodels' human.zae is not installed";
+  const fs::path dir = fresh_dir("strapless-cleft");
+  std::ifstream in(std::string(SD_SOURCE_DIR) + "/tests/cli/sketches/strapless-dress-human.json");
+  nlohmann::json sketch = nlohmann::json::parse(in, nullptr, true, /*ignore_comments=*/true);
+  // The trial's fabric file ("my linen": 0.19 kg/m², 12,000 / 9,000 N/m, friction 0.4).
+  const nlohmann::json linen = {{"name", "my linen"},
+                                {"area_density", {{"value", 0.19}, {"unit", "kg/m^2"}}},
+                                {"stretch_warp", {{"value", 12000.0}, {"unit", "N/m"}}},
+                                {"stretch_weft", {{"value", 9000.0}, {"unit", "N/m"}}},
+                                {"shear", {{"value", 60.0}, {"unit", "N/m"}}},
+                                {"bend", {{"value", 2.0e-05}, {"unit", "N*m"}}},
+                                {"damping", {{"value", 0.001}, {"unit", "s"}}},
+                                {"bend_damping", {{"value", 0.05}, {"unit", "s"}}},
+                                {"friction", {{"value", 0.4}, {"unit", "1"}}},
+                                {"thickness", {{"value", 0.35}, {"unit", "mm"}}}};
+  std::ofstream(dir / "my-linen.json") << linen.dump(2);
+  sketch["fabric"] = "my-linen.json";
+  sketch["simulate"]["duration"] = 20;
+  sketch["output"] = {{"images", nlohmann::json::array()}};
+  const CommandResult ran = run_sketchdrape("run " + write_sketch(dir, sketch).string() + " -o " +
+                                            (dir / "out").string());
+  ASSERT_EQ(ran.exit_code, 0) << ran.output;
+  const nlohmann::json report = read_json(dir / "out" / "report.json");
+  EXPECT_TRUE(report["at_rest"].get<bool>()) << report["rest"].dump();
+  EXPECT_EQ(report["penetrating_vertices_final"].get<int>(), 0);
+  EXPECT_EQ(report["piercing_body_vertices_final"].get<int>(), 0);
+  // Measured 4.9 % on the back bodice; the pumped drape ended at 45 %. 15 %: the drape warning's
+  // bound for a panel left stretched.
+  for (const nlohmann::json& panel : report["strain"])
+    EXPECT_LT(panel["strain_max"].get<double>(), 0.15) << panel.dump();
+  fs::remove_all(dir);
+}
+
 TEST(RunCommand, FramesWriteAPictureSequenceOfTheDrape) {
   // 0.5 s at 8 frames per second: t = 0, 0.125, ..., 0.5, one PNG each, even though the file
   // asks for no other image; the pictures differ as the sheet falls.
