@@ -9,6 +9,7 @@
 #include "garment/body_surface.hpp"
 #include "garment/garment_mesh.hpp"
 #include "garment/quality_gate.hpp"
+#include "garment/sketch_inputs.hpp"
 #include "meshing/tri_mesh.hpp"
 #include "scene/sketch_file.hpp"
 
