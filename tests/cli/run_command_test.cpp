@@ -78,9 +78,8 @@ TEST(RunCommand, HemDrawnIntoTheLegsDrapesToRest) {
 // and back skirt meet at a four-panel junction in the seat's cleft (validate warns:
 // junction_in_cleft). The cleft's walls, beside the cloth bridging them, held it with body-vertex
 // springs pushing sideways from both cheeks: the 10 s drape ended not at rest with the back 45 %
-// stretched, and the 20 s one blew up at 15.3 s (497 m/s). Springs now come only from body
-// vertices that face the cloth (sim/body_piercings.cpp, kMinFacing): measured, at rest at 17.5 s,
-// 0 retries, 4.9 % strain at most.
+// stretched, and the 20 s one blew up at 15.3 s (497 m/s). A crease's walls beside the cloth now
+// get no springs (sim/body_piercings.cpp, kMinFacing).
 TEST(RunCommand, StraplessDressOverTheSeatsCleftRestsInItsTwentySeconds) {
   if (!fs::exists("/usr/share/assimp/models/Collada/human.zae"))
     GTEST_SKIP() << "assimp-testmodels' human.zae is not installed";
