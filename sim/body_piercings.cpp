@@ -23,17 +23,6 @@ Eigen::Vector3d row(const Eigen::VectorXd& x, Eigen::Index vertex) {
 
 // Body vertices per chunk at least: most fall outside the cloth's box and cost a comparison.
 constexpr int kBodyVertexGrain = 1024;
-// A body vertex on a wall of a crease (another part of the body facing it within kCreaseProbe
-// along its normal: the seat's cleft, between the thighs) whose normal is more than
-// acos(kMinFacing) from the cloth triangle's is beside the cloth bridging the crease, not under
-// it: no spring. The walls' springs pushed the cloth sideways from both cheeks: on the Collada
-// strapless dress, whose back lies over the seat's cleft, that pumped the cloth until it blew up
-// at 15 s (docs/collision.md, "Cloth caught in a cleft"). Elsewhere the edge-on bound
-// kMinFacingAnywhere (78°) holds as before: applied to every body vertex, 60° left the capelet's
-// shaped drape moving at the end of its time.
-constexpr double kMinFacing = 0.5;
-constexpr double kMinFacingAnywhere = 0.2;
-constexpr double kCreaseProbe = 0.025;  // m
 
 // The height of body vertex b over the cloth where the closest point of triangle t to it lies on
 // one of t's corners or inner edges: along the cloth's angle-weighted pseudo-normal there
@@ -121,14 +110,8 @@ std::optional<BodyPiercing> BodyCollider::piercing_of_pair(const Eigen::VectorXd
   const Eigen::Vector3d p0 = row(x, triangle[0]), p1 = row(x, triangle[1]),
                         p2 = row(x, triangle[2]);
   Eigen::Vector3d normal = triangle_normal(p0, p1, p2);
-  const Eigen::Vector3d body_normal = vertex_normals_[body_vertex].normalized();
-  const double facing = normal.dot(body_normal);
-  if (std::abs(facing) < kMinFacingAnywhere) return std::nullopt;  // degenerate or edge-on
-  if (std::abs(facing) < kMinFacing) {  // beside the cloth, if on a crease's wall
-    const std::optional<BodyProximity> across =
-        nearest(b + kCreaseProbe * body_normal, 1.0, kCreaseProbe);
-    if (across && across->normal.dot(body_normal) < 0.0) return std::nullopt;
-  }
+  const double facing = normal.dot(vertex_normals_[body_vertex].normalized());
+  if (std::abs(facing) < 0.2) return std::nullopt;  // degenerate (zero normal) or edge-on
   if (facing < 0.0) normal = -normal;
   BodyPiercing piercing;
   piercing.body_vertex = body_vertex;
@@ -287,13 +270,7 @@ std::vector<BodyPiercing> BodyCollider::find_piercings(
         Eigen::Vector3d normal = normals[static_cast<std::size_t>(t)];
         const double facing = normal.dot(body_normal);
         // Cloth edge-on to the body surface there (or degenerate): not covering the vertex.
-        if (std::abs(facing) < kMinFacingAnywhere) continue;
-        // Beside the cloth on a wall of a crease the cloth bridges: not covering it either.
-        if (std::abs(facing) < kMinFacing) {
-          const std::optional<BodyProximity> across =
-              nearest(b + kCreaseProbe * body_normal, 1.0, kCreaseProbe);
-          if (across && across->normal.dot(body_normal) < 0.0) continue;
-        }
+        if (std::abs(facing) < 0.2) continue;
         if (facing < 0.0) normal = -normal;
         // The height over the triangle's closest point is the height over its plane (the closest
         // point lies in it): the band test needs no closest point.

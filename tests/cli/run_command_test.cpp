@@ -76,11 +76,11 @@ TEST(RunCommand, HemDrawnIntoTheLegsDrapesToRest) {
 
 // Trial 35's strapless dress on the Collada human in the user's own linen, 20 s: its back bodice
 // and back skirt meet at a four-panel junction in the seat's cleft (validate warns:
-// junction_in_cleft). The cleft's walls, beside the cloth bridging them, held it with body-vertex
-// springs pushing sideways from both cheeks: the 10 s drape ended not at rest with the back 45 %
-// stretched, and the 20 s one blew up at 15.3 s (497 m/s). A crease's walls beside the cloth now
-// get no springs (sim/body_piercings.cpp, kMinFacing).
-TEST(RunCommand, StraplessDressOverTheSeatsCleftRestsInItsTwentySeconds) {
+// junction_in_cleft). It settles by 3.5 s, then the cleft's walls pump the cloth (body-vertex
+// springs pushing it sideways from both cheeks, docs/collision.md "Cloth caught in a cleft") and
+// it blew up at 15.35 s with a vertex at 497 m/s. Settled once and thrown about again, it now
+// stops first (measured: at 10.54 s, 24.7 s of CPU), naming the place and the cause.
+TEST(RunCommand, StraplessDressThrownAboutInTheSeatsCleftStopsBeforeItBlowsUp) {
   if (!fs::exists("/usr/share/assimp/models/Collada/human.zae"))
     GTEST_SKIP() << "assimp-testmodels' human.zae is not installed";
   const fs::path dir = fresh_dir("strapless-cleft");
@@ -103,15 +103,12 @@ TEST(RunCommand, StraplessDressOverTheSeatsCleftRestsInItsTwentySeconds) {
   sketch["output"] = {{"images", nlohmann::json::array()}};
   const CommandResult ran = run_sketchdrape("run " + write_sketch(dir, sketch).string() + " -o " +
                                             (dir / "out").string());
-  ASSERT_EQ(ran.exit_code, 0) << ran.output;
-  const nlohmann::json report = read_json(dir / "out" / "report.json");
-  EXPECT_TRUE(report["at_rest"].get<bool>()) << report["rest"].dump();
-  EXPECT_EQ(report["penetrating_vertices_final"].get<int>(), 0);
-  EXPECT_EQ(report["piercing_body_vertices_final"].get<int>(), 0);
-  // Measured 4.9 % on the back bodice; the pumped drape ended at 45 %. 15 %: the drape warning's
-  // bound for a panel left stretched.
-  for (const nlohmann::json& panel : report["strain"])
-    EXPECT_LT(panel["strain_max"].get<double>(), 0.15) << panel.dump();
+  EXPECT_EQ(ran.exit_code, 1) << ran.output;
+  EXPECT_NE(ran.output.find("thrown about: the drape had settled"), std::string::npos)
+      << ran.output;
+  EXPECT_NE(ran.output.find("near the crotch"), std::string::npos) << ran.output;
+  EXPECT_EQ(ran.output.find("m/s (limit"), std::string::npos) << ran.output;  // not blown up
+  EXPECT_TRUE(fs::exists(dir / "out" / "drape-failed.obj"));
   fs::remove_all(dir);
 }
 
