@@ -38,7 +38,10 @@ struct QualityWarning {
   std::string panel;
   std::string kind;    // "inverted_quads", "min_angle", "aspect_ratio", "near_vertices",
                        // "quad_size", "self_intersection" (count: crossing triangle pairs),
-                       // "inside_body" (check_quality_tried only; count: quads, worst: m deep)
+                       // "inside_body" (check_quality_tried only; count: quads, worst: m deep),
+                       // "junction_in_cleft" (check_quality_tried only; a seam junction in a
+                       // cleft of the body, body_clefts.hpp; panel: the first of the junction's,
+                       // count: its panels, worst: the cleft's width in m)
   int count = 0;       // quads (or vertex pairs) of that kind in the panel
   double worst = 0.0;  // the worst value (degrees, ratio, metres, or size / edge_length)
   Eigen::Vector3d where = Eigen::Vector3d::Zero();  // m, the worst place

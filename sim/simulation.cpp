@@ -1,5 +1,6 @@
 #include "sim/simulation.hpp"
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 #include <time.h>
 
@@ -101,6 +102,10 @@ void SimulationSettings::validate() const {
           "the at-rest thresholds must be positive and the window zero or more");
   require(stuck_steps >= 0 && std::isfinite(stuck_share) && stuck_share > 0.0 && stuck_share <= 1.0,
           "the stuck test needs a window of zero (off) or more steps and a share in (0, 1]");
+  require(unsettled_retries >= 0 && std::isfinite(settled_energy) && settled_energy > 0.0 &&
+              std::isfinite(unsettled_window) && unsettled_window > 0.0,
+          "the thrown-about test needs a settled energy and a window above zero and zero (off) or "
+          "more retries");
   require(std::isfinite(rest_not_before) && rest_not_before >= 0.0,
           "the earliest at-rest time must be zero or more seconds");
   require(forces.gravity.allFinite() && forces.wind.allFinite() && std::isfinite(forces.air_drag) &&
@@ -530,6 +535,12 @@ void Simulation::accept(Attempt& attempt, double h) {
   const double kinetic = kinetic_energy(model_, v_);
   // A body still moving (a pose sequence not yet over) is not a scene at rest.
   const bool body_moving = contact_ && contact_->motion() && time_ < contact_->motion()->end_time();
+  if (report_.settled_time < 0.0 && !body_moving && time_ >= settings_.rest_not_before &&
+      kinetic / mass < settings_.settled_energy)
+    report_.settled_time = time_;
+  while (!unsettled_retry_times_.empty() &&
+         unsettled_retry_times_.front() < time_ - settings_.unsettled_window)
+    unsettled_retry_times_.pop_front();
   rest_history_.push_back({time_, speed, kinetic / mass, h});
   std::erase_if(rest_history_, [this](const std::array<double, 4>& r) {
     return r[0] < time_ - settings_.rest_window - 1e-12;
@@ -601,6 +612,25 @@ StepOutcome Simulation::step(double max_step) {
     spdlog::error("sim: t = {:.6f} s: {}", time_, outcome.failure_reason);
     return outcome;
   }
+  // Settled once and thrown about again (SimulationSettings::unsettled_retries): no further
+  // step, a failure that says where, before a vertex flies off.
+  if (settings_.unsettled_retries > 0 &&
+      static_cast<int>(unsettled_retry_times_.size()) >= settings_.unsettled_retries) {
+    outcome.unsettled = true;
+    outcome.dt = dt_;
+    outcome.failure_vertex = last_retry_vertex_;
+    outcome.failure_reason = fmt::format(
+        "thrown about: the drape had settled (kinetic energy below {:.3g} J/kg at t = {:.2f} s), "
+        "then {} steps within {:.3g} s failed their checks here and were retried shorter (the "
+        "last: {}); cloth caught in a crease of the body (a cleft: the seat, between the legs) "
+        "and pumped by its contacts would blow up, so the drape stops; move the seam junction "
+        "there out of the crease or let the panel bridge it (validate names a junction in a "
+        "cleft)",
+        settings_.settled_energy, report_.settled_time, unsettled_retry_times_.size(),
+        settings_.unsettled_window, last_retry_reason_);
+    spdlog::error("sim: t = {:.6f} s: {}", time_, outcome.failure_reason);
+    return outcome;
+  }
   double h = std::min(dt_, max_step);
   const double planned = dt_;  // before a cut to land on max_step
   // Land exactly on max_step instead of leaving a sliver for the next step.
@@ -616,6 +646,8 @@ StepOutcome Simulation::step(double max_step) {
     cg_total_ += candidate.cg_iterations;
     report_.cg_iterations_max = std::max(report_.cg_iterations_max, candidate.cg_iterations_max);
     if (candidate.failure.empty()) break;
+    last_retry_reason_ = candidate.failure;
+    last_retry_vertex_ = candidate.failure_vertex;
     // A BDF2 step whose Newton iteration failed is first retried at the same step as the
     // linearly implicit step, one solve linearised at the start (implicit Euler for the first
     // step); only a failure of that one halves the step.
@@ -671,6 +703,8 @@ StepOutcome Simulation::step(double max_step) {
   fallback_ = false;
   outcome.accepted = true;
   outcome.dt = h;
+  if (report_.settled_time >= 0.0 && (outcome.retries > 0 || outcome.forced))
+    unsettled_retry_times_.push_back(time_);
   outcome.newton_iterations = candidate.solve.newton_iterations;
   outcome.cg_iterations = candidate.cg_iterations;
   newton_total_ += candidate.solve.newton_iterations;
@@ -746,6 +780,7 @@ SimulationReport Simulation::run(const RunHooks& hooks) {
     if (!outcome.accepted) {
       report_.failed = true;
       report_.stuck = outcome.stuck;
+      report_.unsettled = outcome.unsettled;
       report_.failure_reason = outcome.failure_reason;
       report_.failure_vertex = outcome.failure_vertex;
       if (hooks.after_step) hooks.after_step(outcome);

@@ -80,6 +80,17 @@ struct SimulationSettings {
   // (docs/simulator.md, "Stuck drapes").
   int stuck_steps = 250;
   double stuck_share = 0.8;
+  // A drape that had settled and is thrown about again fails before it blows up: once the
+  // kinetic energy per kg has been below settled_energy (with the body still and the rest
+  // shape no longer changing, rest_not_before), unsettled_retries steps retried within
+  // unsettled_window seconds of simulated time stop the run, naming the place where the
+  // attempts failed. Trial 35's strapless dress on the Collada human settled to 1.6e-6 J/kg by
+  // 6.7 s, then its back, caught in the seat's cleft, was thrown about with 10-20 retries a
+  // second until a vertex reached 497 m/s at 15.3 s (docs/collision.md, "Cloth caught in a
+  // cleft"). 0 retries: never.
+  double settled_energy = 1.0e-5;  // J/kg
+  int unsettled_retries = 10;
+  double unsettled_window = 1.0;  // s
   bool stop_at_rest = true;
   double rest_speed = 5.0e-3;           // m/s, maximum vertex speed at rest
   double rest_kinetic_energy = 1.0e-6;  // J/kg, kinetic energy per unit mass at rest
@@ -145,6 +156,9 @@ struct SimulationReport {
   std::string failure_reason;
   int failure_vertex = -1;  // where: the fastest (or first non-finite) vertex of the failed step
   bool stuck = false;       // failed because it was stuck at the minimum step (stuck_steps)
+  // failed because, once settled, it was thrown about again (SimulationSettings::settled_energy)
+  bool unsettled = false;
+  double settled_time = -1.0;  // s: when the drape first settled (settled_energy), −1: never
   int vertices = 0;
   int triangles = 0;
   int linear_solves = 0;
@@ -217,6 +231,7 @@ struct StepOutcome {
   std::string failure_reason;  // when not accepted
   int failure_vertex = -1;     // when not accepted: the vertex where it broke (fastest)
   bool stuck = false;          // not taken: the run was stuck at the minimum step
+  bool unsettled = false;      // not taken: settled once, the drape is thrown about again
 };
 
 class Simulation {
@@ -346,6 +361,11 @@ class Simulation {
   std::string last_forced_reason_;
   int last_forced_vertex_ = -1;
   double last_forced_dt_ = 0.0;
+  // Since the drape settled (SimulationSettings::settled_energy): the times of the steps that
+  // were retried within the last unsettled_window, and the last failed attempt's check and vertex.
+  std::deque<double> unsettled_retry_times_;
+  std::string last_retry_reason_;
+  int last_retry_vertex_ = -1;
 };
 
 }  // namespace sd::sim
