@@ -13,6 +13,7 @@
 #include <string_view>
 #include <vector>
 
+#include "sim/diamond_membrane.hpp"
 #include "sim/fabric.hpp"
 
 namespace sd::sim {
@@ -100,9 +101,13 @@ struct ClothModelOptions {
   double bend_stencil_stiffness = 0.0;
   // Whether clamp_bending also reads the pinned points behind a clamp's edge in the free
   // vertices' rows as ghosts (the even extension of the free side; docs/simulator.md, "Ghost
-  // points at a clamp"). Off by default: alone it stiffens the 4-8 mesh at 45° into its membrane
-  // locking (silk's Peirce chord 39.7°), which the diamonds' virtual centres have to remove first.
-  bool clamp_ghost_points = false;
+  // points at a clamp"). On by default with diamond_membrane: alone it stiffens the 4-8 mesh at
+  // 45° into its membrane locking (silk's Peirce chord 39.7°), which the diamonds remove.
+  bool clamp_ghost_points = true;
+  // Whether the membrane of each diamond of the 4-8 mesh (DiamondElement) is evaluated with its
+  // centre moved to where a smooth bend puts it (docs/simulator.md, "The diamond membrane"):
+  // removes the 4-8 mesh's membrane locking at 45°; flat cloth is unchanged.
+  bool diamond_membrane = true;
 };
 
 // Row-major 3n-by-3n matrix, the layout the system matrix and the Jacobians share.
@@ -210,8 +215,12 @@ struct ClothModel {
   std::vector<BendStencil> stencils;  // with ClothModelOptions::bend_stencil_stiffness > 0
   double bend_stencil_stiffness = 0.0;
   bool clamp_ghost_points = false;  // ClothModelOptions::clamp_ghost_points
-  Eigen::VectorXd mass;             // #V lumped masses, kg
-  Eigen::VectorXd vertex_area;      // #V rest area attributed to each vertex (a third of each face)
+  // With ClothModelOptions::diamond_membrane: the diamonds, and the triangles in none of them
+  // (whose membrane is evaluated alone). Without, both empty: every triangle alone.
+  std::vector<DiamondElement> diamonds;
+  std::vector<int> lone_triangles;
+  Eigen::VectorXd mass;         // #V lumped masses, kg
+  Eigen::VectorXd vertex_area;  // #V rest area attributed to each vertex (a third of each face)
   BlockPattern pattern;
   FlatBendOperator flat_bends;  // with BendModel::quadratic, see FlatBendOperator
 

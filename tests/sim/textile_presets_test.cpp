@@ -135,8 +135,10 @@ INSTANTIATE_TEST_SUITE_P(
 // along and 4 across, clamped by three lines of vertices, settled by the static solver with the
 // quadratic bending: every preset on the 4-8 mesh along the strip and at 45° (issue 21's two
 // orientations), and on an equilateral mesh with edges across and an irregular jittered grid
-// (triangulations a designer imports). The tolerance is issue 21's ±1.5°; measured 40.23° (silk,
-// 4-8 at 45°: the stiffest membrane against its bending) to 42.25° (jersey, 4-8 at 45°).
+// (triangulations a designer imports). The tolerance is issue 21's ±1.5°. Measured with the
+// defaults (the diamond membrane and ghost points at the clamp): 41.68° to 41.97° for every preset
+// on every mesh (4-8 along 41.85-41.95°, at 45° 41.96-41.97°); before them 40.23° (silk, 4-8 at
+// 45°, its membrane locked) to 42.25° (docs/simulator.md, "The diamond membrane").
 TEST(PeirceCantilever, ChordIsWithinOneAndAHalfDegreesForEveryPresetOnEveryMesh) {
   const double peirce = test::cantilever_elastica(8.0).chord_angle_deg();
   for (const std::string& name : fabric_preset_names()) {
@@ -166,14 +168,16 @@ TEST(PeirceCantilever, ChordIsWithinOneAndAHalfDegreesForEveryPresetOnEveryMesh)
 
 // The effective rigidity at coarse resolution, on square cells: a cotton strip as wide as its
 // free length L = c (α = 1), 4 and 8 cells along and as many across, clamped by three lines of
-// vertices; B_eff/B from the small-deflection drop against the elastica's. Measured: 0.914,
-// 0.947, 0.941, 0.920 at 4 cells (4-8 along, 4-8 at 45°, equilateral, irregular) and 0.973,
-// 0.960, 0.984, 0.979 at 8. Issue 21 asks ±8 % at 4 cells: three meshes meet it, the 4-8 mesh
-// along the strip misses by 0.7 %, so the bound here is 9 %. On the narrow strips of
+// vertices; B_eff/B from the small-deflection drop against the elastica's. Measured with the
+// defaults (ghost points at the clamp, the diamond membrane): 0.933, 0.954, 0.941, 0.920 at 4
+// cells (4-8 along, 4-8 at 45°, equilateral, irregular) and 0.979, 0.985, 0.984, 0.979 at 8
+// (0.914, 0.947, 0.941, 0.920 and 0.973, 0.960, 0.984, 0.979 without them). The bound is issue
+// 21's ±8 % at 4 cells; the irregular grid (0.920, a static solve, so the same on every run) is
+// on its edge, the imported triangulations being untouched by both changes. On the narrow strips of
 // `QuadraticBending.EffectiveRigidityConvergesToB` (L/4 wide, 2 cells across: cells twice as long
 // as wide) the same 4 cells give 0.82-1.46 (docs/simulator.md): the coarse error is the cells'
 // elongation and the strip's narrowness, not the count along.
-TEST(PeirceCantilever, RigidityOnFourSquareCellsIsWithinNinePercentOfB) {
+TEST(PeirceCantilever, RigidityOnFourSquareCellsIsWithinEightPercentOfB) {
   const FabricParameters fabric = fabric_preset("cotton");
   const double length = std::cbrt(fabric.bend / (fabric.area_density * 9.81));
   for (const test::StripMesh mesh :
@@ -191,7 +195,7 @@ TEST(PeirceCantilever, RigidityOnFourSquareCellsIsWithinNinePercentOfB) {
       const double rigidity = 1.0 / test::elastica_alpha_for_drop((clamp - tip) / length);
       std::printf("rigidity %-26s %d square cells: B_eff/B %.3f\n",
                   test::strip_mesh_name(mesh).c_str(), cells, rigidity);
-      EXPECT_NEAR(rigidity, 1.0, cells == 4 ? 0.09 : 0.05) << test::strip_mesh_name(mesh);
+      EXPECT_NEAR(rigidity, 1.0, cells == 4 ? 0.08 : 0.05) << test::strip_mesh_name(mesh);
       EXPECT_LT(std::abs(rigidity - 1.0), previous_error) << test::strip_mesh_name(mesh);
       previous_error = std::abs(rigidity - 1.0);
     }
