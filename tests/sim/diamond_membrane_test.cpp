@@ -169,6 +169,7 @@ TEST(DiamondMembrane, ForceAndExactJacobiansMatchFiniteDifferences) {
     for (const Compression compression : {Compression::linear, Compression::buckling}) {
       const test::Strip strip = test::make_strip(mesh, 0.04, 0.02, 4, 2);
       ClothModelOptions options;
+      options.diamond_membrane = true;
       options.compression = compression;
       const ClothModel model = build_cloth_model(strip.input, test_fabric(), options);
       ASSERT_FALSE(model.diamonds.empty());
@@ -221,7 +222,9 @@ TEST(DiamondMembrane, ForceAndExactJacobiansMatchFiniteDifferences) {
 TEST(DiamondMembrane, SolveJacobianIsSymmetricNegativeSemidefiniteAndItsProductIsTheMatrix) {
   std::mt19937 rng(17);
   const test::Strip strip = test::make_strip(test::StripMesh::four_eight_45, 0.04, 0.02, 4, 2);
-  const ClothModel model = build_cloth_model(strip.input, test_fabric());
+  ClothModelOptions options;
+  options.diamond_membrane = true;
+  const ClothModel model = build_cloth_model(strip.input, test_fabric(), options);
   ASSERT_FALSE(model.diamonds.empty());
   ForceSettings settings;
   for (int trial = 0; trial < 4; ++trial) {
@@ -254,9 +257,9 @@ TEST(DiamondMembrane, FlatClothIsUnchanged) {
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
   for (const test::StripMesh mesh : {test::StripMesh::four_eight, test::StripMesh::four_eight_45}) {
     const test::Strip strip = test::make_strip(mesh, 0.04, 0.02, 4, 2);
-    ClothModelOptions off;
-    off.diamond_membrane = false;
-    const ClothModel with = build_cloth_model(strip.input, test_fabric());
+    ClothModelOptions on, off;
+    on.diamond_membrane = true;
+    const ClothModel with = build_cloth_model(strip.input, test_fabric(), on);
     const ClothModel without = build_cloth_model(strip.input, test_fabric(), off);
     Eigen::VectorXd x(3 * with.vertex_count);
     for (int i = 0; i < with.vertex_count; ++i) {

@@ -111,8 +111,8 @@ TEST_P(CusickPreset, DrapesWithinItsPublishedRangeWhereConverged) {
   EXPECT_TRUE(d.at_rest);
   if (range.above_range) {
     // Silk stays above its range where converged (the bench's two-specimen means 0.450-0.459 at
-    // 51 cells, 0.475-0.478 at 61, before the diamond membrane; this specimen 0.469 with it and
-    // the ghost points, 0.455 before; docs/simulator.md, "The diamond membrane"): its known
+    // 51 cells, 0.475-0.478 at 61; this specimen 0.455, and 0.469 with the diamond membrane and
+    // the ghost points; docs/simulator.md, "The diamond membrane"): its known
     // reading is asserted, so that the docs' figure stays true and a change that brings silk
     // into its range (or further out) is seen.
     EXPECT_GE(d.shadow.drape_coefficient, range.high);
@@ -136,10 +136,10 @@ INSTANTIATE_TEST_SUITE_P(
 // along and 4 across, clamped by three lines of vertices, settled by the static solver with the
 // quadratic bending: every preset on the 4-8 mesh along the strip and at 45° (issue 21's two
 // orientations), and on an equilateral mesh with edges across and an irregular jittered grid
-// (triangulations a designer imports). The tolerance is issue 21's ±1.5°. Measured with the
-// defaults (the diamond membrane and ghost points at the clamp): 41.68° to 41.97° for every preset
-// on every mesh (4-8 along 41.85-41.95°, at 45° 41.96-41.97°); before them 40.23° (silk, 4-8 at
-// 45°, its membrane locked) to 42.25° (docs/simulator.md, "The diamond membrane").
+// (triangulations a designer imports), with the diamond membrane and ghost points at the clamp
+// (options, not yet the defaults). The tolerance is issue 21's ±1.5°. Measured: 41.68° to 41.97°
+// for every preset on every mesh (4-8 along 41.85-41.95°, at 45° 41.96-41.97°); without them 40.23°
+// (silk, 4-8 at 45°, its membrane locked) to 42.25° (docs/simulator.md, "The diamond membrane").
 TEST(PeirceCantilever, ChordIsWithinOneAndAHalfDegreesForEveryPresetOnEveryMesh) {
   const double peirce = test::cantilever_elastica(8.0).chord_angle_deg();
   for (const std::string& name : fabric_preset_names()) {
@@ -149,7 +149,10 @@ TEST(PeirceCantilever, ChordIsWithinOneAndAHalfDegreesForEveryPresetOnEveryMesh)
          {test::StripMesh::four_eight, test::StripMesh::four_eight_45,
           test::StripMesh::equilateral_across, test::StripMesh::irregular}) {
       const test::Strip strip = test::make_strip(mesh, length, 0.25 * length, 16, 4);
-      const ClothModel model = build_cloth_model(strip.input, fabric);
+      ClothModelOptions options;
+      options.clamp_ghost_points = true;  // with the diamond membrane (docs/simulator.md)
+      options.diamond_membrane = true;
+      const ClothModel model = build_cloth_model(strip.input, fabric, options);
       Eigen::VectorXd x = flatten_positions(strip.input.rest_positions);
       const StaticResult solved = solve_static(model, x, strip.clamped);
       const bool converged = solved.converged;
@@ -169,8 +172,8 @@ TEST(PeirceCantilever, ChordIsWithinOneAndAHalfDegreesForEveryPresetOnEveryMesh)
 
 // The effective rigidity at coarse resolution, on square cells: a cotton strip as wide as its
 // free length L = c (α = 1), 4 and 8 cells along and as many across, clamped by three lines of
-// vertices; B_eff/B from the small-deflection drop against the elastica's. Measured with the
-// defaults (ghost points at the clamp, the diamond membrane): 0.933, 0.954, 0.941, 0.920 at 4
+// vertices; B_eff/B from the small-deflection drop against the elastica's, with ghost points at
+// the clamp and the diamond membrane. Measured: 0.933, 0.954, 0.941, 0.920 at 4
 // cells (4-8 along, 4-8 at 45°, equilateral, irregular) and 0.979, 0.985, 0.984, 0.979 at 8
 // (0.914, 0.947, 0.941, 0.920 and 0.973, 0.960, 0.984, 0.979 without them). The bound is issue
 // 21's ±8 % at 4 cells; the irregular grid (0.920, a static solve, so the same on every run) is
@@ -187,7 +190,10 @@ TEST(PeirceCantilever, RigidityOnFourSquareCellsIsWithinEightPercentOfB) {
     double previous_error = 1.0;
     for (const int cells : {4, 8}) {
       const test::Strip strip = test::make_strip(mesh, length, length, cells, cells);
-      const ClothModel model = build_cloth_model(strip.input, fabric);
+      ClothModelOptions options;
+      options.clamp_ghost_points = true;  // with the diamond membrane (docs/simulator.md)
+      options.diamond_membrane = true;
+      const ClothModel model = build_cloth_model(strip.input, fabric, options);
       Eigen::VectorXd x = flatten_positions(strip.input.rest_positions);
       ASSERT_TRUE(solve_static(model, x, strip.clamped).converged);
       double clamp = 0.0, tip = 0.0;
