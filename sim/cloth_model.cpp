@@ -402,6 +402,31 @@ void ghost_clamped_points(VertexBendElement& b, const std::vector<char>& is_pinn
   b.rows = rows;
 }
 
+// The diamonds of the membrane (ClothModelOptions::diamond_membrane), the triangles in none, and
+// the diamonds' block offsets (every pair of a diamond's vertices shares a triangle or a hinge).
+void set_diamonds(ClothModel& model, const ClothInput& input, const Neighbours& neighbours,
+                  const ClothModelOptions& options) {
+  model.diamonds.clear();
+  model.lone_triangles.clear();
+  if (!options.diamond_membrane) return;
+  model.diamonds = make_diamonds(input.rest_positions, model.triangles, input.rest_uv.rows() > 0);
+  std::vector<char> in_diamond(model.triangles.size(), 0);
+  for (DiamondElement& d : model.diamonds) {
+    for (int f : d.triangles) in_diamond[static_cast<std::size_t>(f)] = 1;
+    for (int k = 0; k < 5; ++k)
+      for (int l = 0; l < 5; ++l) {
+        const int i = d.vertices[static_cast<std::size_t>(k)];
+        const int j = d.vertices[static_cast<std::size_t>(l)];
+        const int offset = neighbours.offset(i, j);
+        if (neighbours.list[static_cast<std::size_t>(neighbours.start[static_cast<std::size_t>(i)] +
+                                                     offset / 3)] != j)
+          throw std::logic_error("cloth model: a diamond's vertices are not in the pattern");
+        d.blocks[static_cast<std::size_t>(5 * k + l)] = offset;
+      }
+  }
+  for (std::size_t f = 0; f < model.triangles.size(); ++f)
+    if (!in_diamond[f]) model.lone_triangles.push_back(static_cast<int>(f));
+}
 }  // namespace
 
 void scale_rest_shapes(ClothModel& model, const Eigen::MatrixXd& scale) {
@@ -624,6 +649,7 @@ ClothModel build_cloth_model(const ClothInput& input, const FabricParameters& fa
                      {});
   model.pattern.zero_matrix = zero_pattern_matrix(neighbours);
   set_block_offsets(model, neighbours, {});
+  set_diamonds(model, input, neighbours, options);
   build_flat_bend_operator(model);
   return model;
 }
@@ -927,6 +953,7 @@ ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse&
           previous.pattern.diagonal_offsets[static_cast<std::size_t>(
               reuse.previous_vertex[static_cast<std::size_t>(i)])];
   set_block_offsets(model, neighbours, changed_row, fresh_bends);
+  set_diamonds(model, input, neighbours, options);
   build_flat_bend_operator(model);
   return model;
 }

@@ -13,6 +13,7 @@
 #include <string_view>
 #include <vector>
 
+#include "sim/diamond_membrane.hpp"
 #include "sim/fabric.hpp"
 
 namespace sd::sim {
@@ -101,8 +102,14 @@ struct ClothModelOptions {
   // Whether clamp_bending also reads the pinned points behind a clamp's edge in the free
   // vertices' rows as ghosts (the even extension of the free side; docs/simulator.md, "Ghost
   // points at a clamp"). Off by default: alone it stiffens the 4-8 mesh at 45° into its membrane
-  // locking (silk's Peirce chord 39.7°), which the diamonds' virtual centres have to remove first.
+  // locking (silk's Peirce chord 39.7°), which diamond_membrane removes, and that is not yet
+  // stable in dynamic runs.
   bool clamp_ghost_points = false;
+  // Whether the membrane of each diamond of the 4-8 mesh (DiamondElement) is evaluated with its
+  // centre moved to where a smooth bend puts it (docs/simulator.md, "The diamond membrane"):
+  // removes the 4-8 mesh's membrane locking at 45°; flat cloth is unchanged. Off by default: the
+  // implicit solve leaves out the map's curvature, and a hanging sheet then blows up.
+  bool diamond_membrane = false;
 };
 
 // Row-major 3n-by-3n matrix, the layout the system matrix and the Jacobians share.
@@ -210,8 +217,12 @@ struct ClothModel {
   std::vector<BendStencil> stencils;  // with ClothModelOptions::bend_stencil_stiffness > 0
   double bend_stencil_stiffness = 0.0;
   bool clamp_ghost_points = false;  // ClothModelOptions::clamp_ghost_points
-  Eigen::VectorXd mass;             // #V lumped masses, kg
-  Eigen::VectorXd vertex_area;      // #V rest area attributed to each vertex (a third of each face)
+  // With ClothModelOptions::diamond_membrane: the diamonds, and the triangles in none of them
+  // (whose membrane is evaluated alone). Without, both empty: every triangle alone.
+  std::vector<DiamondElement> diamonds;
+  std::vector<int> lone_triangles;
+  Eigen::VectorXd mass;         // #V lumped masses, kg
+  Eigen::VectorXd vertex_area;  // #V rest area attributed to each vertex (a third of each face)
   BlockPattern pattern;
   FlatBendOperator flat_bends;  // with BendModel::quadratic, see FlatBendOperator
 

@@ -643,6 +643,104 @@ void triangle_solve_contribution(std::span<const TriangleTerm> parts, const int*
   if (want_matrix) total.matrix = matrix;
 }
 
+// The membrane (stretch, shear, the compression model) of triangle t at positions x0, x1, x2 of
+// its vertices: what evaluate_forces adds for it. `vertices` index its vertices in `v` and in the
+// jacobian's product input (the triangle's own, or local ones for a diamond).
+void triangle_membrane(const ClothModel& model, const ForceTerms& terms, double damping_scale,
+                       const TriangleElement& t, const Vector3d& x0, const Vector3d& x1,
+                       const Vector3d& x2, const int* vertices, const Eigen::VectorXd& v,
+                       const JacobianTarget* jacobian, ElementContribution<9, 3>& out) {
+  const bool exact = jacobian != nullptr && jacobian->kind == JacobianKind::exact;
+  const bool solve = jacobian != nullptr && !exact;
+  // The solve (triangle_solve_contribution) needs no Hessian matrices.
+  TriangleConditions c = triangle_conditions(t, x0, x1, x2, exact);
+  const FabricParameters& fabric = model.fabric;
+  std::array<TriangleTerm, 3> parts;
+  int count = 0;
+  // ε* = N*/K with N* = π²·B / l² for the triangle's width l along each direction (only
+  // with the buckling compression; infinity leaves compression quadratic).
+  const bool buckling = model.compression == Compression::buckling;
+  const double pi2b = std::numbers::pi * std::numbers::pi * fabric.bend;
+  if (terms.stretch) {
+    const double k_u = fabric.stretch_warp * t.rest_area;
+    const double k_v = fabric.stretch_weft * t.rest_area;
+    const double eps_u =
+        buckling ? pi2b / (t.width_u * t.width_u * fabric.stretch_warp) : kLinearCompression;
+    const double eps_v =
+        buckling ? pi2b / (t.width_v * t.width_v * fabric.stretch_weft) : kLinearCompression;
+    parts[count++] = {&c.warp,
+                      stretch_energy(c.warp.value, k_u, eps_u, fabric.tensile_warp, t.rest_area),
+                      damping_scale * fabric.damping * k_u,
+                      &t.du,
+                      &c.warp_vector,
+                      &EnergyBreakdown::stretch};
+    parts[count++] = {&c.weft,
+                      stretch_energy(c.weft.value, k_v, eps_v, fabric.tensile_weft, t.rest_area),
+                      damping_scale * fabric.damping * k_v,
+                      &t.dv,
+                      &c.weft_vector,
+                      &EnergyBreakdown::stretch};
+  }
+  if (terms.shear) {
+    const double k_s = fabric.shear * t.rest_area;
+    parts[count++] = {&c.shear,
+                      quadratic_energy(c.shear.value, 0.0, k_s),
+                      damping_scale * fabric.damping * k_s,
+                      nullptr,
+                      nullptr,
+                      &EnergyBreakdown::shear};
+  }
+  // Bias wrinkling (bias_wrinkle), where the capped warp and weft leave the compressed bias
+  // beyond its Euler load N*_b: the larger of the triangle's own along the bias and the mean
+  // of its warp and weft loads, so that it never acts without shear (at γ = 0 the capped
+  // yarns keep ½·(σ_u + σ_v) ≥ −N*_b). The measured tensile curves keep the yarn caps only.
+  Eigen::Matrix3d coupling = Eigen::Matrix3d::Zero();
+  bool coupled = false;
+  if (buckling && terms.stretch && terms.shear && fabric.tensile_warp.empty() &&
+      fabric.tensile_weft.empty()) {
+    const double area = t.rest_area;
+    const double s = c.shear.value < 0.0 ? -1.0 : 1.0;
+    const double n_u = pi2b / (t.width_u * t.width_u), n_v = pi2b / (t.width_v * t.width_v);
+    const double bias_stress = 0.5 * (parts[0].energy.slope + parts[1].energy.slope) / area -
+                               fabric.shear * std::abs(c.shear.value);
+    // N*_b is at least the mean: the triangle's bias extent is needed only below it.
+    double n_b = 0.5 * (n_u + n_v);
+    if (bias_stress + n_b < 0.0) {
+      const double width_b = bias_width(t, s);
+      n_b = std::max(n_b, pi2b / (width_b * width_b));
+    }
+    const Eigen::Vector3d n_star(n_u, n_v, n_b);
+    if (bias_stress + n_b < 0.0) {
+      const Eigen::Vector3d stiffness(fabric.stretch_warp, fabric.stretch_weft, fabric.shear);
+      const BiasWrinkle w = bias_wrinkle(Eigen::Vector3d(c.warp.value, c.weft.value, c.shear.value),
+                                         stiffness, n_star, s);
+      for (int j = 0; j < 3; ++j) {
+        const double e = w.elastic(j);
+        parts[static_cast<std::size_t>(j)].energy = {
+            area * (0.5 * stiffness(j) * e * e + n_star(j) * w.wrinkle(j)), area * stiffness(j) * e,
+            area * w.hessian(j, j)};
+      }
+      coupling = area * w.hessian;
+      coupling.diagonal().setZero();
+      coupled = true;
+    }
+  }
+  if (solve) {
+    triangle_solve_contribution(
+        std::span<const TriangleTerm>(parts.data(), static_cast<std::size_t>(count)), vertices, v,
+        *jacobian, out);
+    if (coupled) add_condition_coupling(c, coupling, vertices, *jacobian, out.conditions[0]);
+    return;
+  }
+  for (int j = 0; j < count; ++j) {
+    const TriangleTerm& part = parts[static_cast<std::size_t>(j)];
+    condition_contribution(*part.condition, part.energy, part.damping, part.d != nullptr, vertices,
+                           v, jacobian, out.next(part.into));
+  }
+  if (coupled && jacobian != nullptr)
+    add_condition_coupling(c, coupling, vertices, *jacobian, out.conditions[0]);
+}
+
 // Adds the contributions of elements 0 … count − 1: contribute(k, out) fills element k's (the
 // conditions and their derivatives: most of the work of a force evaluation), element(k) gives
 // its vertices and block offsets. On one thread each element is added as it is computed. On
@@ -708,6 +806,144 @@ void add_elements(int count, int vertex_count, const Element& element, const Con
   }
 }
 
+// The membrane of the diamonds (ClothModel::diamonds, docs/simulator.md "The diamond membrane"):
+// each of a diamond's four triangles is evaluated by triangle_membrane at the mapped positions
+// y = (x_c + g(x), x_1 … x_4) with the velocities J·v, J = ∂y/∂x = I + E_c·G (G = ∂g/∂x in the
+// centre's rows). The energy is the triangles' at y; the force Jᵀ·f(y); the solve's matrix
+// Jᵀ·(dfdx_scale·K + dfdv_scale·D)·J and product Jᵀ·K·J·u, K and D the triangles' own at y. The
+// exact Jacobian adds the map's curvature Σ_i f_c,i·∇²g_i (f_c the force on the mapped centre)
+// and the damping's dependence on x through J·v; the solve leaves both out (the first is
+// indefinite and vanishes on flat cloth, the second is the damping's ∂/∂x, dropped everywhere).
+void add_diamonds(const ClothModel& model, const ForceTerms& terms, double damping_scale,
+                  const Eigen::VectorXd& x, const Eigen::VectorXd& v, Eigen::VectorXd& force,
+                  EnergyBreakdown& energy, const JacobianTarget* jacobian) {
+  using Vector15 = Eigen::Matrix<double, 15, 1>;
+  using Matrix15 = Eigen::Matrix<double, 15, 15>;
+  const bool exact = jacobian != nullptr && jacobian->kind == JacobianKind::exact;
+  const bool want_product = jacobian != nullptr && jacobian->product_input != nullptr;
+  const bool want_matrix = jacobian != nullptr && jacobian->matrix != nullptr;
+  const bool damped = damping_scale * model.fabric.damping > 0.0;
+  // Any matrix: triangle_membrane only asks whether there is one, and fills its local block.
+  static const SparseMatrixR kLocalMatrix;
+  const auto element = [&](int k) {
+    const DiamondElement& d = model.diamonds[static_cast<std::size_t>(k)];
+    return std::make_pair(d.vertices.data(), d.blocks.data());
+  };
+  const auto contribute = [&](int k, ElementContribution<15, 2>& out) {
+    const DiamondElement& d = model.diamonds[static_cast<std::size_t>(k)];
+    Vector15 local_x, local_v, local_u = Vector15::Zero();
+    for (int j = 0; j < 5; ++j) {
+      const int vertex = d.vertices[static_cast<std::size_t>(j)];
+      local_x.segment<3>(3 * j) = x.segment<3>(3 * vertex);
+      local_v.segment<3>(3 * j) = v.segment<3>(3 * vertex);
+      if (want_product) local_u.segment<3>(3 * j) = jacobian->product_input->segment<3>(3 * vertex);
+    }
+    DiamondMap map;
+    diamond_centre_map(d, local_x, exact, map);
+    const Eigen::Matrix<double, 3, 15>& g = map.jacobian;
+    Vector15 y = local_x;
+    y.head<3>() += map.offset;
+    // The triangles read velocities and the product's input by local index (0 the centre).
+    thread_local Eigen::VectorXd mapped_v, mapped_u, unused;
+    mapped_v = local_v;
+    mapped_v.head<3>() += g * local_v;
+    if (want_product) {
+      mapped_u = local_u;
+      mapped_u.head<3>() += g * local_u;
+    }
+    JacobianTarget local;
+    local.kind = exact ? JacobianKind::exact : JacobianKind::solve;
+    local.matrix = want_matrix || exact ? const_cast<SparseMatrixR*>(&kLocalMatrix) : nullptr;
+    local.dfdx_scale = exact ? 1.0 : jacobian != nullptr ? jacobian->dfdx_scale : 0.0;
+    local.dfdv_scale = exact ? 0.0 : jacobian != nullptr ? jacobian->dfdv_scale : 0.0;
+    local.product_input = want_product && !exact ? &mapped_u : nullptr;
+    local.product_output = &unused;
+    Vector15 f = Vector15::Zero(), product = Vector15::Zero();
+    Matrix15 matrix = Matrix15::Zero(), damping = Matrix15::Zero();  // exact: K and D
+    double stretch = 0.0, shear = 0.0;
+    ElementContribution<9, 3> part;
+    for (int f_index : d.triangles) {
+      const TriangleElement& t = model.triangles[static_cast<std::size_t>(f_index)];
+      std::array<int, 3> at{};  // the triangle's vertices as local indices
+      for (int j = 0; j < 3; ++j)
+        at[static_cast<std::size_t>(j)] =
+            static_cast<int>(std::find(d.vertices.begin(), d.vertices.end(),
+                                       t.vertices[static_cast<std::size_t>(j)]) -
+                             d.vertices.begin());
+      const auto add = [&](const ElementContribution<9, 3>& c, bool forces, Matrix15& into) {
+        for (int j = 0; j < c.count; ++j) {
+          const ConditionContribution<9>& cc = c.conditions[static_cast<std::size_t>(j)];
+          if (forces) {
+            (c.energy[static_cast<std::size_t>(j)] == &EnergyBreakdown::shear ? shear : stretch) +=
+                cc.energy;
+          }
+          if (cc.energy_only) continue;
+          for (int a = 0; a < 3; ++a) {
+            const int p = at[static_cast<std::size_t>(a)];
+            if (forces) {
+              f.segment<3>(3 * p) += cc.force.segment<3>(3 * a);
+              if (want_product && !exact) product.segment<3>(3 * p) += cc.product.segment<3>(3 * a);
+            }
+            if (local.matrix == nullptr) continue;
+            for (int b = 0; b < 3; ++b)
+              into.block<3, 3>(3 * p, 3 * at[static_cast<std::size_t>(b)]) +=
+                  cc.matrix.block<3, 3>(3 * a, 3 * b);
+          }
+        }
+      };
+      const Vector3d y0 = y.segment<3>(3 * at[0]), y1 = y.segment<3>(3 * at[1]),
+                     y2 = y.segment<3>(3 * at[2]);
+      part.count = 0;
+      triangle_membrane(model, terms, damping_scale, t, y0, y1, y2, at.data(), mapped_v,
+                        jacobian != nullptr ? &local : nullptr, part);
+      add(part, true, matrix);
+      if (exact && damped) {  // ∂f/∂v of the triangle at y, apart from its ∂f/∂x
+        JacobianTarget rates = local;
+        rates.dfdx_scale = 0.0;
+        rates.dfdv_scale = 1.0;
+        part.count = 0;
+        triangle_membrane(model, terms, damping_scale, t, y0, y1, y2, at.data(), mapped_v, &rates,
+                          part);
+        add(part, false, damping);
+      }
+    }
+    ConditionContribution<15>& total = out.next(&EnergyBreakdown::stretch);
+    total.energy = stretch;
+    total.energy_only = false;
+    ConditionContribution<15>& shear_part = out.next(&EnergyBreakdown::shear);
+    shear_part.energy = shear;
+    shear_part.energy_only = true;
+    // Pulled back through J: Jᵀ·w = w + Gᵀ·w_c.
+    const Vector3d f_centre = f.head<3>();
+    total.force = f + g.transpose() * f_centre;
+    if (jacobian == nullptr) return;
+    // J's action on a matrix's columns: M·J = M + M_{·c}·G.
+    const auto times_j = [&](const Matrix15& m) -> Matrix15 { return m + m.leftCols<3>() * g; };
+    const auto pull_back = [&](const Matrix15& m) -> Matrix15 {
+      return m + g.transpose() * m.topRows<3>();
+    };
+    if (!exact) {
+      if (want_product) total.product = product + g.transpose() * product.head<3>();
+      if (want_matrix) total.matrix = pull_back(times_j(matrix));
+      return;
+    }
+    Matrix15 dfdx = pull_back(times_j(matrix));
+    for (int i = 0; i < 3; ++i) dfdx += f_centre(i) * map.hessian[static_cast<std::size_t>(i)];
+    Matrix15 dfdv = Matrix15::Zero();
+    if (damped) {
+      Eigen::Matrix<double, 3, 15> velocity_map;  // ∂(G·v)/∂x: row i is (∇²g_i·v)ᵀ
+      for (int i = 0; i < 3; ++i)
+        velocity_map.row(i) = (map.hessian[static_cast<std::size_t>(i)] * local_v).transpose();
+      dfdx += pull_back(damping.leftCols<3>() * velocity_map);
+      dfdv = pull_back(times_j(damping));
+    }
+    if (want_product) total.product = dfdx * local_u;
+    if (want_matrix) total.matrix = jacobian->dfdx_scale * dfdx + jacobian->dfdv_scale * dfdv;
+  };
+  add_elements<15, 2>(static_cast<int>(model.diamonds.size()), model.vertex_count, element,
+                      contribute, force, energy, jacobian);
+}
+
 }  // namespace
 
 void evaluate_forces(const ClothModel& model, const ForceSettings& settings,
@@ -723,105 +959,23 @@ void evaluate_forces(const ClothModel& model, const ForceSettings& settings,
 
   if (terms.stretch || terms.shear) {
     const auto element = [&](int k) {
-      const TriangleElement& t = model.triangles[static_cast<std::size_t>(k)];
+      const TriangleElement& t = model.triangles[static_cast<std::size_t>(
+          model.diamonds.empty() ? k : model.lone_triangles[static_cast<std::size_t>(k)])];
       return std::make_pair(t.vertices.data(), t.blocks.data());
     };
     const auto contribute = [&](int k, ElementContribution<9, 3>& out) {
-      const TriangleElement& t = model.triangles[static_cast<std::size_t>(k)];
+      const TriangleElement& t = model.triangles[static_cast<std::size_t>(
+          model.diamonds.empty() ? k : model.lone_triangles[static_cast<std::size_t>(k)])];
       const auto& vs = t.vertices;
-      const bool solve = jacobian != nullptr && !exact;
-      // The solve (triangle_solve_contribution) needs no Hessian matrices.
-      TriangleConditions c = triangle_conditions(
-          t, x.segment<3>(3 * vs[0]), x.segment<3>(3 * vs[1]), x.segment<3>(3 * vs[2]), exact);
-      std::array<TriangleTerm, 3> parts;
-      int count = 0;
-      // ε* = N*/K with N* = π²·B / l² for the triangle's width l along each direction (only
-      // with the buckling compression; infinity leaves compression quadratic).
-      const bool buckling = model.compression == Compression::buckling;
-      const double pi2b = std::numbers::pi * std::numbers::pi * fabric.bend;
-      if (terms.stretch) {
-        const double k_u = fabric.stretch_warp * t.rest_area;
-        const double k_v = fabric.stretch_weft * t.rest_area;
-        const double eps_u =
-            buckling ? pi2b / (t.width_u * t.width_u * fabric.stretch_warp) : kLinearCompression;
-        const double eps_v =
-            buckling ? pi2b / (t.width_v * t.width_v * fabric.stretch_weft) : kLinearCompression;
-        parts[count++] = {
-            &c.warp,
-            stretch_energy(c.warp.value, k_u, eps_u, fabric.tensile_warp, t.rest_area),
-            damping_scale * fabric.damping * k_u,
-            &t.du,
-            &c.warp_vector,
-            &EnergyBreakdown::stretch};
-        parts[count++] = {
-            &c.weft,
-            stretch_energy(c.weft.value, k_v, eps_v, fabric.tensile_weft, t.rest_area),
-            damping_scale * fabric.damping * k_v,
-            &t.dv,
-            &c.weft_vector,
-            &EnergyBreakdown::stretch};
-      }
-      if (terms.shear) {
-        const double k_s = fabric.shear * t.rest_area;
-        parts[count++] = {&c.shear,
-                          quadratic_energy(c.shear.value, 0.0, k_s),
-                          damping_scale * fabric.damping * k_s,
-                          nullptr,
-                          nullptr,
-                          &EnergyBreakdown::shear};
-      }
-      // Bias wrinkling (bias_wrinkle), where the capped warp and weft leave the compressed bias
-      // beyond its Euler load N*_b: the larger of the triangle's own along the bias and the mean
-      // of its warp and weft loads, so that it never acts without shear (at γ = 0 the capped
-      // yarns keep ½·(σ_u + σ_v) ≥ −N*_b). The measured tensile curves keep the yarn caps only.
-      Eigen::Matrix3d coupling = Eigen::Matrix3d::Zero();
-      bool coupled = false;
-      if (buckling && terms.stretch && terms.shear && fabric.tensile_warp.empty() &&
-          fabric.tensile_weft.empty()) {
-        const double area = t.rest_area;
-        const double s = c.shear.value < 0.0 ? -1.0 : 1.0;
-        const double n_u = pi2b / (t.width_u * t.width_u), n_v = pi2b / (t.width_v * t.width_v);
-        const double bias_stress = 0.5 * (parts[0].energy.slope + parts[1].energy.slope) / area -
-                                   fabric.shear * std::abs(c.shear.value);
-        // N*_b is at least the mean: the triangle's bias extent is needed only below it.
-        double n_b = 0.5 * (n_u + n_v);
-        if (bias_stress + n_b < 0.0) {
-          const double width_b = bias_width(t, s);
-          n_b = std::max(n_b, pi2b / (width_b * width_b));
-        }
-        const Eigen::Vector3d n_star(n_u, n_v, n_b);
-        if (bias_stress + n_b < 0.0) {
-          const Eigen::Vector3d stiffness(fabric.stretch_warp, fabric.stretch_weft, fabric.shear);
-          const BiasWrinkle w = bias_wrinkle(
-              Eigen::Vector3d(c.warp.value, c.weft.value, c.shear.value), stiffness, n_star, s);
-          for (int j = 0; j < 3; ++j) {
-            const double e = w.elastic(j);
-            parts[static_cast<std::size_t>(j)].energy = {
-                area * (0.5 * stiffness(j) * e * e + n_star(j) * w.wrinkle(j)),
-                area * stiffness(j) * e, area * w.hessian(j, j)};
-          }
-          coupling = area * w.hessian;
-          coupling.diagonal().setZero();
-          coupled = true;
-        }
-      }
-      if (solve) {
-        triangle_solve_contribution(
-            std::span<const TriangleTerm>(parts.data(), static_cast<std::size_t>(count)), vs.data(),
-            v, *jacobian, out);
-        if (coupled) add_condition_coupling(c, coupling, vs.data(), *jacobian, out.conditions[0]);
-        return;
-      }
-      for (int j = 0; j < count; ++j) {
-        const TriangleTerm& part = parts[static_cast<std::size_t>(j)];
-        condition_contribution(*part.condition, part.energy, part.damping, part.d != nullptr,
-                               vs.data(), v, jacobian, out.next(part.into));
-      }
-      if (coupled && jacobian != nullptr)
-        add_condition_coupling(c, coupling, vs.data(), *jacobian, out.conditions[0]);
+      triangle_membrane(model, terms, damping_scale, t, x.segment<3>(3 * vs[0]),
+                        x.segment<3>(3 * vs[1]), x.segment<3>(3 * vs[2]), vs.data(), v, jacobian,
+                        out);
     };
-    add_elements<9, 3>(static_cast<int>(model.triangles.size()), n, element, contribute, force,
-                       local_energy, jacobian);
+    const int lone = static_cast<int>(model.diamonds.empty() ? model.triangles.size()
+                                                             : model.lone_triangles.size());
+    add_elements<9, 3>(lone, n, element, contribute, force, local_energy, jacobian);
+    if (!model.diamonds.empty())
+      add_diamonds(model, terms, damping_scale, x, v, force, local_energy, jacobian);
   }
   if (terms.bend && fabric.bend > 0.0 && model.bend_model == BendModel::quadratic) {
     const double beta = damping_scale * fabric.bend_damping;

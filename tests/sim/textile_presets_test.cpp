@@ -111,9 +111,10 @@ TEST_P(CusickPreset, DrapesWithinItsPublishedRangeWhereConverged) {
   EXPECT_TRUE(d.at_rest);
   if (range.above_range) {
     // Silk stays above its range where converged (the bench's two-specimen means 0.450-0.459 at
-    // 51 cells, 0.475-0.478 at 61; this specimen 0.455; docs/simulator.md, "The Cusick drape of
-    // silk"): its known reading is asserted, so that the docs' figure stays true and a change
-    // that brings silk into its range (or further out) is seen.
+    // 51 cells, 0.475-0.478 at 61; this specimen 0.455, and 0.469 with the diamond membrane and
+    // the ghost points; docs/simulator.md, "The diamond membrane"): its known
+    // reading is asserted, so that the docs' figure stays true and a change that brings silk
+    // into its range (or further out) is seen.
     EXPECT_GE(d.shadow.drape_coefficient, range.high);
     EXPECT_LE(d.shadow.drape_coefficient, 0.50);
   } else {
@@ -135,8 +136,10 @@ INSTANTIATE_TEST_SUITE_P(
 // along and 4 across, clamped by three lines of vertices, settled by the static solver with the
 // quadratic bending: every preset on the 4-8 mesh along the strip and at 45° (issue 21's two
 // orientations), and on an equilateral mesh with edges across and an irregular jittered grid
-// (triangulations a designer imports). The tolerance is issue 21's ±1.5°; measured 40.23° (silk,
-// 4-8 at 45°: the stiffest membrane against its bending) to 42.25° (jersey, 4-8 at 45°).
+// (triangulations a designer imports), with the diamond membrane and ghost points at the clamp
+// (options, not yet the defaults). The tolerance is issue 21's ±1.5°. Measured: 41.68° to 41.97°
+// for every preset on every mesh (4-8 along 41.85-41.95°, at 45° 41.96-41.97°); without them 40.23°
+// (silk, 4-8 at 45°, its membrane locked) to 42.25° (docs/simulator.md, "The diamond membrane").
 TEST(PeirceCantilever, ChordIsWithinOneAndAHalfDegreesForEveryPresetOnEveryMesh) {
   const double peirce = test::cantilever_elastica(8.0).chord_angle_deg();
   for (const std::string& name : fabric_preset_names()) {
@@ -146,7 +149,10 @@ TEST(PeirceCantilever, ChordIsWithinOneAndAHalfDegreesForEveryPresetOnEveryMesh)
          {test::StripMesh::four_eight, test::StripMesh::four_eight_45,
           test::StripMesh::equilateral_across, test::StripMesh::irregular}) {
       const test::Strip strip = test::make_strip(mesh, length, 0.25 * length, 16, 4);
-      const ClothModel model = build_cloth_model(strip.input, fabric);
+      ClothModelOptions options;
+      options.clamp_ghost_points = true;  // with the diamond membrane (docs/simulator.md)
+      options.diamond_membrane = true;
+      const ClothModel model = build_cloth_model(strip.input, fabric, options);
       Eigen::VectorXd x = flatten_positions(strip.input.rest_positions);
       const StaticResult solved = solve_static(model, x, strip.clamped);
       const bool converged = solved.converged;
@@ -166,14 +172,16 @@ TEST(PeirceCantilever, ChordIsWithinOneAndAHalfDegreesForEveryPresetOnEveryMesh)
 
 // The effective rigidity at coarse resolution, on square cells: a cotton strip as wide as its
 // free length L = c (α = 1), 4 and 8 cells along and as many across, clamped by three lines of
-// vertices; B_eff/B from the small-deflection drop against the elastica's. Measured: 0.914,
-// 0.947, 0.941, 0.920 at 4 cells (4-8 along, 4-8 at 45°, equilateral, irregular) and 0.973,
-// 0.960, 0.984, 0.979 at 8. Issue 21 asks ±8 % at 4 cells: three meshes meet it, the 4-8 mesh
-// along the strip misses by 0.7 %, so the bound here is 9 %. On the narrow strips of
+// vertices; B_eff/B from the small-deflection drop against the elastica's, with ghost points at
+// the clamp and the diamond membrane. Measured: 0.933, 0.954, 0.941, 0.920 at 4
+// cells (4-8 along, 4-8 at 45°, equilateral, irregular) and 0.979, 0.985, 0.984, 0.979 at 8
+// (0.914, 0.947, 0.941, 0.920 and 0.973, 0.960, 0.984, 0.979 without them). The bound is issue
+// 21's ±8 % at 4 cells; the irregular grid (0.920, a static solve, so the same on every run) is
+// on its edge, the imported triangulations being untouched by both changes. On the narrow strips of
 // `QuadraticBending.EffectiveRigidityConvergesToB` (L/4 wide, 2 cells across: cells twice as long
 // as wide) the same 4 cells give 0.82-1.46 (docs/simulator.md): the coarse error is the cells'
 // elongation and the strip's narrowness, not the count along.
-TEST(PeirceCantilever, RigidityOnFourSquareCellsIsWithinNinePercentOfB) {
+TEST(PeirceCantilever, RigidityOnFourSquareCellsIsWithinEightPercentOfB) {
   const FabricParameters fabric = fabric_preset("cotton");
   const double length = std::cbrt(fabric.bend / (fabric.area_density * 9.81));
   for (const test::StripMesh mesh :
@@ -182,7 +190,10 @@ TEST(PeirceCantilever, RigidityOnFourSquareCellsIsWithinNinePercentOfB) {
     double previous_error = 1.0;
     for (const int cells : {4, 8}) {
       const test::Strip strip = test::make_strip(mesh, length, length, cells, cells);
-      const ClothModel model = build_cloth_model(strip.input, fabric);
+      ClothModelOptions options;
+      options.clamp_ghost_points = true;  // with the diamond membrane (docs/simulator.md)
+      options.diamond_membrane = true;
+      const ClothModel model = build_cloth_model(strip.input, fabric, options);
       Eigen::VectorXd x = flatten_positions(strip.input.rest_positions);
       ASSERT_TRUE(solve_static(model, x, strip.clamped).converged);
       double clamp = 0.0, tip = 0.0;
@@ -191,7 +202,7 @@ TEST(PeirceCantilever, RigidityOnFourSquareCellsIsWithinNinePercentOfB) {
       const double rigidity = 1.0 / test::elastica_alpha_for_drop((clamp - tip) / length);
       std::printf("rigidity %-26s %d square cells: B_eff/B %.3f\n",
                   test::strip_mesh_name(mesh).c_str(), cells, rigidity);
-      EXPECT_NEAR(rigidity, 1.0, cells == 4 ? 0.09 : 0.05) << test::strip_mesh_name(mesh);
+      EXPECT_NEAR(rigidity, 1.0, cells == 4 ? 0.08 : 0.05) << test::strip_mesh_name(mesh);
       EXPECT_LT(std::abs(rigidity - 1.0), previous_error) << test::strip_mesh_name(mesh);
       previous_error = std::abs(rigidity - 1.0);
     }

@@ -1,0 +1,240 @@
+#include "sim/diamond_membrane.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <type_traits>
+
+#include "sim/cloth_model.hpp"
+
+namespace sd::sim {
+namespace {
+
+using Eigen::Vector3d;
+using Gradient = Eigen::Matrix<double, 15, 1>;
+using Hessian = Eigen::Matrix<double, 15, 15>;
+
+// A value with its exact derivatives with respect to the diamond's 15 coordinates (forward
+// mode): the gradient, and with kSecond the Hessian. The map is a few dozen operations, so
+// carrying both through them is cheaper and safer than a hand-expanded second derivative.
+template <bool kSecond>
+struct Jet {
+  double value = 0.0;
+  Gradient gradient = Gradient::Zero();
+  std::conditional_t<kSecond, Hessian, char> hessian{};
+
+  Jet() {
+    if constexpr (kSecond) hessian.setZero();
+  }
+  explicit Jet(double v) : Jet() { value = v; }
+};
+
+template <bool S>
+Jet<S> operator+(const Jet<S>& a, const Jet<S>& b) {
+  Jet<S> r(a.value + b.value);
+  r.gradient = a.gradient + b.gradient;
+  if constexpr (S) r.hessian = a.hessian + b.hessian;
+  return r;
+}
+
+template <bool S>
+Jet<S> operator-(const Jet<S>& a, const Jet<S>& b) {
+  Jet<S> r(a.value - b.value);
+  r.gradient = a.gradient - b.gradient;
+  if constexpr (S) r.hessian = a.hessian - b.hessian;
+  return r;
+}
+
+template <bool S>
+Jet<S> operator*(double s, const Jet<S>& a) {
+  Jet<S> r(s * a.value);
+  r.gradient = s * a.gradient;
+  if constexpr (S) r.hessian = s * a.hessian;
+  return r;
+}
+
+template <bool S>
+Jet<S> operator*(const Jet<S>& a, const Jet<S>& b) {
+  Jet<S> r(a.value * b.value);
+  r.gradient = a.value * b.gradient + b.value * a.gradient;
+  if constexpr (S) {
+    const Hessian outer = a.gradient * b.gradient.transpose();
+    r.hessian = a.value * b.hessian + b.value * a.hessian + outer + outer.transpose();
+  }
+  return r;
+}
+
+// 1/a and √a by the chain rule: φ(a) with φ', φ''.
+template <bool S>
+Jet<S> apply(const Jet<S>& a, double value, double slope, double curvature) {
+  Jet<S> r(value);
+  r.gradient = slope * a.gradient;
+  if constexpr (S) r.hessian = slope * a.hessian + curvature * a.gradient * a.gradient.transpose();
+  return r;
+}
+
+template <bool S>
+Jet<S> inverse(const Jet<S>& a) {
+  const double i = 1.0 / a.value;
+  return apply(a, i, -i * i, 2.0 * i * i * i);
+}
+
+template <bool S>
+Jet<S> square_root(const Jet<S>& a) {
+  const double s = std::sqrt(a.value);
+  return apply(a, s, 0.5 / s, -0.25 / (s * a.value));
+}
+
+template <bool S>
+using JetVector = std::array<Jet<S>, 3>;
+
+template <bool S>
+JetVector<S> minus(const JetVector<S>& a, const JetVector<S>& b) {
+  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+}
+
+template <bool S>
+Jet<S> dot(const JetVector<S>& a, const JetVector<S>& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+template <bool S>
+JetVector<S> cross(const JetVector<S>& a, const JetVector<S>& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+
+// The map's value g and its derivatives; false where the diagonals are (nearly) parallel.
+template <bool S>
+bool centre_map(const DiamondElement& d, const Eigen::Matrix<double, 15, 1>& x,
+                JetVector<S>& offset) {
+  std::array<JetVector<S>, 5> p;
+  for (int k = 0; k < 5; ++k)
+    for (int i = 0; i < 3; ++i) {
+      p[k][i] = Jet<S>(x(3 * k + i));
+      p[k][i].gradient(3 * k + i) = 1.0;
+    }
+  const JetVector<S> m = cross(minus(p[3], p[1]), minus(p[4], p[2]));
+  const Jet<S> m2 = dot(m, m);
+  // Parallel diagonals: |m|² is 1e-12 of the diagonals' squared lengths' product.
+  const double scale = (x.segment<3>(9) - x.segment<3>(3)).squaredNorm() *
+                       (x.segment<3>(12) - x.segment<3>(6)).squaredNorm();
+  if (!(m2.value > 1e-24 * scale)) return false;
+  const Jet<S> inverse_length = inverse(square_root(m2));
+  const JetVector<S> n = {inverse_length * m[0], inverse_length * m[1], inverse_length * m[2]};
+  // Heights of the corner pairs' midpoints: n·(½(x₁ + x₃) − x_c), n·(½(x₂ + x₄) − x_c).
+  JetVector<S> q1, q2;
+  for (int i = 0; i < 3; ++i) {
+    q1[i] = 0.5 * (p[1][i] + p[3][i]) - p[0][i];
+    q2[i] = 0.5 * (p[2][i] + p[4][i]) - p[0][i];
+  }
+  const Jet<S> h1 = dot(n, q1), h2 = dot(n, q2);
+  const Jet<S> f = h1 * h2 * (h1 + h2) * inverse(h1 * h1 + h2 * h2 + Jet<S>(d.regularisation));
+  const Jet<S> lift = f - Jet<S>(d.rest_offset);
+  offset = {lift * n[0], lift * n[1], lift * n[2]};
+  return true;
+}
+
+}  // namespace
+
+void diamond_centre_map(const DiamondElement& diamond, const Eigen::Matrix<double, 15, 1>& x,
+                        bool with_hessian, DiamondMap& out) {
+  out.offset.setZero();
+  out.jacobian.setZero();
+  if (with_hessian) {
+    for (Hessian& h : out.hessian) h.setZero();
+    JetVector<true> g;
+    if (!centre_map<true>(diamond, x, g)) return;
+    for (int i = 0; i < 3; ++i) {
+      out.offset(i) = g[i].value;
+      out.jacobian.row(i) = g[i].gradient.transpose();
+      out.hessian[i] = g[i].hessian;
+    }
+    return;
+  }
+  JetVector<false> g;
+  if (!centre_map<false>(diamond, x, g)) return;
+  for (int i = 0; i < 3; ++i) {
+    out.offset(i) = g[i].value;
+    out.jacobian.row(i) = g[i].gradient.transpose();
+  }
+}
+
+std::vector<DiamondElement> make_diamonds(const Eigen::MatrixX3d& rest,
+                                          const std::vector<TriangleElement>& triangles,
+                                          bool flat_rest) {
+  const auto n = static_cast<std::size_t>(rest.rows());
+  // The triangles around each vertex (CSR).
+  std::vector<int> start(n + 1, 0);
+  for (const TriangleElement& t : triangles)
+    for (int v : t.vertices) ++start[static_cast<std::size_t>(v) + 1];
+  for (std::size_t i = 0; i < n; ++i) start[i + 1] += start[i];
+  std::vector<int> around(static_cast<std::size_t>(start[n]));
+  {
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for (std::size_t f = 0; f < triangles.size(); ++f)
+      for (int v : triangles[f].vertices)
+        around[static_cast<std::size_t>(fill[static_cast<std::size_t>(v)]++)] = static_cast<int>(f);
+  }
+  std::vector<char> taken(triangles.size(), 0);
+  std::vector<DiamondElement> diamonds;
+  for (std::size_t c = 0; c < n; ++c) {
+    if (start[c + 1] - start[c] != 4) continue;
+    // Each triangle as (c, a, b) in its own order: the fan closes when the b of one is the a of
+    // the next, four times round.
+    std::array<int, 4> faces{}, a{}, b{};
+    bool free = true;
+    for (int k = 0; k < 4; ++k) {
+      const int f = around[static_cast<std::size_t>(start[c] + k)];
+      const auto& v = triangles[static_cast<std::size_t>(f)].vertices;
+      const int at = v[0] == static_cast<int>(c) ? 0 : v[1] == static_cast<int>(c) ? 1 : 2;
+      faces[static_cast<std::size_t>(k)] = f;
+      a[static_cast<std::size_t>(k)] = v[static_cast<std::size_t>((at + 1) % 3)];
+      b[static_cast<std::size_t>(k)] = v[static_cast<std::size_t>((at + 2) % 3)];
+      free = free && !taken[static_cast<std::size_t>(f)];
+    }
+    if (!free) continue;
+    DiamondElement d;
+    d.vertices[0] = static_cast<int>(c);
+    std::array<int, 4> order{};
+    std::array<char, 4> used{};
+    int current = 0;
+    bool closed = true;
+    for (int k = 0; k < 4 && closed; ++k) {
+      order[static_cast<std::size_t>(k)] = current;
+      used[static_cast<std::size_t>(current)] = 1;
+      d.vertices[static_cast<std::size_t>(k) + 1] = a[static_cast<std::size_t>(current)];
+      int next = -1;
+      for (int j = 0; j < 4; ++j)
+        if (a[static_cast<std::size_t>(j)] == b[static_cast<std::size_t>(current)]) next = j;
+      if (next < 0 || (k < 3 && used[static_cast<std::size_t>(next)]) || (k == 3 && next != 0))
+        closed = false;
+      current = next;
+    }
+    if (!closed) continue;
+    for (int k = 0; k < 4; ++k)
+      d.triangles[static_cast<std::size_t>(k)] = faces[static_cast<std::size_t>(order[k])];
+    // The centre near the midpoint of both diagonals (a quarter of the half-diagonal).
+    const auto at = [&](int k) {
+      return Vector3d(rest.row(d.vertices[static_cast<std::size_t>(k)]).transpose());
+    };
+    const double a13 = 0.5 * (at(3) - at(1)).norm(), a24 = 0.5 * (at(4) - at(2)).norm();
+    if (!(a13 > 0.0) || !(a24 > 0.0) || (0.5 * (at(1) + at(3)) - at(0)).norm() > 0.25 * a13 ||
+        (0.5 * (at(2) + at(4)) - at(0)).norm() > 0.25 * a24)
+      continue;
+    const double epsilon = 0.01 * 0.5 * (a13 + a24);
+    d.regularisation = epsilon * epsilon;
+    if (!flat_rest) {
+      Eigen::Matrix<double, 15, 1> x;
+      for (int k = 0; k < 5; ++k) x.segment<3>(3 * k) = at(k);
+      DiamondMap map;
+      diamond_centre_map(d, x, false, map);
+      const Vector3d m = (at(3) - at(1)).cross(at(4) - at(2));
+      d.rest_offset = m.norm() > 0.0 ? map.offset.dot(m.normalized()) : 0.0;
+    }
+    for (int f : d.triangles) taken[static_cast<std::size_t>(f)] = 1;
+    diamonds.push_back(d);
+  }
+  return diamonds;
+}
+
+}  // namespace sd::sim
