@@ -535,7 +535,8 @@ void Simulation::accept(Attempt& attempt, double h) {
   const double kinetic = kinetic_energy(model_, v_);
   // A body still moving (a pose sequence not yet over) is not a scene at rest.
   const bool body_moving = contact_ && contact_->motion() && time_ < contact_->motion()->end_time();
-  if (report_.settled_time < 0.0 && !body_moving && time_ >= settings_.rest_not_before &&
+  moved_ = moved_ || kinetic / mass > settings_.settled_energy;
+  if (report_.settled_time < 0.0 && moved_ && !body_moving && time_ >= settings_.rest_not_before &&
       kinetic / mass < settings_.settled_energy)
     report_.settled_time = time_;
   while (!unsettled_retry_times_.empty() &&

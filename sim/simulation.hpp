@@ -87,9 +87,12 @@ struct SimulationSettings {
   // attempts failed. Trial 35's strapless dress on the Collada human settled to 1.6e-6 J/kg by
   // 6.7 s, then its back, caught in the seat's cleft, was thrown about with 10-20 retries a
   // second until a vertex reached 497 m/s at 15.3 s (docs/collision.md, "Cloth caught in a
-  // cleft"). 0 retries: never.
+  // cleft"). The cloth must have moved first (its energy above settled_energy once): a scene
+  // starting still has not settled (a stiff stress sheet, still at 0.03 s and retrying as it
+  // fell, was stopped). 0 retries, the default: never; garment drapes set 10
+  // (src/app/pipeline/cloth_scene.cpp).
   double settled_energy = 1.0e-5;  // J/kg
-  int unsettled_retries = 10;
+  int unsettled_retries = 0;
   double unsettled_window = 1.0;  // s
   bool stop_at_rest = true;
   double rest_speed = 5.0e-3;           // m/s, maximum vertex speed at rest
@@ -364,6 +367,7 @@ class Simulation {
   // Since the drape settled (SimulationSettings::settled_energy): the times of the steps that
   // were retried within the last unsettled_window, and the last failed attempt's check and vertex.
   std::deque<double> unsettled_retry_times_;
+  bool moved_ = false;  // the kinetic energy has been above settled_energy (settling needs it)
   std::string last_retry_reason_;
   int last_retry_vertex_ = -1;
 };

@@ -414,6 +414,10 @@ sim::SimulationSettings simulation_settings(const scene::Sketch& sketch) {
   settings.contact.fade_carried_push = spec.fade_carried_push.value_or(flat);
   // Garments fold onto themselves (a skirt's front and back, a sleeve); a sheet scene asks.
   settings.self_contact.enabled = spec.self_collision.value_or(!sketch.sheet.has_value());
+  // A garment thrown about again after it settled (cloth caught in a cleft of the body) stops
+  // before it blows up (docs/collision.md, "Cloth caught in a cleft"); a sheet scene's retries
+  // are its own (the stress matrix's stiff sheets retry as they fall).
+  if (!sketch.sheet) settings.unsettled_retries = 10;
   try {
     settings.validate();
   } catch (const sim::InvalidSimulationSettingsError& e) {
