@@ -27,21 +27,6 @@
 namespace sd::sim {
 namespace {
 
-// ∂f/∂x·x_scale + ∂f/∂v·v_scale as a dense matrix.
-Eigen::MatrixXd dense_jacobian(const ClothModel& model, const ForceSettings& settings,
-                               const Eigen::VectorXd& x, const Eigen::VectorXd& v, double x_scale,
-                               double v_scale, JacobianKind kind) {
-  SparseMatrixR matrix = model.pattern.zero_matrix;
-  JacobianTarget target;
-  target.kind = kind;
-  target.matrix = &matrix;
-  target.dfdx_scale = x_scale;
-  target.dfdv_scale = v_scale;
-  Eigen::VectorXd force;
-  evaluate_forces(model, settings, x, v, force, nullptr, &target);
-  return Eigen::MatrixXd(matrix);
-}
-
 // Ghost points at the clamp and the diamond membrane (docs/simulator.md, "The diamond membrane").
 ClothModelOptions diamond_options() {
   ClothModelOptions options;
@@ -174,8 +159,10 @@ TEST(QuadraticBending, ForcesAndJacobiansMatchFiniteDifferences) {
     for (int trial = 0; trial < 3; ++trial) {
       const Eigen::VectorXd x = testing::random_configuration(input.rest_positions, rng);
       const Eigen::VectorXd v = Eigen::VectorXd::Random(x.size());
-      const Eigen::MatrixXd dfdx = dense_jacobian(model, settings, x, v, 1, 0, JacobianKind::exact);
-      const Eigen::MatrixXd dfdv = dense_jacobian(model, settings, x, v, 0, 1, JacobianKind::exact);
+      const Eigen::MatrixXd dfdx =
+          testing::dense_jacobian(model, settings, x, v, 1, 0, JacobianKind::exact);
+      const Eigen::MatrixXd dfdv =
+          testing::dense_jacobian(model, settings, x, v, 0, 1, JacobianKind::exact);
       const testing::ForceDifferences d = testing::force_differences(model, settings, x, v);
       const Eigen::MatrixXd& fd_x = d.dfdx;
       const Eigen::MatrixXd& fd_v = d.dfdv;
@@ -184,7 +171,8 @@ TEST(QuadraticBending, ForcesAndJacobiansMatchFiniteDifferences) {
       EXPECT_LE((force + grad).norm(), 1e-6 * force.norm()) << curved << " trial " << trial;
       EXPECT_LE((fd_x - dfdx).norm(), 1e-6 * dfdx.norm()) << curved << " trial " << trial;
       EXPECT_LE((fd_v - dfdv).norm(), 1e-6 * dfdv.norm()) << curved << " trial " << trial;
-      const Eigen::MatrixXd j = dense_jacobian(model, settings, x, v, 1, 0, JacobianKind::solve);
+      const Eigen::MatrixXd j =
+          testing::dense_jacobian(model, settings, x, v, 1, 0, JacobianKind::solve);
       EXPECT_LE((j - j.transpose()).norm(), 1e-12 * j.norm());
       EXPECT_LE(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(j).eigenvalues().maxCoeff(),
                 1e-9 * j.norm());

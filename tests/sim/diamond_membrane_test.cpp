@@ -14,6 +14,7 @@
 
 #include "sim/cloth_model.hpp"
 #include "sim/forces.hpp"
+#include "tests/sim/force_differences.hpp"
 #include "tests/sim/strip_meshes.hpp"
 
 namespace sd::sim {
@@ -46,20 +47,6 @@ Eigen::VectorXd bent_configuration(const ClothModel& model, const ClothInput& in
     x.segment<3>(3 * i) = q;
   }
   return x;
-}
-
-Eigen::MatrixXd dense_jacobian(const ClothModel& model, const ForceSettings& settings,
-                               const Eigen::VectorXd& x, const Eigen::VectorXd& v, double x_scale,
-                               double v_scale, JacobianKind kind) {
-  SparseMatrixR matrix = model.pattern.zero_matrix;
-  JacobianTarget target;
-  target.kind = kind;
-  target.matrix = &matrix;
-  target.dfdx_scale = x_scale;
-  target.dfdv_scale = v_scale;
-  Eigen::VectorXd force;
-  evaluate_forces(model, settings, x, v, force, nullptr, &target);
-  return Eigen::MatrixXd(matrix);
 }
 
 // Both 4-8 levels: every triangle is in at most one diamond, each diamond's four triangles are
@@ -209,8 +196,10 @@ TEST(DiamondMembrane, ForceAndExactJacobiansMatchFiniteDifferences) {
           fd_v.col(j) = (fp - fm) / (2 * h);
         }
         EXPECT_LE((gradient + force).norm(), 1e-5 * force.norm()) << name;
-        const Eigen::MatrixXd dfdx = dense_jacobian(model, damped, x, v, 1, 0, JacobianKind::exact);
-        const Eigen::MatrixXd dfdv = dense_jacobian(model, damped, x, v, 0, 1, JacobianKind::exact);
+        const Eigen::MatrixXd dfdx =
+            testing::dense_jacobian(model, damped, x, v, 1, 0, JacobianKind::exact);
+        const Eigen::MatrixXd dfdv =
+            testing::dense_jacobian(model, damped, x, v, 0, 1, JacobianKind::exact);
         EXPECT_LE((fd_x - dfdx).norm(), 1e-5 * dfdx.norm()) << name;
         EXPECT_LE((fd_v - dfdv).norm(), 1e-5 * dfdv.norm()) << name;
       }
@@ -233,13 +222,14 @@ TEST(DiamondMembrane, SolveJacobianIsSymmetricNegativeSemidefiniteAndItsProductI
     const Eigen::VectorXd u = Eigen::VectorXd::Random(x.size());
     for (double xs : {1.0, 0.0}) {
       const Eigen::MatrixXd j =
-          dense_jacobian(model, settings, x, v, xs, 1.0 - xs, JacobianKind::solve);
+          testing::dense_jacobian(model, settings, x, v, xs, 1.0 - xs, JacobianKind::solve);
       EXPECT_LE((j - j.transpose()).norm(), 1e-12 * j.norm());
       const Eigen::VectorXd eigenvalues =
           Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(j).eigenvalues();
       EXPECT_LE(eigenvalues.maxCoeff(), 1e-9 * j.norm()) << "trial " << trial;
     }
-    const Eigen::MatrixXd dfdx = dense_jacobian(model, settings, x, v, 1, 0, JacobianKind::solve);
+    const Eigen::MatrixXd dfdx =
+        testing::dense_jacobian(model, settings, x, v, 1, 0, JacobianKind::solve);
     JacobianTarget target;
     Eigen::VectorXd product = Eigen::VectorXd::Zero(x.size()), force;
     target.product_input = &u;
@@ -277,9 +267,9 @@ TEST(DiamondMembrane, FlatClothIsUnchanged) {
     EXPECT_NEAR(e_with.stretch, e_without.stretch, 1e-12 * e_without.stretch);
     EXPECT_NEAR(e_with.shear, e_without.shear, 1e-12 * e_without.shear);
     const Eigen::MatrixXd j_with =
-        dense_jacobian(with, settings, x, v, 1, 0.1, JacobianKind::solve);
+        testing::dense_jacobian(with, settings, x, v, 1, 0.1, JacobianKind::solve);
     const Eigen::MatrixXd j_without =
-        dense_jacobian(without, settings, x, v, 1, 0.1, JacobianKind::solve);
+        testing::dense_jacobian(without, settings, x, v, 1, 0.1, JacobianKind::solve);
     EXPECT_LE((j_with - j_without).norm(), 1e-12 * j_without.norm());
   }
 }

@@ -9,6 +9,21 @@
 
 namespace sd::sim::testing {
 
+// The assembled ∂f/∂x·x_scale + ∂f/∂v·v_scale of `kind` (exact or the solve's) as a dense matrix.
+inline Eigen::MatrixXd dense_jacobian(const ClothModel& model, const ForceSettings& settings,
+                                      const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                                      double x_scale, double v_scale, JacobianKind kind) {
+  SparseMatrixR matrix = model.pattern.zero_matrix;
+  JacobianTarget target;
+  target.kind = kind;
+  target.matrix = &matrix;
+  target.dfdx_scale = x_scale;
+  target.dfdv_scale = v_scale;
+  Eigen::VectorXd force;
+  evaluate_forces(model, settings, x, v, force, nullptr, &target);
+  return Eigen::MatrixXd(matrix);
+}
+
 struct ForceDifferences {
   Eigen::MatrixXd dfdx, dfdv;          // 3n × 3n
   Eigen::VectorXd bend_gradient;       // ∂E_bend/∂x

@@ -75,20 +75,6 @@ Fixture make_fixture() {
   return f;
 }
 
-Eigen::MatrixXd dense_jacobian(const ClothModel& model, const ForceSettings& settings,
-                               const Eigen::VectorXd& x, const Eigen::VectorXd& v, double x_scale,
-                               double v_scale, JacobianKind kind) {
-  SparseMatrixR matrix = model.pattern.zero_matrix;
-  JacobianTarget target;
-  target.kind = kind;
-  target.matrix = &matrix;
-  target.dfdx_scale = x_scale;
-  target.dfdv_scale = v_scale;
-  Eigen::VectorXd force;
-  evaluate_forces(model, settings, x, v, force, nullptr, &target);
-  return Eigen::MatrixXd(matrix);
-}
-
 // At rest velocity, the membrane force is −∇(E_stretch + E_shear) (central differences of the
 // energy, h = 1e-7 m) and the exact Jacobian matches central differences of the force, both to
 // 1e-5 relative.
@@ -109,7 +95,8 @@ void expect_membrane_derivatives(const ClothModel& model, const ForceSettings& s
     gradient[j] = (ep.stretch + ep.shear - em.stretch - em.shear) / (2 * h);
   }
   EXPECT_LE((gradient + force).norm(), 1e-5 * force.norm()) << "trial " << trial;
-  const Eigen::MatrixXd dfdx = dense_jacobian(model, settings, x, v, 1, 0, JacobianKind::exact);
+  const Eigen::MatrixXd dfdx =
+      testing::dense_jacobian(model, settings, x, v, 1, 0, JacobianKind::exact);
   EXPECT_LE((d.dfdx - dfdx).norm(), 1e-5 * dfdx.norm()) << "trial " << trial;
 }
 
@@ -155,9 +142,9 @@ TEST(Forces, ExactJacobiansMatchFiniteDifferences) {
       Eigen::VectorXd v(x.size());
       for (Eigen::Index j = 0; j < v.size(); ++j) v[j] = normal(rng);
       const Eigen::MatrixXd dfdx =
-          dense_jacobian(f.model, settings, x, v, 1, 0, JacobianKind::exact);
+          testing::dense_jacobian(f.model, settings, x, v, 1, 0, JacobianKind::exact);
       const Eigen::MatrixXd dfdv =
-          dense_jacobian(f.model, settings, x, v, 0, 1, JacobianKind::exact);
+          testing::dense_jacobian(f.model, settings, x, v, 0, 1, JacobianKind::exact);
       Eigen::MatrixXd fd_x(x.size(), x.size()), fd_v(x.size(), x.size());
       const double h = 1e-6;
       Eigen::VectorXd fp, fm;
@@ -198,7 +185,7 @@ TEST(Forces, SolveJacobianIsSymmetricNegativeSemidefinite) {
     const Eigen::VectorXd v = Eigen::VectorXd::Random(x.size());
     for (double xs : {1.0, 0.0}) {
       const Eigen::MatrixXd j =
-          dense_jacobian(f.model, settings, x, v, xs, 1.0 - xs, JacobianKind::solve);
+          testing::dense_jacobian(f.model, settings, x, v, xs, 1.0 - xs, JacobianKind::solve);
       EXPECT_LE((j - j.transpose()).norm(), 1e-12 * j.norm());
       const Eigen::VectorXd eigenvalues =
           Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(j).eigenvalues();
@@ -215,7 +202,7 @@ TEST(Forces, JacobianProductEqualsMatrixProduct) {
   const Eigen::VectorXd v = Eigen::VectorXd::Random(x.size());
   const Eigen::VectorXd u = Eigen::VectorXd::Random(x.size());
   for (JacobianKind kind : {JacobianKind::exact, JacobianKind::solve}) {
-    const Eigen::MatrixXd dfdx = dense_jacobian(f.model, settings, x, v, 1, 0, kind);
+    const Eigen::MatrixXd dfdx = testing::dense_jacobian(f.model, settings, x, v, 1, 0, kind);
     JacobianTarget target;
     target.kind = kind;
     Eigen::VectorXd product = Eigen::VectorXd::Zero(x.size()), force;
@@ -238,9 +225,9 @@ TEST(Forces, SolveJacobianKeepsTheStretchCurvatureOnlyWhileStretched) {
   for (double scale : {1.1, 0.9}) {
     const Eigen::VectorXd x = scale * rest;
     const Eigen::MatrixXd exact =
-        dense_jacobian(f.model, settings, x, v, 1, 0, JacobianKind::exact);
+        testing::dense_jacobian(f.model, settings, x, v, 1, 0, JacobianKind::exact);
     const Eigen::MatrixXd solve =
-        dense_jacobian(f.model, settings, x, v, 1, 0, JacobianKind::solve);
+        testing::dense_jacobian(f.model, settings, x, v, 1, 0, JacobianKind::solve);
     if (scale > 1.0) {
       EXPECT_LE((solve - exact).norm(), 1e-12 * exact.norm());
     } else {
@@ -273,8 +260,10 @@ TEST(Forces, BendStencilsMatchFiniteDifferences) {
   for (int trial = 0; trial < 5; ++trial) {
     const Eigen::VectorXd x = testing::random_configuration(scene.input.rest_positions, rng);
     const Eigen::VectorXd v = Eigen::VectorXd::Random(x.size());
-    const Eigen::MatrixXd dfdx = dense_jacobian(model, settings, x, v, 1, 0, JacobianKind::exact);
-    const Eigen::MatrixXd dfdv = dense_jacobian(model, settings, x, v, 0, 1, JacobianKind::exact);
+    const Eigen::MatrixXd dfdx =
+        testing::dense_jacobian(model, settings, x, v, 1, 0, JacobianKind::exact);
+    const Eigen::MatrixXd dfdv =
+        testing::dense_jacobian(model, settings, x, v, 0, 1, JacobianKind::exact);
     const testing::ForceDifferences d = testing::force_differences(model, settings, x, v);
     const Eigen::MatrixXd& fd_x = d.dfdx;
     const Eigen::MatrixXd& fd_v = d.dfdv;
@@ -283,7 +272,8 @@ TEST(Forces, BendStencilsMatchFiniteDifferences) {
     EXPECT_LE((force + grad).norm(), 1e-5 * force.norm()) << "trial " << trial;
     EXPECT_LE((fd_x - dfdx).norm(), 1e-5 * dfdx.norm()) << "trial " << trial;
     EXPECT_LE((fd_v - dfdv).norm(), 1e-5 * dfdv.norm()) << "trial " << trial;
-    const Eigen::MatrixXd j = dense_jacobian(model, settings, x, v, 1, 0, JacobianKind::solve);
+    const Eigen::MatrixXd j =
+        testing::dense_jacobian(model, settings, x, v, 1, 0, JacobianKind::solve);
     EXPECT_LE((j - j.transpose()).norm(), 1e-12 * j.norm());
     EXPECT_LE(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(j).eigenvalues().maxCoeff(),
               1e-9 * j.norm());
@@ -558,7 +548,8 @@ TEST(Forces, BiasWrinklingMatchesFiniteDifferences) {
     }
     expect_membrane_derivatives(f.model, settings, x, trial);
     const Eigen::VectorXd v = Eigen::VectorXd::Zero(x.size());
-    const Eigen::MatrixXd j = dense_jacobian(f.model, settings, x, v, 1, 0, JacobianKind::solve);
+    const Eigen::MatrixXd j =
+        testing::dense_jacobian(f.model, settings, x, v, 1, 0, JacobianKind::solve);
     EXPECT_LE((j - j.transpose()).norm(), 1e-12 * j.norm()) << "trial " << trial;
     EXPECT_LE(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(j).eigenvalues().maxCoeff(),
               1e-9 * j.norm())
