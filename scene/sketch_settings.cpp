@@ -6,12 +6,16 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <tuple>
 
 #include "scene/sketch_sections.hpp"
 #include "sim/sheet.hpp"
 
 namespace sd::scene::detail {
 namespace {
+
+// s: the adaptive lookahead and change interval are below this (see parse_adaptive).
+constexpr double kMaxAdaptiveSeconds = 1.0;
 
 // "adaptive": true | false | {"enabled": ..., "refine_threshold": ..., ...}.
 void parse_adaptive(const Reader& r, const json& a, SimulateSpec& sim) {
@@ -27,7 +31,8 @@ void parse_adaptive(const Reader& r, const json& a, SimulateSpec& sim) {
            "0.002, ...}");
   r.check_keys(a, path,
                {"enabled", "refine_threshold", "coarsen_threshold", "steady_rate", "min_lifetime",
-                "min_level", "max_level", "max_vertices", "merge_batch", "even_levels"});
+                "min_level", "max_level", "max_vertices", "merge_batch", "even_levels",
+                "target_levels", "lookahead", "change_interval"});
   sim::AdaptiveSettings& s = sim.adaptive_settings;  // the simulator's defaults where unset
   if (a.contains("enabled")) sim.adaptive = r.boolean(a["enabled"], path + "/enabled");
   if (a.contains("refine_threshold"))
@@ -65,6 +70,23 @@ void parse_adaptive(const Reader& r, const json& a, SimulateSpec& sim) {
              "them can go at once); it must be below 1");
   }
   if (a.contains("even_levels")) s.even_levels = r.boolean(a["even_levels"], path + "/even_levels");
+  if (a.contains("target_levels"))
+    s.target_levels = r.boolean(a["target_levels"], path + "/target_levels");
+  // Both are times of the order of a few steps: the lookahead is also the length of the trial
+  // run before the first step (a copy of the whole drape), so a second or more would cost a
+  // drape of its own; an interval of a second or more would leave a falling garment on its
+  // first mesh.
+  for (const auto& [key, seconds, what] :
+       {std::tuple{"lookahead", &s.lookahead, "a refinement lookahead"},
+        std::tuple{"change_interval", &s.change_interval, "an interval between mesh changes"}}) {
+    if (!a.contains(key)) continue;
+    *seconds = r.number(a[key], path + "/" + key);
+    if (!(*seconds >= 0.0 && *seconds < kMaxAdaptiveSeconds))
+      r.fail(path + "/" + key,
+             fmt::format("{} of {} s is outside 0 .. {} s (below {} s; 0.1 s is usual, 0 turns "
+                         "it off)",
+                         what, *seconds, kMaxAdaptiveSeconds, kMaxAdaptiveSeconds));
+  }
 }
 
 // "pattern": true, false, or an object of settings.

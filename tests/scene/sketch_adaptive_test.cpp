@@ -49,10 +49,14 @@ TEST(AdaptiveSketch, BoolAndObjectForms) {
   EXPECT_EQ(d.max_vertices, sim_defaults.max_vertices);
   EXPECT_EQ(d.merge_batch, sim_defaults.merge_batch);
   EXPECT_EQ(d.even_levels, sim_defaults.even_levels);
+  EXPECT_EQ(d.target_levels, sim_defaults.target_levels);
+  EXPECT_EQ(d.lookahead, sim_defaults.lookahead);
+  EXPECT_EQ(d.change_interval, sim_defaults.change_interval);
   const Sketch s = parse_sketch(
       sketch_with(R"({"enabled": true, "refine_threshold": 0.004, "coarsen_threshold": 0.001,
                       "steady_rate": 0.1, "min_lifetime": 0.5, "min_level": 1, "max_level": 5,
-                      "max_vertices": 800, "merge_batch": 0.1, "even_levels": true})"),
+                      "max_vertices": 800, "merge_batch": 0.1, "even_levels": true,
+                      "target_levels": true, "lookahead": 0.1, "change_interval": 0.05})"),
       "t.json");
   const sim::AdaptiveSettings& a = s.simulate.adaptive_settings;
   EXPECT_TRUE(s.simulate.adaptive);
@@ -65,6 +69,9 @@ TEST(AdaptiveSketch, BoolAndObjectForms) {
   EXPECT_EQ(a.max_vertices, 800);
   EXPECT_DOUBLE_EQ(a.merge_batch, 0.1);
   EXPECT_TRUE(a.even_levels);
+  EXPECT_TRUE(a.target_levels);
+  EXPECT_DOUBLE_EQ(a.lookahead, 0.1);
+  EXPECT_DOUBLE_EQ(a.change_interval, 0.05);
   EXPECT_FALSE(parse_sketch(sketch_with(R"({"enabled": false})"), "t.json").simulate.adaptive);
 }
 
@@ -89,6 +96,16 @@ TEST(AdaptiveSketch, BadValuesNameTheirPath) {
   EXPECT_EQ(error_of(R"({"steady_rate": -0.1})").rfind("/simulate/adaptive/steady_rate:", 0), 0u);
   EXPECT_EQ(error_of(R"({"enabled": 1})").rfind("/simulate/adaptive/enabled:", 0), 0u);
   EXPECT_EQ(error_of(R"({"even_levels": "yes"})").rfind("/simulate/adaptive/even_levels:", 0), 0u);
+  EXPECT_EQ(error_of(R"({"target_levels": 1})").rfind("/simulate/adaptive/target_levels:", 0),
+            0u);
+  EXPECT_EQ(error_of(R"({"lookahead": -0.1})").rfind("/simulate/adaptive/lookahead:", 0), 0u);
+  EXPECT_EQ(error_of(R"({"lookahead": 1})")
+                .rfind("/simulate/adaptive/lookahead: a refinement lookahead of 1 s is outside", 0),
+            0u);
+  EXPECT_EQ(error_of(R"({"change_interval": 100})")
+                .rfind("/simulate/adaptive/change_interval: an interval between mesh changes", 0),
+            0u);
+  EXPECT_EQ(error_of(R"({"lookahead": 0, "change_interval": 0.999})"), "");
   EXPECT_EQ(error_of(R"({"refine": 0.1})").rfind("/simulate/adaptive", 0), 0u);  // unknown key
   EXPECT_EQ(error_of(R"({"max_vertices": 0})"), "");
   // A value against the simulator's default is left to run (AdaptiveSettings::validate): the
