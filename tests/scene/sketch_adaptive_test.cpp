@@ -96,8 +96,7 @@ TEST(AdaptiveSketch, BadValuesNameTheirPath) {
   EXPECT_EQ(error_of(R"({"steady_rate": -0.1})").rfind("/simulate/adaptive/steady_rate:", 0), 0u);
   EXPECT_EQ(error_of(R"({"enabled": 1})").rfind("/simulate/adaptive/enabled:", 0), 0u);
   EXPECT_EQ(error_of(R"({"even_levels": "yes"})").rfind("/simulate/adaptive/even_levels:", 0), 0u);
-  EXPECT_EQ(error_of(R"({"target_levels": 1})").rfind("/simulate/adaptive/target_levels:", 0),
-            0u);
+  EXPECT_EQ(error_of(R"({"target_levels": 1})").rfind("/simulate/adaptive/target_levels:", 0), 0u);
   EXPECT_EQ(error_of(R"({"lookahead": -0.1})").rfind("/simulate/adaptive/lookahead:", 0), 0u);
   EXPECT_EQ(error_of(R"({"lookahead": 1})")
                 .rfind("/simulate/adaptive/lookahead: a refinement lookahead of 1 s is outside", 0),
