@@ -410,6 +410,22 @@ void set_diamonds(ClothModel& model, const ClothInput& input, const Neighbours& 
   model.lone_triangles.clear();
   if (!options.diamond_membrane) return;
   model.diamonds = make_diamonds(input.rest_positions, model.triangles, input.rest_uv.rows() > 0);
+  // Only diamonds whose half-diagonal a is at most half the fabric's bending length
+  // c = (B/ρg)^⅓. The map cannot tell the centre's own dimple from a bend at 45° to the diagonals
+  // (both leave the four corners in one plane above the centre), so where it lifts the centre the
+  // membrane no longer holds the centre's normal position and only the bending does: under its
+  // weight the centre sinks by about (a/c)³ of a cell (over the bending's constant). On 6-8 cm
+  // cells (a/c ≈ 3-4) a hanging sheet's centres fell through it; at a = 0.8c the 32-cell sheet of
+  // Simulation.ResolutionInvariance sagged 4.6 cm against 2.7-3.1 cm (docs/simulator.md, "The
+  // diamond membrane"). The cantilever strips (a ≤ c/4) and the Cusick discs (0.4c) keep theirs.
+  if (model.fabric.bend > 0.0 && model.fabric.area_density > 0.0) {
+    const double c = std::cbrt(model.fabric.bend / (model.fabric.area_density * 9.81));
+    std::erase_if(model.diamonds, [c](const DiamondElement& d) {
+      return std::sqrt(d.regularisation) > 0.01 * 0.5 * c;  // ε = 0.01·a
+    });
+  } else {
+    model.diamonds.clear();
+  }
   std::vector<char> in_diamond(model.triangles.size(), 0);
   for (DiamondElement& d : model.diamonds) {
     for (int f : d.triangles) in_diamond[static_cast<std::size_t>(f)] = 1;

@@ -1,5 +1,6 @@
 #include "sim/forces.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
@@ -806,14 +807,33 @@ void add_elements(int count, int vertex_count, const Element& element, const Con
   }
 }
 
+// The map's curvature Σ_i f_c,i·∇²g_i (f_c the force on the mapped centre) as the implicit solve
+// keeps it: its negative semi-definite part (the eigenvalues above zero, which soften, dropped),
+// so the solve matrix stays symmetric negative semi-definite. Near flat it is of order
+// |f_c|/ε; left out, a hanging sheet's step is explicit in it (docs/simulator.md, "The diamond
+// membrane").
+Eigen::Matrix<double, 15, 15> solve_curvature(const DiamondElement& d,
+                                              const Eigen::Matrix<double, 15, 1>& x,
+                                              const Vector3d& f_centre) {
+  using Matrix15 = Eigen::Matrix<double, 15, 15>;
+  DiamondMap full;
+  diamond_centre_map(d, x, true, full);
+  Matrix15 c = Matrix15::Zero();
+  for (int i = 0; i < 3; ++i) c += f_centre(i) * full.hessian[static_cast<std::size_t>(i)];
+  const Matrix15 symmetric = 0.5 * (c + c.transpose());
+  const Eigen::SelfAdjointEigenSolver<Matrix15> eig(symmetric);
+  const Eigen::Matrix<double, 15, 1> lambda = eig.eigenvalues().cwiseMin(0.0);
+  return eig.eigenvectors() * lambda.asDiagonal() * eig.eigenvectors().transpose();
+}
+
 // The membrane of the diamonds (ClothModel::diamonds, docs/simulator.md "The diamond membrane"):
 // each of a diamond's four triangles is evaluated by triangle_membrane at the mapped positions
 // y = (x_c + g(x), x_1 … x_4) with the velocities J·v, J = ∂y/∂x = I + E_c·G (G = ∂g/∂x in the
 // centre's rows). The energy is the triangles' at y; the force Jᵀ·f(y); the solve's matrix
-// Jᵀ·(dfdx_scale·K + dfdv_scale·D)·J and product Jᵀ·K·J·u, K and D the triangles' own at y. The
-// exact Jacobian adds the map's curvature Σ_i f_c,i·∇²g_i (f_c the force on the mapped centre)
-// and the damping's dependence on x through J·v; the solve leaves both out (the first is
-// indefinite and vanishes on flat cloth, the second is the damping's ∂/∂x, dropped everywhere).
+// Jᵀ·(dfdx_scale·K + dfdv_scale·D)·J and product Jᵀ·K·J·u, K and D the triangles' own at y, plus
+// the negative semi-definite part of the map's curvature Σ_i f_c,i·∇²g_i (solve_curvature). The
+// exact Jacobian adds the whole curvature and the damping's dependence on x through J·v, which
+// the solve leaves out (the damping's ∂/∂x, dropped for every element).
 void add_diamonds(const ClothModel& model, const ForceTerms& terms, double damping_scale,
                   const Eigen::VectorXd& x, const Eigen::VectorXd& v, Eigen::VectorXd& force,
                   EnergyBreakdown& energy, const JacobianTarget* jacobian) {
@@ -923,8 +943,10 @@ void add_diamonds(const ClothModel& model, const ForceTerms& terms, double dampi
       return m + g.transpose() * m.topRows<3>();
     };
     if (!exact) {
-      if (want_product) total.product = product + g.transpose() * product.head<3>();
-      if (want_matrix) total.matrix = pull_back(times_j(matrix));
+      const Matrix15 stiff = solve_curvature(d, local_x, f_centre);
+      if (want_product)
+        total.product = product + g.transpose() * product.head<3>() + stiff * local_u;
+      if (want_matrix) total.matrix = pull_back(times_j(matrix)) + jacobian->dfdx_scale * stiff;
       return;
     }
     Matrix15 dfdx = pull_back(times_j(matrix));
