@@ -11,58 +11,107 @@ namespace sd::sim {
 
 namespace {
 
-// Whether `a` is made of 3x3 blocks as the cloth's matrices are: the three rows of a vertex hold
-// the same columns, in runs of three starting at a multiple of three (one pass over the indices).
-bool has_vertex_blocks(const SparseMatrixR& a) {
-  if (a.rows() % 3 != 0 || a.cols() != a.rows() || !a.isCompressed()) return false;
-  const int* outer = a.outerIndexPtr();
-  const int* inner = a.innerIndexPtr();
-  for (Eigen::Index i = 0; i < a.rows() / 3; ++i) {
-    const int begin = outer[3 * i];
-    const int width = outer[3 * i + 1] - begin;
-    if (width % 3 != 0 || outer[3 * i + 2] - outer[3 * i + 1] != width ||
-        outer[3 * i + 3] - outer[3 * i + 2] != width)
-      return false;
-    for (int k = 0; k < width; k += 3) {
-      const int column = inner[begin + k];
-      if (column % 3 != 0) return false;
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c)
-          if (inner[begin + r * width + k + c] != column + c) return false;
-    }
-  }
-  return true;
-}
-
 // Vertices per chunk of the threaded product: a 32×32 sheet's 1,089 vertices make 4 chunks of
 // about 60 µs of work each, well above oneTBB's cost of handing one out.
 constexpr int kProductGrain = 256;
 
-// y = A x for a matrix of vertex blocks (has_vertex_blocks): one column index and one load of
-// x's three entries per block for the three rows, where the scalar product reads them three
-// times. The PCG's products are about a third of a sheet's solve (docs/benchmarks.md). The rows
-// are cut into chunks on the threads; each row is summed the same way on any thread count.
-void multiply_vertex_blocks(const SparseMatrixR& a, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+// Whether a 3×3 block, its rows `stride` apart in `values`, is c·I (off-diagonals exactly zero,
+// the diagonal three equal numbers).
+bool is_scaled_identity(const double* values, int stride) {
+  const double* r1 = values + stride;
+  const double* r2 = r1 + stride;
+  return values[1] == 0.0 && values[2] == 0.0 && r1[0] == 0.0 && r1[2] == 0.0 && r2[0] == 0.0 &&
+         r2[1] == 0.0 && r1[1] == values[0] && r2[2] == values[0];
+}
+
+}  // namespace
+
+bool VertexBlockMatrix::build(const SparseMatrixR& a) {
+  vertices_ = 0;
+  if (a.rows() % 3 != 0 || a.cols() != a.rows() || !a.isCompressed()) return false;
+  const int n = static_cast<int>(a.rows() / 3);
   const int* outer = a.outerIndexPtr();
   const int* inner = a.innerIndexPtr();
   const double* values = a.valuePtr();
-  const double* in = x.data();
-  y.resize(a.rows());
-  double* out = y.data();
-  parallel_chunks(static_cast<int>(a.rows() / 3), kProductGrain, [&](int, int low, int high) {
+  chunks_.resize(static_cast<std::size_t>(chunk_count(n, kProductGrain)));
+  std::vector<char> valid(chunks_.size(), 1);
+  parallel_chunks(n, kProductGrain, [&](int c, int low, int high) {
+    Chunk& chunk = chunks_[static_cast<std::size_t>(c)];
+    chunk.block_start.assign(1, 0);
+    chunk.column.clear();
+    chunk.values.clear();
     for (int i = low; i < high; ++i) {
+      // The three rows of a vertex hold the same columns, in runs of three from a multiple of
+      // three: the structure the product relies on.
       const int begin = outer[3 * i];
       const int width = outer[3 * i + 1] - begin;
-      const double* row0 = values + begin;
-      const double* row1 = row0 + width;
-      const double* row2 = row1 + width;
-      double sum0 = 0.0, sum1 = 0.0, sum2 = 0.0;
+      if (width % 3 != 0 || outer[3 * i + 2] - outer[3 * i + 1] != width ||
+          outer[3 * i + 3] - outer[3 * i + 2] != width) {
+        valid[static_cast<std::size_t>(c)] = 0;
+        return;
+      }
       for (int k = 0; k < width; k += 3) {
-        const double* xj = in + inner[begin + k];
-        const double x0 = xj[0], x1 = xj[1], x2 = xj[2];
-        sum0 += row0[k] * x0 + row0[k + 1] * x1 + row0[k + 2] * x2;
-        sum1 += row1[k] * x0 + row1[k + 1] * x1 + row1[k + 2] * x2;
-        sum2 += row2[k] * x0 + row2[k + 1] * x1 + row2[k + 2] * x2;
+        const int column = inner[begin + k];
+        bool block = column % 3 == 0;
+        for (int r = 0; r < 3 && block; ++r)
+          for (int d = 0; d < 3; ++d)
+            block = block && inner[begin + r * width + k + d] == column + d;
+        if (!block) {
+          valid[static_cast<std::size_t>(c)] = 0;
+          return;
+        }
+        const double* entries = values + begin + k;
+        if (is_scaled_identity(entries, width)) {
+          chunk.column.push_back(-column - 1);
+          chunk.values.push_back(entries[0]);
+        } else {
+          chunk.column.push_back(column);
+          for (int r = 0; r < 3; ++r)
+            chunk.values.insert(chunk.values.end(), entries + r * width, entries + r * width + 3);
+        }
+      }
+      chunk.block_start.push_back(static_cast<int>(chunk.column.size()));
+    }
+  });
+  if (std::find(valid.begin(), valid.end(), 0) != valid.end()) return false;
+  vertices_ = n;
+  return true;
+}
+
+int VertexBlockMatrix::scaled_identity_blocks() const {
+  int count = 0;
+  for (const Chunk& chunk : chunks_)
+    count += static_cast<int>(std::count_if(chunk.column.begin(), chunk.column.end(),
+                                            [](int column) { return column < 0; }));
+  return count;
+}
+
+void VertexBlockMatrix::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+  const double* in = x.data();
+  y.resize(3 * vertices_);
+  double* out = y.data();
+  parallel_chunks(vertices_, kProductGrain, [&](int c, int low, int high) {
+    const Chunk& chunk = chunks_[static_cast<std::size_t>(c)];
+    const int* column = chunk.column.data();
+    const double* v = chunk.values.data();
+    for (int i = low; i < high; ++i) {
+      double sum0 = 0.0, sum1 = 0.0, sum2 = 0.0;
+      for (int b = chunk.block_start[i - low]; b < chunk.block_start[i - low + 1]; ++b) {
+        if (column[b] < 0) {
+          // c·I: the nine-entry sums below with six exact zeros, so the same numbers.
+          const double* xj = in - column[b] - 1;
+          const double scale = *v++;
+          sum0 += scale * xj[0];
+          sum1 += scale * xj[1];
+          sum2 += scale * xj[2];
+        } else {
+          const double* xj = in + column[b];
+          const double x0 = xj[0], x1 = xj[1], x2 = xj[2];
+          sum0 += v[0] * x0 + v[1] * x1 + v[2] * x2;
+          sum1 += v[3] * x0 + v[4] * x1 + v[5] * x2;
+          sum2 += v[6] * x0 + v[7] * x1 + v[8] * x2;
+          v += 9;
+        }
       }
       out[3 * i] = sum0;
       out[3 * i + 1] = sum1;
@@ -70,8 +119,6 @@ void multiply_vertex_blocks(const SparseMatrixR& a, const Eigen::VectorXd& x, Ei
     }
   });
 }
-
-}  // namespace
 
 bool BlockIncompleteCholesky::factorize(const SparseMatrixR& a,
                                         const std::vector<int>& diagonal_offsets,
@@ -234,10 +281,10 @@ LinearSolveStats PcgSolver::solve(const SparseMatrixR& a, const std::vector<int>
   }
   const bool incomplete = incomplete_ready_;
   const bool coarse = coarse_ready_;
-  const bool blocks = has_vertex_blocks(a);
+  const bool blocks = product_.build(a);
   const auto multiply = [&](const Eigen::VectorXd& x, Eigen::VectorXd& y) {
     if (blocks)
-      multiply_vertex_blocks(a, x, y);
+      product_.multiply(x, y);
     else
       y.noalias() = a * x;
   };

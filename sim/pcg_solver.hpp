@@ -68,6 +68,34 @@ class BlockIncompleteCholesky {
   double shift_ = 0.0;
 };
 
+// A's 3×3 vertex blocks as the PCG's products read them. The three rows of a vertex hold the
+// same block columns, so one column index and one load of x's three entries serve the three
+// rows; and a block that is c·I (on a sheet, the flat bends' couplings of a vertex with the
+// second ring of its neighbours: about two thirds of the blocks) is kept as the one number c.
+// The product is then the same numbers as the scalar rows' (the six zeros add nothing) from
+// about a third of the bytes (docs/benchmarks.md, "Eleventh round"). Rows are cut into chunks
+// on the threads, each row summed the same way on any thread count.
+class VertexBlockMatrix {
+ public:
+  // False when `a` is not made of vertex blocks (then multiply must not be called).
+  bool build(const SparseMatrixR& a);
+  // y = A x, 3n.
+  void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
+  // Blocks kept as one number (for tests and benchmarks).
+  int scaled_identity_blocks() const;
+
+ private:
+  // One chunk of the product's rows (parallel_chunks' chunks): vertex low + r's blocks are
+  // [block_start[r], block_start[r+1]); column 3j for a full block (nine values, row by row),
+  // −3j − 1 for c·I (one value), values in block order.
+  struct Chunk {
+    std::vector<int> block_start, column;
+    std::vector<double> values;
+  };
+  std::vector<Chunk> chunks_;
+  int vertices_ = 0;
+};
+
 // Baraff & Witkin's modified preconditioned conjugate gradient: the iterates stay in the
 // filtered subspace, so constrained directions never change. Stops when the preconditioned
 // residual norm has dropped by `tolerance` relative to the start, or after `max_iterations`.
@@ -97,6 +125,7 @@ class PcgSolver {
   Eigen::VectorXd r_, c_, q_, t_;
   Eigen::VectorXd cycle_residual_, cycle_product_, cycle_coarse_;  // the two-level cycle's
   std::vector<Eigen::Matrix3d> inverse_blocks_;
+  VertexBlockMatrix product_;
   BlockIncompleteCholesky incomplete_;
   CoarseCorrection coarse_;
 };
