@@ -490,6 +490,16 @@ Body load_body(const std::string& path, const BodyOptions& options) {
   // Facing follows the common convention of the up axis: Z-up files (Blender) face -Y,
   // Y-up files (glTF, OBJ) face +Z, X-up files face +Z.
   raw.facing = raw.up.axis == 2 ? AxisDirection{1, -raw.up.sign} : AxisDirection{2, 1};
+  if (options.facing) {
+    // Given (trial 37: a T-posed figure stood up with "up" then faced sideways, its arms along
+    // the depth, and had no landmarks): across the up axis, or there is no such rotation.
+    if (options.facing->axis == raw.up.axis)
+      throw BodyFacingError(fmt::format(
+          "\"facing\": \"{}\" runs along the up axis {}: a figure faces across its up axis; "
+          "give one of the other two axes",
+          options.facing->name(), raw.up.name()));
+    raw.facing = *options.facing;
+  }
   raw.height = extent[raw.up.axis];
   if (!(raw.height > 0)) throw BodyError("body file '" + file + "' is flat along its up axis");
 
@@ -538,6 +548,15 @@ Body load_body(const std::string& path, const BodyOptions& options) {
         "the body would be {:.4g} m tall ({:.4g} file units at {:.4g} m per unit), outside {} .. "
         "{} m: give a 'height' or a 'scale' that makes it a body's size",
         height_m, raw.height, raw.scale, kMinBodyHeight, kMaxBodyHeight));
+  // Taller than any person: accepted (a scene's obstacle may be anything up to 5 m), but a
+  // garment's body this tall is a unit mistake (trial 37: "scale": 0.0254 on a file in cm made a
+  // 4.37 m figure, and the error came later as a curve that misses the body).
+  if (height_m > kTallestPerson)
+    body.warnings.push_back(fmt::format(
+        "the body is {:.2f} m tall ({:.4g} file units at {:.4g} m per unit), taller than any "
+        "person: if it is a figure, check its \"scale\" (0.01 for a file in centimetres, "
+        "0.001 in millimetres, 0.0254 in inches) or give its \"height\"",
+        height_m, raw.height, raw.scale));
   const Eigen::Matrix3d rotation = frame_rotation(raw.up, raw.facing);
   mesh.vertices = (mesh.vertices * rotation.transpose()) * raw.scale;
   const meshing::BoundingBox box = meshing::bounding_box(mesh);

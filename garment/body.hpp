@@ -29,8 +29,10 @@ struct AxisDirection {
 
 struct BodyOptions {
   std::optional<AxisDirection> up;  // the file's up axis; inferred when empty
-  std::optional<double> scale;      // file units → metres; inferred when empty
-  std::optional<double> height;     // target height in metres; wins over scale
+  // The way the figure faces in the file, across `up`; by the up axis's convention when empty.
+  std::optional<AxisDirection> facing;
+  std::optional<double> scale;   // file units → metres; inferred when empty
+  std::optional<double> height;  // target height in metres; wins over scale
 };
 
 // What the file held before normalisation, and what was done to it.

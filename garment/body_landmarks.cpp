@@ -291,6 +291,51 @@ const Landmark& BodyLandmarks::nearest(const Eigen::Vector3d& p) const {
   return *best;
 }
 
+namespace {
+
+// What a standing human figure's landmarks cannot be, with margins far outside people's range
+// (standard proportions: hips ~0.53, waist ~0.63, chest ~0.72, neck base ~0.82 of the height;
+// hips and chest ~15-30 % more girth than the waist): each a sentence. Trial 37's low-polygon
+// man (an MDL file) had chest, waist and hips all 1.088 m round at two heights, the neck's base
+// level with the armpits and the shoulders at the top of the head.
+std::vector<std::string> proportion_doubts(const BodyLandmarks& l, double height) {
+  std::vector<std::string> doubts;
+  const double y_waist = l.find("waist")->position.y(), y_hips = l.find("hips")->position.y();
+  const double y_chest = l.find("chest")->position.y(), y_neck = l.find("neck_base")->position.y();
+  const double y_armpit =
+      std::max(l.find("left_armpit")->position.y(), l.find("right_armpit")->position.y());
+  const double y_shoulder =
+      std::max(l.find("left_shoulder")->position.y(), l.find("right_shoulder")->position.y());
+  if (std::max(l.chest_girth, l.hip_girth) < 1.02 * l.waist_girth)
+    doubts.push_back(fmt::format(
+        "the torso has no waist: chest {:.3f} m, waist {:.3f} m and hips {:.3f} m round (a "
+        "person's chest and hips are 10-40 % more than the waist)",
+        l.chest_girth, l.waist_girth, l.hip_girth));
+  // A person's chest is at most ~1.5 times the waist round; a slice through arms held out level
+  // (a T-pose) takes them in: trial 37's IQM figure read a 4.76 m chest over a 1.08 m waist.
+  if (l.chest_girth > 2.0 * l.waist_girth)
+    doubts.push_back(fmt::format(
+        "the chest is {:.3f} m round, more than twice the waist ({:.3f} m): the arms seem held "
+        "out level with it (a T-pose), and the landmarks need arms hanging apart from the torso",
+        l.chest_girth, l.waist_girth));
+  if (y_waist - y_hips < 0.02 * height || y_chest - y_waist < 0.02 * height)
+    doubts.push_back(fmt::format(
+        "hips, waist and chest were found at {:.3f}, {:.3f} and {:.3f} m, less than 2 % of the "
+        "height apart",
+        y_hips, y_waist, y_chest));
+  if (y_neck - y_armpit < 0.02 * height)
+    doubts.push_back(fmt::format("the neck's base ({:.3f} m) is level with the armpits ({:.3f} m)",
+                                 y_neck, y_armpit));
+  if (y_shoulder > y_neck + 0.06 * height)
+    doubts.push_back(fmt::format(
+        "the shoulder points ({:.3f} m) are far above the neck's base ({:.3f} m): the figure's "
+        "arms may be raised, or the head taken for a shoulder",
+        y_shoulder, y_neck));
+  return doubts;
+}
+
+}  // namespace
+
 BodyLandmarks find_landmarks(const meshing::TriMesh& body) {
   if (body.vertex_count() == 0) throw std::runtime_error("the body has no vertices");
   const double height = body.vertices.col(1).maxCoeff();
@@ -465,6 +510,7 @@ BodyLandmarks find_landmarks(const meshing::TriMesh& body) {
   std::vector<Landmark> ordered;
   for (const std::string& name : landmark_names()) ordered.push_back(*out.find(name));
   out.points = std::move(ordered);
+  out.doubts = proportion_doubts(out, height);
   return out;
 }
 

@@ -25,6 +25,10 @@ struct BodyLandmarks {
   double chest_girth = 0.0;      // m, around the torso's convex hull (a tape measure's path)
   double waist_girth = 0.0;
   double hip_girth = 0.0;
+  // Sentences saying which landmarks break a human figure's proportions (a low-polygon figure
+  // whose torso is a box, shoulders found at the top of the head): found, but not to be
+  // trusted. Empty for the built-in body and the Collada human.
+  std::vector<std::string> doubts;
 
   // nullptr when there is no landmark of that name.
   const Landmark* find(std::string_view name) const;

@@ -138,6 +138,7 @@ struct BodySpec {
   std::optional<double> height;          // metres
   std::optional<double> scale;           // metres per file unit
   std::optional<std::string> up;         // "+z", "y", ...
+  std::optional<std::string> facing;     // the way the figure faces in the file; by convention
   std::optional<BodyMotionSpec> motion;  // a still body when absent
 };
 

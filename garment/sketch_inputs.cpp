@@ -25,9 +25,12 @@ Body load_sketch_body(const GarmentRequest& sketch) {
       sketch.body.mesh == "builtin" ? "builtin" : sketch.resolve(sketch.body.mesh).string();
   try {
     if (sketch.body.up) options.up = AxisDirection::parse(*sketch.body.up);
+    if (sketch.body.facing) options.facing = AxisDirection::parse(*sketch.body.facing);
     return load_body(path, options);
   } catch (const BodyUpError& e) {
     sketch.fail("/body/up", e.what());
+  } catch (const BodyFacingError& e) {
+    sketch.fail("/body/facing", e.what());
   } catch (const BodyError& e) {
     sketch.fail("/body/mesh",
                 fmt::format("the body '{}' cannot be used: {}", sketch.body.mesh, e.what()));

@@ -21,6 +21,7 @@ inline constexpr double kMaxCoordinate = 100.0;       // m: any point, camera or
 inline constexpr double kMaxSheetSide = 100.0;        // m: a sheet's width or height
 inline constexpr double kMinBodyHeight = 0.1;         // m: body.height, and a body after scaling
 inline constexpr double kMaxBodyHeight = 5.0;         // m
+inline constexpr double kTallestPerson = 2.5;         // m: a body taller than this is warned of
 inline constexpr double kMaxJunctionTolerance = 0.2;  // m
 inline constexpr int kMaxCurves = 1000;
 inline constexpr int kMaxPanels = 1000;

@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -375,38 +376,34 @@ Mesh48Remap Mesh48::compact() {
   };
   const auto map_b = [&](BlockId k) { return k.valid() ? BlockId(remap.blocks[k.value()]) : k; };
 
-  std::vector<Vertex> vertices(static_cast<std::size_t>(remap.vertex_count));
-  for (std::size_t i = 0; i < vertices_.size(); ++i) {
-    if (!vertices_[i].alive) continue;
-    Vertex v = vertices_[i];
+  // Each live slot moved to its rank, its references renamed by `rename`.
+  const auto pack = [](auto& slots, const std::vector<int>& map, int count, auto rename) {
+    std::remove_reference_t<decltype(slots)> packed(static_cast<std::size_t>(count));
+    for (std::size_t i = 0; i < slots.size(); ++i) {
+      if (!slots[i].alive) continue;
+      auto item = slots[i];
+      rename(item);
+      packed[map[i]] = item;
+    }
+    slots = std::move(packed);
+  };
+  pack(vertices_, remap.vertices, remap.vertex_count, [&](Vertex& v) {
     v.parent = map_b(v.parent);
     v.triangle = map_t(v.triangle);
-    vertices[remap.vertices[i]] = v;
-  }
-  std::vector<Triangle> triangles(static_cast<std::size_t>(remap.triangle_count));
-  for (std::size_t i = 0; i < triangles_.size(); ++i) {
-    if (!triangles_[i].alive) continue;
-    Triangle t = triangles_[i];
+  });
+  pack(triangles_, remap.triangles, remap.triangle_count, [&](Triangle& t) {
     for (auto& v : t.v) v = map_v(v);
     for (auto& n : t.adj) n = map_t(n);
     t.block = map_b(t.block);
-    triangles[remap.triangles[i]] = t;
-  }
-  std::vector<Block> blocks(static_cast<std::size_t>(remap.block_count));
-  for (std::size_t i = 0; i < blocks_.size(); ++i) {
-    if (!blocks_[i].alive) continue;
-    Block k = blocks_[i];
+  });
+  pack(blocks_, remap.blocks, remap.block_count, [&](Block& k) {
     for (auto& v : k.diagonal) v = map_v(v);
     for (auto& v : k.apex) v = map_v(v);
     for (auto& t : k.tri) t = map_t(t);
     for (auto& p : k.parent) p = map_b(p);
     for (auto& c : k.child) c = map_b(c);
     k.split = map_v(k.split);
-    blocks[remap.blocks[i]] = k;
-  }
-  vertices_ = std::move(vertices);
-  triangles_ = std::move(triangles);
-  blocks_ = std::move(blocks);
+  });
   free_vertices_.clear();
   free_triangles_.clear();
   free_blocks_.clear();

@@ -1,6 +1,7 @@
 // The garment request's sections of a sketch file: the body, "curves", "panels" and "join".
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
@@ -60,7 +61,7 @@ void parse_body(const Reader& r, const json& j, BodySpec& body) {
     return;
   }
   r.require_object(j, path, "body");
-  r.check_keys(j, path, {"mesh", "height", "up", "scale", "motion"});
+  r.check_keys(j, path, {"mesh", "height", "up", "facing", "scale", "motion"});
   if (j.contains("mesh")) body.mesh = r.text(j["mesh"], path + "/mesh");
   if (body.mesh.empty()) r.fail(path + "/mesh", "the body mesh path is empty");
   if (j.contains("height")) {
@@ -70,14 +71,17 @@ void parse_body(const Reader& r, const json& j, BodySpec& body) {
                                                      "a body height of", kUsualBodyHeight));
   }
   if (j.contains("scale")) body.scale = r.positive(j["scale"], path + "/scale");
-  if (j.contains("up")) {
-    const std::string up = r.text(j["up"], path + "/up");
-    static const std::set<std::string> kAxes = {"x", "y", "z", "+x", "+y", "+z", "-x", "-y", "-z",
-                                                "X", "Y", "Z", "+X", "+Y", "+Z", "-X", "-Y", "-Z"};
-    if (!kAxes.contains(up))
-      r.fail(path + "/up", fmt::format("'{}' is not an axis; use +x, -x, +y, -y, +z or -z", up));
-    body.up = up;
-  }
+  static const std::set<std::string> kAxes = {"x", "y", "z", "+x", "+y", "+z", "-x", "-y", "-z",
+                                              "X", "Y", "Z", "+X", "+Y", "+Z", "-X", "-Y", "-Z"};
+  const auto axis = [&](const char* key) {
+    const std::string text = r.text(j[key], path + "/" + key);
+    if (!kAxes.contains(text))
+      r.fail(path + "/" + key,
+             fmt::format("'{}' is not an axis; use +x, -x, +y, -y, +z or -z", text));
+    return text;
+  };
+  if (j.contains("up")) body.up = axis("up");
+  if (j.contains("facing")) body.facing = axis("facing");
   if (j.contains("motion")) {
     const std::string mpath = path + "/motion";
     const json& m = j["motion"];
@@ -117,13 +121,19 @@ const BodyLandmarks& sketch_landmarks(const Reader& r, const Sketch& sk, const s
   static std::mutex mutex;
   static std::map<std::string, BodyLandmarks> cache;
   const std::string key =
-      fmt::format("{}|{}|{}|{}", sk.resolve(sk.body.mesh).string(), sk.body.height.value_or(0),
-                  sk.body.scale.value_or(0), sk.body.up.value_or(""));
+      fmt::format("{}|{}|{}|{}|{}", sk.resolve(sk.body.mesh).string(), sk.body.height.value_or(0),
+                  sk.body.scale.value_or(0), sk.body.up.value_or(""), sk.body.facing.value_or(""));
   const std::lock_guard lock(mutex);
   if (const auto it = cache.find(key); it != cache.end()) return it->second;
   const Body body = load_sketch_body(sk);
   try {
-    return cache.emplace(key, find_landmarks(body.mesh)).first->second;
+    const BodyLandmarks& landmarks = cache.emplace(key, find_landmarks(body.mesh)).first->second;
+    for (const std::string& doubt : landmarks.doubts)
+      spdlog::warn(
+          "{}: points are given relative to the body's landmarks, but they look wrong: {}; the "
+          "points may land elsewhere than meant (`sketchdrape info` lists the landmarks)",
+          sk.resolve(sk.body.mesh).string(), doubt);
+    return landmarks;
   } catch (const std::runtime_error& e) {
     r.fail(path, fmt::format("a point is given relative to a landmark, but the body has none: {}",
                              e.what()));

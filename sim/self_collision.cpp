@@ -566,19 +566,9 @@ std::vector<SelfPair> SelfCollider::find_proximities(const Eigen::VectorXd& x, d
     out.push_back(pair);
   };
   const auto leaf = [&](int ta, int tb, std::vector<SelfPair>& out, long long& tests) {
-    for (int k = 0; k < 3; ++k) {
-      const int va = triangles_[ta][k], vb = triangles_[tb][k];
-      if (vertex_owner_[va] == ta) vertex_face(va, tb, out, tests);
-      if (vertex_owner_[vb] == tb) vertex_face(vb, ta, out, tests);
-    }
-    for (int i = 0; i < 3; ++i) {
-      const int e = triangle_edges_[ta][i];
-      if (edge_owner_[e] != ta) continue;
-      for (int j = 0; j < 3; ++j) {
-        const int g = triangle_edges_[tb][j];
-        if (edge_owner_[g] == tb) edge_edge(e, g, out, tests);
-      }
-    }
+    for_each_owned_element_pair(
+        ta, tb, [&](int v, int t) { vertex_face(v, t, out, tests); },
+        [&](int e, int g) { edge_edge(e, g, out, tests); });
   };
   std::vector<std::array<int, 2>> leaves;
   collect_leaves(x, x, leaves, s);
@@ -647,19 +637,9 @@ std::vector<SelfPair> SelfCollider::find_collisions(const Eigen::VectorXd& x0,
       out.push_back(hit);
   };
   const auto leaf = [&](int ta, int tb, std::vector<SelfPair>& out, long long& tests) {
-    for (int k = 0; k < 3; ++k) {
-      const int va = triangles_[ta][k], vb = triangles_[tb][k];
-      if (vertex_owner_[va] == ta) vertex_face(va, tb, out, tests);
-      if (vertex_owner_[vb] == tb) vertex_face(vb, ta, out, tests);
-    }
-    for (int i = 0; i < 3; ++i) {
-      const int e = triangle_edges_[ta][i];
-      if (edge_owner_[e] != ta) continue;
-      for (int j = 0; j < 3; ++j) {
-        const int g = triangle_edges_[tb][j];
-        if (edge_owner_[g] == tb) edge_edge(e, g, out, tests);
-      }
-    }
+    for_each_owned_element_pair(
+        ta, tb, [&](int v, int t) { vertex_face(v, t, out, tests); },
+        [&](int e, int g) { edge_edge(e, g, out, tests); });
   };
   std::vector<std::array<int, 2>> leaves;
   collect_leaves(x0, x1, leaves, s);

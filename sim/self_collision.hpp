@@ -115,6 +115,26 @@ class SelfCollider {
   template <class LeafTest>
   void pair_test(int a, int b, LeafTest& leaf, SelfQueryStats& stats, int depth = 0,
                  std::vector<WalkPiece>* pieces = nullptr);
+  // The element tests of one triangle pair: each vertex against the other triangle and each
+  // edge against the other's edges, each element taken at its owner triangle only, so a pair
+  // shared by neighbouring triangles is tested once.
+  template <class VertexFace, class EdgeEdge>
+  void for_each_owned_element_pair(int ta, int tb, VertexFace&& vertex_face,
+                                   EdgeEdge&& edge_edge) const {
+    for (int k = 0; k < 3; ++k) {
+      const int va = triangles_[ta][k], vb = triangles_[tb][k];
+      if (vertex_owner_[va] == ta) vertex_face(va, tb);
+      if (vertex_owner_[vb] == tb) vertex_face(vb, ta);
+    }
+    for (int i = 0; i < 3; ++i) {
+      const int e = triangle_edges_[ta][i];
+      if (edge_owner_[e] != ta) continue;
+      for (int j = 0; j < 3; ++j) {
+        const int g = triangle_edges_[tb][j];
+        if (edge_owner_[g] == tb) edge_edge(e, g);
+      }
+    }
+  }
   // What self_test(0, ...) reaches, in its order: the triangle pairs (appended to `leaves`)
   // and the counts. The top levels are walked here; the pieces below them (subtrees and node
   // pairs) run on the threads and are joined in traversal order.

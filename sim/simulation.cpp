@@ -583,9 +583,11 @@ void Simulation::accept(Attempt& attempt, double h) {
   if (still) {
     rest_time_ += h;
     report_.rest_drift = drift;
+    report_.rest_still_time = rest_time_;
   } else {
     rest_anchor_ = x_;
     rest_time_ = 0.0;
+    report_.rest_still_time = 0.0;
     // Not in a still stretch: there is no drift to give (NaN, "null" in report.json), not 0,
     // which read as perfectly still next to a final speed of 9 cm/s.
     report_.rest_drift = std::numeric_limits<double>::quiet_NaN();

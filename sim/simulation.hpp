@@ -207,6 +207,9 @@ struct SimulationReport {
   // m: the largest displacement of a vertex since the current still stretch began (the whole
   // run's still steps when at rest), the figure the at-rest test bounds by rest_speed·rest_window.
   double rest_drift = 0.0;
+  // s: how long the current still stretch has lasted (at rest needs rest_window of it); 0 when
+  // the last step was not still.
+  double rest_still_time = 0.0;
   // Self-contact (zero when off; sim/self_contact.hpp).
   int self_intersections_start = 0;  // intersecting triangle pairs of the start
   int self_untangled_vertices = 0;   // vertices the start's untangling moved

@@ -389,13 +389,15 @@ TEST(BenchTextile, DenimCantileverAndDrapeAreWrittenWithTheirMeasures) {
 }
 
 // `--fabric` also takes a fabric file (docs/fabrics.md): a copy of the denim preset with half its
-// bending rigidity measures as such (c = (B/ρg)^(1/3) is 2^(-1/3) of denim's), named by its path;
+// bending rigidity measures as such (c = (B/ρg)^(1/3) is 2^(-1/3) of denim's), named by its
+// "name" and path;
 // a file that is not a valid fabric exits 2 with the file's error and writes nothing.
 TEST(BenchTextile, FabricFilesAreMeasuredLikePresets) {
   const fs::path dir = fresh_dir("textile-file");
   fs::create_directories(dir);
   nlohmann::json denim = read_json(fs::path(SD_SOURCE_DIR) / "data/fabrics/denim.json");
   denim["bend"]["value"] = 0.5 * denim["bend"]["value"].get<double>();
+  denim["name"] = "soft-denim";
   const fs::path soft = dir / "soft-denim.json";
   std::ofstream(soft) << denim.dump(1);
   const auto result = run_sketchdrape("bench --textile --fabric " + soft.string() +
@@ -406,7 +408,8 @@ TEST(BenchTextile, FabricFilesAreMeasuredLikePresets) {
   const nlohmann::json json = read_json(dir / "out" / "textile.json");
   ASSERT_EQ(json.at("cantilever").size(), 1u);
   const auto& strip = json.at("cantilever").at(0);
-  EXPECT_EQ(strip.at("fabric").get<std::string>(), soft.string());
+  // Named by the file's own "name", the file after it (trial 37).
+  EXPECT_EQ(strip.at("fabric").get<std::string>(), "soft-denim (" + soft.string() + ")");
   EXPECT_NEAR(strip.at("predicted_c_m").get<double>(), 0.02924 * std::cbrt(0.5), 2e-4);
   EXPECT_NEAR(strip.at("chord_deg").get<double>(), 41.5, 4.0);  // 8 cells: 42.8° for the presets
   nlohmann::json broken = denim;

@@ -122,6 +122,18 @@ TEST(Cli, InfoSliceNamesEachOutlinesPart) {
   EXPECT_NE(text.output.find("  left leg "), std::string::npos) << text.output;
 }
 
+// A slice height that is not a number or misses the figure is a usage mistake (exit 2 with a
+// sentence), not an empty answer: the built-in body spans 0 .. 1.75 m.
+TEST(Cli, InfoSliceOutsideTheBodyOrNotANumberExitsTwo) {
+  for (const char* height : {"nan", "99", "-5"}) {
+    const CommandResult r = run_sketchdrape(std::string("info builtin --slice ") + height);
+    EXPECT_EQ(r.exit_code, 2) << height << ": " << r.output;
+    EXPECT_NE(r.output.find("error:"), std::string::npos) << r.output;
+  }
+  const CommandResult above = run_sketchdrape("info builtin --slice 99");
+  EXPECT_NE(above.output.find("outside the body"), std::string::npos) << above.output;
+}
+
 TEST(Cli, InfoOnMissingFileExitsTwoWithSentence) {
   const CommandResult r = run_sketchdrape("info /nonexistent/body.obj");
   EXPECT_EQ(r.exit_code, 2);

@@ -48,6 +48,7 @@ void expect_plausible(const BodyLandmarks& l, double height) {
   EXPECT_LT(l.waist_girth, l.hip_girth);
   EXPECT_GT(l.waist_girth, 0.3 * height);
   EXPECT_LT(l.hip_girth, 0.8 * height);
+  EXPECT_TRUE(l.doubts.empty()) << l.doubts.front();
 }
 
 TEST(BodyLandmarks, BuiltinBody) {
@@ -122,6 +123,20 @@ TEST(BodyLandmarks, ColladaHumanInMetres) {
   };
   EXPECT_LT(arm_girth(wrist.y()), arm_girth(wrist.y() + 0.05));
   EXPECT_LT(arm_girth(wrist.y()), arm_girth(wrist.y() - 0.025));
+}
+
+// A figure whose landmarks break human proportions is flagged (trial 37: Debian's low-polygon
+// Half-Life man has chest, waist and hips of one girth, the neck's base level with the armpits
+// and the shoulders at the top of the head); the two human bodies are not (expect_plausible
+// above checks they have no doubts).
+TEST(BodyLandmarks, AFigureOutOfHumanProportionIsDoubted) {
+  const std::filesystem::path file = "/usr/share/assimp/models/MDL/MDL (HL1)/man.mdl";
+  if (!std::filesystem::exists(file)) GTEST_SKIP() << "assimp-testmodels' man.mdl is not installed";
+  const BodyLandmarks l = find_landmarks(load_body(file.string()).mesh);
+  ASSERT_FALSE(l.doubts.empty());
+  std::string all;
+  for (const std::string& d : l.doubts) all += d + "\n";
+  EXPECT_NE(all.find("the torso has no waist"), std::string::npos) << all;
 }
 
 TEST(BodyLandmarks, ASphereHasNone) {

@@ -76,6 +76,24 @@ TEST(Body, BuiltinFacesPlusZ) {
   EXPECT_LT(std::abs(chin.first - throat.first), 0.01);  // -z: back of the neck
 }
 
+// "facing" turns the figure about its up axis (trial 37: a T-posed file facing +x had its arms
+// along the depth and no landmarks). The built-in body faces -y in its Z-up file: given that,
+// nothing changes; given +x, the figure turns a quarter: its arm span, along x before, runs
+// along z; along the up axis it is refused.
+TEST(Body, FacingTurnsTheFigureAboutItsUpAxis) {
+  const meshing::BoundingBox as_is = meshing::bounding_box(load_body("builtin").mesh);
+  BodyOptions options;
+  options.facing = AxisDirection::parse("-y");
+  const meshing::BoundingBox same = meshing::bounding_box(load_body("builtin", options).mesh);
+  EXPECT_NEAR((same.extent() - as_is.extent()).norm(), 0.0, 1e-12);
+  options.facing = AxisDirection::parse("+x");
+  const meshing::BoundingBox turned = meshing::bounding_box(load_body("builtin", options).mesh);
+  EXPECT_NEAR(turned.extent().z(), as_is.extent().x(), 1e-9);
+  EXPECT_NEAR(turned.extent().x(), as_is.extent().z(), 1e-9);
+  options.facing = AxisDirection::parse("+z");
+  EXPECT_THROW(load_body("builtin", options), BodyFacingError);
+}
+
 TEST(Body, HeightOptionWins) {
   BodyOptions options;
   options.height = 1.60;
@@ -153,6 +171,17 @@ TEST(Body, UnitsAreInferredFromHeight) {
   const Body in_inches = load_body(write_temp("inches.obj", short_obj), inches);
   EXPECT_NEAR(meshing::bounding_box(in_inches.mesh).extent().y(), 67 * 0.0254, 1e-12);
   EXPECT_TRUE(in_inches.warnings.empty());
+  // Trial 37: a file in centimetres given the scale of inches is a 4.3 m figure: loaded (an
+  // obstacle may be that tall) but warned of with the scales of the common units.
+  const std::string cm_obj =
+      "v 0 0 0\nv 30 0 0\nv 0 170 0\nv 0 0 20\n"
+      "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  const Body giant = load_body(write_temp("cm-as-inches.obj", cm_obj), inches);
+  ASSERT_EQ(giant.warnings.size(), 1u);
+  EXPECT_NE(giant.warnings[0].find("the body is 4.32 m tall (170 file units at 0.0254 m per "
+                                   "unit), taller than any person"),
+            std::string::npos)
+      << giant.warnings[0];
 }
 
 TEST(Body, BadFilesGiveASentence) {

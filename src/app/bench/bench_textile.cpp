@@ -34,11 +34,22 @@ sim::FabricParameters textile_fabric(const std::string& fabric) {
   return is_file ? sim::load_fabric_file(fabric) : sim::fabric_preset(fabric);
 }
 
+namespace {
+
+// A fabric's label in the tables: a preset's name, or a file's fabric by its own "name" with the
+// file after it (trial 37: the table said "crepe-de-chine.json", not the fabric it holds).
+std::string fabric_label(const std::string& asked, const sim::FabricParameters& fabric) {
+  if (fabric.name.empty() || fabric.name == asked || fabric.name == "custom") return asked;
+  return fmt::format("{} ({})", fabric.name, asked);
+}
+
+}  // namespace
+
 CantileverPoint run_cantilever(const std::string& name, int cells) {
   const auto start = Clock::now();
   const sim::FabricParameters fabric = textile_fabric(name);
   CantileverPoint point;
-  point.fabric = name;
+  point.fabric = fabric_label(name, fabric);
   point.cells = cells;
   point.predicted_c = std::cbrt(fabric.bend / (fabric.area_density * 9.81));
   // A strip 4 cells wide, the overhang 2c in `cells` square cells beyond a clamp of three lines
@@ -99,7 +110,7 @@ CusickPoint run_cusick(const std::string& name, int cells, int specimens) {
   settings.duration = 8.0;
   settings.record_energy = false;
   CusickPoint point;
-  point.fabric = name;
+  point.fabric = fabric_label(name, fabric);
   point.cells = cells;
   point.vertices = model.vertex_count;
   point.specimens = specimens;

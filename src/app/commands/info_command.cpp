@@ -5,6 +5,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <stdexcept>
 
 #include "garment/body.hpp"
 #include "garment/body_landmarks.hpp"
@@ -16,6 +17,7 @@ namespace {
 struct InfoOptions {
   std::string body;
   std::string up;
+  std::string facing;
   double height = 0;
   double scale = 0;
   bool json = false;
@@ -30,12 +32,23 @@ nlohmann::json box_json(const meshing::BoundingBox& box) {
 void run_info(const InfoOptions& options) {
   garment::BodyOptions body_options;
   if (!options.up.empty()) body_options.up = garment::AxisDirection::parse(options.up);
+  if (!options.facing.empty()) body_options.facing = garment::AxisDirection::parse(options.facing);
   if (options.height > 0) body_options.height = options.height;
   if (options.scale > 0) body_options.scale = options.scale;
   const garment::Body body = garment::load_body(options.body, body_options);
   const meshing::TriMeshTopology topo = meshing::analyse_topology(body.mesh);
   const meshing::BoundingBox box = meshing::bounding_box(body.mesh);
   const garment::RawBodyInfo& raw = body.raw;
+  // A slice outside the figure has no outline: a mistake (a height in cm, or in the file's own
+  // frame), not an empty answer.
+  for (const double y : options.slices) {
+    if (y < box.min.y() || y > box.max.y())
+      throw std::invalid_argument(
+          fmt::format("--slice {:g} is outside the body, which spans {:.3f} .. {:.3f} m in the "
+                      "normalised frame "
+                      "(feet at the bottom, metres; see docs/bodies.md)",
+                      y, box.min.y(), box.max.y()));
+  }
 
   nlohmann::json out = {
       {"source", raw.source},
@@ -82,6 +95,7 @@ void run_info(const InfoOptions& options) {
     out["girths_m"] = {{"chest", landmarks->chest_girth},
                        {"waist", landmarks->waist_girth},
                        {"hips", landmarks->hip_girth}};
+    out["landmark_doubts"] = landmarks->doubts;
   } else {
     out["landmarks"] = nullptr;
     out["landmarks_problem"] = landmark_problem;
@@ -158,6 +172,10 @@ void run_info(const InfoOptions& options) {
       "girths      chest {:.3f} m, waist {:.3f} m, hips {:.3f} m (convex hull of "
       "the torso's slice)\n",
       landmarks->chest_girth, landmarks->waist_girth, landmarks->hip_girth);
+  for (const std::string& doubt : landmarks->doubts)
+    std::cout << "warning     the landmarks look wrong: " << doubt
+              << "; is this a standing human figure, feet down, facing +z after normalisation? "
+                 "(docs/bodies.md, \"Landmarks\")\n";
 }
 
 }  // namespace
@@ -170,6 +188,9 @@ void add_info_command(CLI::App& app, const GlobalOptions& /*global*/) {
       ->required();
   cmd->add_option("--up", options->up,
                   "The file's up axis (x, y, z, -x, ...); inferred if omitted");
+  cmd->add_option("--facing", options->facing,
+                  "The way the figure faces in the file (x, -x, z, ...), across the up axis; by "
+                  "the up axis's convention if omitted (Z up: -y, else +z)");
   cmd->add_option("--height", options->height, "Scale the body to this height in metres")
       ->check(finite_range(0.1, 5.0));
   cmd->add_option("--scale", options->scale, "Metres per file unit")
@@ -177,7 +198,8 @@ void add_info_command(CLI::App& app, const GlobalOptions& /*global*/) {
   cmd->add_flag("--json", options->json, "Print one JSON object instead of text");
   cmd->add_option("--slice", options->slices,
                   "Also print the body's outlines at this height (m, normalised frame; repeat for "
-                  "several): where legs, arms and torso are, to place curves");
+                  "several): where legs, arms and torso are, to place curves")
+      ->check(finite_range(-1e3, 1e3));
   cmd->callback([options] { run_info(*options); });
 }
 

@@ -422,6 +422,8 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
       where.at = draped.vertices.row(fastest).transpose();
       where.flat_rest = flat_rest;
       where.rest_ramp = scene.rest_ramp;  // with the gather's default ramp
+      where.still_s = report.rest_still_time;
+      where.drift_m = std::isnan(report.rest_drift) ? 0.0 : report.rest_drift;
       for (Eigen::Index t = 0; t < draped.faces.rows() && where.panel.empty(); ++t)
         if ((draped.faces.row(t).array() == fastest).any() && t < triangle_group.size() &&
             triangle_group(t) >= 0 &&

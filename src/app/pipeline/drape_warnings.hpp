@@ -50,6 +50,10 @@ struct StillMoving {
   int vertices = 0;
   bool flat_rest = false;  // draped from the flat pattern ("rest": "flat")
   double rest_ramp = 0.0;  // s, simulate.rest_ramp
+  // Whether the drape was in a still stretch when the time ran out (drift within the at-rest
+  // bound, but for less than the window): its length and the largest drift so far.
+  double still_s = 0.0;  // s; 0: the last step moved
+  double drift_m = 0.0;
 };
 
 // "<file>: the drape did not come to rest in 3.0 s: ..." with the at-rest limits and what to try:
