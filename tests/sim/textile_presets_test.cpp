@@ -1,11 +1,11 @@
 // The textile tests of every fabric preset (docs/fabrics.md): Peirce's cantilever (ASTM D1388) at
 // 16 cells on the 4-8 mesh in both orientations and on two imported triangulations, its
 // rigidity on 4 and 8 square cells, and the Cusick drape (ISO 9073-9), one specimen each at 2.5
-// cells per bending length, where the DC has converged, as `sketchdrape bench --textile` drapes
-// it ("Cusick drape", "The protocol"). Integration tests: on the loaded 2-core machine the 24
-// static cantilevers took 25-53 s, the square cells 4 s, and the six Cusick drapes at 2.5 cells
-// per c (26 to 58 cells across) 76 s of CPU together (10 minutes of wall time at load 20-25);
-// the means over several specimens at two resolutions come from the bench (docs/fabrics.md).
+// and 3 cells per bending length, the two finest resolutions of issue 21's convergence check, as
+// `sketchdrape bench --textile` drapes it ("Cusick drape", "The protocol"). Integration tests: on
+// the loaded 2-core machine the 24 static cantilevers took 25-53 s, the square cells 4 s, and the
+// twelve Cusick drapes (26 to 69 cells across) about 4-5 minutes of CPU together (0.9-47 s each);
+// the bench gives the third resolution, the grain and the specimens' scatter (docs/fabrics.md).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -97,10 +97,15 @@ int cells_per_c(const FabricParameters& fabric, double per_c) {
   return std::max(4, static_cast<int>(std::ceil(0.30 * per_c / c - 1e-9)));
 }
 
-// Issue 21's Cusick criterion on one specimen per resolution: at 2.5 and 3 cells per bending
-// length each drape comes to rest with 4-10 nodes and its DC inside the preset's published range,
-// not widened, and the two DCs agree within CONVERGENCE_BAND. The means over several specimens
-// and three resolutions come from the bench (docs/fabrics.md, "Cusick drape").
+// Issue 21's Cusick criterion on one specimen per resolution, with the diamond membrane and the
+// clamp's ghost points on: at 2.5 and 3 cells per bending length each drape comes to rest with
+// 4-10 nodes and its DC inside the preset's published range, not widened, and the two DCs agree
+// within the issue's 0.03. Measured (session 37; the bench's first specimen, the same drape):
+// cotton 0.633/0.639 (6/6 nodes), denim 0.846/0.852 (4/4), jersey 0.334 (6) at 58 cells,
+// polyester 0.597/0.579 (4/4), silk 0.469/0.488 (5/4), wool 0.542/0.547 (4/6). The band is the
+// criterion itself, not a margin for scatter: one specimen per resolution, so a change that moves
+// the fold count of one drape (4 to 5 nodes moves polyester by about 0.02-0.04) can fail it, as it
+// could fail the standard's reading of one specimen.
 TEST_P(CusickPreset, DrapesWithinItsPublishedRangeAndConverges) {
   const PresetRange& range = GetParam();
   const FabricParameters fabric = fabric_preset(range.name);
@@ -114,9 +119,12 @@ TEST_P(CusickPreset, DrapesWithinItsPublishedRangeAndConverges) {
                 d.at_rest ? "at rest" : "not at rest", d.seconds);
     EXPECT_TRUE(d.at_rest) << cells << " cells";
     if (range.above_range) {
-      // Silk stays above its range (docs/fabrics.md, "Silk"): its known reading is asserted.
+      // Silk stays above its range with its cited constants (docs/fabrics.md, "Silk", "A light
+      // silk, searched for again"): its known reading is asserted, 0.462-0.488 over both
+      // resolutions and three grains, below 0.52 (the bench's two-specimen means reached 0.48),
+      // so that a change that brings silk into its range, or further out, is seen.
       EXPECT_GE(d.shadow.drape_coefficient, range.high) << cells << " cells";
-      EXPECT_LE(d.shadow.drape_coefficient, 0.50) << cells << " cells";
+      EXPECT_LE(d.shadow.drape_coefficient, 0.52) << cells << " cells";
     } else {
       EXPECT_GE(d.shadow.drape_coefficient, range.low) << cells << " cells";
       EXPECT_LE(d.shadow.drape_coefficient, range.high) << cells << " cells";
@@ -124,7 +132,7 @@ TEST_P(CusickPreset, DrapesWithinItsPublishedRangeAndConverges) {
     EXPECT_GE(d.shadow.nodes, 4) << cells << " cells";
     EXPECT_LE(d.shadow.nodes, 10) << cells << " cells";
   }
-  // Issue 21: converged to ±0.03 between the two finest resolutions.
+  // Issue 21: converged to ±0.03 between the two finest resolutions (measured: -0.018 to +0.019).
   EXPECT_NEAR(dc[1], dc[0], 0.03);
 }
 
