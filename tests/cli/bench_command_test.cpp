@@ -423,6 +423,37 @@ TEST(BenchTextile, FabricFilesAreMeasuredLikePresets) {
   EXPECT_FALSE(fs::exists(dir / "bad"));
 }
 
+// The membrane options and the specimen's grain are set per study and written with its points:
+// `--diamond-membrane on --ghost-points on` appear as the study's "model", each `--cusick-grain`
+// angle is its own point (the warp turned against the disc's mesh: denim's warp is 1.7 times as
+// stiff as its weft, so the drape differs), each at rest with the time it rested by. A value
+// other than on or off exits 2 and writes nothing.
+TEST(BenchTextile, MembraneOptionsAndGrainAreWrittenWithEachPoint) {
+  const fs::path dir = fresh_dir("textile-options");
+  const auto result = run_sketchdrape(
+      "bench --textile --fabric denim --cantilever-cells 8 --cusick-cells 10 --cusick-grain 0 45 "
+      "--cusick-specimens 1 --diamond-membrane on --ghost-points on --json -o " +
+      (dir / "out").string());
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const nlohmann::json json = read_json(dir / "out" / "textile.json");
+  EXPECT_TRUE(json.at("model").at("diamond_membrane").get<bool>());
+  EXPECT_TRUE(json.at("model").at("clamp_ghost_points").get<bool>());
+  ASSERT_EQ(json.at("cusick").size(), 2u);
+  for (int k = 0; k < 2; ++k) {
+    const auto& drape = json.at("cusick").at(k);
+    EXPECT_EQ(drape.at("grain_deg").get<double>(), k == 0 ? 0.0 : 45.0);
+    EXPECT_TRUE(drape.at("converged").get<bool>());
+    EXPECT_GT(drape.at("rest_time_s").get<double>(), 0.25);  // at least one rest window
+    EXPECT_LT(drape.at("rest_time_s").get<double>(), 8.0);
+  }
+  EXPECT_NE(json.at("cusick").at(0).at("drape_coefficient").get<double>(),
+            json.at("cusick").at(1).at("drape_coefficient").get<double>());
+  const auto bad = run_sketchdrape("bench --textile --fabric denim --diamond-membrane maybe -o " +
+                                   (dir / "bad").string());
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_FALSE(fs::exists(dir / "bad"));
+}
+
 // `--cusick-cells-per-c` picks each fabric's Cusick resolutions from its bending length
 // c = (B/ρg)^(1/3): the fewest cells across the 30 cm disc that give at least that many cells
 // per c (silk, c = 1.493 cm: 41 and 51 for 2 and 2.5; denim, 2.924 cm: 21 and 26). It cannot be

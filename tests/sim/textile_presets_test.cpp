@@ -1,11 +1,11 @@
 // The textile tests of every fabric preset (docs/fabrics.md): Peirce's cantilever (ASTM D1388) at
 // 16 cells on the 4-8 mesh in both orientations and on two imported triangulations, its
 // rigidity on 4 and 8 square cells, and the Cusick drape (ISO 9073-9), one specimen each at 2.5
-// cells per bending length, where the DC has converged, as `sketchdrape bench --textile` drapes
-// it ("Cusick drape", "The protocol"). Integration tests: on the loaded 2-core machine the 24
-// static cantilevers took 25-53 s, the square cells 4 s, and the six Cusick drapes at 2.5 cells
-// per c (26 to 58 cells across) 76 s of CPU together (10 minutes of wall time at load 20-25);
-// the means over several specimens at two resolutions come from the bench (docs/fabrics.md).
+// and 3 cells per bending length, the two finest resolutions of issue 21's convergence check, as
+// `sketchdrape bench --textile` drapes it ("Cusick drape", "The protocol"). Integration tests: on
+// the loaded 2-core machine the 24 static cantilevers took 25-53 s, the square cells 4 s, and the
+// twelve Cusick drapes (26 to 69 cells across) about 4-5 minutes of CPU together (0.9-47 s each);
+// the bench gives the third resolution, the grain and the specimens' scatter (docs/fabrics.md).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -48,14 +48,17 @@ struct Drape {
   double seconds = 0.0;
 };
 
-// One specimen: the quadratic bending and the buckling compression, dropped flat with a random
-// lift of up to 0.1 mm (the bench's first seed), implicit Euler at 1/60 s with CHOLMOD, to rest
-// or 8 s.
+// One specimen: the quadratic bending and the buckling compression, with the diamond membrane and
+// the clamp's ghost points set on explicitly (docs/fabrics.md, "Cusick drape"), dropped flat with
+// a random lift of up to 0.1 mm (the bench's first seed), implicit Euler at 1/60 s with CHOLMOD,
+// to rest or 8 s.
 Drape drape(const FabricParameters& fabric, int cells) {
   const auto start = std::chrono::steady_clock::now();
   const SheetScene scene = testing::cusick_disc(cells);
   ClothModelOptions options;
   options.compression = Compression::buckling;
+  options.diamond_membrane = true;
+  options.clamp_ghost_points = true;
   const ClothModel model = build_cloth_model(scene.input, fabric, options);
   Eigen::VectorXd x = flatten_positions(scene.input.rest_positions);
   std::vector<char> pinned(static_cast<size_t>(model.vertex_count), 0);
@@ -85,44 +88,52 @@ Drape drape(const FabricParameters& fabric, int cells) {
 
 class CusickPreset : public ::testing::TestWithParam<PresetRange> {};
 
-// Cells across the 30 cm disc for 2.5 cells per bending length c = (B/ρg)^(1/3), the coarser of
-// the two resolutions where the bench's DC converges (`bench --textile --cusick-cells-per-c 2.5
-// 3`, docs/fabrics.md, "Convergence follows the cells per bending length"; the same rounding as
-// app::cusick_cells_for): silk 51, jersey 58, wool 45, polyester 43, cotton 38, denim 26.
-int converged_cells(const FabricParameters& fabric) {
+// Cells across the 30 cm disc for `per_c` cells per bending length c = (B/ρg)^(1/3), the same
+// rounding as app::cusick_cells_for: at 2.5 and 3 per c, the two finest resolutions of the
+// bench's check (docs/fabrics.md, "Convergence follows the cells per bending length"), silk 51
+// and 61, jersey 58 and 69, wool 45 and 54, polyester 43 and 52, cotton 38 and 46, denim 26 and 31.
+int cells_per_c(const FabricParameters& fabric, double per_c) {
   const double c = std::cbrt(fabric.bend / (fabric.area_density * 9.81));
-  return std::max(4, static_cast<int>(std::ceil(0.30 * 2.5 / c - 1e-9)));
+  return std::max(4, static_cast<int>(std::ceil(0.30 * per_c / c - 1e-9)));
 }
 
-// Where the DC has converged (2.5 cells per bending length: the bench's mean there is within 0.03
-// of its mean at 3 per c for every preset, docs/fabrics.md; converged as a discretisation, which
-// keeps the membrane locking of docs/simulator.md, "The Cusick drape of silk") one specimen comes
-// to rest with 4-10 nodes and its DC inside the preset's published range, not widened: the
-// coarse-disc bias (1.5 cm cells read up to 0.10 low) is gone at this resolution. Specimens
-// scatter by about ±0.01 here (wool, the closest to its range's edge: 0.520-0.532 over five).
-TEST_P(CusickPreset, DrapesWithinItsPublishedRangeWhereConverged) {
+// Issue 21's Cusick criterion on one specimen per resolution, with the diamond membrane and the
+// clamp's ghost points on: at 2.5 and 3 cells per bending length each drape comes to rest with
+// 4-10 nodes and its DC inside the preset's published range, not widened, and the two DCs agree
+// within the issue's 0.03. Measured (session 37; the bench's first specimen, the same drape):
+// cotton 0.633/0.639 (6/6 nodes), denim 0.846/0.852 (4/4), jersey 0.334/0.321 (6/6),
+// polyester 0.597/0.579 (4/4), silk 0.469/0.488 (5/4), wool 0.542/0.547 (4/6). The band is the
+// criterion itself, not a margin for scatter: one specimen per resolution, so a change that moves
+// the fold count of one drape (4 to 5 nodes moves polyester by about 0.02-0.04) can fail it, as it
+// could fail the standard's reading of one specimen.
+TEST_P(CusickPreset, DrapesWithinItsPublishedRangeAndConverges) {
   const PresetRange& range = GetParam();
   const FabricParameters fabric = fabric_preset(range.name);
-  const int cells = converged_cells(fabric);
-  const Drape d = drape(fabric, cells);
-  std::printf("Cusick %s, %d cells, one specimen: DC %.3f, %d nodes, %s, %.1f s\n",
-              range.name.c_str(), cells, d.shadow.drape_coefficient, d.shadow.nodes,
-              d.at_rest ? "at rest" : "not at rest", d.seconds);
-  EXPECT_TRUE(d.at_rest);
-  if (range.above_range) {
-    // Silk stays above its range where converged (the bench's two-specimen means 0.450-0.459 at
-    // 51 cells, 0.475-0.478 at 61; this specimen 0.455, and 0.469 with the diamond membrane and
-    // the ghost points; docs/simulator.md, "The diamond membrane"): its known
-    // reading is asserted, so that the docs' figure stays true and a change that brings silk
-    // into its range (or further out) is seen.
-    EXPECT_GE(d.shadow.drape_coefficient, range.high);
-    EXPECT_LE(d.shadow.drape_coefficient, 0.50);
-  } else {
-    EXPECT_GE(d.shadow.drape_coefficient, range.low);
-    EXPECT_LE(d.shadow.drape_coefficient, range.high);
+  double dc[2] = {0.0, 0.0};
+  for (int k = 0; k < 2; ++k) {
+    const int cells = cells_per_c(fabric, k == 0 ? 2.5 : 3.0);
+    const Drape d = drape(fabric, cells);
+    dc[k] = d.shadow.drape_coefficient;
+    std::printf("Cusick %s, %d cells, one specimen: DC %.3f, %d nodes, %s, %.1f s\n",
+                range.name.c_str(), cells, d.shadow.drape_coefficient, d.shadow.nodes,
+                d.at_rest ? "at rest" : "not at rest", d.seconds);
+    EXPECT_TRUE(d.at_rest) << cells << " cells";
+    if (range.above_range) {
+      // Silk stays above its range with its cited constants (docs/fabrics.md, "Silk", "A light
+      // silk, searched for again"): its known reading is asserted, 0.462-0.488 over both
+      // resolutions and three grains, below 0.52 (the bench's two-specimen means reached 0.48),
+      // so that a change that brings silk into its range, or further out, is seen.
+      EXPECT_GE(d.shadow.drape_coefficient, range.high) << cells << " cells";
+      EXPECT_LE(d.shadow.drape_coefficient, 0.52) << cells << " cells";
+    } else {
+      EXPECT_GE(d.shadow.drape_coefficient, range.low) << cells << " cells";
+      EXPECT_LE(d.shadow.drape_coefficient, range.high) << cells << " cells";
+    }
+    EXPECT_GE(d.shadow.nodes, 4) << cells << " cells";
+    EXPECT_LE(d.shadow.nodes, 10) << cells << " cells";
   }
-  EXPECT_GE(d.shadow.nodes, 4);
-  EXPECT_LE(d.shadow.nodes, 10);
+  // Issue 21: converged to ±0.03 between the two finest resolutions (measured: -0.018 to +0.019).
+  EXPECT_NEAR(dc[1], dc[0], 0.03);
 }
 
 INSTANTIATE_TEST_SUITE_P(

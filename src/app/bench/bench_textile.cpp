@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -45,7 +46,14 @@ std::string fabric_label(const std::string& asked, const sim::FabricParameters& 
 
 }  // namespace
 
-CantileverPoint run_cantilever(const std::string& name, int cells) {
+sim::ClothModelOptions textile_model_options(const TextileOptions& options) {
+  sim::ClothModelOptions model;
+  if (options.diamond_membrane) model.diamond_membrane = *options.diamond_membrane;
+  if (options.clamp_ghost_points) model.clamp_ghost_points = *options.clamp_ghost_points;
+  return model;
+}
+
+CantileverPoint run_cantilever(const std::string& name, int cells, const TextileOptions& options) {
   const auto start = Clock::now();
   const sim::FabricParameters fabric = textile_fabric(name);
   CantileverPoint point;
@@ -64,11 +72,12 @@ CantileverPoint run_cantilever(const std::string& name, int cells) {
   spec.centre = {0.0, 1.0, 0.0};
   spec.pins = {"top:3"};
   const sim::SheetScene scene = sim::build_sheet(spec);
-  const sim::ClothModel model = sim::build_cloth_model(scene.input, fabric);
+  const sim::ClothModel model =
+      sim::build_cloth_model(scene.input, fabric, textile_model_options(options));
   Eigen::VectorXd x = sim::flatten_positions(scene.input.rest_positions);
-  sim::StaticOptions options;
-  options.load_steps = 8;
-  point.converged = sim::solve_static(model, x, scene.pinned_vertices, options).converged;
+  sim::StaticOptions static_options;
+  static_options.load_steps = 8;
+  point.converged = sim::solve_static(model, x, scene.pinned_vertices, static_options).converged;
   const Eigen::MatrixX3d draped =
       Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(x.data(),
                                                                                   x.size() / 3, 3);
@@ -80,7 +89,8 @@ CantileverPoint run_cantilever(const std::string& name, int cells) {
   return point;
 }
 
-CusickPoint run_cusick(const std::string& name, int cells, int specimens) {
+CusickPoint run_cusick(const std::string& name, int cells, int specimens,
+                       const TextileOptions& options, double grain_deg) {
   const auto start = Clock::now();
   const sim::FabricParameters fabric = textile_fabric(name);
   sim::SheetSpec spec;
@@ -90,8 +100,12 @@ CusickPoint run_cusick(const std::string& name, int cells, int specimens) {
   spec.orientation = sim::SheetOrientation::horizontal;
   spec.centre = {0.0, 1.0, 0.0};
   spec.pins = {"centre:0.09"};
-  const sim::SheetScene scene = sim::build_sheet(spec);
-  sim::ClothModelOptions model_options;
+  sim::SheetScene scene = sim::build_sheet(spec);
+  // The warp turned about the vertical against the mesh (the disc's warp runs along −Z).
+  const Eigen::AngleAxisd turn(grain_deg * std::numbers::pi / 180.0, Eigen::Vector3d::UnitY());
+  for (Eigen::Index t = 0; t < scene.input.warp.rows(); ++t)
+    scene.input.warp.row(t) = (turn * scene.input.warp.row(t).transpose()).transpose();
+  sim::ClothModelOptions model_options = textile_model_options(options);
   model_options.compression = sim::Compression::buckling;
   const sim::ClothModel model = sim::build_cloth_model(scene.input, fabric, model_options);
   std::vector<sim::Pin> pins;
@@ -102,16 +116,18 @@ CusickPoint run_cusick(const std::string& name, int cells, int specimens) {
   }
   // The drape as `run` drapes data/scenes/cusick-drape-cotton.json, at the step of its
   // measurements (docs/fabrics.md): dropped flat, implicit Euler at 1/60 s, to rest (every vertex
-  // slower than 5 mm/s for 0.25 s, the simulator's rule) or 8 s.
+  // slower than 5 mm/s for 0.25 s, the simulator's rule) or 8 s (both settable).
   sim::SimulationSettings settings;
   settings.integrator = sim::Integrator::implicit_euler;
   settings.solver = sim::LinearSolverKind::cholmod;
   settings.dt = 1.0 / 60.0;
-  settings.duration = 8.0;
+  settings.duration = options.cusick_duration;
+  settings.rest_speed = options.cusick_rest_speed;
   settings.record_energy = false;
   CusickPoint point;
   point.fabric = fabric_label(name, fabric);
   point.cells = cells;
+  point.grain_deg = grain_deg;
   point.vertices = model.vertex_count;
   point.specimens = specimens;
   point.converged = true;
@@ -129,6 +145,7 @@ CusickPoint run_cusick(const std::string& name, int cells, int specimens) {
     sim::Simulation simulation(model, x, pins, settings);
     const sim::SimulationReport report = simulation.run();
     point.converged = point.converged && report.at_rest && !report.failed;
+    point.rest_time = std::max(point.rest_time, simulation.time());
     const Eigen::VectorXd& y = simulation.positions();
     Eigen::MatrixX3d positions(model.vertex_count, 3);
     for (int v = 0; v < model.vertex_count; ++v) positions.row(v) = y.segment<3>(3 * v).transpose();
@@ -158,7 +175,7 @@ void run_textile(const TextileOptions& options, std::vector<CantileverPoint>& ca
       options.fabrics.empty() ? sim::fabric_preset_names() : options.fabrics;
   for (const std::string& fabric : fabrics) {
     for (const int cells : options.cantilever_cells) {
-      cantilevers.push_back(run_cantilever(fabric, cells));
+      cantilevers.push_back(run_cantilever(fabric, cells, options));
       const CantileverPoint& p = cantilevers.back();
       note(fmt::format(
           "cantilever {} {} cells: chord {:.2f} deg, c {:.2f} cm (predicted {:.2f}), "
@@ -172,15 +189,16 @@ void run_textile(const TextileOptions& options, std::vector<CantileverPoint>& ca
       for (const double per_c : options.cusick_cells_per_c)
         cusick_cells.push_back(cusick_cells_for(parameters, per_c));
     }
-    for (const int cells : cusick_cells) {
-      drapes.push_back(run_cusick(fabric, cells, options.cusick_specimens));
-      const CusickPoint& p = drapes.back();
-      note(fmt::format(
-          "Cusick {} {} cells: DC {:.3f} ({:.3f}-{:.3f} over {} specimens), {} nodes{}, "
-          "{:.1f} s",
-          fabric, cells, p.drape_coefficient, p.dc_min, p.dc_max, p.specimens, p.nodes,
-          p.converged ? "" : " (not at rest)", p.seconds));
-    }
+    for (const double grain : options.cusick_grain_deg)
+      for (const int cells : cusick_cells) {
+        drapes.push_back(run_cusick(fabric, cells, options.cusick_specimens, options, grain));
+        const CusickPoint& p = drapes.back();
+        note(fmt::format(
+            "Cusick {} {} cells, grain {:g} deg: DC {:.3f} ({:.3f}-{:.3f} over {} specimens), "
+            "{} nodes{}, rested by {:.2f} s, {:.1f} s",
+            fabric, cells, grain, p.drape_coefficient, p.dc_min, p.dc_max, p.specimens, p.nodes,
+            p.converged ? "" : " (not at rest)", p.rest_time, p.seconds));
+      }
   }
 }
 
@@ -194,13 +212,14 @@ std::string textile_table(const std::vector<CantileverPoint>& cantilevers,
                        100 * p.predicted_c, 100 * p.simulated_c, p.chord_deg,
                        p.converged ? "converged" : "not converged");
   out +=
-      "\n| fabric | cells across the disc | vertices | DC (mean) | DC (min-max) | nodes | "
-      "specimens | dynamic drape |\n"
-      "|---|---|---|---|---|---|---|---|\n";
+      "\n| fabric | cells across the disc | grain | vertices | DC (mean) | DC (min-max) | nodes "
+      "| specimens | dynamic drape |\n"
+      "|---|---|---|---|---|---|---|---|---|\n";
   for (const CusickPoint& p : drapes)
-    out += fmt::format("| {} | {} | {} | {:.3f} | {:.3f}-{:.3f} | {} | {} | {} |\n", p.fabric,
-                       p.cells, p.vertices, p.drape_coefficient, p.dc_min, p.dc_max, p.nodes,
-                       p.specimens, p.converged ? "at rest" : "not at rest");
+    out += fmt::format(
+        "| {} | {} | {:g}° | {} | {:.3f} | {:.3f}-{:.3f} | {} | {} | {} |\n", p.fabric, p.cells,
+        p.grain_deg, p.vertices, p.drape_coefficient, p.dc_min, p.dc_max, p.nodes, p.specimens,
+        p.converged ? fmt::format("at rest by {:.2f} s", p.rest_time) : std::string("not at rest"));
   return out;
 }
 
@@ -214,11 +233,12 @@ std::string cantilever_csv(const std::vector<CantileverPoint>& cantilevers) {
 
 std::string cusick_csv(const std::vector<CusickPoint>& drapes) {
   std::string out =
-      "fabric,cells,vertices,drape_coefficient,nodes,converged,seconds,dc_min,dc_max,specimens\n";
+      "fabric,cells,vertices,drape_coefficient,nodes,converged,seconds,dc_min,dc_max,specimens,"
+      "grain_deg,rest_time_s\n";
   for (const CusickPoint& p : drapes)
-    out += fmt::format("{},{},{},{:.4f},{},{},{:.2f},{:.4f},{:.4f},{}\n", p.fabric, p.cells,
-                       p.vertices, p.drape_coefficient, p.nodes, p.converged ? 1 : 0, p.seconds,
-                       p.dc_min, p.dc_max, p.specimens);
+    out += fmt::format("{},{},{},{:.4f},{},{},{:.2f},{:.4f},{:.4f},{},{:g},{:.3f}\n", p.fabric,
+                       p.cells, p.vertices, p.drape_coefficient, p.nodes, p.converged ? 1 : 0,
+                       p.seconds, p.dc_min, p.dc_max, p.specimens, p.grain_deg, p.rest_time);
   return out;
 }
 

@@ -8,10 +8,12 @@
 // scaled to give l/2 at 41.5° (ASTM D1388's fixed-angle reading).
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "sim/cantilever.hpp"
+#include "sim/cloth_model.hpp"
 #include "sim/fabric.hpp"
 
 namespace sd::app {
@@ -24,7 +26,21 @@ struct TextileOptions {
   // (docs/fabrics.md, "Convergence follows the cells per bending length"; 2.5 and 3).
   std::vector<double> cusick_cells_per_c;
   int cusick_specimens = 3;  // drapes per point, each from its own random lift (their mean)
+  // The specimen's warp turned by these angles (degrees, about the vertical) against the disc's
+  // mesh, whose sectors and core square have a fourfold layout: each angle is its own point. A
+  // converged DC does not depend on it (docs/fabrics.md, "Cusick drape").
+  std::vector<double> cusick_grain_deg = {0.0};
+  // The membrane and clamp options of both tests; unset: ClothModelOptions' defaults.
+  std::optional<bool> diamond_membrane;
+  std::optional<bool> clamp_ghost_points;
+  // The drape's rest rule (sim::SimulationSettings::rest_speed, m/s) and its longest run (s).
+  double cusick_rest_speed = 5.0e-3;
+  double cusick_duration = 8.0;
 };
+
+// The model options a textile study measures with: ClothModelOptions' defaults, with the
+// diamond membrane and the clamp's ghost points as `options` sets them.
+sim::ClothModelOptions textile_model_options(const TextileOptions& options);
 
 struct CantileverPoint {
   std::string fabric;
@@ -40,12 +56,14 @@ struct CusickPoint {
   std::string fabric;
   int cells = 0;
   int vertices = 0;
+  double grain_deg = 0.0;          // the warp's turn against the mesh (TextileOptions)
   double drape_coefficient = 0.0;  // the mean over the specimens
   double dc_min = 0.0;
   double dc_max = 0.0;
   int specimens = 0;
   int nodes = 0;           // the mean over the specimens, rounded
   bool converged = false;  // every specimen's drape came to rest
+  double rest_time = 0.0;  // s, the latest simulated time a specimen came to rest (or stopped)
   double seconds = 0.0;
 };
 
@@ -57,9 +75,12 @@ sim::FabricParameters textile_fabric(const std::string& fabric);
 // c = (B/ρg)^(1/3): ⌈0.30 m · per_c / c⌉, at least 4.
 int cusick_cells_for(const sim::FabricParameters& fabric, double per_c);
 
-CantileverPoint run_cantilever(const std::string& fabric, int cells);
-// The Cusick drape of `specimens` discs, dynamic with the buckling compression, to rest.
-CusickPoint run_cusick(const std::string& fabric, int cells, int specimens);
+CantileverPoint run_cantilever(const std::string& fabric, int cells,
+                               const TextileOptions& options = {});
+// The Cusick drape of `specimens` discs, dynamic with the buckling compression, to rest, the
+// warp turned by `grain_deg` against the mesh.
+CusickPoint run_cusick(const std::string& fabric, int cells, int specimens,
+                       const TextileOptions& options = {}, double grain_deg = 0.0);
 
 // Peirce's bending length from the chord angle θ (degrees) of an overhang l (m); l/2 at 41.5°.
 using sim::peirce_bending_length;

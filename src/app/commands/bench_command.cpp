@@ -233,7 +233,8 @@ void run_textile_study(const BenchOptions& options, const GlobalOptions& global)
   const long count = static_cast<long>(
       (o.fabrics.empty() ? known.size() : o.fabrics.size()) *
       (o.cantilever_cells.size() +
-       (o.cusick_cells_per_c.empty() ? o.cusick_cells.size() : o.cusick_cells_per_c.size())));
+       o.cusick_grain_deg.size() *
+           (o.cusick_cells_per_c.empty() ? o.cusick_cells.size() : o.cusick_cells_per_c.size())));
   Progress progress("bench --textile", count, global.quiet);
   long done = 0;
   std::vector<CantileverPoint> cantilevers;
@@ -256,6 +257,7 @@ void run_textile_study(const BenchOptions& options, const GlobalOptions& global)
   for (const CusickPoint& p : drapes)
     json["cusick"].push_back({{"fabric", p.fabric},
                               {"cells", p.cells},
+                              {"grain_deg", p.grain_deg},
                               {"vertices", p.vertices},
                               {"drape_coefficient", p.drape_coefficient},
                               {"drape_coefficient_min", p.dc_min},
@@ -263,7 +265,13 @@ void run_textile_study(const BenchOptions& options, const GlobalOptions& global)
                               {"specimens", p.specimens},
                               {"nodes", p.nodes},
                               {"converged", p.converged},
+                              {"rest_time_s", p.rest_time},
                               {"seconds", p.seconds}});
+  nlohmann::json model = nlohmann::json::object();
+  const sim::ClothModelOptions model_options = textile_model_options(o);
+  model["diamond_membrane"] = model_options.diamond_membrane;
+  model["clamp_ghost_points"] = model_options.clamp_ghost_points;
+  json["model"] = model;
   const fs::path dir = options.out;
   const std::string table = textile_table(cantilevers, drapes);
   StagedOutputs outputs;
@@ -479,6 +487,28 @@ void add_bench_command(CLI::App& app, const GlobalOptions& global) {
                   "With --textile: Cusick drapes per point, each from its own random lift; the "
                   "table gives their mean and range (default 3)")
       ->check(CLI::Range(1, 20));
+  cmd->add_option("--cusick-grain", options->textile_options.cusick_grain_deg,
+                  "With --textile: the specimen's warp turned by these angles (degrees) against "
+                  "the disc's mesh, each its own point (default 0)")
+      ->check(CLI::Range(-360.0, 360.0));
+  cmd->add_option("--cusick-rest-speed", options->textile_options.cusick_rest_speed,
+                  "With --textile: a drape is at rest when every vertex stays slower than this "
+                  "(m/s) for 0.25 s (default 0.005)")
+      ->check(CLI::Range(1e-5, 1.0));
+  cmd->add_option("--cusick-duration", options->textile_options.cusick_duration,
+                  "With --textile: the longest a Cusick drape runs (s, default 8)")
+      ->check(CLI::Range(0.5, 60.0));
+  const auto on_off = [](std::optional<bool>& target) {
+    return [&target](const std::string& value) { target = value == "on"; };
+  };
+  cmd->add_option_function<std::string>(
+         "--diamond-membrane", on_off(options->textile_options.diamond_membrane),
+         "With --textile: on or off, the diamond membrane (default: the simulator's)")
+      ->check(CLI::IsMember({"on", "off"}));
+  cmd->add_option_function<std::string>(
+         "--ghost-points", on_off(options->textile_options.clamp_ghost_points),
+         "With --textile: on or off, the clamp's ghost points (default: the simulator's)")
+      ->check(CLI::IsMember({"on", "off"}));
   cmd->add_option("--worker", options->worker_config)->group("");  // internal: one run
   cmd->add_option("--worker-scene", options->worker_scene)->group("");
   cmd->add_option("--worker-out", options->worker_out)->group("");
