@@ -40,7 +40,7 @@ std::optional<BodyCleft> cleft_at(const BodySurface& body, const Eigen::Vector3d
       if (std::abs(opening.y()) > max_tilt) continue;  // opens downwards (or up)
       // The narrowest pair: the crease where it is closest.
       if (found && ab.norm() >= found->width) continue;
-      found = BodyCleft{wa.position, wb.position, opening, ab.norm()};
+      found = BodyCleft{wa.position, wb.position, wa.normal, wb.normal, opening, ab.norm()};
     }
   // Only where the offset surfaces of the two walls meet: walls closer than twice the offset
   // (and the slack). A wider crease leaves room for the cloth on each wall.
@@ -75,8 +75,12 @@ std::vector<JunctionInCleft> find_junctions_in_clefts(const Garment& garment,
     }
     const std::optional<BodyCleft> cleft = cleft_at(body, p, probe);
     if (!cleft) continue;
+    // Held by both walls only when nearer than the offset to each: a junction at the offset
+    // from one wall (or farther) has room on that side.
+    const double a = cleft->clearance_a(p), b = cleft->clearance_b(p);
+    if (a >= probe.offset || b >= probe.offset) continue;
     std::sort(panels.begin(), panels.end());
-    found.push_back({p, panels, *cleft});
+    found.push_back({p, panels, *cleft, a, b});
   }
   return found;
 }

@@ -43,14 +43,17 @@ struct CurveSpec {
   ViewSpec view;                          // the view `points` were drawn in
   std::vector<Eigen::Vector2d> points;    // view-plane metres; empty when points3d is given
   std::vector<Eigen::Vector3d> points3d;  // world metres; empty when points is given
-  double offset = 0.0;                    // metres along the body normal (default: file's)
-  bool on_body = true;                    // project/snap onto the body's offset surface
-  bool smooth = true;                     // Catmull-Rom through the points (false: polyline)
-  bool closed = false;                    // the last point joins the first
-  std::optional<double> edge_length;      // metres; overrides panel and global
-  std::optional<int> edges;               // fixed edge count (parity may not change it)
-  std::optional<double> seam_allowance;   // metres, along this curve in the pattern (a seam's
-                                          // two sides, or an edge's); default: the panel's
+  // Per points3d point: given relative to a landmark ({"at": ...}) rather than as [x, y, z]
+  // (empty: none is).
+  std::vector<bool> at_landmark;
+  double offset = 0.0;                   // metres along the body normal (default: file's)
+  bool on_body = true;                   // project/snap onto the body's offset surface
+  bool smooth = true;                    // Catmull-Rom through the points (false: polyline)
+  bool closed = false;                   // the last point joins the first
+  std::optional<double> edge_length;     // metres; overrides panel and global
+  std::optional<int> edges;              // fixed edge count (parity may not change it)
+  std::optional<double> seam_allowance;  // metres, along this curve in the pattern (a seam's
+                                         // two sides, or an edge's); default: the panel's
 
   bool is_3d() const { return !points3d.empty(); }
 };

@@ -17,6 +17,7 @@
 #include <unordered_map>
 
 #include "garment/material_frames.hpp"
+#include "garment/piece_grain.hpp"
 
 namespace sd::garment {
 namespace {
@@ -814,6 +815,18 @@ FlatPattern flatten_garment(const Garment& garment, const FlatteningOptions& opt
       }
     }
     if (!flat.warning.empty() && !told_with_original) pattern.warnings.push_back(flat.warning);
+    // A strap laid across the grain (piece_grain.hpp), said once for a panel and its mirror copy.
+    if (!garment.panels[p].mirror_copy)
+      if (std::string across = cross_grain_warning(flat, garment.panels[p]); !across.empty()) {
+        const std::string prefix = "panel '" + name + "':";
+        const bool mirrored =
+            std::any_of(garment.panels.begin(), garment.panels.end(),
+                        [&](const GarmentPanel& g) { return g.id == name + ".mirror"; });
+        if (mirrored && across.starts_with(prefix))
+          across = fmt::format("panel '{}' and its mirror copy '{}.mirror':{}", name, name,
+                               across.substr(prefix.size()));
+        pattern.warnings.push_back(std::move(across));
+      }
     pattern.panels.push_back(std::move(flat));
   }
 

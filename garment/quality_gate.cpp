@@ -358,10 +358,11 @@ std::vector<QualityWarning> check_quality_tried(const Garment& garment,
         place(inside.where, q.landmark), outcome);
     warnings.push_back(std::move(q));
   }
-  // Seam junctions in a cleft of the body (body_clefts.hpp): the cloth there is held by both of
-  // the crease's walls and pulled by every panel of the junction. Trial 35's strapless dress on
-  // the Collada human, its four back panels meeting in the seat's cleft, was not at rest in 10 s
-  // and blew up at 15 s; with the seam moved 12 cm up it rested at 3.4 s.
+  // Seam junctions bridging a cleft of the body (body_clefts.hpp): the cloth there is held by
+  // both of the crease's walls and pulled by every panel of the junction; a junction whose
+  // panels follow the crease, each on its own wall (the cropped jacket's underarm), is not. Trial
+  // 35's strapless dress on the Collada human, its four back panels meeting in the seat's cleft,
+  // was not at rest in 10 s and blew up at 15 s; with the seam moved 12 cm up it rested at 3.4 s.
   CleftProbe probe;
   probe.offset = sketch.offset;
   for (const JunctionInCleft& j : find_junctions_in_clefts(garment, *surface, probe)) {
@@ -380,11 +381,13 @@ std::vector<QualityWarning> check_quality_tried(const Garment& garment,
                             : (o.x() < 0.0 ? "the right" : "the left");
     q.message = fmt::format(
         "the seam junction of panels '{}' ({}) lies in a cleft of the body (two body surfaces "
-        "facing each other, {:.1f} cm apart, opening towards {}): the cloth there is held by both "
+        "facing each other, {:.1f} cm apart, opening towards {}) and bridges it, {:.1f} and {:.1f} "
+        "cm from the two sides where the offset is {:.1f} cm: the cloth there is held by both "
         "sides while {} panels pull on it, and the drape may not come to rest; move the seam "
         "above or below the cleft, or let one panel bridge it (end the curves away from it)",
         fmt::join(names, "', '"), place(j.where, q.landmark), 100.0 * j.cleft.width, opens,
-        names.size());
+        100.0 * std::max(j.clearance_a, 0.0), 100.0 * std::max(j.clearance_b, 0.0),
+        100.0 * sketch.offset, names.size());
     warnings.push_back(std::move(q));
   }
   return warnings;

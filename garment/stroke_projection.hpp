@@ -45,6 +45,9 @@ struct ProjectedCurve {
   double offset = 0;
   bool on_body = true;
   int misses = 0;  // samples whose ray missed the body (depth interpolated)
+  // points3d curves on the body: per written point, how far (m) the snap onto the body moved
+  // it; -1 for a point given relative to a landmark. Empty for other curves.
+  std::vector<double> written_moves;
 };
 
 // Samples a Catmull-Rom spline (centripetal) through `points` (or the polyline when !smooth) at
@@ -59,8 +62,25 @@ std::vector<Eigen::Matrix<double, D, 1>> sample_stroke(
 ProjectedCurve project_curve(const GarmentRequest& sketch, const CurveSpec& curve,
                              const BodySurface* body);
 
-// All curves of the sketch, in file order.
+// All curves of the sketch, in file order. Warns (once per file and sentence) when written
+// points moved far onto the body (moved_points_warning).
 std::vector<ProjectedCurve> project_curves(const GarmentRequest& sketch, const BodySurface& body);
+
+// m: a written [x, y, z] point that the snap onto the body moves farther than this was likely
+// written for another body (or another size of it). Measured with `validate`, each design on the
+// body it was written for (the 37 designs, 6 examples, 18 files of repro/ and the cleft tests'
+// two): the largest move of any written point is 5.35 cm (the cotton shift dress's back
+// neckline, written out in the air behind the nape; 53 of the 63 files under 3.2 cm); the
+// designs moved to the other body that get as far as joining their curves: 7.7 cm (the Collada
+// pencil skirt on the built-in body) to 12.7 cm (trial 36's halter), and the rest fail earlier
+// with a curve folded by the snap, whose error names its farthest move (7.5-13.7 cm).
+inline constexpr double kWrittenPointMoveLimit = 0.06;
+
+// The sentence (with the file, the curve's JSON path, the point, how far it moved and its nearest
+// landmark) when the largest move of a written point of `curves` is above `limit`; "" when none.
+std::string moved_points_warning(const GarmentRequest& sketch,
+                                 const std::vector<ProjectedCurve>& curves, const BodySurface& body,
+                                 double limit = kWrittenPointMoveLimit);
 
 // Index pair (i, j) of the first two non-adjacent segments of a polyline that cross (2D) or come
 // closer than `tolerance` (3D); {-1, -1} when none do.

@@ -190,9 +190,11 @@ CurveSpec parse_curve(const Reader& r, const json& j, const std::string& path, c
     const std::string ip = fmt::format("{}/{}", ppath, i);
     if (has_2d)
       curve.points.push_back(r.position<2>(pts[i], ip));
-    else
+    else {
       curve.points3d.push_back(pts[i].is_object() ? landmark_point(r, pts[i], ip, sk)
                                                   : r.position<3>(pts[i], ip));
+      curve.at_landmark.push_back(pts[i].is_object());
+    }
   }
   if (j.contains("view")) {
     if (has_3d)

@@ -76,18 +76,14 @@ TEST_P(Design, MeshesWithoutQualityWarnings) {
   const fs::path sketch = staged_design(name, dir);
   // (The cropped jacket was allowed `self_intersection` until 27 November: its back crossed its
   // back sleeve in 13 triangle pairs in the narrow crease under the left arm, where both lay on
-  // the arm's wall; docs/garment.md, "Narrow creases".) Its underarm junction lies in that
-  // crease, narrower than twice the offset, which validate calls a cleft
-  // (garment/body_clefts.hpp, `junction_in_cleft`): since each panel there now lies on its own
-  // wall the warning is a false alarm for the jacket, allowed for it alone until the cleft test
-  // tells a bridged cleft from a crease whose walls the panels follow (stop-36 note).
-  const bool jacket = name == "cropped-jacket";
-  const CommandResult meshed = run_sketchdrape("-q mesh " + std::string(jacket ? "" : "--strict ") +
-                                               sketch.string() + " -o " + (dir / "mesh").string());
+  // the arm's wall; docs/garment.md, "Narrow creases"; and then `junction_in_cleft` for its
+  // underarm junction in that crease, until the cleft test learnt that its panels follow the
+  // crease, each on its own wall: garment/body_clefts.hpp.)
+  const CommandResult meshed =
+      run_sketchdrape("-q mesh --strict " + sketch.string() + " -o " + (dir / "mesh").string());
   ASSERT_EQ(meshed.exit_code, 0) << meshed.output;
   const nlohmann::json report = read_json(dir / "mesh" / "report.json");
-  for (const nlohmann::json& warning : report["warnings"])
-    EXPECT_TRUE(jacket && warning["kind"] == "junction_in_cleft") << warning.dump(2);
+  for (const nlohmann::json& warning : report["warnings"]) ADD_FAILURE() << warning.dump(2);
   for (const nlohmann::json& panel : report["panels"]) {
     EXPECT_EQ(panel["quality"]["inverted_quads"].get<int>(), 0) << panel["id"];
     EXPECT_LT(panel["quality"]["max_aspect_ratio"].get<double>(), 10.0) << panel["id"];

@@ -537,6 +537,44 @@ TEST(PatternCommand, CentrePiecesAreCutOnTheFold) {
             (std::vector<std::string>{"yoke_front", "yoke_back", "skirt_front", "skirt_back"}));
 }
 
+// Trial 36, P15: the slip dress's 3 cm straps over the shoulders take the vertical as their grain
+// ("auto"), which runs across them there; `pattern` says so, naming the strap, the angle and the
+// "grain" turn that lays it along; with that turn written in the file the strap's length lies
+// within 30° of the grain and nothing is said. The bias-cut skirt (turned 45° on purpose) is not
+// questioned.
+TEST(PatternCommand, AStrapCutAcrossTheGrainIsWarnedAndItsTurnLaysItAlong) {
+  if (!fs::exists("/usr/share/assimp/models/Collada/human.zae"))
+    GTEST_SKIP() << "assimp-testmodels' human.zae is not installed";
+  std::ifstream in(std::string(SD_SOURCE_DIR) + "/tests/cli/sketches/slip-dress-straps-human.json");
+  nlohmann::json sketch = nlohmann::json::parse(in, nullptr, true, /*ignore_comments=*/true);
+  const fs::path dir = fresh_dir("straps");
+  fs::create_directories(dir);
+  const auto pattern = [&](const std::string& name) {
+    std::ofstream(dir / (name + ".json")) << sketch.dump(2);
+    return run_sketchdrape("pattern " + (dir / (name + ".json")).string() + " -o " +
+                           (dir / name).string());
+  };
+  const CommandResult across = pattern("across");
+  ASSERT_EQ(across.exit_code, 0) << across.output;
+  const std::regex said(
+      "panel 'strap' and its mirror copy 'strap.mirror': a long narrow piece \\(([0-9]+) × "
+      "([0-9]+) mm[^)]*\\) is cut with its length ([0-9]+)° off the grain line[^\\n]*give the "
+      "panel \"grain\": (-?[0-9]+)");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(across.output, m, said)) << across.output;
+  EXPECT_GT(std::stod(m[1]), 4 * std::stod(m[2])) << "long and narrow";
+  EXPECT_GT(std::stod(m[3]), 30.0);
+  EXPECT_EQ(across.output.find("a long narrow piece", m.position(0) + m.length(0)),
+            std::string::npos)
+      << "only the strap (the bias skirt is not questioned)";
+  for (auto& panel : sketch["panels"])
+    if (panel["id"] == "strap") panel["grain"] = std::stoi(m[4]);
+  const CommandResult along = pattern("along");
+  ASSERT_EQ(along.exit_code, 0) << along.output;
+  EXPECT_EQ(along.output.find("a long narrow piece"), std::string::npos) << along.output;
+  fs::remove_all(dir);
+}
+
 // The t-shirt's front and back, whose centre lines bowed 11 and 15 mm flattened freely, are cut
 // on the fold: every point of the sewing line along the fold within 0.5 mm of the fold line
 // (a pencil line), the fold along the grain, the free bow reported; the fabric the pattern takes

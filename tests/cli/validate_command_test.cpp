@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "tests/cli/run_command.hpp"
@@ -91,3 +92,51 @@ TEST(ValidateCommand, AFolderAsTheFabricIsSaidToBeOne) {
 }
 
 }  // namespace
+
+// Trial 36, P13: absolute points written for another body. The built-in body's capelet moved
+// onto the Collada human (and the human's tank top onto the built-in body) is warned, before
+// anything else fails, with the written point that moved farthest, by its path, and the advice
+// to write points relative to landmarks; each design on its own body is not. The built-in tank
+// top on the human fails earlier, a curve folded by the snap, and that error says it too.
+TEST(ValidateCommand, PointsWrittenForAnotherBodySayHowFarTheyMoved) {
+  const std::string human = "/usr/share/assimp/models/Collada/human.zae";
+  if (!fs::exists(human)) GTEST_SKIP() << "assimp-testmodels' human.zae is not installed";
+  const fs::path dir = fs::temp_directory_path() / "sd-validate-moved";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const auto validate = [&](const std::string& design, const nlohmann::json& body) {
+    std::ifstream in(std::string(SD_SOURCE_DIR) + "/data/designs/" + design + ".json");
+    nlohmann::json sketch = nlohmann::json::parse(in, nullptr, true, /*ignore_comments=*/true);
+    if (!body.is_null()) sketch["body"] = body;
+    sketch["output"] = {{"images", nlohmann::json::array()}};
+    const fs::path file = dir / (design + (body.is_null() ? "" : "-moved") + ".json");
+    std::ofstream(file) << sketch.dump(2);
+    return run_sketchdrape("validate " + file.string());
+  };
+  const std::string said = "likely written for another body";
+  const nlohmann::json on_human = {{"mesh", human}};
+  for (const auto& [design, body] :
+       {std::pair<std::string, nlohmann::json>{"capelet", on_human},
+        std::pair<std::string, nlohmann::json>{"tank-human", "builtin"}}) {
+    const CommandResult own = validate(design, nullptr);
+    EXPECT_EQ(own.exit_code, 0) << own.output;
+    EXPECT_EQ(own.output.find(said), std::string::npos) << own.output;
+    const CommandResult other = validate(design, body);
+    const size_t warning = other.output.find(said);
+    ASSERT_NE(warning, std::string::npos) << other.output;
+    EXPECT_NE(other.output.find("/points3d/"), std::string::npos) << other.output;
+    EXPECT_NE(other.output.find("moved more than 6 cm"), std::string::npos) << other.output;
+    EXPECT_NE(other.output.find("near the "), std::string::npos) << other.output;
+    EXPECT_NE(other.output.find("relative to a landmark"), std::string::npos) << other.output;
+    // Before any error the moved curves lead to.
+    const size_t error = other.output.find("error:");
+    if (error != std::string::npos) {
+      EXPECT_LT(warning, error) << other.output;
+    }
+  }
+  const CommandResult folded = validate("tank-top", on_human);
+  EXPECT_EQ(folded.exit_code, 2) << folded.output;
+  EXPECT_NE(folded.output.find("moved farthest"), std::string::npos) << folded.output;
+  EXPECT_NE(folded.output.find(said), std::string::npos) << folded.output;
+  fs::remove_all(dir);
+}

@@ -173,6 +173,52 @@ TEST(StrokeProjection, Points3dFoldedBySnappingNameTheFarthestMove) {
   }
 }
 
+// Written points far off the body (written for another body) are named: the one that moved
+// farthest, by its JSON path and how far, and how many moved more than the limit; a point given
+// relative to a landmark is not counted (it follows its landmark), nor one a few centimetres off.
+TEST(StrokeProjection, WrittenPointsMovedFarOntoTheBodyAreNamed) {
+  const BodySurface body(meshing::icosphere(kRadius, 5, kCentre));
+  GarmentRequest sketch;
+  sketch.file = "t.json";
+  const auto curve = [&](const std::string& id, std::vector<Eigen::Vector3d> points,
+                         std::vector<bool> at_landmark) {
+    CurveSpec c;
+    c.id = id;
+    c.json_path = "/curves/" + std::to_string(sketch.curves.size());
+    c.points3d = std::move(points);
+    c.at_landmark = std::move(at_landmark);
+    c.offset = 0.01;
+    sketch.curves.push_back(c);
+  };
+  // On the sphere's offset surface (r = 0.31) at 2 and 3 cm out: near enough.
+  curve("near", {{0.0, 1.0, 0.33}, {0.0, 1.1, std::sqrt(0.34 * 0.34 - 0.01)}}, {false, false});
+  std::vector<ProjectedCurve> projected = project_curves(sketch, body);
+  ASSERT_EQ(projected[0].written_moves.size(), 2u);
+  EXPECT_NEAR(projected[0].written_moves[0], 0.02, 1e-3);  // the facets: within 1 mm
+  EXPECT_NEAR(projected[0].written_moves[1], 0.03, 1e-3);
+  EXPECT_EQ(moved_points_warning(sketch, projected, body), "");
+  // 9 cm out, and a landmark-relative point 15 cm out (the sphere has no landmarks: the flag is
+  // what the sketch reader sets).
+  curve("far", {{0.4, 1.0, 0.0}, {0.0, 1.0, -0.46}, {-0.31, 1.0, 0.0}}, {false, true, false});
+  projected = project_curves(sketch, body);
+  EXPECT_LT(projected[1].written_moves[1], 0.0) << "not counted";
+  const std::string said = moved_points_warning(sketch, projected, body);
+  EXPECT_NE(said.find("t.json: /curves/1/points3d/0: point 0 of curve 'far', written at (0.400, "
+                      "1.000, 0.000) m, moved 9.0 cm onto the body"),
+            std::string::npos)
+      << said;
+  EXPECT_NE(said.find("1 of the file's 4 written [x, y, z] points moved more than 6 cm"),
+            std::string::npos)
+      << said;
+  EXPECT_NE(said.find("\"at\""), std::string::npos) << said;
+  EXPECT_NE(said.find("Points relative to a landmark"), std::string::npos) << said;
+  // The curves off the body and view strokes are not snapped: not counted.
+  for (CurveSpec& c : sketch.curves) c.on_body = false;
+  projected = project_curves(sketch, body);
+  EXPECT_TRUE(projected[1].written_moves.empty());
+  EXPECT_EQ(moved_points_warning(sketch, projected, body), "");
+}
+
 TEST(StrokeProjection, SelfIntersectionFound) {
   const std::vector<Eigen::Vector2d> figure8 = {{0, 0}, {1, 1}, {1, 0}, {0, 1}};
   EXPECT_GE(find_self_intersection(figure8, false).first, 0);
