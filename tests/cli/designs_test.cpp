@@ -292,7 +292,123 @@ TEST(GatheredTier, FoldsUnderItsSeamMoreThanAnIsotropicEaseAndRests) {
   fs::remove_all(dir);
 }
 
-const std::vector<std::string> gathered_designs = {"tiered-skirt"};
+// The length of a garment's hem: its boundary edges within 8 cm of its lowest vertex (a skirt's
+// hem hangs lower than any other free edge). Gathered cloth that folds into flutes below its
+// seam carries its cut width down to the hem, so the hem grows from its drawn length towards
+// the gather; squeezed flat, it stays near the drawn one.
+double hem_length(const fs::path& obj) {
+  std::ifstream in(obj);
+  std::string line;
+  std::vector<Eigen::Vector3d> vertices;
+  std::map<std::pair<int, int>, int> edges;
+  while (std::getline(in, line)) {
+    std::istringstream s(line);
+    std::string tag;
+    s >> tag;
+    if (tag == "v") {
+      Eigen::Vector3d p;
+      s >> p.x() >> p.y() >> p.z();
+      vertices.push_back(p);
+    } else if (tag == "f") {
+      std::vector<int> f;
+      std::string token;
+      while (s >> token) f.push_back(std::stoi(token.substr(0, token.find('/'))) - 1);
+      for (size_t k = 0; k < f.size(); ++k) ++edges[std::minmax(f[k], f[(k + 1) % f.size()])];
+    }
+  }
+  double lowest = 1e300;
+  for (const auto& [edge, count] : edges)
+    lowest = std::min({lowest, vertices[static_cast<size_t>(edge.first)].y(),
+                       vertices[static_cast<size_t>(edge.second)].y()});
+  double length = 0;
+  for (const auto& [edge, count] : edges) {
+    const Eigen::Vector3d& a = vertices[static_cast<size_t>(edge.first)];
+    const Eigen::Vector3d& b = vertices[static_cast<size_t>(edge.second)];
+    if (count == 1 && a.y() < lowest + 0.08 && b.y() < lowest + 0.08) length += (a - b).norm();
+  }
+  return length;
+}
+
+// Trial 37's flounce skirt (data/designs/repro/flounce-skirt-human.json: a hip yoke and a flounce
+// gathered round the body) drapes at 1.6 and at 2.0, the largest gather a file may ask for,
+// starting gathered with the buckling compression (src/app/pipeline/cloth_scene.hpp, gathered;
+// with the linear compression it failed at t = 0.0004 s at 1.6), comes to rest outside the body,
+// and each mirror pair strains alike: at weft 1.5 the trial's yoke reached 58 % on one half and
+// 93 % on the other while the linear compression threw the skirt about. Its hem is longer than
+// drawn: the flounce hangs in flutes, not squeezed flat.
+nlohmann::json flounce_drape(const std::string& variant, double weft, const std::string& rest) {
+  const fs::path dir = fs::temp_directory_path() / "sd_designs_drape" / "flounce" / variant;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  nlohmann::json sketch =
+      read_json(fs::path(SD_SOURCE_DIR) / "data/designs/repro/flounce-skirt-human.json");
+  sketch["output"] = {{"images", nlohmann::json::array()}};
+  for (nlohmann::json& panel : sketch["panels"])
+    if (panel["id"].get<std::string>().rfind("flounce", 0) == 0) panel["ease"] = {{"weft", weft}};
+  sketch["simulate"]["rest"] = rest;
+  sketch["simulate"]["duration"] = 10.0;
+  std::ofstream(dir / "flounce.json") << sketch.dump(2);
+  const CommandResult meshed = run_sketchdrape("-q mesh " + (dir / "flounce.json").string() +
+                                               " -o " + (dir / "mesh").string());
+  EXPECT_EQ(meshed.exit_code, 0) << meshed.output;
+  const CommandResult ran = run_sketchdrape("-q run " + (dir / "flounce.json").string() + " -o " +
+                                            (dir / "run").string());
+  EXPECT_EQ(ran.exit_code, 0) << variant << ": " << ran.output;
+  nlohmann::json report = read_json(dir / "run" / "report.json");
+  report["hem_drawn_m"] = hem_length(dir / "mesh" / "garment.obj");
+  report["hem_draped_m"] = hem_length(dir / "run" / "drape.obj");
+  fs::remove_all(dir);
+  return report;
+}
+
+void expect_mirror_halves_alike(const nlohmann::json& report) {
+  std::map<std::string, nlohmann::json> strain;
+  for (const nlohmann::json& group : report["strain"])
+    strain[group["group"].get<std::string>()] = group;
+  int pairs = 0;
+  for (const auto& [name, group] : strain) {
+    if (!strain.contains(name + ".mirror")) continue;
+    const nlohmann::json& mirror = strain[name + ".mirror"];
+    ++pairs;
+    // Measured (27 November): the largest difference of the mean strains 0.6 % (flounce_back at
+    // 1.6), of the largest 2.3 %; the trial's thrown-about yoke differed by 35 %.
+    EXPECT_NEAR(group["strain_mean"].get<double>(), mirror["strain_mean"].get<double>(), 0.02)
+        << name;
+    EXPECT_NEAR(group["strain_max"].get<double>(), mirror["strain_max"].get<double>(), 0.08)
+        << name;
+  }
+  EXPECT_EQ(pairs, 6);
+}
+
+// The hem of trial 37's flounce (on its own variant body) measured against its drawn 1.46 m:
+// squeezed flat, 1.26 times (shaped, buckling, weft 1.6) and 1.28 (flat, weft 1.5, the trial's);
+// starting gathered, 1.56 and 1.46. Half-way.
+constexpr double kFlutedHem = 1.37;
+
+TEST(GatheredFlounce, DrapesAtOnePointSixAndTwoToRestWithMirrorHalvesAlike) {
+  if (!fs::exists("/usr/share/assimp/models/Collada/human.zae"))
+    GTEST_SKIP() << "the Collada human is not installed";
+  for (const double weft : {1.6, 2.0}) {
+    const nlohmann::json report = flounce_drape("shaped-" + std::to_string(weft), weft, "shaped");
+    SCOPED_TRACE(weft);
+    expect_at_rest_outside_the_body(report);
+    EXPECT_EQ(report["compression"], "buckling");
+    expect_mirror_halves_alike(report);
+    EXPECT_GT(report["hem_draped_m"].get<double>(),
+              kFlutedHem * report["hem_drawn_m"].get<double>());
+  }
+}
+
+TEST(GatheredFlounce, FromFlatClothFoldsIntoFlutes) {
+  if (!fs::exists("/usr/share/assimp/models/Collada/human.zae"))
+    GTEST_SKIP() << "the Collada human is not installed";
+  const nlohmann::json report = flounce_drape("flat-1.5", 1.5, "flat");
+  expect_at_rest_outside_the_body(report);
+  expect_mirror_halves_alike(report);
+  EXPECT_GT(report["hem_draped_m"].get<double>(), kFlutedHem * report["hem_drawn_m"].get<double>());
+}
+
+const std::vector<std::string> gathered_designs = {"tiered-skirt", "gathered-dirndl-skirt"};
 
 // Every design in data/designs is draped by one of the lists above: a design added to the
 // corpus without a drape would only be meshed.
