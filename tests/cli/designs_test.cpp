@@ -185,8 +185,10 @@ INSTANTIATE_TEST_SUITE_P(Corpus, DesignDrapeTop, ::testing::ValuesIn(other_desig
 // penetration. Wall time at load 10-11 on the 2 cores: maxi-dress 62 s, gored-midi-skirt 63 s,
 // long-aline-skirt-human 57 s, slit-maxi-skirt 68 s (and pencil-skirt-plain 9 s above); the whole
 // of designs_tests took 105 s wall at -j2 and load 4-8.
+// The gathered dirndl skirt (27 November): 29 s of CPU for its first 10 s, not yet at rest.
 const std::vector<std::string> long_garments = {"maxi-dress", "gored-midi-skirt",
-                                                "long-aline-skirt-human", "slit-maxi-skirt"};
+                                                "long-aline-skirt-human", "slit-maxi-skirt",
+                                                "gathered-dirndl-skirt"};
 
 INSTANTIATE_TEST_SUITE_P(Long, DesignDrapeTop, ::testing::ValuesIn(long_garments), test_name);
 
@@ -346,7 +348,7 @@ nlohmann::json flounce_drape(const std::string& variant, double weft, const std:
   for (nlohmann::json& panel : sketch["panels"])
     if (panel["id"].get<std::string>().rfind("flounce", 0) == 0) panel["ease"] = {{"weft", weft}};
   sketch["simulate"]["rest"] = rest;
-  sketch["simulate"]["duration"] = 10.0;
+  sketch["simulate"]["duration"] = 20.0;  // as the tiered skirt's; the run stops at rest
   std::ofstream(dir / "flounce.json") << sketch.dump(2);
   const CommandResult meshed = run_sketchdrape("-q mesh " + (dir / "flounce.json").string() +
                                                " -o " + (dir / "mesh").string());
@@ -357,7 +359,7 @@ nlohmann::json flounce_drape(const std::string& variant, double weft, const std:
   nlohmann::json report = read_json(dir / "run" / "report.json");
   report["hem_drawn_m"] = hem_length(dir / "mesh" / "garment.obj");
   report["hem_draped_m"] = hem_length(dir / "run" / "drape.obj");
-  fs::remove_all(dir);
+  if (!::testing::Test::HasFailure()) fs::remove_all(dir);
   return report;
 }
 
@@ -370,11 +372,15 @@ void expect_mirror_halves_alike(const nlohmann::json& report) {
     if (!strain.contains(name + ".mirror")) continue;
     const nlohmann::json& mirror = strain[name + ".mirror"];
     ++pairs;
-    // Measured (27 November): the largest difference of the mean strains 0.6 % (flounce_back at
-    // 1.6), of the largest 2.3 %; the trial's thrown-about yoke differed by 35 %.
+    // Measured (27 November, shaped 1.6 on the Collada human, at rest at 14.1 s): the mean
+    // strains of a pair differ by 0.4 % at most, the largest stretches by 2.3 % (flounce_back:
+    // 1.3 % and 3.6 %). strain_max is not compared: it is one triangle's worst, and the rows at
+    // the gathered seam hold the gather as buckled compression, which costs the same at any
+    // depth (0.40 and 0.70 on flounce_front's pair). The trial's yoke pair, 0.58 and 0.93, had
+    // the mean 0.036 and stretch_max 0.45 and 0.46: one triangle's worst in a drape thrown about.
     EXPECT_NEAR(group["strain_mean"].get<double>(), mirror["strain_mean"].get<double>(), 0.02)
         << name;
-    EXPECT_NEAR(group["strain_max"].get<double>(), mirror["strain_max"].get<double>(), 0.08)
+    EXPECT_NEAR(group["stretch_max"].get<double>(), mirror["stretch_max"].get<double>(), 0.04)
         << name;
   }
   EXPECT_EQ(pairs, 6);
@@ -408,7 +414,7 @@ TEST(GatheredFlounce, FromFlatClothFoldsIntoFlutes) {
   EXPECT_GT(report["hem_draped_m"].get<double>(), kFlutedHem * report["hem_drawn_m"].get<double>());
 }
 
-const std::vector<std::string> gathered_designs = {"tiered-skirt", "gathered-dirndl-skirt"};
+const std::vector<std::string> gathered_designs = {"tiered-skirt"};
 
 // Every design in data/designs is draped by one of the lists above: a design added to the
 // corpus without a drape would only be meshed.
