@@ -459,7 +459,7 @@ void build_garment_scene(const scene::Sketch& sketch, ClothScene& scene) {
   scene.start = arrays.rest_positions;
   pin_above(sketch, scene);
   flat_rest_shapes(sketch, g, m48, frames, scene);
-  scene.gathered_panels = gather_start(g, frames, scene);
+  if (sketch.simulate.gather_start) scene.gathered_panels = gather_start(g, frames, scene);
   scene.mesh48 = std::move(m48);
   scene.garment = std::move(g);
 }

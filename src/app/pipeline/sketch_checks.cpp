@@ -120,18 +120,22 @@ std::vector<std::string> gather_warnings(const scene::Sketch& sketch) {
         scene_fabric(sketch, panel.fabric, panel.json_path + "/fabric");
     const double stiffness = weft ? fabric.stretch_weft : fabric.stretch_warp;
     const double strain = 1.0 - 1.0 / ratio;
-    // The gather starts as a spring squeezed by `strain` and unloads at about the strain times
-    // the fabric's wave speed √(K/ρ) (docs/pattern.md, "A gather draped from flat cloth").
+    // The rows at the gathered seam stay squeezed by `strain` (the rest of the panel starts
+    // folded into flutes: cloth_scene.cpp, gather_start), and the linear model answers that with
+    // K·strain, which stretches the seam open; a panel that starts as drawn (no gathered seam)
+    // is squeezed whole and springs out at about the strain times the fabric's wave speed
+    // √(K/ρ) (docs/pattern.md, "A gather draped from flat cloth").
     const double speed = strain * std::sqrt(stiffness / fabric.area_density);
     warnings.push_back(fmt::format(
         "{}: {}/ease: panel '{}' is gathered {:g} : 1 along its {}, but \"simulate\": "
-        "{{\"compression\": \"linear\"}} answers the gather with the fabric's tensile "
-        "stiffness: the panel starts {:.0f} % short of its cut size along the gather and springs "
-        "out at about {:.0f} m/s ({} at {:g} N/m; a step fails above 50 m/s), or holds the seam it "
-        "is gathered into stretched; leave \"compression\" out (a gathered drape gets "
+        "{{\"compression\": \"linear\"}} answers a gather with the fabric's tensile "
+        "stiffness: the cloth at the gathered seam is {:.0f} % shorter than cut and pushes that "
+        "seam open with {:.0f} N/m ({} at {:g} N/m; trial 37's flounce at 1.5 stretched its yoke "
+        "45 % and was thrown about), and cloth squeezed so springs out at about {:.0f} m/s (a "
+        "step fails above 50 m/s); leave \"compression\" out (a gathered drape gets "
         "\"buckling\") or gather by {:g} or less",
-        sketch.file, panel.json_path, panel.id, ratio, weft ? "weft" : "warp", 100 * strain, speed,
-        fabric.name, stiffness, kGatherEase));
+        sketch.file, panel.json_path, panel.id, ratio, weft ? "weft" : "warp", 100 * strain,
+        stiffness * strain, fabric.name, stiffness, speed, kGatherEase));
   }
   return warnings;
 }
