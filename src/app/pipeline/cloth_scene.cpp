@@ -413,7 +413,9 @@ void build_garment_scene(const scene::Sketch& sketch, ClothScene& scene) {
   scene.bend_model =
       sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::hinges);
   scene.compression =
-      !sketch.simulate.compression_given && (gathered_flat(sketch) || gathered(sketch))
+      // "gather_start": false keeps a shaped gather's drape as it was before trial 37 (linear).
+      !sketch.simulate.compression_given &&
+              (gathered_flat(sketch) || (gathered(sketch) && sketch.simulate.gather_start))
           ? sim::Compression::buckling
           : sim::parse_compression(sketch.simulate.compression).value_or(sim::Compression::linear);
   const garment::PanelSpec* first_spec = sketch.find_panel(first.id);
