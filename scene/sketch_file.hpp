@@ -65,6 +65,9 @@ struct SimulateSpec {
   // released at no load (ContactSettings::fade_carried_push, docs/collision.md). Unset: on when
   // any panel rests flat, off for shaped rest (docs/pattern.md, "Drapes that do not rest").
   std::optional<bool> fade_carried_push;
+  // A gathered panel starts folded into flutes as long as it is cut (docs/pattern.md, "Gathers
+  // that start gathered"); false: as drawn, squeezed along the gather.
+  bool gather_start = true;
   // The cloth's rest shape: "shaped" (each triangle as drawn on the body) or "flat" (the
   // triangle in the panel's flattened pattern piece, docs/pattern.md). Panels may override it.
   std::string rest = "shaped";

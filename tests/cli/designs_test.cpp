@@ -288,6 +288,141 @@ TEST(GatheredTier, FoldsUnderItsSeamMoreThanAnIsotropicEaseAndRests) {
   fs::remove_all(dir);
 }
 
+// The length of a garment's hem: its boundary edges within 8 cm of its lowest vertex (a skirt's
+// hem hangs lower than any other free edge). Gathered cloth that folds into flutes below its
+// seam carries its cut width down to the hem, so the hem grows from its drawn length towards
+// the gather; squeezed flat, it stays near the drawn one.
+double hem_length(const fs::path& obj) {
+  std::ifstream in(obj);
+  std::string line;
+  std::vector<Eigen::Vector3d> vertices;
+  std::map<std::pair<int, int>, int> edges;
+  while (std::getline(in, line)) {
+    std::istringstream s(line);
+    std::string tag;
+    s >> tag;
+    if (tag == "v") {
+      Eigen::Vector3d p;
+      s >> p.x() >> p.y() >> p.z();
+      vertices.push_back(p);
+    } else if (tag == "f") {
+      std::vector<int> f;
+      std::string token;
+      while (s >> token) f.push_back(std::stoi(token.substr(0, token.find('/'))) - 1);
+      for (size_t k = 0; k < f.size(); ++k) ++edges[std::minmax(f[k], f[(k + 1) % f.size()])];
+    }
+  }
+  double lowest = 1e300;
+  for (const auto& [edge, count] : edges)
+    lowest = std::min({lowest, vertices[static_cast<size_t>(edge.first)].y(),
+                       vertices[static_cast<size_t>(edge.second)].y()});
+  double length = 0;
+  for (const auto& [edge, count] : edges) {
+    const Eigen::Vector3d& a = vertices[static_cast<size_t>(edge.first)];
+    const Eigen::Vector3d& b = vertices[static_cast<size_t>(edge.second)];
+    if (count == 1 && a.y() < lowest + 0.08 && b.y() < lowest + 0.08) length += (a - b).norm();
+  }
+  return length;
+}
+
+// Trial 37's flounce skirt (data/designs/repro/flounce-skirt-human.json: a hip yoke and a flounce
+// gathered round the body) drapes at 1.6 and at 2.0, the largest gather a file may ask for,
+// starting gathered with the buckling compression (src/app/pipeline/cloth_scene.hpp, gathered;
+// with the linear compression it failed at t = 0.0004 s at 1.6), comes to rest outside the body,
+// and each mirror pair strains alike: at weft 1.5 the trial's yoke reached 58 % on one half and
+// 93 % on the other while the linear compression threw the skirt about. Its hem is longer than
+// drawn: the flounce hangs in flutes, not squeezed flat.
+nlohmann::json flounce_drape(const std::string& variant, double weft, const std::string& rest) {
+  const fs::path dir = fs::temp_directory_path() / "sd_designs_drape" / "flounce" / variant;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  nlohmann::json sketch =
+      read_json(fs::path(SD_SOURCE_DIR) / "data/designs/repro/flounce-skirt-human.json");
+  sketch["output"] = {{"images", nlohmann::json::array()}};
+  for (nlohmann::json& panel : sketch["panels"])
+    if (panel["id"].get<std::string>().rfind("flounce", 0) == 0) panel["ease"] = {{"weft", weft}};
+  sketch["simulate"]["rest"] = rest;
+  sketch["simulate"]["duration"] = 20.0;  // as the tiered skirt's; the run stops at rest
+  std::ofstream(dir / "flounce.json") << sketch.dump(2);
+  const CommandResult meshed = run_sketchdrape("-q mesh " + (dir / "flounce.json").string() +
+                                               " -o " + (dir / "mesh").string());
+  EXPECT_EQ(meshed.exit_code, 0) << meshed.output;
+  const CommandResult ran = run_sketchdrape("-q run " + (dir / "flounce.json").string() + " -o " +
+                                            (dir / "run").string());
+  EXPECT_EQ(ran.exit_code, 0) << variant << ": " << ran.output;
+  nlohmann::json report = read_json(dir / "run" / "report.json");
+  report["hem_drawn_m"] = hem_length(dir / "mesh" / "garment.obj");
+  report["hem_draped_m"] = hem_length(dir / "run" / "drape.obj");
+  if (!::testing::Test::HasFailure()) fs::remove_all(dir);
+  return report;
+}
+
+void expect_mirror_halves_alike(const nlohmann::json& report) {
+  std::map<std::string, nlohmann::json> strain;
+  for (const nlohmann::json& group : report["strain"])
+    strain[group["group"].get<std::string>()] = group;
+  int pairs = 0;
+  for (const auto& [name, group] : strain) {
+    if (!strain.contains(name + ".mirror")) continue;
+    const nlohmann::json& mirror = strain[name + ".mirror"];
+    ++pairs;
+    // Measured (27 November, shaped 1.6 on the Collada human, at rest at 14.1 s): the mean
+    // strains of a pair differ by 0.4 % at most, the largest stretches by 2.3 % (flounce_back:
+    // 1.3 % and 3.6 %). strain_max is not compared: it is one triangle's worst, and the rows at
+    // the gathered seam hold the gather as buckled compression, which costs the same at any
+    // depth (0.40 and 0.70 on flounce_front's pair). The trial's yoke pair, 0.58 and 0.93, had
+    // the mean 0.036 and stretch_max 0.45 and 0.46: one triangle's worst in a drape thrown about.
+    EXPECT_NEAR(group["strain_mean"].get<double>(), mirror["strain_mean"].get<double>(), 0.02)
+        << name;
+    EXPECT_NEAR(group["stretch_max"].get<double>(), mirror["stretch_max"].get<double>(), 0.04)
+        << name;
+  }
+  EXPECT_EQ(pairs, 6);
+}
+
+// The hem of trial 37's flounce (on its own variant body) measured against its drawn 1.46 m:
+// squeezed flat, 1.26 times (shaped, buckling, weft 1.6) and 1.28 (flat, weft 1.5, the trial's);
+// starting gathered, 1.56 and 1.46. Half-way.
+constexpr double kFlutedHem = 1.37;
+
+// A gathered drape that is not at rest within its 20 s still must not be thrown about: the
+// trial's flounce at 1.5 still moved at 1.2 m/s after 4 s. Measured at 20 s (27 November): the
+// flat 1.5 drape 0.55 cm/s, the shaped 2.0 one 10.7 cm/s (docs/pattern.md, "Gathers that start
+// gathered"): about twice those.
+void expect_calm_outside_the_body(const nlohmann::json& report, double speed) {
+  EXPECT_EQ(report["penetrating_vertices_final"].get<int>(), 0);
+  if (!report["at_rest"].get<bool>()) {
+    EXPECT_LT(report["rest"]["speed_final_m_s"].get<double>(), speed);
+  }
+}
+
+TEST(GatheredFlounce, DrapesAtOnePointSixToRestAndAtTwoWithMirrorHalvesAlike) {
+  if (!fs::exists("/usr/share/assimp/models/Collada/human.zae"))
+    GTEST_SKIP() << "the Collada human is not installed";
+  for (const double weft : {1.6, 2.0}) {
+    const nlohmann::json report = flounce_drape("shaped-" + std::to_string(weft), weft, "shaped");
+    SCOPED_TRACE(weft);
+    if (weft == 1.6) {
+      expect_at_rest_outside_the_body(report);  // at rest at 14.07 s
+    } else {
+      expect_calm_outside_the_body(report, 0.2);
+    }
+    EXPECT_EQ(report["compression"], "buckling");
+    expect_mirror_halves_alike(report);
+    EXPECT_GT(report["hem_draped_m"].get<double>(),
+              kFlutedHem * report["hem_drawn_m"].get<double>());
+  }
+}
+
+TEST(GatheredFlounce, FromFlatClothFoldsIntoFlutes) {
+  if (!fs::exists("/usr/share/assimp/models/Collada/human.zae"))
+    GTEST_SKIP() << "the Collada human is not installed";
+  const nlohmann::json report = flounce_drape("flat-1.5", 1.5, "flat");
+  expect_calm_outside_the_body(report, 0.012);
+  expect_mirror_halves_alike(report);
+  EXPECT_GT(report["hem_draped_m"].get<double>(), kFlutedHem * report["hem_drawn_m"].get<double>());
+}
+
 const std::vector<std::string> gathered_designs = {"tiered-skirt"};
 
 // Every design in data/designs is draped by one of the lists above: a design added to the

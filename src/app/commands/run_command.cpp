@@ -334,7 +334,8 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   // One driver: the cloth's 4-8 mesh, adapting or not (a sheet that does not adapt drapes on its
   // own triangles).
   RunReport out;                           // report.json, filled as the drape goes
-  out.warnings = fabric_warnings(sketch);  // logged by check_sketch
+  out.warnings = fabric_warnings(sketch);  // logged by check_sketch, as are the gather warnings
+  for (std::string& warning : gather_warnings(sketch)) out.warnings.push_back(std::move(warning));
   // The body's repairs and defects (an open body, inconsistent triangles), logged as it loaded.
   if (scene.body)
     out.warnings.insert(out.warnings.end(), scene.body->warnings.begin(),

@@ -241,6 +241,165 @@ void flat_rest_shapes(const scene::Sketch& sketch, const garment::Garment& g,
     throw std::runtime_error("flat rest: a triangle's vertex is missing from its pattern piece");
 }
 
+// The slope of a gathered panel's flutes: a sine of height A (0 to A) and period P has the slope
+// π·A/P·sin(2π·s/P), and its length over one period is P times the mean of sqrt(1 + m²·sin²)
+// with m = π·A/P. The m at which that mean is `ratio` (a flute profile as long as the cloth cut
+// `ratio` times the seam), by bisection; 1.9 for 1.6, 2.6 for 2.
+double flute_slope(double ratio) {
+  const auto stretch = [](double m) {
+    constexpr int kSamples = 64;  // midpoint rule over a period; exact to 1e-6 here
+    double sum = 0;
+    for (int i = 0; i < kSamples; ++i) {
+      const double s = std::sin(std::numbers::pi * (i + 0.5) / kSamples);
+      sum += std::sqrt(1.0 + m * m * s * s);
+    }
+    return sum / kSamples;
+  };
+  double low = 0.0, high = 10.0;
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (low + high);
+    (stretch(mid) < ratio ? low : high) = mid;
+  }
+  return 0.5 * (low + high);
+}
+
+// A gathered panel (gather_ratio above kGatherEase) starts gathered, as cloth is when its
+// gathering thread has been drawn up. Drawn at the length of the seam it is sewn to, it started
+// 1 − 1/ratio short of its rest along the gather, and even with the buckling compression (where
+// that costs only the Euler load) it stayed so, squeezed flat: trial 37's flounce at weft 1.5,
+// from flat cloth, hung as a plain A-line, 35 % compressed, with no flute. Here its cloth is
+// folded out along its normal into flutes of period P (four of the panel's mean edge lengths, a
+// flute the mesh resolves) and height h (flute_slope: the profile h·(1 − cos(2π·s/P))/2, s the
+// coordinate along the gather on the flattened piece, is `ratio` times as long as its chord, so
+// the mirror copy's flutes are the reflection). The vertices on its seams stay; below the
+// gathered seam each flute leaves it at an angle and bends parallel to the drawn surface 2·h
+// down it, keeping every vertex's distance from the seam. The rows next to the seam keep the
+// rest of the gather as buckled compression. Flat cloth's rest ramp then starts from the
+// gathered length, not the drawn one. Returns the panels gathered so.
+int gather_start(const garment::Garment& g, const garment::MaterialFrames& frames,
+                 ClothScene& scene) {
+  std::vector<double> ratio(g.panels.size(), 1.0);
+  bool any = false;
+  for (size_t p = 0; p < g.panels.size(); ++p) {
+    ratio[p] = gather_ratio(g.panels[p].ease);
+    any = any || ratio[p] > kGatherEase;
+  }
+  if (!any) return 0;
+  std::optional<garment::FlatPattern> flattened;
+  const garment::FlatPattern* pattern = scene.flat_pattern ? &*scene.flat_pattern : nullptr;
+  if (!pattern) {
+    try {
+      garment::FlatteningOptions options;
+      options.straight_centre_cost = -1;  // as the flat rest's (flat_rest_shapes)
+      flattened = garment::flatten_garment(g, options);
+      pattern = &*flattened;
+    } catch (const garment::PatternError& e) {
+      // A piece that cannot be flattened (validate says so) drapes as drawn, ungathered.
+      spdlog::debug("the gathered panels start as drawn: {}", e.what());
+      return 0;
+    }
+  }
+  const Eigen::Index nv = g.mesh.vertex_count();
+  // Per vertex: the panels it belongs to (a seam vertex has two or more).
+  std::vector<std::vector<int>> vertex_panels(static_cast<size_t>(nv));
+  for (Eigen::Index q = 0; q < g.mesh.face_count(); ++q)
+    for (int k = 0; k < 4; ++k) {
+      std::vector<int>& list = vertex_panels[static_cast<size_t>(g.mesh.faces(q, k))];
+      if (std::find(list.begin(), list.end(), g.face_panel(q)) == list.end())
+        list.push_back(g.face_panel(q));
+    }
+  std::vector<char> starts_gathered(g.panels.size(), 0);
+  for (const garment::FlatPanel& piece : pattern->panels) {
+    const auto p = static_cast<size_t>(piece.panel);
+    if (ratio[p] <= kGatherEase) continue;
+    const garment::PanelEase& ease = g.panels[p].ease;
+    // The piece's x is across the grain (the weft), y along it (FlatPanel::uv).
+    const int along = ease.weft > ease.warp ? 0 : 1;
+    // Per vertex: the panel's normal, warp and weft (summed over its quads), and its mean edge.
+    Eigen::MatrixX3d normal = Eigen::MatrixX3d::Zero(nv, 3), warp = normal, weft = normal;
+    double edge_sum = 0;
+    int edges = 0;
+    for (Eigen::Index q = 0; q < g.mesh.face_count(); ++q) {
+      if (g.face_panel(q) != piece.panel) continue;
+      for (int k = 0; k < 4; ++k) {
+        const int v = g.mesh.faces(q, k);
+        normal.row(v) += frames.normal.row(q);
+        warp.row(v) += frames.warp.row(q);
+        weft.row(v) += frames.weft.row(q);
+        edge_sum +=
+            (g.mesh.vertices.row(v) - g.mesh.vertices.row(g.mesh.faces(q, (k + 1) % 4))).norm();
+        ++edges;
+      }
+    }
+    if (edges == 0) continue;
+    const double period = 4.0 * edge_sum / edges;
+    const double height = flute_slope(ratio[p]) * period / std::numbers::pi;
+    // The piece's seams: those running along the gather (the gathered seam), the others (a side
+    // seam, across the gather), by the direction of each seam edge of the outline.
+    std::vector<Eigen::Vector2d> gathered_seam, cross_seam;
+    const auto shared = [&](int local) {
+      return vertex_panels[static_cast<size_t>(piece.vertices[static_cast<size_t>(local)])].size() >
+             1;
+    };
+    for (size_t b = 0; b < piece.boundary.size(); ++b) {
+      const int i = piece.boundary[b], j = piece.boundary[(b + 1) % piece.boundary.size()];
+      if (!shared(i) || !shared(j)) continue;
+      const Eigen::Vector2d a = piece.uv.row(i).transpose(), c = piece.uv.row(j).transpose();
+      const Eigen::Vector2d d = c - a;
+      auto& list = std::abs(d(along)) > std::abs(d(1 - along)) ? gathered_seam : cross_seam;
+      list.push_back(a);
+      list.push_back(0.5 * (a + c));
+      list.push_back(c);
+    }
+    if (gathered_seam.empty()) continue;
+    // Each flute leaves the gathered seam at the angle asin(h/kBend) and turns back parallel to
+    // the drawn surface kBend down it, h = height·(1 − cos(2π·s/P))/2 out: along the warp every
+    // vertex keeps its distance from the seam (the cloth is bent, not stretched), and from kBend
+    // on the gathered direction is as long as the cloth is cut. Next to a cross seam (fixed) the
+    // flutes grow over one period.
+    const double bend = 2.0 * height;
+    for (size_t l = 0; l < piece.vertices.size(); ++l) {
+      const int v = piece.vertices[l];
+      if (shared(static_cast<int>(l)) || normal.row(v).norm() == 0.0) continue;
+      const Eigen::Vector2d at = piece.uv.row(static_cast<Eigen::Index>(l)).transpose();
+      double distance = std::numeric_limits<double>::infinity(), across = distance;
+      Eigen::Vector2d from = at;
+      for (const Eigen::Vector2d& s : gathered_seam)
+        if ((s - at).norm() < distance) {
+          distance = (s - at).norm();
+          from = s;
+        }
+      for (const Eigen::Vector2d& s : cross_seam) across = std::min(across, (s - at).norm());
+      const double c = std::min(across / period, 1.0);
+      const double out = height * c * c * (3.0 - 2.0 * c) * 0.5 *
+                         (1.0 - std::cos(2.0 * std::numbers::pi * at(along) / period));
+      const double run = std::min(distance, bend);
+      const double angle = std::asin(std::min(out / bend, 1.0));
+      // Away from the seam on the piece, in 3D: the piece's y is the warp, its x minus the weft.
+      const Eigen::Vector2d away = (at - from) / std::max(distance, 1e-12);
+      const Eigen::RowVector3d down =
+          (away.y() * warp.row(v).normalized() - away.x() * weft.row(v).normalized()).normalized();
+      scene.start.row(v) +=
+          run * std::sin(angle) * normal.row(v).normalized() - run * (1.0 - std::cos(angle)) * down;
+    }
+    starts_gathered[p] = 1;
+  }
+  // Flat cloth's ramp (flat_rest_shapes) starts from the drawn triangles divided by the ease;
+  // a gathered panel now starts gathered, `ratio` times longer along the gather than drawn, so its
+  // start is divided by the smaller factor only.
+  if (scene.start_rest_uv.rows() > 0 && scene.face_ease.cols() == 2)
+    for (Eigen::Index t = 0; t < scene.start_rest_uv.rows(); ++t) {
+      if (!starts_gathered[static_cast<size_t>(g.face_panel(scene.triangle_face(t)))]) continue;
+      const auto ease = scene.face_ease.row(scene.triangle_face(t));
+      const double low = std::min(ease(0), ease(1));
+      for (int k = 0; k < 3; ++k) {
+        scene.start_rest_uv(t, 2 * k) *= ease(0) / low;
+        scene.start_rest_uv(t, 2 * k + 1) *= ease(1) / low;
+      }
+    }
+  return static_cast<int>(std::count(starts_gathered.begin(), starts_gathered.end(), 1));
+}
+
 void build_garment_scene(const scene::Sketch& sketch, ClothScene& scene) {
   MeshedGarment meshed = mesh_garment(sketch);  // the stage `mesh` writes out
   scene.body = std::move(meshed.body);
@@ -254,7 +413,9 @@ void build_garment_scene(const scene::Sketch& sketch, ClothScene& scene) {
   scene.bend_model =
       sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::hinges);
   scene.compression =
-      !sketch.simulate.compression_given && gathered_flat(sketch)
+      // "gather_start": false keeps a shaped gather's drape as it was before trial 37 (linear).
+      !sketch.simulate.compression_given &&
+              (gathered_flat(sketch) || (gathered(sketch) && sketch.simulate.gather_start))
           ? sim::Compression::buckling
           : sim::parse_compression(sketch.simulate.compression).value_or(sim::Compression::linear);
   const garment::PanelSpec* first_spec = sketch.find_panel(first.id);
@@ -300,6 +461,7 @@ void build_garment_scene(const scene::Sketch& sketch, ClothScene& scene) {
   scene.start = arrays.rest_positions;
   pin_above(sketch, scene);
   flat_rest_shapes(sketch, g, m48, frames, scene);
+  if (sketch.simulate.gather_start) scene.gathered_panels = gather_start(g, frames, scene);
   scene.mesh48 = std::move(m48);
   scene.garment = std::move(g);
 }
@@ -375,6 +537,15 @@ bool gathered_flat(const scene::Sketch& sketch) {
     return panel.rest.value_or(sketch.simulate.rest) == "flat" &&
            std::max(panel.ease.warp, panel.ease.weft) > kGatherEase;
   });
+}
+
+double gather_ratio(const garment::PanelEase& ease) {
+  return std::max(ease.warp, ease.weft) / std::min(ease.warp, ease.weft);
+}
+
+bool gathered(const scene::Sketch& sketch) {
+  return std::any_of(sketch.panels.begin(), sketch.panels.end(),
+                     [](const auto& panel) { return gather_ratio(panel.ease) > kGatherEase; });
 }
 
 double rest_ramp_of(const scene::Sketch& sketch) {

@@ -61,6 +61,9 @@ struct ClothScene {
   // the rest ramp starts, and the ramp's time (simulate.rest_ramp, s; 0: none).
   Eigen::MatrixXd start_rest_uv;
   double rest_ramp = 0.0;
+  // Panels that start gathered (cloth_scene.cpp, gather_start): their cloth folded out along its
+  // normal into flutes as long as it is cut.
+  int gathered_panels = 0;
   sim::BendModel bend_model = sim::BendModel::hinges;  // simulate.bending
   // simulate.compression
   sim::Compression compression = sim::Compression::linear;
@@ -122,6 +125,16 @@ sim::FabricParameters scene_fabric(const scene::Sketch& sketch, const std::strin
 constexpr double kGatherEase = 1.1;  // released at once: 9 % compression, 20 m/s in cotton
 constexpr double kGatherRamp = 1.0;  // s
 bool gathered_flat(const scene::Sketch& sketch);
+// How many times longer a panel is cut along one direction of its cloth than along the other:
+// max/min of its warp and weft ease ({"weft": 1.6}: 1.6; a number, 1). Above kGatherEase the
+// panel is gathered into the seams that run that way, whatever its rest shape.
+double gather_ratio(const garment::PanelEase& ease);
+// Whether any panel, shaped or flat, has a gather_ratio above kGatherEase. Shaped, such a panel
+// starts 1 − 1/ratio short of its rest along the gather as well, and with the linear compression
+// trial 37's flounce (weft 1.6) failed at t = 0.0004 s (50.7 m/s) and at weft 1.5 held the
+// flounce out at K·ε against the yoke above it (45 % stretch at the seam, still moving at
+// 1.2 m/s after 4 s): such a drape gets the buckling compression unless its file says otherwise.
+bool gathered(const scene::Sketch& sketch);
 // s: the rest ramp of a drape (ClothScene::rest_ramp): the file's `simulate.rest_ramp`, else
 // kGatherRamp for a gathered flat drape (gathered_flat), else 0.
 double rest_ramp_of(const scene::Sketch& sketch);

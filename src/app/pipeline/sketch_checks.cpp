@@ -105,6 +105,39 @@ void check_sketch(const scene::Sketch& sketch) {
     if (panel.fabric != sketch.fabric) check_fabric(panel.fabric, panel.json_path + "/fabric");
   (void)simulation_settings(sketch);
   for (const std::string& warning : fabric_warnings(sketch)) spdlog::warn("{}", warning);
+  for (const std::string& warning : gather_warnings(sketch)) spdlog::warn("{}", warning);
+}
+
+std::vector<std::string> gather_warnings(const scene::Sketch& sketch) {
+  std::vector<std::string> warnings;
+  if (!sketch.simulate.compression_given || sketch.simulate.compression != "linear")
+    return warnings;
+  for (const garment::PanelSpec& panel : sketch.panels) {
+    const double ratio = gather_ratio(panel.ease);
+    if (ratio <= kGatherEase) continue;
+    const bool weft = panel.ease.weft > panel.ease.warp;
+    const sim::FabricParameters fabric =
+        scene_fabric(sketch, panel.fabric, panel.json_path + "/fabric");
+    const double stiffness = weft ? fabric.stretch_weft : fabric.stretch_warp;
+    const double strain = 1.0 - 1.0 / ratio;
+    // The rows at the gathered seam stay squeezed by `strain` (the rest of the panel starts
+    // folded into flutes: cloth_scene.cpp, gather_start), and the linear model answers that with
+    // K·strain, which stretches the seam open; a panel that starts as drawn (no gathered seam)
+    // is squeezed whole and springs out at about the strain times the fabric's wave speed
+    // √(K/ρ) (docs/pattern.md, "A gather draped from flat cloth").
+    const double speed = strain * std::sqrt(stiffness / fabric.area_density);
+    warnings.push_back(fmt::format(
+        "{}: {}/ease: panel '{}' is gathered {:g} : 1 along its {}, but \"simulate\": "
+        "{{\"compression\": \"linear\"}} answers a gather with the fabric's tensile "
+        "stiffness: the cloth at the gathered seam is {:.0f} % shorter than cut and pushes that "
+        "seam open with {:.0f} N/m ({} at {:g} N/m; trial 37's flounce at 1.5 stretched its yoke "
+        "45 % and was thrown about), and cloth squeezed so springs out at about {:.0f} m/s (a "
+        "step fails above 50 m/s); leave \"compression\" out (a gathered drape gets "
+        "\"buckling\") or gather by {:g} or less",
+        sketch.file, panel.json_path, panel.id, ratio, weft ? "weft" : "warp", 100 * strain,
+        stiffness * strain, fabric.name, stiffness, speed, kGatherEase));
+  }
+  return warnings;
 }
 
 std::vector<std::string> fabric_warnings(const scene::Sketch& sketch) {

@@ -23,6 +23,12 @@ void check_sketch(const scene::Sketch& sketch);
 // report.json. Call after check_sketch (a bad fabric is not reported here).
 std::vector<std::string> fabric_warnings(const scene::Sketch& sketch);
 
+// A panel gathered more than kGatherEase : 1 (cloth_scene.hpp, gather_ratio) in a drape whose
+// file asks for the linear compression, which cannot drape it (trial 37's flounce at weft 1.6:
+// 50.7 m/s at t = 0.0004 s): one "<file>: <JSON path>: <sentence>" line per such panel, with
+// what to change. Logged by check_sketch.
+std::vector<std::string> gather_warnings(const scene::Sketch& sketch);
+
 // What a run may use: --max-memory (default: 60 % of the memory the system has available now)
 // and --max-time (default: none).
 struct RunLimits {
