@@ -285,13 +285,17 @@ void SelfCollider::build(int index, int begin, int end, const Eigen::VectorXd& x
   }
 }
 
-void SelfCollider::refit(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1, double inflate) {
+void SelfCollider::refit(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1, double inflate,
+                         bool dirty_only) {
   const Eigen::Vector3d grow = Eigen::Vector3d::Constant(inflate);
   // One pose (the proximity queries): n1 = n0, so a leaf's cone has half-angle atan2(|n0 × n0|,
   // n0 · n0) = atan2(0, 1) = 0 and axis 2 n0 / |2 n0|: the same bits without the second normal
   // and the atan2 (the atan2s were 2.3 % of the 2 cm tee's drape, docs/benchmarks.md).
   const bool one_pose = &x0 == &x1;
   const auto refit_node = [&](int i) {
+    // A node without a moved triangle keeps the box and cone of the last refit: they depend
+    // only on its triangles' corners at x0 and x1, which are the same.
+    if (dirty_only && dirty_[i] == 0) return;
     Node& node = nodes_[i];
     if (node.left < 0) {
       const std::array<int, 3>& t = triangles_[order_[node.begin]];
@@ -587,10 +591,11 @@ std::vector<SelfPair> SelfCollider::find_collisions(const Eigen::VectorXd& x0,
   s.triangles = triangle_count();
   std::vector<SelfPair> pairs;
   if (nodes_.empty()) return pairs;
-  refit(x0, x1, 0.5 * tolerance);
   if (moved != nullptr) {
     // Every element pair with a moved vertex is tested at a triangle pair holding a moved
     // triangle (an element's owner holds the element), so pruning node pairs with none is exact.
+    // The same flags restrict the refit: the tree was last refitted at (x0, x1) as the last
+    // query saw them, which differ only at the moved vertices.
     dirty_.assign(nodes_.size(), 0);
     for (int i = static_cast<int>(nodes_.size()) - 1; i >= 0; --i) {
       const Node& node = nodes_[i];
@@ -601,6 +606,7 @@ std::vector<SelfPair> SelfCollider::find_collisions(const Eigen::VectorXd& x0,
       }
     }
   }
+  refit(x0, x1, 0.5 * tolerance, moved != nullptr);
   const auto gather = [&](const std::array<int, 4>& v, const Eigen::VectorXd& x) {
     return std::array<Eigen::Vector3d, 4>{row(x, v[0]), row(x, v[1]), row(x, v[2]), row(x, v[3])};
   };

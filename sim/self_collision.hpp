@@ -77,6 +77,9 @@ class SelfCollider {
   // a collision.
   // With `moved` (#V flags), only the pairs with at least one flagged vertex: the others are as
   // the last query found them when only those vertices changed (the fail-safe's later rounds).
+  // The last query must then have been find_collisions with the same x0 and tolerance, and x1
+  // differ from its x1 at flagged vertices only: the tree is refitted at the nodes holding a
+  // flagged vertex alone.
   std::vector<SelfPair> find_collisions(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1,
                                         double tolerance, SelfQueryStats* stats = nullptr,
                                         const std::vector<unsigned char>* moved = nullptr);
@@ -99,7 +102,10 @@ class SelfCollider {
   };
   // Builds the subtree over order_[begin, end) at nodes_[index] (preorder, presized).
   void build(int index, int begin, int end, const Eigen::VectorXd& x, int depth);
-  void refit(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1, double inflate);
+  // Boxes (inflated by `inflate`, m) and normal cones of the step x0 → x1, bottom-up. With
+  // `dirty_only`, only the nodes flagged in dirty_ (the others are as the last refit left them).
+  void refit(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1, double inflate,
+             bool dirty_only = false);
   bool region_is_safe(const Node& node, const Eigen::VectorXd& x0, const Eigen::VectorXd& x1);
   // Where a split traversal stopped: self_test(a) or pair_test(a, b) to run below it, or a
   // pair of triangles (a, b) met above the split.
