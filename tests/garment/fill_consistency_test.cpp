@@ -46,10 +46,12 @@ constexpr double kSmallest = 0.5, kLargest = 2.0, kOutsideShare = 0.04;
 // round") weighted those vertices in the smoothing along the body (99 → 67) and let a plan have as
 // many quads as the counts-only plan, which made the hip cape's back monotone but gives the
 // tapering capes more small quads at their necks (712 → 740: small 493 → 553, large 219 → 187),
-// for 79 → 66 gate warnings and 10 → 6 folded quads over the same sweep. Bounds that only hold
-// what is reached: a change of the filler or of the smoothing that adds out-of-band quads fails
-// here, one that removes some lowers them.
-constexpr int kMostOutside = 740, kMostLargeAtValence5 = 67;
+// for 79 → 66 gate warnings and 10 → 6 folded quads over the same sweep. The yoke flared skirt,
+// added with that round after its sweep, brings 5,550 quads and (by difference) 36 outside (740 →
+// 776, measured when the round landed: 776 of 203,020; 712 of 196,233 without the round and the
+// skirt). Bounds that only hold what is reached: a change of the filler or of the smoothing that
+// adds out-of-band quads fails here, one that removes some lowers them.
+constexpr int kMostOutside = 776, kMostLargeAtValence5 = 67;
 
 std::vector<fs::path> garment_files() {
   std::vector<fs::path> files = test::example_files();
