@@ -8,7 +8,7 @@ and `edge_length` set (as tests/garment/fill_consistency_test.cpp does), meshed 
 folded quads, smallest corner, worst aspect ratio, and the quads whose mean side lies outside
 0.5-2 edge lengths (small / large, and whether they touch an interior vertex of valence 5 or
 more); per garment the gate's warnings. Prints one JSON object per line (file, edge, panel ...)
-to stdout, or with --summary a table.
+to stdout, or with --summary the totals (--from-jsonl FILE summarises an earlier output).
 
     scripts/fill_sweep.py --binary build/sketchdrape --edges 0.02,0.025,0.03,0.035 \
         data/examples/*.json data/designs/*.json > sweep.jsonl
@@ -139,18 +139,65 @@ def run(binary, path, edge, work):
     return rows
 
 
+def summary(rows):
+    """The sweep's totals: quads, quads outside the band, gate warnings (and garments warned),
+    folded quads, smallest corner, worst aspect ratio, and panels whose quad count rises as the
+    edge length grows (mirror copies left out, as the test does)."""
+    garments = [r for r in rows if r.get("panel") is None and "error" not in r]
+    panels = [r for r in rows if r.get("panel") is not None and not r["mirror"]]
+    counts = {}
+    for r in panels:
+        counts.setdefault((r["file"], r["panel"]), []).append((r["edge"], r["quads"]))
+    rising = sum(any(b[1] > a[1] for a, b in zip(c, c[1:]))
+                 for c in (sorted(v) for v in counts.values()))
+    every = [r for r in rows if r.get("panel") is not None]
+    figures = [
+        ("meshes", len(garments)),
+        ("refused", sum("error" in r for r in rows)),
+        ("quads", sum(r["quads"] for r in garments)),
+        ("outside 0.5-2 e (small / large)", "%d (%d / %d)" % (
+            sum(r["small"] + r["large"] for r in every), sum(r["small"] for r in every),
+            sum(r["large"] for r in every))),
+        ("gate warnings (garments warned)", "%d (%d)" % (
+            sum(sum(r["warnings"].values()) for r in garments),
+            sum(bool(r["warnings"]) for r in garments))),
+        ("folded quads", sum(r["folded"] for r in every)),
+        ("smallest corner (deg)", "%.2f" % min(r["min_angle"] for r in every)),
+        ("worst aspect ratio", "%.1f" % max(r["max_aspect"] for r in every)),
+        ("panels not monotone", rising),
+    ]
+    for name, value in figures:
+        print(f"{name:34s} {value}")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--binary", default="build/sketchdrape")
     parser.add_argument("--edges", default="0.02,0.025,0.03,0.035")
-    parser.add_argument("files", nargs="+")
+    parser.add_argument("--summary", action="store_true",
+                        help="print the sweep's totals instead of one JSON object per line")
+    parser.add_argument("--from-jsonl", metavar="FILE",
+                        help="summarise an earlier sweep's output instead of meshing")
+    parser.add_argument("files", nargs="*")
     args = parser.parse_args()
+    if args.from_jsonl:
+        with open(args.from_jsonl) as f:
+            summary([json.loads(line) for line in f if line.strip()])
+        return
+    if not args.files:
+        parser.error("no sketch files given")
     edges = [float(e) for e in args.edges.split(",")]
+    rows = []
     with tempfile.TemporaryDirectory() as work:
         for path in args.files:
             for edge in edges:
                 for row in run(args.binary, path, edge, work):
-                    print(json.dumps(row), flush=True)
+                    if args.summary:
+                        rows.append(row)
+                    else:
+                        print(json.dumps(row), flush=True)
+    if args.summary:
+        summary(rows)
 
 
 if __name__ == "__main__":
