@@ -7,8 +7,9 @@ and `edge_length` set (as tests/garment/fill_consistency_test.cpp does), meshed 
 `sketchdrape mesh`; from report.json and garment.obj, per panel: quads, partition, distortion,
 folded quads, smallest corner, worst aspect ratio, and the quads whose mean side lies outside
 0.5-2 edge lengths (small / large, and whether they touch an interior vertex of valence 5 or
-more); per garment the gate's warnings. Prints one JSON object per line (file, edge, panel ...)
-to stdout, or with --summary the totals (--from-jsonl FILE summarises an earlier output).
+more) and those with a side outside it (short_side / long_side); per garment the gate's
+warnings. Prints one JSON object per line (file, edge, panel ...) to stdout, or with --summary
+the totals (--from-jsonl FILE summarises an earlier output).
 
     scripts/fill_sweep.py --binary build/sketchdrape --edges 0.02,0.025,0.03,0.035 \
         data/examples/*.json data/designs/*.json > sweep.jsonl
@@ -66,7 +67,8 @@ def dist(a, b):
 
 
 def band(vertices, faces, groups, edge):
-    """Per panel: (small, large, large at interior valence 5+, small at interior valence 3)."""
+    """Per panel: (small, large, large at interior valence 5+, small at interior valence 3,
+    quads with a side under 0.5 e, quads with a side over 2 e)."""
     by_panel = {}
     for f, g in zip(faces, groups):
         by_panel.setdefault(g, []).append(f)
@@ -83,9 +85,12 @@ def band(vertices, faces, groups, edge):
                 valence[v] = valence.get(v, 0) + 1
                 if count == 1:
                     boundary.add(v)
-        small = large = large5 = small3 = 0
+        small = large = large5 = small3 = short_side = long_side = 0
         for q in quads:
-            side = sum(dist(vertices[q[k]], vertices[q[(k + 1) % 4]]) for k in range(4)) / 4 / edge
+            sides = [dist(vertices[q[k]], vertices[q[(k + 1) % 4]]) / edge for k in range(4)]
+            short_side += min(sides) < 0.5
+            long_side += max(sides) > 2.0
+            side = sum(sides) / 4
             if 0.5 <= side <= 2.0:
                 continue
             interior = [v for v in q if v not in boundary]
@@ -95,7 +100,7 @@ def band(vertices, faces, groups, edge):
             else:
                 large += 1
                 large5 += any(valence[v] >= 5 for v in interior)
-        result[panel] = (small, large, large5, small3)
+        result[panel] = (small, large, large5, small3, short_side, long_side)
     return result
 
 
@@ -128,12 +133,13 @@ def run(binary, path, edge, work):
     rows = []
     for p in report["panels"]:
         q = p["quality"]
-        small, large, large5, small3 = bands.get(p["id"], (0, 0, 0, 0))
+        small, large, large5, small3, short_side, long_side = bands.get(p["id"], (0,) * 6)
         rows.append({"file": name, "edge": edge, "panel": p["id"], "mirror": p["mirror_copy"],
                      "quads": p["quads"], "sides": p["side_counts"], "partition": p["partition"],
                      "distortion": p["distortion"], "folded": q["inverted_quads"],
                      "min_angle": q["min_angle_deg"], "max_aspect": q["max_aspect_ratio"],
-                     "small": small, "large": large, "large5": large5, "small3": small3})
+                     "small": small, "large": large, "large5": large5, "small3": small3,
+                     "short_side": short_side, "long_side": long_side})
     rows.append({"file": name, "edge": edge, "panel": None, "warnings": warnings,
                  "quads": len(faces)})
     return rows
@@ -158,6 +164,8 @@ def summary(rows):
         ("outside 0.5-2 e (small / large)", "%d (%d / %d)" % (
             sum(r["small"] + r["large"] for r in every), sum(r["small"] for r in every),
             sum(r["large"] for r in every))),
+        ("a side outside 0.5-2 e (short / long)", "%d / %d" % (
+            sum(r.get("short_side", 0) for r in every), sum(r.get("long_side", 0) for r in every))),
         ("gate warnings (garments warned)", "%d (%d)" % (
             sum(sum(r["warnings"].values()) for r in garments),
             sum(bool(r["warnings"]) for r in garments))),
