@@ -42,10 +42,15 @@ struct SurfaceRelaxationResult {
 
 // Gauss-Seidel sweeps over the vertices not marked in `fixed` (#V flags, nonzero = fixed):
 // each moves by the tangential part of (mean of its edge neighbours − itself), at most
-// `max_step` long, then is lifted. In the mean a free neighbour of valence 3 weighs 0 (the
-// weight 1 + 2 cos(2π/k) that balances rhombi of one size around a vertex of valence k): a ring
-// of rhombi of one size around such a vertex is then an equilibrium, where uniform weights shrink
-// the quads there to about half the size of the next ring.
+// `max_step` long, then is lifted. In the mean a free neighbour of valence k weighs
+// valence_weight(k) (below): a ring of rhombi of one size around an irregular vertex is then an
+// equilibrium, where uniform weights shrink the quads around a vertex of valence 3 to about half
+// the size of the next ring and grow those around a vertex of valence 5 or more.
+// The weight 1 + 2 cos(2π/k) of a vertex of valence k in its neighbours' means, the one that
+// balances rhombi of one size around it: 0 at valence 3 (exactly), 1 at 4 (exactly: a grid
+// relaxes as with plain means), 1.618 at 5, 2 at 6.
+double valence_weight(int valence);
+
 SurfaceRelaxationResult relax_on_surface(meshing::QuadMesh& mesh, std::span<const char> fixed,
                                          const SurfaceLift& lift,
                                          const SurfaceRelaxationOptions& options = {});
