@@ -46,7 +46,7 @@ TEST(SurfaceRelaxation, SpreadsACollapsedInteriorBackToTheUniformGrid) {
 // around c of valence k; the interior (c, the k spoke midpoints, the k rhombus centres) starts
 // pulled towards c and is relaxed with the outline fixed. Returns how far the result is from the
 // tiling (with the weights of relax_on_surface the tiling is the fixed point of the sweeps).
-double distance_from_rhombus_tiling(int k) {
+double distance_from_rhombus_tiling(int k, bool weigh_high_valence = false) {
   // Vertices s A_i + t A_{i+1} for the spokes A_i (length 2 at 90° + 360° i / k), s, t in
   // {0, 1/2, 1}, numbered as they are first met.
   std::vector<Eigen::Vector3d> points;
@@ -87,8 +87,12 @@ double distance_from_rhombus_tiling(int k) {
   const SurfaceLift plane = [](const Eigen::Vector3d& p) {
     return LiftedPoint{{p.x(), p.y(), 0.0}, Eigen::Vector3d::UnitZ()};
   };
-  const SurfaceRelaxationResult result = relax_on_surface(
-      mesh, fixed, plane, {.max_sweeps = 2000, .tolerance = 1e-13, .max_step = 1.0});
+  const SurfaceRelaxationResult result =
+      relax_on_surface(mesh, fixed, plane,
+                       {.max_sweeps = 2000,
+                        .tolerance = 1e-13,
+                        .max_step = 1.0,
+                        .weigh_high_valence = weigh_high_valence});
   EXPECT_LT(result.sweeps, 2000);
   return (mesh.vertices - tiling.vertices).cwiseAbs().maxCoeff();
 }
@@ -101,9 +105,12 @@ TEST(SurfaceRelaxation, QuadsAroundAValenceThreeVertexKeepTheSizeOfTheirNeighbou
 }
 
 // Five rhombi (72° at the centre): plain means push the spoke midpoints out (the large quads at
-// valence-5 vertices of the corpus); the weight 1 + 2 cos 72° = 1.618 of the centre holds them.
+// valence-5 vertices of the corpus); the weight 1 + 2 cos 72° = 1.618 of the centre, with
+// weigh_high_valence, holds them. By default (off, for the arms-lowering t-shirt's drape) the
+// plain means stay: the tiling is left by more than a tenth of a quad's side (measured 0.18).
 TEST(SurfaceRelaxation, QuadsAroundAValenceFiveVertexKeepTheSizeOfTheirNeighbours) {
-  EXPECT_LT(distance_from_rhombus_tiling(5), 1e-9);
+  EXPECT_LT(distance_from_rhombus_tiling(5, true), 1e-9);
+  EXPECT_GT(distance_from_rhombus_tiling(5), 0.1);
 }
 
 TEST(SurfaceRelaxation, ValenceWeightsBalanceRhombiOfOneSize) {
