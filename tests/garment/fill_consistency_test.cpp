@@ -49,9 +49,12 @@ constexpr double kSmallest = 0.5, kLargest = 2.0, kOutsideShare = 0.04;
 // for 79 → 66 gate warnings and 10 → 6 folded quads over the same sweep. The yoke flared skirt,
 // added with that round after its sweep, brings 5,550 quads and (by difference) 36 outside (740 →
 // 776, measured when the round landed: 776 of 203,020; 712 of 196,233 without the round and the
-// skirt). Bounds that only hold what is reached: a change of the filler or of the smoothing that
-// adds out-of-band quads fails here, one that removes some lowers them.
-constexpr int kMostOutside = 776, kMostLargeAtValence5 = 67;
+// skirt). The tenth round's plan-rank rule and the eleventh's holding back of the valence 5+
+// weights (the arms-lowering t-shirt's drape: docs/garment.md, "Fill consistency, eleventh
+// round") leave 794 of 202,850 (99 large at valence 5+ again). Bounds that only hold what is
+// reached: a change of the filler or of the smoothing that adds out-of-band quads fails here, one
+// that removes some lowers them.
+constexpr int kMostOutside = 794, kMostLargeAtValence5 = 99;
 
 std::vector<fs::path> garment_files() {
   std::vector<fs::path> files = test::example_files();
