@@ -32,6 +32,13 @@ struct SurfaceRelaxationOptions {
   // this from where the move aimed has jumped across a ridge of the closest-point map (under
   // the arm, between the arm and the torso) and is refused: the vertex stays for that sweep.
   double max_step = 0.0125;
+  // Weigh free vertices of valence 5 and more by valence_weight(k) too (valence 3 always is).
+  // Off by default: over every example and design at 2-3.5 cm it lowers the large quads at such
+  // vertices (99 → 67) and the gate's warnings, but it moves the t-shirt fronts' vertices at the
+  // armpit by up to 9.5 mm, and the arms-lowering t-shirt's drapes (adaptive and from the flat
+  // pattern), whose armpit squeeze rests only at a few settings, then end moving there
+  // (docs/garment.md, "Fill consistency, eleventh round").
+  bool weigh_high_valence = false;
 };
 
 struct SurfaceRelaxationResult {
@@ -42,10 +49,16 @@ struct SurfaceRelaxationResult {
 
 // Gauss-Seidel sweeps over the vertices not marked in `fixed` (#V flags, nonzero = fixed):
 // each moves by the tangential part of (mean of its edge neighbours − itself), at most
-// `max_step` long, then is lifted. In the mean a free neighbour of valence 3 weighs 0 (the
-// weight 1 + 2 cos(2π/k) that balances rhombi of one size around a vertex of valence k): a ring
-// of rhombi of one size around such a vertex is then an equilibrium, where uniform weights shrink
-// the quads there to about half the size of the next ring.
+// `max_step` long, then is lifted. In the mean a free neighbour of valence 3 weighs
+// valence_weight(3) = 0, and with `weigh_high_valence` one of valence 5 or more weighs
+// valence_weight(k) (below), else 1: a ring of rhombi of one size around such an irregular vertex
+// is then an equilibrium, where uniform weights shrink the quads around a vertex of valence 3 to
+// about half the size of the next ring and grow those around a vertex of valence 5 or more.
+// The weight 1 + 2 cos(2π/k) of a vertex of valence k in its neighbours' means, the one that
+// balances rhombi of one size around it: 0 at valence 3 (exactly), 1 at 4 (exactly: a grid
+// relaxes as with plain means), 1.618 at 5, 2 at 6.
+double valence_weight(int valence);
+
 SurfaceRelaxationResult relax_on_surface(meshing::QuadMesh& mesh, std::span<const char> fixed,
                                          const SurfaceLift& lift,
                                          const SurfaceRelaxationOptions& options = {});

@@ -42,17 +42,19 @@ constexpr double kSmallest = 0.5, kLargest = 2.0, kOutsideShare = 0.04;
 // measured on 27 November 2026 (docs/garment.md, "Which plans and which vertices": 578 of about
 // 170,000, then 712 with the four designs added that day: wide-leg trousers, hip cape, capelet on
 // the Collada human, tiered skirt), and of them the large quads at an interior vertex of valence 5
-// or more (73, then 99), whose
-// cause, the plain mean of the smoothing around such a vertex, is not mended yet. Bounds that
-// only hold what is reached: a change of the filler or of the smoothing that adds out-of-band
-// quads fails here, one that removes some lowers them.
-constexpr int kMostOutside = 712, kMostLargeAtValence5 = 99;
-
-// Panels whose quad count is known not to fall with the edge length (issue 18, open): the hip
-// cape's back has 395 quads at 2 cm and 413 at 2.5 cm. Their other figures are still checked.
-bool known_not_monotone(const std::string& design, const std::string& panel) {
-  return design == "hip-cape" && panel == "back";
-}
+// or more (73, then 99). Issue 18's ninth round (docs/garment.md, "Fill consistency, ninth
+// round") weighted those vertices in the smoothing along the body (99 → 67) and let a plan have as
+// many quads as the counts-only plan, which made the hip cape's back monotone but gives the
+// tapering capes more small quads at their necks (712 → 740: small 493 → 553, large 219 → 187),
+// for 79 → 66 gate warnings and 10 → 6 folded quads over the same sweep. The yoke flared skirt,
+// added with that round after its sweep, brings 5,550 quads and (by difference) 36 outside (740 →
+// 776, measured when the round landed: 776 of 203,020; 712 of 196,233 without the round and the
+// skirt). The tenth round's plan-rank rule and the eleventh's holding back of the valence 5+
+// weights (the arms-lowering t-shirt's drape: docs/garment.md, "Fill consistency, eleventh
+// round") leave 794 of 202,850 (99 large at valence 5+ again). Bounds that only hold what is
+// reached: a change of the filler or of the smoothing that adds out-of-band quads fails here, one
+// that removes some lowers them.
+constexpr int kMostOutside = 794, kMostLargeAtValence5 = 99;
 
 std::vector<fs::path> garment_files() {
   std::vector<fs::path> files = test::example_files();
@@ -149,7 +151,7 @@ TEST(FillConsistency, QuadCountsFallAndSizesFollowTheEdgeLength) {
       for (const GarmentPanel& panel : garment.panels) {
         if (panel.mirror_copy) continue;
         const auto it = previous.find(panel.id);
-        if (it != previous.end() && !known_not_monotone(file.stem().string(), panel.id)) {
+        if (it != previous.end()) {
           EXPECT_LE(panel.faces, it->second)
               << file.filename() << " panel '" << panel.id << "' at " << edge
               << " m has more quads (" << panel.faces << ") than at the shorter edge before ("
