@@ -271,8 +271,8 @@ LinearSolveStats PcgSolver::solve(const SparseMatrixR& a, const std::vector<int>
   if (!reuse) {
     // The two-level cycle's IC(0) (and the coarse matrix from its B) on the membrane pattern:
     // the coarse level carries the smooth error the bends' weak second-ring couplings hold, and
-    // the factor and its sweeps cost about a third (pinned 128x128 sheet: 7.0 iterations a solve
-    // against 7.9, stepping CPU 0.68x; docs/benchmarks.md, "Twelfth round").
+    // the factor and its sweeps get several times cheaper (pinned 128x128 sheet: 7.0 iterations
+    // a solve against 7.9, stepping CPU 0.68x; docs/benchmarks.md, "Twelfth round").
     const bool reduced =
         preconditioner_ == PcgPreconditioner::two_level && membrane_.build(a, diagonal_offsets);
     incomplete_ready_ =
