@@ -10,6 +10,7 @@
 #include "sim/cloth_model.hpp"
 #include "sim/coarse_correction.hpp"
 #include "sim/constraint_filter.hpp"
+#include "sim/membrane_pattern.hpp"
 
 namespace sd::sim {
 
@@ -25,7 +26,10 @@ enum class PcgPreconditioner {
   block_jacobi,               // the inverse of each 3x3 diagonal block (Baraff & Witkin)
   block_incomplete_cholesky,  // IC(0) on 3x3 blocks of the filtered matrix, see below
   // IC(0) balanced by an exact solve on vertex aggregates (CoarseCorrection): a two-level
-  // preconditioner whose iterations grow far less with the resolution than IC(0)'s.
+  // preconditioner whose iterations grow far less with the resolution than IC(0)'s. Both levels
+  // are made from the matrix's membrane pattern (MembranePattern: the flat bends' second-ring
+  // couplings moved to the diagonal): as few iterations, and a factor several times cheaper to
+  // make and to apply.
   two_level,
 };
 
@@ -126,6 +130,7 @@ class PcgSolver {
   Eigen::VectorXd cycle_residual_, cycle_product_, cycle_coarse_;  // the two-level cycle's
   std::vector<Eigen::Matrix3d> inverse_blocks_;
   VertexBlockMatrix product_;
+  MembranePattern membrane_;
   BlockIncompleteCholesky incomplete_;
   CoarseCorrection coarse_;
 };
