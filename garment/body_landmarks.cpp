@@ -336,6 +336,41 @@ std::vector<std::string> proportion_doubts(const BodyLandmarks& l, double height
 
 }  // namespace
 
+namespace {
+
+// Landmark::size of every landmark of `l` (docs/bodies.md, "Landmarks").
+void set_landmark_sizes(const meshing::TriMesh& body, double height, BodyLandmarks& l) {
+  const auto y_of = [&](const char* name) { return l.find(name)->position.y(); };
+  for (Landmark& mark : l.points) {
+    const std::string& n = mark.name;
+    const bool limb =
+        n.ends_with("elbow") || n.ends_with("wrist") || n.ends_with("knee") || n.ends_with("ankle");
+    // A torso landmark's level: the shoulders and armpits lie where the arms join the torso,
+    // whose slice is not the torso's alone; the crotch where the legs part.
+    double y = mark.position.y();
+    if (n.ends_with("shoulder") || n.ends_with("armpit")) y = y_of("chest");
+    if (n == "crotch") y = y_of("hips");
+    const std::vector<SliceOutline> outlines = slice_body(body, y);
+    const SliceOutline* best = nullptr;
+    double best_distance = 0.0;
+    for (const SliceOutline& o : outlines) {
+      // The torso: the outline across the median plane, else the nearest to it; a limb's: the
+      // outline nearest the landmark.
+      const bool spans = o.min.x() < 0.0 && o.max.x() > 0.0;
+      const double d =
+          limb ? std::hypot(o.centroid.x() - mark.position.x(), o.centroid.z() - mark.position.z())
+               : (spans ? 0.0 : std::abs(o.centroid.x()));
+      if (best == nullptr || d < best_distance) best = &o, best_distance = d;
+    }
+    if (best == nullptr) continue;  // keeps the size 1: offsets in metres
+    mark.size = limb ? Eigen::Vector3d(best->girth, height, best->girth)
+                     : Eigen::Vector3d(best->max.x() - best->min.x(), height,
+                                       best->max.z() - best->min.z());
+  }
+}
+
+}  // namespace
+
 BodyLandmarks find_landmarks(const meshing::TriMesh& body) {
   if (body.vertex_count() == 0) throw std::runtime_error("the body has no vertices");
   const double height = body.vertices.col(1).maxCoeff();
@@ -510,8 +545,38 @@ BodyLandmarks find_landmarks(const meshing::TriMesh& body) {
   std::vector<Landmark> ordered;
   for (const std::string& name : landmark_names()) ordered.push_back(*out.find(name));
   out.points = std::move(ordered);
+  out.height = height;
+  set_landmark_sizes(body, height, out);
   out.doubts = proportion_doubts(out, height);
   return out;
+}
+
+Eigen::Vector3d landmark_point_for(const BodyLandmarks& body, const BodyLandmarks& drawn,
+                                   const Landmark& l, const Eigen::Vector3d& offset) {
+  const Landmark* d = drawn.find(l.name);
+  if (d == nullptr) return l.position + offset;
+  Eigen::Vector3d p = l.position + offset.cwiseProduct(l.size).cwiseQuotient(d->size);
+  if (l.name.ends_with("elbow") || l.name.ends_with("wrist")) return p;
+  // The levels of both bodies, from the feet up (each rises on both: find_landmarks orders them).
+  std::vector<double> from = {0.0}, to = {0.0};
+  for (const char* name : {"left_ankle", "left_knee", "crotch", "hips", "waist", "chest",
+                           "left_armpit", "left_shoulder", "neck_base"}) {
+    const Landmark* a = drawn.find(name);
+    const Landmark* b = body.find(name);
+    if (a == nullptr || b == nullptr) return p;
+    from.push_back(a->position.y());
+    to.push_back(b->position.y());
+  }
+  from.push_back(drawn.height);
+  to.push_back(body.height);
+  for (size_t i = 1; i < from.size(); ++i)
+    if (!(from[i] > from[i - 1]) || !(to[i] > to[i - 1])) return p;  // a level out of order
+  const double y = d->position.y() + offset.y();
+  // Beyond the feet or the top, the nearest segment's scale.
+  size_t i = 1;
+  while (i + 1 < from.size() && y > from[i]) ++i;
+  p.y() = to[i - 1] + (y - from[i - 1]) * (to[i] - to[i - 1]) / (from[i] - from[i - 1]);
+  return p;
 }
 
 }  // namespace sd::garment

@@ -17,6 +17,12 @@ namespace sd::garment {
 struct Landmark {
   std::string name;          // "left_armpit", "waist", ...
   Eigen::Vector3d position;  // m, normalised frame
+  // m: the size of the body there, by which an offset from the landmark scales onto another
+  // body: across (x), up (y) and front to back (z). At a torso landmark the torso's width, the
+  // body's height and the torso's depth at the landmark's level (the chest's level for the
+  // shoulders and armpits, the hips' for the crotch); at a limb's the limb's girth across and
+  // front to back and the body's height up.
+  Eigen::Vector3d size = Eigen::Vector3d::Ones();
 };
 
 struct BodyLandmarks {
@@ -25,6 +31,7 @@ struct BodyLandmarks {
   double chest_girth = 0.0;      // m, around the torso's convex hull (a tape measure's path)
   double waist_girth = 0.0;
   double hip_girth = 0.0;
+  double height = 0.0;  // m, the body's top above the feet
   // Sentences saying which landmarks break a human figure's proportions (a low-polygon figure
   // whose torso is a box, shoulders found at the top of the head): found, but not to be
   // trusted. Empty for the built-in body and the Collada human.
@@ -37,6 +44,16 @@ struct BodyLandmarks {
   // (docs/bodies.md, "Landmarks"). The body has at least one.
   const Landmark& nearest(const Eigen::Vector3d& p) const;
 };
+
+// The point `offset` (m) from landmark `l` of a body, written for another body whose landmarks are
+// `drawn` (docs/sketch-format.md, "Points relative to a landmark"): across and front to back the
+// offset scales by the two bodies' sizes at the landmark (Landmark::size); up, at a landmark of
+// the torso or a leg, the height it reaches maps piecewise linearly between the two bodies'
+// levels (feet, ankle, knee, crotch, hips, waist, chest, armpit, shoulder, neck base, top), so a
+// hem written 39 cm below the hips, between knee and crotch, stays at that place between them;
+// at an elbow or a wrist the offset scales by the bodies' heights.
+Eigen::Vector3d landmark_point_for(const BodyLandmarks& body, const BodyLandmarks& drawn,
+                                   const Landmark& l, const Eigen::Vector3d& offset);
 
 // One closed outline of a horizontal slice of the body (a leg, an arm, the torso).
 struct SliceOutline {

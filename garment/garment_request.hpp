@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -143,6 +144,10 @@ struct BodySpec {
   std::optional<std::string> up;         // "+z", "y", ...
   std::optional<std::string> facing;     // the way the figure faces in the file; by convention
   std::optional<BodyMotionSpec> motion;  // a still body when absent
+  // "drawn_on": the body the offsets of landmark points were written for; on another body they
+  // scale by its size at each landmark (docs/sketch-format.md, "Points relative to a
+  // landmark"). Fixed metres when empty.
+  std::shared_ptr<const BodySpec> drawn_on;
 };
 
 // The garment to build: what every garment algorithm takes.

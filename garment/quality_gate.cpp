@@ -17,6 +17,7 @@
 
 #include "garment/body_clearance.hpp"
 #include "garment/body_clefts.hpp"
+#include "garment/crossing_advice.hpp"
 #include "garment/garment_crossings.hpp"
 
 namespace sd::garment {
@@ -319,6 +320,9 @@ std::vector<QualityWarning> check_quality_tried(const Garment& garment,
     w.corners.clear();
     w.corners_hint.clear();
   }
+  // Panels crossing in a narrow crease: its width, and a smaller offset when one helps.
+  if (!surface) surface.emplace(body);
+  advise_crossings_in_creases(warnings, sketch, *surface, warnings_with);
   // The cloth inside the body before the drape (body_clearance.hpp), after the trials above (which
   // compare counts of check_quality's kinds only).
   if (!surface) surface.emplace(body);

@@ -14,26 +14,30 @@
 namespace sd::garment {
 
 Body load_sketch_body(const GarmentRequest& sketch) {
-  if (sketch.body.mesh == "none")
-    sketch.fail("/body/mesh",
+  return load_sketch_body(sketch, sketch.body, "/body");
+}
+
+Body load_sketch_body(const GarmentRequest& sketch, const BodySpec& spec,
+                      const std::string& where) {
+  if (spec.mesh == "none")
+    sketch.fail(where + "/mesh",
                 "a garment is designed on a body: give \"builtin\" or a body mesh "
                 "file instead of \"none\"");
   BodyOptions options;
-  options.height = sketch.body.height;
-  options.scale = sketch.body.scale;
-  const std::string path =
-      sketch.body.mesh == "builtin" ? "builtin" : sketch.resolve(sketch.body.mesh).string();
+  options.height = spec.height;
+  options.scale = spec.scale;
+  const std::string path = spec.mesh == "builtin" ? "builtin" : sketch.resolve(spec.mesh).string();
   try {
-    if (sketch.body.up) options.up = AxisDirection::parse(*sketch.body.up);
-    if (sketch.body.facing) options.facing = AxisDirection::parse(*sketch.body.facing);
+    if (spec.up) options.up = AxisDirection::parse(*spec.up);
+    if (spec.facing) options.facing = AxisDirection::parse(*spec.facing);
     return load_body(path, options);
   } catch (const BodyUpError& e) {
-    sketch.fail("/body/up", e.what());
+    sketch.fail(where + "/up", e.what());
   } catch (const BodyFacingError& e) {
-    sketch.fail("/body/facing", e.what());
+    sketch.fail(where + "/facing", e.what());
   } catch (const BodyError& e) {
-    sketch.fail("/body/mesh",
-                fmt::format("the body '{}' cannot be used: {}", sketch.body.mesh, e.what()));
+    sketch.fail(where + "/mesh",
+                fmt::format("the body '{}' cannot be used: {}", spec.mesh, e.what()));
   }
 }
 

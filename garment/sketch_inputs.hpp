@@ -11,6 +11,9 @@ namespace sd::garment {
 // The sketch's body (builtin or a path relative to the sketch file) with its height, scale and
 // up axis. A body that cannot be loaded throws SketchError at /body/mesh.
 Body load_sketch_body(const GarmentRequest& sketch);
+// The same for another body of the sketch (`spec` at JSON path `path`, e.g. "/body/drawn_on"),
+// its mesh path relative to the sketch file.
+Body load_sketch_body(const GarmentRequest& sketch, const BodySpec& spec, const std::string& path);
 
 // The triangle garment of "garment_mesh" (Wavefront OBJ; polygons are fan-triangulated), in
 // metres as written. Throws SketchError at /garment_mesh when it is missing, unreadable or has

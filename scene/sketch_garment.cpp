@@ -55,13 +55,22 @@ void parse_body_poses(const Reader& r, const json& m, const std::string& mpath,
 }  // namespace
 
 void parse_body(const Reader& r, const json& j, BodySpec& body) {
-  const std::string path = "/body";
+  parse_body(r, j, body, "/body");
+}
+
+void parse_body(const Reader& r, const json& j, BodySpec& body, const std::string& path) {
+  // "drawn_on" is a body of its own, without a motion or a "drawn_on".
+  const bool drawn_on = path != "/body";
   if (j.is_string()) {  // shorthand: "body": "builtin"
     body.mesh = r.text(j, path);
+    if (drawn_on && body.mesh.empty()) r.fail(path, "the body mesh path is empty");
     return;
   }
-  r.require_object(j, path, "body");
-  r.check_keys(j, path, {"mesh", "height", "up", "facing", "scale", "motion"});
+  r.require_object(j, path, drawn_on ? "the body the offsets were written for" : "body");
+  if (drawn_on)
+    r.check_keys(j, path, {"mesh", "height", "up", "facing", "scale"});
+  else
+    r.check_keys(j, path, {"mesh", "height", "up", "facing", "scale", "motion", "drawn_on"});
   if (j.contains("mesh")) body.mesh = r.text(j["mesh"], path + "/mesh");
   if (body.mesh.empty()) r.fail(path + "/mesh", "the body mesh path is empty");
   if (j.contains("height")) {
@@ -82,6 +91,14 @@ void parse_body(const Reader& r, const json& j, BodySpec& body) {
   };
   if (j.contains("up")) body.up = axis("up");
   if (j.contains("facing")) body.facing = axis("facing");
+  if (j.contains("drawn_on")) {
+    BodySpec reference;
+    parse_body(r, j["drawn_on"], reference, path + "/drawn_on");
+    if (reference.mesh == "none")
+      r.fail(path + "/drawn_on",
+             "offsets are written for a body: give \"builtin\" or a body mesh file");
+    body.drawn_on = std::make_shared<const BodySpec>(std::move(reference));
+  }
   if (j.contains("motion")) {
     const std::string mpath = path + "/motion";
     const json& m = j["motion"];
@@ -117,26 +134,28 @@ namespace {
 
 // The landmarks of the sketch's body (docs/bodies.md), found once per body and kept: a sketch
 // that places points relative to them loads its body while it is read.
-const BodyLandmarks& sketch_landmarks(const Reader& r, const Sketch& sk, const std::string& path) {
+const BodyLandmarks& sketch_landmarks(const Reader& r, const Sketch& sk, const std::string& path,
+                                      const BodySpec& spec, const std::string& spec_path) {
   static std::mutex mutex;
   static std::map<std::string, BodyLandmarks> cache;
   const std::string key =
-      fmt::format("{}|{}|{}|{}|{}", sk.resolve(sk.body.mesh).string(), sk.body.height.value_or(0),
-                  sk.body.scale.value_or(0), sk.body.up.value_or(""), sk.body.facing.value_or(""));
+      fmt::format("{}|{}|{}|{}|{}", sk.resolve(spec.mesh).string(), spec.height.value_or(0),
+                  spec.scale.value_or(0), spec.up.value_or(""), spec.facing.value_or(""));
   const std::lock_guard lock(mutex);
   if (const auto it = cache.find(key); it != cache.end()) return it->second;
-  const Body body = load_sketch_body(sk);
+  const Body body = load_sketch_body(sk, spec, spec_path);
   try {
     const BodyLandmarks& landmarks = cache.emplace(key, find_landmarks(body.mesh)).first->second;
     for (const std::string& doubt : landmarks.doubts)
       spdlog::warn(
           "{}: points are given relative to the body's landmarks, but they look wrong: {}; the "
           "points may land elsewhere than meant (`sketchdrape info` lists the landmarks)",
-          sk.resolve(sk.body.mesh).string(), doubt);
+          sk.resolve(spec.mesh).string(), doubt);
     return landmarks;
   } catch (const std::runtime_error& e) {
-    r.fail(path, fmt::format("a point is given relative to a landmark, but the body has none: {}",
-                             e.what()));
+    r.fail(spec_path == "/body" ? path : spec_path,
+           fmt::format("a point is given relative to a landmark, but the body {}has none: {}",
+                       spec_path == "/body" ? "" : "the offsets were written for ", e.what()));
   }
 }
 
@@ -151,8 +170,13 @@ Eigen::Vector3d landmark_point(const Reader& r, const json& j, const std::string
   const std::string name = r.text(j["at"], path + "/at");
   const Eigen::Vector3d offset =
       j.contains("offset") ? r.vector<3>(j["offset"], path + "/offset") : Eigen::Vector3d::Zero();
-  const BodyLandmarks& landmarks = sketch_landmarks(r, sk, path);
-  if (const Landmark* l = landmarks.find(name)) return l->position + offset;
+  const BodyLandmarks& landmarks = sketch_landmarks(r, sk, path, sk.body, "/body");
+  if (const Landmark* l = landmarks.find(name)) {
+    if (!sk.body.drawn_on) return l->position + offset;
+    // Written for another body: the offset scales by the two bodies' sizes at the landmark.
+    const BodyLandmarks& drawn = sketch_landmarks(r, sk, path, *sk.body.drawn_on, "/body/drawn_on");
+    return landmark_point_for(landmarks, drawn, *l, offset);
+  }
   std::string names, hint;
   size_t best = 4;  // suggest only close spellings ("left_sholder", "rightarmpit", "Waist")
   for (const std::string& n : landmark_names()) {

@@ -12,6 +12,8 @@ namespace sd::scene::detail {
 
 // The garment request's sections (sketch_garment.cpp).
 void parse_body(const Reader& r, const json& j, BodySpec& body);
+// The same for a body at another JSON path ("/body/drawn_on"): no "motion" or "drawn_on" there.
+void parse_body(const Reader& r, const json& j, BodySpec& body, const std::string& path);
 // "curves", "panels" and "join": the file has curves and panels (not a sheet or garment_mesh).
 void parse_garment(const Reader& r, const json& root, Sketch& sketch);
 

@@ -176,5 +176,54 @@ TEST(BodyLandmarks, SketchPointsRelativeToALandmark) {
   }
 }
 
+// Offsets written for another body ("drawn_on") scale by the two bodies' sizes at the landmark.
+// The built-in body loaded at 1.925 m is the same figure 1.1 times larger in every direction, so
+// every size is 1.1 times the 1.75 m one's (to the slicing's resolution: a slice at a level 1.1
+// times as high cuts the same triangles, so the widths agree to 1e-9) and an offset written for
+// the 1.75 m body lands 1.1 times as far on the larger one.
+TEST(BodyLandmarks, OffsetsWrittenForAnotherBodyScaleWithIt) {
+  const BodyLandmarks small = find_landmarks(load_body("builtin").mesh);
+  BodyOptions tall_options;
+  tall_options.height = 1.925;
+  const BodyLandmarks tall = find_landmarks(load_body("builtin", tall_options).mesh);
+  for (const Landmark& l : small.points) {
+    const Eigen::Vector3d ratio = tall.find(l.name)->size.cwiseQuotient(l.size);
+    EXPECT_NEAR(ratio.x(), 1.1, 1e-6) << l.name;
+    EXPECT_NEAR(ratio.y(), 1.1, 1e-6) << l.name;
+    EXPECT_NEAR(ratio.z(), 1.1, 1e-6) << l.name;
+  }
+  // The sizes are the body's: the hips' width is the torso's at the hips, not 1 m.
+  EXPECT_GT(small.find("hips")->size.x(), 0.3);
+  EXPECT_LT(small.find("hips")->size.x(), 0.5);
+  const auto point = [](const std::string& body) {
+    const Sketch s = parse_sketch(R"({"body": )" + body + R"(,
+      "curves": [ { "id": "c", "points3d": [ {"at": "hips", "offset": [0.2, -0.1, -0.1]},
+                                             [0.1, 1.3, 0.1] ] } ],
+      "panels": [ { "id": "p", "boundary": ["c"] } ] })",
+                                  "drawn.json", ".");
+    return Eigen::Vector3d(s.curves.front().points3d.front());
+  };
+  const Eigen::Vector3d offset(0.2, -0.1, -0.1);
+  const Eigen::Vector3d hips = tall.find("hips")->position;
+  // Without "drawn_on" the offset is metres as written; drawn on the body itself, the same.
+  EXPECT_LT((point(R"({"mesh": "builtin", "height": 1.925})") - (hips + offset)).norm(), 1e-12);
+  EXPECT_LT((point(R"({"mesh": "builtin", "height": 1.925, "drawn_on": {"mesh": "builtin",
+             "height": 1.925}})") -
+             (hips + offset))
+                .norm(),
+            1e-12);
+  // Drawn on the 1.75 m body: 1.1 times the offset.
+  EXPECT_LT((point(R"({"mesh": "builtin", "height": 1.925, "drawn_on": "builtin"})") -
+             (hips + 1.1 * offset))
+                .norm(),
+            1e-6);
+  try {
+    point(R"({"mesh": "builtin", "drawn_on": {"mesh": "builtin", "motion": {}}})");
+    FAIL() << "a motion of the body the offsets were drawn on was accepted";
+  } catch (const SketchError& e) {
+    EXPECT_EQ(e.json_path(), "/body/drawn_on/motion");
+  }
+}
+
 }  // namespace
 }  // namespace sd::garment

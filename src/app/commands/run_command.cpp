@@ -243,6 +243,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
       // Not a standing figure: the trace gives positions only.
     }
   }
+  std::optional<Clock::time_point> drape_start;  // when the drape's first step began
   const auto on_step = [&](const sim::ClothDriver& d) {
     const sim::Simulation& s = d.simulation();
     if (const double resident = peak_resident_memory_bytes();
@@ -252,11 +253,22 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
           "the {} it may take (--max-memory); limit adaptive detail with "
           "simulate.adaptive.max_vertices or max_level; nothing was written",
           s.time(), memory_text(resident), s.model().vertex_count, memory_text(memory_budget)));
+    // --max-time bounds the whole command (a job's wall time), set-up included: the message
+    // says how much of it the set-up took, which a large body or garment makes most of it.
     if (limits.max_time_s &&
-        std::chrono::duration<double>(Clock::now() - start).count() > *limits.max_time_s)
+        std::chrono::duration<double>(Clock::now() - start).count() > *limits.max_time_s) {
+      const double setup_s =
+          std::chrono::duration<double>(drape_start.value_or(Clock::now()) - start).count();
+      const double elapsed_s = std::chrono::duration<double>(Clock::now() - start).count();
       throw RunLimitExceeded(fmt::format(
-          "stopped at t = {:.3f} s of the drape: --max-time {:g} s passed; nothing was written",
-          s.time(), *limits.max_time_s));
+          "stopped at t = {:.3f} s of the drape: --max-time {:g} s passed ({:.1f} s of wall time "
+          "since the command started: {:.1f} s of set-up, reading the body and the sketch, meshing "
+          "and laying out the pattern, then {:.1f} s of drape){}; nothing was written",
+          s.time(), *limits.max_time_s, elapsed_s, setup_s, elapsed_s - setup_s,
+          setup_s > 0.5 * *limits.max_time_s
+              ? "; the set-up took most of the time: give a larger --max-time"
+              : ""));
+    }
     progress.update(static_cast<long>(s.time() * 1000), fmt::format("t = {:.2f} s", s.time()));
     if (!options.trace) return;
     const sim::SimulationReport& r = s.report();
@@ -369,6 +381,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
         frames.push_back({d.time(), {d.positions(), d.faces()}, groups_of(d)});
       return true;
     };
+    drape_start = Clock::now();
     report = driver.run(observer);
     draped.vertices = driver.positions();
     draped.faces = driver.faces();
@@ -703,7 +716,8 @@ void add_run_command(CLI::App& app, const GlobalOptions& global) {
                   "Refuse a drape estimated to need more memory than this (e.g. 4G, 512M; "
                   "default: the memory available)");
   cmd->add_option("--max-time", options->max_time_s,
-                  "Stop (writing nothing) after this many seconds of wall time; refuse a drape "
+                  "Stop (writing nothing) once this many seconds of wall time have passed "
+                  "since the command started (set-up and meshing count); refuse a drape "
                   "without stop_at_rest estimated to take longer")
       ->check(finite_range(1e-3, 1e9));
   cmd->callback([options, &global] { run_drape(*options, global); });
