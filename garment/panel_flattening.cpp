@@ -487,10 +487,28 @@ FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
     uv = start;  // ARAP folded what LSCM kept unfolded: keep the conformal map
     folded = 0;
   }
+  // The mean 2D image of the warp in a flattening (area-weighted unit images; +y when none),
+  // over the triangles `use` marks (all when empty).
+  const auto mean_grain = [&](const Eigen::MatrixX2d& map, const std::vector<char>& use = {}) {
+    Eigen::Vector2d grain = Eigen::Vector2d::Zero();
+    for (Eigen::Index f = 0; f < t.rows(); ++f) {
+      if (!use.empty() && !use[static_cast<size_t>(f)]) continue;
+      const RestTriangle& r = rest[static_cast<size_t>(f)];
+      const Eigen::Vector3d w3 = triangle_warp.row(triangle_warp.rows() == 1 ? 0 : f).transpose();
+      const Eigen::Vector2d local(w3.dot(r.e1), w3.dot(r.e2));
+      const Eigen::Vector2d image = jacobian(map, t, f, r) * local;
+      if (image.norm() > 0) grain += r.area * image.normalized();
+    }
+    return grain.norm() < 1e-12 ? Eigen::Vector2d::UnitY() : grain;
+  };
   // A centre line to hold straight (the piece is then cut on the fold): flattened again from the
   // same start turned with the run's chord on the y axis, the run's x held at 0; kept when it
-  // folds nothing and costs at most `straight_centre_cost` of 95th-percentile stretch.
+  // folds nothing, costs at most `straight_centre_cost` of 95th-percentile stretch and lies
+  // along the grain or the cross grain within `fold_off_grain_deg` (fabric is folded along a
+  // thread; a fold across the grain drawn, as a bias cut's, would cut the piece on the straight
+  // grain: such a piece keeps its free flattening and its centre seam, cut 2).
   bool straight = false;
+  bool cross = false;  // the held centre line lies along the weft, not the warp
   if (folded == 0 && centre_run.size() >= 3 && options.straight_centre_cost >= 0) {
     const Eigen::RowVector2d a = start.row(centre_run.front());
     const Eigen::Vector2d chord = (start.row(centre_run.back()) - a).transpose();
@@ -501,7 +519,24 @@ FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
     if (folded_triangles(held, t, rest) == 0) {
       const FlatDistortion free = measure(uv, t, rest);
       const FlatDistortion line = measure(held, t, rest);
-      if (line.length_p95 <= free.length_p95 + options.straight_centre_cost) {
+      // The warp where the fold will be: its mean image over the triangles touching the centre
+      // line. (Over the whole half piece the warp's mean leans off the centre where the piece
+      // curves: a hip yoke's vertical warp fans out like a cone's rulings, 6.5° on average for
+      // trial 38's back yoke, though along its centre line it runs along the line.)
+      std::vector<char> on_line(static_cast<size_t>(v.rows()), 0),
+          touching(static_cast<size_t>(t.rows()), 0);
+      for (const int i : centre_run) on_line[static_cast<size_t>(i)] = 1;
+      for (Eigen::Index f = 0; f < t.rows(); ++f)
+        for (int k = 0; k < 3; ++k)
+          touching[static_cast<size_t>(f)] |= on_line[static_cast<size_t>(t(f, k))];
+      const Eigen::Vector2d grain = mean_grain(held, touching);
+      // The held line is the y axis: its angle to the warp's image there, 0 .. 90°.
+      const double off =
+          std::acos(std::min(1.0, std::abs(grain.normalized().y()))) * 180.0 / std::numbers::pi;
+      out.centre_off_grain_deg = off;
+      const bool on_thread =
+          off <= options.fold_off_grain_deg || 90.0 - off <= options.fold_off_grain_deg;
+      if (line.length_p95 <= free.length_p95 + options.straight_centre_cost && on_thread) {
         out.centre_run = centre_run;
         out.free_centre_bow = bow_from_chord(uv, centre_run);
         out.free_distortion = free;
@@ -510,6 +545,7 @@ FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
         out.iterations = sweeps;
         uv = held;
         straight = true;
+        cross = off > options.fold_off_grain_deg;
       }
     }
   }
@@ -523,21 +559,14 @@ FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
                           d.worst_point.z()));
   }
 
-  // Grain: the mean 2D image of the warp, turned onto +y.
-  Eigen::Vector2d grain = Eigen::Vector2d::Zero();
-  for (Eigen::Index f = 0; f < t.rows(); ++f) {
-    const RestTriangle& r = rest[static_cast<size_t>(f)];
-    const Eigen::Vector3d w3 = triangle_warp.row(triangle_warp.rows() == 1 ? 0 : f).transpose();
-    const Eigen::Vector2d local(w3.dot(r.e1), w3.dot(r.e2));
-    const Eigen::Vector2d image = jacobian(uv, t, f, r) * local;
-    if (image.norm() > 0) grain += r.area * image.normalized();
-  }
-  if (grain.norm() < 1e-12) grain = Eigen::Vector2d::UnitY();
-  // A straight centre line is the fold, and a fold lies along the warp (fabric is folded
-  // lengthwise): the piece is turned with it on +y, the way nearer the warp's mean image. For a
-  // symmetric panel that is the grain of the whole piece the half and its mirror make.
+  // Grain: the mean 2D image of the warp, turned onto +y. A straight centre line is the fold,
+  // and a fold lies along a thread: the piece is turned with it on +y (along the warp, the way
+  // nearer the warp's mean image) or on +x (along the weft); for a symmetric panel that is the
+  // grain of the whole piece the half and its mirror make.
+  const Eigen::Vector2d grain = mean_grain(uv);
   double turn = std::numbers::pi / 2 - std::atan2(grain.y(), grain.x());
-  if (straight) turn = grain.y() >= 0 ? 0.0 : std::numbers::pi;
+  if (straight && !cross) turn = grain.y() >= 0 ? 0.0 : std::numbers::pi;
+  if (straight && cross) turn = grain.x() >= 0 ? std::numbers::pi / 2 : -std::numbers::pi / 2;
   const Eigen::Matrix2d rotation = Eigen::Rotation2Dd(turn).toRotationMatrix();
   uv = (uv * rotation.transpose()).eval();
   uv.rowwise() -= uv.colwise().minCoeff();
@@ -666,6 +695,7 @@ std::optional<FlatPanel> reflected_piece(const FlatPanel& original, const Eigen:
   out.distortion = original.distortion;
   out.centre_run = original.centre_run;  // the original's numbering: the caller renumbers it
   out.free_centre_bow = original.free_centre_bow;
+  out.centre_off_grain_deg = original.centre_off_grain_deg;
   out.free_distortion = original.free_distortion;
   out.distortion.worst_point.x() = -original.distortion.worst_point.x();
   out.distortion.worst_point_2d.x() = width - original.distortion.worst_point_2d.x();

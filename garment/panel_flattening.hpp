@@ -50,6 +50,13 @@ struct FlatteningOptions {
   // points, a back over a deep hollow of the spine 3.2-3.8, a crotch curve 3.2-16, a hood 37-40
   // (docs/pattern.md, "Cut on the fold").
   double straight_centre_cost = 0.025;
+  // Cut on the fold, a piece's grain is where the fold puts it: its centre line lies on a
+  // thread of the folded fabric. A centre line more than this (degrees) off both the warp and
+  // the weft (its panel's grain turned on purpose, a bias cut) where it runs is not held
+  // straight nor cut on the fold: the piece keeps its centre seam and its grain as drawn, cut 2.
+  // 2°: fabric is itself woven up to 1-2° askew, and a bias cut is 45° off (docs/pattern.md,
+  // "Folds on the grain", with the angles measured on the examples and designs).
+  double fold_off_grain_deg = 2.0;
 };
 
 // A point on a piece's outline: on edge `edge` (FlatPanel::boundary[edge] → boundary[edge + 1],
@@ -102,6 +109,10 @@ struct FlatPanel {
   // on one line along +y. Empty when the piece was flattened freely. Then also what the free
   // flattening gave: how far the run bowed from its chord (m) and the free distortion.
   std::vector<int> centre_run;
+  // The panel's centre line's angle (degrees, 0 .. 90) to the warp's mean image over the
+  // triangles touching it, in its flattening held straight, whether or not that was kept; −1
+  // when the panel has no centre line to hold.
+  double centre_off_grain_deg = -1;
   double free_centre_bow = 0;
   FlatDistortion free_distortion;
   // A mirror copy whose 3D triangles are exactly its original's reflected: the index (into
