@@ -503,10 +503,8 @@ FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
   };
   // A centre line to hold straight (the piece is then cut on the fold): flattened again from the
   // same start turned with the run's chord on the y axis, the run's x held at 0; kept when it
-  // folds nothing, costs at most `straight_centre_cost` of 95th-percentile stretch and lies
-  // along the grain or the cross grain within `fold_off_grain_deg` (fabric is folded along a
-  // thread; a fold across the grain drawn, as a bias cut's, would cut the piece on the straight
-  // grain: such a piece keeps its free flattening and its centre seam, cut 2).
+  // folds nothing and costs at most `straight_centre_cost` of 95th-percentile stretch. (The
+  // caller passes no run for a panel whose grain is turned off the threads: flatten_garment.)
   bool straight = false;
   bool cross = false;  // the held centre line lies along the weft, not the warp
   if (folded == 0 && centre_run.size() >= 3 && options.straight_centre_cost >= 0) {
@@ -519,24 +517,7 @@ FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
     if (folded_triangles(held, t, rest) == 0) {
       const FlatDistortion free = measure(uv, t, rest);
       const FlatDistortion line = measure(held, t, rest);
-      // The warp where the fold will be: its mean image over the triangles touching the centre
-      // line. (Over the whole half piece the warp's mean leans off the centre where the piece
-      // curves: a hip yoke's vertical warp fans out like a cone's rulings, 6.5° on average for
-      // trial 38's back yoke, though along its centre line it runs along the line.)
-      std::vector<char> on_line(static_cast<size_t>(v.rows()), 0),
-          touching(static_cast<size_t>(t.rows()), 0);
-      for (const int i : centre_run) on_line[static_cast<size_t>(i)] = 1;
-      for (Eigen::Index f = 0; f < t.rows(); ++f)
-        for (int k = 0; k < 3; ++k)
-          touching[static_cast<size_t>(f)] |= on_line[static_cast<size_t>(t(f, k))];
-      const Eigen::Vector2d grain = mean_grain(held, touching);
-      // The held line is the y axis: its angle to the warp's image there, 0 .. 90°.
-      const double off =
-          std::acos(std::min(1.0, std::abs(grain.normalized().y()))) * 180.0 / std::numbers::pi;
-      out.centre_off_grain_deg = off;
-      const bool on_thread =
-          off <= options.fold_off_grain_deg || 90.0 - off <= options.fold_off_grain_deg;
-      if (line.length_p95 <= free.length_p95 + options.straight_centre_cost && on_thread) {
+      if (line.length_p95 <= free.length_p95 + options.straight_centre_cost) {
         out.centre_run = centre_run;
         out.free_centre_bow = bow_from_chord(uv, centre_run);
         out.free_distortion = free;
@@ -545,7 +526,9 @@ FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
         out.iterations = sweeps;
         uv = held;
         straight = true;
-        cross = off > options.fold_off_grain_deg;
+        // A panel turned 90° (a collar cut across the grain) is folded across the warp.
+        const Eigen::Vector2d grain = mean_grain(held);
+        cross = std::abs(grain.x()) > std::abs(grain.y());
       }
     }
   }
@@ -823,10 +806,19 @@ FlatPattern flatten_garment(const Garment& garment, const FlatteningOptions& opt
           if (reflected) reflected->reflection_of = static_cast<int>(o);
         }
     }
-    const std::vector<int> run = centre_run(p, global, disk_boundary(name, v.rows(), t));
+    std::vector<int> run = centre_run(p, global, disk_boundary(name, v.rows(), t));
+    // A fold is a thread of the folded fabric: a panel whose grain is turned off the threads of
+    // its centre line (a bias cut, "grain": 45) keeps its centre seam, cut 2 as drawn. By
+    // symmetry the warp of a panel not turned runs along its centre line (the vertical, or the
+    // limb's axis, projected into the plane x = 0), so the turn is the fold's angle to the grain.
+    const double off_thread = std::abs(std::remainder(garment.panels[p].grain_turn_deg, 90.0));
+    const bool on_thread = off_thread <= options.fold_off_grain_deg;
+    const bool has_run = !run.empty();
+    if (!on_thread) run.clear();
     FlatPanel flat = reflected ? std::move(*reflected)
                                : flatten_with_warp(name, v, t, warp, options, on_body, run);
     if (reflected && !flat.centre_run.empty()) flat.centre_run = run;
+    flat.centre_off_grain_deg = has_run ? off_thread : -1.0;
     flat.panel = static_cast<int>(p);
     flat.vertices = std::move(global);
     flat.triangle_quad = std::move(quad_of);
