@@ -1054,17 +1054,21 @@ TEST(PatternCommand, BiasPanelsKeepTheirCentreSeamInPatternAndFlatRest) {
       EXPECT_GT(centre_seam[k][id], 30.0) << k << " " << id;
       EXPECT_LT(centre_seam[k][id], 60.0) << k << " " << id;
     }
-    for (const auto& [id, piece] : pieces)
-      if (piece["on_fold"].get<bool>())
+    for (const auto& [id, piece] : pieces) {
+      if (piece["on_fold"].get<bool>()) {
         EXPECT_LE(off_grain(piece["fold_line"][0], piece["fold_line"][1]), 2.0)
             << k << " " << id << ": a fold lies along the grain";
+      }
+    }
   }
   // The shaped rest's yokes are held straight and folded on the grain, as before.
   const auto shaped_json = nlohmann::json::parse(read(patterns[0]));
-  for (const auto& piece : shaped_json["pieces"])
-    if (piece["id"].get<std::string>().starts_with("yoke") &&
-        !piece["id"].get<std::string>().ends_with(".mirror"))
-      EXPECT_TRUE(piece["on_fold"].get<bool>()) << piece["id"];
+  for (const auto& piece : shaped_json["pieces"]) {
+    const std::string id = piece["id"];
+    if (id.starts_with("yoke") && !id.ends_with(".mirror")) {
+      EXPECT_TRUE(piece["on_fold"].get<bool>()) << id;
+    }
+  }
   // Pattern and flat rest give the bias pieces the same flattening: the same centre seams.
   for (const std::string id : {"skirt_front", "skirt_back"})
     EXPECT_NEAR(centre_seam[0][id], centre_seam[1][id], 1e-6) << id;
