@@ -195,6 +195,10 @@ PanelNetwork resolve_network(const GarmentRequest& sketch, const BodySurface& bo
         const NetworkEdge& edge = net.edges[static_cast<size_t>(e.edge)];
         size.boundary_edges += counts.counts[static_cast<size_t>(e.edge)];
         size.boundary_length += edge.length;
+        const int spec = net.curves[static_cast<size_t>(edge.curve)].spec;
+        if (spec >= 0 && sketch.curves[static_cast<size_t>(spec)].edges)
+          size.fixed.push_back(
+              {spec, static_cast<double>(counts.counts[static_cast<size_t>(e.edge)]), edge.length});
         const Eigen::Index n = edge.points.rows();
         for (Eigen::Index j = 0; j + 1 < n; ++j)
           outline.emplace_back(edge.points.row(e.forward ? j : n - 1 - j).transpose());

@@ -487,10 +487,26 @@ FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
     uv = start;  // ARAP folded what LSCM kept unfolded: keep the conformal map
     folded = 0;
   }
+  // The mean 2D image of the warp in a flattening (area-weighted unit images; +y when none),
+  // over the triangles `use` marks (all when empty).
+  const auto mean_grain = [&](const Eigen::MatrixX2d& map, const std::vector<char>& use = {}) {
+    Eigen::Vector2d grain = Eigen::Vector2d::Zero();
+    for (Eigen::Index f = 0; f < t.rows(); ++f) {
+      if (!use.empty() && !use[static_cast<size_t>(f)]) continue;
+      const RestTriangle& r = rest[static_cast<size_t>(f)];
+      const Eigen::Vector3d w3 = triangle_warp.row(triangle_warp.rows() == 1 ? 0 : f).transpose();
+      const Eigen::Vector2d local(w3.dot(r.e1), w3.dot(r.e2));
+      const Eigen::Vector2d image = jacobian(map, t, f, r) * local;
+      if (image.norm() > 0) grain += r.area * image.normalized();
+    }
+    return grain.norm() < 1e-12 ? Eigen::Vector2d::UnitY() : grain;
+  };
   // A centre line to hold straight (the piece is then cut on the fold): flattened again from the
   // same start turned with the run's chord on the y axis, the run's x held at 0; kept when it
-  // folds nothing and costs at most `straight_centre_cost` of 95th-percentile stretch.
+  // folds nothing and costs at most `straight_centre_cost` of 95th-percentile stretch. (The
+  // caller passes no run for a panel whose grain is turned off the threads: flatten_garment.)
   bool straight = false;
+  bool cross = false;  // the held centre line lies along the weft, not the warp
   if (folded == 0 && centre_run.size() >= 3 && options.straight_centre_cost >= 0) {
     const Eigen::RowVector2d a = start.row(centre_run.front());
     const Eigen::Vector2d chord = (start.row(centre_run.back()) - a).transpose();
@@ -510,6 +526,9 @@ FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
         out.iterations = sweeps;
         uv = held;
         straight = true;
+        // A panel turned 90° (a collar cut across the grain) is folded across the warp.
+        const Eigen::Vector2d grain = mean_grain(held);
+        cross = std::abs(grain.x()) > std::abs(grain.y());
       }
     }
   }
@@ -523,21 +542,14 @@ FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
                           d.worst_point.z()));
   }
 
-  // Grain: the mean 2D image of the warp, turned onto +y.
-  Eigen::Vector2d grain = Eigen::Vector2d::Zero();
-  for (Eigen::Index f = 0; f < t.rows(); ++f) {
-    const RestTriangle& r = rest[static_cast<size_t>(f)];
-    const Eigen::Vector3d w3 = triangle_warp.row(triangle_warp.rows() == 1 ? 0 : f).transpose();
-    const Eigen::Vector2d local(w3.dot(r.e1), w3.dot(r.e2));
-    const Eigen::Vector2d image = jacobian(uv, t, f, r) * local;
-    if (image.norm() > 0) grain += r.area * image.normalized();
-  }
-  if (grain.norm() < 1e-12) grain = Eigen::Vector2d::UnitY();
-  // A straight centre line is the fold, and a fold lies along the warp (fabric is folded
-  // lengthwise): the piece is turned with it on +y, the way nearer the warp's mean image. For a
-  // symmetric panel that is the grain of the whole piece the half and its mirror make.
+  // Grain: the mean 2D image of the warp, turned onto +y. A straight centre line is the fold,
+  // and a fold lies along a thread: the piece is turned with it on +y (along the warp, the way
+  // nearer the warp's mean image) or on +x (along the weft); for a symmetric panel that is the
+  // grain of the whole piece the half and its mirror make.
+  const Eigen::Vector2d grain = mean_grain(uv);
   double turn = std::numbers::pi / 2 - std::atan2(grain.y(), grain.x());
-  if (straight) turn = grain.y() >= 0 ? 0.0 : std::numbers::pi;
+  if (straight && !cross) turn = grain.y() >= 0 ? 0.0 : std::numbers::pi;
+  if (straight && cross) turn = grain.x() >= 0 ? std::numbers::pi / 2 : -std::numbers::pi / 2;
   const Eigen::Matrix2d rotation = Eigen::Rotation2Dd(turn).toRotationMatrix();
   uv = (uv * rotation.transpose()).eval();
   uv.rowwise() -= uv.colwise().minCoeff();
@@ -666,6 +678,7 @@ std::optional<FlatPanel> reflected_piece(const FlatPanel& original, const Eigen:
   out.distortion = original.distortion;
   out.centre_run = original.centre_run;  // the original's numbering: the caller renumbers it
   out.free_centre_bow = original.free_centre_bow;
+  out.centre_off_grain_deg = original.centre_off_grain_deg;
   out.free_distortion = original.free_distortion;
   out.distortion.worst_point.x() = -original.distortion.worst_point.x();
   out.distortion.worst_point_2d.x() = width - original.distortion.worst_point_2d.x();
@@ -793,10 +806,19 @@ FlatPattern flatten_garment(const Garment& garment, const FlatteningOptions& opt
           if (reflected) reflected->reflection_of = static_cast<int>(o);
         }
     }
-    const std::vector<int> run = centre_run(p, global, disk_boundary(name, v.rows(), t));
+    std::vector<int> run = centre_run(p, global, disk_boundary(name, v.rows(), t));
+    // A fold is a thread of the folded fabric: a panel whose grain is turned off the threads of
+    // its centre line (a bias cut, "grain": 45) keeps its centre seam, cut 2 as drawn. By
+    // symmetry the warp of a panel not turned runs along its centre line (the vertical, or the
+    // limb's axis, projected into the plane x = 0), so the turn is the fold's angle to the grain.
+    const double off_thread = std::abs(std::remainder(garment.panels[p].grain_turn_deg, 90.0));
+    const bool on_thread = off_thread <= options.fold_off_grain_deg;
+    const bool has_run = !run.empty();
+    if (!on_thread) run.clear();
     FlatPanel flat = reflected ? std::move(*reflected)
                                : flatten_with_warp(name, v, t, warp, options, on_body, run);
     if (reflected && !flat.centre_run.empty()) flat.centre_run = run;
+    flat.centre_off_grain_deg = has_run ? off_thread : -1.0;
     flat.panel = static_cast<int>(p);
     flat.vertices = std::move(global);
     flat.triangle_quad = std::move(quad_of);

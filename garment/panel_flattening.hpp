@@ -50,6 +50,12 @@ struct FlatteningOptions {
   // points, a back over a deep hollow of the spine 3.2-3.8, a crotch curve 3.2-16, a hood 37-40
   // (docs/pattern.md, "Cut on the fold").
   double straight_centre_cost = 0.025;
+  // Cut on the fold, a piece's grain is where the fold puts it: its centre line lies on a
+  // thread of the folded fabric. A panel whose grain is turned more than this (degrees) off the
+  // threads of its centre line (a bias cut, "grain": 45) is not held straight nor cut on the
+  // fold: the piece keeps its centre seam and its grain as drawn, cut 2. 2°: fabric is itself
+  // woven up to 1-2° askew (docs/pattern.md, "Folds on the grain").
+  double fold_off_grain_deg = 2.0;
 };
 
 // A point on a piece's outline: on edge `edge` (FlatPanel::boundary[edge] → boundary[edge + 1],
@@ -102,6 +108,12 @@ struct FlatPanel {
   // on one line along +y. Empty when the piece was flattened freely. Then also what the free
   // flattening gave: how far the run bowed from its chord (m) and the free distortion.
   std::vector<int> centre_run;
+  // For a panel with a centre line (a run on the mirror plane sewn to its mirror copy): the
+  // angle between that line and the nearest thread, warp or weft (degrees, 0 .. 45): its
+  // grain's turn (GarmentPanel::grain_turn_deg) folded onto the threads, since the warp of a
+  // panel not turned runs along its centre line. Above fold_off_grain_deg the line is not held
+  // straight. −1 when the panel has no centre line.
+  double centre_off_grain_deg = -1;
   double free_centre_bow = 0;
   FlatDistortion free_distortion;
   // A mirror copy whose 3D triangles are exactly its original's reflected: the index (into

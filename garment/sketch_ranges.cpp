@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <string_view>
 #include <vector>
 
@@ -203,22 +204,19 @@ double fan_area(const std::vector<Eigen::Vector3d>& outline) {
 }
 
 void check_panel_sizes(const GarmentRequest& sketch, const std::vector<PanelSize>& panels) {
-  double total = 0;
-  size_t largest = 0;
-  std::vector<double> quads;
-  for (size_t p = 0; p < panels.size(); ++p) {
-    quads.push_back(estimated_quads(panels[p]));
-    total += quads.back();
-    if (!panels[p].mirror_copy && (panels[largest].mirror_copy || quads[p] > quads[largest]))
-      largest = p;
-  }
+  const auto total_quads = [](const std::vector<PanelSize>& sizes) {
+    double total = 0;
+    for (const PanelSize& size : sizes) total += estimated_quads(size);
+    return total;
+  };
+  const double total = total_quads(panels);
   if (total <= kMaxGarmentQuads || panels.empty()) return;
-  // Quads scale with 1/edge_length²: edges this factor longer would fit.
-  const double factor = std::sqrt(total / kMaxGarmentQuads);
+  size_t largest = 0;
+  for (size_t p = 0; p < panels.size(); ++p)
+    if (!panels[p].mirror_copy && (panels[largest].mirror_copy ||
+                                   estimated_quads(panels[p]) > estimated_quads(panels[largest])))
+      largest = p;
   const double seconds = total * kMeshingSecondsPerQuad;
-  const std::string time =
-      seconds < 120 ? fmt::format("{:.0f} s", seconds) : fmt::format("{:.0f} min", seconds / 60);
-  const double edge = panels[largest].boundary_length / panels[largest].boundary_edges;
   // "378,000": a count to three figures, with thousands separated.
   const auto count = [](double n) {
     const double scale = std::pow(10.0, std::max(0.0, std::floor(std::log10(n)) - 2));
@@ -227,15 +225,79 @@ void check_panel_sizes(const GarmentRequest& sketch, const std::vector<PanelSize
       digits.insert(static_cast<size_t>(k), ",");
     return digits;
   };
-  sketch.fail(
-      panels[largest].path,
-      fmt::format("the garment would have about {} quads (panel '{}' about {}, with edges "
-                  "of {:.3g} m), more than the {} this program meshes: meshing them would "
-                  "take about {} of CPU and {:.1f} GB of memory; use edges about {:.2g} times "
-                  "longer (\"edge_length\" {:.2g} m or more) or fewer \"edges\"",
-                  count(total), panels[largest].id, count(quads[largest]), edge,
-                  count(kMaxGarmentQuads), time, total * kMeshingBytesPerQuad / 1e9, factor,
-                  std::ceil(factor * edge * 1e4) / 1e4));
+  const std::string limit = fmt::format(
+      "more than the {} this program meshes: meshing them would take about {} of CPU and {:.1f} "
+      "GB of memory",
+      count(kMaxGarmentQuads),
+      seconds < 120 ? fmt::format("{:.0f} s", seconds) : fmt::format("{:.0f} min", seconds / 60),
+      total * kMeshingBytesPerQuad / 1e9);
+
+  // Curves whose fixed "edges" cut edges far (over twice) shorter than the rest of the panel's
+  // outline (or than the file's edge_length when the whole outline is fixed): with counts that
+  // give them that edge, would the garment fit? Then the count is what to change, not the length.
+  std::map<int, double> scale;    // curve → the factor its edges should grow by (the largest)
+  std::map<int, double> natural;  // curve → the edge its panels give it (m)
+  for (const PanelSize& size : panels) {
+    double fixed_edges = 0, fixed_length = 0;
+    for (const PanelSize::FixedEdges& f : size.fixed)
+      fixed_edges += f.edges, fixed_length += f.length;
+    const double free_edges = size.boundary_edges - fixed_edges;
+    const double edge =
+        free_edges > 0.5 ? (size.boundary_length - fixed_length) / free_edges : sketch.edge_length;
+    for (const PanelSize::FixedEdges& f : size.fixed) {
+      if (!(f.edges > 0) || !(f.length > 0)) continue;
+      const double own = f.length / f.edges;
+      if (own * 2 < edge && edge / own > scale[f.curve]) {
+        scale[f.curve] = edge / own;
+        natural[f.curve] = edge;
+      }
+    }
+  }
+  if (!scale.empty()) {
+    std::vector<PanelSize> fewer = panels;
+    for (PanelSize& size : fewer)
+      for (PanelSize::FixedEdges& f : size.fixed)
+        if (scale.count(f.curve)) {
+          const double edges = std::max(1.0, std::round(f.edges / scale[f.curve]));
+          size.boundary_edges += edges - f.edges;
+          f.edges = edges;
+        }
+    if (total_quads(fewer) <= kMaxGarmentQuads) {
+      // Name the curve that cuts the shortest edges, with the count that gives it its panel's.
+      const auto worst =
+          std::max_element(scale.begin(), scale.end(),
+                           [](const auto& a, const auto& b) { return a.second < b.second; });
+      const CurveSpec& curve = sketch.curves[static_cast<size_t>(worst->first)];
+      const int edges = *curve.edges;
+      const int fits = std::max(1, static_cast<int>(std::lround(edges / worst->second)));
+      sketch.fail(curve.json_path + "/edges",
+                  fmt::format("curve '{}' is cut into {} edges of {:.2g} m, where the rest of its "
+                              "panel has edges of about {:.2g} m: the garment would have about {} "
+                              "quads, {}; give it about {} \"edges\" (or none, to take its "
+                              "panel's edge length)",
+                              curve.id, edges, natural[worst->first] / worst->second,
+                              natural[worst->first], count(total), limit, fits));
+    }
+  }
+
+  // Quads scale with 1/edge_length²: edges this factor longer would fit.
+  const double factor = std::sqrt(total / kMaxGarmentQuads);
+  const double edge = panels[largest].boundary_length / panels[largest].boundary_edges;
+  const double suggested = std::ceil(factor * edge * 1e4) / 1e4;
+  // A factor that rounds to 1 ("about 1 times longer") is said as "slightly"; an edge length
+  // below the smallest a file may give (a fixed count's edges) is not suggested.
+  const std::string longer = factor < 1.5 ? std::string("slightly longer edges")
+                                          : fmt::format("edges about {:.2g} times longer", factor);
+  const std::string advice =
+      suggested >= kMinEdgeLength
+          ? fmt::format("use {} (\"edge_length\" {:.2g} m or more) or fewer \"edges\"", longer,
+                        suggested)
+          : fmt::format("use {}: fewer \"edges\" on the curves that fix them", longer);
+  sketch.fail(panels[largest].path,
+              fmt::format("the garment would have about {} quads (panel '{}' about {}, with edges "
+                          "of {:.3g} m), {}; {}",
+                          count(total), panels[largest].id, count(estimated_quads(panels[largest])),
+                          edge, limit, advice));
 }
 
 }  // namespace sd::garment

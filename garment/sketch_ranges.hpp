@@ -87,6 +87,8 @@ inline constexpr UsualRange kUsualFabricWidth{0.9, 3.2};
 inline constexpr UsualRange kUsualBodyHeight{0.5, 2.5};
 inline constexpr UsualRange kUsualSheetSide{0.1, 3.0};
 inline constexpr UsualRange kUsualJunctionTolerance{0.002, 0.05};
+// The shortest "edge_length" a file may give (m; scene/sketch_reader.hpp refuses less).
+inline constexpr double kMinEdgeLength = 0.002;
 
 // "130 m is outside ...": the sentence for a coordinate or length `value` (metres) that is out of
 // range, with a hint when it reads as centimetres or millimetres typed for metres (its hundredth
@@ -112,6 +114,14 @@ struct PanelSize {
   double boundary_edges = 0;
   double boundary_length = 0;  // m
   double area = 0;  // m²: the fan of triangles from its outline's centroid to its outline
+  // The outline's pieces of curves with a fixed "edges" count (CurveSpec::edges): the curve
+  // (index into GarmentRequest::curves) and the edges and length (m) it gives this outline.
+  struct FixedEdges {
+    int curve = -1;
+    double edges = 0;
+    double length = 0;
+  };
+  std::vector<FixedEdges> fixed;
 };
 
 // A panel's quads, estimated: its area over its mean boundary edge squared (the filler keeps
@@ -125,9 +135,11 @@ double estimated_quads(const PanelSize& panel);
 double fan_area(const std::vector<Eigen::Vector3d>& outline);
 
 // Before filling: the garment's estimated quads (sum over panels) must stay below
-// kMaxGarmentQuads. Throws SketchError at the largest panel's path, saying how many quads the
-// garment would have, what meshing them would cost (kMeshingSecondsPerQuad, kMeshingBytesPerQuad)
-// and the edge length that would fit.
+// kMaxGarmentQuads. Throws SketchError saying how many quads the garment would have, what
+// meshing them would cost (kMeshingSecondsPerQuad, kMeshingBytesPerQuad) and what would fit: at
+// a curve's "edges" when fixed counts cut edges far shorter than the rest of their panels' and
+// counts that give them their panels' edge would fit (the count to give), else at the largest
+// panel's path with the edge length that would fit.
 void check_panel_sizes(const GarmentRequest& sketch, const std::vector<PanelSize>& panels);
 
 }  // namespace sd::garment

@@ -172,9 +172,9 @@ class Reader {
   // An edge length in metres: 2 mm .. 50 cm.
   double edge_length(const json& value, const std::string& path) const {
     const double x = positive(value, path);
-    if (x < 0.002 || x > 0.5)
-      fail(path,
-           out_of_range_sentence(x, 0.002, 0.5, "an edge length of", garment::kUsualEdgeLength));
+    if (x < garment::kMinEdgeLength || x > 0.5)
+      fail(path, out_of_range_sentence(x, garment::kMinEdgeLength, 0.5, "an edge length of",
+                                       garment::kUsualEdgeLength));
     return x;
   }
 

@@ -35,6 +35,7 @@
 #include "src/app/pipeline/preview_images.hpp"
 #include "src/app/pipeline/progress.hpp"
 #include "src/app/pipeline/run_report.hpp"
+#include "src/app/pipeline/seam_ease_warnings.hpp"
 #include "src/app/pipeline/self_intersections.hpp"
 #include "src/app/pipeline/sketch_checks.hpp"
 #include "src/render/renderer.hpp"
@@ -348,6 +349,9 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   RunReport out;                           // report.json, filled as the drape goes
   out.warnings = fabric_warnings(sketch);  // logged by check_sketch, as are the gather warnings
   for (std::string& warning : gather_warnings(sketch)) out.warnings.push_back(std::move(warning));
+  if (scene.garment)  // logged as the garment was meshed (garment_stage.cpp)
+    for (std::string& warning : seam_ease_warnings(sketch, *scene.garment))
+      out.warnings.push_back(std::move(warning));
   // The body's repairs and defects (an open body, inconsistent triangles), logged as it loaded.
   if (scene.body)
     out.warnings.insert(out.warnings.end(), scene.body->warnings.begin(),

@@ -1,6 +1,7 @@
 #include "src/app/pipeline/garment_stage.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <chrono>
@@ -12,6 +13,7 @@
 #include "garment/sketch_error.hpp"
 #include "garment/sketch_inputs.hpp"
 #include "src/app/pipeline/quality_warnings.hpp"
+#include "src/app/pipeline/seam_ease_warnings.hpp"
 
 namespace sd::app {
 namespace {
@@ -118,6 +120,7 @@ MeshedGarment mesh_garment(const scene::Sketch& sketch) {
     }
   }();
   const double meshing_ms = ms_since(mesh_start);
+  for (const std::string& warning : seam_ease_warnings(sketch, g)) spdlog::warn("{}", warning);
 
   std::vector<std::string> groups;
   std::vector<int> panel_group(g.panels.size());

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <numbers>
 
 #include "sim/fabric.hpp"
 #include "src/app/pipeline/markup_escape.hpp"
@@ -109,14 +110,14 @@ constexpr double kFoldStraightness = 2e-3;
 
 // The outline edges of panel `flat` (not a mirror copy) that lie on the garment's mirror plane
 // x = 0, when its mirror copy is in the pattern and those edges make one straight run (within
-// kFoldStraightness of its chord, in 2D): the piece is cut on the fold there, and stands for
-// its copy too. Empty otherwise.
+// kFoldStraightness of its chord, in 2D) along the grain line or across it (within
+// `off_grain_deg`: the fold is a thread of the folded fabric) and opened out the piece fits
+// across the fabric: the piece is cut on the fold there, and stands for its copy too. Empty
+// otherwise.
 std::vector<bool> fold_edges(const garment::Garment& garment, const garment::FlatPattern& pattern,
                              const garment::FlatPanel& flat, const std::vector<double>& own,
-                             double opened_width_limit) {
+                             double opened_width_limit, double off_grain_deg) {
   if (flat.id.ends_with(".mirror")) return {};
-  // Opened out, both halves must fit across the fabric (the layout lays it out so).
-  if (2 * flat.uv.col(0).maxCoeff() > opened_width_limit) return {};
   const bool has_copy = std::any_of(pattern.panels.begin(), pattern.panels.end(),
                                     [&](const auto& p) { return p.id == flat.id + ".mirror"; });
   if (!has_copy) return {};
@@ -146,6 +147,19 @@ std::vector<bool> fold_edges(const garment::Garment& garment, const garment::Fla
     const Eigen::Vector2d q = flat.uv.row(flat.boundary[(k + 1) % n]).transpose() - a;
     if (std::abs(along.x() * q.y() - along.y() * q.x()) > kFoldStraightness) return {};
   }
+  // The piece's grain line is +y: the fold along it or across it, not on the bias.
+  const double off = std::acos(std::min(1.0, std::abs(along.y()))) * 180.0 / std::numbers::pi;
+  if (off > off_grain_deg && 90.0 - off > off_grain_deg) return {};
+  // Opened out (the piece and its reflection across the fold), both halves must fit across the
+  // fabric (the layout lays it out so).
+  double lo = 0, hi = 0;
+  for (Eigen::Index v = 0; v < flat.uv.rows(); ++v) {
+    const Eigen::Vector2d p = flat.uv.row(v).transpose() - a;
+    const Eigen::Vector2d mirrored = 2 * p.dot(along) * along - p;
+    lo = std::min({lo, p.x(), mirrored.x()});
+    hi = std::max({hi, p.x(), mirrored.x()});
+  }
+  if (hi - lo > opened_width_limit) return {};
   return fold;
 }
 
@@ -303,8 +317,9 @@ PatternSheet build_pattern_sheet(const scene::Sketch& sketch, const garment::Gar
         widest_allowance = std::max(widest_allowance, a);
       const double opened_limit =
           (spec.fabric_width - 2 * layout.gap - 0.008) / panel.ease.weft - 2 * widest_allowance;
-      layout.fold_edge.push_back(
-          fold_edges(garment, sheet.pattern, flat, layout.edge_allowance.back(), opened_limit));
+      layout.fold_edge.push_back(fold_edges(garment, sheet.pattern, flat,
+                                            layout.edge_allowance.back(), opened_limit,
+                                            flattening.fold_off_grain_deg));
       sheet.fabrics.push_back(fabric_label(sketch, panel.fabric));
     }
     // A fold piece's mirror copy is its other half: not cut on its own.
@@ -599,8 +614,11 @@ nlohmann::json distortion_json(const garment::FlatDistortion& d) {
 // The centre line held straight by the flattening (FlatPanel::centre_run), with what the free
 // flattening gave for comparison; null for a piece flattened freely.
 nlohmann::json centre_line_json(const garment::FlatPanel& flat) {
-  if (flat.centre_run.empty()) return nullptr;
+  if (flat.centre_off_grain_deg < 0) return nullptr;
+  if (flat.centre_run.empty())
+    return {{"held_straight", false}, {"off_grain_deg", flat.centre_off_grain_deg}};
   return {{"held_straight", true},
+          {"off_grain_deg", flat.centre_off_grain_deg},
           {"free_bow_mm", kMm * flat.free_centre_bow},
           {"free_distortion", distortion_json(flat.free_distortion)}};
 }
