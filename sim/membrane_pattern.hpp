@@ -17,6 +17,10 @@
 
 namespace sd::sim {
 
+// Whether the 3×3 block whose rows start at `values`, `stride` apart, is c·I (off-diagonals
+// exactly zero, the diagonal three equal numbers): the flat bends' blocks and the mass.
+bool is_scaled_identity(const double* values, int stride);
+
 class MembranePattern {
  public:
   // From A (3n by 3n, made of vertex blocks; diagonal_offsets as in ClothModel's pattern).

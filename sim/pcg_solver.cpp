@@ -15,15 +15,6 @@ namespace {
 // about 60 µs of work each, well above oneTBB's cost of handing one out.
 constexpr int kProductGrain = 256;
 
-// Whether a 3×3 block, its rows `stride` apart in `values`, is c·I (off-diagonals exactly zero,
-// the diagonal three equal numbers).
-bool is_scaled_identity(const double* values, int stride) {
-  const double* r1 = values + stride;
-  const double* r2 = r1 + stride;
-  return values[1] == 0.0 && values[2] == 0.0 && r1[0] == 0.0 && r1[2] == 0.0 && r2[0] == 0.0 &&
-         r2[1] == 0.0 && r1[1] == values[0] && r2[2] == values[0];
-}
-
 }  // namespace
 
 bool VertexBlockMatrix::build(const SparseMatrixR& a) {
