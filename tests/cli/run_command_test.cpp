@@ -605,8 +605,9 @@ TEST(RunCommand, APanelLeftStretchedIsWarnedAbout) {
     back += text.find("panel 'bodice_back' ends stretched") != std::string::npos;
     // The two waist seams (0.8 against 1) are also warned before the drape, once each.
     seams += text.find("whose two sides rest 20.0 %") != std::string::npos;
-    if (text.find("ends stretched") != std::string::npos)
+    if (text.find("ends stretched") != std::string::npos) {
       EXPECT_EQ(text.find("peplum"), std::string::npos) << text;
+    }
     EXPECT_EQ(text.find(".mirror' ends"), std::string::npos) << text;
   }
   EXPECT_EQ(front, 1) << report["warnings"].dump(2);
