@@ -61,9 +61,9 @@ std::vector<std::string> seam_ease_warnings(const scene::Sketch& sketch,
         "mm), whose two sides rest {:.1f} % ({:.0f} mm) apart in length: the simulator cannot "
         "ease the longer side in as ripples a few millimetres wide, so the seam holds it "
         "squeezed by about half of that and the other side stretched by the other half, and "
-        "past {:g} % the cloth at such a seam may never come to rest (trial 38's strapless "
-        "dress, a 0.95 bodice sewn to a skirt at 1, still moved at 4 cm/s under that seam after "
-        "8 s). Keep the eases of panels sewn together within {:g} % of each other: give '{}' an "
+        "past {:g} % the cloth at such a seam may never come to rest (a strapless dress with "
+        "its bodice at 0.95 sewn to a skirt at 1 still moved at 4 cm/s under that seam after 8 "
+        "s). Keep the eases of panels sewn together within {:g} % of each other: give '{}' an "
         "ease of at most {:g}, or '{}' at least {:g}; for fullness on purpose gather it "
         "({{\"weft\": ...}}, docs/sketch-format.md, \"Gathers\")",
         sketch.file, path, base(pa.id), ea, base(pb.id), eb, base(key.first), 1e3 * length,
