@@ -21,31 +21,7 @@ import os
 import subprocess
 import sys
 import tempfile
-
-
-def strip_comments(text):
-    """JSON with // comments (the sketch format allows them) to plain JSON."""
-    out, i, in_string = [], 0, False
-    while i < len(text):
-        c = text[i]
-        if in_string:
-            out.append(c)
-            if c == "\\":
-                out.append(text[i + 1])
-                i += 1
-            elif c == '"':
-                in_string = False
-        elif c == '"':
-            in_string = True
-            out.append(c)
-        elif text.startswith("//", i):
-            while i < len(text) and text[i] != "\n":
-                i += 1
-            continue
-        else:
-            out.append(c)
-        i += 1
-    return "".join(out)
+from sketch_json import strip_comments  # scripts/sketch_json.py, beside this file
 
 
 def read_obj(path):
