@@ -20,6 +20,8 @@
 #include <string>
 #include <vector>
 
+#include "garment/body_facing.hpp"
+#include "garment/body_landmarks.hpp"
 #include "garment/body_up_error.hpp"
 #include "garment/input_checks.hpp"
 #include "garment/sketch_error.hpp"
@@ -408,6 +410,48 @@ std::string builtin_body_path() {
   return kBuiltinPath;
 }
 
+namespace {
+
+// A figure given "facing" or "up" that turn it round (trial 38: the built-in body with "facing":
+// "+y" faced -Z, its landmarks were found on its back, and the first error was two curves 7 cm
+// apart): refused with the facing that would be right. Only for a standing figure: a body
+// without landmarks (an obstacle, a figure turned sideways) is left as given.
+void check_facing(const Body& body, const BodyOptions& options) {
+  BodyLandmarks landmarks;
+  try {
+    landmarks = find_landmarks(body.mesh);
+  } catch (const std::runtime_error&) {
+    return;
+  }
+  const FacingCues cues = facing_cues(body.mesh, landmarks);
+  if (!cues.backwards()) return;
+  const RawBodyInfo& raw = body.raw;
+  const AxisDirection right{raw.facing.axis, -raw.facing.sign};
+  const AxisDirection convention =
+      raw.up.axis == 2 ? AxisDirection{1, -raw.up.sign} : AxisDirection{2, 1};
+  const std::string given =
+      options.facing ? fmt::format("with \"facing\": \"{}\"", raw.facing.name())
+                     : fmt::format("with \"up\": \"{}\" (whose convention faces the figure {})",
+                                   raw.up.name(), raw.facing.name());
+  std::string measured = fmt::format(
+      "its head reaches {:.1f} cm out behind the neck and {:.1f} cm in front of it (a face "
+      "reaches farther forward than the back of the head)",
+      100 * cues.head.behind, 100 * cues.head.ahead);
+  if (!cues.head.found) measured.clear();
+  if (cues.feet.found)
+    measured += fmt::format(
+        "{}its feet {:.1f} cm behind the ankles and {:.1f} cm in front (toes reach farther "
+        "than heels)",
+        measured.empty() ? "" : ", ", 100 * cues.feet.behind, 100 * cues.feet.ahead);
+  throw BodyFacingError(fmt::format(
+      "{} the figure faces backwards: {}; give \"facing\": \"{}\"{}", given, measured, right.name(),
+      right.axis == convention.axis && right.sign == convention.sign
+          ? " (the convention for this up axis, so \"facing\" can also be left out)"
+          : ""));
+}
+
+}  // namespace
+
 Body load_body(const std::string& path, const BodyOptions& options) {
   const bool builtin = path == "builtin";
   const std::string file = builtin ? kBuiltinPath : path;
@@ -563,6 +607,7 @@ Body load_body(const std::string& path, const BodyOptions& options) {
   raw.shift = Eigen::Vector3d(-box.centre().x(), -box.min.y(), -box.centre().z());
   mesh.vertices.rowwise() += raw.shift.transpose();
   body.mesh = std::move(mesh);
+  if (options.facing || options.up) check_facing(body, options);
   // Said once per process: a sketch whose points name landmarks loads its body while it is
   // read and again to mesh it, and the designer saw each repair twice.
   static std::mutex mutex;
