@@ -505,6 +505,28 @@ TEST(Garment, ShiftDressDrawnOnTheBuiltinBodyIsCleanOnTheColladaHuman) {
   }
 }
 
+// Trial 38's halter top kept a quad 2.36 times the edge in its one-piece front (round the neck:
+// six corners, two reflex layout vertices the filler put on the hem and the neckline). With a
+// seam across the strap (data/designs/author-38/halter-top.json) it is clean; without the
+// strap's own edge_length it has the one warning, and the gate offers exactly that curve.
+TEST(Garment, HalterTopWithASeamAcrossTheStrapIsClean) {
+  const Sketch halter =
+      load_sketch(std::filesystem::path(SD_SOURCE_DIR) / "data/designs/author-38/halter-top.json");
+  const Body body = load_sketch_body(halter);
+  const BodySurface surface(body.mesh);
+  EXPECT_TRUE(
+      check_quality_tried(build_garment(halter, surface), halter, body.mesh, nullptr).empty());
+  GarmentRequest plain = halter;
+  for (CurveSpec& curve : plain.curves)
+    if (curve.id == "strap_lo") curve.edge_length.reset();
+  const std::vector<QualityWarning> told =
+      check_quality_tried(build_garment(plain, surface), plain, body.mesh, nullptr);
+  ASSERT_EQ(told.size(), 1u);
+  EXPECT_EQ(told[0].kind, "quad_size");
+  EXPECT_EQ(told[0].curve, "strap_lo");
+  EXPECT_DOUBLE_EQ(told[0].curve_edge_length, 0.016);
+}
+
 // Above QualityLimits::max_trial_quads the advice that needs the garment meshed again is not
 // tried, and so not offered: the tank top's back, offered a corner list that cleans it (above),
 // gets the plain warning, the same warnings in number and kind (no trial build is run, so a fine
