@@ -412,10 +412,11 @@ std::string builtin_body_path() {
 
 namespace {
 
-// A figure given "facing" or "up" that turn it round (trial 38: the built-in body with "facing":
-// "+y" faced -Z, its landmarks were found on its back, and the first error was two curves 7 cm
-// apart): refused with the facing that would be right. Only for a standing figure: a body
-// without landmarks (an obstacle, a figure turned sideways) is left as given.
+// A figure whose given "facing" (or "up", by its convention) turns it round is refused with the
+// facing that would be right (trial 38: the built-in body with "facing": "+y" faced -Z, its
+// landmarks were found on its back, and the first error was two curves 7 cm apart). Only for a
+// standing figure: a body without landmarks (an obstacle, a figure turned sideways) is left as
+// given.
 void check_facing(const Body& body, const BodyOptions& options) {
   BodyLandmarks landmarks;
   try {
