@@ -122,6 +122,26 @@ TEST(Cli, InfoSliceNamesEachOutlinesPart) {
   EXPECT_NE(text.output.find("  left leg "), std::string::npos) << text.output;
 }
 
+// `info` says which way the figure faces by its head (docs/bodies.md, Normalisation): the
+// built-in body's face reaches 7.5 cm forward of its neck, its skull 3 cm back (lean 0.43; 0.3
+// leaves room for a slice's change of the neck's base). Given --facing that turns it round,
+// `info` refuses it with the facing that is right (exit 2), as a sketch does at /body/facing.
+TEST(Cli, InfoSaysWhichWayTheFigureFaces) {
+  const CommandResult r = run_sketchdrape("info builtin --json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = nlohmann::json::parse(r.output);
+  EXPECT_TRUE(j["facing_cues"]["head"]["found"].get<bool>());
+  EXPECT_GT(j["facing_cues"]["head"]["lean"].get<double>(), 0.3);
+  EXPECT_FALSE(j["facing_cues"]["backwards"].get<bool>());
+  const CommandResult text = run_sketchdrape("info builtin");
+  EXPECT_NE(text.output.find("facing      its head reaches"), std::string::npos) << text.output;
+  EXPECT_EQ(text.output.find("faces backwards"), std::string::npos) << text.output;
+  const CommandResult turned = run_sketchdrape("info builtin --facing +y");
+  EXPECT_EQ(turned.exit_code, 2) << turned.output;
+  EXPECT_NE(turned.output.find("faces backwards"), std::string::npos) << turned.output;
+  EXPECT_NE(turned.output.find("give \"facing\": \"-y\""), std::string::npos) << turned.output;
+}
+
 // A slice height that is not a number or misses the figure is a usage mistake (exit 2 with a
 // sentence), not an empty answer: the built-in body spans 0 .. 1.75 m.
 TEST(Cli, InfoSliceOutsideTheBodyOrNotANumberExitsTwo) {

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "garment/body.hpp"
+#include "garment/body_facing.hpp"
 #include "garment/body_landmarks.hpp"
 #include "src/app/commands/cli.hpp"
 
@@ -81,6 +82,7 @@ void run_info(const InfoOptions& options) {
   };
   // Landmarks, when the body looks like a standing figure (a mannequin's torso alone has none).
   std::optional<garment::BodyLandmarks> landmarks;
+  std::optional<garment::FacingCues> facing;  // which way it faces, from its head and feet
   std::string landmark_problem;
   try {
     landmarks = garment::find_landmarks(body.mesh);
@@ -96,6 +98,14 @@ void run_info(const InfoOptions& options) {
                        {"waist", landmarks->waist_girth},
                        {"hips", landmarks->hip_girth}};
     out["landmark_doubts"] = landmarks->doubts;
+    facing = garment::facing_cues(body.mesh, *landmarks);
+    const auto cue_json = [](const garment::FacingCue& c) {
+      return nlohmann::json{
+          {"found", c.found}, {"ahead_m", c.ahead}, {"behind_m", c.behind}, {"lean", c.lean()}};
+    };
+    out["facing_cues"] = {{"head", cue_json(facing->head)},
+                          {"feet", cue_json(facing->feet)},
+                          {"backwards", facing->backwards()}};
   } else {
     out["landmarks"] = nullptr;
     out["landmarks_problem"] = landmark_problem;
@@ -172,6 +182,26 @@ void run_info(const InfoOptions& options) {
       "girths      chest {:.3f} m, waist {:.3f} m, hips {:.3f} m (convex hull of "
       "the torso's slice)\n",
       landmarks->chest_girth, landmarks->waist_girth, landmarks->hip_girth);
+  // The facing the figure shows (docs/bodies.md, Normalisation): a body loaded with a given
+  // facing that turns it round is refused before this; one that breaks its up axis's convention
+  // unasked is told here.
+  std::string shown;
+  if (facing->head.found)
+    shown = fmt::format("its head reaches {:.1f} cm forward of the neck, {:.1f} cm back",
+                        100 * facing->head.ahead, 100 * facing->head.behind);
+  if (facing->feet.found)
+    shown +=
+        fmt::format("{}its toes {:.1f} cm forward of the ankles, heels {:.1f} cm back",
+                    shown.empty() ? "" : "; ", 100 * facing->feet.ahead, 100 * facing->feet.behind);
+  if (shown.empty()) shown = "not measured (no head above the neck, no feet)";
+  std::cout << fmt::format("facing      {}\n", shown);
+  if (facing->backwards())
+    std::cout << fmt::format(
+        "warning     the figure faces backwards (its face{} behind): give --facing {} (in a "
+        "sketch, \"body\": {{\"facing\": \"{}\"}})\n",
+        facing->feet.found ? " and toes" : "",
+        garment::AxisDirection{raw.facing.axis, -raw.facing.sign}.name(),
+        garment::AxisDirection{raw.facing.axis, -raw.facing.sign}.name());
   for (const std::string& doubt : landmarks->doubts)
     std::cout << "warning     the landmarks look wrong: " << doubt
               << "; is this a standing human figure, feet down, facing +z after normalisation? "
