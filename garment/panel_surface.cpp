@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
 #include <algorithm>
 #include <stdexcept>
 #include <vector>
@@ -24,39 +25,67 @@ std::vector<std::pair<int, int>> quad_edges(const meshing::QuadMesh& mesh) {
   return edges;
 }
 
-// Solves L x = 0 for the unmarked vertices with the marked ones as boundary values.
+// Solves L x = 0 for the unmarked vertices with the marked ones as boundary values: each at the
+// mean of its edge neighbours, neighbour u weighing weight[u] (empty: every one 1). A vertex whose
+// neighbours all weigh 0 takes their plain mean. Uniform weights make L symmetric (LDLT); others
+// do not (LU).
 void solve_harmonic(meshing::QuadMesh& mesh, const std::vector<std::pair<int, int>>& edges,
-                    const std::vector<char>& held) {
+                    const std::vector<char>& held, std::span<const double> weight = {}) {
   const auto nv = static_cast<size_t>(mesh.vertex_count());
   std::vector<int> unknown(nv, -1);
   int n = 0;
   for (size_t v = 0; v < nv; ++v)
     if (!held[v]) unknown[v] = n++;
   if (n == 0) return;
+  // Every unknown's neighbours' total weight: a row whose total is 0 falls back to weights 1.
+  const auto weight_of = [&](int u) {
+    return weight.empty() ? 1.0 : weight[static_cast<size_t>(u)];
+  };
+  std::vector<double> total(static_cast<size_t>(n), 0.0);
+  for (const auto& [a, b] : edges) {
+    if (const int ia = unknown[static_cast<size_t>(a)]; ia >= 0)
+      total[static_cast<size_t>(ia)] += weight_of(b);
+    if (const int ib = unknown[static_cast<size_t>(b)]; ib >= 0)
+      total[static_cast<size_t>(ib)] += weight_of(a);
+  }
+  const auto in_row = [&](int i, int u) {
+    return total[static_cast<size_t>(i)] > 0 ? weight_of(u) : 1.0;
+  };
   std::vector<Eigen::Triplet<double>> triplets;
   triplets.reserve(edges.size() * 4);
   Eigen::MatrixX3d rhs = Eigen::MatrixX3d::Zero(n, 3);
-  std::vector<int> degree(static_cast<size_t>(n), 0);
+  std::vector<double> diagonal(static_cast<size_t>(n), 0.0);
+  const auto add = [&](int i, int to) {  // row i gains the neighbour `to`
+    const double w = in_row(i, to);
+    diagonal[static_cast<size_t>(i)] += w;
+    if (const int j = unknown[static_cast<size_t>(to)]; j >= 0)
+      triplets.emplace_back(i, j, -w);
+    else
+      rhs.row(i) += w * mesh.vertices.row(to);
+  };
   for (const auto& [a, b] : edges) {
-    const int ia = unknown[static_cast<size_t>(a)], ib = unknown[static_cast<size_t>(b)];
-    if (ia >= 0) ++degree[static_cast<size_t>(ia)];
-    if (ib >= 0) ++degree[static_cast<size_t>(ib)];
-    if (ia >= 0 && ib >= 0) {
-      triplets.emplace_back(ia, ib, -1.0);
-      triplets.emplace_back(ib, ia, -1.0);
-    } else if (ia >= 0) {
-      rhs.row(ia) += mesh.vertices.row(b);
-    } else if (ib >= 0) {
-      rhs.row(ib) += mesh.vertices.row(a);
-    }
+    if (const int ia = unknown[static_cast<size_t>(a)]; ia >= 0) add(ia, b);
+    if (const int ib = unknown[static_cast<size_t>(b)]; ib >= 0) add(ib, a);
   }
-  for (int i = 0; i < n; ++i) triplets.emplace_back(i, i, degree[static_cast<size_t>(i)]);
+  for (int i = 0; i < n; ++i) triplets.emplace_back(i, i, diagonal[static_cast<size_t>(i)]);
   Eigen::SparseMatrix<double> laplacian(n, n);
   laplacian.setFromTriplets(triplets.begin(), triplets.end());
-  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(laplacian);
-  if (solver.info() != Eigen::Success)
-    throw std::invalid_argument("span_harmonic: a part of the free vertices touches no fixed one");
-  const Eigen::MatrixX3d x = solver.solve(rhs);
+  Eigen::MatrixX3d x;
+  if (weight.empty()) {
+    const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(laplacian);
+    if (solver.info() != Eigen::Success)
+      throw std::invalid_argument(
+          "span_harmonic: a part of the free vertices touches no fixed one");
+    x = solver.solve(rhs);
+  } else {
+    laplacian.makeCompressed();
+    Eigen::SparseLU<Eigen::SparseMatrix<double>> solver;
+    solver.compute(laplacian);
+    if (solver.info() != Eigen::Success)
+      throw std::invalid_argument(
+          "span_harmonic: a part of the free vertices touches no fixed one");
+    x = solver.solve(rhs);
+  }
   for (size_t v = 0; v < nv; ++v)
     if (unknown[v] >= 0) mesh.vertices.row(static_cast<Eigen::Index>(v)) = x.row(unknown[v]);
 }
@@ -84,21 +113,25 @@ std::array<Eigen::Vector3d, 9> quad_samples(const meshing::QuadMesh& mesh, Eigen
 }
 
 SpannedSurface span_over_obstacle(meshing::QuadMesh& mesh, std::span<const char> fixed,
-                                  const PushOut& push_out, int max_rounds) {
+                                  const PushOut& push_out, int max_rounds,
+                                  std::span<const double> weights) {
   return span_over_obstacle(
       mesh, fixed,
       [&push_out](const Eigen::Vector3d& p, const Eigen::Vector3d&) { return push_out(p); }, false,
-      max_rounds);
+      max_rounds, weights);
 }
 
 SpannedSurface span_over_obstacle(meshing::QuadMesh& mesh, std::span<const char> fixed,
-                                  const PushAlong& push_along, bool release, int max_rounds) {
-  if (static_cast<Eigen::Index>(fixed.size()) != mesh.vertex_count())
-    throw std::invalid_argument("span_over_obstacle: one fixed flag per vertex is needed");
+                                  const PushAlong& push_along, bool release, int max_rounds,
+                                  std::span<const double> weights) {
+  if (static_cast<Eigen::Index>(fixed.size()) != mesh.vertex_count() ||
+      (!weights.empty() && static_cast<Eigen::Index>(weights.size()) != mesh.vertex_count()))
+    throw std::invalid_argument(
+        "span_over_obstacle: one fixed flag (and one weight, if any) per vertex is needed");
   const std::vector<std::pair<int, int>> edges = quad_edges(mesh);
   std::vector<char> held(fixed.begin(), fixed.end());
   std::vector<char> lifted_hold(fixed.size(), 0);  // held by a quad's sample, never released
-  solve_harmonic(mesh, edges, held);
+  solve_harmonic(mesh, edges, held, weights);
   SpannedSurface result;
   std::vector<Eigen::Vector3d> normals;
   std::vector<std::vector<int>> neighbours(static_cast<size_t>(release ? mesh.vertex_count() : 0));
@@ -185,7 +218,7 @@ SpannedSurface span_over_obstacle(meshing::QuadMesh& mesh, std::span<const char>
       result.settled = false;
       break;
     }
-    solve_harmonic(mesh, edges, held);
+    solve_harmonic(mesh, edges, held, weights);
     ++result.rounds;
   }
   return result;

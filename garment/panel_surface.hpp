@@ -50,8 +50,13 @@ std::array<Eigen::Vector3d, 9> quad_samples(const meshing::QuadMesh& mesh, Eigen
 // a quad with a sample (quad_samples) inside has its free corners moved by that sample's push
 // (the deepest one's; a translation of the corners moves the sample by the same) and held, and
 // the rest solved again, until no sample is inside either.
+// `weights` (#V, or empty for 1 each): each vertex's weight in its neighbours' means, as
+// mean_weights (surface_relaxation.hpp) gives them: a ring of quads round an irregular vertex
+// then keeps the size of the next ring, where uniform weights shrink it round a vertex of
+// valence 3.
 SpannedSurface span_over_obstacle(meshing::QuadMesh& mesh, std::span<const char> fixed,
-                                  const PushOut& push_out, int max_rounds = 30);
+                                  const PushOut& push_out, int max_rounds = 30,
+                                  std::span<const double> weights = {});
 // The same, each round's pushes given the spanned surface's normals at the vertices (taken after
 // that round's harmonic solve, before any push). With `release`, once a round pushes nothing,
 // every held vertex whose neighbours' mean `push_along` leaves where it is (outside the obstacle)
@@ -59,6 +64,7 @@ SpannedSurface span_over_obstacle(meshing::QuadMesh& mesh, std::span<const char>
 // touches the body only where the body holds it up (an obstacle problem's contact set), not
 // wherever it was once pushed.
 SpannedSurface span_over_obstacle(meshing::QuadMesh& mesh, std::span<const char> fixed,
-                                  const PushAlong& push_along, bool release, int max_rounds = 30);
+                                  const PushAlong& push_along, bool release, int max_rounds = 30,
+                                  std::span<const double> weights = {});
 
 }  // namespace sd::garment

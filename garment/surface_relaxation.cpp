@@ -14,6 +14,26 @@ double valence_weight(int valence) {
   return std::max(0.0, 1 + 2 * std::cos(2 * std::numbers::pi / valence));
 }
 
+std::vector<double> mean_weights(const meshing::QuadMesh& mesh, std::span<const char> fixed,
+                                 bool high_valence) {
+  std::vector<std::vector<int>> neighbours(static_cast<std::size_t>(mesh.vertex_count()));
+  for (Eigen::Index f = 0; f < mesh.face_count(); ++f)
+    for (int k = 0; k < 4; ++k) {
+      const int a = mesh.faces(f, k), b = mesh.faces(f, (k + 1) % 4);
+      neighbours[static_cast<std::size_t>(a)].push_back(b);
+      neighbours[static_cast<std::size_t>(b)].push_back(a);
+    }
+  std::vector<double> weights(neighbours.size(), 1.0);
+  for (std::size_t v = 0; v < neighbours.size(); ++v) {
+    auto& around = neighbours[v];
+    std::sort(around.begin(), around.end());
+    around.erase(std::unique(around.begin(), around.end()), around.end());
+    const int valence = static_cast<int>(around.size());
+    if (!fixed[v] && (valence < 5 || high_valence)) weights[v] = valence_weight(valence);
+  }
+  return weights;
+}
+
 SurfaceRelaxationResult relax_on_surface(meshing::QuadMesh& mesh, std::span<const char> fixed,
                                          const SurfaceLift& lift,
                                          const SurfaceRelaxationOptions& options) {
@@ -58,11 +78,7 @@ SurfaceRelaxationResult relax_on_surface(meshing::QuadMesh& mesh, std::span<cons
   // filler's own Jacobi sweeps keep plain means: weighted there too, folded quads went 5 → 11 (the
   // trousers' front on the Collada human at 2 cm folds 6 quads) and warnings 44 → 48 (measured with
   // the boundary judged about the body's normals, not adopted).
-  std::vector<double> weights(static_cast<std::size_t>(vertex_count), 1.0);
-  for (Eigen::Index v = 0; v < vertex_count; ++v)
-    if (const int valence = static_cast<int>(neighbours[static_cast<std::size_t>(v)].size());
-        !fixed[static_cast<std::size_t>(v)] && (valence < 5 || options.weigh_high_valence))
-      weights[static_cast<std::size_t>(v)] = valence_weight(valence);
+  const std::vector<double> weights = mean_weights(mesh, fixed, options.weigh_high_valence);
   SurfaceRelaxationResult result;
   for (; result.sweeps < options.max_sweeps; ++result.sweeps) {
     if (result.sweeps > 0 && result.last_move <= options.tolerance) break;

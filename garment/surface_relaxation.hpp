@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 #include <functional>
 #include <span>
+#include <vector>
 
 #include "meshing/quad_mesh.hpp"
 
@@ -58,6 +59,12 @@ struct SurfaceRelaxationResult {
 // balances rhombi of one size around it: 0 at valence 3 (exactly), 1 at 4 (exactly: a grid
 // relaxes as with plain means), 1.618 at 5, 2 at 6.
 double valence_weight(int valence);
+
+// Each vertex's weight in its neighbours' means (#V): valence_weight(k) for a vertex not marked in
+// `fixed` of valence k below 5 (0 at 3, 1 at 4), and of 5 or more with `high_valence`; 1 for the
+// rest (a fixed vertex, and one of valence 5 or more without `high_valence`).
+std::vector<double> mean_weights(const meshing::QuadMesh& mesh, std::span<const char> fixed,
+                                 bool high_valence);
 
 SurfaceRelaxationResult relax_on_surface(meshing::QuadMesh& mesh, std::span<const char> fixed,
                                          const SurfaceLift& lift,

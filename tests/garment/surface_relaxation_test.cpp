@@ -42,43 +42,11 @@ TEST(SurfaceRelaxation, SpreadsACollapsedInteriorBackToTheUniformGrid) {
   EXPECT_LT((mesh.vertices - grid.vertices).cwiseAbs().maxCoeff(), 1e-10);
 }
 
-// k rhombi of side 2 around a centre c (angle 2π/k at c), each cut 2 × 2: 4k quads of side 1
-// around c of valence k; the interior (c, the k spoke midpoints, the k rhombus centres) starts
-// pulled towards c and is relaxed with the outline fixed. Returns how far the result is from the
+// test::rhombus_tiling(k), the interior (c, the k spoke midpoints, the k rhombus centres) pulled
+// towards c and relaxed with the outline fixed. Returns how far the result is from the
 // tiling (with the weights of relax_on_surface the tiling is the fixed point of the sweeps).
 double distance_from_rhombus_tiling(int k, bool weigh_high_valence = false) {
-  // Vertices s A_i + t A_{i+1} for the spokes A_i (length 2 at 90° + 360° i / k), s, t in
-  // {0, 1/2, 1}, numbered as they are first met.
-  std::vector<Eigen::Vector3d> points;
-  std::vector<char> fixed;
-  const auto id = [&](const Eigen::Vector3d& p, bool interior) {
-    for (size_t v = 0; v < points.size(); ++v)
-      if ((points[v] - p).norm() < 1e-12) return static_cast<int>(v);
-    points.push_back(p);
-    fixed.push_back(interior ? 0 : 1);
-    return static_cast<int>(points.size()) - 1;
-  };
-  std::vector<std::array<int, 4>> quads;
-  for (int i = 0; i < k; ++i) {
-    const auto spoke = [k](int j) {
-      const double a = std::numbers::pi / 2 + 2 * std::numbers::pi / k * j;
-      return Eigen::Vector3d(2 * std::cos(a), 2 * std::sin(a), 0);
-    };
-    const Eigen::Vector3d a = spoke(i), b = spoke(i + 1);
-    for (int s = 0; s < 2; ++s)
-      for (int t = 0; t < 2; ++t) {
-        const auto at = [&](int u, int w) { return id(0.5 * u * a + 0.5 * w * b, u < 2 && w < 2); };
-        quads.push_back({at(s, t), at(s + 1, t), at(s + 1, t + 1), at(s, t + 1)});
-      }
-  }
-  meshing::QuadMesh mesh;
-  mesh.vertices.resize(static_cast<Eigen::Index>(points.size()), 3);
-  for (size_t v = 0; v < points.size(); ++v)
-    mesh.vertices.row(static_cast<Eigen::Index>(v)) = points[v].transpose();
-  mesh.faces.resize(static_cast<Eigen::Index>(quads.size()), 4);
-  for (size_t f = 0; f < quads.size(); ++f)
-    for (int c = 0; c < 4; ++c)
-      mesh.faces(static_cast<Eigen::Index>(f), c) = quads[f][static_cast<size_t>(c)];
+  auto [mesh, fixed] = test::rhombus_tiling(k);
   EXPECT_EQ(mesh.vertex_count(), 6 * k + 1);
   EXPECT_EQ(std::count(fixed.begin(), fixed.end(), 0), 2 * k + 1);
   const meshing::QuadMesh tiling = mesh;
