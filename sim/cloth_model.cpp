@@ -407,11 +407,11 @@ void ghost_clamped_points(VertexBendElement& b, const std::vector<char>& is_pinn
   b.rows = rows;
 }
 
-// The diamonds of the membrane (ClothModelOptions::diamond_membrane), the triangles in none, and
-// the diamonds' block offsets. A diamond couples its centre, corners and the corners' neighbours
-// (the predicted centre, sim/diamond_membrane.hpp): all in the centre's vertex bend (its two-ring)
-// with the quadratic bending, so in the pattern; a diamond whose pairs are not (the hinge model)
-// is left out, its triangles evaluated alone.
+// The triangles in no diamond (ClothModelOptions::diamond_membrane) and the diamonds' block
+// offsets. A diamond couples its centre, corners and the corners' neighbours (the predicted
+// centre, sim/diamond_membrane.hpp); run_starts and collect_neighbours put those pairs in the
+// pattern. A diamond whose pairs are still missing (an adaptive update's unchanged rows) is left
+// out, its triangles evaluated alone.
 void set_diamonds(ClothModel& model, const Neighbours& neighbours,
                   const ClothModelOptions& options) {
   model.lone_triangles.clear();
