@@ -928,16 +928,28 @@ ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse&
           changed_row[static_cast<std::size_t>(k)] = 1;
   }
 
-  // The diamonds afresh; a diamond touching a changed row has all its rows collected anew (its
-  // pairs reach up to four rings, which an unchanged row's previous run may lack).
+  // The diamonds afresh; a diamond, old or new, touching a changed row has all its rows
+  // collected anew (its pairs reach up to four rings, which an unchanged row's previous run may
+  // lack, or hold when the diamond is gone).
   model.diamonds.clear();
-  if (options.diamond_membrane) {
+  if (options.diamond_membrane)
     model.diamonds = make_diamonds(input.rest_positions, model.triangles, input.rest_uv.rows() > 0);
-    for (const DiamondElement& d : model.diamonds)
-      if (std::any_of(d.vertices.begin(), d.vertices.end(),
-                      [&](int v) { return changed_row[static_cast<std::size_t>(v)] != 0; }))
-        for (int v : d.vertices) changed_row[static_cast<std::size_t>(v)] = 1;
-  }
+  // Touched means by a row the elements changed (not one marked here): a diamond that differs
+  // from the previous model's has such a row, and one that does not kept its pairs' runs.
+  const std::vector<char> element_changed = changed_row;
+  const auto mark = [&](const DiamondElement& d, const auto& row_of) {
+    bool touched = false;
+    for (int q : d.vertices) {
+      const int k = row_of(q);
+      touched = touched || k < 0 || element_changed[static_cast<std::size_t>(k)] != 0;
+    }
+    if (touched)
+      for (int q : d.vertices)
+        if (const int k = row_of(q); k >= 0) changed_row[static_cast<std::size_t>(k)] = 1;
+  };
+  for (const DiamondElement& d : previous.diamonds)
+    mark(d, [&](int q) { return next_vertex[static_cast<std::size_t>(q)]; });
+  for (const DiamondElement& d : model.diamonds) mark(d, [](int v) { return v; });
 
   // Pattern: unchanged rows are the previous rows renumbered (kept vertices keep their order,
   // so each run stays sorted), the changed ones are collected from the elements and sorted.
