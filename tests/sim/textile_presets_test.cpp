@@ -5,7 +5,7 @@
 // `sketchdrape bench --textile` drapes it ("Cusick drape", "The protocol") but from a smooth start
 // (the bench's is white noise per vertex, averaged over specimens). Integration tests: on
 // the loaded 2-core machine the 24 static cantilevers took 25-53 s, the square cells 4 s, and the
-// twelve Cusick drapes (26 to 69 cells across) about 4-5 minutes of CPU together (0.9-47 s each);
+// twelve Cusick drapes (26 to 69 cells across) about 8.5 minutes of CPU together (2.5-98 s each);
 // the bench gives the third resolution, the grain and the specimens' scatter (docs/fabrics.md).
 #include <gtest/gtest.h>
 
