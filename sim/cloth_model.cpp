@@ -177,7 +177,8 @@ struct Neighbours {
 std::vector<int> run_starts(int n, const std::vector<TriangleElement>& triangles,
                             const std::vector<HingeElement>& hinges,
                             const std::vector<BendStencil>& stencils,
-                            const std::vector<VertexBendElement>& vertex_bends) {
+                            const std::vector<VertexBendElement>& vertex_bends,
+                            const std::vector<DiamondElement>& diamonds) {
   std::vector<int> start(n + 1, 0);
   for (int i = 0; i < n; ++i) start[i + 1] = 1;  // itself
   for (const TriangleElement& t : triangles)
@@ -188,6 +189,8 @@ std::vector<int> run_starts(int n, const std::vector<TriangleElement>& triangles
     for (int v : b.vertices) start[v + 1] += static_cast<int>(b.vertices.size()) - 1;
   for (const VertexBendElement& b : vertex_bends)
     for (int v : b.vertices) start[v + 1] += static_cast<int>(b.vertices.size()) - 1;
+  for (const DiamondElement& d : diamonds)
+    for (int v : d.vertices) start[v + 1] += DiamondElement::kVertices - 1;
   for (int i = 0; i < n; ++i) start[i + 1] += start[i];
   return start;
 }
@@ -200,6 +203,7 @@ void collect_neighbours(Neighbours& neighbours, const std::vector<TriangleElemen
                         const std::vector<HingeElement>& hinges,
                         const std::vector<BendStencil>& stencils,
                         const std::vector<VertexBendElement>& vertex_bends,
+                        const std::vector<DiamondElement>& diamonds,
                         const std::vector<char>& wanted) {
   const int n = static_cast<int>(neighbours.size.size());
   const auto want = [&](int v) { return wanted.empty() || wanted[static_cast<std::size_t>(v)]; };
@@ -217,6 +221,7 @@ void collect_neighbours(Neighbours& neighbours, const std::vector<TriangleElemen
   for (const HingeElement& h : hinges) connect(h.vertices.data(), 4);
   for (const BendStencil& b : stencils)
     connect(b.vertices.data(), static_cast<int>(b.vertices.size()));
+  for (const DiamondElement& d : diamonds) connect(d.vertices.data(), DiamondElement::kVertices);
   // The vertex bends over each wanted vertex (CSR by vertex).
   std::vector<int> bend_start(static_cast<std::size_t>(n) + 1, 0);
   for (const VertexBendElement& b : vertex_bends)
@@ -402,44 +407,33 @@ void ghost_clamped_points(VertexBendElement& b, const std::vector<char>& is_pinn
   b.rows = rows;
 }
 
-// The diamonds of the membrane (ClothModelOptions::diamond_membrane), the triangles in none, and
-// the diamonds' block offsets (every pair of a diamond's vertices shares a triangle or a hinge).
-void set_diamonds(ClothModel& model, const ClothInput& input, const Neighbours& neighbours,
+// The triangles in no diamond (ClothModelOptions::diamond_membrane) and the diamonds' block
+// offsets. A diamond couples its centre, corners and the corners' neighbours (the predicted
+// centre, sim/diamond_membrane.hpp); run_starts and collect_neighbours put those pairs in the
+// pattern. A diamond whose pairs are still missing (an adaptive update's unchanged rows) is left
+// out, its triangles evaluated alone.
+void set_diamonds(ClothModel& model, const Neighbours& neighbours,
                   const ClothModelOptions& options) {
-  model.diamonds.clear();
   model.lone_triangles.clear();
   if (!options.diamond_membrane) return;
-  model.diamonds = make_diamonds(input.rest_positions, model.triangles, input.rest_uv.rows() > 0);
-  // Only diamonds whose half-diagonal a is at most half the fabric's bending length
-  // c = (B/ρg)^⅓. The map cannot tell the centre's own dimple from a bend at 45° to the diagonals
-  // (both leave the four corners in one plane above the centre), so where it lifts the centre the
-  // membrane no longer holds the centre's normal position and only the bending does: under its
-  // weight the centre sinks by about (a/c)³ of a cell (over the bending's constant). On 6-8 cm
-  // cells (a/c ≈ 3-4) a hanging sheet's centres fell through it; at a = 0.8c the 32-cell sheet of
-  // Simulation.ResolutionInvariance sagged 4.6 cm against 2.7-3.1 cm (docs/simulator.md, "The
-  // diamond membrane"). The cantilever strips (a ≤ c/4) and the Cusick discs (0.4c) keep theirs.
-  if (model.fabric.bend > 0.0 && model.fabric.area_density > 0.0) {
-    const double c = std::cbrt(model.fabric.bend / (model.fabric.area_density * 9.81));
-    std::erase_if(model.diamonds, [c](const DiamondElement& d) {
-      return std::sqrt(d.regularisation) > 0.01 * 0.5 * c;  // ε = 0.01·a
-    });
-  } else {
-    model.diamonds.clear();
-  }
-  std::vector<char> in_diamond(model.triangles.size(), 0);
-  for (DiamondElement& d : model.diamonds) {
-    for (int f : d.triangles) in_diamond[static_cast<std::size_t>(f)] = 1;
-    for (int k = 0; k < 5; ++k)
-      for (int l = 0; l < 5; ++l) {
+  constexpr int kVertices = DiamondElement::kVertices;
+  std::erase_if(model.diamonds, [&](DiamondElement& d) {
+    for (int k = 0; k < kVertices; ++k)
+      for (int l = 0; l < kVertices; ++l) {
         const int i = d.vertices[static_cast<std::size_t>(k)];
         const int j = d.vertices[static_cast<std::size_t>(l)];
         const int offset = neighbours.offset(i, j);
-        if (neighbours.list[static_cast<std::size_t>(neighbours.start[static_cast<std::size_t>(i)] +
+        if (offset / 3 >= neighbours.size[static_cast<std::size_t>(i)] ||
+            neighbours.list[static_cast<std::size_t>(neighbours.start[static_cast<std::size_t>(i)] +
                                                      offset / 3)] != j)
-          throw std::logic_error("cloth model: a diamond's vertices are not in the pattern");
-        d.blocks[static_cast<std::size_t>(5 * k + l)] = offset;
+          return true;
+        d.blocks[static_cast<std::size_t>(kVertices * k + l)] = offset;
       }
-  }
+    return false;
+  });
+  std::vector<char> in_diamond(model.triangles.size(), 0);
+  for (const DiamondElement& d : model.diamonds)
+    for (int f : d.triangles) in_diamond[static_cast<std::size_t>(f)] = 1;
   for (std::size_t f = 0; f < model.triangles.size(); ++f)
     if (!in_diamond[f]) model.lone_triangles.push_back(static_cast<int>(f));
 }
@@ -652,20 +646,23 @@ ClothModel build_cloth_model(const ClothInput& input, const FabricParameters& fa
   model.compression = options.compression;
   if (options.bend_model == BendModel::quadratic)
     model.vertex_bends = make_vertex_bends(rest, input.triangles, options.bend_rest);
+  model.diamonds.clear();
+  if (options.diamond_membrane)
+    model.diamonds = make_diamonds(input.rest_positions, model.triangles, input.rest_uv.rows() > 0);
 
   // Block sparsity pattern: vertex adjacency through triangles and hinges, as one flat array
   // (CSR by vertex: room for every element's entries, then each vertex's run sorted and
   // deduplicated in place).
   Neighbours neighbours;
-  neighbours.start =
-      run_starts(n, model.triangles, model.hinges, model.stencils, model.vertex_bends);
+  neighbours.start = run_starts(n, model.triangles, model.hinges, model.stencils,
+                                model.vertex_bends, model.diamonds);
   neighbours.list.resize(static_cast<std::size_t>(neighbours.start[n]));
   neighbours.size.resize(n);
   collect_neighbours(neighbours, model.triangles, model.hinges, model.stencils, model.vertex_bends,
-                     {});
+                     model.diamonds, {});
   model.pattern.zero_matrix = zero_pattern_matrix(neighbours);
   set_block_offsets(model, neighbours, {});
-  set_diamonds(model, input, neighbours, options);
+  set_diamonds(model, neighbours, options);
   build_flat_bend_operator(model);
   return model;
 }
@@ -931,6 +928,29 @@ ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse&
           changed_row[static_cast<std::size_t>(k)] = 1;
   }
 
+  // The diamonds afresh; a diamond, old or new, touching a changed row has all its rows
+  // collected anew (its pairs reach up to four rings, which an unchanged row's previous run may
+  // lack, or hold when the diamond is gone).
+  model.diamonds.clear();
+  if (options.diamond_membrane)
+    model.diamonds = make_diamonds(input.rest_positions, model.triangles, input.rest_uv.rows() > 0);
+  // Touched means by a row the elements changed (not one marked here): a diamond that differs
+  // from the previous model's has such a row, and one that does not kept its pairs' runs.
+  const std::vector<char> element_changed = changed_row;
+  const auto mark = [&](const DiamondElement& d, const auto& row_of) {
+    bool touched = false;
+    for (int q : d.vertices) {
+      const int k = row_of(q);
+      touched = touched || k < 0 || element_changed[static_cast<std::size_t>(k)] != 0;
+    }
+    if (touched)
+      for (int q : d.vertices)
+        if (const int k = row_of(q); k >= 0) changed_row[static_cast<std::size_t>(k)] = 1;
+  };
+  for (const DiamondElement& d : previous.diamonds)
+    mark(d, [&](int q) { return next_vertex[static_cast<std::size_t>(q)]; });
+  for (const DiamondElement& d : model.diamonds) mark(d, [](int v) { return v; });
+
   // Pattern: unchanged rows are the previous rows renumbered (kept vertices keep their order,
   // so each run stays sorted), the changed ones are collected from the elements and sorted.
   const SparseMatrixR& old_pattern = previous.pattern.zero_matrix;
@@ -939,8 +959,8 @@ ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse&
     return (old_pattern.outerIndexPtr()[3 * p + 1] - old_pattern.outerIndexPtr()[3 * p]) / 3;
   };
   // A changed row gets room as in build_cloth_model, an unchanged one its previous size.
-  const std::vector<int> room =
-      run_starts(n, model.triangles, model.hinges, model.stencils, model.vertex_bends);
+  const std::vector<int> room = run_starts(n, model.triangles, model.hinges, model.stencils,
+                                           model.vertex_bends, model.diamonds);
   Neighbours neighbours;
   neighbours.start.assign(static_cast<std::size_t>(n) + 1, 0);
   for (int i = 0; i < n; ++i)
@@ -959,7 +979,7 @@ ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse&
     neighbours.size[i] = size;
   }
   collect_neighbours(neighbours, model.triangles, model.hinges, model.stencils, model.vertex_bends,
-                     changed_row);
+                     model.diamonds, changed_row);
   model.pattern.zero_matrix = zero_pattern_matrix(neighbours);
   // Offsets in unchanged rows are the previous ones (kept elements brought them along).
   model.pattern.diagonal_offsets.resize(static_cast<std::size_t>(n));
@@ -969,7 +989,7 @@ ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse&
           previous.pattern.diagonal_offsets[static_cast<std::size_t>(
               reuse.previous_vertex[static_cast<std::size_t>(i)])];
   set_block_offsets(model, neighbours, changed_row, fresh_bends);
-  set_diamonds(model, input, neighbours, options);
+  set_diamonds(model, neighbours, options);
   build_flat_bend_operator(model);
   return model;
 }

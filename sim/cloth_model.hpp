@@ -107,10 +107,9 @@ struct ClothModelOptions {
   bool clamp_ghost_points = false;
   // Whether the membrane of each diamond of the 4-8 mesh (DiamondElement) is evaluated with its
   // centre moved to where a smooth bend puts it (docs/simulator.md, "The diamond membrane"):
-  // removes the 4-8 mesh's membrane locking at 45°; flat cloth is unchanged. Only diamonds of at
-  // most half the fabric's bending length: the map frees the centre's normal position, which on
-  // coarser cells sinks under its weight. Off by default (docs/simulator.md, "In the implicit
-  // solve").
+  // removes the 4-8 mesh's membrane locking at 45°; flat cloth is unchanged; a dent of the centre
+  // is charged as any vertex's (the heights are measured from the centre its corners and their
+  // neighbours predict). Off by default (docs/simulator.md, "The predicted centre").
   bool diamond_membrane = false;
 };
 

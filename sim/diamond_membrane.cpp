@@ -11,10 +11,12 @@ namespace sd::sim {
 namespace {
 
 using Eigen::Vector3d;
-using Gradient = Eigen::Matrix<double, 15, 1>;
-using Hessian = Eigen::Matrix<double, 15, 15>;
+using Gradient = Eigen::Matrix<double, 18, 1>;
+using Hessian = Eigen::Matrix<double, 18, 18>;
+using Points = Eigen::Matrix<double, 18, 1>;
+constexpr int kVertices = DiamondElement::kVertices;
 
-// A value with its exact derivatives with respect to the diamond's 15 coordinates (forward
+// A value with its exact derivatives with respect to the six points' 18 coordinates (forward
 // mode): the gradient, and with kSecond the Hessian. The map is a few dozen operations, so
 // carrying both through them is cheaper and safer than a hand-expanded second derivative.
 template <bool kSecond>
@@ -103,12 +105,12 @@ JetVector<S> cross(const JetVector<S>& a, const JetVector<S>& b) {
   return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
 
-// The map's value g and its derivatives; false where the diagonals are (nearly) parallel.
+// The map's value g and its derivatives in the six points z = (x_c, x₁, …, x₄, p); false where
+// the diagonals are (nearly) parallel.
 template <bool S>
-bool centre_map(const DiamondElement& d, const Eigen::Matrix<double, 15, 1>& x,
-                JetVector<S>& offset) {
-  std::array<JetVector<S>, 5> p;
-  for (int k = 0; k < 5; ++k)
+bool centre_map(const DiamondElement& d, const Points& x, JetVector<S>& offset) {
+  std::array<JetVector<S>, 6> p;
+  for (int k = 0; k < 6; ++k)
     for (int i = 0; i < 3; ++i) {
       p[k][i] = Jet<S>(x(3 * k + i));
       p[k][i].gradient(3 * k + i) = 1.0;
@@ -121,11 +123,12 @@ bool centre_map(const DiamondElement& d, const Eigen::Matrix<double, 15, 1>& x,
   if (!(m2.value > 1e-24 * scale)) return false;
   const Jet<S> inverse_length = inverse(square_root(m2));
   const JetVector<S> n = {inverse_length * m[0], inverse_length * m[1], inverse_length * m[2]};
-  // Heights of the corner pairs' midpoints: n·(½(x₁ + x₃) − x_c), n·(½(x₂ + x₄) − x_c).
+  // Heights of the corner pairs' midpoints above the predicted centre p: n·(½(x₁ + x₃) − p),
+  // n·(½(x₂ + x₄) − p). The centre x_c is not in them: the map adds to it.
   JetVector<S> q1, q2;
   for (int i = 0; i < 3; ++i) {
-    q1[i] = 0.5 * (p[1][i] + p[3][i]) - p[0][i];
-    q2[i] = 0.5 * (p[2][i] + p[4][i]) - p[0][i];
+    q1[i] = 0.5 * (p[1][i] + p[3][i]) - p[5][i];
+    q2[i] = 0.5 * (p[2][i] + p[4][i]) - p[5][i];
   }
   const Jet<S> h1 = dot(n, q1), h2 = dot(n, q2);
   const Jet<S> f = h1 * h2 * (h1 + h2) * inverse(h1 * h1 + h2 * h2 + Jet<S>(d.regularisation));
@@ -134,29 +137,88 @@ bool centre_map(const DiamondElement& d, const Eigen::Matrix<double, 15, 1>& x,
   return true;
 }
 
+// The corners' neighbours and the weights of the predicted centre p (docs/simulator.md, "The
+// diamond membrane"). The corners of the diamonds form a grid of their own, the diamond one of its
+// cells; the second difference D(k, j) = x_j − 2·x_k + o(k, j) of corner k along the line from
+// its fellow corner j is, on a smooth surface, κ·L² with κ the curvature along that line and L
+// the corners' spacing. On a quadratic surface z = ½(A·s² + 2B·s·t + C·t²) (s, t along the
+// diagonals, corners at a) the corners' mean lies (A + C)·a²/4 above the centre and the eight
+// second differences sum to 8·(A + C)·a², so p = x̄ − ΣD/32 = (5/16)·Σx_k − (1/32)·Σo: exact on
+// any quadratic (and, by symmetry, with errors of fourth order), without the centre. A second
+// difference the mesh lacks (a border) is the mean of those along the same direction (the lines
+// 1-2 and 3-4, or 2-3 and 4-1); with none along a direction, that direction's curvature is taken
+// as zero.
+template <class Beyond>
+void set_predictor(DiamondElement& d, const Beyond& beyond) {
+  // Outer slots 5..12 as (k, j) pairs, corners 1..4.
+  static constexpr std::array<std::array<int, 2>, 8> kPairs = {
+      {{1, 4}, {1, 2}, {2, 1}, {2, 3}, {3, 2}, {3, 4}, {4, 3}, {4, 1}}};
+  d.weights.fill(0.0);
+  for (int k = 1; k <= 4; ++k) d.weights[static_cast<std::size_t>(k)] = 0.25;
+  std::array<char, 8> found{};
+  for (std::size_t s = 0; s < 8; ++s) {
+    const int o = beyond(d.vertices[static_cast<std::size_t>(kPairs[s][0])],
+                         d.vertices[static_cast<std::size_t>(kPairs[s][1])]);
+    found[s] =
+        o >= 0 && std::find(d.vertices.begin(), d.vertices.begin() + 5 + static_cast<long>(s), o) ==
+                      d.vertices.begin() + 5 + static_cast<long>(s);
+    d.vertices[5 + s] = found[s] ? o : d.vertices[0];
+  }
+  // Direction of a pair's line: 1-2 and 3-4 one, 2-3 and 4-1 the other.
+  const auto direction = [](std::size_t s) {
+    const int k = kPairs[s][0], j = kPairs[s][1];
+    return (std::min(k, j) == 1 && std::max(k, j) == 2) ||
+                   (std::min(k, j) == 3 && std::max(k, j) == 4)
+               ? 0
+               : 1;
+  };
+  for (int dir = 0; dir < 2; ++dir) {
+    int count = 0;
+    for (std::size_t s = 0; s < 8; ++s) count += direction(s) == dir && found[s];
+    if (count == 0) continue;
+    const double share = -(4.0 / count) / 32.0;  // each found D stands for 4/count of the four
+    for (std::size_t s = 0; s < 8; ++s) {
+      if (direction(s) != dir || !found[s]) continue;
+      d.weights[5 + s] += share;
+      d.weights[static_cast<std::size_t>(kPairs[s][0])] -= 2.0 * share;
+      d.weights[static_cast<std::size_t>(kPairs[s][1])] += share;
+    }
+  }
+}
+
 }  // namespace
 
-void diamond_centre_map(const DiamondElement& diamond, const Eigen::Matrix<double, 15, 1>& x,
-                        bool with_hessian, DiamondMap& out) {
+void diamond_centre_map(const DiamondElement& diamond, const DiamondVector& x, bool with_hessian,
+                        DiamondMap& out) {
   out.offset.setZero();
   out.jacobian.setZero();
+  out.points.setZero();
+  for (int k = 0; k < 15; ++k) out.points(k, k) = 1.0;
+  for (int s = 1; s < kVertices; ++s)
+    for (int i = 0; i < 3; ++i)
+      out.points(15 + i, 3 * s + i) = diamond.weights[static_cast<std::size_t>(s)];
+  const Points z = out.points * x;
   if (with_hessian) {
-    for (Hessian& h : out.hessian) h.setZero();
+    for (auto& h : out.point_hessian) h.setZero();
     JetVector<true> g;
-    if (!centre_map<true>(diamond, x, g)) return;
+    if (!centre_map<true>(diamond, z, g)) return;
     for (int i = 0; i < 3; ++i) {
       out.offset(i) = g[i].value;
-      out.jacobian.row(i) = g[i].gradient.transpose();
-      out.hessian[i] = g[i].hessian;
+      out.jacobian.row(i) = g[i].gradient.transpose() * out.points;
+      out.point_hessian[static_cast<std::size_t>(i)] = g[i].hessian;
     }
     return;
   }
   JetVector<false> g;
-  if (!centre_map<false>(diamond, x, g)) return;
+  if (!centre_map<false>(diamond, z, g)) return;
   for (int i = 0; i < 3; ++i) {
     out.offset(i) = g[i].value;
-    out.jacobian.row(i) = g[i].gradient.transpose();
+    out.jacobian.row(i) = g[i].gradient.transpose() * out.points;
   }
+}
+
+DiamondMatrix diamond_map_hessian(const DiamondMap& map, int i) {
+  return map.points.transpose() * map.point_hessian[static_cast<std::size_t>(i)] * map.points;
 }
 
 std::vector<DiamondElement> make_diamonds(const Eigen::MatrixX3d& rest,
@@ -175,6 +237,26 @@ std::vector<DiamondElement> make_diamonds(const Eigen::MatrixX3d& rest,
       for (int v : triangles[f].vertices)
         around[static_cast<std::size_t>(fill[static_cast<std::size_t>(v)]++)] = static_cast<int>(f);
   }
+  // The vertex of `corner`'s triangles nearest to 2·x_corner − x_fellow (the next vertex on the
+  // line from its fellow corner through it), if within a quarter of their distance; else -1.
+  const auto beyond = [&](int corner, int fellow) {
+    const Vector3d xc = rest.row(corner).transpose();
+    const Vector3d target = 2.0 * xc - Vector3d(rest.row(fellow).transpose());
+    const double tolerance = 0.25 * (Vector3d(rest.row(fellow).transpose()) - xc).norm();
+    int best = -1;
+    double best_distance = tolerance;
+    for (int k = start[static_cast<std::size_t>(corner)];
+         k < start[static_cast<std::size_t>(corner) + 1]; ++k)
+      for (int v :
+           triangles[static_cast<std::size_t>(around[static_cast<std::size_t>(k)])].vertices) {
+        const double distance = (Vector3d(rest.row(v).transpose()) - target).norm();
+        if (distance <= best_distance) {
+          best = v;
+          best_distance = distance;
+        }
+      }
+    return best;
+  };
   std::vector<char> taken(triangles.size(), 0);
   std::vector<DiamondElement> diamonds;
   for (std::size_t c = 0; c < n; ++c) {
@@ -223,9 +305,12 @@ std::vector<DiamondElement> make_diamonds(const Eigen::MatrixX3d& rest,
       continue;
     const double epsilon = 0.01 * 0.5 * (a13 + a24);
     d.regularisation = epsilon * epsilon;
+    set_predictor(d, beyond);
     if (!flat_rest) {
-      Eigen::Matrix<double, 15, 1> x;
-      for (int k = 0; k < 5; ++k) x.segment<3>(3 * k) = at(k);
+      DiamondVector x;
+      for (int k = 0; k < kVertices; ++k)
+        x.segment<3>(3 * k) =
+            Vector3d(rest.row(d.vertices[static_cast<std::size_t>(k)]).transpose());
       DiamondMap map;
       diamond_centre_map(d, x, false, map);
       const Vector3d m = (at(3) - at(1)).cross(at(4) - at(2));

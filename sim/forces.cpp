@@ -808,22 +808,23 @@ void add_elements(int count, int vertex_count, const Element& element, const Con
 }
 
 // The map's curvature Σ_i f_c,i·∇²g_i (f_c the force on the mapped centre) as the implicit solve
-// keeps it: its negative semi-definite part (the eigenvalues above zero, which soften, dropped),
-// so the solve matrix stays symmetric negative semi-definite. Near flat it is of order
-// |f_c|/ε; left out, a hanging sheet's step is explicit in it (docs/simulator.md, "The diamond
-// membrane").
-Eigen::Matrix<double, 15, 15> solve_curvature(const DiamondElement& d,
-                                              const Eigen::Matrix<double, 15, 1>& x,
-                                              const Vector3d& f_centre) {
-  using Matrix15 = Eigen::Matrix<double, 15, 15>;
+// keeps it: Lᵀ·C₋·L, C₋ the negative semi-definite part of C = Σ_i f_c,i·H_i in the six points'
+// coordinates (the eigenvalues above zero, which soften, dropped), so the solve matrix stays
+// symmetric negative semi-definite. Near flat it is of order |f_c|/ε; left out, a hanging sheet's
+// step is explicit in it (docs/simulator.md, "The diamond membrane").
+DiamondMatrix solve_curvature(const DiamondElement& d, const DiamondVector& x,
+                              const Vector3d& f_centre) {
+  using Matrix18 = Eigen::Matrix<double, 18, 18>;
   DiamondMap full;
   diamond_centre_map(d, x, true, full);
-  Matrix15 c = Matrix15::Zero();
-  for (int i = 0; i < 3; ++i) c += f_centre(i) * full.hessian[static_cast<std::size_t>(i)];
-  const Matrix15 symmetric = 0.5 * (c + c.transpose());
-  const Eigen::SelfAdjointEigenSolver<Matrix15> eig(symmetric);
-  const Eigen::Matrix<double, 15, 1> lambda = eig.eigenvalues().cwiseMin(0.0);
-  return eig.eigenvectors() * lambda.asDiagonal() * eig.eigenvectors().transpose();
+  Matrix18 c = Matrix18::Zero();
+  for (int i = 0; i < 3; ++i) c += f_centre(i) * full.point_hessian[static_cast<std::size_t>(i)];
+  const Matrix18 symmetric = 0.5 * (c + c.transpose());
+  const Eigen::SelfAdjointEigenSolver<Matrix18> eig(symmetric);
+  const Eigen::Matrix<double, 18, 1> lambda = eig.eigenvalues().cwiseMin(0.0);
+  const Eigen::Matrix<double, 18, 3 * DiamondElement::kVertices> vl =
+      eig.eigenvectors().transpose() * full.points;
+  return vl.transpose() * lambda.asDiagonal() * vl;
 }
 
 // The membrane of the diamonds (ClothModel::diamonds, docs/simulator.md "The diamond membrane"):
@@ -837,8 +838,9 @@ Eigen::Matrix<double, 15, 15> solve_curvature(const DiamondElement& d,
 void add_diamonds(const ClothModel& model, const ForceTerms& terms, double damping_scale,
                   const Eigen::VectorXd& x, const Eigen::VectorXd& v, Eigen::VectorXd& force,
                   EnergyBreakdown& energy, const JacobianTarget* jacobian) {
-  using Vector15 = Eigen::Matrix<double, 15, 1>;
-  using Matrix15 = Eigen::Matrix<double, 15, 15>;
+  constexpr int kN = 3 * DiamondElement::kVertices;
+  using LocalVector = DiamondVector;  // the diamond's 13 vertices (39 coordinates)
+  using LocalMatrix = DiamondMatrix;
   const bool exact = jacobian != nullptr && jacobian->kind == JacobianKind::exact;
   const bool want_product = jacobian != nullptr && jacobian->product_input != nullptr;
   const bool want_matrix = jacobian != nullptr && jacobian->matrix != nullptr;
@@ -849,10 +851,10 @@ void add_diamonds(const ClothModel& model, const ForceTerms& terms, double dampi
     const DiamondElement& d = model.diamonds[static_cast<std::size_t>(k)];
     return std::make_pair(d.vertices.data(), d.blocks.data());
   };
-  const auto contribute = [&](int k, ElementContribution<15, 2>& out) {
+  const auto contribute = [&](int k, ElementContribution<kN, 2>& out) {
     const DiamondElement& d = model.diamonds[static_cast<std::size_t>(k)];
-    Vector15 local_x, local_v, local_u = Vector15::Zero();
-    for (int j = 0; j < 5; ++j) {
+    LocalVector local_x, local_v, local_u = LocalVector::Zero();
+    for (int j = 0; j < DiamondElement::kVertices; ++j) {
       const int vertex = d.vertices[static_cast<std::size_t>(j)];
       local_x.segment<3>(3 * j) = x.segment<3>(3 * vertex);
       local_v.segment<3>(3 * j) = v.segment<3>(3 * vertex);
@@ -860,8 +862,8 @@ void add_diamonds(const ClothModel& model, const ForceTerms& terms, double dampi
     }
     DiamondMap map;
     diamond_centre_map(d, local_x, exact, map);
-    const Eigen::Matrix<double, 3, 15>& g = map.jacobian;
-    Vector15 y = local_x;
+    const Eigen::Matrix<double, 3, kN>& g = map.jacobian;
+    LocalVector y = local_x;
     y.head<3>() += map.offset;
     // The triangles read velocities and the product's input by local index (0 the centre).
     thread_local Eigen::VectorXd mapped_v, mapped_u, unused;
@@ -878,8 +880,8 @@ void add_diamonds(const ClothModel& model, const ForceTerms& terms, double dampi
     local.dfdv_scale = exact ? 0.0 : jacobian != nullptr ? jacobian->dfdv_scale : 0.0;
     local.product_input = want_product && !exact ? &mapped_u : nullptr;
     local.product_output = &unused;
-    Vector15 f = Vector15::Zero(), product = Vector15::Zero();
-    Matrix15 matrix = Matrix15::Zero(), damping = Matrix15::Zero();  // exact: K and D
+    LocalVector f = LocalVector::Zero(), product = LocalVector::Zero();
+    LocalMatrix matrix = LocalMatrix::Zero(), damping = LocalMatrix::Zero();  // exact: K and D
     double stretch = 0.0, shear = 0.0;
     ElementContribution<9, 3> part;
     for (int f_index : d.triangles) {
@@ -887,10 +889,10 @@ void add_diamonds(const ClothModel& model, const ForceTerms& terms, double dampi
       std::array<int, 3> at{};  // the triangle's vertices as local indices
       for (int j = 0; j < 3; ++j)
         at[static_cast<std::size_t>(j)] =
-            static_cast<int>(std::find(d.vertices.begin(), d.vertices.end(),
+            static_cast<int>(std::find(d.vertices.begin(), d.vertices.begin() + 5,
                                        t.vertices[static_cast<std::size_t>(j)]) -
                              d.vertices.begin());
-      const auto add = [&](const ElementContribution<9, 3>& c, bool forces, Matrix15& into) {
+      const auto add = [&](const ElementContribution<9, 3>& c, bool forces, LocalMatrix& into) {
         for (int j = 0; j < c.count; ++j) {
           const ConditionContribution<9>& cc = c.conditions[static_cast<std::size_t>(j)];
           if (forces) {
@@ -927,10 +929,10 @@ void add_diamonds(const ClothModel& model, const ForceTerms& terms, double dampi
         add(part, false, damping);
       }
     }
-    ConditionContribution<15>& total = out.next(&EnergyBreakdown::stretch);
+    ConditionContribution<kN>& total = out.next(&EnergyBreakdown::stretch);
     total.energy = stretch;
     total.energy_only = false;
-    ConditionContribution<15>& shear_part = out.next(&EnergyBreakdown::shear);
+    ConditionContribution<kN>& shear_part = out.next(&EnergyBreakdown::shear);
     shear_part.energy = shear;
     shear_part.energy_only = true;
     // Pulled back through J: Jᵀ·w = w + Gᵀ·w_c.
@@ -938,31 +940,37 @@ void add_diamonds(const ClothModel& model, const ForceTerms& terms, double dampi
     total.force = f + g.transpose() * f_centre;
     if (jacobian == nullptr) return;
     // J's action on a matrix's columns: M·J = M + M_{·c}·G.
-    const auto times_j = [&](const Matrix15& m) -> Matrix15 { return m + m.leftCols<3>() * g; };
-    const auto pull_back = [&](const Matrix15& m) -> Matrix15 {
+    const auto times_j = [&](const LocalMatrix& m) -> LocalMatrix {
+      return m + m.leftCols<3>() * g;
+    };
+    const auto pull_back = [&](const LocalMatrix& m) -> LocalMatrix {
       return m + g.transpose() * m.topRows<3>();
     };
     if (!exact) {
-      const Matrix15 stiff = solve_curvature(d, local_x, f_centre);
+      const LocalMatrix stiff = solve_curvature(d, local_x, f_centre);
       if (want_product)
         total.product = product + g.transpose() * product.head<3>() + stiff * local_u;
       if (want_matrix) total.matrix = pull_back(times_j(matrix)) + jacobian->dfdx_scale * stiff;
       return;
     }
-    Matrix15 dfdx = pull_back(times_j(matrix));
-    for (int i = 0; i < 3; ++i) dfdx += f_centre(i) * map.hessian[static_cast<std::size_t>(i)];
-    Matrix15 dfdv = Matrix15::Zero();
+    LocalMatrix dfdx = pull_back(times_j(matrix));
+    std::array<LocalMatrix, 3> hessian;
+    for (int i = 0; i < 3; ++i) {
+      hessian[static_cast<std::size_t>(i)] = diamond_map_hessian(map, i);
+      dfdx += f_centre(i) * hessian[static_cast<std::size_t>(i)];
+    }
+    LocalMatrix dfdv = LocalMatrix::Zero();
     if (damped) {
-      Eigen::Matrix<double, 3, 15> velocity_map;  // ∂(G·v)/∂x: row i is (∇²g_i·v)ᵀ
+      Eigen::Matrix<double, 3, kN> velocity_map;  // ∂(G·v)/∂x: row i is (∇²g_i·v)ᵀ
       for (int i = 0; i < 3; ++i)
-        velocity_map.row(i) = (map.hessian[static_cast<std::size_t>(i)] * local_v).transpose();
+        velocity_map.row(i) = (hessian[static_cast<std::size_t>(i)] * local_v).transpose();
       dfdx += pull_back(damping.leftCols<3>() * velocity_map);
       dfdv = pull_back(times_j(damping));
     }
     if (want_product) total.product = dfdx * local_u;
     if (want_matrix) total.matrix = jacobian->dfdx_scale * dfdx + jacobian->dfdv_scale * dfdv;
   };
-  add_elements<15, 2>(static_cast<int>(model.diamonds.size()), model.vertex_count, element,
+  add_elements<kN, 2>(static_cast<int>(model.diamonds.size()), model.vertex_count, element,
                       contribute, force, energy, jacobian);
 }
 

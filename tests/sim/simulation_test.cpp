@@ -290,7 +290,8 @@ TEST(Simulation, ResolutionInvariance) {
 }
 
 // Error at T against a much smaller step, for two steps h and h/2: observed order log2(e1/e2).
-double observed_order(Integrator integrator, int bdf2_newton = 20) {
+double observed_order(Integrator integrator, int bdf2_newton = 20,
+                      const ClothModelOptions& options = {}) {
   SheetSpec spec;
   spec.size = {0.3, 0.3};
   spec.columns = 4;
@@ -305,7 +306,7 @@ double observed_order(Integrator integrator, int bdf2_newton = 20) {
   fabric.shear = 5.0;
   fabric.bend = 1e-4;
   fabric.damping = fabric.bend_damping = 0.0;
-  const ClothModel model = build_cloth_model(scene.input, fabric);
+  const ClothModel model = build_cloth_model(scene.input, fabric, options);
   const auto run = [&](double dt, Integrator method, int newton) {
     SimulationSettings settings;
     settings.integrator = method;
@@ -349,9 +350,15 @@ TEST(Simulation, ConvergenceOrderBdf2IsTwo) {
 
 // The linearly implicit BDF2 step (one solve linearised at the start, the fallback) keeps
 // second order in this smooth regime: the projected Jacobian is exact for the stretched,
-// undamped sheet up to the shear/bend curvature terms it drops.
+// undamped sheet up to the shear/bend curvature terms it drops. With the plain triangles'
+// membrane, explicitly: the diamond membrane's solve matrix also drops the positive part of its
+// map's curvature, of order |f_c|/ε near flat (docs/simulator.md, "The diamond membrane"), and
+// the linearised step is then first order in it (measured: orders 1.82, 1.43; with the whole
+// curvature put in the solve, a probe, 2.47, 1.83).
 TEST(Simulation, ConvergenceOrderLinearisedBdf2) {
-  const double order = observed_order(Integrator::bdf2, 1);
+  ClothModelOptions plain;
+  plain.diamond_membrane = false;
+  const double order = observed_order(Integrator::bdf2, 1, plain);
   EXPECT_GT(order, 1.7);
   EXPECT_LT(order, 2.4);
 }
