@@ -320,6 +320,7 @@ bool ImplicitSolver::linear_solve(const ClothModel& model, const ConstraintFilte
       pcg_.set_preconditioner(settings.pcg_preconditioner);
       stats = pcg_.solve(system(), system_diagonal(model), filter, rhs_, z_, step_,
                          settings.pcg_tolerance, settings.pcg_max_iterations, refactor);
+      pcg_pattern_ = -1;
       if (!stats.converged || !step_.allFinite()) {
         result.linear_failure =
             "the CHOLMOD factorisation failed (the system is not positive definite) and PCG on "
@@ -330,8 +331,12 @@ bool ImplicitSolver::linear_solve(const ClothModel& model, const ConstraintFilte
     ++solves_since_factor_;
   } else {
     pcg_.set_preconditioner(settings.pcg_preconditioner);
+    // matrix_ keeps its pattern until the mesh changes (pattern_changes_); the widened matrix
+    // is made anew each time.
+    const bool same_pattern = !widened_ && pcg_pattern_ == pattern_changes_;
     stats = pcg_.solve(system(), system_diagonal(model), filter, rhs_, z_, step_,
-                       settings.pcg_tolerance, settings.pcg_max_iterations, refactor);
+                       settings.pcg_tolerance, settings.pcg_max_iterations, refactor, same_pattern);
+    pcg_pattern_ = widened_ ? -1 : pattern_changes_;
   }
   ++result.linear_solves;
   result.cg_iterations += stats.iterations;

@@ -244,6 +244,7 @@ class ImplicitSolver {
 
   SparseMatrixR matrix_;
   int pattern_changes_ = 0;  // times matrix_ took a new mesh pattern (an adaptive change)
+  int pcg_pattern_ = -1;     // pattern_changes_ at the PCG's last solve of matrix_, else -1
   // With CHOLMOD: the cross blocks the widened pattern keeps (vertex row, column; sorted), a
   // superset of this step's, so that a spring pair that comes and goes does not change the
   // pattern and cost a new symbolic analysis (zero blocks do not change the system). Reset when

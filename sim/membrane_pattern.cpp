@@ -2,13 +2,6 @@
 
 namespace sd::sim {
 
-bool is_scaled_identity(const double* values, int stride) {
-  const double* r1 = values + stride;
-  const double* r2 = r1 + stride;
-  return values[1] == 0.0 && values[2] == 0.0 && r1[0] == 0.0 && r1[2] == 0.0 && r2[0] == 0.0 &&
-         r2[1] == 0.0 && r1[1] == values[0] && r2[2] == values[0];
-}
-
 bool MembranePattern::build(const SparseMatrixR& a, const std::vector<int>& diagonal_offsets) {
   if (a.rows() % 3 != 0 || a.cols() != a.rows() || !a.isCompressed()) return false;
   const int n = static_cast<int>(a.rows() / 3);

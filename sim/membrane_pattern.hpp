@@ -18,8 +18,14 @@
 namespace sd::sim {
 
 // Whether the 3×3 block whose rows start at `values`, `stride` apart, is c·I (off-diagonals
-// exactly zero, the diagonal three equal numbers): the flat bends' blocks and the mass.
-bool is_scaled_identity(const double* values, int stride);
+// exactly zero, the diagonal three equal numbers): the flat bends' blocks and the mass. Inline:
+// it is asked of every block of every solve.
+inline bool is_scaled_identity(const double* values, int stride) {
+  const double* r1 = values + stride;
+  const double* r2 = r1 + stride;
+  return values[1] == 0.0 && values[2] == 0.0 && r1[0] == 0.0 && r1[2] == 0.0 && r2[0] == 0.0 &&
+         r2[1] == 0.0 && r1[1] == values[0] && r2[2] == values[0];
+}
 
 class MembranePattern {
  public:

@@ -17,7 +17,45 @@ constexpr int kProductGrain = 256;
 
 }  // namespace
 
-bool VertexBlockMatrix::build(const SparseMatrixR& a) {
+bool VertexBlockMatrix::refill(const SparseMatrixR& a) {
+  if (vertices_ == 0 || a.rows() != 3 * vertices_ || a.cols() != a.rows() || !a.isCompressed() ||
+      a.nonZeros() != nonzeros_)
+    return false;
+  const int* outer = a.outerIndexPtr();
+  const double* values = a.valuePtr();
+  std::vector<char> kept(chunks_.size(), 1);
+  parallel_chunks(vertices_, kProductGrain, [&](int c, int low, int high) {
+    Chunk& chunk = chunks_[static_cast<std::size_t>(c)];
+    const int* column = chunk.column.data();
+    double* v = chunk.values.data();
+    int b = 0;
+    for (int i = low; i < high; ++i) {
+      const int begin = outer[3 * i];
+      const int width = outer[3 * i + 1] - begin;
+      if (3 * (chunk.block_start[i - low + 1] - chunk.block_start[i - low]) != width) {
+        kept[static_cast<std::size_t>(c)] = 0;  // not the pattern the caller said it was
+        return;
+      }
+      for (int k = 0; k < width; k += 3, ++b) {
+        const double* entries = values + begin + k;
+        if (column[b] < 0) {
+          if (!is_scaled_identity(entries, width)) {
+            kept[static_cast<std::size_t>(c)] = 0;
+            return;
+          }
+          *v++ = entries[0];
+        } else {
+          // A block that has become c·I stays full: the same sums (its six zeros add nothing).
+          for (int r = 0; r < 3; ++r, v += 3) std::copy_n(entries + r * width, 3, v);
+        }
+      }
+    }
+  });
+  return std::find(kept.begin(), kept.end(), 0) == kept.end();
+}
+
+bool VertexBlockMatrix::build(const SparseMatrixR& a, bool same_pattern) {
+  if (same_pattern && refill(a)) return true;
   vertices_ = 0;
   if (a.rows() % 3 != 0 || a.cols() != a.rows() || !a.isCompressed()) return false;
   const int n = static_cast<int>(a.rows() / 3);
@@ -66,6 +104,7 @@ bool VertexBlockMatrix::build(const SparseMatrixR& a) {
   });
   if (std::find(valid.begin(), valid.end(), 0) != valid.end()) return false;
   vertices_ = n;
+  nonzeros_ = a.nonZeros();
   return true;
 }
 
@@ -256,7 +295,8 @@ void PcgSolver::build_block_jacobi(const SparseMatrixR& a,
 LinearSolveStats PcgSolver::solve(const SparseMatrixR& a, const std::vector<int>& diagonal_offsets,
                                   const ConstraintFilter& filter, const Eigen::VectorXd& b,
                                   const Eigen::VectorXd& z, Eigen::VectorXd& s, double tolerance,
-                                  int max_iterations, bool refresh_preconditioner) {
+                                  int max_iterations, bool refresh_preconditioner,
+                                  bool same_pattern) {
   const int n = filter.vertex_count();
   const bool reuse = !refresh_preconditioner && prepared_vertices_ == n;
   if (!reuse) {
@@ -280,7 +320,7 @@ LinearSolveStats PcgSolver::solve(const SparseMatrixR& a, const std::vector<int>
   }
   const bool incomplete = incomplete_ready_;
   const bool coarse = coarse_ready_;
-  const bool blocks = product_.build(a);
+  const bool blocks = product_.build(a, same_pattern);
   const auto multiply = [&](const Eigen::VectorXd& x, Eigen::VectorXd& y) {
     if (blocks)
       product_.multiply(x, y);

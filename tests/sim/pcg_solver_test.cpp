@@ -149,6 +149,67 @@ TEST(LinearSolvers, VertexBlockProductIsTheRowSumsOfItsBlocks) {
   EXPECT_FALSE(refused.build(scalar));
 }
 
+// A matrix with the last build's pattern (new values, as every solve of a fixed mesh) is only
+// gathered into the kept layout: its product is the same bits as a fresh build's; a block kept as
+// c·I that no longer is one, or a matrix whose rows do not fit the kept layout, makes it a full
+// build, not a wrong product.
+TEST(LinearSolvers, VertexBlockRefillOfTheSamePatternGivesAFreshBuildsProduct) {
+  const System first = make_system(1.0 / 24, 8);
+  const System second = make_system(1.0 / 40, 8);  // the same mesh: the same pattern, new values
+  ASSERT_EQ(first.a.nonZeros(), second.a.nonZeros());
+  const int n = first.model.vertex_count;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  Eigen::VectorXd x(3 * n);
+  for (int k = 0; k < 3 * n; ++k) x[k] = uniform(rng);
+  const auto fresh_product = [&](const SparseMatrixR& a) {
+    VertexBlockMatrix fresh;
+    EXPECT_TRUE(fresh.build(a));
+    Eigen::VectorXd y;
+    fresh.multiply(x, y);
+    return y;
+  };
+  const auto same_bits = [](const Eigen::VectorXd& p, const Eigen::VectorXd& q) {
+    return p.size() == q.size() &&
+           std::memcmp(p.data(), q.data(), sizeof(double) * static_cast<std::size_t>(p.size())) ==
+               0;
+  };
+  VertexBlockMatrix kept;
+  ASSERT_TRUE(kept.build(first.a));
+  const int identity_blocks = kept.scaled_identity_blocks();
+  Eigen::VectorXd y;
+  ASSERT_TRUE(kept.build(second.a, /*same_pattern=*/true));
+  kept.multiply(x, y);
+  EXPECT_TRUE(same_bits(y, fresh_product(second.a)));
+  EXPECT_EQ(kept.scaled_identity_blocks(), identity_blocks);
+  // The last c·I block of the first vertex that has one, made full: the layout no longer holds.
+  SparseMatrixR changed = second.a;
+  const int* outer = changed.outerIndexPtr();
+  const int width = outer[1] - outer[0];
+  bool made_full = false;
+  for (int k = width - 3; k >= 0 && !made_full; k -= 3)
+    if (is_scaled_identity(changed.valuePtr() + outer[0] + k, width)) {
+      changed.valuePtr()[outer[0] + k + 1] = 1e-3;  // entry (0, 1) of the block
+      changed.valuePtr()[outer[1] + k] = 1e-3;      // and (1, 0)
+      made_full = true;
+    }
+  ASSERT_TRUE(made_full);
+  ASSERT_TRUE(kept.build(changed, true));
+  kept.multiply(x, y);
+  EXPECT_TRUE(same_bits(y, fresh_product(changed)));
+  EXPECT_EQ(kept.scaled_identity_blocks(), identity_blocks - 1);
+  // A smaller mesh passed as the same pattern is built afresh, not read through the old layout.
+  const System smaller = make_system(1.0 / 24, 6);
+  Eigen::VectorXd x_small = x.head(3 * smaller.model.vertex_count);
+  ASSERT_TRUE(kept.build(smaller.a, true));
+  kept.multiply(x_small, y);
+  VertexBlockMatrix small_fresh;
+  ASSERT_TRUE(small_fresh.build(smaller.a));
+  Eigen::VectorXd expected;
+  small_fresh.multiply(x_small, expected);
+  EXPECT_TRUE(same_bits(y, expected));
+}
+
 // The filtered matrix S A S + (I − S) as a dense matrix.
 Eigen::MatrixXd dense_filtered(const System& s) {
   const int n = s.model.vertex_count;
