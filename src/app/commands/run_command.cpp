@@ -352,6 +352,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   if (scene.garment)  // logged as the garment was meshed (garment_stage.cpp)
     for (std::string& warning : seam_ease_warnings(sketch, *scene.garment))
       out.warnings.push_back(std::move(warning));
+  if (!scene.flat_rest_differs.empty()) out.warnings.push_back(scene.flat_rest_differs);
   // The body's repairs and defects (an open body, inconsistent triangles), logged as it loaded.
   if (scene.body)
     out.warnings.insert(out.warnings.end(), scene.body->warnings.begin(),
