@@ -59,6 +59,21 @@ struct Body {
   std::vector<std::string> warnings;  // repairs made while loading
 };
 
+// A hole of an open body: a loop (or a chain) of boundary edges, the edges of one triangle only.
+struct BodyHole {
+  Eigen::Vector3d centre;  // m, the mean of its rim's vertices (in the mesh's frame)
+  double across = 0;       // m, the rim's largest extent: how wide the hole is
+  int edges = 0;           // boundary edges round it
+};
+
+// The holes of `mesh`, largest first: its boundary edges grouped by the vertices they share.
+std::vector<BodyHole> body_holes(const meshing::TriMesh& mesh);
+
+// The hole of `holes` whose rim comes within `margin` (m) of `p` (its centre within half its
+// width plus the margin), the nearest such; null when none does.
+const BodyHole* hole_near(const std::vector<BodyHole>& holes, const Eigen::Vector3d& p,
+                          double margin);
+
 // Path of the built-in mannequin: HUMAN.blend from Debian's assimp-testmodels.
 std::string builtin_body_path();
 

@@ -488,16 +488,35 @@ FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
     folded = 0;
   }
   // The mean 2D image of the warp in a flattening (area-weighted unit images; +y when none),
-  // over the triangles `use` marks (all when empty).
+  // over the triangles `use` marks (all when empty); the images' best axis instead where it fits
+  // them better by more than options.axis_grain_gain (a strap whose warp runs up it on the front
+  // and up it the other way on the back), turned to agree with their mean.
   const auto mean_grain = [&](const Eigen::MatrixX2d& map, const std::vector<char>& use = {}) {
     Eigen::Vector2d grain = Eigen::Vector2d::Zero();
+    Eigen::Vector2d doubled = Eigen::Vector2d::Zero();  // Σ area · (cos 2θ, sin 2θ)
+    double area = 0;
     for (Eigen::Index f = 0; f < t.rows(); ++f) {
       if (!use.empty() && !use[static_cast<size_t>(f)]) continue;
       const RestTriangle& r = rest[static_cast<size_t>(f)];
       const Eigen::Vector3d w3 = triangle_warp.row(triangle_warp.rows() == 1 ? 0 : f).transpose();
       const Eigen::Vector2d local(w3.dot(r.e1), w3.dot(r.e2));
       const Eigen::Vector2d image = jacobian(map, t, f, r) * local;
-      if (image.norm() > 0) grain += r.area * image.normalized();
+      if (!(image.norm() > 0)) continue;
+      const Eigen::Vector2d u = image.normalized();
+      grain += r.area * u;
+      doubled += r.area * Eigen::Vector2d(u.x() * u.x() - u.y() * u.y(), 2 * u.x() * u.y());
+      area += r.area;
+    }
+    if (grain.norm() >= 1e-12 && area > 0) {
+      // The mean sin² of the images' angles to a line at angle φ is (1 − R₂ cos 2(φ − φ₂)) / 2
+      // (R₂ = |doubled| / area, φ₂ its half angle): the axis φ₂ fits better than the arrows'
+      // mean φ₁ by R₂ sin²(φ₁ − φ₂).
+      const double axis_angle = 0.5 * std::atan2(doubled.y(), doubled.x());
+      const double off = std::atan2(grain.y(), grain.x()) - axis_angle;
+      if (doubled.norm() / area * std::sin(off) * std::sin(off) > options.axis_grain_gain) {
+        Eigen::Vector2d axis(std::cos(axis_angle), std::sin(axis_angle));
+        return axis.dot(grain) < 0 ? Eigen::Vector2d(-axis) : axis;
+      }
     }
     return grain.norm() < 1e-12 ? Eigen::Vector2d::UnitY() : grain;
   };

@@ -56,6 +56,17 @@ struct FlatteningOptions {
   // fold: the piece keeps its centre seam and its grain as drawn, cut 2. 2°: fabric is itself
   // woven up to 1-2° askew (docs/pattern.md, "Folds on the grain").
   double fold_off_grain_deg = 2.0;
+  // A thread has no sense: cloth stretches alike either way along its warp. A piece's grain is the
+  // mean of its warp's 2D images as arrows, unless the line that fits them best as threads (the
+  // least-squares axis: the mean of their doubled angles, halved) fits them better by more than
+  // this, in the area-weighted mean of sin² of each warp's angle to the grain. That is a piece
+  // whose warps run both ways along it: a strap over the shoulder, its warp up the strap on the
+  // front and up it again, the other way, on the back, whose arrows cancel along the strap and
+  // leave a residue across it (trial 39, P18). Measured with `pattern` on the examples, the
+  // designs and the CLI tests' sketches: every piece but the straps gains at most 0.0025 (the
+  // one-shoulder top's back strap, arrows 4.5° off the axis); the straps 0.23 (overalls), 0.24
+  // (camisole) and 0.65 (trial 36's slip dress) (docs/pattern.md, "Straps over the shoulder").
+  double axis_grain_gain = 0.05;
 };
 
 // A point on a piece's outline: on edge `edge` (FlatPanel::boundary[edge] → boundary[edge + 1],

@@ -1,11 +1,11 @@
 #pragma once
 // Long narrow pattern pieces (a strap, a waistband, a tie) laid across the grain. The grain of a
 // piece follows its panel's `grain` (the body's vertical by default), which says nothing about
-// the piece's own shape: a strap drawn over the shoulder takes the vertical's projection, which
-// runs across the strap along most of it (trial 36's slip dress: its 3 cm straps were laid
-// across the marker's grain with no word). Cut so, a strap stretches along its length, where the
-// weft gives more than the warp. A bias cut is the exception, and a panel whose grain is turned
-// on purpose is not questioned.
+// the piece's own shape: a waistband or a collar round the neck takes the vertical's projection,
+// which runs across it. (A strap over the shoulder does not: the vertical runs up it on the front
+// and the back alike, and flatten_garment takes the line its warp runs along: trial 39, P18.) Cut
+// so, a piece stretches along its length, where the weft gives more than the warp. A bias cut is
+// the exception, and a panel whose grain is turned on purpose is not questioned.
 
 #include <string>
 

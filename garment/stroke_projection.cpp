@@ -10,6 +10,7 @@
 #include <set>
 #include <string>
 
+#include "garment/body.hpp"
 #include "garment/body_landmarks.hpp"
 
 namespace sd::garment {
@@ -471,10 +472,28 @@ ProjectedCurve project_curve(const GarmentRequest& sketch, const CurveSpec& curv
                     "relative to a landmark\") follow it onto this one")
               : std::string());
     }
+    // On an open body (a scan), points snapped near a hole land on its rim, on either side of
+    // it: the hole is the cause, not the points (trial 39, P6). 3 cm: about an edge length.
+    std::string hole;
+    if (body != nullptr) {
+      const std::vector<BodyHole> holes = body_holes(body->mesh());
+      if (const BodyHole* h = hole_near(holes, where.transpose(), 0.03); h != nullptr) {
+        const BodyLandmarks* landmarks = body->landmarks();
+        hole = fmt::format(
+            ". The curve runs over a hole of the body there: an opening {:.1f} cm across at "
+            "({:.3f}, {:.3f}, {:.3f}) m{}, {} boundary edges; points moved onto the body land on "
+            "its rim. Close the hole in the body file, or draw the curve clear of it",
+            100 * h->across, h->centre.x(), h->centre.y(), h->centre.z(),
+            landmarks != nullptr && !landmarks->points.empty()
+                ? fmt::format(", near the landmark '{}'", landmarks->nearest(h->centre).name)
+                : std::string(),
+            h->edges);
+      }
+    }
     sketch.fail(points_path,
-                fmt::format("curve '{}' crosses itself near ({:.3f}, {:.3f}, {:.3f}){}; a curve "
+                fmt::format("curve '{}' crosses itself near ({:.3f}, {:.3f}, {:.3f}){}{}; a curve "
                             "must not cross itself",
-                            curve.id, where.x(), where.y(), where.z(), snapped));
+                            curve.id, where.x(), where.y(), where.z(), snapped, hole));
   }
   if (body != nullptr) check_crossing_seen_from_outside(sketch, curve, points_path, *body, out);
   return out;

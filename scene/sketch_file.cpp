@@ -92,10 +92,8 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
       r.fail("/corner_angle", "a corner angle is a turn in degrees below 180");
   }
   if (root.contains("relax_iterations"))
-    sketch.relax_iterations = r.integer(root["relax_iterations"], "/relax_iterations", 0);
-  if (sketch.relax_iterations > kMaxRelaxIterations)
-    r.fail("/relax_iterations", fmt::format("{} sweeps is more than the {} allowed",
-                                            sketch.relax_iterations, kMaxRelaxIterations));
+    sketch.relax_iterations =
+        r.integer(root["relax_iterations"], "/relax_iterations", 0, kMaxRelaxIterations);
   if (root.contains("fabric")) {
     // A preset name, a path to a fabric file, or the fabric's constants inline (the presets'
     // schema, checked when the scene is built).

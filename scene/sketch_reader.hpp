@@ -11,6 +11,7 @@
 #include <array>
 #include <initializer_list>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 #include <string>
 #include <string_view>
@@ -111,11 +112,16 @@ class Reader {
     return x;
   }
 
-  int integer(const json& value, const std::string& path, int min_value) const {
+  // A whole number from min_value; with max_value, at most that, and the message gives both
+  // (trial 39, P16: "at least 0, got 1e23" for a value whose range is 0 .. 1000).
+  int integer(const json& value, const std::string& path, int min_value,
+              std::optional<int> max_value = std::nullopt) const {
     const double x = number(value, path);
-    if (x != std::floor(x) || x < min_value || x > 1e7)
-      fail(path,
-           fmt::format("expected a whole number of at least {}, got {}", min_value, value.dump()));
+    if (x != std::floor(x) || x < min_value || x > max_value.value_or(10000000))
+      fail(path, max_value ? fmt::format("expected a whole number from {} to {}, got {}", min_value,
+                                         *max_value, value.dump())
+                           : fmt::format("expected a whole number of at least {}, got {}",
+                                         min_value, value.dump()));
     return static_cast<int>(x);
   }
 

@@ -134,6 +134,29 @@ TEST(ClothScene, RestRampStartsFromTheDrawnTrianglesTurnedOntoThePattern) {
   EXPECT_EQ(plain.start_rest_uv.rows(), 0);
 }
 
+// `run` with "rest": "flat" drapes the freely flattened pieces, where `pattern` cuts a piece
+// whose centre line lies on the grain on the fold: the same file gave two patterns with no word
+// (trial 39, P2). The flat rest now says so, naming the pieces (the t-shirt's front and back);
+// two patches with no centre line say nothing.
+TEST(ClothScene, FlatRestSaysItsPiecesAreNotPatternsFoldedOnes) {
+  const std::filesystem::path file =
+      std::filesystem::path(SD_SOURCE_DIR) / "data/examples/tshirt.json";
+  std::ifstream in(file);
+  nlohmann::json tshirt = nlohmann::json::parse(in, nullptr, true, /*ignore_comments=*/true);
+  tshirt["simulate"]["rest"] = "flat";
+  const ClothScene flat = build_cloth_scene(scene::parse_sketch(tshirt.dump(), file.string()));
+  EXPECT_NE(flat.flat_rest_differs.find("the flat rest drapes the pattern pieces flattened "
+                                        "freely"),
+            std::string::npos)
+      << flat.flat_rest_differs;
+  EXPECT_NE(flat.flat_rest_differs.find("2 pieces ('front', 'back') are cut here as mirror pairs"),
+            std::string::npos)
+      << flat.flat_rest_differs;
+  std::string patches = two_patches(1.0);
+  patches.insert(patches.rfind('}'), R"(, "simulate": { "rest": "flat" })");
+  EXPECT_EQ(build_cloth_scene(scene::parse_sketch(patches, "p.json")).flat_rest_differs, "");
+}
+
 // A gathered panel draped from flat cloth (cut 1.5 times wider than drawn: `"ease": {"weft":
 // 1.5}`) starts at its drawn, sewn size: a rest ramp of kGatherRamp that brings the ease in, so
 // each start triangle, scaled by the ease as the model scales it, is congruent to the drawn one;

@@ -70,6 +70,17 @@ TEST(Cli, EveryCommandLineMistakeIsAnErrorSentence) {
   const CommandResult frames = run_sketchdrape("run " + sketch + " --frames 1e308");
   EXPECT_EQ(frames.exit_code, 2) << frames.output;
   EXPECT_NE(frames.output.find("error: "), std::string::npos) << frames.output;
+  // --frames is a rate: its range says per what (trial 39, P15: read as a count "bounded by
+  // 0.001"); a global option's mistake points to the program's --help, not the command's.
+  const CommandResult negative = run_sketchdrape("run " + sketch + " --frames -1");
+  EXPECT_NE(negative.output.find("--frames: -1 is outside 0.001 .. 1000 pictures per simulated "
+                                 "second"),
+            std::string::npos)
+      << negative.output;
+  const CommandResult threads = run_sketchdrape("--threads 0 validate " + sketch);
+  EXPECT_EQ(threads.exit_code, 2) << threads.output;
+  EXPECT_NE(threads.output.find("; `sketchdrape --help` says what it takes"), std::string::npos)
+      << threads.output;
   const CommandResult missing = run_sketchdrape("validate");
   EXPECT_EQ(missing.exit_code, 2) << missing.output;
   EXPECT_NE(missing.output.find("error: "), std::string::npos) << missing.output;

@@ -1,5 +1,6 @@
 #include "garment/body.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -113,6 +114,37 @@ TEST(Body, SmallObjIsCentredOnTheFloor) {
   EXPECT_NEAR(box.extent().y(), 2.0, 1e-12);
   EXPECT_NEAR(box.min.y(), 0.0, 1e-12);
   EXPECT_TRUE(meshing::analyse_topology(body.mesh).closed());
+}
+
+// An open body (a scan with holes) is warned with where each hole is and how wide, in the
+// normalised frame the sketch's points use (trial 39, P6: "34 boundary edge(s)" only). Here a
+// tetrahedron without its slanted face: one hole, its rim that face's three corners.
+TEST(Body, OpenBodyWarningSaysWhereTheHoleIs) {
+  BodyOptions options;
+  options.up = AxisDirection::parse("y");
+  options.scale = 1.0;
+  const Body body = load_body(write_temp("open.obj",
+                                         "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+                                         "f 1 3 2\nf 1 2 4\nf 1 4 3\n"),
+                              options);
+  const std::vector<BodyHole> holes = body_holes(body.mesh);
+  ASSERT_EQ(holes.size(), 1u);
+  EXPECT_EQ(holes[0].edges, 3);
+  // The rim (1,0,0), (0,1,0), (0,0,1) moved as the mesh was: its mean and its box's diagonal.
+  const Eigen::Vector3d shift = body.raw.shift;
+  EXPECT_NEAR(holes[0].across, std::sqrt(3.0), 1e-12);
+  EXPECT_LT((holes[0].centre - (Eigen::Vector3d(1, 1, 1) / 3 + shift)).norm(), 1e-12);
+  ASSERT_EQ(body.warnings.size(), 1u);
+  EXPECT_NE(body.warnings[0].find(fmt::format(
+                "the body is open (3 boundary edge(s)): collision treats the body as a closed "
+                "surface, so cloth may fall through its holes or end on the wrong side near "
+                "them; 1 hole: 173.2 cm across at ({:.3f}, {:.3f}, {:.3f}) m",
+                holes[0].centre.x(), holes[0].centre.y(), holes[0].centre.z())),
+            std::string::npos)
+      << body.warnings[0];
+  EXPECT_EQ(hole_near(holes, holes[0].centre, 0.0), &holes[0]);
+  EXPECT_EQ(hole_near(holes, holes[0].centre + Eigen::Vector3d(0, 2, 0), 0.03), nullptr);
+  EXPECT_TRUE(body_holes(load_body("builtin").mesh).empty()) << "the built-in body is closed";
 }
 
 // A pose is put in the frame of the rest body, not normalised again: a figure that raised an

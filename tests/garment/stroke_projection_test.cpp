@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
+#include "garment/sketch_error.hpp"
 #include "tests/garment/test_helpers.hpp"
 
 namespace sd::garment {
@@ -93,6 +95,38 @@ TEST(StrokeProjection, CurveMissingEverythingIsAnError) {
   c.on_body = false;  // drawn in free space: fine, lies in the view plane
   const ProjectedCurve p = project_curve(sketch_with(c), c, &body);
   EXPECT_NEAR(p.points(0, 2), 0.0, 1e-12);
+}
+
+// A curve written over a hole of an open body (a scan) folds once its points are moved onto
+// the body, each landing on the hole's rim: the error says the curve runs over a hole there,
+// where and how wide (trial 39, P6: only "crosses itself" was said). A sphere of 30 cm with its
+// front cap (every triangle within 12 cm of the front pole) cut out.
+TEST(StrokeProjection, CurveOverAHoleOfTheBodySaysSo) {
+  const meshing::TriMesh sphere = meshing::icosphere(kRadius, 5, kCentre);
+  meshing::TriMesh open = sphere;
+  std::vector<Eigen::Index> kept;
+  for (Eigen::Index f = 0; f < sphere.faces.rows(); ++f) {
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) c += sphere.vertices.row(sphere.faces(f, k)).transpose() / 3;
+    if ((c - (kCentre + Eigen::Vector3d(0, 0, kRadius))).norm() > 0.12) kept.push_back(f);
+  }
+  open.faces.resize(static_cast<Eigen::Index>(kept.size()), 3);
+  for (size_t i = 0; i < kept.size(); ++i)
+    open.faces.row(static_cast<Eigen::Index>(i)) = sphere.faces.row(kept[i]);
+  const BodySurface body(open);
+  CurveSpec c;
+  c.id = "cf";
+  c.points3d = {{-0.2, 1.0, 0.22}, {0.0, 1.0, 0.2}, {0.2, 1.0, 0.22}};
+  try {
+    project_curve(sketch_with(c), c, &body);
+    ADD_FAILURE() << "accepted";
+  } catch (const SketchError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("curve 'cf' crosses itself"), std::string::npos) << what;
+    EXPECT_NE(what.find("The curve runs over a hole of the body there: an opening"),
+              std::string::npos)
+        << what;
+  }
 }
 
 TEST(StrokeProjection, Points3dSnapToOffsetSurface) {

@@ -406,5 +406,49 @@ TEST(Fabric, FileErrorsNameTheNormalisedPathAndTheKey) {
   std::filesystem::remove_all(dir);
 }
 
+// A key given twice in one object of a fabric file is refused at its path, with the sentence a
+// sketch's duplicate key gets (trial 39, P1: a file with "friction" 0.4, then 30 was read as 30
+// without a word, where the same in an inline fabric was refused), at every level, and through
+// load_fabric_file with the file's name.
+TEST(Fabric, AKeyGivenTwiceIsRefusedAtItsPath) {
+  const auto refusal = [](const std::string& text) {
+    try {
+      parse_fabric_json(text, "x.json");
+    } catch (const InvalidFabricError& e) {
+      return e.pointer() + " | " + e.what();
+    }
+    return std::string("no error");
+  };
+  const std::string top = refusal(cotton_with("friction", R"({"value": 0.5, "unit": "1"})"));
+  EXPECT_EQ(top,
+            "/friction | x.json: /friction: the key 'friction' is given twice in this "
+            "object; JSON would keep only the last one: remove one of them");
+  std::string constant = cotton_with("note", R"("a note")");
+  constant.replace(constant.find(R"("unit": "N*m")"), 13, R"("unit": "N*m", "value": 1)");
+  EXPECT_EQ(refusal(constant).substr(0, refusal(constant).find(" | ")), "/bend/value");
+  const std::string point =
+      refusal(cotton_with("tensile_warp", R"({"strain_unit": "%", "stress_unit": "N/m",
+                                             "points": [[0, 0], {"a": 1, "a": 2}]})"));
+  EXPECT_EQ(point.substr(0, point.find(" | ")), "/tensile_warp/points/1/a") << point;
+  // Keys that differ, or the same key in two objects, are not refused.
+  EXPECT_NO_THROW(parse_fabric_json(cotton_with("note", R"({"friction": 1})"), "x.json"));
+
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "sd-fabric-test-dup";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "dup.json") << cotton_with("friction", R"({"value": 30, "unit": "1"})");
+  try {
+    load_fabric_file((dir / "dup.json").string());
+    ADD_FAILURE() << "accepted";
+  } catch (const InvalidFabricError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind((dir / "dup.json").string() + ": /friction: the key "
+                                                                        "'friction' is given twice",
+                                          0),
+              0u)
+        << e.what();
+  }
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace sd::sim

@@ -89,6 +89,12 @@ std::string parse_error_sentence(const CLI::App& app, int argc, char** argv,
   const CLI::App* command = command_in(app, argc, argv);
   std::string text = e.what();
   while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+  // A global option's mistake (--threads 0 before the command) is explained by the program's
+  // own --help, not the command's (trial 39, P15).
+  for (const CLI::Option* option : app.get_options())
+    for (const std::string& name : option->get_lnames())
+      if (text.starts_with("--" + name + ":"))
+        return fmt::format("{}; `sketchdrape --help` says what it takes", text);
   return command == nullptr ? fmt::format("{}; `sketchdrape --help` lists the commands", text)
                             : fmt::format("{}; `sketchdrape {} --help` says what it takes", text,
                                           command->get_name());
@@ -132,9 +138,9 @@ std::string unknown_option_sentence(const CLI::App& app, int argc, char** argv) 
 
 }  // namespace
 
-CLI::Validator finite_range(double low, double high) {
+CLI::Validator finite_range(double low, double high, const std::string& unit) {
   return CLI::Validator(
-      [low, high](std::string& text) -> std::string {
+      [low, high, unit](std::string& text) -> std::string {
         double value = 0;
         try {
           size_t used = 0;
@@ -145,7 +151,8 @@ CLI::Validator finite_range(double low, double high) {
         }
         if (!std::isfinite(value)) return "'" + text + "' is not a finite number";
         if (value < low || value > high)
-          return fmt::format("{} is outside {:g} .. {:g}", text, low, high);
+          return fmt::format("{} is outside {:g} .. {:g}{}", text, low, high,
+                             unit.empty() ? "" : " " + unit);
         return {};
       },
       fmt::format("NUMBER in [{:g}, {:g}]", low, high));

@@ -20,7 +20,7 @@ struct GlobalOptions {
 
 // A command-line number check: finite (no nan, inf, 1e999) and within [low, high]. CLI11's own
 // range checks let "nan" through (every comparison with NaN is false).
-CLI::Validator finite_range(double low, double high);
+CLI::Validator finite_range(double low, double high, const std::string& unit = "");
 
 // An output path that is not empty: `-o ''` wrote into the working directory (trial 36).
 CLI::Validator non_empty_path();

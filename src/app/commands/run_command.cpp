@@ -352,6 +352,7 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   if (scene.garment)  // logged as the garment was meshed (garment_stage.cpp)
     for (std::string& warning : seam_ease_warnings(sketch, *scene.garment))
       out.warnings.push_back(std::move(warning));
+  if (!scene.flat_rest_differs.empty()) out.warnings.push_back(scene.flat_rest_differs);
   // The body's repairs and defects (an open body, inconsistent triangles), logged as it loaded.
   if (scene.body)
     out.warnings.insert(out.warnings.end(), scene.body->warnings.begin(),
@@ -715,7 +716,7 @@ void add_run_command(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--frames", options->frames_per_second,
                   "Also write frames/frame-NNNN-<view>.png: this many pictures per simulated "
                   "second (the first image's view, the body at its pose)")
-      ->check(finite_range(1e-3, 1000));
+      ->check(finite_range(1e-3, 1000, "pictures per simulated second"));
   cmd->add_option("--max-memory", options->max_memory,
                   "Refuse a drape estimated to need more memory than this (e.g. 4G, 512M; "
                   "default: the memory available)");

@@ -56,6 +56,11 @@ struct ClothScene {
   // input.rest_uv holds every triangle's rest coordinates (the pattern piece's triangle for flat
   // panels, the drawn triangle for shaped ones) and the hinges rest flat when all panels are flat.
   std::optional<garment::FlatPattern> flat_pattern;
+  // With flat rest: the sentence saying that the pieces draped (and written by output.pattern)
+  // are the free flattening, which differs from `pattern`'s for pieces `pattern` cuts on the
+  // fold; empty when no piece has a centre line on the grain (trial 39, P2). Logged once, and in
+  // report.json's warnings.
+  std::string flat_rest_differs;
   bool bend_rest_flat = false;
   // With flat rest: every triangle's drawn coordinates (rows and frames of input.rest_uv), where
   // the rest ramp starts, and the ramp's time (simulate.rest_ramp, s; 0: none).
