@@ -33,6 +33,24 @@ std::string_view integrator_short_name(Integrator integrator) {
   return integrator == Integrator::bdf2 ? "bdf2" : "ie";
 }
 
+std::string_view rest_break_name(RestBreak reason) {
+  switch (reason) {
+    case RestBreak::none:
+      return "none";
+    case RestBreak::body_moving:
+      return "body moving";
+    case RestBreak::too_early:
+      return "too early";
+    case RestBreak::new_anchor:
+      return "new anchor";
+    case RestBreak::kinetic_energy:
+      return "kinetic energy";
+    case RestBreak::drift:
+      return "drift";
+  }
+  return "none";
+}
+
 std::optional<Integrator> parse_integrator(std::string_view name) {
   if (name == "implicit-euler" || name == "ie") return Integrator::implicit_euler;
   if (name == "bdf2") return Integrator::bdf2;
@@ -572,14 +590,24 @@ void Simulation::accept(Attempt& attempt, double h) {
   // own energy is below the bound, as before (docs/simulator.md, "Step control and at rest").
   const double drift_limit = settings_.rest_speed * settings_.rest_window;
   double drift = 0.0;
+  int drift_vertex = -1;
   const bool anchored = rest_anchor_.size() == x_.size();
   if (anchored)
-    for (Eigen::Index i = 0; i < x_.size() / 3; ++i)
-      drift = std::max(drift, (x_.segment<3>(3 * i) - rest_anchor_.segment<3>(3 * i)).norm());
+    for (Eigen::Index i = 0; i < x_.size() / 3; ++i) {
+      const double d = (x_.segment<3>(3 * i) - rest_anchor_.segment<3>(3 * i)).norm();
+      if (d > drift) drift = d, drift_vertex = static_cast<int>(i);
+    }
   const bool calm = kinetic / mass < settings_.rest_kinetic_energy ||
                     report_.rest_kinetic_per_kg_window_mean < settings_.rest_kinetic_energy;
-  const bool still = anchored && drift <= drift_limit && calm && !body_moving &&
-                     time_ >= settings_.rest_not_before;
+  report_.rest_break = body_moving                         ? RestBreak::body_moving
+                       : time_ < settings_.rest_not_before ? RestBreak::too_early
+                       : !anchored                         ? RestBreak::new_anchor
+                       : !calm                             ? RestBreak::kinetic_energy
+                       : drift > drift_limit               ? RestBreak::drift
+                                                           : RestBreak::none;
+  report_.rest_break_vertex = drift_vertex;
+  report_.rest_break_drift = drift;
+  const bool still = report_.rest_break == RestBreak::none;
   if (still) {
     rest_time_ += h;
     report_.rest_drift = drift;

@@ -142,6 +142,14 @@ struct EnergySample {
   double potential = 0.0;
 };
 
+// What ended (or kept from starting) a still stretch of the at-rest test at an accepted step,
+// the first that holds in this order: the body still moving, before rest_not_before, no anchor
+// to measure from (a mesh change that could not carry it), the kinetic energy (the step's and
+// its mean over the window both at or above rest_kinetic_energy), a vertex farther than
+// rest_speed·rest_window from the anchor.
+enum class RestBreak { none, body_moving, too_early, new_anchor, kinetic_energy, drift };
+std::string_view rest_break_name(RestBreak reason);
+
 struct SimulationReport {
   int steps = 0;          // accepted steps
   double sim_time = 0.0;  // s simulated
@@ -210,6 +218,13 @@ struct SimulationReport {
   // s: how long the current still stretch has lasted (at rest needs rest_window of it); 0 when
   // the last step was not still.
   double rest_still_time = 0.0;
+  // Why the last step did not continue a still stretch (RestBreak::none when it did): what a
+  // drape that does not rest keeps doing (run --trace's "rest"). Whenever there was an anchor,
+  // the vertex farthest from it and how far (m): with RestBreak::drift, the one that ended the
+  // stretch; −1 and 0 without an anchor or with no vertex moved.
+  RestBreak rest_break = RestBreak::none;
+  int rest_break_vertex = -1;
+  double rest_break_drift = 0.0;
   // Self-contact (zero when off; sim/self_contact.hpp).
   int self_intersections_start = 0;  // intersecting triangle pairs of the start
   int self_untangled_vertices = 0;   // vertices the start's untangling moved

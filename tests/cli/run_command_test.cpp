@@ -271,6 +271,16 @@ TEST(RunCommand, SheetSceneWritesReportMeshAndTrace) {
     // at-rest 5 mm/s: all 47 unpinned vertices move.
     if (lines == 1) {
       EXPECT_EQ(j["moving"], 47);
+      // That first step is no still one: the kinetic energy ended the stretch (its bound is
+      // 1e-6 J/kg, a speed of 1.4 mm/s).
+      EXPECT_EQ(j["rest"]["break"], "kinetic energy");
+      EXPECT_EQ(j["rest"]["still_s"].get<double>(), 0.0);
+    }
+    // A still step names the vertex farthest from the stretch's anchor, within the drift limit.
+    if (j["rest"]["break"] == "none") {
+      EXPECT_GT(j["rest"]["still_s"].get<double>(), 0.0);
+      EXPECT_LE(j["rest"]["drift"]["distance"].get<double>(), 0.005 * 0.25);
+      EXPECT_LT(j["rest"]["drift"]["vertex"].get<int>(), 49);
     }
     last = j;
   }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <random>
 #include <string>
 #include <utility>
@@ -207,6 +208,60 @@ TEST(Simulation, AtRestBoundsTheDriftOverTheWindow) {
   // No vertex can have drifted farther than the largest speed over the window allows.
   EXPECT_LE(report.rest_drift, report.rest_speed_window * settings.rest_window * (1 + 1e-9) +
                                    settings.dt * report.rest_speed_window);
+}
+
+// What kept a drape from resting is told step by step (run --trace's "rest"): each step that
+// did not continue a still stretch names why, and a drift names the vertex that left the anchor
+// (the positions at the last step that was not still) farthest and how far.
+TEST(Simulation, AtRestSaysWhatEndedEachStillStretch) {
+  const HangingSheet h = hanging_sheet(6);
+  // With the energy bound as set, the swinging sheet's steps break on the kinetic energy; with
+  // it at 10 J/kg (every step calm: the sheet never swings at 4.5 m/s), only the drift can end
+  // a stretch, and the swing carries vertices beyond rest_speed·rest_window from their anchor
+  // before it settles.
+  for (const double energy_bound : {1e-6, 10.0}) {
+    SCOPED_TRACE(energy_bound);
+    SimulationSettings settings = damped_settling_settings();
+    settings.rest_kinetic_energy = energy_bound;
+    Simulation sim = make_simulation(h, settings);
+    const double limit = settings.rest_speed * settings.rest_window;
+    Eigen::VectorXd anchor = sim.positions();  // the first stretch is measured from the start
+    std::map<RestBreak, int> breaks;
+    const SimulationReport report = sim.run([&](const Simulation& s) {
+      const SimulationReport& r = s.report();
+      ++breaks[r.rest_break];
+      if (r.rest_break != RestBreak::kinetic_energy) {
+        // The reported vertex and distance are the largest displacement from the anchor.
+        double farthest = 0.0;
+        int vertex = -1;
+        for (Eigen::Index i = 0; i < anchor.size() / 3; ++i) {
+          const double d = (s.positions().segment<3>(3 * i) - anchor.segment<3>(3 * i)).norm();
+          if (d > farthest) farthest = d, vertex = static_cast<int>(i);
+        }
+        EXPECT_EQ(r.rest_break_vertex, vertex);
+        EXPECT_DOUBLE_EQ(r.rest_break_drift, farthest);
+        EXPECT_EQ(r.rest_break == RestBreak::drift, farthest > limit);
+      } else {
+        EXPECT_GE(r.rest_kinetic_per_kg_final, settings.rest_kinetic_energy);
+        EXPECT_GE(r.rest_kinetic_per_kg_window_mean, settings.rest_kinetic_energy);
+      }
+      EXPECT_EQ(r.rest_break == RestBreak::none, r.rest_still_time > 0.0);
+      if (r.rest_break != RestBreak::none) anchor = s.positions();
+    });
+    ASSERT_TRUE(report.at_rest);
+    EXPECT_EQ(report.rest_break, RestBreak::none);
+    EXPECT_EQ(breaks[RestBreak::too_early], 0);
+    EXPECT_EQ(breaks[RestBreak::new_anchor], 0);  // the mesh never changes
+    EXPECT_EQ(breaks[RestBreak::body_moving], 0);
+    if (energy_bound > 1.0) {
+      EXPECT_EQ(breaks[RestBreak::kinetic_energy], 0);
+      EXPECT_GT(breaks[RestBreak::drift], 0);
+    } else {
+      EXPECT_GT(breaks[RestBreak::kinetic_energy], 0);
+    }
+  }
+  EXPECT_EQ(rest_break_name(RestBreak::drift), "drift");
+  EXPECT_EQ(rest_break_name(RestBreak::kinetic_energy), "kinetic energy");
 }
 
 // Adaptive detail replaces the mesh mid-drape: the still stretch's drift is carried through

@@ -300,25 +300,39 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
         fastest = i;
       }
     }
-    const Eigen::Vector3d at = s.positions().segment<3>(3 * fastest);
-    std::string panel;
     const Eigen::MatrixX3i& faces = d.faces();
     const Eigen::VectorXi sources = d.source_faces();
-    for (Eigen::Index t = 0; t < faces.rows() && panel.empty(); ++t)
-      if ((faces.row(t).array() == fastest).any() && sources(t) < scene.face_group.size() &&
-          scene.face_group(sources(t)) < static_cast<int>(scene.group_names.size()))
-        panel = scene.group_names[static_cast<size_t>(scene.face_group(sources(t)))];
-    std::string held = "free";
-    if (s.contact())
-      for (const sim::ActiveContact& c : s.contact()->contacts())
-        if (c.contact.vertex == fastest) held = c.released ? "released" : "held";
-    line["fastest"] = {{"vertex", fastest},
-                       {"speed", top},
-                       {"at", {at.x(), at.y(), at.z()}},
-                       {"panel", panel},
-                       {"contact", held}};
-    if (landmarks) line["fastest"]["near"] = landmarks->nearest(at).name;
+    // A vertex as the trace names it: where, in which panel, near which landmark, and whether
+    // a body contact holds it.
+    const auto place = [&](int vertex) {
+      const Eigen::Vector3d at = s.positions().segment<3>(3 * vertex);
+      std::string panel;
+      for (Eigen::Index t = 0; t < faces.rows() && panel.empty(); ++t)
+        if ((faces.row(t).array() == vertex).any() && sources(t) < scene.face_group.size() &&
+            scene.face_group(sources(t)) < static_cast<int>(scene.group_names.size()))
+          panel = scene.group_names[static_cast<size_t>(scene.face_group(sources(t)))];
+      std::string held = "free";
+      if (s.contact())
+        for (const sim::ActiveContact& c : s.contact()->contacts())
+          if (c.contact.vertex == vertex) held = c.released ? "released" : "held";
+      nlohmann::json where = {{"vertex", vertex},
+                              {"at", {at.x(), at.y(), at.z()}},
+                              {"panel", panel},
+                              {"contact", held}};
+      if (landmarks) where["near"] = landmarks->nearest(at).name;
+      return where;
+    };
+    line["fastest"] = place(fastest);
+    line["fastest"]["speed"] = top;
     line["moving"] = moving;
+    // The at-rest test's view of the step: how long the cloth has been still, and otherwise
+    // what ended the still stretch (with a drift, the vertex that left the anchor farthest).
+    line["rest"] = {{"still_s", r.rest_still_time}, {"break", sim::rest_break_name(r.rest_break)}};
+    if (r.rest_break == sim::RestBreak::drift ||
+        (r.rest_break == sim::RestBreak::none && r.rest_break_vertex >= 0)) {
+      line["rest"]["drift"] = place(r.rest_break_vertex);
+      line["rest"]["drift"]["distance"] = r.rest_break_drift;
+    }
     if (s.contact()) {
       const sim::ContactStepStats& c = s.contact()->step_stats();
       line["contacts"] = {{"held", c.contacts},
