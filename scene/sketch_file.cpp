@@ -43,10 +43,8 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
                            position_of(text, nul + 1)));
   json root;
   try {
-    DuplicateKeyCheck duplicates(sketch);
-    root =
-        json::parse(mark_overflowing_numbers(text), std::ref(duplicates), /*allow_exceptions=*/true,
-                    /*ignore_comments=*/true);
+    root = json::parse(mark_overflowing_numbers(text), strict_json_check(sketch),
+                       /*allow_exceptions=*/true, /*ignore_comments=*/true);
   } catch (const json::parse_error& e) {
     std::string detail = e.what();
     const size_t colon = detail.find("error while parsing");

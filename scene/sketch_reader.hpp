@@ -1,9 +1,10 @@
 #pragma once
 // Inside the scene layer: reading a sketch file's JSON with what a message needs. Reader checks
 // each value's type and range and fails with the file, the JSON path and a sentence
-// (SketchError); DuplicateKeyCheck follows nlohmann's parser to refuse a key given twice; numbers
-// that overflow a double are marked before parsing so that they are refused at their path too.
-// The parsers of the file's sections (sketch_sections.hpp) use them; nothing outside scene/ does.
+// (SketchError); strict_json_check (sim/strict_json.hpp) follows nlohmann's parser to refuse a key
+// given twice; numbers that overflow a double are marked before parsing so that they are refused at
+// their path too. The parsers of the file's sections (sketch_sections.hpp) use them; nothing
+// outside scene/ does.
 
 #include <fmt/format.h>
 
@@ -21,6 +22,7 @@
 #include "garment/sketch_ranges.hpp"
 #include "scene/sketch_file.hpp"
 #include "sim/edit_distance.hpp"
+#include "sim/strict_json.hpp"
 
 namespace sd::scene::detail {
 
@@ -272,87 +274,15 @@ class Reader {
   const Sketch& sketch_;
 };
 
-constexpr int kMaxNesting = 64;
-
-// Tracks the JSON path while nlohmann's parser reports events, to reject a key given twice in
-// one object (JSON allows it and keeps the last value, silently dropping the first).
-class DuplicateKeyCheck {
- public:
-  explicit DuplicateKeyCheck(const Sketch& sketch) : sketch_(sketch) {}
-
-  bool operator()(int depth, json::parse_event_t event, json& parsed) {
-    // A sketch file nests a few levels (a point in a list in a curve in the list of curves);
-    // thousands of levels are a damaged or hostile file, and cost time and memory to build.
-    // The path is that of the element that goes too deep (its container entered first, so that
-    // it reads /0 where nothing was counted yet, not /-1), shortened to its first levels: 64
-    // levels of "/0" said nothing more (trial 35).
-    if (depth > kMaxNesting) {
-      if (event == json::parse_event_t::object_start || event == json::parse_event_t::array_start)
-        enter_element();
-      sketch_.fail(path(kShownLevels) + "/…",
-                   fmt::format("lists and objects are nested more than {} levels deep here (the "
-                               "path shows the first {}); a sketch file needs fewer than 10",
-                               kMaxNesting, kShownLevels));
-    }
-    switch (event) {
-      case json::parse_event_t::object_start:
-      case json::parse_event_t::array_start:
-        enter_element();
-        frames_.push_back({event == json::parse_event_t::array_start, -1, {}, {}});
-        break;
-      case json::parse_event_t::key: {
-        Frame& f = frames_.back();
-        f.key = parsed.get<std::string>();
-        if (!f.keys.insert(f.key).second)
-          sketch_.fail(path(),
-                       fmt::format("the key '{}' is given twice in this object; JSON would keep "
-                                   "only the last one: remove one of them",
-                                   f.key));
-        break;
-      }
-      case json::parse_event_t::object_end:
-      case json::parse_event_t::array_end:
-        frames_.pop_back();
-        break;
-      case json::parse_event_t::value:
-        enter_element();
-        break;
-    }
-    return true;
-  }
-
- private:
-  struct Frame {
-    bool array = false;
-    long index = -1;
-    std::set<std::string> keys;
-    std::string key;
-  };
-
-  // A value or container begins: in an array it is the next element.
-  void enter_element() {
-    if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
-  }
-
-  static constexpr std::size_t kShownLevels = 6;
-
-  // "/a/0/b": keys with JSON Pointer escapes (~0 for ~, ~1 for /); the first `levels` only.
-  std::string path(std::size_t levels = std::string::npos) const {
-    std::string out;
-    for (const Frame& f : frames_) {
-      if (levels-- == 0) break;
-      if (f.array) {
-        out += "/" + std::to_string(f.index);
-        continue;
-      }
-      out += "/";
-      for (char c : f.key) out += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
-    }
-    return out;
-  }
-
-  const Sketch& sketch_;
-  std::vector<Frame> frames_;
-};
+// The sketch's callback for nlohmann's parser: a key given twice in one object, or nesting deeper
+// than a sketch needs, is refused at its JSON path (sim::StrictJsonCallback follows the events).
+inline sim::StrictJsonCallback strict_json_check(const Sketch& sketch) {
+  // A sketch file nests a few levels (a point in a list in a curve in the list of curves).
+  return sim::StrictJsonCallback(
+      [&sketch](const std::string& path, const std::string& sentence) {
+        sketch.fail(path, sentence);
+      },
+      "a sketch file", 10);
+}
 
 }  // namespace sd::scene::detail

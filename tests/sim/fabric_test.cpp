@@ -450,5 +450,28 @@ TEST(Fabric, AKeyGivenTwiceIsRefusedAtItsPath) {
   std::filesystem::remove_all(dir);
 }
 
+// A fabric nests three levels (a curve's points); thousands are a damaged or hostile file, whose
+// parsed tree costs memory and a deep recursion to free: refused at the element that goes too
+// deep, the path cut to its first six levels as the sketch reader does.
+TEST(Fabric, NestingDeeperThanAFabricNeedsIsRefused) {
+  const std::string deep = cotton_with("note", std::string(100000, '[') + std::string(100000, ']'));
+  try {
+    parse_fabric_json(deep, "x.json");
+    ADD_FAILURE() << "a fabric nested 100,000 levels deep was read";
+  } catch (const InvalidFabricError& e) {
+    EXPECT_EQ(e.pointer(), "/note/0/0/0/0/0/…");
+    EXPECT_NE(std::string(e.what()).find("nested more than 64 levels deep here"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("a fabric file needs fewer than 5"), std::string::npos)
+        << e.what();
+  }
+  // 63 levels pass the reader's check (the note's type is the schema's business, not this test's).
+  try {
+    parse_fabric_json(cotton_with("note", std::string(63, '[') + std::string(63, ']')), "x.json");
+  } catch (const InvalidFabricError& e) {
+    EXPECT_EQ(std::string(e.what()).find("nested more than"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace sd::sim
