@@ -106,15 +106,6 @@ CholmodSolver::CholmodSolver(CholmodMethod method)
     : method_(method), factor_(std::make_unique<Factor>()) {
   factor_->llt.setMode(method == CholmodMethod::supernodal ? Eigen::CholmodSupernodalLLt
                                                            : Eigen::CholmodSimplicialLLt);
-  // Larger supernodes than CHOLMOD's defaults (4, 16, 48 columns for the three relaxation
-  // thresholds): a vertex is three columns, so the defaults merge only a handful of vertices,
-  // and bigger dense blocks make the BLAS calls cheaper for a few more stored zeros. Measured on
-  // garments: 7–10 % less CPU a factorisation, the same factor pattern's flops and the same
-  // steps (docs/benchmarks.md, "Twelfth round" and "Thirteenth round").
-  cholmod_common& common = factor_->llt.cholmod();
-  common.nrelax[0] = 8;
-  common.nrelax[1] = 32;
-  common.nrelax[2] = 96;
 }
 CholmodSolver::~CholmodSolver() = default;
 CholmodSolver::CholmodSolver(CholmodSolver&&) noexcept = default;
