@@ -159,18 +159,20 @@ std::string cotton_with(const std::string& key, const std::string& curve) {
          key + R"(": )" + curve + "}";
 }
 
+// "pointer | message" of the error reading `text` as a fabric, or "no error".
+std::string refusal(const std::string& text) {
+  try {
+    parse_fabric_json(text, "x.json");
+  } catch (const InvalidFabricError& e) {
+    return e.pointer() + " | " + e.what();
+  }
+  return "no error";
+}
+
 // A key the fabric schema does not have is refused at its pointer with the nearest known key,
 // at every level (the fabric, a constant, a tensile curve): a misspelt constant would otherwise
 // be dropped, its preset default used without a word.
 TEST(Fabric, UnknownKeysAreRefusedWithTheNearestKnownOne) {
-  const auto refusal = [](const std::string& text) {
-    try {
-      parse_fabric_json(text, "x.json");
-    } catch (const InvalidFabricError& e) {
-      return e.pointer() + " | " + e.what();
-    }
-    return std::string("no error");
-  };
   const std::string top = refusal(cotton_with("frictoin", R"({"value": 0.5, "unit": "1"})"));
   EXPECT_EQ(top.substr(0, top.find(" | ")), "/frictoin") << top;
   EXPECT_NE(top.find("x.json: /frictoin: unknown key 'frictoin' (did you mean 'friction'?)"),
@@ -411,14 +413,6 @@ TEST(Fabric, FileErrorsNameTheNormalisedPathAndTheKey) {
 // without a word, where the same in an inline fabric was refused), at every level, and through
 // load_fabric_file with the file's name.
 TEST(Fabric, AKeyGivenTwiceIsRefusedAtItsPath) {
-  const auto refusal = [](const std::string& text) {
-    try {
-      parse_fabric_json(text, "x.json");
-    } catch (const InvalidFabricError& e) {
-      return e.pointer() + " | " + e.what();
-    }
-    return std::string("no error");
-  };
   const std::string top = refusal(cotton_with("friction", R"({"value": 0.5, "unit": "1"})"));
   EXPECT_EQ(top,
             "/friction | x.json: /friction: the key 'friction' is given twice in this "
