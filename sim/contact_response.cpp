@@ -20,6 +20,9 @@ namespace {
 // the cloth's triangles); shallower starts push each vertex alone. 2 cm is where `validate` used
 // to say a start was not known to recover (garment/quality_gate.cpp).
 constexpr double kRegionRepairDepth = 0.02;
+// PROBE (round 37, end): the push stops stiffening at a gap of c/10, not the header's c/100
+// (kPushFloorFraction; the unit test BodyVertexPushStiffensTowardsTheVertex still has c/100).
+constexpr double kProbeFloor = 0.1;
 constexpr double kNoImpulse = std::numeric_limits<double>::quiet_NaN();
 // A contact of the last step is kept while its vertex is within (1 + kHoldMargin)·thickness:
 // a vertex held at exactly `thickness` ends a step on the tangent plane, a hair farther from a
@@ -495,7 +498,7 @@ BodyVertexPush body_vertex_push(double depth, double clearance, double base_stif
   if (!(depth > 0.0) || !(clearance > 0.0) || !(base_stiffness > 0.0)) return {};
   // gap: how far the point still is in front of the body vertex; below the floor the push goes
   // on along its tangent there.
-  const double floor = kPushFloorFraction * clearance;
+  const double floor = kProbeFloor * clearance;
   const double gap = clearance - depth;
   const double at = std::max(gap, floor);
   const double ratio = clearance / at;
@@ -507,7 +510,7 @@ BodyVertexPush body_vertex_push(double depth, double clearance, double base_stif
 
 double body_vertex_push_depth(double force, double clearance, double base_stiffness) {
   if (!(force > 0.0)) return 0.0;
-  const double floor = kPushFloorFraction * clearance;
+  const double floor = kProbeFloor * clearance;
   const BodyVertexPush at_floor = body_vertex_push(clearance - floor, clearance, base_stiffness);
   if (force <= at_floor.force)  // F = k₀ c d / (c − d)
     return force * clearance / (base_stiffness * clearance + force);
