@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <tuple>
 #include <utility>
@@ -20,9 +21,6 @@ namespace {
 // the cloth's triangles); shallower starts push each vertex alone. 2 cm is where `validate` used
 // to say a start was not known to recover (garment/quality_gate.cpp).
 constexpr double kRegionRepairDepth = 0.02;
-// PROBE (round 37, end): the push stops stiffening at a gap of c/10, not the header's c/100
-// (kPushFloorFraction; the unit test BodyVertexPushStiffensTowardsTheVertex still has c/100).
-constexpr double kProbeFloor = 0.1;
 constexpr double kNoImpulse = std::numeric_limits<double>::quiet_NaN();
 // A contact of the last step is kept while its vertex is within (1 + kHoldMargin)·thickness:
 // a vertex held at exactly `thickness` ends a step on the tangent plane, a hair farther from a
@@ -72,6 +70,20 @@ constexpr int kHeldSpringGrain = 16;
 // pressed on the hips left 5 body vertices 1.7 mm through the A-line skirt; 400 and
 // 1,000 rad/s left none, and 400 the least motion at the end.
 constexpr double kSpringFrequency = 400.0;  // rad/s
+// A body-vertex push stiffens no further than K = kPushStepStiffness times m/β² (m its point's
+// effective mass, β the step's position factor, h for backward Euler): a spring of stiffness k
+// on the point resolves k β²/(m + k β²) of its linearised residual in one implicit step, 99 %
+// at K = 100, so a stiffer push makes no step firmer; what it does make is a larger force
+// wherever the point cannot move (cloth squeezed between two body parts: its contact with one
+// part holds it while the other part's push rises on), and that force went sideways into the
+// corners (the flat arms-lowering t-shirt failed at 4.43 s with 98 m/s in the armpit, the
+// strapless dress blew up in the seat's cleft at 11.79 s). Measured (docs/collision.md): K = 100
+// rests both. At 1/60 s steps the push then stops stiffening at a gap of 2c/3 (stiffness 2.25
+// k₀); any load up to about 2 k₀ c (some 50 times the point's weight) is still held in front of
+// the body vertex.
+constexpr double kPushStepStiffness = 100.0;
+// The floor stays inside the clearance for steps longer than 1/44 s (ω β / √K above 0.9).
+constexpr double kMaxPushFloorFraction = 0.9;
 // The force of one body vertex's push is capped at this many times the whole cloth's weight: a
 // tip can hold up a hanging sheet (or a waistband pressed on a hip), but a squeeze that no
 // motion of the cloth can clear (two body parts closing on it) cannot ask for an unbounded push.
@@ -494,11 +506,12 @@ void ContactResponse::constrain_start(const Eigen::VectorXd& x_hat, const Eigen:
   spring_start_piercings(x_hat + y, v0, beta, filter, extra);
 }
 
-BodyVertexPush body_vertex_push(double depth, double clearance, double base_stiffness) {
+BodyVertexPush body_vertex_push(double depth, double clearance, double base_stiffness,
+                                double floor_fraction) {
   if (!(depth > 0.0) || !(clearance > 0.0) || !(base_stiffness > 0.0)) return {};
   // gap: how far the point still is in front of the body vertex; below the floor the push goes
   // on along its tangent there.
-  const double floor = kProbeFloor * clearance;
+  const double floor = floor_fraction * clearance;
   const double gap = clearance - depth;
   const double at = std::max(gap, floor);
   const double ratio = clearance / at;
@@ -508,10 +521,12 @@ BodyVertexPush body_vertex_push(double depth, double clearance, double base_stif
   return push;
 }
 
-double body_vertex_push_depth(double force, double clearance, double base_stiffness) {
+double body_vertex_push_depth(double force, double clearance, double base_stiffness,
+                              double floor_fraction) {
   if (!(force > 0.0)) return 0.0;
-  const double floor = kProbeFloor * clearance;
-  const BodyVertexPush at_floor = body_vertex_push(clearance - floor, clearance, base_stiffness);
+  const double floor = floor_fraction * clearance;
+  const BodyVertexPush at_floor =
+      body_vertex_push(clearance - floor, clearance, base_stiffness, floor_fraction);
   if (force <= at_floor.force)  // F = k₀ c d / (c − d)
     return force * clearance / (base_stiffness * clearance + force);
   return clearance - floor + (force - at_floor.force) / at_floor.stiffness;
@@ -561,14 +576,19 @@ PointSpring ContactResponse::linearised_push(const SpringSource& source, double 
   // solve pushes the point out no farther than the push itself would, and the next step
   // linearises again nearer; at the cap's depth the force is the cap.
   const double base = source.mass * kSpringFrequency * kSpringFrequency;
-  const double d =
-      source.mass > 0.0
-          ? std::clamp(depth, 0.0,
-                       body_vertex_push_depth(max_spring_preload(), source.clearance, base))
-          : std::max(depth, 0.0);
+  // The push stops stiffening where its stiffness reaches what the step can resolve,
+  // kPushStepStiffness·m/β² (docs/collision.md, "A bound for the push in a squeeze"): the law's
+  // stiffness k₀ c²/g² reaches it at the gap g = c ω β / √K.
+  const double floor_fraction = std::clamp(kSpringFrequency * beta_ / std::sqrt(kPushStepStiffness),
+                                           kPushFloorFraction, kMaxPushFloorFraction);
+  const double d = source.mass > 0.0
+                       ? std::clamp(depth, 0.0,
+                                    body_vertex_push_depth(max_spring_preload(), source.clearance,
+                                                           base, floor_fraction))
+                       : std::max(depth, 0.0);
   spring.target = source.goal - d;
   if (!(source.mass > 0.0) || !(share > 0.0)) return spring;  // corners pinned: nothing moves
-  const BodyVertexPush push = body_vertex_push(d, source.clearance, base);
+  const BodyVertexPush push = body_vertex_push(d, source.clearance, base, floor_fraction);
   const double stiffness = d > 0.0 ? push.stiffness : base;
   spring.preload = share * push.force;
   spring.stiffness = share * stiffness;

@@ -30,10 +30,10 @@
 // of it (or about to be at the step's end), pushes the triangle's point over it outwards along
 // the triangle's normal: a push whose force is a function of the point's depth in that
 // clearance alone (body_vertex_push: as soft as before where the point enters the clearance,
-// stiffening without bound towards the body vertex), damped, and linearised in the implicit
-// solve as a spring on the point's corners (PointSpring); the end check's re-solves linearise
-// it again where the step ended. Nothing of it is carried to the next step, so no cycle of
-// catching and releasing can put energy into the drape, and it is never a jump in position.
+// stiffening towards the body vertex up to what the step can resolve), damped, and linearised in
+// the implicit solve as a spring on the point's corners (PointSpring); the end check's re-solves
+// linearise it again where the step ended. Nothing of it is carried to the next step, so no cycle
+// of catching and releasing can put energy into the drape, and it is never a jump in position.
 // (Until 28 November each spring's end force was carried to the next step as a preload, raised
 // by stiffness × the gap left: an integrator that kept drapes rocking, docs/collision.md; before
 // 26 November the corners' normal velocities were constraints of the filter, which failed where
@@ -117,9 +117,15 @@ struct BodyVertexPush {
   double stiffness = 0.0;  // N/m
 };
 inline constexpr double kPushFloorFraction = 0.01;
-BodyVertexPush body_vertex_push(double depth, double clearance, double base_stiffness);
+// `floor_fraction` (in (0, 1)) moves the floor to that fraction of the clearance: the push then
+// stops stiffening at k₀ / floor_fraction². The simulator's floor is where the stiffness reaches
+// what one implicit step can resolve (100 m/β², docs/collision.md "A bound for the push in a
+// squeeze"): 2c/3 at 1/60 s steps.
+BodyVertexPush body_vertex_push(double depth, double clearance, double base_stiffness,
+                                double floor_fraction = kPushFloorFraction);
 // The depth at which body_vertex_push reaches `force` (N; its inverse; 0 for no force).
-double body_vertex_push_depth(double force, double clearance, double base_stiffness);
+double body_vertex_push_depth(double force, double clearance, double base_stiffness,
+                              double floor_fraction = kPushFloorFraction);
 
 // One body vertex's push on one cloth triangle in a step: where it comes from and where it
 // vanishes (the solve's PointSpring is its linearisation).

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "sim/body_collider.hpp"
+#include "sim/body_motion.hpp"
 #include "sim/contact_response.hpp"
 #include "sim/sheet.hpp"
 #include "sim/simulation.hpp"
@@ -333,9 +334,12 @@ TEST(ContactHysteresis, BodyVertexSpringsInAPinchKeepAThirdOfTheGap) {
     ASSERT_GE(extra.springs.size(), 4u);
     // Each corner is h = thickness − gap through the cloth, at depth c + h in its clearance c;
     // the push's tangent there has F / F' = its own, whatever the share (which scales both),
-    // and that ratio tells the clearances apart (0.318 mm at c = 0.9 mm, 0.330 mm at 1.5 mm).
+    // and that ratio tells the clearances apart (1.10 mm at c = 0.9 mm, 1.63 mm at 1.5 mm). At
+    // 1/60 s steps the push stops stiffening at a gap of ω h / 10 = 2/3 of its clearance
+    // (sim/contact_response.cpp, kPushStepStiffness).
     const double h = kThickness - gap;
-    const BodyVertexPush push = body_vertex_push(expected + h, expected, 1.0);
+    const double floor_fraction = 400.0 / 60.0 / 10.0;
+    const BodyVertexPush push = body_vertex_push(expected + h, expected, 1.0, floor_fraction);
     for (const PointSpring& spring : extra.springs) {
       ASSERT_NEAR(spring.normal.y(), -1.0, 1e-12);  // pushing the cloth down, off the lid
       EXPECT_NEAR(spring.preload / spring.stiffness, push.force / push.stiffness, 1e-9)
@@ -530,7 +534,65 @@ TEST(ContactHysteresis, BodyVertexPushStiffensTowardsTheVertex) {
   // body_vertex_push_depth is its inverse, on both sides of the floor.
   for (const double d : {1e-5, 0.5 * c, 0.995 * c, c, c + 0.002})
     EXPECT_NEAR(body_vertex_push_depth(body_vertex_push(d, c, k0).force, c, k0), d, 1e-12) << d;
+  // With the floor moved out to 2c/3 (the simulator's at 1/60 s steps) the push stops
+  // stiffening there at k₀ (3/2)² = 2.25 k₀, having reached k₀ c / 2; continuous, and its
+  // inverse on both sides.
+  const double f = 2.0 / 3.0;
+  EXPECT_NEAR(body_vertex_push(c / 3.0, c, k0, f).force, 0.5 * k0 * c, 1e-9 * k0 * c);
+  EXPECT_NEAR(body_vertex_push(c / 3.0 + 0.001, c, k0, f).stiffness, 2.25 * k0, 1e-9 * k0);
+  EXPECT_NEAR(body_vertex_push(c + 0.001, c, k0, f).force,
+              0.5 * k0 * c + 2.25 * k0 * (2.0 * c / 3.0 + 0.001), 1e-9 * k0 * c);
+  for (const double d : {1e-5, 0.2 * c, c / 3.0, c, c + 0.002})
+    EXPECT_NEAR(body_vertex_push_depth(body_vertex_push(d, c, k0, f).force, c, k0, f), d, 1e-12)
+        << d;
 }
 
 }  // namespace
 }  // namespace sd::sim
+
+// A squeeze the cloth cannot get out of: a cone's tip, pointing down, lowered onto cloth lying
+// on a table until it is 1 mm above the table (a third of the contact thickness), then held.
+// Under the tip the table's contacts hold the cloth up and the tip's push presses it down, and
+// no place between them is clear of both. The push must stay bounded there (a finite force
+// and stiffness, docs/collision.md "A bound for the push in a squeeze"): the drape does not fail,
+// no vertex is thrown about, and the cloth comes to rest on the table with the tip through it.
+// MEASURED_PINCH.
+TEST(ContactHysteresis, ClothSqueezedBetweenATipAndATableStaysBounded) {
+  meshing::TriMesh tip = testing::make_cone(0.05, 0.1, 16, Vector3d(0.013, 0.0, 0.007));
+  tip.vertices.col(1) = -tip.vertices.col(1);  // apex down at y = -0.1
+  tip.faces.col(1).swap(tip.faces.col(2));     // still facing out
+  const meshing::TriMesh body = merged(table(), tip);
+  constexpr double kStart = 0.12, kEnd = 0.101, kLowerTime = 0.3;  // apex 2 cm up to 1 mm
+  const PoseSequence motion = make_pose_sequence(body, {0.0, kLowerTime}, [&](double t) {
+    Eigen::MatrixX3d shift = Eigen::MatrixX3d::Zero(body.vertices.rows(), 3);
+    const double y = kStart + (kEnd - kStart) * std::min(t / kLowerTime, 1.0);
+    shift.bottomRows(tip.vertices.rows()).col(1).setConstant(y);
+    return shift;
+  });
+  const SheetSetup s = horizontal_sheet(9, 0.3, {0.0, kThickness, 0.0});
+  SimulationSettings settings = box_settings(2.0);
+  settings.stop_at_rest = true;
+  settings.contact.check_body_vertices = true;
+  Simulation sim(s.model, flatten_positions(s.scene.input.rest_positions), {}, settings);
+  sim.set_body_motion(motion);
+  double fastest = 0.0;  // m/s, after the tip reaches the cloth
+  int pushed_steps = 0;
+  const SimulationReport report = sim.run([&](const Simulation& step) {
+    pushed_steps += step.contact()->step_stats().piercings_held > 0;
+    if (step.time() < 0.2) return;
+    for (Eigen::Index i = 0; i < step.velocities().size() / 3; ++i)
+      fastest = std::max(fastest, step.velocities().segment<3>(3 * i).norm());
+  });
+  std::printf(
+      "cloth squeezed under a tip 1 mm above a table: failed %d, at rest %d at %.2f s, %d steps, "
+      "%d retries, %d steps pushed, fastest %.3g m/s after 0.2 s, highest body vertex through "
+      "%.2f mm\n",
+      report.failed, report.at_rest, report.sim_time, report.steps, report.retries, pushed_steps,
+      fastest, 1e3 * sim.contact()->step_stats().max_piercing);
+  EXPECT_FALSE(report.failed);
+  EXPECT_GT(pushed_steps, 0);  // the tip's push took part
+  // The tip comes down at 6.3 cm/s; the cloth it presses may slide out from under it about as
+  // fast, not at the metres per second of an unbounded push.
+  EXPECT_LT(fastest, 0.5);
+  EXPECT_TRUE(report.at_rest);
+}
