@@ -303,15 +303,18 @@ TEST(ContactHysteresis, PinchBudgetOnlyWhereTheGapCrossesTheCloth) {
 }
 
 // The body-vertex springs take the same share of a pinch as the contacts: the corners of a lid
-// 0.9 thicknesses (2.7 mm) over a table, 0.3 mm through cloth lying on the table at the
-// thickness, keep the cloth a third of the gap (0.9 mm) from them when the floor allows it
+// 3.2 mm over a table, 0.2 mm in front of cloth lying on the table at the thickness (3 mm), keep
+// the cloth a third of the gap (1.07 mm) from them when the floor allows it
 // (pinch_floor a quarter thickness), not the springs' own clearance (half a thickness, 1.5 mm),
 // which would ask for cloth within the table's share. At the default floor (half a thickness)
 // the share is the clearance. The lid lies between the sheet's vertices (3.75 cm apart), so
 // every vertex stays at the thickness and the cloth flat, each of the lid's corners at the same
 // depth in its clearance.
 TEST(ContactHysteresis, BodyVertexSpringsInAPinchKeepAThirdOfTheGap) {
-  const double gap = 0.9 * kThickness;
+  // In front of the cloth, not through it: a corner through it is deep enough for the push to
+  // reach its cap (twice the sheet's weight), where it is linearised at the cap's depth, which
+  // depends on each point's mass, not on the clearance.
+  const double gap = kThickness + 0.0002;
   const meshing::TriMesh body =
       merged(table(), testing::make_box({0.005, gap, 0.005}, {0.025, gap + 0.02, 0.025}));
   const SheetSetup s = horizontal_sheet(8, 0.3, {0.0, kThickness, 0.0});
@@ -332,9 +335,10 @@ TEST(ContactHysteresis, BodyVertexSpringsInAPinchKeepAThirdOfTheGap) {
     EXPECT_LT(y.cwiseAbs().maxCoeff(), 1e-12);  // no vertex moved: the cloth is flat
     // The lid's four bottom corners, each over one or two of the sheet's triangles.
     ASSERT_GE(extra.springs.size(), 4u);
-    // Each corner is h = thickness − gap through the cloth, at depth c + h in its clearance c;
-    // the push's tangent there has F / F' = its own, whatever the share (which scales both),
-    // and that ratio tells the clearances apart (1.10 mm at c = 0.9 mm, 1.63 mm at 1.5 mm). At
+    // Each corner is h = thickness − gap through the cloth (−0.2 mm: in front of it), at depth
+    // c + h in its clearance c; the push's tangent there has F / F' = its own, whatever the share
+    // (which scales both), and that ratio tells the clearances apart (0.75 mm at c = 1.07 mm,
+    // 1.13 mm at 1.5 mm). At
     // 1/60 s steps the push stops stiffening at a gap of ω h / 10 = 2/3 of its clearance
     // (sim/contact_response.cpp, kPushStepStiffness).
     const double h = kThickness - gap;
@@ -547,16 +551,15 @@ TEST(ContactHysteresis, BodyVertexPushStiffensTowardsTheVertex) {
         << d;
 }
 
-}  // namespace
-}  // namespace sd::sim
-
 // A squeeze the cloth cannot get out of: a cone's tip, pointing down, lowered onto cloth lying
 // on a table until it is 1 mm above the table (a third of the contact thickness), then held.
 // Under the tip the table's contacts hold the cloth up and the tip's push presses it down, and
 // no place between them is clear of both. The push must stay bounded there (a finite force
 // and stiffness, docs/collision.md "A bound for the push in a squeeze"): the drape does not fail,
 // no vertex is thrown about, and the cloth comes to rest on the table with the tip through it.
-// MEASURED_PINCH.
+// Measured with the push bounded by what the step resolves: at rest at 0.55 s, 33 steps, the tip
+// 2.0 mm through, the cloth still (held by friction on the table). Not yet run against the
+// unbounded law, so it may not tell the two apart (docs/collision.md).
 TEST(ContactHysteresis, ClothSqueezedBetweenATipAndATableStaysBounded) {
   meshing::TriMesh tip = testing::make_cone(0.05, 0.1, 16, Vector3d(0.013, 0.0, 0.007));
   tip.vertices.col(1) = -tip.vertices.col(1);  // apex down at y = -0.1
@@ -596,3 +599,6 @@ TEST(ContactHysteresis, ClothSqueezedBetweenATipAndATableStaysBounded) {
   EXPECT_LT(fastest, 0.5);
   EXPECT_TRUE(report.at_rest);
 }
+
+}  // namespace
+}  // namespace sd::sim
