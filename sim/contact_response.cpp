@@ -70,18 +70,23 @@ constexpr int kHeldSpringGrain = 16;
 // pressed on the hips left 5 body vertices 1.7 mm through the A-line skirt; 400 and
 // 1,000 rad/s left none, and 400 the least motion at the end.
 constexpr double kSpringFrequency = 400.0;  // rad/s
-// A body-vertex push stiffens no further than K = kPushStepStiffness times m/β² (m its point's
-// effective mass, β the step's position factor, h for backward Euler): a spring of stiffness k
-// on the point resolves k β²/(m + k β²) of its linearised residual in one implicit step, 99 %
-// at K = 100, so a stiffer push makes no step firmer; what it does make is a larger force
-// wherever the point cannot move (cloth squeezed between two body parts: its contact with one
-// part holds it while the other part's push rises on), and that force went sideways into the
-// corners (the flat arms-lowering t-shirt failed at 4.43 s with 98 m/s in the armpit, the
-// strapless dress blew up in the seat's cleft at 11.79 s). Measured (docs/collision.md): K = 100
-// rests both. At 1/60 s steps the push then stops stiffening at a gap of 2c/3 (stiffness 2.25
-// k₀); any load up to about 2 k₀ c (some 50 times the point's weight) is still held in front of
-// the body vertex.
-constexpr double kPushStepStiffness = 100.0;
+// A body-vertex push stiffens no further than K times m/β² (m its point's effective mass, β the
+// step's position factor, h for backward Euler): a spring of stiffness k on the point resolves
+// k β²/(m + k β²) of its linearised residual in one implicit step, 99 % at K = 100, 99.9 % at
+// K = 1,000, so a stiffer push makes no step firmer; what it does make is a larger force
+// wherever the point cannot move. Two bounds (docs/collision.md, "The bound only in a
+// squeeze"). In a squeeze (another body part faces the body vertex across the cloth,
+// SpringSource::squeezed) the cloth's contact with that part holds it while this part's push
+// rises on, and the force went sideways into the corners (the flat arms-lowering t-shirt failed
+// at 4.43 s with 98 m/s in the armpit, the strapless dress blew up in the seat's cleft at
+// 11.79 s): K = 100 rests both; the push then stops stiffening at a gap of 2c/3 at 1/60 s steps
+// (stiffness 2.25 k₀). Elsewhere a load rests on the body vertex (a collar on the neck, the
+// lowered sleeve on the shoulder) and K = 100 let it through (2 body vertices through the
+// collar top, 1 through the shaped arms-lowering t-shirt); unbounded (the floor at c/100, 10⁴
+// k₀) the fine t-shirt and the flat arms-lowering t-shirt never rested. K = 1,000 (the floor at
+// 0.21 c, 22.5 k₀) passes all four.
+constexpr double kSqueezedPushStepStiffness = 100.0;
+constexpr double kOpenPushStepStiffness = 1000.0;
 // The floor stays inside the clearance for steps longer than 1/44 s (ω β / √K above 0.9).
 constexpr double kMaxPushFloorFraction = 0.9;
 // The force of one body vertex's push is capped at this many times the whole cloth's weight: a
@@ -373,19 +378,21 @@ double ContactResponse::contact_thickness(const BodyContact& contact,
   return std::clamp(*gap / 3.0, settings_.pinch_floor * thickness, thickness);
 }
 
-double ContactResponse::spring_clearance(const BodyPiercing& p, const Eigen::VectorXd& x) const {
+ContactResponse::PushRoom ContactResponse::push_room(const BodyPiercing& p,
+                                                     const Eigen::VectorXd& x) const {
   const double clearance = kPiercingClearance * settings_.thickness;
-  if (!settings_.pinch_budget) return clearance;
   // The body vertex, from the triangle's point under it and its height along the normal.
   const std::array<int, 3>& t = cloth_.triangles[p.cloth_triangle];
   Eigen::Vector3d vertex = p.height * p.normal;
   for (int k = 0; k < 3; ++k) vertex += p.barycentric[k] * x.segment<3>(3 * t[k]);
+  const std::optional<double> gap = pinch_gap(vertex, p.normal, p.normal);
+  if (!gap) return {clearance, false};
+  if (!settings_.pinch_budget) return {clearance, true};
   // The same budget as the contacts: a third of the gap to a facing body part across the
   // cloth, so that the springs of the two sides do not ask for the same cloth twice.
-  const std::optional<double> gap = pinch_gap(vertex, p.normal, p.normal);
-  if (!gap) return clearance;
-  return std::clamp(*gap / 3.0, std::min(settings_.pinch_floor * settings_.thickness, clearance),
-                    clearance);
+  return {std::clamp(*gap / 3.0, std::min(settings_.pinch_floor * settings_.thickness, clearance),
+                     clearance),
+          true};
 }
 
 int ContactResponse::add_contact(const BodyContact& contact, double thickness,
@@ -542,7 +549,8 @@ double ContactResponse::point_mass(const BodyPiercing& p) const {
 }
 
 SpringSource ContactResponse::spring_source(const BodyPiercing& p, const Eigen::VectorXd& x,
-                                            double clearance) const {
+                                            const PushRoom& room) const {
+  const double clearance = room.clearance;
   SpringSource source;
   source.body_vertex = p.body_vertex;
   source.triangle = p.cloth_triangle;
@@ -551,6 +559,7 @@ SpringSource ContactResponse::spring_source(const BodyPiercing& p, const Eigen::
   source.body_velocity = p.body_velocity;
   source.clearance = clearance;
   source.mass = point_mass(p);
+  source.squeezed = room.squeezed;
   // The body vertex is p.height above the point along the normal: the push vanishes where the
   // point is the clearance in front of it.
   PointSpring probe;
@@ -577,9 +586,11 @@ PointSpring ContactResponse::linearised_push(const SpringSource& source, double 
   // linearises again nearer; at the cap's depth the force is the cap.
   const double base = source.mass * kSpringFrequency * kSpringFrequency;
   // The push stops stiffening where its stiffness reaches what the step can resolve,
-  // kPushStepStiffness·m/β² (docs/collision.md, "A bound for the push in a squeeze"): the law's
+  // K·m/β² (kSqueezedPushStepStiffness in a squeeze, else kOpenPushStepStiffness): the law's
   // stiffness k₀ c²/g² reaches it at the gap g = c ω β / √K.
-  const double floor_fraction = std::clamp(kSpringFrequency * beta_ / std::sqrt(kPushStepStiffness),
+  const double step_stiffness =
+      source.squeezed ? kSqueezedPushStepStiffness : kOpenPushStepStiffness;
+  const double floor_fraction = std::clamp(kSpringFrequency * beta_ / std::sqrt(step_stiffness),
                                            kPushFloorFraction, kMaxPushFloorFraction);
   const double d = source.mass > 0.0
                        ? std::clamp(depth, 0.0,
@@ -669,11 +680,11 @@ void ContactResponse::spring_start_piercings(const Eigen::VectorXd& start,
       const auto [with_body, coasting] =
           end_heights(p, cloth_.triangles[p.cloth_triangle], v0, beta);
       // Inside a pinch (pinch_budget) the clearance is the vertex's share of the gap.
-      const double own = spring_clearance(p, start);
-      const double expected = own + std::max({p.height, with_body, coasting});
+      const PushRoom room = push_room(p, start);
+      const double expected = room.clearance + std::max({p.height, with_body, coasting});
       if (!(expected > 0.0)) continue;
-      sources.push_back(spring_source(p, start, own));
-      depths.push_back(own + p.height);
+      sources.push_back(spring_source(p, start, room));
+      depths.push_back(room.clearance + p.height);
       weights.push_back(expected);
     }
     push_body_vertex(sources, depths, weights, extra);
@@ -730,9 +741,9 @@ int ContactResponse::spring_end_piercings(const Eigen::VectorXd& x1, StepForces&
         return s.triangle == p.cloth_triangle;
       });
       if (same != sources.end()) continue;  // its depth at x1 is known
-      const double own = spring_clearance(p, x1);
-      sources.push_back(spring_source(p, x1, own));
-      depths.push_back(own + p.height);
+      const PushRoom room = push_room(p, x1);
+      sources.push_back(spring_source(p, x1, room));
+      depths.push_back(room.clearance + p.height);
     }
     push_body_vertex(sources, depths, depths, extra);
   }

@@ -119,8 +119,9 @@ struct BodyVertexPush {
 inline constexpr double kPushFloorFraction = 0.01;
 // `floor_fraction` (in (0, 1)) moves the floor to that fraction of the clearance: the push then
 // stops stiffening at k₀ / floor_fraction². The simulator's floor is where the stiffness reaches
-// what one implicit step can resolve (100 m/β², docs/collision.md "A bound for the push in a
-// squeeze"): 2c/3 at 1/60 s steps.
+// what one implicit step can resolve, K m/β² (docs/collision.md "The bound only in a squeeze"):
+// K = 100 where another body part faces the vertex across the cloth (2c/3 at 1/60 s steps),
+// K = 1,000 elsewhere (0.21 c).
 BodyVertexPush body_vertex_push(double depth, double clearance, double base_stiffness,
                                 double floor_fraction = kPushFloorFraction);
 // The depth at which body_vertex_push reaches `force` (N; its inverse; 0 for no force).
@@ -139,6 +140,10 @@ struct SpringSource {
   double goal = 0.0;       // m along the normal: the push vanishes where n·p reaches it
   double clearance = 0.0;  // m
   double mass = 0.0;       // kg, the point's effective mass (0: its corners pinned)
+  // Another body part faces the vertex across the cloth (ContactResponse::pinch_gap): the
+  // push's stiffness is bounded by what one step resolves (docs/collision.md, "The bound only
+  // in a squeeze").
+  bool squeezed = false;
 };
 
 // One constrained contact of a step: the body contact and what the solve was asked for.
@@ -266,10 +271,15 @@ class ContactResponse {
   // pinch_budget a third of the gap to a body part facing it across a pinch. x: the cloth's
   // positions (3n), for the cloth's normal at the vertex (inside a gap or bridging its opening).
   double contact_thickness(const BodyContact& contact, const Eigen::VectorXd& x) const;
-  // m: the clearance a body-vertex spring keeps between its body vertex and the cloth: half
-  // the thickness, or with pinch_budget at most a third of the gap to a body part facing the
-  // vertex across the cloth. x: the cloth's positions the piercing was found at.
-  double spring_clearance(const BodyPiercing& p, const Eigen::VectorXd& x) const;
+  // The room a body-vertex push has: the clearance it keeps between its body vertex and the
+  // cloth (m; half the thickness, or with pinch_budget at most a third of the gap to a body part
+  // facing the vertex across the cloth), and whether such a part faces it (a squeeze, where
+  // the push's stiffness is bounded). x: the cloth's positions the piercing was found at.
+  struct PushRoom {
+    double clearance = 0.0;  // m
+    bool squeezed = false;
+  };
+  PushRoom push_room(const BodyPiercing& p, const Eigen::VectorXd& x) const;
   // m: with pinch_budget, the gap from `point` on the body along its outward `normal` to a body
   // surface facing it within kPinchGapThicknesses thicknesses, when that surface lies across the
   // cloth (the gap runs along `cloth_normal`, any length and sign); none when nothing faces it
@@ -291,9 +301,9 @@ class ContactResponse {
   // Normal forces (N) of the last solve's contacts from its constraint impulse (3n, N·s), per
   // cloth vertex into last_normal_force_.
   void record_normal_forces(const Eigen::VectorXd& impulse);
-  // The piercing's push source at positions x (the body at its end pose), with its clearance.
+  // The piercing's push source at positions x (the body at its end pose), with its room.
   SpringSource spring_source(const BodyPiercing& p, const Eigen::VectorXd& x,
-                             double clearance) const;
+                             const PushRoom& room) const;
   // The push of `source` linearised at `depth` (m inside its clearance; ≤ 0: at its start),
   // times `share`.
   PointSpring linearised_push(const SpringSource& source, double depth, double share) const;
