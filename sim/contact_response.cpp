@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <limits>
 #include <tuple>
@@ -568,12 +567,6 @@ SpringSource ContactResponse::spring_source(const BodyPiercing& p, const Eigen::
   probe.normal = p.normal;
   source.goal =
       along_spring_normal(probe, cloth_.triangles[p.cloth_triangle], x) + p.height + clearance;
-  if (std::getenv("SD_SPRING_LOG")) {  // PROBE
-    Eigen::Vector3d at = p.height * p.normal;
-    for (int k = 0; k < 3; ++k)
-      at += p.barycentric[k] * x.segment<3>(3 * cloth_.triangles[p.cloth_triangle][k]);
-    std::fprintf(stderr, "BV %d %.4f %.4f %.4f\n", p.body_vertex, at.x(), at.y(), at.z());
-  }
   return source;
 }
 
@@ -595,9 +588,8 @@ PointSpring ContactResponse::linearised_push(const SpringSource& source, double 
   // The push stops stiffening where its stiffness reaches what the step can resolve,
   // K·m/β² (kSqueezedPushStepStiffness in a squeeze, else kOpenPushStepStiffness): the law's
   // stiffness k₀ c²/g² reaches it at the gap g = c ω β / √K.
-  static const double squeezed_k = std::getenv("SD_PUSH_K_SQUEEZED") ? std::atof(std::getenv("SD_PUSH_K_SQUEEZED")) : kSqueezedPushStepStiffness;  // PROBE
-  static const double open_k = std::getenv("SD_PUSH_K_OPEN") ? std::atof(std::getenv("SD_PUSH_K_OPEN")) : kOpenPushStepStiffness;  // PROBE
-  const double step_stiffness = source.squeezed ? squeezed_k : open_k;
+  const double step_stiffness =
+      source.squeezed ? kSqueezedPushStepStiffness : kOpenPushStepStiffness;
   const double floor_fraction = std::clamp(kSpringFrequency * beta_ / std::sqrt(step_stiffness),
                                            kPushFloorFraction, kMaxPushFloorFraction);
   const double d = source.mass > 0.0
@@ -634,17 +626,6 @@ void ContactResponse::push_body_vertex(const std::vector<SpringSource>& sources,
     if (!(share > 0.0)) continue;
     spring_sources_.push_back(sources[k]);
     extra.springs.push_back(linearised_push(sources[k], depths[k], share));
-    if (const char* watch = std::getenv("SD_SPRING_LOG")) {  // PROBE
-      const int v = std::atoi(watch);
-      const std::array<int, 3>& c = cloth_.triangles[sources[k].triangle];
-      if (v < 0 || c[0] == v || c[1] == v || c[2] == v) {
-        const PointSpring& sp = extra.springs.back();
-        std::fprintf(stderr, "SPRING bv %d tri %d (%d %d %d) depth %.3e clr %.3e sq %d share %.2f F %.4f k %.1f m %.3e n %.3f %.3f %.3f\n",
-                     sources[k].body_vertex, sources[k].triangle, c[0], c[1], c[2], depths[k],
-                     sources[k].clearance, int(sources[k].squeezed), share, sp.preload, sp.stiffness,
-                     sources[k].mass, sources[k].normal.x(), sources[k].normal.y(), sources[k].normal.z());
-      }
-    }
   }
 }
 
@@ -711,64 +692,12 @@ void ContactResponse::spring_start_piercings(const Eigen::VectorXd& start,
   stats_.piercings_held = static_cast<int>(extra.springs.size());
 }
 
-BodyVertexPush ContactResponse::push_law(const SpringSource& source, double depth) const {
-  const double base = source.mass * kSpringFrequency * kSpringFrequency;
-  static const double squeezed_k = std::getenv("SD_PUSH_K_SQUEEZED") ? std::atof(std::getenv("SD_PUSH_K_SQUEEZED")) : kSqueezedPushStepStiffness;  // PROBE
-  static const double open_k = std::getenv("SD_PUSH_K_OPEN") ? std::atof(std::getenv("SD_PUSH_K_OPEN")) : kOpenPushStepStiffness;  // PROBE
-  const double step_stiffness = source.squeezed ? squeezed_k : open_k;
-  const double floor_fraction = std::clamp(kSpringFrequency * beta_ / std::sqrt(step_stiffness),
-                                           kPushFloorFraction, kMaxPushFloorFraction);
-  const double cap_depth =
-      body_vertex_push_depth(max_spring_preload(), source.clearance, base, floor_fraction);
-  return body_vertex_push(std::min(depth, cap_depth), source.clearance, base, floor_fraction);
-}
-
-std::vector<int> ContactResponse::pushes_off_their_law(const Eigen::VectorXd& x1,
-                                                       const StepForces& extra) const {
-  static const double tolerance = std::getenv("SD_PUSH_NEWTON") ? std::atof(std::getenv("SD_PUSH_NEWTON")) : -1.0;  // PROBE
-  std::vector<int> off;
-  if (!(tolerance > 0.0)) return off;
-  // Per body vertex: its pushes' end force as the solve had it (the linearisation) and as the
-  // law has it at the depths where the step ended.
-  std::vector<std::pair<int, std::pair<double, double>>> sums;
-  for (std::size_t s = 0; s < spring_sources_.size() && s < extra.springs.size(); ++s) {
-    const SpringSource& source = spring_sources_[s];
-    const PointSpring& spring = extra.springs[s];
-    if (!(source.mass > 0.0) || !(spring.stiffness > 0.0)) continue;
-    const double along = along_spring_normal(spring, cloth_.triangles[source.triangle], x1);
-    const double linear = spring.preload + spring.stiffness * (spring.target - along);
-    // The spring's share of its body vertex's push: its stiffness against the law's at its
-    // linearisation depth.
-    const double d0 = source.goal - spring.target;
-    const BodyVertexPush at0 = push_law(source, d0);
-    const double base = source.mass * kSpringFrequency * kSpringFrequency;
-    const double k0 = d0 > 0.0 ? at0.stiffness : base;
-    const double part = k0 > 0.0 ? spring.stiffness / k0 : 0.0;
-    const double law = part * push_law(source, source.goal - along).force;
-    sums.push_back({source.body_vertex, {linear, law}});
-  }
-  std::sort(sums.begin(), sums.end(),
-            [](const auto& a, const auto& b) { return a.first < b.first; });
-  for (std::size_t first = 0, last = 0; first < sums.size(); first = last) {
-    double linear = 0.0, law = 0.0;
-    for (last = first; last < sums.size() && sums[last].first == sums[first].first; ++last) {
-      linear += sums[last].second.first;
-      law += sums[last].second.second;
-    }
-    if (std::abs(linear - law) > tolerance * std::max(law, 1e-3))
-      off.push_back(sums[first].first);
-  }
-  return off;
-}
-
 int ContactResponse::spring_end_piercings(const Eigen::VectorXd& x1, StepForces& extra) {
   // A body vertex still through the cloth at x1: its pushes are linearised again where the step
   // ended (a Newton step on the push, which stiffens towards the vertex), with a push for every
   // triangle it is now through. Nothing of the force is kept for the next step.
   std::vector<int> vertices;
   for (const BodyPiercing& p : piercings_) vertices.push_back(p.body_vertex);
-  const std::vector<int> off = pushes_off_their_law(x1, extra);
-  vertices.insert(vertices.end(), off.begin(), off.end());
   std::sort(vertices.begin(), vertices.end());
   vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
   if (vertices.empty()) return 0;
@@ -816,7 +745,6 @@ int ContactResponse::spring_end_piercings(const Eigen::VectorXd& x1, StepForces&
       sources.push_back(spring_source(p, x1, room));
       depths.push_back(room.clearance + p.height);
     }
-    if (std::binary_search(off.begin(), off.end(), body_vertex)) ++changed;
     push_body_vertex(sources, depths, depths, extra);
   }
   return changed;
@@ -890,8 +818,7 @@ int ContactResponse::constrain_deep(const Eigen::VectorXd& x0, const Eigen::Vect
   // re-solve every step and never come to rest.
   piercings_ =
       repair ? std::vector<BodyPiercing>{} : find_piercings(x1, settings_.penetration_tolerance);
-  if (stats_.resolves >= settings_.max_resolves ||
-      (too_deep_.empty() && piercings_.empty() && pushes_off_their_law(x1, extra).empty()))
+  if ((too_deep_.empty() && piercings_.empty()) || stats_.resolves >= settings_.max_resolves)
     return 0;
   for (const BodyContact& c : too_deep_)
     add_contact(c, contact_thickness(c, x1), x_hat, beta, filter, y, false);

@@ -323,12 +323,6 @@ class ContactResponse {
   // End check: the pushes of a body vertex through the cloth at x1 are linearised again there,
   // with a push for each triangle it is through. Returns how many piercings were resolved.
   int spring_end_piercings(const Eigen::VectorXd& x1, StepForces& extra);
-  // The law's push (body_vertex_push with this step's bound and the cap) of `source` at `depth`.
-  BodyVertexPush push_law(const SpringSource& source, double depth) const;
-  // Body vertices (sorted) whose pushes' linearisation in `extra` ends the step at x1 with a
-  // force off the law's there by more than a tolerance: re-linearised at x1 and solved again
-  // (a Newton step on the push, within max_resolves).
-  std::vector<int> pushes_off_their_law(const Eigen::VectorXd& x1, const StepForces& extra) const;
   // The pairs that pushed in this attempt and their points at x (for the next step's search).
   void record_spring_pairs(const Eigen::VectorXd& x);
 

@@ -1,5 +1,3 @@
-#include <cstdio>
-#include <cstdlib>
 #include "src/app/pipeline/run_report.hpp"
 
 #include <Eigen/SVD>
@@ -173,14 +171,6 @@ std::vector<GroupStrain> group_strains(const sim::ClothModel& model,
     }
     const Eigen::Vector2d sigma = Eigen::JacobiSVD<Eigen::Matrix<double, 3, 2>>(f).singularValues();
     const double strain = std::max(sigma(0) - 1, 1 - sigma(1));
-    if (const char* dump = std::getenv("SD_STRAIN_DUMP")) {  // PROBE
-      static FILE* dump_file = std::fopen(dump, "w");
-      const Eigen::Vector3d c = (positions.row(e.vertices[0]) + positions.row(e.vertices[1]) +
-                                 positions.row(e.vertices[2])).transpose() / 3;
-      std::fprintf(dump_file, "%zu %d %d %d %.5f %.5f %.5f %.5f %.5f\n", t, e.vertices[0], e.vertices[1],
-                   e.vertices[2], c.x(), c.y(), c.z(), sigma(0), sigma(1));
-      std::fflush(dump_file);
-    }
     const size_t g = t < static_cast<size_t>(triangle_group.size())
                          ? static_cast<size_t>(triangle_group(static_cast<Eigen::Index>(t)))
                          : 0;
