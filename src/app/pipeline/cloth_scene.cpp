@@ -1,4 +1,3 @@
-#include <cstdlib>
 #include "src/app/pipeline/cloth_scene.hpp"
 
 #include <fmt/format.h>
@@ -580,7 +579,6 @@ sim::SimulationSettings simulation_settings(const scene::Sketch& sketch) {
   settings.contact.check_body_vertices = spec.check_body_vertices;
   // Garments fold onto themselves (a skirt's front and back, a sleeve); a sheet scene asks.
   settings.self_contact.enabled = spec.self_collision.value_or(!sketch.sheet.has_value());
-  if (const char* t = std::getenv("SD_SELF_THICKNESS")) settings.self_contact.thickness = std::atof(t);  // PROBE
   // A garment thrown about again after it settled (cloth caught in a cleft of the body) stops
   // before it blows up (docs/collision.md, "Cloth caught in a cleft"); a sheet scene's retries
   // are its own (the stress matrix's stiff sheets retry as they fall).
