@@ -1,4 +1,3 @@
-#include <cstdlib>
 #include "sim/self_contact.hpp"
 
 #include <Eigen/Dense>
@@ -291,7 +290,7 @@ void SelfContactResponse::add_springs(const Eigen::VectorXd& start, const Eigen:
     const bool separating =
         velocity != nullptr &&
         along_pair_normal(spring, *velocity) >
-            (std::getenv("SD_SEP_SHARE") ? std::atof(std::getenv("SD_SEP_SHARE")) : kSeparatingShare) * kPushPerStep * (settings_.thickness - pair.distance) / beta;
+            kSeparatingShare * kPushPerStep * (settings_.thickness - pair.distance) / beta;
     if (separating) {
       // No push, but a pair that pressed on the other layer in the last steps still rubs on it
       // (a layer resting under gravity alternates between steps with a spring and steps caught
