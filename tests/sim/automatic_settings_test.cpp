@@ -80,7 +80,7 @@ TEST(AutomaticSettings, SheetStepsFollowThePinsTheBodyAndTheMotion) {
   AutomaticChoice choice = choose_settings(scene);
   EXPECT_DOUBLE_EQ(choice.dt, kAutomaticSheetStep);
   EXPECT_DOUBLE_EQ(choice.step_error, kAutomaticSwingStepError);
-  EXPECT_NE(choice.reason.find("from 1/40 s up to 1/20 s by a local error of 2 mm"),
+  EXPECT_NE(choice.reason.find("from 1/40 s up to 1/20 s by a local error of 2.5 mm"),
             std::string::npos)
       << choice.reason;
   EXPECT_NE(choice.reason.find("free to swing"), std::string::npos) << choice.reason;
