@@ -61,6 +61,10 @@ struct SimulateSpec {
   // without it a preview shows the body through the cloth; off saves up to half a drape's
   // time (docs/collision.md).
   bool check_body_vertices = true;
+  // The body-vertex springs' carried push fades across their hold margin, so a spring is
+  // released at no load (ContactSettings::fade_carried_push, docs/collision.md). Unset: on when
+  // any panel rests flat, off for shaped rest (docs/pattern.md, "Drapes that do not rest").
+  std::optional<bool> fade_carried_push;
   // A gathered panel starts folded into flutes as long as it is cut (docs/pattern.md, "Gathers
   // that start gathered"); false: as drawn, squeezed along the gather.
   bool gather_start = true;

@@ -128,7 +128,7 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
   r.check_keys(j, path,
                {"duration", "adaptive", "time_step", "integrator", "solver", "bending",
                 "compression", "stop_at_rest", "gravity", "pin_above", "check_body_vertices",
-                "rest", "self_collision", "rest_ramp", "gather_start"});
+                "rest", "self_collision", "rest_ramp", "fade_carried_push", "gather_start"});
   if (j.contains("pin_above")) sim.pin_above = r.number(j["pin_above"], path + "/pin_above");
   if (j.contains("duration")) {
     sim.duration = r.positive(j["duration"], path + "/duration");
@@ -199,6 +199,8 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
     sim.check_body_vertices = r.boolean(j["check_body_vertices"], path + "/check_body_vertices");
   if (j.contains("gather_start"))
     sim.gather_start = r.boolean(j["gather_start"], path + "/gather_start");
+  if (j.contains("fade_carried_push"))
+    sim.fade_carried_push = r.boolean(j["fade_carried_push"], path + "/fade_carried_push");
   if (j.contains("rest")) {
     sim.rest = r.text(j["rest"], path + "/rest");
     if (sim.rest != "flat" && sim.rest != "shaped")

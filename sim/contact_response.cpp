@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <limits>
 #include <tuple>
 #include <utility>
@@ -56,42 +55,36 @@ constexpr double kMinPiercingReach = 0.01;  // m
 // outside by its own contact, and a tip sliding out beside it (measured on the cone test:
 // 3.3 mm, then 8.6 mm the next step) has that vertex as its closest point, outside the body.
 constexpr double kPiercingUncheckedFraction = 0.5;
-// A renumbered cloth (adaptive detail) follows each pair that pushed last step to the new
-// triangles within this many thicknesses of its point.
+// A body vertex with a spring last step keeps it while the triangle's point over the vertex would
+// end the step within the clearance plus this many thicknesses in front of it (the same
+// hysteresis as kHoldMargin for contacts: without it a triangle resting on a tip at the
+// clearance drops out as soon as it ends a hair farther, falls back and is pushed again).
 constexpr double kPiercingHoldMargin = 0.25;
 // Held springs per chunk when a renumbered cloth's triangles are searched for them (each tests
 // every triangle's box: about 5 µs on a 4,000-triangle garment).
 constexpr int kHeldSpringGrain = 16;
-// A body-vertex push's base stiffness is that of its point's effective mass m (1/Σ w_k²/m_k over
-// the free corners) oscillating at this angular frequency: k₀ = m ω² (body_vertex_push). It is
-// the push's stiffness where the point enters the clearance, and grows towards the body vertex.
-// Resolution independent, and at any step size a physical oscillator rather than a jump.
-// Measured on the examples (docs/collision.md): at 120 rad/s springs too soft for a waistband
-// pressed on the hips left 5 body vertices 1.7 mm through the A-line skirt; 400 and
-// 1,000 rad/s left none, and 400 the least motion at the end.
+// With ContactSettings::spring_band a held spring is kept while its point is within this many
+// thicknesses past the clearance in front of the body vertex (a real separation; otherwise
+// kPiercingHoldMargin, a 0.75 mm band narrower than the cycles it met: on the flat capelet's
+// neckline a spring pushed its point out past it, was dropped, the cloth fell back through and
+// was caught again every 9 steps, 39 <-> 40 springs, a 5 mm cycle), and until its force turns
+// adhesive. Off by default: measured, it fails two smooth-body tests (docs/collision.md).
+constexpr double kPiercingReleaseBand = 1.0;
+// A spring's stiffness and damping are those of its point's effective
+// mass m (1/Σ w_k²/m_k over the free corners) oscillating at this angular frequency, critically
+// damped: k = m ω², c = 2 m ω. Resolution independent, and at any step size a physical
+// oscillator rather than a jump: a 1 cm gap closes at most at about ω·1 cm/e = 1.5 m/s, however
+// small step control makes the step (a constraint's correction Δx became Δx/h). Measured on the
+// examples (docs/collision.md): at 120 rad/s springs too soft for a waistband pressed on the
+// hips left 5 body vertices 1.7 mm through the A-line skirt; 400 and 1,000 rad/s left none, and
+// 400 the least motion at the end.
 constexpr double kSpringFrequency = 400.0;  // rad/s
-// A body-vertex push stiffens no further than K times m/β² (m its point's effective mass, β the
-// step's position factor, h for backward Euler): a spring of stiffness k on the point resolves
-// k β²/(m + k β²) of its linearised residual in one implicit step, 99 % at K = 100, 99.9 % at
-// K = 1,000, so a stiffer push makes no step firmer; what it does make is a larger force
-// wherever the point cannot move. Two bounds (docs/collision.md, "The bound only in a
-// squeeze"). In a squeeze (another body part faces the body vertex across the cloth,
-// SpringSource::squeezed) the cloth's contact with that part holds it while this part's push
-// rises on, and the force went sideways into the corners (the flat arms-lowering t-shirt failed
-// at 4.43 s with 98 m/s in the armpit, the strapless dress blew up in the seat's cleft at
-// 11.79 s): K = 100 rests both; the push then stops stiffening at a gap of 2c/3 at 1/60 s steps
-// (stiffness 2.25 k₀). Elsewhere a load rests on the body vertex (a collar on the neck, the
-// lowered sleeve on the shoulder) and K = 100 let it through (2 body vertices through the
-// collar top, 1 through the shaped arms-lowering t-shirt); unbounded (the floor at c/100, 10⁴
-// k₀) the fine t-shirt and the flat arms-lowering t-shirt never rested. K = 1,000 (the floor at
-// 0.21 c, 22.5 k₀) passes all four.
-constexpr double kSqueezedPushStepStiffness = 100.0;
-constexpr double kOpenPushStepStiffness = 1000.0;
-// The floor stays inside the clearance for steps longer than 1/44 s (ω β / √K above 0.9).
-constexpr double kMaxPushFloorFraction = 0.9;
-// The force of one body vertex's push is capped at this many times the whole cloth's weight: a
-// tip can hold up a hanging sheet (or a waistband pressed on a hip), but a squeeze that no
-// motion of the cloth can clear (two body parts closing on it) cannot ask for an unbounded push.
+// The force a spring carries to the next step (and raises in a re-solve) is capped at this many
+// times the whole cloth's weight: a tip can hold up a hanging sheet (or a waistband pressed on a
+// hip), but a squeeze that no motion of the cloth can clear (two body parts closing on it)
+// cannot build up an unbounded push. Measured: a cap of 100 times the point's own weight
+// (resolution dependent: a point of a finer mesh weighs less) left a body vertex 1.03 mm
+// through the t-shirt adapted to level 2.
 constexpr double kMaxSpringLoadClothWeights = 2.0;
 // ContactSettings::pinch_budget: a body surface facing a contact's (normals more than
 // kPinchFacingCos apart) closer than this many thicknesses along the contact's normal makes a
@@ -233,8 +226,12 @@ void ContactResponse::reset_cloth(const Eigen::VectorXd& x, const Eigen::VectorX
   too_deep_.clear();
   end_contacts_.clear();
   accepted_contacts_.clear();
-  // The pairs that pushed were the old cloth's triangles.
-  spring_sources_.clear();
+  // A body vertex's spring force is its load and carries over to a new cloth; the pairs it was
+  // held by were the old cloth's triangles.
+  if (last_piercing_force_.size() != static_cast<std::size_t>(collider_.vertex_count()))
+    last_piercing_force_.assign(static_cast<std::size_t>(collider_.vertex_count()), kNoImpulse);
+  spring_body_vertex_.clear();
+  spring_past_clearance_.clear();
   spring_ends_.clear();
   // A renumbered cloth (adaptive detail's splits and merges): the held pairs named the old
   // triangles. Each follows its point on the cloth to the new triangles that hold it (a split's
@@ -378,21 +375,19 @@ double ContactResponse::contact_thickness(const BodyContact& contact,
   return std::clamp(*gap / 3.0, settings_.pinch_floor * thickness, thickness);
 }
 
-ContactResponse::PushRoom ContactResponse::push_room(const BodyPiercing& p,
-                                                     const Eigen::VectorXd& x) const {
+double ContactResponse::spring_clearance(const BodyPiercing& p, const Eigen::VectorXd& x) const {
   const double clearance = kPiercingClearance * settings_.thickness;
+  if (!settings_.pinch_budget) return clearance;
   // The body vertex, from the triangle's point under it and its height along the normal.
   const std::array<int, 3>& t = cloth_.triangles[p.cloth_triangle];
   Eigen::Vector3d vertex = p.height * p.normal;
   for (int k = 0; k < 3; ++k) vertex += p.barycentric[k] * x.segment<3>(3 * t[k]);
-  const std::optional<double> gap = pinch_gap(vertex, p.normal, p.normal);
-  if (!gap) return {clearance, false};
-  if (!settings_.pinch_budget) return {clearance, true};
   // The same budget as the contacts: a third of the gap to a facing body part across the
   // cloth, so that the springs of the two sides do not ask for the same cloth twice.
-  return {std::clamp(*gap / 3.0, std::min(settings_.pinch_floor * settings_.thickness, clearance),
-                     clearance),
-          true};
+  const std::optional<double> gap = pinch_gap(vertex, p.normal, p.normal);
+  if (!gap) return clearance;
+  return std::clamp(*gap / 3.0, std::min(settings_.pinch_floor * settings_.thickness, clearance),
+                    clearance);
 }
 
 int ContactResponse::add_contact(const BodyContact& contact, double thickness,
@@ -513,135 +508,68 @@ void ContactResponse::constrain_start(const Eigen::VectorXd& x_hat, const Eigen:
   spring_start_piercings(x_hat + y, v0, beta, filter, extra);
 }
 
-BodyVertexPush body_vertex_push(double depth, double clearance, double base_stiffness,
-                                double floor_fraction) {
-  if (!(depth > 0.0) || !(clearance > 0.0) || !(base_stiffness > 0.0)) return {};
-  // gap: how far the point still is in front of the body vertex; below the floor the push goes
-  // on along its tangent there.
-  const double floor = floor_fraction * clearance;
-  const double gap = clearance - depth;
-  const double at = std::max(gap, floor);
-  const double ratio = clearance / at;
-  BodyVertexPush push;
-  push.stiffness = base_stiffness * ratio * ratio;
-  push.force = base_stiffness * ratio * (clearance - at) + push.stiffness * (at - gap);
-  return push;
-}
-
-double body_vertex_push_depth(double force, double clearance, double base_stiffness,
-                              double floor_fraction) {
-  if (!(force > 0.0)) return 0.0;
-  const double floor = floor_fraction * clearance;
-  const BodyVertexPush at_floor =
-      body_vertex_push(clearance - floor, clearance, base_stiffness, floor_fraction);
-  if (force <= at_floor.force)  // F = k₀ c d / (c − d)
-    return force * clearance / (base_stiffness * clearance + force);
-  return clearance - floor + (force - at_floor.force) / at_floor.stiffness;
-}
-
 double ContactResponse::point_mass(const BodyPiercing& p) const {
   const std::array<int, 3>& t = cloth_.triangles[p.cloth_triangle];
+  double mass = 0.0;
+  for (int k = 0; k < 3; ++k) mass += p.barycentric[k] * mass_[t[k]];
+  return mass;
+}
+
+PointSpring ContactResponse::piercing_spring(const BodyPiercing& p, const Eigen::VectorXd& x,
+                                             const std::vector<unsigned char>& pinned,
+                                             double preload, double clearance) const {
+  const std::array<int, 3>& t = cloth_.triangles[p.cloth_triangle];
+  PointSpring spring;
+  spring.triangle = p.cloth_triangle;
+  spring.weights = p.barycentric;
+  spring.normal = p.normal;
   double inverse_mass = 0.0;
   for (int k = 0; k < 3; ++k)
-    if (pinned_.empty() || pinned_[t[k]] == 0)
+    if (pinned.empty() || pinned[t[k]] == 0)
       inverse_mass += p.barycentric[k] * p.barycentric[k] / mass_[t[k]];
-  return inverse_mass > 0.0 ? 1.0 / inverse_mass : 0.0;
-}
-
-SpringSource ContactResponse::spring_source(const BodyPiercing& p, const Eigen::VectorXd& x,
-                                            const PushRoom& room) const {
-  const double clearance = room.clearance;
-  SpringSource source;
-  source.body_vertex = p.body_vertex;
-  source.triangle = p.cloth_triangle;
-  source.weights = p.barycentric;
-  source.normal = p.normal;
-  source.body_velocity = p.body_velocity;
-  source.clearance = clearance;
-  source.mass = point_mass(p);
-  source.squeezed = room.squeezed;
-  // The body vertex is p.height above the point along the normal: the push vanishes where the
-  // point is the clearance in front of it.
-  PointSpring probe;
-  probe.weights = p.barycentric;
-  probe.normal = p.normal;
-  source.goal =
-      along_spring_normal(probe, cloth_.triangles[p.cloth_triangle], x) + p.height + clearance;
-  return source;
-}
-
-PointSpring ContactResponse::linearised_push(const SpringSource& source, double depth,
-                                             double share) const {
-  PointSpring spring;
-  spring.triangle = source.triangle;
-  spring.weights = source.weights;
-  spring.normal = source.normal;
-  spring.reference_velocity = source.body_velocity;
-  // Tangent of the push at depth d ≥ 0 (d = goal − n·p): F ≈ F(d) + F'(d) (target − n·p) with
-  // target = goal − d. At d = 0 (a point still outside the clearance, expected to enter it this
-  // step) that is k₀ (goal − n·p): the push's own slope where it starts.
-  // A point deeper than where the push reaches its cap (max_spring_preload) is linearised at
-  // that depth instead: the push's tangent there lies below it (the push is convex), so the
-  // solve pushes the point out no farther than the push itself would, and the next step
-  // linearises again nearer; at the cap's depth the force is the cap.
-  const double base = source.mass * kSpringFrequency * kSpringFrequency;
-  // The push stops stiffening where its stiffness reaches what the step can resolve,
-  // K·m/β² (kSqueezedPushStepStiffness in a squeeze, else kOpenPushStepStiffness): the law's
-  // stiffness k₀ c²/g² reaches it at the gap g = c ω β / √K.
-  const double step_stiffness =
-      source.squeezed ? kSqueezedPushStepStiffness : kOpenPushStepStiffness;
-  const double floor_fraction = std::clamp(kSpringFrequency * beta_ / std::sqrt(step_stiffness),
-                                           kPushFloorFraction, kMaxPushFloorFraction);
-  const double d = source.mass > 0.0
-                       ? std::clamp(depth, 0.0,
-                                    body_vertex_push_depth(max_spring_preload(), source.clearance,
-                                                           base, floor_fraction))
-                       : std::max(depth, 0.0);
-  spring.target = source.goal - d;
-  if (!(source.mass > 0.0) || !(share > 0.0)) return spring;  // corners pinned: nothing moves
-  const BodyVertexPush push = body_vertex_push(d, source.clearance, base, floor_fraction);
-  const double stiffness = d > 0.0 ? push.stiffness : base;
-  spring.preload = share * push.force;
-  spring.stiffness = share * stiffness;
-  // Critically damped at the tangent's stiffness.
-  spring.damping = share * 2.0 * std::sqrt(stiffness * source.mass);
+  // The body vertex is the height above the point; the point must end the clearance in front of
+  // it.
+  // With the band a point already farther than that keeps its distance: the spring
+  // starts the step pushing (its preload) or not at all, never pulling the cloth back onto the
+  // vertex (which, released at the band's edge, fell back through and was caught again).
+  const double push = p.height + clearance;
+  spring.target = settings_.spring_band ? along_spring_normal(spring, t, x) + std::max(push, 0.0)
+                                        : along_spring_normal(spring, t, x) + p.height + clearance;
+  spring.reference_velocity = p.body_velocity;
+  if (!(inverse_mass > 0.0)) return spring;  // all corners pinned: nothing can move
+  const double mass = 1.0 / inverse_mass;
+  spring.stiffness = mass * kSpringFrequency * kSpringFrequency;
+  spring.damping = 2.0 * mass * kSpringFrequency;
+  spring.preload = std::min(preload, max_spring_preload());
   return spring;
+}
+
+double ContactResponse::target_past_clearance(const BodyPiercing& p, double clearance) const {
+  return settings_.spring_band ? std::max(-(p.height + clearance), 0.0) : 0.0;
 }
 
 double ContactResponse::max_spring_preload() const {
   return kMaxSpringLoadClothWeights * gravity_ * mass_.sum();
 }
 
-void ContactResponse::push_body_vertex(const std::vector<SpringSource>& sources,
-                                       const std::vector<double>& depths,
-                                       const std::vector<double>& weights, StepForces& extra) {
-  // One body vertex's pushes on several triangles (under a cloth edge, or the cloth sliding
-  // over it) share its push by their weights (how deep each point is, or is expected to end, in
-  // the clearance): together they push as one triangle would, and a triangle entering or
-  // leaving the clearance (weight 0) changes nothing at once.
-  double total = 0.0;
-  for (double w : weights) total += std::max(w, 0.0);
-  for (std::size_t k = 0; k < sources.size(); ++k) {
-    const double share = total > 0.0 ? std::max(weights[k], 0.0) / total : 0.0;
-    if (!(share > 0.0)) continue;
-    spring_sources_.push_back(sources[k]);
-    extra.springs.push_back(linearised_push(sources[k], depths[k], share));
-  }
-}
-
 void ContactResponse::spring_start_piercings(const Eigen::VectorXd& start,
                                              const Eigen::VectorXd& v0, double beta,
                                              const ConstraintFilter& filter, StepForces& extra) {
-  spring_sources_.clear();
+  spring_body_vertex_.clear();
+  spring_past_clearance_.clear();
   if (!settings_.check_body_vertices || cloth_.triangles.empty() || repairing()) return;
   const int n = static_cast<int>(start.size() / 3);
+  const double clearance = kPiercingClearance * settings_.thickness;
+  const double margin =
+      (settings_.spring_band ? kPiercingReleaseBand : kPiercingHoldMargin) * settings_.thickness;
+  const double hold = clearance + margin;
   pinned_.assign(static_cast<std::size_t>(n), 0);
   for (int i = 0; i < n; ++i) pinned_[i] = filter.is_pinned(i);
   // Every triangle near a body vertex, not only the highest: a vertex under a cloth edge is
   // under both triangles, and a spring on one let the other end the step through it (measured:
   // a re-solve in 106 of the t-shirt's 120 steps).
   std::vector<BodyPiercing> candidates = find_piercings(start, -piercing_reach(), true);
-  // The pairs that pushed last step, whether or not the search reports them now (in front
+  // The pairs that had springs last step, whether or not the search reports them now (in front
   // of the cloth, find_piercings keeps only a vertex over a triangle's face; one in front of a
   // cloth edge that the last step pushed back came through again every step, measured: a
   // re-solve in 114 of the t-shirt's 120 steps).
@@ -662,101 +590,110 @@ void ContactResponse::spring_start_piercings(const Eigen::VectorXd& start,
             start, cloth_.triangles[static_cast<std::size_t>(triangle)], triangle, body_vertex))
       candidates.insert(found, *p);
   }
-  // A push only where the point is within its clearance of the body vertex (or through) at the
-  // start, or is expected to end the step there (moving with the body vertex, or coasting):
-  // linearised at its depth (0 for one still outside). Elsewhere the push is zero, so a pair
-  // that leaves or enters the clearance changes the force by nothing: no hold band is needed.
-  std::vector<SpringSource> sources;
-  std::vector<double> depths, weights;
-  for (std::size_t first = 0, last = 0; first < candidates.size(); first = last) {
-    while (last < candidates.size() &&
-           candidates[last].body_vertex == candidates[first].body_vertex)
-      ++last;
-    sources.clear();
-    depths.clear();
-    weights.clear();
+  std::vector<BodyPiercing> springs;
+  std::vector<double> clearances;  // per spring, m
+  for (const BodyPiercing& p : candidates) {
+    const auto [with_body, coasting] = end_heights(p, cloth_.triangles[p.cloth_triangle], v0, beta);
+    const double carried = last_piercing_force_[p.body_vertex];
+    bool held = !std::isnan(carried);
+    // With the band, released by the sign of its force, as a contact is: it ended pulling the
+    // point onto the vertex by more than kReleaseFraction of the point's weight. It is caught
+    // again only within the clearance.
+    if (held && settings_.spring_band && carried < -kReleaseFraction * gravity_ * point_mass(p))
+      held = false;
+    // A spring only where it would push: the point ends within the clearance of the body vertex
+    // (or through), or the vertex had a spring last step and the cloth has not left its reach
+    // (the same hysteresis as contacts: dropping a spring as soon as it ended a hair beyond the
+    // clearance let the cloth fall back through the next step, and a sheet on a sphere
+    // re-solved every step).
+    if (held ? with_body <= -hold : std::max(with_body, coasting) <= -clearance) continue;
+    // Inside a pinch (pinch_budget) the clearance is the vertex's share of the gap, held like
+    // a pinched contact up to (1 + kHoldMargin) times it: the two sides' bands stay apart.
+    const double own = spring_clearance(p, start);
+    if (own < clearance &&
+        (held ? with_body <= -(1.0 + kHoldMargin) * own : std::max(with_body, coasting) <= -own))
+      continue;
+    springs.push_back(p);
+    clearances.push_back(own);
+  }
+  // The load a body vertex carried last step is shared by its springs (sorted by body vertex),
+  // and so are the stiffness and damping: a vertex under a cloth edge pushes no harder than one
+  // under a face (with full springs on both triangles the pair overshot past the hold distance,
+  // was dropped and fell back, and the sheet on the sphere never settled).
+  for (std::size_t first = 0, last = 0; first < springs.size(); first = last) {
+    while (last < springs.size() && springs[last].body_vertex == springs[first].body_vertex) ++last;
+    const double force = last_piercing_force_[springs[first].body_vertex];
+    const double share = std::isnan(force) ? 0.0 : std::max(force, 0.0) / (last - first);
     for (std::size_t k = first; k < last; ++k) {
-      const BodyPiercing& p = candidates[k];
-      const auto [with_body, coasting] =
-          end_heights(p, cloth_.triangles[p.cloth_triangle], v0, beta);
-      // Inside a pinch (pinch_budget) the clearance is the vertex's share of the gap.
-      const PushRoom room = push_room(p, start);
-      const double expected = room.clearance + std::max({p.height, with_body, coasting});
-      if (!(expected > 0.0)) continue;
-      sources.push_back(spring_source(p, start, room));
-      depths.push_back(room.clearance + p.height);
-      weights.push_back(expected);
+      spring_body_vertex_.push_back(springs[k].body_vertex);
+      spring_past_clearance_.push_back(target_past_clearance(springs[k], clearances[k]));
+      PointSpring spring = piercing_spring(springs[k], start, pinned_, share, clearances[k]);
+      spring.stiffness /= static_cast<double>(last - first);
+      spring.damping /= static_cast<double>(last - first);
+      extra.springs.push_back(spring);
     }
-    push_body_vertex(sources, depths, weights, extra);
   }
   stats_.piercings_held = static_cast<int>(extra.springs.size());
 }
 
 int ContactResponse::spring_end_piercings(const Eigen::VectorXd& x1, StepForces& extra) {
-  // A body vertex still through the cloth at x1: its pushes are linearised again where the step
-  // ended (a Newton step on the push, which stiffens towards the vertex), with a push for every
-  // triangle it is now through. Nothing of the force is kept for the next step.
-  std::vector<int> vertices;
-  for (const BodyPiercing& p : piercings_) vertices.push_back(p.body_vertex);
-  std::sort(vertices.begin(), vertices.end());
-  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
-  if (vertices.empty()) return 0;
-  const auto resolved = [&](int body_vertex) {
-    return std::binary_search(vertices.begin(), vertices.end(), body_vertex);
-  };
-  // The other vertices' springs stay as they are.
-  std::vector<SpringSource> kept_sources;
-  std::vector<PointSpring> kept_springs;
-  std::vector<SpringSource> old_sources;
-  for (std::size_t s = 0; s < spring_sources_.size(); ++s) {
-    if (resolved(spring_sources_[s].body_vertex)) {
-      old_sources.push_back(spring_sources_[s]);
-      continue;
-    }
-    kept_sources.push_back(spring_sources_[s]);
-    kept_springs.push_back(extra.springs[s]);
-  }
-  spring_sources_ = std::move(kept_sources);
-  extra.springs = std::move(kept_springs);
   int changed = 0;
-  std::vector<SpringSource> sources;
-  std::vector<double> depths;
-  for (int body_vertex : vertices) {
-    sources.clear();
-    depths.clear();
-    for (const SpringSource& old : old_sources) {
-      if (old.body_vertex != body_vertex) continue;
-      PointSpring probe;
-      probe.weights = old.weights;
-      probe.normal = old.normal;
-      const double depth =
-          old.goal - along_spring_normal(probe, cloth_.triangles[old.triangle], x1);
-      sources.push_back(old);
-      depths.push_back(depth);
+  const std::size_t springs = extra.springs.size();
+  for (const BodyPiercing& p : piercings_) {
+    // The body vertex's springs: the load they end with at x1, and the one on p's triangle.
+    double carried = 0.0;
+    std::size_t match = springs;
+    for (std::size_t s = 0; s < springs; ++s) {
+      if (spring_body_vertex_[s] != p.body_vertex) continue;
+      const PointSpring& spring = extra.springs[s];
+      const double along = along_spring_normal(spring, cloth_.triangles[spring.triangle], x1);
+      carried += std::max(0.0, spring.preload + spring.stiffness * (spring.target - along));
+      if (spring.triangle == p.cloth_triangle) match = s;
     }
-    for (const BodyPiercing& p : piercings_) {
-      if (p.body_vertex != body_vertex) continue;
-      ++changed;
-      const auto same = std::find_if(sources.begin(), sources.end(), [&](const SpringSource& s) {
-        return s.triangle == p.cloth_triangle;
-      });
-      if (same != sources.end()) continue;  // its depth at x1 is known
-      const PushRoom room = push_room(p, x1);
-      sources.push_back(spring_source(p, x1, room));
-      depths.push_back(room.clearance + p.height);
+    if (match < springs) {
+      // Still through its spring's triangle: carry what the vertex's springs ended pushing with
+      // as this one's preload (an augmented-Lagrangian update), so the next solve pushes harder
+      // where the spring alone is too soft.
+      PointSpring& spring = extra.springs[match];
+      const double preload = std::min(carried, max_spring_preload());
+      if (preload <= spring.preload) continue;
+      spring.preload = preload;
+    } else {
+      // New, or through another triangle (the cloth slid over the vertex): a spring for that
+      // triangle, carrying the load. The old springs stay (their triangles may still rest on
+      // the vertex).
+      const double own = spring_clearance(p, x1);
+      spring_body_vertex_.push_back(p.body_vertex);
+      spring_past_clearance_.push_back(target_past_clearance(p, own));
+      extra.springs.push_back(piercing_spring(p, x1, pinned_, carried, own));
     }
-    push_body_vertex(sources, depths, depths, extra);
+    ++changed;
   }
   return changed;
 }
 
-void ContactResponse::record_spring_pairs(const Eigen::VectorXd& x) {
+void ContactResponse::record_spring_forces(const Eigen::VectorXd& x, const StepForces& extra) {
   spring_ends_.clear();
-  for (const SpringSource& source : spring_sources_) {
-    const std::array<int, 3>& c = cloth_.triangles[source.triangle];
+  const double margin =
+      (settings_.spring_band ? kPiercingReleaseBand : kPiercingHoldMargin) * settings_.thickness;
+  for (std::size_t s = 0; s < spring_body_vertex_.size(); ++s) {
+    const PointSpring& spring = extra.springs[s];
+    const double along = along_spring_normal(spring, cloth_.triangles[spring.triangle], x);
+    double force = spring.preload + spring.stiffness * (spring.target - along);
+    // With fade_carried_push the push carried past the clearance fades to nothing across the
+    // hold margin, so a spring whose point leaves the hold is released at no load
+    // (docs/collision.md, "The hem's cycle, traced"). Carried in full, the push that built up
+    // while the cloth was caught is still there when it is dropped (15 mN of the hand's 45 at
+    // the t-shirt's hem): it pushed the cloth out, the cloth fell back free, was caught and
+    // pushed again, and every such cycle put energy in.
+    const double past = along - (spring.target - spring_past_clearance_[s]);
+    if (settings_.fade_carried_push && force > 0.0 && past > 0.0)
+      force *= std::max(0.0, 1.0 - past / margin);
+    const std::array<int, 3>& c = cloth_.triangles[spring.triangle];
     Eigen::Vector3d point = Eigen::Vector3d::Zero();
-    for (int k = 0; k < 3; ++k) point += source.weights[k] * x.segment<3>(3 * c[k]);
-    spring_ends_.push_back({source.body_vertex, source.triangle, point});
+    for (int k = 0; k < 3; ++k) point += spring.weights[k] * x.segment<3>(3 * c[k]);
+    spring_ends_.push_back(
+        {spring_body_vertex_[s], spring.triangle, std::min(force, max_spring_preload()), point});
   }
 }
 
@@ -829,7 +766,7 @@ int ContactResponse::constrain_deep(const Eigen::VectorXd& x0, const Eigen::Vect
   return added;
 }
 
-void ContactResponse::finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v) {
+void ContactResponse::finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v, const StepForces& extra) {
   Stopwatch watch(stats_.collision_seconds);
   // Last resort for what the re-solves did not fix: onto the surface, with the body's normal
   // velocity (the approaching part of the relative velocity removed).
@@ -856,8 +793,8 @@ void ContactResponse::finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v) {
     spdlog::debug("sim: {} cloth vertices projected out of the body after {} re-solves",
                   stats_.projected, stats_.resolves);
   // Body vertices still through the cloth after the re-solves stay so until the next step's
-  // pushes (from their depth then) push them out: nothing is lifted.
-  record_spring_pairs(x);
+  // springs (carrying the force they ended with) push them out: nothing is lifted.
+  record_spring_forces(x, extra);
   for (const BodyPiercing& p : piercings_) {
     stats_.max_piercing = std::max(stats_.max_piercing, p.height);
     if (p.height > settings_.penetration_tolerance) ++stats_.piercing;
@@ -882,6 +819,7 @@ void ContactResponse::finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v) {
 
 void ContactResponse::record_normal_forces(const Eigen::VectorXd& impulse) {
   std::fill(last_normal_force_.begin(), last_normal_force_.end(), kNoImpulse);
+  std::fill(last_piercing_force_.begin(), last_piercing_force_.end(), kNoImpulse);
   if (impulse.size() != static_cast<Eigen::Index>(3 * last_normal_force_.size())) return;
   for (const ActiveContact& a : active_) {
     if (a.released || a.repair) continue;
@@ -893,6 +831,18 @@ void ContactResponse::record_normal_forces(const Eigen::VectorXd& impulse) {
 void ContactResponse::accept_step(const Eigen::VectorXd& impulse) {
   record_normal_forces(impulse);
   held_springs_ = spring_ends_;
+  // A body vertex with several springs (under a cloth edge, or the cloth slid over it) carries
+  // the sum of their pushes (or, when none pushed, the least pull: it stays held).
+  for (const SpringEnd& end : held_springs_) {
+    const double force = end.force;
+    double& carried = last_piercing_force_[end.body_vertex];
+    if (std::isnan(carried))
+      carried = force;
+    else if (carried > 0.0 || force > 0.0)
+      carried = std::max(carried, 0.0) + std::max(force, 0.0);
+    else
+      carried = std::max(carried, force);
+  }
   accepted_contacts_ = active_;
   if (repairing()) {
     ++repair_step_;

@@ -26,18 +26,15 @@
 //
 // With `check_body_vertices`, body vertices are also kept behind the cloth triangles (sharp
 // features: a cloth triangle can span a cone tip or a shoulder with its three corners
-// outside). A body vertex through a triangle, or within `kPiercingClearance`·thickness in front
-// of it (or about to be at the step's end), pushes the triangle's point over it outwards along
-// the triangle's normal: a push whose force is a function of the point's depth in that
-// clearance alone (body_vertex_push: as soft as before where the point enters the clearance,
-// stiffening towards the body vertex up to what the step can resolve), damped, and linearised in
-// the implicit solve as a spring on the point's corners (PointSpring); the end check's re-solves
-// linearise it again where the step ended. Nothing of it is carried to the next step, so no cycle
-// of catching and releasing can put energy into the drape, and it is never a jump in position.
-// (Until 28 November each spring's end force was carried to the next step as a preload, raised
-// by stiffness × the gap left: an integrator that kept drapes rocking, docs/collision.md; before
-// 26 November the corners' normal velocities were constraints of the filter, which failed where
-// body parts close on the cloth.)
+// outside). A body vertex through a triangle, or about to end the step closer than
+// `kPiercingClearance`·thickness in front of it, pushes the triangle's point over it out to that
+// clearance along the triangle's normal. The push is a critically damped spring of the implicit
+// solve on the point's corners (PointSpring), on every triangle near the vertex, whose end force
+// is carried to the next step and raised by the end check's re-solves: soft, so two body parts
+// squeezing the cloth between them cannot ask for opposite motions of one corner, and never a
+// jump in position. (Until 26 November the corners' normal velocities were constraints of the
+// filter and what the re-solves left was lifted as a position change; that response failed
+// where body parts close on the cloth, docs/collision.md.)
 //
 // The simulator (sim/simulation.hpp) drives this; it is separate so that the contact logic
 // reads in one place and can be tested on its own.
@@ -76,6 +73,21 @@ struct ContactSettings {
   // elbows, corners). See docs/collision.md, "Body vertices poking through the cloth", for
   // what it does and costs.
   bool check_body_vertices = false;
+  // Body-vertex springs with a band between catching and releasing (docs/collision.md,
+  // "Catching and releasing body-vertex springs"): a spring never starts a step pulling its
+  // point back onto the body vertex (a point farther than the clearance keeps its distance), a
+  // held spring is released when its force turned adhesive (more than a tenth of its point's
+  // weight, as contacts are) or its point is a thickness past the clearance, and caught again
+  // only within the clearance. Off by default (measured: the flat capelet rests with it, but a
+  // sheet hung on a cone tip is let 1.09 mm through and a sheet on a sphere rests later).
+  bool spring_band = false;
+  // The push a body-vertex spring carries to the next step fades linearly to nothing across the
+  // hold margin past its clearance, so a spring whose point leaves the hold is released at no
+  // load instead of still pushing (docs/collision.md, "The hem's cycle, traced": the pump of
+  // the flat arms-lowering t-shirt's hem). Off by default (measured: the flat t-shirt, the flat
+  // sleeveless dress and the two quadratic-bending skirts rest with it, sooner, but the hooded
+  // top's neckline cycles until 8.6 s, at rest at 3.3 s without it).
+  bool fade_carried_push = false;
   // Where a second body part faces the contact's surface closer than 2.5 thicknesses along
   // its normal, across the cloth (the armpit as the arm comes down, between the thighs), each
   // side's contact keeps a third of the gap (at least `pinch_floor` thicknesses) instead of the
@@ -103,49 +115,6 @@ class InvalidContactSettingsError : public std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
-// The push of a body vertex on the cloth point over it (N, along the cloth's normal) and its
-// stiffness dF/dd (N/m), for the point `depth` d inside the clearance c in front of the vertex
-// (d = c − gap; d ≤ 0: outside, no push): with k₀ the point's base stiffness,
-//     F = k₀ c d / (c − d),   F' = k₀ c² / (c − d)²,
-// k₀ d where the point enters the clearance, stiffening as the point nears the vertex, so a
-// load F is held at a gap of about k₀ c² / F in front of it. Below a gap of
-// kPushFloorFraction·c (where it pushes 99 k₀ c) it goes on along its tangent there, stiffness
-// 10⁴ k₀: 199 k₀ c with the point on the vertex, finite when the point is through. A function
-// of the geometry alone: the same depth, the same push.
-struct BodyVertexPush {
-  double force = 0.0;      // N
-  double stiffness = 0.0;  // N/m
-};
-inline constexpr double kPushFloorFraction = 0.01;
-// `floor_fraction` (in (0, 1)) moves the floor to that fraction of the clearance: the push then
-// stops stiffening at k₀ / floor_fraction². The simulator's floor is where the stiffness reaches
-// what one implicit step can resolve, K m/β² (docs/collision.md "The bound only in a squeeze"):
-// K = 100 where another body part faces the vertex across the cloth (2c/3 at 1/60 s steps),
-// K = 1,000 elsewhere (0.21 c).
-BodyVertexPush body_vertex_push(double depth, double clearance, double base_stiffness,
-                                double floor_fraction = kPushFloorFraction);
-// The depth at which body_vertex_push reaches `force` (N; its inverse; 0 for no force).
-double body_vertex_push_depth(double force, double clearance, double base_stiffness,
-                              double floor_fraction = kPushFloorFraction);
-
-// One body vertex's push on one cloth triangle in a step: where it comes from and where it
-// vanishes (the solve's PointSpring is its linearisation).
-struct SpringSource {
-  int body_vertex = -1;
-  int triangle = -1;
-  Eigen::Vector3d weights = Eigen::Vector3d::Zero();  // the point's barycentric weights
-  Eigen::Vector3d normal =
-      Eigen::Vector3d::UnitY();  // the triangle's, towards the vertex's outside
-  Eigen::Vector3d body_velocity = Eigen::Vector3d::Zero();  // m/s, the body vertex's
-  double goal = 0.0;       // m along the normal: the push vanishes where n·p reaches it
-  double clearance = 0.0;  // m
-  double mass = 0.0;       // kg, the point's effective mass (0: its corners pinned)
-  // Another body part faces the vertex across the cloth (ContactResponse::pinch_gap): the
-  // push's stiffness is bounded by what one step resolves (docs/collision.md, "The bound only
-  // in a squeeze").
-  bool squeezed = false;
-};
-
 // One constrained contact of a step: the body contact and what the solve was asked for.
 struct ActiveContact {
   BodyContact contact;
@@ -166,10 +135,10 @@ struct ContactStepStats {
   int stuck = 0;                 // contacts in the stick regime (or stopped by friction)
   int repairing = 0;             // vertices still being pushed out of an intersecting start
   double max_penetration = 0.0;  // m, deepest vertex inside the body at the end (repair excluded)
-  // Body vertices poking through cloth triangles (sharp features): pushes in the solve,
+  // Body vertices poking through cloth triangles (sharp features): springs in the solve,
   // re-solved like deep vertices. Measured at the end of the step.
-  int piercings_held = 0;      // pushes (springs) at the start of the step
-  int piercings_resolved = 0;  // pushes linearised again by the end check
+  int piercings_held = 0;      // springs at the start of the step
+  int piercings_resolved = 0;  // springs added or raised by the end check
   int piercing = 0;            // body vertices more than the tolerance through the cloth at the end
   double max_piercing = 0.0;   // m, highest body vertex above the cloth at the end (0: none)
   int penetrating = 0;         // vertices deeper than the tolerance at the end (repair excluded)
@@ -235,10 +204,10 @@ class ContactResponse {
                      Eigen::VectorXd& y, StepForces& extra);
 
   // After the last solve: projects the vertices the last end check found too deep onto
-  // point + thickness·normal with the body's normal velocity, remembers which pairs pushed (so
-  // that the next step looks at them even in front of a cloth edge), and measures the
-  // penetration and piercing.
-  void finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v);
+  // point + thickness·normal with the body's normal velocity, remembers the springs' end
+  // forces (`extra`: the step's forces) for the next step, and measures the penetration and
+  // piercing.
+  void finish_step(Eigen::VectorXd& x, Eigen::VectorXd& v, const StepForces& extra);
 
   ContactStepStats& step_stats() { return stats_; }
   const ContactStepStats& step_stats() const { return stats_; }
@@ -271,15 +240,10 @@ class ContactResponse {
   // pinch_budget a third of the gap to a body part facing it across a pinch. x: the cloth's
   // positions (3n), for the cloth's normal at the vertex (inside a gap or bridging its opening).
   double contact_thickness(const BodyContact& contact, const Eigen::VectorXd& x) const;
-  // The room a body-vertex push has: the clearance it keeps between its body vertex and the
-  // cloth (m; half the thickness, or with pinch_budget at most a third of the gap to a body part
-  // facing the vertex across the cloth), and whether such a part faces it (a squeeze, where
-  // the push's stiffness is bounded). x: the cloth's positions the piercing was found at.
-  struct PushRoom {
-    double clearance = 0.0;  // m
-    bool squeezed = false;
-  };
-  PushRoom push_room(const BodyPiercing& p, const Eigen::VectorXd& x) const;
+  // m: the clearance a body-vertex spring keeps between its body vertex and the cloth: half
+  // the thickness, or with pinch_budget at most a third of the gap to a body part facing the
+  // vertex across the cloth. x: the cloth's positions the piercing was found at.
+  double spring_clearance(const BodyPiercing& p, const Eigen::VectorXd& x) const;
   // m: with pinch_budget, the gap from `point` on the body along its outward `normal` to a body
   // surface facing it within kPinchGapThicknesses thicknesses, when that surface lies across the
   // cloth (the gap runs along `cloth_normal`, any length and sign); none when nothing faces it
@@ -301,30 +265,29 @@ class ContactResponse {
   // Normal forces (N) of the last solve's contacts from its constraint impulse (3n, N·s), per
   // cloth vertex into last_normal_force_.
   void record_normal_forces(const Eigen::VectorXd& impulse);
-  // The piercing's push source at positions x (the body at its end pose), with its room.
-  SpringSource spring_source(const BodyPiercing& p, const Eigen::VectorXd& x,
-                             const PushRoom& room) const;
-  // The push of `source` linearised at `depth` (m inside its clearance; ≤ 0: at its start),
-  // times `share`.
-  PointSpring linearised_push(const SpringSource& source, double depth, double share) const;
-  // One body vertex's pushes into `extra` (and spring_sources_): linearised at `depths`, its
-  // push shared by `weights`.
-  void push_body_vertex(const std::vector<SpringSource>& sources, const std::vector<double>& depths,
-                        const std::vector<double>& weights, StepForces& extra);
-  // The largest push of one body vertex (N): kMaxSpringLoadClothWeights times the cloth's weight.
+  // The spring that pushes piercing p's triangle to the clearance in
+  // front of its body vertex, from positions x (the body at its end pose), with `preload`.
+  PointSpring piercing_spring(const BodyPiercing& p, const Eigen::VectorXd& x,
+                              const std::vector<unsigned char>& pinned, double preload,
+                              double clearance) const;
+  // The largest preload a spring carries (N): kMaxSpringLoadClothWeights times the cloth's
+  // weight.
   double max_spring_preload() const;
-  // kg: the effective mass of a piercing's point (1/Σ w_k²/m_k over its free corners; 0 when
-  // all are pinned).
+  // m: how far past the clearance piercing_spring puts a spring's target (with spring_band, a
+  // point already farther keeps its distance; 0 otherwise).
+  double target_past_clearance(const BodyPiercing& p, double clearance) const;
+  // kg: the cloth mass at a piercing's point (its triangle's corner masses by its weights).
   double point_mass(const BodyPiercing& p) const;
-  // Start of step: body vertices within their clearance of the cloth at `start` (x̂ + y), or
-  // about to be, get their pushes in `extra`.
+  // Start of step: body vertices through the cloth at `start` (x̂ + y), about to be, or held
+  // last step, become springs in `extra`.
   void spring_start_piercings(const Eigen::VectorXd& start, const Eigen::VectorXd& v0, double beta,
                               const ConstraintFilter& filter, StepForces& extra);
-  // End check: the pushes of a body vertex through the cloth at x1 are linearised again there,
-  // with a push for each triangle it is through. Returns how many piercings were resolved.
+  // End check: a piercing of x1 gets a spring, or its spring's preload rises by the springs'
+  // force at x1. Returns how many changed.
   int spring_end_piercings(const Eigen::VectorXd& x1, StepForces& extra);
-  // The pairs that pushed in this attempt and their points at x (for the next step's search).
-  void record_spring_pairs(const Eigen::VectorXd& x);
+  // The force (N; negative: it ended pulling) each spring of this attempt ends with at x, to
+  // carry to the next step.
+  void record_spring_forces(const Eigen::VectorXd& x, const StepForces& extra);
 
   ContactSettings settings_;
   BodyCollider collider_;
@@ -348,20 +311,27 @@ class ContactResponse {
   std::vector<BodyContact> end_contacts_;
   ClothTriangles cloth_;                 // the cloth's triangles (set_cloth_triangles)
   std::vector<BodyPiercing> piercings_;  // from the last end check, after the last solve
-  std::vector<unsigned char> pinned_;    // per cloth vertex, pinned in the step's filter
-  Eigen::VectorXd mass_;                 // per cloth vertex, kg
-  double gravity_ = 9.81;                // m/s²
-  // Per spring of the attempt's StepForces, its source.
-  std::vector<SpringSource> spring_sources_;
-  // A pair that pushed: its body vertex, triangle and the cloth point (m).
+  // Per body vertex: the force (N, along the triangles' normals; < 0: it ended pulling) its
+  // springs ended the last accepted step with, NaN when it had none.
+  std::vector<double> last_piercing_force_;
+  std::vector<unsigned char> pinned_;  // per cloth vertex, pinned in the step's filter
+  Eigen::VectorXd mass_;               // per cloth vertex, kg
+  double gravity_ = 9.81;              // m/s²
+  // Per spring of the attempt's StepForces, its body vertex.
+  std::vector<int> spring_body_vertex_;
+  // Per spring of the attempt's StepForces, m its target lies past the clearance in front of its
+  // body vertex (target_past_clearance).
+  std::vector<double> spring_past_clearance_;
+  // How a spring ended a step: its pair and the force (N; negative: it ended pulling).
   struct SpringEnd {
     int body_vertex = -1;
     int triangle = -1;
-    Eigen::Vector3d point = Eigen::Vector3d::Zero();
+    double force = 0.0;
+    Eigen::Vector3d point = Eigen::Vector3d::Zero();  // m: the spring's point on the cloth
   };
-  // This attempt's pushing pairs at its end (record_spring_pairs), and those of the last
-  // accepted step, whose pairs the next start follows even where find_piercings does not report
-  // them (a body vertex in front of a cloth edge).
+  // This attempt's springs at its end (record_spring_forces), and those of the last accepted
+  // step, whose pairs the next start follows even where find_piercings does not report them (a
+  // body vertex in front of a cloth edge).
   std::vector<SpringEnd> spring_ends_;
   std::vector<SpringEnd> held_springs_;
   ContactStepStats stats_;

@@ -454,7 +454,7 @@ Simulation::Attempt Simulation::attempt(double h) {
     contact->apply_friction(result.solve.constraint_impulse, model_.mass, x_hat + y, beta, result.v,
                             result.x);
     if (contact->constrain_deep(x_, result.x, x_hat, beta, filter_, y, contact_forces_) == 0) {
-      contact->finish_step(result.x, result.v);
+      contact->finish_step(result.x, result.v, contact_forces_);
       break;
     }
   }

@@ -273,6 +273,26 @@ TEST(ClothScene, PanelGatheredAlongASeamStartsGathered) {
   }
 }
 
+// Flat cloth's body-vertex springs are released at no load (ContactSettings::fade_carried_push)
+// unless the file says otherwise; shaped cloth's keep their push (docs/pattern.md, "Drapes that
+// do not rest").
+TEST(ClothScene, FlatRestFadesTheCarriedPushUnlessTheFileSaysOtherwise) {
+  const auto fade = [](const std::string& simulate) {
+    std::string text = two_patches(1.0);
+    if (!simulate.empty()) text.insert(text.rfind('}'), ", \"simulate\": " + simulate);
+    return simulation_settings(scene::parse_sketch(text, "fade.json")).contact.fade_carried_push;
+  };
+  EXPECT_FALSE(fade(""));
+  EXPECT_TRUE(fade(R"({ "rest": "flat" })"));
+  EXPECT_FALSE(fade(R"({ "rest": "flat", "fade_carried_push": false })"));
+  EXPECT_TRUE(fade(R"({ "fade_carried_push": true })"));
+  // One flat panel is enough: its springs are the garment's.
+  std::string one_flat = two_patches(1.0);
+  one_flat.replace(one_flat.find(R"("id": "right",)"), 14, R"("id": "right", "rest": "flat",)");
+  EXPECT_TRUE(
+      simulation_settings(scene::parse_sketch(one_flat, "one.json")).contact.fade_carried_push);
+}
+
 // A sheet with "layers": copies stacked by layer_offset and turned by layer_turn about the
 // vertical through the centre, one group each; self-collision is off for sheets unless asked and
 // on for garments.

@@ -47,6 +47,7 @@ TEST(SketchFile, MinimalFileGetsDefaults) {
   EXPECT_TRUE(s.simulate.time_step_auto);
   EXPECT_FALSE(s.simulate.pin_above.has_value());
   EXPECT_TRUE(s.simulate.check_body_vertices);
+  EXPECT_FALSE(s.simulate.fade_carried_push.has_value());  // unset: the rest shape's default
   EXPECT_FALSE(s.body.motion.has_value());
   EXPECT_EQ(s.output.mesh, "garment.obj");
   EXPECT_TRUE(s.output.images.empty());
@@ -142,7 +143,7 @@ TEST(SketchFile, ReadsEverySection) {
     "join": [ { "id": "pq", "panels": ["p", "q"] } ],
     "simulate": { "duration": 2, "adaptive": false, "time_step": 0.01, "integrator": "implicit-euler",
                   "solver": "cholmod", "stop_at_rest": false, "gravity": [0, -9.8, 0],
-                  "check_body_vertices": false },
+                  "check_body_vertices": false, "fade_carried_push": true },
     "output": { "images": [ { "view": "back", "size": [640, 480], "wireframe": true },
                             { "view": "three-quarter" } ],
                 "mesh": "g.glb", "report": false, "wireframe": true }
@@ -176,7 +177,8 @@ TEST(SketchFile, ReadsEverySection) {
   EXPECT_FALSE(s.simulate.time_step_auto);  // the file's 0.01 s
   EXPECT_DOUBLE_EQ(s.simulate.time_step, 0.01);
   EXPECT_DOUBLE_EQ(s.simulate.gravity.y(), -9.8);
-  EXPECT_FALSE(s.simulate.check_body_vertices);  // the default is on
+  EXPECT_FALSE(s.simulate.check_body_vertices);                        // the default is on
+  EXPECT_EQ(s.simulate.fade_carried_push, std::optional<bool>(true));  // unset by default
   ASSERT_EQ(s.output.images.size(), 2u);
   EXPECT_EQ(s.output.images[0].view, "back");
   EXPECT_EQ(s.output.images[0].width, 640);

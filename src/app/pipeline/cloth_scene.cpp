@@ -602,6 +602,12 @@ sim::SimulationSettings simulation_settings(const scene::Sketch& sketch) {
   settings.stop_at_rest = spec.stop_at_rest;
   settings.forces.gravity = spec.gravity;
   settings.contact.check_body_vertices = spec.check_body_vertices;
+  // Flat cloth is held against the body's double curvature under tension (each piece is 5-10 %
+  // short over the shoulder blades, the seat, the neck's base), so its body-vertex springs carry
+  // a push, and dropped still pushing they pumped the cycles that kept flat drapes moving
+  // (docs/pattern.md, "Drapes that do not rest"): from flat cloth the push fades across the
+  // hold. Shaped cloth merely lies on the body; the fade kept the shaped hooded top hunting.
+  settings.contact.fade_carried_push = spec.fade_carried_push.value_or(flat);
   // Garments fold onto themselves (a skirt's front and back, a sleeve); a sheet scene asks.
   settings.self_contact.enabled = spec.self_collision.value_or(!sketch.sheet.has_value());
   // A garment thrown about again after it settled (cloth caught in a cleft of the body) stops
