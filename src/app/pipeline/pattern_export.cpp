@@ -423,7 +423,8 @@ std::string pattern_svg(const PatternSheet& sheet) {
     const LabelPlacement at =
         place_label(outline, {g0.x(), length - g0.y()}, {g1.x(), length - g1.y()}, text);
     svg += fmt::format("<g class=\"label\" transform=\"translate({:.1f} {:.1f}){}\"{}>\n",
-                       at.anchor.x(), at.anchor.y(), at.along ? " rotate(-90)" : "",
+                       at.anchor.x(), at.anchor.y(),
+                       at.turn_deg != 0 ? fmt::format(" rotate({:g})", -at.turn_deg) : "",
                        at.centred ? " text-anchor=\"middle\"" : "");
     svg +=
         fmt::format("<text x=\"0\" y=\"0\" font-size=\"{:.1f}\" font-weight=\"bold\">{}</text>\n",
