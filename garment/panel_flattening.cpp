@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -633,6 +634,55 @@ void add_balance_notches(FlatPanel& flat, const std::vector<int>& run,
   }
 }
 
+// A quad of a mirrored panel that reaches over the mirror plane x = 0 into its mirror copy:
+// two opposite corners on the plane, the other two on either side. garment_mesh.cpp makes one
+// where a doublet sits on the centre seam between a panel and its copy (two quads folded onto
+// each other there are merged into one, which keeps one panel's id): the garment is symmetric
+// but its panels are not, the seam stepping one vertex into the copy. Cut along the plane
+// diagonal, each half to the panel on its side, the panel and its copy are mirror images again
+// and sewn along the plane (trial 39: the shortalls' `front` was cut 1 and its copy "pair with",
+// their cutting lines 18 mm apart at the step).
+struct QuadSplit {
+  int quad = -1;
+  std::array<Eigen::Vector3i, 2> halves;  // corners of the quad, counter-clockwise as the quad
+  std::array<int, 2> panels{-1, -1};      // the panel of each half
+};
+
+std::vector<QuadSplit> quads_over_mirror_plane(const Garment& garment,
+                                               const std::vector<int>& partner) {
+  const meshing::QuadMesh& mesh = garment.mesh;
+  // The side of the plane each panel lies on: the sign of its quads' summed centroid x.
+  std::vector<double> side(garment.panels.size(), 0.0);
+  for (Eigen::Index q = 0; q < mesh.face_count(); ++q)
+    for (int k = 0; k < 4; ++k)
+      side[static_cast<size_t>(garment.face_panel(q))] += mesh.vertices(mesh.faces(q, k), 0);
+  // On the plane as centre_run has it (the mirror copies' curves are reflected bit for bit).
+  constexpr double kOnPlane = 1e-6;
+  std::vector<QuadSplit> out;
+  for (Eigen::Index q = 0; q < mesh.face_count(); ++q) {
+    const int p = garment.face_panel(q);
+    const int m = partner[static_cast<size_t>(p)];
+    if (m < 0 || side[static_cast<size_t>(p)] * side[static_cast<size_t>(m)] >= 0) continue;
+    const auto x = [&](int k) { return mesh.vertices(mesh.faces(q, k % 4), 0); };
+    for (int k = 0; k < 2; ++k) {
+      if (std::abs(x(k)) > kOnPlane || std::abs(x(k + 2)) > kOnPlane ||
+          std::abs(x(k + 1)) <= kOnPlane || std::abs(x(k + 3)) <= kOnPlane ||
+          (x(k + 1) > 0) == (x(k + 3) > 0))
+        continue;
+      const auto panel_on = [&](double at) {
+        return (at > 0) == (side[static_cast<size_t>(p)] > 0) ? p : m;
+      };
+      QuadSplit split;
+      split.quad = static_cast<int>(q);
+      split.halves = {Eigen::Vector3i(k, k + 1, k + 2), Eigen::Vector3i(k + 2, (k + 3) % 4, k)};
+      split.panels = {panel_on(x(k + 1)), panel_on(x(k + 3))};
+      out.push_back(split);
+      break;
+    }
+  }
+  return out;
+}
+
 // A mirror copy's piece as its original's reflected, when the copy's triangles are exactly the
 // original's reflected across x = 0 (build_garment reflects the original's fill, every
 // position's x negated bit for bit, and split_quad then picks the same diagonals): the
@@ -734,12 +784,36 @@ FlatPattern flatten_garment(const Garment& garment, const FlatteningOptions& opt
   FlatPattern pattern;
   const Eigen::Index nv = mesh.vertex_count();
 
-  // Which panel lies across each directed garment edge: the one traversing it backwards.
+  // Each panel's mirror partner ("front" and "front.mirror"), or −1.
+  std::vector<int> mirror_of(garment.panels.size(), -1);
+  for (size_t p = 0; p < garment.panels.size(); ++p)
+    for (size_t q = 0; q < garment.panels.size(); ++q)
+      if (garment.panels[q].id == garment.panels[p].id + ".mirror") {
+        mirror_of[p] = static_cast<int>(q);
+        mirror_of[q] = static_cast<int>(p);
+      }
+  const std::vector<QuadSplit> splits = quads_over_mirror_plane(garment, mirror_of);
+  std::unordered_map<int, const QuadSplit*> split_of;
+  for (const QuadSplit& split : splits) split_of[split.quad] = &split;
+
+  // Which panel lies across each directed garment edge: the one traversing it backwards (a quad
+  // split over the mirror plane: each half's panel, the plane diagonal between them).
   std::unordered_map<long long, int> edge_panel;
   const auto key = [&](int a, int b) { return static_cast<long long>(a) * nv + b; };
-  for (Eigen::Index q = 0; q < mesh.face_count(); ++q)
-    for (int k = 0; k < 4; ++k)
-      edge_panel[key(mesh.faces(q, k), mesh.faces(q, (k + 1) % 4))] = garment.face_panel(q);
+  for (Eigen::Index q = 0; q < mesh.face_count(); ++q) {
+    const auto split = split_of.find(static_cast<int>(q));
+    if (split == split_of.end()) {
+      for (int k = 0; k < 4; ++k)
+        edge_panel[key(mesh.faces(q, k), mesh.faces(q, (k + 1) % 4))] = garment.face_panel(q);
+      continue;
+    }
+    for (int h = 0; h < 2; ++h) {
+      const Eigen::Vector3i& tri = split->second->halves[static_cast<size_t>(h)];
+      for (int k = 0; k < 3; ++k)
+        edge_panel[key(mesh.faces(q, tri[k]), mesh.faces(q, tri[(k + 1) % 3]))] =
+            split->second->panels[static_cast<size_t>(h)];
+    }
+  }
   // The panel's centre line: its one run of outline edges on the mirror plane x = 0 sewn to its
   // own mirror copy ("front" and "front.mirror"), as local vertices in outline order; empty when
   // it has none, or several (then there is no one line to fold along).
@@ -784,9 +858,25 @@ FlatPattern flatten_garment(const Garment& garment, const FlatteningOptions& opt
     std::vector<Eigen::Vector3i> tris;
     std::vector<int> tri_quad;
     for (Eigen::Index q = 0; q < mesh.face_count(); ++q) {
-      if (garment.face_panel(q) != static_cast<int>(p)) continue;
-      Eigen::Vector4i corners;
+      // The quad's triangles that are this panel's, as corners of the quad.
+      std::vector<Eigen::Vector3i> mine;
+      if (const auto split = split_of.find(static_cast<int>(q)); split != split_of.end()) {
+        for (int h = 0; h < 2; ++h)
+          if (split->second->panels[static_cast<size_t>(h)] == static_cast<int>(p))
+            mine.push_back(split->second->halves[static_cast<size_t>(h)]);
+      } else if (garment.face_panel(q) == static_cast<int>(p)) {
+        Eigen::MatrixX3d positions(4, 3);
+        for (int k = 0; k < 4; ++k) positions.row(k) = mesh.vertices.row(mesh.faces(q, k));
+        const auto both = split_quad(positions, Eigen::Vector4i(0, 1, 2, 3));
+        mine.assign(both.begin(), both.end());
+      }
+      if (mine.empty()) continue;
+      Eigen::Vector4i corners = Eigen::Vector4i::Constant(-1);
       for (int k = 0; k < 4; ++k) {
+        if (std::none_of(mine.begin(), mine.end(), [&](const Eigen::Vector3i& tri) {
+              return tri[0] == k || tri[1] == k || tri[2] == k;
+            }))
+          continue;
         int& l = local[static_cast<size_t>(mesh.faces(q, k))];
         if (l < 0) {
           l = static_cast<int>(global.size());
@@ -794,9 +884,7 @@ FlatPattern flatten_garment(const Garment& garment, const FlatteningOptions& opt
         }
         corners[k] = l;
       }
-      Eigen::MatrixX3d positions(4, 3);
-      for (int k = 0; k < 4; ++k) positions.row(k) = mesh.vertices.row(mesh.faces(q, k));
-      for (const Eigen::Vector3i& tri : split_quad(positions, Eigen::Vector4i(0, 1, 2, 3))) {
+      for (const Eigen::Vector3i& tri : mine) {
         tris.emplace_back(corners[tri[0]], corners[tri[1]], corners[tri[2]]);
         tri_quad.push_back(static_cast<int>(q));
       }

@@ -33,8 +33,8 @@ Scene cloth_over_body_scene(const meshing::TriMesh& body, const meshing::TriMesh
   SceneMesh& c = scene.meshes.emplace_back();
   c.mesh = cloth;
   c.role = MeshRole::kCloth;
-  c.face_colours =
-      panel_colours(panel_ids.size() ? panel_ids : Eigen::VectorXi::Zero(cloth.face_count()));
+  c.face_colours = panel_colours(
+      panel_ids.size() ? panel_ids : Eigen::VectorXi::Zero(cloth.face_count()), cloth.faces);
   return scene;
 }
 

@@ -22,8 +22,8 @@ std::vector<Image> render_views(Renderer& renderer, const Scene& scene,
                                 const std::function<void(size_t)>& on_view_done = {});
 
 // A body (opaque, neutral colour) and cloth over it (two-sided, one colour per panel id from
-// panel_colours). `panel_ids` is #F of the cloth, or empty for a single panel. Add a
-// wireframe to scene.meshes[1] if wanted.
+// panel_colours, panels sewn together in different colours). `panel_ids` is #F of the cloth, or
+// empty for a single panel. Add a wireframe to scene.meshes[1] if wanted.
 Scene cloth_over_body_scene(const meshing::TriMesh& body, const meshing::TriMesh& cloth,
                             const Eigen::VectorXi& panel_ids = {});
 

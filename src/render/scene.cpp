@@ -86,6 +86,59 @@ Eigen::Vector3f colour_map(ColourMap map, double t) {
   return (1 - w) * to_vector(kViridis[i]) + w * to_vector(kViridis[i + 1]);
 }
 
+Eigen::Vector3f panel_palette_colour(int slot) {
+  if (slot < 0) throw std::invalid_argument(fmt::format("palette slot {} is negative", slot));
+  return to_vector(kPanelColours[static_cast<size_t>(slot) % kPanelColours.size()]);
+}
+
+std::vector<int> panel_palette_slots(const Eigen::VectorXi& panel_ids,
+                                     const Eigen::MatrixXi& faces) {
+  if (faces.rows() != panel_ids.size())
+    throw std::invalid_argument(
+        fmt::format("{} panel ids for {} faces", panel_ids.size(), faces.rows()));
+  if (panel_ids.size() == 0) return {};
+  if (panel_ids.minCoeff() < 0)
+    throw std::invalid_argument(fmt::format("panel id {} is negative", panel_ids.minCoeff()));
+  const size_t panels = static_cast<size_t>(panel_ids.maxCoeff()) + 1;
+  // Sewn neighbours: the panels on either side of each edge.
+  std::unordered_map<std::uint64_t, int> edge_panel;
+  std::vector<std::vector<int>> sewn(panels);
+  for (Eigen::Index f = 0; f < faces.rows(); ++f)
+    for (Eigen::Index k = 0; k < faces.cols(); ++k) {
+      const int a = faces(f, k), b = faces(f, (k + 1) % faces.cols());
+      const auto [it, added] = edge_panel.emplace(edge_key(a, b), panel_ids[f]);
+      if (!added && it->second != panel_ids[f]) {
+        sewn[static_cast<size_t>(it->second)].push_back(panel_ids[f]);
+        sewn[static_cast<size_t>(panel_ids[f])].push_back(it->second);
+      }
+    }
+  const size_t palette = kPanelColours.size();
+  std::vector<int> slot(panels, -1);
+  for (size_t p = 0; p < panels; ++p) {
+    std::vector<char> taken(palette, 0);
+    for (int q : sewn[p])
+      if (slot[static_cast<size_t>(q)] >= 0)
+        taken[static_cast<size_t>(slot[static_cast<size_t>(q)])] = 1;
+    slot[p] = static_cast<int>(p % palette);
+    for (size_t k = 0; k < palette; ++k) {
+      const size_t s = (p + k) % palette;
+      if (!taken[s]) {
+        slot[p] = static_cast<int>(s);
+        break;
+      }
+    }
+  }
+  return slot;
+}
+
+Eigen::MatrixX3f panel_colours(const Eigen::VectorXi& panel_ids, const Eigen::MatrixXi& faces) {
+  const std::vector<int> slot = panel_palette_slots(panel_ids, faces);
+  Eigen::MatrixX3f out(panel_ids.size(), 3);
+  for (Eigen::Index f = 0; f < panel_ids.size(); ++f)
+    out.row(f) = panel_palette_colour(slot[static_cast<size_t>(panel_ids[f])]).transpose();
+  return out;
+}
+
 Eigen::MatrixX3f panel_colours(const Eigen::VectorXi& panel_ids) {
   Eigen::MatrixX3f out(panel_ids.size(), 3);
   for (Eigen::Index f = 0; f < panel_ids.size(); ++f) {

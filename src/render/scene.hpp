@@ -66,6 +66,22 @@ struct Scene {
 // colours; the same id always gets the same colour. Returns #F by 3.
 Eigen::MatrixX3f panel_colours(const Eigen::VectorXi& panel_ids);
 
+// The palette's colour `slot` (taken modulo the palette's size, slot >= 0).
+Eigen::Vector3f panel_palette_colour(int slot);
+
+// A palette slot for each panel id 0 .. max(panel_ids) such that two panels sewn together (whose
+// faces share an edge of `faces`: #F by k >= 3 corners in order, rows in step with `panel_ids`)
+// differ while the palette lasts. Greedy, in id order: a panel takes its own slot (id modulo the
+// palette's size) when no sewn neighbour coloured before it has it, else the first free slot
+// after it. So a garment of up to 8 panels keeps the colours by id, and its 9th panel is not
+// given the colour of the 1st when they are sewn (trial 39: skirt_front had bodice_front's
+// colour, the waist seam was invisible). Deterministic; unsewn panels may share a colour.
+std::vector<int> panel_palette_slots(const Eigen::VectorXi& panel_ids,
+                                     const Eigen::MatrixXi& faces);
+
+// Per-face colours (#F by 3) by panel_palette_slots: sewn panels in different colours.
+Eigen::MatrixX3f panel_colours(const Eigen::VectorXi& panel_ids, const Eigen::MatrixXi& faces);
+
 // Every edge of the triangles once, as #E by 2 (smaller index first), sorted.
 Eigen::MatrixX2i triangle_edges(const meshing::TriMesh& mesh);
 

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
+#include <vector>
 
 namespace sd::app {
 namespace {
@@ -27,9 +29,12 @@ std::vector<Eigen::Vector2d> corners(const LabelPlacement& at, const LabelText& 
   const double y0 = -0.8 * at.size, y1 = at.size * (1 + 0.9 * double(text.lines.size() - 1));
   std::vector<Eigen::Vector2d> out;
   for (const double x : {x0, x1})
-    for (const double y : {y0, y1})
-      out.push_back(at.along ? Eigen::Vector2d(at.anchor.x() + y, at.anchor.y() - x)
-                             : Eigen::Vector2d(at.anchor.x() + x, at.anchor.y() + y));
+    for (const double y : {y0, y1}) {
+      // SVG's rotate(−turn) about the anchor.
+      const double a = at.turn_deg * std::numbers::pi / 180;
+      out.emplace_back(at.anchor.x() + x * std::cos(a) + y * std::sin(a),
+                       at.anchor.y() - x * std::sin(a) + y * std::cos(a));
+    }
   return out;
 }
 
@@ -42,7 +47,7 @@ TEST(PatternLabel, TextWidthCountsCharactersNotBytes) {
 TEST(PatternLabel, AWidePieceGetsTheLargestTypeBesideItsGrainLine) {
   const LabelPlacement at = place_label(rectangle(600, 700), {300, 50}, {300, 650}, typical());
   EXPECT_TRUE(at.fits);
-  EXPECT_FALSE(at.along);
+  EXPECT_EQ(at.turn_deg, 0);
   EXPECT_DOUBLE_EQ(at.size, 9.0);
   EXPECT_GT(at.anchor.x(), 300);  // right of the grain line
   EXPECT_NEAR(at.anchor.y(), 350, 1e-9);
@@ -55,7 +60,7 @@ TEST(PatternLabel, ANarrowGoreGetsItsLabelAlongItsLength) {
   const LabelText text = typical();
   const LabelPlacement at = place_label(strip, {22.5, 20}, {22.5, 580}, text);
   ASSERT_TRUE(at.fits);
-  EXPECT_TRUE(at.along);
+  EXPECT_EQ(at.turn_deg, 90);
   EXPECT_GE(at.size, 4.0);
   for (const Eigen::Vector2d& c : corners(at, text)) {
     EXPECT_GT(c.x(), 0);
@@ -77,6 +82,34 @@ TEST(PatternLabel, ATriangleKeepsTheBlockOffItsSlantedSide) {
     EXPECT_GT(c.x(), 0);
     EXPECT_LT(c.y(), 400);
     EXPECT_LT(c.x(), c.y());  // left of the hypotenuse y = x
+  }
+}
+
+TEST(PatternLabel, ASlantedStrapGetsItsLabelAlongIt) {
+  // A strap 30 mm wide and 500 mm long laid at 50° across the sheet (SVG frame, y down: running
+  // down to the right), its grain line vertical, as trial 39's shortalls strap lay: neither
+  // across nor a quarter turned does a 5 mm label fit (the old placements gave it 2 mm text at
+  // the centroid); turned along the strap it does, every corner inside the strap.
+  const double a = 50 * std::numbers::pi / 180, length = 500, half = 15;
+  const Eigen::Vector2d d(std::cos(a), std::sin(a)), n(-std::sin(a), std::cos(a));
+  Eigen::MatrixX2d strap(4, 2);
+  strap.row(0) = -half * n;
+  strap.row(1) = length * d - half * n;
+  strap.row(2) = length * d + half * n;
+  strap.row(3) = half * n;
+  const LabelText text{"strap",
+                       {"30 × 500 mm · denim",
+                        "cut 2 (mirror pair) · strap and strap.mirror · ease 1 · stretch 1.2 % "
+                        "(95th pct)"}};
+  const Eigen::Vector2d mid = 0.5 * length * d;
+  const LabelPlacement at = place_label(strap, {mid.x(), 0}, {mid.x(), length * d.y()}, text);
+  ASSERT_TRUE(at.fits);
+  EXPECT_GE(at.size, 5.0);
+  EXPECT_NEAR(at.turn_deg, -50, 1.0);  // reads along the strap, left to right
+  for (const Eigen::Vector2d& c : corners(at, text)) {
+    EXPECT_LT(std::abs(c.dot(n)), half) << c.transpose();
+    EXPECT_GT(c.dot(d), 0) << c.transpose();
+    EXPECT_LT(c.dot(d), length) << c.transpose();
   }
 }
 

@@ -15,6 +15,7 @@
 #include "garment/body_surface.hpp"
 #include "garment/garment_mesh.hpp"
 #include "garment/material_frames.hpp"
+#include "garment/pattern_layout.hpp"
 #include "garment/piece_grain.hpp"
 #include "garment/sketch_inputs.hpp"
 #include "scene/sketch_file.hpp"
@@ -409,10 +410,10 @@ void expect_mirror_pairs_equal(const Garment& g, const FlatPattern& pattern,
     const Eigen::Vector2d size_o = original.uv.colwise().maxCoeff(),
                           size_c = copy.uv.colwise().maxCoeff();
     if (copy.reflection_of < 0) {
-      // Flattened on its own only where the copy differs in 3D: the shorts' centre front has a
-      // doublet merged into one quad on one side only (garment_mesh.cpp), so the copy has one
-      // vertex and two triangles fewer. Then the pieces agree to the flattening's accuracy
-      // (measured: 0.02 mm in size, 0.10 mm at worst vertex by vertex).
+      // Flattened on its own only where the copy differs in 3D (the shorts' front pair did
+      // until its quad over the centre seam was cut along the plane: one vertex and two
+      // triangles fewer in the copy). Then the pieces agree to the flattening's accuracy
+      // (measured then: 0.02 mm in size, 0.10 mm at worst vertex by vertex).
       EXPECT_TRUE(copy.vertices.size() != original.vertices.size() ||
                   copy.triangles.rows() != original.triangles.rows())
           << file << " " << id << " is its original reflected but was flattened on its own";
@@ -521,6 +522,67 @@ TEST(PanelFlattening, SymmetricBodiceCentreLineIsHeldStraight) {
   const Garment shorts = build_garment(load_sketch(example("shorts.json")), surface);
   for (const FlatPanel& flat : flatten_garment(shorts).panels)
     EXPECT_TRUE(flat.centre_run.empty()) << "shorts " << flat.id;
+}
+
+// The shorts' centre front has a doublet (two quads folded onto each other) merged into one quad
+// (garment_mesh.cpp), which keeps one panel's id although it reaches over the mirror plane: the
+// mesh is symmetric, its panels are not, and `front.mirror` was flattened on its own, its
+// outline stepping one quad (18 mm on trial 39's shortalls) away from `front`'s turned over; the
+// sheet cut them as two pieces "pair with". Cut along the plane diagonal, half to each side,
+// the copy is its original reflected, vertex for vertex, and the pair is cut 2.
+TEST(PanelFlattening, AQuadOverTheCentreSeamIsCutAlongItForAMirrorPair) {
+  static const Body body = load_body("builtin");
+  static const BodySurface surface(body.mesh);
+  const Garment g = build_garment(
+      load_sketch(std::filesystem::path(SD_SOURCE_DIR) / "data/examples/shorts.json"), surface);
+  ASSERT_EQ(g.merged_doublets, 1);  // the premise: one quad reaches over x = 0
+  size_t front = 0, copy = 0;
+  for (size_t p = 0; p < g.panels.size(); ++p) {
+    if (g.panels[p].id == "front") front = p;
+    if (g.panels[p].id == "front.mirror") copy = p;
+  }
+  ASSERT_NE(front, copy);
+  int over = 0;
+  for (Eigen::Index q = 0; q < g.mesh.face_count(); ++q) {
+    const int p = g.face_panel(q);
+    if (p != static_cast<int>(front) && p != static_cast<int>(copy)) continue;
+    const auto x = [&](int k) { return g.mesh.vertices(g.mesh.faces(q, k), 0); };
+    over += std::min({x(0), x(1), x(2), x(3)}) < -1e-6 && std::max({x(0), x(1), x(2), x(3)}) > 1e-6;
+  }
+  ASSERT_EQ(over, 1);
+
+  const FlatPattern pattern = flatten_garment(g);
+  const FlatPanel &a = pattern.panels[front], &b = pattern.panels[copy];
+  EXPECT_EQ(b.reflection_of, static_cast<int>(front));
+  EXPECT_EQ(a.vertices.size(), b.vertices.size());
+  EXPECT_EQ(a.triangles.rows(), b.triangles.rows());
+  EXPECT_EQ(mirror_piece_gap(g, a, b), 0.0);
+  // Each piece on its own side of the plane, and the two sewn along it.
+  const double side = g.mesh.vertices(a.vertices[0], 0) >= 0 ? 1.0 : -1.0;
+  for (const int v : a.vertices) EXPECT_GE(side * g.mesh.vertices(v, 0), -1e-6);
+  for (const int v : b.vertices) EXPECT_LE(side * g.mesh.vertices(v, 0), 1e-6);
+  int centre_seams = 0;
+  for (const PatternSeam& seam : pattern.seams) {
+    if (std::minmax(seam.panel_a, seam.panel_b) !=
+        std::minmax(static_cast<int>(front), static_cast<int>(copy)))
+      continue;
+    ++centre_seams;
+    const FlatPanel& sewn = pattern.panels[static_cast<size_t>(seam.panel_a)];
+    for (const int l : seam.vertices_a)
+      EXPECT_LE(std::abs(g.mesh.vertices(sewn.vertices[static_cast<size_t>(l)], 0)), 1e-6);
+    EXPECT_LE(seam.mismatch(), 1e-12);
+  }
+  EXPECT_EQ(centre_seams, 1);
+  // On the sheet: one piece, cut 2.
+  const PatternLayout layout = lay_out_pattern(pattern);
+  for (const PatternPiece& piece : layout.pieces) {
+    if (piece.panel == static_cast<int>(front)) {
+      EXPECT_EQ(piece.quantity, 2);
+    }
+    if (piece.panel == static_cast<int>(copy)) {
+      EXPECT_EQ(piece.quantity, 0);
+    }
+  }
 }
 
 // Every example garment: flat pieces never fold, both sides of every seam are equally long.

@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <map>
 #include <set>
+#include <vector>
 
 #include "tests/render/test_scenes.hpp"
 
@@ -83,6 +86,86 @@ TEST(Scene, PanelColoursAreStableAndDistinct) {
   for (int a = 0; a < 8; ++a)
     for (int b = a + 1; b < 8; ++b) EXPECT_GT((c.row(a) - c.row(b)).norm(), 0.1);
   EXPECT_THROW(panel_colours(Eigen::VectorXi::Constant(1, -1)), std::invalid_argument);
+}
+
+// A dress-like garment of 12 panels, each 2 × 2 quads: a top row of 6 (bodice pieces) sewn to a
+// bottom row of 6 (skirt pieces) and each row's neighbours to each other. The skirt's ids are
+// those of trial 39's dress: ids 8-11 under 0-3, so that colouring by id alone (id modulo the 8
+// colours) gives 0 and 8, 1 and 9, ... one colour across the waist seam.
+struct PanelGrid {
+  Eigen::MatrixX3i triangles;
+  Eigen::VectorXi triangle_panel;
+};
+
+PanelGrid twelve_panel_garment() {
+  constexpr int kColumns = 12, kRows = 4;  // quads; each panel 2 × 2
+  const std::array<std::array<int, 6>, 2> panel_of{{{0, 1, 2, 3, 4, 5}, {8, 9, 10, 11, 6, 7}}};
+  Eigen::MatrixX4i quads(kColumns * kRows, 4);
+  Eigen::VectorXi quad_panel(kColumns * kRows);
+  const auto vertex = [](int i, int j) { return j * (kColumns + 1) + i; };
+  for (int j = 0; j < kRows; ++j)
+    for (int i = 0; i < kColumns; ++i) {
+      const int q = j * kColumns + i;
+      quads.row(q) << vertex(i, j), vertex(i + 1, j), vertex(i + 1, j + 1), vertex(i, j + 1);
+      quad_panel(q) = panel_of[static_cast<size_t>(j / 2)][static_cast<size_t>(i / 2)];
+    }
+  PanelGrid grid;
+  grid.triangles = triangulate_quads(quads);
+  grid.triangle_panel.resize(grid.triangles.rows());
+  for (Eigen::Index q = 0; q < quads.rows(); ++q)
+    grid.triangle_panel(2 * q) = grid.triangle_panel(2 * q + 1) = quad_panel(q);
+  return grid;
+}
+
+// Pairs of faces across an edge that belong to different panels, and how many of them show one
+// colour.
+int sewn_edges_of_one_colour(const PanelGrid& grid, const Eigen::MatrixX3f& colours,
+                             int* sewn_edges) {
+  std::map<std::pair<int, int>, std::vector<int>> faces_of;
+  for (Eigen::Index f = 0; f < grid.triangles.rows(); ++f)
+    for (int k = 0; k < 3; ++k)
+      faces_of[std::minmax(grid.triangles(f, k), grid.triangles(f, (k + 1) % 3))].push_back(
+          static_cast<int>(f));
+  int same = 0;
+  *sewn_edges = 0;
+  for (const auto& [edge, faces] : faces_of) {
+    if (faces.size() != 2 || grid.triangle_panel(faces[0]) == grid.triangle_panel(faces[1]))
+      continue;
+    ++*sewn_edges;
+    if (colours.row(faces[0]).isApprox(colours.row(faces[1]))) ++same;
+  }
+  return same;
+}
+
+TEST(Scene, PanelsSewnTogetherNeverShareAColour) {
+  const PanelGrid grid = twelve_panel_garment();
+  int sewn = 0;
+  // By id alone the waist seam under panels 0-3 is one colour on both sides: the test's premise.
+  EXPECT_EQ(sewn_edges_of_one_colour(grid, panel_colours(grid.triangle_panel), &sewn), 8);
+  EXPECT_EQ(sewn, (5 + 5) * 2 + 6 * 2);  // 5 + 5 row seams and 6 waist seams, 2 quad edges each
+  const Eigen::MatrixX3f colours = panel_colours(grid.triangle_panel, grid.triangles);
+  EXPECT_EQ(sewn_edges_of_one_colour(grid, colours, &sewn), 0);
+  // Every panel is one colour from the palette, and the colouring does not vary between calls.
+  const std::vector<int> slots = panel_palette_slots(grid.triangle_panel, grid.triangles);
+  ASSERT_EQ(slots.size(), 12u);
+  for (Eigen::Index f = 0; f < grid.triangles.rows(); ++f)
+    EXPECT_TRUE(colours.row(f).transpose().isApprox(
+        panel_palette_colour(slots[static_cast<size_t>(grid.triangle_panel(f))])));
+  EXPECT_EQ(panel_palette_slots(grid.triangle_panel, grid.triangles), slots);
+  // The first 8 panels keep their colours by id (no neighbour coloured before them has it).
+  for (int p = 0; p < 8; ++p) EXPECT_EQ(slots[static_cast<size_t>(p)], p);
+}
+
+TEST(Scene, PanelColoursByIdWhenFewPanelsOrNoneSewn) {
+  // Eight panels sewn in a row keep the colours of panel_colours(ids).
+  PanelGrid grid = twelve_panel_garment();
+  for (Eigen::Index f = 0; f < grid.triangle_panel.size(); ++f)
+    grid.triangle_panel(f) = grid.triangle_panel(f) % 8;
+  EXPECT_TRUE(panel_colours(grid.triangle_panel, grid.triangles)
+                  .isApprox(panel_colours(grid.triangle_panel)));
+  EXPECT_THROW(panel_palette_slots(Eigen::VectorXi::Zero(3), grid.triangles),
+               std::invalid_argument);
+  EXPECT_THROW(panel_palette_colour(-1), std::invalid_argument);
 }
 
 TEST(Scene, ValidationNamesTheProblem) {

@@ -14,11 +14,13 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <array>
 #include <assimp/Importer.hpp>
 #include <cctype>
 #include <chrono>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <optional>
 #include <stdexcept>
 
@@ -154,6 +156,24 @@ GarmentMesh load_garment_mesh(const std::string& path) {
   return out;
 }
 
+// The faces with each vertex replaced by the first one at the same position: assimp gives every
+// group of a garment file its own vertices, so the panels sewn together share positions only.
+Eigen::MatrixXi faces_joined_by_position(const meshing::TriMesh& mesh) {
+  std::map<std::array<double, 3>, int> first;
+  std::vector<int> joined(static_cast<size_t>(mesh.vertices.rows()));
+  for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v)
+    joined[static_cast<size_t>(v)] =
+        first
+            .emplace(std::array{mesh.vertices(v, 0), mesh.vertices(v, 1), mesh.vertices(v, 2)},
+                     static_cast<int>(v))
+            .first->second;
+  Eigen::MatrixXi faces = mesh.faces;
+  for (Eigen::Index f = 0; f < faces.rows(); ++f)
+    for (Eigen::Index k = 0; k < faces.cols(); ++k)
+      faces(f, k) = joined[static_cast<size_t>(faces(f, k))];
+  return faces;
+}
+
 Eigen::Vector3d point_option(const std::vector<double>& values, const char* name) {
   if (values.size() != 3)
     throw std::invalid_argument(fmt::format("{} needs three numbers X,Y,Z in metres", name));
@@ -213,7 +233,8 @@ void run_render(const RenderOptions& options, const GlobalOptions& global) {
     body.role = render::MeshRole::kBody;
     GarmentMesh garment_mesh = load_garment_mesh(options.mesh);
     render::SceneMesh& cloth = scene.meshes.emplace_back();
-    cloth.face_colours = render::panel_colours(garment_mesh.panel_ids);
+    cloth.face_colours =
+        render::panel_colours(garment_mesh.panel_ids, faces_joined_by_position(garment_mesh.mesh));
     cloth.mesh = std::move(garment_mesh.mesh);
     cloth.role = render::MeshRole::kCloth;
   }

@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <limits>
 #include <numbers>
@@ -225,9 +226,29 @@ void flat_rest_shapes(const scene::Sketch& sketch, const garment::Garment& g,
   // The rest ramp starts in the drawn triangles (u along the same warp, v along n × warp).
   scene.start_rest_uv = scene.input.rest_uv;
   scene.rest_ramp = rest_ramp_of(sketch);
+  // A quad over the mirror plane is cut between a panel's piece and its mirror copy's along the
+  // plane (garment/panel_flattening.cpp, quads_over_mirror_plane): its triangles take the piece
+  // that holds their three corners, and keep their drawn shape when neither piece does.
+  std::vector<size_t> partner(g.panels.size());
+  for (size_t p = 0; p < g.panels.size(); ++p) {
+    partner[p] = p;
+    for (size_t q = 0; q < g.panels.size(); ++q)
+      if (g.panels[q].id == g.panels[p].id + ".mirror" ||
+          g.panels[p].id == g.panels[q].id + ".mirror")
+        partner[p] = q;
+  }
+  const auto holds = [&](size_t panel, Eigen::Index t) {
+    for (int k = 0; k < 3; ++k)
+      if (std::isnan(panel_uv[panel](arrays.faces(t, k), 0))) return false;
+    return true;
+  };
   for (Eigen::Index t = 0; t < arrays.faces.rows(); ++t) {
-    const size_t panel = static_cast<size_t>(g.face_panel(triangle_quad(t)));
+    size_t panel = static_cast<size_t>(g.face_panel(triangle_quad(t)));
     if (!flat[panel]) continue;
+    if (!holds(panel, t)) {
+      if (!holds(partner[panel], t)) continue;
+      panel = partner[panel];
+    }
     for (int k = 0; k < 3; ++k)
       scene.input.rest_uv.block<1, 2>(t, 2 * k) = panel_uv[panel].row(arrays.faces(t, k));
     // The ramp blends the drawn triangle into the pattern's coordinate by coordinate: turned

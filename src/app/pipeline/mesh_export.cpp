@@ -77,6 +77,13 @@ std::string to_glb(const ExportMesh& mesh, const std::string& object_name) {
   tri.faces.resize(static_cast<Eigen::Index>(all.size()), 3);
   for (size_t i = 0; i < all.size(); ++i) tri.faces.row(static_cast<Eigen::Index>(i)) = all[i];
   const Eigen::MatrixX3d normals = meshing::vertex_normals(tri);
+  // The previews' colours: groups sewn together in different colours (render::panel_colours).
+  std::vector<int> slots;
+  if (!mesh.face_groups.empty())
+    slots = render::panel_palette_slots(
+        Eigen::Map<const Eigen::VectorXi>(mesh.face_groups.data(),
+                                          static_cast<Eigen::Index>(mesh.face_groups.size())),
+        mesh.faces);
 
   for (int g = 0; g < groups; ++g) {
     std::vector<Eigen::Vector3i> triangles;
@@ -121,7 +128,8 @@ std::string to_glb(const ExportMesh& mesh, const std::string& object_name) {
     auto* material = new aiMaterial();
     const aiString name(group_name(mesh, g));
     material->AddProperty(&name, AI_MATKEY_NAME);
-    const Eigen::Vector3f c = render::panel_colours(Eigen::VectorXi::Constant(1, g)).row(0);
+    const Eigen::Vector3f c = render::panel_palette_colour(
+        static_cast<size_t>(g) < slots.size() ? slots[static_cast<size_t>(g)] : g);
     const aiColor4D colour(c.x(), c.y(), c.z(), 1.0f);
     material->AddProperty(&colour, 1, AI_MATKEY_COLOR_DIFFUSE);
     material->AddProperty(&colour, 1, AI_MATKEY_BASE_COLOR);

@@ -22,7 +22,8 @@ struct ExportMesh {
 std::string to_obj(const ExportMesh& mesh, const std::string& object_name);
 
 // Binary glTF 2.0 (.glb): one glTF mesh per group, each with its material colour taken from the
-// renderer's panel palette (render::panel_colours) so files and previews agree; smooth
+// renderer's panel palette as the previews colour it (render::panel_palette_slots: groups sewn
+// together in different colours) so files and previews agree; smooth
 // normals. Quads are split along their shorter diagonal. Throws std::runtime_error if assimp's
 // exporter fails.
 std::string to_glb(const ExportMesh& mesh, const std::string& object_name);

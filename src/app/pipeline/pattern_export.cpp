@@ -71,7 +71,7 @@ std::vector<double> edge_allowances(const scene::Sketch& sketch, const garment::
     const int a = flat.vertices[static_cast<size_t>(flat.boundary[k])];
     const int b = flat.vertices[static_cast<size_t>(flat.boundary[(k + 1) % flat.boundary.size()])];
     const auto found = garment.edge_curve.find(std::minmax(a, b));
-    if (found == garment.edge_curve.end()) continue;
+    if (found == garment.edge_curve.end()) continue;  // takes its neighbour's (below)
     std::string id = found->second;
     if (id.ends_with(".mirror")) id.resize(id.size() - 7);
     for (const garment::CurveSpec& curve : sketch.curves)
@@ -81,6 +81,13 @@ std::vector<double> edge_allowances(const scene::Sketch& sketch, const garment::
       }
   }
   if (!any) out.clear();
+  // An edge on no curve (the diagonal a quad over the mirror plane is cut along,
+  // panel_flattening.cpp) continues the curve before it.
+  for (size_t k = 0; k < out.size(); ++k)
+    if (const int a = flat.vertices[static_cast<size_t>(flat.boundary[k])],
+        b = flat.vertices[static_cast<size_t>(flat.boundary[(k + 1) % out.size()])];
+        !garment.edge_curve.contains(std::minmax(a, b)) && k > 0)
+      out[k] = out[k - 1];
   return out;
 }
 
@@ -95,6 +102,10 @@ std::vector<bool> curve_corners(const garment::Garment& garment, const garment::
     const auto found = garment.edge_curve.find(std::minmax(a, b));
     if (found != garment.edge_curve.end()) curve[k] = found->second;
   }
+  // An edge on no curve (the diagonal a quad over the mirror plane is cut along,
+  // panel_flattening.cpp) continues the curve before it: no corner at its ends.
+  for (size_t k = 0; k < 2 * n; ++k)
+    if (curve[k % n].empty()) curve[k % n] = curve[(k + n - 1) % n];
   std::vector<bool> out(n, false);
   for (size_t k = 0; k < n; ++k) out[k] = curve[k] != curve[(k + n - 1) % n];
   return out;
@@ -412,7 +423,8 @@ std::string pattern_svg(const PatternSheet& sheet) {
     const LabelPlacement at =
         place_label(outline, {g0.x(), length - g0.y()}, {g1.x(), length - g1.y()}, text);
     svg += fmt::format("<g class=\"label\" transform=\"translate({:.1f} {:.1f}){}\"{}>\n",
-                       at.anchor.x(), at.anchor.y(), at.along ? " rotate(-90)" : "",
+                       at.anchor.x(), at.anchor.y(),
+                       at.turn_deg != 0 ? fmt::format(" rotate({:g})", -at.turn_deg) : "",
                        at.centred ? " text-anchor=\"middle\"" : "");
     svg +=
         fmt::format("<text x=\"0\" y=\"0\" font-size=\"{:.1f}\" font-weight=\"bold\">{}</text>\n",

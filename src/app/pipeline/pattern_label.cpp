@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
+#include <numbers>
+#include <vector>
 
 namespace sd::app {
 namespace {
@@ -39,9 +42,20 @@ Block block(const LabelText& text, double size, bool centred) {
   return {x0, x0 + width, -0.8 * size, last + descent};
 }
 
+// The text frame turned by turn_deg anticlockwise as seen (SVG's rotate(−turn), y down).
 Eigen::Vector2d to_sheet(const LabelPlacement& at, double x, double y) {
-  return at.along ? Eigen::Vector2d(at.anchor.x() + y, at.anchor.y() - x)
-                  : Eigen::Vector2d(at.anchor.x() + x, at.anchor.y() + y);
+  if (at.turn_deg == 0) return {at.anchor.x() + x, at.anchor.y() + y};
+  if (at.turn_deg == 90) return {at.anchor.x() + y, at.anchor.y() - x};
+  const double a = at.turn_deg * std::numbers::pi / 180, c = std::cos(a), s = std::sin(a);
+  return {at.anchor.x() + x * c + y * s, at.anchor.y() - x * s + y * c};
+}
+
+// A sheet offset in the text frame (to_sheet's inverse, less the anchor).
+Eigen::Vector2d to_text(const LabelPlacement& at, const Eigen::Vector2d& d) {
+  if (at.turn_deg == 0) return d;
+  if (at.turn_deg == 90) return {-d.y(), d.x()};
+  const double a = at.turn_deg * std::numbers::pi / 180, c = std::cos(a), s = std::sin(a);
+  return {d.x() * c - d.y() * s, d.x() * s + d.y() * c};
 }
 
 // The block, grown by the margin, inside the outline: points every ≤ 2 mm along its sides inside,
@@ -60,11 +74,23 @@ bool fits(const Eigen::MatrixX2d& outline, const LabelPlacement& at, const Block
       !side(x0, y1, x0, y0))
     return false;
   for (Eigen::Index i = 0; i < outline.rows(); ++i) {
-    const Eigen::Vector2d d = outline.row(i).transpose() - at.anchor;
-    const double x = at.along ? -d.y() : d.x(), y = at.along ? d.x() : d.y();
-    if (x > x0 && x < x1 && y > y0 && y < y1) return false;
+    const Eigen::Vector2d t = to_text(at, outline.row(i).transpose() - at.anchor);
+    if (t.x() > x0 && t.x() < x1 && t.y() > y0 && t.y() < y1) return false;
   }
   return true;
+}
+
+// Whether the segment a-b (the grain line) passes through the block grown by the margin.
+bool crosses(const LabelPlacement& at, const Block& b, const Eigen::Vector2d& a,
+             const Eigen::Vector2d& c) {
+  const int steps = std::max(1, int(std::ceil((c - a).norm())));  // every ≤ 1 mm
+  for (int k = 0; k <= steps; ++k) {
+    const Eigen::Vector2d t = to_text(at, a + (c - a) * (double(k) / steps) - at.anchor);
+    if (t.x() > b.x0 - kMargin && t.x() < b.x1 + kMargin && t.y() > b.y0 - kMargin &&
+        t.y() < b.y1 + kMargin)
+      return true;
+  }
+  return false;
 }
 
 Eigen::Vector2d centroid(const Eigen::MatrixX2d& polygon) {
@@ -78,6 +104,53 @@ Eigen::Vector2d centroid(const Eigen::MatrixX2d& polygon) {
   }
   if (std::abs(area) < 1e-12) return polygon.colwise().mean().transpose();
   return c / (3 * area);
+}
+
+// Where a label may sit turned along a strip: points of the piece at least 0.7 of the widest
+// inner distance from its outline (the middle of a strip, all along it), each with the turn of
+// its nearest outline side, at most 48 of them spread over the piece.
+struct Slant {
+  Eigen::Vector2d centre;
+  double turn_deg;
+};
+
+std::vector<Slant> slants(const Eigen::MatrixX2d& outline) {
+  const Eigen::Vector2d lo = outline.colwise().minCoeff(), hi = outline.colwise().maxCoeff();
+  const double step = std::max(2.0, (hi - lo).maxCoeff() / 80);
+  struct Inner {
+    Eigen::Vector2d at;
+    double depth;
+    Eigen::Vector2d side;
+  };
+  std::vector<Inner> inner;
+  double deepest = 0;
+  for (double y = lo.y() + 0.5 * step; y < hi.y(); y += step)
+    for (double x = lo.x() + 0.5 * step; x < hi.x(); x += step) {
+      const Eigen::Vector2d p(x, y);
+      if (!inside(outline, p)) continue;
+      Inner in{p, std::numeric_limits<double>::infinity(), Eigen::Vector2d::UnitX()};
+      for (Eigen::Index i = 0, n = outline.rows(); i < n; ++i) {
+        const Eigen::Vector2d a = outline.row(i), b = outline.row((i + 1) % n);
+        const Eigen::Vector2d d = b - a;
+        const double t = std::clamp((p - a).dot(d) / std::max(d.squaredNorm(), 1e-12), 0.0, 1.0);
+        const double gap = (a + t * d - p).norm();
+        if (gap < in.depth) in.depth = gap, in.side = d;
+      }
+      deepest = std::max(deepest, in.depth);
+      inner.push_back(in);
+    }
+  std::erase_if(inner, [&](const Inner& in) { return in.depth < 0.7 * deepest; });
+  std::vector<Slant> out;
+  const size_t stride = std::max<size_t>(1, (inner.size() + 47) / 48);
+  for (size_t i = 0; i < inner.size(); i += stride) {
+    // Seen on the sheet (y down), the side's anticlockwise angle, turned to read left to right
+    // or upwards.
+    double turn = std::atan2(-inner[i].side.y(), inner[i].side.x()) * 180 / std::numbers::pi;
+    if (turn > 90) turn -= 180;
+    if (turn <= -90) turn += 180;
+    out.push_back({inner[i].at, std::round(10 * turn) / 10});  // as the SVG writes it
+  }
+  return out;
 }
 
 }  // namespace
@@ -94,6 +167,7 @@ LabelPlacement place_label(const Eigen::MatrixX2d& outline, const Eigen::Vector2
                            const Eigen::Vector2d& grain_b, const LabelText& text) {
   const Eigen::Vector2d middle = 0.5 * (grain_a + grain_b);
   const Eigen::Vector2d centre = centroid(outline);
+  std::vector<Slant> slanted;  // made when the first size fits nowhere else
   for (double size = kLargest; size >= kSmallest - 1e-9; size *= 0.9) {
     const double gap = 0.6 * size;  // between the grain line and the text
     // In order of preference: beside the grain line's middle (its right, then its left), then
@@ -102,7 +176,7 @@ LabelPlacement place_label(const Eigen::MatrixX2d& outline, const Eigen::Vector2
       for (const bool along : {false, true}) {
         LabelPlacement at;
         at.size = size;
-        at.along = along;
+        at.turn_deg = along ? 90 : 0;
         at.centred = where == 2 || along;
         const Block b = block(text, size, at.centred);
         const double height = b.y1 - b.y0;
@@ -120,6 +194,22 @@ LabelPlacement place_label(const Eigen::MatrixX2d& outline, const Eigen::Vector2
           at.anchor = {x, middle.y()};
         }
         if (fits(outline, at, b)) {
+          at.fits = true;
+          return at;
+        }
+      }
+    // Turned along the strip, the block's middle on a point of its middle: clear of the grain
+    // line where it fits so, else over it (as the label at the centroid is).
+    if (slanted.empty()) slanted = slants(outline);
+    for (const bool over_grain : {false, true})
+      for (const Slant& slant : slanted) {
+        LabelPlacement at;
+        at.size = size;
+        at.turn_deg = slant.turn_deg;
+        at.centred = true;
+        const Block b = block(text, size, true);
+        at.anchor = slant.centre - (to_sheet(at, 0, 0.5 * (b.y0 + b.y1)) - at.anchor);
+        if ((over_grain || !crosses(at, b, grain_a, grain_b)) && fits(outline, at, b)) {
           at.fits = true;
           return at;
         }

@@ -1,9 +1,9 @@
 #pragma once
 // Where a pattern piece's label fits: the piece's name and two lines of figures, placed beside
 // the grain line, across it or at the piece's middle, horizontal or turned a quarter along a
-// narrow piece, at the largest type size (up to 9 mm) whose text block lies inside the piece's
-// sewing line. A gore or a waistband 4 cm wide gets its label along its length instead of
-// spilling over its neighbours on the sheet.
+// narrow piece, or turned along a slanted or bent strip, at the largest type size (up to 9 mm)
+// whose text block lies inside the piece's sewing line. A gore or a waistband 4 cm wide gets its
+// label along its length instead of spilling over its neighbours on the sheet.
 
 #include <Eigen/Core>
 #include <string>
@@ -19,7 +19,9 @@ struct LabelText {
 struct LabelPlacement {
   Eigen::Vector2d anchor = Eigen::Vector2d::Zero();  // mm, SVG frame (y down): the title's start
   double size = 0;                                   // mm, the title's font size
-  bool along = false;    // turned a quarter turn anticlockwise (reads upwards)
+  // Turned anticlockwise by this many degrees about the anchor, −90 < turn ≤ 90 (never upside
+  // down): 0 across the sheet, 90 along a piece (reads upwards), else along a slanted strip.
+  double turn_deg = 0;
   bool centred = false;  // text-anchor middle (else start)
   bool fits = false;     // the whole block lies inside the outline
 };
@@ -31,7 +33,10 @@ double text_width(const std::string& text, double size, bool bold);
 
 // `outline`: the piece's sewing line (mm, SVG frame), closed, first point not repeated.
 // `grain_a`, `grain_b`: the grain line's ends (mm, SVG frame). Sizes from 9 mm down to 2 mm are
-// tried; when none fits, the smallest at the middle is returned with `fits` false.
+// tried, each beside the grain line, then at the centroid (across, then a quarter turned), then
+// centred on points along the middle of the piece turned along its nearest side (a strap cut
+// slanted or bent across the sheet: trial 39's shortalls strap got 2 mm text at its centroid);
+// when none fits, the smallest at the centroid is returned with `fits` false.
 LabelPlacement place_label(const Eigen::MatrixX2d& outline, const Eigen::Vector2d& grain_a,
                            const Eigen::Vector2d& grain_b, const LabelText& text);
 

@@ -18,9 +18,9 @@ render::Scene preview_scene(const meshing::TriMesh* body, const PreviewCloth& cl
     render::SceneMesh& c = scene.meshes.emplace_back();
     c.mesh = cloth.mesh;
     c.role = render::MeshRole::kCloth;
-    c.face_colours = render::panel_colours(cloth.face_panel.size()
-                                               ? cloth.face_panel
-                                               : Eigen::VectorXi::Zero(cloth.mesh.face_count()));
+    c.face_colours = render::panel_colours(
+        cloth.face_panel.size() ? cloth.face_panel : Eigen::VectorXi::Zero(cloth.mesh.face_count()),
+        cloth.mesh.faces);
   }
   if (wireframe) {
     render::Wireframe wire;
