@@ -18,6 +18,14 @@ inline constexpr double kStillAirDrag = 0.1;
 // is 13-35 s for garments of 0.5-1.4 m, and a drape caught in a contact cycle runs it all.
 inline constexpr double kMaxSettleDuration = 10.0;
 
+// The default duration of a garment with a gathered panel (cloth_scene.hpp, gathered), s: its
+// flutes settle by slipping over each other and the body, in bursts, long after any swing has
+// died, and no pendulum describes that. Measured: trial 39's gathered skirt (cotton, weft 1.6, no
+// duration) was not at rest at the 10 s cap (3.1 cm/s) and rested at 15.35 s, 12.31 s on round
+// 40's body-vertex push; trial 37's flounce at weft 1.6 at 14.07 s; the corpus's gathered designs
+// give 20 s themselves (docs/simulator.md, "Long garments and the default duration").
+inline constexpr double kGatheredSettleDuration = 20.0;
+
 // The time a cloth hanging over `length` metres needs for a swing to decay from `start_speed`
 // to `rest_speed` (m/s): a uniform sheet swinging from its top edge is a pendulum with
 // ω² = 3g/(2L); its amplitude decays at γ = c/(2ρ) from the air drag c over the areal density ρ
