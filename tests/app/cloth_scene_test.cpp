@@ -324,7 +324,8 @@ TEST(ClothScene, SheetLayersAndTheSelfCollisionDefault) {
 // own duration is kept, and so is the default when the drape is told not to stop at rest: it
 // would run every step of the longer time.
 // A garment with a gathered panel gets kGatheredSettleDuration, longer than any settle time the
-// cap allows (trial 39's gathered skirt was still moving at the cap and rested at 12-15 s); a
+// cap allows (trial 39's gathered skirt was still moving at the cap and rested at 12-15 s, the
+// dirndl reproducer at 21.65 s); a
 // panel eased below kGatherEase (1.05) is not gathered, and the file's duration and a drape not
 // stopping at rest keep theirs.
 TEST(ClothScene, GarmentDurationFollowsTheSettleTimeOnlyWhenTheDrapeMayStopAtRest) {
