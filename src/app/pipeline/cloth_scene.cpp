@@ -675,6 +675,8 @@ sim::AutomaticChoice apply_automatic_settings(const scene::Sketch& sketch, const
     settle.rest_speed = settings.rest_speed;
     settings.duration =
         std::max(settings.duration, std::min(settle_time(settle), kMaxSettleDuration));
+    // Gathers settle in their flutes longer than the swing the formula models (settle_time.hpp).
+    if (gathered(sketch)) settings.duration = std::max(settings.duration, kGatheredSettleDuration);
   }
   return choice;
 }

@@ -150,8 +150,10 @@ sim::SimulationSettings simulation_settings(const scene::Sketch& sketch);
 
 // The file's "solver": "auto" and "time_step": "auto" (the defaults) resolved for the built
 // scene (sim/automatic_settings.hpp: its size, garment or sheet, self-contact); settings the
-// file gives are kept. Returns the rule's choice (its `reason` for the report). `motion`: the run
-// writes the motion (`run --frames N`), not only the drape.
+// file gives are kept; a garment without a duration of its own gets its settle time (at most
+// kMaxSettleDuration; kGatheredSettleDuration with a gathered panel, settle_time.hpp). Returns the
+// rule's choice (its `reason` for the report). `motion`: the run writes the motion (`run --frames
+// N`), not only the drape.
 sim::AutomaticChoice apply_automatic_settings(const scene::Sketch& sketch, const ClothScene& scene,
                                               sim::SimulationSettings& settings,
                                               bool motion = false);
