@@ -433,7 +433,8 @@ void set_diamonds(ClothModel& model, const Neighbours& neighbours,
   });
   std::vector<char> in_diamond(model.triangles.size(), 0);
   for (const DiamondElement& d : model.diamonds)
-    for (int f : d.triangles) in_diamond[static_cast<std::size_t>(f)] = 1;
+    for (int f : d.triangles)
+      if (f >= 0) in_diamond[static_cast<std::size_t>(f)] = 1;
   for (std::size_t f = 0; f < model.triangles.size(); ++f)
     if (!in_diamond[f]) model.lone_triangles.push_back(static_cast<int>(f));
 }

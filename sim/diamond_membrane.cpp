@@ -319,6 +319,117 @@ std::vector<DiamondElement> make_diamonds(const Eigen::MatrixX3d& rest,
     for (int f : d.triangles) taken[static_cast<std::size_t>(f)] = 1;
     diamonds.push_back(d);
   }
+  // Partial diamonds: an adaptive split of a diamond's triangle leaves the centre with fewer
+  // than four of its own. Each remaining triangle keeps the centre's map (taken from the four
+  // corners, which are still vertices), so a split changes the membrane of the split triangles
+  // only. Exact 4-8 geometry only (right isosceles triangles, the corners' mirror images present
+  // to rounding), so imported and irregular meshes, and the interior of a fixed 4-8 mesh, where
+  // every such centre is a whole diamond, are not affected.
+  const auto point = [&](int v) { return Vector3d(rest.row(v).transpose()); };
+  const auto right_angle_at = [&](const std::array<int, 3>& v, int k, double& leg) {
+    const Vector3d c = point(v[static_cast<std::size_t>(k)]);
+    const Vector3d u = point(v[static_cast<std::size_t>((k + 1) % 3)]) - c;
+    const Vector3d w = point(v[static_cast<std::size_t>((k + 2) % 3)]) - c;
+    leg = u.norm();
+    constexpr double kExact = 1e-9;  // rounding of midpoints a few levels deep
+    return leg > 0.0 && std::abs(w.norm() - leg) <= kExact * leg &&
+           std::abs(u.dot(w)) <= kExact * leg * leg;
+  };
+  for (std::size_t c = 0; c < n; ++c) {
+    // c's free triangles with their right angle at c: (c, b_k, b_k+1) in their own order.
+    std::array<int, 4> corners{-1, -1, -1, -1};
+    std::array<int, 4> faces{-1, -1, -1, -1};
+    double leg = 0.0;
+    bool ok = true;
+    for (int k = start[c]; k < start[c + 1] && ok; ++k) {
+      const int f = around[static_cast<std::size_t>(k)];
+      if (taken[static_cast<std::size_t>(f)]) continue;
+      const auto& v = triangles[static_cast<std::size_t>(f)].vertices;
+      const int at = v[0] == static_cast<int>(c) ? 0 : v[1] == static_cast<int>(c) ? 1 : 2;
+      double l = 0.0;
+      if (!right_angle_at(v, at, l)) continue;
+      const int u = v[static_cast<std::size_t>((at + 1) % 3)];
+      const int w = v[static_cast<std::size_t>((at + 2) % 3)];
+      if (corners[0] < 0) {
+        leg = l;
+        corners[0] = u;
+        corners[1] = w;
+        faces[0] = f;
+        continue;
+      }
+      if (std::abs(l - leg) > 1e-9 * leg) {
+        ok = false;
+        break;
+      }
+      // Which sector: u is corner s, w corner s + 1, with corners 2, 3 the mirrors of 0, 1.
+      const Vector3d xc = point(static_cast<int>(c));
+      const auto is_corner = [&](int vertex, int s) {
+        const int base = s % 2;
+        const Vector3d expected =
+            s < 2 ? point(corners[static_cast<std::size_t>(base)])
+                  : Vector3d(2.0 * xc - point(corners[static_cast<std::size_t>(base)]));
+        return (point(vertex) - expected).norm() <= 1e-9 * leg;
+      };
+      int sector = -1;
+      for (int s = 1; s < 4; ++s)
+        if (is_corner(u, s) && is_corner(w, (s + 1) % 4)) sector = s;
+      if (sector < 0 || faces[static_cast<std::size_t>(sector)] >= 0) {
+        ok = false;
+        break;
+      }
+      faces[static_cast<std::size_t>(sector)] = f;
+      corners[static_cast<std::size_t>(sector)] = u;
+      corners[static_cast<std::size_t>((sector + 1) % 4)] = w;
+    }
+    if (!ok || corners[0] < 0) continue;
+    // Corners no remaining triangle names: the vertex at the mirror image, within c's two-ring
+    // (a split of the sector (c, b, b') joins c to the midpoint of b b', which is joined to b').
+    const Vector3d xc = point(static_cast<int>(c));
+    for (int s = 2; s < 4 && ok; ++s) {
+      if (corners[static_cast<std::size_t>(s)] >= 0) continue;
+      const Vector3d target = 2.0 * xc - point(corners[static_cast<std::size_t>(s - 2)]);
+      int found = -1;
+      for (int k = start[c]; k < start[c + 1] && found < 0; ++k)
+        for (int m :
+             triangles[static_cast<std::size_t>(around[static_cast<std::size_t>(k)])].vertices)
+          for (int j = start[static_cast<std::size_t>(m)];
+               j < start[static_cast<std::size_t>(m) + 1] && found < 0; ++j)
+            for (int o :
+                 triangles[static_cast<std::size_t>(around[static_cast<std::size_t>(j)])].vertices)
+              if ((point(o) - target).norm() <= 1e-9 * leg) found = o;
+      corners[static_cast<std::size_t>(s)] = found;
+      ok = found >= 0;
+    }
+    if (!ok) continue;
+    // The same mirror test for corners a triangle named (1 from 0's triangle, 3 from 1's).
+    for (int s = 0; s < 2 && ok; ++s)
+      ok = (point(corners[static_cast<std::size_t>(s)]) +
+            point(corners[static_cast<std::size_t>(s + 2)]) - 2.0 * xc)
+               .norm() <= 1e-9 * leg;
+    if (!ok) continue;
+    DiamondElement d;
+    d.vertices[0] = static_cast<int>(c);
+    for (int k = 0; k < 4; ++k) {
+      d.vertices[static_cast<std::size_t>(k) + 1] = corners[static_cast<std::size_t>(k)];
+      d.triangles[static_cast<std::size_t>(k)] = faces[static_cast<std::size_t>(k)];
+    }
+    const double epsilon = 0.01 * leg;  // the half-diagonals are the legs
+    d.regularisation = epsilon * epsilon;
+    set_predictor(d, beyond);
+    if (!flat_rest) {
+      DiamondVector x;
+      for (int k = 0; k < kVertices; ++k)
+        x.segment<3>(3 * k) = point(d.vertices[static_cast<std::size_t>(k)]);
+      DiamondMap map;
+      diamond_centre_map(d, x, false, map);
+      const Vector3d m =
+          (point(corners[2]) - point(corners[0])).cross(point(corners[3]) - point(corners[1]));
+      d.rest_offset = m.norm() > 0.0 ? map.offset.dot(m.normalized()) : 0.0;
+    }
+    for (int f : d.triangles)
+      if (f >= 0) taken[static_cast<std::size_t>(f)] = 1;
+    diamonds.push_back(d);
+  }
   return diamonds;
 }
 

@@ -30,16 +30,21 @@ struct DiamondElement {
   // lacks (at a border) is the centre again, with weight 0.
   std::array<int, kVertices> vertices{};
   std::array<double, kVertices> weights{};  // w_s of the predicted centre p (Σ w_s = 1, w_0 = 0)
-  std::array<int, 4> triangles{};           // rows of ClothModel::triangles
+  // Rows of ClothModel::triangles, (c, b_k, b_k+1) in fan order; -1 for a sector an adaptive
+  // split has replaced (a partial diamond: its other triangles keep the centre's map).
+  std::array<int, 4> triangles{};
   double regularisation = 0.0;  // ε² = (0.01·a)², a the mean rest half-diagonal; m²
   double rest_offset = 0.0;     // f̄: f at the rest positions (0 on a flat rest), m
   std::array<int, kVertices * kVertices> blocks{};  // offset of block (k, l), see BlockPattern
 };
 
-// The diamonds of a mesh (each triangle in at most one, vertices in increasing order of their
-// centre), their corners' neighbours, the predictor's weights and their regularisation;
-// `flat_rest` (the membrane's rest is a flat layout, rest_uv) sets f̄ = 0, otherwise f̄ is read
-// from `rest`. Blocks are left for the pattern.
+// The diamonds of a mesh (each triangle in at most one; the whole ones in increasing order of
+// their centre, then the partial ones, likewise), their corners' neighbours, the predictor's
+// weights and their regularisation; `flat_rest` (the membrane's rest is a flat layout, rest_uv)
+// sets f̄ = 0, otherwise f̄ is read from `rest`. Then the partial diamonds of an adaptive 4-8 mesh: a
+// centre whose fan a split has broken keeps its map on the triangles it still has (exact right
+// isosceles triangles with the right angle at the centre, the four corners present as vertices).
+// Blocks are left for the pattern.
 std::vector<DiamondElement> make_diamonds(const Eigen::MatrixX3d& rest,
                                           const std::vector<TriangleElement>& triangles,
                                           bool flat_rest);

@@ -885,6 +885,7 @@ void add_diamonds(const ClothModel& model, const ForceTerms& terms, double dampi
     double stretch = 0.0, shear = 0.0;
     ElementContribution<9, 3> part;
     for (int f_index : d.triangles) {
+      if (f_index < 0) continue;  // a partial diamond's split sector
       const TriangleElement& t = model.triangles[static_cast<std::size_t>(f_index)];
       std::array<int, 3> at{};  // the triangle's vertices as local indices
       for (int j = 0; j < 3; ++j)
