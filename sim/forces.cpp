@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -1102,6 +1103,25 @@ double max_stretch_strain(const ClothModel& model, const Eigen::VectorXd& x) {
       wv += t.dv[k] * x.segment<3>(3 * t.vertices[k]);
     }
     strain = std::max({strain, wu.norm() - 1.0, wv.norm() - 1.0});
+  }
+  return strain;
+}
+
+Eigen::Vector2d principal_stretches(const TriangleElement& t, const Eigen::VectorXd& x) {
+  Eigen::Matrix<double, 3, 2> f = Eigen::Matrix<double, 3, 2>::Zero();
+  for (int k = 0; k < 3; ++k) {
+    f.col(0) += t.du[k] * x.segment<3>(3 * t.vertices[k]);
+    f.col(1) += t.dv[k] * x.segment<3>(3 * t.vertices[k]);
+  }
+  return Eigen::JacobiSVD<Eigen::Matrix<double, 3, 2>>(f).singularValues();
+}
+
+PrincipalStrain max_principal_strain(const ClothModel& model, const Eigen::VectorXd& x) {
+  PrincipalStrain strain;
+  for (const TriangleElement& t : model.triangles) {
+    const Eigen::Vector2d sigma = principal_stretches(t, x);
+    strain.stretch = std::max(strain.stretch, sigma(0) - 1.0);
+    strain.compression = std::max(strain.compression, 1.0 - sigma(1));
   }
   return strain;
 }

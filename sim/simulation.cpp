@@ -850,6 +850,9 @@ SimulationReport Simulation::run(const RunHooks& hooks) {
   report_.newton_iterations_mean =
       report_.steps > 0 ? static_cast<double>(newton_total_) / report_.steps : 0.0;
   report_.max_strain = max_stretch_strain(model_, x_);
+  const PrincipalStrain principal = max_principal_strain(model_, x_);
+  report_.max_principal_stretch = principal.stretch;
+  report_.max_principal_compression = principal.compression;
   report_.nan_free = x_.allFinite() && v_.allFinite();
   report_.cholmod_factorizations = solver_.cholmod().numeric_factorizations();
   report_.cholmod_analyses = solver_.cholmod().symbolic_analyses();

@@ -187,7 +187,11 @@ struct SimulationReport {
   double solve_s = 0.0;      // in linear solves (PCG or CHOLMOD factor + solve)
   double collision_s = 0.0;  // in collider queries, body motion and contact bookkeeping
   double other_s = 0.0;      // the rest (bookkeeping, checks, energy samples, callbacks)
-  double max_strain = 0.0;   // largest stretch strain at the end
+  double max_strain = 0.0;   // largest stretch strain at the end (warp or weft, max_stretch_strain)
+  // Largest engineering principal strains at the end (max_principal_strain): stretch σ₁ − 1
+  // and compression 1 − σ₂ in any direction, shear's included, which max_strain does not see.
+  double max_principal_stretch = 0.0;
+  double max_principal_compression = 0.0;
   // Body contact (zero without a body). Penetration is depth inside the body (negative signed
   // distance), measured after every accepted step; vertices still being pushed out of an
   // intersecting start are left out of it until their repair is over.

@@ -735,6 +735,35 @@ TEST(BodyCollider, BodyVertexBesideAClothCornerIsSidedByThePseudoNormal) {
   EXPECT_GT(through.front().height, 0.005);
 }
 
+// The simulator's count of body vertices through the cloth (ContactResponse::count_piercing:
+// heights over 1 mm, the penetration tolerance, sided by the pseudo-normal, a 1 cm reach taken
+// unchecked to 5 mm) on a cloth folded over a body point (the armpit fold of the 2 cm tee,
+// docs/collision.md "The piercing count in the armpit fold"): the cone's apex 3 mm through the
+// fold's inner layer and 3 mm under its outer one is through the cloth, counted once with the
+// inner layer's 3 mm; the same fold lifted 6 mm, the apex 3 mm in front of both layers, is not.
+TEST(BodyCollider, BodyVertexThroughOneLayerOfAFoldIsCounted) {
+  const BodyCollider collider(testing::make_cone(0.1, 0.2, 24));  // apex (0, 0.2, 0), normal +y
+  // Inner layer at y = 0.197 over x in [-0.04, 0.02], folded back at the crease x = 0.02 (edge
+  // 1-2) to y = 0.215 at x = -0.04: 3 mm over the apex at x = 0.
+  const auto fold = [](double lift) {
+    Eigen::VectorXd x(18);
+    x << -0.04, 0.197, -0.03, 0.02, 0.197, -0.03, 0.02, 0.197, 0.03, -0.04, 0.197, 0.03,  //
+        -0.04, 0.215, -0.03, -0.04, 0.215, 0.03;
+    for (int k = 0; k < 6; ++k) x[3 * k + 1] += lift;
+    return x;
+  };
+  const ClothTriangles cloth(Triangles{{0, 1, 2}, {0, 2, 3}, {1, 4, 5}, {1, 5, 2}});
+  const auto count = [&](const Eigen::VectorXd& x) {
+    return collider.find_piercings(x, cloth, 0.001, 0.01, 0.005, nullptr, false, true);
+  };
+  const std::vector<BodyPiercing> through = count(fold(0.0));
+  ASSERT_EQ(through.size(), 1u);
+  EXPECT_EQ(through.front().body_vertex, 0);
+  EXPECT_LT(through.front().cloth_triangle, 2);       // the inner layer
+  EXPECT_NEAR(through.front().height, 0.003, 1e-12);  // a plane's height: exact to rounding
+  EXPECT_TRUE(count(fold(0.006)).empty());
+}
+
 TEST(BodyCollider, ClothBeyondAThinBodyPartIsNotAPiercing) {
   // A 1 cm slab; cloth 3 mm under it (a sleeve under the arm): the slab's top corners are
   // 13 mm "in front of" the cloth along their normals, but the cloth does not enter the body.

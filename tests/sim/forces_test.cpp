@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -633,6 +634,50 @@ TEST(Forces, BiasWrinklingCapsBiasCompressionAtItsEulerLoadAndKeepsTension) {
     EXPECT_EQ(e_linear.stretch + e_linear.shear, e_buckling.stretch + e_buckling.shear);
     EXPECT_GT(e_linear.shear, 0.0);
   }
+}
+
+// A simple shear by γ (the weft turned by γ towards the warp, F = [1 tan γ; 0 1] in (warp, weft)
+// coordinates) keeps the warp's length and lengthens the weft by 1/cos γ only, while its
+// principal stretches are the singular values of F, √(1 + k²/4) ± k/2 with k = tan γ: at
+// γ = 11° (the flat arms-lowering tee's armpit, docs/collision.md) 1.102 and 0.908 against
+// 1.9 % along the weft. Both for any rigid rotation of the sheet. Tolerance 1e-12: du, dv and
+// the rest positions carry a few ulps of 1/m (cloth_model_test), the SVD a few of 1.
+TEST(Forces, PrincipalStrainSeesTheShearThatWarpAndWeftStrainMisses) {
+  const Fixture f = make_fixture();
+  const double k = std::tan(11.0 * std::numbers::pi / 180.0);
+  Eigen::Matrix2d shear;
+  shear << 1.0, k, 0.0, 1.0;
+  const Eigen::VectorXd sheared = mapped_positions(f, shear);
+  Eigen::VectorXd turned = sheared;
+  const Eigen::Matrix3d rotation =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1.0, 2.0, -0.5).normalized()).toRotationMatrix();
+  for (Eigen::Index i = 0; i < turned.size(); i += 3)
+    turned.segment<3>(i) = rotation * sheared.segment<3>(i) + Eigen::Vector3d(0.3, -1.0, 2.0);
+  const double sigma1 = std::sqrt(1.0 + k * k / 4.0) + k / 2.0;
+  const double sigma2 = std::sqrt(1.0 + k * k / 4.0) - k / 2.0;
+  for (const Eigen::VectorXd& x : {sheared, turned}) {
+    for (const TriangleElement& t : f.model.triangles) {
+      const Eigen::Vector2d sigma = principal_stretches(t, x);
+      EXPECT_NEAR(sigma(0), sigma1, 1e-12);
+      EXPECT_NEAR(sigma(1), sigma2, 1e-12);
+    }
+    const PrincipalStrain principal = max_principal_strain(f.model, x);
+    EXPECT_NEAR(principal.stretch, sigma1 - 1.0, 1e-12);      // 10.2 %
+    EXPECT_NEAR(principal.compression, 1.0 - sigma2, 1e-12);  // 9.2 %
+    EXPECT_NEAR(max_stretch_strain(f.model, x),
+                1.0 / std::cos(11.0 * std::numbers::pi / 180.0) - 1.0,
+                1e-12);  // 1.9 %
+  }
+  // Unstrained (at rest and moved rigidly): both zero; stretched 5 % along the warp: the same
+  // 5 % in both measures, and no compression.
+  const PrincipalStrain rest =
+      max_principal_strain(f.model, flatten_positions(f.scene.input.rest_positions));
+  EXPECT_NEAR(rest.stretch, 0.0, 1e-12);
+  EXPECT_NEAR(rest.compression, 0.0, 1e-12);
+  const Eigen::VectorXd pulled = mapped_positions(f, Eigen::Vector2d(1.05, 1.0).asDiagonal());
+  EXPECT_NEAR(max_principal_strain(f.model, pulled).stretch, 0.05, 1e-12);
+  EXPECT_NEAR(max_principal_strain(f.model, pulled).compression, 0.0, 1e-12);
+  EXPECT_NEAR(max_stretch_strain(f.model, pulled), 0.05, 1e-12);
 }
 
 }  // namespace

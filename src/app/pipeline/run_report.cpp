@@ -1,8 +1,9 @@
 #include "src/app/pipeline/run_report.hpp"
 
-#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+
+#include "sim/forces.hpp"
 
 namespace sd::app {
 namespace {
@@ -43,6 +44,8 @@ nlohmann::json simulation_json(const sim::SimulationReport& r, const sim::Simula
           {"dt_min_used", r.dt_min_used},
           {"dt_max_used", r.dt_max_used},
           {"max_strain", r.max_strain},
+          {"max_principal_stretch", r.max_principal_stretch},
+          {"max_principal_compression", r.max_principal_compression},
           {"rest",
            {{"speed_window_m_s", r.rest_speed_window},
             {"kinetic_per_kg_window_J_kg", r.rest_kinetic_per_kg_window},
@@ -151,8 +154,8 @@ std::optional<MeshingSummary> meshing_summary(const ClothScene& scene) {
 }
 
 // How far the drape is from the cloth's rest shape (the pattern with "rest": "flat"), per group:
-// each triangle's principal stretches σ₁ ≥ σ₂ of [w_u w_v] (Baraff & Witkin's deformation
-// gradient against the model's rest triangle), strain = max(σ₁ − 1, 1 − σ₂); max and
+// each triangle's principal stretches σ₁ ≥ σ₂ (sim::principal_stretches, the report's
+// max_principal_stretch / _compression over all groups), strain = max(σ₁ − 1, 1 − σ₂); max and
 // rest-area-weighted mean.
 std::vector<GroupStrain> group_strains(const sim::ClothModel& model,
                                        const Eigen::MatrixX3d& positions,
@@ -162,14 +165,10 @@ std::vector<GroupStrain> group_strains(const sim::ClothModel& model,
       area(group_names.size(), 0.0);
   std::vector<GroupStrain> out;
   for (const std::string& name : group_names) out.push_back({name});
+  const Eigen::VectorXd x = sim::flatten_positions(positions);
   for (size_t t = 0; t < model.triangles.size(); ++t) {
     const sim::TriangleElement& e = model.triangles[t];
-    Eigen::Matrix<double, 3, 2> f = Eigen::Matrix<double, 3, 2>::Zero();
-    for (int k = 0; k < 3; ++k) {
-      f.col(0) += e.du[k] * positions.row(e.vertices[k]).transpose();
-      f.col(1) += e.dv[k] * positions.row(e.vertices[k]).transpose();
-    }
-    const Eigen::Vector2d sigma = Eigen::JacobiSVD<Eigen::Matrix<double, 3, 2>>(f).singularValues();
+    const Eigen::Vector2d sigma = sim::principal_stretches(e, x);
     const double strain = std::max(sigma(0) - 1, 1 - sigma(1));
     const size_t g = t < static_cast<size_t>(triangle_group.size())
                          ? static_cast<size_t>(triangle_group(static_cast<Eigen::Index>(t)))
