@@ -35,10 +35,9 @@ Eigen::MatrixX3d lattice_path(const std::vector<Eigen::Vector2i>& corners) {
 // sides, the notch's three edges one side, so both of its concave corners are side vertices of
 // that side and the six real corners turn 6 quarter turns where a disk turns 4: a rectilinear
 // layout needs two reflex vertices. Of these 200 regions, 86 are filled by one (the rest by
-// padded or shifted-corner layouts of the same distortion); each must put both at the notch's
-// corners. Ranked by the edge counts alone (most quads, then the longest shortest run), 34 of
-// the regions were filled by a rectilinear layout with them elsewhere (and none with them at
-// the notch).
+// other constructions); each must put both at the notch's corners. Ranked by the edge counts alone
+// (most quads, then the longest shortest run), 34 of the regions were filled by a rectilinear
+// layout with them elsewhere (and none with them at the notch).
 TEST(RectilinearLayout, ReflexVerticesGoWhereTheSideTurnsInwards) {
   int rectilinear = 0;
   for (int w = 3; w <= 6; ++w)
