@@ -254,6 +254,13 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
   const double reach = spec.edge_length.value_or(sketch.edge_length);
   meshing::FillGeometryOptions options;
   options.relax_iterations = sketch.relax_iterations;
+  // The boundary turns about the body's normal where it runs near the body (within the offset
+  // and two edges): a strap round the back of the neck seen from the front would turn the
+  // wrong way; a hem spanning the legs keeps the loop's own normal.
+  options.surface_normal = [&body, offset, reach](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+    const SurfacePoint s = body.closest_point(p);
+    return s.distance <= offset + 2 * reach ? s.normal : Eigen::Vector3d::Zero();
+  };
   // Each query starts from the last answer found in the same cell of half an edge length: a
   // vertex moves less than that per relaxation sweep, so the hint is usually its own last
   // projection (a hash collision only gives a poorer hint, never another answer).

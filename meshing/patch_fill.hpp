@@ -70,6 +70,12 @@ struct FillGeometryOptions {
   // is the result (without the planar placement that follows on an unprojected fill), otherwise
   // the fill goes on as without it, to the same result.
   std::function<bool(const FilledPatch&)> good_enough;
+  // Optional: the unit normal of the surface the panel lies on near a boundary point (zero when
+  // unknown there). The boundary's turn at each vertex, which decides where the layout puts its
+  // corners and reflex vertices (docs/meshing.md, "Reflex vertices where the boundary turns"), is
+  // then measured about it instead of about the loop's overall normal: seen from the front, a
+  // strap running round the back of the neck turns the wrong way.
+  std::function<Eigen::Vector3d(const Eigen::Vector3d&)> surface_normal;
 };
 
 struct FilledPatch {

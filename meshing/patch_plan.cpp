@@ -101,7 +101,9 @@ BoundaryShape straight_sided_shape(std::span<const int> counts) {
 // Interior angles of the boundary loop about its Newell normal (for a panel on a curved body
 // the overall normal; the sign of a turn is right as long as the surface tilts less than 90°
 // from it).
-BoundaryShape measured_shape(const std::vector<Eigen::MatrixX3d>& side_points) {
+BoundaryShape measured_shape(
+    const std::vector<Eigen::MatrixX3d>& side_points,
+    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& surface_normal) {
   std::vector<Eigen::Vector3d> loop;
   for (const auto& side : side_points)
     for (Eigen::Index r = 0; r + 1 < side.rows(); ++r) loop.emplace_back(side.row(r).transpose());
@@ -121,11 +123,21 @@ BoundaryShape measured_shape(const std::vector<Eigen::MatrixX3d>& side_points) {
   shape.planar = newell.norm() > 0 && off_plane <= 1e-9 * extent;
   shape.reflex.assign(size, 0);
   shape.flat.assign(size, 0);
+  shape.turn.assign(size, 0.0);
   for (size_t k = 0; k < size; ++k) {
     const Eigen::Vector3d in = loop[k] - loop[(k + size - 1) % size];
     const Eigen::Vector3d out = loop[(k + 1) % size] - loop[k];
+    Eigen::Vector3d normal = shape.normal;
+    if (surface_normal) {
+      const Eigen::Vector3d local = surface_normal(loop[k]);
+      if (local.norm() > 0.5) normal = local.normalized();
+    }
+    // The flags keep the loop's own normal: about the body's normals they would change which
+    // corners count as reflex in most garments (docs/meshing.md, "Reflex vertices where the
+    // boundary turns": measured, not taken).
     const double turn = std::atan2(shape.normal.dot(in.cross(out)), in.dot(out));
     const double interior = 180.0 - turn * 180.0 / std::numbers::pi;
+    shape.turn[k] = std::atan2(normal.dot(in.cross(out)), in.dot(out)) / (std::numbers::pi / 2);
     shape.reflex[k] = interior > 180.0 + kReflexSlackDegrees;
     shape.flat[k] = interior > kFlatDegrees;
   }
@@ -139,8 +151,10 @@ namespace {
 detail::StripRegion region_of(std::span<const int> loop_ids, std::span<const int> counts,
                               const BoundaryShape& shape, std::span<const int> strip_corners) {
   detail::StripRegion region;
+  region.measured = !shape.turn.empty();
   for (size_t p = 0; p < loop_ids.size(); ++p)
-    region.loop.push_back({loop_ids[p], 0, 3, shape.flat[p] != 0, shape.reflex[p] != 0});
+    region.loop.push_back({loop_ids[p], 0, 3, shape.flat[p] != 0, shape.reflex[p] != 0,
+                           region.measured ? shape.turn[p] : 0.0});
   region.corners = corner_positions(counts);
   for (const int c : region.corners) region.loop[static_cast<size_t>(c)].regular = 2;
   if (!strip_corners.empty()) region.corners.assign(strip_corners.begin(), strip_corners.end());

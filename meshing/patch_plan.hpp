@@ -4,6 +4,7 @@
 // places it. Not part of the library's interface.
 
 #include <Eigen/Core>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -28,6 +29,8 @@ struct BoundaryShape {
   std::vector<char> reflex;  // interior angle above 180°: one quad there is folded
   std::vector<char> flat;    // interior angle above kFlatDegrees (reflex included)
   bool measured = false;     // from real side points (not the count-only assumption)
+  // Measured only: the turn to the left at each position about `normal`, in quarter turns.
+  std::vector<double> turn;
   // Every boundary vertex within 1e-9 of the boundary's extent from the plane through the
   // first one square to `normal`: a fill without projection then lies in that plane, and a
   // quad turning the wrong way about `normal` is folded even when its neighbours turned with
@@ -75,7 +78,11 @@ BoundaryShape straight_sided_shape(std::span<const int> counts);
 // Interior angles of the boundary loop about its Newell normal (for a panel on a curved body
 // the overall normal; the sign of a turn is right as long as the surface tilts less than 90°
 // from it).
-BoundaryShape measured_shape(const std::vector<Eigen::MatrixX3d>& side_points);
+// With `surface_normal` (FillGeometryOptions::surface_normal), each turn is measured about the
+// surface's normal at that vertex where it is known, and the loop's overall normal elsewhere.
+BoundaryShape measured_shape(
+    const std::vector<Eigen::MatrixX3d>& side_points,
+    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& surface_normal = {});
 
 // The best plan for these counts on a boundary of this shape; when the Yasseen construction
 // wins, `yasseen` receives it already built on `side_points`.

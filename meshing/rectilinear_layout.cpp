@@ -5,6 +5,7 @@
 #include <climits>
 #include <cstdint>
 #include <cstdlib>
+#include <span>
 #include <stdexcept>
 #include <tuple>
 
@@ -39,6 +40,27 @@ bool lattice_walk(std::span<const int> turns, std::vector<std::array<int, 2>>& p
   return std::adjacent_find(keys.begin(), keys.end()) == keys.end();
 }
 
+// How far the lattice walk's heading strays from the boundary's: after each position, the
+// quarter turns the walk has made less those the boundary has made, its mean taken off (the
+// walk may be turned as a whole). The boundary's turns are first evened out to add up to 4 like
+// the walk's (a loop measured about one normal on a curved surface turns a little more or less),
+// the difference spread over every position. So a reflex vertex placed where the boundary turns
+// inwards costs nothing, and one placed on a straight hem bends the whole walk between it and the
+// bend it should have been at.
+double heading_mismatch(std::span<const int> turns, std::span<const double> boundary) {
+  const auto size = static_cast<double>(turns.size());
+  double total = 0;
+  for (const double t : boundary) total += t;
+  const double spread = (total - 4) / size;
+  double heading = 0, sum = 0, sum_squares = 0;
+  for (size_t p = 0; p < turns.size(); ++p) {
+    heading += turns[p] - (boundary[p] - spread);
+    sum += heading;
+    sum_squares += heading * heading;
+  }
+  return sum_squares - sum * sum / size;
+}
+
 int turn_cost(const PositionCosts& costs, size_t p, int turn) {
   return turn == 1 ? costs.as_corner[p] : turn == 0 ? costs.as_side[p] : costs.as_reflex[p];
 }
@@ -49,6 +71,8 @@ std::optional<RectilinearLayout> best_rectilinear_layout(const PositionCosts& co
                                                          int& budget) {
   const auto size = static_cast<int>(costs.as_side.size());
   if (costs.as_reflex.size() != costs.as_side.size() || size < 4) return std::nullopt;
+  if (!costs.turn.empty() && costs.turn.size() != costs.as_side.size())
+    throw std::logic_error("a turn for every loop position");
   // Every position starts at its cheapest turn; a layout is a set of changes from there, each
   // adding `extra` >= 1 to the cost (|valence − regular| is convex in the turn, and the fold
   // penalty only raises a corner) and `shift` to Σ t.
@@ -140,13 +164,16 @@ std::optional<RectilinearLayout> best_rectilinear_layout(const PositionCosts& co
       layout.cells += points[p][0] * q[1] - q[0] * points[p][1];
     }
     layout.cells /= 2;  // shoelace: the walk is counter-clockwise
+    if (!costs.turn.empty()) layout.mismatch = heading_mismatch(turns, costs.turn);
     for (int p = 0; p < size; ++p) {
       const int t = turns[static_cast<size_t>(p)];
       layout.irregular += turn_cost(costs, static_cast<size_t>(p), t) % kFoldPenalty != 0 ? 1 : 0;
       if (t == 1 && !costs.flat.empty() && costs.flat[static_cast<size_t>(p)]) ++layout.flat;
     }
-    if (!best || std::tuple(layout.irregular, layout.flat, -layout.cells, -layout.shortest) <
-                     std::tuple(best->irregular, best->flat, -best->cells, -best->shortest)) {
+    if (!best ||
+        std::tuple(layout.irregular, layout.flat, layout.mismatch, -layout.cells,
+                   -layout.shortest) < std::tuple(best->irregular, best->flat, best->mismatch,
+                                                  -best->cells, -best->shortest)) {
       layout.turns = turns;
       best = std::move(layout);
     }

@@ -30,11 +30,15 @@ struct RectilinearLayout {
   int flat = 0;            // layout corners (t = +1) at positions flagged flat
   int cells = 0;     // quads: for a boundary of S edges, more quads is a rounder lattice polygon
   int shortest = 0;  // the shortest straight run of the walk, in edges
-  int checks = 0;    // budget units spent
+  // With PositionCosts::turn: how far the walk's heading strays from the boundary's, Σ over the
+  // edges of (lattice heading − boundary heading − their mean difference)², in quarter turns².
+  double mismatch = 0;
+  int checks = 0;  // budget units spent
 };
 
 // The cheapest rectilinear layout of the loop whose cost is at most `max_cost` (ties: fewest
-// irregular vertices, fewest flat corners, most quads, longest shortest run), searching turn
+// irregular vertices, fewest flat corners, least heading mismatch when the boundary's turns are
+// known, most quads, longest shortest run), searching turn
 // changes from each position's cheapest turn in order of added cost; every candidate change
 // looked at takes one unit of `budget` (decremented). Regions that need more than
 // kMaxTurnShift quarter turns of change (e.g. n >= 9 plain sides) are not searched. Needs

@@ -236,6 +236,8 @@ bool StripRegion::strip(int side, QuadMeshBuilder* builder, const Eigen::Vector3
     }
   }
   std::vector<LoopVertex> chain(static_cast<size_t>(l - 1), LoopVertex{-1, 1, 4, false, false});
+  // A chain runs one edge inside the side and turns where the side does.
+  for (int k = 1; k < l; ++k) chain[static_cast<size_t>(k - 1)].turn = at(a + k).turn;
   if (builder != nullptr) {
     auto pos = [&](int p) -> Eigen::Vector3d { return builder->position(at(p).id); };
     for (int k = 1; k < l; ++k) {
@@ -294,6 +296,7 @@ PositionCosts StripRegion::costs() const {
     costs.as_side.push_back(std::abs(v.outside + 3 - v.regular));
     costs.flat.push_back(single_quad && v.exposed ? 1 : 0);
     costs.as_reflex.push_back(std::abs(v.outside + 4 - v.regular));
+    if (measured) costs.turn.push_back(v.turn);
   }
   return costs;
 }

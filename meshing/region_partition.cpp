@@ -301,7 +301,8 @@ PositionCosts region_costs(std::span<const int> side_counts) {
   PositionCosts costs{std::vector<int>(static_cast<size_t>(total), 1),
                       std::vector<int>(static_cast<size_t>(total), 0),
                       std::vector<char>(static_cast<size_t>(total), 1),
-                      std::vector<int>(static_cast<size_t>(total), 1)};
+                      std::vector<int>(static_cast<size_t>(total), 1),
+                      {}};
   int p = 0;
   for (const int count : side_counts) {
     costs.as_corner[static_cast<size_t>(p)] = 0;

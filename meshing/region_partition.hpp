@@ -47,6 +47,11 @@ struct PositionCosts {
   // Optional (empty = not offered): the cost as a *reflex* layout vertex (gaining two edges into
   // the polygon, three quads), used only by the rectilinear layouts (rectilinear_layout.hpp).
   std::vector<int> as_reflex;
+  // Optional (empty = unknown): how far the boundary turns at each position, in quarter turns
+  // to the left (+1 at a square convex corner, −1 at a square concave one), measured from its
+  // points. Among rectilinear layouts of equal cost the search prefers the one whose lattice
+  // walk turns where the boundary does (rectilinear_layout.hpp).
+  std::vector<double> turn;
 };
 
 // The least costly layout found: cost = |n' − 4| (the centre) + the position costs. Searches
@@ -82,6 +87,7 @@ struct LoopVertex {
   bool exposed = false;  // on the region's boundary with a flat or reflex angle: valence 2 here
                          // would leave one quad with that angle
   bool reflex = false;   // ... and that quad would be folded
+  double turn = 0;       // the boundary's turn there, quarter turns (PositionCosts::turn)
 };
 
 struct StripRegion {
@@ -89,8 +95,9 @@ struct StripRegion {
   std::vector<int> corners;      // loop position of corner i, side i from corner i to i+1
   int fixed_cost = 0;            // distortion of the vertices already enclosed by strips
   int fixed_irregular = 0;
-  int folded = 0;  // enclosed vertices of valence 2 where the boundary is reflex
-  int flat = 0;    // ... flat or reflex
+  int folded = 0;         // enclosed vertices of valence 2 where the boundary is reflex
+  int flat = 0;           // ... flat or reflex
+  bool measured = false;  // the loop's `turn`s are measured (else PositionCosts::turn is empty)
 
   // Adds a strip along side `side`; false (nothing changed) when a neighbouring side has fewer
   // than 2 edges or the loop would shrink below 4 vertices. With a builder, creates the chain's
