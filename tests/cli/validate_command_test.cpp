@@ -49,6 +49,55 @@ TEST(ValidateCommand, SheetLineNamesTheFabricOnce) {
   fs::remove_all(dir);
 }
 
+// Trial 39, P7: a fabric file whose "name" holds BEL, ANSI colour escapes and U+202E (the
+// right-to-left override) rang the terminal and turned it red from validate's "ok" line, and
+// U+202E was echoed raw in every message. Nothing of it reaches the terminal raw, in the ok line
+// or in an error; each is quoted as an escape.
+TEST(ValidateCommand, NoControlOrBidiCharacterOfTheFileReachesTheTerminal) {
+  const fs::path dir = fs::temp_directory_path() / "sd-validate-printable";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string name = "lin\\u0007\\u001b[31mRED\\u001b[0m \\u202eevil";
+  const auto fabric = [&](double friction) {
+    // Trial 39's linen in KES-F units (its h60-fabric-ctrl-name.json).
+    return R"({"name": ")" + name + R"(", "area_density": {"value": 180, "unit": "g/m^2"},
+      "stretch_warp": {"value": 3.27, "unit": "% EMT"},
+      "stretch_weft": {"value": 4.086, "unit": "% EMT"},
+      "shear": {"value": 1.0677, "unit": "gf/cm/deg"},
+      "bend": {"value": 0.204, "unit": "gf*cm^2/cm"}, "damping": {"value": 0.001, "unit": "s"},
+      "bend_damping": {"value": 0.05, "unit": "s"}, "thickness": {"value": 0.4, "unit": "mm"},
+      "friction": {"value": )" +
+           std::to_string(friction) + R"(, "unit": "1"}})";
+  };
+  std::ofstream(dir / "linen.json") << fabric(0.4);
+  std::ofstream(dir / "odd.json") << fabric(30);
+  for (const char* f : {"linen.json", "odd.json"})
+    std::ofstream(dir / (std::string("sheet-") + f))
+        << R"({"sheet": {"size": [0.2, 0.2], "resolution": [4, 4]}, "fabric": ")" << f << "\"}";
+  // An id with U+202E: refused, quoted.
+  std::ofstream(dir / "bidi.json") << "{\"curves\": [{\"id\": \"side\xe2\x80\xae"
+                                      "edis\", \"view\": \"front\", "
+                                      "\"points\": [[0, 1], [0.1, 1]]}], \"panels\": []}";
+  const auto raw = [](const std::string& out) {
+    return out.find('\x07') != std::string::npos || out.find('\x1b') != std::string::npos ||
+           out.find("\xe2\x80\xae") != std::string::npos;
+  };
+  const CommandResult ok = run_sketchdrape("validate " + (dir / "sheet-linen.json").string());
+  EXPECT_EQ(ok.exit_code, 0) << ok.output;
+  EXPECT_FALSE(raw(ok.output)) << ok.output;
+  EXPECT_NE(ok.output.find("fabric lin\\x07\\x1b[31mRED\\x1b[0m \\u202eevil)"), std::string::npos)
+      << ok.output;
+  const CommandResult odd = run_sketchdrape("validate " + (dir / "sheet-odd.json").string());
+  EXPECT_EQ(odd.exit_code, 2) << odd.output;
+  EXPECT_FALSE(raw(odd.output)) << odd.output;
+  EXPECT_NE(odd.output.find("\\u202eevil"), std::string::npos) << odd.output;
+  const CommandResult bidi = run_sketchdrape("validate " + (dir / "bidi.json").string());
+  EXPECT_EQ(bidi.exit_code, 2) << bidi.output;
+  EXPECT_FALSE(raw(bidi.output)) << bidi.output;
+  EXPECT_NE(bidi.output.find("id 'side\\u202eedis'"), std::string::npos) << bidi.output;
+  fs::remove_all(dir);
+}
+
 // The trapeze dress of trial 35 with assimp's duck given as its body: the refusal spoke of a
 // curve crossing itself; it says first that the body has no landmarks, so is no standing figure.
 TEST(ValidateCommand, ABodyThatIsNoFigureIsNamedFirst) {
