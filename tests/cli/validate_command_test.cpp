@@ -98,6 +98,35 @@ TEST(ValidateCommand, NoControlOrBidiCharacterOfTheFileReachesTheTerminal) {
   fs::remove_all(dir);
 }
 
+// Trial 39, P13: gravity pointing up drew no word (the cloth fell off the body, and the advice
+// was about a snugger fit). It is warned, with Earth's; sideways gravity is not.
+TEST(ValidateCommand, GravityPointingUpIsWarned) {
+  const fs::path dir = fs::temp_directory_path() / "sd-validate-gravity";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const auto validate = [&](const std::string& gravity) {
+    std::ofstream(dir / "sheet.json")
+        << R"({"sheet": {"size": [0.2, 0.2], "resolution": [4, 4]}, "fabric": "cotton",
+              "simulate": {"gravity": )"
+        << gravity << "}}";
+    return run_sketchdrape("validate " + (dir / "sheet.json").string());
+  };
+  const CommandResult up = validate("[0, 9.81, 0]");
+  EXPECT_EQ(up.exit_code, 0) << up.output;
+  EXPECT_NE(up.output.find("sheet.json: /simulate/gravity: gravity [0, 9.81, 0] m/s² points "
+                           "straight up"),
+            std::string::npos)
+      << up.output;
+  EXPECT_NE(up.output.find("Earth's gravity is [0, -9.81, 0]"), std::string::npos) << up.output;
+  EXPECT_NE(up.output.find("; 1 warning(s)"), std::string::npos) << up.output;
+  const CommandResult slanted = validate("[9.81, 9.81, 0]");
+  EXPECT_NE(slanted.output.find("points 45° above the horizontal"), std::string::npos)
+      << slanted.output;
+  const CommandResult sideways = validate("[9.81, 0, 0]");
+  EXPECT_EQ(sideways.output.find("/simulate/gravity"), std::string::npos) << sideways.output;
+  fs::remove_all(dir);
+}
+
 // The trapeze dress of trial 35 with assimp's duck given as its body: the refusal spoke of a
 // curve crossing itself; it says first that the body has no landmarks, so is no standing figure.
 TEST(ValidateCommand, ABodyThatIsNoFigureIsNamedFirst) {
