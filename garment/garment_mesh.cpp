@@ -54,10 +54,15 @@ struct VertexPool {
 // of a region along its boundary, and a mirrored panel and its copy do it at the same place)
 // becomes an interior vertex of valence 2: quads F1 = (b, c, x, a) and F2 = (b, a, y, c) folded
 // onto each other along a-b-c. Such a doublet is removed by merging them into (c, x, a, y),
-// which keeps F1's panel. Returns how many were removed; `faces`/`face_panel` are edited.
-int remove_doublets(std::vector<std::array<int, 4>>& faces, std::vector<int>& face_panel,
-                    size_t vertex_count) {
-  int removed = 0;
+// which keeps F1's panel. Returns each one removed; `faces`/`face_panel` are edited.
+struct Doublet {
+  int vertex = -1;             // b, left in no face
+  int neighbour = -1;          // c: b-c is an edge of the seam b was on
+  int panel = -1, other = -1;  // of F1 and F2
+};
+std::vector<Doublet> remove_doublets(std::vector<std::array<int, 4>>& faces,
+                                     std::vector<int>& face_panel, size_t vertex_count) {
+  std::vector<Doublet> removed;
   for (bool changed = true; changed;) {
     changed = false;
     std::vector<std::vector<int>> incident(vertex_count);
@@ -72,10 +77,12 @@ int remove_doublets(std::vector<std::array<int, 4>>& faces, std::vector<int>& fa
       };
       const std::array<int, 4> f1 = rotated(incident[b][0]), f2 = rotated(incident[b][1]);
       if (f2[1] != f1[3] || f2[3] != f1[1]) continue;  // b is a boundary vertex, not a doublet
+      removed.push_back({static_cast<int>(b), f1[1],
+                         face_panel[static_cast<size_t>(incident[b][0])],
+                         face_panel[static_cast<size_t>(incident[b][1])]});
       faces[static_cast<size_t>(incident[b][0])] = {f1[1], f1[2], f1[3], f2[2]};
       faces.erase(faces.begin() + incident[b][1]);
       face_panel.erase(face_panel.begin() + incident[b][1]);
-      ++removed;
       changed = true;
     }
   }
@@ -471,7 +478,15 @@ int repair_stitched_folds(const GarmentRequest& sketch, const CurveNetwork& net,
 // filled. `faces` (pool ids), `face_panel` and `pool` are renumbered in place.
 void assemble_mesh(std::vector<std::array<int, 4>>& faces, std::vector<int>& face_panel,
                    VertexPool& pool, Garment& garment) {
-  garment.merged_doublets = remove_doublets(faces, face_panel, pool.positions.size());
+  garment.merged_doublets.clear();
+  for (const Doublet& d : remove_doublets(faces, face_panel, pool.positions.size())) {
+    const auto curve = garment.edge_curve.find(std::minmax(d.vertex, d.neighbour));
+    garment.merged_doublets.push_back(
+        {pool.positions[static_cast<size_t>(d.vertex)],
+         garment.panels[static_cast<size_t>(d.panel)].id,
+         garment.panels[static_cast<size_t>(d.other)].id,
+         curve == garment.edge_curve.end() ? std::string() : curve->second});
+  }
   for (GarmentPanel& p : garment.panels) p.faces = 0;
   for (int p : face_panel) ++garment.panels[static_cast<size_t>(p)].faces;
   // Drop vertices no face uses (the centres of removed doublets), keeping order.
@@ -1198,13 +1213,6 @@ Garment build_garment(const GarmentRequest& sketch, const BodySurface& body) {
   };
   check_overlapping_boundaries(sketch, body, net, pool, faces, face_panel, garment);
   check_seam_directions(sketch, body, pool, faces, face_panel, curve_of, garment);
-  // Said after the checks: two panels folded onto each other along a seam leave doublets there,
-  // and the seam check's error names the cause (a warning before it would only add noise).
-  if (const int doublets = garment.merged_doublets; doublets > 0)
-    spdlog::warn(
-        "{} seam vertex(es) had only two quads folded onto each other; merged them into "
-        "one quad each (the seam steps one vertex aside there)",
-        doublets);
   label_panels(sketch, body, faces, face_panel, pool, garment);
   // The grain: a panel on a limb may run along it (panel_grain.hpp); the landmarks are found only
   // then (a body that is not a standing figure has none: every panel is vertical).
