@@ -97,4 +97,12 @@ FacingCues facing_cues(const meshing::TriMesh& body, const BodyLandmarks& landma
   return {head_cue(body, landmarks), feet_cue(body, landmarks)};
 }
 
+std::optional<TurnedFigure> looks_turned(const meshing::TriMesh& body) {
+  if (body.vertex_count() == 0) return std::nullopt;
+  const double width = body.vertices.col(0).maxCoeff() - body.vertices.col(0).minCoeff();
+  const double depth = body.vertices.col(2).maxCoeff() - body.vertices.col(2).minCoeff();
+  if (!(depth > width)) return std::nullopt;
+  return TurnedFigure{depth, width};
+}
+
 }  // namespace sd::garment

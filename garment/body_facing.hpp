@@ -37,4 +37,13 @@ inline constexpr double kFacingLean = 0.2;
 
 FacingCues facing_cues(const meshing::TriMesh& body, const BodyLandmarks& landmarks);
 
+// A normalised figure deeper (along Z) than wide (along X): a figure facing +X or -X in a file
+// read as facing the convention's way, its arms then running front to back (trial 39's Collada
+// human re-exported Z up facing +X: 1.05 m deep, 0.43 m wide). Its depth and width in m; nullopt
+// when it is wider than deep, as a standing figure facing +Z is.
+struct TurnedFigure {
+  double depth = 0.0, width = 0.0;
+};
+std::optional<TurnedFigure> looks_turned(const meshing::TriMesh& body);
+
 }  // namespace sd::garment

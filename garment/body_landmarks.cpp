@@ -11,6 +11,8 @@
 #include <optional>
 #include <stdexcept>
 
+#include "garment/body_facing.hpp"
+
 namespace sd::garment {
 namespace {
 
@@ -384,11 +386,21 @@ BodyLandmarks find_landmarks(const meshing::TriMesh& body) {
   std::vector<Level> levels;
   for (double y = 0.01 * height + 1e-7 * height; y < 0.99 * height; y += step)
     levels.push_back({y, slice(body, y)});
-  const auto fail = [](const std::string& what) {
+  // A figure turned a quarter round (its arms front to back) is the likely cause when it is
+  // deeper than wide: said, with what to give (trial 39, P14: the hint was in docs/bodies.md
+  // only).
+  const std::optional<TurnedFigure> turned = looks_turned(body);
+  const auto fail = [&turned](const std::string& what) {
     throw std::runtime_error(fmt::format(
         "cannot find the body's {}: landmarks need a standing figure, feet on the floor, arms "
-        "apart from the torso",
-        what));
+        "apart from the torso{}",
+        what,
+        turned ? fmt::format("; the figure looks turned: it is {:.2f} m deep (front to back) and "
+                             "{:.2f} m wide, so its arms run front to back; give the way it faces "
+                             "in the file (`info --facing`, in a sketch \"body\": {{\"facing\": "
+                             "...}}; docs/bodies.md)",
+                             turned->depth, turned->width)
+               : std::string()));
   };
 
   // Crotch: the lowest slice above a quarter of the height whose torso outline spans x = 0.

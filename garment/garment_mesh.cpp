@@ -54,10 +54,15 @@ struct VertexPool {
 // of a region along its boundary, and a mirrored panel and its copy do it at the same place)
 // becomes an interior vertex of valence 2: quads F1 = (b, c, x, a) and F2 = (b, a, y, c) folded
 // onto each other along a-b-c. Such a doublet is removed by merging them into (c, x, a, y),
-// which keeps F1's panel. Returns how many were removed; `faces`/`face_panel` are edited.
-int remove_doublets(std::vector<std::array<int, 4>>& faces, std::vector<int>& face_panel,
-                    size_t vertex_count) {
-  int removed = 0;
+// which keeps F1's panel. Returns each one removed; `faces`/`face_panel` are edited.
+struct Doublet {
+  int vertex = -1;             // b, left in no face
+  int neighbour = -1;          // c: b-c is an edge of the seam b was on
+  int panel = -1, other = -1;  // of F1 and F2
+};
+std::vector<Doublet> remove_doublets(std::vector<std::array<int, 4>>& faces,
+                                     std::vector<int>& face_panel, size_t vertex_count) {
+  std::vector<Doublet> removed;
   for (bool changed = true; changed;) {
     changed = false;
     std::vector<std::vector<int>> incident(vertex_count);
@@ -72,10 +77,12 @@ int remove_doublets(std::vector<std::array<int, 4>>& faces, std::vector<int>& fa
       };
       const std::array<int, 4> f1 = rotated(incident[b][0]), f2 = rotated(incident[b][1]);
       if (f2[1] != f1[3] || f2[3] != f1[1]) continue;  // b is a boundary vertex, not a doublet
+      removed.push_back({static_cast<int>(b), f1[1],
+                         face_panel[static_cast<size_t>(incident[b][0])],
+                         face_panel[static_cast<size_t>(incident[b][1])]});
       faces[static_cast<size_t>(incident[b][0])] = {f1[1], f1[2], f1[3], f2[2]};
       faces.erase(faces.begin() + incident[b][1]);
       face_panel.erase(face_panel.begin() + incident[b][1]);
-      ++removed;
       changed = true;
     }
   }
@@ -471,7 +478,15 @@ int repair_stitched_folds(const GarmentRequest& sketch, const CurveNetwork& net,
 // filled. `faces` (pool ids), `face_panel` and `pool` are renumbered in place.
 void assemble_mesh(std::vector<std::array<int, 4>>& faces, std::vector<int>& face_panel,
                    VertexPool& pool, Garment& garment) {
-  garment.merged_doublets = remove_doublets(faces, face_panel, pool.positions.size());
+  garment.merged_doublets.clear();
+  for (const Doublet& d : remove_doublets(faces, face_panel, pool.positions.size())) {
+    const auto curve = garment.edge_curve.find(std::minmax(d.vertex, d.neighbour));
+    garment.merged_doublets.push_back(
+        {pool.positions[static_cast<size_t>(d.vertex)],
+         garment.panels[static_cast<size_t>(d.panel)].id,
+         garment.panels[static_cast<size_t>(d.other)].id,
+         curve == garment.edge_curve.end() ? std::string() : curve->second});
+  }
   for (GarmentPanel& p : garment.panels) p.faces = 0;
   for (int p : face_panel) ++garment.panels[static_cast<size_t>(p)].faces;
   // Drop vertices no face uses (the centres of removed doublets), keeping order.
@@ -564,6 +579,65 @@ void settle_crossings_in_creases(const std::vector<PanelLoop>& loops,
   move(pool, &garment);
 }
 
+// Stage 5a, the panels' outlines: a panel whose curves run over each other (three curves along
+// one line, or a triangle 1 mm tall) encloses no area. Said as that, before the fan check below
+// takes the outline touching itself for two panels that meet at a point (trial 39, P8). Each
+// outline vertex's distance to the rest of the outline, leaving out the stretch within two edge
+// lengths of it along the outline: the other side of the panel for a panel at least one quad
+// wide (an edge length or more), near zero where the outline runs back along itself. Refused
+// when that holds for half the outline's vertices: below a tenth of the edge length (a tip or a
+// narrow spike of a real panel is a few vertices).
+void check_panel_outlines(const GarmentRequest& sketch, const CurveNetwork& net,
+                          const std::vector<PanelLoop>& loops) {
+  for (const PanelLoop& loop : loops) {
+    if (loop.mirror_copy) continue;  // the original's outline, reflected
+    // The outline in order, from the curve pieces' polylines (each piece's first point is the
+    // previous one's last).
+    std::vector<Eigen::Vector3d> outline;
+    std::vector<double> along;  // arc length at each point
+    for (const LoopEdge& e : loop.edges) {
+      const Eigen::MatrixX3d& points = net.edges[static_cast<size_t>(e.edge)].points;
+      for (Eigen::Index k = 1; k < points.rows(); ++k) {
+        const Eigen::Vector3d p = points.row(e.forward ? k : points.rows() - 1 - k).transpose();
+        along.push_back(outline.empty() ? 0.0 : along.back() + (p - outline.back()).norm());
+        outline.push_back(p);
+      }
+    }
+    if (outline.size() < 3) continue;
+    const size_t n = outline.size();
+    const double length = along.back() + (outline.front() - outline.back()).norm();
+    const PanelSpec& spec = sketch.panels[static_cast<size_t>(loop.spec)];
+    const double target = spec.edge_length.value_or(sketch.edge_length);
+    std::vector<double> apart(n, std::numeric_limits<double>::infinity());
+    for (size_t i = 0; i < n; ++i)
+      for (size_t j = 0; j < n; ++j) {
+        const size_t k = (j + 1) % n;
+        const auto gap = [&](size_t m) {
+          const double d = std::abs(along[m] - along[i]);
+          return std::min(d, length - d);
+        };
+        if (gap(j) <= 2 * target || gap(k) <= 2 * target) continue;
+        const Eigen::Vector3d ab = outline[k] - outline[j];
+        const double t =
+            ab.squaredNorm() > 0
+                ? std::clamp((outline[i] - outline[j]).dot(ab) / ab.squaredNorm(), 0.0, 1.0)
+                : 0.0;
+        apart[i] = std::min(apart[i], (outline[j] + t * ab - outline[i]).norm());
+      }
+    std::nth_element(apart.begin(), apart.begin() + static_cast<std::ptrdiff_t>(n / 2),
+                     apart.end());
+    const double typical = apart[n / 2];
+    if (!(typical < 0.1 * target)) continue;
+    sketch.fail(loop.json_path,
+                fmt::format("panel '{}' encloses no area: its curves run over each other (its "
+                            "outline, {:.1f} cm long, runs back along itself, {:.1f} mm from its "
+                            "other side along half its length). A panel's curves go round the "
+                            "piece of cloth it is, like a front's centre front, neckline, "
+                            "shoulder, armhole, side and hem: draw them apart",
+                            loop.id, 100 * length, 1e3 * typical));
+  }
+}
+
 // Stage 5, the seams checked: every vertex's quads form one fan.
 void check_fans(const GarmentRequest& sketch, const CurveNetwork& net, const Garment& garment,
                 const std::vector<std::array<int, 4>>& faces, const std::vector<int>& face_panel,
@@ -613,6 +687,8 @@ void check_fans(const GarmentRequest& sketch, const CurveNetwork& net, const Gar
         names.insert(garment.panels[static_cast<size_t>(face_panel[static_cast<size_t>(f)])].id);
       std::string list;
       for (const std::string& name : names) list += (list.empty() ? "'" : ", '") + name + "'";
+      // One panel touching itself: its outline passes through the point twice.
+      list = names.size() == 1 ? "panel " + list + " meets itself" : "panels " + list + " meet";
       const Eigen::Vector3d& p = pool.positions[v];
       // Curve ends moved onto the mirror plane there, each near enough to it, but farther from
       // their own mirror copies than the tolerance (culottes' inner hems ending 1.2 cm either
@@ -628,7 +704,7 @@ void check_fans(const GarmentRequest& sketch, const CurveNetwork& net, const Gar
         sketch.fail(
             "/panels",
             fmt::format(
-                "panels {} meet only at the point ({:.3f}, {:.3f}, {:.3f}) m, not along a seam: "
+                "{} only at the point ({:.3f}, {:.3f}, {:.3f}) m, not along a seam: "
                 "{} {} {:.1f} cm from the mirror plane x = 0, closer than junction_tolerance "
                 "({:.1f} cm), so {} moved onto it and joined to {} mirror copy, {:.1f} cm away. "
                 "To keep the two sides apart, end the curves at least {:.1f} cm from x = 0 or "
@@ -641,7 +717,7 @@ void check_fans(const GarmentRequest& sketch, const CurveNetwork& net, const Gar
       }
       sketch.fail(
           "/panels",
-          fmt::format("panels {} meet only at the point ({:.3f}, {:.3f}, {:.3f}) m, not along "
+          fmt::format("{} only at the point ({:.3f}, {:.3f}, {:.3f}) m, not along "
                       "a seam: two curves there run along one seam without being one curve. "
                       "Give both panels the same curve (on the other side of a mirrored "
                       "garment, the copy '<curve>.mirror')",
@@ -1124,6 +1200,7 @@ Garment build_garment(const GarmentRequest& sketch, const BodySurface& body) {
                         garment);
   settle_crossings_in_creases(loops, loop_globals, creases, faces, face_panel, pool, garment);
   assemble_mesh(faces, face_panel, pool, garment);
+  check_panel_outlines(sketch, net, loops);
   check_fans(sketch, net, garment, faces, face_panel, pool);
   const auto curve_of = [&](int a, int b) -> std::string {
     for (size_t e = 0; e < net.edges.size(); ++e) {
@@ -1136,13 +1213,6 @@ Garment build_garment(const GarmentRequest& sketch, const BodySurface& body) {
   };
   check_overlapping_boundaries(sketch, body, net, pool, faces, face_panel, garment);
   check_seam_directions(sketch, body, pool, faces, face_panel, curve_of, garment);
-  // Said after the checks: two panels folded onto each other along a seam leave doublets there,
-  // and the seam check's error names the cause (a warning before it would only add noise).
-  if (const int doublets = garment.merged_doublets; doublets > 0)
-    spdlog::warn(
-        "{} seam vertex(es) had only two quads folded onto each other; merged them into "
-        "one quad each (the seam steps one vertex aside there)",
-        doublets);
   label_panels(sketch, body, faces, face_panel, pool, garment);
   // The grain: a panel on a limb may run along it (panel_grain.hpp); the landmarks are found only
   // then (a body that is not a standing figure has none: every panel is vertical).

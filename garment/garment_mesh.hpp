@@ -71,10 +71,16 @@ struct Garment {
   int seam_edges = 0;      // mesh edges shared by two panels
   int parity_changes = 0;  // curve pieces whose count the parity fix changed
   int curve_pieces = 0;    // network edges used by panels
-  // Seam vertices left inside only two quads folded onto each other, merged away (warned): a
-  // side vertex of one quad on a seam a panel shares with its own mirror copy (the shorts' centre
-  // front has one).
-  int merged_doublets = 0;
+  // Seam vertices left inside only two quads folded onto each other, merged away (the quality
+  // gate warns of each, quality_gate.hpp): a side vertex of one quad on a seam a panel shares
+  // with its own mirror copy (the shorts' centre front has one). Each where it was (m), the
+  // panels of its two quads (the merged quad keeps the first's) and the curve of its seam ("" if
+  // not known).
+  struct MergedSeamVertex {
+    Eigen::Vector3d where = Eigen::Vector3d::Zero();
+    std::string panel, other, curve;
+  };
+  std::vector<MergedSeamVertex> merged_doublets;
   // The network curve (its id: "hem", "side.mirror") that each mesh edge on a panel's outline
   // lies on, by the edge's (lower, higher) vertex: which seam or edge of the sketch a piece's
   // outline follows (a curve's own seam allowance). Edges made by merging a doublet are absent.

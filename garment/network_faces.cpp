@@ -15,6 +15,9 @@ namespace {
 
 // A seed closer than this to a curve is on it: which side it means is a guess.
 constexpr double kSeedOnCurve = 0.002;  // metres
+// m: a "point3d" seed deeper inside the body than this is refused; nearer its surface it was
+// likely written by eye on the skin.
+constexpr double kSeedInsideBody = 0.02;
 
 // A curve end at a junction: edge `edge` leaving node `node` (at its start when at_start).
 struct Dart {
@@ -175,7 +178,22 @@ NetworkFaces trace_faces(const CurveNetwork& net, const BodySurface& body) {
 Eigen::Vector3d seed_position(const GarmentRequest& sketch, const PanelSpec& panel,
                               const BodySurface& body) {
   const SeedSpec& seed = *panel.seed;
-  if (seed.point3d) return *seed.point3d;
+  if (seed.point3d) {
+    // Deep inside, the body's surface nearest to the seed is no region the designer pointed at
+    // (a seed at the torso's centre was said to lie on the centre back, the curve nearest to it:
+    // trial 39, P11).
+    const double depth = -body.signed_distance(*seed.point3d);
+    if (depth > kSeedInsideBody)
+      sketch.fail(
+          seed.json_path + "/point3d",
+          fmt::format("the seed of panel '{}', ({:.3f}, {:.3f}, {:.3f}) m, lies inside the "
+                      "body, {:.1f} cm below its surface, so it does not point at a region; "
+                      "give a point on the body inside the panel (`info BODY --slice Y` "
+                      "prints the body's outlines at height Y)",
+                      panel.id, seed.point3d->x(), seed.point3d->y(), seed.point3d->z(),
+                      100 * depth));
+    return *seed.point3d;
+  }
   const ViewFrame frame = view_frame(seed.view);
   Eigen::Vector3d origin, direction;
   frame.ray(*seed.point, 10.0, origin, direction);

@@ -410,4 +410,33 @@ std::vector<QualityWarning> check_quality_tried(const Garment& garment,
   return warnings;
 }
 
+std::vector<QualityWarning> merged_seam_vertex_warnings(const Garment& garment,
+                                                        const BodyLandmarks* landmarks) {
+  std::vector<QualityWarning> warnings;
+  for (const Garment::MergedSeamVertex& d : garment.merged_doublets) {
+    const bool copy = d.panel.ends_with(".mirror"), other_copy = d.other.ends_with(".mirror");
+    if (copy && other_copy) continue;  // the original's warning holds for the copy
+    QualityWarning q;
+    q.panel = copy ? d.other : d.panel;
+    const std::string& other = copy ? d.panel : d.other;
+    q.kind = "merged_seam_vertex";
+    q.count = 1;
+    q.worst = 1.0;
+    q.where = d.where;
+    if (landmarks != nullptr) q.landmark = landmarks->nearest(d.where).name;
+    q.message = fmt::format(
+        "panel '{}': a vertex of {} with panel '{}' lay in only two quads, folded onto each "
+        "other; they were merged into one quad, so the seam steps one vertex aside there (a small "
+        "kink in the drape). The filler's layout of the panel puts it there, not the sketch (a "
+        "different \"edge_length\" for the curve does not move it: docs/garment.md, \"Seam "
+        "vertices folded between a panel and its mirror copy\"), so --strict does not count it; "
+        "{}",
+        q.panel,
+        d.curve.empty() ? std::string("the seam") : fmt::format("the seam on curve '{}'", d.curve),
+        other, place(d.where, q.landmark));
+    warnings.push_back(std::move(q));
+  }
+  return warnings;
+}
+
 }  // namespace sd::garment

@@ -17,7 +17,8 @@
 namespace sd::garment {
 
 // Fixed limits (parse time).
-inline constexpr double kMaxCoordinate = 100.0;       // m: any point, camera or sheet centre
+inline constexpr double kMaxCoordinate = 100.0;  // m: any point, camera or sheet centre
+inline constexpr size_t kMaxIdLength = 64;  // characters of a panel's, a curve's or a group's id
 inline constexpr double kMaxSheetSide = 100.0;        // m: a sheet's width or height
 inline constexpr double kMinBodyHeight = 0.1;         // m: body.height, and a body after scaling
 inline constexpr double kMaxBodyHeight = 5.0;         // m

@@ -120,6 +120,15 @@ void snap_bridging_gaps(std::vector<Eigen::Vector3d>& samples, const BodySurface
   samples = std::move(moved);
 }
 
+// How far a written point moved onto the body, to `placed` on the curve's offset surface: no
+// farther than from the point to the skin, since the curve's own "offset" lifting a point written
+// on the skin is what was asked (trial 39, P12: "offset": 0.5 read as a 49.7 cm move).
+double written_point_move(const BodySurface& body, const Eigen::Vector3d& written,
+                          const Eigen::Vector3d& placed) {
+  return std::min((placed - written).norm(),
+                  (body.closest_point(written).position - written).norm());
+}
+
 }  // namespace
 
 Eigen::Vector3d ViewFrame::plane_point(const Eigen::Vector2d& uv) const {
@@ -349,7 +358,7 @@ ProjectedCurve project_curve(const GarmentRequest& sketch, const CurveSpec& curv
           if ((dense[i] - curve.points3d[k]).squaredNorm() <
               (dense[at] - curve.points3d[k]).squaredNorm())
             at = i;
-        out.written_moves.push_back((placed[at] - curve.points3d[k]).norm());
+        out.written_moves.push_back(written_point_move(*body, curve.points3d[k], placed[at]));
       }
     }
     out.points.resize(static_cast<Eigen::Index>(placed.size()), 3);
@@ -446,32 +455,6 @@ ProjectedCurve project_curve(const GarmentRequest& sketch, const CurveSpec& curv
   const auto [i, j] = find_self_intersection(out.points, curve.closed, 1e-3);
   if (i >= 0) {
     const Eigen::RowVector3d where = out.points.row(i);
-    // Written points snapped onto the body can fold a curve that does not cross itself as
-    // written (points around a limb's axis guessed a few centimetres off, each landing on the
-    // nearest side): say which written point moved farthest, so that the designer looks there.
-    std::string snapped;
-    if (curve.is_3d() && curve.on_body && body != nullptr) {
-      size_t farthest = 0;
-      double moved = -1;
-      for (size_t k = 0; k < curve.points3d.size(); ++k) {
-        const double m =
-            (body->snap_to_offset(curve.points3d[k], curve.offset) - curve.points3d[k]).norm();
-        if (m > moved) moved = m, farthest = k;
-      }
-      const Eigen::Vector3d& written = curve.points3d[farthest];
-      snapped = fmt::format(
-          " once its points are moved onto the body: point {} ({:.3f}, {:.3f}, {:.3f}) moved "
-          "farthest, {:.1f} cm; write the points near the body's surface (`info BODY --slice Y` "
-          "prints its outlines at height Y){}",
-          farthest, written.x(), written.y(), written.z(), moved * 100,
-          moved > kWrittenPointMoveLimit
-              ? std::string(
-                    ". A point that far off was likely written for another body: points given "
-                    "relative to a landmark of the body they were drawn on ({\"at\": "
-                    "\"left_armpit\", \"offset\": [dx, dy, dz]}, docs/sketch-format.md, \"Points "
-                    "relative to a landmark\") follow it onto this one")
-              : std::string());
-    }
     // On an open body (a scan), points snapped near a hole land on its rim, on either side of
     // it: the hole is the cause, not the points (trial 39, P6). 3 cm: about an edge length.
     std::string hole;
@@ -490,10 +473,52 @@ ProjectedCurve project_curve(const GarmentRequest& sketch, const CurveSpec& curv
             h->edges);
       }
     }
+    // Written points snapped onto the body can fold a curve that does not cross itself as
+    // written (points around a limb's axis guessed a few centimetres off, each landing on the
+    // nearest side): say which written point moved farthest, so that the designer looks there.
+    // A point farther off than points are written by eye leads the sentence, unless a hole of
+    // the body is the cause: the crossing is only what the move made of the curve (trial 39,
+    // P11: a curve 1.95 m off the body was told it crosses itself).
+    std::string headline = fmt::format("curve '{}' crosses itself near ({:.3f}, {:.3f}, {:.3f})",
+                                       curve.id, where.x(), where.y(), where.z());
+    std::string snapped;
+    if (curve.is_3d() && curve.on_body && body != nullptr) {
+      size_t farthest = 0;
+      double moved = -1;
+      for (size_t k = 0; k < curve.points3d.size(); ++k) {
+        const double m = written_point_move(*body, curve.points3d[k],
+                                            body->snap_to_offset(curve.points3d[k], curve.offset));
+        if (m > moved) moved = m, farthest = k;
+      }
+      const Eigen::Vector3d& written = curve.points3d[farthest];
+      const std::string distance =
+          moved >= 1.0 ? fmt::format("{:.2f} m", moved) : fmt::format("{:.1f} cm", 100 * moved);
+      const std::string near_surface =
+          "write the points near the body's surface (`info BODY --slice Y` prints its outlines "
+          "at height Y)";
+      if (moved > kWrittenPointMoveLimit && hole.empty()) {
+        const bool inside = body->signed_distance(written) < 0;
+        headline = fmt::format(
+            "curve '{}' is written {} {} the body: its point {} ({:.3f}, {:.3f}, {:.3f}), the one "
+            "that moved farthest, lies that {} its surface, and moved onto it the curve crosses "
+            "itself near ({:.3f}, {:.3f}, {:.3f})",
+            curve.id, distance, inside ? "inside" : "off", farthest, written.x(), written.y(),
+            written.z(), inside ? "deep below" : "far from", where.x(), where.y(), where.z());
+        snapped = fmt::format(
+            ". A point that far off was likely written for another body: points given relative "
+            "to a landmark of the body they were drawn on ({{\"at\": \"left_armpit\", \"offset\": "
+            "[dx, dy, dz]}}, docs/sketch-format.md, \"Points relative to a landmark\") follow it "
+            "onto this one; or {}",
+            near_surface);
+      } else {
+        snapped = fmt::format(
+            " once its points are moved onto the body: point {} ({:.3f}, {:.3f}, {:.3f}) moved "
+            "farthest, {}; {}",
+            farthest, written.x(), written.y(), written.z(), distance, near_surface);
+      }
+    }
     sketch.fail(points_path,
-                fmt::format("curve '{}' crosses itself near ({:.3f}, {:.3f}, {:.3f}){}{}; a curve "
-                            "must not cross itself",
-                            curve.id, where.x(), where.y(), where.z(), snapped, hole));
+                fmt::format("{}{}{}; a curve must not cross itself", headline, snapped, hole));
   }
   if (body != nullptr) check_crossing_seen_from_outside(sketch, curve, points_path, *body, out);
   return out;

@@ -46,7 +46,8 @@ struct ProjectedCurve {
   bool on_body = true;
   int misses = 0;  // samples whose ray missed the body (depth interpolated)
   // points3d curves on the body: per written point, how far (m) the snap onto the body moved
-  // it; -1 for a point given relative to a landmark. Empty for other curves.
+  // it, not counting the curve's own "offset" (no more than the point's distance to the skin);
+  // -1 for a point given relative to a landmark. Empty for other curves.
   std::vector<double> written_moves;
 };
 

@@ -142,6 +142,12 @@ class Reader {
   std::string identifier(const json& value, const std::string& path) const {
     std::string id = text(value, path);
     if (id.empty()) fail(path, "an id must not be empty");
+    // An id names a panel or a curve in every message, in garment.obj's groups and in
+    // report.json: a 100,000-character id was written into all of them (trial 39, P17).
+    if (id.size() > kMaxIdLength)
+      fail(path, fmt::format("an id may have at most {} characters, and '{}' is longer: give a "
+                             "short name, such as 'front' or 'hem_b'",
+                             kMaxIdLength, garment::excerpt(id, 20)));
     const bool ok = std::all_of(id.begin(), id.end(), [](char c) {
       return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
     });

@@ -640,7 +640,7 @@ StepOutcome Simulation::step(double max_step) {
         << (stretched ? "the cloth held stretched beyond the limit" : "without progress")
         << " and the simulated time crawling; it would not finish";
     outcome.failure_reason = why.str();
-    spdlog::error("sim: t = {:.6f} s: {}", time_, outcome.failure_reason);
+    spdlog::debug("sim: t = {:.6f} s: {}", time_, outcome.failure_reason);
     return outcome;
   }
   // Settled once and thrown about again (SimulationSettings::unsettled_retries): no further
@@ -659,7 +659,7 @@ StepOutcome Simulation::step(double max_step) {
         "cleft)",
         settings_.settled_energy, report_.settled_time, unsettled_retry_times_.size(),
         settings_.unsettled_window, last_retry_reason_);
-    spdlog::error("sim: t = {:.6f} s: {}", time_, outcome.failure_reason);
+    spdlog::debug("sim: t = {:.6f} s: {}", time_, outcome.failure_reason);
     return outcome;
   }
   double h = std::min(dt_, max_step);
@@ -715,7 +715,9 @@ StepOutcome Simulation::step(double max_step) {
         outcome.forced = true;
         break;
       }
-      spdlog::error("sim: t = {:.6f} s: step failed at the minimum step {:.3g} s: {}", time_, h,
+      // A debug line: the caller says it once, with where (run: "the simulation failed at t =
+      // ... in panel ..."; trial 39, P13 found this one printed raw before it).
+      spdlog::debug("sim: t = {:.6f} s: step failed at the minimum step {:.3g} s: {}", time_, h,
                     candidate.failure);
       outcome.failure_reason = candidate.failure;
       outcome.failure_vertex = candidate.failure_vertex;

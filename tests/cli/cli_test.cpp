@@ -153,6 +153,22 @@ TEST(Cli, InfoSaysWhichWayTheFigureFaces) {
   EXPECT_NE(turned.output.find("give \"facing\": \"-y\""), std::string::npos) << turned.output;
 }
 
+// Trial 39, P14: a figure facing +x read by the convention (facing -y, Z up) has no landmarks,
+// and `info` said only that landmarks need a standing figure. The built-in body (Z up, facing
+// -y) read with --facing +x is such a figure: told that it looks turned, with the facings to
+// try, along the axis that is neither its up nor the facing it was read with.
+TEST(Cli, InfoSaysATurnedFigureLooksTurned) {
+  const CommandResult r = run_sketchdrape("info builtin --facing +x");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("landmarks   none: cannot find the body's "), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("the figure looks turned: it is "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("so its arms run front to back"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(": try --facing +y or -y\n"), std::string::npos) << r.output;
+  // Facing the convention's way: no such hint.
+  EXPECT_EQ(run_sketchdrape("info builtin").output.find("looks turned"), std::string::npos);
+}
+
 // A slice height that is not a number or misses the figure is a usage mistake (exit 2 with a
 // sentence), not an empty answer: the built-in body spans 0 .. 1.75 m.
 TEST(Cli, InfoSliceOutsideTheBodyOrNotANumberExitsTwo) {

@@ -470,6 +470,11 @@ TEST(DesignDrapeFailure, SaysWhereAndWritesTheLastState) {
       run_sketchdrape("run " + (dir / "fails.json").string() + " -o " + (dir / "run").string());
   EXPECT_EQ(ran.exit_code, 1) << ran.output;
   EXPECT_NE(ran.output.find("in panel '"), std::string::npos) << ran.output;
+  // One error, the run's, and no advice on the fit of a drape that broke (trial 39, P13: the
+  // simulator's raw line came first, and "the garment settled ... slid" after a blow-up).
+  EXPECT_EQ(ran.output.find("sim: t = "), std::string::npos) << ran.output;
+  EXPECT_EQ(ran.output.find("error:"), ran.output.rfind("error:")) << ran.output;
+  EXPECT_EQ(ran.output.find("settled"), std::string::npos) << ran.output;
   EXPECT_NE(ran.output.find(", near the "), std::string::npos) << ran.output;
   EXPECT_NE(ran.output.find("m/s (limit 50)"), std::string::npos) << ran.output;
   EXPECT_TRUE(fs::exists(dir / "run" / "drape-failed.obj"));

@@ -673,6 +673,9 @@ TEST(RunCommand, AFailedDrapeKeepsItsTrace) {
   EXPECT_NE(r.output.find("the steps up to it in " + (out / "trace.jsonl").string()),
             std::string::npos)
       << r.output;
+  // One error line, the run's: not the simulator's raw one before it (trial 39, P13).
+  EXPECT_EQ(r.output.find("sim: t = "), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("error:"), r.output.rfind("error:")) << r.output;
   EXPECT_TRUE(fs::exists(out / "drape-failed.obj"));
   EXPECT_FALSE(fs::exists(out / "report.json"));
   std::ifstream in(out / "trace.jsonl");

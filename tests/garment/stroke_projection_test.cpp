@@ -200,8 +200,11 @@ TEST(StrokeProjection, Points3dFoldedBySnappingNameTheFarthestMove) {
     FAIL() << "the folded curve was accepted";
   } catch (const SketchError& e) {
     EXPECT_EQ(e.json_path(), "/curves/0/points3d");
-    EXPECT_NE(e.sentence().find("once its points are moved onto the body: point 2 (0.014, 1.000, "
-                                "0.014) moved farthest, 28."),
+    // 28 cm: farther than points are written by eye, so the move leads (trial 39, P11).
+    EXPECT_EQ(e.sentence().rfind("curve 'cuff' is written 28.", 0), 0u) << e.sentence();
+    EXPECT_NE(e.sentence().find("cm inside the body: its point 2 (0.014, 1.000, 0.014), the one "
+                                "that moved farthest, lies that deep below its surface, and moved "
+                                "onto it the curve crosses itself near"),
               std::string::npos)
         << e.sentence();
   }
@@ -251,6 +254,33 @@ TEST(StrokeProjection, WrittenPointsMovedFarOntoTheBodyAreNamed) {
   projected = project_curves(sketch, body);
   EXPECT_TRUE(projected[1].written_moves.empty());
   EXPECT_EQ(moved_points_warning(sketch, projected, body), "");
+}
+
+// Trial 39, P12: a curve's own "offset": 0.5 lifted its points, written on the skin, 50 cm out,
+// and that was counted as a move "likely written for another body". The offset the curve asks
+// for is no move: points written on the skin or on the offset surface are both where they were
+// meant to be.
+TEST(StrokeProjection, ACurvesOwnOffsetIsNoMove) {
+  const BodySurface body(meshing::icosphere(kRadius, 5, kCentre));
+  GarmentRequest sketch;
+  sketch.file = "t.json";
+  CurveSpec c;
+  c.id = "lifted";
+  c.json_path = "/curves/0";
+  c.offset = 0.2;
+  // On the skin (r = 0.3), then on the offset surface (r = 0.5), then 10 cm beyond it.
+  c.points3d = {{0.0, 1.0, 0.3}, {0.5, 1.0, 0.0}, {0.0, 1.0, -0.6}};
+  c.at_landmark = {false, false, false};
+  sketch.curves.push_back(c);
+  const std::vector<ProjectedCurve> projected = project_curves(sketch, body);
+  ASSERT_EQ(projected[0].written_moves.size(), 3u);
+  EXPECT_LT(projected[0].written_moves[0], 2e-3);  // the facets: within 2 mm
+  EXPECT_LT(projected[0].written_moves[1], 2e-3);
+  EXPECT_NEAR(projected[0].written_moves[2], 0.1, 2e-3);
+  const std::string said = moved_points_warning(sketch, projected, body);
+  EXPECT_NE(said.find("/curves/0/points3d/2: point 2 of curve 'lifted'"), std::string::npos)
+      << said;
+  EXPECT_NE(said.find("1 of the file's 3 written"), std::string::npos) << said;
 }
 
 TEST(StrokeProjection, SelfIntersectionFound) {

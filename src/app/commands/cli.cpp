@@ -1,17 +1,21 @@
 #include "src/app/commands/cli.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/pattern_formatter.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <memory>
 #include <new>
 #include <stdexcept>
+#include <string_view>
 #include <utility>
 
 #include "garment/panel_tasks.hpp"
+#include "garment/sketch_error.hpp"
 #include "sim/edit_distance.hpp"
 #include "sim/parallel.hpp"
 #include "src/app/version.hpp"
@@ -19,10 +23,28 @@
 namespace sd::app {
 namespace {
 
+// A log line's message as garment::printable writes it (a flag for spdlog's pattern): every
+// error, warning and info line quotes the user's text (ids, fabric names, paths) without a
+// control or bidi character reaching the terminal, whichever stage wrote it (trial 39, P7).
+class PrintableMessage final : public spdlog::custom_flag_formatter {
+ public:
+  void format(const spdlog::details::log_msg& message, const std::tm& /*time*/,
+              spdlog::memory_buf_t& out) override {
+    const std::string text =
+        garment::printable(std::string_view(message.payload.data(), message.payload.size()), true);
+    out.append(text.data(), text.data() + text.size());
+  }
+  std::unique_ptr<custom_flag_formatter> clone() const override {
+    return std::make_unique<PrintableMessage>();
+  }
+};
+
 void configure_logging(const GlobalOptions& global) {
   if (spdlog::get("sketchdrape")) return;  // a second time: for an error after a failed parse
   auto logger = spdlog::stderr_color_mt("sketchdrape");
-  logger->set_pattern("%^%l%$: %v");
+  auto formatter = std::make_unique<spdlog::pattern_formatter>();
+  formatter->add_flag<PrintableMessage>('*').set_pattern("%^%l%$: %*");
+  logger->set_formatter(std::move(formatter));
   spdlog::set_default_logger(logger);
   spdlog::set_level(global.quiet     ? spdlog::level::err
                     : global.verbose ? spdlog::level::debug

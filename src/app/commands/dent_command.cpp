@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include "garment/body.hpp"
+#include "garment/sketch_error.hpp"
 #include "meshing/slice_dent.hpp"
 #include "src/app/commands/cli.hpp"
 
@@ -32,7 +33,7 @@ void run_dent(const DentOptions& options) {
   const meshing::SliceDent dent = meshing::slice_dent(mesh.mesh, options.from, options.to);
   std::cout << fmt::format(
       "{}: slice dent {:.4f} m at {:.0f} % of the height ({} slices from {:.0f} % to {:.0f} %)\n",
-      options.mesh, dent.depth,
+      garment::printable(options.mesh), dent.depth,
       100 * (dent.height - mesh.mesh.vertices.col(1).minCoeff()) /
           std::max(1e-12,
                    mesh.mesh.vertices.col(1).maxCoeff() - mesh.mesh.vertices.col(1).minCoeff()),

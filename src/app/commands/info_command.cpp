@@ -10,6 +10,7 @@
 #include "garment/body.hpp"
 #include "garment/body_facing.hpp"
 #include "garment/body_landmarks.hpp"
+#include "garment/sketch_error.hpp"
 #include "src/app/commands/cli.hpp"
 
 namespace sd::app {
@@ -88,6 +89,14 @@ void run_info(const InfoOptions& options) {
     landmarks = garment::find_landmarks(body.mesh);
   } catch (const std::runtime_error& e) {
     landmark_problem = e.what();
+    // Turned a quarter round: it faces along the file's third axis, the one neither up nor the
+    // facing it was read with (trial 39, P14).
+    if (garment::looks_turned(body.mesh)) {
+      const int third = 3 - raw.up.axis - raw.facing.axis;
+      landmark_problem +=
+          fmt::format(": try --facing {} or {}", garment::AxisDirection{third, 1}.name(),
+                      garment::AxisDirection{third, -1}.name());
+    }
   }
   if (landmarks) {
     nlohmann::json points = nlohmann::json::object();
@@ -157,21 +166,22 @@ void run_info(const InfoOptions& options) {
       "            bbox [{:.3f} {:.3f} {:.3f}] .. [{:.3f} {:.3f} {:.3f}] m\n"
       "topology    closed {}, edge-manifold {}, oriented {}, {} component(s), {} boundary "
       "edge(s), {} non-manifold edge(s), {} degenerate face(s)\n",
-      raw.source, body.mesh.vertex_count(), body.mesh.face_count(), raw.meshes, b.extent().x(),
-      b.extent().y(), b.extent().z(), b.min.x(), b.min.y(), b.min.z(), b.max.x(), b.max.y(),
-      b.max.z(), raw.up.name(), raw.up_inferred ? "inferred" : "given", raw.facing.name(),
-      raw.height, raw.scale, raw.scale_rule, box.extent().y(), box.min.x(), box.min.y(),
-      box.min.z(), box.max.x(), box.max.y(), box.max.z(), topo.closed() ? "yes" : "no",
+      garment::printable(raw.source), body.mesh.vertex_count(), body.mesh.face_count(), raw.meshes,
+      b.extent().x(), b.extent().y(), b.extent().z(), b.min.x(), b.min.y(), b.min.z(), b.max.x(),
+      b.max.y(), b.max.z(), raw.up.name(), raw.up_inferred ? "inferred" : "given",
+      raw.facing.name(), raw.height, raw.scale, raw.scale_rule, box.extent().y(), box.min.x(),
+      box.min.y(), box.min.z(), box.max.x(), box.max.y(), box.max.z(), topo.closed() ? "yes" : "no",
       topo.edge_manifold() ? "yes" : "no", topo.oriented() ? "yes" : "no", topo.components,
       topo.boundary_edges, topo.non_manifold_edges, topo.degenerate_faces);
   if (raw.flipped_inside_out)
     std::cout << fmt::format(
         "orientation inside out in the file (volume {:.4g} units³): faces flipped\n",
         raw.signed_volume);
-  for (const std::string& warning : body.warnings) std::cout << "warning     " << warning << "\n";
+  for (const std::string& warning : body.warnings)
+    std::cout << "warning     " << garment::printable(warning) << "\n";
   std::cout << slice_text;
   if (!landmarks) {
-    std::cout << fmt::format("landmarks   none: {}\n", landmark_problem);
+    std::cout << fmt::format("landmarks   none: {}\n", garment::printable(landmark_problem));
     return;
   }
   std::cout << "landmarks   (m, normalised frame: x to the body's left, y up, z forward)\n";

@@ -12,6 +12,7 @@
 
 #include "garment/body_surface.hpp"
 #include "garment/garment_mesh.hpp"
+#include "garment/sketch_error.hpp"
 #include "garment/sketch_inputs.hpp"
 #include "garment/sketch_ranges.hpp"
 #include "scene/sketch_file.hpp"
@@ -56,7 +57,7 @@ void run_pattern(const PatternOptions& options) {
   std::cout << fmt::format(
       "{} → {}: {} pieces{}, {:.0f} mm of {:.0f} mm wide fabric, efficiency {:.0f} %, seams "
       "within {:.2f} %, {} warning(s)\n",
-      sketch.file, options.out, layout.pieces.size(),
+      garment::printable(sketch.file), garment::printable(options.out), layout.pieces.size(),
       layout.pairs > 0 ? fmt::format(" ({} mirror pair{} drawn once, cut 2)", layout.pairs,
                                      layout.pairs == 1 ? "" : "s")
                        : std::string(),

@@ -11,6 +11,7 @@
 #include <memory>
 #include <mutex>
 
+#include "garment/sketch_error.hpp"
 #include "scene/sketch_file.hpp"
 #include "src/app/commands/cli.hpp"
 #include "src/app/pipeline/cloth_scene.hpp"
@@ -104,7 +105,10 @@ void run_validate(const ValidateOptions& options) {
                   ? fmt::format("; {} mesh quality warning(s)", total)
                   : fmt::format("; {} warning(s), {} of them mesh quality warning(s)", total,
                                 warnings.size());
-  std::cout << fmt::format("{}: ok ({}, fabric {}){}\n", sketch.file, what, fabric, counted);
+  // The file's own text (its path, a fabric file's "name") as every message quotes it.
+  std::cout << garment::printable(
+                   fmt::format("{}: ok ({}, fabric {}){}", sketch.file, what, fabric, counted))
+            << "\n";
   if (options.strict && !warnings.empty())
     throw std::runtime_error(
         fmt::format("{}: {} mesh quality warning(s) and --strict", sketch.file, warnings.size()));

@@ -23,6 +23,10 @@ std::vector<garment::QualityWarning> quality_warnings(const garment::Garment& ga
   std::vector<garment::QualityWarning> warnings =
       garment::check_quality_tried(garment, sketch, body.mesh, landmarks ? &*landmarks : nullptr);
   for (const garment::QualityWarning& w : warnings) spdlog::warn("{}: {}", sketch.file, w.message);
+  // Told here, once per command, with the gate's (not counted by --strict: quality_gate.hpp).
+  for (const garment::QualityWarning& w :
+       garment::merged_seam_vertex_warnings(garment, landmarks ? &*landmarks : nullptr))
+    spdlog::warn("{}: {}", sketch.file, w.message);
   return warnings;
 }
 

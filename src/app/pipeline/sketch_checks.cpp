@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <numbers>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -106,6 +107,20 @@ void check_sketch(const scene::Sketch& sketch) {
   (void)simulation_settings(sketch);
   for (const std::string& warning : fabric_warnings(sketch)) spdlog::warn("{}", warning);
   for (const std::string& warning : gather_warnings(sketch)) spdlog::warn("{}", warning);
+  for (const std::string& warning : gravity_warnings(sketch)) spdlog::warn("{}", warning);
+}
+
+std::vector<std::string> gravity_warnings(const scene::Sketch& sketch) {
+  const Eigen::Vector3d& g = sketch.simulate.gravity;
+  if (!(g.y() > 0.0)) return {};
+  const double above = std::asin(std::min(1.0, g.y() / g.norm())) * 180.0 / std::numbers::pi;
+  return {fmt::format(
+      "{}: /simulate/gravity: gravity [{:g}, {:g}, {:g}] m/s² points {}: +y is the body's up "
+      "(docs/bodies.md), so the cloth falls off the body away from its feet, and the drape shows "
+      "no fit; Earth's gravity is [0, -9.81, 0] (leave \"gravity\" out for it)",
+      sketch.file, g.x(), g.y(), g.z(),
+      above > 89.5 ? std::string("straight up")
+                   : fmt::format("{:.0f}° above the horizontal", above))};
 }
 
 std::vector<std::string> gather_warnings(const scene::Sketch& sketch) {

@@ -29,6 +29,12 @@ std::vector<std::string> fabric_warnings(const scene::Sketch& sketch);
 // what to change. Logged by check_sketch.
 std::vector<std::string> gather_warnings(const scene::Sketch& sketch);
 
+// Gravity with a part along +y, the body's up (trial 39, P13: [0, 9.81, 0] drew no word): one
+// "<file>: /simulate/gravity: <sentence>" line, else none. A warning, not a refusal: a scene may
+// ask for any direction (stress turns it about), but a garment falls off its body. Logged by
+// check_sketch.
+std::vector<std::string> gravity_warnings(const scene::Sketch& sketch);
+
 // What a run may use: --max-memory (default: 60 % of the memory the system has available now)
 // and --max-time (default: none).
 struct RunLimits {
