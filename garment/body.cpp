@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <assimp/Importer.hpp>
 #include <cctype>
 #include <cmath>
@@ -82,6 +83,7 @@ Eigen::Matrix3d frame_rotation(const AxisDirection& up, const AxisDirection& fac
 struct CleanupCounts {
   Eigen::Index merged_vertices = 0;
   Eigen::Index dropped_faces = 0;
+  Eigen::Index duplicate_faces = 0;  // a face given again on the same three corners
   Eigen::Index unused_vertices = 0;
 };
 
@@ -109,8 +111,10 @@ CleanupCounts weld_and_clean(meshing::TriMesh& mesh, double tolerance, double mi
       }
     }
   }
-  // Keep faces with three distinct welded corners and a non-zero area.
+  // Keep faces with three distinct welded corners and a non-zero area, each once: an export that
+  // writes every face twice (trial 40), in either orientation, made every edge non-manifold.
   std::vector<Eigen::Vector3i> faces;
+  std::set<std::array<int, 3>> corners_seen;
   faces.reserve(static_cast<size_t>(mesh.face_count()));
   for (Eigen::Index f = 0; f < mesh.face_count(); ++f) {
     Eigen::Vector3i t;
@@ -120,6 +124,12 @@ CleanupCounts weld_and_clean(meshing::TriMesh& mesh, double tolerance, double mi
     if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2] ||
         !(0.5 * (b - a).cross(c - a).norm() > min_area)) {
       ++counts.dropped_faces;
+      continue;
+    }
+    std::array<int, 3> corners{t[0], t[1], t[2]};
+    std::sort(corners.begin(), corners.end());
+    if (!corners_seen.insert(corners).second) {
+      ++counts.duplicate_faces;
       continue;
     }
     faces.push_back(t);
@@ -273,6 +283,11 @@ meshing::TriMesh read_body_mesh(const std::string& file, Body& body) {
   const CleanupCounts cleanup = weld_and_clean(mesh, 1e-6 * diagonal, 1e-12 * diagonal * diagonal);
   if (mesh.face_count() == 0)
     throw BodyError("body file '" + file + "' has no triangle with a non-zero area");
+  if (cleanup.duplicate_faces > 0)
+    body.warnings.push_back(fmt::format(
+        "{} of the {} faces of body file '{}' are given twice (on the same three corners, as a "
+        "doubled export writes them); the copies were removed",
+        cleanup.duplicate_faces, tris.size(), file));
   if (cleanup.dropped_faces > 0)
     body.warnings.push_back(
         fmt::format("dropped {} degenerate triangle(s) (zero area or repeated corners)",

@@ -250,6 +250,21 @@ TEST(Body, DegenerateFacesAreDroppedWithAWarning) {
   EXPECT_NE(body.warnings[0].find("degenerate"), std::string::npos);
 }
 
+// Trial 40: an export that wrote every face twice made every edge "shared by more than two
+// triangles". The copies (one as given, one turned over) are removed and named with the file.
+TEST(Body, DuplicatedFacesAreRemovedWithAWarning) {
+  const std::string obj = tetrahedron_obj("f 1 3 2\nf 4 2 1\nf 1 4 3\nf 4 3 2\n");
+  const std::string file = write_temp("doubled.obj", obj);
+  const Body body = load_body(file);
+  EXPECT_EQ(body.mesh.face_count(), 4);
+  ASSERT_EQ(body.warnings.size(), 1u) << body.warnings.back();
+  EXPECT_NE(body.warnings[0].find("4 of the 8 faces of body file '" + file + "' are given twice"),
+            std::string::npos)
+      << body.warnings[0];
+  // A mesh without copies says nothing (the warning cannot come from elsewhere).
+  EXPECT_TRUE(load_body(write_temp("tet.obj", tetrahedron_obj())).warnings.empty());
+}
+
 TEST(Body, NonManifoldEdgeIsAWarning) {
   const std::string obj = tetrahedron_obj("v 1 1 -1\nf 1 2 5\n");
   const Body body = load_body(write_temp("nonmanifold.obj", obj));
