@@ -266,8 +266,16 @@ meshing::TriMesh read_body_mesh(const std::string& file, Body& body) {
         "modifier",
         file, tris.size(), kMaxBodyTriangles));
   for (const auto& p : points)
-    if (!p.allFinite())
+    if (!p.allFinite()) {
+      // In an OBJ the line, as for a vertex cut short (trial 40: "v inf 0 0" on line 101).
+      std::string ext = std::filesystem::path(file).extension().string();
+      std::transform(ext.begin(), ext.end(), ext.begin(),
+                     [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+      if (ext == ".obj")
+        if (const std::optional<std::string> defect = obj_defect(file))
+          throw BodyError("body file '" + file + "' cannot be read: " + *defect);
       throw BodyError("body file '" + file + "' has NaN or infinite vertex coordinates");
+    }
 
   meshing::TriMesh mesh;
   mesh.vertices.resize(static_cast<Eigen::Index>(points.size()), 3);

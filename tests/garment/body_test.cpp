@@ -239,6 +239,13 @@ TEST(Body, BadFilesGiveASentence) {
       "v nan 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
   const std::string nan_error = body_error(write_temp("nan.obj", nan_obj));
   EXPECT_NE(nan_error, "");
+  // Trial 40: an infinite coordinate is named by its line, as a vertex cut short is.
+  const std::string inf_obj =
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 inf\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  const std::string inf_error = body_error(write_temp("inf.obj", inf_obj));
+  EXPECT_NE(inf_error.find("line 4 ('v 0 0 inf') is not a vertex of three finite numbers"),
+            std::string::npos)
+      << inf_error;
 }
 
 TEST(Body, DegenerateFacesAreDroppedWithAWarning) {
