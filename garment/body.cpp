@@ -717,6 +717,25 @@ Body load_body(const std::string& path, const BodyOptions& options) {
   return body;
 }
 
+std::string upside_down_advice(const Body& body) {
+  // Turned over about the facing axis (a proper rotation: still facing +Z), feet back on the
+  // floor.
+  meshing::TriMesh turned = body.mesh;
+  turned.vertices.col(0) *= -1.0;
+  turned.vertices.col(1) *= -1.0;
+  turned.vertices.col(1).array() -= turned.vertices.col(1).minCoeff();
+  try {
+    find_landmarks(turned);
+  } catch (const std::runtime_error&) {
+    return "";
+  }
+  const AxisDirection down{body.raw.up.axis, -body.raw.up.sign};
+  return fmt::format(
+      "the figure looks upside down (it has landmarks once turned over): give "
+      "\"up\": \"{}\"",
+      down.name());
+}
+
 meshing::TriMesh load_body_pose(const std::string& path, const Body& rest) {
   Body scratch;
   meshing::TriMesh mesh = read_body_mesh(path, scratch);

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <string>
 
+#include "garment/body_landmarks.hpp"
 #include "garment/body_up_error.hpp"
 
 namespace sd::garment {
@@ -270,6 +271,21 @@ TEST(Body, DuplicatedFacesAreRemovedWithAWarning) {
       << body.warnings[0];
   // A mesh without copies says nothing (the warning cannot come from elsewhere).
   EXPECT_TRUE(load_body(write_temp("tet.obj", tetrahedron_obj())).warnings.empty());
+}
+
+// Trial 40: an inches body with its head towards -x stood on its head by the inferred +x, and the
+// only message was that it had no landmarks. Turned over it has them: that is said, with the up.
+TEST(Body, UpsideDownFigureIsSaidToBeOne) {
+  BodyOptions head_down;
+  head_down.up = AxisDirection{2, -1};  // the file is Z-up
+  const Body body = load_body("builtin", head_down);
+  EXPECT_THROW(find_landmarks(body.mesh), std::runtime_error);
+  EXPECT_NE(upside_down_advice(body).find("the figure looks upside down (it has landmarks once "
+                                          "turned over): give \"up\": \"+z\""),
+            std::string::npos)
+      << upside_down_advice(body);
+  // Upright, turned over it has none: nothing to say.
+  EXPECT_EQ(upside_down_advice(load_body("builtin")), "");
 }
 
 TEST(Body, NonManifoldEdgeIsAWarning) {

@@ -88,6 +88,8 @@ void run_info(const InfoOptions& options) {
     landmarks = garment::find_landmarks(body.mesh);
   } catch (const std::runtime_error& e) {
     landmark_problem = e.what();
+    if (const std::string turned = garment::upside_down_advice(body); !turned.empty())
+      landmark_problem = turned + "; " + landmark_problem;
   }
   if (landmarks) {
     nlohmann::json points = nlohmann::json::object();
