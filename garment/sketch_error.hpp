@@ -30,6 +30,20 @@ inline std::string excerpt(std::string_view text, size_t max_chars = 60) {
   return out;
 }
 
+// The length of the well-formed UTF-8 sequence of several bytes starting at text[i], 0 when
+// there is none there (an ASCII byte, or a byte of another encoding such as Latin-1's 0xE9).
+inline size_t utf8_sequence_length(std::string_view text, size_t i) {
+  const auto lead = static_cast<unsigned char>(text[i]);
+  const size_t length = lead >= 0xc2 && lead <= 0xdf   ? 2
+                        : lead >= 0xe0 && lead <= 0xef ? 3
+                        : lead >= 0xf0 && lead <= 0xf4 ? 4
+                                                       : 0;
+  if (length == 0 || i + length > text.size()) return 0;
+  for (size_t k = 1; k < length; ++k)
+    if ((static_cast<unsigned char>(text[i + k]) & 0xc0) != 0x80) return 0;
+  return length;
+}
+
 class SketchError : public std::invalid_argument {
  public:
   // `json_path` may be empty (a syntax error has a line and column instead, put in the sentence).
@@ -50,10 +64,16 @@ class SketchError : public std::invalid_argument {
     std::string text = file + ": ";
     if (!path.empty()) text += path + ": ";
     text += sentence;
+    // Nor a byte that is not UTF-8 (trial 40: a Latin-1 'é' was echoed raw).
     std::string out;
-    for (const char c : text) {
+    for (size_t i = 0; i < text.size(); ++i) {
+      const char c = text[i];
       const auto u = static_cast<unsigned char>(c);
-      if ((u < 0x20 && c != '\n' && c != '\t') || u == 0x7f) {
+      const size_t sequence = utf8_sequence_length(text, i);
+      if (sequence > 1) {
+        out.append(text, i, sequence);
+        i += sequence - 1;
+      } else if ((u < 0x20 && c != '\n' && c != '\t') || u >= 0x7f) {
         char hex[5];
         std::snprintf(hex, sizeof hex, "\\x%02x", u);
         out += hex;
