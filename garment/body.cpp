@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <assimp/Importer.hpp>
 #include <cctype>
 #include <cmath>
@@ -82,6 +83,7 @@ Eigen::Matrix3d frame_rotation(const AxisDirection& up, const AxisDirection& fac
 struct CleanupCounts {
   Eigen::Index merged_vertices = 0;
   Eigen::Index dropped_faces = 0;
+  Eigen::Index duplicate_faces = 0;  // a face given again on the same three corners
   Eigen::Index unused_vertices = 0;
 };
 
@@ -109,8 +111,10 @@ CleanupCounts weld_and_clean(meshing::TriMesh& mesh, double tolerance, double mi
       }
     }
   }
-  // Keep faces with three distinct welded corners and a non-zero area.
+  // Keep faces with three distinct welded corners and a non-zero area, each once: an export that
+  // writes every face twice (trial 40), in either orientation, made every edge non-manifold.
   std::vector<Eigen::Vector3i> faces;
+  std::set<std::array<int, 3>> corners_seen;
   faces.reserve(static_cast<size_t>(mesh.face_count()));
   for (Eigen::Index f = 0; f < mesh.face_count(); ++f) {
     Eigen::Vector3i t;
@@ -120,6 +124,12 @@ CleanupCounts weld_and_clean(meshing::TriMesh& mesh, double tolerance, double mi
     if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2] ||
         !(0.5 * (b - a).cross(c - a).norm() > min_area)) {
       ++counts.dropped_faces;
+      continue;
+    }
+    std::array<int, 3> corners{t[0], t[1], t[2]};
+    std::sort(corners.begin(), corners.end());
+    if (!corners_seen.insert(corners).second) {
+      ++counts.duplicate_faces;
       continue;
     }
     faces.push_back(t);
@@ -256,8 +266,16 @@ meshing::TriMesh read_body_mesh(const std::string& file, Body& body) {
         "modifier",
         file, tris.size(), kMaxBodyTriangles));
   for (const auto& p : points)
-    if (!p.allFinite())
+    if (!p.allFinite()) {
+      // In an OBJ the line, as for a vertex cut short (trial 40: "v inf 0 0" on line 101).
+      std::string ext = std::filesystem::path(file).extension().string();
+      std::transform(ext.begin(), ext.end(), ext.begin(),
+                     [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+      if (ext == ".obj")
+        if (const std::optional<std::string> defect = obj_defect(file))
+          throw BodyError("body file '" + file + "' cannot be read: " + *defect);
       throw BodyError("body file '" + file + "' has NaN or infinite vertex coordinates");
+    }
 
   meshing::TriMesh mesh;
   mesh.vertices.resize(static_cast<Eigen::Index>(points.size()), 3);
@@ -273,6 +291,11 @@ meshing::TriMesh read_body_mesh(const std::string& file, Body& body) {
   const CleanupCounts cleanup = weld_and_clean(mesh, 1e-6 * diagonal, 1e-12 * diagonal * diagonal);
   if (mesh.face_count() == 0)
     throw BodyError("body file '" + file + "' has no triangle with a non-zero area");
+  if (cleanup.duplicate_faces > 0)
+    body.warnings.push_back(fmt::format(
+        "{} of the {} faces of body file '{}' are given twice (on the same three corners, as a "
+        "doubled export writes them); the copies were removed",
+        cleanup.duplicate_faces, tris.size(), file));
   if (cleanup.dropped_faces > 0)
     body.warnings.push_back(
         fmt::format("dropped {} degenerate triangle(s) (zero area or repeated corners)",
@@ -692,6 +715,25 @@ Body load_body(const std::string& path, const BodyOptions& options) {
   for (const auto& warning : body.warnings)
     if (said.insert(fmt::format("{}: {}", file, warning)).second) spdlog::warn("{}", warning);
   return body;
+}
+
+std::string upside_down_advice(const Body& body) {
+  // Turned over about the facing axis (a proper rotation: still facing +Z), feet back on the
+  // floor.
+  meshing::TriMesh turned = body.mesh;
+  turned.vertices.col(0) *= -1.0;
+  turned.vertices.col(1) *= -1.0;
+  turned.vertices.col(1).array() -= turned.vertices.col(1).minCoeff();
+  try {
+    find_landmarks(turned);
+  } catch (const std::runtime_error&) {
+    return "";
+  }
+  const AxisDirection down{body.raw.up.axis, -body.raw.up.sign};
+  return fmt::format(
+      "the figure looks upside down (it has landmarks once turned over): give "
+      "\"up\": \"{}\"",
+      down.name());
 }
 
 meshing::TriMesh load_body_pose(const std::string& path, const Body& rest) {

@@ -82,6 +82,11 @@ std::string builtin_body_path();
 // unused vertices (with a warning), then normalises. Throws BodyError on unusable input.
 Body load_body(const std::string& path, const BodyOptions& options = {});
 
+// For a body without landmarks: "the figure looks upside down: give "up": "-x"" when its
+// landmarks are found once it is turned over (trial 40: an inches body with its head towards -x
+// stood on its head by the inferred +x), else "". Costs a landmark search: only on failure.
+std::string upside_down_advice(const Body& body);
+
 // Refuses, before assimp reads it, a mesh file whose OFF or PLY header would make assimp reserve
 // more memory than the file could fill or read for ever (a PLY header without an end_header
 // line, or with numbers or binary bytes in it). `what` opens the message ("body file", "garment

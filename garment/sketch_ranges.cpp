@@ -34,9 +34,18 @@ std::string outside_sentence(const Eigen::Vector3d& p, const Reach& reach,
       axis = k;
       break;
     }
+  // A body far shorter or taller than a person (trial 40: "height": 0.1) is the likelier slip
+  // than the point: asked first.
+  const std::string tall =
+      reach.height < 1.0 || reach.height > 2.5
+          ? fmt::format(
+                "{:.2f} m tall: is that meant? A body's \"height\" is in metres, a "
+                "grown figure's 1.5-1.9",
+                reach.height)
+          : fmt::format("{:.2f} m tall", reach.height);
   return fmt::format(
-      "{} is too far from the body ({:.2f} m tall): points must lie within {:.2f} m of it, and {}",
-      what, reach.height, kBodyMarginHeights * reach.height,
+      "{} is too far from the body ({}): points must lie within {:.2f} m of it, and {}", what, tall,
+      kBodyMarginHeights * reach.height,
       out_of_range_sentence(p[axis], reach.low[axis], reach.high[axis],
                             fmt::format("{} =", kAxis[axis]),
                             {reach.low[axis] + kBodyMarginHeights * reach.height,

@@ -58,8 +58,33 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
         word == "nan" || word == "inf"
             ? "; NaN and Infinity are not numbers in JSON: every number must be finite"
             : "";
-    r.fail("", fmt::format("{}: the file is not valid JSON ({}){}", position_of(text, e.byte),
-                           detail, hint));
+    // The common slips in a designer's words (trial 40 P13): the parser's say "invalid literal".
+    const size_t at = std::min<size_t>(e.byte, text.size());
+    const char last = at > 0 ? text[at - 1] : '\0';
+    size_t before = at > 0 ? at - 1 : 0;
+    while (before > 0 && std::isspace(static_cast<unsigned char>(text[before - 1]))) --before;
+    std::string plain;
+    if (last == '+')
+      plain = "a number cannot start with '+': write 0.1, not +0.1";
+    else if ((last == 'x' || last == 'X') && at >= 2 && text[at - 2] == '0')
+      plain = "numbers are decimal in JSON: write 16, not 0x10";
+    else if (last == '\'')
+      plain = "text is written in double quotes (\"top\"), not single quotes ('top')";
+    else if ((last == ']' || last == '}') && before > 0 && text[before - 1] == ',')
+      plain = fmt::format(
+          "a comma before '{}' (after the last item) is not allowed in JSON: "
+          "remove it",
+          last);
+    if (!plain.empty())
+      r.fail("",
+             fmt::format("{}: the file is not valid JSON: {}", position_of(text, e.byte), plain));
+    const std::string not_utf8 =
+        detail.find("ill-formed UTF-8") != std::string::npos
+            ? "; the file is not UTF-8 text (Latin-1 or a Windows code page?): save it as UTF-8 "
+              "in the editor"
+            : "";
+    r.fail("", fmt::format("{}: the file is not valid JSON ({}){}{}", position_of(text, e.byte),
+                           detail, hint, not_utf8));
   }
   r.require_object(root, "", "a sketch file");
   r.check_keys(root, "",

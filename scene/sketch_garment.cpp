@@ -153,8 +153,10 @@ const BodyLandmarks& sketch_landmarks(const Reader& r, const Sketch& sk, const s
           sk.resolve(spec.mesh).string(), doubt);
     return landmarks;
   } catch (const std::runtime_error& e) {
+    const std::string upside_down = upside_down_advice(body);
     r.fail(spec_path == "/body" ? path : spec_path,
-           fmt::format("a point is given relative to a landmark, but the body {}has none: {}",
+           fmt::format("{}a point is given relative to a landmark, but the body {}has none: {}",
+                       upside_down.empty() ? "" : upside_down + "; ",
                        spec_path == "/body" ? "" : "the offsets were written for ", e.what()));
   }
 }

@@ -154,6 +154,13 @@ void parse_simulate(const Reader& r, const json& j, SimulateSpec& sim) {
              fmt::format("a time step of {:.6g} s is outside {:g} .. {:g} s (the step control "
                          "shortens steps itself when it needs to; 1/60 s is the default)",
                          sim.time_step, kMinTimeStep, kMaxTimeStep));
+    // Trial 40: 0.1 s steps for 1e-5 s ran one clipped step and wrote the garment as drawn.
+    if (sim.duration_given && sim.duration < sim.time_step)
+      r.fail(path + "/duration",
+             fmt::format("a drape of {:.6g} s is shorter than one time step ({:.6g} s, "
+                         "\"time_step\"): the cloth would not move; a garment settles within a "
+                         "few seconds (e.g. \"duration\": 3)",
+                         sim.duration, sim.time_step));
   }
   if (j.contains("integrator")) {
     sim.integrator = r.text(j["integrator"], path + "/integrator");

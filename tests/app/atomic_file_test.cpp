@@ -37,6 +37,28 @@ TEST(AtomicFile, UnwritableFolderThrows) {
   EXPECT_THROW(write_file_atomically("/nonexistent-folder/a.txt", "x"), std::runtime_error);
 }
 
+// Trial 40: -o a dangling symbolic link said "cannot create folder ... (File exists)" of a folder
+// the user could not see. It says where the link leads.
+TEST(OutputFolder, DanglingSymbolicLinkIsSaidToBeOne) {
+  const fs::path dir = fresh_dir("dangling");
+  fs::create_symlink(dir / "gone" / "deeper", dir / "link");
+  try {
+    check_output_folder(dir / "link");
+    ADD_FAILURE() << "a dangling link was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(
+        std::string(e.what()).find("'" + (dir / "link").string() + "' is a symbolic link to '" +
+                                   (dir / "gone" / "deeper").string() + "', which does not exist"),
+        std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir / "gone"));
+  // A link to a folder is written through (outtests h50).
+  fs::create_directory(dir / "real");
+  fs::create_directory_symlink(dir / "real", dir / "good");
+  EXPECT_NO_THROW(check_output_folder(dir / "good"));
+}
+
 TEST(StagedOutputs, NothingAppearsUntilCommit) {
   const fs::path dir = fresh_dir("commit");
   StagedOutputs outputs;

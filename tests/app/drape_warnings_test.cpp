@@ -140,6 +140,28 @@ TEST(DrapeWarnings, NotAtRestButSettlingSaysHowLongItWasStill) {
   EXPECT_EQ(text.find("still moves"), std::string::npos) << text;
 }
 
+// Trial 40: "duration": 1e-5 with 0.1 s steps ran one step, and the still cloth was called "very
+// likely its final shape". Still after less than one at-rest window says nothing of the shape.
+TEST(DrapeWarnings, NotAtRestAfterLessThanAWindowClaimsNoFinalShape) {
+  StillMoving where;
+  where.at = {0.0, 1.2, 0.1};
+  where.vertices = 42;
+  where.still_s = 1e-5;
+  const std::string text = not_at_rest_warning("h29.json", 1e-5, 0.005, 0.25, where);
+  EXPECT_NE(text.find("h29.json: the drape ran only 1e-05 s, shorter than the 0.25 s"),
+            std::string::npos)
+      << text;
+  EXPECT_EQ(text.find("final shape."), std::string::npos) << text;
+  EXPECT_EQ(text.find("settling"), std::string::npos) << text;
+  EXPECT_NE(text.find("{\"duration\": 3}"), std::string::npos) << text;
+  // Moving after a short run: where it moves, as before.
+  where.still_s = 0.0;
+  where.moving = 10;
+  where.speed = 0.3;
+  EXPECT_NE(not_at_rest_warning("h29.json", 0.2, 0.005, 0.25, where).find("still moves"),
+            std::string::npos);
+}
+
 // Trial 35: the strapless dress draped flat was still moving at 14 cm/s after 10 s and was told
 // to double the duration; "rest_ramp": 1, which docs/sketch-format.md recommends for that, made
 // it rest at 2.98 s. From the flat pattern released at once the ramp comes first; with a ramp

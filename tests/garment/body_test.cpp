@@ -7,6 +7,7 @@
 #include <fstream>
 #include <string>
 
+#include "garment/body_landmarks.hpp"
 #include "garment/body_up_error.hpp"
 
 namespace sd::garment {
@@ -239,6 +240,13 @@ TEST(Body, BadFilesGiveASentence) {
       "v nan 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
   const std::string nan_error = body_error(write_temp("nan.obj", nan_obj));
   EXPECT_NE(nan_error, "");
+  // Trial 40: an infinite coordinate is named by its line, as a vertex cut short is.
+  const std::string inf_obj =
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 inf\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  const std::string inf_error = body_error(write_temp("inf.obj", inf_obj));
+  EXPECT_NE(inf_error.find("line 4 ('v 0 0 inf') is not a vertex of three finite numbers"),
+            std::string::npos)
+      << inf_error;
 }
 
 TEST(Body, DegenerateFacesAreDroppedWithAWarning) {
@@ -248,6 +256,36 @@ TEST(Body, DegenerateFacesAreDroppedWithAWarning) {
   EXPECT_EQ(body.mesh.face_count(), 4);
   ASSERT_EQ(body.warnings.size(), 1u);
   EXPECT_NE(body.warnings[0].find("degenerate"), std::string::npos);
+}
+
+// Trial 40: an export that wrote every face twice made every edge "shared by more than two
+// triangles". The copies (one as given, one turned over) are removed and named with the file.
+TEST(Body, DuplicatedFacesAreRemovedWithAWarning) {
+  const std::string obj = tetrahedron_obj("f 1 3 2\nf 4 2 1\nf 1 4 3\nf 4 3 2\n");
+  const std::string file = write_temp("doubled.obj", obj);
+  const Body body = load_body(file);
+  EXPECT_EQ(body.mesh.face_count(), 4);
+  ASSERT_EQ(body.warnings.size(), 1u) << body.warnings.back();
+  EXPECT_NE(body.warnings[0].find("4 of the 8 faces of body file '" + file + "' are given twice"),
+            std::string::npos)
+      << body.warnings[0];
+  // A mesh without copies says nothing (the warning cannot come from elsewhere).
+  EXPECT_TRUE(load_body(write_temp("tet.obj", tetrahedron_obj())).warnings.empty());
+}
+
+// Trial 40: an inches body with its head towards -x stood on its head by the inferred +x, and the
+// only message was that it had no landmarks. Turned over it has them: that is said, with the up.
+TEST(Body, UpsideDownFigureIsSaidToBeOne) {
+  BodyOptions head_down;
+  head_down.up = AxisDirection{2, -1};  // the file is Z-up
+  const Body body = load_body("builtin", head_down);
+  EXPECT_THROW(find_landmarks(body.mesh), std::runtime_error);
+  EXPECT_NE(upside_down_advice(body).find("the figure looks upside down (it has landmarks once "
+                                          "turned over): give \"up\": \"+z\""),
+            std::string::npos)
+      << upside_down_advice(body);
+  // Upright, turned over it has none: nothing to say.
+  EXPECT_EQ(upside_down_advice(load_body("builtin")), "");
 }
 
 TEST(Body, NonManifoldEdgeIsAWarning) {

@@ -89,9 +89,11 @@ void run_info(const InfoOptions& options) {
     landmarks = garment::find_landmarks(body.mesh);
   } catch (const std::runtime_error& e) {
     landmark_problem = e.what();
-    // Turned a quarter round: it faces along the file's third axis, the one neither up nor the
-    // facing it was read with (trial 39, P14).
-    if (garment::looks_turned(body.mesh)) {
+    // Stood on its head (trial 40, P3), or turned a quarter round: then it faces along the
+    // file's third axis, the one neither up nor the facing it was read with (trial 39, P14).
+    if (const std::string upside = garment::upside_down_advice(body); !upside.empty()) {
+      landmark_problem = upside + "; " + landmark_problem;
+    } else if (garment::looks_turned(body.mesh)) {
       const int third = 3 - raw.up.axis - raw.facing.axis;
       landmark_problem +=
           fmt::format(": try --facing {} or {}", garment::AxisDirection{third, 1}.name(),

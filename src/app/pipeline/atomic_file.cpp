@@ -202,6 +202,10 @@ void check_output_folder(const std::filesystem::path& dir_in) {
       if (!fs::is_directory(status)) refuse("'" + base.string() + "' is a file, not a folder");
       break;
     }
+    // A symbolic link to nowhere looks missing but cannot be made (trial 40: "File exists").
+    if (fs::is_symlink(fs::symlink_status(base, ec)))
+      refuse("'" + base.string() + "' is a symbolic link to '" +
+             fs::read_symlink(base, ec).string() + "', which does not exist");
     missing.push_back(base);
     if (base == base.parent_path()) break;
   }

@@ -136,6 +136,16 @@ std::string not_at_rest_warning(const std::string& file, double duration_s, doub
             "{\"rest_ramp\": 1} first, which sews the cut pieces up over 1 s so that the cloth "
             "starts unstrained (docs/pattern.md, \"Drape time and the rest ramp\"), then"
           : "; try";
+  // Still, or nearly, after less than one at-rest window (trial 40: "duration": 1e-5 ran one step
+  // and was called "very likely its final shape"): the cloth had no time to move, so its
+  // stillness says nothing of its final shape. (Moving after a short run: the text below.)
+  if (duration_s < rest_window_s && (where.still_s > 0.0 || where.moving == 0))
+    return fmt::format(
+        "{}: the drape ran only {:g} s, shorter than the {:g} s over which cloth must stay still "
+        "to count as at rest, so the result is little more than the garment as drawn and says "
+        "nothing of its final shape; give a longer \"simulate\": {{\"duration\": {:g}}} (a "
+        "garment settles within a few seconds)",
+        file, duration_s, rest_window_s, std::max(3.0, 4 * rest_window_s));
   // Still, but not yet for a whole window (trial 37's tunic: 0.27 mm of drift, fewer than 0.25 s
   // of it): say so rather than "still moves", which read as a contradiction of report.json.
   if (where.still_s > 0.0)
