@@ -209,6 +209,16 @@ std::optional<std::string> obj_defect(const std::string& file) {
   return std::nullopt;
 }
 
+// A file named .obj (any case) with a defect obj_defect finds is refused with its line.
+void throw_obj_defect(const std::string& file) {
+  std::string ext = std::filesystem::path(file).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext != ".obj") return;
+  if (const std::optional<std::string> defect = obj_defect(file))
+    throw BodyError("body file '" + file + "' cannot be read: " + *defect);
+}
+
 // The triangles of `file` as assimp reads them, merged, welded and cleaned; file units and axes.
 // Repairs are added to body.warnings, the mesh count to body.raw.meshes.
 meshing::TriMesh read_body_mesh(const std::string& file, Body& body) {
@@ -237,12 +247,7 @@ meshing::TriMesh read_body_mesh(const std::string& file, Body& body) {
       throw BodyError("body file '" + file +
                       "' holds no mesh: no vertices and faces could be read from it (is it "
                       "really a mesh file of the format its name ends in?)");
-    std::string ext = std::filesystem::path(file).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    if (ext == ".obj")
-      if (const std::optional<std::string> defect = obj_defect(file))
-        throw BodyError("body file '" + file + "' cannot be read: " + *defect);
+    throw_obj_defect(file);
     // assimp's own words otherwise, without its doubled spaces ("Mesh  contains": an empty name).
     std::string words;
     for (const char c : reason)
@@ -268,12 +273,7 @@ meshing::TriMesh read_body_mesh(const std::string& file, Body& body) {
   for (const auto& p : points)
     if (!p.allFinite()) {
       // In an OBJ the line, as for a vertex cut short (trial 40: "v inf 0 0" on line 101).
-      std::string ext = std::filesystem::path(file).extension().string();
-      std::transform(ext.begin(), ext.end(), ext.begin(),
-                     [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-      if (ext == ".obj")
-        if (const std::optional<std::string> defect = obj_defect(file))
-          throw BodyError("body file '" + file + "' cannot be read: " + *defect);
+      throw_obj_defect(file);
       throw BodyError("body file '" + file + "' has NaN or infinite vertex coordinates");
     }
 

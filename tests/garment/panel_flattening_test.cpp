@@ -535,7 +535,7 @@ TEST(PanelFlattening, AQuadOverTheCentreSeamIsCutAlongItForAMirrorPair) {
   static const BodySurface surface(body.mesh);
   const Garment g = build_garment(
       load_sketch(std::filesystem::path(SD_SOURCE_DIR) / "data/examples/shorts.json"), surface);
-  ASSERT_EQ(g.merged_doublets, 1);  // the premise: one quad reaches over x = 0
+  ASSERT_EQ(g.merged_doublets.size(), 1u);  // the premise: one quad reaches over x = 0
   size_t front = 0, copy = 0;
   for (size_t p = 0; p < g.panels.size(); ++p) {
     if (g.panels[p].id == "front") front = p;
