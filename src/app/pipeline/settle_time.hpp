@@ -21,8 +21,9 @@ inline constexpr double kMaxSettleDuration = 10.0;
 // The default duration of a garment with a gathered panel (cloth_scene.hpp, gathered), s: its
 // flutes settle by slipping over each other and the body, in bursts, long after any swing has
 // died, and no pendulum describes that. Measured (one thread): trial 39's gathered skirt (cotton,
-// weft 1.6, no duration; not at rest at the 10 s cap, 3.1 cm/s) rests at 12.31 s on round 40's
-// body-vertex push (15.35 s on round 39's binary), the dirndl reproducer at weft 1.8 at 21.65 s;
+// weft 1.6, no duration; not at rest at the 10 s cap, 3.1 cm/s) rests at 12.31 s on a tree
+// carrying an unlanded body-vertex push (docs/benchmarks.md, "Round 40"; 15.35 s on round 39's
+// binary), the dirndl reproducer at weft 1.8 at 21.65 s;
 // trial 37's flounce at weft 1.6 rested at 14.07 s. 30 s covers them with room, and a gathered
 // drape caught in a cycle still stops (docs/simulator.md, "Long garments and the default
 // duration").
