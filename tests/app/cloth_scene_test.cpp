@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "garment/panel_flattening.hpp"
 #include "scene/sketch_file.hpp"
 #include "sim/cloth_model.hpp"
 #include "src/app/pipeline/settle_time.hpp"
@@ -155,6 +156,33 @@ TEST(ClothScene, FlatRestSaysItsPiecesAreNotPatternsFoldedOnes) {
   std::string patches = two_patches(1.0);
   patches.insert(patches.rfind('}'), R"(, "simulate": { "rest": "flat" })");
   EXPECT_EQ(build_cloth_scene(scene::parse_sketch(patches, "p.json")).flat_rest_differs, "");
+
+  // The named pieces are the only ones that differ: every other piece of the flat rest is
+  // `pattern`'s (the same flattening with its default options: the same polygon to 1e-9 m, bit
+  // for bit in fact), and each piece `pattern` holds straight is one the warning names (or its
+  // mirror copy), a different shape (its free centre line bows 11 and 15 mm: points more than
+  // 5 mm apart).
+  ASSERT_TRUE(flat.garment && flat.flat_pattern);
+  const garment::FlatPattern cut = garment::flatten_garment(*flat.garment);
+  ASSERT_EQ(cut.panels.size(), flat.flat_pattern->panels.size());
+  int held = 0;
+  for (size_t p = 0; p < cut.panels.size(); ++p) {
+    const garment::FlatPanel& pattern_piece = cut.panels[p];
+    const garment::FlatPanel& rest_piece = flat.flat_pattern->panels[p];
+    ASSERT_EQ(pattern_piece.id, rest_piece.id);
+    ASSERT_EQ(pattern_piece.uv.rows(), rest_piece.uv.rows());
+    if (!pattern_piece.centre_run.empty()) {
+      ++held;
+      const std::string original = pattern_piece.id.substr(0, pattern_piece.id.find('.'));
+      EXPECT_NE(flat.flat_rest_differs.find("'" + original + "'"), std::string::npos)
+          << pattern_piece.id;
+      EXPECT_GT((pattern_piece.uv - rest_piece.uv).cwiseAbs().maxCoeff(), 0.005)
+          << pattern_piece.id;
+      continue;
+    }
+    EXPECT_LE((pattern_piece.uv - rest_piece.uv).cwiseAbs().maxCoeff(), 1e-9) << pattern_piece.id;
+  }
+  EXPECT_EQ(held, 4);  // front, back and their mirror copies
 }
 
 // A gathered panel draped from flat cloth (cut 1.5 times wider than drawn: `"ease": {"weft":
