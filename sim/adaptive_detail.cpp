@@ -77,6 +77,8 @@ void AdaptiveSettings::validate() const {
           "the interval between topology changes must be zero (every step) or positive seconds");
   require(std::isfinite(lookahead) && lookahead >= 0.0,
           "the refinement lookahead must be zero (none) or a positive time in seconds");
+  require(std::isfinite(motion_horizon) && motion_horizon >= 0.0,
+          "the motion criterion's horizon must be zero (off) or a positive time in seconds");
 }
 
 AdaptiveCloth::AdaptiveCloth(meshing::Mesh48 mesh, AdaptiveMaterial material,
@@ -239,7 +241,7 @@ bool AdaptiveCloth::split_stays_off_body(BlockId k, const Eigen::MatrixX3d& x) c
 void AdaptiveCloth::set_body(const meshing::TriMesh& body) {
   simulation_->set_body(body);
   body_sag_cache_.clear();
-  if (settings_.lookahead > 0.0) still_body_ = body;
+  if (settings_.lookahead > 0.0 || settings_.motion_horizon > 0.0) still_body_ = body;
 }
 
 void AdaptiveCloth::set_body_motion(PoseSequence motion) {
@@ -392,6 +394,7 @@ double AdaptiveCloth::rebuild(AdaptiveTransfer& state, const SimulationSettings*
   } else {
     simulation_->replace_model(std::move(model), flatten_positions(state.x),
                                flatten_positions(state.v), std::move(pins), state.origin);
+    last_origin_ = state.origin;
   }
   return seconds_since(start);
 }
@@ -518,8 +521,24 @@ AdaptStats AdaptiveCloth::adapt() {
   // Between regular changes (change_interval) only an edge a whole level behind (sag above
   // twice the threshold) changes the mesh; the lookahead covers the time to the next change.
   const bool due = time() >= next_change_ - 1e-9 * settings_.change_interval;
+  // The motion criterion, at most every horizon: merges wait for it (they need its word that
+  // the coarser mesh moves alike), and its errors join the estimate.
+  const double horizon = settings_.motion_horizon;
+  const bool motion_check = horizon > 0.0 && time() >= next_motion_check_ - 1e-9 * horizon;
+  MotionErrors motion;
+  if (motion_check) {
+    motion = motion_errors();
+    next_motion_check_ = time() + horizon;
+  }
   std::vector<std::pair<double, BlockId>> merges;
-  if (settings_.coarsen && due) merges = merge_candidates(merge_inputs());
+  if (settings_.coarsen && due && (horizon == 0.0 || motion_check)) {
+    merges = merge_candidates(merge_inputs());
+    if (motion_check)
+      std::erase_if(merges, [&](const std::pair<double, BlockId>& merge) {
+        return motion.vertex(mesh_.split_vertex(merge.second).value()) >
+               settings_.coarsen_threshold;
+      });
+  }
   std::vector<std::pair<double, int>> refinements;
   if (settings_.refine) {
     Eigen::VectorXd errors = edge_errors();
@@ -530,6 +549,7 @@ AdaptStats AdaptiveCloth::adapt() {
           bend_sags(arrays_, edge_rest_,
                     simulation_->positions() + settings_.lookahead * simulation_->velocities()));
     }
+    if (motion_check) errors = errors.cwiseMax(motion.edge);
     refinements = refine_candidates(errors, arrays_, settings_);
   }
   std::vector<BlockId> odd_blocks;
@@ -608,6 +628,76 @@ Eigen::VectorXd AdaptiveCloth::preview_sags() const {
   }
 
   return sags;
+}
+
+MotionErrors AdaptiveCloth::motion_errors() const {
+  MotionErrors out;
+  out.vertex = Eigen::VectorXd::Zero(mesh_.vertex_count());
+  out.edge = Eigen::VectorXd::Zero(arrays_.interior_edges.rows());
+  const double horizon = settings_.motion_horizon;
+  // The copies are built from the current mesh as input, which pattern rest shapes refuse.
+  if (!(horizon > 0.0) || root_uv_.rows() > 0 || !ramp_finished_) return out;
+  // One implicit step over the whole horizon: the two meshes' responses to the same state,
+  // pins and body (one step of the run's dt grown by (horizon/dt)² sees nothing away from pins
+  // and contacts at a still start, where every mesh falls alike for one step).
+  SimulationSettings trial = simulation_->settings();
+  trial.dt = horizon;
+  trial.duration = horizon;
+  trial.stop_at_rest = false;
+  const double start = time();
+  std::vector<Pin> pins;
+  for (const PinRecord& pin : pins_) {
+    Pin copy{pin.vertex, {}};
+    if (pin.path) copy.path = [path = pin.path, start](double t) { return path(start + t); };
+    pins.push_back(std::move(copy));
+  }
+  AdaptiveSettings fixed;
+  fixed.enabled = false;
+  const Eigen::MatrixX3d x = positions();
+  const auto trial_copy = [&] {
+    AdaptiveCloth copy(mesh_, material_, x, pins, trial, fixed);
+    copy.simulation_->set_velocities(simulation_->velocities());
+    if (still_body_.face_count() > 0) copy.set_body(still_body_);
+    return copy;
+  };
+  AdaptiveCloth coarse = trial_copy();
+  AdaptiveCloth fine = trial_copy();
+  std::vector<BlockId> leaves;
+  for (BlockId k : fine.mesh_.leaf_blocks())
+    if (fine.mesh_.level(k) < settings_.max_level) leaves.push_back(k);
+  if (leaves.empty() || !fine.split_blocks(leaves).changed()) return out;
+  const Eigen::VectorXd coarse_start = coarse.simulation_->positions();
+  const Eigen::VectorXd fine_start = fine.simulation_->positions();
+  if (!coarse.simulation_->step(horizon).accepted || !fine.simulation_->step(horizon).accepted)
+    return out;
+  const Eigen::VectorXd coarse_move = coarse.simulation_->positions() - coarse_start;
+  const Eigen::VectorXd fine_move = fine.simulation_->positions() - fine_start;
+  // Displacements, not positions: a split vertex moved off the body starts away from the
+  // midpoint, which is not a difference in motion.
+  const auto key = [](int a, int b) {
+    return (static_cast<std::int64_t>(std::min(a, b)) << 32) | std::max(a, b);
+  };
+  std::unordered_map<std::int64_t, double> midpoints;
+  const auto& origin = fine.last_origin_;
+  for (std::size_t i = 0; i < origin.size(); ++i) {
+    const VertexOrigin& from = origin[i];
+    if (from.a < 0 || from.b < 0) continue;  // made between vertices the batch made
+    const Eigen::Vector3d expected = 0.5 * (row3(coarse_move, from.a) + row3(coarse_move, from.b));
+    const double d = (row3(fine_move, static_cast<int>(i)) - expected).norm();
+    if (from.a == from.b) {
+      out.vertex(from.a) = std::max(out.vertex(from.a), d);
+    } else {
+      double& m = midpoints[key(from.a, from.b)];
+      m = std::max(m, d);
+    }
+  }
+  for (Eigen::Index r = 0; r < out.edge.size(); ++r) {
+    const int i = arrays_.interior_edges(r, 0), j = arrays_.interior_edges(r, 1);
+    double e = std::max(out.vertex(i), out.vertex(j));
+    if (const auto m = midpoints.find(key(i, j)); m != midpoints.end()) e = std::max(e, m->second);
+    out.edge(r) = e;
+  }
+  return out;
 }
 
 AdaptStats AdaptiveCloth::refine_ahead() {
@@ -704,6 +794,22 @@ StepOutcome AdaptiveCloth::step(double max_step) {
     looked_ahead_ = true;
     for (int round = 0; round < settings_.max_level && refine_ahead().changed(); ++round) {
     }
+  }
+  if (!motion_started_ && settings_.enabled && settings_.refine && settings_.motion_horizon > 0.0) {
+    // Before the first step: refine where the motion differs, round by round (one level per
+    // block and round), until the once-refined copy moves alike everywhere.
+    motion_started_ = true;
+    for (int round = 0; round < settings_.max_level; ++round) {
+      AdaptStats stats;
+      const auto estimate_start = Clock::now();
+      const auto refinements = refine_candidates(motion_errors().edge, arrays_, settings_);
+      stats.estimate_s = seconds_since(estimate_start);
+      const auto operations_start = Clock::now();
+      AdaptiveTransfer state = begin_transfer();
+      split_edges(refinements, state, stats);
+      if (!finish(state, stats, operations_start).changed()) break;
+    }
+    next_motion_check_ = time() + settings_.motion_horizon;
   }
   if (!ramp_finished_) {
     // The step starts in the rest shapes of its start time; from the first step at or after the

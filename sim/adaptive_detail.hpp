@@ -81,6 +81,13 @@ struct AdaptStats {
   ConservedQuantities before, after;
 };
 
+// The motion criterion's errors (AdaptiveSettings::motion_horizon), metres: how far the current
+// mesh's motion over the horizon is from that of the mesh refined once everywhere.
+struct MotionErrors {
+  Eigen::VectorXd vertex;  // #V: at each vertex of the current mesh
+  Eigen::VectorXd edge;    // per interior edge: the largest of its ends' and its midpoint's
+};
+
 // One accepted step: time after it and what the adaptation then did.
 struct AdaptiveStepRecord {
   double time = 0.0;
@@ -201,6 +208,14 @@ class AdaptiveCloth {
   // an edge whose sag plus twice that motion stays below the refine threshold (it cannot decide
   // a split either way).
   Eigen::VectorXd body_sags();
+  // The motion criterion at the current state (AdaptiveSettings::motion_horizon; zeros when it
+  // is off, with pattern rest shapes, on the rest ramp, or when a trial step fails): one
+  // implicit step of the horizon from the current positions and velocities on a copy of the
+  // cloth as it is and on a copy with every leaf block below max_level split once (same pins,
+  // settings and still body; the cloth is not changed). Per vertex of the refined copy, d =
+  // |its displacement − the coarse displacement there| (the midpoint of its diagonal's for a
+  // vertex the split made).
+  MotionErrors motion_errors() const;
   // Σ m_i v_i, kg·m/s.
   Eigen::Vector3d linear_momentum() const;
   ConservedQuantities conserved_quantities() const;
@@ -269,7 +284,13 @@ class AdaptiveCloth {
   BodySagCache body_sag_cache_;  // carried through topology changes by rebuild
   meshing::TriMesh still_body_;  // the body of set_body, for the trial step; empty otherwise
   bool looked_ahead_ = false;    // refine_ahead has been called by the first step
-  double next_change_ = 0.0;     // s: the next regular topology change (change_interval)
+  // The motion criterion: refinement before the first step done; the time of the next check.
+  bool motion_started_ = false;
+  double next_motion_check_ = 0.0;
+  // Where each vertex of the last rebuild comes from (ids before its batch): the motion
+  // criterion's refined copy reads it.
+  std::vector<VertexOrigin> last_origin_;
+  double next_change_ = 0.0;  // s: the next regular topology change (change_interval)
   AdaptiveReport report_;
 };
 

@@ -63,6 +63,18 @@ struct AdaptiveSettings {
   // CHOLMOD analysis; with lookahead ≥ this interval the regions that will bend before the next
   // change are refined at this one. 0: every step.
   double change_interval = 0.0;
+  // s: the motion criterion's horizon (docs/adaptive.md, "Where the motion differs"). 0: off.
+  // Before the first step (round by round until nothing changes) and then at most every
+  // horizon, one implicit step of the horizon is taken from the current state on two copies of
+  // the cloth, the mesh as it is and the mesh with every leaf block split once; per vertex the
+  // two displacements differ by d (a vertex the split made is compared with the midpoint of its
+  // diagonal's), the motion error. An edge whose ends or midpoint have a motion error above
+  // refine_threshold is split, and merges are made only on those steps and only where the
+  // motion error at the split vertex is below coarsen_threshold. The sag estimate sees how far
+  // the mesh is from a smooth surface; this sees how far its motion is from a finer mesh's (a
+  // flat coarse region that swings or lands unlike a fine one). Not applied to pattern rest
+  // shapes (rest_uv): the copies are built from the current mesh.
+  double motion_horizon = 0.0;
   bool refine = true;
   bool coarsen = true;
   // Measure energies, total mass and linear momentum just before and just after each topology

@@ -6,7 +6,7 @@
 //   adaptive_bench --study=DIR [--quick] [--scene=SCENE] [--only=RUN] [--finest=N]
 //                  [--perturbed=K] [--adaptive-start=L] [--even-levels] [--fine-ladder]
 //                  [--target-levels=0|1] [--lookahead=S] [--change-interval=S] [--max-level=L]
-//                  [--sample-errors]
+//                  [--motion-horizon=S] [--sample-errors]
 //                                             the work-precision study: the 3-corner and 2-corner
 //                                             sheets, a tablecloth and a sheet dropped on a sphere
 //                                             run fixed at levels N-4, N-2, N
@@ -25,8 +25,9 @@
 //                                             (default 0); --even-levels: adaptive runs keep
 //                                             even levels; --fine-ladder: thresholds in steps
 //                                             of √2 instead of 2; --target-levels,
-//                                             --lookahead, --change-interval: the adaptive
-//                                             runs' AdaptiveSettings of those names;
+//                                             --lookahead, --change-interval,
+//                                             --motion-horizon: the adaptive runs'
+//                                             AdaptiveSettings of those names;
 //                                             --max-level: their max level instead of N;
 //                                             --sample-errors: print each run's error at
 //                                             every sample time; --threads=N: the
@@ -79,10 +80,11 @@ AdaptiveSettings adaptive_settings(double refine_threshold, int max_level,
 
 // The study's adaptive runs with the method options of the command line applied.
 struct MethodOptions {
-  int target_levels = -1;  // -1: the default
-  double lookahead = -1;   // s; negative: the default
-  double interval = -1;    // s; negative: the default
-  int max_level = -1;      // the adaptive runs' max level; -1: the study's finest
+  int target_levels = -1;      // -1: the default
+  double lookahead = -1;       // s; negative: the default
+  double interval = -1;        // s; negative: the default
+  int max_level = -1;          // the adaptive runs' max level; -1: the study's finest
+  double motion_horizon = -1;  // s; negative: the default
 };
 MethodOptions g_method;
 
@@ -92,6 +94,7 @@ AdaptiveSettings study_settings(double refine_threshold, int max_level, bool eve
   if (g_method.lookahead >= 0) settings.lookahead = g_method.lookahead;
   if (g_method.interval >= 0) settings.change_interval = g_method.interval;
   if (g_method.max_level >= 0) settings.max_level = g_method.max_level;
+  if (g_method.motion_horizon >= 0) settings.motion_horizon = g_method.motion_horizon;
   return settings;
 }
 
@@ -484,6 +487,8 @@ int main(int argc, char** argv) {
       g_method.interval = std::atof(argv[i] + 18);
     else if (std::strncmp(argv[i], "--max-level=", 12) == 0)
       g_method.max_level = std::atoi(argv[i] + 12);
+    else if (std::strncmp(argv[i], "--motion-horizon=", 17) == 0)
+      g_method.motion_horizon = std::atof(argv[i] + 17);
     else if (std::strncmp(argv[i], "--lookahead=", 12) == 0)
       g_method.lookahead = std::atof(argv[i] + 12);
     else if (std::strcmp(argv[i], "--sample-errors") == 0)

@@ -689,6 +689,67 @@ TEST(AdaptiveDetail, ChangeIntervalKeepsTopologyChangesRare) {
   EXPECT_GT(batched.splits, 0);
 }
 
+// The motion criterion (motion_horizon) refines where the coarse mesh moves unlike a once-refined
+// one although it is flat (no sag for the estimate to see), and not where it moves alike.
+TEST(AdaptiveDetail, MotionCriterionRefinesWhereTheCoarseMotionDiffers) {
+  AdaptiveSettings adaptive;
+  adaptive.refine_threshold = 2e-3;
+  adaptive.coarsen_threshold = 5e-4;
+  adaptive.motion_horizon = 0.1;
+  // Triangles that reach a level above 2 within `half_width` of x = edge_x, and elsewhere.
+  const auto finest_levels = [](const AdaptiveCloth& cloth, double edge_x, double half_width) {
+    std::pair<int, int> levels{0, 0};  // near, far
+    for (Eigen::Index f = 0; f < cloth.faces().rows(); ++f) {
+      double x = 0;
+      for (int k = 0; k < 3; ++k) x += cloth.rest_positions()(cloth.faces()(f, k), 0) / 3.0;
+      int& level = std::abs(x - edge_x) < half_width ? levels.first : levels.second;
+      level = std::max(level, cloth.face_levels()(f));
+    }
+    return levels;
+  };
+  {
+    // A flat strip lying on a table's edge, half of it over the floor: the half off the table
+    // starts to fall and bends over the edge. Flat and still, it has no sag; the coarse mesh
+    // (0.125 m triangles) bends over the edge later and wider than the refined one.
+    AdaptiveSheetSpec spec;
+    spec.pins = {};
+    spec.body = testing::make_box({-1.0, 0.0, -1.0}, {0.0, 0.997, 1.0});
+    AdaptiveCloth cloth = make_adaptive_sheet(spec, 2, adaptive);
+    ASSERT_LT(cloth.edge_errors().maxCoeff(), 0.1 * adaptive.refine_threshold);
+    EXPECT_GT(cloth.motion_errors().edge.maxCoeff(), adaptive.refine_threshold);
+    const int vertices = cloth.mesh().vertex_count();
+    ASSERT_TRUE(cloth.step().accepted);  // refines before the step
+    EXPECT_GT(cloth.mesh().vertex_count(), vertices);
+    const auto [near, far] = finest_levels(cloth, 0.0, 0.2);
+    EXPECT_GT(near, 2);
+    EXPECT_GE(near, far);
+  }
+  {
+    // The same sheet in free fall (no table, no pins): it falls as a rigid body on every mesh,
+    // and the difference is the solver's rounding (measured below 1e-14 m).
+    AdaptiveSheetSpec spec;
+    spec.pins = {};
+    AdaptiveCloth cloth = make_adaptive_sheet(spec, 2, adaptive);
+    EXPECT_LT(cloth.motion_errors().edge.maxCoeff(), 1e-3 * adaptive.refine_threshold);
+    const int vertices = cloth.mesh().vertex_count();
+    const int changes = cloth.report().topology_changes;  // the start's uniform refinement
+    for (int k = 0; k < 12; ++k) ASSERT_TRUE(cloth.step().accepted);  // two checks after the start
+    EXPECT_EQ(cloth.mesh().vertex_count(), vertices);
+    EXPECT_EQ(cloth.report().topology_changes, changes);
+  }
+  {
+    // Off (the default): the criterion measures nothing and the flat strip is not refined
+    // before it moves.
+    AdaptiveSheetSpec spec;
+    spec.pins = {};
+    spec.body = testing::make_box({-1.0, 0.0, -1.0}, {0.0, 0.997, 1.0});
+    AdaptiveSettings off = adaptive;
+    off.motion_horizon = 0.0;
+    AdaptiveCloth cloth = make_adaptive_sheet(spec, 2, off);
+    EXPECT_EQ(cloth.motion_errors().edge.maxCoeff(), 0.0);
+  }
+}
+
 TEST(AdaptiveDetail, ChurnStress) {
   AdaptiveSheetSpec spec;
   spec.quads = 2;
