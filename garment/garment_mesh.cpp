@@ -173,6 +173,33 @@ void check_single_edges_apart(const GarmentRequest& sketch, const BodySurface& b
   }
 }
 
+// A mirrored panel is one side's half of a piece, its copy the other's: one drawn whole across
+// the mirror plane x = 0 (its outline farther than the junction tolerance on both sides) would
+// lie over its copy. Fails at its "mirror" naming how far it reaches either side. Before, a front
+// drawn whole with "mirror": true was refused as two panels meeting "only at the point" (or, as
+// trial 40's P4 made the message, as its hem lying on its own mirror copy).
+void check_mirrored_halves(const GarmentRequest& sketch, const CurveNetwork& net,
+                           const std::vector<PanelLoop>& loops) {
+  const double tol = sketch.junction_tolerance;
+  for (const PanelLoop& loop : loops) {
+    if (loop.mirror_copy || !sketch.panels[static_cast<size_t>(loop.spec)].mirror) continue;
+    double low = std::numeric_limits<double>::infinity(), high = -low;
+    for (const LoopEdge& e : loop.edges) {
+      const Eigen::MatrixX3d& points = net.edges[static_cast<size_t>(e.edge)].points;
+      low = std::min(low, points.col(0).minCoeff());
+      high = std::max(high, points.col(0).maxCoeff());
+    }
+    if (!(low < -tol && high > tol)) continue;
+    sketch.fail(loop.json_path + "/mirror",
+                fmt::format("panel '{}' has \"mirror\": true but reaches across the mirror plane "
+                            "x = 0 (its outline runs from x = {:.3f} to {:.3f} m), so its mirror "
+                            "copy would lie over it. A mirrored panel is one half of a piece, on "
+                            "one side of x = 0 (its centre curve drawn at x = 0): draw only that "
+                            "half, or remove \"mirror\" for a panel drawn whole",
+                            loop.id, low, high));
+  }
+}
+
 PanelNetwork resolve_network(const GarmentRequest& sketch, const BodySurface& body) {
   check_against_body(sketch, body.box());
   const std::vector<ProjectedCurve> projected = project_curves(sketch, body);
@@ -187,6 +214,7 @@ PanelNetwork resolve_network(const GarmentRequest& sketch, const BodySurface& bo
     net = build_network(sketch, projected, mirrored);
   }
   std::vector<PanelLoop> loops = resolve_panels(sketch, net, body);
+  check_mirrored_halves(sketch, net, loops);
   EdgeCounts counts = compute_edge_counts(sketch, net, loops);
   check_single_edges_apart(sketch, body, net, loops, counts);
   {
@@ -702,15 +730,17 @@ std::optional<std::pair<std::string, std::string>> coinciding_curves(const Garme
                                   : fmt::format("lie within {:.0f} mm of each other", 1e3 * apart);
       // The copy of a mirrored curve is named in a boundary list as '<curve>.mirror'; the curve
       // drawn again instead is in the file (a copy's own path is its original's).
-      const CurveSpec& extra_spec = sketch.curves[static_cast<size_t>(extra.spec)];
       return std::pair{
-          extra.mirror_copy ? std::string("/panels") : extra_spec.json_path,
+          extra.mirror_copy || extra.spec < 0
+              ? std::string("/panels")
+              : sketch.curves[static_cast<size_t>(extra.spec)].json_path,
           fmt::format(
               "curves '{}' and '{}' {} {}: {} each have their own copy of one seam, "
               "so they meet only at its ends. Give both panels the same curve (name "
               "'{}' in both boundary lists{})",
               ca.id, cb.id, how, run, panels, kept.id,
-              extra.mirror_copy ? std::string() : fmt::format(" and delete '{}'", extra.id))};
+              (extra.mirror_copy ? std::string() : fmt::format(" and delete '{}'", extra.id)) +
+                  (whole ? "" : "; a panel takes the piece of a curve between its junctions"))};
     }
   }
   return std::nullopt;
