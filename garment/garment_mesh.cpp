@@ -173,6 +173,33 @@ void check_single_edges_apart(const GarmentRequest& sketch, const BodySurface& b
   }
 }
 
+// A mirrored panel is one side's half of a piece, its copy the other's: one drawn whole across
+// the mirror plane x = 0 (its outline farther than the junction tolerance on both sides) would
+// lie over its copy. Fails at its "mirror" naming how far it reaches either side. Before, a front
+// drawn whole with "mirror": true was refused as two panels meeting "only at the point" (or, as
+// trial 40's P4 made the message, as its hem lying on its own mirror copy).
+void check_mirrored_halves(const GarmentRequest& sketch, const CurveNetwork& net,
+                           const std::vector<PanelLoop>& loops) {
+  const double tol = sketch.junction_tolerance;
+  for (const PanelLoop& loop : loops) {
+    if (loop.mirror_copy || !sketch.panels[static_cast<size_t>(loop.spec)].mirror) continue;
+    double low = std::numeric_limits<double>::infinity(), high = -low;
+    for (const LoopEdge& e : loop.edges) {
+      const Eigen::MatrixX3d& points = net.edges[static_cast<size_t>(e.edge)].points;
+      low = std::min(low, points.col(0).minCoeff());
+      high = std::max(high, points.col(0).maxCoeff());
+    }
+    if (!(low < -tol && high > tol)) continue;
+    sketch.fail(loop.json_path + "/mirror",
+                fmt::format("panel '{}' has \"mirror\": true but reaches across the mirror plane "
+                            "x = 0 (its outline runs from x = {:.3f} to {:.3f} m), so its mirror "
+                            "copy would lie over it. A mirrored panel is one half of a piece, on "
+                            "one side of x = 0 (its centre curve drawn at x = 0): draw only that "
+                            "half, or remove \"mirror\" for a panel drawn whole",
+                            loop.id, low, high));
+  }
+}
+
 PanelNetwork resolve_network(const GarmentRequest& sketch, const BodySurface& body) {
   check_against_body(sketch, body.box());
   const std::vector<ProjectedCurve> projected = project_curves(sketch, body);
@@ -187,6 +214,7 @@ PanelNetwork resolve_network(const GarmentRequest& sketch, const BodySurface& bo
     net = build_network(sketch, projected, mirrored);
   }
   std::vector<PanelLoop> loops = resolve_panels(sketch, net, body);
+  check_mirrored_halves(sketch, net, loops);
   EdgeCounts counts = compute_edge_counts(sketch, net, loops);
   check_single_edges_apart(sketch, body, net, loops, counts);
   {
@@ -638,6 +666,86 @@ void check_panel_outlines(const GarmentRequest& sketch, const CurveNetwork& net,
   }
 }
 
+// Farthest any point of polyline `a` lies from polyline `b` (m).
+double farthest_from(const Eigen::MatrixX3d& a, const Eigen::MatrixX3d& b) {
+  double farthest = 0;
+  for (Eigen::Index i = 0; i < a.rows(); ++i) {
+    const Eigen::Vector3d p = a.row(i).transpose();
+    double nearest = std::numeric_limits<double>::infinity();
+    for (Eigen::Index j = 0; j + 1 < b.rows(); ++j) {
+      const Eigen::Vector3d s = b.row(j).transpose(), t = b.row(j + 1).transpose();
+      const Eigen::Vector3d st = t - s;
+      const double u =
+          st.squaredNorm() > 0 ? std::clamp((p - s).dot(st) / st.squaredNorm(), 0.0, 1.0) : 0.0;
+      nearest = std::min(nearest, (s + u * st - p).norm());
+    }
+    farthest = std::max(farthest, nearest);
+  }
+  return farthest;
+}
+
+// Two curves drawn along one seam, each used by one of its two panels (`panels`: "panels 'a' and
+// 'b'"): the network pieces of two different curves between the same two junctions, one of
+// them at `p` (a place where the panels meet only at a point), lying within the junction
+// tolerance of each other all along. The JSON path of the curve to delete and the sentence that
+// names both, how far they run together and which to keep; nothing when there are none
+// (trial 40, P4: 'right2' drawn with exactly the points of 'right' was reported as panels meeting
+// "only at the point" where the two curves lay on each other over all of their 20 cm).
+std::optional<std::pair<std::string, std::string>> coinciding_curves(const GarmentRequest& sketch,
+                                                                     const CurveNetwork& net,
+                                                                     const Eigen::Vector3d& p,
+                                                                     const std::string& panels) {
+  const double tol = sketch.junction_tolerance;
+  for (size_t i = 0; i < net.edges.size(); ++i) {
+    const NetworkEdge& a = net.edges[i];
+    if (a.from == a.to) continue;
+    const double from_a = std::min((net.nodes[static_cast<size_t>(a.from)] - p).norm(),
+                                   (net.nodes[static_cast<size_t>(a.to)] - p).norm());
+    if (from_a > tol) continue;
+    for (size_t j = 0; j < net.edges.size(); ++j) {
+      const NetworkEdge& b = net.edges[j];
+      if (j == i || b.curve == a.curve || std::minmax(a.from, a.to) != std::minmax(b.from, b.to))
+        continue;
+      const double apart =
+          std::max(farthest_from(a.points, b.points), farthest_from(b.points, a.points));
+      if (apart > tol) continue;
+      const NetworkCurve& ca = net.curves[static_cast<size_t>(a.curve)];
+      const NetworkCurve& cb = net.curves[static_cast<size_t>(b.curve)];
+      // Keep a mirror copy (the curve a mirrored garment already has), else the first drawn;
+      // the other is the one to delete.
+      const bool a_kept = ca.mirror_copy != cb.mirror_copy ? ca.mirror_copy : ca.spec <= cb.spec;
+      const NetworkCurve& kept = a_kept ? ca : cb;
+      const NetworkCurve& extra = a_kept ? cb : ca;
+      const bool whole = ca.edges.size() == 1 && cb.edges.size() == 1;
+      const Eigen::Vector3d& s = net.nodes[static_cast<size_t>(a.from)];
+      const Eigen::Vector3d& t = net.nodes[static_cast<size_t>(a.to)];
+      const std::string run =
+          whole ? fmt::format("over their whole length ({:.1f} cm)", 100 * a.length)
+                : fmt::format(
+                      "for {:.1f} cm, from ({:.3f}, {:.3f}, {:.3f}) to ({:.3f}, {:.3f}, "
+                      "{:.3f}) m",
+                      100 * a.length, s.x(), s.y(), s.z(), t.x(), t.y(), t.z());
+      const std::string how = apart < 0.001
+                                  ? "lie on each other"
+                                  : fmt::format("lie within {:.0f} mm of each other", 1e3 * apart);
+      // The copy of a mirrored curve is named in a boundary list as '<curve>.mirror'; the curve
+      // drawn again instead is in the file (a copy's own path is its original's).
+      return std::pair{
+          extra.mirror_copy || extra.spec < 0
+              ? std::string("/panels")
+              : sketch.curves[static_cast<size_t>(extra.spec)].json_path,
+          fmt::format(
+              "curves '{}' and '{}' {} {}: {} each have their own copy of one seam, "
+              "so they meet only at its ends. Give both panels the same curve (name "
+              "'{}' in both boundary lists{})",
+              ca.id, cb.id, how, run, panels, kept.id,
+              (extra.mirror_copy ? std::string() : fmt::format(" and delete '{}'", extra.id)) +
+                  (whole ? "" : "; a panel takes the piece of a curve between its junctions"))};
+    }
+  }
+  return std::nullopt;
+}
+
 // Stage 5, the seams checked: every vertex's quads form one fan.
 void check_fans(const GarmentRequest& sketch, const CurveNetwork& net, const Garment& garment,
                 const std::vector<std::array<int, 4>>& faces, const std::vector<int>& face_panel,
@@ -715,6 +823,11 @@ void check_fans(const GarmentRequest& sketch, const CurveNetwork& net, const Gar
                 snap.ends.size() == 1 ? "its" : "their", 200 * from_plane, 100 * tol,
                 std::floor(1000 * snap.from_plane) / 10));  // below |x|: no longer moved
       }
+      if (names.size() == 2)
+        if (const auto twice = coinciding_curves(
+                sketch, net, p,
+                fmt::format("panels '{}' and '{}'", *names.begin(), *names.rbegin())))
+          sketch.fail(twice->first, twice->second);
       sketch.fail(
           "/panels",
           fmt::format("{} only at the point ({:.3f}, {:.3f}, {:.3f}) m, not along "

@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <mutex>
@@ -554,7 +555,8 @@ void parse_garment(const Reader& r, const json& root, Sketch& sketch) {
       if (!jj.contains("id")) r.fail(ip, "a join needs an \"id\" for the merged panel");
       join.id = r.identifier(jj["id"], ip + "/id");
       if (!jj.contains("panels") || !jj["panels"].is_array() || jj["panels"].size() < 2)
-        r.fail(ip + "/panels", "a join lists at least two panel ids");
+        r.fail(ip + "/panels",
+               "a join lists at least two panel ids (the panels sewn into one piece of cloth)");
       for (size_t k = 0; k < jj["panels"].size(); ++k) {
         const std::string kp = fmt::format("{}/panels/{}", ip, k);
         const std::string id = r.text(jj["panels"][k], kp);
@@ -564,8 +566,16 @@ void parse_garment(const Reader& r, const json& root, Sketch& sketch) {
         if (is_copy && !p->mirror)
           r.fail(kp, fmt::format("panel '{}' has no mirror copy (set \"mirror\": true on '{}')", id,
                                  p->id));
-        if (!joined.insert(id).second)
+        if (!joined.insert(id).second) {
+          if (std::find(join.panels.begin(), join.panels.end(), id) != join.panels.end())
+            r.fail(kp, fmt::format("panel '{}' is listed twice in join '{}'", id, join.id));
+          for (const JoinSpec& other : sketch.joins)
+            if (std::find(other.panels.begin(), other.panels.end(), id) != other.panels.end())
+              r.fail(kp, fmt::format("panel '{}' is already part of join '{}' ({}); a panel "
+                                     "belongs to at most one join",
+                                     id, other.id, other.json_path));
           r.fail(kp, fmt::format("panel '{}' is already part of a join", id));
+        }
         join.panels.push_back(id);
       }
       for (const JoinSpec& other : sketch.joins)

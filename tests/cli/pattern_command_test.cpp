@@ -650,6 +650,65 @@ TEST(PatternCommand, BodiceCentreFrontIsStraightAndCutOnTheFold) {
   EXPECT_LT(json["sheet_length_mm"].get<double>(), length);
 }
 
+// Trial 40, P8: the command's line said "16 pieces (4 mirror pairs drawn once, cut 2), 1345 mm
+// ... efficiency 53 %" for the sheath dress and the SVG's footer "8 pieces (12 to cut) ... 799 mm
+// used · efficiency 45 %": the line counted every panel and its mirror copy, named no piece cut
+// on the fold, and the footer gave the sheet's length as the fabric used. The t-shirt (front and
+// back on the fold, the sleeves a mirror pair) is now counted one way in all three: pieces to
+// cut (a fold piece once, a mirror pair twice), pieces drawn, the fold pieces by name, and the
+// fabric of every piece cut from one layer.
+TEST(PatternCommand, LineSvgAndJsonCountPiecesAndFabricTheSameWay) {
+  const fs::path out = fresh_dir("counts");
+  const CommandResult r =
+      run_sketchdrape("pattern " + example("tshirt").string() + " -o " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto json = nlohmann::json::parse(read(out / "pattern.json"));
+  int to_cut = 0, drawn = 0;
+  std::vector<std::string> folds;
+  for (const auto& piece : json["pieces"]) {
+    to_cut += piece["folded_into"].get<std::string>().empty() ? 1 : 0;
+    drawn += piece["quantity"].get<int>() > 0 ? 1 : 0;
+    if (piece["on_fold"].get<bool>()) folds.push_back(piece["id"]);
+  }
+  EXPECT_EQ(json["pieces_to_cut"].get<int>(), to_cut);
+  EXPECT_EQ(json["pieces_drawn"].get<int>(), drawn);
+  EXPECT_EQ(json["fold_pieces"].get<std::vector<std::string>>(), folds);
+  ASSERT_EQ(folds, (std::vector<std::string>{"front", "back"}));
+  ASSERT_GT(json["mirror_pairs"].get<int>(), 0);
+  // 2 fold pieces cut once each, every other panel (the sleeves and their copies) cut once.
+  EXPECT_EQ(to_cut, static_cast<int>(json["pieces"].size()) - 2);
+  const std::string summary = json["pieces_summary"];
+  EXPECT_EQ(summary.rfind(fmt::format("{} pieces to cut, drawn as {} (2 cut on the fold: 'front', "
+                                      "'back'; {} mirror pair",
+                                      to_cut, drawn, json["mirror_pairs"].get<int>()),
+                          0),
+            0u)
+      << summary;
+  const std::string fabric = fmt::format(
+      "{:.0f} mm of {:.0f} mm wide fabric (every piece cut from one layer), efficiency {:.0f} %",
+      json["fabric_length_mm"].get<double>(), json["fabric_width_mm"].get<double>(),
+      100 * json["efficiency"].get<double>());
+  EXPECT_NE(r.output.find(": " + summary + ", " + fabric), std::string::npos) << r.output;
+  const std::string svg = read(out / "pattern.svg");
+  std::string escaped;
+  for (char c : summary) escaped += c == '\'' ? std::string("&#39;") : std::string(1, c);
+  EXPECT_NE(svg.find(" · " + escaped + " · fabric "), std::string::npos)
+      << svg.substr(svg.size() - 900);
+  EXPECT_NE(svg.find(fmt::format("{:.0f} mm used cutting every piece from one layer · efficiency "
+                                 "{:.0f} %",
+                                 json["fabric_length_mm"].get<double>(),
+                                 100 * json["efficiency"].get<double>())),
+            std::string::npos)
+      << svg.substr(svg.size() - 900);
+  // The sheet's own length is the drawing's, not fabric used.
+  EXPECT_NE(svg.find(fmt::format("this sheet, {:.0f} mm long, draws",
+                                 json["sheet_length_mm"].get<double>())),
+            std::string::npos)
+      << svg.substr(svg.size() - 900);
+  EXPECT_EQ(svg.find(fmt::format("{:.0f} mm used", json["sheet_length_mm"].get<double>())),
+            std::string::npos);
+}
+
 // The sheet in a real browser: the SVG parses (one <g class="piece"> per piece in the DOM) and
 // a screenshot at 0.8 px/mm shows white pieces covering the fabric in the proportion the sheet
 // reports as its efficiency.

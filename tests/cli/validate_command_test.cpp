@@ -276,3 +276,46 @@ TEST(ValidateCommand, SeamWithEasesFivePercentApartIsWarned) {
   EXPECT_EQ(close.output.find("sewn along curve"), std::string::npos) << close.output;
   fs::remove_all(dir);
 }
+
+// Trial 40, P5: a curve drawn exactly over a panel's edge and named by no panel (a forgotten
+// panel, or a boundary list that names another curve than meant) was silently ignored. It is
+// warned once with its path and id, counted in the line, and --strict fails on it (validate and
+// mesh: a designer would want to know); the same file without the curve is clean.
+TEST(ValidateCommand, ACurveInNoPanelIsWarnedAndStrictCountsIt) {
+  const fs::path dir = fs::temp_directory_path() / "sd-validate-unused-curve";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string curves = R"(
+    { "id": "top", "view": "front", "points": [[-0.1, 1.3], [0.1, 1.3]] },
+    { "id": "right", "view": "front", "points": [[0.1, 1.3], [0.1, 1.1]] },
+    { "id": "bottom", "view": "front", "points": [[0.1, 1.1], [-0.1, 1.1]] },
+    { "id": "left", "view": "front", "points": [[-0.1, 1.1], [-0.1, 1.3]] })";
+  const std::string panels =
+      R"("panels": [{ "id": "patch", "boundary": ["top", "right", "bottom", "left"] }])";
+  std::ofstream(dir / "dart.json") << R"({"curves": [)" << curves << R"(,
+    { "id": "dart", "view": "front", "points": [[0.1, 1.28], [0.1, 1.12]] }], )"
+                                   << panels << "}";
+  std::ofstream(dir / "clean.json") << R"({"curves": [)" << curves << "], " << panels << "}";
+  const std::string file = (dir / "dart.json").string();
+  const CommandResult v = run_sketchdrape("validate " + file);
+  EXPECT_EQ(v.exit_code, 0) << v.output;
+  const std::string said =
+      "/curves/4: curve 'dart' is in no panel: a forgotten panel or a typo "
+      "in a boundary list?";
+  const size_t at = v.output.find(said);
+  ASSERT_NE(at, std::string::npos) << v.output;
+  EXPECT_EQ(v.output.find(said, at + 1), std::string::npos) << "told twice:\n" << v.output;
+  EXPECT_NE(v.output.find("; 1 warning(s)"), std::string::npos) << v.output;
+  const CommandResult strict = run_sketchdrape("validate --strict " + file);
+  EXPECT_EQ(strict.exit_code, 1) << strict.output;
+  EXPECT_NE(strict.output.find(file + ": 1 curve(s) in no panel and --strict"), std::string::npos)
+      << strict.output;
+  const CommandResult mesh =
+      run_sketchdrape("mesh --strict " + file + " -o " + (dir / "out").string());
+  EXPECT_EQ(mesh.exit_code, 1) << mesh.output;
+  EXPECT_NE(mesh.output.find(said), std::string::npos) << mesh.output;
+  const CommandResult clean = run_sketchdrape("validate --strict " + (dir / "clean.json").string());
+  EXPECT_EQ(clean.exit_code, 0) << clean.output;
+  EXPECT_EQ(clean.output.find("in no panel"), std::string::npos) << clean.output;
+  fs::remove_all(dir);
+}

@@ -1,5 +1,6 @@
 #include "garment/garment_mesh.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -484,6 +485,48 @@ TEST(Garment, QuadSizeAdviceTriesTheCurvesNearTheQuads) {
   for (CurveSpec& curve : finer.curves)
     if (curve.id == size->curve) curve.edge_length = size->curve_edge_length;
   EXPECT_LT(count(finer), before);
+}
+
+// Trial 40, P9: the poncho's back at 3 cm (data/designs/repro/poncho-back-coarse.json) has quads
+// up to 2.13 times the edge at the shoulder, and none of its curves with an edge_length of its own
+// alone helps, so the warning offered nothing until the designer lowered the panel to 2.5 cm (then
+// it offered 'cb' at 1.7 cm). The first warning now offers the panel a fifth lower (2.4 cm) with
+// one of its curves: neither alone gives fewer warnings, both together do.
+TEST(Garment, QuadSizeAdviceLowersThePanelWhenNoCurveAloneHelps) {
+  const Sketch poncho = load_sketch(std::filesystem::path(SD_SOURCE_DIR) /
+                                    "data/designs/repro/poncho-back-coarse.json");
+  const Body body = load_sketch_body(poncho);
+  const BodySurface surface(body.mesh);
+  const auto count = [&](const GarmentRequest& sketch) {
+    return check_quality(build_garment(sketch, surface), sketch, nullptr).size();
+  };
+  const std::vector<QualityWarning> told =
+      check_quality_tried(build_garment(poncho, surface), poncho, body.mesh, nullptr);
+  const QualityWarning* size = nullptr;
+  for (const QualityWarning& w : told)
+    if (w.kind == "quad_size" && w.panel == "back") size = &w;
+  ASSERT_NE(size, nullptr);
+  ASSERT_FALSE(size->curve.empty()) << size->message;
+  EXPECT_DOUBLE_EQ(size->panel_edge_length, 0.024);
+  EXPECT_NE(size->message.find(fmt::format(
+                "panel 'back' with \"edge_length\": 0.024 and curve '{}' with its own "
+                "\"edge_length\": {:g} (more edges along both) give the garment fewer warnings",
+                size->curve, size->curve_edge_length)),
+            std::string::npos)
+      << size->message;
+  const std::size_t before = count(poncho);
+  GarmentRequest curve_only = poncho;
+  for (CurveSpec& curve : curve_only.curves)
+    if (curve.id == size->curve) curve.edge_length = size->curve_edge_length;
+  EXPECT_GE(count(curve_only), before);
+  GarmentRequest panel_only = poncho;
+  for (PanelSpec& panel : panel_only.panels)
+    if (panel.id == "back") panel.edge_length = size->panel_edge_length;
+  EXPECT_GE(count(panel_only), before);
+  GarmentRequest both = curve_only;
+  for (PanelSpec& panel : both.panels)
+    if (panel.id == "back") panel.edge_length = size->panel_edge_length;
+  EXPECT_LT(count(both), before);
 }
 
 // Trial 38 / issue 18: the shift dress written on the built-in body and moved to the Collada

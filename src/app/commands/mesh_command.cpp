@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "garment/garment_mesh.hpp"
+#include "garment/unused_curves.hpp"
 #include "meshing/mesh48.hpp"
 #include "scene/sketch_file.hpp"
 #include "src/app/commands/cli.hpp"
@@ -221,9 +222,10 @@ void run_mesh(const MeshOptions& options) {
   spdlog::info("meshed {} → {}: {} panels, {} quads, distortion {} ({:.0f} ms meshing)",
                sketch.file, dir.string(), g.panels.size(), g.mesh.face_count(), distortion,
                mesh_ms);
-  if (options.strict && !warnings.empty())
-    throw std::runtime_error(
-        fmt::format("{}: {} mesh quality warning(s) and --strict", sketch.file, warnings.size()));
+  if (const std::string failure =
+          strict_failure(sketch.file, warnings, garment::unused_curve_warnings(sketch, g).size());
+      options.strict && !failure.empty())
+    throw std::runtime_error(failure);
 }
 
 }  // namespace
@@ -238,7 +240,8 @@ void add_mesh_command(CLI::App& app, const GlobalOptions& /*global*/) {
   cmd->add_option("-o,--out", options->out, "Output directory (created if needed)")
       ->check(non_empty_path());
   cmd->add_flag("--strict", options->strict,
-                "Exit with code 1 when the quality gate warns (the outputs are still written)");
+                "Exit with code 1 when the quality gate warns or a curve is in no panel (the "
+                "outputs are still written)");
   cmd->callback([options] { run_mesh(*options); });
 }
 

@@ -15,6 +15,7 @@
 #include "garment/sketch_error.hpp"
 #include "garment/sketch_inputs.hpp"
 #include "garment/sketch_ranges.hpp"
+#include "garment/unused_curves.hpp"
 #include "scene/sketch_file.hpp"
 #include "src/app/commands/cli.hpp"
 #include "src/app/pipeline/atomic_file.hpp"
@@ -43,6 +44,8 @@ void run_pattern(const PatternOptions& options) {
   const garment::Body body = garment::load_sketch_body(sketch);
   const garment::BodySurface surface(body.mesh);
   const garment::Garment g = garment::build_garment(sketch, surface);
+  const std::vector<std::string> unused = garment::unused_curve_warnings(sketch, g);
+  for (const std::string& warning : unused) spdlog::warn("{}", warning);
   const PatternSheet sheet = build_pattern_sheet(sketch, g, spec, nullptr, 0.0, &body);
   StagedOutputs outputs;
   outputs.keep(sketch.file);
@@ -54,15 +57,16 @@ void run_pattern(const PatternOptions& options) {
   for (const garment::PatternSeam& seam : sheet.pattern.seams)
     worst = std::max(worst, seam.mismatch());
   const garment::PatternLayout& layout = sheet.layout;
+  // The pieces and the fabric as the SVG's footer and pattern.json say them (trial 40, P8: this
+  // line counted every panel and its mirror copy, "16 pieces", where the sheet said 8 drawn, 12
+  // to cut, and named no piece cut on the fold).
   std::cout << fmt::format(
-      "{} → {}: {} pieces{}, {:.0f} mm of {:.0f} mm wide fabric, efficiency {:.0f} %, seams "
-      "within {:.2f} %, {} warning(s)\n",
-      garment::printable(sketch.file), garment::printable(options.out), layout.pieces.size(),
-      layout.pairs > 0 ? fmt::format(" ({} mirror pair{} drawn once, cut 2)", layout.pairs,
-                                     layout.pairs == 1 ? "" : "s")
-                       : std::string(),
-      1000 * layout.length_used, 1000 * layout.fabric_width, 100 * layout.efficiency, 100 * worst,
-      sheet.pattern.warnings.size());
+      "{} → {}: {}, {:.0f} mm of {:.0f} mm wide fabric (every piece cut from one layer), "
+      "efficiency {:.0f} %, seams within {:.2f} %, {} warning(s)\n",
+      garment::printable(sketch.file), garment::printable(options.out),
+      garment::printable(pieces_summary(piece_counts(sheet))), 1000 * layout.length_used,
+      1000 * layout.fabric_width, 100 * layout.efficiency, 100 * worst,
+      sheet.pattern.warnings.size() + unused.size());
 }
 
 }  // namespace

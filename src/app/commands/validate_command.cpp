@@ -12,6 +12,7 @@
 #include <mutex>
 
 #include "garment/sketch_error.hpp"
+#include "garment/unused_curves.hpp"
 #include "scene/sketch_file.hpp"
 #include "src/app/commands/cli.hpp"
 #include "src/app/pipeline/cloth_scene.hpp"
@@ -109,9 +110,11 @@ void run_validate(const ValidateOptions& options) {
   std::cout << garment::printable(
                    fmt::format("{}: ok ({}, fabric {}){}", sketch.file, what, fabric, counted))
             << "\n";
-  if (options.strict && !warnings.empty())
-    throw std::runtime_error(
-        fmt::format("{}: {} mesh quality warning(s) and --strict", sketch.file, warnings.size()));
+  const size_t unused =
+      scene.garment ? garment::unused_curve_warnings(sketch, *scene.garment).size() : 0;
+  if (const std::string failure = strict_failure(sketch.file, warnings, unused);
+      options.strict && !failure.empty())
+    throw std::runtime_error(failure);
 }
 
 }  // namespace
@@ -123,7 +126,8 @@ void add_validate_command(CLI::App& app, const GlobalOptions& /*global*/) {
       "Check a sketch file (fields, body, curves on the body, panels, edge counts); "
       "writes nothing");
   cmd->add_option("SKETCH", options->sketch, "Sketch file (format sketchdrape/1)")->required();
-  cmd->add_flag("--strict", options->strict, "Exit with code 1 when the quality gate warns");
+  cmd->add_flag("--strict", options->strict,
+                "Exit with code 1 when the quality gate warns or a curve is in no panel");
   cmd->callback([options] { run_validate(*options); });
 }
 

@@ -12,6 +12,7 @@
 #include "garment/body_surface.hpp"
 #include "garment/sketch_error.hpp"
 #include "garment/sketch_inputs.hpp"
+#include "garment/unused_curves.hpp"
 #include "src/app/pipeline/quality_warnings.hpp"
 #include "src/app/pipeline/seam_ease_warnings.hpp"
 
@@ -121,6 +122,8 @@ MeshedGarment mesh_garment(const scene::Sketch& sketch) {
   }();
   const double meshing_ms = ms_since(mesh_start);
   for (const std::string& warning : seam_ease_warnings(sketch, g)) spdlog::warn("{}", warning);
+  for (const std::string& warning : garment::unused_curve_warnings(sketch, g))
+    spdlog::warn("{}", warning);
 
   std::vector<std::string> groups;
   std::vector<int> panel_group(g.panels.size());

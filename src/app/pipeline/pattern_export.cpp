@@ -1,6 +1,7 @@
 #include "src/app/pipeline/pattern_export.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -353,6 +354,34 @@ PatternSheet build_pattern_sheet(const scene::Sketch& sketch, const garment::Gar
   return sheet;
 }
 
+PieceCounts piece_counts(const PatternSheet& sheet) {
+  PieceCounts counts;
+  for (const garment::PatternPiece& piece : sheet.layout.pieces) {
+    if (piece.folded_into < 0) ++counts.to_cut;
+    if (piece.quantity > 0) ++counts.drawn;
+    if (piece.on_fold) counts.on_fold.push_back(piece_name(sheet, piece));
+  }
+  counts.mirror_pairs = sheet.layout.pairs;
+  return counts;
+}
+
+std::string pieces_summary(const PieceCounts& counts) {
+  std::string text = fmt::format("{} piece{} to cut", counts.to_cut, counts.to_cut == 1 ? "" : "s");
+  if (counts.drawn != counts.to_cut) text += fmt::format(", drawn as {}", counts.drawn);
+  std::vector<std::string> how;
+  if (!counts.on_fold.empty()) {
+    std::vector<std::string> quoted;
+    for (const std::string& id : counts.on_fold) quoted.push_back("'" + id + "'");
+    how.push_back(
+        fmt::format("{} cut on the fold: {}", counts.on_fold.size(), fmt::join(quoted, ", ")));
+  }
+  if (counts.mirror_pairs > 0)
+    how.push_back(fmt::format("{} mirror pair{} drawn once, cut 2", counts.mirror_pairs,
+                              counts.mirror_pairs == 1 ? "" : "s"));
+  if (!how.empty()) text += fmt::format(" ({})", fmt::join(how, "; "));
+  return text;
+}
+
 std::string pattern_svg(const PatternSheet& sheet) {
   const garment::PatternLayout& layout = sheet.layout;
   const double width = kMm * layout.fabric_width;
@@ -450,26 +479,27 @@ std::string pattern_svg(const PatternSheet& sheet) {
       "<text x=\"10\" y=\"{:.1f}\" font-size=\"4\">0</text><text x=\"100\" y=\"{:.1f}\" "
       "font-size=\"4\">100 mm</text>\n</g>\n",
       y + 8, y + 8);
-  const auto drawn = std::count_if(layout.pieces.begin(), layout.pieces.end(),
-                                   [](const auto& piece) { return piece.quantity > 0; });
-  const auto to_cut = std::count_if(layout.pieces.begin(), layout.pieces.end(),
-                                    [](const auto& piece) { return piece.folded_into < 0; });
+  // The fabric a cutter needs (every piece from one layer) is the figure everywhere (the
+  // `pattern` line, pattern.json's fabric_length_mm and efficiency); the sheet's own length is
+  // the drawing's, where a mirror pair is drawn once and a fold piece as its half (trial 40, P8:
+  // the footer said "799 mm used · efficiency 45 %" where the line said 1345 mm and 53 %).
   svg += fmt::format(
-      "<text class=\"note\" x=\"130\" y=\"{:.1f}\" font-size=\"5\">{} · {} pieces{} · fabric "
-      "{:.0f} mm wide, {:.0f} mm used · efficiency {:.0f} % · seam allowance included · true "
-      "scale (mm)</text>\n",
-      y + 4, markup_escape(sheet.title), drawn,
-      layout.pairs > 0 ? fmt::format(" ({} to cut)", to_cut) : std::string(), width, length,
-      100 * layout.sheet_efficiency);
+      "<text class=\"note\" x=\"130\" y=\"{:.1f}\" font-size=\"5\">{} · {} · fabric {:.0f} mm "
+      "wide, {:.0f} mm used cutting every piece from one layer · efficiency {:.0f} % · seam "
+      "allowance included · true scale (mm)</text>\n",
+      y + 4, markup_escape(sheet.title), markup_escape(pieces_summary(piece_counts(sheet))), width,
+      kMm * layout.length_used, 100 * layout.efficiency);
   const bool folds = std::any_of(layout.pieces.begin(), layout.pieces.end(),
                                  [](const auto& piece) { return piece.on_fold; });
   if (layout.pairs > 0 || folds)
     svg += fmt::format(
-        "<text class=\"note\" x=\"130\" y=\"{:.1f}\" font-size=\"5\">{}{}every piece cut "
-        "from one layer takes {:.0f} mm of fabric (efficiency {:.0f} %)</text>\n",
-        y + 11, layout.pairs > 0 ? "cut 2 pieces: cut twice, the second turned over; " : "",
-        folds ? "CUT 1 ON FOLD pieces: both halves, the fold along the grain; " : "",
-        kMm * layout.length_used, 100 * layout.efficiency);
+        "<text class=\"note\" x=\"130\" y=\"{:.1f}\" font-size=\"5\">this sheet, {:.0f} mm "
+        "long, draws {}{}{}</text>\n",
+        y + 11, length,
+        layout.pairs > 0 ? "each cut 2 piece once (cut twice, the second turned over)" : "",
+        layout.pairs > 0 && folds ? " and " : "",
+        folds ? "each CUT 1 ON FOLD piece as its half (cut both halves, the fold along the grain)"
+              : "");
   svg += "</svg>\n";
   return svg;
 }
@@ -704,6 +734,7 @@ nlohmann::json ease_json(const garment::PanelEase& ease) {
 
 nlohmann::json pattern_json(const PatternSheet& sheet) {
   const garment::PatternLayout& layout = sheet.layout;
+  const PieceCounts counts = piece_counts(sheet);
   nlohmann::json pieces = nlohmann::json::array();
   for (const garment::PatternPiece& piece : layout.pieces) {
     const garment::FlatPanel& flat = sheet.pattern.panels[static_cast<size_t>(piece.panel)];
@@ -794,12 +825,17 @@ nlohmann::json pattern_json(const PatternSheet& sheet) {
           {"sheet_length_mm", kMm * layout.sheet_length},
           {"sheet_efficiency", layout.sheet_efficiency},
           {"mirror_pairs", layout.pairs},
+          {"pieces_to_cut", counts.to_cut},
+          {"pieces_drawn", counts.drawn},
+          {"fold_pieces", counts.on_fold},
+          {"pieces_summary", pieces_summary(counts)},
           {"pieces", pieces},
           {"seams", seams},
           {"warnings", sheet.pattern.warnings}};
 }
 
 nlohmann::json pattern_summary(const PatternSheet& sheet) {
+  const PieceCounts counts = piece_counts(sheet);
   nlohmann::json pieces = nlohmann::json::array();
   for (const garment::FlatPanel& flat : sheet.pattern.panels)
     pieces.push_back({{"id", flat.id}, {"distortion", distortion_json(flat.distortion)}});
@@ -814,6 +850,10 @@ nlohmann::json pattern_summary(const PatternSheet& sheet) {
           {"efficiency", sheet.layout.efficiency},
           {"sheet_length_mm", kMm * sheet.layout.sheet_length},
           {"mirror_pairs", sheet.layout.pairs},
+          {"pieces_to_cut", counts.to_cut},
+          {"pieces_drawn", counts.drawn},
+          {"fold_pieces", counts.on_fold},
+          {"pieces_summary", pieces_summary(counts)},
           {"warnings", sheet.pattern.warnings},
           {"timing_ms", {{"flatten", sheet.flatten_ms}, {"layout", sheet.layout_ms}}}};
 }

@@ -39,6 +39,20 @@ PatternSheet build_pattern_sheet(const scene::Sketch& sketch, const garment::Gar
                                  const garment::FlatPattern* flattened = nullptr,
                                  double flattened_ms = 0.0, const garment::Body* body = nullptr);
 
+// The pieces as the `pattern` command's line, the SVG's footer and pattern.json
+// ("pieces_summary") all say them: how many pieces are cut, how many are drawn when that
+// differs, and the pieces cut on the fold by name and the mirror pairs by count. "12 pieces to
+// cut, drawn as 8 (4 cut on the fold: 'cfront', 'cback', 'skirt_cf', 'skirt_cb'; 4 mirror pairs
+// drawn once, cut 2)"; "2 pieces to cut (2 cut on the fold: 'front', 'back')"; "5 pieces to cut".
+struct PieceCounts {
+  int to_cut = 0;                    // every piece as often as it is cut; a piece on the fold once
+  int drawn = 0;                     // on the sheet: a mirror pair once, a fold piece as its half
+  std::vector<std::string> on_fold;  // the pieces cut on the fold, in pattern order
+  int mirror_pairs = 0;
+};
+PieceCounts piece_counts(const PatternSheet& sheet);
+std::string pieces_summary(const PieceCounts& counts);
+
 std::string pattern_svg(const PatternSheet& sheet);
 std::string pattern_dxf(const PatternSheet& sheet);
 nlohmann::json pattern_json(const PatternSheet& sheet);

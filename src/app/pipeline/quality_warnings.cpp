@@ -59,6 +59,17 @@ std::string flattening_failure(const garment::Garment& garment,
   return error;
 }
 
+std::string strict_failure(const std::string& file,
+                           const std::vector<garment::QualityWarning>& warnings,
+                           size_t unused_curves) {
+  if (warnings.empty() && unused_curves == 0) return "";
+  std::vector<std::string> parts;
+  if (!warnings.empty())
+    parts.push_back(fmt::format("{} mesh quality warning(s)", warnings.size()));
+  if (unused_curves > 0) parts.push_back(fmt::format("{} curve(s) in no panel", unused_curves));
+  return fmt::format("{}: {} and --strict", file, fmt::join(parts, ", "));
+}
+
 nlohmann::json warnings_json(const std::vector<garment::QualityWarning>& warnings) {
   nlohmann::json out = nlohmann::json::array();
   for (const garment::QualityWarning& w : warnings)

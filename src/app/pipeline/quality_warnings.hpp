@@ -25,6 +25,14 @@ std::string flattening_failure(const garment::Garment& garment,
                                const garment::GarmentRequest& sketch, const garment::Body& body,
                                const std::string& panel, const std::string& error);
 
+// What `validate --strict` and `mesh --strict` count: the gate's warnings and the curves in no
+// panel (garment/unused_curves.hpp; logged by the garment stage). Empty when there are none,
+// else the failure's sentence: "<file>: 2 mesh quality warning(s), 1 curve(s) in no panel and
+// --strict".
+std::string strict_failure(const std::string& file,
+                           const std::vector<garment::QualityWarning>& warnings,
+                           size_t unused_curves);
+
 nlohmann::json warnings_json(const std::vector<garment::QualityWarning>& warnings);
 
 }  // namespace sd::app
