@@ -45,14 +45,15 @@ std::string place(const Eigen::Vector3d& p, const std::string& landmark) {
 // A panel that runs out into a long thin arm (a halter's strap round the neck, a bib's neck
 // strap): a side of at most kArmEnd edges between two sides each at least kArmLength times as
 // long. The filler's layouts keep such an arm as many quads wide as its end all the way to where
-// it joins the body (a rectilinear layout has no interior vertex to add a column with; the
-// others put theirs in the body), so where the arm widens its quads widen and the turn onto the
-// body is squeezed: the one-piece halter's front (sides 13, 5, 27, 2, 20, 11) kept a quad 2.43
-// times the edge, trial 40's (13, 11, 27, 3, 23, 13) 2.1° corners where the strap turns onto the
-// chest. Neither a corner at that turn (trial 40: 4 warnings instead of 2; the repro: 5 instead
-// of 1) nor a smaller edge_length on the strap's curves (1.5-1.7 cm: 1 to 7 warnings) cleared
-// it; the arm cut as its own panel, seamed across where it meets the body, did (the repro:
-// clean under --strict once the gate's offered edge_length for the armhole was taken).
+// it joins the body (a rectilinear layout has no irregular interior vertex to add a column
+// with, nor has any layout whose irregular vertices all lie in the body), so where the arm
+// widens its quads widen and the turn onto the body is squeezed: the one-piece halter's front
+// (sides 13, 5, 27, 2, 20, 11) kept a quad 2.43 times the edge, trial 40's (13, 11, 27, 3, 23,
+// 13) 2.1° corners where the strap turns onto the chest (1 quad 2.07 times the edge since 0696a36).
+// Neither a corner at that turn (trial 40: 4 warnings instead of 2; the repro: 5 instead of 1) nor
+// a smaller edge_length on the strap's curves (1.5-1.7 cm: 1 to 7 warnings) cleared it; the arm cut
+// as its own panel, seamed across where it meets the body, did (the repro: clean under --strict
+// once the gate's offered edge_length for the armhole was taken).
 constexpr int kArmEnd = 3;
 constexpr int kArmLength = 6;
 
