@@ -512,6 +512,17 @@ FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
           std::optional<Built> none;
           count_plan = choose_plan(counts, straight, display, none);
           most_quads = std::max(kMostQuadShare * *asked, quads_of(*count_plan));
+          // Among its equal rectilinear layouts, the one whose walk turns where the boundary
+          // does, unless that one has too few or too many quads (docs/meshing.md, "Long thin
+          // arms": trial 40's one-piece halter kept its reflex vertices on the hem and the
+          // neckline, 5 corners under 10° where the strap turns onto the chest).
+          if (!count_plan->turns.empty() && !shape.turn.empty()) {
+            BoundaryShape turning = straight;
+            turning.turn = shape.turn;
+            Plan by_turns = choose_plan(counts, turning, display, none);
+            if (by_turns.turns != count_plan->turns && !off_count(quads_of(by_turns)))
+              count_plan = std::move(by_turns);
+          }
         }
       }
       tried.push_back(plan);

@@ -134,6 +134,64 @@ TEST(QualityGate, QuadsMuchLargerThanAskedAreFound) {
   EXPECT_NEAR(size->worst, 3.0, 1e-9);
 }
 
+// A strip of 2 × `length` quads of 3 cm: its outline as four curves, the end 'strap_end' (2 edges
+// along y = 0), 'outer' (up x = 2), 'top' (2) and 'inner' (down x = 0).
+Garment strip_garment(int length) {
+  Garment g;
+  g.mesh = test::quad_grid(2, length);
+  g.mesh.vertices *= 0.03;
+  g.face_panel = Eigen::VectorXi::Zero(g.mesh.face_count());
+  GarmentPanel panel;
+  panel.id = "front";
+  panel.curves = {"strap_end", "outer", "top", "inner"};
+  panel.side_counts = {2, length, 2, length};
+  g.panels.push_back(panel);
+  const auto id = [](int i, int j) { return j * 3 + i; };
+  for (int i = 0; i < 2; ++i) {
+    g.edge_curve[{id(i, 0), id(i + 1, 0)}] = "strap_end";
+    g.edge_curve[{id(i, length), id(i + 1, length)}] = "top";
+  }
+  for (int j = 0; j < length; ++j) {
+    g.edge_curve[{id(2, j), id(2, j + 1)}] = "outer";
+    g.edge_curve[{id(0, j), id(0, j + 1)}] = "inner";
+  }
+  return g;
+}
+
+TEST(QualityGate, APanelWithALongThinArmIsToldWhatToChange) {
+  // Like the one-piece halter's strap (data/designs/repro/halter-one-piece.json: its end 2 edges
+  // across between sides of 27 and 20): an end of 2 edges between sides of 12, which leave it
+  // parallel. The quads are 3 cm where 1 cm is asked, so the panel has a quad_size warning to
+  // advise on.
+  const Garment g = strip_garment(12);
+  const QualityWarning* size =
+      find_kind(check_quality(g, sketch_with_edge(0.01), nullptr), "quad_size");
+  ASSERT_NE(size, nullptr);
+  EXPECT_NE(size->message.find("long thin arm ('strap_end' with 2 edge(s) across its end, between "
+                               "'inner' with 12 and 'outer' with 12 edges)"),
+            std::string::npos)
+      << size->message;
+  EXPECT_NE(size->message.find("seam across it where it meets the body"), std::string::npos);
+  // The advice sits before the place, where the gate's offers go (at the first ';').
+  EXPECT_LT(size->message.find("long thin arm"), size->message.find(';'));
+
+  // The same outline narrowing to its end (a raglan sleeve at the neck): its sides leave the end
+  // 2 × 26.6° apart (x spread by 1 + y / 2 about the middle), more than kArmSpread. No advice.
+  Garment wedge = strip_garment(12);
+  for (Eigen::Index v = 0; v < wedge.mesh.vertex_count(); ++v) {
+    const double y = wedge.mesh.vertices(v, 1) / 0.03;
+    wedge.mesh.vertices(v, 0) = 0.03 + (wedge.mesh.vertices(v, 0) - 0.03) * (1 + y / 2);
+  }
+  size = find_kind(check_quality(wedge, sketch_with_edge(0.01), nullptr), "quad_size");
+  ASSERT_NE(size, nullptr);
+  EXPECT_EQ(size->message.find("long thin arm"), std::string::npos) << size->message;
+
+  // An end of 2 edges between sides of 11, less than kArmLength = 6 times as long: no arm.
+  size = find_kind(check_quality(strip_garment(11), sketch_with_edge(0.01), nullptr), "quad_size");
+  ASSERT_NE(size, nullptr);
+  EXPECT_EQ(size->message.find("long thin arm"), std::string::npos) << size->message;
+}
+
 TEST(QualityGate, ClothInsideTheBodyIsNamedWithItsDepth) {
   // A 6 × 6 grid of 3 cm quads at z = 0 over a ball of radius 0.1 m whose top pokes 5 mm
   // through the middle of quad (2, 2): the cloth there lies 5 mm inside the body (less the
