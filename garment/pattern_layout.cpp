@@ -253,14 +253,21 @@ void grain_line(PatternPiece& piece) {
 // flared tier, its side seams 26-28° off the grain, cut them 11-13 % long and its front and
 // back 1.6 % apart (docs/pattern.md, "Gathered seams"). So the piece is slashed and spread as a
 // pattern maker spreads a flared piece: about the apex where the lines of its seam sides along
-// the grain meet (the chords of the sides closer to the other axis than to the gather), every
+// the grain meet (the chords, closer to the other axis than to the gather, of the sides sewn to
+// a piece cut with the same ease: not gathered into anything), every
 // point's distance from the apex is scaled by n and its angle from the grain line through the
 // apex by g / n. A straight side through the apex keeps n times its length and an arc about it
 // is gathered g times. Sides meeting farther than kFanReach extents away (within 3° of
 // parallel, where the two maps differ by under 0.2 % for g / n = 1.5) or fewer than two
 // sides along the grain: diag(weft, warp), the same limit.
-Eigen::MatrixX2d eased_outline(const FlatPattern& pattern, size_t p, const PanelEase& ease) {
+Eigen::MatrixX2d eased_outline(const FlatPattern& pattern, size_t p,
+                               const std::vector<PanelEase>& eases) {
   constexpr double kFanReach = 20;
+  const auto ease_of = [&](int panel) {
+    return static_cast<size_t>(panel) < eases.size() ? eases[static_cast<size_t>(panel)]
+                                                     : PanelEase{};
+  };
+  const PanelEase ease = ease_of(static_cast<int>(p));
   const FlatPanel& flat = pattern.panels[p];
   const auto n = static_cast<Eigen::Index>(flat.boundary.size());
   Eigen::MatrixX2d uv(n, 2);
@@ -276,8 +283,8 @@ Eigen::MatrixX2d eased_outline(const FlatPattern& pattern, size_t p, const Panel
   Eigen::Matrix2d normal = Eigen::Matrix2d::Zero();
   Eigen::Vector2d rhs = Eigen::Vector2d::Zero();
   int sides = 0;
-  const auto add_side = [&](const std::vector<int>& vertices) {
-    if (vertices.size() < 2) return;
+  const auto add_side = [&](const std::vector<int>& vertices, int partner) {
+    if (vertices.size() < 2 || !(ease_of(partner) == ease)) return;
     const Eigen::Vector2d q = flat.uv.row(vertices.front()).transpose();
     const Eigen::Vector2d d = flat.uv.row(vertices.back()).transpose() - q;
     if (d.norm() <= 0 || std::abs(d[across]) >= std::abs(d[1 - across])) return;
@@ -288,8 +295,8 @@ Eigen::MatrixX2d eased_outline(const FlatPattern& pattern, size_t p, const Panel
     ++sides;
   };
   for (const PatternSeam& seam : pattern.seams) {
-    if (static_cast<size_t>(seam.panel_a) == p) add_side(seam.vertices_a);
-    if (static_cast<size_t>(seam.panel_b) == p) add_side(seam.vertices_b);
+    if (static_cast<size_t>(seam.panel_a) == p) add_side(seam.vertices_a, seam.panel_b);
+    if (static_cast<size_t>(seam.panel_b) == p) add_side(seam.vertices_b, seam.panel_a);
   }
   const Eigen::Vector2d centre = uv.colwise().mean().transpose();
   const double extent = (uv.colwise().maxCoeff() - uv.colwise().minCoeff()).norm();
@@ -425,7 +432,7 @@ PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOpt
       piece.allowances.front().first = piece.allowances.back().first;  // the run across point 0
       piece.allowances.pop_back();
     }
-    piece.sewing = eased_outline(pattern, p, piece.ease);
+    piece.sewing = eased_outline(pattern, p, options.panel_ease);
     // A fold is straight: the points of the fold run are moved onto its chord (within 2 mm,
     // as the app chose it: PatternLayoutOptions::fold_edge).
     if (p < options.fold_edge.size() && options.fold_edge[p].size() == edges)
