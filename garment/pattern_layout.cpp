@@ -254,12 +254,12 @@ void grain_line(PatternPiece& piece) {
 // back 1.6 % apart (docs/pattern.md, "Gathered seams"). So the piece is slashed and spread as a
 // pattern maker spreads a flared piece: about the apex where the lines of its seam sides along
 // the grain meet (the chords, closer to the other axis than to the gather, of the sides sewn to
-// a piece cut with the same ease: not gathered into anything), every
-// point's distance from the apex is scaled by n and its angle from the grain line through the
-// apex by g / n. A straight side through the apex keeps n times its length and an arc about it
-// is gathered g times. Sides meeting farther than kFanReach extents away (within 3° of
-// parallel, where the two maps differ by under 0.2 % for g / n = 1.5) or fewer than two
-// sides along the grain: diag(weft, warp), the same limit.
+// a piece cut with the same ease: not gathered into anything), every point's distance from the
+// apex is scaled by n and its angle from the grain line through the apex by g / n. A straight
+// side through the apex keeps n times its length and an arc about it is gathered g times. Sides
+// meeting farther than kFanReach extents away (within 3° of parallel, where the two maps differ
+// by under 0.2 % for g / n = 1.5), fewer than two sides along the grain, or a piece reaching
+// round its apex: diag(weft, warp), the spread's limit for parallel sides.
 Eigen::MatrixX2d eased_outline(const FlatPattern& pattern, size_t p,
                                const std::vector<PanelEase>& eases) {
   constexpr double kFanReach = 20;
