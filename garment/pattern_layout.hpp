@@ -70,7 +70,9 @@ struct AllowanceRun {
 
 // One piece in its own frame: piece = scale() · FlatPanel::uv + origin (m), warp along +y, the
 // cutting line's bounding box starting at (0, 0): x scaled by the weft ease, y by the warp
-// ease, so a gathered piece (different factors) is cut longer than the seams it is sewn to.
+// ease. A gathered piece (different factors) is cut longer than the seams it gathers into:
+// spread about the apex of its sides along the grain (docs/pattern.md, "Gathered seams"), so
+// that those sides keep the smaller factor; scale() · uv is then its limit for parallel sides.
 // On the fabric it sits at `placement`.
 struct PatternPiece {
   int panel = -1;  // index into FlatPattern::panels

@@ -705,6 +705,49 @@ TEST(PanelFlattening, StrapOverTheShoulderIsCutAlongTheWarpItDrapesWith) {
   }
 }
 
+// The pieces as cut (lay_out_pattern with each panel's ease): every seam's two sides, each
+// divided by the ease the designer gave it along that side (an isotropic panel's factor; a
+// gathered panel's weft factor for a side running across the grain, its warp factor for one
+// along it), within 0.5 % of each other, as the issue asks of a pattern's seams (the same bound
+// as the flattening's `mismatch`): a seam is sewn, a gathered one gathered by exactly its
+// factor. The flattening's check above is made before the ease and did not see the tiered
+// skirt's gathered tier cut its side seams 1.6 % apart (179.0 and 176.2 mm) and its gathered
+// edges 1.5 % short of 1.5 times their partners when the ease scaled the whole piece across.
+double worst_cut_seam(const Garment& g, const FlatPattern& pattern, const std::string& name) {
+  PatternLayoutOptions options;
+  options.fabric_width = 10;  // m: no piece refused for its width; the seams are what is tested
+  for (const FlatPanel& flat : pattern.panels)
+    options.panel_ease.push_back(g.panels[static_cast<size_t>(flat.panel)].ease);
+  const PatternLayout layout = lay_out_pattern(pattern, options);
+  const auto side = [&](int panel, const std::vector<int>& vertices) {
+    const FlatPanel& flat = pattern.panels[static_cast<size_t>(panel)];
+    const PatternPiece& piece = layout.pieces[static_cast<size_t>(panel)];
+    double length = 0;
+    for (size_t k = 0; k + 1 < vertices.size(); ++k) {
+      const auto at = [&](int v) {
+        return piece.sewing.row(std::find(flat.boundary.begin(), flat.boundary.end(), v) -
+                                flat.boundary.begin());
+      };
+      length += (at(vertices[k + 1]) - at(vertices[k])).norm();
+    }
+    const Eigen::RowVector2d chord = flat.uv.row(vertices.back()) - flat.uv.row(vertices.front());
+    const bool across = std::abs(chord.x()) > std::abs(chord.y());
+    return length / (across ? piece.ease.weft : piece.ease.warp);
+  };
+  double worst = 0;
+  for (const PatternSeam& seam : pattern.seams) {
+    const double a = side(seam.panel_a, seam.vertices_a), b = side(seam.panel_b, seam.vertices_b);
+    const double difference = std::abs(a - b) / std::max(a, b);
+    EXPECT_LE(difference, 0.005) << name << ": seam between "
+                                 << pattern.panels[static_cast<size_t>(seam.panel_a)].id << " ("
+                                 << 1e3 * a << " mm) and "
+                                 << pattern.panels[static_cast<size_t>(seam.panel_b)].id << " ("
+                                 << 1e3 * b << " mm) as cut, each divided by its ease";
+    worst = std::max(worst, difference);
+  }
+  return worst;
+}
+
 TEST(PanelFlattening, ExampleSeamsSew) {
   static const Body body = load_body("builtin");
   static const BodySurface surface(body.mesh);
@@ -721,16 +764,17 @@ TEST(PanelFlattening, ExampleSeamsSew) {
       worst = std::max(worst, seam.mismatch());
     }
     expect_mirror_pairs_equal(g, pattern, file.filename().string());
+    const double cut = worst_cut_seam(g, pattern, file.filename().string());
     double stretch = 0;
     for (const FlatPanel& flat : pattern.panels) {
       EXPECT_EQ(inverted_triangles(flat), 0) << file << " " << flat.id;
       stretch = std::max(stretch, flat.distortion.length_p95);
     }
     std::printf(
-        "%s: %zu pieces, %zu seams, worst seam mismatch %.3f %%, worst stretch (95th "
-        "percentile) %.2f %%\n",
+        "%s: %zu pieces, %zu seams, worst seam mismatch %.3f %% (as cut, eases divided out "
+        "%.3f %%), worst stretch (95th percentile) %.2f %%\n",
         file.filename().c_str(), pattern.panels.size(), pattern.seams.size(), 100 * worst,
-        100 * stretch);
+        100 * cut, 100 * stretch);
   }
 }
 
@@ -758,6 +802,8 @@ TEST(PanelFlattening, DesignSeamsSew) {
     for (const FlatPanel& flat : pattern.panels)
       EXPECT_EQ(inverted_triangles(flat), 0) << file << " " << flat.id;
     expect_mirror_pairs_equal(g, pattern, file.filename().string());
+    std::printf("%s: worst seam as cut, eases divided out, %.3f %%\n", file.filename().c_str(),
+                100 * worst_cut_seam(g, pattern, file.filename().string()));
   }
 }
 

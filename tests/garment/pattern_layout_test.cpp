@@ -234,5 +234,83 @@ TEST(PatternLayout, FoldPieceTakesBothHalvesOfTheFabric) {
   EXPECT_NEAR(seamed.length_used, 2 * gap + 0.32, 1e-9);
 }
 
+// A gathered piece is spread about the apex of its sides along the grain (pattern_layout.cpp,
+// eased_outline), not scaled across as a whole: a flared half tier (an annular sector, radii 0.6
+// and 0.9 m about the apex at (0, 1), from the centre line straight down to 20° off it) cut with
+// "weft" 1.5 keeps its side seam and centre line at their 0.3 m, with the centre line on the grain
+// (x constant), and its top and hem arcs come out 1.5 times as long. Scaling x by 1.5 would have
+// cut the side seam sqrt(cos² 20° + 1.5² sin² 20°) = 7.1 % long. Bounds: the side's and centre's
+// points stay on their rays exactly (1e-12 m); a chord of an arc spread by 1.5 is 2r sin(0.75 δ)
+// against 2r sin(δ / 2), 1.5 times as long to (1.25 / 24) δ² = 6e-5 at δ = 2°, bound 1e-4. Two
+// sides sewn to pieces cut with a different ease (gathered into them) do not set the apex, and
+// parallel sides give the plain scale.
+TEST(PatternLayout, GatheredFlaredPieceIsSpreadAboutItsApex) {
+  const int steps = 10;
+  const double pi = 3.14159265358979323846, spread = 20 * pi / 180;
+  const Eigen::Vector2d apex(0, 1);
+  const auto at = [&](double r, double angle) {
+    return Eigen::Vector2d(apex + r * Eigen::Vector2d(std::sin(angle), -std::cos(angle)));
+  };
+  // CCW: the hem from the centre out, the side up, the top back in, the centre line down.
+  std::vector<Eigen::Vector2d> points;
+  for (int k = 0; k < steps; ++k) points.push_back(at(0.9, spread * k / steps));
+  for (int k = 0; k < steps; ++k) points.push_back(at(0.9 - 0.3 * k / steps, spread));
+  for (int k = 0; k < steps; ++k) points.push_back(at(0.6, spread * (steps - k) / steps));
+  for (int k = 0; k < steps; ++k) points.push_back(at(0.6 + 0.3 * k / steps, 0));
+  FlatPattern pattern = one_piece(points, 1);
+  pattern.panels.push_back(pattern.panels[0]);
+  pattern.panels[1].id = "back";
+  pattern.panels[1].panel = 1;
+  const auto run = [](int first, int count) {
+    std::vector<int> v;
+    for (int k = 0; k <= count; ++k) v.push_back((first + k) % (4 * steps));
+    return v;
+  };
+  PatternSeam side, centre;
+  side.panel_a = 0, side.panel_b = 1, side.vertices_a = side.vertices_b = run(steps, steps);
+  centre.panel_a = 0, centre.panel_b = 1, centre.vertices_a = run(3 * steps, steps);
+  centre.vertices_b = centre.vertices_a;
+  pattern.seams = {side, centre};
+  PatternLayoutOptions options;
+  options.panel_ease = {PanelEase{1.0, 1.5}, PanelEase{1.0, 1.5}};
+  const PatternLayout layout = lay_out_pattern(pattern, options);
+  const Eigen::MatrixX2d& cut = layout.pieces[0].sewing;
+  const auto length = [&](const Eigen::MatrixX2d& p, int first, int count) {
+    double l = 0;
+    for (int k = 0; k < count; ++k)
+      l += (p.row((first + k + 1) % p.rows()) - p.row((first + k) % p.rows())).norm();
+    return l;
+  };
+  Eigen::MatrixX2d flat(4 * steps, 2);
+  for (int k = 0; k < 4 * steps; ++k) flat.row(k) = points[static_cast<size_t>(k)].transpose();
+  EXPECT_NEAR(length(cut, steps, steps), 0.3, 1e-12) << "the side seam";
+  EXPECT_NEAR(length(cut, 3 * steps, steps), 0.3, 1e-12) << "the centre line";
+  for (int k = 3 * steps; k < 4 * steps; ++k) EXPECT_NEAR(cut(k, 0), cut(0, 0), 1e-12);
+  EXPECT_NEAR(length(cut, 0, steps) / length(flat, 0, steps), 1.5, 1.5e-4) << "the hem";
+  EXPECT_NEAR(length(cut, 2 * steps, steps) / length(flat, 2 * steps, steps), 1.5, 1.5e-4)
+      << "the top";
+  // The same sides sewn to pieces cut with another ease: scaled across as a whole.
+  options.panel_ease[1] = PanelEase{};
+  const Eigen::MatrixX2d& scaled = lay_out_pattern(pattern, options).pieces[0].sewing;
+  const double affine =
+      std::sqrt(std::pow(std::cos(spread), 2) + 2.25 * std::pow(std::sin(spread), 2));
+  EXPECT_NEAR(length(scaled, steps, steps), 0.3 * affine, 1e-12);
+  EXPECT_GT(affine, 1.07);
+  // Parallel sides (a rectangle): the plain scale, 1.5 times as wide, as tall as drawn.
+  FlatPattern rectangle = one_piece({{0, 0}, {0.4, 0}, {0.4, 0.3}, {0, 0.3}}, 5);
+  rectangle.panels.push_back(rectangle.panels[0]);
+  rectangle.panels[1].panel = 1;
+  PatternSeam left, right;
+  left.panel_a = right.panel_a = 0, left.panel_b = right.panel_b = 1;
+  left.vertices_a = left.vertices_b = {15, 16, 17, 18, 19, 0};
+  right.vertices_a = right.vertices_b = {5, 6, 7, 8, 9, 10};
+  rectangle.seams = {left, right};
+  options.panel_ease = {PanelEase{1.0, 1.5}, PanelEase{1.0, 1.5}};
+  const PatternPiece wide = lay_out_pattern(rectangle, options).pieces[0];
+  const Eigen::Vector2d size = wide.sewing.colwise().maxCoeff() - wide.sewing.colwise().minCoeff();
+  EXPECT_NEAR(size.x(), 0.6, 1e-12);
+  EXPECT_NEAR(size.y(), 0.3, 1e-12);
+}
+
 }  // namespace
 }  // namespace sd::garment

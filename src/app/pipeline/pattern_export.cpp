@@ -675,14 +675,14 @@ Eigen::MatrixX2d flat_seam_side(const PatternSheet& sheet, int panel,
   return out;
 }
 
-// A seam side's polyline in its piece's frame (m, ease applied).
+// A seam side's polyline in its piece's frame (m, ease applied): the piece's sewing points.
 Eigen::MatrixX2d seam_side(const PatternSheet& sheet, int panel, const std::vector<int>& vertices) {
   const garment::FlatPanel& flat = sheet.pattern.panels[static_cast<size_t>(panel)];
   const garment::PatternPiece& piece = sheet.layout.pieces[static_cast<size_t>(panel)];
   Eigen::MatrixX2d out(static_cast<Eigen::Index>(vertices.size()), 2);
   for (size_t k = 0; k < vertices.size(); ++k)
-    out.row(static_cast<Eigen::Index>(k)) =
-        flat.uv.row(vertices[k]).cwiseProduct(piece.scale().transpose()) + piece.origin.transpose();
+    out.row(static_cast<Eigen::Index>(k)) = piece.sewing.row(
+        std::find(flat.boundary.begin(), flat.boundary.end(), vertices[k]) - flat.boundary.begin());
   return out;
 }
 
