@@ -732,6 +732,37 @@ TEST(HostileInput, InsideOutBodyIsFlippedAndOpenBodyWarned) {
 // An open body's warning, shown on the terminal, is in run's report.json `warnings` too, and
 // validate's summary counts every warning it printed (the trial-34 summary counted only the
 // quality gate's and left out the body's, the fabric's and the pattern's).
+// The docs' minimal file (a patch on the chest that goes round nothing) fell 126 m and failed
+// at 50 m/s after 5 s of drape (trial 41, P2): it is stopped once all of it is below the feet,
+// with the reason and a pin height, exit 2 and nothing written. Held by its top edge it drapes.
+TEST(HostileInput, ClothThatFallsOffTheBodyIsStoppedWithTheReason) {
+  const fs::path dir = fresh_dir("falls-off");
+  // 3 s: free fall from the chest below the feet takes about 0.5 s; without the check the
+  // run would go on to the duration's end (or fail at 50 m/s after 5 s).
+  write(dir / "falls.json",
+        square("", R"(, "simulate": {"duration": 3}, "output": {"images": []})"));
+  const CommandResult falls =
+      run_sketchdrape("run " + (dir / "falls.json").string() + " -o " + (dir / "out").string());
+  EXPECT_EQ(falls.exit_code, 2) << falls.output;
+  EXPECT_NE(falls.output.find((dir / "falls.json").string() +
+                              ": /panels/0: the cloth fell off the body: nothing holds panel "
+                              "'patch' up"),
+            std::string::npos)
+      << falls.output;
+  EXPECT_NE(falls.output.find(R"("pin_above": 1.29)"), std::string::npos) << falls.output;
+  EXPECT_EQ(falls.output.find("the simulation failed"), std::string::npos) << falls.output;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+
+  // The pin the message offers holds it: the run ends normally.
+  write(dir / "held.json", square("", R"(, "simulate": {"duration": 3, "pin_above": 1.29},
+          "output": {"images": []})"));
+  const CommandResult held =
+      run_sketchdrape("-q run " + (dir / "held.json").string() + " -o " + (dir / "held").string());
+  EXPECT_EQ(held.exit_code, 0) << held.output;
+  EXPECT_TRUE(fs::exists(dir / "held" / "drape.obj"));
+  fs::remove_all(dir);
+}
+
 TEST(HostileInput, AnOpenBodyIsWarnedInTheReportAndCounted) {
   const fs::path dir = fresh_dir("open-body");
   // The octahedron of the test above without one face, with a small sheet held above it.
