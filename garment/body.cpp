@@ -33,6 +33,11 @@
 namespace sd::garment {
 namespace {
 
+// File units: a body outside these without "height" or "scale" is refused rather than guessed
+// (kilometres give 0.0018, micrometres 1.8e6).
+constexpr double kMinGuessedHeight = 1e-4;
+constexpr double kMaxGuessedHeight = 1e7;
+
 constexpr const char* kBuiltinPath = "/usr/share/assimp/models/BLEND/HUMAN.blend";
 constexpr double kBuiltinHeight = 1.75;
 
@@ -331,6 +336,12 @@ void check_mesh_file_header(const std::string& file, const std::string& what) {
   std::string header(65536, '\0');
   in.read(header.data(), static_cast<std::streamsize>(header.size()));
   header.resize(static_cast<size_t>(in.gcount()));
+  // gzip's magic bytes (trial 41, P9: a gzipped OBJ reached assimp, which said "OBJ: Invalid
+  // face index.").
+  if (header.starts_with("\x1f\x8b"))
+    throw BodyError(what + " '" + file +
+                    "' is gzip-compressed (it starts with gzip's bytes 1f 8b): unpack it first "
+                    "(gunzip) and give the unpacked file");
   std::istringstream words(header);
   std::string word;
   double vertices = 0, faces = 0;
@@ -662,6 +673,15 @@ Body load_body(const std::string& path, const BodyOptions& options) {
   } else if (raw.height >= 500 && raw.height <= 2500) {
     raw.scale = 0.001;
     raw.scale_rule = "height looks like millimetres";
+  } else if (!(raw.height >= kMinGuessedHeight && raw.height <= kMaxGuessedHeight)) {
+    // No unit makes such a file a figure (trial 41, P8: a human in units of 1e30 was quietly
+    // made 1.75 m tall): a guess would hide a broken export.
+    throw BodyError(fmt::format(
+        "the body is {:.4g} file units tall, which no unit makes a body's size (metres, "
+        "centimetres, millimetres, inches or even micrometres): the file's coordinates are "
+        "probably broken; if it is right, give its \"height\" in metres or its \"scale\" in "
+        "metres per file unit",
+        raw.height));
   } else {
     raw.scale = kBuiltinHeight / raw.height;
     raw.scale_rule = fmt::format("unknown units: scaled to {:.2f} m", kBuiltinHeight);
@@ -712,8 +732,11 @@ Body load_body(const std::string& path, const BodyOptions& options) {
   static std::mutex mutex;
   static std::set<std::string> said;
   const std::lock_guard lock(mutex);
+  // Named by its file, as every other message is (trial 41, P8: "the body is inside out"
+  // named no file).
   for (const auto& warning : body.warnings)
-    if (said.insert(fmt::format("{}: {}", file, warning)).second) spdlog::warn("{}", warning);
+    if (said.insert(fmt::format("{}: {}", file, warning)).second)
+      spdlog::warn("body file '{}': {}", file, warning);
   return body;
 }
 

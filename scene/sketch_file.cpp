@@ -32,6 +32,11 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
       if (text[i + zero] != '\0' || text[i + 1 - zero] == '\0') return false;
     return true;
   };
+  // gzip's magic bytes (trial 41, P9: "line 1, column 4: the file holds a NUL byte").
+  if (text.starts_with("\x1f\x8b"))
+    r.fail("",
+           "the file is gzip-compressed (it starts with gzip's bytes 1f 8b): unpack it first "
+           "(gunzip) and give the unpacked .json file");
   if (utf16())
     r.fail("",
            "the file is UTF-16 text; this program reads sketch files in UTF-8 (save it as "
@@ -155,6 +160,13 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
 }
 
 Sketch load_sketch(const std::filesystem::path& path) {
+  // The shell convention for standard input (trial 41, P13: "-: the sketch file does not
+  // exist"); a file really named "-" is still read.
+  if (path == "-" && !std::filesystem::exists(path))
+    throw SketchError(path.string(), "",
+                      "reading a sketch from standard input ('-') is not supported: save it to "
+                      "a file and give the file's name (its paths, such as the body's, are "
+                      "relative to that file's folder)");
   if (const auto problem = input_file_problem(path, kMaxSketchFileBytes))
     throw SketchError(path.string(), "", "the sketch file " + *problem);
   std::ifstream in(path, std::ios::binary);

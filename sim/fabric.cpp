@@ -106,29 +106,65 @@ struct CurveUnit {
 constexpr CurveUnit kStrainUnits[] = {{"1", 1.0}, {"%", 0.01}};
 constexpr CurveUnit kStressUnits[] = {{"N/m", 1.0}, {"gf/cm", 0.9807}};
 
-// Refuses a key of `object` (at `pointer`) not in `known`, as the sketch reader does: a
+// The known key a designer most likely meant by `key`: a close spelling, or a known key that
+// `key` is one word of ("density" for "area_density", "tensile" for "tensile_warp").
+std::string_view meant_key(std::string_view key, const std::vector<std::string_view>& known) {
+  std::string_view best;
+  size_t best_distance = 3;  // suggest only close spellings
+  for (std::string_view k : known)
+    if (const size_t d = edit_distance(key, k); d < best_distance) best = k, best_distance = d;
+  if (!best.empty() || key.empty()) return best;
+  for (std::string_view k : known)
+    if ((k.size() > key.size() && k.ends_with(key) && k[k.size() - key.size() - 1] == '_') ||
+        (k.size() > key.size() && k.starts_with(key) && k[key.size()] == '_'))
+      return k;
+  return {};
+}
+
+// Refuses the keys of `object` (at `pointer`) not in `known`, as the sketch reader does: a
 // misspelt constant would otherwise be dropped silently (a "frictoin" next to the default
-// "friction") or reported only as the correct key missing.
+// "friction") or reported only as the correct key missing. Every unknown key is named, each
+// with what it probably meant (trial 41, P11: {"preset": "cotton", "density": 0} named only
+// 'density' and offered no 'area_density').
 void check_fabric_keys(const nlohmann::json& object, const std::string& where,
                        const std::string& pointer, const std::vector<std::string_view>& known) {
+  std::vector<std::string> unknown;
+  bool all_placed = true;  // every unknown key has a suggestion
   for (const auto& [key, value] : object.items()) {
     if (std::find(known.begin(), known.end(), key) != known.end()) continue;
-    std::string_view best;
-    size_t best_distance = 3;  // suggest only close spellings
-    for (std::string_view k : known)
-      if (const size_t d = edit_distance(key, k); d < best_distance) best = k, best_distance = d;
-    std::string sentence = "unknown key '" + key + "'";
-    if (!best.empty()) {
-      sentence += " (did you mean '" + std::string(best) + "'?)";
+    std::string text = "'" + key + "'";
+    if (const std::string_view best = meant_key(key, known); !best.empty()) {
+      text += " (did you mean '" + std::string(best) + "'?)";
+    } else if (key == "preset" || key == "base" || key == "based_on" || key == "fabric") {
+      // A preset with changes is a natural guess; it does not exist.
+      text +=
+          " (a fabric object cannot start from a preset and change some of its constants: it "
+          "gives every constant itself; copy data/fabrics/<preset>.json, change it and give "
+          "its path instead)";
     } else {
-      sentence += " (known keys here: ";
-      for (size_t i = 0; i < known.size(); ++i)
-        sentence += std::string(i == 0 ? "" : ", ") + std::string(known[i]);
-      sentence += ")";
+      all_placed = false;
     }
-    throw InvalidFabricError(where + ": " + pointer + "/" + key + ": " + sentence,
-                             pointer + "/" + key);
+    unknown.push_back(text);
   }
+  if (unknown.empty()) return;
+  std::string sentence = unknown.size() == 1 ? "unknown key " : "unknown keys ";
+  for (size_t i = 0; i < unknown.size(); ++i)
+    sentence += (i == 0 ? "" : (i + 1 == unknown.size() ? " and " : ", ")) + unknown[i];
+  if (!all_placed) {
+    sentence += " (known keys here: ";
+    for (size_t i = 0; i < known.size(); ++i)
+      sentence += std::string(i == 0 ? "" : ", ") + std::string(known[i]);
+    sentence += ")";
+  }
+  // The path of the first (in the order the JSON reader gives them, alphabetical).
+  std::string first;
+  for (const auto& [key, value] : object.items())
+    if (std::find(known.begin(), known.end(), key) == known.end()) {
+      first = key;
+      break;
+    }
+  throw InvalidFabricError(where + ": " + pointer + "/" + first + ": " + sentence,
+                           pointer + "/" + first);
 }
 
 template <size_t N>
