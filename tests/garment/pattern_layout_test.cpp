@@ -291,7 +291,7 @@ TEST(PatternLayout, GatheredFlaredPieceIsSpreadAboutItsApex) {
       << "the top";
   // The same sides sewn to pieces cut with another ease: scaled across as a whole.
   options.panel_ease[1] = PanelEase{};
-  const Eigen::MatrixX2d& scaled = lay_out_pattern(pattern, options).pieces[0].sewing;
+  const Eigen::MatrixX2d scaled = lay_out_pattern(pattern, options).pieces[0].sewing;
   const double affine =
       std::sqrt(std::pow(std::cos(spread), 2) + 2.25 * std::pow(std::sin(spread), 2));
   EXPECT_NEAR(length(scaled, steps, steps), 0.3 * affine, 1e-12);

@@ -163,9 +163,10 @@ TEST(QualityGate, APanelWithALongThinArmIsToldWhatToChange) {
   // across between sides of 27 and 20): an end of 2 edges between sides of 12, which leave it
   // parallel. The quads are 3 cm where 1 cm is asked, so the panel has a quad_size warning to
   // advise on.
+  // Each check's warnings are kept alive while `size` points into them.
   const Garment g = strip_garment(12);
-  const QualityWarning* size =
-      find_kind(check_quality(g, sketch_with_edge(0.01), nullptr), "quad_size");
+  const std::vector<QualityWarning> strip = check_quality(g, sketch_with_edge(0.01), nullptr);
+  const QualityWarning* size = find_kind(strip, "quad_size");
   ASSERT_NE(size, nullptr);
   EXPECT_NE(size->message.find("long thin arm ('strap_end' with 2 edge(s) across its end, between "
                                "'inner' with 12 and 'outer' with 12 edges)"),
@@ -182,12 +183,15 @@ TEST(QualityGate, APanelWithALongThinArmIsToldWhatToChange) {
     const double y = wedge.mesh.vertices(v, 1) / 0.03;
     wedge.mesh.vertices(v, 0) = 0.03 + (wedge.mesh.vertices(v, 0) - 0.03) * (1 + y / 2);
   }
-  size = find_kind(check_quality(wedge, sketch_with_edge(0.01), nullptr), "quad_size");
+  const std::vector<QualityWarning> wedged = check_quality(wedge, sketch_with_edge(0.01), nullptr);
+  size = find_kind(wedged, "quad_size");
   ASSERT_NE(size, nullptr);
   EXPECT_EQ(size->message.find("long thin arm"), std::string::npos) << size->message;
 
   // An end of 2 edges between sides of 11, less than kArmLength = 6 times as long: no arm.
-  size = find_kind(check_quality(strip_garment(11), sketch_with_edge(0.01), nullptr), "quad_size");
+  const std::vector<QualityWarning> shorter =
+      check_quality(strip_garment(11), sketch_with_edge(0.01), nullptr);
+  size = find_kind(shorter, "quad_size");
   ASSERT_NE(size, nullptr);
   EXPECT_EQ(size->message.find("long thin arm"), std::string::npos) << size->message;
 }
