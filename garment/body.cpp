@@ -363,9 +363,12 @@ void check_mesh_file_header(const std::string& file, const std::string& what) {
       if (!(counts >> faces)) faces = 0;
       break;
     }
-  } else if (word.compare(0, 3, "ply") == 0) {
-    // assimp takes any file that starts with "ply" for PLY, whatever follows on the line (the
-    // third finding: "ply" and binary bytes, no end_header, read for over 10 s).
+  } else if (word.size() >= 3 && std::tolower(static_cast<unsigned char>(word[0])) == 'p' &&
+             std::tolower(static_cast<unsigned char>(word[1])) == 'l' &&
+             std::tolower(static_cast<unsigned char>(word[2])) == 'y') {
+    // assimp takes any file that starts with "ply", in any case ("Ply": a fuzz finding of
+    // session 41), for PLY, whatever follows on the line (the third finding: "ply" and binary
+    // bytes, no end_header, read for over 10 s).
     // assimp's PLY reader never returns on a header without end_header (found by
     // tests/fuzz/body_loader_fuzz): such a file is refused before it is read.
     if (header.find("end_header") == std::string::npos)

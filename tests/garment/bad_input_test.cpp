@@ -127,6 +127,13 @@ TEST(BadInput, FuzzFindingsEndWithAClearError) {
   } catch (const BodyError& e) {
     EXPECT_NE(std::string(e.what()).find("has no end_header"), std::string::npos) << e.what();
   }
+  // The same with the magic word capitalised ("Ply"): assimp reads it as PLY all the same.
+  try {
+    load_body((dir / "body-ply-capitalised-without-end-header.ply").string());
+    ADD_FAILURE() << "accepted";
+  } catch (const BodyError& e) {
+    EXPECT_NE(std::string(e.what()).find("has no end_header"), std::string::npos) << e.what();
+  }
   // "end_header" only inside another word ("floend_headerat32"): the same loop.
   try {
     load_body((dir / "body-ply-end-header-inside-a-word.ply").string());
