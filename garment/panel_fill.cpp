@@ -18,6 +18,7 @@
 #include "garment/quality_gate.hpp"
 #include "garment/surface_relaxation.hpp"
 #include "garment/surface_untangle.hpp"
+#include "meshing/arm_widening.hpp"
 #include "meshing/quad_quality.hpp"
 
 namespace sd::garment {
@@ -254,6 +255,9 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
   const double reach = spec.edge_length.value_or(sketch.edge_length);
   meshing::FillGeometryOptions options;
   options.relax_iterations = sketch.relax_iterations;
+  // The fill of a panel with a widening arm cut across the arm is tried below, once the panel
+  // is finished, and judged by the finished quads.
+  options.widen_arms = false;
   // The boundary turns about the body's normal where it runs near the body (within the offset
   // and two edges): a strap round the back of the neck seen from the front would turn the
   // wrong way; a hem spanning the legs keeps the loop's own normal.
@@ -591,6 +595,35 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
     meshing::FilledPatch other = fill_on_body(along);
     if (rank(other.quality) < rank(patch.quality)) patch = std::move(other);
   }
+  // A panel that runs out into a long thin arm which widens towards the body (a one-piece
+  // halter's strap) keeps the arm as many quads wide as its end all the way to where it joins,
+  // so its quads there grow past the gate's size limit. With quads off size and such an arm
+  // (meshing/arm_widening.hpp), the panel is filled again cut across the arm where it joins,
+  // each part on its own (the arm gets a valence-3/valence-5 pair that adds quads across it),
+  // finished as a whole like any fill, and kept when it has fewer quads off size and folds and
+  // slivers no more (docs/meshing.md, "Round 42: an arm that widens"). Panels without quads off
+  // size are not touched.
+  if (const int off_size = quads_off_size(patch.mesh, reach); off_size > 0)
+    if (const std::optional<meshing::ArmCut> cut = meshing::find_arm_cut(side_points)) {
+      meshing::FillGeometryOptions part = fit == PanelFit::kBody ? options : free_options;
+      try {
+        meshing::FilledPatch widened = finish(meshing::fill_with_arm_cut(
+            side_points, *cut,
+            [&part](const std::vector<Eigen::MatrixX3d>& points) {
+              return meshing::fill_region(points, part);
+            },
+            part));
+        const auto sliver = [](const meshing::QuadQuality& q) {
+          return q.max_aspect_ratio >= kSliverAspect;
+        };
+        if (widened.quality.inverted_quads <= patch.quality.inverted_quads &&
+            (!sliver(widened.quality) || sliver(patch.quality)) &&
+            quads_off_size(widened.mesh, reach) < off_size)
+          patch = std::move(widened);
+      } catch (const meshing::FillError&) {
+        // A part that cannot be filled: the panel keeps its fill.
+      }
+    }
   // Folds that every start, plan, smoothing and unfolding left: mended by local changes of the
   // quads at each fold (fold_repair.hpp), kept only when the gate's measures improve. A clean
   // panel is not touched.

@@ -16,6 +16,7 @@
 #include <tuple>
 #include <utility>
 
+#include "meshing/arm_widening.hpp"
 #include "meshing/patch_plan.hpp"
 #include "meshing/patch_relaxation.hpp"
 
@@ -341,8 +342,11 @@ PatchTopology fill_region(std::span<const int> side_counts) {
                      plan);
 }
 
-FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
-                        const FillGeometryOptions& options) {
+namespace {
+
+// fill_region without the arm widening: the plan search and its fallbacks.
+FilledPatch fill_searched(const std::vector<Eigen::MatrixX3d>& side_points,
+                          const FillGeometryOptions& options) {
   check_side_points(side_points);
   std::vector<int> counts;
   for (const auto& side : side_points) counts.push_back(static_cast<int>(side.rows()) - 1);
@@ -606,6 +610,44 @@ FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
       best_patch->mesh.faces.rows() <= kThinQuadMaxQuads)
     widen_thin_quads(*best_patch, shape.normal);
   return std::move(*best_patch);
+}
+
+// A fill whose worst quad size (worst_quad_size) is above this is tried again cut across a
+// widening arm: the quality gate warns above 2 (docs/garment.md).
+constexpr double kWidenAbove = 2.0;
+
+}  // namespace
+
+FilledPatch fill_region(const std::vector<Eigen::MatrixX3d>& side_points,
+                        const FillGeometryOptions& options) {
+  FilledPatch patch = fill_searched(side_points, options);
+  if (!options.widen_arms) return patch;
+  double length = 0;
+  Eigen::Index edges = 0;
+  for (const auto& side : side_points) {
+    for (Eigen::Index r = 0; r + 1 < side.rows(); ++r)
+      length += (side.row(r + 1) - side.row(r)).norm();
+    edges += side.rows() - 1;
+  }
+  const double edge = length / static_cast<double>(edges);
+  const double worst = worst_quad_size(patch.mesh, edge);
+  if (worst <= kWidenAbove) return patch;
+  const std::optional<ArmCut> cut = find_arm_cut(side_points);
+  if (!cut) return patch;
+  FillGeometryOptions part_options = options;
+  part_options.widen_arms = false;
+  part_options.good_enough = nullptr;  // the caller's judgement is of whole regions
+  FilledPatch widened = fill_with_arm_cut(
+      side_points, *cut,
+      [&](const std::vector<Eigen::MatrixX3d>& part) { return fill_searched(part, part_options); },
+      options);
+  const auto sliver = [](const FilledPatch& p) {
+    return p.quality.max_aspect_ratio >= kDegenerateAspect;
+  };
+  if (widened.quality.inverted_quads <= patch.quality.inverted_quads &&
+      (!sliver(widened) || sliver(patch)) && worst_quad_size(widened.mesh, edge) < worst)
+    return widened;
+  return patch;
 }
 
 namespace {

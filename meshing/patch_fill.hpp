@@ -76,6 +76,13 @@ struct FillGeometryOptions {
   // then measured about it instead of about the loop's overall normal: seen from the front, a
   // strap running round the back of the neck turns the wrong way.
   std::function<Eigen::Vector3d(const Eigen::Vector3d&)> surface_normal;
+  // When the fill has a quad whose mean side is more than twice the boundary's mean edge or
+  // less than half of it, and the region has a long thin arm that widens (find_arm_cut,
+  // meshing/arm_widening.hpp), the region is also filled cut across the arm, each part on its
+  // own, and that fill is kept when its worst quad size is better and it folds no more quads and
+  // has no new sliver (docs/meshing.md, "Round 42: an arm that widens"). A caller that makes that
+  // choice itself (garment/panel_fill.cpp, with its own finishing of each part) turns it off.
+  bool widen_arms = true;
 };
 
 struct FilledPatch {
