@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cstdint>
 #include <cstring>
@@ -597,15 +598,21 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
   }
   // A panel that runs out into a long thin arm which widens towards the body (a one-piece
   // halter's strap) keeps the arm as many quads wide as its end all the way to where it joins,
-  // so its quads there grow past the gate's size limit. With quads off size and such an arm
-  // (meshing/arm_widening.hpp), the panel is filled again cut across the arm where it joins,
-  // each part on its own (the arm gets a valence-3/valence-5 pair that adds quads across it),
-  // finished as a whole like any fill, and kept when it has fewer quads off size and folds and
-  // slivers no more (docs/meshing.md, "Round 42: an arm that widens"). Panels without quads off
-  // size are not touched.
-  if (const int off_size = quads_off_size(patch.mesh, reach); off_size > 0)
+  // so its quads there grow past the gate's size limit and the body's next to them are squeezed
+  // (folds, slivers). With such flaws and such an arm (meshing/arm_widening.hpp), the panel is
+  // filled again cut across the arm where it joins, each part on its own (the arm gets a
+  // valence-3/valence-5 pair that adds quads across it), finished as a whole like any fill, and
+  // kept when it has no more folded quads, slivers or quads off size than the first fill and
+  // fewer of one of them (docs/meshing.md, "Round 42: an arm that widens"). A panel without them
+  // is not touched.
+  const auto flaws = [&](const meshing::FilledPatch& filled) {
+    return std::array<int, 3>{filled.quality.inverted_quads,
+                              filled.quality.max_aspect_ratio >= kSliverAspect ? 1 : 0,
+                              quads_off_size(filled.mesh, reach)};
+  };
+  if (const std::array<int, 3> before = flaws(patch); before != std::array<int, 3>{})
     if (const std::optional<meshing::ArmCut> cut = meshing::find_arm_cut(side_points)) {
-      meshing::FillGeometryOptions part = fit == PanelFit::kBody ? options : free_options;
+      const meshing::FillGeometryOptions part = fit == PanelFit::kBody ? options : free_options;
       try {
         meshing::FilledPatch widened = finish(meshing::fill_with_arm_cut(
             side_points, *cut,
@@ -613,13 +620,10 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
               return meshing::fill_region(points, part);
             },
             part));
-        const auto sliver = [](const meshing::QuadQuality& q) {
-          return q.max_aspect_ratio >= kSliverAspect;
-        };
-        if (widened.quality.inverted_quads <= patch.quality.inverted_quads &&
-            (!sliver(widened.quality) || sliver(patch.quality)) &&
-            quads_off_size(widened.mesh, reach) < off_size)
-          patch = std::move(widened);
+        const std::array<int, 3> after = flaws(widened);
+        bool no_worse = true;
+        for (size_t k = 0; k < after.size(); ++k) no_worse = no_worse && after[k] <= before[k];
+        if (no_worse && after != before) patch = std::move(widened);
       } catch (const meshing::FillError&) {
         // A part that cannot be filled: the panel keeps its fill.
       }

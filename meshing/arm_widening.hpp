@@ -27,14 +27,16 @@ struct ArmCut {
   double cut_width = 0;  // distance between the cut's two ends
 };
 
-// The arm that most needs widening, if any: a side of at most kArmEndEdges edges between two
-// sides each at least kArmSideRatio times as long (the quality gate's "long thin arm"), walked
-// from its end along both sides, pairing each vertex of the side before it with the nearest
-// vertex of the side after it, up to where the sides diverge (the width grows by more than
-// kJoinSlope mean edge lengths per edge) or the width reaches kMostWidening times the end's. The
-// cut is the last such pair; `across` is its width over the region's mean boundary edge length
-// rounded to the parity the parts need. nullopt when no arm needs more quads across at the cut
-// than at its end, or the arm is shorter than kLeastArmEdges. side_points as for fill_region.
+// The arm that most needs widening, if any: a side of at most kArmEndEdges (4) edges between two
+// sides each at least kArmSideRatio (4) times as long (a long thin arm), walked from its end
+// along both sides, pairing each vertex of the side before it with the nearest vertex of the side
+// after it, up to where the sides diverge (the width grows by more than kJoinSlope (0.5) of the
+// step along the side) or the width reaches kMostWidening (3) times the end's. The cut is the last
+// such pair, at least kLeastArmEdges (3) edges from the end on both sides and no nearer the end
+// than kLeastArmLength (2) times its width, and kLeastWidening (1.25) times as wide as the end;
+// `across` is its width over the region's mean boundary
+// edge length rounded to the parity the parts need. nullopt when no arm needs more quads across at
+// the cut than at its end. side_points as for fill_region.
 std::optional<ArmCut> find_arm_cut(const std::vector<Eigen::MatrixX3d>& side_points);
 
 // The two parts of a region cut at `cut`: the arm (4 sides: the arm's side before the end from
