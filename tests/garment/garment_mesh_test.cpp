@@ -4,9 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <set>
+#include <string>
 
 #include "garment/body.hpp"
 #include "garment/material_frames.hpp"
@@ -568,6 +570,25 @@ TEST(Garment, HalterTopWithASeamAcrossTheStrapIsClean) {
   EXPECT_EQ(told[0].kind, "quad_size");
   EXPECT_EQ(told[0].curve, "strap_lo");
   EXPECT_DOUBLE_EQ(told[0].curve_edge_length, 0.016);
+}
+
+// Issue 18, round 42 (docs/meshing.md, "Round 42: an arm that widens"): one-piece panels that run
+// out into a strap widening towards the body, written without tuning (data/designs/repro/), were
+// refused by --strict (1, 5 and 7 warnings: quads 2.4-3.4 × the edge, folds, slivers); filled
+// with a cut across the strap where it joins, every panel passes the gate, and the strap's panel
+// is the one the cut changed ("arm-cut").
+TEST(Garment, OnePieceStrapsThatWidenPassTheGate) {
+  for (const char* name : {"halter-one-piece", "bib-apron-top", "thin-strap-one-shoulder"}) {
+    const Sketch sketch = load_sketch(std::filesystem::path(SD_SOURCE_DIR) / "data/designs/repro" /
+                                      (std::string(name) + ".json"));
+    const Body body = load_sketch_body(sketch);
+    const BodySurface surface(body.mesh);
+    const Garment garment = build_garment(sketch, surface);
+    EXPECT_TRUE(check_quality_tried(garment, sketch, body.mesh, nullptr).empty()) << name;
+    EXPECT_TRUE(std::any_of(garment.panels.begin(), garment.panels.end(),
+                            [](const GarmentPanel& p) { return p.partition == "arm-cut"; }))
+        << name;
+  }
 }
 
 // Above QualityLimits::max_trial_quads the advice that needs the garment meshed again is not
