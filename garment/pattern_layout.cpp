@@ -246,79 +246,6 @@ void grain_line(PatternPiece& piece) {
   piece.grain_end = {centroid.x(), hi - 0.2 * (hi - lo)};
 }
 
-// A gathered piece's outline (FlatPanel::boundary's points, m, before `origin`) as cut. Its
-// ease gathers by g across one axis (x when the weft factor is the larger, else y) and keeps n
-// (the other factor) along the other. Scaled by diag(weft, warp) at once, a seam running θ off
-// the grain would be lengthened by sqrt(n² cos²θ + g² sin²θ) instead of n: the tiered skirt's
-// flared tier, its side seams 26-28° off the grain, cut them 11-13 % long and its front and
-// back 1.6 % apart (docs/pattern.md, "Gathered seams"). So the piece is slashed and spread as a
-// pattern maker spreads a flared piece: about the apex where the lines of its seam sides along
-// the grain meet (the chords, closer to the other axis than to the gather, of the sides sewn to
-// a piece cut with the same ease: not gathered into anything), every point's distance from the
-// apex is scaled by n and its angle from the grain line through the apex by g / n. A straight
-// side through the apex keeps n times its length and an arc about it is gathered g times. Sides
-// meeting farther than kFanReach extents away (within 3° of parallel, where the two maps differ
-// by under 0.2 % for g / n = 1.5), fewer than two sides along the grain, or a piece reaching
-// round its apex: diag(weft, warp), the spread's limit for parallel sides.
-Eigen::MatrixX2d eased_outline(const FlatPattern& pattern, size_t p,
-                               const std::vector<PanelEase>& eases) {
-  constexpr double kFanReach = 20;
-  const auto ease_of = [&](int panel) {
-    return static_cast<size_t>(panel) < eases.size() ? eases[static_cast<size_t>(panel)]
-                                                     : PanelEase{};
-  };
-  const PanelEase ease = ease_of(static_cast<int>(p));
-  const FlatPanel& flat = pattern.panels[p];
-  const auto n = static_cast<Eigen::Index>(flat.boundary.size());
-  Eigen::MatrixX2d uv(n, 2);
-  for (Eigen::Index k = 0; k < n; ++k)
-    uv.row(k) = flat.uv.row(flat.boundary[static_cast<size_t>(k)]);
-  Eigen::MatrixX2d affine = uv;
-  affine.col(0) *= ease.weft;
-  affine.col(1) *= ease.warp;
-  if (ease.isotropic() || n < 3) return affine;
-  const int across = ease.weft > ease.warp ? 0 : 1;
-  const double gather = std::max(ease.weft, ease.warp), kept = std::min(ease.weft, ease.warp);
-  // The apex: the point nearest (least squares) to the lines of the sides along the grain.
-  Eigen::Matrix2d normal = Eigen::Matrix2d::Zero();
-  Eigen::Vector2d rhs = Eigen::Vector2d::Zero();
-  int sides = 0;
-  const auto add_side = [&](const std::vector<int>& vertices, int partner) {
-    if (vertices.size() < 2 || !(ease_of(partner) == ease)) return;
-    const Eigen::Vector2d q = flat.uv.row(vertices.front()).transpose();
-    const Eigen::Vector2d d = flat.uv.row(vertices.back()).transpose() - q;
-    if (d.norm() <= 0 || std::abs(d[across]) >= std::abs(d[1 - across])) return;
-    const Eigen::Vector2d u = d.normalized();
-    const Eigen::Matrix2d off = Eigen::Matrix2d::Identity() - u * u.transpose();
-    normal += off;
-    rhs += off * q;
-    ++sides;
-  };
-  for (const PatternSeam& seam : pattern.seams) {
-    if (static_cast<size_t>(seam.panel_a) == p) add_side(seam.vertices_a, seam.panel_b);
-    if (static_cast<size_t>(seam.panel_b) == p) add_side(seam.vertices_b, seam.panel_a);
-  }
-  const Eigen::Vector2d centre = uv.colwise().mean().transpose();
-  const double extent = (uv.colwise().maxCoeff() - uv.colwise().minCoeff()).norm();
-  if (sides < 2 || normal.determinant() <= 1e-12) return affine;
-  const Eigen::Vector2d apex = normal.inverse() * rhs;
-  if ((apex - centre).norm() > kFanReach * extent) return affine;
-  // The grain line through the apex, pointing into the piece, and its left normal.
-  Eigen::Vector2d down = Eigen::Vector2d::Zero();
-  down[1 - across] = centre[1 - across] >= apex[1 - across] ? 1 : -1;
-  const Eigen::Vector2d left(-down.y(), down.x());
-  const double spread = gather / kept;
-  Eigen::MatrixX2d out(n, 2);
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const Eigen::Vector2d v = uv.row(k).transpose() - apex;
-    const double angle = spread * std::atan2(left.dot(v), down.dot(v));
-    // A piece reaching round its apex (half a turn or more once spread) has no fan.
-    if (std::abs(angle) >= 0.9 * std::numbers::pi) return affine;
-    out.row(k) = (kept * v.norm() * (std::cos(angle) * down + std::sin(angle) * left)).transpose();
-  }
-  return out;
-}
-
 // m: the farthest any point of closed polygon a lies from closed polygon b's outline.
 double farthest_from(const Eigen::MatrixX2d& a, const Eigen::MatrixX2d& b) {
   double worst = 0;
@@ -397,6 +324,86 @@ FabricShape unfolded_shape(const PatternPiece& piece) {
 
 }  // namespace
 
+// A gathered piece's ease gathers by g across one axis (x when the weft factor is the larger,
+// else y) and keeps n (the other factor) along the other. Scaled by diag(weft, warp) at once, a
+// seam running θ off the grain would be lengthened by sqrt(n² cos²θ + g² sin²θ) instead of n:
+// the tiered skirt's flared tier, its side seams 26-28° off the grain, cut them 11-13 % long and
+// its front and back 1.6 % apart (docs/pattern.md, "Gathered seams"). So the piece is slashed
+// and spread as a pattern maker spreads a flared piece: about the apex where the lines of its
+// seam sides along the grain meet (the chords, closer to the other axis than to the gather, of
+// the sides sewn to a piece cut with the same ease: not gathered into anything), every point's
+// distance from the apex is scaled by n and its angle from the grain line through the apex by
+// g / n. A straight side through the apex keeps n times its length and an arc about it is
+// gathered g times. Sides meeting farther than kFanReach extents away (within 3° of parallel,
+// where the two maps differ by under 0.2 % for g / n = 1.5), fewer than two sides along the
+// grain, or an outline reaching round its apex: diag(weft, warp), the spread's limit for
+// parallel sides. The apex and those tests are the outline's; interior points (inside it, so
+// within its angles about an apex outside it) follow the same map.
+EasedPiece eased_piece(const FlatPattern& pattern, size_t p, const std::vector<PanelEase>& eases) {
+  constexpr double kFanReach = 20;
+  const auto ease_of = [&](int panel) {
+    return static_cast<size_t>(panel) < eases.size() ? eases[static_cast<size_t>(panel)]
+                                                     : PanelEase{};
+  };
+  const PanelEase ease = ease_of(static_cast<int>(p));
+  const FlatPanel& flat = pattern.panels[p];
+  EasedPiece eased;
+  eased.uv = flat.uv;
+  eased.uv.col(0) *= ease.weft;
+  eased.uv.col(1) *= ease.warp;
+  const auto n = static_cast<Eigen::Index>(flat.boundary.size());
+  if (ease.isotropic() || n < 3) return eased;
+  Eigen::MatrixX2d outline(n, 2);
+  for (Eigen::Index k = 0; k < n; ++k)
+    outline.row(k) = flat.uv.row(flat.boundary[static_cast<size_t>(k)]);
+  const int across = ease.weft > ease.warp ? 0 : 1;
+  const double gather = std::max(ease.weft, ease.warp), kept = std::min(ease.weft, ease.warp);
+  // The apex: the point nearest (least squares) to the lines of the sides along the grain.
+  Eigen::Matrix2d normal = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d rhs = Eigen::Vector2d::Zero();
+  int sides = 0;
+  const auto add_side = [&](const std::vector<int>& vertices, int partner) {
+    if (vertices.size() < 2 || !(ease_of(partner) == ease)) return;
+    const Eigen::Vector2d q = flat.uv.row(vertices.front()).transpose();
+    const Eigen::Vector2d d = flat.uv.row(vertices.back()).transpose() - q;
+    if (d.norm() <= 0 || std::abs(d[across]) >= std::abs(d[1 - across])) return;
+    const Eigen::Vector2d u = d.normalized();
+    const Eigen::Matrix2d off = Eigen::Matrix2d::Identity() - u * u.transpose();
+    normal += off;
+    rhs += off * q;
+    ++sides;
+  };
+  for (const PatternSeam& seam : pattern.seams) {
+    if (static_cast<size_t>(seam.panel_a) == p) add_side(seam.vertices_a, seam.panel_b);
+    if (static_cast<size_t>(seam.panel_b) == p) add_side(seam.vertices_b, seam.panel_a);
+  }
+  const Eigen::Vector2d centre = outline.colwise().mean().transpose();
+  const double extent = (outline.colwise().maxCoeff() - outline.colwise().minCoeff()).norm();
+  if (sides < 2 || normal.determinant() <= 1e-12) return eased;
+  const Eigen::Vector2d apex = normal.inverse() * rhs;
+  if ((apex - centre).norm() > kFanReach * extent) return eased;
+  // The grain line through the apex, pointing into the piece, and its left normal.
+  Eigen::Vector2d down = Eigen::Vector2d::Zero();
+  down[1 - across] = centre[1 - across] >= apex[1 - across] ? 1 : -1;
+  const Eigen::Vector2d left(-down.y(), down.x());
+  const double spread = gather / kept;
+  const auto angle_of = [&](const Eigen::Vector2d& v) {
+    return spread * std::atan2(left.dot(v), down.dot(v));
+  };
+  // An outline reaching round its apex (half a turn or more once spread) has no fan.
+  for (Eigen::Index k = 0; k < n; ++k)
+    if (std::abs(angle_of(outline.row(k).transpose() - apex)) >= 0.9 * std::numbers::pi)
+      return eased;
+  for (Eigen::Index k = 0; k < flat.uv.rows(); ++k) {
+    const Eigen::Vector2d v = flat.uv.row(k).transpose() - apex;
+    const double angle = angle_of(v);
+    eased.uv.row(k) =
+        (kept * v.norm() * (std::cos(angle) * down + std::sin(angle) * left)).transpose();
+  }
+  eased.spread = true;
+  return eased;
+}
+
 PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOptions& options) {
   PatternLayout layout;
   layout.fabric_width = options.fabric_width;
@@ -432,7 +439,12 @@ PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOpt
       piece.allowances.front().first = piece.allowances.back().first;  // the run across point 0
       piece.allowances.pop_back();
     }
-    piece.sewing = eased_outline(pattern, p, options.panel_ease);
+    {
+      const EasedPiece eased = eased_piece(pattern, p, options.panel_ease);
+      piece.sewing.resize(static_cast<Eigen::Index>(edges), 2);
+      for (size_t k = 0; k < edges; ++k)
+        piece.sewing.row(static_cast<Eigen::Index>(k)) = eased.uv.row(flat.boundary[k]);
+    }
     // A fold is straight: the points of the fold run are moved onto its chord (within 2 mm,
     // as the app chose it: PatternLayoutOptions::fold_edge).
     if (p < options.fold_edge.size() && options.fold_edge[p].size() == edges)

@@ -130,6 +130,18 @@ struct PatternLayout {
   int pairs = 0;  // pieces drawn once for a mirror pair
 };
 
+// Every point of FlatPattern piece p (FlatPanel::uv's rows, m, before `origin`) as cut with its
+// ease (`eases` per FlatPattern panel; empty or short: 1): the piece frame scaled by diag(weft,
+// warp), or, for a gathered piece whose sides along the grain meet at an apex, spread about it
+// (docs/pattern.md, "Gathered seams"); `spread` says which. The sewing line is this map's image
+// of the outline, and the flat rest drapes this map's image of every triangle, so that the
+// cloth draped is the cloth cut.
+struct EasedPiece {
+  Eigen::MatrixX2d uv;  // #L by 2
+  bool spread = false;
+};
+EasedPiece eased_piece(const FlatPattern& pattern, size_t p, const std::vector<PanelEase>& eases);
+
 // Lays out every piece (a mirror pair's once on the sheet: PatternLayoutOptions::pair_mirrors).
 // Throws PatternError for a piece whose outline crosses itself in 2D, whose
 // cutting line with different seam allowances crosses itself (a concave curve tighter than its
