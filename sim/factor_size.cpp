@@ -8,6 +8,8 @@
 #include <tuple>
 #include <vector>
 
+#include "sim/diamond_membrane.hpp"
+
 namespace sd::sim {
 namespace {
 
@@ -17,7 +19,10 @@ struct VertexGraph {
   std::vector<int> outer, inner;
 };
 
-VertexGraph vertex_graph(const Eigen::MatrixX3i& triangles, int n) {
+// The pairs of `diamonds` (every two of a diamond's 13 vertices, as collect_neighbours in
+// sim/cloth_model.cpp couples them) are added to those of the triangles and hinges.
+VertexGraph vertex_graph(const Eigen::MatrixX3i& triangles, int n,
+                         const std::vector<DiamondElement>& diamonds) {
   // Edges with the corner opposite them, sorted: an edge met twice is a hinge whose two far
   // corners are coupled (a flat sort rather than a map; a 1000×1000 sheet has 6 million).
   struct FaceEdge {
@@ -35,7 +40,9 @@ VertexGraph vertex_graph(const Eigen::MatrixX3i& triangles, int n) {
   });
   // Pairs (i, j) in both orders, packed into 64 bits so that one sort groups them by column.
   std::vector<std::uint64_t> pairs;
-  pairs.reserve(2 * edges.size() + static_cast<std::size_t>(n));
+  constexpr int kDiamondVertices = DiamondElement::kVertices;
+  pairs.reserve(2 * edges.size() + static_cast<std::size_t>(n) +
+                diamonds.size() * kDiamondVertices * (kDiamondVertices - 1));
   const auto add = [&](int i, int j) {
     pairs.push_back((static_cast<std::uint64_t>(i) << 32) | static_cast<std::uint32_t>(j));
     pairs.push_back((static_cast<std::uint64_t>(j) << 32) | static_cast<std::uint32_t>(i));
@@ -51,6 +58,12 @@ VertexGraph vertex_graph(const Eigen::MatrixX3i& triangles, int n) {
     begin = end;
   }
   std::vector<FaceEdge>().swap(edges);
+  // A missing neighbour's slot holds the centre again: its pairs repeat the centre's.
+  for (const DiamondElement& d : diamonds)
+    for (int k = 0; k < kDiamondVertices; ++k)
+      for (int l = k + 1; l < kDiamondVertices; ++l)
+        if (d.vertices[static_cast<std::size_t>(k)] != d.vertices[static_cast<std::size_t>(l)])
+          add(d.vertices[static_cast<std::size_t>(k)], d.vertices[static_cast<std::size_t>(l)]);
   std::sort(pairs.begin(), pairs.end());
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
   VertexGraph graph;
@@ -64,13 +77,12 @@ VertexGraph vertex_graph(const Eigen::MatrixX3i& triangles, int n) {
   return graph;
 }
 
-}  // namespace
-
-FactorSize predict_factor_size(const Eigen::MatrixX3i& triangles, int vertex_count,
-                               BendModel bend_model) {
+// The analysis of the graph of these triangles and diamonds; `bend_model` as below.
+FactorSize analyse(const Eigen::MatrixX3i& triangles, int vertex_count,
+                   const std::vector<DiamondElement>& diamonds, BendModel bend_model) {
   FactorSize size;
   if (vertex_count <= 0) return size;
-  VertexGraph graph = vertex_graph(triangles, vertex_count);
+  VertexGraph graph = vertex_graph(triangles, vertex_count, diamonds);
   cholmod_sparse pattern{};
   pattern.nrow = pattern.ncol = static_cast<std::size_t>(vertex_count);
   pattern.nzmax = graph.inner.size();
@@ -118,6 +130,28 @@ FactorSize predict_factor_size(const Eigen::MatrixX3i& triangles, int vertex_cou
     size.bytes *= kQuadraticBendingFactorScale;
   }
   return size;
+}
+
+}  // namespace
+
+FactorSize predict_factor_size(const Eigen::MatrixX3i& triangles, int vertex_count,
+                               BendModel bend_model) {
+  return analyse(triangles, vertex_count, {}, bend_model);
+}
+
+FactorSize predict_factor_size(const ClothInput& input, const ClothModelOptions& options) {
+  const int n = static_cast<int>(input.rest_positions.rows());
+  std::vector<DiamondElement> diamonds;
+  if (options.diamond_membrane) {
+    // make_diamonds reads the triangles' vertices only.
+    std::vector<TriangleElement> triangles(static_cast<std::size_t>(input.triangles.rows()));
+    for (Eigen::Index f = 0; f < input.triangles.rows(); ++f)
+      for (int k = 0; k < 3; ++k)
+        triangles[static_cast<std::size_t>(f)].vertices[static_cast<std::size_t>(k)] =
+            input.triangles(f, k);
+    diamonds = make_diamonds(input.rest_positions, triangles, input.rest_uv.rows() > 0);
+  }
+  return analyse(input.triangles, n, diamonds, options.bend_model);
 }
 
 }  // namespace sd::sim

@@ -36,6 +36,16 @@ struct FactorSize {
 FactorSize predict_factor_size(const Eigen::MatrixX3i& triangles, int vertex_count,
                                BendModel bend_model = BendModel::hinges);
 
+// The same for the model build_cloth_model(input, fabric, options) makes, which with
+// options.diamond_membrane also couples every two of each diamond's 13 vertices (the centre, its
+// corners and their neighbours, sim/diamond_membrane.hpp): the diamonds are found as the model
+// finds them (make_diamonds on the rest positions) and their pairs added to the vertex graph, so
+// the prediction is again the solver's analysis for the hinges (a diamond holds up to four rings
+// apart: without its pairs the prediction was 0.47-0.58 of the nonzeros). With the quadratic
+// bending it stays the bound below (2.27 times the analysis's bytes with the diamonds on a 40×30
+// sheet, where the triangles' graph alone gave 0.92). Costs make_diamonds, linear in the mesh.
+FactorSize predict_factor_size(const ClothInput& input, const ClothModelOptions& options);
+
 inline constexpr double kQuadraticBendingFactorScale = 3.0;
 
 }  // namespace sd::sim
