@@ -11,6 +11,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <mutex>
 #include <numbers>
 #include <numeric>
 #include <optional>
@@ -241,6 +242,14 @@ PanelNetwork resolve_network(const GarmentRequest& sketch, const BodySurface& bo
       size.area = fan_area(outline);
     }
     check_panel_sizes(sketch, sizes);
+    // Said before the long fill, once per file and panel: the gate's trials build it again.
+    for (const std::string& warning : fine_edge_warnings(sketch, sizes)) {
+      static std::mutex mutex;
+      static std::set<std::string> said;
+      const std::lock_guard lock(mutex);
+      if (said.insert(warning.substr(0, warning.find(" has edges of"))).second)
+        spdlog::warn("{}", warning);
+    }
     double total = 0;
     for (const PanelSize& size : sizes) total += estimated_quads(size);
     spdlog::debug("{}: about {:.0f} quads expected", sketch.file, total);

@@ -95,6 +95,50 @@ int folded_triangles(const Eigen::MatrixX2d& uv, const Eigen::MatrixX3i& t,
   return folded;
 }
 
+// Where a flat piece's outline crosses itself: two boundary edges (not sharing a point) whose
+// 2D segments cross properly. A disk mapped without an inverted triangle is one layer of cloth
+// everywhere unless its outline crosses itself; then part of it lies over another part (a
+// sleeve drawn with its end turned up, a flounce wound more than once round): no flat cloth
+// holds both. Returns the number of crossing pairs and the first pair's edges (boundary
+// positions, edge i runs from boundary[i] to boundary[i + 1]). O(n²) over the outline's n
+// edges behind a box test: a 30 × 45 cm panel at 2 mm has about 750.
+struct OutlineCrossing {
+  int pairs = 0;
+  int edge_a = -1, edge_b = -1;
+};
+
+OutlineCrossing outline_crossings(const Eigen::MatrixX2d& uv, const std::vector<int>& boundary) {
+  OutlineCrossing out;
+  const int n = static_cast<int>(boundary.size());
+  const auto point = [&](int i) -> Eigen::Vector2d {
+    return uv.row(boundary[static_cast<size_t>((i % n + n) % n)]).transpose();
+  };
+  const auto cross = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a,
+                        const Eigen::Vector2d& b) {
+    return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+  };
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector2d a0 = point(i), a1 = point(i + 1);
+    for (int j = i + 2; j < n; ++j) {
+      if (i == 0 && j == n - 1) continue;  // the loop's last edge meets its first
+      const Eigen::Vector2d b0 = point(j), b1 = point(j + 1);
+      if (std::max(a0.x(), a1.x()) < std::min(b0.x(), b1.x()) ||
+          std::max(b0.x(), b1.x()) < std::min(a0.x(), a1.x()) ||
+          std::max(a0.y(), a1.y()) < std::min(b0.y(), b1.y()) ||
+          std::max(b0.y(), b1.y()) < std::min(a0.y(), a1.y()))
+        continue;
+      const double d1 = cross(a0, a1, b0), d2 = cross(a0, a1, b1);
+      const double d3 = cross(b0, b1, a0), d4 = cross(b0, b1, a1);
+      if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) &&
+          ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0))) {
+        if (out.pairs == 0) out.edge_a = i, out.edge_b = j;
+        ++out.pairs;
+      }
+    }
+  }
+  return out;
+}
+
 // The boundary of a disk as one counter-clockwise loop of local vertices; throws PatternError
 // when the triangles do not form a disk (V − E + F ≠ 1, or several boundary loops).
 std::vector<int> disk_boundary(const std::string& name, Eigen::Index vertex_count,
@@ -467,10 +511,50 @@ double bow_from_chord(const Eigen::MatrixX2d& uv, const std::vector<int>& run) {
   return bow;
 }
 
+FlatPanel flatten_freely(const std::string& name, const Eigen::MatrixX3d& v,
+                         const Eigen::MatrixX3i& t, const Eigen::MatrixX3d& triangle_warp,
+                         const FlatteningOptions& options, bool on_body,
+                         const std::vector<int>& centre_run);
+
+// flatten_freely, with the cause said when a refused piece is drawn folded: a panel taken into a
+// crease of the body (trial 41, P1: a kimono front whose underarm curve dives into the armpit)
+// turns back on itself there, and its flattening folds or stretches beyond use. It was told it
+// "curves too much, like a nearly closed cap", which sent the designer to seams and darts; the
+// place and the fold are what to change.
 FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
                             const Eigen::MatrixX3i& t, const Eigen::MatrixX3d& triangle_warp,
                             const FlatteningOptions& options, bool on_body = true,
                             const std::vector<int>& centre_run = {}) {
+  try {
+    return flatten_freely(name, v, t, triangle_warp, options, on_body, centre_run);
+  } catch (const PatternError& e) {
+    const std::string why = e.what();
+    const std::string lead = fmt::format("panel '{}' cannot be cut from flat cloth: ", name);
+    if (!why.starts_with(lead)) throw;  // not a disk, not oriented: no flattening was made
+    const SurfaceFold fold = sharpest_fold(v, t, kTurnedBackDeg);
+    if (fold.edges == 0) throw;
+    std::string cause = why.substr(lead.size());
+    if (const size_t cut = cause.find("; it curves too much"); cut != std::string::npos)
+      cause.erase(cut);
+    if (const size_t cut = cause.find(", so its edge is shorter"); cut != std::string::npos)
+      cause.erase(cut);
+    throw PatternError(
+        name,
+        fmt::format("panel '{}' cannot be cut from flat cloth: it is drawn folded into a crease "
+                    "of the body, where its surface turns back on itself (two neighbouring "
+                    "triangles of it face {:.0f}° apart at {}), and no flat piece lies like "
+                    "that: {}. Draw the panel's curve there across the crease instead of into "
+                    "it (a kimono's underarm seam bridges the armpit from the sleeve to the side "
+                    "seam: docs/garment.md, \"Seams across a gap\"), or split the panel there",
+                    name, fold.angle_deg, point_text(fold.where), cause),
+        fold.where);
+  }
+}
+
+FlatPanel flatten_freely(const std::string& name, const Eigen::MatrixX3d& v,
+                         const Eigen::MatrixX3i& t, const Eigen::MatrixX3d& triangle_warp,
+                         const FlatteningOptions& options, bool on_body,
+                         const std::vector<int>& centre_run) {
   FlatPanel out;
   out.id = name;
   out.triangles = t;
@@ -560,6 +644,27 @@ FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
                           "too much, like a nearly closed cap: split it with seams or darts",
                           name, folded, t.rows(), d.worst_point.x(), d.worst_point.y(),
                           d.worst_point.z()));
+  }
+
+  // Not folded, but lying over itself: refused like a fold (trial 41, P7).
+  if (const OutlineCrossing c = outline_crossings(uv, out.boundary); c.pairs > 0) {
+    const auto middle = [&](int edge) -> Eigen::Vector3d {
+      const size_t n = out.boundary.size();
+      return 0.5 * (v.row(out.boundary[static_cast<size_t>(edge)]) +
+                    v.row(out.boundary[(static_cast<size_t>(edge) + 1) % n]))
+                       .transpose();
+    };
+    const Eigen::Vector3d a = middle(c.edge_a), b = middle(c.edge_b);
+    throw PatternError(
+        name,
+        fmt::format("panel '{}' cannot be cut from flat cloth: flattened, the piece lies over "
+                    "itself (no triangle folds, but its outline crosses itself{}: its edge near "
+                    "({:.3f}, {:.3f}, {:.3f}) m comes down over its edge near ({:.3f}, {:.3f}, "
+                    "{:.3f}) m), as a sleeve drawn with its end turned back up or a flounce "
+                    "wound more than once round would; cut it in two with a seam across the "
+                    "turn between those places (a turned-up cuff is a piece of its own)",
+                    name, c.pairs > 1 ? fmt::format(" at {} places", c.pairs) : std::string(),
+                    a.x(), a.y(), a.z(), b.x(), b.y(), b.z()));
   }
 
   // Grain: the mean 2D image of the warp, turned onto +y. A straight centre line is the fold,
@@ -756,6 +861,58 @@ std::optional<FlatPanel> reflected_piece(const FlatPanel& original, const Eigen:
 }
 
 }  // namespace
+
+std::string point_text(const Eigen::Vector3d& p) {
+  return fmt::format("({:.3f}, {:.3f}, {:.3f}) m", p.x(), p.y(), p.z());
+}
+
+SurfaceFold sharpest_fold(const Eigen::MatrixX3d& vertices, const Eigen::MatrixXi& faces,
+                          double threshold_deg, const Eigen::VectorXi* group) {
+  if (faces.cols() == 4) {
+    // Quads as the pattern splits them (split_quad): a warped quad of a crease folds across its
+    // diagonal, and the kimono front drawn into the armpit turns 140° between triangles where
+    // its quads' normals are 84° apart.
+    Eigen::MatrixXi triangles(2 * faces.rows(), 3);
+    Eigen::VectorXi halves(2 * faces.rows());
+    for (Eigen::Index f = 0; f < faces.rows(); ++f) {
+      const auto two = split_quad(vertices, faces.row(f).transpose());
+      for (Eigen::Index k = 0; k < 2; ++k) {
+        triangles.row(2 * f + k) = two[static_cast<size_t>(k)].transpose();
+        halves(2 * f + k) = group != nullptr ? (*group)(f) : 0;
+      }
+    }
+    return sharpest_fold(vertices, triangles, threshold_deg, &halves);
+  }
+  const Eigen::Index corners = faces.cols();
+  const auto normal = [&](Eigen::Index f) -> Eigen::Vector3d {
+    const auto p = [&](int k) -> Eigen::Vector3d { return vertices.row(faces(f, k)).transpose(); };
+    const Eigen::Vector3d n = corners == 4 ? Eigen::Vector3d((p(2) - p(0)).cross(p(3) - p(1)))
+                                           : Eigen::Vector3d((p(1) - p(0)).cross(p(2) - p(0)));
+    return n.norm() > 0 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::Zero();
+  };
+  std::map<std::pair<int, int>, Eigen::Index> first;  // undirected edge → the face seen first
+  SurfaceFold fold;
+  const double cos_threshold = std::cos(threshold_deg * std::numbers::pi / 180);
+  double lowest_cos = 2;
+  for (Eigen::Index f = 0; f < faces.rows(); ++f)
+    for (Eigen::Index k = 0; k < corners; ++k) {
+      const int a = faces(f, k), b = faces(f, (k + 1) % corners);
+      const auto [it, fresh] = first.emplace(std::minmax(a, b), f);
+      if (fresh) continue;
+      const Eigen::Index g = it->second;
+      if (group != nullptr && (*group)(f) != (*group)(g)) continue;
+      const Eigen::Vector3d nf = normal(f), ng = normal(g);
+      if (nf.isZero() || ng.isZero()) continue;
+      const double c = std::clamp(nf.dot(ng), -1.0, 1.0);
+      if (c < cos_threshold) ++fold.edges;
+      if (c < lowest_cos) {
+        lowest_cos = c;
+        fold.angle_deg = std::acos(c) * 180 / std::numbers::pi;
+        fold.where = 0.5 * (vertices.row(a) + vertices.row(b)).transpose();
+      }
+    }
+  return fold;
+}
 
 double PatternSeam::mismatch() const {
   const double longest = std::max(length_a, length_b);

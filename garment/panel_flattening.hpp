@@ -20,11 +20,41 @@ class PatternError : public std::runtime_error {
  public:
   PatternError(std::string panel, const std::string& message)
       : std::runtime_error(message), panel_(std::move(panel)) {}
+  // A refusal at one place: `where` (m) is written in the message as point_text(where), after
+  // which the caller may name the body's nearest landmark.
+  PatternError(std::string panel, const std::string& message, const Eigen::Vector3d& where)
+      : std::runtime_error(message), panel_(std::move(panel)), where_(where), placed_(true) {}
   const std::string& panel() const { return panel_; }
+  bool placed() const { return placed_; }
+  const Eigen::Vector3d& where() const { return where_; }
 
  private:
   std::string panel_;
+  Eigen::Vector3d where_ = Eigen::Vector3d::Zero();
+  bool placed_ = false;
 };
+
+// "(0.151, 1.232, -0.012) m": a place as the pattern's messages write it.
+std::string point_text(const Eigen::Vector3d& p);
+
+// Where a surface turns back on itself: the two neighbouring faces (sharing an edge) whose
+// normals are farthest apart. A panel drawn into a crease of the body (a kimono's underarm taken
+// deep into the armpit) folds there: its faces on the two walls of the crease face each other.
+struct SurfaceFold {
+  double angle_deg = 0;  // between the two faces' normals (0: flat, 180: folded flat)
+  Eigen::Vector3d where = Eigen::Vector3d::Zero();  // the middle of their shared edge (m)
+  int edges = 0;  // shared edges whose faces turn more than the threshold asked
+};
+// Faces: #F rows of 3 (triangles) or 4 (quads, split into two triangles along the diagonal
+// the pattern splits them on) vertex indices into `vertices` (#V by 3); only faces with the same
+// `group` (when given, #F) are neighbours.
+SurfaceFold sharpest_fold(const Eigen::MatrixX3d& vertices, const Eigen::MatrixXi& faces,
+                          double threshold_deg, const Eigen::VectorXi* group = nullptr);
+// Neighbouring faces of one panel whose normals are more than this far apart: the surface turns
+// back on itself. Over the 49 examples and designs the largest angle between neighbouring
+// triangles of a panel is 108° (the raglan top's front sleeve), then 87°; trial 41's kimono drawn
+// into the armpit turns 140° and 177° (docs/sketch-format.md, `folded_surface`).
+inline constexpr double kTurnedBackDeg = 120.0;
 
 struct FlatteningOptions {
   // Length distortion (|σ − 1| of the 3D → 2D map, 95th percentile) above which a panel gets a

@@ -41,7 +41,7 @@ Body load_sketch_body(const GarmentRequest& sketch, const BodySpec& spec,
   }
 }
 
-meshing::TriMesh load_garment_mesh(const GarmentRequest& sketch) {
+meshing::TriMesh load_garment_mesh(const GarmentRequest& sketch, long* file_faces) {
   const std::string where = "/garment_mesh";
   const std::filesystem::path path = sketch.resolve(*sketch.garment_mesh);
   if (const auto problem = input_file_problem(path, kMaxMeshFileBytes))
@@ -55,6 +55,7 @@ meshing::TriMesh load_garment_mesh(const GarmentRequest& sketch) {
     sketch.fail(where, "a garment mesh must be a Wavefront .obj file");
   std::vector<Eigen::Vector3d> vertices;
   std::vector<Eigen::Vector3i> faces;
+  long polygons = 0;
   std::string line;
   int line_number = 0;
   while (std::getline(in, line)) {
@@ -89,6 +90,7 @@ meshing::TriMesh load_garment_mesh(const GarmentRequest& sketch) {
         sketch.fail(where, fmt::format("line {} of '{}' is a face with fewer than 3 vertices",
                                        line_number, path.filename().string()));
       for (size_t k = 1; k + 1 < ids.size(); ++k) faces.emplace_back(ids[0], ids[k], ids[k + 1]);
+      ++polygons;
     }
   }
   if (faces.empty()) sketch.fail(where, fmt::format("'{}' has no faces", path.filename().string()));
@@ -101,6 +103,7 @@ meshing::TriMesh load_garment_mesh(const GarmentRequest& sketch) {
     mesh.faces.row(static_cast<Eigen::Index>(f)) = faces[f].transpose();
   if (const auto problem = mesh_problem(mesh))
     sketch.fail(where, fmt::format("the garment mesh '{}' {}", path.filename().string(), *problem));
+  if (file_faces != nullptr) *file_faces = polygons;
   return mesh;
 }
 

@@ -17,7 +17,8 @@ Body load_sketch_body(const GarmentRequest& sketch, const BodySpec& spec, const 
 
 // The triangle garment of "garment_mesh" (Wavefront OBJ; polygons are fan-triangulated), in
 // metres as written. Throws SketchError at /garment_mesh when it is missing, unreadable or has
-// no faces or non-finite or out-of-range values.
-meshing::TriMesh load_garment_mesh(const GarmentRequest& sketch);
+// no faces or non-finite or out-of-range values. `file_faces`, when given, gets the number of faces
+// the file writes (its "f" lines: a quad is one face there and two triangles here).
+meshing::TriMesh load_garment_mesh(const GarmentRequest& sketch, long* file_faces = nullptr);
 
 }  // namespace sd::garment

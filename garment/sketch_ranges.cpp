@@ -192,6 +192,15 @@ namespace {
 // their own edge lengths the meshes had 0.93-1.38 times the quads of the fan's area over the mean
 // boundary edge squared, 1.11 in the median (the fan cuts across a panel curving round the body).
 constexpr double kSurfaceOverFan = 1.1;
+
+// "378,000": a count to three figures, with thousands separated.
+std::string rounded_count(double n) {
+  const double scale = std::pow(10.0, std::max(0.0, std::floor(std::log10(n)) - 2));
+  std::string digits = fmt::format("{:.0f}", std::round(n / scale) * scale);
+  for (int k = static_cast<int>(digits.size()) - 3; k > 0; k -= 3)
+    digits.insert(static_cast<size_t>(k), ",");
+  return digits;
+}
 }  // namespace
 
 double estimated_quads(const PanelSize& panel) {
@@ -212,6 +221,31 @@ double fan_area(const std::vector<Eigen::Vector3d>& outline) {
   return area;
 }
 
+std::vector<std::string> fine_edge_warnings(const GarmentRequest& sketch,
+                                            const std::vector<PanelSize>& panels) {
+  std::vector<std::string> out;
+  for (const PanelSize& size : panels) {
+    if (size.mirror_copy || !(size.boundary_edges > 0) || !(size.boundary_length > 0)) continue;
+    const double edge = size.boundary_length / size.boundary_edges;
+    if (!(edge < kCleanEdgeLength * (1 - kCleanEdgeSlack))) continue;
+    const double quads = estimated_quads(size);
+    const double seconds = quads * kMeshingSecondsPerQuad;
+    out.push_back(fmt::format(
+        "{}: {}: panel '{}' has edges of {:.1f} mm along its outline, which make about {} "
+        "quads of it ({:.3f} m² over the edge squared; meshing takes about {:.0f} s of CPU); "
+        "below {:.0f} mm the quad filler was measured to leave slivers, vertices on one spot and "
+        "quads inside the body (a 30 x 45 cm panel: clean at 4 mm, 9,348 quads; 6-7 quality "
+        "warnings at 2-3 mm, up to 37,395 quads; docs/sketch-format.md, \"Limits\"). Give it an "
+        "\"edge_length\" of {:g} or more, or keep this one if the quality gate's warnings after "
+        "meshing name nothing in panel '{}' (a smaller panel can be clean finer): this is a "
+        "warning, the file is meshed as written",
+        sketch.file, size.path, size.id, 1e3 * edge, rounded_count(quads),
+        kSurfaceOverFan * size.area, std::max(1.0, seconds), 1e3 * kCleanEdgeLength,
+        kCleanEdgeLength, size.id));
+  }
+  return out;
+}
+
 void check_panel_sizes(const GarmentRequest& sketch, const std::vector<PanelSize>& panels) {
   const auto total_quads = [](const std::vector<PanelSize>& sizes) {
     double total = 0;
@@ -226,14 +260,7 @@ void check_panel_sizes(const GarmentRequest& sketch, const std::vector<PanelSize
                                    estimated_quads(panels[p]) > estimated_quads(panels[largest])))
       largest = p;
   const double seconds = total * kMeshingSecondsPerQuad;
-  // "378,000": a count to three figures, with thousands separated.
-  const auto count = [](double n) {
-    const double scale = std::pow(10.0, std::max(0.0, std::floor(std::log10(n)) - 2));
-    std::string digits = fmt::format("{:.0f}", std::round(n / scale) * scale);
-    for (int k = static_cast<int>(digits.size()) - 3; k > 0; k -= 3)
-      digits.insert(static_cast<size_t>(k), ",");
-    return digits;
-  };
+  const auto count = rounded_count;
   const std::string limit = fmt::format(
       "more than the {} this program meshes: meshing them would take about {} of CPU and {:.1f} "
       "GB of memory",

@@ -143,4 +143,22 @@ double fan_area(const std::vector<Eigen::Vector3d>& outline);
 // panel's path with the edge length that would fit.
 void check_panel_sizes(const GarmentRequest& sketch, const std::vector<PanelSize>& panels);
 
+// Below this mean edge along its outline (m) a panel is warned about before it is filled, with the
+// quads its edge implies: where the quad filler was measured to stay clean (trial 41, P3, on the
+// built-in body's front: a 30 × 45 cm panel clean at 4 mm, 9,348 quads; 2 quality warnings at
+// 3.5 mm; 6-7 at 2-3 mm, 16,871-37,395 quads, with slivers, vertices on one spot and quads
+// inside the body; a 20 × 20 cm patch clean at 3 mm). Not a quad count: the patch broke at 6,885
+// quads where the large panel was clean at 9,348 (docs/sketch-format.md, "Limits").
+inline constexpr double kCleanEdgeLength = 0.004;
+// The counts round each curve's length over its edge, so a panel asked for 4 mm has a mean edge
+// within a few per cent of it: 3 % below is still "at 4 mm".
+inline constexpr double kCleanEdgeSlack = 0.03;
+
+// Before filling: a sentence for every panel (not a mirror copy) whose mean boundary edge is
+// below kCleanEdgeLength, with the quads it implies (estimated_quads), what meshing them costs and
+// what was measured; empty when none is. A warning, not a refusal: a smaller panel can be clean
+// finer (the patch above), and the quality gate judges the mesh made.
+std::vector<std::string> fine_edge_warnings(const GarmentRequest& sketch,
+                                            const std::vector<PanelSize>& panels);
+
 }  // namespace sd::garment

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -201,6 +202,39 @@ TEST(BadInput, ABodyOverTheTriangleLimitIsRefused) {
     EXPECT_NE(std::string(e.what()).find("Decimate"), std::string::npos) << e.what();
   }
   std::filesystem::remove(path);
+}
+
+// Trial 41, P3: a 30 x 45 cm panel at "edge_length" 0.002 made 37,395 quads and 7 warnings after
+// a long fill, with nothing said first. Before filling, a panel whose outline's edges are below
+// the 4 mm where such a panel was measured clean is told the quads that implies (its area over
+// the edge squared) and what was measured; at 4 mm (and a count's rounding below it) nothing is
+// said, nor for a mirror copy (its original is told).
+TEST(BadInput, AnEdgeLengthBelowTheMeasuredCleanOneIsToldItsQuadsBeforeFilling) {
+  GarmentRequest sketch;
+  sketch.file = "patch.json";
+  const auto rectangle = [](double edge, bool mirror_copy) {
+    PanelSize size;
+    size.id = mirror_copy ? "patch.mirror" : "patch";
+    size.path = "/panels/0";
+    size.mirror_copy = mirror_copy;
+    size.boundary_length = 2 * (0.30 + 0.45);
+    size.boundary_edges = std::round(size.boundary_length / edge);
+    size.area = 0.30 * 0.45;
+    return size;
+  };
+  const std::vector<std::string> fine = fine_edge_warnings(sketch, {rectangle(0.002, false)});
+  ASSERT_EQ(fine.size(), 1u);
+  // 1.1 × 0.135 m² / (2 mm)² = 37,125, capped at a square's (B/4)² = 35,156 for its 750 boundary
+  // edges (estimated_quads); the fill of the real panel made 37,395.
+  EXPECT_NE(fine[0].find("patch.json: /panels/0: panel 'patch' has edges of 2.0 mm along its "
+                         "outline, which make about 35,200 quads of it"),
+            std::string::npos)
+      << fine[0];
+  EXPECT_NE(fine[0].find("\"edge_length\" of 0.004 or more"), std::string::npos) << fine[0];
+  EXPECT_EQ(fine_edge_warnings(sketch, {rectangle(0.0035, false)}).size(), 1u);
+  EXPECT_TRUE(fine_edge_warnings(sketch, {rectangle(0.004, false)}).empty());
+  EXPECT_TRUE(fine_edge_warnings(sketch, {rectangle(0.0039, false)}).empty());
+  EXPECT_TRUE(fine_edge_warnings(sketch, {rectangle(0.002, true)}).empty());
 }
 
 }  // namespace sd::garment

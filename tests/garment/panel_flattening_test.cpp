@@ -282,6 +282,35 @@ TEST(PanelFlattening, TubeIsNotADisk) {
   }
 }
 
+// Trial 41, P7: a piece that flattens without a fold but lies over itself. A strip 10 cm wide
+// wound 1.2 turns round a vertical axis at 20-30 cm, 5 cm lower per turn (a flounce wound
+// round, a sleeve whose end is turned back up): nearly flat, so its flattening is an annulus
+// of 432°, whose ends overlap by 72° with every triangle the right way up. It is refused like a
+// folded piece, naming both places of the overlap; the same strip wound 0.8 turns is cut.
+TEST(PanelFlattening, APieceThatLiesOverItselfIsRefused) {
+  const auto wound = [](double turns) {
+    return grid_garment(
+        static_cast<int>(std::lround(60 * turns)), 4,
+        [turns](double s, double t) {
+          const double a = 2 * kPi * turns * s, r = 0.2 + 0.1 * t;
+          return Eigen::Vector3d(r * std::sin(a), 1.0 - 0.05 * turns * s, r * std::cos(a));
+        },
+        "flounce");
+  };
+  const FlatPattern once = flatten_garment(wound(0.8));
+  EXPECT_EQ(inverted_triangles(once.panels[0]), 0);
+  try {
+    flatten_garment(wound(1.2));
+    ADD_FAILURE() << "a strip wound 1.2 turns was cut as one flat piece";
+  } catch (const PatternError& e) {
+    EXPECT_EQ(e.panel(), "flounce");
+    const std::string message = e.what();
+    EXPECT_NE(message.find("lies over itself"), std::string::npos) << message;
+    EXPECT_NE(message.find("outline crosses itself"), std::string::npos) << message;
+    EXPECT_EQ(message.find("nearly closed cap"), std::string::npos) << message;
+  }
+}
+
 TEST(PanelFlattening, TwoHalvesOfASkirtSewAlongTheirSeams) {
   // Front and back halves of a cone (an A-line skirt), two seams at the sides.
   Garment g = grid_garment(32, 8, [](double s, double t) {

@@ -113,6 +113,7 @@ void run_mesh(const MeshOptions& options) {
     report["garment_mesh"] = sketch.resolve(*sketch.garment_mesh).string();
     report["totals"] = {{"vertices", tris.vertex_count()},
                         {"triangles", tris.face_count()},
+                        {"file_faces", imported.file_faces},
                         {"blocks_48", stats.blocks},
                         {"boundary_blocks_48", stats.boundary_blocks},
                         {"unswapped_blocks_48", stats.unswapped_blocks},

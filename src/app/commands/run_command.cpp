@@ -739,6 +739,13 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   if (scene.body) out.body = scene.body->raw.source;
   out.pinned_vertices = scene.pinned.size();
   out.meshing = meshing_summary(scene);
+  if (scene.imported)
+    out.imported = nlohmann::json{{"file", sketch.resolve(*sketch.garment_mesh).string()},
+                                  {"vertices", scene.imported->vertices},
+                                  {"triangles", scene.imported->triangles},
+                                  {"file_faces", scene.imported->faces},
+                                  {"vertices_48", scene.start.rows()},
+                                  {"triangles_48", scene.input.triangles.rows()}};
   out.bending = sim::bend_model_name(scene.bend_model);
   out.compression = sim::compression_name(scene.compression);
   out.cusick = cusick_json(sketch, draped);

@@ -181,9 +181,42 @@ void flat_rest_shapes(const scene::Sketch& sketch, const garment::Garment& g,
     const garment::PanelSpec* spec = sketch.find_panel(e.panel());
     if (!spec && e.panel().ends_with(".mirror"))
       spec = sketch.find_panel(e.panel().substr(0, e.panel().size() - 7));
-    sketch.fail(spec ? spec->json_path + "/rest" : "/simulate/rest",
-                scene.body ? flattening_failure(g, sketch, *scene.body, e.panel(), e.what())
-                           : std::string(e.what()));
+    // At the key that asked for the flat rest: the panel's own, else the file's (trial 41, P4:
+    // a file-wide "rest": "flat" was refused at /panels/0/rest, a key the file did not have,
+    // and read as `mesh` refusing a per-panel rest). The key is accepted; the piece is not.
+    const std::string failure =
+        scene.body ? flattening_failure(g, sketch, *scene.body, e) : std::string(e.what());
+    // The key that makes panel p rest flat, and its words.
+    const auto asked = [&](size_t p) -> std::pair<std::string, std::string> {
+      const garment::PanelSpec* own = sketch.find_panel(g.panels[p].id);
+      if (!own && g.panels[p].id.ends_with(".mirror"))
+        own = sketch.find_panel(g.panels[p].id.substr(0, g.panels[p].id.size() - 7));
+      if (own != nullptr && own->rest) return {own->json_path + "/rest", "its \"rest\": \"flat\""};
+      return {"/simulate/rest", "the file's \"simulate\": {\"rest\": \"flat\"}"};
+    };
+    size_t failed = 0;
+    while (failed < g.panels.size() && g.panels[failed].id != e.panel()) ++failed;
+    const std::string name = spec != nullptr ? spec->id : e.panel();
+    if (failed < g.panels.size() && flat[failed]) {
+      const auto [path, words] = asked(failed);
+      sketch.fail(path, fmt::format("panel '{}' rests flat ({}) and drapes from its flattened "
+                                    "pattern piece, but {}; or give {} \"rest\": \"shaped\" to "
+                                    "drape it as drawn",
+                                    name, words, failure,
+                                    path == "/simulate/rest"
+                                        ? fmt::format("the panel (\"panels\": [{{\"id\": "
+                                                      "\"{}\", …, \"rest\": \"shaped\"}}])",
+                                                      name)
+                                        : std::string("it")));
+    }
+    // A shaped panel, flattened with the rest: the pattern is made whole for the flat ones.
+    size_t first_flat = 0;
+    while (first_flat < g.panels.size() && !flat[first_flat]) ++first_flat;
+    const auto [path, words] = asked(first_flat < g.panels.size() ? first_flat : 0);
+    sketch.fail(path, fmt::format("with panel '{}' resting flat ({}) the whole garment is "
+                                  "flattened, and {}; panel '{}' itself rests shaped",
+                                  g.panels[first_flat < g.panels.size() ? first_flat : 0].id, words,
+                                  failure, name));
   }
   scene.flattening_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -552,6 +585,7 @@ void build_imported_scene(const scene::Sketch& sketch, ClothScene& scene) {
     scene.triangle_face(t) = m48.source_face(arrays.triangle_ids[static_cast<size_t>(t)]);
   scene.start = arrays.rest_positions;
   scene.face_group = Eigen::VectorXi::Zero(triangles.face_count());
+  scene.imported = {triangles.vertex_count(), triangles.face_count(), imported.file_faces};
   scene.group_names = {"garment"};
   scene.fabric_name = sketch.fabric;
   scene.fabric = scene_fabric(sketch, sketch.fabric, "/fabric");

@@ -49,6 +49,16 @@ struct ClothScene {
   // The body's poses over the drape ("body": {"motion": ...}); absent for a still body.
   std::optional<sim::PoseSequence> body_motion;
   std::optional<garment::Garment> garment;
+  // An imported garment ("garment_mesh"): the file's own counts, for the messages and the
+  // report. The cloth simulated (input, mesh48) is its √3 4-8 conversion, which has a vertex
+  // more per triangle and a triangle pair per edge (trial 41, P10: validate called those the
+  // file's).
+  struct ImportedCounts {
+    Eigen::Index vertices = 0;
+    Eigen::Index triangles = 0;  // polygons fanned into triangles
+    long faces = 0;              // as the file writes them (a quad is one)
+  };
+  std::optional<ImportedCounts> imported;
   std::vector<std::string> group_names;
   double body_ms = 0;     // time spent loading the garment's body
   double meshing_ms = 0;  // time spent building the garment

@@ -138,7 +138,8 @@ MeshedGarment mesh_garment(const scene::Sketch& sketch) {
 }
 
 ImportedGarment import_garment(const scene::Sketch& sketch) {
-  meshing::TriMesh triangles = garment::load_garment_mesh(sketch);
+  long file_faces = 0;
+  meshing::TriMesh triangles = garment::load_garment_mesh(sketch, &file_faces);
   meshing::Sqrt3Stats stats;
   meshing::Mesh48 m48 = [&] {
     try {
@@ -149,7 +150,7 @@ ImportedGarment import_garment(const scene::Sketch& sketch) {
     }
   }();
   check_mesh48(m48);
-  return {std::move(triangles), std::move(m48), stats};
+  return {std::move(triangles), file_faces, std::move(m48), stats};
 }
 
 }  // namespace sd::app

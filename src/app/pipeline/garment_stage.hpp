@@ -38,8 +38,9 @@ MeshedGarment mesh_garment(const scene::Sketch& sketch);
 
 // A sketch's "garment_mesh": the triangles as read and their 4-8 mesh by the sqrt3 conversion.
 struct ImportedGarment {
-  meshing::TriMesh triangles;
-  meshing::Mesh48 mesh48;  // validated
+  meshing::TriMesh triangles;  // the file's faces, polygons fanned into triangles
+  long file_faces = 0;         // the faces the file writes (a quad is one)
+  meshing::Mesh48 mesh48;      // validated
   meshing::Sqrt3Stats stats;
 };
 

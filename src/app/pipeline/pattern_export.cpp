@@ -347,7 +347,7 @@ PatternSheet build_pattern_sheet(const scene::Sketch& sketch, const garment::Gar
   } catch (const garment::PatternError& e) {
     const garment::PanelSpec* ps = panel_spec(sketch, e.panel());
     sketch.fail(ps ? ps->json_path : "/panels",
-                body ? flattening_failure(garment, sketch, *body, e.panel(), e.what()) : e.what());
+                body ? flattening_failure(garment, sketch, *body, e) : e.what());
   }
   if (!flattened)
     for (const std::string& warning : sheet.pattern.warnings) spdlog::warn("{}", warning);

@@ -32,7 +32,20 @@ std::vector<garment::QualityWarning> quality_warnings(const garment::Garment& ga
 
 std::string flattening_failure(const garment::Garment& garment,
                                const garment::GarmentRequest& sketch, const garment::Body& body,
-                               const std::string& panel, const std::string& error) {
+                               const garment::PatternError& refusal) {
+  const std::string& panel = refusal.panel();
+  std::string error = refusal.what();
+  if (refusal.placed()) {
+    const std::string at = garment::point_text(refusal.where());
+    if (const size_t found = error.find(at); found != std::string::npos) {
+      try {
+        const garment::BodyLandmarks landmarks = garment::find_landmarks(body.mesh);
+        error.insert(found + at.size(), ", near the " + landmarks.nearest(refusal.where()).name);
+      } catch (const std::runtime_error&) {
+        // Not a standing figure: the place alone.
+      }
+    }
+  }
   const std::string original =
       panel.ends_with(".mirror") ? panel.substr(0, panel.size() - 7) : panel;
   // The panel's curves used as written: the ones that can pass through a leg.

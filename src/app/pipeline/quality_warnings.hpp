@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "garment/body.hpp"
+#include "garment/panel_flattening.hpp"
 #include "garment/quality_gate.hpp"
 
 namespace sd::app {
@@ -17,13 +18,14 @@ std::vector<garment::QualityWarning> quality_warnings(const garment::Garment& ga
                                                       const garment::GarmentRequest& sketch,
                                                       const garment::Body& body);
 
-// The message of a panel that cannot be flattened (`error`, from garment::PatternError), after
-// the gate's warnings are logged: when cloth of that panel (or of its original, for a mirror
-// copy) lies inside the body before the drape, a curve drawn through the body is the likely
-// cause (a hem through the legs makes a panel that bends round them), and the message says so.
+// The message of a panel that cannot be flattened (`error`), after the gate's warnings are
+// logged: when cloth of that panel (or of its original, for a mirror copy) lies inside the body
+// before the drape, a curve drawn through the body is the likely cause (a hem through the legs
+// makes a panel that bends round them), and the message says so. A refusal at one place is
+// told the body's landmark nearest it.
 std::string flattening_failure(const garment::Garment& garment,
                                const garment::GarmentRequest& sketch, const garment::Body& body,
-                               const std::string& panel, const std::string& error);
+                               const garment::PatternError& error);
 
 // What `validate --strict` and `mesh --strict` count: the gate's warnings and the curves in no
 // panel (garment/unused_curves.hpp; logged by the garment stage). Empty when there are none,

@@ -210,6 +210,7 @@ nlohmann::json run_report_json(const RunReport& r) {
   out["body"] = r.body ? nlohmann::json(*r.body) : nlohmann::json(nullptr);
   out["pinned_vertices"] = r.pinned_vertices;
   out["meshing"] = r.meshing ? meshing_json(*r.meshing) : nlohmann::json(nullptr);
+  if (r.imported) out["imported"] = *r.imported;
   out["bending"] = r.bending;
   out["compression"] = r.compression;
   if (r.cusick) out["cusick"] = *r.cusick;

@@ -71,6 +71,9 @@ struct RunReport {
   std::optional<std::string> body;  // the body's source; none for a sheet without a body
   std::size_t pinned_vertices = 0;
   std::optional<MeshingSummary> meshing;
+  // An imported garment: the file ("garment_mesh"), its own vertices, triangles and faces as
+  // written, and the √3 4-8 mesh's level-0 vertices and triangles that were draped.
+  std::optional<nlohmann::json> imported;
   std::string bending;      // the bend model that ran
   std::string compression;  // the membrane's compression model that ran
   // A horizontal disc held at its centre: the Cusick drape test's measures (DC, nodes).
