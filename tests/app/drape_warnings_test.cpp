@@ -224,7 +224,7 @@ TEST(DrapeWarnings, KineticEnergyTrendTellsSustainedFromSettlingMotion) {
   // 30 s: the third quarter is 15-22.5 s, the last 22.5-30 s: 2^-7.5 of it when halving per s.
   EXPECT_NEAR(kinetic_energy_trend(time, settling, 30.0), std::exp2(-7.5), 1e-3);
   EXPECT_NEAR(kinetic_energy_trend(time, steady, 30.0), 1.0, 1e-2);
-  // Shorter than kSustainedFrom: no verdict (a hem may still be swinging).
+  // Shorter than kSustainedFrom: no verdict (a slow creep keeps a steady energy until it stops).
   EXPECT_EQ(kinetic_energy_trend(time, steady, kSustainedFrom - 1.0), 0.0);
   EXPECT_EQ(kinetic_energy_trend({}, {}, 30.0), 0.0);
 }
