@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
+#include <vector>
 
 namespace sd::app {
 namespace {
@@ -207,4 +209,49 @@ TEST(DrapeWarnings, OverstretchedNamesThePanelThePlaceAndTheRemedy) {
 }
 
 }  // namespace
+
+// Trial 42: a gathered peplum on the adaptive mesh moved at a mean kinetic energy of 6e-5 J/kg
+// from 5 s to 60 s and was told to double its duration each time (30 → 60 → 120 s). The trend
+// is the last quarter's mean over the third quarter's: a settling motion (energy halving every
+// second) is far below kSustainedTrend, a sustained one (steady, or flaring up) at or above it.
+TEST(DrapeWarnings, KineticEnergyTrendTellsSustainedFromSettlingMotion) {
+  std::vector<double> time, settling, steady;
+  for (int k = 1; k <= 1800; ++k) {
+    time.push_back(k / 60.0);
+    settling.push_back(1e-3 * std::exp2(-k / 60.0));
+    steady.push_back(k % 2 == 0 ? 8e-6 : 4e-6);  // flickering about a constant level
+  }
+  // 30 s: the third quarter is 15-22.5 s, the last 22.5-30 s: 2^-7.5 of it when halving per s.
+  EXPECT_NEAR(kinetic_energy_trend(time, settling, 30.0), std::exp2(-7.5), 1e-3);
+  EXPECT_NEAR(kinetic_energy_trend(time, steady, 30.0), 1.0, 1e-2);
+  // Shorter than kSustainedFrom: no verdict (a slow creep keeps a steady energy until it stops).
+  EXPECT_EQ(kinetic_energy_trend(time, steady, kSustainedFrom - 1.0), 0.0);
+  EXPECT_EQ(kinetic_energy_trend({}, {}, 30.0), 0.0);
+}
+
+TEST(DrapeWarnings, SustainedMotionIsNotSentToALongerDuration) {
+  StillMoving where;
+  where.speed = 0.129;
+  where.at = {-0.034, 1.063, 0.134};
+  where.panel = "peplum_front.mirror";
+  where.landmark = "waist";
+  where.moving = 836;
+  where.vertices = 2082;
+  where.kinetic_trend = 1.3;
+  const std::string sustained =
+      not_at_rest_warning("peplum-blouse-gathered.json", 30.0, 0.005, 0.25, where);
+  EXPECT_NE(sustained.find("its motion is sustained, not settling"), std::string::npos)
+      << sustained;
+  EXPECT_NE(sustained.find("1.3 times"), std::string::npos) << sustained;
+  EXPECT_NE(sustained.find("\"adaptive\": false"), std::string::npos) << sustained;
+  EXPECT_EQ(sustained.find("\"duration\": 60"), std::string::npos) << sustained;
+  // Settling (the energy fell by more than half): a longer duration is still the advice.
+  where.kinetic_trend = 0.2;
+  const std::string settling =
+      not_at_rest_warning("peplum-blouse-gathered.json", 30.0, 0.005, 0.25, where);
+  EXPECT_EQ(settling.find("sustained"), std::string::npos) << settling;
+  EXPECT_NE(settling.find("try a longer \"simulate\": {\"duration\": 60}"), std::string::npos)
+      << settling;
+}
+
 }  // namespace sd::app

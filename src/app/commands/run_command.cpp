@@ -536,6 +536,14 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
       where.rest_ramp = scene.rest_ramp;  // with the gather's default ramp
       where.still_s = report.rest_still_time;
       where.drift_m = std::isnan(report.rest_drift) ? 0.0 : report.rest_drift;
+      {
+        std::vector<double> time, kinetic;
+        for (const sim::EnergySample& e : s.report().energy) {
+          time.push_back(e.time);
+          kinetic.push_back(e.kinetic);
+        }
+        where.kinetic_trend = kinetic_energy_trend(time, kinetic, report.sim_time);
+      }
       for (Eigen::Index t = 0; t < draped.faces.rows() && where.panel.empty(); ++t)
         if ((draped.faces.row(t).array() == fastest).any() && t < triangle_group.size() &&
             triangle_group(t) >= 0 &&

@@ -122,6 +122,25 @@ std::string settled_warning(const std::string& file, double drop_m,
                     one_panel ? "that panel" : "those panels");
 }
 
+double kinetic_energy_trend(const std::vector<double>& time, const std::vector<double>& kinetic,
+                            double duration_s) {
+  if (duration_s < kSustainedFrom || time.size() != kinetic.size()) return 0.0;
+  const double half = 0.5 * duration_s, last = 0.75 * duration_s;
+  double earlier = 0.0, later = 0.0;
+  int earlier_count = 0, later_count = 0;
+  for (size_t i = 0; i < time.size(); ++i) {
+    if (time[i] > last) {
+      later += kinetic[i];
+      ++later_count;
+    } else if (time[i] > half) {
+      earlier += kinetic[i];
+      ++earlier_count;
+    }
+  }
+  if (earlier_count == 0 || later_count == 0 || !(earlier > 0.0)) return 0.0;
+  return (later / later_count) / (earlier / earlier_count);
+}
+
 std::string not_at_rest_warning(const std::string& file, double duration_s, double rest_speed,
                                 double rest_window_s, const StillMoving& where) {
   std::string place = where.panel.empty() ? "" : fmt::format("in panel '{}' ", where.panel);
@@ -157,6 +176,21 @@ std::string not_at_rest_warning(const std::string& file, double duration_s, doub
         "{{\"duration\": {:g}}}; report.json's \"rest\" gives the residual",
         file, duration_s, where.still_s, 1000 * where.drift_m, 1000 * rest_speed * rest_window_s,
         rest_window_s, 100 * where.speed, place, duration_s + 1.0);
+  // Not settling (trial 42's gathered peplum, 30 s, then 60 s, each time told to double it):
+  // the energy did not fall over the last half of a long run, so a longer one will not help.
+  if (where.kinetic_trend >= kSustainedTrend)
+    return fmt::format(
+        "{}: the drape did not come to rest in {:g} s, and its motion is sustained, not "
+        "settling: the cloth still moves at {:.1f} cm/s {} ({} of {} vertices faster than the "
+        "at-rest {:.1f} cm/s), and its mean kinetic energy over the last quarter of the run was "
+        "{:.2g} times that over the quarter before (a settling drape's falls), so a longer "
+        "\"duration\" will not bring it to rest. Something keeps it moving: a "
+        "gathered panel (\"ease\" above 1) on the adaptive mesh does (try \"simulate\": "
+        "{{\"adaptive\": false}}; docs/adaptive.md, \"A gathered panel that never rests\"), "
+        "and so does cloth caught where it rubs the body or itself; report.json's \"rest\" "
+        "gives the residual",
+        file, duration_s, 100 * where.speed, place, where.moving, where.vertices, 100 * rest_speed,
+        where.kinetic_trend);
   return fmt::format(
       "{}: the drape did not come to rest in {:g} s: the cloth still moves at {:.1f} cm/s {} "
       "({} of {} vertices faster than the at-rest {:.1f} cm/s held for {:g} s), so the result "

@@ -54,11 +54,33 @@ struct StillMoving {
   // bound, but for less than the window): its length and the largest drift so far.
   double still_s = 0.0;  // s; 0: the last step moved
   double drift_m = 0.0;
+  // The mean kinetic energy over the run's last quarter divided by its mean over the quarter
+  // before (kinetic_energy_trend); 0 when not known (a run shorter than kSustainedFrom).
+  double kinetic_trend = 0.0;
 };
+
+// A run at least this long (s) whose kinetic energy did not fall by half from the third quarter
+// of the run to the last (kSustainedTrend) moves in a sustained way, not settling, so a longer
+// duration does not help (trial 42's gathered peplum on the adaptive mesh: a mean kinetic energy
+// of 6e-5 J/kg from 5 to 60 s; docs/adaptive.md, "A gathered panel that never rests"). 30 s is
+// the duration a gathered garment is given (settle_time.hpp, kGatheredSettleDuration); the
+// slowest garment of the corpus rests at 21.65 s. Shorter runs are not judged: trial 42's trumpet
+// skirt ended its 10 s with a trend of 1.1 (a slow creep at a steady energy) and rested at
+// 12.64 s.
+inline constexpr double kSustainedFrom = 30.0;
+inline constexpr double kSustainedTrend = 0.5;
+
+// The mean of `kinetic` over the samples with times in the last quarter of [0, duration_s],
+// divided by its mean over the quarter before; 0 when duration_s < kSustainedFrom, when either
+// quarter holds no sample, or when the earlier quarter's mean is 0. `time` and `kinetic` are the
+// per-step samples (sim::SimulationReport::energy), of the same length.
+double kinetic_energy_trend(const std::vector<double>& time, const std::vector<double>& kinetic,
+                            double duration_s);
 
 // "<file>: the drape did not come to rest in 3.0 s: ..." with the at-rest limits and what to try:
 // from the flat pattern without a rest ramp, "rest_ramp": 1 first (docs/pattern.md, "Drape time
-// and the rest ramp"), else a longer duration and a snugger fit.
+// and the rest ramp"), else a longer duration and a snugger fit; a sustained motion
+// (kinetic_trend at least kSustainedTrend) is said to be one, and no longer duration offered.
 std::string not_at_rest_warning(const std::string& file, double duration_s, double rest_speed,
                                 double rest_window_s, const StillMoving& where);
 
