@@ -13,6 +13,7 @@
 #include <optional>
 #include <string>
 
+#include "garment/body_landmarks.hpp"
 #include "garment/network_faces.hpp"
 
 namespace sd::garment {
@@ -271,6 +272,113 @@ std::vector<LoopEdge> resolve_explicit(const GarmentRequest& sketch, const Curve
   return loop;
 }
 
+// Two different curves of one panel's outline that cross each other seen from outside the body
+// (a bow-tie: 'right' drawn from the top-right corner to the bottom-left and 'left' from the
+// bottom-right to the top-left): the view of the check of one curve crossing itself
+// (stroke_projection.cpp, find_crossing_seen_from_outside): segments whose outward directions (the
+// body's nearest normals) agree within 60°, crossing in the plane across their mean outward
+// direction. Pieces of one curve are left to that check. Two curves drawn on one surface cross
+// with no depth between them; the corpus's outlines that come near themselves seen from outside
+// pass 2-3.4 cm apart in depth (a hood's face opening in front of the front neckline, 3.0 cm;
+// a sleeve's armhole and underarm at the armpit, 2.1 cm), or cross 1.6 mm along the outline from
+// the junction where they meet, a little past each other (a dress's hip curve and centre back):
+// a bow-tie's strands cross half its outline from each other.
+constexpr double kOutlineCrossingDepth = 0.01;  // m
+
+struct OutlineCrossing {
+  int curve_a = -1, curve_b = -1;  // network curve indices, in loop order
+  Eigen::Vector3d where = Eigen::Vector3d::Zero();
+};
+
+// shortest_loop: m, the least outline between the two strands (the panel's edge length: a fold
+// shorter than one mesh edge is lost in the fill).
+std::optional<OutlineCrossing> find_outline_crossing(const CurveNetwork& net,
+                                                     const BodySurface& body,
+                                                     const std::vector<LoopEdge>& edges,
+                                                     double shortest_loop) {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<int> curve;  // of the segment starting at each point
+  for (const LoopEdge& e : edges) {
+    const Eigen::MatrixX3d pts = ordered_points(net, e);
+    for (Eigen::Index k = 0; k + 1 < pts.rows(); ++k) {
+      points.push_back(pts.row(k).transpose());
+      curve.push_back(net.edges[static_cast<size_t>(e.edge)].curve);
+    }
+  }
+  const size_t n = points.size();
+  if (n < 4) return std::nullopt;
+  std::vector<Eigen::Vector3d> outward(n);
+  SurfacePoint near = body.closest_point(points[0]);
+  for (size_t k = 0; k < n; ++k) {
+    near = body.closest_point(points[k], near);
+    outward[k] = near.normal;
+  }
+  std::vector<double> length(n);
+  double perimeter = 0;
+  for (size_t k = 0; k < n; ++k) perimeter += length[k] = (points[(k + 1) % n] - points[k]).norm();
+  const auto cross2 = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return a.x() * b.y() - a.y() * b.x();
+  };
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = i + 2; j < n; ++j) {
+      if (curve[i] == curve[j] || (i == 0 && j + 1 == n)) continue;
+      const Eigen::Vector3d &a = points[i], &b = points[(i + 1) % n], &c = points[j],
+                            &d = points[(j + 1) % n];
+      if ((0.5 * (a + b - c - d)).norm() > kOutlineCrossingDepth + 0.5 * (length[i] + length[j]))
+        continue;
+      const Eigen::Vector3d na = outward[i] + outward[(i + 1) % n],
+                            nc = outward[j] + outward[(j + 1) % n];
+      if (na.norm() == 0 || nc.norm() == 0 || na.normalized().dot(nc.normalized()) < 0.5) continue;
+      const Eigen::Vector3d normal = (na.normalized() + nc.normalized()).normalized();
+      const Eigen::Vector3d u = normal.unitOrthogonal(), v = normal.cross(u);
+      const auto flat = [&](const Eigen::Vector3d& p) {
+        return Eigen::Vector2d(p.dot(u), p.dot(v));
+      };
+      const Eigen::Vector2d fa = flat(a), fb = flat(b), fc = flat(c), fd = flat(d);
+      const double denom = cross2(fb - fa, fd - fc);
+      if (denom == 0) continue;
+      // Strictly inside both segments: strands that only touch at a junction do not cross.
+      const double s = cross2(fc - fa, fd - fc) / denom, t = cross2(fc - fa, fb - fa) / denom;
+      if (!(s > 0 && s < 1 && t > 0 && t < 1)) continue;
+      const Eigen::Vector3d on_ab = a + s * (b - a), on_cd = c + t * (d - c);
+      if ((on_ab - on_cd).norm() >= kOutlineCrossingDepth) continue;
+      // The outline between the two strands, the shorter way round: a loop shorter than
+      // `shortest_loop` is where two curves meet at a junction a little past each other.
+      double arc = 0;
+      for (size_t k = i; k <= j; ++k) arc += length[k];
+      arc -= s * length[i] + (1 - t) * length[j];
+      if (std::min(arc, perimeter - arc) < shortest_loop) continue;
+      return OutlineCrossing{curve[i], curve[j], 0.5 * (on_ab + on_cd)};
+    }
+  return std::nullopt;
+}
+
+// Fails at the panel's boundary when two of its curves cross each other (find_outline_crossing).
+void check_outline_crossing(const GarmentRequest& sketch, const CurveNetwork& net,
+                            const BodySurface& body, const PanelSpec& spec,
+                            const std::vector<LoopEdge>& edges) {
+  const std::optional<OutlineCrossing> crossing =
+      find_outline_crossing(net, body, edges, spec.edge_length.value_or(sketch.edge_length));
+  if (!crossing) return;
+  const std::string& a = net.curves[static_cast<size_t>(crossing->curve_a)].id;
+  const std::string& b = net.curves[static_cast<size_t>(crossing->curve_b)].id;
+  std::string landmark;
+  if (const BodyLandmarks* landmarks = body.landmarks();
+      landmarks != nullptr && !landmarks->points.empty())
+    landmark = fmt::format(", near the {}", landmarks->nearest(crossing->where).name);
+  // To the millimetre, without "-0.000" on the centre line.
+  const Eigen::Vector3d rounded =
+      (crossing->where * 1000).array().round().matrix() / 1000 + Eigen::Vector3d::Zero();
+  sketch.fail(
+      spec.json_path + "/boundary",
+      fmt::format("curves '{}' and '{}' of panel '{}' cross each other at {} m{}: a panel's "
+                  "outline must not cross itself (the panel would be a bow-tie folded over "
+                  "itself). Each curve runs from the junction where the one before it in the "
+                  "list ends to the junction where the next begins: check that neither is drawn "
+                  "to the opposite corner, and that the list goes round the panel in order",
+                  a, b, spec.id, at(rounded), landmark));
+}
+
 // A panel's own vote on its facing: which side of its boundary it lies on, seen along the body
 // normal n. Over its boundary points p (every fourth; c their centroid, t the step to the next
 // point) the sum of w (n × t) · (c − p) is positive when the panel lies on the left of its loop,
@@ -464,6 +572,7 @@ std::vector<PanelLoop> resolve_panels(const GarmentRequest& sketch, const CurveN
                                 it->second, spec.id));
     } else {
       loop.edges = resolve_explicit(sketch, net, spec);
+      check_outline_crossing(sketch, net, body, spec, loop.edges);
     }
     votes.push_back(
         facing_vote(net, body, loop.edges, spec.edge_length.value_or(sketch.edge_length)));

@@ -219,14 +219,16 @@ void Simulation::replace_model(ClothModel model, Eigen::VectorXd x, Eigen::Vecto
           kUntangleStrainShare * settings_.max_strain, &left_at);
       spdlog::debug("sim: the start's untangling moved {} vertices; its stretch strain is {:.3g}",
                     report_.self_untangled_vertices, max_stretch_strain(model_, x_));
-      if (report_.self_untangle_left > 0)
-        spdlog::warn(
-            "sim: {} pair(s) of cloth triangles pass through each other at the start around "
+      if (report_.self_untangle_left > 0) {
+        report_.self_untangle_warning = fmt::format(
+            "{} pair(s) of cloth triangles pass through each other at the start around "
             "({:.3f}, {:.3f}, {:.3f}) m and stay so: separating them would stretch the cloth "
             "more than {:.0f} % (or took every round); the layers there may stay through each "
             "other (validate names the panel: sliver or folded quads there)",
             report_.self_untangle_left, left_at.x(), left_at.y(), left_at.z(),
             100.0 * kUntangleStrainShare * settings_.max_strain);
+        spdlog::warn("sim: {}", report_.self_untangle_warning);
+      }
     }
     report_.self_collision_s +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

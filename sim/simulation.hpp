@@ -233,12 +233,15 @@ struct SimulationReport {
   int self_intersections_start = 0;  // intersecting triangle pairs of the start
   int self_untangled_vertices = 0;   // vertices the start's untangling moved
   int self_untangle_left = 0;        // pairs the untangling could not separate
-  int self_contacts_max = 0;         // most repulsion springs in one accepted step
-  int self_contacts_final = 0;       // in the last step
-  int self_collisions = 0;           // colliding pairs the continuous test found, summed over steps
-  int self_zone_vertices = 0;        // vertices moved rigidly by impact zones, summed over steps
-  int self_unresolved_steps = 0;     // accepted steps whose fail-safe left a collision
-  double self_collision_s = 0.0;     // wall time of self-contact (detection and response)
+  // The warning logged when it left some ("21 pair(s) of cloth triangles pass through each
+  // other at the start ... and stay so ..."), for report.json's warnings; empty otherwise.
+  std::string self_untangle_warning;
+  int self_contacts_max = 0;      // most repulsion springs in one accepted step
+  int self_contacts_final = 0;    // in the last step
+  int self_collisions = 0;        // colliding pairs the continuous test found, summed over steps
+  int self_zone_vertices = 0;     // vertices moved rigidly by impact zones, summed over steps
+  int self_unresolved_steps = 0;  // accepted steps whose fail-safe left a collision
+  double self_collision_s = 0.0;  // wall time of self-contact (detection and response)
   // Share of the cloth's triangles inside regions the curvature test culled, over all steps.
   double self_culled_share = 0.0;
   long long self_culled_triangles = 0;  // summed over accepted steps (for the share)

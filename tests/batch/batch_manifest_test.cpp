@@ -329,5 +329,25 @@ TEST(LoadBatchJobs, SketchFilesAndManifestsTogetherSortedById) {
             std::string::npos);
 }
 
+// Trial 42, P8: the manifest of docs/batch.md without its "format" line was run as a sketch whose
+// job failed with "sketch.json: /jobs: unknown key 'jobs' (did you mean 'join'?)". It is a bad
+// manifest (exit code 2, nothing runs), named as such.
+TEST(LoadBatchJobs, AManifestWithoutItsFormatIsABadManifest) {
+  const fs::path dir = manifest_dir("no-format");
+  test::write_text(dir / "noformat.json", R"({"jobs": ["sketches/dress.json"]})");
+  const std::string input = (dir / "noformat.json").string();
+  EXPECT_EQ(error_of([&] { load_batch_jobs({input}); }),
+            input +
+                ": it has \"jobs\" like a batch manifest but no \"format\": "
+                "\"sketchdrape-batch/1\"");
+  test::write_text(dir / "wrong.json",
+                   R"({"format": "sketchdrape/1", "jobs": ["sketches/dress.json"]})");
+  const std::string wrong = (dir / "wrong.json").string();
+  EXPECT_EQ(error_of([&] { load_batch_jobs({wrong}); }),
+            wrong +
+                ": it has \"jobs\" like a batch manifest but its \"format\" is "
+                "\"sketchdrape/1\", not \"sketchdrape-batch/1\"");
+}
+
 }  // namespace
 }  // namespace sd::app

@@ -137,6 +137,43 @@ TEST(PanelLoop, CurvesThatDoNotMeetNameThePanel) {
   }
 }
 
+// Trial 42, P1: a bow-tie, 'right' drawn from the top-right corner to the bottom-left and 'left'
+// from the bottom-right to the top-left, crossing at (0, 1.0) on the front of the sphere. Each
+// curve is fine on its own; the panel folds over itself. It was meshed and draped (21 cloth
+// triangles through each other); now the boundary names both curves and the place.
+TEST(PanelLoop, TwoCurvesOfAnOutlineThatCrossEachOtherAreAnErrorSayingWhere) {
+  const std::string json = R"({
+    "curves": [
+      { "id": "top",    "points": [[-0.1, 1.1], [0.1, 1.1]] },
+      { "id": "right",  "points": [[0.1, 1.1], [-0.1, 0.9]] },
+      { "id": "bottom", "points": [[-0.1, 0.9], [0.1, 0.9]] },
+      { "id": "left",   "points": [[0.1, 0.9], [-0.1, 1.1]] }
+    ],
+    "panels": [ { "id": "patch", "boundary": ["top", "right", "bottom", "left"] } ] })";
+  try {
+    resolve(json);
+    FAIL() << "a bow-tie panel was accepted";
+  } catch (const SketchError& e) {
+    EXPECT_EQ(e.json_path(), "/panels/0/boundary");
+    const std::string what = e.sentence();
+    EXPECT_NE(what.find("curves 'right' and 'left' of panel 'patch' cross each other at ("),
+              std::string::npos)
+        << what;
+    EXPECT_NE(what.find(", 1.000, "), std::string::npos) << what;  // y of the crossing
+    EXPECT_NE(what.find("a panel's outline must not cross itself"), std::string::npos) << what;
+  }
+  // The same four curves listed round the square (its sides drawn the other way) are a panel.
+  const std::string square = R"({
+    "curves": [
+      { "id": "top",    "points": [[-0.1, 1.1], [0.1, 1.1]] },
+      { "id": "right",  "points": [[0.1, 1.1], [0.1, 0.9]] },
+      { "id": "bottom", "points": [[-0.1, 0.9], [0.1, 0.9]] },
+      { "id": "left",   "points": [[-0.1, 0.9], [-0.1, 1.1]] }
+    ],
+    "panels": [ { "id": "patch", "boundary": ["top", "right", "bottom", "left"] } ] })";
+  EXPECT_EQ(resolve(square).loops.size(), 1u);
+}
+
 // A closed tube of radius `r` round a bent limb: straight down from (0, top, 0) for `upper`, then
 // bent towards +z by `bend` radians on a circle of radius `turn`, then straight for `lower`
 // (a forearm turned forward). Rings of `around` vertices every 5 mm of the centreline, capped at

@@ -631,6 +631,18 @@ std::vector<BatchJob> load_batch_jobs(const std::vector<std::string>& inputs) {
                                     /*ignore_comments=*/true);
       const bool manifest =
           root.is_object() && root.contains("format") && root["format"] == kManifestFormat;
+      // A manifest whose "format" line was left out was run as a sketch and failed with
+      // "sketch.json: /jobs: unknown key 'jobs' (did you mean 'join'?)" (trial 42, P8): a sketch
+      // has no "jobs", so the file is a manifest that does not say so.
+      if (!manifest && root.is_object() && root.contains("jobs"))
+        throw ManifestError(
+            input, "",
+            root.contains("format")
+                ? fmt::format("it has \"jobs\" like a batch manifest but its \"format\" is {}, "
+                              "not \"{}\"",
+                              root["format"].dump(), kManifestFormat)
+                : fmt::format("it has \"jobs\" like a batch manifest but no \"format\": \"{}\"",
+                              kManifestFormat));
       if (manifest)
         found = parse_json_manifest(text, input, base_dir);
       else  // a sketch file; if it is broken, its job fails with the parser's message

@@ -224,7 +224,8 @@ void run_mesh(const MeshOptions& options) {
                sketch.file, dir.string(), g.panels.size(), g.mesh.face_count(), distortion,
                mesh_ms);
   if (const std::string failure =
-          strict_failure(sketch.file, warnings, garment::unused_curve_warnings(sketch, g).size());
+          strict_failure(sketch.file, warnings, garment::unused_curve_warnings(sketch, g).size(),
+                         garment::half_mirrored_warnings(sketch, g).size());
       options.strict && !failure.empty())
     throw std::runtime_error(failure);
 }

@@ -485,6 +485,10 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
     triangle_group = groups_of(driver);
     out.strain = group_strains(driver.simulation().model(), draped.vertices, triangle_group,
                                scene.group_names);
+    // Cloth the start's untangling left through itself (logged by the simulation): report.json
+    // carries the sentence too, as an at_rest drape with no warnings looked clean (trial 42, P2).
+    if (!report.self_untangle_warning.empty())
+      out.warnings.push_back(fmt::format("{}: {}", sketch.file, report.self_untangle_warning));
     // How far the garment went down from where it was drawn: its centre of mass, from the
     // potential energy −Σ m g·x of the first and last samples (mass is conserved through
     // adaptive detail's splits and merges).

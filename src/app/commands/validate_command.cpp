@@ -121,7 +121,9 @@ void run_validate(const ValidateOptions& options) {
             << "\n";
   const size_t unused =
       scene.garment ? garment::unused_curve_warnings(sketch, *scene.garment).size() : 0;
-  if (const std::string failure = strict_failure(sketch.file, warnings, unused);
+  const size_t half_mirrored =
+      scene.garment ? garment::half_mirrored_warnings(sketch, *scene.garment).size() : 0;
+  if (const std::string failure = strict_failure(sketch.file, warnings, unused, half_mirrored);
       options.strict && !failure.empty())
     throw std::runtime_error(failure);
 }

@@ -124,6 +124,8 @@ MeshedGarment mesh_garment(const scene::Sketch& sketch) {
   for (const std::string& warning : seam_ease_warnings(sketch, g)) spdlog::warn("{}", warning);
   for (const std::string& warning : garment::unused_curve_warnings(sketch, g))
     spdlog::warn("{}", warning);
+  for (const std::string& warning : garment::half_mirrored_warnings(sketch, g))
+    spdlog::warn("{}", warning);
 
   std::vector<std::string> groups;
   std::vector<int> panel_group(g.panels.size());

@@ -74,12 +74,15 @@ std::string flattening_failure(const garment::Garment& garment,
 
 std::string strict_failure(const std::string& file,
                            const std::vector<garment::QualityWarning>& warnings,
-                           size_t unused_curves) {
-  if (warnings.empty() && unused_curves == 0) return "";
+                           size_t unused_curves, size_t half_mirrored) {
+  if (warnings.empty() && unused_curves == 0 && half_mirrored == 0) return "";
   std::vector<std::string> parts;
   if (!warnings.empty())
     parts.push_back(fmt::format("{} mesh quality warning(s)", warnings.size()));
   if (unused_curves > 0) parts.push_back(fmt::format("{} curve(s) in no panel", unused_curves));
+  if (half_mirrored > 0)
+    parts.push_back(
+        fmt::format("{} curve(s) whose mirror copy borders fewer panels", half_mirrored));
   return fmt::format("{}: {} and --strict", file, fmt::join(parts, ", "));
 }
 

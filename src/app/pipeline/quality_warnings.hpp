@@ -30,10 +30,11 @@ std::string flattening_failure(const garment::Garment& garment,
 // What `validate --strict` and `mesh --strict` count: the gate's warnings and the curves in no
 // panel (garment/unused_curves.hpp; logged by the garment stage). Empty when there are none,
 // else the failure's sentence: "<file>: 2 mesh quality warning(s), 1 curve(s) in no panel and
-// --strict".
+// --strict". `half_mirrored`: the curves whose mirror copy borders fewer panels
+// (garment::half_mirrored_warnings).
 std::string strict_failure(const std::string& file,
                            const std::vector<garment::QualityWarning>& warnings,
-                           size_t unused_curves);
+                           size_t unused_curves, size_t half_mirrored = 0);
 
 nlohmann::json warnings_json(const std::vector<garment::QualityWarning>& warnings);
 
