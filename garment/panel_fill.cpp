@@ -76,12 +76,7 @@ int quads_off_size(const meshing::QuadMesh& mesh, double edge) {
   const QualityLimits limits;
   int outside = 0;
   for (Eigen::Index f = 0; f < mesh.face_count(); ++f) {
-    double perimeter = 0;
-    for (int k = 0; k < 4; ++k)
-      perimeter +=
-          (mesh.vertices.row(mesh.faces(f, (k + 1) % 4)) - mesh.vertices.row(mesh.faces(f, k)))
-              .norm();
-    const double side = perimeter / 4 / edge;
+    const double side = meshing::mean_side(mesh, f) / edge;
     outside += side < limits.size_low || side > limits.size_high ? 1 : 0;
   }
   return outside;

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "meshing/patch_relaxation.hpp"
+#include "meshing/quad_quality.hpp"
 
 namespace sd::meshing {
 namespace {
@@ -216,12 +217,7 @@ FilledPatch fill_with_arm_cut(
 double worst_quad_size(const QuadMesh& mesh, double edge) {
   double worst = 1;
   for (Eigen::Index f = 0; f < mesh.face_count(); ++f) {
-    double perimeter = 0;
-    for (int k = 0; k < 4; ++k)
-      perimeter +=
-          (mesh.vertices.row(mesh.faces(f, (k + 1) % 4)) - mesh.vertices.row(mesh.faces(f, k)))
-              .norm();
-    const double side = perimeter / 4;
+    const double side = mean_side(mesh, f);
     worst = std::max({worst, side / edge, edge / std::max(side, 1e-300)});
   }
   return worst;

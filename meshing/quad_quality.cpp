@@ -122,4 +122,13 @@ QuadQuality measure_quality(const QuadMesh& mesh, std::span<const int> corner_ve
   return quality;
 }
 
+double mean_side(const QuadMesh& mesh, Eigen::Index face) {
+  double perimeter = 0;
+  for (int k = 0; k < 4; ++k)
+    perimeter +=
+        (mesh.vertices.row(mesh.faces(face, (k + 1) % 4)) - mesh.vertices.row(mesh.faces(face, k)))
+            .norm();
+  return perimeter / 4;
+}
+
 }  // namespace sd::meshing

@@ -29,4 +29,8 @@ QuadQuality measure_valence(const QuadMesh& mesh, std::span<const int> corner_ve
 // products around the vertex), so a folded quad shows up as negative even on a curved patch.
 QuadQuality measure_quality(const QuadMesh& mesh, std::span<const int> corner_vertices);
 
+// The mean length of quad `face`'s four sides: its size, as the fill and the quality gate compare
+// it with the edge length asked for.
+double mean_side(const QuadMesh& mesh, Eigen::Index face);
+
 }  // namespace sd::meshing
