@@ -68,14 +68,6 @@ std::vector<fs::path> garment_files() {
   return files;
 }
 
-double mean_side(const meshing::QuadMesh& mesh, Eigen::Index f) {
-  double sum = 0;
-  for (int k = 0; k < 4; ++k)
-    sum += (mesh.vertices.row(mesh.faces(f, (k + 1) % 4)) - mesh.vertices.row(mesh.faces(f, k)))
-               .norm();
-  return sum / 4;
-}
-
 // Each vertex of panel `panel`'s quads: "boundary" (on an edge of one of its quads: the panel's
 // outline, seams included), else by its valence among them, "interior valence 3", "interior
 // valence 5+" or "regular"; vertices of other panels are "".
@@ -126,7 +118,7 @@ TEST(FillConsistency, QuadCountsFallAndSizesFollowTheEdgeLength) {
       std::map<int, std::vector<std::string>> kinds;  // by panel, when first needed
       int outside = 0;
       for (Eigen::Index f = 0; f < garment.mesh.face_count(); ++f) {
-        const double side = mean_side(garment.mesh, f) / edge;
+        const double side = meshing::mean_side(garment.mesh, f) / edge;
         if (side >= kSmallest && side <= kLargest) continue;
         ++outside;
         // Where it is in its panel: on the panel's boundary, at an interior vertex of valence 3,
