@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -112,6 +113,51 @@ TEST(MeshCommand, RefusesWhatValidateRefuses) {
         << r.output;
   }
   EXPECT_FALSE(fs::exists(dir / "out"));
+  fs::remove_all(dir);
+}
+
+// Trial 42, P11: `mesh` of a garment_mesh file that asks for pictures wrote none and said
+// nothing (a sheet likewise). It draws them as it does a sketch's: the cloth's triangles over the
+// body, garment-<view>.png, one per listed image; none when the file lists none.
+TEST(MeshCommand, AnImportedGarmentOrASheetGetsItsImages) {
+  const fs::path dir = fresh_dir("imported-images");
+  fs::create_directories(dir);
+  {
+    // A tube round the hips, 24 quads round and 8 down (as validate's imported-garment test).
+    std::ofstream obj(dir / "tube.obj");
+    constexpr int kRound = 24, kDown = 8;
+    for (int j = 0; j <= kDown; ++j)
+      for (int i = 0; i < kRound; ++i) {
+        const double a = 2 * 3.14159265358979 * i / kRound;
+        obj << "v " << 0.22 * std::sin(a) << " " << 0.95 - 0.35 * j / kDown << " "
+            << 0.22 * std::cos(a) << "\n";
+      }
+    for (int j = 0; j < kDown; ++j)
+      for (int i = 0; i < kRound; ++i) {
+        const int a = j * kRound + i + 1, b = j * kRound + (i + 1) % kRound + 1;
+        obj << "f " << a << " " << a + kRound << " " << b + kRound << " " << b << "\n";
+      }
+  }
+  std::ofstream(dir / "tube.json") << R"({"garment_mesh": "tube.obj", "output": {"images": [
+      {"view": "front", "size": [120, 180]}, {"view": "left", "size": [120, 180]}]}})";
+  std::ofstream(dir / "plain.json") << R"({"garment_mesh": "tube.obj"})";
+  std::ofstream(dir / "sheet.json") << R"({"sheet": {"size": [0.5, 0.5], "resolution": [8, 8],
+      "pins": ["top"]}, "output": {"images": [{"view": "front", "size": [120, 180]}]}})";
+  const CommandResult tube =
+      run_sketchdrape("mesh " + (dir / "tube.json").string() + " -o " + (dir / "tube").string());
+  ASSERT_EQ(tube.exit_code, 0) << tube.output;
+  for (const char* f :
+       {"garment.obj", "garment48.obj", "report.json", "garment-front.png", "garment-left.png"})
+    EXPECT_TRUE(fs::exists(dir / "tube" / f)) << f;
+  const CommandResult plain =
+      run_sketchdrape("mesh " + (dir / "plain.json").string() + " -o " + (dir / "plain").string());
+  ASSERT_EQ(plain.exit_code, 0) << plain.output;
+  EXPECT_TRUE(fs::exists(dir / "plain" / "garment.obj"));
+  EXPECT_FALSE(fs::exists(dir / "plain" / "garment-front.png"));
+  const CommandResult sheet =
+      run_sketchdrape("mesh " + (dir / "sheet.json").string() + " -o " + (dir / "sheet").string());
+  ASSERT_EQ(sheet.exit_code, 0) << sheet.output;
+  EXPECT_TRUE(fs::exists(dir / "sheet" / "garment-front.png"));
   fs::remove_all(dir);
 }
 

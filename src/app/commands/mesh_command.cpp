@@ -1,7 +1,8 @@
 // `sketchdrape mesh SKETCH [-o DIR]`: the sketch's panels as one stitched quad mesh
 // (garment.obj or .glb, one group per panel), its 4-8 triangle mesh (garment48.obj), a report
 // (report.json: per panel sides, counts, distortion, quality; totals) and, when the file asks
-// for images, PNGs of the panels on the body. No simulation. All files appear together or not
+// for images, PNGs of the panels on the body (of a sheet's or an imported garment's triangles in
+// one colour). No simulation. All files appear together or not
 // at all.
 
 #include <fmt/format.h>
@@ -25,6 +26,7 @@
 #include "src/app/pipeline/quality_warnings.hpp"
 #include "src/app/pipeline/sketch_checks.hpp"
 #include "src/render/previews.hpp"
+#include "src/render/scene.hpp"
 
 namespace sd::app {
 namespace {
@@ -80,6 +82,16 @@ void run_mesh(const MeshOptions& options) {
   // flat rest's flattening, the body's poses, the drape's size): `mesh` refuses the same files
   // (trial 35: "pin_above": 2.5 was meshed with exit 0 and refused by validate).
   const ClothScene scene = build_cloth_scene_within_limits(sketch);
+  // The pictures the file asks for of a cloth without panels (a sheet, an imported garment): in
+  // one colour, its triangles' edges as the wireframe, over the body when the scene has one. They
+  // were silently left out before (trial 42, P11).
+  const auto stage_triangle_images = [&](const meshing::TriMesh& cloth) {
+    if (sketch.output.images.empty()) return;
+    const PreviewCloth preview{cloth, {}, render::triangle_edges(cloth), {}, {}};
+    stage_preview_images(sketch.output.images, sketch.output.wireframe,
+                         scene.body ? &scene.body->mesh : nullptr, preview, "garment", dir,
+                         outputs);
+  };
 
   if (sketch.sheet) {
     // A sheet scene: its grid of triangles is the fixed mesh `run` simulates (a sheet that asks
@@ -92,6 +104,10 @@ void run_mesh(const MeshOptions& options) {
     report["totals"] = {{"vertices", scene.input.rest_positions.rows()},
                         {"triangles", scene.input.triangles.rows()},
                         {"pinned_vertices", scene.pinned.size()}};
+    meshing::TriMesh cloth;
+    cloth.vertices = scene.input.rest_positions;
+    cloth.faces = scene.input.triangles;
+    stage_triangle_images(cloth);
     if (sketch.output.report) outputs.stage(dir / "report.json", report.dump(2) + "\n");
     outputs.commit();
     spdlog::info("meshed {} → {} (a sheet of {} triangles)", sketch.file, dir.string(),
@@ -118,6 +134,7 @@ void run_mesh(const MeshOptions& options) {
                         {"boundary_blocks_48", stats.boundary_blocks},
                         {"unswapped_blocks_48", stats.unswapped_blocks},
                         {"triangles_48", m48.triangle_count()}};
+    stage_triangle_images(tris);
     if (sketch.output.report) outputs.stage(dir / "report.json", report.dump(2) + "\n");
     outputs.commit();
     spdlog::info("meshed {} → {} ({} triangles, {} 4-8 blocks)", sketch.file, dir.string(),

@@ -249,8 +249,8 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
   spdlog::debug("settings: {}", automatic.reason);
   settings.energy_from_next_step = !options.trace;  // the trace reads each step's own sample
   const RunEstimate estimate =
-      estimate_run(sketch, scene.input.triangles, static_cast<int>(scene.start.rows()),
-                   options.frames_per_second, settings.duration, settings.dt);
+      estimate_run(sketch, scene.input, scene_model_options(scene), options.frames_per_second,
+                   settings.duration, settings.dt);
   check_run_fits(sketch, estimate, limits, options.frames_per_second);
   spdlog::debug(
       "estimate: {:.0f} vertices, {:.2f} GB ({:.2f} GB the factor), at most {:.0f} steps ({:.0f} "

@@ -130,8 +130,7 @@ void build_sheet_scene(const scene::Sketch& sketch, ClothScene& scene) {
   scene.pinned.erase(std::unique(scene.pinned.begin(), scene.pinned.end()), scene.pinned.end());
   scene.fabric_name = sketch.fabric;
   scene.fabric = scene_fabric(sketch, sketch.fabric, "/fabric");
-  scene.bend_model =
-      sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::quadratic);
+  scene.bend_model = scene_bend_model(sketch);
   scene.compression =
       sim::parse_compression(sketch.simulate.compression).value_or(sim::Compression::linear);
 }
@@ -514,8 +513,7 @@ void build_garment_scene(const scene::Sketch& sketch, ClothScene& scene) {
   // One fabric per simulation for now: the first panel's; others are reported if different.
   const garment::GarmentPanel& first = g.panels.front();
   scene.fabric_name = first.fabric;
-  scene.bend_model =
-      sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::hinges);
+  scene.bend_model = scene_bend_model(sketch);
   scene.compression =
       // "gather_start": false keeps a shaped gather's drape as it was before trial 37 (linear).
       !sketch.simulate.compression_given &&
@@ -589,8 +587,7 @@ void build_imported_scene(const scene::Sketch& sketch, ClothScene& scene) {
   scene.group_names = {"garment"};
   scene.fabric_name = sketch.fabric;
   scene.fabric = scene_fabric(sketch, sketch.fabric, "/fabric");
-  scene.bend_model =
-      sim::parse_bend_model(sketch.simulate.bending).value_or(sim::BendModel::quadratic);
+  scene.bend_model = scene_bend_model(sketch);
   scene.compression =
       sim::parse_compression(sketch.simulate.compression).value_or(sim::Compression::linear);
   pin_above(sketch, scene);
@@ -740,12 +737,23 @@ sim::AutomaticChoice apply_automatic_settings(const scene::Sketch& sketch, const
   return choice;
 }
 
-sim::ClothModel build_scene_model(const ClothScene& scene) {
+sim::BendModel scene_bend_model(const scene::Sketch& sketch) {
+  return sim::parse_bend_model(sketch.simulate.bending)
+      .value_or(sketch.sheet || sketch.garment_mesh ? sim::BendModel::quadratic
+                                                    : sim::BendModel::hinges);
+}
+
+sim::ClothModelOptions scene_model_options(const ClothScene& scene) {
   sim::ClothModelOptions options;
   options.bend_model = scene.bend_model;
   options.compression = scene.compression;
   if (scene.bend_rest_flat) options.bend_rest = sim::BendRestShape::flat;
-  sim::ClothModel model = sim::build_cloth_model(scene.input, scene.fabric, options);
+  return options;
+}
+
+sim::ClothModel build_scene_model(const ClothScene& scene) {
+  sim::ClothModel model =
+      sim::build_cloth_model(scene.input, scene.fabric, scene_model_options(scene));
   if (scene.face_ease.size() > 0) {
     Eigen::MatrixXd triangle_ease(scene.triangle_face.size(), scene.face_ease.cols());
     for (Eigen::Index t = 0; t < triangle_ease.rows(); ++t)
@@ -758,9 +766,7 @@ sim::ClothModel build_scene_model(const ClothScene& scene) {
 sim::AdaptiveMaterial scene_material(const ClothScene& scene) {
   sim::AdaptiveMaterial material;
   material.fabric = scene.fabric;
-  material.model_options.bend_model = scene.bend_model;
-  material.model_options.compression = scene.compression;
-  if (scene.bend_rest_flat) material.model_options.bend_rest = sim::BendRestShape::flat;
+  material.model_options = scene_model_options(scene);
   material.source_warp = scene.face_warp;
   material.up = scene.input.up;
   material.source_ease = scene.face_ease;
@@ -842,9 +848,8 @@ ClothScene build_cloth_scene_within_limits(const scene::Sketch& sketch) {
   if (const auto estimate = estimate_before_building(sketch, 0))
     check_run_fits(sketch, *estimate, RunLimits{}, 0);
   ClothScene scene = build_cloth_scene(sketch);
-  check_run_fits(
-      sketch, estimate_run(sketch, scene.input.triangles, static_cast<int>(scene.start.rows()), 0),
-      RunLimits{}, 0);
+  check_run_fits(sketch, estimate_run(sketch, scene.input, scene_model_options(scene), 0),
+                 RunLimits{}, 0);
   return scene;
 }
 

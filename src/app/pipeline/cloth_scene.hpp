@@ -99,6 +99,15 @@ ClothScene build_cloth_scene_within_limits(const scene::Sketch& sketch);
 // body.
 meshing::TriMesh body_at(const ClothScene& scene, double t);
 
+// The bending model of the sketch's cloth: simulate.bending, else its kind's default (the
+// quadratic bending for a sheet and an imported garment_mesh, the hinges for sketched panels).
+sim::BendModel scene_bend_model(const scene::Sketch& sketch);
+
+// The options the scene's cloth model is built with (build_scene_model, scene_material): the
+// simulator's defaults with the scene's bending, compression and bending rest. The memory check
+// predicts the solver's factor from them (sketch_checks.hpp, estimate_run).
+sim::ClothModelOptions scene_model_options(const ClothScene& scene);
+
 // The simulator's model of the scene's cloth on its fixed mesh: build_cloth_model on the input,
 // then each triangle's rest shape scaled by its panel's ease (lengths along the warp by a and
 // along the weft by b, so rest area and mass by a·b; see sim::scale_rest_shapes). A waistband with

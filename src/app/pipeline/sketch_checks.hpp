@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "scene/sketch_file.hpp"
+#include "sim/cloth_model.hpp"
 #include "sim/simulation.hpp"
 
 namespace sd::app {
@@ -82,8 +83,9 @@ std::optional<std::string> rendering_over_budget(double resident, const Renderer
                                                  bool library_loaded, double budget, bool given);
 
 // A drape's cost, estimated before it starts: the CHOLMOD factor's size from the symbolic
-// analysis of the cloth's mesh (sim::predict_factor_size), plus the measured cost per vertex of
-// the model, the forces and the contacts (docs/cli.md, "Limits").
+// analysis of the cloth's model (sim::predict_factor_size of its input and options: its bending's
+// pattern and, with the diamond membrane, the diamonds' 13-vertex couplings), plus the measured
+// cost per vertex of the model, the forces and the contacts (docs/cli.md, "Limits").
 struct RunEstimate {
   double vertices = 0;
   double memory_bytes = 0;  // peak resident memory
@@ -95,14 +97,15 @@ struct RunEstimate {
   double duration = 0;      // s, the drape's duration the estimate assumes
   double time_step = 0;     // s, its largest step
 };
-// `triangles`: the cloth's #F×3 triangles into `vertices` vertices; the duration and the step
-// are the file's.
-RunEstimate estimate_run(const scene::Sketch& sketch, const Eigen::MatrixX3i& triangles,
-                         int vertices, double frames_per_second);
+// `cloth`: the cloth's input (its rest positions and triangles), modelled with `model` (the
+// scene's: scene_model_options); the duration and the step are the file's.
+RunEstimate estimate_run(const scene::Sketch& sketch, const sim::ClothInput& cloth,
+                         const sim::ClothModelOptions& model, double frames_per_second);
 // The same for the duration and step the run will take (the automatic settings may change both:
 // a garment without a duration of its own gets its settle time, settle_time.hpp).
-RunEstimate estimate_run(const scene::Sketch& sketch, const Eigen::MatrixX3i& triangles,
-                         int vertices, double frames_per_second, double duration, double time_step);
+RunEstimate estimate_run(const scene::Sketch& sketch, const sim::ClothInput& cloth,
+                         const sim::ClothModelOptions& model, double frames_per_second,
+                         double duration, double time_step);
 
 // The estimate of a cloth whose mesh is known without building the scene (a sheet: its grid of
 // triangles, without the body or the model); nullopt for a garment. A sheet whose factor alone,
