@@ -87,7 +87,8 @@ TEST(SketchChecks, RenderingIsCheckedAgainstTheBudget) {
 // diagonal, so that the numeric factorisation succeeds; the analysis reads only the pattern), as
 // in tests/sim/factor_size_test.cpp.
 double solver_factor_bytes(const sim::ClothInput& input, const sim::ClothModelOptions& options) {
-  const sim::ClothModel model = sim::build_cloth_model(input, sim::fabric_preset("cotton"), options);
+  const sim::ClothModel model =
+      sim::build_cloth_model(input, sim::fabric_preset("cotton"), options);
   sim::SparseMatrixR a = model.pattern.zero_matrix;
   for (int i = 0; i < model.vertex_count; ++i)
     for (int k = 0; k < 3; ++k) a.coeffRef(3 * i + k, 3 * i + k) = 1.0;
@@ -141,8 +142,7 @@ TEST(SketchChecks, TheEstimateUsesTheScenesModelOptions) {
   EXPECT_EQ(options.bend_model, sim::BendModel::quadratic);
   const std::optional<RunEstimate> before = estimate_before_building(quadratic, 0);
   ASSERT_TRUE(before);
-  EXPECT_DOUBLE_EQ(before->factor_bytes,
-                   sim::predict_factor_size(scene.input, options).bytes);
+  EXPECT_DOUBLE_EQ(before->factor_bytes, sim::predict_factor_size(scene.input, options).bytes);
   EXPECT_DOUBLE_EQ(estimate_run(quadratic, scene.input, options, 0).factor_bytes,
                    before->factor_bytes);
 }

@@ -628,6 +628,37 @@ TEST(HostileInput, PicturesAreCountedInTheBudgetOnlyWhenAsked) {
   fs::remove_all(dir);
 }
 
+// Trial 42, P7: under --max-memory 1MB a patch whose pictures alone need 129 MB was told "about
+// 4 vertices would fit". Nothing fits beside the pictures: the message says so and offers the
+// budget this run needs (its estimate, 156 MB, and a tenth: 180 MB; it peaks at 160 MB, so 156M
+// and 160M stop it before its pictures), which the run then takes, pictures drawn.
+TEST(HostileInput, NoClothFitsBesideThePicturesAndTheOfferedBudgetDoes) {
+  const fs::path dir = fresh_dir("budget-offered");
+  write(dir / "patch.json", R"({"curves": [
+      {"id": "top", "view": "front", "points": [[-0.1, 1.3], [0.1, 1.3]]},
+      {"id": "right", "view": "front", "points": [[0.1, 1.3], [0.1, 1.1]]},
+      {"id": "bottom", "view": "front", "points": [[0.1, 1.1], [-0.1, 1.1]]},
+      {"id": "left", "view": "front", "points": [[-0.1, 1.1], [-0.1, 1.3]]}],
+    "panels": [{"id": "patch", "boundary": ["top", "right", "bottom", "left"]}],
+    "simulate": {"pin_above": 1.29}})");
+  const CommandResult refused = run_sketchdrape("run " + (dir / "patch.json").string() +
+                                                " --max-memory 1MB -o " + (dir / "out").string());
+  EXPECT_EQ(refused.exit_code, 2) << refused.output;
+  EXPECT_NE(refused.output.find("the pictures alone need 129 MB (600x900: "), std::string::npos)
+      << refused.output;
+  EXPECT_NE(refused.output.find("so no cloth fits beside them: give --max-memory 180 MB or more "
+                                "(this run is estimated at 156 MB)"),
+            std::string::npos)
+      << refused.output;
+  EXPECT_EQ(refused.output.find("would fit"), std::string::npos) << refused.output;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+  const CommandResult offered = run_sketchdrape("-q run " + (dir / "patch.json").string() +
+                                                " --max-memory 180M -o " + (dir / "out").string());
+  EXPECT_EQ(offered.exit_code, 0) << offered.output;
+  EXPECT_TRUE(fs::exists(dir / "out" / "drape-front.png"));
+  fs::remove_all(dir);
+}
+
 // OSMesa is opened only when pictures are asked for, and before the drape: a library that
 // cannot be opened (SKETCHDRAPE_OSMESA names another; docs/rendering.md) fails at once with exit
 // code 1, naming the library and Debian's package, with nothing written; a run without pictures

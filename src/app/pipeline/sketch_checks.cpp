@@ -407,9 +407,10 @@ void check_run_fits(const scene::Sketch& sketch, const RunEstimate& estimate,
         bare.memory_bytes = drape;
         const std::string without =
             memory_scaled(bare, kMinVertices) <= memory
-                ? fmt::format("; without them the run still needs about {}, and about {:.0f} "
-                              "vertices would fit",
-                              size_text(drape), fitting_vertices(bare))
+                ? fmt::format(
+                      "; without them the run still needs about {}, and about {:.0f} "
+                      "vertices would fit",
+                      size_text(drape), fitting_vertices(bare))
                 : fmt::format("; without them the run still needs about {}", size_text(drape));
         sketch.fail(
             sketch.output.images_listed ? "/output/images" : "",
