@@ -143,7 +143,9 @@ void build_sheet_scene(const scene::Sketch& sketch, ClothScene& scene) {
 // flattened more exactly (1000 ARAP sweeps), the collar top's back sticks and slips at the
 // waist, and the tiered skirt hangs 4.8 mm lower. Round 42 cut the gathered tier as `pattern`
 // does (spread about its apex, below) and measured again: the tiered skirt still hangs 4.3 mm
-// lower (top 1.0199 m, its test's floor 1.02 m), the other two are unchanged.
+// lower (top 1.0199 m, its test's floor 1.02 m), the other two are unchanged. Round 43 traced
+// that to the fold's grain, not the pieces (same seams, centre lines and ease): cut on the fold
+// the fitted back yoke's side runs 13° off grain and shears there under its hoop tension.
 garment::FlatteningOptions flat_rest_flattening() {
   garment::FlatteningOptions flattening;
   flattening.straight_centre_cost = -1;
