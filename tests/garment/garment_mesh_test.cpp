@@ -399,8 +399,10 @@ TEST(Garment, AFoldingPanelIsToldWhichTurningCornerToDrop) {
 // to drop its back's corner at 'side', which turned its 2 warnings into 3 (1 since
 // garment/fold_repair mends the back's fold at the neck, 2 or more with that list): that offer is
 // now left out, and its front's quads 2.38 times the edge length below the armhole get a curve's
-// own edge_length instead, which applied leaves fewer warnings. The tank top's corner list,
-// which cleaned its back, is still offered, and applying it leaves fewer warnings too.
+// own edge_length instead, which applied left fewer warnings. Since round 43 (the panel's
+// finishing ranked by the gate's measures, docs/meshing.md) that front is clean as it is, so the
+// shell top is told nothing but the body's inside_body. The tank top's corner list, which
+// cleaned its back, is still offered, and applying it leaves fewer warnings too.
 TEST(Garment, TheGatesAdviceAppliedLeavesFewerWarnings) {
   const std::filesystem::path repro = std::filesystem::path(SD_SOURCE_DIR) / "data/designs/repro";
   const Sketch shell = load_sketch(repro / "shell-top-human.json");
@@ -417,25 +419,12 @@ TEST(Garment, TheGatesAdviceAppliedLeavesFewerWarnings) {
   // The advice is weighed by check_quality's kinds; the body's `inside_body` (the back 9 mm
   // inside the neck) comes on top and is not advice.
   std::erase_if(told, [](const QualityWarning& w) { return w.kind == "inside_body"; });
-  ASSERT_EQ(told.size(), 1u);
+  EXPECT_TRUE(told.empty()) << told.front().message;
   // What following the dropped offer gives (the reason it is dropped).
   GarmentRequest without_side = shell;
   for (PanelSpec& panel : without_side.panels)
     if (panel.id == "back") panel.corners = {"cb", "neck_b", "shoulder", "armhole_b", "hem_b"};
   EXPECT_GT(count(without_side), told.size());
-  const QualityWarning* size = nullptr;
-  for (const QualityWarning& w : told) {
-    EXPECT_TRUE(w.corners.empty()) << w.message;
-    EXPECT_EQ(w.message.find("\"corners\""), std::string::npos) << w.message;
-    if (w.kind == "quad_size") size = &w;
-  }
-  ASSERT_NE(size, nullptr);
-  ASSERT_FALSE(size->curve.empty()) << size->message;
-  EXPECT_NE(size->message.find("'" + size->curve + "'"), std::string::npos);
-  GarmentRequest finer = shell;
-  for (CurveSpec& curve : finer.curves)
-    if (curve.id == size->curve) curve.edge_length = size->curve_edge_length;
-  EXPECT_LT(count(finer), told.size());
 
   const Sketch tank = load_sketch(repro / "tank-human.json");
   const BodySurface tank_surface(load_sketch_body(tank).mesh);
@@ -590,7 +579,9 @@ TEST(Garment, ShiftDressDrawnOnTheBuiltinBodyIsCleanOnTheColladaHuman) {
 // Trial 38's halter top kept a quad 2.36 times the edge in its one-piece front (round the neck:
 // six corners, two reflex layout vertices the filler put on the hem and the neckline). With a
 // seam across the strap (data/designs/author-38/halter-top.json) it is clean; without the
-// strap's own edge_length it has the one warning, and the gate offers exactly that curve.
+// strap's own edge_length it has the one warning, and the gate offers exactly that curve: at
+// 1.8 cm since round 43 (its quads 2.11 times the edge instead of 2.39 once the smoothing is
+// ranked by the gate's measures, docs/meshing.md; the file keeps the 1.6 cm offered before).
 TEST(Garment, HalterTopWithASeamAcrossTheStrapIsClean) {
   const Sketch halter =
       load_sketch(std::filesystem::path(SD_SOURCE_DIR) / "data/designs/author-38/halter-top.json");
@@ -606,7 +597,7 @@ TEST(Garment, HalterTopWithASeamAcrossTheStrapIsClean) {
   ASSERT_EQ(told.size(), 1u);
   EXPECT_EQ(told[0].kind, "quad_size");
   EXPECT_EQ(told[0].curve, "strap_lo");
-  EXPECT_DOUBLE_EQ(told[0].curve_edge_length, 0.016);
+  EXPECT_DOUBLE_EQ(told[0].curve_edge_length, 0.018);
 }
 
 // Issue 18, round 42 (docs/meshing.md, "Round 42: an arm that widens"): one-piece panels that run
@@ -625,6 +616,24 @@ TEST(Garment, OnePieceStrapsThatWidenPassTheGate) {
     EXPECT_TRUE(std::any_of(garment.panels.begin(), garment.panels.end(),
                             [](const GarmentPanel& p) { return p.partition == "arm-cut"; }))
         << name;
+  }
+}
+
+// Issue 18, round 43 (docs/meshing.md, "Round 43: quads off size after the smoothing"): the
+// one-piece one-shoulder top's back (a 4-edge shoulder between sides of 13 and 21 edges, no
+// arm) is filled with a valence-6 vertex under the strap; the fill had 4 quads up to 2.29 × the
+// edge round it and was kept over its smoothing along the body for a better worst corner. Chosen
+// by the gate's measures, with the smoothing that weighs that vertex as a candidate, it is clean;
+// so is the kimono tee's (1 quad_size warning before).
+TEST(Garment, OnePieceBackWideningUnderTheStrapPassesTheGate) {
+  for (const char* name : {"one-shoulder-top-one-piece", "kimono-tee"}) {
+    const Sketch sketch = load_sketch(std::filesystem::path(SD_SOURCE_DIR) / "data/designs/repro" /
+                                      (std::string(name) + ".json"));
+    const Body body = load_sketch_body(sketch);
+    const BodySurface surface(body.mesh);
+    const Garment garment = build_garment(sketch, surface);
+    for (const QualityWarning& w : check_quality(garment, sketch, nullptr))
+      ADD_FAILURE() << name << ": " << w.message;
   }
 }
 
