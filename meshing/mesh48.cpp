@@ -95,6 +95,7 @@ Mesh48 Mesh48::build(std::vector<Eigen::Vector3d> rest,
   m.triangles_.resize(triangles.size());
   m.root_normals_.resize(triangles.size());
   m.root_areas_.resize(triangles.size());
+  m.root_corners_.resize(triangles.size());
 
   for (int t = 0; t < nt; ++t) {
     Triangle& tri = m.triangles_[t];
@@ -111,6 +112,7 @@ Mesh48 Mesh48::build(std::vector<Eigen::Vector3d> rest,
                              " has (nearly) zero area; remove the collapsed face first");
     m.root_normals_[t] = (b - a).cross(c - a).normalized();
     m.root_areas_[t] = triangle_area(a, b, c);
+    m.root_corners_[t] = {a, b, c};
     m.input_area_ += m.root_areas_[t];
   }
   const HalfEdgeIndex index(nv, nt, [&](int f, int k) { return triangles[f][k]; });
@@ -395,6 +397,12 @@ int Mesh48::source_face(TriangleId t) const {
 }
 int Mesh48::root(TriangleId t) const {
   return triangle_at(t).root;
+}
+const std::array<Eigen::Vector3d, 3>& Mesh48::root_corners(int r) const {
+  return root_corners_.at(static_cast<std::size_t>(r));
+}
+int Mesh48::root_source(int r) const {
+  return root_source_.at(static_cast<std::size_t>(r));
 }
 
 double Mesh48::rest_area(TriangleId t) const {

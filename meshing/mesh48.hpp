@@ -136,6 +136,12 @@ class Mesh48 {
   // vertices' rest positions being midpoints of rest positions, so data given affinely on the
   // level-0 triangles (a flattened pattern's coordinates) reaches every level.
   int root(TriangleId t) const;
+  int root_count() const { return static_cast<int>(root_corners_.size()); }
+  // Level-0 triangle r's corners' rest positions, in its (apex, b, c) order (the order arrays()
+  // gives its row while it is alive), and its input face (source_face). Let data computed on
+  // the level-0 triangles (the buckling width of a cloth element) reach every level.
+  const std::array<Eigen::Vector3d, 3>& root_corners(int r) const;
+  int root_source(int r) const;
   double rest_area(TriangleId t) const;
   Eigen::Vector3d rest_normal(TriangleId t) const;  // unit
 
@@ -254,7 +260,8 @@ class Mesh48 {
   // total boundary length.
   std::vector<Eigen::Vector3d> root_normals_;
   std::vector<double> root_areas_;
-  std::vector<int> root_source_;  // input face of each level-0 triangle
+  std::vector<int> root_source_;                              // input face of each level-0 triangle
+  std::vector<std::array<Eigen::Vector3d, 3>> root_corners_;  // (apex, b, c) rest positions
   double input_area_ = 0;
   double input_boundary_length_ = 0;
 };

@@ -298,6 +298,31 @@ Eigen::MatrixXd AdaptiveCloth::ease_scale() const {
   return scale;
 }
 
+Eigen::MatrixX2d AdaptiveCloth::root_widths(const Eigen::MatrixXd& roots) const {
+  const int count = mesh_.root_count();
+  ClothInput input;
+  input.rest_positions.resize(3 * static_cast<Eigen::Index>(count), 3);
+  input.triangles.resize(count, 3);
+  input.up = material_.up;
+  if (material_.source_warp.rows() > 0) input.warp.resize(count, 3);
+  for (int r = 0; r < count; ++r) {
+    for (int k = 0; k < 3; ++k) {
+      input.rest_positions.row(3 * r + k) = mesh_.root_corners(r)[static_cast<std::size_t>(k)];
+      input.triangles(r, k) = 3 * r + k;
+    }
+    if (input.warp.rows() > 0) input.warp.row(r) = material_.source_warp.row(mesh_.root_source(r));
+  }
+  input.rest_uv = roots;
+  return rest_widths(input);
+}
+
+Eigen::MatrixX2d AdaptiveCloth::buckling_widths(const Eigen::MatrixX2d& roots) const {
+  Eigen::MatrixX2d widths(arrays_.faces.rows(), 2);
+  for (Eigen::Index f = 0; f < widths.rows(); ++f)
+    widths.row(f) = roots.row(mesh_.root(arrays_.triangle_ids[static_cast<std::size_t>(f)]));
+  return widths;
+}
+
 std::vector<TriangleElement> AdaptiveCloth::ramped_triangles() const {
   const double t = simulation_ ? simulation_->time() : 0.0;
   const double a = std::min(t / material_.rest_ramp, 1.0);
@@ -305,10 +330,12 @@ std::vector<TriangleElement> AdaptiveCloth::ramped_triangles() const {
   input.rest_positions = arrays_.rest_positions;
   input.triangles = arrays_.faces;
   input.up = material_.up;
-  input.rest_uv = pattern_rest_uv(a >= 1.0 ? root_uv_
-                                           : ((1.0 - a * a * (3.0 - 2.0 * a)) * root_start_uv_ +
-                                              (a * a * (3.0 - 2.0 * a)) * root_uv_)
-                                                 .eval());
+  const Eigen::MatrixXd roots = a >= 1.0 ? root_uv_
+                                         : ((1.0 - a * a * (3.0 - 2.0 * a)) * root_start_uv_ +
+                                            (a * a * (3.0 - 2.0 * a)) * root_uv_)
+                                               .eval();
+  input.rest_uv = pattern_rest_uv(roots);
+  input.buckling_width = buckling_widths(a >= 1.0 ? root_width_ : root_widths(roots));
   ClothModel model = build_cloth_model(input, material_.fabric, material_.model_options);
   const Eigen::MatrixXd scale = ease_scale();
   if (scale.size() > 0) scale_rest_shapes(model, scale);
@@ -342,6 +369,8 @@ double AdaptiveCloth::rebuild(AdaptiveTransfer& state, const SimulationSettings*
       input.warp.row(f) = material_.source_warp.row(source);
     }
   }
+  if (first) root_width_ = root_widths(root_uv_);
+  input.buckling_width = buckling_widths(root_width_);
   const Eigen::MatrixXd ease_scale = this->ease_scale();  // per face, empty without ease
   ClothModel model;
   if (first) {

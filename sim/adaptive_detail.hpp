@@ -273,6 +273,15 @@ class AdaptiveCloth {
   // the roots' coordinates `roots` (root_uv_ or a blend on the ramp).
   Eigen::MatrixXd pattern_rest_uv() const { return pattern_rest_uv(root_uv_); }
   Eigen::MatrixXd pattern_rest_uv(const Eigen::MatrixXd& roots) const;
+  // The buckling widths (ClothInput::buckling_width) of each level-0 triangle (#roots by 2):
+  // its own rest extent along warp and weft, for the roots' coordinates `roots` (root_uv_ or a
+  // blend on the ramp; empty without rest_uv: the 3D rest shape). Set on the first rebuild.
+  Eigen::MatrixX2d root_width_;
+  Eigen::MatrixX2d root_widths(const Eigen::MatrixXd& roots) const;
+  // Those of every triangle of the current mesh: its level-0 ancestor's, so that a split or
+  // merge keeps the Euler load that caps a buckled triangle's compression (docs/adaptive.md,
+  // "A gathered panel that never rests").
+  Eigen::MatrixX2d buckling_widths(const Eigen::MatrixX2d& roots) const;
   // The ease of every triangle of the current mesh (its input face's; #F by 2: warp, weft), or
   // empty without ease.
   Eigen::MatrixXd ease_scale() const;

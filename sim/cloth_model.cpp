@@ -85,6 +85,12 @@ void check_input(const ClothInput& input) {
                             std::to_string(input.rest_uv.cols()));
   if (input.rest_uv.rows() != 0 && !input.rest_uv.allFinite())
     throw InvalidClothError("the rest coordinates contain a non-finite number");
+  if (input.buckling_width.rows() != 0 &&
+      (input.buckling_width.rows() != input.triangles.rows() ||
+       !(input.buckling_width.array() > 0.0).all() || !input.buckling_width.allFinite()))
+    throw InvalidClothError("the buckling widths must be 2 positive lengths for every triangle (" +
+                            std::to_string(input.triangles.rows()) + "), got " +
+                            std::to_string(input.buckling_width.rows()) + " rows");
   if (input.warp.rows() != 0 && input.warp.rows() != input.triangles.rows())
     throw InvalidClothError("the warp directions must be given for every triangle (" +
                             std::to_string(input.triangles.rows()) + "), got " +
@@ -109,8 +115,11 @@ double unscaled_rest_area(const Eigen::MatrixX3d& rest, const std::array<int, 3>
   return 0.5 * (Vector3d(rest.row(v[1])) - p0).cross(Vector3d(rest.row(v[2])) - p0).norm();
 }
 
-// Triangle f flattened in its own (warp, weft) frame; blocks are left for the pattern.
-TriangleElement make_triangle(const ClothInput& input, Eigen::Index f, double extent) {
+// Triangle f flattened in its own (warp, weft) frame; blocks are left for the pattern. Its
+// buckling widths are input.buckling_width's, or its own extent when none are given or
+// `own_widths`.
+TriangleElement make_triangle(const ClothInput& input, Eigen::Index f, double extent,
+                              bool own_widths = false) {
   const Eigen::MatrixX3d& rest = input.rest_positions;
   TriangleElement t;
   for (int k = 0; k < 3; ++k) t.vertices[k] = input.triangles(f, k);
@@ -138,8 +147,13 @@ TriangleElement make_triangle(const ClothInput& input, Eigen::Index f, double ex
     const Vector3d weft = normal.cross(warp);
     d << (p1 - p0).dot(warp), (p2 - p0).dot(warp), (p1 - p0).dot(weft), (p2 - p0).dot(weft);
   }
-  t.width_u = std::max({0.0, d(0, 0), d(0, 1)}) - std::min({0.0, d(0, 0), d(0, 1)});
-  t.width_v = std::max({0.0, d(1, 0), d(1, 1)}) - std::min({0.0, d(1, 0), d(1, 1)});
+  if (input.buckling_width.rows() > 0 && !own_widths) {
+    t.width_u = input.buckling_width(f, 0);
+    t.width_v = input.buckling_width(f, 1);
+  } else {
+    t.width_u = std::max({0.0, d(0, 0), d(0, 1)}) - std::min({0.0, d(0, 0), d(0, 1)});
+    t.width_v = std::max({0.0, d(1, 0), d(1, 1)}) - std::min({0.0, d(1, 0), d(1, 1)});
+  }
   const Eigen::Matrix2d inverse = d.inverse();
   t.du = Vector3d(-inverse(0, 0) - inverse(1, 0), inverse(0, 0), inverse(1, 0));
   t.dv = Vector3d(-inverse(0, 1) - inverse(1, 1), inverse(0, 1), inverse(1, 1));
@@ -439,6 +453,17 @@ void set_diamonds(ClothModel& model, const Neighbours& neighbours,
     if (!in_diamond[f]) model.lone_triangles.push_back(static_cast<int>(f));
 }
 }  // namespace
+
+Eigen::MatrixX2d rest_widths(const ClothInput& input) {
+  check_input(input);
+  const double extent = rest_extent(input.rest_positions);
+  Eigen::MatrixX2d widths(input.triangles.rows(), 2);
+  for (Eigen::Index f = 0; f < input.triangles.rows(); ++f) {
+    const TriangleElement t = make_triangle(input, f, extent, /*own_widths=*/true);
+    widths.row(f) << t.width_u, t.width_v;
+  }
+  return widths;
+}
 
 void scale_rest_shapes(ClothModel& model, const Eigen::MatrixXd& scale) {
   if (scale.rows() != static_cast<Eigen::Index>(model.triangles.size()) || scale.cols() < 1 ||

@@ -38,6 +38,12 @@ struct ClothInput {
   // triangles, which no 3D rest shape can hold (seam vertices have one position per piece).
   // The warp directions are then not used for stretch and shear.
   Eigen::MatrixXd rest_uv;
+  // #F by 2 widths (warp, weft; metres, positive) whose Euler load caps each triangle's
+  // compression under Compression::buckling, or empty: each triangle's own rest extent (what
+  // rest_widths gives). A refined triangle is given its level-0 ancestor's, so that a split
+  // keeps the cap N* = π²B/l² and with it the energy of a buckled region (docs/adaptive.md,
+  // "A gathered panel that never rests").
+  Eigen::MatrixX2d buckling_width;
 };
 
 enum class BendRestShape {
@@ -72,8 +78,9 @@ enum class Compression {
   // stiffness, which real fabric never does (it buckles out of its plane at almost no load).
   linear,
   // Choi & Ko's (2002) post-buckling response: along a direction the compressive force per
-  // width stops growing at the Euler load N* = π²·B / l² of the triangle's own width l along
-  // that direction, the largest load an element of that length carries before it would buckle
+  // width stops growing at the Euler load N* = π²·B / l² of the triangle's width l along
+  // that direction (its own, or ClothInput::buckling_width: on the adaptive mesh its level-0
+  // ancestor's), the largest load an element of that length carries before it would buckle
   // out of its plane. Beyond the buckling strain ε* = N*/K the energy grows linearly, A·N*
   // per unit strain: the triangle shortens as a strip that has buckled below the mesh's
   // resolution. As l → 0 the cap N* grows as 1/l², so the response converges to linear.
@@ -124,8 +131,10 @@ struct TriangleElement {
   Eigen::Vector3d du = Eigen::Vector3d::Zero();
   Eigen::Vector3d dv = Eigen::Vector3d::Zero();
   std::array<int, 9> blocks{};  // offset of block (a,b) in the matrix row, see BlockPattern
-  double width_u = 0.0;         // m, the rest triangle's extent along the warp (Compression)
-  double width_v = 0.0;         // m, along the weft
+  // m, the rest triangle's extent along the warp and the weft, or ClothInput::buckling_width
+  // (the widths of the Euler load of Compression::buckling)
+  double width_u = 0.0;
+  double width_v = 0.0;
 };
 
 // One interior edge (x0,x1) with opposite vertices x2 (first triangle) and x3 (second).
@@ -257,6 +266,11 @@ struct ClothModelReuse {
 ClothModel update_cloth_model(const ClothModel& previous, const ClothModelReuse& reuse,
                               const ClothInput& input, const Eigen::MatrixXd& scale,
                               const ClothModelOptions& options = {});
+
+// Each triangle's own rest extent along its warp and weft (#F by 2, metres): the widths
+// build_cloth_model gives its elements when input.buckling_width is empty. Throws
+// InvalidClothError as build_cloth_model for a mesh it cannot use.
+Eigen::MatrixX2d rest_widths(const ClothInput& input);
 
 // Scales each triangle's rest shape along its warp by a and along its weft by b (a panel's
 // `ease`): its rest coordinates (u, v) become (a·u, b·v), so the gradient operators du by 1/a,

@@ -44,9 +44,26 @@ Eigen::VectorXd lumped_masses(const AdaptiveCloth& cloth) {
   return mass;
 }
 
+// The buckling widths of the level-0 triangles (#roots by 2) of a cloth still at level 0: its
+// model's own.
+Eigen::MatrixX2d level0_widths(const AdaptiveCloth& cloth) {
+  EXPECT_EQ(cloth.mesh().max_level(), 0);
+  const meshing::Mesh48Arrays arrays = cloth.mesh().arrays();
+  Eigen::MatrixX2d widths(arrays.faces.rows(), 2);
+  for (Eigen::Index f = 0; f < widths.rows(); ++f) {
+    const TriangleElement& t = cloth.simulation().model().triangles[static_cast<std::size_t>(f)];
+    widths.row(cloth.mesh().root(arrays.triangle_ids[static_cast<std::size_t>(f)])) << t.width_u,
+        t.width_v;
+  }
+  return widths;
+}
+
 // The reference for the cloth's model: build_cloth_model and scale_rest_shapes on its current
-// mesh, with the material's warp and ease per input face (as AdaptiveCloth's first build).
-ClothModel reference_model(const AdaptiveCloth& cloth, const AdaptiveMaterial& material) {
+// mesh, with the material's warp and ease per input face (as AdaptiveCloth's first build) and
+// each triangle's buckling widths its level-0 triangle's (`root_widths`, #roots by 2: the
+// widths of the first build's model, whose triangles are the roots).
+ClothModel reference_model(const AdaptiveCloth& cloth, const AdaptiveMaterial& material,
+                           const Eigen::MatrixX2d& root_widths) {
   const meshing::Mesh48Arrays arrays = cloth.mesh().arrays();
   ClothInput input;
   input.rest_positions = arrays.rest_positions;
@@ -54,10 +71,13 @@ ClothModel reference_model(const AdaptiveCloth& cloth, const AdaptiveMaterial& m
   input.up = material.up;
   Eigen::VectorXd scale(arrays.faces.rows());
   if (material.source_warp.rows() > 0) input.warp.resize(arrays.faces.rows(), 3);
+  input.buckling_width.resize(arrays.faces.rows(), 2);
   for (Eigen::Index f = 0; f < arrays.faces.rows(); ++f) {
-    const int source = cloth.mesh().source_face(arrays.triangle_ids[static_cast<std::size_t>(f)]);
+    const meshing::TriangleId t = arrays.triangle_ids[static_cast<std::size_t>(f)];
+    const int source = cloth.mesh().source_face(t);
     if (material.source_warp.rows() > 0) input.warp.row(f) = material.source_warp.row(source);
     scale(f) = material.source_ease.size() > 0 ? material.source_ease(source) : 1.0;
+    input.buckling_width.row(f) = root_widths.row(cloth.mesh().root(t));
   }
   ClothModel model = build_cloth_model(input, material.fabric, material.model_options);
   if (material.source_ease.size() > 0) scale_rest_shapes(model, scale);
@@ -69,9 +89,9 @@ ClothModel reference_model(const AdaptiveCloth& cloth, const AdaptiveMaterial& m
 // pattern arrays and vertex areas. Masses: the model holds the carried ones (equal to the
 // lumped masses to rounding).
 void expect_reference_model(const AdaptiveCloth& cloth, const AdaptiveMaterial& material,
-                            int change) {
+                            const Eigen::MatrixX2d& root_widths, int change) {
   const ClothModel& model = cloth.simulation().model();
-  const ClothModel reference = reference_model(cloth, material);
+  const ClothModel reference = reference_model(cloth, material, root_widths);
   ASSERT_EQ(model.vertex_count, reference.vertex_count) << "change " << change;
   ASSERT_EQ(model.triangles.size(), reference.triangles.size()) << "change " << change;
   for (std::size_t t = 0; t < model.triangles.size(); ++t) {
@@ -80,6 +100,8 @@ void expect_reference_model(const AdaptiveCloth& cloth, const AdaptiveMaterial& 
     ASSERT_EQ(got.rest_area, want.rest_area) << "change " << change << ", triangle " << t;
     ASSERT_EQ(got.du, want.du) << "change " << change << ", triangle " << t;
     ASSERT_EQ(got.dv, want.dv) << "change " << change << ", triangle " << t;
+    ASSERT_EQ(got.width_u, want.width_u) << "change " << change << ", triangle " << t;
+    ASSERT_EQ(got.width_v, want.width_v) << "change " << change << ", triangle " << t;
     ASSERT_EQ(got.blocks, want.blocks) << "change " << change << ", triangle " << t;
   }
   ASSERT_EQ(model.hinges.size(), reference.hinges.size()) << "change " << change;
@@ -153,7 +175,8 @@ TEST(AdaptiveDetail, IncrementalModelEqualsTheRebuiltOne) {
     const AdaptiveMaterial material = sheet.material;
     AdaptiveCloth cloth(std::move(sheet.mesh), sheet.material, {}, sheet.pins,
                         testing::adaptive_sheet_settings(spec), fixed());
-    expect_reference_model(cloth, material, 0);
+    const Eigen::MatrixX2d root_widths = level0_widths(cloth);
+    expect_reference_model(cloth, material, root_widths, 0);
     if (variant == 2) {
       EXPECT_FALSE(cloth.simulation().model().stencils.empty());
     }
@@ -177,7 +200,7 @@ TEST(AdaptiveDetail, IncrementalModelEqualsTheRebuiltOne) {
       if (!stats.changed()) continue;
       ++changes;
       merges += stats.merges;
-      ASSERT_NO_FATAL_FAILURE(expect_reference_model(cloth, material, changes));
+      ASSERT_NO_FATAL_FAILURE(expect_reference_model(cloth, material, root_widths, changes));
       ASSERT_TRUE(cloth.step().accepted) << "change " << changes;
     }
     EXPECT_GT(merges, 50);
@@ -265,6 +288,67 @@ TEST(AdaptiveDetail, EachSplitConservesMassMomentumAndMembraneEnergy) {
   EXPECT_GT(splits, 5);
 }
 
+// Under the buckling compression (Compression::buckling) a triangle compressed past its buckling
+// strain holds A·N*·(|ε| − ε*/2) per direction, N* = π²B/l² the Euler load of its width l. The
+// children of a split are the same affine image as their parent, so with the parent's N* they
+// hold its energy. With their own widths (1/√2 to 1/2 of the parent's) their cap was 2-4 times
+// higher and every split of a buckled region raised its membrane energy by as much, which kept
+// a gathered peplum from coming to rest (docs/adaptive.md, "A gathered panel that never
+// rests"). A flat sheet squeezed to 70 % in its plane (far past ε*, below 1e-6 here), split
+// block by block to level 3 and merged back to level 0: every triangle keeps its level-0
+// triangle's widths, and the membrane energy stays what it was, to rounding.
+TEST(AdaptiveDetail, SplitsAndMergesKeepTheBucklingCapOfASqueezedSheet) {
+  AdaptiveSheetSpec spec;
+  spec.quads = 2;
+  spec.pins = {};
+  testing::AdaptiveSheet sheet = testing::build_adaptive_sheet(spec);
+  sheet.material.model_options.compression = Compression::buckling;
+  const Eigen::MatrixX3d rest = sheet.mesh.arrays().rest_positions;
+  const Eigen::RowVector3d centre = rest.colwise().mean();
+  const Eigen::MatrixX3d squeezed = (0.7 * (rest.rowwise() - centre)).rowwise() + centre;
+  AdaptiveCloth cloth(std::move(sheet.mesh), sheet.material, squeezed, {},
+                      testing::adaptive_sheet_settings(spec), fixed());
+  const Eigen::MatrixX2d roots = level0_widths(cloth);
+  const auto membrane = [&] {
+    const EnergyBreakdown energy = cloth.conserved_quantities().energy;
+    return energy.stretch + energy.shear;
+  };
+  const auto expect_root_widths = [&](int change) {
+    const meshing::Mesh48Arrays arrays = cloth.mesh().arrays();
+    const std::vector<TriangleElement>& triangles = cloth.simulation().model().triangles;
+    for (std::size_t f = 0; f < triangles.size(); ++f) {
+      const int r = cloth.mesh().root(arrays.triangle_ids[f]);
+      ASSERT_EQ(triangles[f].width_u, roots(r, 0)) << "change " << change << ", triangle " << f;
+      ASSERT_EQ(triangles[f].width_v, roots(r, 1)) << "change " << change << ", triangle " << f;
+    }
+  };
+  const double initial = membrane();
+  // Capped: the linear membrane would hold ½·K·A·ε² per direction, far more.
+  const double area = spec.size * spec.size;
+  const FabricParameters& fabric = cloth.simulation().model().fabric;
+  EXPECT_GT(initial, 0.0);
+  EXPECT_LT(initial, 0.01 * 0.5 * (fabric.stretch_warp + fabric.stretch_weft) * area * 0.09);
+  int changes = 0;
+  while (cloth.mesh().max_level() < 3) {
+    const std::vector<BlockId> leaves = cloth.mesh().leaf_blocks();
+    const AdaptStats stats = cloth.split_blocks({leaves[(7 * changes) % leaves.size()]});
+    ASSERT_TRUE(stats.changed());
+    ++changes;
+    ASSERT_NO_FATAL_FAILURE(expect_root_widths(changes));
+    ASSERT_NEAR(membrane(), initial, 1e-9 * initial) << "after split " << changes;
+  }
+  const int splits = changes;
+  while (!cloth.mesh().mergeable_blocks().empty()) {
+    const AdaptStats stats = cloth.merge_blocks({cloth.mesh().mergeable_blocks().front()});
+    ASSERT_TRUE(stats.changed());
+    ++changes;
+    ASSERT_NO_FATAL_FAILURE(expect_root_widths(changes));
+    ASSERT_NEAR(membrane(), initial, 1e-9 * initial) << "after merge " << changes - splits;
+  }
+  EXPECT_EQ(cloth.mesh().max_level(), 0);
+  EXPECT_GE(splits, 3);
+}
+
 // A split with the diamond membrane (ClothModelOptions::diamond_membrane) breaks the diamonds of
 // the block's two apexes (each loses the triangle that was split). They keep their centre's map
 // on their other triangles (partial diamonds, sim/diamond_membrane.cpp), so an interior split
@@ -290,6 +374,7 @@ TEST(AdaptiveDetail, ASplitOfABentSheetKeepsTheApexesDiamonds) {
     flat.material.model_options.diamond_membrane = true;
     AdaptiveCloth refined(flat.mesh, flat.material, {}, {}, testing::adaptive_sheet_settings(spec),
                           fixed());
+    const Eigen::MatrixX2d root_widths = level0_widths(refined);
     refined.refine_uniformly(3);
     const Eigen::MatrixX3d rest = refined.rest_positions();
     // The cylinder: radius 15 cm, axis in the sheet's plane at `angle` to its sides.
@@ -330,7 +415,7 @@ TEST(AdaptiveDetail, ASplitOfABentSheetKeepsTheApexesDiamonds) {
                   cloth.simulation().model().lone_triangles.size());
       // The incrementally updated model's diamonds are the rebuilt model's, blocks included.
       const ClothModel& model = cloth.simulation().model();
-      const ClothModel reference = reference_model(cloth, flat.material);
+      const ClothModel reference = reference_model(cloth, flat.material, root_widths);
       ASSERT_EQ(model.diamonds.size(), reference.diamonds.size());
       for (std::size_t d = 0; d < model.diamonds.size(); ++d) {
         EXPECT_EQ(model.diamonds[d].vertices, reference.diamonds[d].vertices) << "diamond " << d;
