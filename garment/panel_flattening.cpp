@@ -707,6 +707,44 @@ std::array<Eigen::Vector3i, 2> split_quad(const Eigen::MatrixX3d& v, const Eigen
   return {Eigen::Vector3i(q[0], q[1], q[3]), Eigen::Vector3i(q[1], q[2], q[3])};
 }
 
+// The largest angle (degrees, 0 .. 90) between a centre line (`line`: local vertices along the
+// outline) and the warp beside it: each edge of the line against the grain axis projected into
+// the plane of the triangle on that edge (the warp there before the panel's turn). On a bodice
+// or a skirt, however far its centre flares from the vertical, that warp runs down the line
+// (0.3-24° on the examples and designs); on a crotch curve, which turns from the vertical at the
+// waist to forward under the seat while the leg's warp hangs along the leg, it crosses the
+// line's lower part (59-90°), and so does it a hood's crown.
+double centre_across_warp_deg(const Eigen::MatrixX3d& v, const Eigen::MatrixX3i& t,
+                              const std::vector<int>& line, const Eigen::Vector3d& axis) {
+  double worst = 0;
+  for (size_t k = 1; k < line.size(); ++k) {
+    const int a = line[k - 1], b = line[k];
+    for (Eigen::Index f = 0; f < t.rows(); ++f) {
+      const auto has = [&](int i) { return t(f, 0) == i || t(f, 1) == i || t(f, 2) == i; };
+      if (!has(a) || !has(b)) continue;
+      const Eigen::Vector3d p0 = v.row(t(f, 0)), p1 = v.row(t(f, 1)), p2 = v.row(t(f, 2));
+      const Eigen::Vector3d normal = (p1 - p0).cross(p2 - p0).normalized();
+      const Eigen::Vector3d warp = axis - axis.dot(normal) * normal;
+      const Eigen::Vector3d edge = (v.row(b) - v.row(a)).transpose();
+      if (warp.norm() < 1e-9 || edge.norm() < 1e-12) break;  // no warp in the plane: no figure
+      const double c = std::abs(edge.normalized().dot(warp.normalized()));
+      worst = std::max(worst, std::acos(std::min(1.0, c)) * 180.0 / std::numbers::pi);
+      break;
+    }
+  }
+  return worst;
+}
+
+// The angle (degrees, 0 .. 45) between the chord of `line` (local vertices) in the flat piece
+// `uv` and the nearer thread, warp (+y) or weft (+x).
+double chord_off_thread_deg(const Eigen::MatrixX2d& uv, const std::vector<int>& line) {
+  const Eigen::Vector2d chord = (uv.row(line.back()) - uv.row(line.front())).transpose();
+  if (!(chord.norm() > 0)) return 0.0;
+  const double off = std::acos(std::min(1.0, std::abs(chord.normalized().y()))) * 180.0 /
+                     std::numbers::pi;
+  return std::min(off, 90.0 - off);
+}
+
 double polyline_length(const Eigen::MatrixX2d& uv, const std::vector<int>& vertices) {
   double length = 0;
   for (size_t k = 1; k < vertices.size(); ++k)
@@ -1070,19 +1108,35 @@ FlatPattern flatten_garment(const Garment& garment, const FlatteningOptions& opt
           if (reflected) reflected->reflection_of = static_cast<int>(o);
         }
     }
-    std::vector<int> run = centre_run(p, global, disk_boundary(name, v.rows(), t));
+    const std::vector<int> line = centre_run(p, global, disk_boundary(name, v.rows(), t));
     // A fold is a thread of the folded fabric: a panel whose grain is turned off the threads of
     // its centre line (a bias cut, "grain": 45) keeps its centre seam, cut 2 as drawn. By
     // symmetry the warp of a panel not turned runs along its centre line (the vertical, or the
-    // limb's axis, projected into the plane x = 0), so the turn is the fold's angle to the grain.
+    // limb's axis, projected into the plane x = 0), so the turn is the fold's angle to the grain
+    // where the line runs along that axis; where it turns away from it (a crotch curve, vertical
+    // at the waist and forward under the seat) the warp beside it crosses it instead, and held
+    // straight the line is no thread: the piece's grain is turned off the fold (trial 43, P2).
     const double off_thread = std::abs(std::remainder(garment.panels[p].grain_turn_deg, 90.0));
-    const bool on_thread = off_thread <= options.fold_off_grain_deg;
-    const bool has_run = !run.empty();
-    if (!on_thread) run.clear();
+    const bool has_run = !line.empty();
+    const double across_warp =
+        has_run ? centre_across_warp_deg(v, t, line, garment.panels[p].grain_axis) : -1.0;
+    const bool on_thread =
+        off_thread <= options.fold_off_grain_deg && across_warp <= options.fold_across_warp_deg;
+    const std::vector<int> run = on_thread ? line : std::vector<int>{};
     FlatPanel flat = reflected ? std::move(*reflected)
                                : flatten_with_warp(name, v, t, warp, options, on_body, run);
     if (reflected && !flat.centre_run.empty()) flat.centre_run = run;
-    flat.centre_off_grain_deg = has_run ? off_thread : -1.0;
+    flat.centre_across_warp_deg = across_warp;
+    // What the cut piece has: a line on a thread is held (and folded) on the grain line but for
+    // the panel's turn; a line off the threads keeps its seam, and its chord in the piece lies
+    // that far off the grain line (+y) or the cross grain (a mirror copy cut as its original
+    // turned over: the original's).
+    if (!has_run)
+      flat.centre_off_grain_deg = -1.0;
+    else if (on_thread)
+      flat.centre_off_grain_deg = off_thread;
+    else if (!reflected)
+      flat.centre_off_grain_deg = chord_off_thread_deg(flat.uv, line);
     flat.panel = static_cast<int>(p);
     flat.vertices = std::move(global);
     flat.triangle_quad = std::move(quad_of);

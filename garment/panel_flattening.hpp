@@ -86,6 +86,13 @@ struct FlatteningOptions {
   // fold: the piece keeps its centre seam and its grain as drawn, cut 2. 2°: fabric is itself
   // woven up to 1-2° askew (docs/pattern.md, "Folds on the grain").
   double fold_off_grain_deg = 2.0;
+  // Nor when the warp beside the centre line crosses it anywhere by more than this (degrees;
+  // FlatPanel::centre_across_warp_deg): a crotch curve turns forward under the seat, away from
+  // the leg's warp, and held straight as a fold it would turn the whole leg off the grain (trial
+  // 43, P2: 26°). 45°: beyond it the line runs nearer the weft than the warp there, no thread;
+  // on the examples and designs the bodices, skirts, capes and collars reach 0.3-24°, the
+  // crotch curves 59-90° (docs/pattern.md, "Folds on the grain").
+  double fold_across_warp_deg = 45.0;
   // A thread has no sense: cloth stretches alike either way along its warp. A piece's grain is the
   // mean of its warp's 2D images as arrows, unless the line that fits them best as threads (the
   // least-squares axis: the mean of their doubled angles, halved) fits them better by more than
@@ -150,11 +157,17 @@ struct FlatPanel {
   // flattening gave: how far the run bowed from its chord (m) and the free distortion.
   std::vector<int> centre_run;
   // For a panel with a centre line (a run on the mirror plane sewn to its mirror copy): the
-  // angle between that line and the nearest thread, warp or weft (degrees, 0 .. 45): its
-  // grain's turn (GarmentPanel::grain_turn_deg) folded onto the threads, since the warp of a
-  // panel not turned runs along its centre line. Above fold_off_grain_deg the line is not held
-  // straight. −1 when the panel has no centre line.
+  // angle between that line and the nearest thread, warp or weft (degrees, 0 .. 45), as the cut
+  // piece has it. A line on a thread (the panel's turn within fold_off_grain_deg of the threads,
+  // the warp beside it within fold_across_warp_deg) is held straight on the grain line: its
+  // grain's turn (GarmentPanel::grain_turn_deg) folded onto the threads. Any other line keeps
+  // its seam: the angle of its chord in the piece to the grain line or the cross grain (a bias
+  // panel's about 45°, a crotch curve's 30-40°). −1 when the panel has no centre line.
   double centre_off_grain_deg = -1;
+  // For a panel with a centre line: the largest angle between it and the warp beside it (before
+  // the panel's turn, degrees, 0 .. 90); above fold_across_warp_deg the line is not held
+  // straight. −1 when the panel has no centre line.
+  double centre_across_warp_deg = -1;
   double free_centre_bow = 0;
   FlatDistortion free_distortion;
   // A mirror copy whose 3D triangles are exactly its original's reflected: the index (into

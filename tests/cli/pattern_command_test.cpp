@@ -1165,6 +1165,61 @@ TEST(PatternCommand, BiasPanelsKeepTheirCentreSeamInPatternAndFlatRest) {
     EXPECT_NEAR(centre_seam[0][id], centre_seam[1][id], 1e-6) << id;
 }
 
+// Trial 43, P2: a centre line is a fold only when it is a thread. The shipped wide-leg trousers
+// with the hem 4 cm higher and 3.5 cm wider held the back crotch curve straight (its cost fell
+// under straight_centre_cost) and cut both back legs as one piece on the fold, each leg's long
+// axis 26.1° off the grain line drawn along the fold, while pattern.json gave the centre line
+// 0.0° off grain. The crotch curve turns from the vertical at the waist to forward under the
+// seat, the leg's warp crossing it there (up to 74.7°, over fold_across_warp_deg 45°): the back
+// legs are now a mirror pair, cut 2, each leg's long axis (the principal axis of its sewing line)
+// within 1° of its grain line like the front legs' (measured 0.9°), and pattern.json gives the
+// crotch seam the angle its chord has to the grain line in the cut piece (27.6°, > 15°).
+TEST(PatternCommand, CrotchCurveIsNotAFoldAndLegsKeepTheirGrain) {
+  const fs::path dir = fresh_dir("crotch-fold");
+  const fs::path sketch =
+      fs::path(SD_SOURCE_DIR) / "tests/cli/sketches/wide-leg-trousers-wider-hem.json";
+  const CommandResult result =
+      run_sketchdrape("pattern " + sketch.string() + " -o " + (dir / "pattern").string());
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const auto json = nlohmann::json::parse(read(dir / "pattern/pattern.json"));
+  std::map<std::string, nlohmann::json> pieces;
+  for (const auto& piece : json["pieces"]) pieces[piece["id"]] = piece;
+  for (const std::string id : {"leg_front", "leg_back"}) {
+    const auto& piece = pieces.at(id);
+    EXPECT_FALSE(piece["on_fold"].get<bool>()) << id;
+    EXPECT_EQ(piece["quantity"], 2) << id;  // a mirror pair
+    EXPECT_FALSE(piece["centre_line"]["held_straight"].get<bool>()) << id;
+    EXPECT_GT(piece["centre_line"]["off_grain_deg"].get<double>(), 15.0) << id;
+    // The leg's long axis: the principal axis of its sewing line.
+    double mx = 0, my = 0;
+    const auto& line = piece["sewing_line"];
+    for (const auto& q : line) {
+      mx += q[0].get<double>() / static_cast<double>(line.size());
+      my += q[1].get<double>() / static_cast<double>(line.size());
+    }
+    double sxx = 0, syy = 0, sxy = 0;
+    for (const auto& q : line) {
+      const double dx = q[0].get<double>() - mx, dy = q[1].get<double>() - my;
+      sxx += dx * dx;
+      syy += dy * dy;
+      sxy += dx * dy;
+    }
+    const double axis = 0.5 * std::atan2(2 * sxy, sxx - syy);
+    const auto& grain = piece["grain_line"];
+    const double gx = grain[1][0].get<double>() - grain[0][0].get<double>();
+    const double gy = grain[1][1].get<double>() - grain[0][1].get<double>();
+    const double cosine =
+        std::abs(std::cos(axis) * gx + std::sin(axis) * gy) / std::hypot(gx, gy);
+    EXPECT_LT(std::acos(std::min(1.0, cosine)) * 180.0 / std::numbers::pi, 1.5)
+        << id << ": the leg hangs along its grain line";
+  }
+  // The yokes' centre lines run down the grain: still cut on the fold.
+  for (const std::string id : {"yoke_front", "yoke_back"}) {
+    EXPECT_TRUE(pieces.at(id)["on_fold"].get<bool>()) << id;
+    EXPECT_LE(pieces.at(id)["centre_line"]["off_grain_deg"].get<double>(), 2.0) << id;
+  }
+}
+
 // A tube skirt (front and back halves of a 0.28 m cylinder, 0.4 m long, hung by its waist
 // around the mannequin's legs without touching them): the pattern pieces are exact rectangles, so
 // draped from flat cloth it must hang like the drape from its drawn shape. The two rests have the

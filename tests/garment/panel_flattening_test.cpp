@@ -644,9 +644,14 @@ TEST(PanelFlattening, BiasPanelCentreLineIsNotHeldForAFold) {
        {"skirt_front", "skirt_back", "skirt_front.mirror", "skirt_back.mirror"}) {
     const FlatPanel bias = find(pattern, id);
     EXPECT_TRUE(bias.centre_run.empty()) << id;
-    // The centre line's angle to the nearest thread: the panel's turn, 45° (the copy's −45°).
-    EXPECT_NEAR(bias.centre_off_grain_deg, 45.0, 1e-9) << id;
-    EXPECT_GT(bias.centre_off_grain_deg, FlatteningOptions{}.fold_off_grain_deg) << id;
+    // The centre line's angle to the nearest thread as the cut piece has it (trial 43, P2):
+    // its chord against the piece's grain line, 45° as drawn spread by the flare (the centre
+    // seams 37-55° off the grain line: 35-45° from the nearer thread).
+    EXPECT_GT(bias.centre_off_grain_deg, 30.0) << id;
+    EXPECT_LE(bias.centre_off_grain_deg, 45.0) << id;
+    // Its warp (before the turn) runs down it: off the thread by the turn alone.
+    EXPECT_GE(bias.centre_across_warp_deg, 0.0) << id;
+    EXPECT_LT(bias.centre_across_warp_deg, FlatteningOptions{}.fold_across_warp_deg) << id;
     // The same piece as the flat rest's free flattening, to the bit: pattern and run agree.
     const FlatPanel loose = find(free, id);
     ASSERT_EQ(bias.uv.rows(), loose.uv.rows()) << id;

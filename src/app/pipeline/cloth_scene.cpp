@@ -231,6 +231,7 @@ void flat_rest_shapes(const scene::Sketch& sketch, const garment::Garment& g,
   for (const garment::FlatPanel& piece : scene.flat_pattern->panels)
     if (flat[static_cast<size_t>(piece.panel)] && piece.centre_off_grain_deg >= 0 &&
         piece.centre_off_grain_deg <= garment::FlatteningOptions{}.fold_off_grain_deg &&
+        piece.centre_across_warp_deg <= garment::FlatteningOptions{}.fold_across_warp_deg &&
         !g.panels[static_cast<size_t>(piece.panel)].mirror_copy) {
       centred += (centred.empty() ? "'" : ", '") + piece.id + "'";
       ++centred_count;

@@ -130,6 +130,9 @@ std::vector<bool> fold_edges(const garment::Garment& garment, const garment::Fla
                              const garment::FlatPanel& flat, const std::vector<double>& own,
                              double opened_width_limit, double off_grain_deg) {
   if (flat.id.ends_with(".mirror")) return {};
+  // A centre line that the warp beside it crosses somewhere (a crotch curve) is no thread,
+  // however straight it lies in the piece (FlatteningOptions::fold_across_warp_deg).
+  if (flat.centre_across_warp_deg > garment::FlatteningOptions{}.fold_across_warp_deg) return {};
   const bool has_copy = std::any_of(pattern.panels.begin(), pattern.panels.end(),
                                     [&](const auto& p) { return p.id == flat.id + ".mirror"; });
   if (!has_copy) return {};
