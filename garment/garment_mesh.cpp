@@ -178,19 +178,73 @@ void check_single_edges_apart(const GarmentRequest& sketch, const BodySurface& b
 // the mirror plane x = 0 (its outline farther than the junction tolerance on both sides) would
 // lie over its copy. Fails at its "mirror" naming how far it reaches either side. Before, a front
 // drawn whole with "mirror": true was refused as two panels meeting "only at the point" (or, as
-// trial 40's P4 made the message, as its hem lying on its own mirror copy).
-void check_mirrored_halves(const GarmentRequest& sketch, const CurveNetwork& net,
-                           const std::vector<PanelLoop>& loops) {
+// trial 40's P4 made the message, as its hem lying on its own mirror copy). A panel whose
+// junctions all lie on one side (or on the plane) is a half with a curve straying across between
+// them: one written point typed on the wrong side (trial 42, P12: a side seam's middle point at
+// x = -0.165 for 0.165, and the panel was blamed as drawn whole). That fails at the curve's
+// written point nearest to where the outline reaches farthest across.
+void check_mirrored_halves(const GarmentRequest& sketch, const BodySurface& body,
+                           const CurveNetwork& net, const std::vector<PanelLoop>& loops) {
   const double tol = sketch.junction_tolerance;
   for (const PanelLoop& loop : loops) {
     if (loop.mirror_copy || !sketch.panels[static_cast<size_t>(loop.spec)].mirror) continue;
     double low = std::numeric_limits<double>::infinity(), high = -low;
+    double junction_low = low, junction_high = high;
     for (const LoopEdge& e : loop.edges) {
-      const Eigen::MatrixX3d& points = net.edges[static_cast<size_t>(e.edge)].points;
-      low = std::min(low, points.col(0).minCoeff());
-      high = std::max(high, points.col(0).maxCoeff());
+      const NetworkEdge& edge = net.edges[static_cast<size_t>(e.edge)];
+      low = std::min(low, edge.points.col(0).minCoeff());
+      high = std::max(high, edge.points.col(0).maxCoeff());
+      for (const int node : {edge.from, edge.to}) {
+        junction_low = std::min(junction_low, net.nodes[static_cast<size_t>(node)].x());
+        junction_high = std::max(junction_high, net.nodes[static_cast<size_t>(node)].x());
+      }
     }
     if (!(low < -tol && high > tol)) continue;
+    // The side of x = 0 the junctions are on (+1, -1), or 0 when on both or only on the plane.
+    const int side = junction_low >= -tol && junction_high > tol   ? 1
+                     : junction_high <= tol && junction_low < -tol ? -1
+                                                                   : 0;
+    if (side != 0) {
+      // The point of the outline farthest across, and its curve.
+      double farthest = 0;
+      Eigen::Vector3d where = Eigen::Vector3d::Zero();
+      const NetworkCurve* stray = nullptr;
+      for (const LoopEdge& e : loop.edges) {
+        const NetworkEdge& edge = net.edges[static_cast<size_t>(e.edge)];
+        for (Eigen::Index k = 0; k < edge.points.rows(); ++k)
+          if (-side * edge.points(k, 0) > farthest) {
+            farthest = -side * edge.points(k, 0);
+            where = edge.points.row(k).transpose();
+            stray = &net.curves[static_cast<size_t>(edge.curve)];
+          }
+      }
+      const CurveSpec& spec = sketch.curves[static_cast<size_t>(stray->spec)];
+      // A mirror copy's written points are its original's, reflected.
+      const Eigen::Vector3d written_where =
+          stray->mirror_copy ? Eigen::Vector3d(-where.x(), where.y(), where.z()) : where;
+      const std::optional<WrittenPoint> point = nearest_written_point(spec, written_where);
+      const std::string key = spec.is_3d() ? "/points3d" : "/points";
+      std::string landmark;
+      if (const BodyLandmarks* landmarks = body.landmarks())
+        landmark = fmt::format(", near the {}", landmarks->nearest(where).name);
+      const char* own = side > 0 ? "x > 0" : "x < 0";
+      sketch.fail(
+          spec.json_path + key + (point ? fmt::format("/{}", point->index) : std::string()),
+          fmt::format(
+              "curve '{}' of panel '{}' reaches {:.1f} cm across the mirror plane x = 0 at "
+              "({:.3f}, {:.3f}, {:.3f}) m{}, while the panel's junctions all lie on the {} side{}: "
+              "a sign typed wrong? Panel '{}' has \"mirror\": true, so it is one half of a "
+              "piece, on one side of x = 0, and its mirror copy would lie over it there: move "
+              "the point to the {} side",
+              stray->id, loop.id, 100 * farthest, where.x(), where.y(), where.z(), landmark, own,
+              point ? fmt::format("; the curve's written point nearest there is {}, {}{}",
+                                  point->index, point->text,
+                                  stray->mirror_copy
+                                      ? fmt::format(" (of '{}', whose copy it is)", spec.id)
+                                      : std::string())
+                    : std::string(),
+              loop.id, own));
+    }
     sketch.fail(loop.json_path + "/mirror",
                 fmt::format("panel '{}' has \"mirror\": true but reaches across the mirror plane "
                             "x = 0 (its outline runs from x = {:.3f} to {:.3f} m), so its mirror "
@@ -215,7 +269,7 @@ PanelNetwork resolve_network(const GarmentRequest& sketch, const BodySurface& bo
     net = build_network(sketch, projected, mirrored);
   }
   std::vector<PanelLoop> loops = resolve_panels(sketch, net, body);
-  check_mirrored_halves(sketch, net, loops);
+  check_mirrored_halves(sketch, body, net, loops);
   EdgeCounts counts = compute_edge_counts(sketch, net, loops);
   check_single_edges_apart(sketch, body, net, loops, counts);
   {
@@ -856,12 +910,18 @@ void check_fans(const GarmentRequest& sketch, const CurveNetwork& net, const Gar
 // network's junctions (where curves meet by design), add up to more than kOverlapRun for one pair
 // of curves, naming both curves, both panels and the place. Two curves side by side with their
 // panels on either side (a slit's two edges below its top) are an opening, not an overlap.
+// Which curve is drawn in the wrong place: the one whose panel lies on the other side of the body
+// from the overlap (its quads' area vectors summed, against the overlapping quads' normal), more
+// than kOverlapBlameMargin apart; else both are named. Trial 42 (P12): a front waist seam whose
+// middle point was typed at the back was told to move the back's waist seam, the later curve of
+// the file, and the error now points at the front's and its written point nearest the overlap.
+constexpr double kOverlapBlameMargin = 0.2;  // in cosines: the panels' facings must differ so much
 void check_overlapping_boundaries(const GarmentRequest& sketch, const BodySurface& body,
                                   const CurveNetwork& net, const VertexPool& pool,
                                   const std::vector<std::array<int, 4>>& faces,
                                   const std::vector<int>& face_panel, const Garment& garment) {
   struct CurveEdge {
-    Eigen::Vector3d middle, inward;
+    Eigen::Vector3d middle, inward, normal;  // normal: of the edge's quad, unit
     double length = 0;
     const std::string* curve = nullptr;
     int panel = -1;
@@ -889,54 +949,121 @@ void check_overlapping_boundaries(const GarmentRequest& sketch, const BodySurfac
       e.inward = c - e.middle;
       e.inward = (e.inward - e.inward.dot(along) * along).normalized();
       e.length = (q - p).norm();
+      const auto corner = [&](size_t i) -> const Eigen::Vector3d& {
+        return pool.positions[static_cast<size_t>(faces[f][i])];
+      };
+      e.normal = (corner(2) - corner(0)).cross(corner(3) - corner(1)).normalized();
       e.curve = &it->second;
       e.panel = face_panel[f];
       edges.push_back(e);
     }
-  // Per (curve, panel, curve, panel): the length of the first curve's edges over the second.
-  std::map<std::tuple<std::string, int, std::string, int>, std::pair<double, Eigen::Vector3d>>
-      overlaps;  // value: the length and the mean place
+  // Per (curve, panel, curve, panel): the length of the first curve's edges over the second,
+  // their mean place and their quads' normals summed (weighted by length).
+  struct Overlap {
+    double length = 0;
+    Eigen::Vector3d where = Eigen::Vector3d::Zero();
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  };
+  std::map<std::tuple<std::string, int, std::string, int>, Overlap> overlaps;
   for (const CurveEdge& a : edges)
     for (const CurveEdge& b : edges) {
       if (*a.curve == *b.curve || (a.middle - b.middle).norm() >= near ||
           a.inward.dot(b.inward) <= 0.5)
         continue;
-      auto& [length, where] = overlaps[{*a.curve, a.panel, *b.curve, b.panel}];
-      where = (length * where + a.length * a.middle) / (length + a.length);  // their mean
-      length += a.length;
+      Overlap& o = overlaps[{*a.curve, a.panel, *b.curve, b.panel}];
+      o.where = (o.length * o.where + a.length * a.middle) / (o.length + a.length);  // their mean
+      o.length += a.length;
+      o.normal += a.length * a.normal;
     }
-  const std::pair<const std::tuple<std::string, int, std::string, int>,
-                  std::pair<double, Eigen::Vector3d>>* worst = nullptr;
+  const std::pair<const std::tuple<std::string, int, std::string, int>, Overlap>* worst = nullptr;
   for (const auto& entry : overlaps) {
     spdlog::debug(
         "curves '{}' and '{}' run within {:.1f} mm of each other, their panels on one "
         "side, for {:.1f} cm",
-        std::get<0>(entry.first), std::get<2>(entry.first), 1e3 * near, 1e2 * entry.second.first);
-    if (!worst || entry.second.first > worst->second.first) worst = &entry;
+        std::get<0>(entry.first), std::get<2>(entry.first), 1e3 * near, 1e2 * entry.second.length);
+    if (!worst || entry.second.length > worst->second.length) worst = &entry;
   }
-  if (!worst || worst->second.first <= kOverlapRun) return;
+  if (!worst || worst->second.length <= kOverlapRun) return;
   const auto& [curve_a, panel_a, curve_b, panel_b] = worst->first;
   const auto base = [](const std::string& id) {
     return id.ends_with(".mirror") ? id.substr(0, id.size() - 7) : id;
   };
-  const CurveSpec* later = nullptr;
+  const Eigen::Vector3d& where = worst->second.where;
+  // How far each panel faces the way the overlap does: its quads' area vectors summed, over their
+  // areas (1 for a flat panel, near 0 for one wrapped round a limb), against the overlap's normal
+  // (both curves' quads, which point the same way there).
+  Eigen::Vector3d facing = worst->second.normal;
+  if (const auto it = overlaps.find({curve_b, panel_b, curve_a, panel_a}); it != overlaps.end())
+    facing += it->second.normal;
+  facing.normalize();
+  const auto faces_here = [&](int panel) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    double area = 0;
+    for (size_t f = 0; f < faces.size(); ++f) {
+      if (face_panel[f] != panel) continue;
+      const auto corner = [&](size_t i) -> const Eigen::Vector3d& {
+        return pool.positions[static_cast<size_t>(faces[f][i])];
+      };
+      const Eigen::Vector3d vector_area =
+          0.5 * (corner(2) - corner(0)).cross(corner(3) - corner(1));
+      sum += vector_area;
+      area += vector_area.norm();
+    }
+    return area > 0 ? sum.dot(facing) / area : 0.0;
+  };
+  const double facing_a = faces_here(panel_a), facing_b = faces_here(panel_b);
+  const std::string& panel_name_a = garment.panels[static_cast<size_t>(panel_a)].id;
+  const std::string& panel_name_b = garment.panels[static_cast<size_t>(panel_b)].id;
+  spdlog::debug("overlap of '{}' and '{}': their panels face its way by {:.2f} and {:.2f}", curve_a,
+                curve_b, facing_a, facing_b);
+  // The curve drawn away from its panel, when one panel faces the overlap's way much less.
+  const std::string* stray = nullptr;
+  if (std::abs(facing_a - facing_b) > kOverlapBlameMargin)
+    stray = facing_a < facing_b ? &curve_a : &curve_b;
+  const CurveSpec* spec = nullptr;  // the stray's, else the later of the two in the file
   for (const CurveSpec& c : sketch.curves)
-    if (c.id == base(curve_a) || c.id == base(curve_b)) later = &c;
-  const Eigen::Vector3d& where = worst->second.second;
+    if (stray ? c.id == base(*stray) : c.id == base(curve_a) || c.id == base(curve_b)) spec = &c;
   std::string landmark;
   if (const BodyLandmarks* landmarks = body.landmarks())
     landmark = fmt::format(", near the {}", landmarks->nearest(where).name);
-  sketch.fail(
-      later ? later->json_path + (later->is_3d() ? "/points3d" : "/points") : "/panels",
-      fmt::format("curves '{}' (panel '{}') and '{}' (panel '{}') run along each other for {:.1f} "
-                  "cm around ({:.3f}, {:.3f}, {:.3f}) m{}, with both panels on the same side of "
-                  "them: the panels lie over each other there, which the drape cannot separate. "
-                  "If '{}' belongs elsewhere (a back curve drawn on the front?), move its points "
-                  "there; if the two panels meet along this line, they must lie on either side of "
-                  "it: give both the same curve",
-                  curve_a, garment.panels[static_cast<size_t>(panel_a)].id, curve_b,
-                  garment.panels[static_cast<size_t>(panel_b)].id, 1e2 * worst->second.first,
-                  where.x(), where.y(), where.z(), landmark, later ? later->id : base(curve_b)));
+  std::string advice;
+  std::string path = "/panels";
+  if (stray != nullptr && spec != nullptr) {
+    const std::string& own_panel = stray == &curve_a ? panel_name_a : panel_name_b;
+    const std::string& other_panel = stray == &curve_a ? panel_name_b : panel_name_a;
+    // A mirror copy's written points are its original's, reflected.
+    const Eigen::Vector3d written_where =
+        *stray == spec->id ? where : Eigen::Vector3d(-where.x(), where.y(), where.z());
+    const std::optional<WrittenPoint> point = nearest_written_point(*spec, written_where);
+    path = spec->json_path + (spec->is_3d() ? "/points3d" : "/points") +
+           (point ? fmt::format("/{}", point->index) : std::string());
+    advice = fmt::format(
+        "Panel '{}' lies mostly on the other side of the body from here, panel '{}' on this "
+        "side, so '{}' is likely drawn in the wrong place{}: move its points there to where "
+        "panel '{}' is; if the two panels meet along this line, they must lie on either side of "
+        "it: give both the same curve",
+        own_panel, other_panel, *stray,
+        point ? fmt::format(
+                    " (its written point nearest here is {}, {}{})", point->index, point->text,
+                    *stray == spec->id ? std::string()
+                                       : fmt::format(" of '{}', whose copy it is", spec->id))
+              : std::string(),
+        own_panel);
+  } else {
+    if (spec != nullptr) path = spec->json_path + (spec->is_3d() ? "/points3d" : "/points");
+    advice = fmt::format(
+        "One of the two is likely drawn in the wrong place (a back curve drawn on the front?): "
+        "'{}' or '{}', move its points to where its panel is; if the two panels meet along this "
+        "line, they must lie on either side of it: give both the same curve",
+        curve_a, curve_b);
+  }
+  sketch.fail(path,
+              fmt::format("curves '{}' (panel '{}') and '{}' (panel '{}') run along each other for "
+                          "{:.1f} cm around ({:.3f}, {:.3f}, {:.3f}) m{}, with both panels on the "
+                          "same side of them: the panels lie over each other there, which the "
+                          "drape cannot separate. {}",
+                          curve_a, panel_name_a, curve_b, panel_name_b, 1e2 * worst->second.length,
+                          where.x(), where.y(), where.z(), landmark, advice));
 }
 
 // ... and the two panels of a seam run it in opposite directions; counts the seam edges.
@@ -1220,6 +1347,25 @@ Garment build_garment(const GarmentRequest& sketch, const BodySurface& body) {
       std::sort(named.begin(), named.end());
       for (const auto& [index, turning] : named)
         panel.turning_corners.emplace_back(spec.boundary[static_cast<size_t>(index)], turning);
+    } else if (!spec.corners.empty() && !loop.mirror_copy) {
+      // Named by the same rule (the curve listed later of the two that meet there).
+      const int count = static_cast<int>(spec.boundary.size());
+      const size_t m = loop.edges.size();
+      std::vector<std::pair<int, GarmentPanel::ListedCorner>> named;
+      for (const int k : loop.side_begin) {
+        const LoopEdge& e = loop.edges[static_cast<size_t>(k)];
+        const int a = loop.edges[(static_cast<size_t>(k) + m - 1) % m].boundary;
+        const int b = e.boundary;
+        if (a < 0 || b < 0 || a == b) continue;
+        const int index = (a + 1) % count == b ? b : a;
+        named.emplace_back(index, GarmentPanel::ListedCorner{
+                                      spec.boundary[static_cast<size_t>(index)],
+                                      net.nodes[static_cast<size_t>(loop_start_node(net, e))],
+                                      loop.turning_deg[static_cast<size_t>(k)]});
+      }
+      std::sort(named.begin(), named.end(),
+                [](const auto& x, const auto& y) { return x.first < y.first; });
+      for (auto& [index, corner] : named) panel.listed_corners.push_back(std::move(corner));
     }
     for (const LoopEdge& e : loop.edges) {
       panel.curves.push_back(

@@ -55,6 +55,15 @@ struct GarmentPanel {
   // the panel's boundary list, with the turning angle in degrees. The quality gate suggests
   // the list without the gentlest one.
   std::vector<std::pair<std::string, double>> turning_corners;
+  // The corners the panel lists in "corners" (empty when it lists none): the curve that begins at
+  // each, as "corners" names it, the junction's place (m) and its turning angle (degrees), in the
+  // order of the panel's boundary list. The quality gate says so when a sliver lies at one.
+  struct ListedCorner {
+    std::string curve;
+    Eigen::Vector3d at = Eigen::Vector3d::Zero();
+    double turning_deg = 0;
+  };
+  std::vector<ListedCorner> listed_corners;
   // The grain (GrainSpec, garment_request.hpp): "vertical" or "limb" as chosen, the unit
   // direction whose projection into each quad is the warp there (+Y, or the limb's axis pointing
   // towards the body), and the turn about the outward normal (degrees; a mirror copy's is the

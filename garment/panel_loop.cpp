@@ -15,6 +15,7 @@
 
 #include "garment/body_landmarks.hpp"
 #include "garment/network_faces.hpp"
+#include "garment/stroke_projection.hpp"
 
 namespace sd::garment {
 namespace {
@@ -274,15 +275,15 @@ std::vector<LoopEdge> resolve_explicit(const GarmentRequest& sketch, const Curve
 
 // Two different curves of one panel's outline that cross each other seen from outside the body
 // (a bow-tie: 'right' drawn from the top-right corner to the bottom-left and 'left' from the
-// bottom-right to the top-left): the view of the check of one curve crossing itself
-// (stroke_projection.cpp, find_crossing_seen_from_outside): segments whose outward directions (the
-// body's nearest normals) agree within 60°, crossing in the plane across their mean outward
-// direction. Pieces of one curve are left to that check. Two curves drawn on one surface cross
-// with no depth between them; the corpus's outlines that come near themselves seen from outside
-// pass 2-3.4 cm apart in depth (a hood's face opening in front of the front neckline, 3.0 cm;
-// a sleeve's armhole and underarm at the armpit, 2.1 cm), or cross 1.6 mm along the outline from
-// the junction where they meet, a little past each other (a dress's hip curve and centre back):
-// a bow-tie's strands cross half its outline from each other.
+// bottom-right to the top-left): the view of the check of one curve crossing itself, by the same
+// segment test (crossing_seen_from_outside, stroke_projection.hpp): segments whose outward
+// directions (the body's nearest normals) agree within 60°, crossing in the plane across their
+// mean outward direction. Pieces of one curve are left to that check. Two curves drawn on one
+// surface cross with no depth between them; the corpus's outlines that come near themselves seen
+// from outside pass 2-3.4 cm apart in depth (a hood's face opening in front of the front
+// neckline, 3.0 cm; a sleeve's armhole and underarm at the armpit, 2.1 cm), or cross 1.6 mm along
+// the outline from the junction where they meet, a little past each other (a dress's hip curve and
+// centre back): a bow-tie's strands cross half its outline from each other.
 constexpr double kOutlineCrossingDepth = 0.01;  // m
 
 struct OutlineCrossing {
@@ -316,9 +317,6 @@ std::optional<OutlineCrossing> find_outline_crossing(const CurveNetwork& net,
   std::vector<double> length(n);
   double perimeter = 0;
   for (size_t k = 0; k < n; ++k) perimeter += length[k] = (points[(k + 1) % n] - points[k]).norm();
-  const auto cross2 = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-    return a.x() * b.y() - a.y() * b.x();
-  };
   for (size_t i = 0; i < n; ++i)
     for (size_t j = i + 2; j < n; ++j) {
       if (curve[i] == curve[j] || (i == 0 && j + 1 == n)) continue;
@@ -326,20 +324,11 @@ std::optional<OutlineCrossing> find_outline_crossing(const CurveNetwork& net,
                             &d = points[(j + 1) % n];
       if ((0.5 * (a + b - c - d)).norm() > kOutlineCrossingDepth + 0.5 * (length[i] + length[j]))
         continue;
-      const Eigen::Vector3d na = outward[i] + outward[(i + 1) % n],
-                            nc = outward[j] + outward[(j + 1) % n];
-      if (na.norm() == 0 || nc.norm() == 0 || na.normalized().dot(nc.normalized()) < 0.5) continue;
-      const Eigen::Vector3d normal = (na.normalized() + nc.normalized()).normalized();
-      const Eigen::Vector3d u = normal.unitOrthogonal(), v = normal.cross(u);
-      const auto flat = [&](const Eigen::Vector3d& p) {
-        return Eigen::Vector2d(p.dot(u), p.dot(v));
-      };
-      const Eigen::Vector2d fa = flat(a), fb = flat(b), fc = flat(c), fd = flat(d);
-      const double denom = cross2(fb - fa, fd - fc);
-      if (denom == 0) continue;
-      // Strictly inside both segments: strands that only touch at a junction do not cross.
-      const double s = cross2(fc - fa, fd - fc) / denom, t = cross2(fc - fa, fb - fa) / denom;
-      if (!(s > 0 && s < 1 && t > 0 && t < 1)) continue;
+      // A proper crossing: strands that only touch at a junction do not cross.
+      const std::optional<Eigen::Vector2d> st = crossing_seen_from_outside(
+          a, b, c, d, outward[i] + outward[(i + 1) % n], outward[j] + outward[(j + 1) % n]);
+      if (!st) continue;
+      const double s = st->x(), t = st->y();
       const Eigen::Vector3d on_ab = a + s * (b - a), on_cd = c + t * (d - c);
       if ((on_ab - on_cd).norm() >= kOutlineCrossingDepth) continue;
       // The outline between the two strands, the shorter way round: a loop shorter than

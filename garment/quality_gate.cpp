@@ -58,6 +58,10 @@ std::string place(const Eigen::Vector3d& p, const std::string& landmark) {
 constexpr int kArmEnd = 3;
 constexpr int kArmLength = 6;
 
+// A sliver is at a listed corner when the corner is within this many edge lengths of the
+// sliver's quad centre (the quad at a corner has its centre about one edge in).
+constexpr double kListedCornerReach = 2.0;
+
 // The curves of each side of `panel` (its curves grouped by their edge counts on the outline), or
 // empty when they do not add up (a corner inside a curve).
 std::vector<std::vector<std::string>> side_curves(const Garment& garment,
@@ -268,6 +272,29 @@ std::vector<QualityWarning> check_quality(const Garment& garment, const GarmentR
           "filler may fit a plain grid, \"corners\": [{}])",
           gentlest->first, gentlest->second, fmt::join(rest, ", "));
     }
+    // A sliver at a corner the panel already lists (trial 42, P5: the bolero's back, its six
+    // curves all listed, was told to list the corner where 'shoulder' begins, which it did; what
+    // cleaned it was the list left out). Said so, with the list without that corner, which
+    // check_quality_tried tries (and, when that does not help, no list at all).
+    const GarmentPanel::ListedCorner* listed = nullptr;
+    if (angle.count > 0)
+      for (const GarmentPanel::ListedCorner& c : panel.listed_corners)
+        if ((c.at - angle.where).norm() <= kListedCornerReach * target &&
+            (listed == nullptr || (c.at - angle.where).norm() < (listed->at - angle.where).norm()))
+          listed = &c;
+    std::string listed_hint;
+    std::vector<std::string> listed_rest;
+    if (listed != nullptr && panel.listed_corners.size() > 3) {
+      std::vector<std::string> quoted;
+      for (const GarmentPanel::ListedCorner& c : panel.listed_corners)
+        if (&c != listed) {
+          listed_rest.push_back(c.curve);
+          quoted.push_back(fmt::format("\"{}\"", c.curve));
+        }
+      listed_hint =
+          fmt::format(" (without it the filler may fit the panel better: \"corners\": [{}])",
+                      fmt::join(quoted, ", "));
+    }
     const std::string arm = thin_arm_advice(garment, panel);
     const auto emit = [&](const Worst& w, const char* kind, const std::string& sentence) {
       if (w.count == 0) return;
@@ -283,6 +310,12 @@ std::vector<QualityWarning> check_quality(const Garment& garment, const GarmentR
         q.corners = corner_list;
         q.corners_hint = fewer_corners;
       }
+      if (!listed_hint.empty() && sentence.find(listed_hint) != std::string::npos) {
+        q.corners = listed_rest;
+        q.corners_hint = listed_hint;
+      }
+      if (listed != nullptr && std::string_view(kind) == "min_angle")
+        q.listed_corner = listed->curve;
       warnings.push_back(std::move(q));
     };
     emit(inverted, "inverted_quads",
@@ -291,10 +324,17 @@ std::vector<QualityWarning> check_quality(const Garment& garment, const GarmentR
                      "facing each other have similar edge counts{}{};",
                      inverted.count, inverted.value, fewer_corners, arm));
     emit(angle, "min_angle",
-         fmt::format("{} quad(s) have a corner below {:.0f}° (the smallest {:.1f}°); a boundary "
-                     "corner there is too sharp or not listed in \"corners\": give it as a corner "
-                     "or round the curves{};",
-                     angle.count, limits.min_angle_deg, angle.value, arm));
+         listed != nullptr
+             ? fmt::format("{} quad(s) have a corner below {:.0f}° (the smallest {:.1f}°) at the "
+                           "corner where '{}' begins (the outline turns {:.0f}° there), which "
+                           "\"corners\" already lists{}: round the curves there or move the "
+                           "junction{};",
+                           angle.count, limits.min_angle_deg, angle.value, listed->curve,
+                           listed->turning_deg, listed_hint, arm)
+             : fmt::format("{} quad(s) have a corner below {:.0f}° (the smallest {:.1f}°); a "
+                           "boundary corner there is too sharp or not listed in \"corners\": "
+                           "give it as a corner or round the curves{};",
+                           angle.count, limits.min_angle_deg, angle.value, arm));
     emit(aspect, "aspect_ratio",
          fmt::format("{} quad(s) are long and thin (the worst {:.1f} times longer than wide); "
                      "sides facing each other have very different edge counts there: give them "
@@ -529,24 +569,52 @@ std::vector<QualityWarning> check_quality_tried(const Garment& garment,
     }
     w.panel_edge_length = 0.0;
   };
+  // A panel whose listed corner has a sliver and whose list without it does not help: the garment
+  // without the panel's "corners" list (its corners where the outline turns most).
+  std::unordered_map<std::string, bool> unlisted_helps;
   for (QualityWarning& w : warnings) {
     if (w.kind == "quad_size" && w.worst > limits.size_high) offer_curve_edge_length(w);
-    if (w.corners.empty()) continue;
-    auto known = helps.find(w.panel);
-    if (known == helps.end()) {
+    if (w.corners.empty() && w.listed_corner.empty()) continue;
+    std::size_t at = std::string::npos;  // where an offer left out stood
+    if (!w.corners.empty()) {
+      auto known = helps.find(w.panel);
+      if (known == helps.end()) {
+        GarmentRequest trial = sketch;
+        bool found = false;
+        for (PanelSpec& spec : trial.panels)
+          if (spec.id == w.panel) spec.corners = w.corners, found = true;
+        // A list the loop cannot take (no valid panel) is not offered either.
+        const bool better = found && warnings_with(trial) < warnings.size();
+        known = helps.emplace(w.panel, better).first;
+      }
+      if (known->second) continue;
+      at = w.message.find(w.corners_hint);
+      if (at != std::string::npos) w.message.erase(at, w.corners_hint.size());
+      w.corners.clear();
+      w.corners_hint.clear();
+    }
+    if (w.listed_corner.empty()) continue;
+    auto unlisted = unlisted_helps.find(w.panel);
+    if (unlisted == unlisted_helps.end()) {
       GarmentRequest trial = sketch;
       bool found = false;
       for (PanelSpec& spec : trial.panels)
-        if (spec.id == w.panel) spec.corners = w.corners, found = true;
-      // A list the loop cannot take (no valid panel) is not offered either.
+        if (spec.id == w.panel && !spec.corners.empty()) spec.corners.clear(), found = true;
       const bool better = found && warnings_with(trial) < warnings.size();
-      known = helps.emplace(w.panel, better).first;
+      unlisted = unlisted_helps.emplace(w.panel, better).first;
     }
-    if (known->second) continue;
-    const std::size_t at = w.message.find(w.corners_hint);
-    if (at != std::string::npos) w.message.erase(at, w.corners_hint.size());
-    w.corners.clear();
-    w.corners_hint.clear();
+    if (!unlisted->second) continue;
+    if (at == std::string::npos) {
+      const std::string listed = "\"corners\" already lists";
+      at = w.message.find(listed);
+      if (at == std::string::npos) continue;
+      at += listed.size();
+    }
+    w.corners_hint =
+        " (without the panel's \"corners\" list, its corners then where its outline turns most, "
+        "the garment has fewer warnings: remove \"corners\")";
+    w.message.insert(at, w.corners_hint);
+    w.corners_unlisted = true;
   }
   // Panels crossing in a narrow crease: its width, and a smaller offset when one helps.
   if (!surface) surface.emplace(body);

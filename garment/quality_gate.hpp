@@ -52,6 +52,12 @@ struct QualityWarning {
   // gentlest) and the words that offer it, as they appear in `message`; empty when none.
   std::vector<std::string> corners;
   std::string corners_hint;
+  // A min_angle warning's sliver at a corner the panel lists in "corners": the curve that begins
+  // there (its message says the corner is listed); else empty.
+  std::string listed_corner;
+  // check_quality_tried's other offer for such a panel: the garment has fewer warnings without
+  // its "corners" list (the corners then where its outline turns most); `corners` is then empty.
+  bool corners_unlisted = false;
   // A curve the message offers its own edge_length for (m; check_quality_tried), else empty.
   std::string curve;
   double curve_edge_length = 0.0;

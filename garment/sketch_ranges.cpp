@@ -34,18 +34,9 @@ std::string outside_sentence(const Eigen::Vector3d& p, const Reach& reach,
       axis = k;
       break;
     }
-  // A body far shorter or taller than a person (trial 40: "height": 0.1) is the likelier slip
-  // than the point: asked first.
-  const std::string tall =
-      reach.height < 1.0 || reach.height > 2.5
-          ? fmt::format(
-                "{:.2f} m tall: is that meant? A body's \"height\" is in metres, a "
-                "grown figure's 1.5-1.9",
-                reach.height)
-          : fmt::format("{:.2f} m tall", reach.height);
   return fmt::format(
-      "{} is too far from the body ({}): points must lie within {:.2f} m of it, and {}", what, tall,
-      kBodyMarginHeights * reach.height,
+      "{} is too far from the body ({}): points must lie within {:.2f} m of it, and {}", what,
+      body_height_clause(reach.height), kBodyMarginHeights * reach.height,
       out_of_range_sentence(p[axis], reach.low[axis], reach.high[axis],
                             fmt::format("{} =", kAxis[axis]),
                             {reach.low[axis] + kBodyMarginHeights * reach.height,
@@ -62,6 +53,16 @@ double polygon_length(const std::vector<Eigen::Matrix<double, D, 1>>& points, bo
 }
 
 }  // namespace
+
+std::string body_height_clause(double height) {
+  // A body far shorter or taller than a person (trial 40: "height": 0.1) is the likelier slip
+  // than the point: asked first.
+  if (height < kShortestPerson || height > kTallestPerson)
+    return fmt::format(
+        "{:.2f} m tall: is that meant? A body's \"height\" is in metres, a grown figure's 1.5-1.9",
+        height);
+  return fmt::format("{:.2f} m tall", height);
+}
 
 std::string out_of_range_sentence(double value, double low, double high, const std::string& what,
                                   UsualRange usual) {

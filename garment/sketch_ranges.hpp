@@ -19,10 +19,11 @@ namespace sd::garment {
 // Fixed limits (parse time).
 inline constexpr double kMaxCoordinate = 100.0;  // m: any point, camera or sheet centre
 inline constexpr size_t kMaxIdLength = 64;  // characters of a panel's, a curve's or a group's id
-inline constexpr double kMaxSheetSide = 100.0;        // m: a sheet's width or height
-inline constexpr double kMinBodyHeight = 0.1;         // m: body.height, and a body after scaling
-inline constexpr double kMaxBodyHeight = 5.0;         // m
-inline constexpr double kTallestPerson = 2.5;         // m: a body taller than this is warned of
+inline constexpr double kMaxSheetSide = 100.0;  // m: a sheet's width or height
+inline constexpr double kMinBodyHeight = 0.1;   // m: body.height, and a body after scaling
+inline constexpr double kMaxBodyHeight = 5.0;   // m
+inline constexpr double kTallestPerson = 2.5;   // m: a body taller than this is warned of
+inline constexpr double kShortestPerson = 1.0;  // m: errors ask whether a body this short is meant
 inline constexpr double kMaxJunctionTolerance = 0.2;  // m
 inline constexpr int kMaxCurves = 1000;
 inline constexpr int kMaxPanels = 1000;
@@ -97,6 +98,12 @@ inline constexpr double kMinEdgeLength = 0.002;
 // allowance of 10 is 10 mm, not 10 cm; a hem at 520 is 520 mm, not 5.2 m), both when both fit.
 std::string out_of_range_sentence(double value, double low, double high, const std::string& what,
                                   UsualRange usual = {});
+
+// "1.75 m tall" for a body `height` metres tall; outside kShortestPerson .. kTallestPerson
+// "0.65 m tall: is that meant? A body's "height" is in metres, …": in an error about a point
+// out of reach or a curve that misses the body, the body's size is the likelier slip (trial 40:
+// "height": 0.1; trial 42, P10: an inch file read as centimetres).
+std::string body_height_clause(double height);
 
 // Every point, seed and camera of the sketch against the body's bounding box (metres, after
 // normalisation): within kBodyMarginHeights body heights of it; every curve's control polygon

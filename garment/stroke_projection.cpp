@@ -12,6 +12,7 @@
 
 #include "garment/body.hpp"
 #include "garment/body_landmarks.hpp"
+#include "garment/sketch_ranges.hpp"
 
 namespace sd::garment {
 namespace {
@@ -241,6 +242,49 @@ std::pair<int, int> find_self_intersection(const Eigen::MatrixX3d& polyline, boo
   return {-1, -1};
 }
 
+std::optional<WrittenPoint> nearest_written_point(const CurveSpec& curve,
+                                                  const Eigen::Vector3d& where) {
+  if (curve.is_3d()) {
+    size_t best = 0;
+    for (size_t k = 1; k < curve.points3d.size(); ++k)
+      if ((curve.points3d[k] - where).norm() < (curve.points3d[best] - where).norm()) best = k;
+    const Eigen::Vector3d& p = curve.points3d[best];
+    return WrittenPoint{static_cast<int>(best),
+                        fmt::format("({:.3f}, {:.3f}, {:.3f})", p.x(), p.y(), p.z())};
+  }
+  if (curve.view.kind == ViewKind::kCamera || curve.points.empty()) return std::nullopt;
+  const ViewFrame frame = view_frame(curve.view);
+  const Eigen::Vector2d uv((where - frame.plane_origin).dot(frame.right),
+                           (where - frame.plane_origin).dot(frame.up));
+  size_t best = 0;
+  for (size_t k = 1; k < curve.points.size(); ++k)
+    if ((curve.points[k] - uv).norm() < (curve.points[best] - uv).norm()) best = k;
+  const Eigen::Vector2d& p = curve.points[best];
+  return WrittenPoint{static_cast<int>(best), fmt::format("({:.3f}, {:.3f}) in the {} view", p.x(),
+                                                          p.y(), curve.view.name())};
+}
+
+std::optional<Eigen::Vector2d> crossing_seen_from_outside(const Eigen::Vector3d& a,
+                                                          const Eigen::Vector3d& b,
+                                                          const Eigen::Vector3d& c,
+                                                          const Eigen::Vector3d& d,
+                                                          const Eigen::Vector3d& outward_ab,
+                                                          const Eigen::Vector3d& outward_cd) {
+  if (outward_ab.norm() == 0 || outward_cd.norm() == 0 ||
+      outward_ab.normalized().dot(outward_cd.normalized()) < 0.5)
+    return std::nullopt;
+  // Coordinates in the plane across the mean outward direction.
+  const Eigen::Vector3d normal = (outward_ab.normalized() + outward_cd.normalized()).normalized();
+  const Eigen::Vector3d u = normal.unitOrthogonal(), v = normal.cross(u);
+  const auto flat = [&](const Eigen::Vector3d& p) { return Eigen::Vector2d(p.dot(u), p.dot(v)); };
+  const Eigen::Vector2d fa = flat(a), fb = flat(b), fc = flat(c), fd = flat(d);
+  if (!segments_cross(fa, fb, fc, fd)) return std::nullopt;
+  const double denom = cross2(fb - fa, fd - fc);
+  if (denom == 0) return std::nullopt;  // parallel to rounding, though their ends straddle
+  return Eigen::Vector2d(std::clamp(cross2(fc - fa, fd - fc) / denom, 0.0, 1.0),
+                         std::clamp(cross2(fc - fa, fb - fa) / denom, 0.0, 1.0));
+}
+
 std::pair<int, int> find_crossing_seen_from_outside(const Eigen::MatrixX3d& polyline, bool closed,
                                                     const std::vector<Eigen::Vector3d>& outward,
                                                     double reach) {
@@ -251,19 +295,12 @@ std::pair<int, int> find_crossing_seen_from_outside(const Eigen::MatrixX3d& poly
     for (int j = i + 3; j < segments; ++j) {
       if (closed && (i + segments - j) < 3) continue;
       const Eigen::Vector3d a = point(i), b = point(i + 1), c = point(j), d = point(j + 1);
-      const Eigen::Vector3d na = outward[static_cast<size_t>(i)] +
-                                 outward[static_cast<size_t>((i + 1) % n)],
-                            nc = outward[static_cast<size_t>(j)] +
-                                 outward[static_cast<size_t>((j + 1) % n)];
-      if (na.norm() == 0 || nc.norm() == 0 || na.normalized().dot(nc.normalized()) < 0.5) continue;
       if (segment_distance(a, b, c, d) >= reach) continue;
-      // Coordinates in the plane across the mean outward direction.
-      const Eigen::Vector3d normal = (na.normalized() + nc.normalized()).normalized();
-      const Eigen::Vector3d u = normal.unitOrthogonal(), v = normal.cross(u);
-      const auto flat = [&](const Eigen::Vector3d& p) {
-        return Eigen::Vector2d(p.dot(u), p.dot(v));
-      };
-      if (segments_cross(flat(a), flat(b), flat(c), flat(d))) return {i, j};
+      if (crossing_seen_from_outside(
+              a, b, c, d,
+              outward[static_cast<size_t>(i)] + outward[static_cast<size_t>((i + 1) % n)],
+              outward[static_cast<size_t>(j)] + outward[static_cast<size_t>((j + 1) % n)]))
+        return {i, j};
     }
   return {-1, -1};
 }
@@ -301,24 +338,8 @@ void check_crossing_seen_from_outside(const GarmentRequest& sketch, const CurveS
     landmark = fmt::format(", near the {}", landmarks->nearest(where).name);
   // The written point nearest to the crossing, where the designer looks first.
   std::string written;
-  if (curve.is_3d()) {
-    size_t best = 0;
-    for (size_t k = 1; k < curve.points3d.size(); ++k)
-      if ((curve.points3d[k] - where).norm() < (curve.points3d[best] - where).norm()) best = k;
-    const Eigen::Vector3d& p = curve.points3d[best];
-    written = fmt::format(" (the nearest written point is {}, ({:.3f}, {:.3f}, {:.3f}))", best,
-                          p.x(), p.y(), p.z());
-  } else if (curve.view.kind != ViewKind::kCamera) {
-    const ViewFrame frame = view_frame(curve.view);
-    const Eigen::Vector2d uv((where - frame.plane_origin).dot(frame.right),
-                             (where - frame.plane_origin).dot(frame.up));
-    size_t best = 0;
-    for (size_t k = 1; k < curve.points.size(); ++k)
-      if ((curve.points[k] - uv).norm() < (curve.points[best] - uv).norm()) best = k;
-    const Eigen::Vector2d& p = curve.points[best];
-    written = fmt::format(" (the nearest written point is {}, ({:.3f}, {:.3f}) in the {} view)",
-                          best, p.x(), p.y(), curve.view.name());
-  }
+  if (const std::optional<WrittenPoint> p = nearest_written_point(curve, where))
+    written = fmt::format(" (the nearest written point is {}, {})", p->index, p->text);
   sketch.fail(
       points_path,
       fmt::format("curve '{}' crosses itself seen from outside the body at ({:.3f}, {:.3f}, "
@@ -399,12 +420,17 @@ ProjectedCurve project_curve(const GarmentRequest& sketch, const CurveSpec& curv
         ++hits;
       }
     }
-    if (hits == 0)
+    if (hits == 0) {
+      // The body's size first when it is far from a person's (as for a point out of reach).
+      const double height = body->box().extent().y();
+      const bool odd = height < kShortestPerson || height > kTallestPerson;
       sketch.fail(points_path,
                   fmt::format("curve '{}' misses the body entirely in the {} view: none of its "
-                              "rays meets the mannequin (check the coordinates: metres, y up "
+                              "rays meets the mannequin ({}check the coordinates: metres, y up "
                               "from the feet), or set \"on_body\": false",
-                              curve.id, curve.view.name()));
+                              curve.id, curve.view.name(),
+                              odd ? body_height_clause(height) + "; " : std::string()));
+    }
     // Misses take their depth from the nearest hits on either side (linear in sample index,
     // which is proportional to 2D arc length), or from the one hit side at the ends.
     out.misses = static_cast<int>(n) - hits;

@@ -5,6 +5,7 @@
 // offset surface when on_body is true.
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -89,6 +90,27 @@ std::pair<int, int> find_self_intersection(const std::vector<Eigen::Vector2d>& p
                                            bool closed);
 std::pair<int, int> find_self_intersection(const Eigen::MatrixX3d& polyline, bool closed,
                                            double tolerance);
+
+// The written point of `curve` nearest to `where` (m, world; a point of its projected polyline):
+// its index in "points3d" or "points" and its coordinates as written ("(0.165, 1.170, -0.010)",
+// or "(0.100, 1.300) in the front view"), for an error to point the designer at. A view point is
+// compared in its view's plane; none for a perspective camera's.
+struct WrittenPoint {
+  int index = 0;
+  std::string text;
+};
+std::optional<WrittenPoint> nearest_written_point(const CurveSpec& curve,
+                                                  const Eigen::Vector3d& where);
+
+// Where segments (a, b) and (c, d) cross seen from outside the body: `outward_ab` and
+// `outward_cd` (each the sum of the body's nearest normals at the segment's ends; zero means no
+// direction) agree within 60°, and the two segments cross properly (neither touching the other's
+// line at an end) in the plane across their mean outward direction. The crossing's parameters
+// (s along a→b, t along c→d, both in [0, 1]), or nullopt. Shared by a curve crossing itself
+// (find_crossing_seen_from_outside) and a panel's outline crossing itself (panel_loop.cpp).
+std::optional<Eigen::Vector2d> crossing_seen_from_outside(
+    const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+    const Eigen::Vector3d& d, const Eigen::Vector3d& outward_ab, const Eigen::Vector3d& outward_cd);
 
 // Index pair (i, j) of the first two non-adjacent segments of a 3D polyline (#P by 3) that cross
 // seen from outside the body: segments less than `reach` metres apart whose outward directions

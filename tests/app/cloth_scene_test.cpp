@@ -156,6 +156,19 @@ TEST(ClothScene, FlatRestSaysItsPiecesAreNotPatternsFoldedOnes) {
   EXPECT_NE(flat.flat_rest_differs.find("2 pieces ('front', 'back') are cut here as mirror pairs"),
             std::string::npos)
       << flat.flat_rest_differs;
+  // The pattern files only when the file asks for them (trial 42, P6: "the pattern this run
+  // writes" in a run that wrote none).
+  EXPECT_NE(flat.flat_rest_differs.find("so the pieces draped here differ from `pattern`'s"),
+            std::string::npos)
+      << flat.flat_rest_differs;
+  EXPECT_EQ(flat.flat_rest_differs.find("pattern files"), std::string::npos);
+  tshirt["output"]["pattern"] = true;
+  const ClothScene written = build_cloth_scene(scene::parse_sketch(tshirt.dump(), file.string()));
+  EXPECT_NE(written.flat_rest_differs.find("so the pieces draped here (and those of the pattern "
+                                           "files written for \"output\": {\"pattern\"}) differ "
+                                           "from `pattern`'s"),
+            std::string::npos)
+      << written.flat_rest_differs;
   std::string patches = two_patches(1.0);
   patches.insert(patches.rfind('}'), R"(, "simulate": { "rest": "flat" })");
   EXPECT_EQ(build_cloth_scene(scene::parse_sketch(patches, "p.json")).flat_rest_differs, "");

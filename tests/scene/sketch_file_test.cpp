@@ -208,6 +208,47 @@ TEST(SketchFile, EaseObjectGivesWarpAndWeft) {
   EXPECT_THROW(ease(R"([1, 1.5])"), garment::SketchError);
 }
 
+// An ease typed as a percentage (trial 42, P3): every reading that gives a factor in range is
+// offered, "x % looser" (the sentence's own 1.05 = 5 % looser) up to 100 and "x % of the size"
+// from 50 to 200, so that 50 is told 1.5 as well as 0.5 and 5 or 8 are told 1.05 or 1.08.
+TEST(SketchFile, EaseTypedAsPercentageIsToldEachReading) {
+  const auto error = [](const std::string& value) -> std::string {
+    try {
+      (void)parse_sketch(R"({"format": "sketchdrape/1",
+        "curves": [{ "id": "c", "view": "front", "points": [[0, 1], [0.1, 1], [0.1, 1.1]] }],
+        "panels": [{ "id": "p", "boundary": ["c"], "ease": )" +
+                             value + R"( }]})",
+                         "test.json");
+    } catch (const garment::SketchError& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  const std::string looser = "% looser, write";
+  const std::string of_size = "% of the size as designed, write";
+  const std::string five = error("5");
+  EXPECT_NE(five.find("; if you meant 5 % looser, write 1.05"), std::string::npos) << five;
+  EXPECT_EQ(five.find(of_size), std::string::npos) << five;
+  const std::string eight = error(R"({"weft": 8})");
+  EXPECT_NE(eight.find("ease 8 along the weft is outside"), std::string::npos) << eight;
+  EXPECT_NE(eight.find("; if you meant 8 % looser, write 1.08"), std::string::npos) << eight;
+  const std::string fifty = error("50");
+  EXPECT_NE(fifty.find("; if you meant 50 % looser, write 1.5; if you meant 50 % of the size as "
+                       "designed, write 0.5"),
+            std::string::npos)
+      << fifty;
+  const std::string hundred_eight = error("108");
+  EXPECT_NE(hundred_eight.find("; if you meant 108 % of the size as designed, write 1.08"),
+            std::string::npos)
+      << hundred_eight;
+  EXPECT_EQ(hundred_eight.find(looser), std::string::npos) << hundred_eight;
+  // No reading fits: 2.5 % looser is 1.025, but 250 is neither.
+  EXPECT_NE(error("2.5").find("; if you meant 2.5 % looser, write 1.025"), std::string::npos);
+  const std::string far = error("250");
+  EXPECT_EQ(far.find("if you meant"), std::string::npos) << far;
+  EXPECT_EQ(error("0.3").find("if you meant"), std::string::npos);
+}
+
 TEST(SketchFile, SolverAndStepMayBeAutomatic) {
   const Sketch s = parse_sketch(R"({"format": "sketchdrape/1",
       "sheet": {"size": [1, 1], "resolution": [4, 4]},

@@ -237,15 +237,20 @@ void flat_rest_shapes(const scene::Sketch& sketch, const garment::Garment& g,
       ++centred_count;
     }
   if (centred_count > 0) {
+    // The pattern files only when the file asks for them (trial 42, P6: the sentence spoke of
+    // "the pattern this run writes" in a run that wrote none).
     scene.flat_rest_differs = fmt::format(
         "{}: the flat rest drapes the pattern pieces flattened freely, with their centre lines "
         "as they fall: {} {} ({}) {} cut here as {} sewn along a curved centre seam, where "
         "`sketchdrape pattern` holds {} centre line straight and cuts {} on the fold, so the "
-        "pieces draped here (and the pattern this run writes) differ from `pattern`'s in shape "
-        "and size (docs/pattern.md, \"Not done: the flat rest\")",
+        "pieces draped here{} differ from `pattern`'s in shape and size (docs/pattern.md, \"Not "
+        "done: the flat rest\")",
         sketch.file, centred_count, centred_count == 1 ? "piece" : "pieces", centred,
         centred_count == 1 ? "is" : "are", centred_count == 1 ? "a mirror pair" : "mirror pairs",
-        centred_count == 1 ? "its" : "their", centred_count == 1 ? "it" : "them");
+        centred_count == 1 ? "its" : "their", centred_count == 1 ? "it" : "them",
+        sketch.output.pattern
+            ? " (and those of the pattern files written for \"output\": {\"pattern\"})"
+            : "");
     spdlog::warn("{}", scene.flat_rest_differs);
   }
   scene.bend_rest_flat = all;
