@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 
 #include "sim/forces.hpp"
 #include "sim/simulation.hpp"
@@ -85,6 +86,153 @@ TEST(SelfContactResponse, FailSafeLandsAPairThatStartedCloseWhereItStarted) {
     EXPECT_NEAR(x1[3 * i + 1], gap, 1e-9) << "vertex " << i;  // where it started, not 0.2 mm
     EXPECT_NEAR(v1[3 * i + 1], 0.0, 1e-7) << "vertex " << i;  // and at rest along the normal
   }
+}
+
+// Two layers 1 mm apart (within the 2 mm thickness): a pinned 10 cm square at y = 0 and a 6 cm
+// square over its middle, turned 30° so that no edges are parallel. Each is one quad. `order`
+// (empty: 0 to 7) renumbers the vertices: row i is the vertex order[i] of the unnumbered layers
+// (a mesh change that kept every vertex; the order is its ClothModelReuse::previous_vertex).
+struct TwoLayers {
+  ClothModel model;
+  Eigen::VectorXd x;
+  std::vector<unsigned char> pinned;
+};
+
+TwoLayers two_layers(double gap, std::vector<int> order = {}) {
+  if (order.empty()) order = {0, 1, 2, 3, 4, 5, 6, 7};
+  Eigen::MatrixX3d rest(8, 3);
+  const double angle = std::numbers::pi / 6.0;
+  for (int k = 0; k < 4; ++k) {
+    const double u = (k == 1 || k == 2) ? 1.0 : -1.0, w = k >= 2 ? 1.0 : -1.0;
+    rest.row(k) << 0.05 * u, 0.0, 0.05 * w;
+    rest.row(4 + k) << 0.03 * (u * std::cos(angle) - w * std::sin(angle)), gap,
+        0.03 * (u * std::sin(angle) + w * std::cos(angle));
+  }
+  std::vector<int> row_of(8);
+  for (int i = 0; i < 8; ++i) row_of[static_cast<std::size_t>(order[i])] = i;
+  ClothInput input;
+  input.rest_positions.resize(8, 3);
+  for (int i = 0; i < 8; ++i) input.rest_positions.row(i) = rest.row(order[i]);
+  const int triangles[4][3] = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}};
+  input.triangles.resize(4, 3);
+  for (int t = 0; t < 4; ++t)
+    for (int k = 0; k < 3; ++k) input.triangles(t, k) = row_of[triangles[t][k]];
+  TwoLayers layers{build_cloth_model(input, fabric_preset("cotton")), {}, {}};
+  layers.x.resize(24);
+  layers.pinned.resize(8);
+  for (int i = 0; i < 8; ++i) {
+    layers.x.segment<3>(3 * i) = input.rest_positions.row(i);
+    layers.pinned[static_cast<std::size_t>(i)] = order[i] < 4 ? 1 : 0;
+  }
+  return layers;
+}
+
+// The springs add_springs gives the two layers when the upper one leaves at `pushes` times its
+// push's speed (a tenth of the way to the thickness per step, at β = 1/60 s).
+std::vector<PairSpring> springs_leaving_at(SelfContactResponse& response, const TwoLayers& layers,
+                                           double gap, double pushes) {
+  const double beta = 1.0 / 60.0, thickness = response.settings().thickness;
+  Eigen::VectorXd v = Eigen::VectorXd::Zero(24);
+  for (int i = 0; i < 8; ++i)
+    if (layers.pinned[static_cast<std::size_t>(i)] == 0)
+      v[3 * i + 1] = pushes * 0.1 * (thickness - gap) / beta;
+  StepForces extra;
+  response.add_springs(layers.x, layers.model.mass, layers.pinned, extra, &v, beta);
+  std::vector<PairSpring> springs;
+  for (const PairSpring& spring : extra.pair_springs) {
+    if (!(spring.stiffness > 0.0)) continue;
+    // Every spring starts its step pushing the pair apart (or not at all), never pulling it back.
+    EXPECT_GE(spring.stiffness * (spring.target - along_pair_normal(spring, layers.x)) -
+                  spring.damping * along_pair_normal(spring, v),
+              0.0);
+    springs.push_back(spring);
+  }
+  return springs;
+}
+
+// A separating pair's spring by its age (sim/self_contact.cpp, kOldPairSteps): a pair new to
+// contact leaving faster than 0.2 pushes gets none (it may be bouncing off a pile it just hit:
+// a spring there stretched the crumpled strip at its crush); after three accepted steps in
+// contact the same pair gets a share fading with its speed, full below 0.2 pushes and none from
+// ω β / 2 = 3.3 pushes (a pair at rest in a pile whose springs flipped on and off every step).
+// The three steps here carry no spring and no force (the layer leaves at 10 pushes), so the
+// pairs drop out of the friction's bookkeeping and must still age; a retried attempt does not
+// age them and a new mesh starts them again.
+TEST(SelfContactResponse, LeavingPairKeepsAFadingSpringOnlyAfterThreeStepsInContact) {
+  const double gap = 0.001;
+  const TwoLayers layers = two_layers(gap);
+  SelfContactSettings settings;
+  settings.enabled = true;
+  settings.culling = false;
+  settings.friction = 0.0;
+  SelfContactResponse response(settings);
+  response.set_cloth(layers.model, layers.x);
+  const std::vector<PairSpring> full = springs_leaving_at(response, layers, gap, 0.1);
+  ASSERT_GE(full.size(), 4u);  // the four upper corners over the lower square, and edge pairs
+  for (int step = 0; step < 3; ++step) {
+    EXPECT_TRUE(springs_leaving_at(response, layers, gap, 1.0).empty()) << "step " << step;
+    // a retried attempt: no age
+    EXPECT_TRUE(springs_leaving_at(response, layers, gap, 10.0).empty());
+    response.accept_step();
+  }
+  // Three steps old: at 0.1 pushes the full spring as a new pair's, at 1 push a part of it.
+  const std::vector<PairSpring> old_slow = springs_leaving_at(response, layers, gap, 0.1);
+  ASSERT_EQ(old_slow.size(), full.size());
+  for (std::size_t p = 0; p < full.size(); ++p)
+    EXPECT_DOUBLE_EQ(old_slow[p].stiffness, full[p].stiffness);
+  const std::vector<PairSpring> fading = springs_leaving_at(response, layers, gap, 1.0);
+  ASSERT_EQ(fading.size(), full.size());
+  for (std::size_t p = 0; p < full.size(); ++p) {
+    EXPECT_GT(fading[p].stiffness, 0.0);
+    EXPECT_LT(fading[p].stiffness, full[p].stiffness);
+  }
+  EXPECT_TRUE(springs_leaving_at(response, layers, gap, 4.0).empty());  // past ω β / 2
+  // A new mesh: every pair is new to contact again.
+  response.set_cloth(layers.model, layers.x);
+  EXPECT_TRUE(springs_leaving_at(response, layers, gap, 1.0).empty());
+}
+
+// An adaptive mesh change renumbers the vertices (Simulation::replace_model with the vertices'
+// origins): a pair on vertices the change kept is the same pair and keeps its age, one on a
+// vertex the change made is new. Here the same two layers come back with their vertices in the
+// reverse order (every key differs, edge-edge pairs' edges swap ends): after three steps in
+// contact the layer leaving at 1 push keeps the old pairs' fading spring on the renumbered mesh;
+// with the upper layer's vertices made by the change, it gets none, as a new pair.
+TEST(SelfContactResponse, PairsOnKeptVerticesKeepTheirAgeThroughAMeshChange) {
+  const double gap = 0.001;
+  const TwoLayers layers = two_layers(gap);
+  SelfContactSettings settings;
+  settings.enabled = true;
+  settings.culling = false;
+  settings.friction = 0.0;
+  const auto aged = [&] {
+    SelfContactResponse response(settings);
+    response.set_cloth(layers.model, layers.x);
+    for (int step = 0; step < 3; ++step) {
+      EXPECT_TRUE(springs_leaving_at(response, layers, gap, 1.0).empty());
+      response.accept_step();
+    }
+    return response;
+  };
+  const std::vector<int> reversed = {7, 6, 5, 4, 3, 2, 1, 0};
+  const TwoLayers renumbered = two_layers(gap, reversed);
+  SelfContactResponse kept = aged();
+  const std::vector<PairSpring> before = springs_leaving_at(kept, layers, gap, 1.0);
+  ASSERT_GE(before.size(), 4u);
+  kept.set_cloth(renumbered.model, renumbered.x, reversed);
+  const std::vector<PairSpring> after = springs_leaving_at(kept, renumbered, gap, 1.0);
+  ASSERT_EQ(after.size(), before.size());
+  double stiffness_before = 0.0, stiffness_after = 0.0;
+  for (const PairSpring& spring : before) stiffness_before += spring.stiffness;
+  for (const PairSpring& spring : after) {
+    EXPECT_GT(spring.stiffness, 0.0);
+    stiffness_after += spring.stiffness;
+  }
+  EXPECT_NEAR(stiffness_after, stiffness_before, 1e-9 * stiffness_before);
+  // The upper layer's vertices (rows 0-3 of the renumbered mesh) made by the change.
+  SelfContactResponse made = aged();
+  made.set_cloth(renumbered.model, renumbered.x, {-1, -1, -1, -1, 3, 2, 1, 0});
+  EXPECT_TRUE(springs_leaving_at(made, renumbered, gap, 1.0).empty());
 }
 
 TEST(SelfContactResponse, UntangleSeparatesAStartThatPassesThroughItself) {
