@@ -733,16 +733,20 @@ std::optional<std::pair<std::string, std::string>> coinciding_curves(const Garme
                               : sketch.curves[static_cast<size_t>(original.spec)].json_path,
             fmt::format(
                 "curve '{}' and its own mirror copy '{}' lie within {:.0f} mm of each other: the "
-                "curve is meant to lie on the mirror plane x = 0 (a centre seam of {}), but it "
-                "runs up to {:.1f} mm off it, at ({:.3f}, {:.3f}, {:.3f}) m, so the two panels "
-                "each have their own copy of the seam and meet only at its ends. A curve of a "
-                "mirrored panel is its own mirror when it stays within {:.1f} mm of x = 0 (a "
-                "quarter of junction_tolerance) or every point is written at x = 0: write its "
-                "points at x = 0, or relative to a landmark on the plane (neck_base, chest, "
-                "waist, hips, crotch) with an offset of 0 across",
-                original.id, original.id + ".mirror", std::max(1.0, 1e3 * apart), panels, 1e3 * off,
-                own.points(far, 0), own.points(far, 1), own.points(far, 2),
-                1e3 * kOnPlaneFraction * tol)};
+                "curve is meant to lie on the mirror plane x = 0 (a centre seam of {}), but as "
+                "projected onto the body it runs more than {:.1f} mm (a quarter of "
+                "junction_tolerance) off it{}, so it is not its own mirror, and the two panels "
+                "each have their own copy of the seam and meet only at its ends: write its "
+                "points at x = 0 (a curve whose every point is written at x = 0 is its own "
+                "mirror), or relative to a landmark on the plane (neck_base, chest, waist, hips, "
+                "crotch) with an offset of 0 across",
+                original.id, original.id + ".mirror", std::max(1.0, 1e3 * apart), panels,
+                1e3 * kOnPlaneFraction * tol,
+                off >= 5e-4
+                    ? fmt::format(" (meshed, up to {:.1f} mm, at ({:.3f}, {:.3f}, {:.3f}) m)",
+                                  1e3 * off, own.points(far, 0), own.points(far, 1),
+                                  own.points(far, 2))
+                    : std::string())};
       }
       // Keep a mirror copy (the curve a mirrored garment already has), else the first drawn;
       // the other is the one to delete.
