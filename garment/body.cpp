@@ -224,6 +224,40 @@ void throw_obj_defect(const std::string& file) {
     throw BodyError("body file '" + file + "' cannot be read: " + *defect);
 }
 
+// A file assimp could not read whose contents are of another kind than its name says: a PLY
+// named .obj (trial 43, P9: assimp's OBJ reader said "Invalid face index" and the designer was
+// told to export the file again), or a sketch file given where a mesh goes (P13: `render
+// dress.json` quoted assimp's PLY reader, "Incorrect magic number"). Refused with what it is.
+void throw_misnamed(const std::string& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::string head(4096, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<size_t>(in.gcount()));
+  std::string ext = std::filesystem::path(file).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::string lower = head.substr(0, 3);
+  std::transform(lower.begin(), lower.end(), lower.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (lower == "ply" && ext != ".ply")
+    throw BodyError(fmt::format(
+        "body file '{}' is a PLY file (it begins with 'ply') named {}: assimp picks its reader by "
+        "the name, so rename it to .ply",
+        file, ext.empty() ? "without an extension" : "'" + ext + "'"));
+  const size_t first = head.find_first_not_of(" \t\r\n");
+  const bool json_like =
+      first != std::string::npos && (head[first] == '{' || head.compare(first, 2, "//") == 0);
+  if (json_like &&
+      (head.find("\"sketchdrape/1\"") != std::string::npos ||
+       head.find("\"curves\"") != std::string::npos || head.find("\"sheet\"") != std::string::npos))
+    throw BodyError(fmt::format(
+        "'{}' is a sketch file, not a mesh: a body is a mesh file (OBJ, PLY, STL, glTF, FBX, "
+        "Collada, ...) or 'builtin'; a sketch names its body in \"body\" (its mesh, with "
+        "\"up\", \"facing\", \"scale\": give those to `info` or `render` as --up, --facing, "
+        "--scale)",
+        file));
+}
+
 // The triangles of `file` as assimp reads them, merged, welded and cleaned; file units and axes.
 // Repairs are added to body.warnings, the mesh count to body.raw.meshes.
 meshing::TriMesh read_body_mesh(const std::string& file, Body& body) {
@@ -248,6 +282,7 @@ meshing::TriMesh read_body_mesh(const std::string& file, Body& body) {
     // assimp's words for a file of no mesh it knows (random bytes named .obj) say nothing to a
     // designer: "Validation failed: aiScene::mNumMeshes is 0".
     const std::string reason = importer.GetErrorString();
+    throw_misnamed(file);
     if (reason.find("mNumMeshes is 0") != std::string::npos)
       throw BodyError("body file '" + file +
                       "' holds no mesh: no vertices and faces could be read from it (is it "

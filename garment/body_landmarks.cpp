@@ -395,12 +395,13 @@ BodyLandmarks find_landmarks(const meshing::TriMesh& body) {
         "cannot find the body's {}: landmarks need a standing figure, feet on the floor, arms "
         "apart from the torso{}",
         what,
-        turned ? fmt::format("; the figure looks turned: it is {:.2f} m deep (front to back) and "
-                             "{:.2f} m wide, so its arms run front to back; give the way it faces "
-                             "in the file (`info --facing`, in a sketch \"body\": {{\"facing\": "
-                             "...}}; docs/bodies.md)",
-                             turned->depth, turned->width)
-               : std::string()));
+        turned
+            ? fmt::format("; the figure looks turned: it is {:.2f} m deep (front to back) and "
+                          "{:.2f} m wide, so its arms run front to back; give the way it faces "
+                          "in the file (`info --facing`, `render --facing`, in a sketch \"body\": "
+                          "{{\"facing\": ...}}; docs/bodies.md)",
+                          turned->depth, turned->width)
+            : std::string()));
   };
 
   // Crotch: the lowest slice above a quarter of the height whose torso outline spans x = 0.
@@ -568,6 +569,11 @@ Eigen::Vector3d landmark_point_for(const BodyLandmarks& body, const BodyLandmark
   const Landmark* d = drawn.find(l.name);
   if (d == nullptr) return l.position + offset;
   Eigen::Vector3d p = l.position + offset.cwiseProduct(l.size).cwiseQuotient(d->size);
+  // The mirror plane stays the mirror plane: a point the offset puts on x = 0 of the body it was
+  // written for (within kOnPlaneRounding) lands on x = 0 here. Scaled by the torso's width, a
+  // centre-back point written from the left armpit landed a few millimetres off the plane, and
+  // its curve was no longer its own mirror (trial 43, P5).
+  if (std::abs(d->position.x() + offset.x()) <= kOnPlaneRounding) p.x() = 0;
   if (l.name.ends_with("elbow") || l.name.ends_with("wrist")) return p;
   // The levels of both bodies, from the feet up (each rises on both: find_landmarks orders them).
   std::vector<double> from = {0.0}, to = {0.0};

@@ -45,13 +45,19 @@ struct BodyLandmarks {
   const Landmark& nearest(const Eigen::Vector3d& p) const;
 };
 
+// How far from x = 0 a landmark point may be written and still mean the mirror plane (m): `info`
+// prints landmarks in millimetres and a designer types the offset so, each rounded by up to half
+// a millimetre (the built-in left armpit at 0.176 and an offset of -0.176 across).
+inline constexpr double kOnPlaneRounding = 0.001;
+
 // The point `offset` (m) from landmark `l` of a body, written for another body whose landmarks are
 // `drawn` (docs/sketch-format.md, "Points relative to a landmark"): across and front to back the
 // offset scales by the two bodies' sizes at the landmark (Landmark::size); up, at a landmark of
 // the torso or a leg, the height it reaches maps piecewise linearly between the two bodies'
 // levels (feet, ankle, knee, crotch, hips, waist, chest, armpit, shoulder, neck base, top), so a
 // hem written 39 cm below the hips, between knee and crotch, stays at that place between them;
-// at an elbow or a wrist the offset scales by the bodies' heights.
+// at an elbow or a wrist the offset scales by the bodies' heights. A point within
+// kOnPlaneRounding of the drawn body's mirror plane x = 0 lands on this body's plane.
 Eigen::Vector3d landmark_point_for(const BodyLandmarks& body, const BodyLandmarks& drawn,
                                    const Landmark& l, const Eigen::Vector3d& offset);
 

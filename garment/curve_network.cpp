@@ -9,8 +9,6 @@
 namespace sd::garment {
 namespace {
 
-constexpr double kOnPlaneFraction = 0.25;
-
 struct UnionFind {
   std::vector<int> parent;
   explicit UnionFind(int n) : parent(static_cast<size_t>(n)) {

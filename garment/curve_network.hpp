@@ -14,6 +14,10 @@
 
 namespace sd::garment {
 
+// A curve of a mirrored panel within this fraction of the junction tolerance of x = 0 all along
+// (3.75 mm at the default 1.5 cm) lies on the plane: it is snapped onto it and is its own mirror.
+inline constexpr double kOnPlaneFraction = 0.25;
+
 struct NetworkEdge {
   int curve = -1;           // NetworkCurve index
   int from = -1, to = -1;   // node indices

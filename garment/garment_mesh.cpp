@@ -774,6 +774,34 @@ std::optional<std::pair<std::string, std::string>> coinciding_curves(const Garme
       if (apart > tol) continue;
       const NetworkCurve& ca = net.curves[static_cast<size_t>(a.curve)];
       const NetworkCurve& cb = net.curves[static_cast<size_t>(b.curve)];
+      // A curve beside its own mirror copy was meant to lie on the plane x = 0 (a centre seam)
+      // but runs off it: "name 'cb_top.mirror' in both lists and delete 'cb_top'" asked for a
+      // curve shared with itself (trial 43, P5). Say how far off it is and what puts it on.
+      if (ca.id + ".mirror" == cb.id || cb.id + ".mirror" == ca.id) {
+        const NetworkCurve& original = ca.mirror_copy ? cb : ca;
+        const NetworkEdge& own = ca.mirror_copy ? b : a;
+        Eigen::Index far = 0;
+        const double off = own.points.col(0).cwiseAbs().maxCoeff(&far);
+        return std::pair{
+            original.spec < 0 ? std::string("/panels")
+                              : sketch.curves[static_cast<size_t>(original.spec)].json_path,
+            fmt::format(
+                "curve '{}' and its own mirror copy '{}' lie within {:.0f} mm of each other: the "
+                "curve is meant to lie on the mirror plane x = 0 (a centre seam of {}), but as "
+                "projected onto the body it runs more than {:.1f} mm (a quarter of "
+                "junction_tolerance) off it{}, so it is not its own mirror, and the two panels "
+                "each have their own copy of the seam and meet only at its ends: write its "
+                "points at x = 0 (a curve whose every point is written at x = 0 is its own "
+                "mirror), or relative to a landmark on the plane (neck_base, chest, waist, hips, "
+                "crotch) with an offset of 0 across",
+                original.id, original.id + ".mirror", std::max(1.0, 1e3 * apart), panels,
+                1e3 * kOnPlaneFraction * tol,
+                off >= 5e-4
+                    ? fmt::format(" (meshed, up to {:.1f} mm, at ({:.3f}, {:.3f}, {:.3f}) m)",
+                                  1e3 * off, own.points(far, 0), own.points(far, 1),
+                                  own.points(far, 2))
+                    : std::string())};
+      }
       // Keep a mirror copy (the curve a mirrored garment already has), else the first drawn;
       // the other is the one to delete.
       const bool a_kept = ca.mirror_copy != cb.mirror_copy ? ca.mirror_copy : ca.spec <= cb.spec;

@@ -62,7 +62,8 @@ struct QualityWarning {
   std::string curve;
   double curve_edge_length = 0.0;
   // The panel's own edge_length the message offers with it (m; a fifth below the panel's, when
-  // no curve alone helps), else 0.
+  // no curve alone helps; for "inside_body", 0.7 of it when that was tried and clears the
+  // panel), else 0.
   double panel_edge_length = 0.0;
 };
 

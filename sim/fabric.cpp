@@ -281,6 +281,39 @@ void FabricParameters::validate() const {
   }
 }
 
+namespace {
+
+// For a constant written in its SI unit and refused by its range: "; if you meant 135 g/m^2
+// (FAST W), write "unit": "g/m^2"", for the other units that read it within the usual range of
+// apparel fabrics (else within the physical range); empty when none does.
+std::string unit_slip_hint(const nlohmann::json& document, const std::string& pointer) {
+  if (pointer.size() < 2) return "";
+  const std::string key = pointer.substr(1);
+  const ConstantSpec* spec = nullptr;
+  for (const ConstantSpec& s : kConstants)
+    if (key == s.key) spec = &s;
+  if (spec == nullptr || !document.contains(key) || !document[key].is_object()) return "";
+  const nlohmann::json& entry = document[key];
+  if (!entry.contains("unit") || entry["unit"] != spec->unit || !entry["value"].is_number())
+    return "";
+  const double value = entry["value"].get<double>();
+  for (const int wanted : {2, 1}) {
+    std::string hint;
+    for (const UnitSpec& other : kOtherUnits) {
+      if (std::string_view(other.key) != key || !(other.scale > 0.0)) continue;
+      if (physical_range_fit(key, value * other.scale) != wanted) continue;
+      std::ostringstream reading;
+      reading << (hint.empty() ? "" : "; or") << " " << value << " " << other.unit << " ("
+              << other.what << "), write \"unit\": \"" << other.unit << "\"";
+      hint += reading.str();
+    }
+    if (!hint.empty()) return "; if you meant" + hint;
+  }
+  return "";
+}
+
+}  // namespace
+
 FabricParameters parse_fabric_json(std::string_view text, const std::string& origin) {
   nlohmann::json document;
   try {
@@ -293,7 +326,20 @@ FabricParameters parse_fabric_json(std::string_view text, const std::string& ori
         "a fabric file", 5);
     document = nlohmann::json::parse(text, strict, true, /*ignore_comments=*/true);
   } catch (const nlohmann::json::parse_error& error) {
-    throw InvalidFabricError(origin + ": not valid JSON (" + error.what() + ")");
+    // As a sketch's syntax error is said: where, then the parser's words without its exception
+    // name (trial 43, P16: "[json.exception.parse_error.101] parse error at line 1, ...").
+    std::string detail = error.what(), where;
+    if (const size_t bracket = detail.find("] ");
+        detail.starts_with("[json.exception") && bracket != std::string::npos)
+      detail = detail.substr(bracket + 2);
+    if (detail.starts_with("parse error at ")) {
+      const size_t colon = detail.find(": ");
+      if (colon != std::string::npos) {
+        where = detail.substr(15, colon - 15) + ": ";
+        detail = detail.substr(colon + 2);
+      }
+    }
+    throw InvalidFabricError(origin + ": " + where + "the file is not valid JSON (" + detail + ")");
   }
   if (!document.is_object()) throw InvalidFabricError(origin + ": a fabric must be a JSON object");
   FabricParameters fabric;
@@ -349,9 +395,12 @@ FabricParameters parse_fabric_json(std::string_view text, const std::string& ori
     fabric.validate();
     check_physical_range(fabric);
   } catch (const InvalidFabricError& e) {
-    // The constant's key in the file (the sketch's error names the sketch's own path).
-    throw InvalidFabricError(
-        origin + ": " + (e.pointer().empty() ? "" : e.pointer() + ": ") + e.what(), e.pointer());
+    // The constant's key in the file (the sketch's error names the sketch's own path), and the
+    // unit it was likely meant in when written in the SI unit (trial 43, P16: a FAST weight of
+    // 135 typed with "kg/m^2" was refused with the range alone).
+    throw InvalidFabricError(origin + ": " + (e.pointer().empty() ? "" : e.pointer() + ": ") +
+                                 e.what() + unit_slip_hint(document, e.pointer()),
+                             e.pointer());
   }
   return fabric;
 }

@@ -83,6 +83,15 @@ void check_physical_range(const FabricParameters& fabric) {
   }
 }
 
+int physical_range_fit(std::string_view key, double value) {
+  for (const PhysicalRange& r : kRanges) {
+    if (key != r.key) continue;
+    if (!(value >= r.lowest && value <= r.highest)) return 0;
+    return value >= r.usual_low && value <= r.usual_high ? 2 : 1;
+  }
+  return -1;
+}
+
 std::vector<FabricNote> unusual_constants(const FabricParameters& fabric) {
   std::vector<FabricNote> notes;
   for (const PhysicalRange& r : kRanges) {

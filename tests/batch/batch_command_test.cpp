@@ -194,6 +194,34 @@ TEST(BatchCommand, BadJobsFailWithTheirReasonWhileOthersFinish) {
   EXPECT_NE(html.find("<tr class=\"job bad-input\" data-id=\"negative-edge\""), std::string::npos);
 }
 
+// Trial 43 P10: a sketch naming a fabric file relative to its own folder, and a matrix value
+// naming one relative to the manifest's, both mesh; before, every such job failed with "the
+// fabric file does not exist" (the job's copy of the sketch lives in the job's folder).
+TEST(BatchCommand, FabricFilesResolveAgainstTheSketchAndTheManifest) {
+  const fs::path dir = fresh_batch_dir("fabric_files");
+  fs::create_directories(dir / "sketches" / "fabrics");
+  fs::create_directories(dir / "fabrics");
+  fs::copy_file(fs::path(SD_SOURCE_DIR) / "data" / "fabrics" / "jersey.json",
+                dir / "sketches" / "fabrics" / "mine.json");
+  fs::copy_file(fs::path(SD_SOURCE_DIR) / "data" / "fabrics" / "silk.json",
+                dir / "fabrics" / "other.json");
+  json sketch = json::parse(read_text(kExamples / "a-line-skirt.json"), nullptr, true, true);
+  sketch["fabric"] = "fabrics/mine.json";
+  write_text(dir / "sketches" / "skirt.json", sketch.dump(2));
+  write_text(dir / "m.json", R"({"format": "sketchdrape-batch/1", "set": {"/output/images": []},
+      "jobs": [{"sketch": "sketches/skirt.json", "id": "own"},
+               {"sketch": "sketches/skirt.json", "id": "override",
+                "set": {"/fabric": "fabrics/other.json"}}]})");
+  const fs::path out = dir / "out";
+  const CommandResult r = run_sketchdrape("batch " + shell_quoted(dir / "m.json") + " -o " +
+                                          shell_quoted(out) + " --stage mesh -j 2");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  const auto jobs = jobs_by_id(read_json(out / "batch.json"));
+  ASSERT_EQ(jobs.size(), 2u) << r.output;
+  EXPECT_EQ(jobs.at("own")["status"], "done") << jobs.at("own");
+  EXPECT_EQ(jobs.at("override")["status"], "done") << jobs.at("override");
+}
+
 TEST(BatchCommand, BadManifestExitsTwoBeforeRunningAnything) {
   const fs::path dir = fresh_batch_dir("bad_manifest");
   write_text(dir / "m.json", R"({"format": "sketchdrape-batch/1", "jobs": [

@@ -45,6 +45,39 @@ TEST(PlanJob, MergesOverridesAndMakesBodyPathAbsolute) {
   EXPECT_EQ(p.inputs_hash.size(), 64u);
 }
 
+// Trial 43 P10: a fabric file named relative to the sketch was left relative, so the job's copy
+// of the sketch (in the job's folder) named a file that is not there and every such job failed.
+TEST(PlanJob, MakesFabricFilePathsAbsoluteAndCountsTheirContents) {
+  const fs::path dir = sketch_dir("plan_fabric_file");
+  test::write_text(dir / "fabrics" / "mine.json", R"({"name": "mine"})");
+  std::string text = test::read_text(dir / "s.json");
+  text.replace(text.find("\"jersey\""), 8, "\"fabrics/mine.json\"");
+  text.replace(text.find("\"curves\""), 0,
+               R"("panels": [{"id": "p", "fabric": "fabrics/mine.json"},
+                             {"id": "q", "fabric": "denim"}, {"id": "r", "fabric": "linnen"}],
+               )");
+  test::write_text(dir / "s.json", text);
+  auto plan = [&](const json& overrides) {
+    FileDigests files;  // fresh, so a changed fabric file is read again
+    return plan_job(job_for(dir, overrides), "mesh", "1.0", files);
+  };
+  const PlannedJob p = plan(json::object());
+  ASSERT_TRUE(p.document) << p.input_error;
+  const std::string absolute = (dir / "fabrics" / "mine.json").string();
+  EXPECT_EQ((*p.document)["fabric"], absolute);
+  EXPECT_EQ((*p.document)["panels"][0]["fabric"], absolute);
+  EXPECT_EQ((*p.document)["panels"][1]["fabric"], "denim") << "a preset stays a preset";
+  EXPECT_EQ((*p.document)["panels"][2]["fabric"], "linnen")
+      << "an unknown name is not a path: its error quotes it as written";
+  // The fabric file's contents count toward the digest, as a body file's do.
+  test::write_text(dir / "fabrics" / "mine.json", R"({"name": "mine, changed"})");
+  EXPECT_NE(p.inputs_hash, plan(json::object()).inputs_hash);
+  // An inline fabric (an object) is no path.
+  const PlannedJob inline_fabric = plan(json::parse(R"({"fabric": {"name": "x"}})"));
+  ASSERT_TRUE(inline_fabric.document) << inline_fabric.input_error;
+  EXPECT_EQ((*inline_fabric.document)["fabric"], json::parse(R"({"name": "x"})"));
+}
+
 TEST(PlanJob, DigestChangesWithEveryInputAndOnlyThen) {
   const fs::path dir = sketch_dir("plan_digest");
   auto digest = [&](const json& overrides, const std::string& stage, const std::string& version) {

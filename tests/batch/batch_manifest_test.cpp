@@ -121,6 +121,20 @@ TEST(JsonManifest, RelativeFileOverridesResolveAgainstTheManifest) {
   EXPECT_EQ(jobs[1].overrides["garment_mesh"], "/abs/g.obj");
 }
 
+// Trial 43 P10: a fabric file in an override (a matrix value here) resolves against the
+// manifest's folder like a body; presets stay names.
+TEST(JsonManifest, RelativeFabricFileOverridesResolveAgainstTheManifest) {
+  const fs::path dir = manifest_dir("json_fabric_paths");
+  const auto jobs = parse_json_manifest(R"({"format": "sketchdrape-batch/1", "jobs": [
+      {"sketch": "sketches/dress.json",
+       "matrix": {"/fabric": ["denim", "fabrics/viscose.json", "/abs/silk.json"]}}]})",
+                                        "m.json", dir);
+  std::set<std::string> fabrics;
+  for (const BatchJob& j : jobs) fabrics.insert(j.overrides["fabric"].get<std::string>());
+  EXPECT_EQ(fabrics, (std::set<std::string>{"denim", (dir / "fabrics" / "viscose.json").string(),
+                                            "/abs/silk.json"}));
+}
+
 TEST(JsonManifest, ErrorsNameTheFileThePathAndWhatIsWrong) {
   const fs::path dir = manifest_dir("json_errors");
   auto parse = [&](const std::string& text) {

@@ -933,7 +933,10 @@ TEST(HostileInput, InterruptedRunLeavesNothing) {
 }
 
 // A temporary of a process that is gone (SIGKILL) is removed by the next command that writes
-// into its folder once it is ten minutes old; a fresh one, or one of a live process, is kept.
+// into its folder when it was written before that command started (trial 43, P7: only those ten
+// minutes old were, silently, so a run killed a minute earlier left them for good), and the
+// command says so; one of a live process, or one written since the command started (another
+// machine's live process on a shared folder: here dated an hour ahead), is kept.
 TEST(HostileInput, StaleTemporariesOfDeadProcessesAreRemoved) {
   const fs::path dir = fresh_dir("stale");
   // A PID that is not alive: a child that has exited and been reaped.
@@ -943,17 +946,29 @@ TEST(HostileInput, StaleTemporariesOfDeadProcessesAreRemoved) {
   const fs::path old_dead = dir / fmt_name(".garment.obj.tmp-", dead, 0);
   const fs::path fresh_dead = dir / fmt_name(".report.json.tmp-", dead, 1);
   const fs::path old_alive = dir / fmt_name(".garment48.obj.tmp-", getpid(), 0);
-  for (const fs::path& p : {old_dead, fresh_dead, old_alive}) write(p, "partial");
+  const fs::path later_dead = dir / fmt_name(".drape.obj.tmp-", dead, 2);
+  for (const fs::path& p : {old_dead, fresh_dead, old_alive, later_dead}) write(p, "partial");
   const auto hour_ago = fs::file_time_type::clock::now() - std::chrono::hours(1);
   fs::last_write_time(old_dead, hour_ago);
   fs::last_write_time(old_alive, hour_ago);
+  fs::last_write_time(later_dead, fs::file_time_type::clock::now() + std::chrono::hours(1));
   write(dir / "sheet.json", R"({"sheet": {"size": [1, 1], "resolution": [2, 2]}})");
   const CommandResult r =
       run_sketchdrape("mesh " + (dir / "sheet.json").string() + " -o " + dir.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_FALSE(fs::exists(old_dead));
-  EXPECT_TRUE(fs::exists(fresh_dead));
+  EXPECT_FALSE(fs::exists(fresh_dead)) << "written a moment before the command started";
   EXPECT_TRUE(fs::exists(old_alive));
+  EXPECT_TRUE(fs::exists(later_dead));
+  EXPECT_NE(r.output.find(fmt::format("info: removed 2 temporary files from '{}' that a command no "
+                                      "longer running (process {}, killed or crashed",
+                                      dir.string(), dead)),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find(fmt_name(".garment.obj.tmp-", dead, 0) + ", " +
+                          fmt_name(".report.json.tmp-", dead, 1)),
+            std::string::npos)
+      << r.output;
   fs::remove_all(dir);
 }
 

@@ -9,6 +9,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "garment/body.hpp"
 #include "src/render/image.hpp"
 #include "tests/cli/run_command.hpp"
 
@@ -101,6 +102,38 @@ TEST_F(RenderCommand, BadSizeOrMissingFileExitsTwo) {
   const CommandResult no_output = run_sketchdrape("render builtin");
   EXPECT_EQ(no_output.exit_code, 2);
   EXPECT_EQ(file_count(dir_), 0u);
+}
+
+// Trial 43, P12: a body file that breaks its up axis's facing convention (Y up, facing +x
+// instead of +z) has landmarks only when read with --facing; `render` had no --facing (nor
+// --up, --height, --scale), so `render --landmarks` could not draw it, and its error sent the
+// user to `info --facing`. The built-in body turned a quarter round, in centimetres.
+TEST_F(RenderCommand, DrawsLandmarksOfABodyReadWithTheOptionsInfoTakes) {
+  const meshing::TriMesh body = garment::load_body("builtin").mesh;  // m, +y up, facing +z
+  const fs::path obj = dir_ / "turned.obj";
+  {
+    std::ofstream out(obj);
+    for (Eigen::Index v = 0; v < body.vertices.rows(); ++v)  // (x, y, z) -> (z, y, -x): faces +x
+      out << "v " << 100 * body.vertices(v, 2) << " " << 100 * body.vertices(v, 1) << " "
+          << -100 * body.vertices(v, 0) << "\n";
+    for (Eigen::Index f = 0; f < body.faces.rows(); ++f)
+      out << "f " << body.faces(f, 0) + 1 << " " << body.faces(f, 1) + 1 << " "
+          << body.faces(f, 2) + 1 << "\n";
+  }
+  const CommandResult plain = run_sketchdrape(
+      "render " + obj.string() + " --landmarks --size 40x60 -o " + (dir_ / "plain.png").string());
+  EXPECT_NE(plain.exit_code, 0) << plain.output;  // 1: no landmarks is not a usage error
+  EXPECT_NE(plain.output.find("looks turned"), std::string::npos) << plain.output;
+  EXPECT_NE(plain.output.find("`render --facing`"), std::string::npos) << plain.output;
+  const fs::path png = dir_ / "landmarks.png";
+  const CommandResult r =
+      run_sketchdrape("render " + obj.string() + " --up +y --facing +x --height 1.6 --landmarks " +
+                      "--size 40x60 -o " + png.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(read_png(png).size(), (render::ImageSize{40, 60}));
+  // `info` takes the same option set (one definition, cli.hpp's add_body_file_options).
+  const CommandResult info = run_sketchdrape("info " + obj.string() + " --facing +x --json");
+  EXPECT_EQ(info.exit_code, 0) << info.output;
 }
 
 // A garment file in the body's frame: a tube around the hips with two groups (panels).

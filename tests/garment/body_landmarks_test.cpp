@@ -225,5 +225,33 @@ TEST(BodyLandmarks, OffsetsWrittenForAnotherBodyScaleWithIt) {
   }
 }
 
+// Trial 43, P5: a centre-back point written from the left armpit of the built-in body (its x
+// 0.176, the offset -0.176 across, both as `info` prints them) scaled by the other body's torso
+// width landed a few millimetres off x = 0, and its curve was no longer its own mirror. A point
+// the offset puts within kOnPlaneRounding of the drawn body's plane lands on the plane; farther
+// off, the offset scales as before. The other body here: the built-in one with its left armpit
+// 1.4 cm farther out and its torso 10 % narrower there (so the scaled offset misses the plane).
+TEST(BodyLandmarks, APointWrittenOnTheMirrorPlaneStaysOnItOnAnotherBody) {
+  const BodyLandmarks drawn = find_landmarks(load_body("builtin").mesh);
+  BodyLandmarks body = drawn;
+  for (Landmark& l : body.points) {
+    if (l.name != "left_armpit") continue;
+    l.position.x() += 0.014;
+    l.size.x() *= 0.9;
+  }
+  const Landmark& armpit = *body.find("left_armpit");
+  const double printed = std::round(1e3 * drawn.find("left_armpit")->position.x()) / 1e3;
+  const Eigen::Vector3d on_plane =
+      landmark_point_for(body, drawn, armpit, Eigen::Vector3d(-printed, -0.03, -0.1));
+  EXPECT_EQ(on_plane.x(), 0.0) << "the armpit's x as printed, taken off across: on the plane";
+  // Before: 0.190 - 0.176 * 0.9 = 3.2 cm off it.
+  const double off = 0.003;  // 3 mm off the drawn body's plane: meant off it, scaled
+  const Eigen::Vector3d beside =
+      landmark_point_for(body, drawn, armpit, Eigen::Vector3d(-printed + off, -0.03, -0.1));
+  EXPECT_NEAR(beside.x(), armpit.position.x() + 0.9 * (-printed + off), 1e-12);
+  // Front to back the offset is as before (the depth is the same on both bodies).
+  EXPECT_NEAR(on_plane.z(), armpit.position.z() - 0.1, 1e-12);
+}
+
 }  // namespace
 }  // namespace sd::garment

@@ -249,6 +249,27 @@ TEST(Body, BadFilesGiveASentence) {
       << inf_error;
 }
 
+// Trial 43, P9 and P13: a PLY named .obj was read by assimp's OBJ reader and the designer told
+// "OBJ: Invalid face index" (export again?); a sketch file given as a body (`render dress.json`)
+// quoted assimp's PLY reader, "Incorrect magic number". Each is said for what it is.
+TEST(Body, AFileOfAnotherKindThanItsNameIsSaidToBeOne) {
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  EXPECT_NO_THROW(load_body(write_temp("tetra.ply", ply))) << "the same file named .ply reads";
+  const std::string as_obj = body_error(write_temp("tetra-as.obj", ply));
+  EXPECT_NE(as_obj.find("tetra-as.obj' is a PLY file (it begins with 'ply') named '.obj': "),
+            std::string::npos)
+      << as_obj;
+  EXPECT_NE(as_obj.find("rename it to .ply"), std::string::npos) << as_obj;
+  const std::string sketch =
+      body_error(write_temp("dress.json",
+                            "// a dress\n{\"format\": \"sketchdrape/1\", \"body\": {\"mesh\": "
+                            "\"human.ply\"}, \"curves\": []}\n"));
+  EXPECT_NE(sketch.find("dress.json' is a sketch file, not a mesh"), std::string::npos) << sketch;
+}
+
 TEST(Body, DegenerateFacesAreDroppedWithAWarning) {
   // Two extra faces: one with a repeated corner, one with three collinear corners.
   const std::string obj = tetrahedron_obj("v 2 0 0\nf 1 2 2\nf 1 2 5\n");

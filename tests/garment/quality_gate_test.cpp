@@ -217,6 +217,14 @@ TEST(QualityGate, ClothInsideTheBodyIsNamedWithItsDepth) {
   EXPECT_EQ(inside->landmark, "left_knee");
   EXPECT_NE(inside->message.find("inside the body"), std::string::npos);
   EXPECT_NE(inside->message.find("pushes them out at its start"), std::string::npos);
+  // Trial 43, P3: a smaller edge_length was offered whether or not it helped (there it made 5
+  // warnings of 1), with no number, and the sentence ended in ';'. Now it is offered, with its
+  // number (0.7 of 3 cm), only after the sketch meshed at it had no quad inside the ball.
+  EXPECT_NE(inside->message.find("\"edge_length\": 0.021, whose quads follow the body"),
+            std::string::npos)
+      << inside->message;
+  EXPECT_DOUBLE_EQ(inside->panel_edge_length, 0.021);
+  EXPECT_NE(inside->message.back(), ';') << inside->message;
   // 50 mm through: deeper than the drape's start is known to recover from (45 mm), said so.
   const meshing::TriMesh deeper = meshing::icosphere(0.1, 5, {0.075, 0.075, -0.05});
   const std::vector<QualityWarning> deeper_warnings =

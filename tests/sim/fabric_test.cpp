@@ -364,6 +364,36 @@ TEST(Fabric, ConstantsOutsideThePhysicalRangeAreRefused) {
   EXPECT_THROW(check_physical_range(stiff), InvalidFabricError);
 }
 
+// Trial 43, P16: a FAST weight typed with the SI unit (135 "kg/m^2" for 135 g/m^2) was refused
+// with the range alone; the units that read the value as an apparel fabric's are offered. A
+// value given in another unit than the SI one is not second-guessed. A file cut off mid-string
+// quoted the parser's exception ("[json.exception.parse_error.101] parse error at ..."): now the
+// place first and the parser's words, as a sketch's syntax error.
+TEST(Fabric, AConstantOutOfRangeInTheSiUnitOffersTheUnitItWasLikelyMeantIn) {
+  const auto error = [](const std::string& text) {
+    try {
+      parse_fabric_json(text, "x.json");
+    } catch (const InvalidFabricError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const std::string gsm =
+      error(cotton_where("area_density", R"({"value": 135, "unit": "kg/m^2"})"));
+  EXPECT_NE(gsm.find("no real fabric has"), std::string::npos) << gsm;
+  EXPECT_NE(gsm.find("; if you meant 135 g/m^2 (FAST W), write \"unit\": \"g/m^2\""),
+            std::string::npos)
+      << gsm;
+  EXPECT_EQ(gsm.find("mg/cm^2"), std::string::npos) << "1.35 kg/m^2 is no apparel fabric: " << gsm;
+  const std::string other = error(cotton_where("area_density", R"({"value": 2, "unit": "g/m^2"})"));
+  EXPECT_EQ(other.find("if you meant"), std::string::npos) << other;
+  const std::string cut = error(R"({"name": "c", "area_density": {"value": 0.1, "unit": "kg/m^2)");
+  EXPECT_EQ(cut.find("json.exception"), std::string::npos) << cut;
+  EXPECT_EQ(cut.rfind("x.json: line 1, column ", 0), 0u) << cut;
+  EXPECT_NE(cut.find(": the file is not valid JSON (syntax error while parsing"), std::string::npos)
+      << cut;
+}
+
 // Physically possible but rare for apparel: a note naming the constant, its value, the usual
 // range and what to check; usual values give none.
 TEST(Fabric, UnusualConstantsAreNotedNotRefused) {

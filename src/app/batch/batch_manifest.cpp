@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include "src/app/pipeline/cloth_scene.hpp"
 #include "src/app/pipeline/sha256.hpp"
 
 namespace sd::app {
@@ -52,6 +53,15 @@ std::string manifest_as_sketch_sentence(const std::string& given, const std::str
       "'{}' is {}, not a sketch file; a manifest's jobs name sketch files (give another "
       "manifest to batch as an input of its own)",
       given, kind);
+}
+
+// Calls f on the sketch document's fabric names: the file's "fabric" and each panel's.
+template <typename Json, typename F>
+void for_each_fabric(Json& document, F&& f) {
+  if (document.contains("fabric")) f(document["fabric"]);
+  if (!document.contains("panels") || !document["panels"].is_array()) return;
+  for (auto& panel : document["panels"])
+    if (panel.is_object() && panel.contains("fabric")) f(panel["fabric"]);
 }
 
 std::filesystem::path absolute_path(const std::filesystem::path& base_dir,
@@ -443,6 +453,11 @@ void absolutise_file_references(json& document, const std::filesystem::path& bas
     if (body.is_object() && body.contains("mesh")) fix(body["mesh"]);
   }
   if (document.contains("garment_mesh")) fix(document["garment_mesh"]);
+  // A fabric file, the file's or a panel's, as `run` reads it (scene_fabric): against the
+  // sketch's folder; presets, unknown names and inline fabrics stay as they are.
+  for_each_fabric(document, [&](json& fabric) {
+    if (fabric.is_string() && fabric_name_is_path(fabric.get<std::string>())) fix(fabric);
+  });
 }
 
 std::vector<std::filesystem::path> referenced_files(const json& document) {
@@ -459,6 +474,9 @@ std::vector<std::filesystem::path> referenced_files(const json& document) {
     if (body.is_object() && body.contains("mesh")) add(body["mesh"]);
   }
   if (document.contains("garment_mesh")) add(document["garment_mesh"]);
+  for_each_fabric(document, [&](const json& fabric) {
+    if (fabric.is_string() && fabric_name_is_path(fabric.get<std::string>())) add(fabric);
+  });
   return files;
 }
 

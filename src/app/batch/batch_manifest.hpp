@@ -74,11 +74,11 @@ nlohmann::json combine_patches(const nlohmann::json& earlier, const nlohmann::js
 std::vector<std::pair<std::string, nlohmann::json>> patch_leaves(const nlohmann::json& patch);
 
 // Rewrites the file references of a sketch document or patch (body.mesh or a "body" string,
-// garment_mesh) that are relative paths into absolute ones against `base_dir`. "builtin" and
-// absolute paths are left alone.
+// garment_mesh, a fabric file named by the file's or a panel's "fabric") that are relative paths
+// into absolute ones against `base_dir`. "builtin", presets and absolute paths are left alone.
 void absolutise_file_references(nlohmann::json& document, const std::filesystem::path& base_dir);
 
-// The files a merged sketch document reads (body mesh, garment mesh), absolute.
+// The files a merged sketch document reads (body mesh, garment mesh, fabric files), absolute.
 std::vector<std::filesystem::path> referenced_files(const nlohmann::json& document);
 
 // The slice `index` (1-based) of `count` of a job list sorted by id: jobs at positions

@@ -190,6 +190,25 @@ CLI::Validator non_empty_path() {
       "PATH");
 }
 
+garment::BodyOptions BodyFileOptions::body_options() const {
+  garment::BodyOptions out;
+  if (!up.empty()) out.up = garment::AxisDirection::parse(up);
+  if (!facing.empty()) out.facing = garment::AxisDirection::parse(facing);
+  if (height > 0) out.height = height;
+  if (scale > 0) out.scale = scale;
+  return out;
+}
+
+void add_body_file_options(CLI::App& cmd, BodyFileOptions& options) {
+  cmd.add_option("--up", options.up, "The file's up axis (x, y, z, -x, ...); inferred if omitted");
+  cmd.add_option("--facing", options.facing,
+                 "The way the figure faces in the file (x, -x, z, ...), across the up axis; by "
+                 "the up axis's convention if omitted (Z up: -y, else +z)");
+  cmd.add_option("--height", options.height, "Scale the body to this height in metres")
+      ->check(finite_range(0.1, 5.0));
+  cmd.add_option("--scale", options.scale, "Metres per file unit")->check(finite_range(1e-9, 1e9));
+}
+
 int run_cli(int argc, char** argv) {
   CLI::App app{"sketchdrape: sketch-based garment design — quad meshing, cloth draping, previews"};
   app.set_version_flag("--version", std::string("sketchdrape ") + kVersion);

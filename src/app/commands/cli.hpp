@@ -2,6 +2,9 @@
 // The sketchdrape command line: subcommands, global flags and exit codes (docs/cli.md).
 
 #include <CLI/CLI.hpp>
+#include <string>
+
+#include "garment/body.hpp"
 
 namespace sd::app {
 
@@ -24,6 +27,18 @@ CLI::Validator finite_range(double low, double high, const std::string& unit = "
 
 // An output path that is not empty: `-o ''` wrote into the working directory (trial 36).
 CLI::Validator non_empty_path();
+
+// How to read a body file (docs/bodies.md, "Normalisation"), as a sketch's "body" object says
+// it: `info` and `render` take the same options (--up, --facing, --height, --scale), so a body
+// that needs one can be both described and drawn with its landmarks (trial 43, P12).
+struct BodyFileOptions {
+  std::string up;      // the file's up axis; inferred when empty
+  std::string facing;  // the way the figure faces in the file; by the up axis's convention
+  double height = 0;   // m; 0: not given
+  double scale = 0;    // metres per file unit; 0: not given
+  garment::BodyOptions body_options() const;
+};
+void add_body_file_options(CLI::App& cmd, BodyFileOptions& options);
 
 // Parses argv, runs the chosen subcommand and maps exceptions to exit codes:
 // std::invalid_argument (bad input) → 2, any other std::exception → 1.

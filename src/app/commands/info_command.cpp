@@ -18,10 +18,7 @@ namespace {
 
 struct InfoOptions {
   std::string body;
-  std::string up;
-  std::string facing;
-  double height = 0;
-  double scale = 0;
+  BodyFileOptions reading;  // --up, --facing, --height, --scale
   bool json = false;
   std::vector<double> slices;  // heights, m (normalised frame)
 };
@@ -32,12 +29,7 @@ nlohmann::json box_json(const meshing::BoundingBox& box) {
 }
 
 void run_info(const InfoOptions& options) {
-  garment::BodyOptions body_options;
-  if (!options.up.empty()) body_options.up = garment::AxisDirection::parse(options.up);
-  if (!options.facing.empty()) body_options.facing = garment::AxisDirection::parse(options.facing);
-  if (options.height > 0) body_options.height = options.height;
-  if (options.scale > 0) body_options.scale = options.scale;
-  const garment::Body body = garment::load_body(options.body, body_options);
+  const garment::Body body = garment::load_body(options.body, options.reading.body_options());
   const meshing::TriMeshTopology topo = meshing::analyse_topology(body.mesh);
   const meshing::BoundingBox box = meshing::bounding_box(body.mesh);
   const garment::RawBodyInfo& raw = body.raw;
@@ -228,15 +220,7 @@ void add_info_command(CLI::App& app, const GlobalOptions& /*global*/) {
       "info", "Describe a body mesh: size, up axis, topology, and how it will be normalised");
   cmd->add_option("BODY", options->body, "Body mesh file (any format assimp reads) or 'builtin'")
       ->required();
-  cmd->add_option("--up", options->up,
-                  "The file's up axis (x, y, z, -x, ...); inferred if omitted");
-  cmd->add_option("--facing", options->facing,
-                  "The way the figure faces in the file (x, -x, z, ...), across the up axis; by "
-                  "the up axis's convention if omitted (Z up: -y, else +z)");
-  cmd->add_option("--height", options->height, "Scale the body to this height in metres")
-      ->check(finite_range(0.1, 5.0));
-  cmd->add_option("--scale", options->scale, "Metres per file unit")
-      ->check(finite_range(1e-9, 1e9));
+  add_body_file_options(*cmd, options->reading);
   cmd->add_flag("--json", options->json, "Print one JSON object instead of text");
   cmd->add_option("--slice", options->slices,
                   "Also print the body's outlines at this height (m, normalised frame; repeat for "

@@ -1,6 +1,8 @@
-// `sketchdrape render MESH [--body BODY] [--view V ...] [--size WxH] -o OUT`: preview images.
+// `sketchdrape render MESH [--body BODY] [--up A] [--facing A] [--height M] [--scale S]
+// [--view V ...] [--size WxH] -o OUT`: preview images.
 //
-// MESH alone is a body ("builtin" or any file assimp reads), normalised by load_body. With
+// MESH alone is a body ("builtin" or any file assimp reads), normalised by load_body with the
+// body options `info` takes. With
 // --body, MESH is a garment drawn as cloth over that body; it must already be in the body's
 // normalised frame (metres, +Y up, facing +Z, feet on y = 0), as the pipeline exports it, and
 // each mesh/group in the file becomes one panel colour.
@@ -48,6 +50,7 @@ class MeshFileError : public std::invalid_argument {
 struct RenderOptions {
   std::string mesh;
   std::string body;
+  BodyFileOptions reading;  // how to read the body file, as `info` takes it
   std::vector<std::string> views;
   std::string size = "800x1200";
   std::string output;
@@ -225,11 +228,11 @@ void run_render(const RenderOptions& options, const GlobalOptions& global) {
   scene.shadows = !options.no_shadows;
   if (options.body.empty()) {
     render::SceneMesh& body = scene.meshes.emplace_back();
-    body.mesh = garment::load_body(options.mesh).mesh;
+    body.mesh = garment::load_body(options.mesh, options.reading.body_options()).mesh;
     body.role = render::MeshRole::kBody;
   } else {
     render::SceneMesh& body = scene.meshes.emplace_back();
-    body.mesh = garment::load_body(options.body).mesh;
+    body.mesh = garment::load_body(options.body, options.reading.body_options()).mesh;
     body.role = render::MeshRole::kBody;
     GarmentMesh garment_mesh = load_garment_mesh(options.mesh);
     render::SceneMesh& cloth = scene.meshes.emplace_back();
@@ -291,6 +294,9 @@ void add_render_command(CLI::App& app, const GlobalOptions& global) {
       ->required();
   cmd->add_option("--body", options->body,
                   "Draw MESH as cloth over this body ('builtin' or a file)");
+  // The body (MESH, or --body's) read as `info` reads it: a file that breaks its up axis's
+  // facing convention or needs a scale is drawn, and its landmarks found, only with these.
+  add_body_file_options(*cmd, options->reading);
   cmd->add_option("--view", options->views,
                   "front, back, left, right, three-quarter or top; repeat for several (default "
                   "front)");

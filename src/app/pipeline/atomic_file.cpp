@@ -2,8 +2,10 @@
 
 #include <fcntl.h>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <pthread.h>
 #include <signal.h>
+#include <spdlog/spdlog.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -116,10 +118,18 @@ void release(std::array<std::atomic<char*>, N>& slots, const char* held) {
   }
 }
 
+// When this process started (static initialisation, before main): a temporary last written
+// before it is not of this command.
+const std::filesystem::file_time_type g_process_start =
+    std::filesystem::file_time_type::clock::now();
+
 // Removes `.NAME.tmp-PID-N` files in `dir` left by processes that are gone (killed with SIGKILL,
-// or crashed): the PID is not alive on this machine and the file has not changed for ten
-// minutes (on a folder shared by a cluster the PID may be another machine's live process; its
-// temporaries are fresh). Once per folder and process.
+// or crashed): the PID is not alive on this machine and the file was last written before this
+// command started, or has not changed for ten minutes; says which it removed. On a folder shared
+// by a cluster the PID may be another machine's live process: its temporaries are written after
+// this command started, so they stay until ten minutes old. (Only ten minutes counted before,
+// so a run into the folder of one killed a minute earlier left its temporaries beside its own
+// outputs without a word: trial 43, P7.) Once per folder and process.
 void sweep_stale_temporaries(const std::filesystem::path& dir) {
   static std::mutex mutex;
   static std::set<std::filesystem::path> swept;
@@ -129,6 +139,8 @@ void sweep_stale_temporaries(const std::filesystem::path& dir) {
   }
   std::error_code ec;
   const auto now = std::filesystem::file_time_type::clock::now();
+  std::vector<std::string> removed;
+  std::set<long> gone;
   for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
     const std::string name = entry.path().filename().string();
     const size_t tag = name.rfind(".tmp-");
@@ -143,9 +155,24 @@ void sweep_stale_temporaries(const std::filesystem::path& dir) {
     if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;  // alive, or not ours
     std::error_code time_ec;
     const auto changed = std::filesystem::last_write_time(entry.path(), time_ec);
-    if (time_ec || now - changed < std::chrono::minutes(10)) continue;
-    std::filesystem::remove(entry.path(), time_ec);
+    if (time_ec || (changed >= g_process_start && now - changed < std::chrono::minutes(10)))
+      continue;
+    if (std::filesystem::remove(entry.path(), time_ec)) {
+      removed.push_back(name);
+      gone.insert(pid);
+    }
   }
+  if (removed.empty()) return;
+  std::sort(removed.begin(), removed.end());
+  std::string pids;
+  for (const long pid : gone) pids += (pids.empty() ? "" : ", ") + std::to_string(pid);
+  spdlog::info(
+      "removed {} temporary file{} from '{}' that {} command{} no longer running "
+      "({} {}, killed or crashed before it finished) left there: {}",
+      removed.size(), removed.size() == 1 ? "" : "s", dir.string(),
+      gone.size() == 1 ? "a" : "earlier", gone.size() == 1 ? "" : "s",
+      gone.size() == 1 ? "process" : "processes", pids,
+      fmt::format("{}", fmt::join(removed, ", ")));
 }
 
 std::filesystem::path temporary_name(const std::filesystem::path& path) {

@@ -30,7 +30,8 @@ void check_output_folder(const std::filesystem::path& dir);
 // A set of output files that appear together or not at all. Files are staged under temporary
 // names; commit() renames them all into place; destruction without commit() removes them, and so
 // does SIGINT, SIGTERM or SIGHUP (the process then dies by the signal). Staging in a folder first
-// removes the temporaries that processes gone for ten minutes left there (SIGKILL, a crash).
+// removes the temporaries that processes no longer running left there (SIGKILL, a crash) before
+// this one started or ten minutes ago, and says so.
 class StagedOutputs {
  public:
   StagedOutputs() = default;

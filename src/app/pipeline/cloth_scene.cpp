@@ -604,6 +604,12 @@ void build_imported_scene(const scene::Sketch& sketch, ClothScene& scene) {
 
 }  // namespace
 
+bool fabric_name_is_path(const std::string& name) {
+  const std::vector<std::string> presets = sim::fabric_preset_names();
+  if (std::find(presets.begin(), presets.end(), name) != presets.end()) return false;
+  return name.ends_with(".json") || name.find('/') != std::string::npos;
+}
+
 sim::FabricParameters scene_fabric(const scene::Sketch& sketch, const std::string& name,
                                    const std::string& json_path) {
   // A panel without its own fabric carries the file's name for it, inline ones included.

@@ -136,6 +136,12 @@ Eigen::VectorXi triangle_groups(const ClothScene& scene, const Eigen::VectorXi& 
 sim::FabricParameters scene_fabric(const scene::Sketch& sketch, const std::string& name,
                                    const std::string& json_path);
 
+// Whether scene_fabric reads the fabric `name` as a path relative to the sketch's folder (a
+// fabric file, "fabrics/linen.json", or a folder, "fabrics/") rather than as a preset: a name
+// that is not a preset and ends in .json or holds a '/'. `batch` makes such names absolute
+// before a job's copy of the sketch moves to the job's folder, as it does the body's path.
+bool fabric_name_is_path(const std::string& name);
+
 // Whether a panel draped from flat cloth is cut more than kGatherEase times its drawn size along
 // its warp or weft (a gather: `"ease": {"weft": 1.5}`). Drawn at its sewn size, such a panel
 // starts compressed by 1 − 1/ease; with the linear compression model (stress K·ε on both sides)
