@@ -740,8 +740,8 @@ double centre_across_warp_deg(const Eigen::MatrixX3d& v, const Eigen::MatrixX3i&
 double chord_off_thread_deg(const Eigen::MatrixX2d& uv, const std::vector<int>& line) {
   const Eigen::Vector2d chord = (uv.row(line.back()) - uv.row(line.front())).transpose();
   if (!(chord.norm() > 0)) return 0.0;
-  const double off = std::acos(std::min(1.0, std::abs(chord.normalized().y()))) * 180.0 /
-                     std::numbers::pi;
+  const double off =
+      std::acos(std::min(1.0, std::abs(chord.normalized().y()))) * 180.0 / std::numbers::pi;
   return std::min(off, 90.0 - off);
 }
 

@@ -1208,8 +1208,7 @@ TEST(PatternCommand, CrotchCurveIsNotAFoldAndLegsKeepTheirGrain) {
     const auto& grain = piece["grain_line"];
     const double gx = grain[1][0].get<double>() - grain[0][0].get<double>();
     const double gy = grain[1][1].get<double>() - grain[0][1].get<double>();
-    const double cosine =
-        std::abs(std::cos(axis) * gx + std::sin(axis) * gy) / std::hypot(gx, gy);
+    const double cosine = std::abs(std::cos(axis) * gx + std::sin(axis) * gy) / std::hypot(gx, gy);
     EXPECT_LT(std::acos(std::min(1.0, cosine)) * 180.0 / std::numbers::pi, 1.5)
         << id << ": the leg hangs along its grain line";
   }
