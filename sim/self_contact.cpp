@@ -28,17 +28,6 @@ constexpr double kPushPerStep = 0.1;
 // piling sheet 3.4 times the collisions; 1 (Bridson et al.'s bound) lets the crumpled strip
 // under BDF2 gain twice its energy scale; 0.2 keeps both (0.53× and 0.59 mm).
 constexpr double kSeparatingShare = 0.2;
-// A pair within the thickness at the start of each of this many accepted steps before the
-// current one (an old pair) gets the ramp below instead of that switch: its spring fades
-// linearly from full at kSeparatingShare pushes to none at ω β / 2 pushes, where a critically
-// damped spring would start the step pulling the pair back (round 41). Old pairs are a resting
-// pile's: with the switch they flipped on and off every step (the crumpled strip after its crush:
-// 1,081 on and 1,099 off a step, 112 of the fail-safe's 209 collisions a step were pairs just
-// released). Young pairs keep the switch: at the crumpled strip's crush (0.1 s) the pairs
-// bouncing apart at 1–40 mm/s were born one or two steps before, and any spring on them raised
-// the implicit solve's peak strain (0.094 → 0.174; docs/collision.md, "Why the crumpled strip
-// stretches"). Three steps keep that crush exactly as with the switch.
-constexpr int kOldPairSteps = 3;
 // Friction between layers (step 2 of sim/self_contact.hpp): below this relative tangential
 // speed (m/s) a pair is held by the largest drag Coulomb allows, μF/ε; a fifth of the rest speed
 // (5 mm/s), so that a sticking layer's creep stays well inside "at rest".
@@ -56,21 +45,6 @@ constexpr double kLandingFloor = 0.25;
 // Gauss-Seidel sweeps of impulses over every pair found so far in the step between two
 // continuous queries (a query costs far more than a sweep).
 constexpr int kImpulseSweeps = 4;
-
-// The share of its full spring a pair separating at `pushes` (its normal speed at the step's
-// start over its push's speed) gets: main's switch for a young pair (full up to kSeparatingShare,
-// none above), the ramp for an old one (kOldPairSteps). A spring k (target − s) − c ṡ with k = m
-// ω², c = 2 m ω, target − s = β·push starts the step with m ω (ω β push − 2 ṡ): ≥ 0 up to ω β / 2
-// pushes, so the ramp ends there (a step so short that this comes before 2 kSeparatingShare
-// starts the ramp at half of it).
-double spring_share(double pushes, double beta, bool old) {
-  if (!old) return pushes > kSeparatingShare ? 0.0 : 1.0;
-  const double end = kSpringFrequency * beta / 2.0;
-  const double first = end < 2.0 * kSeparatingShare ? end / 2.0 : kSeparatingShare;
-  if (!(pushes > first)) return 1.0;  // also a pair at the thickness, not moving (0/0)
-  if (pushes >= end) return 0.0;
-  return (end - pushes) / (end - first);
-}
 
 Eigen::Vector3d row(const Eigen::VectorXd& x, int i) {
   return x.segment<3>(3 * i);
@@ -132,22 +106,17 @@ void move_rigidly(const std::vector<int>& members, const Eigen::VectorXd& x0, Ei
 }
 
 // The same pair whichever way a query met it: an edge-edge pair's two edges in a fixed order.
-// The key of a pair of `kind` on vertices v (SelfPair::vertices' order): an edge-edge pair's
-// edges each from the lower vertex and the lower edge first, so that either way round is one key.
-SelfContactResponse::PairKey key_of(SelfPairKind kind, const std::array<int, 4>& v) {
-  if (kind == SelfPairKind::edge_edge &&
+SelfContactResponse::PairKey key_of(const SelfPair& pair) {
+  const std::array<int, 4>& v = pair.vertices;
+  if (pair.kind == SelfPairKind::edge_edge &&
       std::make_pair(std::min(v[2], v[3]), std::max(v[2], v[3])) <
           std::make_pair(std::min(v[0], v[1]), std::max(v[0], v[1])))
-    return {static_cast<int>(kind), std::min(v[2], v[3]), std::max(v[2], v[3]),
+    return {static_cast<int>(pair.kind), std::min(v[2], v[3]), std::max(v[2], v[3]),
             std::min(v[0], v[1]), std::max(v[0], v[1])};
-  if (kind == SelfPairKind::edge_edge)
-    return {static_cast<int>(kind), std::min(v[0], v[1]), std::max(v[0], v[1]),
+  if (pair.kind == SelfPairKind::edge_edge)
+    return {static_cast<int>(pair.kind), std::min(v[0], v[1]), std::max(v[0], v[1]),
             std::min(v[2], v[3]), std::max(v[2], v[3])};
-  return {static_cast<int>(kind), v[0], v[1], v[2], v[3]};
-}
-
-SelfContactResponse::PairKey key_of(const SelfPair& pair) {
-  return key_of(pair.kind, pair.vertices);
+  return {static_cast<int>(pair.kind), v[0], v[1], v[2], v[3]};
 }
 
 }  // namespace
@@ -173,21 +142,6 @@ void SelfContactResponse::accept_step() {
     if (forces[0] > 0.0) next[key][1] = forces[0];
   lagged_ = std::move(next);
   step_force_.clear();
-  // A pair's age counts the accepted steps it started within the thickness in a row, whatever it
-  // carried: a separating pair has no force and leaves lagged_, but stays the same old pair.
-  std::unordered_map<PairKey, int, PairKeyHash> ages;
-  ages.reserve(near_keys_.size());
-  for (const PairKey& key : near_keys_) {
-    const auto found = age_.find(key);
-    ages[key] = found == age_.end() ? 1 : found->second + 1;
-  }
-  age_ = std::move(ages);
-  near_keys_.clear();
-}
-
-int SelfContactResponse::pair_age(const PairKey& key) const {
-  const auto found = age_.find(key);
-  return found == age_.end() ? 0 : found->second;
 }
 
 void SelfContactSettings::validate() const {
@@ -208,45 +162,13 @@ SelfContactResponse::SelfContactResponse(SelfContactSettings settings)
   settings_.validate();
 }
 
-void SelfContactResponse::set_cloth(const ClothModel& model, const Eigen::VectorXd& x,
-                                    const std::vector<int>& previous_vertex) {
+void SelfContactResponse::set_cloth(const ClothModel& model, const Eigen::VectorXd& x) {
   std::vector<std::array<int, 3>> triangles;
   triangles.reserve(model.triangles.size());
   for (const TriangleElement& t : model.triangles) triangles.push_back(t.vertices);
   collider_ = SelfCollider(std::move(triangles), x);
   collider_.set_culling(settings_.culling);
-  // The mesh was renumbered. A pair whose four vertices were all in the mesh before is the one
-  // it was and keeps its age (an adaptive step changes a few vertices; forgetting every age
-  // there gave all the pairs of a resting tee main's switch again for three steps at each of
-  // its mesh changes); any other is new to contact. The lagged forces start again, as before.
-  std::unordered_map<PairKey, int, PairKeyHash> ages;
-  if (!previous_vertex.empty()) {
-    if (static_cast<int>(previous_vertex.size()) != model.vertex_count)
-      throw std::invalid_argument("set_cloth needs the previous row of every vertex, or none");
-    std::vector<int> now;  // previous row -> new row, −1 for a vertex that is gone
-    for (std::size_t i = 0; i < previous_vertex.size(); ++i) {
-      const int p = previous_vertex[i];
-      if (p < 0) continue;
-      if (static_cast<std::size_t>(p) >= now.size())
-        now.resize(static_cast<std::size_t>(p) + 1, -1);
-      now[static_cast<std::size_t>(p)] = static_cast<int>(i);
-    }
-    for (const auto& [key, age] : age_) {
-      std::array<int, 4> v{};
-      bool kept = true;
-      for (int k = 0; k < 4 && kept; ++k) {
-        const int p = key[static_cast<std::size_t>(k) + 1];
-        v[static_cast<std::size_t>(k)] = p >= 0 && static_cast<std::size_t>(p) < now.size()
-                                             ? now[static_cast<std::size_t>(p)]
-                                             : -1;
-        kept = v[static_cast<std::size_t>(k)] >= 0;
-      }
-      if (kept) ages[key_of(static_cast<SelfPairKind>(key[0]), v)] = age;
-    }
-  }
-  age_ = std::move(ages);
-  lagged_.clear();
-  near_keys_.clear();
+  lagged_.clear();  // the mesh was renumbered: no pair is the one it was
   step_force_.clear();
 }
 
@@ -329,7 +251,6 @@ void SelfContactResponse::add_springs(const Eigen::VectorXd& start, const Eigen:
   step_force_.clear();
   spring_keys_.clear();
   first_spring_ = extra.pair_springs.size();
-  near_keys_.clear();  // a retried attempt starts again
   SelfQueryStats query;
   const std::vector<SelfPair> pairs =
       collider_.find_proximities(start, settings_.thickness, &query);
@@ -342,7 +263,6 @@ void SelfContactResponse::add_springs(const Eigen::VectorXd& start, const Eigen:
     double slide = 0.0;      // m/s: relative tangential speed at the start
     double lagged = 0.0;     // N
     double distance = 0.0;   // m: separation at the start
-    double share = 1.0;      // of the full spring (spring_share)
   };
   std::vector<Sizing> sizing;
   for (const SelfPair& pair : pairs) {
@@ -356,7 +276,6 @@ void SelfContactResponse::add_springs(const Eigen::VectorXd& start, const Eigen:
     spring.weights = pair.weights;
     spring.normal = pair.normal;
     const PairKey key = key_of(pair);
-    near_keys_.push_back(key);
     const double lagged = in_solve_friction ? lagged_force(key) : 0.0;
     double slide = 0.0;
     if (velocity != nullptr) {
@@ -367,54 +286,48 @@ void SelfContactResponse::add_springs(const Eigen::VectorXd& start, const Eigen:
     // not already moving apart gets one (Bridson et al. 2002 §7.2 bound the repulsion the same
     // way). A spring born with the full thickness as its target holds ½ k (thickness − s)² it
     // did not take from anywhere; in a pile those pushes stretched the cloth step after step
-    // (the crumpled stress strip ended at rest with 14 times its energy scale in stretch). A
-    // young pair leaving faster than kSeparatingShare pushes gets none; an old one a share
-    // fading with its speed (spring_share).
-    const double share =
-        velocity == nullptr
-            ? 1.0
-            : spring_share(along_pair_normal(spring, *velocity) /
-                               (kPushPerStep * (settings_.thickness - pair.distance) / beta),
-                           beta, pair_age(key) >= kOldPairSteps);
-    if (!(share > 0.0)) {
+    // (the crumpled stress strip ended at rest with 14 times its energy scale in stretch).
+    const bool separating =
+        velocity != nullptr &&
+        along_pair_normal(spring, *velocity) >
+            kSeparatingShare * kPushPerStep * (settings_.thickness - pair.distance) / beta;
+    if (separating) {
       // No push, but a pair that pressed on the other layer in the last steps still rubs on it
       // (a layer resting under gravity alternates between steps with a spring and steps caught
       // by the fail-safe: friction in only one of them let it slide).
       if (!(lagged > 0.0)) continue;
     } else {
       spring.target = pair.distance + kPushPerStep * (settings_.thickness - pair.distance);
-      spring.stiffness = share * effective * kSpringFrequency * kSpringFrequency;
-      spring.damping = share * 2.0 * effective * kSpringFrequency;
+      spring.stiffness = effective * kSpringFrequency * kSpringFrequency;
+      spring.damping = 2.0 * effective * kSpringFrequency;
     }
     extra.pair_springs.push_back(spring);
     spring_keys_.push_back(key);
-    sizing.push_back({effective, slide, lagged, pair.distance, share});
+    sizing.push_back({effective, slide, lagged, pair.distance});
   }
   // A vertex inside a pile is near many elements at once; the sum of their springs on it would
   // be many times one spring's stiffness, and their coupling across the pairs is explicit
   // (measured: a crumpled strip gained 40 times its energy scale). Each spring is divided by the
   // square root of the largest number of springs sharing one of its vertices (dividing by the
   // number itself left too little to hold layers apart: the fail-safe then did the work, 88 %
-  // of the piling sheet's time). A spring with a share of its full stiffness counts as that
-  // share of one.
-  std::vector<double> count(static_cast<std::size_t>(mass.size()), 0.0);
+  // of the piling sheet's time).
+  std::vector<int> count(static_cast<std::size_t>(mass.size()), 0);
   for (std::size_t p = first_spring_; p < extra.pair_springs.size(); ++p) {
     const PairSpring& spring = extra.pair_springs[p];
     if (spring.stiffness > 0.0)
       for (int k = 0; k < 4; ++k)
-        if (std::abs(spring.weights[k]) > 0.0)
-          count[spring.vertices[k]] += sizing[p - first_spring_].share;
+        if (std::abs(spring.weights[k]) > 0.0) ++count[spring.vertices[k]];
   }
   int springs = 0;
   for (std::size_t p = first_spring_; p < extra.pair_springs.size(); ++p) {
     PairSpring& spring = extra.pair_springs[p];
     const Sizing& size = sizing[p - first_spring_];
     if (spring.stiffness > 0.0) {
-      double most = 1.0;
+      int most = 1;
       for (int k = 0; k < 4; ++k)
         if (std::abs(spring.weights[k]) > 0.0) most = std::max(most, count[spring.vertices[k]]);
-      spring.stiffness /= std::sqrt(most);
-      spring.damping /= std::sqrt(most);
+      spring.stiffness /= std::sqrt(static_cast<double>(most));
+      spring.damping /= std::sqrt(static_cast<double>(most));
       ++springs;
     }
     if (!in_solve_friction) continue;

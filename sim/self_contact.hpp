@@ -75,11 +75,7 @@ class SelfContactResponse {
 
   const SelfContactSettings& settings() const { return settings_; }
   // A new or changed mesh (adaptive refinement renumbers it): rebuilds the tree at x (3n).
-  // previous_vertex (#V, or empty for a new cloth): the row of each vertex in the mesh before,
-  // −1 for a vertex the change made (ClothModelReuse::previous_vertex); a pair whose four
-  // vertices all had one keeps its age (pair_age), every other pair is new to contact.
-  void set_cloth(const ClothModel& model, const Eigen::VectorXd& x,
-                 const std::vector<int>& previous_vertex = {});
+  void set_cloth(const ClothModel& model, const Eigen::VectorXd& x);
   void set_fabric_friction(double friction) { fabric_friction_ = friction; }
   double friction() const {
     return settings_.friction >= 0.0 ? settings_.friction : fabric_friction_;
@@ -119,8 +115,7 @@ class SelfContactResponse {
                const StepForces& extra);
 
   // The step was accepted: the normal forces resolve() measured become the lagged forces the
-  // next step's friction is sized from, and every pair add_springs found within the thickness
-  // ages by a step (the others are forgotten). A rejected attempt leaves both as they were.
+  // next step's friction is sized from (a rejected attempt leaves them as they were).
   void accept_step();
 
   const SelfContactStepStats& step_stats() const { return stats_; }
@@ -132,11 +127,6 @@ class SelfContactResponse {
   struct PairKeyHash {
     std::size_t operator()(const PairKey& key) const;
   };
-  // The accepted steps in a row the pair started within the thickness (0: new to contact). From
-  // kOldPairSteps on, a separating pair's spring fades with its speed instead of switching off
-  // (add_springs; sim/self_contact.cpp). A changed mesh (set_cloth) keeps the ages of the pairs
-  // whose vertices it kept.
-  int pair_age(const PairKey& key) const;
 
  private:
   // One Gauss-Seidel round of inelastic impulses over `hits`; each impulse's force (impulse/β²
@@ -157,8 +147,6 @@ class SelfContactResponse {
   // step and of the one before it.
   std::unordered_map<PairKey, std::array<double, 2>, PairKeyHash> lagged_;
   std::unordered_map<PairKey, double, PairKeyHash> step_force_;  // this attempt's, N
-  std::unordered_map<PairKey, int, PairKeyHash> age_;            // pair_age of the pairs near now
-  std::vector<PairKey> near_keys_;    // the pairs within the thickness at this attempt's start
   std::vector<PairKey> spring_keys_;  // the key of each pair spring added this attempt
   std::size_t first_spring_ = 0;      // index of this response's first spring in the extra forces
 };

@@ -168,11 +168,6 @@ void Simulation::set_triangle_rest_shapes(const std::vector<TriangleElement>& re
 
 void Simulation::replace_model(ClothModel model, Eigen::VectorXd x, Eigen::VectorXd v,
                                std::vector<Pin> pins) {
-  install_model(std::move(model), std::move(x), std::move(v), std::move(pins), {});
-}
-
-void Simulation::install_model(ClothModel model, Eigen::VectorXd x, Eigen::VectorXd v,
-                               std::vector<Pin> pins, const std::vector<int>& previous_vertex) {
   flush_energy_sample();
   const int n = model.vertex_count;
   if (x.size() != 3 * n)
@@ -209,7 +204,7 @@ void Simulation::install_model(ClothModel model, Eigen::VectorXd x, Eigen::Vecto
     const bool first = !self_contact_;
     if (first) self_contact_ = std::make_unique<SelfContactResponse>(settings_.self_contact);
     self_contact_->set_fabric_friction(model_.fabric.friction);
-    self_contact_->set_cloth(model_, x_, previous_vertex);
+    self_contact_->set_cloth(model_, x_);
     if (first) {
       // A designed start that passes through itself is smoothed apart once, before anything
       // moves: the continuous tests would keep the intersections for the whole run. Pinned
@@ -264,11 +259,7 @@ void Simulation::replace_model(ClothModel model, Eigen::VectorXd x, Eigen::Vecto
   // that adapted reported a drift of 0 while its hem still moved at 9 cm/s).
   Eigen::VectorXd displaced;
   if (rest_anchor_.size() == x_.size()) displaced = x_ - rest_anchor_;
-  // The same vertex when both origins are one old vertex (as ClothModelReuse::previous_vertex).
-  std::vector<int> previous_vertex(origin.size(), -1);
-  for (std::size_t i = 0; i < origin.size(); ++i)
-    if (origin[i].a >= 0 && origin[i].a == origin[i].b) previous_vertex[i] = origin[i].a;
-  install_model(std::move(model), std::move(x), std::move(v), std::move(pins), previous_vertex);
+  replace_model(std::move(model), std::move(x), std::move(v), std::move(pins));
   if (displaced.size() > 0) {
     const auto moved = [&](int i) -> Eigen::Vector3d {
       if (i < 0 || 3 * i + 2 >= displaced.size()) return Eigen::Vector3d::Zero();

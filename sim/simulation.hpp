@@ -291,8 +291,7 @@ class Simulation {
   // vertex i comes from: the body contacts' memory of the last step (which contacts pressed
   // and how hard, per unit mass) carries over to the same particles, and to a vertex made
   // between two pressed ones, so that held contacts and friction do not restart at every
-  // topology change; so do the self-contact pairs' ages, for pairs on vertices kept as they were
-  // (origin a = b).
+  // topology change.
   void replace_model(ClothModel model, Eigen::VectorXd x, Eigen::VectorXd v, std::vector<Pin> pins,
                      const std::vector<VertexOrigin>& origin);
   void set_velocities(const Eigen::VectorXd& v);
@@ -350,11 +349,6 @@ class Simulation {
   Attempt attempt(double h);
   void accept(Attempt& attempt, double h);
   void start_body();
-  // replace_model; previous_vertex (#V or empty): each vertex's row in the mesh before, −1 for a
-  // new one (the self-contact pairs on kept vertices keep their age;
-  // SelfContactResponse::set_cloth).
-  void install_model(ClothModel model, Eigen::VectorXd x, Eigen::VectorXd v, std::vector<Pin> pins,
-                     const std::vector<int>& previous_vertex);
   // Appends the pending energy sample (SimulationSettings::energy_from_next_step) from `energy`
   // when given, else from a force evaluation at the current state.
   void flush_energy_sample(const EnergyBreakdown* energy = nullptr);
