@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "tests/cli/hip_tube_obj.hpp"
 #include "tests/cli/run_command.hpp"
 #include "tests/garment/bad_cases.hpp"
 
@@ -122,22 +123,7 @@ TEST(MeshCommand, RefusesWhatValidateRefuses) {
 TEST(MeshCommand, AnImportedGarmentOrASheetGetsItsImages) {
   const fs::path dir = fresh_dir("imported-images");
   fs::create_directories(dir);
-  {
-    // A tube round the hips, 24 quads round and 8 down (as validate's imported-garment test).
-    std::ofstream obj(dir / "tube.obj");
-    constexpr int kRound = 24, kDown = 8;
-    for (int j = 0; j <= kDown; ++j)
-      for (int i = 0; i < kRound; ++i) {
-        const double a = 2 * 3.14159265358979 * i / kRound;
-        obj << "v " << 0.22 * std::sin(a) << " " << 0.95 - 0.35 * j / kDown << " "
-            << 0.22 * std::cos(a) << "\n";
-      }
-    for (int j = 0; j < kDown; ++j)
-      for (int i = 0; i < kRound; ++i) {
-        const int a = j * kRound + i + 1, b = j * kRound + (i + 1) % kRound + 1;
-        obj << "f " << a << " " << a + kRound << " " << b + kRound << " " << b << "\n";
-      }
-  }
+  write_hip_tube_obj(dir / "tube.obj");
   std::ofstream(dir / "tube.json") << R"({"garment_mesh": "tube.obj", "output": {"images": [
       {"view": "front", "size": [120, 180]}, {"view": "left", "size": [120, 180]}]}})";
   std::ofstream(dir / "plain.json") << R"({"garment_mesh": "tube.obj"})";

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "tests/cli/hip_tube_obj.hpp"
 #include "tests/cli/run_command.hpp"
 
 namespace {
@@ -17,6 +18,7 @@ namespace {
 namespace fs = std::filesystem;
 using sd::test::CommandResult;
 using sd::test::run_sketchdrape;
+using sd::test::write_hip_tube_obj;
 
 // A hem drawn through the legs with a pattern asked for (trial 34): the panel cannot be
 // flattened, but the cause is the cloth inside the body, not a cap that seams would split. The
@@ -410,22 +412,7 @@ TEST(ValidateCommand, AnImportedGarmentIsCountedAsItsFileHasIt) {
   const fs::path dir = fs::temp_directory_path() / "sd-validate-imported";
   fs::remove_all(dir);
   fs::create_directories(dir);
-  {
-    // A tube round the hips, 24 quads round and 8 down: 216 vertices, 192 quads.
-    std::ofstream obj(dir / "tube.obj");
-    constexpr int kRound = 24, kDown = 8;
-    for (int j = 0; j <= kDown; ++j)
-      for (int i = 0; i < kRound; ++i) {
-        const double a = 2 * 3.14159265358979 * i / kRound;
-        obj << "v " << 0.22 * std::sin(a) << " " << 0.95 - 0.35 * j / kDown << " "
-            << 0.22 * std::cos(a) << "\n";
-      }
-    for (int j = 0; j < kDown; ++j)
-      for (int i = 0; i < kRound; ++i) {
-        const int a = j * kRound + i + 1, b = j * kRound + (i + 1) % kRound + 1;
-        obj << "f " << a << " " << a + kRound << " " << b + kRound << " " << b << "\n";
-      }
-  }
+  write_hip_tube_obj(dir / "tube.obj");
   std::ofstream(dir / "tube.json")
       << R"({"garment_mesh": "tube.obj", "simulate": {"duration": 0.05, "pin_above": 0.94}})";
   const std::string file = (dir / "tube.json").string();
