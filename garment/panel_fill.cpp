@@ -635,6 +635,15 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
                               filled.quality.max_aspect_ratio >= kSliverAspect ? 1 : 0,
                               quads_off_size(filled.mesh, reach)};
   };
+  // Keeps `other` when it has no more folded quads, slivers or quads off size than the panel's
+  // fill and fewer of one of them.
+  const auto keep_if_fewer_flaws = [&](meshing::FilledPatch&& other,
+                                       const std::array<int, 3>& before) {
+    const std::array<int, 3> after = flaws(other);
+    bool no_worse = true;
+    for (size_t k = 0; k < after.size(); ++k) no_worse = no_worse && after[k] <= before[k];
+    if (no_worse && after != before) patch = std::move(other);
+  };
   if (const std::array<int, 3> before = flaws(patch); before != std::array<int, 3>{})
     if (const std::optional<meshing::ArmCut> cut = meshing::find_arm_cut(side_points)) {
       const meshing::FillGeometryOptions part = fit == PanelFit::kBody ? options : free_options;
@@ -645,10 +654,7 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
               return meshing::fill_region(points, part);
             },
             part));
-        const std::array<int, 3> after = flaws(widened);
-        bool no_worse = true;
-        for (size_t k = 0; k < after.size(); ++k) no_worse = no_worse && after[k] <= before[k];
-        if (no_worse && after != before) patch = std::move(widened);
+        keep_if_fewer_flaws(std::move(widened), before);
       } catch (const meshing::FillError&) {
         // A part that cannot be filled: the panel keeps its fill.
       }
@@ -656,20 +662,44 @@ meshing::FilledPatch fill_panel(const GarmentRequest& sketch, const PanelSpec& s
   // Folds that every start, plan, smoothing and unfolding left: mended by local changes of the
   // quads at each fold (fold_repair.hpp), kept only when the gate's measures improve. A clean
   // panel is not touched.
-  if (patch.quality.inverted_quads > 0) {
-    std::vector<char> fixed(static_cast<size_t>(patch.mesh.vertex_count()), 0);
-    for (const auto& side : patch.topology.side_vertices)
+  const auto repair = [&](meshing::FilledPatch& filled) {
+    if (filled.quality.inverted_quads == 0) return;
+    std::vector<char> fixed(static_cast<size_t>(filled.mesh.vertex_count()), 0);
+    for (const auto& side : filled.topology.side_vertices)
       for (const int v : side) fixed[static_cast<size_t>(v)] = 1;
-    const std::vector<int> corners = patch.topology.corner_vertices();
-    const FoldRepairResult repaired = repair_folds(patch.mesh, fixed, corners, options.project);
+    const std::vector<int> corners = filled.topology.corner_vertices();
+    const FoldRepairResult repaired = repair_folds(filled.mesh, fixed, corners, options.project);
     if (repaired.edge_turns + repaired.smoothings > 0) {
-      patch.quality = meshing::measure_quality(patch.mesh, corners);
+      filled.quality = meshing::measure_quality(filled.mesh, corners);
       // The layout's connectivity follows the turned edges; its distortion is the new one.
-      patch.topology.mesh.faces = patch.mesh.faces;
-      patch.topology.distortion = patch.quality.distortion;
-      patch.topology.irregular_vertices = patch.quality.irregular_vertices;
+      filled.topology.mesh.faces = filled.mesh.faces;
+      filled.topology.distortion = filled.quality.distortion;
+      filled.topology.irregular_vertices = filled.quality.irregular_vertices;
     }
-  }
+  };
+  repair(patch);
+  // A body panel that still has such flaws after the fold repair and whose boundary turns one
+  // way about the loop's overall normal and the other about the body's (a strap over the shoulder,
+  // a neckline cut into a front that wraps the chest): the layout put its single-quad corners and
+  // its reflex vertices by the loop's normal, so a corner the body sees as convex may be avoided as
+  // "reflex" and the region's narrowing taken up where the boundary does not turn. Filled again
+  // with the reflex and flat positions judged about the body's normals (the same turns the layout
+  // already ranks by), its folds mended as above, and kept by the same rule as the arm cut
+  // (docs/meshing.md, "Round 44").
+  // Only for a sliver or quads off size: a fold alone that the repair left is not what the
+  // other flags mend (on the Collada shirt's back sleeve the refill without it came out inside
+  // the body and turned back on itself, two new gate warnings the panel's measures do not see).
+  if (fit == PanelFit::kBody)
+    if (const std::array<int, 3> before = flaws(patch); before[1] + before[2] > 0) {
+      meshing::FillGeometryOptions about_body = options;
+      about_body.flags_about_surface = true;
+      meshing::FilledPatch other = fill_on_body(about_body);
+      repair(other);
+      // Nor a corner under the gate's limit where the fill had none.
+      const double sharp = QualityLimits{}.min_angle_deg;
+      if (other.quality.min_angle_deg >= sharp || patch.quality.min_angle_deg < sharp)
+        keep_if_fewer_flaws(std::move(other), before);
+    }
   // Narrow creases (crease_wall.hpp), once the panel is filled: each vertex that lies on the
   // offset surface (or inside it) would go onto its own wall of a crease, at the offset that
   // fits. After the fill, not in its projection: the fill's choice among plans and smoothings at

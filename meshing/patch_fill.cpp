@@ -351,7 +351,8 @@ FilledPatch fill_searched(const std::vector<Eigen::MatrixX3d>& side_points,
   std::vector<int> counts;
   for (const auto& side : side_points) counts.push_back(static_cast<int>(side.rows()) - 1);
   check_counts(counts);
-  const BoundaryShape shape = measured_shape(side_points, options.surface_normal);
+  const BoundaryShape shape =
+      measured_shape(side_points, options.surface_normal, options.flags_about_surface);
   // The plans are ranked by their corners and valences, not by the size of their quads: a plan
   // with thin spokes can fill the region with a fraction of the quads its edges ask for (a
   // raglan sleeve of sides (12, 8, 5, 21, 2): 62 quads of ~15 cm² for 3 cm edges, where 108

@@ -76,6 +76,13 @@ struct FillGeometryOptions {
   // then measured about it instead of about the loop's overall normal: seen from the front, a
   // strap running round the back of the neck turns the wrong way.
   std::function<Eigen::Vector3d(const Eigen::Vector3d&)> surface_normal;
+  // With `surface_normal`: which boundary vertices are reflex or flat (a layout corner there
+  // folds or is flat: the fold penalty, padding) is judged about it as well, not only the turns.
+  // Off by default: about the body's normals most garments' plans change, some for the worse
+  // (docs/meshing.md, "Reflex vertices where the boundary turns"); a caller tries it as a second
+  // fill of a region whose first fill has flaws (garment/panel_fill.cpp, docs/meshing.md,
+  // "Round 44").
+  bool flags_about_surface = false;
   // When the fill has a quad whose mean side is more than twice the boundary's mean edge or
   // less than half of it, and the region has a long thin arm that widens (find_arm_cut,
   // meshing/arm_widening.hpp), the region is also filled cut across the arm, each part on its

@@ -103,7 +103,8 @@ BoundaryShape straight_sided_shape(std::span<const int> counts) {
 // from it).
 BoundaryShape measured_shape(
     const std::vector<Eigen::MatrixX3d>& side_points,
-    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& surface_normal) {
+    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& surface_normal,
+    bool flags_about_surface) {
   std::vector<Eigen::Vector3d> loop;
   for (const auto& side : side_points)
     for (Eigen::Index r = 0; r + 1 < side.rows(); ++r) loop.emplace_back(side.row(r).transpose());
@@ -132,10 +133,11 @@ BoundaryShape measured_shape(
       const Eigen::Vector3d local = surface_normal(loop[k]);
       if (local.norm() > 0.5) normal = local.normalized();
     }
-    // The flags keep the loop's own normal: about the body's normals they would change which
-    // corners count as reflex in most garments (docs/meshing.md, "Reflex vertices where the
-    // boundary turns": measured, not taken).
-    const double turn = std::atan2(shape.normal.dot(in.cross(out)), in.dot(out));
+    // The flags keep the loop's own normal unless asked: about the body's normals they would
+    // change which corners count as reflex in most garments (docs/meshing.md, "Reflex vertices
+    // where the boundary turns": measured, not taken as the default).
+    const Eigen::Vector3d& flag_normal = flags_about_surface ? normal : shape.normal;
+    const double turn = std::atan2(flag_normal.dot(in.cross(out)), in.dot(out));
     const double interior = 180.0 - turn * 180.0 / std::numbers::pi;
     shape.turn[k] = std::atan2(normal.dot(in.cross(out)), in.dot(out)) / (std::numbers::pi / 2);
     shape.reflex[k] = interior > 180.0 + kReflexSlackDegrees;

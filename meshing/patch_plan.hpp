@@ -79,10 +79,12 @@ BoundaryShape straight_sided_shape(std::span<const int> counts);
 // the overall normal; the sign of a turn is right as long as the surface tilts less than 90°
 // from it).
 // With `surface_normal` (FillGeometryOptions::surface_normal), each turn is measured about the
-// surface's normal at that vertex where it is known, and the loop's overall normal elsewhere.
+// surface's normal at that vertex where it is known, and the loop's overall normal elsewhere;
+// with `flags_about_surface` the reflex and flat flags too (FillGeometryOptions).
 BoundaryShape measured_shape(
     const std::vector<Eigen::MatrixX3d>& side_points,
-    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& surface_normal = {});
+    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& surface_normal = {},
+    bool flags_about_surface = false);
 
 // The best plan for these counts on a boundary of this shape; when the Yasseen construction
 // wins, `yasseen` receives it already built on `side_points`.

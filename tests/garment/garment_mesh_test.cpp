@@ -669,5 +669,24 @@ TEST(Garment, TheGatesAdviceIsNotTriedAboveTheQuadLimit) {
   }
 }
 
+// Issue 18, round 44 (docs/meshing.md, "Round 44"): the kimono blouse's back (a sleeve cut in one
+// with the bodice) was planned with its reflex and flat boundary positions judged about the
+// loop's overall normal, which the sleeve's run over the shoulder turns against: 9 quads off
+// the gate's size band, distortion 28 for the garment and 3 warnings. A body panel left with a
+// sliver or quads off size is filled again with those positions judged about the body's normals
+// and takes that fill when it has fewer flaws and no more of any: the blouse is clean, and so
+// is the peplum bodice (its back had a sliver, 1 warning).
+TEST(Garment, PanelsRefilledWithCornersJudgedAboutTheBodyPassTheGate) {
+  for (const char* name : {"kimono-blouse", "fill-peplum-bodice"}) {
+    const Sketch sketch = load_sketch(std::filesystem::path(SD_SOURCE_DIR) / "data/designs/repro" /
+                                      (std::string(name) + ".json"));
+    const Body body = load_sketch_body(sketch);
+    const BodySurface surface(body.mesh);
+    const Garment garment = build_garment(sketch, surface);
+    for (const QualityWarning& w : check_quality(garment, sketch, nullptr))
+      ADD_FAILURE() << name << ": " << w.message;
+  }
+}
+
 }  // namespace
 }  // namespace sd::garment
