@@ -365,10 +365,13 @@ TEST(Garment, TJunctionSplitsTheCurve) {
 }
 
 // The tank top of the third rehearsal on the Collada human (data/designs/repro/tank-human.json):
-// its back folds with the underarm, where the armhole runs on into the side seam at 51°, as a
-// sixth corner (garment/fold_repair mends the 3 folds, the long thin quads there stay). The
-// gate's warning names that corner and gives "corners" without it, and with that list
-// (data/designs/tank-human.json) the back has no fold and no warning.
+// its back folded with the underarm, where the armhole runs on into the side seam at 51°, as a
+// sixth corner (garment/fold_repair mended the 3 folds, the long thin quads there stayed), and
+// the gate's warning named that corner and gave "corners" without it; with that list
+// (data/designs/tank-human.json) the back has no fold and no warning. Since round 44 the filler
+// does that itself (the back filled again with its corners judged about the body: no warning on
+// it), so the told corner is checked on the forearm long-sleeve top's back sleeve, long thin quads
+// where the underarm begins (81°).
 TEST(Garment, AFoldingPanelIsToldWhichTurningCornerToDrop) {
   const std::filesystem::path designs = std::filesystem::path(SD_SOURCE_DIR) / "data/designs";
   const Sketch first = load_sketch(designs / "repro/tank-human.json");
@@ -376,13 +379,17 @@ TEST(Garment, AFoldingPanelIsToldWhichTurningCornerToDrop) {
     GTEST_SKIP() << "the Collada human (assimp-testmodels) is not installed";
   const Body body = load_sketch_body(first);
   const BodySurface surface(body.mesh);
-  const Garment folded = build_garment(first, surface);
+  for (const QualityWarning& w : check_quality(build_garment(first, surface), first, nullptr))
+    EXPECT_NE(w.panel, "back") << w.message;
+  const Sketch forearm = load_sketch(designs / "repro/long-sleeve-top-human-forearm.json");
+  const BodySurface forearm_surface(load_sketch_body(forearm).mesh);
   bool told = false;
-  for (const QualityWarning& w : check_quality(folded, first, nullptr))
-    told = told || (w.panel == "back" && (w.kind == "inverted_quads" || w.kind == "aspect_ratio") &&
-                    w.message.find("where 'side' begins") != std::string::npos &&
-                    w.message.find(R"("corners": ["cb", "neck_back", "strap", "armhole_back", )"
-                                   R"("hem_back"])") != std::string::npos);
+  for (const QualityWarning& w :
+       check_quality(build_garment(forearm, forearm_surface), forearm, nullptr))
+    told = told || (w.panel == "sleeve_back" && w.kind == "aspect_ratio" &&
+                    w.message.find("where 'underarm' begins") != std::string::npos &&
+                    w.message.find(R"("corners": ["armhole_b", "sleeve_top", "cuff_b"])") !=
+                        std::string::npos);
   EXPECT_TRUE(told);
 
   const Sketch second = load_sketch(designs / "tank-human.json");
@@ -401,8 +408,10 @@ TEST(Garment, AFoldingPanelIsToldWhichTurningCornerToDrop) {
 // now left out, and its front's quads 2.38 times the edge length below the armhole get a curve's
 // own edge_length instead, which applied left fewer warnings. Since round 43 (the panel's
 // finishing ranked by the gate's measures, docs/meshing.md) that front is clean as it is, so the
-// shell top is told nothing but the body's inside_body. The tank top's corner list, which
-// cleaned its back, is still offered, and applying it leaves fewer warnings too.
+// shell top is told nothing but the body's inside_body. The tank top's back, whose corner list
+// the trial kept and which applied left fewer warnings, is filled clean since round 44 (its
+// corners judged about the body, docs/meshing.md): no file of the corpus has a kept corner list
+// now (the forearm long-sleeve top's is tried and dropped), so that half of the test went.
 TEST(Garment, TheGatesAdviceAppliedLeavesFewerWarnings) {
   const std::filesystem::path repro = std::filesystem::path(SD_SOURCE_DIR) / "data/designs/repro";
   const Sketch shell = load_sketch(repro / "shell-top-human.json");
@@ -420,25 +429,12 @@ TEST(Garment, TheGatesAdviceAppliedLeavesFewerWarnings) {
   // inside the neck) comes on top and is not advice.
   std::erase_if(told, [](const QualityWarning& w) { return w.kind == "inside_body"; });
   EXPECT_TRUE(told.empty()) << told.front().message;
-  // What following the dropped offer gives (the reason it is dropped).
+  // What following the dropped offer gives (the reason it is dropped): no fewer warnings (more
+  // until round 44; since then the back with that list is filled clean too, as without it).
   GarmentRequest without_side = shell;
   for (PanelSpec& panel : without_side.panels)
     if (panel.id == "back") panel.corners = {"cb", "neck_b", "shoulder", "armhole_b", "hem_b"};
-  EXPECT_GT(count(without_side), told.size());
-
-  const Sketch tank = load_sketch(repro / "tank-human.json");
-  const BodySurface tank_surface(load_sketch_body(tank).mesh);
-  const std::vector<QualityWarning> tank_told = check_quality_tried(
-      build_garment(tank, tank_surface), tank, load_sketch_body(tank).mesh, nullptr);
-  std::vector<std::string> corners;
-  for (const QualityWarning& w : tank_told)
-    if (w.panel == "back" && !w.corners.empty()) corners = w.corners;
-  ASSERT_FALSE(corners.empty());
-  GarmentRequest tank_fewer = tank;
-  for (PanelSpec& panel : tank_fewer.panels)
-    if (panel.id == "back") panel.corners = corners;
-  EXPECT_LT(check_quality(build_garment(tank_fewer, tank_surface), tank_fewer, nullptr).size(),
-            tank_told.size());
+  EXPECT_GE(count(without_side), told.size());
 }
 
 // A panel's quads larger than asked get a curve's own edge_length from the few curves nearest
@@ -638,12 +634,13 @@ TEST(Garment, OnePieceBackWideningUnderTheStrapPassesTheGate) {
 }
 
 // Above QualityLimits::max_trial_quads the advice that needs the garment meshed again is not
-// tried, and so not offered: the tank top's back, offered a corner list that cleans it (above),
-// gets the plain warning, the same warnings in number and kind (no trial build is run, so a fine
-// preview does not spend minutes re-meshing before it says anything).
+// tried, and so not offered: the forearm long-sleeve top's back sleeve, offered an untried corner
+// list (the tank top's back was the example until round 44 filled it clean), gets the plain
+// warning, the same warnings in number and kind (no trial build is run, so a fine preview does not
+// spend minutes re-meshing before it says anything).
 TEST(Garment, TheGatesAdviceIsNotTriedAboveTheQuadLimit) {
-  const Sketch tank =
-      load_sketch(std::filesystem::path(SD_SOURCE_DIR) / "data/designs/repro/tank-human.json");
+  const Sketch tank = load_sketch(std::filesystem::path(SD_SOURCE_DIR) /
+                                  "data/designs/repro/long-sleeve-top-human-forearm.json");
   if (!std::filesystem::exists(tank.resolve(tank.body.mesh)))
     GTEST_SKIP() << "the Collada human (assimp-testmodels) is not installed";
   const Body body = load_sketch_body(tank);
@@ -658,7 +655,7 @@ TEST(Garment, TheGatesAdviceIsNotTriedAboveTheQuadLimit) {
   ASSERT_EQ(told.size(), plain.size());
   bool offered_before = false;
   for (const QualityWarning& w : plain) offered_before |= !w.corners.empty();
-  EXPECT_TRUE(offered_before);  // the untried list, which the trial keeps (test above)
+  EXPECT_TRUE(offered_before);  // the untried list (which the trial, run, drops here)
   for (size_t i = 0; i < told.size(); ++i) {
     EXPECT_EQ(told[i].kind, plain[i].kind);
     EXPECT_TRUE(told[i].corners.empty()) << told[i].message;
