@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <optional>
@@ -514,7 +515,7 @@ double bow_from_chord(const Eigen::MatrixX2d& uv, const std::vector<int>& run) {
 FlatPanel flatten_freely(const std::string& name, const Eigen::MatrixX3d& v,
                          const Eigen::MatrixX3i& t, const Eigen::MatrixX3d& triangle_warp,
                          const FlatteningOptions& options, bool on_body,
-                         const std::vector<int>& centre_run);
+                         const std::vector<int>& centre_run, double max_fold_turn_deg);
 
 // flatten_freely, with the cause said when a refused piece is drawn folded: a panel taken into a
 // crease of the body (trial 41, P1: a kimono front whose underarm curve dives into the armpit)
@@ -524,9 +525,11 @@ FlatPanel flatten_freely(const std::string& name, const Eigen::MatrixX3d& v,
 FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
                             const Eigen::MatrixX3i& t, const Eigen::MatrixX3d& triangle_warp,
                             const FlatteningOptions& options, bool on_body = true,
-                            const std::vector<int>& centre_run = {}) {
+                            const std::vector<int>& centre_run = {},
+                            double max_fold_turn_deg = std::numeric_limits<double>::infinity()) {
   try {
-    return flatten_freely(name, v, t, triangle_warp, options, on_body, centre_run);
+    return flatten_freely(name, v, t, triangle_warp, options, on_body, centre_run,
+                          max_fold_turn_deg);
   } catch (const PatternError& e) {
     const std::string why = e.what();
     const std::string lead = fmt::format("panel '{}' cannot be cut from flat cloth: ", name);
@@ -554,7 +557,7 @@ FlatPanel flatten_with_warp(const std::string& name, const Eigen::MatrixX3d& v,
 FlatPanel flatten_freely(const std::string& name, const Eigen::MatrixX3d& v,
                          const Eigen::MatrixX3i& t, const Eigen::MatrixX3d& triangle_warp,
                          const FlatteningOptions& options, bool on_body,
-                         const std::vector<int>& centre_run) {
+                         const std::vector<int>& centre_run, double max_fold_turn_deg) {
   FlatPanel out;
   out.id = name;
   out.triangles = t;
@@ -607,8 +610,10 @@ FlatPanel flatten_freely(const std::string& name, const Eigen::MatrixX3d& v,
   };
   // A centre line to hold straight (the piece is then cut on the fold): flattened again from the
   // same start turned with the run's chord on the y axis, the run's x held at 0; kept when it
-  // folds nothing and costs at most `straight_centre_cost` of 95th-percentile stretch. (The
-  // caller passes no run for a panel whose grain is turned off the threads: flatten_garment.)
+  // folds nothing, costs at most `straight_centre_cost` of 95th-percentile stretch and turns the
+  // piece's threads off its mean warp by at most `max_fold_turn_deg` (a fitted piece's
+  // FlatteningOptions::fitted_fold_turn_deg). (The caller passes no run for a panel whose grain
+  // is turned off the threads: flatten_garment.)
   bool straight = false;
   bool cross = false;  // the held centre line lies along the weft, not the warp
   if (folded == 0 && centre_run.size() >= 3 && options.straight_centre_cost >= 0) {
@@ -621,7 +626,13 @@ FlatPanel flatten_freely(const std::string& name, const Eigen::MatrixX3d& v,
     if (folded_triangles(held, t, rest) == 0) {
       const FlatDistortion free = measure(uv, t, rest);
       const FlatDistortion line = measure(held, t, rest);
-      if (line.length_p95 <= free.length_p95 + options.straight_centre_cost) {
+      // The fold (+y here) against the warp's mean image: the nearer thread's angle to it.
+      const Eigen::Vector2d warp = mean_grain(held).normalized();
+      const double off = std::acos(std::min(1.0, std::abs(warp.y()))) * 180.0 / std::numbers::pi;
+      out.fold_turn_deg = std::min(off, 90.0 - off);
+      const bool cheap = line.length_p95 <= free.length_p95 + options.straight_centre_cost;
+      out.fold_turn_refused = cheap && out.fold_turn_deg > max_fold_turn_deg;
+      if (cheap && !out.fold_turn_refused) {
         out.centre_run = centre_run;
         out.free_centre_bow = bow_from_chord(uv, centre_run);
         out.free_distortion = free;
@@ -891,6 +902,8 @@ std::optional<FlatPanel> reflected_piece(const FlatPanel& original, const Eigen:
   out.centre_run = original.centre_run;  // the original's numbering: the caller renumbers it
   out.free_centre_bow = original.free_centre_bow;
   out.centre_off_grain_deg = original.centre_off_grain_deg;
+  out.fold_turn_deg = original.fold_turn_deg;
+  out.fold_turn_refused = original.fold_turn_refused;
   out.free_distortion = original.free_distortion;
   out.distortion.worst_point.x() = -original.distortion.worst_point.x();
   out.distortion.worst_point_2d.x() = width - original.distortion.worst_point_2d.x();
@@ -1123,17 +1136,23 @@ FlatPattern flatten_garment(const Garment& garment, const FlatteningOptions& opt
     const bool on_thread =
         off_thread <= options.fold_off_grain_deg && across_warp <= options.fold_across_warp_deg;
     const std::vector<int> run = on_thread ? line : std::vector<int>{};
-    FlatPanel flat = reflected ? std::move(*reflected)
-                               : flatten_with_warp(name, v, t, warp, options, on_body, run);
+    const PanelEase& ease = garment.panels[p].ease;
+    const double max_turn = ease.warp < 1.0 || ease.weft < 1.0
+                                ? options.fitted_fold_turn_deg
+                                : std::numeric_limits<double>::infinity();
+    FlatPanel flat = reflected
+                         ? std::move(*reflected)
+                         : flatten_with_warp(name, v, t, warp, options, on_body, run, max_turn);
     if (reflected && !flat.centre_run.empty()) flat.centre_run = run;
     flat.centre_across_warp_deg = across_warp;
     // What the cut piece has: a line on a thread is held (and folded) on the grain line but for
     // the panel's turn; a line off the threads keeps its seam, and its chord in the piece lies
     // that far off the grain line (+y) or the cross grain (a mirror copy cut as its original
-    // turned over: the original's).
+    // turned over: the original's); so does a line on a thread whose fold would turn a fitted
+    // piece's threads too far (FlatteningOptions::fitted_fold_turn_deg).
     if (!has_run)
       flat.centre_off_grain_deg = -1.0;
-    else if (on_thread)
+    else if (on_thread && !flat.fold_turn_refused)
       flat.centre_off_grain_deg = off_thread;
     else if (!reflected)
       flat.centre_off_grain_deg = chord_off_thread_deg(flat.uv, line);

@@ -93,6 +93,20 @@ struct FlatteningOptions {
   // on the examples and designs the bodices, skirts, capes and collars reach 0.3-24°, the
   // crotch curves 59-90° (docs/pattern.md, "Folds on the grain").
   double fold_across_warp_deg = 45.0;
+  // Cut on the fold, every thread of a piece is parallel to its fold, where the warp on the body
+  // runs along the centre line only there and turns away from it across the piece: the fold
+  // turns the piece's threads by the angle between the fold and the mean 2D image of its warp,
+  // as the piece held straight has it (FlatPanel::fold_turn_deg), and at the side seam by about
+  // twice that. A fitted piece (ease under 1 either way: cut smaller than the body, a band under
+  // tension round it) shears where its threads run off that tension, so above this turn
+  // (degrees) it is not held straight nor cut on the fold but cut as a mirrored pair with a
+  // centre seam, each half on its own mean warp (as jeans cut their back yoke). 2°: the
+  // fold_off_grain_deg a turned panel is allowed, fabric's own skew; on the examples and designs
+  // the fitted front yokes turn 0.66-1.81°, the fitted back yokes 6.44-10.41°, and cut on the fold
+  // the back yokes pull the tiered skirt 3.7 mm down and keep the circle skirt from resting
+  // (docs/pattern.md, "Round 44"). A piece at ease 1 or more is not held to it: no hoop tension
+  // (the back yokes of three skirts at ease 1, turned 6.2-8.9°, rest on the fold).
+  double fitted_fold_turn_deg = 2.0;
   // A thread has no sense: cloth stretches alike either way along its warp. A piece's grain is the
   // mean of its warp's 2D images as arrows, unless the line that fits them best as threads (the
   // least-squares axis: the mean of their doubled angles, halved) fits them better by more than
@@ -168,6 +182,14 @@ struct FlatPanel {
   // the panel's turn, degrees, 0 .. 90); above fold_across_warp_deg the line is not held
   // straight. −1 when the panel has no centre line.
   double centre_across_warp_deg = -1;
+  // For a panel whose centre line was flattened held straight (kept or not): the angle between
+  // that line (the fold) and the mean 2D image of the warp over the held piece (degrees, 0 ..
+  // 45, to the nearer thread): how far the fold turns the piece's threads off the warp's. −1 when
+  // no held flattening was made. `fold_turn_refused`: the held flattening was not kept for that
+  // turn (a fitted piece, FlatteningOptions::fitted_fold_turn_deg): the piece keeps its centre
+  // seam.
+  double fold_turn_deg = -1;
+  bool fold_turn_refused = false;
   double free_centre_bow = 0;
   FlatDistortion free_distortion;
   // A mirror copy whose 3D triangles are exactly its original's reflected: the index (into

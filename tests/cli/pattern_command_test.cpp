@@ -19,6 +19,7 @@
 #include <utility>
 #include <vector>
 
+#include "garment/panel_flattening.hpp"
 #include "src/render/image.hpp"
 #include "tests/cli/run_command.hpp"
 
@@ -496,11 +497,16 @@ TEST(PatternCommand, CentrePiecesAreCutOnTheFold) {
   const auto json = nlohmann::json::parse(read(out / "pattern.json"));
   const std::string svg = read(out / "pattern.svg");
   std::vector<std::string> folds;
+  const auto on_fold = [&json](const std::string& id) {
+    for (const auto& piece : json["pieces"])
+      if (piece["id"] == id) return piece["on_fold"].get<bool>();
+    return false;
+  };
   for (const auto& piece : json["pieces"]) {
     const std::string id = piece["id"];
     if (!piece["on_fold"].get<bool>()) {
       EXPECT_TRUE(piece["fold_line"].is_null()) << id;
-      if (id.ends_with(".mirror")) {
+      if (id.ends_with(".mirror") && on_fold(id.substr(0, id.size() - 7))) {
         EXPECT_EQ(piece["folded_into"], id.substr(0, id.size() - 7)) << id;
         EXPECT_EQ(svg.find("id=\"piece-" + id + "\""), std::string::npos) << id;
       } else {
@@ -534,8 +540,70 @@ TEST(PatternCommand, CentrePiecesAreCutOnTheFold) {
     EXPECT_NE(drawn.find(">CUT 1 ON FOLD</text>"), std::string::npos) << id;
     EXPECT_NE(drawn.find("data-fold=\"1\""), std::string::npos) << id;
   }
-  EXPECT_EQ(folds,
-            (std::vector<std::string>{"yoke_front", "yoke_back", "skirt_front", "skirt_back"}));
+  // The back yoke, fitted and turned 6.4° by its fold, is a mirror pair (the next test).
+  EXPECT_EQ(folds, (std::vector<std::string>{"yoke_front", "skirt_front", "skirt_back"}));
+}
+
+// A fitted piece (ease under 1) whose fold would turn its threads more than
+// fitted_fold_turn_deg off its mean warp is cut as a mirrored pair with a centre seam, as jeans
+// cut their back yoke (docs/pattern.md, "Round 44"): the A-line skirt's back yoke (ease 0.97,
+// turned 6.4°: cut on the fold its side seam ran about 13° off grain and sheared under the
+// yoke's hoop tension). Its front yoke (turned 1.8°) stays on the fold, and so does the skirt's
+// back at ease 1 (turned 7.9°: no hoop tension).
+TEST(PatternCommand, AFittedPieceWhoseFoldTurnsItsThreadsIsCutAsAPair) {
+  const fs::path out = fresh_dir("fold-turn");
+  const CommandResult r =
+      run_sketchdrape("pattern " + example("a-line-skirt").string() + " -o " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto json = nlohmann::json::parse(read(out / "pattern.json"));
+  const std::string svg = read(out / "pattern.svg");
+  const double limit = garment::FlatteningOptions{}.fitted_fold_turn_deg;
+  std::map<std::string, nlohmann::json> pieces;
+  for (const auto& piece : json["pieces"]) pieces[piece["id"]] = piece;
+  for (const std::string id : {"yoke_back", "yoke_back.mirror"}) {
+    ASSERT_TRUE(pieces.contains(id)) << id;
+    const auto& piece = pieces[id];
+    const auto& centre = piece["centre_line"];
+    EXPECT_FALSE(piece["on_fold"].get<bool>()) << id;
+    EXPECT_TRUE(piece["fold_line"].is_null()) << id;
+    EXPECT_EQ(piece["folded_into"], "") << id;
+    EXPECT_FALSE(centre["held_straight"].get<bool>()) << id;
+    EXPECT_TRUE(centre["seam_for_fold_turn"].get<bool>()) << id;
+    EXPECT_GT(centre["fold_turn_deg"].get<double>(), limit) << id;
+    // Cut on its own mean warp, the centre seam lies as far off the grain line as the fold
+    // would have turned the threads (within a degree: the free and held pieces differ a little).
+    EXPECT_NEAR(centre["off_grain_deg"].get<double>(), centre["fold_turn_deg"].get<double>(), 1.0)
+        << id;
+    // The centre seam has its allowance: no run of the cutting line on the sewing line.
+    for (const auto& run : piece["allowances"]) EXPECT_GT(run["mm"].get<double>(), 0.0) << id;
+  }
+  // One drawn piece, cut 2, its centre seam sewn to the other half's and notched at both ends.
+  EXPECT_EQ(pieces["yoke_back"]["quantity"], 2);
+  EXPECT_EQ(pieces["yoke_back.mirror"]["quantity"], 0);
+  const size_t group = svg.find("id=\"piece-yoke_back\"");
+  ASSERT_NE(group, std::string::npos);
+  const std::string drawn = svg.substr(group, svg.find("</g>\n</g>", group) - group);
+  EXPECT_EQ(drawn.find("class=\"fold\""), std::string::npos);
+  EXPECT_NE(drawn.find("cut 2 (mirror pair)"), std::string::npos) << drawn;
+  bool centre_seam = false;
+  for (const auto& seam : json["seams"])
+    if (seam["a"] == "yoke_back" && seam["b"] == "yoke_back.mirror") {
+      centre_seam = true;
+      EXPECT_NEAR(seam["length_a_mm"].get<double>(), seam["length_b_mm"].get<double>(),
+                  0.005 * seam["length_a_mm"].get<double>());
+    }
+  EXPECT_TRUE(centre_seam);
+  EXPECT_GE(pieces["yoke_back"]["notches"].size(), 4u);
+  // On grain, or at ease 1: on the fold.
+  for (const std::string id : {"yoke_front", "skirt_back"}) {
+    const auto& centre = pieces[id]["centre_line"];
+    EXPECT_TRUE(pieces[id]["on_fold"].get<bool>()) << id;
+    EXPECT_TRUE(centre["held_straight"].get<bool>()) << id;
+    EXPECT_FALSE(centre["seam_for_fold_turn"].get<bool>()) << id;
+  }
+  EXPECT_LT(pieces["yoke_front"]["centre_line"]["fold_turn_deg"].get<double>(), limit);
+  EXPECT_GT(pieces["skirt_back"]["centre_line"]["fold_turn_deg"].get<double>(), limit);
+  EXPECT_EQ(pieces["skirt_back"]["ease"], 1.0);
 }
 
 // A piece cut across the grain is said, naming the piece, the angle and the "grain" turn that
@@ -1152,12 +1220,16 @@ TEST(PatternCommand, BiasPanelsKeepTheirCentreSeamInPatternAndFlatRest) {
       }
     }
   }
-  // The shaped rest's yokes are held straight and folded on the grain, as before.
+  // The shaped rest's front yoke is held straight and folded on the grain, as before; the back
+  // yoke, fitted and turned over fitted_fold_turn_deg by a fold, is a mirror pair (round 44).
   const auto shaped_json = nlohmann::json::parse(read(patterns[0]));
   for (const auto& piece : shaped_json["pieces"]) {
     const std::string id = piece["id"];
-    if (id.starts_with("yoke") && !id.ends_with(".mirror")) {
+    if (id == "yoke_front") {
       EXPECT_TRUE(piece["on_fold"].get<bool>()) << id;
+    } else if (id == "yoke_back") {
+      EXPECT_FALSE(piece["on_fold"].get<bool>()) << id;
+      EXPECT_TRUE(piece["centre_line"]["seam_for_fold_turn"].get<bool>()) << id;
     }
   }
   // Pattern and flat rest give the bias pieces the same flattening: the same centre seams.
@@ -1212,11 +1284,13 @@ TEST(PatternCommand, CrotchCurveIsNotAFoldAndLegsKeepTheirGrain) {
     EXPECT_LT(std::acos(std::min(1.0, cosine)) * 180.0 / std::numbers::pi, 1.5)
         << id << ": the leg hangs along its grain line";
   }
-  // The yokes' centre lines run down the grain: still cut on the fold.
-  for (const std::string id : {"yoke_front", "yoke_back"}) {
-    EXPECT_TRUE(pieces.at(id)["on_fold"].get<bool>()) << id;
-    EXPECT_LE(pieces.at(id)["centre_line"]["off_grain_deg"].get<double>(), 2.0) << id;
-  }
+  // The front yoke's centre line runs down the grain: still cut on the fold. The back yoke
+  // (ease 0.96), whose fold would turn its threads 7.5° off its warp, is a mirror pair with a
+  // centre seam (round 44, AFittedPieceWhoseFoldTurnsItsThreadsIsCutAsAPair).
+  EXPECT_TRUE(pieces.at("yoke_front")["on_fold"].get<bool>());
+  EXPECT_LE(pieces.at("yoke_front")["centre_line"]["off_grain_deg"].get<double>(), 2.0);
+  EXPECT_FALSE(pieces.at("yoke_back")["on_fold"].get<bool>());
+  EXPECT_TRUE(pieces.at("yoke_back")["centre_line"]["seam_for_fold_turn"].get<bool>());
 }
 
 // A tube skirt (front and back halves of a 0.28 m cylinder, 0.4 m long, hung by its waist

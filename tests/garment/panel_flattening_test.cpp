@@ -658,13 +658,60 @@ TEST(PanelFlattening, BiasPanelCentreLineIsNotHeldForAFold) {
     EXPECT_EQ((bias.uv - loose.uv).cwiseAbs().maxCoeff(), 0.0) << id;
     EXPECT_FALSE(find(regardless, id).centre_run.empty()) << id << ": held when any angle goes";
   }
-  for (const std::string id : {"yoke_front", "yoke_back"}) {
-    const FlatPanel yoke = find(pattern, id);
-    ASSERT_GE(yoke.centre_run.size(), 3u) << id;
-    EXPECT_EQ(yoke.centre_off_grain_deg, 0.0) << id;
-    const Eigen::Vector2d chord =
-        yoke.uv.row(yoke.centre_run.back()) - yoke.uv.row(yoke.centre_run.front());
-    EXPECT_LT(std::abs(chord.x()), 1e-9 * chord.norm()) << id << ": the fold runs along +y";
+  const FlatPanel yoke = find(pattern, "yoke_front");
+  ASSERT_GE(yoke.centre_run.size(), 3u);
+  EXPECT_EQ(yoke.centre_off_grain_deg, 0.0);
+  const Eigen::Vector2d chord =
+      yoke.uv.row(yoke.centre_run.back()) - yoke.uv.row(yoke.centre_run.front());
+  EXPECT_LT(std::abs(chord.x()), 1e-9 * chord.norm()) << "the fold runs along +y";
+  // The back yoke (ease 0.97) is on a thread too, but its fold would turn its threads 6.4° off
+  // its warp (FlatteningOptions::fitted_fold_turn_deg): cut free, as a mirror pair, its centre
+  // seam as far off the grain line.
+  const FlatPanel back = find(pattern, "yoke_back");
+  EXPECT_TRUE(back.centre_run.empty());
+  EXPECT_TRUE(back.fold_turn_refused);
+  EXPECT_GT(back.fold_turn_deg, FlatteningOptions{}.fitted_fold_turn_deg);
+  EXPECT_NEAR(back.centre_off_grain_deg, back.fold_turn_deg, 1.0);
+}
+
+// The fold's turn: a fitted piece (ease under 1) whose fold would turn its threads more than
+// fitted_fold_turn_deg off its mean warp keeps its centre seam; the same piece at ease 1, or any
+// piece with the limit lifted, is held straight and cut on the fold (round 44: the A-line
+// skirt's back yoke, turned 6.4°; its front yoke, 1.8°, stays on the fold either way).
+TEST(PanelFlattening, FittedPieceIsNotHeldWhenItsFoldTurnsItsThreads) {
+  static const Body body = load_body("builtin");
+  static const BodySurface surface(body.mesh);
+  const std::filesystem::path file =
+      std::filesystem::path(SD_SOURCE_DIR) / "data/examples/a-line-skirt.json";
+  const Garment fitted = build_garment(load_sketch(file), surface);
+  scene::Sketch loose_sketch = load_sketch(file);
+  for (auto& panel : loose_sketch.panels) panel.ease = {};
+  const Garment loose = build_garment(loose_sketch, surface);
+  FlatteningOptions any_turn;
+  any_turn.fitted_fold_turn_deg = 90;
+  const auto find = [](const FlatPattern& p, const std::string& id) {
+    const auto it = std::find_if(p.panels.begin(), p.panels.end(),
+                                 [&](const FlatPanel& f) { return f.id == id; });
+    EXPECT_NE(it, p.panels.end()) << id;
+    return *it;
+  };
+  const FlatPattern cut = flatten_garment(fitted);
+  const FlatPanel back = find(cut, "yoke_back");
+  EXPECT_TRUE(back.centre_run.empty());
+  EXPECT_TRUE(back.fold_turn_refused);
+  EXPECT_GT(back.fold_turn_deg, 5.0);
+  EXPECT_LT(back.fold_turn_deg, 8.0);
+  EXPECT_TRUE(find(cut, "yoke_back.mirror").fold_turn_refused);
+  const FlatPanel front = find(cut, "yoke_front");
+  EXPECT_FALSE(front.centre_run.empty());
+  EXPECT_FALSE(front.fold_turn_refused);
+  EXPECT_LT(front.fold_turn_deg, FlatteningOptions{}.fitted_fold_turn_deg);
+  for (const FlatPattern& held : {flatten_garment(loose), flatten_garment(fitted, any_turn)}) {
+    const FlatPanel yoke = find(held, "yoke_back");
+    EXPECT_FALSE(yoke.centre_run.empty());
+    EXPECT_FALSE(yoke.fold_turn_refused);
+    EXPECT_NEAR(yoke.fold_turn_deg, back.fold_turn_deg, 0.5);
+    EXPECT_EQ(yoke.centre_off_grain_deg, 0.0);
   }
 }
 

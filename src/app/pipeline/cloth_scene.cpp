@@ -146,6 +146,9 @@ void build_sheet_scene(const scene::Sketch& sketch, ClothScene& scene) {
 // lower (top 1.0199 m, its test's floor 1.02 m), the other two are unchanged. Round 43 traced
 // that to the fold's grain, not the pieces (same seams, centre lines and ease): cut on the fold
 // the fitted back yoke's side runs 13° off grain and shears there under its hoop tension.
+// Round 44 cuts such a piece as a pair (FlatteningOptions::fitted_fold_turn_deg): held with
+// that rule the tiered and circle skirts rest (top 1.0244 m), and the switch waits on the
+// other three (the hip cape, the collar top, the arms-lowering t-shirt: no fitted piece).
 garment::FlatteningOptions flat_rest_flattening() {
   garment::FlatteningOptions flattening;
   flattening.straight_centre_cost = -1;

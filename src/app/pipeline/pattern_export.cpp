@@ -660,10 +660,19 @@ nlohmann::json distortion_json(const garment::FlatDistortion& d) {
 // flattening gave for comparison; null for a piece flattened freely.
 nlohmann::json centre_line_json(const garment::FlatPanel& flat) {
   if (flat.centre_off_grain_deg < 0) return nullptr;
+  // How far a fold turns the piece's threads off its mean warp (null when no held flattening
+  // was made), and whether a fitted piece kept its centre seam for it.
+  const nlohmann::json turn =
+      flat.fold_turn_deg >= 0 ? nlohmann::json(flat.fold_turn_deg) : nlohmann::json(nullptr);
   if (flat.centre_run.empty())
-    return {{"held_straight", false}, {"off_grain_deg", flat.centre_off_grain_deg}};
+    return {{"held_straight", false},
+            {"off_grain_deg", flat.centre_off_grain_deg},
+            {"fold_turn_deg", turn},
+            {"seam_for_fold_turn", flat.fold_turn_refused}};
   return {{"held_straight", true},
           {"off_grain_deg", flat.centre_off_grain_deg},
+          {"fold_turn_deg", turn},
+          {"seam_for_fold_turn", false},
           {"free_bow_mm", kMm * flat.free_centre_bow},
           {"free_distortion", distortion_json(flat.free_distortion)}};
 }
