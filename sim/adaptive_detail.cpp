@@ -28,6 +28,14 @@ using meshing::TriangleId;
 using meshing::VertexId;
 using Clock = std::chrono::steady_clock;
 
+// The error estimates (bend sags |θ − θ0|·w/8 for splits and merges) measure the cloth against
+// the surface it was drawn as, whatever its bending rests in: the level-0 mesh resolves that
+// surface at the file's edge length, so detail is added where the cloth leaves it, for a
+// shaped and a flat-rest drape alike. Against a flat rest (θ0 = 0) every hinge curved round the
+// body asked for detail and held it: trial 44's flat-rest blouse refined its armholes to level
+// 5 and never came to rest (docs/adaptive.md, "Round 44").
+constexpr BendRestShape kEstimateRest = BendRestShape::designed;
+
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -398,7 +406,7 @@ double AdaptiveCloth::rebuild(AdaptiveTransfer& state, const SimulationSettings*
     model.mass = state.m;
   }
 
-  edge_rest_ = edge_rest_geometry(arrays_, material_.model_options.bend_rest);
+  edge_rest_ = edge_rest_geometry(arrays_, kEstimateRest);
 
   std::vector<Pin> pins;
   for (const PinRecord& pin : state.pins) pins.push_back({pin.vertex, pin.path});
@@ -464,7 +472,7 @@ void AdaptiveCloth::count_split(const std::vector<BlockChange>& changes, Adaptiv
 MergeInputs AdaptiveCloth::merge_inputs() const {
   MergeInputs in{mesh_,
                  settings_,
-                 material_.model_options.bend_rest,
+                 kEstimateRest,
                  birth_,
                  simulation_->positions(),
                  simulation_->velocities(),
