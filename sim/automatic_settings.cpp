@@ -29,8 +29,8 @@ AutomaticChoice choose_settings(const SceneTraits& scene) {
     // without it: a garment's contact set changes by tens of vertices a step, so the stale factor
     // needs 8-13 iterations, each a pair of memory-bound supernodal triangular solves costing
     // about a tenth of a factorisation, and most tries fail at the cap and factorise anyway
-    // (the wide-leg jumpsuit: 11 of 19 tries; drape CPU -5 to -10 % without; the maxi dress,
-    // 237 solves on an earlier factor in 473: -10 %; docs/benchmarks.md, round 44).
+    // (the wide-leg jumpsuit: 11 of 19 tries; drape CPU -5 to -11 % without; the maxi dress,
+    // 237 solves on an earlier factor in 473: -4 to -10 %; docs/benchmarks.md, round 44).
     choice.reuse_factor = false;
   } else {
     // A sheet held by pins or lying on a body: the PCG, with IC(0) up to the size where the
