@@ -359,6 +359,24 @@ TEST(ValidateCommand, APanelFoldedIntoTheArmpitIsWarnedAndPatternSaysWhere) {
   fs::remove_all(dir);
 }
 
+// Trial 42, P5, again in trial 43 (data/designs/repro/wrap-dress-listed-corners.json, the wrap
+// dress's try 4): every corner of 'front_over' is listed, yet its sliver (5.4°) was told "a
+// boundary corner there is too sharp or not listed in \"corners\"". The sliver lies 9.2 cm down
+// the 19° wedge where 'wrap' leaves the neckline, 3 edges from the corner: a listed corner was
+// looked for within 2 edges only. A narrow corner's reach is 1 / sin(half its angle) edges.
+TEST(ValidateCommand, ASliverAtANarrowListedCornerIsToldTheCornerIsListed) {
+  const std::string file =
+      std::string(SD_SOURCE_DIR) + "/data/designs/repro/wrap-dress-listed-corners.json";
+  const CommandResult v = run_sketchdrape("validate " + file);
+  EXPECT_EQ(v.exit_code, 0) << v.output;
+  EXPECT_NE(v.output.find("panel 'front_over': 1 quad(s) have a corner below 10° (the smallest "
+                          "5.4°) at the corner where 'wrap' begins (the outline turns 161° there), "
+                          "which \"corners\" already lists"),
+            std::string::npos)
+      << v.output;
+  EXPECT_EQ(v.output.find("not listed in"), std::string::npos) << v.output;
+}
+
 // Trial 41, P4: "rest": "flat" is accepted per panel and per file by every command; a flat rest
 // whose panel cannot be flattened is refused at the key that asked for it (the file's
 // /simulate/rest was refused at /panels/1/rest, a key the file did not have, and read as the
