@@ -47,6 +47,17 @@ struct CurveSpec {
   // Per points3d point: given relative to a landmark ({"at": ...}) rather than as [x, y, z]
   // (empty: none is).
   std::vector<bool> at_landmark;
+  // Per points3d point given relative to a landmark: its name, where that landmark is on this
+  // body and the offset as written (m; with "drawn_on" the point is not their sum: the offset is
+  // scaled for this body). For a point far off the body, which is then told its landmark and the
+  // offset's readings in other units (trial 43, P4, P15). At a limb's landmark (an elbow, a wrist,
+  // a knee, an ankle) also the torso landmark nearest the point where it was drawn and the offset
+  // from it there. Empty names for [x, y, z] points.
+  std::vector<std::string> landmark_name;
+  std::vector<Eigen::Vector3d> landmark_at;
+  std::vector<Eigen::Vector3d> landmark_offset;
+  std::vector<std::string> torso_name;
+  std::vector<Eigen::Vector3d> torso_offset;
   double offset = 0.0;                   // metres along the body normal (default: file's)
   bool on_body = true;                   // project/snap onto the body's offset surface
   bool smooth = true;                    // Catmull-Rom through the points (false: polyline)

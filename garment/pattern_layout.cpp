@@ -14,6 +14,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -204,6 +205,73 @@ Eigen::MatrixX2d offset_outwards(const std::string& name, const Eigen::MatrixX2d
   Eigen::Index row = out.rows() - 1;  // reversed: counter-clockwise like the sewing line
   for (auto v = best->vertices_begin(); v != best->vertices_end(); ++v, --row)
     out.row(row) << v->x(), v->y();
+  return out;
+}
+
+// The sewing line of a piece cut on the fold, offset by one allowance all round but along the
+// fold (points s → e of `sewing`, a straight run, which has none): the piece opened out across
+// the fold (its reflection joined to it there), offset as one piece by the straight skeleton and
+// cut back along the fold line. So the offsets of a concave curve tighter than the allowance merge
+// as on a piece with one allowance all round, where offset_by_edge's mitred lines would cross
+// (trial 43, P1: the jumpsuit's back leg, then folded along its crotch curve, was refused at the
+// default 1 cm; docs/pattern.md, "Seam allowance per seam"). std::nullopt when the opened piece
+// is no simple polygon (the piece reaches across its fold line): the caller mitres edge by edge.
+std::optional<Eigen::MatrixX2d> offset_on_fold(const std::string& name,
+                                               const Eigen::MatrixX2d& sewing, Eigen::Index s,
+                                               Eigen::Index e, double allowance) {
+  const Eigen::Index n = sewing.rows();
+  const Eigen::Vector2d a = sewing.row(s).transpose();
+  const Eigen::Vector2d along = (sewing.row(e).transpose() - a).normalized();
+  const Eigen::Vector2d inside(-along.y(), along.x());  // left of the fold on a CCW outline
+  // The outline off the fold, e → s; then its reflection back, s → e, ends left out (on the fold).
+  std::vector<Eigen::Vector2d> rest;
+  for (Eigen::Index i = e;; i = (i + 1) % n) {
+    const Eigen::Vector2d p = sewing.row(i).transpose();
+    if (inside.dot(p - a) < -1e-9) return std::nullopt;
+    rest.push_back(p);
+    if (i == s) break;
+  }
+  std::vector<Eigen::Vector2d> opened = rest;
+  for (size_t k = rest.size() - 1; k-- > 1;) {
+    const Eigen::Vector2d q = rest[k] - a;
+    opened.push_back(a + 2 * q.dot(along) * along - q);
+  }
+  Eigen::MatrixX2d whole(static_cast<Eigen::Index>(opened.size()), 2);
+  for (size_t k = 0; k < opened.size(); ++k)
+    whole.row(static_cast<Eigen::Index>(k)) = opened[k].transpose();
+  Eigen::MatrixX2d offset;
+  try {
+    offset = offset_outwards(name, whole, allowance);
+  } catch (const PatternError&) {
+    return std::nullopt;
+  }
+  // Clipped to the piece's side of the fold line (Sutherland-Hodgman against one half-plane):
+  // the skeleton of a symmetric polygon is symmetric, so this is its half, and the cutting line
+  // runs along the fold between where the allowances of the fold's neighbours reach it.
+  const auto side = [&](const Eigen::Vector2d& p) {
+    const double f = inside.dot(p - a);
+    return std::abs(f) < 1e-12 ? 0.0 : f;
+  };
+  std::vector<Eigen::Vector2d> half;
+  for (Eigen::Index i = 0; i < offset.rows(); ++i) {
+    const Eigen::Vector2d p = offset.row(i).transpose();
+    const Eigen::Vector2d q = offset.row((i + 1) % offset.rows()).transpose();
+    const double fp = side(p), fq = side(q);
+    if (fp >= 0) half.push_back(p);
+    if (fp * fq < 0) half.push_back(p + fp / (fp - fq) * (q - p));
+  }
+  std::vector<Eigen::Vector2d> cut;
+  for (const Eigen::Vector2d& p : half)
+    if (cut.empty() || (p - cut.back()).norm() > 1e-12) cut.push_back(p);
+  while (cut.size() > 1 && (cut.front() - cut.back()).norm() <= 1e-12) cut.pop_back();
+  Polygon polygon;
+  Eigen::MatrixX2d out(static_cast<Eigen::Index>(cut.size()), 2);
+  for (size_t k = 0; k < cut.size(); ++k) {
+    out.row(static_cast<Eigen::Index>(k)) = cut[k].transpose();
+    polygon.push_back(Kernel::Point_2(cut[k].x(), cut[k].y()));
+  }
+  if (cut.size() < 3 || !polygon.is_simple() || polygon.orientation() != CGAL::COUNTERCLOCKWISE)
+    return std::nullopt;
   return out;
 }
 
@@ -485,9 +553,30 @@ PatternLayout lay_out_pattern(const FlatPattern& pattern, const PatternLayoutOpt
     }
     bool uniform = true;
     for (const double a : dense_allowance) uniform = uniform && a == dense_allowance.front();
-    piece.cutting = !uniform
-                        ? offset_by_edge(flat.id, piece.curve.points, dense_allowance)
-                        : offset_outwards(flat.id, piece.curve.points, dense_allowance.front());
+    // One allowance but along a fold (none there): the skeleton of the piece opened out.
+    std::optional<Eigen::MatrixX2d> folded;
+    if (!uniform && folds) {
+      size_t first = edges;
+      for (size_t k = 0; k < edges; ++k)
+        if (options.fold_edge[p][k] && !options.fold_edge[p][(k + edges - 1) % edges]) first = k;
+      double other = -1;
+      bool one_other = first < edges;
+      for (size_t k = 0; k < edges && one_other; ++k)
+        if (!options.fold_edge[p][k]) {
+          if (other < 0) other = allowance[k];
+          one_other = allowance[k] == other && other > 0;
+        }
+      if (one_other) {
+        size_t last = first;
+        while (options.fold_edge[p][(last + 1) % edges]) last = (last + 1) % edges;
+        folded = offset_on_fold(flat.id, piece.curve.points, piece.curve.at[first],
+                                piece.curve.at[(last + 1) % edges], other);
+      }
+    }
+    piece.cutting = folded ? *folded
+                    : uniform
+                        ? offset_outwards(flat.id, piece.curve.points, dense_allowance.front())
+                        : offset_by_edge(flat.id, piece.curve.points, dense_allowance);
     piece.origin = -piece.cutting.colwise().minCoeff().transpose();
     piece.sewing.rowwise() += piece.origin.transpose();
     piece.curve.points.rowwise() += piece.origin.transpose();

@@ -62,6 +62,8 @@ constexpr int kArmLength = 6;
 // A sliver is at a listed corner when the corner is within this many edge lengths of the
 // sliver's quad centre (the quad at a corner has its centre about one edge in).
 constexpr double kListedCornerReach = 2.0;
+// The sine of half the narrowest corner angle that reach is widened for (5.7°: 20 edges).
+constexpr double kNarrowestSine = 0.05;
 
 // The curves of each side of `panel` (its curves grouped by their edge counts on the outline), or
 // empty when they do not add up (a corner inside a curve).
@@ -277,12 +279,21 @@ std::vector<QualityWarning> check_quality(const Garment& garment, const GarmentR
     // curves all listed, was told to list the corner where 'shoulder' begins, which it did; what
     // cleaned it was the list left out). Said so, with the list without that corner, which
     // check_quality_tried tries (and, when that does not help, no list at all).
+    // A narrow corner's slivers lie farther from its point: its two curves are less than two
+    // edges apart out to 1 / sin(half its angle) edge lengths from it (trial 42's P5 again in
+    // trial 43: the wrap dress's wrap leaves the neckline at a narrow angle, the sliver 8.8 cm
+    // down the wedge between them, 2.9 edges, beyond the 2 edges of a square corner).
+    const auto reach = [&](const GarmentPanel::ListedCorner& c) {
+      const double half = 0.5 * (180.0 - c.turning_deg) * std::numbers::pi / 180.0;
+      return std::max(kListedCornerReach, 1.0 / std::max(std::sin(half), kNarrowestSine)) * target;
+    };
     const GarmentPanel::ListedCorner* listed = nullptr;
     if (angle.count > 0)
-      for (const GarmentPanel::ListedCorner& c : panel.listed_corners)
-        if ((c.at - angle.where).norm() <= kListedCornerReach * target &&
+      for (const GarmentPanel::ListedCorner& c : panel.listed_corners) {
+        if ((c.at - angle.where).norm() <= reach(c) &&
             (listed == nullptr || (c.at - angle.where).norm() < (listed->at - angle.where).norm()))
           listed = &c;
+      }
     std::string listed_hint;
     std::vector<std::string> listed_rest;
     if (listed != nullptr && panel.listed_corners.size() > 3) {

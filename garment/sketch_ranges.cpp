@@ -6,6 +6,7 @@
 #include <cmath>
 #include <map>
 #include <string_view>
+#include <tuple>
 #include <vector>
 
 #include "garment/stroke_projection.hpp"
@@ -41,6 +42,32 @@ std::string outside_sentence(const Eigen::Vector3d& p, const Reach& reach,
                             fmt::format("{} =", kAxis[axis]),
                             {reach.low[axis] + kBodyMarginHeights * reach.height,
                              reach.high[axis] - kBodyMarginHeights * reach.height}));
+}
+
+// The sentence for a landmark point `p` outside `reach` along `axis`, given as landmark `name` at
+// `at` (on this body) plus `offset` as written: the offset is the number typed, so it is quoted
+// with the readings of it in millimetres and centimetres that bring the point within reach (trial
+// 43, P15: an offset typed as [-36, -1, 0] for 36 mm was told "if you typed centimetres, -35.8236
+// cm is -0.358236 m", the reading of the sum). With "drawn_on" the offset is scaled for this body
+// (p - at), and each reading scales it alike.
+std::string offset_sentence(const Eigen::Vector3d& p, int axis, const Reach& reach,
+                            const std::string& what, const std::string& name,
+                            const Eigen::Vector3d& at, const Eigen::Vector3d& offset) {
+  std::string readings;
+  for (const auto& [unit, symbol, scale] :
+       {std::tuple{"millimetres", "mm", 1e-3}, std::tuple{"centimetres", "cm", 1e-2}}) {
+    const double moved = at[axis] + (p[axis] - at[axis]) * scale;
+    if (moved < reach.low[axis] || moved > reach.high[axis]) continue;
+    readings += fmt::format("{} {}, {:g} {} is {:g} m", readings.empty() ? "if you typed" : "; if",
+                            unit, offset[axis], symbol, offset[axis] * scale);
+  }
+  return fmt::format(
+      "{} is too far from the body ({}): it is landmark '{}' at ({:.3f}, {:.3f}, {:.3f}) m plus "
+      "the offset [{:g}, {:g}, {:g}], so its {} = {:.6g} m is outside {:.6g} .. {:.6g} m; "
+      "offsets are in metres{}",
+      what, body_height_clause(reach.height), name, at.x(), at.y(), at.z(), offset.x(), offset.y(),
+      offset.z(), kAxis[axis], p[axis], reach.low[axis], reach.high[axis],
+      readings.empty() ? "" : ": " + readings);
 }
 
 // Length of a control polygon, metres (the spline through the points is about as long).
@@ -126,6 +153,14 @@ void check_against_body(const GarmentRequest& sketch, const meshing::BoundingBox
       const std::string path = fmt::format("{}{}/{}", curve.json_path, key, i);
       if (curve.is_3d()) {
         const Eigen::Vector3d& p = curve.points3d[i];
+        if (i < curve.landmark_name.size() && !curve.landmark_name[i].empty())
+          for (int k = 0; k < 3; ++k)
+            if (p[k] < reach.low[k] || p[k] > reach.high[k])
+              sketch.fail(
+                  fmt::format("{}/offset/{}", path, k),
+                  offset_sentence(p, k, reach, fmt::format("point {} of curve '{}'", i, curve.id),
+                                  curve.landmark_name[i], curve.landmark_at[i],
+                                  curve.landmark_offset[i]));
         for (int k = 0; k < 3; ++k)
           if (p[k] < reach.low[k] || p[k] > reach.high[k])
             sketch.fail(

@@ -530,12 +530,38 @@ ProjectedCurve project_curve(const GarmentRequest& sketch, const CurveSpec& curv
             "itself near ({:.3f}, {:.3f}, {:.3f})",
             curve.id, distance, inside ? "inside" : "off", farthest, written.x(), written.y(),
             written.z(), inside ? "deep below" : "far from", where.x(), where.y(), where.z());
-        snapped = fmt::format(
-            ". A point that far off was likely written for another body: points given relative "
-            "to a landmark of the body they were drawn on ({{\"at\": \"left_armpit\", \"offset\": "
-            "[dx, dy, dz]}}, docs/sketch-format.md, \"Points relative to a landmark\") follow it "
-            "onto this one; or {}",
-            near_surface);
+        const bool relative =
+            farthest < curve.landmark_name.size() && !curve.landmark_name[farthest].empty();
+        if (!relative) {
+          snapped = fmt::format(
+              ". A point that far off was likely written for another body: points given relative "
+              "to a landmark of the body they were drawn on ({{\"at\": \"left_armpit\", "
+              "\"offset\": [dx, dy, dz]}}, docs/sketch-format.md, \"Points relative to a "
+              "landmark\") follow it onto this one; or {}",
+              near_surface);
+        } else {
+          // Relative to a landmark already (trial 43, P4: a hip point written from the hanging
+          // left wrist of the built-in body landed 10 cm off the Collada human, whose arms are
+          // held higher, and was told to use landmark-relative points): say where its landmark
+          // is on this body, and for a limb's, the torso landmark to write it from instead.
+          const std::string& name = curve.landmark_name[farthest];
+          const Eigen::Vector3d& at = curve.landmark_at[farthest];
+          const std::string& torso = curve.torso_name[farthest];
+          const Eigen::Vector3d& t = curve.torso_offset[farthest];
+          snapped = fmt::format(
+              ". The point is relative to '{}', which on this body is at ({:.3f}, {:.3f}, "
+              "{:.3f}) m, {:.1f} cm from it{}",
+              name, at.x(), at.y(), at.z(), 100 * (written - at).norm(),
+              torso.empty()
+                  ? fmt::format(": write it nearer its landmark, or relative to a landmark "
+                                "nearer the place meant; or {}",
+                                near_surface)
+                  : fmt::format(": a landmark of a limb moves with the limb's pose, which "
+                                "bodies do not share; give a point on the torso relative to a "
+                                "torso landmark, here {{\"at\": \"{}\", \"offset\": [{:.3f}, "
+                                "{:.3f}, {:.3f}]}} (the same place where it was drawn)",
+                                torso, t.x(), t.y(), t.z()));
+        }
       } else {
         snapped = fmt::format(
             " once its points are moved onto the body: point {} ({:.3f}, {:.3f}, {:.3f}) moved "

@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <set>
@@ -163,8 +164,25 @@ const BodyLandmarks& sketch_landmarks(const Reader& r, const Sketch& sk, const s
 }
 
 // {"at": "left_armpit", "offset": [dx, dy, dz]}: a landmark's position plus an offset (m).
-Eigen::Vector3d landmark_point(const Reader& r, const json& j, const std::string& path,
-                               const Sketch& sk) {
+// A point given relative to a landmark, with what its errors quote (CurveSpec::landmark_name).
+struct LandmarkPoint {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  std::string name;
+  Eigen::Vector3d at = Eigen::Vector3d::Zero(), offset = Eigen::Vector3d::Zero();
+  std::string torso;
+  Eigen::Vector3d torso_offset = Eigen::Vector3d::Zero();
+};
+
+// A landmark of a limb (it moves with the limb's pose, which bodies do not share) and of the
+// torso.
+bool limb_landmark(const std::string& name) {
+  for (const char* part : {"elbow", "wrist", "knee", "ankle"})
+    if (name.find(part) != std::string::npos) return true;
+  return false;
+}
+
+LandmarkPoint landmark_point(const Reader& r, const json& j, const std::string& path,
+                             const Sketch& sk) {
   r.check_keys(j, path, {"at", "offset"});
   if (!j.contains("at"))
     r.fail(path,
@@ -175,10 +193,32 @@ Eigen::Vector3d landmark_point(const Reader& r, const json& j, const std::string
       j.contains("offset") ? r.vector<3>(j["offset"], path + "/offset") : Eigen::Vector3d::Zero();
   const BodyLandmarks& landmarks = sketch_landmarks(r, sk, path, sk.body, "/body");
   if (const Landmark* l = landmarks.find(name)) {
-    if (!sk.body.drawn_on) return l->position + offset;
-    // Written for another body: the offset scales by the two bodies' sizes at the landmark.
-    const BodyLandmarks& drawn = sketch_landmarks(r, sk, path, *sk.body.drawn_on, "/body/drawn_on");
-    return landmark_point_for(landmarks, drawn, *l, offset);
+    LandmarkPoint out;
+    out.name = name;
+    out.at = l->position;
+    out.offset = offset;
+    const BodyLandmarks* where_drawn = &landmarks;
+    Eigen::Vector3d drawn_point = l->position + offset;
+    if (!sk.body.drawn_on) {
+      out.point = drawn_point;
+    } else {
+      // Written for another body: the offset scales by the two bodies' sizes at the landmark.
+      const BodyLandmarks& drawn =
+          sketch_landmarks(r, sk, path, *sk.body.drawn_on, "/body/drawn_on");
+      out.point = landmark_point_for(landmarks, drawn, *l, offset);
+      if (const Landmark* d = drawn.find(name)) drawn_point = d->position + offset;
+      where_drawn = &drawn;
+    }
+    if (limb_landmark(name)) {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (const Landmark& t : where_drawn->points)
+        if (!limb_landmark(t.name) && (t.position - drawn_point).norm() < nearest) {
+          nearest = (t.position - drawn_point).norm();
+          out.torso = t.name;
+          out.torso_offset = drawn_point - t.position;
+        }
+    }
+    return out;
   }
   std::string names, hint;
   size_t best = 4;  // suggest only close spellings ("left_sholder", "rightarmpit", "Waist")
@@ -218,9 +258,18 @@ CurveSpec parse_curve(const Reader& r, const json& j, const std::string& path, c
     if (has_2d)
       curve.points.push_back(r.position<2>(pts[i], ip));
     else {
-      curve.points3d.push_back(pts[i].is_object() ? landmark_point(r, pts[i], ip, sk)
-                                                  : r.position<3>(pts[i], ip));
+      LandmarkPoint at;
+      if (pts[i].is_object())
+        at = landmark_point(r, pts[i], ip, sk);
+      else
+        at.point = r.position<3>(pts[i], ip);
+      curve.points3d.push_back(at.point);
       curve.at_landmark.push_back(pts[i].is_object());
+      curve.landmark_name.push_back(at.name);
+      curve.landmark_at.push_back(at.at);
+      curve.landmark_offset.push_back(at.offset);
+      curve.torso_name.push_back(at.torso);
+      curve.torso_offset.push_back(at.torso_offset);
     }
   }
   if (j.contains("view")) {

@@ -71,6 +71,31 @@ TEST(DrapeWarnings, SettledWarningNamesWhatHoldsTheGarment) {
   EXPECT_EQ(bare.find("top"), std::string::npos) << bare;
 }
 
+// Trial 43, P6: the tube top's bodice given the advised "ease" 0.95 while its flounce, sewn to it,
+// kept 1: the ease-mismatch warning followed (past 4.5 % a seam may never rest). The advice names
+// the panels sewn to the opening's, with the most they may keep: 0.99 (0.04 / 0.99 = 4.0 %); a
+// panel already that low, and a gathered one (not judged by that warning), are not named.
+TEST(DrapeWarnings, SettledWarningNamesThePanelsSewnToTheTopEdge) {
+  const std::optional<TopOpening> top = top_opening(yoke_over_skirt());
+  ASSERT_TRUE(top);
+  ASSERT_EQ(top->sewn_to.size(), 1u);
+  EXPECT_EQ(top->sewn_to[0].first, "skirt");
+  const std::string text = settled_warning("tube.json", 0.099, top, "chest");
+  EXPECT_NE(text.find("give that panel \"ease\" below 1 (e.g. 0.95) or a smaller \"offset\" so "
+                      "it fits snugly there; with that ease give the panel sewn to it ('skirt') "
+                      "an \"ease\" of at most 0.99, so that the seams between them stay within "
+                      "4.5 %"),
+            std::string::npos)
+      << text;
+  garment::Garment snug = yoke_over_skirt();
+  snug.panels[1].ease = {0.99, 0.99};
+  EXPECT_EQ(settled_warning("tube.json", 0.099, top_opening(snug), "chest").find("sewn to"),
+            std::string::npos);
+  garment::Garment gathered = yoke_over_skirt();
+  gathered.panels[1].ease = {1.0, 1.5};
+  EXPECT_TRUE(top_opening(gathered)->sewn_to.empty());
+}
+
 // Trial 36: a blouse eased 1.08, as docs/sketch-format.md advises, hung 3.8 cm lower and was
 // told to make its back panel 5 % too small. Only the ease of the panels at the top opening
 // counts (they hang the rest), the larger of warp and weft.

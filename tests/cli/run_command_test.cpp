@@ -48,6 +48,39 @@ nlohmann::json small_sheet() {
           {"output", {{"images", nlohmann::json::array()}}}};
 }
 
+// Trial 43, P11: `run` draped a panel the quality gate says starts folded and said nothing of
+// it (the gate belongs to `validate` and `mesh`). It now prints the gate's warnings once, as
+// `validate` does, puts them in report.json's "warnings" and counts them in "quality_warnings".
+// The kimono drawn into the armpit (both its panels turn back on themselves), draped 0.05 s.
+TEST(RunCommand, TheQualityGatesWarningsArePrintedOnceAndCounted) {
+  const fs::path dir = fresh_dir("quality");
+  nlohmann::json sketch =
+      read_json(fs::path(SD_SOURCE_DIR) / "data/designs/repro/kimono-armpit-crease.json");
+  sketch["simulate"]["duration"] = 0.05;
+  sketch["output"]["images"] = nlohmann::json::array();
+  const fs::path file = write_sketch(dir, sketch);
+  const CommandResult validated = run_sketchdrape("validate " + file.string());
+  ASSERT_EQ(validated.exit_code, 0) << validated.output;
+  const CommandResult r = run_sketchdrape("run " + file.string() + " -o " + (dir / "out").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string said = "panel 'front': the panel turns back on itself";
+  ASSERT_NE(validated.output.find(said), std::string::npos) << validated.output;
+  const size_t first = r.output.find(said);
+  EXPECT_NE(first, std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find(said, first + 1), std::string::npos) << r.output;  // once
+  const nlohmann::json report = read_json(dir / "out/report.json");
+  int gate = 0;  // validate's count: "...; N mesh quality warning(s)"
+  const size_t count = validated.output.find(" mesh quality warning(s)");
+  ASSERT_NE(count, std::string::npos) << validated.output;
+  gate = std::stoi(validated.output.substr(validated.output.rfind(' ', count - 1) + 1));
+  EXPECT_EQ(report["quality_warnings"], gate);
+  int listed = 0;
+  for (const auto& w : report["warnings"])
+    listed += w.get<std::string>().find("turns back on itself") != std::string::npos;
+  EXPECT_EQ(listed, 2);  // front and back
+  fs::remove_all(dir);
+}
+
 // Trial 34's dress, its free skirt's hem drawn 4 cm into both legs (validate's inside_body
 // warning: 43 mm). Pushed vertex by vertex to the nearest skin, its cloth went out on both sides
 // of each leg, was caught round it at the strain limit and the run stopped as stuck after 18 s

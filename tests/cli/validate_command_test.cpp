@@ -359,6 +359,54 @@ TEST(ValidateCommand, APanelFoldedIntoTheArmpitIsWarnedAndPatternSaysWhere) {
   fs::remove_all(dir);
 }
 
+// Trial 42, P5, again in trial 43 (data/designs/repro/wrap-dress-listed-corners.json, the wrap
+// dress's try 4): every corner of 'front_over' is listed, yet its sliver (5.4°) was told "a
+// boundary corner there is too sharp or not listed in \"corners\"". The sliver lies 9.2 cm down
+// the 19° wedge where 'wrap' leaves the neckline, 3 edges from the corner: a listed corner was
+// looked for within 2 edges only. A narrow corner's reach is 1 / sin(half its angle) edges.
+TEST(ValidateCommand, ASliverAtANarrowListedCornerIsToldTheCornerIsListed) {
+  const std::string file =
+      std::string(SD_SOURCE_DIR) + "/data/designs/repro/wrap-dress-listed-corners.json";
+  const CommandResult v = run_sketchdrape("validate " + file);
+  EXPECT_EQ(v.exit_code, 0) << v.output;
+  EXPECT_NE(v.output.find("panel 'front_over': 1 quad(s) have a corner below 10° (the smallest "
+                          "5.4°) at the corner where 'wrap' begins (the outline turns 161° there), "
+                          "which \"corners\" already lists"),
+            std::string::npos)
+      << v.output;
+  EXPECT_EQ(v.output.find("not listed in"), std::string::npos) << v.output;
+}
+
+// Trial 43, P4 (data/designs/repro/tiered-dress-wrist-point-human.json): a hip point written
+// from the built-in body's hanging left wrist ("drawn_on": "builtin") lands 10 cm off the Collada
+// human, whose arms are held higher, and was told to give points relative to a landmark, which it
+// was. Now it is told its landmark, where that is on this body, and, a limb's landmark, the torso
+// landmark nearest the point as drawn with the offset from it. Also P15 (an offset typed in mm):
+// tests/garment/bad/landmark-offset-millimetres.json.
+TEST(ValidateCommand, ALandmarkPointOffTheBodyIsToldItsLandmarkAndATorsoOne) {
+  if (!fs::exists("/usr/share/assimp/models/Collada/human.zae"))
+    GTEST_SKIP() << "assimp-testmodels' human.zae is not installed";
+  const std::string file =
+      std::string(SD_SOURCE_DIR) + "/data/designs/repro/tiered-dress-wrist-point-human.json";
+  const CommandResult v = run_sketchdrape("validate " + file);
+  EXPECT_EQ(v.exit_code, 2) << v.output;
+  EXPECT_NE(v.output.find("/curves/9/points3d: curve 'hipline_b' is written 10.2 cm off the body"),
+            std::string::npos)
+      << v.output;
+  EXPECT_NE(v.output.find("The point is relative to 'left_wrist', which on this body is at "
+                          "(0.441, 1.026, 0.053) m, 15.2 cm from it: a landmark of a limb moves "
+                          "with the limb's pose"),
+            std::string::npos)
+      << v.output;
+  EXPECT_NE(v.output.find("relative to a torso landmark, here {\"at\": \"hips\", \"offset\": "
+                          "[0.182, 0.014, -0.124]}"),
+            std::string::npos)
+      << v.output;
+  EXPECT_EQ(v.output.find("points given relative to a landmark of the body they were drawn on"),
+            std::string::npos)
+      << v.output;
+}
+
 // Trial 41, P4: "rest": "flat" is accepted per panel and per file by every command; a flat rest
 // whose panel cannot be flattened is refused at the key that asked for it (the file's
 // /simulate/rest was refused at /panels/1/rest, a key the file did not have, and read as the

@@ -144,6 +144,40 @@ TEST(PatternLayout, CrossingAllowancesAreRefused) {
   }
 }
 
+// The same slot in a piece cut on the fold along its left side, 1 cm allowance everywhere else
+// (the file's uniform allowance; none along the fold). Before, the fold's 0 made two allowances
+// and the mitred path refused it as above (trial 43, P1: the jumpsuit's folded back leg at the
+// default 1 cm). Now the piece opened out across its fold is offset by the straight skeleton,
+// which merges the slot's offsets, and cut back at the fold: exactly the rectangle 0 .. 0.21 by
+// -0.01 .. 0.21 m, the fold its left side, half the opened piece's own cutting line.
+TEST(PatternLayout, UniformAllowanceOnAFoldPieceMergesLikeTheSkeleton) {
+  const std::vector<Eigen::Vector2d> corners = {{0, 0},       {0.2, 0},      {0.2, 0.2},
+                                                {0.105, 0.2}, {0.105, 0.05}, {0.095, 0.05},
+                                                {0.095, 0.2}, {0, 0.2}};
+  const int per = 2;
+  const FlatPattern pattern = one_piece(corners, per);
+  PatternLayoutOptions options;
+  std::vector<bool> fold(8 * per, false);
+  for (int k = 7 * per; k < 8 * per; ++k) fold[static_cast<size_t>(k)] = true;  // x = 0
+  options.fold_edge = {fold};
+  const PatternPiece piece = lay_out_pattern(pattern, options).pieces[0];
+  EXPECT_TRUE(piece.on_fold);
+  EXPECT_NEAR(piece.size.x(), 0.21, 1e-9);
+  EXPECT_NEAR(piece.size.y(), 0.22, 1e-9);
+  EXPECT_NEAR(piece.cut_area, 0.21 * 0.22, 1e-9);
+  // The fold is the cutting line's left side, the allowance 1 cm beyond its ends.
+  EXPECT_NEAR(piece.fold_start.x(), 0.0, 1e-9);
+  EXPECT_NEAR(piece.fold_end.x(), 0.0, 1e-9);
+  EXPECT_NEAR(piece.fold_end.y() - piece.cutting.col(1).minCoeff(), 0.01, 1e-9);
+  // The piece opened out (its mirror image across x = 0 joined on), cut with one allowance.
+  std::vector<Eigen::Vector2d> opened;
+  for (const Eigen::Vector2d& c : corners) opened.push_back(c + Eigen::Vector2d(0.2, 0));
+  for (size_t c = corners.size() - 1; c-- > 1;)
+    opened.push_back(Eigen::Vector2d(0.2 - corners[c].x(), corners[c].y()));
+  const PatternPiece whole = lay_out_pattern(one_piece(opened, 1)).pieces[0];
+  EXPECT_NEAR(piece.cut_area, 0.5 * whole.cut_area, 1e-9);
+}
+
 // A trapezoid "front" and its copy "front.mirror" (x → 0.3 − x, reversed to stay
 // counter-clockwise), each with notches at its hem's ends: one piece to a cutter, drawn once
 // ("cut 2", the copy drawn as it) while the fabric to cut both from one layer is still nested

@@ -34,6 +34,7 @@
 #include "src/app/pipeline/pattern_export.hpp"
 #include "src/app/pipeline/preview_images.hpp"
 #include "src/app/pipeline/progress.hpp"
+#include "src/app/pipeline/quality_warnings.hpp"
 #include "src/app/pipeline/run_report.hpp"
 #include "src/app/pipeline/seam_ease_warnings.hpp"
 #include "src/app/pipeline/self_intersections.hpp"
@@ -243,6 +244,13 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
     pattern_sheet = build_pattern_sheet(sketch, *scene.garment, *sketch.output.pattern,
                                         scene.flat_pattern ? &*scene.flat_pattern : nullptr,
                                         scene.flattening_ms, scene.body ? &*scene.body : nullptr);
+  // The quality gate's warnings, as `validate` and `mesh` print them (trial 43, P11: `run` draped
+  // a panel the gate says starts folded without a word of it): printed once here, before the
+  // drape's time is spent, and counted in report.json ("quality_warnings").
+  std::vector<std::string> quality;
+  if (scene.garment && scene.body)
+    for (const garment::QualityWarning& w : quality_warnings(*scene.garment, sketch, *scene.body))
+      quality.push_back(fmt::format("{}: {}", sketch.file, w.message));
   // "solver"/"time_step": "auto" (the defaults): chosen now that the scene's size is known.
   const sim::AutomaticChoice automatic =
       apply_automatic_settings(sketch, scene, settings, options.frames_per_second > 0.0);
@@ -430,6 +438,8 @@ void run_drape(const RunOptions& options, const GlobalOptions& global) {
     for (std::string& warning : seam_ease_warnings(sketch, *scene.garment))
       out.warnings.push_back(std::move(warning));
   if (!scene.flat_rest_differs.empty()) out.warnings.push_back(scene.flat_rest_differs);
+  out.quality_warnings = static_cast<int>(quality.size());
+  out.warnings.insert(out.warnings.end(), quality.begin(), quality.end());
   // The body's repairs and defects (an open body, inconsistent triangles), logged as it loaded.
   if (scene.body)
     out.warnings.insert(out.warnings.end(), scene.body->warnings.begin(),

@@ -17,6 +17,7 @@
 #include "sim/sheet.hpp"
 #include "sim/simulation.hpp"
 #include "src/app/pipeline/garment_stage.hpp"
+#include "src/app/pipeline/pattern_export.hpp"
 #include "src/app/pipeline/quality_warnings.hpp"
 #include "src/app/pipeline/settle_time.hpp"
 #include "src/app/pipeline/sketch_checks.hpp"
@@ -228,17 +229,37 @@ void flat_rest_shapes(const scene::Sketch& sketch, const garment::Garment& g,
   // `pattern` holds a centre line on the grain straight and cuts its piece on the fold; the flat
   // rest drapes the free pieces (above), so the same file gave two patterns with no word (trial
   // 39, P2: bodice and skirt on the fold in one, mirror pairs with a curved centre seam and
-  // other sizes in the other). Say so, naming the pieces.
+  // other sizes in the other). Say so, naming the pieces `pattern` cuts on the fold by its own
+  // decision (panels_cut_on_fold): trial 43, P8 (and trial 42, P6) named pieces whose centre line
+  // lay on the grain but that `pattern` cuts as pairs (the jumpsuit's front legs, whose crotch
+  // curve costs too much to hold straight). So the garment is flattened as `pattern` does when a
+  // piece resting flat has a centre line (trial 43's flat jumpsuit: `validate` 0.51 s of user
+  // CPU before, 0.55-0.66 s with it, at load 9).
   std::string centred;
   int centred_count = 0;
-  for (const garment::FlatPanel& piece : scene.flat_pattern->panels)
-    if (flat[static_cast<size_t>(piece.panel)] && piece.centre_off_grain_deg >= 0 &&
-        piece.centre_off_grain_deg <= garment::FlatteningOptions{}.fold_off_grain_deg &&
-        piece.centre_across_warp_deg <= garment::FlatteningOptions{}.fold_across_warp_deg &&
-        !g.panels[static_cast<size_t>(piece.panel)].mirror_copy) {
-      centred += (centred.empty() ? "'" : ", '") + piece.id + "'";
-      ++centred_count;
+  const bool any_centre = std::any_of(
+      scene.flat_pattern->panels.begin(), scene.flat_pattern->panels.end(),
+      [&](const garment::FlatPanel& piece) {
+        return flat[static_cast<size_t>(piece.panel)] && piece.centre_off_grain_deg >= 0;
+      });
+  std::vector<std::string> folded;
+  if (any_centre) {
+    try {
+      garment::FlatteningOptions as_pattern;
+      if (sketch.output.pattern) as_pattern.warn_stretch = sketch.output.pattern->max_stretch;
+      folded = panels_cut_on_fold(sketch, g, sketch.output.pattern.value_or(scene::PatternSpec{}),
+                                  garment::flatten_garment(g, as_pattern));
+    } catch (const garment::PatternError&) {
+      // `pattern` refuses the garment (and says why): it cuts nothing on the fold.
     }
+  }
+  for (const std::string& id : folded) {
+    const auto p = std::find_if(g.panels.begin(), g.panels.end(),
+                                [&](const garment::GarmentPanel& panel) { return panel.id == id; });
+    if (p == g.panels.end() || !flat[static_cast<size_t>(p - g.panels.begin())]) continue;
+    centred += (centred.empty() ? "'" : ", '") + id + "'";
+    ++centred_count;
+  }
   if (centred_count > 0) {
     // The pattern files only when the file asks for them (trial 42, P6: the sentence spoke of
     // "the pattern this run writes" in a run that wrote none).

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "garment/garment_mesh.hpp"
@@ -19,6 +20,10 @@ namespace sd::app {
 struct TopOpening {
   std::vector<std::string> curves;
   std::vector<std::string> panels;
+  // The panels sewn to those (not among them; mirror copies named by their original) with their
+  // ease, gathered ones (warp and weft apart) left out: easing the opening's panels in, the
+  // seams to these keep within kSeamEaseLimit only if they follow (trial 43, P6).
+  std::vector<std::pair<std::string, double>> sewn_to;
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
 };
 

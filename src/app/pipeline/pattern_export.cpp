@@ -300,6 +300,45 @@ std::string fabric_label(const scene::Sketch& sketch, const std::string& fabric)
   return std::filesystem::path(fabric).stem().string();
 }
 
+// The layout's settings for the garment flattened as `pattern` flattens it: `spec`'s allowance
+// and fabric width, each panel's own allowance, its ease and corners, and where each piece is cut
+// on the fold (fold_edges). One decision for build_pattern_sheet and panels_cut_on_fold.
+garment::PatternLayoutOptions layout_options(const scene::Sketch& sketch,
+                                             const garment::Garment& garment,
+                                             const scene::PatternSpec& spec,
+                                             const garment::FlatPattern& pattern) {
+  garment::PatternLayoutOptions layout;
+  layout.fabric_width = spec.fabric_width;
+  layout.seam_allowance = spec.seam_allowance;
+  for (const garment::FlatPanel& flat : pattern.panels) {
+    const garment::GarmentPanel& panel = garment.panels[static_cast<size_t>(flat.panel)];
+    const garment::PanelSpec* ps = panel_spec(sketch, panel.id);
+    layout.panel_allowance.push_back(ps && ps->seam_allowance ? *ps->seam_allowance : -1.0);
+    layout.edge_allowance.push_back(edge_allowances(sketch, garment, flat));
+    layout.panel_ease.push_back(panel.ease);
+    layout.corners.push_back(curve_corners(garment, flat));
+    // The widest the half of a fold piece may be, flattened (m): both halves with their
+    // widest allowance, the gaps at the selvedges and 2 mm columns' rounding each side.
+    double widest_allowance =
+        layout.panel_allowance.back() >= 0 ? layout.panel_allowance.back() : spec.seam_allowance;
+    for (const double a : layout.edge_allowance.back())
+      widest_allowance = std::max(widest_allowance, a);
+    const double opened_limit =
+        (spec.fabric_width - 2 * layout.gap - 0.008) / panel.ease.weft - 2 * widest_allowance;
+    layout.fold_edge.push_back(fold_edges(garment, pattern, flat, layout.edge_allowance.back(),
+                                          opened_limit,
+                                          garment::FlatteningOptions{}.fold_off_grain_deg));
+  }
+  // A fold piece's mirror copy is its other half: not cut on its own.
+  layout.folded_into.assign(pattern.panels.size(), -1);
+  for (size_t p = 0; p < pattern.panels.size(); ++p)
+    if (!layout.fold_edge[p].empty())
+      for (size_t q = 0; q < pattern.panels.size(); ++q)
+        if (pattern.panels[q].id == pattern.panels[p].id + ".mirror")
+          layout.folded_into[q] = static_cast<int>(p);
+  return layout;
+}
+
 }  // namespace
 
 PatternSheet build_pattern_sheet(const scene::Sketch& sketch, const garment::Garment& garment,
@@ -314,36 +353,11 @@ PatternSheet build_pattern_sheet(const scene::Sketch& sketch, const garment::Gar
   try {
     sheet.pattern = flattened ? *flattened : garment::flatten_garment(garment, flattening);
     sheet.flatten_ms = flattened ? flattened_ms : ms_since(start);
-    garment::PatternLayoutOptions layout;
-    layout.fabric_width = spec.fabric_width;
-    layout.seam_allowance = spec.seam_allowance;
-    for (const garment::FlatPanel& flat : sheet.pattern.panels) {
-      const garment::GarmentPanel& panel = garment.panels[static_cast<size_t>(flat.panel)];
-      const garment::PanelSpec* ps = panel_spec(sketch, panel.id);
-      layout.panel_allowance.push_back(ps && ps->seam_allowance ? *ps->seam_allowance : -1.0);
-      layout.edge_allowance.push_back(edge_allowances(sketch, garment, flat));
-      layout.panel_ease.push_back(panel.ease);
-      layout.corners.push_back(curve_corners(garment, flat));
-      // The widest the half of a fold piece may be, flattened (m): both halves with their
-      // widest allowance, the gaps at the selvedges and 2 mm columns' rounding each side.
-      double widest_allowance =
-          layout.panel_allowance.back() >= 0 ? layout.panel_allowance.back() : spec.seam_allowance;
-      for (const double a : layout.edge_allowance.back())
-        widest_allowance = std::max(widest_allowance, a);
-      const double opened_limit =
-          (spec.fabric_width - 2 * layout.gap - 0.008) / panel.ease.weft - 2 * widest_allowance;
-      layout.fold_edge.push_back(fold_edges(garment, sheet.pattern, flat,
-                                            layout.edge_allowance.back(), opened_limit,
-                                            flattening.fold_off_grain_deg));
-      sheet.fabrics.push_back(fabric_label(sketch, panel.fabric));
-    }
-    // A fold piece's mirror copy is its other half: not cut on its own.
-    layout.folded_into.assign(sheet.pattern.panels.size(), -1);
-    for (size_t p = 0; p < sheet.pattern.panels.size(); ++p)
-      if (!layout.fold_edge[p].empty())
-        for (size_t q = 0; q < sheet.pattern.panels.size(); ++q)
-          if (sheet.pattern.panels[q].id == sheet.pattern.panels[p].id + ".mirror")
-            layout.folded_into[q] = static_cast<int>(p);
+    const garment::PatternLayoutOptions layout =
+        layout_options(sketch, garment, spec, sheet.pattern);
+    for (const garment::FlatPanel& flat : sheet.pattern.panels)
+      sheet.fabrics.push_back(
+          fabric_label(sketch, garment.panels[static_cast<size_t>(flat.panel)].fabric));
     const auto layout_start = Clock::now();
     sheet.layout = garment::lay_out_pattern(sheet.pattern, layout);
     sheet.layout_ms = ms_since(layout_start);
@@ -355,6 +369,17 @@ PatternSheet build_pattern_sheet(const scene::Sketch& sketch, const garment::Gar
   if (!flattened)
     for (const std::string& warning : sheet.pattern.warnings) spdlog::warn("{}", warning);
   return sheet;
+}
+
+std::vector<std::string> panels_cut_on_fold(const scene::Sketch& sketch,
+                                            const garment::Garment& garment,
+                                            const scene::PatternSpec& spec,
+                                            const garment::FlatPattern& pattern) {
+  const garment::PatternLayoutOptions layout = layout_options(sketch, garment, spec, pattern);
+  std::vector<std::string> folded;
+  for (size_t p = 0; p < pattern.panels.size(); ++p)
+    if (!layout.fold_edge[p].empty()) folded.push_back(pattern.panels[p].id);
+  return folded;
 }
 
 PieceCounts piece_counts(const PatternSheet& sheet) {

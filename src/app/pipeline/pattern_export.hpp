@@ -39,6 +39,15 @@ PatternSheet build_pattern_sheet(const scene::Sketch& sketch, const garment::Gar
                                  const garment::FlatPattern* flattened = nullptr,
                                  double flattened_ms = 0.0, const garment::Body* body = nullptr);
 
+// The panels `pattern` cuts on the fold (ids, in pattern order), by build_pattern_sheet's own
+// decision (fold_edges: a centre line the flattening held straight, one straight run on the
+// grain, without an allowance of its own, both halves across the fabric) for the garment
+// flattened as `pattern` flattens it (`pattern`, FlatteningOptions' defaults) with `spec`.
+std::vector<std::string> panels_cut_on_fold(const scene::Sketch& sketch,
+                                            const garment::Garment& garment,
+                                            const scene::PatternSpec& spec,
+                                            const garment::FlatPattern& pattern);
+
 // The pieces as the `pattern` command's line, the SVG's footer and pattern.json
 // ("pieces_summary") all say them: how many pieces are cut, how many are drawn when that
 // differs, and the pieces cut on the fold by name and the mirror pairs by count. "12 pieces to

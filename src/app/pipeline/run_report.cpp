@@ -239,6 +239,7 @@ nlohmann::json run_report_json(const RunReport& r) {
       r.settled_drop ? nlohmann::json(*r.settled_drop) : nlohmann::json(nullptr);
   // What the run warned about (the same sentences as on the terminal), empty when nothing.
   out["warnings"] = r.warnings;
+  out["quality_warnings"] = r.quality_warnings;
   out["images"] = r.images;
   out["frames"] = r.frames;
   out["body_motion"] = nullptr;

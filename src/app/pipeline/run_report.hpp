@@ -102,6 +102,9 @@ struct RunReport {
   // The run's warnings about the drape (not at rest at the end, settled below where drawn),
   // each the sentence the terminal shows.
   std::vector<std::string> warnings;
+  // The quality gate's warnings (`validate`'s mesh quality warnings, which --strict counts), also
+  // among `warnings`.
+  int quality_warnings = 0;
   std::vector<std::string> images;
   std::size_t frames = 0;
   std::optional<BodyMotionSummary> body_motion;
