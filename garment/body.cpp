@@ -637,17 +637,21 @@ Body load_body(const std::string& path, const BodyOptions& options) {
     // A figure less than half as tall along the given up as along another axis lies on its side
     // (a Y-up file given "+z"): its height would be scaled from its depth, and the landmarks
     // then fail for want of a standing figure. Arms held out make a figure at most about as
-    // wide as it is tall, so half leaves room for any pose. Only for a figure: the built-in
-    // body, or a file without "height" or "scale" whose height along the given up is no
-    // body's in m, cm or mm while along the tallest axis it is one (a ground plane or a rod
-    // under a sheet, given "scale", is wide and flat on purpose).
+    // wide as it is tall, so half leaves room for any pose. Only for a figure: a garment's body
+    // (the proportions decide, whatever "height" or "scale" sets the size: trial 44 gave a Z-up
+    // human "up": "+y" with its "height", and its depth was scaled to 1.66 m, a 6.4 m figure
+    // lying face down that had landmarks), the built-in body, or a file without "height" or
+    // "scale" whose height along the given up is no body's in m, cm or mm while along the
+    // tallest axis it is one (a ground plane or a rod under a sheet, given "scale", is wide and
+    // flat on purpose).
     const auto plausible = [](double h) {
       return (h >= 0.5 && h <= 2.5) || (h >= 50 && h <= 250) || (h >= 500 && h <= 2500);
     };
     const int tallest = tallest_axis();
     const bool figure =
-        !options.height && !options.scale &&
-        (builtin || (!plausible(extent[raw.up.axis]) && plausible(extent[tallest])));
+        options.figure ||
+        (!options.height && !options.scale &&
+         (builtin || (!plausible(extent[raw.up.axis]) && plausible(extent[tallest]))));
     if (figure && tallest != raw.up.axis && extent[raw.up.axis] < 0.5 * extent[tallest]) {
       const char* names = "xyz";
       throw BodyUpError(fmt::format(

@@ -33,6 +33,9 @@ struct BodyOptions {
   std::optional<AxisDirection> facing;
   std::optional<double> scale;   // file units → metres; inferred when empty
   std::optional<double> height;  // target height in metres; wins over scale
+  // The body a garment is designed on: a standing figure, however its size is set, so a given
+  // `up` along which it lies on its side is refused (a scene's floor or rod is not one).
+  bool figure = false;
 };
 
 // What the file held before normalisation, and what was done to it.

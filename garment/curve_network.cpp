@@ -249,6 +249,17 @@ CurveNetwork build_network(const GarmentRequest& sketch, const std::vector<Proje
         if (along < tol || length - along < tol) continue;  // near an end: clustering's job
       }
       w.splits.push_back({param, static_cast<int>(node)});
+      TJoin join;
+      join.node = static_cast<int>(node);
+      join.from = net.nodes[node];
+      join.distance = distance;
+      join.curve = curves[c].id;
+      for (const int a : node_members[node]) {
+        const auto [end_curve, which] = ends[static_cast<size_t>(a)];
+        join.ends.push_back(fmt::format("the {} of '{}'", which == 0 ? "start" : "end",
+                                        curves[static_cast<size_t>(end_curve)].id));
+      }
+      net.t_joins.push_back(std::move(join));
       net.nodes[node] = point_at(w.points, w.closed, param);
       if (w.mirrored) node_mirrored[node] = true;
     }

@@ -44,11 +44,24 @@ struct PlaneSnap {
   std::vector<std::string> ends;                 // "the end of 'hem_f'", ...
 };
 
+// Curve ends joined to the interior of another curve (a T-junction) because they lay within
+// the junction tolerance of it. Kept to explain an error at that junction by its cause (trial
+// 44, P1: a sleeve hem ending 1.9 cm from a side seam split it, and the errors spoke of a 2.4 cm
+// 'side' and of two curves along one seam).
+struct TJoin {
+  int node = -1;                                   // the junction in CurveNetwork::nodes
+  Eigen::Vector3d from = Eigen::Vector3d::Zero();  // m, where the ends were before the move
+  double distance = 0;                             // m, from there to the curve
+  std::string curve;                               // the curve split there
+  std::vector<std::string> ends;                   // "the end of 'underarm'", ...
+};
+
 struct CurveNetwork {
   std::vector<Eigen::Vector3d> nodes;
   std::vector<NetworkEdge> edges;
   std::vector<NetworkCurve> curves;
   std::vector<PlaneSnap> plane_snaps;
+  std::vector<TJoin> t_joins;
 
   // Curve by id ("x.mirror" for a copy; the copy of an on-plane curve is the curve itself);
   // -1 when unknown.

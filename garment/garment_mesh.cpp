@@ -133,6 +133,32 @@ struct PanelNetwork {
   EdgeCounts counts;
 };
 
+// The cause of an error at a junction near `p` when curve ends were joined there to the
+// interior of another curve for lying within the junction tolerance of it (trial 44, P1: a
+// sleeve hem ending 1.9 cm from the side seam cut it in two, and the errors named only the
+// 2.4 cm piece and "two curves along one seam"): a sentence to append, or empty.
+std::string t_join_cause(const GarmentRequest& sketch, const CurveNetwork& net,
+                         const Eigen::Vector3d& p) {
+  const double tol = sketch.junction_tolerance;
+  for (const TJoin& join : net.t_joins) {
+    if ((net.nodes[static_cast<size_t>(join.node)] - p).norm() > 0.25 * tol) continue;
+    std::string ends;  // "the end of 'a', the end of 'b' and the start of 'c'"
+    for (size_t k = 0; k < join.ends.size(); ++k)
+      ends += (k == 0 ? "" : (k + 1 == join.ends.size() ? " and " : ", ")) + join.ends[k];
+    const bool one = join.ends.size() == 1;
+    return fmt::format(
+        ". The cause: {} at ({:.3f}, {:.3f}, {:.3f}) m {} {:.1f} cm from the interior of curve "
+        "'{}', closer than junction_tolerance ({:.1f} cm), so {} joined to it there (a "
+        "T-junction, which cuts '{}' in two); if {} not meant to end on '{}', end {} farther "
+        "from it or lower junction_tolerance below {:.1f} cm",
+        ends, join.from.x(), join.from.y(), join.from.z(), one ? "was" : "were",
+        100 * join.distance, join.curve, 100 * tol, one ? "it was" : "they were", join.curve,
+        one ? "it is" : "they are", join.curve, one ? "it" : "them",
+        std::floor(1000 * join.distance) / 10);
+  }
+  return "";
+}
+
 // Two curve pieces in panels between the same two junctions must not both be one edge: each
 // would be the same straight edge between those junctions, one mesh edge for two seams, and the
 // panels on them would overlap (a coarse edge_length over a shirt's armhole halves made the
@@ -160,6 +186,8 @@ void check_single_edges_apart(const GarmentRequest& sketch, const BodySurface& b
     if (const BodyLandmarks* landmarks = body.landmarks())
       landmark = fmt::format(", near the {}", landmarks->nearest(0.5 * (p + q)).name);
     const double shorter = std::min(edge.length, other.length);
+    std::string cause = t_join_cause(sketch, net, p);
+    if (cause.empty()) cause = t_join_cause(sketch, net, q);
     const CurveSpec& spec = sketch.curves[static_cast<size_t>(std::max(a.spec, b.spec))];
     sketch.fail(
         spec.edge_length ? spec.json_path + "/edge_length" : std::string("/edge_length"),
@@ -168,9 +196,10 @@ void check_single_edges_apart(const GarmentRequest& sketch, const BodySurface& b
                     "this edge length each is a single edge: both become the same straight edge, "
                     "and the panels on them would lie over each other. Give a smaller "
                     "\"edge_length\" (at most {:.3g} m gives each at least two edges), or give "
-                    "these two curves their own \"edge_length\"",
+                    "these two curves their own \"edge_length\"{}",
                     a.id, b.id, p.x(), p.y(), p.z(), q.x(), q.y(), q.z(), landmark,
-                    100 * other.length, 100 * edge.length, std::floor(1e3 * shorter / 1.6) / 1e3));
+                    100 * other.length, 100 * edge.length, std::floor(1e3 * shorter / 1.6) / 1e3,
+                    cause));
   }
 }
 
@@ -919,6 +948,12 @@ void check_fans(const GarmentRequest& sketch, const CurveNetwork& net, const Gar
                 sketch, net, p,
                 fmt::format("panels '{}' and '{}'", *names.begin(), *names.rbegin())))
           sketch.fail(twice->first, twice->second);
+      // Curve ends joined to another curve's interior there, for lying near it: the point is
+      // of the program's making too (trial 44, P1), and the cause is said instead.
+      if (const std::string cause = t_join_cause(sketch, net, p); !cause.empty())
+        sketch.fail("/panels", fmt::format("{} only at the point ({:.3f}, {:.3f}, {:.3f}) m, not "
+                                           "along a seam{}",
+                                           list, p.x(), p.y(), p.z(), cause));
       sketch.fail(
           "/panels",
           fmt::format("{} only at the point ({:.3f}, {:.3f}, {:.3f}) m, not along "

@@ -26,6 +26,8 @@ Body load_sketch_body(const GarmentRequest& sketch, const BodySpec& spec,
   BodyOptions options;
   options.height = spec.height;
   options.scale = spec.scale;
+  // A sketched garment's body is a figure (a sheet's floor or rod is not: it has no curves).
+  options.figure = !sketch.curves.empty();
   const std::string path = spec.mesh == "builtin" ? "builtin" : sketch.resolve(spec.mesh).string();
   try {
     if (spec.up) options.up = AxisDirection::parse(*spec.up);

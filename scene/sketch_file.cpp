@@ -51,6 +51,19 @@ Sketch parse_sketch(std::string_view text, const std::string& file,
     root = json::parse(mark_overflowing_numbers(text), strict_json_check(sketch),
                        /*allow_exceptions=*/true, /*ignore_comments=*/true);
   } catch (const json::parse_error& e) {
+    // Nothing but blanks and comments (trial 44, P9: an empty file was "not valid JSON
+    // (unexpected end of input ...)"): an editor that failed to save, a truncated copy.
+    if (json::accept(std::string(text) + "\nnull", /*ignore_comments=*/true)) {
+      const bool blank = std::all_of(text.begin(), text.end(), [](char c) {
+        return std::isspace(static_cast<unsigned char>(c)) != 0;
+      });
+      r.fail("", fmt::format("the file {}: a sketch is an object {{\"curves\": [...], "
+                             "\"panels\": [...]}} (did the editor fail to save, or the copy "
+                             "stop short?)",
+                             text.empty() ? "is empty (0 bytes)"
+                             : blank      ? "holds only blanks"
+                                          : "holds only comments"));
+    }
     std::string detail = e.what();
     const size_t colon = detail.find("error while parsing");
     if (colon != std::string::npos) detail = detail.substr(colon);

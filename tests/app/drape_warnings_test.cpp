@@ -142,6 +142,24 @@ TEST(DrapeWarnings, NotAtRestSaysWhereItMovesAndWhatToTry) {
   EXPECT_EQ(sheet.find("rest_ramp"), std::string::npos) << sheet;
 }
 
+// Trial 44, P10: a run whose duration came from the automatic settings printed "did not come
+// to rest in 6.06416 s" and "\"duration\": 12.1283"; messages round elsewhere. Three digits
+// below 10 s, whole seconds from there.
+TEST(DrapeWarnings, NotAtRestRoundsTheSeconds) {
+  StillMoving where;
+  where.speed = 0.007;
+  where.at = {0.0, 1.2, 0.1};
+  where.panel = "patch";
+  where.moving = 12;
+  where.vertices = 96;
+  const std::string text = not_at_rest_warning("bd03.json", 6.06416, 0.005, 0.25, where);
+  EXPECT_NE(text.find("did not come to rest in 6.06 s:"), std::string::npos) << text;
+  EXPECT_NE(text.find("{\"duration\": 12}"), std::string::npos) << text;
+  where.still_s = 0.1;
+  const std::string settling = not_at_rest_warning("bd03.json", 6.06416, 0.005, 0.25, where);
+  EXPECT_NE(settling.find("{\"duration\": 7.06}"), std::string::npos) << settling;
+}
+
 // Trial 37: a tunic ended its 3 s still for the last part of a window (0.27 mm of drift, the
 // bound 1.25 mm) with a few vertices flickering at 0.8 cm/s; "the cloth still moves" read as a
 // contradiction of report.json. A drape in a still stretch is said to be settling, with its

@@ -1,6 +1,7 @@
 // `sketchdrape validate` as a user reads it: what the one line says, and what is printed with a
 // refusal.
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "garment/body.hpp"
 #include "tests/cli/hip_tube_obj.hpp"
 #include "tests/cli/run_command.hpp"
 
@@ -172,6 +174,74 @@ TEST(ValidateCommand, ABodyThatIsNoFigureIsNamedFirst) {
             std::string::npos)
       << v.output;
   EXPECT_NE(v.output.find("is it the right body file? With it, "), std::string::npos) << v.output;
+  fs::remove_all(dir);
+}
+
+// The docs' patch on `body`, written to dir/name: `width` m wide and 0.2 m tall from `bottom`
+// m up (the chest by default).
+std::string write_patch_sketch(const fs::path& dir, const std::string& name,
+                               const std::string& body, double width = 0.2, double bottom = 1.1) {
+  fs::create_directories(dir);
+  const double l = -width / 2, r = width / 2, b = bottom, t = bottom + 0.2;
+  std::ofstream(dir / name) << fmt::format(
+      R"({{"format": "sketchdrape/1", "body": {},
+    "curves": [
+      {{"id": "top", "view": "front", "points": [[{l}, {t}], [{r}, {t}]]}},
+      {{"id": "right", "view": "front", "points": [[{r}, {t}], [{r}, {b}]]}},
+      {{"id": "bottom", "view": "front", "points": [[{r}, {b}], [{l}, {b}]]}},
+      {{"id": "left", "view": "front", "points": [[{l}, {b}], [{l}, {t}]]}}],
+    "panels": [{{"id": "patch", "boundary": ["top", "right", "bottom", "left"]}}]}})",
+      body, fmt::arg("l", l), fmt::arg("r", r), fmt::arg("t", t), fmt::arg("b", b));
+  return (dir / name).string();
+}
+
+// An upside-down body (trial 44, P18): `info` said "give "up": "-z"", the sketch's error that
+// the body has no landmarks dropped it. The built-in body is Z-up; given "-z" it stands on its
+// head, and a patch between its legs (where the patch at the chest would be on the standing
+// body) misses it: the refusal gives the "up" that stands it on its feet.
+TEST(ValidateCommand, AnUpsideDownBodyIsSaidToBeOne) {
+  const fs::path dir = fs::temp_directory_path() / "sd-validate-upside-down";
+  const CommandResult v = run_sketchdrape(
+      "validate " +
+      write_patch_sketch(dir, "patch.json", R"({"mesh": "builtin", "up": "-z"})", 0.04, 1.45));
+  EXPECT_EQ(v.exit_code, 2) << v.output;
+  EXPECT_NE(v.output.find("has no landmarks"), std::string::npos) << v.output;
+  EXPECT_NE(v.output.find("the figure looks upside down (it has landmarks once turned over): "
+                          "give \"up\": \"+z\""),
+            std::string::npos)
+      << v.output;
+  EXPECT_EQ(v.output.find("is it the right body file?"), std::string::npos) << v.output;
+  fs::remove_all(dir);
+}
+
+// Two figures in one body file (trial 44, P3: the Collada human twice, a scene with a second
+// mannequin): the pair is wider than tall, so the up axis was inferred along the width, and
+// the refusal spoke only of "facing". It says the file holds two figure-sized meshes and which
+// up axis was inferred, and why. Here the built-in body twice, 1.2 m apart along x, in metres.
+TEST(ValidateCommand, TwoFiguresInOneBodyFileAreSaidToBeTwo) {
+  const fs::path dir = fs::temp_directory_path() / "sd-validate-two-figures";
+  fs::create_directories(dir);
+  const sd::garment::Body one = sd::garment::load_body("builtin");
+  {
+    std::ofstream obj(dir / "two.obj");
+    for (const double dx : {-0.6, 0.6})
+      for (Eigen::Index v = 0; v < one.mesh.vertex_count(); ++v)
+        obj << "v " << one.mesh.vertices(v, 0) + dx << ' ' << one.mesh.vertices(v, 1) << ' '
+            << one.mesh.vertices(v, 2) << '\n';
+    for (const Eigen::Index first : {Eigen::Index{1}, 1 + one.mesh.vertex_count()})
+      for (Eigen::Index f = 0; f < one.mesh.face_count(); ++f)
+        obj << "f " << first + one.mesh.faces(f, 0) << ' ' << first + one.mesh.faces(f, 1) << ' '
+            << first + one.mesh.faces(f, 2) << '\n';
+  }
+  const CommandResult v = run_sketchdrape(
+      "validate " + write_patch_sketch(dir, "patch.json", R"({"mesh": "two.obj", "scale": 1})"));
+  EXPECT_EQ(v.exit_code, 2) << v.output;
+  EXPECT_NE(v.output.find("the file holds 2 separate meshes apart from each other"),
+            std::string::npos)
+      << v.output;
+  EXPECT_NE(v.output.find("the up axis was inferred as +x because the file is longest along x"),
+            std::string::npos)
+      << v.output;
   fs::remove_all(dir);
 }
 

@@ -397,6 +397,15 @@ TEST(Body, UpAlongWhichTheFigureLiesIsRefused) {
   options.up = AxisDirection::parse("+z");
   options.scale = 1.0;  // given: the file is what it is (a ground plane, a rod)
   EXPECT_NO_THROW(load_body(file, options));
+  // A garment's body is a figure whatever sets its size (trial 44, P2: a Z-up human given
+  // "up": "+y" and its "height" lay face down, 6.4 m long, and was draped on).
+  options.figure = true;
+  EXPECT_THROW(load_body(file, options), BodyUpError);
+  options.scale.reset();
+  options.height = 1.7;
+  EXPECT_THROW(load_body(file, options), BodyUpError);
+  options.up = AxisDirection::parse("+y");
+  EXPECT_NO_THROW(load_body(file, options));
 }
 
 }  // namespace

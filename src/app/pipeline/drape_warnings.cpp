@@ -42,6 +42,12 @@ void add_once(std::vector<std::string>& list, const std::string& name) {
   if (std::find(list.begin(), list.end(), name) == list.end()) list.push_back(name);
 }
 
+// Seconds as a message prints them (trial 44, P10: "did not come to rest in 6.06416 s ...
+// \"duration\": 12.1283"): three digits below 10 s, whole seconds from there.
+std::string seconds(double s) {
+  return s >= 10 ? fmt::format("{:.0f}", s) : fmt::format("{:.3g}", s);
+}
+
 }  // namespace
 
 std::optional<TopOpening> top_opening(const garment::Garment& garment) {
@@ -195,29 +201,30 @@ std::string not_at_rest_warning(const std::string& file, double duration_s, doub
   // stillness says nothing of its final shape. (Moving after a short run: the text below.)
   if (duration_s < rest_window_s && (where.still_s > 0.0 || where.moving == 0))
     return fmt::format(
-        "{}: the drape ran only {:g} s, shorter than the {:g} s over which cloth must stay still "
+        "{}: the drape ran only {} s, shorter than the {:g} s over which cloth must stay still "
         "to count as at rest, so the result is little more than the garment as drawn and says "
-        "nothing of its final shape; give a longer \"simulate\": {{\"duration\": {:g}}} (a "
+        "nothing of its final shape; give a longer \"simulate\": {{\"duration\": {}}} (a "
         "garment settles within a few seconds)",
-        file, duration_s, rest_window_s, std::max(3.0, 4 * rest_window_s));
+        file, seconds(duration_s), rest_window_s, seconds(std::max(3.0, 4 * rest_window_s)));
   // Still, but not yet for a whole window (trial 37's tunic: 0.27 mm of drift, fewer than 0.25 s
   // of it): say so rather than "still moves", which read as a contradiction of report.json.
   if (where.still_s > 0.0)
     return fmt::format(
-        "{}: the drape did not come to rest in {:g} s, but it was settling: for its last "
+        "{}: the drape did not come to rest in {} s, but it was settling: for its last "
         "{:.2f} s no vertex moved more than {:.2f} mm (at rest asks for at most {:.2f} mm over "
         "{:g} s), though single vertices still flicker at up to {:.1f} cm/s {}; the result is "
         "very likely its final shape. To have it confirmed, give a longer \"simulate\": "
-        "{{\"duration\": {:g}}}; report.json's \"rest\" gives the residual",
-        file, duration_s, where.still_s, 1000 * where.drift_m, 1000 * rest_speed * rest_window_s,
-        rest_window_s, 100 * where.speed, place, duration_s + 1.0);
+        "{{\"duration\": {}}}; report.json's \"rest\" gives the residual",
+        file, seconds(duration_s), where.still_s, 1000 * where.drift_m,
+        1000 * rest_speed * rest_window_s, rest_window_s, 100 * where.speed, place,
+        seconds(duration_s + 1.0));
   // Not settling (trial 42's gathered peplum, 30 s, then 60 s, each time told to double it):
   // the energy did not fall over the last half of a long run, so a longer one will not help.
   // That peplum's feed, its splits raising the buckling cap, is gone since round 43 (it rests
   // at 11.6 s): the adaptive mesh is named as a suspect to rule out, not as the cause.
   if (where.kinetic_trend >= kSustainedTrend)
     return fmt::format(
-        "{}: the drape did not come to rest in {:g} s, and its motion is sustained, not "
+        "{}: the drape did not come to rest in {} s, and its motion is sustained, not "
         "settling: the cloth still moves at {:.1f} cm/s {} ({} of {} vertices faster than the "
         "at-rest {:.1f} cm/s), and its mean kinetic energy over the last quarter of the run was "
         "{:.2g} times that over the quarter before (a settling drape's falls), so a longer "
@@ -225,16 +232,16 @@ std::string not_at_rest_warning(const std::string& file, double duration_s, doub
         "where it rubs the body or itself does, and so can the adaptive mesh's topology "
         "changes (\"simulate\": {{\"adaptive\": false}} tells them apart: docs/adaptive.md, "
         "\"A gathered panel that never rests\"); report.json's \"rest\" gives the residual",
-        file, duration_s, 100 * where.speed, place, where.moving, where.vertices, 100 * rest_speed,
-        where.kinetic_trend);
+        file, seconds(duration_s), 100 * where.speed, place, where.moving, where.vertices,
+        100 * rest_speed, where.kinetic_trend);
   return fmt::format(
-      "{}: the drape did not come to rest in {:g} s: the cloth still moves at {:.1f} cm/s {} "
+      "{}: the drape did not come to rest in {} s: the cloth still moves at {:.1f} cm/s {} "
       "({} of {} vertices faster than the at-rest {:.1f} cm/s held for {:g} s), so the result "
-      "may not be its final shape{} a longer \"simulate\": {{\"duration\": {:g}}}, and if it "
+      "may not be its final shape{} a longer \"simulate\": {{\"duration\": {}}}, and if it "
       "is still sliding there, a snugger fit where it should hold (\"ease\" below 1 on the "
       "panel that holds it); report.json's \"rest\" gives the residual",
-      file, duration_s, 100 * where.speed, place, where.moving, where.vertices, 100 * rest_speed,
-      rest_window_s, ramp, 2 * duration_s);
+      file, seconds(duration_s), 100 * where.speed, place, where.moving, where.vertices,
+      100 * rest_speed, rest_window_s, ramp, seconds(2 * duration_s));
 }
 
 std::string overstretched_warning(const std::string& file, const std::string& panel, double stretch,

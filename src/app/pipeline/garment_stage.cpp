@@ -6,7 +6,12 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <map>
+#include <numeric>
 #include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "garment/body_landmarks.hpp"
 #include "garment/body_surface.hpp"
@@ -80,6 +85,78 @@ void check_mesh48(const meshing::Mesh48& m48) {
                                    : "the mesh warnings above say what to change there"));
 }
 
+// What in the body file may be why it has no landmarks, beyond the search's own reason (trial
+// 44, P3: the Collada human twice side by side in one file was inferred to stand along x, the
+// pair's width, and the error said only to set "facing"): the figure-sized meshes it holds, and
+// the up axis when it was inferred, with the extents that chose it. Empty when neither applies.
+std::string body_file_cause(const garment::Body& body) {
+  const meshing::TriMesh& mesh = body.mesh;
+  // Connected pieces (triangles sharing vertices), by union-find.
+  std::vector<Eigen::Index> parent(static_cast<size_t>(mesh.vertex_count()));
+  std::iota(parent.begin(), parent.end(), Eigen::Index{0});
+  const auto find = [&parent](Eigen::Index v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (Eigen::Index f = 0; f < mesh.face_count(); ++f)
+    for (int k = 1; k < 3; ++k) parent[find(mesh.faces(f, k))] = find(mesh.faces(f, 0));
+  // Each piece's bounding box; a figure modelled in pieces (the built-in body's head, arms and
+  // legs are separate meshes) is the pieces whose boxes overlap, merged until none does.
+  std::map<Eigen::Index, meshing::BoundingBox> boxes;
+  for (Eigen::Index f = 0; f < mesh.face_count(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d p = mesh.vertices.row(mesh.faces(f, k)).transpose();
+      auto [it, added] = boxes.try_emplace(find(mesh.faces(f, k)), meshing::BoundingBox{p, p});
+      it->second.min = it->second.min.cwiseMin(p);
+      it->second.max = it->second.max.cwiseMax(p);
+    }
+  std::vector<meshing::BoundingBox> groups;
+  for (const auto& [piece, box] : boxes) groups.push_back(box);
+  constexpr size_t kMostPieces = 500;  // a triangle soup is no scene of figures: not grouped
+  for (bool merged = groups.size() <= kMostPieces; merged;) {
+    merged = false;
+    for (size_t a = 0; a < groups.size() && !merged; ++a)
+      for (size_t b = a + 1; b < groups.size() && !merged; ++b)
+        if ((groups[a].min.array() <= groups[b].max.array()).all() &&
+            (groups[b].min.array() <= groups[a].max.array()).all()) {
+          groups[a].min = groups[a].min.cwiseMin(groups[b].min);
+          groups[a].max = groups[a].max.cwiseMax(groups[b].max);
+          groups.erase(groups.begin() + static_cast<std::ptrdiff_t>(b));
+          merged = true;
+        }
+  }
+  // A figure spans most of the body's size along its longest extent (along the height when the
+  // up axis is right, along another axis when it was inferred from the pair's width); eyes,
+  // teeth or a base do not. Half counts a figure however it stands.
+  const double size =
+      (mesh.vertices.colwise().maxCoeff() - mesh.vertices.colwise().minCoeff()).maxCoeff();
+  int figures = 0;
+  if (groups.size() <= kMostPieces)
+    for (const meshing::BoundingBox& box : groups) figures += box.extent().maxCoeff() > 0.5 * size;
+  std::vector<std::string> causes;
+  if (figures > 1)
+    causes.push_back(fmt::format(
+        "the file holds {} separate meshes apart from each other, each at least half the "
+        "body's size (more than one figure, as a scene with a second mannequin? the loader "
+        "merges every mesh of the file "
+        "into one body: export the one figure to dress)",
+        figures));
+  if (body.raw.up_inferred) {
+    const Eigen::Vector3d extent = body.raw.box.extent();
+    const int up = body.raw.up.axis;
+    const char* names = "xyz";
+    causes.push_back(fmt::format(
+        "the up axis was inferred as +{} because the file is longest along {} ({:.4g} units; "
+        "{:.4g} along {}, {:.4g} along {}): if the figure stands along another axis, give "
+        "\"up\"",
+        names[up], names[up], extent[up], extent[(up + 1) % 3], names[(up + 1) % 3],
+        extent[(up + 2) % 3], names[(up + 2) % 3]));
+  }
+  std::string out;
+  for (const std::string& cause : causes) out += (out.empty() ? "" : "; ") + cause;
+  return out;
+}
+
 }  // namespace
 
 meshing::Mesh48 garment_mesh48(const scene::Sketch& sketch, const garment::Body& body,
@@ -114,10 +191,18 @@ MeshedGarment mesh_garment(const scene::Sketch& sketch) {
         why = landmarks.what();
       }
       if (why.empty()) throw;
-      sketch.fail(e.json_path(),
-                  fmt::format("the body '{}' has no landmarks ({}), so it is not a standing "
-                              "human figure: is it the right body file? With it, {}",
-                              sketch.body.mesh, why, e.sentence()));
+      // Upside down (trial 44, P18: `info` said "give "up": "-z"", this error did not): the
+      // file is the right one, read the wrong way up.
+      if (const std::string upside = garment::upside_down_advice(body); !upside.empty())
+        sketch.fail(e.json_path(),
+                    fmt::format("the body '{}' has no landmarks ({}); {}. With it as read, {}",
+                                sketch.body.mesh, why, upside, e.sentence()));
+      const std::string cause = body_file_cause(body);
+      sketch.fail(
+          e.json_path(),
+          fmt::format("the body '{}' has no landmarks ({}){}, so it is not a standing "
+                      "human figure: is it the right body file? With it, {}",
+                      sketch.body.mesh, why, cause.empty() ? "" : "; " + cause, e.sentence()));
     }
   }();
   const double meshing_ms = ms_since(mesh_start);
