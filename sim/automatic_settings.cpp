@@ -24,15 +24,6 @@ AutomaticChoice choose_settings(const SceneTraits& scene) {
   if (scene.garment || scene.self_contact) {
     choice.solver = LinearSolverKind::cholmod;
     choice.dt = 1.0 / 60.0;
-    // Round 44: every linear solve factorises. The PCG on an earlier factor (SimulationSettings::
-    // factor_reuse_iterations) cost as much as it saved or more on every garment measured, with
-    // the same steps and strains without it: a garment's contact set changes by tens of vertices
-    // a step, so the stale factor needs 8-13 iterations, each a pair of memory-bound supernodal
-    // triangular solves costing about a ninth of a factorisation, and many tries fail at the cap
-    // and factorise anyway (the wide-leg jumpsuit: 11 of 19; drape CPU -5 to -11 % without; the
-    // maxi dress, 237 solves on an earlier factor in 473: -4 to -10 %; docs/benchmarks.md,
-    // round 44).
-    choice.reuse_factor = false;
   } else {
     // A sheet held by pins or lying on a body: the PCG, with IC(0) up to the size where the
     // two-level preconditioner becomes cheaper (it was cheaper than CHOLMOD too at 16,641 and
@@ -120,7 +111,6 @@ void apply_choice(const AutomaticChoice& choice, bool solver_automatic, bool ste
   if (solver_automatic) {
     settings.solver = choice.solver;
     settings.pcg_preconditioner = choice.preconditioner;
-    if (!choice.reuse_factor) settings.factor_reuse_iterations = 0;
   }
   if (step_automatic) {
     settings.dt = choice.dt;

@@ -49,10 +49,7 @@ struct AutomaticChoice {
   // The PCG's relative residual reduction (SimulationSettings::pcg_tolerance).
   double pcg_tolerance = kDefaultPcgTolerance;
   double step_error = 0.0;  // m, SimulationSettings::step_error; 0: the step does not follow it
-  // CHOLMOD's solves on an earlier factor (SimulationSettings::factor_reuse_iterations): off for
-  // garments, where the tries cost more than the factorisations they save (round 44).
-  bool reuse_factor = true;
-  std::string reason;  // one sentence for report.json and logs
+  std::string reason;       // one sentence for report.json and logs
 };
 
 // Above this many vertices a sheet's PCG takes the two-level preconditioner: IC(0)'s iterations
@@ -89,8 +86,8 @@ bool pins_hold_shape(const Eigen::MatrixX3d& positions, const std::vector<int>& 
 AutomaticChoice choose_settings(const SceneTraits& scene);
 
 // Fills the solver, preconditioner and dt of `settings` from `choice`, for the parts
-// the caller left automatic (with the solver, the factor reuse); min_dt stays below dt. The PCG
-// tolerance is the choice's only when both are automatic (it was measured at the rule's step).
+// the caller left automatic; min_dt stays below dt. The PCG tolerance is the choice's only when
+// both are automatic (it was measured at the rule's step).
 void apply_choice(const AutomaticChoice& choice, bool solver_automatic, bool step_automatic,
                   SimulationSettings& settings);
 

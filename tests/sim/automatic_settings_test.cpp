@@ -45,36 +45,6 @@ TEST(AutomaticSettings, SelfContactTakesCholmodAndShorterSteps) {
   EXPECT_DOUBLE_EQ(choose_settings(scene).dt, 1.0 / 60.0);
 }
 
-// Round 44: a garment's automatic CHOLMOD factorises at every linear solve (the solves on an
-// earlier factor cost more than they saved on every garment measured); a sheet keeps them, and
-// so does a garment whose file names the solver.
-TEST(AutomaticSettings, GarmentsFactoriseEverySolveUnlessTheFileNamesTheSolver) {
-  SceneTraits scene;
-  scene.vertices = 2600;
-  EXPECT_TRUE(choose_settings(scene).reuse_factor);
-  const int default_reuse = SimulationSettings{}.factor_reuse_iterations;
-  ASSERT_GT(default_reuse, 0);
-  SimulationSettings sheet;
-  apply_choice(choose_settings(scene), true, true, sheet);
-  EXPECT_EQ(sheet.factor_reuse_iterations, default_reuse);
-  for (const bool garment : {false, true}) {
-    SceneTraits cloth = scene;
-    cloth.garment = garment;
-    cloth.self_contact = !garment;
-    const AutomaticChoice choice = choose_settings(cloth);
-    EXPECT_EQ(choice.solver, LinearSolverKind::cholmod);
-    EXPECT_FALSE(choice.reuse_factor);
-    SimulationSettings automatic;
-    apply_choice(choice, true, true, automatic);
-    EXPECT_EQ(automatic.factor_reuse_iterations, 0);
-    EXPECT_NO_THROW(automatic.validate());
-    SimulationSettings given;
-    given.solver = LinearSolverKind::cholmod;
-    apply_choice(choice, false, true, given);
-    EXPECT_EQ(given.factor_reuse_iterations, default_reuse);
-  }
-}
-
 TEST(AutomaticSettings, SettingsTheFileGivesAreKept) {
   SceneTraits scene;
   scene.vertices = 500;
