@@ -551,6 +551,17 @@ TEST(AdaptiveDetail, PinsFollowSplitsAndMerges) {
   EXPECT_TRUE(cloth.step().accepted);
 }
 
+// The quads of an n × n sheet scene, each wound as the adaptive sheets' are.
+Eigen::MatrixX4i sheet_quads(const SheetScene& scene, int n) {
+  Eigen::MatrixX4i quads(n * n, 4);
+  int q = 0;
+  for (int r = 0; r < n; ++r)
+    for (int c = 0; c < n; ++c)
+      quads.row(q++) << scene.vertex(r + 1, c), scene.vertex(r + 1, c + 1), scene.vertex(r, c + 1),
+          scene.vertex(r, c);
+  return quads;
+}
+
 // A sheet hanging flat from its top edge has no bend: nothing is refined and the model is never
 // rebuilt (the solver keeps its symbolic analysis).
 TEST(AdaptiveDetail, FlatHangingSheetIsNotRefined) {
@@ -563,12 +574,7 @@ TEST(AdaptiveDetail, FlatHangingSheetIsNotRefined) {
   vertical.columns = vertical.rows = spec.quads;
   vertical.pins = {"top"};
   const SheetScene scene = build_sheet(vertical);
-  Eigen::MatrixX4i quads(spec.quads * spec.quads, 4);
-  int q = 0;
-  for (int r = 0; r < spec.quads; ++r)
-    for (int c = 0; c < spec.quads; ++c)
-      quads.row(q++) << scene.vertex(r + 1, c), scene.vertex(r + 1, c + 1), scene.vertex(r, c + 1),
-          scene.vertex(r, c);
+  const Eigen::MatrixX4i quads = sheet_quads(scene, spec.quads);
   AdaptiveMaterial material = sheet.material;
   material.source_warp.rowwise() = Eigen::RowVector3d(0.0, 1.0, 0.0);
   std::vector<Pin> pins;
@@ -601,12 +607,7 @@ TEST(AdaptiveDetail, AFlatRestClothInItsDrawnShapeIsNotRefined) {
   vertical.size = {0.4, 0.4};
   vertical.columns = vertical.rows = spec.quads;
   const SheetScene scene = build_sheet(vertical);
-  Eigen::MatrixX4i quads(spec.quads * spec.quads, 4);
-  int q = 0;
-  for (int r = 0; r < spec.quads; ++r)
-    for (int c = 0; c < spec.quads; ++c)
-      quads.row(q++) << scene.vertex(r + 1, c), scene.vertex(r + 1, c + 1), scene.vertex(r, c + 1),
-          scene.vertex(r, c);
+  const Eigen::MatrixX4i quads = sheet_quads(scene, spec.quads);
   // Round a vertical cylinder (axis along y) through the sheet's centre line.
   const double radius = 0.15;
   Eigen::MatrixX3d drawn = scene.input.rest_positions;
